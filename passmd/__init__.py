@@ -1,0 +1,22 @@
+"""passmd: reproducible replication of Nguyen et al. (2018), Coatings 8, 62.
+
+"Improvements of Piezo-Actuated Stick–Slip Micro-Drives: Modeling and Driving
+Waveform". The package follows the paper's structure:
+
+``parameters``  Tables 1–2, the drive's parameter records and the assumptions
+``theory``      closed forms: Hertz, Cattaneo–Mindlin, Eqs. 1 and 7–14
+``contact``     MDR contact with memory (Eqs. 4–6): discrete springs and exact limit
+``dynamics``    hybrid simulation of runner and actuators (Eqs. 2–3)
+``waveforms``   saw-tooth and optimized (Eq. 15) piezo trajectories
+``experiments`` one function per figure panel, returning tidy data
+``ledger``      the paper's claims against our results
+``cli``         the ``passmd`` command line
+"""
+
+__version__ = "0.1.0"
+
+PAPER_CITATION = (
+    "X.-H. Nguyen, T.-H. Mau, I. Meyer, B.-L. Dang, H.-P. Pham, "
+    "\"Improvements of Piezo-Actuated Stick–Slip Micro-Drives: Modeling and Driving "
+    "Waveform\", Coatings 8(2), 62 (2018), doi:10.3390/coatings8020062"
+)

@@ -1,0 +1,105 @@
+"""Input checks shared by every public entry point.
+
+Each check raises :class:`ValueError` whose message names the parameter, the
+offending value and the allowed range, e.g.::
+
+    runner_mass = -0.003 is out of range: must be a finite number > 0 (kg)
+"""
+
+from __future__ import annotations
+
+import math
+from numbers import Real
+
+import numpy as np
+
+
+def _describe(lower, upper, lower_open, upper_open) -> str:
+    parts = []
+    if lower is not None:
+        parts.append(f"{'>' if lower_open else '>='} {lower:g}")
+    if upper is not None:
+        parts.append(f"{'<' if upper_open else '<='} {upper:g}")
+    return " and ".join(parts) if parts else "finite"
+
+
+def check_range(
+    name: str,
+    value,
+    lower: float | None = None,
+    upper: float | None = None,
+    *,
+    lower_open: bool = False,
+    upper_open: bool = False,
+    unit: str = "",
+) -> float:
+    """Return ``float(value)`` if it is a finite real number inside the range.
+
+    Parameters
+    ----------
+    name : str
+        Parameter name used in the error message (the package's own name, e.g.
+        ``"runner_mass"``).
+    value : real
+        The value to check.
+    lower, upper : float or None
+        Bounds; ``None`` leaves that side open.
+    lower_open, upper_open : bool
+        Whether the bound itself is excluded.
+    unit : str
+        Unit shown in the error message.
+    """
+    rng = _describe(lower, upper, lower_open, upper_open)
+    suffix = f" ({unit})" if unit else ""
+    if isinstance(value, bool) or not isinstance(value, (Real, np.floating, np.integer)):
+        raise ValueError(
+            f"{name} = {value!r} is not a number: must be a finite number {rng}{suffix}"
+        )
+    v = float(value)
+    bad = not math.isfinite(v)
+    if not bad and lower is not None:
+        bad = v <= lower if lower_open else v < lower
+    if not bad and upper is not None:
+        bad = v >= upper if upper_open else v > upper
+    if bad:
+        raise ValueError(f"{name} = {value!r} is out of range: must be a finite number {rng}{suffix}")
+    return v
+
+
+def check_positive(name: str, value, unit: str = "") -> float:
+    """Return ``float(value)`` if it is finite and strictly positive."""
+    return check_range(name, value, 0.0, lower_open=True, unit=unit)
+
+
+def check_nonnegative(name: str, value, unit: str = "") -> float:
+    """Return ``float(value)`` if it is finite and >= 0."""
+    return check_range(name, value, 0.0, unit=unit)
+
+
+def check_choice(name: str, value, choices) -> str:
+    """Return ``value`` if it is one of ``choices``."""
+    if value not in choices:
+        allowed = ", ".join(repr(c) for c in choices)
+        raise ValueError(f"{name} = {value!r} is not allowed: must be one of {allowed}")
+    return value
+
+
+def check_array(name: str, values, lower=None, upper=None, *, lower_open=False, unit="") -> np.ndarray:
+    """Return ``values`` as a float array after checking every element is finite and in range."""
+    arr = np.asarray(values, dtype=float)
+    if arr.size == 0:
+        return arr
+    rng = _describe(lower, upper, lower_open, False)
+    suffix = f" ({unit})" if unit else ""
+    bad = ~np.isfinite(arr)
+    if lower is not None:
+        bad |= (arr <= lower) if lower_open else (arr < lower)
+    if upper is not None:
+        bad |= arr > upper
+    if bad.any():
+        first = float(arr.flat[int(np.flatnonzero(bad.ravel())[0])])
+        raise ValueError(
+            f"{name} contains {first:g}, which is out of range: every element must be a "
+            f"finite number {rng}{suffix}"
+        )
+    return arr

@@ -1,0 +1,112 @@
+"""Parameter records: paper values and clear errors on bad input."""
+
+import math
+
+import numpy as np
+import pytest
+
+from passmd import theory
+from passmd.parameters import (
+    ASSUMPTIONS,
+    Actuator,
+    Amplifier,
+    Drive,
+    Material,
+    actuator_for_radius,
+    paper_drive,
+    parameter_table,
+)
+
+
+def test_table2_actuators():
+    a1 = actuator_for_radius(1e-3)
+    assert (a1.stiffness, a1.mass, a1.full_stroke_amplitude) == (6.5e6, 2.2e-8, 202e-9)
+    a2 = actuator_for_radius(0.25e-3)
+    assert (a2.stiffness, a2.mass, a2.full_stroke_amplitude) == (4e6, 1.1e-8, 96e-9)
+    assert a1.damping_ratio == pytest.approx(0.05, rel=1e-12)
+
+
+def test_drive_defaults_are_the_paper_drive():
+    d = paper_drive()
+    assert d.runner_mass == 3e-3 and d.load_cell_stiffness == 2.5e4
+    assert d.friction_coefficient == 0.2 and d.contacts == 6
+    assert d.effective_load_cell_stiffness == 0.0
+    assert d.replace(load_cell=True).effective_load_cell_stiffness == 2.5e4
+    assert d.replace(hemisphere_radius=0.25e-3).actuator.stiffness == 4e6
+    assert Amplifier().full_stroke_time == pytest.approx(2e-6, rel=1e-12)
+
+
+def test_parameter_table_and_assumptions():
+    rows = parameter_table(paper_drive())
+    names = {r["name"] for r in rows}
+    assert {"runner_mass", "actuator.viscosity", "hemisphere_material.youngs_modulus"} <= names
+    assert all(r["source"] for r in rows)
+    assert "actuator_viscosity" in ASSUMPTIONS
+
+
+BAD_NUMBERS = [0.0, -1.0, math.nan, math.inf]
+
+
+@pytest.mark.parametrize("value", BAD_NUMBERS)
+@pytest.mark.parametrize(
+    "name",
+    ["hemisphere_radius", "preload", "friction_coefficient", "runner_mass", "load_cell_stiffness"],
+)
+def test_drive_rejects_bad_numbers(name, value):
+    with pytest.raises(ValueError, match=rf"^{name} = .*(range|number).*"):
+        Drive(**{name: value})
+
+
+@pytest.mark.parametrize("value", BAD_NUMBERS)
+@pytest.mark.parametrize("field,error_name", [
+    ("stiffness", "actuator_stiffness"), ("mass", "actuator_mass"),
+    ("full_stroke_amplitude", "full_stroke_amplitude"),
+])
+def test_actuator_rejects_bad_numbers(field, error_name, value):
+    kwargs = dict(stiffness=6.5e6, mass=2.2e-8, viscosity=0.04, full_stroke_amplitude=202e-9)
+    kwargs[field] = value
+    with pytest.raises(ValueError, match=rf"^{error_name} = "):
+        Actuator(**kwargs)
+
+
+@pytest.mark.parametrize("value", [-1.0, math.nan, math.inf])
+def test_actuator_rejects_bad_viscosity(value):
+    with pytest.raises(ValueError, match=r"^actuator_viscosity = .*>= 0"):
+        Actuator(stiffness=6.5e6, mass=2.2e-8, viscosity=value, full_stroke_amplitude=202e-9)
+
+
+@pytest.mark.parametrize("nu", [-1.0, 0.5, 0.6, -2.0, math.nan])
+def test_material_rejects_bad_poisson(nu):
+    with pytest.raises(ValueError, match=r"^poissons_ratio = .*> -1 and < 0.5"):
+        Material(210e9, nu)
+
+
+@pytest.mark.parametrize("value", BAD_NUMBERS)
+def test_material_rejects_bad_modulus(value):
+    with pytest.raises(ValueError, match=r"^youngs_modulus = "):
+        Material(value, 0.3)
+
+
+@pytest.mark.parametrize("value", BAD_NUMBERS)
+@pytest.mark.parametrize("name", ["peak_to_peak_voltage", "slew_rate"])
+def test_amplifier_rejects_bad_numbers(name, value):
+    with pytest.raises(ValueError, match=rf"^{name} = "):
+        Amplifier(**{name: value})
+
+
+def test_choices_and_types():
+    with pytest.raises(ValueError, match=r"^contacts = 3 .*1, 6"):
+        Drive(contacts=3)
+    with pytest.raises(ValueError, match=r"^actuator_model = 'soft'"):
+        Drive(actuator_model="soft")
+    with pytest.raises(ValueError, match=r"^preload = 'a' is not a number"):
+        Drive(preload="a")
+    with pytest.raises(ValueError, match=r"^hemisphere_radius = 0.0005 is not a paper radius"):
+        paper_drive(0.5e-3)
+
+
+def test_theory_rejects_bad_arrays():
+    with pytest.raises(ValueError, match=r"^preload contains nan"):
+        theory.normal_forces(np.array([0.1, np.nan]))
+    with pytest.raises(ValueError, match=r"^preload contains -0.1"):
+        theory.normal_forces([-0.1])
