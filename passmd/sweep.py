@@ -1,0 +1,371 @@
+"""Parameter sweeps: a grid of independent evaluations, in parallel, cached on disk.
+
+:func:`run` evaluates ``func(**point)`` for every point of a grid and returns a tidy
+:class:`pandas.DataFrame` in grid order (point columns, then result columns), whatever
+order the points finish in. Execution is
+
+* ``"process"`` (default): a local :class:`concurrent.futures.ProcessPoolExecutor`
+  over all cores;
+* ``"dask"``: a Dask ``distributed`` cluster — the one at ``scheduler``
+  (``"tcp://host:8786"``) if given, else a ``LocalCluster`` on this machine;
+* ``"serial"``: in this process, one point after the other;
+* or any :class:`concurrent.futures.Executor` the caller owns (not shut down here).
+
+Every finished point is written to the on-disk cache (:mod:`passmd.cache`) as soon as
+it completes, so an interrupted sweep (Ctrl-C, a failing point, a killed job) keeps
+every finished point and a rerun recomputes only the rest. A progress bar (points
+done, rate, ETA) is shown on a terminal and kept quiet when stderr is not a TTY or the
+``CI`` environment variable is set.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import itertools
+import logging
+import os
+import pickle
+import signal
+import sys
+from collections.abc import Callable, Mapping, Sequence
+
+import pandas as pd
+from tqdm.auto import tqdm
+
+from passmd._validation import check_choice
+from passmd.cache import Cache
+from passmd.parameters import Drive
+from passmd.theory import drive_theory
+
+__all__ = ["EXECUTORS", "drive_theory_point", "grid", "progress_enabled", "run"]
+
+#: Names accepted by ``run(executor=...)``.
+EXECUTORS = ("process", "serial", "dask")
+
+
+def grid(**axes) -> list[dict]:
+    """All combinations of the given axes, last axis fastest (row-major).
+
+    >>> grid(preload=[0.1, 0.2], contacts=[1, 6])
+    [{'preload': 0.1, 'contacts': 1}, {'preload': 0.1, 'contacts': 6}, \
+{'preload': 0.2, 'contacts': 1}, {'preload': 0.2, 'contacts': 6}]
+    """
+    names = list(axes)
+    values = []
+    for name in names:
+        axis = axes[name]
+        if isinstance(axis, (str, bytes)) or not hasattr(axis, "__iter__"):
+            raise ValueError(f"{name} = {axis!r} is not a sequence of values: give a list of values")
+        values.append(list(axis))
+    return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*values)]
+
+
+def drive_theory_point(**drive_fields) -> dict:
+    """Closed forms (:func:`passmd.theory.drive_theory`) of ``Drive(**drive_fields)``.
+
+    A cheap, deterministic point function for sweeps over drive parameters, e.g. the
+    analytic critical amplitude (Eqs. 7–8, 11–12) over a preload grid.
+    """
+    return drive_theory(Drive(**drive_fields))
+
+
+def progress_enabled(progress: bool | None = None, stream=None) -> bool:
+    """Whether to show a progress bar: ``progress`` if given, else TTY and not ``$CI``."""
+    if progress is not None:
+        return bool(progress)
+    stream = sys.stderr if stream is None else stream
+    if os.environ.get("CI"):
+        return False
+    isatty = getattr(stream, "isatty", None)
+    return bool(isatty and isatty())
+
+
+def _call(func, point):
+    """Evaluate one point (runs in the worker)."""
+    return func(**point)
+
+
+def _ignore_sigint():  # pragma: no cover - runs in pool workers
+    """Pool worker initializer: Ctrl-C is handled by the parent, which stops the workers."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _check_points(points) -> list[dict]:
+    if isinstance(points, Mapping) or not isinstance(points, Sequence) or isinstance(points, str):
+        raise ValueError(f"points = {points!r} is not a list of dicts (one dict of parameters per point)")
+    checked = []
+    for i, point in enumerate(points):
+        if not isinstance(point, Mapping) or not all(isinstance(k, str) for k in point):
+            raise ValueError(f"points[{i}] = {point!r} is not a dict of keyword arguments")
+        checked.append(dict(point))
+    return checked
+
+
+def _make_cache(cache) -> Cache | None:
+    if cache is True:
+        return Cache()
+    if cache is False or cache is None:
+        return None
+    if isinstance(cache, Cache):
+        return cache
+    if isinstance(cache, (str, os.PathLike)):
+        return Cache(cache)
+    raise ValueError(f"cache = {cache!r} is not allowed: must be True, False, a Cache or a directory")
+
+
+class _Collector:
+    """Receives finished points: checks the result, caches it, advances the bar."""
+
+    def __init__(self, func, points, keys, cache, bar):
+        self.func, self.points, self.keys, self.cache, self.bar = func, points, keys, cache, bar
+        self.results: dict[int, dict] = {}
+
+    def done(self, index: int, result) -> None:
+        if not isinstance(result, Mapping):
+            raise TypeError(
+                f"{getattr(self.func, '__qualname__', self.func)} returned {type(result).__name__} "
+                f"for points[{index}] = {self.points[index]!r}: it must return a dict"
+            )
+        result = dict(result)
+        clash = sorted(set(result) & set(self.points[index]))
+        if clash:
+            raise ValueError(
+                f"result keys {clash} of points[{index}] clash with parameter names; rename them"
+            )
+        if self.cache is not None:
+            self.cache.put(self.keys[index], result)
+        self.results[index] = result
+        self.bar.update(1)
+
+
+def _annotate(exc: BaseException, index: int, point: dict) -> None:
+    if hasattr(exc, "add_note") and not isinstance(exc, KeyboardInterrupt):
+        exc.add_note(f"while evaluating sweep points[{index}] = {point!r}")
+
+
+def _run_serial(func, todo, points, collect: _Collector) -> None:
+    for i in todo:
+        try:
+            result = func(**points[i])
+        except BaseException as exc:
+            _annotate(exc, i, points[i])
+            raise
+        collect.done(i, result)
+
+
+def _harvest(futures: dict, collect: _Collector) -> None:
+    """Store every future that finished successfully but was not collected yet."""
+    for future, i in futures.items():
+        if i in collect.results or not future.done() or future.cancelled():
+            continue
+        try:
+            if future.exception() is None:
+                collect.done(i, future.result())
+        except Exception:  # a broken result must not hide the original interruption
+            continue
+
+
+def _stop_workers(pool: cf.ProcessPoolExecutor) -> None:
+    """Terminate a process pool's workers at once (Ctrl-C must not wait for running points)."""
+    terminate = getattr(pool, "terminate_workers", None)  # Python >= 3.14
+    if terminate is not None:
+        terminate()
+        return
+    for process in list((getattr(pool, "_processes", None) or {}).values()):
+        process.terminate()
+
+
+def _run_futures(pool: cf.Executor, func, todo, points, collect: _Collector, *, own: bool) -> None:
+    futures = {pool.submit(_call, func, points[i]): i for i in todo}
+    try:
+        for future in cf.as_completed(futures):
+            i = futures[future]
+            try:
+                result = future.result()
+            except BaseException as exc:
+                _annotate(exc, i, points[i])
+                raise
+            collect.done(i, result)
+    except KeyboardInterrupt:
+        _harvest(futures, collect)
+        for future in futures:
+            future.cancel()
+        if own and isinstance(pool, cf.ProcessPoolExecutor):
+            _stop_workers(pool)
+        raise
+    except BaseException:
+        for future in futures:
+            future.cancel()
+        if own:  # let running points finish so that they are cached too
+            pool.shutdown(wait=True, cancel_futures=True)
+        else:
+            cf.wait(futures)
+        _harvest(futures, collect)
+        raise
+
+
+def _run_process(func, todo, points, collect: _Collector, workers) -> None:
+    pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint)
+    try:
+        _run_futures(pool, func, todo, points, collect, own=True)
+    finally:
+        pool.shutdown(wait=False, cancel_futures=True)
+
+
+def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> None:
+    try:
+        from distributed import Client, LocalCluster, as_completed
+    except ImportError as exc:  # pragma: no cover - dask is a declared extra
+        raise ImportError("executor='dask' needs dask.distributed: pip install 'passmd[dask]'") from exc
+    cluster = None
+    if scheduler:
+        client = Client(scheduler)
+    else:
+        cluster = LocalCluster(
+            n_workers=workers or os.cpu_count() or 1,
+            threads_per_worker=1,
+            dashboard_address=None,
+            silence_logs=logging.ERROR,
+        )
+        client = Client(cluster)
+    futures = {}
+    try:
+        futures = {client.submit(_call, func, points[i], pure=False): i for i in todo}
+        for future in as_completed(futures):
+            i = futures[future]
+            try:
+                result = future.result()
+            except BaseException as exc:
+                _annotate(exc, i, points[i])
+                raise
+            collect.done(i, result)
+    except BaseException:
+        for future, i in futures.items():
+            if i not in collect.results and future.status == "finished":
+                try:
+                    collect.done(i, future.result())
+                except Exception:
+                    pass
+        client.cancel(list(futures))
+        raise
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def run(
+    func: Callable[..., Mapping],
+    points: Sequence[Mapping],
+    *,
+    executor: str | cf.Executor = "process",
+    scheduler: str | None = None,
+    workers: int | None = None,
+    cache: bool | Cache | str | os.PathLike = True,
+    progress: bool | None = None,
+    description: str | None = None,
+) -> pd.DataFrame:
+    """Evaluate ``func(**point)`` over a grid of points, in parallel and cached.
+
+    Parameters
+    ----------
+    func : callable
+        A top-level (picklable) function taking the points' keys as keyword
+        arguments and returning a dict of scalars or small arrays (SI units, keys
+        carrying the unit). It must be deterministic: its results are cached.
+    points : list of dict
+        The grid (see :func:`grid`); each dict is one evaluation's keyword arguments.
+    executor : {"process", "serial", "dask"} or concurrent.futures.Executor
+        Where to run. ``"dask"`` connects to ``scheduler`` or starts a local cluster.
+        A ``scheduler`` address implies ``"dask"``.
+    scheduler : str, optional
+        Dask scheduler address, e.g. ``"tcp://10.0.0.5:8786"``.
+    workers : int, optional
+        Worker processes for ``"process"`` and a local Dask cluster; default all cores.
+    cache : bool, Cache or path
+        ``True`` (default): the default :class:`~passmd.cache.Cache`; ``False``: no
+        caching; a :class:`~passmd.cache.Cache` or a directory to use that one.
+    progress : bool, optional
+        Force the progress bar on or off; default: on a TTY unless ``$CI`` is set.
+    description : str, optional
+        Label of the progress bar (default the function's name).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per point, in the order of ``points``: the point's parameters, then
+        the function's results. ``df.attrs["sweep"]`` records how many points were
+        taken from the cache and how many were computed.
+
+    Raises
+    ------
+    KeyboardInterrupt
+        On Ctrl-C, after cancelling pending points and stopping the workers; every
+        point finished so far is in the cache.
+    Exception
+        The first exception a point raised (with a note naming the point), after the
+        points still running finished and were cached.
+    """
+    if scheduler is not None and executor == "process":
+        executor = "dask"
+    if not isinstance(executor, cf.Executor):
+        check_choice("executor", executor, EXECUTORS)
+    if not callable(func):
+        raise ValueError(f"func = {func!r} is not callable")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise ValueError(f"workers = {workers!r} is out of range: must be an integer >= 1")
+    if scheduler is not None and executor != "dask":
+        raise ValueError(f"scheduler = {scheduler!r} needs executor='dask', not {executor!r}")
+    points = _check_points(points)
+    store = _make_cache(cache)
+    if executor != "serial":
+        try:
+            pickle.dumps(func)
+        except Exception as exc:
+            raise ValueError(
+                f"func = {func!r} cannot be sent to worker processes ({exc}); use a top-level "
+                "function or executor='serial'"
+            ) from exc
+
+    keys = [store.key(func, p) for p in points] if store is not None else [None] * len(points)
+    cached: dict[int, dict] = {}
+    if store is not None:
+        for i, key in enumerate(keys):
+            value = store.get(key)
+            if isinstance(value, Mapping):
+                cached[i] = dict(value)
+    todo = [i for i in range(len(points)) if i not in cached]
+
+    label = description or getattr(func, "__name__", "sweep")
+    bar = tqdm(
+        total=len(points),
+        initial=len(cached),
+        desc=label,
+        unit="point",
+        disable=not progress_enabled(progress),
+        file=sys.stderr,
+        dynamic_ncols=True,
+    )
+    collect = _Collector(func, points, keys, store, bar)
+    try:
+        if todo:
+            if isinstance(executor, cf.Executor):
+                _run_futures(executor, func, todo, points, collect, own=False)
+            elif executor == "serial" or (len(todo) == 1 and scheduler is None and executor == "process"):
+                _run_serial(func, todo, points, collect)
+            elif executor == "process":
+                _run_process(func, todo, points, collect, workers)
+            else:
+                _run_dask(func, todo, points, collect, workers, scheduler)
+    finally:
+        bar.close()
+
+    results = {**cached, **collect.results}
+    frame = pd.DataFrame([{**points[i], **results[i]} for i in range(len(points))])
+    frame.attrs["sweep"] = {
+        "points": len(points),
+        "cached": len(cached),
+        "computed": len(collect.results),
+        "function": label,
+    }
+    return frame
