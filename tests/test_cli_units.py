@@ -1,0 +1,84 @@
+"""Quantity parsing at the package's edges (passmd.units).
+
+Conversions are decimal (the typed number times the unit's SI factor, rounded once),
+so "0.25mm" must give exactly the float 0.25e-3: equality, not a tolerance.
+"""
+
+import numpy as np
+import pytest
+
+from passmd.units import QuantityError, dimension_name, from_si, parse_quantities, parse_quantity
+
+
+@pytest.mark.parametrize(
+    ("text", "unit", "expected"),
+    [
+        ("0.4N", "N", 0.4),
+        ("1mm", "mm", 1e-3),
+        ("0.25mm", "mm", 0.25e-3),
+        ("0.25 mm", "mm", 0.25e-3),
+        ("250um", "mm", 250e-6),
+        ("0.25", "mm", 0.25e-3),  # bare number: the display unit
+        (0.25, "mm", 0.25e-3),
+        ("1e-3 m", "mm", 1e-3),
+        ("202nm", "nm", 202e-9),
+        ("-10nm", "nm", -10e-9),
+        ("100kHz", "kHz", 100e3),
+        ("100 Hz", "kHz", 100.0),
+        ("310GPa", "GPa", 310e9),
+        ("3 mN", "N", 3e-3),
+        ("2.2e-5", "g", 2.2e-8),
+        ("6.5e6", "N/m", 6.5e6),
+        ("6.5 MN/m", "N/m", 6.5e6),
+        ("0.1 kg/s", "kg/s", 0.1),
+        ("0.2", "", 0.2),
+        ("20%", "", 0.2),
+    ],
+)
+def test_parse_quantity_to_si(text, unit, expected):
+    assert parse_quantity(text, unit, name="--x") == expected
+
+
+@pytest.mark.parametrize(
+    ("text", "unit", "fragment"),
+    [
+        ("3N", "mm", "--radius = '3N' has the wrong unit: N is a force, expected a length such as '1mm'"),
+        ("1 s", "kHz", "expected a frequency"),
+        ("0.2N", "", "expected a plain number"),
+        ("1 m**2", "mm", "has the wrong unit"),
+        ("1 foo", "mm", "unknown unit 'foo'"),
+        ("abc", "mm", "is not a quantity"),
+        ("nan", "mm", "is not a quantity"),
+        ("", "N", "is not a quantity"),
+    ],
+)
+def test_parse_quantity_errors_name_option_value_and_unit(text, unit, fragment):
+    with pytest.raises(QuantityError) as info:
+        parse_quantity(text, unit, name="--radius")
+    assert fragment in str(info.value)
+    assert "--radius" in str(info.value)
+    assert isinstance(info.value, ValueError)
+
+
+def test_parse_quantity_rejects_non_finite_and_bool():
+    with pytest.raises(QuantityError, match="not a finite number"):
+        parse_quantity(float("inf"), "N", name="--preload")
+    with pytest.raises(QuantityError, match="not a quantity"):
+        parse_quantity(True, "N", name="--preload")
+
+
+def test_parse_quantities_list():
+    assert parse_quantities("0nm,30nm,-10nm,45", "nm", name="--path") == [0.0, 30e-9, -10e-9, 45e-9]
+    assert parse_quantities("0.01um, 20 nm", "nm") == [10e-9, 20e-9]
+    with pytest.raises(QuantityError, match="comma-separated"):
+        parse_quantities("0nm,,3nm", "nm", name="--path")
+    with pytest.raises(QuantityError, match="--path = '3N' has the wrong unit"):
+        parse_quantities("0nm,3N", "nm", name="--path")
+
+
+def test_from_si_inverts_parse():
+    # Division by the unit factor: a round trip within one rounding (rtol 1e-15).
+    assert from_si(202e-9, "nm") == pytest.approx(202.0, rel=1e-15)
+    np.testing.assert_allclose(from_si(np.array([1e3, 2e5]), "kHz"), [1.0, 200.0], rtol=1e-15)
+    assert dimension_name("N/m") == "stiffness (force per length)"
+    assert dimension_name("mm") == "length"

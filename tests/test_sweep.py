@@ -1,0 +1,213 @@
+"""Sweep engine (passmd.sweep): executors agree, grid order, caching, interruption and resume.
+
+The point functions live at module level so worker processes can unpickle them.
+Results of the same deterministic function must be *identical* across executors
+(same code, same inputs, same floating-point operations), so frames are compared
+exactly (check_exact), not within a tolerance.
+"""
+
+import concurrent.futures as cf
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from passmd import sweep
+from passmd.cache import Cache
+from passmd.parameters import Drive
+from passmd.theory import drive_theory
+
+
+def logged_square(x, log):
+    """x² + 1, appending x to a log file so that tests can count evaluations."""
+    with open(log, "a") as fh:
+        fh.write(f"{x!r}\n")
+    return {"y": x * x + 1.0}
+
+
+def slow_first(x, n):
+    """Earlier points take longer, so that they finish last in a pool."""
+    time.sleep(0.05 * (n - x))
+    return {"y": 10 * x}
+
+
+def interrupt_once(x, log, stop_at, flag):
+    """Like logged_square, but raises KeyboardInterrupt (Ctrl-C) at x == stop_at the first time."""
+    if x == stop_at and not Path(flag).exists():
+        Path(flag).touch()
+        raise KeyboardInterrupt
+    return logged_square(x, log)
+
+
+def fail_at(x, bad):
+    if x == bad:
+        raise ValueError(f"x = {x} is out of range")
+    return {"y": x}
+
+
+def not_a_dict(x):
+    return x
+
+
+def clashing(x):
+    return {"x": 2 * x}
+
+
+def evaluations(log: Path) -> list[float]:
+    return [float(line) for line in log.read_text().split()] if log.exists() else []
+
+
+@pytest.fixture
+def store(tmp_path):
+    return Cache(tmp_path / "cache")
+
+
+THEORY_GRID = sweep.grid(
+    preload=[0.1, 0.4, 0.7], contacts=[1, 6], actuator_model=["rigid", "flexible"]
+)
+
+
+@pytest.fixture(scope="module")
+def serial_theory():
+    return sweep.run(sweep.drive_theory_point, THEORY_GRID, executor="serial", cache=False)
+
+
+def test_grid_is_row_major():
+    points = sweep.grid(a=[1, 2], b=["x", "y", "z"])
+    assert points[:4] == [{"a": 1, "b": "x"}, {"a": 1, "b": "y"}, {"a": 1, "b": "z"}, {"a": 2, "b": "x"}]
+    assert len(points) == 6
+    with pytest.raises(ValueError, match="a = 0.5 is not a sequence"):
+        sweep.grid(a=0.5)
+
+
+def test_serial_matches_python_api(serial_theory):
+    assert list(serial_theory.columns[:3]) == ["preload", "contacts", "actuator_model"]
+    assert len(serial_theory) == len(THEORY_GRID)
+    for point, (_, row) in zip(THEORY_GRID, serial_theory.iterrows(), strict=True):
+        expected = drive_theory(Drive(**point))
+        assert row["analytic_critical_amplitude_m"] == expected["analytic_critical_amplitude_m"]
+        assert row["presliding_m"] == expected["presliding_m"]
+
+
+def test_process_pool_identical_to_serial(serial_theory, store):
+    frame = sweep.run(sweep.drive_theory_point, THEORY_GRID, executor="process", workers=2, cache=store)
+    pd.testing.assert_frame_equal(frame, serial_theory, check_exact=True)
+    assert frame.attrs["sweep"]["computed"] == len(THEORY_GRID)
+    again = sweep.run(sweep.drive_theory_point, THEORY_GRID, executor="process", workers=2, cache=store)
+    pd.testing.assert_frame_equal(again, serial_theory, check_exact=True)
+    assert again.attrs["sweep"] == {**frame.attrs["sweep"], "cached": len(THEORY_GRID), "computed": 0}
+
+
+def test_dask_local_cluster_identical_to_serial(serial_theory):
+    """Dask LocalCluster with 2 worker *processes* (processes=True; starts in ~2 s here)."""
+    frame = sweep.run(sweep.drive_theory_point, THEORY_GRID, executor="dask", workers=2, cache=False)
+    pd.testing.assert_frame_equal(frame, serial_theory, check_exact=True)
+
+
+def test_caller_owned_executor(serial_theory):
+    with cf.ThreadPoolExecutor(max_workers=2) as pool:
+        frame = sweep.run(sweep.drive_theory_point, THEORY_GRID, executor=pool, cache=False)
+        assert pool.submit(int, "3").result() == 3  # not shut down by run()
+    pd.testing.assert_frame_equal(frame, serial_theory, check_exact=True)
+
+
+def test_grid_order_regardless_of_completion_order():
+    n = 6
+    points = [{"x": x, "n": n} for x in range(n)]
+    frame = sweep.run(slow_first, points, executor="process", workers=2, cache=False)
+    assert frame["x"].tolist() == list(range(n))
+    assert frame["y"].tolist() == [10 * x for x in range(n)]
+
+
+def test_cache_skips_finished_points(tmp_path, store):
+    log = tmp_path / "log.txt"
+    points = [{"x": float(x), "log": str(log)} for x in range(5)]
+    first = sweep.run(logged_square, points[:3], executor="serial", cache=store)
+    assert evaluations(log) == [0.0, 1.0, 2.0]
+    full = sweep.run(logged_square, points, executor="process", workers=2, cache=store)
+    assert sorted(evaluations(log)) == [0.0, 1.0, 2.0, 3.0, 4.0]  # only the two new points ran
+    assert full["y"].tolist() == [1.0, 2.0, 5.0, 10.0, 17.0]
+    pd.testing.assert_frame_equal(full.iloc[:3], first)
+    sweep.run(logged_square, points, executor="serial", cache=False)  # no cache: all recomputed
+    assert len(evaluations(log)) == 10
+
+
+def test_interrupted_serial_sweep_resumes(tmp_path, store):
+    log, flag = tmp_path / "log.txt", tmp_path / "interrupted"
+    points = [{"x": float(x), "log": str(log), "stop_at": 3.0, "flag": str(flag)} for x in range(6)]
+    with pytest.raises(KeyboardInterrupt):
+        sweep.run(interrupt_once, points, executor="serial", cache=store)
+    assert evaluations(log) == [0.0, 1.0, 2.0]
+    assert len(store.entries()) == 3  # every finished point was cached
+    frame = sweep.run(interrupt_once, points, executor="serial", cache=store)
+    assert evaluations(log) == [0.0, 1.0, 2.0, 3.0, 4.0, 5.0]  # resumed: no point computed twice
+    assert frame["y"].tolist() == [x * x + 1.0 for x in range(6)]
+    assert frame.attrs["sweep"]["cached"] == 3
+
+
+def test_interrupted_process_sweep_resumes(tmp_path, store):
+    """With a pool, which points finished before the interrupt is timing-dependent; the
+    invariant is that the rerun computes exactly the points not in the cache."""
+    log, flag = tmp_path / "log.txt", tmp_path / "interrupted"
+    points = [{"x": float(x), "log": str(log), "stop_at": 2.0, "flag": str(flag)} for x in range(8)]
+    with pytest.raises(KeyboardInterrupt):
+        sweep.run(interrupt_once, points, executor="process", workers=2, cache=store)
+    cached = {i for i, p in enumerate(points) if store.key(interrupt_once, p) in store}
+    assert 2 not in cached
+    before = len(evaluations(log))
+    frame = sweep.run(interrupt_once, points, executor="process", workers=2, cache=store)
+    rerun = evaluations(log)[before:]
+    assert sorted(rerun) == sorted(points[i]["x"] for i in range(8) if i not in cached)
+    assert frame["y"].tolist() == [x * x + 1.0 for x in range(8)]
+    assert frame.attrs["sweep"]["cached"] == len(cached)
+
+
+@pytest.mark.parametrize("executor", ["serial", "process"])
+def test_failing_point_raises_and_keeps_finished_points(executor, store):
+    points = [{"x": x, "bad": 3} for x in range(6)]
+    with pytest.raises(ValueError, match="x = 3 is out of range") as info:
+        sweep.run(fail_at, points, executor=executor, workers=2, cache=store)
+    assert any("points[3]" in note for note in getattr(info.value, "__notes__", []))
+    cached = [i for i, p in enumerate(points) if store.key(fail_at, p) in store]
+    assert 3 not in cached
+    if executor == "serial":
+        assert cached == [0, 1, 2]
+
+
+def test_bad_arguments(store):
+    points = [{"x": 1}]
+    with pytest.raises(ValueError, match="executor = 'threads' is not allowed"):
+        sweep.run(fail_at, points, executor="threads")
+    with pytest.raises(ValueError, match="is not a list of dicts"):
+        sweep.run(fail_at, {"x": 1})
+    with pytest.raises(ValueError, match=r"points\[1\] = 3 is not a dict"):
+        sweep.run(fail_at, [{"x": 1}, 3])
+    with pytest.raises(ValueError, match="workers = 0 is out of range"):
+        sweep.run(fail_at, points, workers=0)
+    with pytest.raises(ValueError, match="cannot be sent to worker processes"):
+        sweep.run(lambda x: {"y": x}, points, executor="process", cache=False)
+    with pytest.raises(ValueError, match="needs executor='dask'"):
+        sweep.run(fail_at, points, executor="serial", scheduler="tcp://localhost:1")
+    with pytest.raises(TypeError, match="it must return a dict"):
+        sweep.run(not_a_dict, points, executor="serial", cache=store)
+    with pytest.raises(ValueError, match="clash with parameter names"):
+        sweep.run(clashing, points, executor="serial", cache=False)
+
+
+def test_lambda_runs_serially_without_cache():
+    frame = sweep.run(lambda x: {"y": 2 * x}, [{"x": 1}, {"x": 2}], executor="serial", cache=False)
+    assert frame["y"].tolist() == [2, 4]
+
+
+def test_progress_quiet_off_tty_and_in_ci(monkeypatch):
+    class Tty:
+        def isatty(self):
+            return True
+
+    monkeypatch.delenv("CI", raising=False)
+    assert sweep.progress_enabled(None, Tty())
+    assert not sweep.progress_enabled(None, object())
+    assert sweep.progress_enabled(True, object())
+    monkeypatch.setenv("CI", "true")
+    assert not sweep.progress_enabled(None, Tty())
