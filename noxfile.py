@@ -9,6 +9,7 @@ installed (``pip install nox uv``), plain virtualenv otherwise.
 from __future__ import annotations
 
 import os
+import time
 
 import nox
 
@@ -33,14 +34,75 @@ def lint(session: nox.Session) -> None:
     session.run("ruff", "check", ".")
 
 
+BOOK_HTML = "book/_build/html"
+SCREENSHOTS = "artifacts/screenshots"
+
+
+def _split_profile(args: list[str]) -> tuple[str, list[str]]:
+    """Take ``--profile NAME`` (or ``--profile=NAME``) out of the session's arguments.
+
+    Without it the profile is ``$PASSMD_PROFILE`` or ``paper``; the value is validated by
+    ``passmd.publish.current_profile`` inside the session's environment.
+    """
+    profile = os.environ.get("PASSMD_PROFILE", "") or "paper"
+    rest: list[str] = []
+    it = iter(args)
+    for arg in it:
+        if arg == "--profile":
+            profile = next(it, "")
+        elif arg.startswith("--profile="):
+            profile = arg.split("=", 1)[1]
+        else:
+            rest.append(arg)
+    return profile, rest
+
+
 @nox.session(python=PYTHON)
 def book(session: nox.Session) -> None:
-    """Build the executed Jupyter Book to book/_build/html (all pages, warnings are errors)."""
+    """Build the executed Jupyter Book to book/_build/html (all pages, warnings are errors).
+
+    ``nox -s book -- --profile quick`` builds on the quick profile (CI); default ``paper``.
+    Every chapter is executed on every build (``execute_notebooks: force``); a cell error or
+    any warning fails the build. Simulation results are reused from passmd's on-disk cache.
+    """
     session.install("-e", ".[book]")
-    env = {"MPLBACKEND": "Agg", "PASSMD_PROFILE": os.environ.get("PASSMD_PROFILE", "paper")}
-    args = list(session.posargs)
-    if "--profile" in args:
-        i = args.index("--profile")
-        env["PASSMD_PROFILE"] = args[i + 1]
-        del args[i : i + 2]
+    profile, args = _split_profile(list(session.posargs))
+    # Chapter kernels must use Jupyter's inline backend (with e.g. MPLBACKEND=Agg inherited
+    # from the shell, their figures would silently not be displayed).
+    env = {"PASSMD_PROFILE": profile, "MPLBACKEND": "module://matplotlib_inline.backend_inline"}
+    # Validate the profile with the package's own check, and build matplotlib's font cache
+    # now: its first-use notice on a fresh machine would otherwise be a stderr warning
+    # inside the first chapter and fail the -W build.
+    session.run(
+        "python", "-c",
+        "import matplotlib.pyplot; from passmd.publish import current_profile; "
+        "print('book profile:', current_profile())",
+        env=env,
+    )
+    start = time.monotonic()
     session.run("jupyter-book", "build", "book", "--all", "-W", "-n", "--keep-going", *args, env=env)
+    session.log(f"book built in {time.monotonic() - start:.0f} s wall time (profile {profile})")
+
+
+@nox.session(python=PYTHON)
+def book_check(session: nox.Session) -> None:
+    """Open the built book in headless Chromium and check every page (run ``book`` first).
+
+    Checks each page of book/_toc.yml loads, shows its figures (decoded images), its ledger
+    table, rendered math and no execution error; screenshots go to artifacts/screenshots/.
+    Then shows on a deliberately broken tiny book that the check fails. Chromium and
+    chromedriver come from the system packages (tools/install_chromium.sh installs them
+    with apt when missing and run as root).
+    """
+    if not os.path.exists(os.path.join(BOOK_HTML, "index.html")):
+        session.error(f"{BOOK_HTML}/index.html is missing: build the book first (nox -s book)")
+    session.run("bash", "tools/install_chromium.sh", external=True)
+    session.install("-e", ".[book,test]")
+    session.run(
+        "python", "tools/check_rendered_book.py", BOOK_HTML,
+        "--toc", "book/_toc.yml", "--screenshots", SCREENSHOTS, *session.posargs,
+    )
+    session.run(
+        "pytest", "tests/test_book_check.py", "-p", "no:cacheprovider",
+        env={"PASSMD_REQUIRE_BROWSER": "1", "MPLBACKEND": "Agg"},
+    )
