@@ -1,0 +1,199 @@
+"""The rendered-page check (tools/check_rendered_book.py).
+
+Pure tests of its rules run everywhere. The browser tests build the deliberately broken tiny
+book in tests/broken_book/ and open it in headless Chromium: they need jupyter-book, selenium
+and the system's chromium/chromedriver, and are skipped without them — except under
+``nox -s book_check``, which sets PASSMD_REQUIRE_BROWSER=1 and turns a skip into a failure.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+BROKEN_BOOK = Path(__file__).resolve().parent / "broken_book"
+
+_spec = importlib.util.spec_from_file_location("check_rendered_book", ROOT / "tools" / "check_rendered_book.py")
+checker = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(checker)
+
+
+def _good_facts(**changes) -> dict:
+    facts = {
+        "has_article": True,
+        "expect": "figures=1 ledger=1",
+        "images": [{"src": "a.png", "ok": True, "width": 600}],
+        "ledger_tables": 1,
+        "error_outputs": [],
+        "stderr_outputs": [],
+        "traceback_in_text": False,
+        "math_total": 2,
+        "math_rendered": 2,
+        "mathjax_loaded": True,
+        "raw_tex": [],
+        "fonts_failed": [],
+        "external_resources": [],
+        "network_errors": [],
+    }
+    facts.update(changes)
+    return facts
+
+
+# ----------------------------------------------------------------------------- rules
+
+
+def test_parse_expect_defaults_and_values():
+    assert checker.parse_expect(None) == {"figures": 1, "ledger": 1}
+    assert checker.parse_expect("figures=3 ledger=0") == {"figures": 3, "ledger": 0}
+    assert checker.parse_expect("ledger=0") == {"figures": 1, "ledger": 0}
+
+
+@pytest.mark.parametrize("bad", ["figures=two", "plots=1", "figures", "figures=-1"])
+def test_parse_expect_rejects_bad_values(bad):
+    with pytest.raises(ValueError, match="passmd-expect"):
+        checker.parse_expect(bad)
+
+
+def test_good_page_has_no_problems():
+    assert checker.page_problems(_good_facts()) == []
+
+
+@pytest.mark.parametrize(
+    ("changes", "fragment"),
+    [
+        ({"has_article": False}, "did not load"),
+        ({"images": [{"src": "gone.png", "ok": False, "width": 0}]}, "broken image"),
+        ({"images": []}, "0 figure(s) shown"),
+        ({"ledger_tables": 0}, "ledger table"),
+        ({"error_outputs": ["ValueError: x"]}, "execution error"),
+        ({"stderr_outputs": ["RuntimeWarning: y"]}, "stderr"),
+        ({"traceback_in_text": True}, "traceback"),
+        ({"math_rendered": 1}, "not rendered"),
+        ({"mathjax_loaded": False}, "MathJax did not load"),
+        ({"raw_tex": ["$$ x $$"]}, "raw TeX"),
+        ({"fonts_failed": ["MJXTEX"]}, "web font"),
+        ({"external_resources": ["https://cdn.example/x.js"]}, "network resource"),
+        ({"network_errors": ["net::ERR_BLOCKED_BY_CLIENT"]}, "network access"),
+        ({"expect": "figures=many"}, "passmd-expect"),
+    ],
+)
+def test_each_defect_is_a_problem(changes, fragment):
+    problems = checker.page_problems(_good_facts(**changes))
+    assert any(fragment in p for p in problems), problems
+
+
+def test_expectations_come_from_the_page():
+    # A page declaring no figures and no ledger (e.g. the introduction) passes without them.
+    facts = _good_facts(expect="figures=0 ledger=0", images=[], ledger_tables=0)
+    assert checker.page_problems(facts) == []
+    # A page without the meta tag must show at least one figure and one ledger table.
+    facts = _good_facts(expect=None, images=[], ledger_tables=0)
+    assert len(checker.page_problems(facts)) == 2
+
+
+def test_toc_pages_lists_every_file_in_order(tmp_path):
+    pytest.importorskip("yaml")
+    toc = tmp_path / "_toc.yml"
+    toc.write_text(
+        "format: jb-book\nroot: intro\nchapters:\n  - file: model.md\n  - file: a\n"
+        "    sections:\n      - file: sub/b\n"
+    )
+    assert checker.toc_pages(toc) == ["intro", "model", "a", "sub/b"]
+
+
+# ----------------------------------------------------------------------------- browser
+
+
+def _require_browser_tools() -> Path:
+    """Path of the jupyter-book executable; skip (or fail under book_check) without the tools."""
+    jupyter_book = Path(sys.executable).parent / "jupyter-book"
+    missing = [
+        name
+        for name, ok in [
+            ("jupyter-book", jupyter_book.exists()),
+            ("selenium", importlib.util.find_spec("selenium") is not None),
+            ("chromium", Path(checker.CHROMIUM).exists()),
+            ("chromedriver", Path(checker.CHROMEDRIVER).exists()),
+        ]
+        if not ok
+    ]
+    if missing:
+        message = "rendered-page check needs " + ", ".join(missing) + " (run: nox -s book_check)"
+        if os.environ.get("PASSMD_REQUIRE_BROWSER") == "1":
+            pytest.fail(message)
+        pytest.skip(message)
+    return jupyter_book
+
+
+def _build(jupyter_book: Path, book: Path) -> Path:
+    # Built without -W on purpose: the build tolerates the defects, the page check must not.
+    result = subprocess.run(
+        [str(jupyter_book), "build", str(book), "--all"],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "MPLBACKEND": "module://matplotlib_inline.backend_inline"},
+        timeout=600,
+    )
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    return book / "_build" / "html"
+
+
+@pytest.fixture(scope="module")
+def broken_book_results(tmp_path_factory):
+    jupyter_book = _require_browser_tools()
+    book = tmp_path_factory.mktemp("books") / "broken_book"
+    shutil.copytree(BROKEN_BOOK, book)
+    html = _build(jupyter_book, book)
+    shots = book / "screenshots"
+    results = checker.check_book(html, checker.toc_pages(book / "_toc.yml"), shots)
+    return results, shots, book
+
+
+@pytest.mark.slow
+def test_check_passes_the_good_page(broken_book_results):
+    results, shots, _ = broken_book_results
+    good = results["good"]
+    assert good["problems"] == []
+    assert good["facts"]["math_total"] == good["facts"]["math_rendered"] == 2
+    assert (shots / "good.png").stat().st_size > 0
+
+
+@pytest.mark.slow
+def test_check_fails_on_missing_figure_and_cell_error(broken_book_results):
+    results, _, _ = broken_book_results
+    problems = results["broken"]["problems"]
+    assert any("broken image" in p and "missing_figure.png" in p for p in problems), problems
+    assert any("execution error" in p and "deliberate cell error" in p for p in problems), problems
+    assert any("ledger table" in p for p in problems), problems
+
+
+@pytest.mark.slow
+def test_command_line_exit_status(broken_book_results, capsys):
+    # main() re-runs the check on the same build through the command-line entry point.
+    _, _, book = broken_book_results
+    status = checker.main([str(book / "_build" / "html"), "--toc", str(book / "_toc.yml")])
+    out = capsys.readouterr().out
+    assert status == 1
+    assert "[ok] good" in out and "[FAIL] broken" in out
+
+
+@pytest.mark.slow
+def test_check_fails_when_math_needs_the_network(tmp_path):
+    # The same good page with MathJax from its default CDN: offline, no math renders.
+    jupyter_book = _require_browser_tools()
+    book = tmp_path / "cdn_book"
+    shutil.copytree(BROKEN_BOOK, book)
+    config = (book / "_config.yml").read_text()
+    (book / "_config.yml").write_text(config.replace("sphinx:\n  extra_extensions: [sphinx-mathjax-offline]\n", ""))
+    (book / "_toc.yml").write_text("format: jb-book\nroot: good\n")
+    html = _build(jupyter_book, book)
+    problems = checker.check_book(html, ["good"])["good"]["problems"]
+    assert any("not rendered" in p or "MathJax did not load" in p for p in problems), problems
+    assert any("network" in p for p in problems), problems

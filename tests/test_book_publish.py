@@ -1,0 +1,149 @@
+"""passmd.publish: the helpers the book's chapters use (profile, CSV links, captions, units)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from passmd import publish
+from passmd.parameters import paper_drive
+
+
+@pytest.fixture
+def book(tmp_path):
+    """A folder that looks like a book's source root, with a chapter subfolder."""
+    (tmp_path / "_config.yml").write_text("title: t\n")
+    (tmp_path / "_toc.yml").write_text("root: intro\n")
+    (tmp_path / "part").mkdir()
+    return tmp_path
+
+
+# ----------------------------------------------------------------------------- profile
+
+
+def test_profile_defaults_to_paper(monkeypatch):
+    monkeypatch.delenv(publish.PROFILE_ENV, raising=False)
+    assert publish.current_profile() == "paper"
+    monkeypatch.setenv(publish.PROFILE_ENV, "  ")
+    assert publish.current_profile() == "paper"
+
+
+@pytest.mark.parametrize("profile", ["quick", "paper"])
+def test_profile_from_environment(monkeypatch, profile):
+    monkeypatch.setenv(publish.PROFILE_ENV, profile)
+    assert publish.current_profile() == profile
+
+
+def test_bad_profile_is_rejected_by_name(monkeypatch):
+    monkeypatch.setenv(publish.PROFILE_ENV, "fast")
+    with pytest.raises(ValueError, match=r"PASSMD_PROFILE = 'fast'.*'quick', 'paper'"):
+        publish.current_profile()
+
+
+# ----------------------------------------------------------------------------- data links
+
+
+def test_book_root_found_from_a_chapter_folder(book, monkeypatch):
+    monkeypatch.chdir(book / "part")
+    assert publish.book_root() == book.resolve()
+    assert publish.book_root(book / "part") == book.resolve()
+
+
+def test_book_root_falls_back_to_start(tmp_path):
+    assert publish.book_root(tmp_path) == tmp_path.resolve()
+
+
+def test_data_link_writes_csv_and_returns_download_role(book, monkeypatch):
+    monkeypatch.chdir(book / "part")
+    df = pd.DataFrame({"amplitude_nm": [10.0, 20.5], "step_nm": [0.0, 3.25]})
+    link = publish.data_link(df, "fig5a")
+    target = book / "_generated" / "data" / "fig5a.csv"
+    pd.testing.assert_frame_equal(pd.read_csv(target), df)
+    assert link == "{download}`fig5a.csv </_generated/data/fig5a.csv>`"
+    assert link._repr_markdown_() == str(link)
+    assert [p.name for p in target.parent.iterdir()] == ["fig5a.csv"]  # no temporary file left
+    assert publish.data_link(df, "fig5a", label="data", root=book).startswith("{download}`data <")
+
+
+@pytest.mark.parametrize("name", ["", "../up", "a/b", "fig.csv", "with space", 5])
+def test_data_link_rejects_bad_names(book, name):
+    with pytest.raises(ValueError, match="name = "):
+        publish.data_link(pd.DataFrame({"x": [1]}), name, root=book)
+
+
+def test_data_link_rejects_non_frames(book):
+    with pytest.raises(ValueError, match="df = list"):
+        publish.data_link([1, 2], "x", root=book)
+
+
+# ----------------------------------------------------------------------------- units
+
+
+@pytest.mark.parametrize(
+    ("value", "unit", "expected"),
+    [
+        (202e-9, "nm", 202.0),
+        (1e-6, "µm", 1.0),
+        (3e-3, "g", 3.0),  # kg -> g
+        (0.115, "mN", 115.0),
+        (110e3, "kHz", 110.0),
+        (0.019, "mm/s", 19.0),
+        (1e-3, "mm", 1.0),
+        (150e6, "V/µs", 150.0),
+    ],
+)
+def test_to_unit_scales(value, unit, expected):
+    # Only a power-of-ten scale is applied: agreement to round-off (1e-12 relative).
+    assert publish.to_unit(value, unit) == pytest.approx(expected, rel=1e-12)
+
+
+def test_to_unit_arrays():
+    out = publish.to_unit([1e-9, 2e-9], "nm")
+    np.testing.assert_allclose(out, [1.0, 2.0], rtol=1e-12)  # round-off only
+
+
+def test_unknown_unit_is_rejected():
+    with pytest.raises(ValueError, match="unit = 'furlongs/fortnight-ish'"):
+        publish.to_unit(1.0, "furlongs/fortnight-ish")
+
+
+def test_format_quantity():
+    assert publish.format_quantity(202e-9, "nm") == "202 nm"
+    assert publish.format_quantity(0.0123456, "N", digits=2) == "0.012 N"
+    with pytest.raises(ValueError, match="must be a scalar"):
+        publish.format_quantity([1.0, 2.0], "nm")
+
+
+# ----------------------------------------------------------------------------- captions
+
+
+def test_drive_parameters_name_the_run():
+    params = publish.drive_parameters(paper_drive(1e-3, 0.4))
+    assert params["R"] == "1 mm"
+    assert params["F_p"] == "0.4 N"
+    assert params["μ"] == "0.2"
+    assert params["m_r"] == "3 g"
+    assert params["actuators"] == "flexible" and "k_p" in params
+    rigid = publish.drive_parameters(paper_drive(0.25e-3, 0.2, actuator_model="rigid", load_cell=True))
+    assert rigid["R"] == "0.25 mm" and "k_p" not in rigid and rigid["k"] == "2.5e+04 N/m"
+
+
+def test_caption_lists_parameters_profile_and_data(book, monkeypatch):
+    monkeypatch.chdir(book)
+    monkeypatch.setenv(publish.PROFILE_ENV, "quick")
+    df = pd.DataFrame({"preload_N": [0.1, 0.2], "critical_amplitude_nm": [30.0, 45.0]})
+    text = publish.caption("Critical amplitude (Fig. 5b).", drive=paper_drive(), data=df, name="fig5b",
+                           frequency="100 Hz")
+    assert text.startswith("**Figure.** Critical amplitude (Fig. 5b).")
+    for part in ("R = 1 mm", "F_p = 0.4 N", "frequency = 100 Hz", "profile: quick",
+                 "{download}`fig5b.csv </_generated/data/fig5b.csv>`"):
+        assert part in text
+    assert (book / "_generated" / "data" / "fig5b.csv").is_file()
+
+
+def test_caption_needs_data_and_name_together(book):
+    with pytest.raises(ValueError, match="data and name"):
+        publish.caption("x", data=pd.DataFrame({"a": [1]}))
+    with pytest.raises(ValueError, match="data and name"):
+        publish.caption("x", name="a")

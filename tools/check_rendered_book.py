@@ -1,0 +1,288 @@
+"""Rendered-page check of the built book in headless Chromium.
+
+Opens every page listed in the book's ``_toc.yml`` from ``book/_build/html`` (file:// URLs,
+all network requests blocked) with the system's Chromium driven by selenium, and fails
+(exit status 1) when a page
+
+* is missing or does not load (no article),
+* shows a broken image (not decoded: ``naturalWidth == 0``) or fewer figures than expected,
+* lacks its ledger table (``table.passmd-ledger`` with at least one row) where expected,
+* shows an execution error or stderr output (myst-nb ``.output.traceback`` / ``.output.stderr``
+  blocks, or a Python traceback anywhere in the text),
+* leaves math unrendered (a ``.math`` element without MathJax output, raw ``$$``/``\\(``/``\\[``
+  in the text) or a web font that failed to load,
+* tries to load anything from the network (the book must display offline).
+
+What a page must show comes from its ``passmd-expect`` meta tag, set in the chapter's front
+matter (``myst: html_meta: passmd-expect: "figures=2 ledger=1"``); pages without it must have
+at least one figure and one ledger table. A full-page screenshot of every page is saved.
+
+Usage: ``python tools/check_rendered_book.py book/_build/html --toc book/_toc.yml
+--screenshots artifacts/screenshots`` (``nox -s book_check`` runs this).
+"""
+
+from __future__ import annotations
+
+import argparse
+import base64
+import json
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+CHROMIUM = "/usr/bin/chromium"
+CHROMEDRIVER = "/usr/bin/chromedriver"
+CHROMIUM_FLAGS = (
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--window-size=1280,1000",
+)
+#: What a page must show when it has no ``passmd-expect`` meta tag.
+DEFAULT_EXPECT = {"figures": 1, "ledger": 1}
+LEDGER_SELECTOR = "table.passmd-ledger"
+MAX_SCREENSHOT_HEIGHT = 30000  # px; Chromium refuses larger captures
+
+# Runs in the page: waits for MathJax and image decoding, then reports what is shown.
+PAGE_FACTS_JS = r"""
+const done = arguments[arguments.length - 1];
+const ledgerSelector = arguments[0];
+(async () => {
+  if (window.MathJax && MathJax.startup && MathJax.startup.promise) {
+    try { await MathJax.startup.promise; } catch (e) {}
+  }
+  const article = document.querySelector('article.bd-article') || document.querySelector('main');
+  const root = article || document.body;
+  const imgs = Array.from(root.querySelectorAll('img'));
+  await Promise.all(imgs.map(img => img.decode().catch(() => null)));
+  try { await document.fonts.ready; } catch (e) {}
+  const skip = 'pre, code, script, style, textarea, mjx-container, .highlight, .MathJax';
+  const walker = document.createTreeWalker(root, NodeFilter.SHOW_TEXT);
+  const rawTex = [];
+  for (let node = walker.nextNode(); node; node = walker.nextNode()) {
+    if (node.parentElement && node.parentElement.closest(skip)) continue;
+    const t = node.textContent;
+    for (const token of ['$$', '\\(', '\\[', '\\begin{', '\\frac']) {
+      if (t.includes(token)) { rawTex.push(t.trim().slice(0, 80)); break; }
+    }
+  }
+  const maths = Array.from(root.querySelectorAll('.math'));
+  const text = root.innerText || '';
+  done({
+    title: document.title,
+    has_article: !!article,
+    expect: (document.querySelector('meta[name="passmd-expect"]') || {}).content || null,
+    images: imgs.map(img => ({
+      src: img.getAttribute('src'),
+      ok: img.complete && img.naturalWidth > 0 && img.naturalHeight > 0,
+      width: img.naturalWidth,
+    })),
+    error_outputs: Array.from(root.querySelectorAll('.output.traceback, .output.error'))
+      .map(e => e.innerText.trim().split('\n').slice(-1)[0].slice(0, 160)),
+    stderr_outputs: Array.from(root.querySelectorAll('.output.stderr'))
+      .map(e => e.innerText.trim().slice(0, 160)),
+    traceback_in_text: text.includes('Traceback (most recent call last)'),
+    math_total: maths.length,
+    math_rendered: maths.filter(m => m.querySelector('mjx-container')).length,
+    mathjax_loaded: !!(window.MathJax && MathJax.startup),
+    raw_tex: rawTex.slice(0, 5),
+    ledger_tables: Array.from(root.querySelectorAll(ledgerSelector))
+      .filter(t => t.querySelectorAll('tbody tr').length > 0).length,
+    fonts_failed: Array.from(document.fonts).filter(f => f.status === 'error').map(f => f.family),
+    external_resources: performance.getEntriesByType('resource').map(e => e.name)
+      .filter(n => !/^(file|data|blob|about):/.test(n)),
+  });
+})();
+"""
+
+
+def toc_pages(toc_file: str | Path) -> list[str]:
+    """Document names (no extension) of every page in a Jupyter Book ``_toc.yml``, in order."""
+    import yaml
+
+    toc = yaml.safe_load(Path(toc_file).read_text(encoding="utf-8"))
+    pages: list[str] = []
+
+    def walk(entries):
+        for entry in entries or []:
+            if "file" in entry:
+                pages.append(str(Path(entry["file"]).with_suffix("")))
+            for key in ("parts", "chapters", "sections"):
+                walk(entry.get(key))
+
+    pages.append(str(Path(toc["root"]).with_suffix("")))
+    walk(toc.get("parts"))
+    walk(toc.get("chapters"))
+    walk(toc.get("sections"))
+    return pages
+
+
+def parse_expect(content: str | None) -> dict[str, int]:
+    """Parse a ``passmd-expect`` meta value such as ``"figures=2 ledger=0"``.
+
+    ``None`` gives :data:`DEFAULT_EXPECT`. Keys: ``figures`` (minimum number of decoded
+    images) and ``ledger`` (minimum number of ledger tables).
+    """
+    expect = dict(DEFAULT_EXPECT)
+    if content is None:
+        return expect
+    for item in content.split():
+        key, sep, value = item.partition("=")
+        if not sep or key not in DEFAULT_EXPECT or not value.isdigit():
+            raise ValueError(
+                f"passmd-expect = {content!r} is not allowed: must be 'figures=<n> ledger=<n>'"
+            )
+        expect[key] = int(value)
+    return expect
+
+
+def page_problems(facts: dict) -> list[str]:
+    """Everything wrong with one rendered page, from the facts ``PAGE_FACTS_JS`` collected."""
+    problems: list[str] = []
+    if not facts.get("has_article"):
+        problems.append("page did not load: no article element")
+    try:
+        expect = parse_expect(facts.get("expect"))
+    except ValueError as err:
+        problems.append(str(err))
+        expect = dict(DEFAULT_EXPECT)
+    images = facts.get("images", [])
+    broken = [img["src"] for img in images if not img["ok"]]
+    for src in broken:
+        problems.append(f"broken image (not decoded): {src}")
+    shown = len(images) - len(broken)
+    if shown < expect["figures"]:
+        problems.append(f"{shown} figure(s) shown, expected at least {expect['figures']}")
+    if facts.get("ledger_tables", 0) < expect["ledger"]:
+        problems.append(
+            f"{facts.get('ledger_tables', 0)} ledger table(s) ({LEDGER_SELECTOR} with rows), "
+            f"expected at least {expect['ledger']}"
+        )
+    for message in facts.get("error_outputs", []):
+        problems.append(f"execution error shown: {message}")
+    for message in facts.get("stderr_outputs", []):
+        problems.append(f"stderr output shown: {message}")
+    if facts.get("traceback_in_text") and not facts.get("error_outputs"):
+        problems.append("a Python traceback is shown in the page text")
+    if facts.get("math_total", 0):
+        if not facts.get("mathjax_loaded"):
+            problems.append("MathJax did not load")
+        missing = facts["math_total"] - facts.get("math_rendered", 0)
+        if missing:
+            problems.append(f"{missing} of {facts['math_total']} math element(s) not rendered by MathJax")
+    for snippet in facts.get("raw_tex", []):
+        problems.append(f"raw TeX left in the page: {snippet!r}")
+    for family in facts.get("fonts_failed", []):
+        problems.append(f"web font failed to load: {family}")
+    for url in dict.fromkeys(facts.get("external_resources", [])):  # each URL once
+        problems.append(f"network resource requested (the book must display offline): {url}")
+    for line in facts.get("network_errors", []):
+        problems.append(f"network access attempted (the book must display offline): {line}")
+    return problems
+
+
+def _driver(user_data_dir: str):
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+
+    options = webdriver.ChromeOptions()
+    options.binary_location = CHROMIUM
+    for flag in CHROMIUM_FLAGS:
+        options.add_argument(flag)
+    options.add_argument(f"--user-data-dir={user_data_dir}")
+    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    driver = webdriver.Chrome(service=Service(executable_path=CHROMEDRIVER), options=options)
+    driver.set_page_load_timeout(120)
+    driver.set_script_timeout(120)
+    # Block every network request: what the book needs must come from the HTML folder.
+    driver.execute_cdp_cmd("Network.enable", {})
+    blocked = ["http://*", "https://*", "ws://*", "wss://*", "ftp://*"]
+    driver.execute_cdp_cmd("Network.setBlockedURLs", {"urls": blocked})
+    return driver
+
+
+def _screenshot(driver, target: Path) -> None:
+    metrics = driver.execute_cdp_cmd("Page.getLayoutMetrics", {})
+    size = metrics.get("cssContentSize") or metrics["contentSize"]
+    clip = {
+        "x": 0,
+        "y": 0,
+        "width": size["width"],
+        "height": min(size["height"], MAX_SCREENSHOT_HEIGHT),
+        "scale": 1,
+    }
+    shot = driver.execute_cdp_cmd(
+        "Page.captureScreenshot", {"format": "png", "captureBeyondViewport": True, "clip": clip}
+    )
+    target.write_bytes(base64.b64decode(shot["data"]))
+
+
+def check_book(html_dir: str | Path, pages: list[str], screenshots: str | Path | None = None) -> dict:
+    """Open each page in headless Chromium; return ``{page: {"facts": ..., "problems": [...]}}``."""
+    html_dir = Path(html_dir).resolve()
+    shots = Path(screenshots) if screenshots else None
+    if shots:
+        shots.mkdir(parents=True, exist_ok=True)
+    results: dict[str, dict] = {}
+    profile = tempfile.mkdtemp(prefix="passmd-chromium-")
+    driver = _driver(profile)
+    try:
+        for page in pages:
+            path = html_dir / f"{page}.html"
+            if not path.is_file():
+                results[page] = {"facts": {}, "problems": [f"page missing: {path}"]}
+                continue
+            driver.get_log("browser")  # drop messages of earlier pages
+            driver.get(path.as_uri())
+            facts = driver.execute_async_script(PAGE_FACTS_JS, LEDGER_SELECTOR)
+            facts["network_errors"] = [
+                entry["message"][:200]
+                for entry in driver.get_log("browser")
+                if "ERR_BLOCKED_BY_CLIENT" in entry["message"]
+                or "ERR_INTERNET_DISCONNECTED" in entry["message"]
+            ]
+            if shots:
+                _screenshot(driver, shots / f"{page.replace('/', '__')}.png")
+            results[page] = {"facts": facts, "problems": page_problems(facts)}
+    finally:
+        driver.quit()
+        shutil.rmtree(profile, ignore_errors=True)
+    return results
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("html_dir", help="built book, e.g. book/_build/html")
+    parser.add_argument("--toc", required=True, help="the book's _toc.yml (which pages to check)")
+    parser.add_argument("--screenshots", help="folder for full-page screenshots")
+    parser.add_argument("--report", help="write the facts and problems of every page as JSON here")
+    args = parser.parse_args(argv)
+
+    results = check_book(args.html_dir, toc_pages(args.toc), args.screenshots)
+    failed = 0
+    for page, result in results.items():
+        facts, problems = result["facts"], result["problems"]
+        figures = sum(img["ok"] for img in facts.get("images", []))
+        status = "FAIL" if problems else "ok"
+        print(
+            f"[{status}] {page}: {figures} figure(s), {facts.get('ledger_tables', 0)} ledger table(s), "
+            f"{facts.get('math_rendered', 0)}/{facts.get('math_total', 0)} math rendered"
+        )
+        for problem in problems:
+            print(f"       - {problem}")
+        failed += bool(problems)
+    if args.report:
+        Path(args.report).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.report).write_text(json.dumps(results, indent=2), encoding="utf-8")
+    print(f"rendered-page check: {len(results) - failed} of {len(results)} page(s) ok")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
