@@ -20,7 +20,9 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 BROKEN_BOOK = Path(__file__).resolve().parent / "broken_book"
 
-_spec = importlib.util.spec_from_file_location("check_rendered_book", ROOT / "tools" / "check_rendered_book.py")
+_spec = importlib.util.spec_from_file_location(
+    "check_rendered_book", ROOT / "tools" / "check_rendered_book.py"
+)
 checker = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(checker)
 
@@ -191,7 +193,9 @@ def test_check_fails_when_math_needs_the_network(tmp_path):
     book = tmp_path / "cdn_book"
     shutil.copytree(BROKEN_BOOK, book)
     config = (book / "_config.yml").read_text()
-    (book / "_config.yml").write_text(config.replace("sphinx:\n  extra_extensions: [sphinx-mathjax-offline]\n", ""))
+    offline_mathjax = "sphinx:\n  extra_extensions: [sphinx-mathjax-offline]\n"
+    assert offline_mathjax in config
+    (book / "_config.yml").write_text(config.replace(offline_mathjax, ""))
     (book / "_toc.yml").write_text("format: jb-book\nroot: good\n")
     html = _build(jupyter_book, book)
     problems = checker.check_book(html, ["good"])["good"]["problems"]
