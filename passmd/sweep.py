@@ -29,6 +29,7 @@ import signal
 import sys
 from collections.abc import Callable, Mapping, Sequence
 
+import numpy as np
 import pandas as pd
 from tqdm.auto import tqdm
 
@@ -37,7 +38,7 @@ from passmd.cache import Cache
 from passmd.parameters import Drive
 from passmd.theory import drive_theory
 
-__all__ = ["EXECUTORS", "drive_theory_point", "grid", "progress_enabled", "run"]
+__all__ = ["EXECUTORS", "drive_theory_point", "grid", "progress_enabled", "run", "sawtooth_point"]
 
 #: Names accepted by ``run(executor=...)``.
 EXECUTORS = ("process", "serial", "dask")
@@ -67,6 +68,28 @@ def drive_theory_point(**drive_fields) -> dict:
     analytic critical amplitude (Eqs. 7–8, 11–12) over a preload grid.
     """
     return drive_theory(Drive(**drive_fields))
+
+
+def sawtooth_point(drive: Drive, amplitude: float, frequency: float, periods: int = 3,
+                   flyback: str = "slew", springs: int | None = None) -> dict:
+    """Measures of one saw-tooth run from rest (:func:`passmd.dynamics.simulate`).
+
+    Returns the run's :meth:`~passmd.dynamics.SimulationResult.summary` (SI, keys
+    carrying the unit; without ``periods``, which is a parameter) plus ``mean_step_m``,
+    the mean of the per-period step sizes (needs ``periods >= 2``). ``springs`` None:
+    exact MDR contacts, else N discrete springs.
+    """
+    from passmd import dynamics, waveforms  # the simulator is only needed by this point function
+
+    wave = waveforms.sawtooth(amplitude, frequency, drive, periods=periods, flyback=flyback)
+    result = dynamics.simulate(drive, wave, contact_model="exact" if springs is None else "discrete",
+                               springs=200 if springs is None else springs, max_points=2)
+    summary = result.summary()
+    del summary["periods"]  # an input of the point, already a column
+    if result.step_sizes.size == 0:
+        raise ValueError(f"periods = {periods!r} is out of range: a step size needs periods >= 2")
+    summary["mean_step_m"] = float(np.mean(result.step_sizes))
+    return summary
 
 
 def progress_enabled(progress: bool | None = None, stream=None) -> bool:

@@ -1,0 +1,819 @@
+"""The ``passmd`` command line.
+
+Subcommands::
+
+    passmd theory               closed forms of a configuration (Eqs. 1, 7–14)
+    passmd critical-amplitude   simulated and analytic critical amplitude A_c
+    passmd run                  one simulation of a driving waveform
+    passmd force                generated force against the load cell
+    passmd contact              tangential force of one MDR contact along a path
+    passmd figure               one paper figure's data and image (not available yet)
+
+Quantities accept units (``0.4N``, ``1mm``, ``0.25 mm``, ``202nm``, ``100kHz``,
+``310GPa``); a bare number is read in the unit ``--help`` shows. Human output uses nm,
+N, mm and kHz; ``--json`` prints one JSON object in SI units whose keys carry the unit.
+
+Exit status: 0 success, 2 usage error (unknown option, wrong unit, out-of-range value,
+capability not available yet), 1 failed run (the simulation diverged, an output file
+could not be written). User errors print one line to stderr, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import textwrap
+from dataclasses import dataclass
+
+import numpy as np
+
+from passmd import __version__
+from passmd._validation import check_range
+from passmd.cache import CACHE_DIR_ENV, DEFAULT_CACHE_DIR, Cache
+from passmd.parameters import (
+    ACTUATOR_DAMPING_RATIO,
+    Actuator,
+    Amplifier,
+    Assumption,
+    Drive,
+    Material,
+    actuator_for_radius,
+    register_assumption,
+)
+from passmd.units import QuantityError, from_si, parse_quantities, parse_quantity
+
+__all__ = ["UsageError", "build_drive", "critical_amplitude_search", "main", "make_parser"]
+
+PROG = "passmd"
+NOT_AVAILABLE = "not available yet"
+
+#: Default "measurable step" threshold of the CLI's critical-amplitude search (m).
+CLI_STEP_THRESHOLD = 1e-9
+
+register_assumption(
+    Assumption(
+        key="cli_critical_amplitude_search",
+        symbol="A_c (CLI)",
+        value=(
+            f"smallest saw-tooth amplitude whose mean step over the run exceeds "
+            f"{CLI_STEP_THRESHOLD * 1e9:g} nm; bisection to 0.5 nm; 100 Hz, 3 periods"
+        ),
+        unit="nm",
+        rationale=(
+            "The paper does not give its protocol for A_c. `passmd critical-amplitude` uses a "
+            "stated, adjustable one (--threshold, --tolerance, --frequency, --periods) and "
+            "reports its bracket; the book's critical-amplitude chapters define and justify theirs."
+        ),
+        sensitivity="CLI output only; every protocol parameter is an option.",
+    )
+)
+
+_DEFAULT = Drive()
+
+DESCRIPTION = """\
+passmd: the piezo-actuated stick-slip micro-drive of Nguyen et al., Coatings 8, 62 (2018).
+
+Quantities accept units (0.4N, 1mm, '0.25 mm', 202nm, 100kHz, 310GPa); a bare number is
+read in the unit the option's help shows. Human output uses nm, N, mm and kHz; --json
+prints one JSON object in SI units whose keys carry the unit (e.g. final_position_m)."""
+
+
+class UsageError(ValueError):
+    """A user error found after argument parsing (exit status 2)."""
+
+
+class NotAvailableError(UsageError):
+    """A capability that later issues add (exit status 2)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (no usage dump) and exit status 2."""
+
+    def error(self, message):  # noqa: D401 - argparse API
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+class _Formatter(argparse.RawDescriptionHelpFormatter):
+    def __init__(self, prog):
+        super().__init__(prog, max_help_position=34, width=100)
+
+
+# --------------------------------------------------------------------------------------
+# Quantity options
+# --------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class _Quantity:
+    """A command-line quantity: flag, display unit, symbol, bounds and default text."""
+
+    flag: str
+    unit: str
+    symbol: str
+    text: str
+    default: str
+    lower: float | None = 0.0
+    lower_open: bool = True
+    upper: float | None = None
+    upper_open: bool = False
+
+    @property
+    def dest(self) -> str:
+        return self.flag.lstrip("-").replace("-", "_")
+
+    def add(self, parser) -> None:
+        unit = f"[{self.unit}]" if self.unit else "[-]"
+        parser.add_argument(
+            self.flag,
+            metavar=self.symbol,
+            default=None,
+            help=f"{self.text} {unit} (default: {self.default})",
+        )
+
+    def parse(self, args) -> float | None:
+        """SI value of the option, ``None`` if not given; range checked in display units."""
+        raw = getattr(args, self.dest)
+        if raw is None:
+            return None
+        value = parse_quantity(raw, self.unit, name=self.flag)
+        shown = float(f"{from_si(value, self.unit):.12g}")
+        check_range(self.flag, shown, self.lower, self.upper, lower_open=self.lower_open,
+                    upper_open=self.upper_open, unit=self.unit or "–")
+        return value
+
+
+def _fmt(value_si: float, unit: str) -> str:
+    return f"{from_si(value_si, unit):.6g} {unit}".rstrip()
+
+
+_ACT = _DEFAULT.actuator
+_AT_R = f"at {_fmt(_DEFAULT.hemisphere_radius, 'mm')}"
+_DRIVE_QUANTITIES = (
+    _Quantity("--preload", "N", "F_p", "preload", _fmt(_DEFAULT.preload, "N")),
+    _Quantity("--radius", "mm", "R", "hemisphere radius", _fmt(_DEFAULT.hemisphere_radius, "mm")),
+    _Quantity("--mu", "", "mu", "friction coefficient", f"{_DEFAULT.friction_coefficient:g}"),
+    _Quantity("--runner-mass", "g", "m_r", "runner mass", _fmt(_DEFAULT.runner_mass, "g")),
+    _Quantity("--load-cell-stiffness", "N/m", "k", "load cell stiffness",
+              _fmt(_DEFAULT.load_cell_stiffness, "N/m")),
+    _Quantity("--hemisphere-modulus", "GPa", "E_1", "Young's modulus of the hemispheres",
+              _fmt(_DEFAULT.hemisphere_material.youngs_modulus, "GPa") + " (ruby)"),
+    _Quantity("--hemisphere-poisson", "", "nu_1", "Poisson's ratio of the hemispheres",
+              f"{_DEFAULT.hemisphere_material.poissons_ratio:g}", -1.0, True, 0.5, True),
+    _Quantity("--runner-modulus", "GPa", "E_2", "Young's modulus of the runner",
+              _fmt(_DEFAULT.runner_material.youngs_modulus, "GPa") + " (steel)"),
+    _Quantity("--runner-poisson", "", "nu_2", "Poisson's ratio of the runner",
+              f"{_DEFAULT.runner_material.poissons_ratio:g}", -1.0, True, 0.5, True),
+    _Quantity("--actuator-stiffness", "N/m", "k_p", "actuator stiffness",
+              f"Table 2 for --radius, {_fmt(_ACT.stiffness, 'N/m')} {_AT_R}"),
+    _Quantity("--actuator-mass", "g", "m_a", "actuator mass",
+              f"Table 2 for --radius, {_fmt(_ACT.mass, 'g')} {_AT_R}"),
+    _Quantity("--actuator-viscosity", "kg/s", "c_p", "actuator viscosity",
+              f"2ζ√(k_p m_a) with ζ = {ACTUATOR_DAMPING_RATIO:g}, {_fmt(_ACT.viscosity, 'kg/s')} {_AT_R}",
+              0.0, False),
+    _Quantity("--full-stroke-amplitude", "nm", "A_max", "actuation amplitude at the full voltage",
+              f"Table 2 for --radius, {_fmt(_ACT.full_stroke_amplitude, 'nm')} {_AT_R}"),
+    _Quantity("--amplifier-voltage", "V", "V_pp", "amplifier peak-to-peak voltage",
+              _fmt(_DEFAULT.amplifier.peak_to_peak_voltage, "V")),
+    _Quantity("--slew-rate", "V/us", "SR", "amplifier slew rate",
+              _fmt(_DEFAULT.amplifier.slew_rate, "V/us")),
+)
+_Q = {q.flag: q for q in _DRIVE_QUANTITIES}
+
+_MATERIAL_FLAGS = ("--hemisphere-modulus", "--hemisphere-poisson", "--runner-modulus", "--runner-poisson")
+
+
+def _add_drive_options(parser, *, contact_only: bool = False) -> None:
+    group = parser.add_argument_group("drive (Tables 1–2; a bare number is in the unit shown)")
+    if not contact_only:
+        group.add_argument("--contacts", type=int, choices=(1, 6), default=_DEFAULT.contacts,
+                           help=f"one-contact or six-contact model (default: {_DEFAULT.contacts})")
+        group.add_argument("--actuator", choices=("rigid", "flexible"), default=_DEFAULT.actuator_model,
+                           help="ideally rigid or mass–spring–damper actuators "
+                                f"(default: {_DEFAULT.actuator_model})")
+    for q in _DRIVE_QUANTITIES:
+        if contact_only and q.flag not in ("--radius", "--mu", *_MATERIAL_FLAGS):
+            continue
+        q.add(group)
+
+
+def _material(base: Material, modulus, poisson) -> Material:
+    if modulus is None and poisson is None:
+        return base
+    return Material(
+        base.youngs_modulus if modulus is None else modulus,
+        base.poissons_ratio if poisson is None else poisson,
+        f"{base.name} (modified)",
+    )
+
+
+def build_drive(args, **fixed) -> Drive:
+    """The :class:`~passmd.parameters.Drive` the parsed options describe (SI inside).
+
+    Actuator: Table 2 for the radius, each given override replacing its field; the
+    viscosity, unless given, is 2ζ√(k_p m_a) of the final k_p and m_a.
+    """
+    v = {flag: q.parse(args) for flag, q in _Q.items() if hasattr(args, q.dest)}
+    radius = v.get("--radius") or _DEFAULT.hemisphere_radius
+    base = actuator_for_radius(radius)
+    k_p = v.get("--actuator-stiffness") or base.stiffness
+    m_a = v.get("--actuator-mass") or base.mass
+    c_p = v.get("--actuator-viscosity")
+    actuator = Actuator(
+        stiffness=k_p,
+        mass=m_a,
+        viscosity=2.0 * ACTUATOR_DAMPING_RATIO * math.sqrt(k_p * m_a) if c_p is None else c_p,
+        full_stroke_amplitude=v.get("--full-stroke-amplitude") or base.full_stroke_amplitude,
+    )
+    amplifier = Amplifier(
+        peak_to_peak_voltage=v.get("--amplifier-voltage") or _DEFAULT.amplifier.peak_to_peak_voltage,
+        slew_rate=v.get("--slew-rate") or _DEFAULT.amplifier.slew_rate,
+    )
+    fields = {
+        "hemisphere_radius": radius,
+        "preload": v.get("--preload") or _DEFAULT.preload,
+        "friction_coefficient": v.get("--mu") or _DEFAULT.friction_coefficient,
+        "runner_mass": v.get("--runner-mass") or _DEFAULT.runner_mass,
+        "load_cell_stiffness": v.get("--load-cell-stiffness") or _DEFAULT.load_cell_stiffness,
+        "hemisphere_material": _material(_DEFAULT.hemisphere_material, v.get("--hemisphere-modulus"),
+                                         v.get("--hemisphere-poisson")),
+        "runner_material": _material(_DEFAULT.runner_material, v.get("--runner-modulus"),
+                                     v.get("--runner-poisson")),
+        "actuator": actuator,
+        "amplifier": amplifier,
+    }
+    if hasattr(args, "contacts"):
+        fields["contacts"] = args.contacts
+        fields["actuator_model"] = args.actuator
+    fields.update(fixed)
+    return Drive(**fields)
+
+
+def drive_record(drive: Drive) -> dict:
+    """The drive's parameters in SI, keys carrying the unit (the ``drive`` object of ``--json``)."""
+    act, amp = drive.actuator, drive.amplifier
+    return {
+        "contacts": drive.contacts,
+        "actuator_model": drive.actuator_model,
+        "preload_N": drive.preload,
+        "hemisphere_radius_m": drive.hemisphere_radius,
+        "friction_coefficient": drive.friction_coefficient,
+        "runner_mass_kg": drive.runner_mass,
+        "load_cell_stiffness_N_per_m": drive.load_cell_stiffness,
+        "load_cell": drive.load_cell,
+        "hemisphere_youngs_modulus_Pa": drive.hemisphere_material.youngs_modulus,
+        "hemisphere_poissons_ratio": drive.hemisphere_material.poissons_ratio,
+        "runner_youngs_modulus_Pa": drive.runner_material.youngs_modulus,
+        "runner_poissons_ratio": drive.runner_material.poissons_ratio,
+        "actuator_stiffness_N_per_m": act.stiffness,
+        "actuator_mass_kg": act.mass,
+        "actuator_viscosity_kg_per_s": act.viscosity,
+        "full_stroke_amplitude_m": act.full_stroke_amplitude,
+        "amplifier_voltage_V": amp.peak_to_peak_voltage,
+        "slew_rate_V_per_s": amp.slew_rate,
+    }
+
+
+# --------------------------------------------------------------------------------------
+# Output
+# --------------------------------------------------------------------------------------
+
+
+def _plain(obj):
+    """JSON-ready: numpy scalars/arrays to Python, non-finite floats refused."""
+    if isinstance(obj, dict):
+        return {str(k): _plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple, np.ndarray)):
+        return [_plain(x) for x in (obj.tolist() if isinstance(obj, np.ndarray) else obj)]
+    if isinstance(obj, (np.bool_, bool)):
+        return bool(obj)
+    if isinstance(obj, (np.integer, int)):
+        return int(obj)
+    if isinstance(obj, (np.floating, float)):
+        if not math.isfinite(float(obj)):
+            raise RuntimeError(f"internal error: non-finite value {obj!r} in the output")
+        return float(obj)
+    return obj
+
+
+def _emit_json(payload: dict, out) -> None:
+    out.write(json.dumps(_plain(payload), indent=2, allow_nan=False) + "\n")
+
+
+def _emit_rows(title: str, rows: list[tuple[str, str]], out) -> None:
+    out.write(title + "\n")
+    width = max((len(label) for label, _ in rows), default=0)
+    for label, value in rows:
+        out.write(f"  {label:<{width}}  {value}\n")
+
+
+def _nm(values) -> str:
+    arr = np.atleast_1d(np.asarray(values, dtype=float))
+    return ", ".join(f"{x:.4g}" for x in from_si(arr, "nm")) + " nm"
+
+
+def _sides(values, unit: str, digits: int = 5) -> str:
+    arr = np.atleast_1d(np.asarray(values, dtype=float))
+    text = [f"{x:.{digits}g}" for x in from_si(arr, unit)]
+    if len(text) == 2:
+        return f"{text[0]} {unit} (side 1, ×2) | {text[1]} {unit} (side 2, ×4)"
+    return f"{text[0]} {unit}"
+
+
+def _describe(drive: Drive) -> str:
+    return (
+        f"R = {_fmt(drive.hemisphere_radius, 'mm')}, F_p = {_fmt(drive.preload, 'N')}, "
+        f"μ = {drive.friction_coefficient:g}, {drive.contacts} contact{'s' * (drive.contacts > 1)}, "
+        f"{drive.actuator_model} actuators"
+    )
+
+
+# --------------------------------------------------------------------------------------
+# Subcommands
+# --------------------------------------------------------------------------------------
+
+
+def _cmd_theory(args, out) -> int:
+    from passmd.theory import drive_theory, runner_frequency
+
+    drive = build_drive(args)
+    result = drive_theory(drive)
+    result["runner_frequency_Hz"] = runner_frequency(drive)
+    result["actuator_natural_frequency_Hz"] = drive.actuator.natural_frequency
+    if args.json:
+        _emit_json({"command": "theory", "drive": drive_record(drive), **result}, out)
+        return 0
+    rows = [
+        ("E* (Eq. 4)", _fmt(result["E_star_Pa"], "GPa")),
+        ("G* (Eq. 4)", _fmt(result["G_star_Pa"], "GPa")),
+        ("normal force per contact F_N (Eq. 1)", _sides(result["normal_force_N"], "N")),
+        ("Hertz contact radius a", _sides(result["contact_radius_m"], "mm")),
+        ("indentation d", _sides(result["indentation_m"], "nm")),
+        ("tangential stiffness 2aG*", _sides(result["tangential_stiffness_N_per_m"], "N/m")),
+        ("presliding u_x,max (Eq. 7/10)", _sides(result["presliding_m"], "nm")),
+        ("actuator deformation u_x,a (Eq. 9/14)", _sides(result["actuator_deformation_m"], "nm")),
+        ("A_c, rigid actuators (Eq. 7/11)", _fmt(result["critical_amplitude_rigid_m"], "nm")),
+        ("A_c, flexible actuators (Eq. 8/12)", _fmt(result["critical_amplitude_flexible_m"], "nm")),
+        ("runner-on-contacts frequency", _fmt(result["runner_frequency_Hz"], "kHz")),
+        ("bare actuator frequency", _fmt(result["actuator_natural_frequency_Hz"], "kHz")),
+    ]
+    _emit_rows(f"passmd theory — {_describe(drive)}", rows, out)
+    return 0
+
+
+def _cmd_contact(args, out) -> int:
+    from passmd.contact import MDRContact
+    from passmd.theory import contact_moduli
+
+    if args.path is None:
+        raise UsageError("--path is required, e.g. --path 0nm,30nm,-10nm,45nm")
+    path = parse_quantities(args.path, "nm", name="--path")
+    normal = _NORMAL_FORCE.parse(args) or _DEFAULT.preload
+    springs = _check_springs(args.springs)
+    drive = build_drive(args)
+    E_star, G_star = contact_moduli(drive)
+    contact = MDRContact(normal, drive.hemisphere_radius, E_star, G_star, drive.friction_coefficient,
+                         springs=springs)
+    forces = contact.path(np.array(path))
+    record = {
+        "command": "contact",
+        "model": contact.model,
+        "springs": springs,
+        "normal_force_N": contact.normal_force,
+        "hemisphere_radius_m": drive.hemisphere_radius,
+        "friction_coefficient": drive.friction_coefficient,
+        "E_star_Pa": E_star,
+        "G_star_Pa": G_star,
+        "sliding_force_N": contact.sliding_force,
+        "presliding_m": contact.presliding,
+        "contact_radius_m": contact.contact_radius,
+        "displacement_m": path,
+        "force_N": forces,
+    }
+    if args.json:
+        _emit_json(record, out)
+        return 0
+    model = "exact (N → ∞)" if springs is None else f"discrete, {springs} springs"
+    out.write(
+        f"passmd contact — {model}, F_N = {_fmt(contact.normal_force, 'N')}, "
+        f"R = {_fmt(drive.hemisphere_radius, 'mm')}, μ = {drive.friction_coefficient:g}\n"
+        f"  μF_N = {contact.sliding_force:.6g} N, u_max = {_fmt(contact.presliding, 'nm')} (Eq. 7)\n"
+        f"  {'u = x_a − x_r [nm]':>20}  {'T [N]':>12}\n"
+    )
+    for u, f in zip(path, forces, strict=True):
+        out.write(f"  {from_si(u, 'nm'):>20.6g}  {f:>12.6g}\n")
+    return 0
+
+
+def _check_springs(springs):
+    if springs is None:
+        return None
+    if springs < 2:
+        raise UsageError(
+            f"--springs = {springs} is out of range: must be an integer >= 2 (omit it for the exact contact)"
+        )
+    return springs
+
+
+def _waveform_args(args, drive):
+    """(amplitude, frequency) in SI after the display-unit checks."""
+    if args.waveform == "optimized":
+        raise NotAvailableError(
+            f"--waveform optimized is {NOT_AVAILABLE}: the optimized waveform (Eq. 15) comes with the "
+            "driving-waveform issue; use --waveform sawtooth"
+        )
+    a_max = drive.actuator.full_stroke_amplitude
+    amplitude = _AMPLITUDE.parse(args)
+    amplitude = a_max if amplitude is None else amplitude
+    if amplitude > a_max * (1 + 1e-12):
+        raise UsageError(
+            f"--amplitude = {from_si(amplitude, 'nm'):.6g} nm is out of range: must be <= "
+            f"{from_si(a_max, 'nm'):.6g} nm, the actuator's full stroke (--full-stroke-amplitude)"
+        )
+    frequency = _FREQUENCY.parse(args) or _DEFAULT_FREQUENCY
+    if args.periods < 1:
+        raise UsageError(f"--periods = {args.periods} is out of range: must be an integer >= 1")
+    return min(amplitude, a_max), frequency
+
+
+def _simulate(args, drive):
+    from passmd import dynamics, waveforms
+
+    amplitude, frequency = _waveform_args(args, drive)
+    springs = _check_springs(args.springs)
+    wave = waveforms.sawtooth(amplitude, frequency, drive, periods=args.periods, flyback=args.flyback)
+    result = dynamics.simulate(
+        drive, wave, contact_model="exact" if springs is None else "discrete",
+        springs=springs or 200, max_points=args.max_points,
+    )
+    return result
+
+
+def _write_outputs(args, result) -> None:
+    if args.csv:
+        try:
+            result.to_frame().to_csv(args.csv, index=False)
+        except OSError as exc:
+            raise OutputError(f"cannot write --csv {args.csv}: {exc.strerror or exc}") from exc
+    if args.plot:
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(7, 4), layout="constrained")
+        ax = fig.add_subplot()
+        t_ms = result.time * 1e3
+        ax.plot(t_ms, from_si(result.piezo_position, "nm"), label="piezo x_p", lw=0.8)
+        ax.plot(t_ms, from_si(result.runner_position, "nm"), label="runner x_r", lw=0.8)
+        ax.set_xlabel("time [ms]")
+        ax.set_ylabel("position [nm]")
+        ax.legend()
+        ax.set_title(_describe(result.drive), fontsize=9)
+        try:
+            fig.savefig(args.plot, dpi=150)
+        except OSError as exc:
+            raise OutputError(f"cannot write --plot {args.plot}: {exc.strerror or exc}") from exc
+
+
+class OutputError(RuntimeError):
+    """An output file could not be written (exit status 1)."""
+
+
+def _run_summary(result) -> dict:
+    summary = result.summary()
+    summary["wall_time_s"] = float(result.wall_time)
+    return summary
+
+
+def _cmd_run(args, out) -> int:
+    drive = build_drive(args, load_cell=bool(args.load_cell))
+    result = _simulate(args, drive)
+    _write_outputs(args, result)
+    summary = _run_summary(result)
+    if args.json:
+        _emit_json({"command": "run", "waveform": args.waveform, "flyback": args.flyback,
+                    "drive": drive_record(drive), **summary}, out)
+        return 0
+    rows = [
+        ("waveform", f"{args.waveform}, A = {_fmt(summary['amplitude_m'], 'nm')}, "
+                     f"f = {_fmt(summary['frequency_Hz'], 'kHz')}, {summary['periods']} periods"),
+        ("final position", _fmt(summary["final_position_m"], "nm")),
+        ("step per period", _nm(summary["step_sizes_m"]) if summary["step_sizes_m"] else "– (one period)"),
+        ("back-step per period", _nm(summary["back_steps_m"])),
+    ]
+    if "mean_velocity_m_per_s" in summary:
+        rows.append(("mean velocity", f"{summary['mean_velocity_m_per_s'] * 1e3:.6g} mm/s"))
+    if "generated_force_N" in summary:
+        rows.append(("generated force", _fmt(summary["generated_force_N"], "N")))
+    step_ns = summary["max_time_step_s"] * 1e9
+    rows.append(("integrator", f"{summary['integrator_steps']} steps of ≤ {step_ns:.3g} ns, "
+                               f"{summary['wall_time_s']:.3g} s"))
+    _emit_rows(f"passmd run — {_describe(drive)}", rows, out)
+    return 0
+
+
+def _cmd_force(args, out) -> int:
+    drive = build_drive(args, load_cell=True)
+    result = _simulate(args, drive)
+    _write_outputs(args, result)
+    summary = _run_summary(result)
+    steps = summary["step_sizes_m"]
+    summary["last_step_size_m"] = steps[-1] if steps else None
+    if args.json:
+        _emit_json({"command": "force", "waveform": args.waveform, "flyback": args.flyback,
+                    "drive": drive_record(drive), **summary}, out)
+        return 0
+    rows = [
+        ("waveform", f"{args.waveform}, A = {_fmt(summary['amplitude_m'], 'nm')}, "
+                     f"f = {_fmt(summary['frequency_Hz'], 'kHz')}, {summary['periods']} periods"),
+        ("generated force k·x̄_r (last period)", _fmt(summary["generated_force_N"], "N")),
+        ("final position", _fmt(summary["final_position_m"], "nm")),
+        ("last step", _fmt(steps[-1], "nm") if steps else "– (one period)"),
+        ("integrator", f"{summary['integrator_steps']} steps, {summary['wall_time_s']:.3g} s"),
+    ]
+    _emit_rows(f"passmd force — {_describe(drive)}, load cell k = "
+               f"{_fmt(drive.load_cell_stiffness, 'N/m')}", rows, out)
+    return 0
+
+
+def critical_amplitude_search(drive: Drive, *, frequency: float = 100.0, periods: int = 3,
+                              threshold: float = CLI_STEP_THRESHOLD, tolerance: float = 0.5e-9,
+                              flyback: str = "slew", springs: int | None = None, workers: int = 1,
+                              cache=True) -> dict:
+    """Smallest saw-tooth amplitude with a measurable step, by bracketing (k-section) search.
+
+    A point "steps" when the mean of its per-period step sizes exceeds ``threshold``.
+    The bracket starts at [0, A_max] (zero amplitude makes no step); each round
+    simulates ``workers`` amplitudes evenly inside the bracket (in parallel through
+    :func:`passmd.sweep.run`, each cached) and keeps the sub-interval where the step
+    first exceeds the threshold, until the bracket is narrower than ``tolerance``.
+
+    Returns
+    -------
+    dict
+        ``critical_amplitude_m`` (the bracket's midpoint, ``None`` if even A_max makes no
+        step), ``bracket_m``, ``threshold_m``, ``simulations`` and the search settings.
+    """
+    from passmd import sweep
+
+    a_max = drive.actuator.full_stroke_amplitude
+    common = {"drive": drive, "frequency": frequency, "periods": periods, "flyback": flyback,
+              "springs": springs}
+
+    def steps(amplitudes):
+        points = [{**common, "amplitude": float(a)} for a in amplitudes]
+        frame = sweep.run(sweep.sawtooth_point, points, executor="serial" if workers == 1 else "process",
+                          workers=workers, cache=cache, progress=False)
+        return frame["mean_step_m"].to_numpy()
+
+    simulations = 1
+    lo, hi = 0.0, a_max
+    if steps([hi])[0] <= threshold:
+        found = None
+    else:
+        while hi - lo > tolerance:
+            inner = lo + (hi - lo) * np.arange(1, workers + 1) / (workers + 1)
+            moving = steps(inner) > threshold
+            simulations += inner.size
+            if moving.any():
+                j = int(np.argmax(moving))
+                hi = float(inner[j])
+                lo = float(inner[j - 1]) if j > 0 else lo
+            else:
+                lo = float(inner[-1])
+        found = 0.5 * (lo + hi)
+    return {
+        "critical_amplitude_m": found,
+        "bracket_m": [lo, hi],
+        "threshold_m": threshold,
+        "tolerance_m": tolerance,
+        "frequency_Hz": frequency,
+        "periods": periods,
+        "flyback": flyback,
+        "simulations": simulations,
+    }
+
+
+def _cmd_critical_amplitude(args, out) -> int:
+    from passmd.theory import drive_theory
+
+    drive = build_drive(args)
+    theory = drive_theory(drive)
+    record = {
+        "command": "critical-amplitude",
+        "drive": drive_record(drive),
+        "analytic_critical_amplitude_m": theory["analytic_critical_amplitude_m"],
+        "critical_amplitude_rigid_m": theory["critical_amplitude_rigid_m"],
+        "critical_amplitude_flexible_m": theory["critical_amplitude_flexible_m"],
+    }
+    if not args.analytic_only:
+        if args.periods < 2:
+            raise UsageError(f"--periods = {args.periods} is out of range: a step needs >= 2 periods")
+        threshold = _THRESHOLD.parse(args) or CLI_STEP_THRESHOLD
+        tolerance = _TOLERANCE.parse(args) or 0.5e-9
+        frequency = _FREQUENCY.parse(args) or _DEFAULT_FREQUENCY
+        if args.workers < 1:
+            raise UsageError(f"--workers = {args.workers} is out of range: must be an integer >= 1")
+        cache = False if args.no_cache else Cache(args.cache_dir) if args.cache_dir else True
+        record.update(critical_amplitude_search(
+            drive, frequency=frequency, periods=args.periods, threshold=threshold, tolerance=tolerance,
+            flyback=args.flyback, springs=_check_springs(args.springs), workers=args.workers, cache=cache,
+        ))
+    if args.json:
+        _emit_json(record, out)
+        return 0
+    rows = []
+    if not args.analytic_only:
+        found = record["critical_amplitude_m"]
+        lo, hi = record["bracket_m"]
+        rows.append(("simulated A_c", f"{_fmt(found, 'nm')}  (bracket {from_si(lo, 'nm'):.4g}–"
+                                      f"{from_si(hi, 'nm'):.4g} nm)" if found is not None else
+                     f"no step > {_fmt(record['threshold_m'], 'nm')} up to the full stroke "
+                     f"{_fmt(hi, 'nm')}"))
+        rows.append(("search", f"mean step > {_fmt(record['threshold_m'], 'nm')}, "
+                               f"f = {_fmt(record['frequency_Hz'], 'kHz')}, {record['periods']} periods, "
+                               f"{record['simulations']} simulations"))
+    eq = "Eq. 7/11" if drive.actuator_model == "rigid" else "Eq. 8/12"
+    rows.append((f"analytic A_c ({eq})", _fmt(record["analytic_critical_amplitude_m"], "nm")))
+    _emit_rows(f"passmd critical-amplitude — {_describe(drive)}", rows, out)
+    return 0
+
+
+def _cmd_figure(args, out) -> int:
+    raise NotAvailableError(
+        f"figure {args.name!r} is {NOT_AVAILABLE}: the paper's figures come with the "
+        "critical-amplitude, force-generation and driving-waveform issues"
+    )
+
+
+# --------------------------------------------------------------------------------------
+# Parser
+# --------------------------------------------------------------------------------------
+
+_DEFAULT_FREQUENCY = 100.0
+_AMPLITUDE = _Quantity("--amplitude", "nm", "A", "actuation amplitude",
+                       "the full stroke, --full-stroke-amplitude", 0.0, False)
+_FREQUENCY = _Quantity("--frequency", "kHz", "f", "driving frequency", _fmt(_DEFAULT_FREQUENCY, "kHz"))
+_NORMAL_FORCE = _Quantity("--normal-force", "N", "F_N", "normal force on the contact",
+                          _fmt(_DEFAULT.preload, "N"))
+_THRESHOLD = _Quantity("--threshold", "nm", "S", "a step counts when the mean step exceeds this",
+                       _fmt(CLI_STEP_THRESHOLD, "nm"))
+_TOLERANCE = _Quantity("--tolerance", "nm", "W", "stop when the bracket is narrower than this", "0.5 nm")
+
+_RUN_KEYS = """\
+--json keys (SI units): final_position_m, settled_positions_m, step_sizes_m,
+back_steps_m, mean_velocity_m_per_s (>= 2 periods), periods, frequency_Hz, amplitude_m,
+integrator_steps, max_time_step_s, wall_time_s, waveform, flyback, drive{...}"""
+
+
+def _add_simulation_options(parser, default_periods: int) -> None:
+    group = parser.add_argument_group("waveform and simulation")
+    group.add_argument("--waveform", choices=("sawtooth", "optimized"), default="sawtooth",
+                       help=f"driving waveform; optimized (Eq. 15) is {NOT_AVAILABLE} (default: sawtooth)")
+    _AMPLITUDE.add(group)
+    _FREQUENCY.add(group)
+    group.add_argument("--periods", type=int, default=default_periods, metavar="N",
+                       help=f"number of driving periods (default: {default_periods})")
+    group.add_argument("--flyback", choices=("slew", "fixed"), default="slew",
+                       help="fly-back duration: slew-rate limited (A/A_max · V_pp/SR) or the fixed "
+                            "full-stroke time (default: slew)")
+    group.add_argument("--springs", type=int, default=None, metavar="N",
+                       help="discrete MDR contacts with N springs (default: exact contact, N → ∞)")
+
+
+def _add_output_options(parser) -> None:
+    group = parser.add_argument_group("output")
+    group.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead")
+    group.add_argument("--csv", metavar="FILE", help="write the time series to FILE (CSV, SI units)")
+    group.add_argument("--plot", metavar="FILE", help="plot piezo and runner position to FILE (PNG)")
+    group.add_argument("--max-points", type=int, default=20000, metavar="N",
+                       help="samples of the recorded time series (default: 20000)")
+
+
+def make_parser() -> argparse.ArgumentParser:
+    """The ``passmd`` argument parser (all subcommands)."""
+    parser = _Parser(
+        prog=PROG,
+        formatter_class=_Formatter,
+        description=DESCRIPTION,
+        epilog="Exit status: 0 ok, 2 usage error, 1 failed run. 'passmd COMMAND --help' for options.",
+    )
+    parser.add_argument("--version", action="version", version=f"passmd {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    def command(name, help_text, epilog):
+        return sub.add_parser(name, help=help_text, description=help_text, epilog=epilog,
+                              formatter_class=_Formatter)
+
+    p = command("theory", "closed forms of a drive configuration (Eqs. 1, 4, 7–14)", textwrap.dedent("""\
+        --json keys (SI units): E_star_Pa, G_star_Pa, normal_force_N, contact_radius_m,
+        indentation_m, tangential_stiffness_N_per_m, presliding_m, actuator_deformation_m
+        (per side: [side 1, side 2] for six contacts), critical_amplitude_rigid_m,
+        critical_amplitude_flexible_m, analytic_critical_amplitude_m (for --actuator),
+        runner_frequency_Hz, actuator_natural_frequency_Hz, drive{...}"""))
+    _add_drive_options(p)
+    p.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead")
+    p.set_defaults(handler=_cmd_theory)
+
+    p = command("critical-amplitude", "simulated and analytic critical amplitude A_c", textwrap.dedent(f"""\
+        The simulated A_c is the smallest saw-tooth amplitude whose mean step over the
+        run exceeds --threshold, found by a bracketing search on [0, A_max] (the paper
+        gives no protocol; this one is stated, adjustable, and reports its bracket).
+        Simulations are cached in {DEFAULT_CACHE_DIR}/ (or ${CACHE_DIR_ENV}, --cache-dir).
+
+        --json keys (SI units): critical_amplitude_m (null if no step up to A_max),
+        bracket_m, analytic_critical_amplitude_m, critical_amplitude_rigid_m,
+        critical_amplitude_flexible_m, threshold_m, tolerance_m, frequency_Hz, periods,
+        flyback, simulations, drive{{...}}"""))
+    _add_drive_options(p)
+    group = p.add_argument_group("search")
+    _FREQUENCY.add(group)
+    group.add_argument("--periods", type=int, default=3, metavar="N",
+                       help="driving periods per simulation (default: 3)")
+    _THRESHOLD.add(group)
+    _TOLERANCE.add(group)
+    group.add_argument("--flyback", choices=("slew", "fixed"), default="slew",
+                       help="fly-back duration rule (default: slew)")
+    group.add_argument("--springs", type=int, default=None, metavar="N",
+                       help="discrete MDR contacts with N springs (default: exact contact)")
+    group.add_argument("--workers", type=int, default=1, metavar="N",
+                       help="amplitudes simulated in parallel per search round (default: 1)")
+    group.add_argument("--analytic-only", action="store_true", help="skip the simulation")
+    group.add_argument("--cache-dir", metavar="DIR",
+                       help=f"cache directory (default: ${CACHE_DIR_ENV} or ./{DEFAULT_CACHE_DIR})")
+    group.add_argument("--no-cache", action="store_true", help="do not read or write the cache")
+    p.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead")
+    p.set_defaults(handler=_cmd_critical_amplitude)
+
+    p = command("run", "one simulation of a driving waveform from rest", _RUN_KEYS +
+                ", generated_force_N (with --load-cell)")
+    _add_drive_options(p)
+    _add_simulation_options(p, default_periods=3)
+    p.add_argument("--load-cell", action="store_true",
+                   help="the runner pushes against the load cell (default: free runner)")
+    _add_output_options(p)
+    p.set_defaults(handler=_cmd_run)
+
+    p = command("force", "generated force against the load cell (Section 4.2)", _RUN_KEYS +
+                ",\ngenerated_force_N (k times the mean runner position over the last period),\n"
+                "last_step_size_m (how far the runner still moved in the last period)")
+    _add_drive_options(p)
+    _add_simulation_options(p, default_periods=100)
+    _add_output_options(p)
+    p.set_defaults(handler=_cmd_force)
+
+    p = command("contact", "tangential force of one MDR contact along a displacement path (Eqs. 4–7)",
+                textwrap.dedent("""\
+        The path is a comma-separated list of displacements u = x_a − x_r (hemisphere
+        minus runner), visited in turn from a virgin contact at u = 0; the force T acts
+        on the runner. Example: --path 0nm,30nm,-10nm,45nm
+
+        --json keys (SI units): displacement_m, force_N, model, springs, normal_force_N,
+        hemisphere_radius_m, friction_coefficient, E_star_Pa, G_star_Pa, sliding_force_N,
+        presliding_m, contact_radius_m"""))
+    group = p.add_argument_group("contact")
+    _NORMAL_FORCE.add(group)
+    group.add_argument("--path", metavar="U1,U2,...",
+                       help="displacements to visit [nm] (required)")
+    group.add_argument("--springs", type=int, default=None, metavar="N",
+                       help="discrete MDR model with N springs (default: exact, N → ∞)")
+    _add_drive_options(p, contact_only=True)
+    p.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead")
+    p.set_defaults(handler=_cmd_contact)
+
+    p = command("figure", f"one paper figure's data (CSV) and image (PNG) — {NOT_AVAILABLE}",
+                "The figures come with the critical-amplitude, force-generation and waveform issues.")
+    p.add_argument("name", metavar="NAME", help="figure panel, e.g. fig5a")
+    p.add_argument("--profile", choices=("quick", "paper"), default="quick",
+                   help="resolution profile (default: quick)")
+    p.add_argument("--out", metavar="DIR", default=".", help="output directory (default: .)")
+    p.set_defaults(handler=_cmd_figure)
+    return parser
+
+
+def main(argv=None, out=None) -> int:
+    """Run the command line; return the exit status (0 ok, 2 usage error, 1 failed run)."""
+    out = sys.stdout if out is None else out
+    parser = make_parser()
+    args = parser.parse_args(argv)
+    prog = f"{PROG} {args.command}"
+    try:
+        return args.handler(args, out)
+    except (UsageError, QuantityError) as exc:
+        sys.stderr.write(f"{prog}: error: {exc}\n")
+        return 2
+    except OutputError as exc:
+        sys.stderr.write(f"{prog}: error: {exc}\n")
+        return 1
+    except KeyboardInterrupt:
+        sys.stderr.write(f"{prog}: interrupted (finished points are kept in the cache)\n")
+        return 130
+    except ValueError as exc:  # the package's input checks (passmd._validation)
+        sys.stderr.write(f"{prog}: error: {exc}\n")
+        return 2
+    except RuntimeError as exc:  # passmd.dynamics.SimulationError and other failed runs
+        sys.stderr.write(f"{prog}: error: run failed: {exc}\n")
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
