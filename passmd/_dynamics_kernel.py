@@ -1,0 +1,195 @@
+"""numba kernel of the hybrid simulation (Eqs. 2–3 with the MDR contacts in the loop).
+
+Only :mod:`passmd.dynamics` calls this; it validates, allocates and interprets. The
+kernel takes plain arrays and scalars.
+
+Scheme: velocity Verlet (kick–drift–kick) on runner and actuators; the actuator's
+viscous term −c_p ẋ_a is treated with the trapezoidal rule in the velocity update
+(implicit in v, still explicit overall). The contact memory is updated exactly once
+per step, with the drifted positions, and the contact force is otherwise evaluated
+purely. Steps are uniform inside each piecewise-linear segment of x_p(t), so the
+waveform's corners fall on step boundaries.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from passmd.contact import contact_force_row, contact_slip_share_row, contact_update_row
+
+# columns of the per-period accumulator array
+PER_WINDOW_INTEGRAL = 0  # ∫ (x_r − x_p) dt over the settle window
+PER_WINDOW_LENGTH = 1  # window length (s)
+PER_WINDOW_END_XP = 2  # x_p at the window's end
+PER_MARK_XR = 3  # x_r at the slip mark
+PER_MIN_XR = 4  # min x_r from the slip mark to the next window
+PER_XR_INTEGRAL = 5  # ∫ x_r dt over the period
+PER_FRICTION_INTEGRAL = 6  # ∫ Σ m_g T_g dt over the period (force on the runner)
+PER_DURATION = 7  # Σ dt over the period
+PER_COLUMNS = 8
+
+# energy accumulators
+EN_INPUT = 0  # work done by the piezo drive
+EN_DAMPING = 1  # dissipated by c_p
+EN_CONTACT = 2  # ∫ T du: stored in and dissipated by the contacts
+EN_COLUMNS = 3
+
+STATUS_OK = 0
+STATUS_DIVERGED = 1
+
+
+@njit(cache=True, error_model="numpy")
+def integrate(
+    seg_t0, seg_t1, seg_x0, seg_x1, seg_n, seg_period, seg_window, seg_mark,
+    runner_mass, load_stiffness, multiplicity, rigid, actuator_mass, actuator_stiffness,
+    actuator_viscosity, params, state, y, record_interval, record, per, energy, position_limit,
+    velocity_limit,
+):
+    """Integrate over all segments; returns (status, steps done, rows recorded).
+
+    ``y`` = [x_r, v_r, x_a(0..G−1), v_a(0..G−1)] is updated in place. ``record`` rows are
+    [t, x_p, x_r, v_r, (x_a, T, slip share) per group].
+    """
+    G = multiplicity.shape[0]
+    x_r = y[0]
+    v_r = y[1]
+    x_a = y[2 : 2 + G].copy()
+    v_a = y[2 + G : 2 + 2 * G].copy()
+    T = np.empty(G)
+    u_old = np.empty(G)
+    a_nd = np.empty(G)  # actuator acceleration without the damping term
+    stretch_old = np.empty(G)  # x_p − x_a at the previous step
+    gam = actuator_viscosity / actuator_mass
+    inv_ma = 1.0 / actuator_mass
+    inv_mr = 1.0 / runner_mass
+    t = seg_t0[0]
+    x_p = seg_x0[0]
+
+    F = 0.0
+    for g in range(G):
+        u = x_a[g] - x_r
+        T[g] = contact_force_row(params, state, g, u)
+        u_old[g] = u
+        F += multiplicity[g] * T[g]
+        a_nd[g] = (actuator_stiffness * (x_p - x_a[g]) - T[g]) / actuator_mass
+    a_r = (F - load_stiffness * x_r) / runner_mass
+
+    n_rec = 0
+    max_rec = record.shape[0]
+    next_rec = t
+    track = -1
+    steps = 0
+    for s in range(seg_t0.shape[0]):
+        k = seg_period[s]
+        n = seg_n[s]
+        dt = (seg_t1[s] - seg_t0[s]) / n
+        vp = (seg_x1[s] - seg_x0[s]) / (seg_t1[s] - seg_t0[s])
+        if seg_mark[s]:
+            track = k
+            per[k, PER_MARK_XR] = x_r
+            per[k, PER_MIN_XR] = x_r
+        in_window = seg_window[s] != 0
+        if in_window and track >= 0 and k > track:
+            track = -1
+        damp = 1.0 / (1.0 + 0.5 * dt * gam)
+        half_dt2 = 0.5 * dt * dt
+        # segment-local accumulators (kept in registers, written back after the segment)
+        acc_xr = 0.0
+        acc_f = 0.0
+        acc_win = 0.0
+        acc_in = 0.0
+        acc_damp = 0.0
+        acc_contact = 0.0
+        min_xr = per[track, PER_MIN_XR] if track >= 0 else 0.0
+        for i in range(n):
+            t_new = seg_t0[s] + (i + 1) * dt
+            xp_new = seg_x0[s] + vp * (t_new - seg_t0[s])
+            xr_old = x_r
+            F_old = F
+            # drift
+            x_r += dt * v_r + half_dt2 * a_r
+            if rigid:
+                for g in range(G):
+                    x_a[g] = xp_new
+            else:
+                for g in range(G):
+                    stretch_old[g] = x_p - x_a[g]
+                    x_a[g] += dt * v_a[g] + half_dt2 * (a_nd[g] - gam * v_a[g])
+            # contact forces, memory committed once per step
+            F = 0.0
+            for g in range(G):
+                u = x_a[g] - x_r
+                Tn = contact_update_row(params, state, g, u)
+                w = multiplicity[g] * 0.5 * (T[g] + Tn)
+                acc_contact += w * (u - u_old[g])
+                if rigid:
+                    acc_in += w * (xp_new - x_p)
+                T[g] = Tn
+                u_old[g] = u
+                F += multiplicity[g] * Tn
+            # kick
+            a_r_new = (F - load_stiffness * x_r) * inv_mr
+            v_r += 0.5 * dt * (a_r + a_r_new)
+            a_r = a_r_new
+            if not rigid:
+                for g in range(G):
+                    a_new = (actuator_stiffness * (xp_new - x_a[g]) - T[g]) * inv_ma
+                    v_old = v_a[g]
+                    v_a[g] = (v_old + 0.5 * dt * (a_nd[g] - gam * v_old + a_new)) * damp
+                    a_nd[g] = a_new
+                    acc_damp += multiplicity[g] * (v_old * v_old + v_a[g] * v_a[g])
+                    # work of the moving piezo base: k_p (x_p − x_a) dx_p, trapezoidal in (x_p − x_a)
+                    acc_in += multiplicity[g] * (stretch_old[g] + xp_new - x_a[g])
+            # per-period measures
+            acc_xr += xr_old + x_r
+            acc_f += F_old + F
+            if in_window:
+                acc_win += (xr_old - x_p) + (x_r - xp_new)
+            if x_r < min_xr:
+                min_xr = x_r
+            t = t_new
+            x_p = xp_new
+            # divergence (also catches NaN: comparisons with NaN are False)
+            ok = abs(x_r) < position_limit and abs(v_r) < velocity_limit
+            if not rigid:
+                for g in range(G):
+                    ok = ok and abs(x_a[g] - x_p) < position_limit and abs(v_a[g]) < velocity_limit
+            if not ok:
+                y[0] = x_r
+                y[1] = v_r
+                return STATUS_DIVERGED, steps + i + 1, n_rec
+            if t >= next_rec and n_rec < max_rec:
+                record[n_rec, 0] = t
+                record[n_rec, 1] = x_p
+                record[n_rec, 2] = x_r
+                record[n_rec, 3] = v_r
+                for g in range(G):
+                    record[n_rec, 4 + 3 * g] = x_a[g]
+                    record[n_rec, 5 + 3 * g] = T[g]
+                    record[n_rec, 6 + 3 * g] = contact_slip_share_row(params, state, g, x_a[g] - x_r)
+                n_rec += 1
+                while next_rec <= t:
+                    next_rec += record_interval
+        steps += n
+        per[k, PER_XR_INTEGRAL] += 0.5 * dt * acc_xr
+        per[k, PER_FRICTION_INTEGRAL] += 0.5 * dt * acc_f
+        per[k, PER_DURATION] += n * dt
+        if in_window:
+            per[k, PER_WINDOW_INTEGRAL] += 0.5 * dt * acc_win
+            per[k, PER_WINDOW_LENGTH] += n * dt
+        if track >= 0:
+            per[track, PER_MIN_XR] = min_xr
+        energy[EN_CONTACT] += acc_contact
+        if rigid:
+            energy[EN_INPUT] += acc_in
+        else:
+            energy[EN_INPUT] += actuator_stiffness * 0.5 * vp * dt * acc_in
+            energy[EN_DAMPING] += actuator_viscosity * 0.5 * dt * acc_damp
+        if in_window:
+            per[k, PER_WINDOW_END_XP] = seg_x1[s]
+    y[0] = x_r
+    y[1] = v_r
+    y[2 : 2 + G] = x_a
+    y[2 + G : 2 + 2 * G] = v_a
+    return STATUS_OK, steps, n_rec

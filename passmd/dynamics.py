@@ -1,0 +1,372 @@
+"""Hybrid dynamic simulation of the drive: runner, actuators and MDR contacts (Section 3).
+
+Macroscopic model (Eqs. 2–3), per contact group g with multiplicity n_g
+(one contact: one group, n = 1; six contacts: side 1 with n = 2 at F_N1, side 2 with
+n = 4 at F_N2, Eq. 1)::
+
+    m_r ẍ_r = −k x_r + Σ_g n_g T_g(u_g),        u_g = x_a,g − x_r
+    m_a ẍ_a,g = k_p (x_p − x_a,g) − c_p ẋ_a,g − T_g(u_g)      (flexible)
+    x_a,g = x_p(t)                                           (rigid)
+
+T_g is the MDR friction force of one contact of group g (Eqs. 4–6, :mod:`passmd.contact`)
+with memory. Sign convention: u = x_a − x_r; +T acts on the runner, −T on the actuator
+(the paper's Eq. 2 writes the same with F_f = T).
+
+Integrator (see :mod:`passmd._dynamics_kernel`): velocity Verlet with a trapezoidal
+damping term, uniform steps inside each linear piece of x_p(t). Why this scheme: the
+stiff mode (actuator on k_p plus the contact's 2aG*, ≈ 3 MHz) is lightly damped and
+oscillatory; an explicit symplectic scheme neither damps it artificially nor drifts in
+energy, costs one contact evaluation per step, and keeps the contact's memory update
+exactly once per step. The step follows from the parameters: a fixed number of steps per
+period of the stiffest mode (flexible) or of the runner-on-contacts mode (rigid), and a
+minimum number of steps on every waveform edge.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from passmd import _dynamics_kernel as kern
+from passmd._validation import check_choice, check_positive, check_range
+from passmd.contact import contact_arrays, contact_stiffness, stack_contacts
+from passmd.parameters import Drive
+from passmd.theory import contact_moduli, normal_forces
+from passmd.waveforms import Waveform
+
+#: Steps per period of the stiffest linearised mode (flexible actuators).
+STEPS_PER_STIFF_PERIOD = 24
+#: Steps per period of the runner-on-contacts mode (rigid actuators).
+STEPS_PER_RUNNER_PERIOD = 400
+#: Minimum number of steps on every linear piece of x_p(t) (resolves the fly-back).
+MIN_SEGMENT_STEPS = 40
+#: Verlet is stable for ω dt < 2; a user step must keep this margin below it.
+STABILITY_MARGIN = 0.9
+
+
+class SimulationError(RuntimeError):
+    """A simulation diverged or could not be carried out."""
+
+
+@dataclass(frozen=True)
+class StepPlan:
+    """How the integrator discretises time for one drive."""
+
+    max_step: float  # largest step (s)
+    stiffest_frequency: float  # frequency of the stiffest linearised mode (Hz)
+    stability_limit: float  # Verlet stability limit 2/ω of that mode (s)
+
+
+def contact_groups(drive: Drive, share_side_state: bool = True):
+    """Normal force and multiplicity of each contact group (Eq. 1).
+
+    With ``share_side_state=False`` the six contacts are six groups of one, so that
+    results do not rely on the by-symmetry sharing of one state per side.
+    """
+    forces = [float(f) for f in normal_forces(drive.preload, drive.contacts)]
+    if drive.contacts == 1:
+        return np.array(forces), np.array([1.0])
+    if share_side_state:
+        return np.array(forces), np.array([2.0, 4.0])
+    return np.array([forces[0]] * 2 + [forces[1]] * 4), np.ones(6)
+
+
+def step_plan(drive: Drive, contact_stiffness_max: float, total_contact_stiffness: float,
+              resolution: float = 1.0) -> StepPlan:
+    """Largest time step from the parameters (flexible: actuator mode; rigid: runner mode).
+
+    Parameters
+    ----------
+    drive : Drive
+        The drive.
+    contact_stiffness_max : float
+        Largest tangential stiffness 2aG* of one contact (N/m).
+    total_contact_stiffness : float
+        Σ n_g 2aG*_g over all contacts (N/m).
+    resolution : float
+        Refinement factor: the step is divided by it (convergence studies).
+    """
+    act = drive.actuator
+    if drive.actuator_model == "flexible":
+        omega = np.sqrt((act.stiffness + contact_stiffness_max) / act.mass)
+        dt = 2 * np.pi / omega / STEPS_PER_STIFF_PERIOD
+    else:
+        omega = np.sqrt((total_contact_stiffness + drive.effective_load_cell_stiffness) / drive.runner_mass)
+        dt = 2 * np.pi / omega / STEPS_PER_RUNNER_PERIOD
+    return StepPlan(dt / resolution, float(omega / (2 * np.pi)), float(2.0 / omega))
+
+
+@dataclass
+class SimulationResult:
+    """Time series (down-sampled) and per-period measures of one simulation, SI units.
+
+    Attributes
+    ----------
+    time, piezo_position, runner_position, runner_velocity : ndarray
+        Recorded samples (s, m, m, m/s).
+    actuator_position, friction_force, slip_share : ndarray, shape (groups, samples)
+        Hemisphere position (m), friction force of one contact (N, on the runner) and the
+        fraction of its MDR springs slipping, per contact group.
+    multiplicity : ndarray
+        Contacts per group.
+    settled_positions : ndarray, shape (periods,)
+        Runner position at the end of each stick phase, vibration averaged out over the
+        settle window (see :mod:`passmd.waveforms`).
+    back_steps : ndarray, shape (periods,)
+        Largest backward excursion of the runner after each slip edge, ≥ 0.
+    period_mean_position, period_mean_friction : ndarray, shape (periods,)
+        Means over each period of x_r and of the total friction force on the runner.
+    energy : dict
+        Work and energy terms of the balance (J); see :meth:`energy_balance`.
+    """
+
+    drive: Drive
+    waveform: Waveform
+    contact_model: str
+    time: np.ndarray
+    piezo_position: np.ndarray
+    runner_position: np.ndarray
+    runner_velocity: np.ndarray
+    actuator_position: np.ndarray
+    friction_force: np.ndarray
+    slip_share: np.ndarray
+    multiplicity: np.ndarray
+    settled_positions: np.ndarray
+    back_steps: np.ndarray
+    period_mean_position: np.ndarray
+    period_mean_friction: np.ndarray
+    energy: dict
+    steps: int
+    max_step: float
+    wall_time: float
+    final_state: np.ndarray = field(repr=False)
+
+    @property
+    def step_sizes(self) -> np.ndarray:
+        """Net runner step across each slip edge: settled position of period k+1 minus k (m)."""
+        return np.diff(self.settled_positions)
+
+    @property
+    def final_position(self) -> float:
+        """Settled runner position in the last period (m); with a saw-tooth it includes the ramp."""
+        return float(self.settled_positions[-1])
+
+    @property
+    def mean_velocity(self) -> float:
+        """Mean runner velocity over the run, from the settled positions of the first and last period (m/s)."""
+        n = self.settled_positions.size
+        if n < 2:
+            raise ValueError("mean_velocity needs a run of at least 2 periods")
+        return float((self.settled_positions[-1] - self.settled_positions[0]) / ((n - 1) * self.waveform.period))
+
+    @property
+    def generated_force(self) -> float:
+        """Force on the load cell k·x̄_r, x̄_r the runner's mean position over the last period (N)."""
+        return float(self.drive.effective_load_cell_stiffness * self.period_mean_position[-1])
+
+    def energy_balance(self) -> dict:
+        """Terms of the energy balance W_in = E_kin + E_el + W_contact + W_damp (J).
+
+        ``residual`` is W_in minus the right-hand side; ``relative_residual`` divides it by
+        the largest term. W_contact = Σ ∫T du is what the contacts stored plus dissipated.
+        """
+        y = self.final_state
+        G = self.multiplicity.size
+        d = self.drive
+        x_r, v_r, x_a, v_a = y[0], y[1], y[2 : 2 + G], y[2 + G :]
+        x_p = float(self.waveform.positions[-1])
+        kinetic = 0.5 * d.runner_mass * v_r**2
+        elastic = 0.5 * d.effective_load_cell_stiffness * x_r**2
+        if d.actuator_model == "flexible":
+            kinetic += float(np.sum(self.multiplicity * 0.5 * d.actuator.mass * v_a**2))
+            elastic += float(np.sum(self.multiplicity * 0.5 * d.actuator.stiffness * (x_p - x_a) ** 2))
+        terms = {
+            "input_work": self.energy["input"],
+            "kinetic": kinetic,
+            "elastic": elastic,
+            "contact_work": self.energy["contact"],
+            "damping": self.energy["damping"],
+        }
+        rhs = kinetic + elastic + terms["contact_work"] + terms["damping"]
+        terms["residual"] = terms["input_work"] - rhs
+        scale = max(abs(v) for v in terms.values())
+        terms["relative_residual"] = terms["residual"] / scale if scale > 0 else 0.0
+        return terms
+
+    def summary(self) -> dict:
+        """Measures in SI units, keys carrying the unit (JSON-ready)."""
+        out = {
+            "final_position_m": self.final_position,
+            "settled_positions_m": self.settled_positions.tolist(),
+            "step_sizes_m": self.step_sizes.tolist(),
+            "back_steps_m": self.back_steps.tolist(),
+            "periods": int(self.waveform.periods),
+            "frequency_Hz": float(self.waveform.frequency),
+            "amplitude_m": float(self.waveform.amplitude),
+            "integrator_steps": int(self.steps),
+            "max_time_step_s": float(self.max_step),
+        }
+        if self.settled_positions.size >= 2:
+            out["mean_velocity_m_per_s"] = self.mean_velocity
+        if self.drive.load_cell:
+            out["generated_force_N"] = self.generated_force
+        return out
+
+    def to_frame(self):
+        """Recorded time series as a pandas DataFrame (SI units, one column per group quantity)."""
+        import pandas as pd
+
+        data = {
+            "time_s": self.time,
+            "piezo_position_m": self.piezo_position,
+            "runner_position_m": self.runner_position,
+            "runner_velocity_m_per_s": self.runner_velocity,
+        }
+        for g in range(self.multiplicity.size):
+            data[f"actuator_position_{g}_m"] = self.actuator_position[g]
+            data[f"friction_force_{g}_N"] = self.friction_force[g]
+            data[f"slip_share_{g}"] = self.slip_share[g]
+        return pd.DataFrame(data)
+
+
+def _segments(waveform: Waveform, max_step: float):
+    t, x = waveform.times, waveform.positions
+    t0, t1, x0, x1 = t[:-1], t[1:], x[:-1], x[1:]
+    n = np.maximum(MIN_SEGMENT_STEPS, np.ceil((t1 - t0) / max_step)).astype(np.int64)
+    period = np.minimum((t0 / waveform.period + 1e-9).astype(np.int64), waveform.periods - 1)
+    starts = waveform.settle_windows[:, 0]
+    ends = waveform.settle_windows[:, 1]
+    window = np.zeros(t0.size, dtype=np.int64)
+    for ws, we in zip(starts, ends, strict=True):
+        window[(t0 >= ws) & (t1 <= we)] = 1
+    mark = np.isin(t0, waveform.slip_marks).astype(np.int64)
+    return t0, t1, x0, x1, n, period, window, mark
+
+
+def simulate(
+    drive: Drive,
+    waveform: Waveform,
+    *,
+    contact_model: str = "exact",
+    springs: int = 200,
+    dt: float | None = None,
+    resolution: float = 1.0,
+    max_points: int = 20000,
+    share_side_state: bool = True,
+) -> SimulationResult:
+    """Simulate the drive under a piezo waveform from rest with virgin contacts.
+
+    Parameters
+    ----------
+    drive : Drive
+        Drive configuration (contacts, rigid/flexible actuators, load cell, materials).
+    waveform : Waveform
+        Desired piezo position x_p(t) (:mod:`passmd.waveforms`).
+    contact_model : {"exact", "discrete"}
+        Exact continuum MDR contact (default) or ``springs`` discrete MDR springs.
+    springs : int
+        Number of MDR springs for the discrete model.
+    dt : float, optional
+        Largest time step in s; default from :func:`step_plan`. Must stay below the
+        Verlet stability limit of the stiffest mode.
+    resolution : float
+        Divides the default step (convergence studies); ignored when ``dt`` is given.
+    max_points : int
+        Number of recorded samples (evenly spaced in time).
+    share_side_state : bool
+        Six contacts: one state per side (default) or six independent contacts.
+
+    Raises
+    ------
+    ValueError
+        Bad input, or a ``dt`` the integrator cannot resolve.
+    SimulationError
+        The integration diverged (non-finite or runaway state).
+    """
+    if not isinstance(drive, Drive):
+        raise ValueError(f"drive = {drive!r} is not a Drive")
+    if not isinstance(waveform, Waveform):
+        raise ValueError(f"waveform = {waveform!r} is not a Waveform")
+    check_choice("contact_model", contact_model, ("exact", "discrete"))
+    check_range("resolution", resolution, 0.0, lower_open=True)
+    if int(max_points) != max_points or max_points < 2:
+        raise ValueError(f"max_points = {max_points!r} is out of range: must be an integer >= 2")
+
+    E_star, G_star = contact_moduli(drive)
+    forces, multiplicity = contact_groups(drive, share_side_state)
+    rows = [
+        contact_arrays(contact_model, F, drive.hemisphere_radius, E_star, G_star,
+                       drive.friction_coefficient, springs=springs if contact_model == "discrete" else None)
+        for F in forces
+    ]
+    params, state = stack_contacts(rows)
+    k_contacts = np.array([contact_stiffness(params[g]) for g in range(len(rows))])
+    plan = step_plan(drive, float(k_contacts.max()), float(np.sum(multiplicity * k_contacts)), resolution)
+    max_step = plan.max_step
+    if dt is not None:
+        check_positive("dt", dt, "s")
+        limit = STABILITY_MARGIN * plan.stability_limit
+        if dt > limit:
+            raise ValueError(
+                f"dt = {dt!r} is out of range: the stiffest mode ({plan.stiffest_frequency / 1e6:.3g} MHz) "
+                f"needs dt < {limit:.3g} s for the explicit integrator to stay stable"
+            )
+        max_step = float(dt)
+
+    G = multiplicity.size
+    y = np.zeros(2 + 2 * G)
+    record = np.empty((int(max_points), 4 + 3 * G))
+    per = np.zeros((waveform.periods, kern.PER_COLUMNS))
+    energy = np.zeros(kern.EN_COLUMNS)
+    segs = _segments(waveform, max_step)
+    record_interval = waveform.duration / (max_points - 1)
+    start = _time.perf_counter()
+    status, steps, n_rec = kern.integrate(
+        *segs,
+        drive.runner_mass, drive.effective_load_cell_stiffness, multiplicity.astype(float),
+        drive.actuator_model == "rigid", drive.actuator.mass, drive.actuator.stiffness,
+        drive.actuator.viscosity, params, state, y, record_interval, record, per, energy,
+        1.0, 100.0,
+    )
+    wall = _time.perf_counter() - start
+    if status != kern.STATUS_OK:
+        raise SimulationError(
+            f"simulation diverged at integrator step {steps} (t = {steps * max_step:.3g} s or earlier): "
+            f"runner position {y[0]!r} m, velocity {y[1]!r} m/s. Likely cause: a time step too large for "
+            f"the stiffest mode ({plan.stiffest_frequency:.3g} Hz, stable below {plan.stability_limit:.3g} s; "
+            f"step used {max_step:.3g} s) or non-physical parameters."
+        )
+    rec = record[:n_rec]
+    window_len = per[:, kern.PER_WINDOW_LENGTH]
+    if np.any(window_len <= 0):
+        raise SimulationError("a period has an empty settle window; the waveform's phase marks are inconsistent")
+    settled = per[:, kern.PER_WINDOW_INTEGRAL] / window_len + per[:, kern.PER_WINDOW_END_XP]
+    duration = per[:, kern.PER_DURATION]
+    return SimulationResult(
+        drive=drive,
+        waveform=waveform,
+        contact_model=contact_model,
+        time=rec[:, 0].copy(),
+        piezo_position=rec[:, 1].copy(),
+        runner_position=rec[:, 2].copy(),
+        runner_velocity=rec[:, 3].copy(),
+        actuator_position=rec[:, 4::3].T.copy(),
+        friction_force=rec[:, 5::3].T.copy(),
+        slip_share=rec[:, 6::3].T.copy(),
+        multiplicity=multiplicity,
+        settled_positions=settled,
+        back_steps=per[:, kern.PER_MARK_XR] - per[:, kern.PER_MIN_XR],
+        period_mean_position=per[:, kern.PER_XR_INTEGRAL] / duration,
+        period_mean_friction=per[:, kern.PER_FRICTION_INTEGRAL] / duration,
+        energy={
+            "input": float(energy[kern.EN_INPUT]),
+            "damping": float(energy[kern.EN_DAMPING]),
+            "contact": float(energy[kern.EN_CONTACT]),
+        },
+        steps=int(steps),
+        max_step=float(max_step),
+        wall_time=wall,
+        final_state=y.copy(),
+    )

@@ -1,0 +1,154 @@
+"""Physics and numerics of the hybrid simulator (passmd.dynamics).
+
+Runs are kept short (1 kHz drive, few periods) so the whole file takes seconds; the
+physics checked does not depend on the drive frequency being the paper's.
+"""
+
+import numpy as np
+import pytest
+
+from passmd import dynamics, theory, waveforms
+from passmd.parameters import Drive
+
+F_TEST = 1000.0  # Hz: 1 ms periods keep tests fast; the runner mode (~5-11 kHz) settles within
+
+
+def one_contact(model="rigid", **kw):
+    return Drive(contacts=1, actuator_model=model, **kw)
+
+
+def presliding(drive):
+    return theory.drive_theory(drive)["presliding_m"][0]
+
+
+def run(drive, amplitude, periods=4, frequency=F_TEST, **kw):
+    wf = waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
+    return dynamics.simulate(drive, wf, **kw)
+
+
+def test_rigid_one_contact_no_step_below_presliding():
+    d = one_contact()
+    res = run(d, 0.5 * presliding(d))
+    # micro-slip only, no net step: what remains is the settled position's averaging error
+    # over the runner's undamped micro-vibration (≈ 0.1 nm here); 2 % of u_x,max (0.8 nm) is
+    # far below a step that full sliding makes (≥ 0.5 u_x,max, next test)
+    assert np.max(np.abs(res.step_sizes)) < 0.02 * presliding(d)
+
+
+def test_rigid_one_contact_step_grows_one_for_one_above_presliding():
+    d = one_contact()
+    u = presliding(d)
+    s3 = run(d, 3 * u).step_sizes[-1]
+    s4 = run(d, 4 * u).step_sizes[-1]
+    assert s3 > 0.5 * u
+    # steady step = A − (a constant set by the contact): slope 1 within 2 % (micro-vibration phase)
+    assert (s4 - s3) / u == pytest.approx(1.0, rel=0.02)
+
+
+@pytest.mark.parametrize("model", ["rigid", "flexible"])
+def test_mirrored_waveform_mirrors_motion(model):
+    d = one_contact(model)
+    wf = waveforms.sawtooth(3 * presliding(d), F_TEST, d, periods=3)
+    fwd = dynamics.simulate(d, wf)
+    back = dynamics.simulate(d, wf.mirrored())
+    # the exact contact is odd in u, so the mirrored run is the negated run up to rounding
+    np.testing.assert_allclose(back.settled_positions, -fwd.settled_positions, rtol=1e-9, atol=1e-18)
+
+
+def test_six_contacts_do_not_rely_on_shared_side_state():
+    d = Drive(actuator_model="flexible")
+    wf = waveforms.sawtooth(120e-9, F_TEST, d, periods=3)
+    shared = dynamics.simulate(d, wf)
+    separate = dynamics.simulate(d, wf, share_side_state=False)
+    # same physics, six states instead of two: only summation order differs
+    np.testing.assert_allclose(separate.settled_positions, shared.settled_positions, rtol=1e-9, atol=1e-15)
+
+
+def _dominant_frequency(t, x):
+    x = x - x.mean()
+    crossings = np.flatnonzero(np.diff(np.signbit(x)))
+    # linear interpolation of the crossing times
+    tc = t[crossings] - x[crossings] * (t[crossings + 1] - t[crossings]) / (x[crossings + 1] - x[crossings])
+    return 0.5 / np.mean(np.diff(tc))
+
+
+def test_linear_limit_rigid_runner_frequency():
+    """μ → large: no slip; after the fly-back the runner rings at √(2aG*/m_r)/2π."""
+    d = one_contact(friction_coefficient=1e4)
+    res = run(d, 20e-9, periods=1, frequency=200.0, max_points=200001)
+    t, x = res.time, res.runner_position - res.piezo_position
+    sel = (t > 0.5 * res.waveform.period) & (t < 0.95 * res.waveform.period)  # ramp, before the fly-back
+    f = _dominant_frequency(t[sel], x[sel])
+    assert f == pytest.approx(theory.runner_frequency(d), rel=0.01)  # Cattaneo-Mindlin slope at |u| << u_max
+
+
+def test_linear_limit_flexible_two_mass_oscillator():
+    """μ → large, flexible actuator: the slow mode of the 2-DOF system (m_r on k_c, k_c in series
+    with the actuator k_p and m_a) from the eigenvalues of the linear system."""
+    d = one_contact("flexible", friction_coefficient=1e4)
+    res = run(d, 20e-9, periods=1, frequency=200.0, max_points=200001)
+    k_c = theory.drive_theory(d)["tangential_stiffness_N_per_m"][0]
+    a = d.actuator
+    M = np.diag([d.runner_mass, a.mass])
+    K = np.array([[k_c, -k_c], [-k_c, k_c + a.stiffness]])
+    w2 = np.sort(np.linalg.eigvals(np.linalg.solve(M, K)).real)
+    f_slow = np.sqrt(w2[0]) / (2 * np.pi)
+    t, x = res.time, res.runner_position - res.piezo_position
+    sel = (t > 0.5 * res.waveform.period) & (t < 0.95 * res.waveform.period)
+    assert _dominant_frequency(t[sel], x[sel]) == pytest.approx(f_slow, rel=0.01)
+
+
+@pytest.mark.parametrize("model", ["rigid", "flexible"])
+def test_time_step_convergence(model):
+    """Halving the step changes the 3-period step size by < 0.5 % (issue 4, trust (a))."""
+    d = Drive(contacts=1, actuator_model=model)
+    wf = waveforms.sawtooth(120e-9, F_TEST, d, periods=3)
+    coarse = dynamics.simulate(d, wf).final_position
+    fine = dynamics.simulate(d, wf, resolution=2.0).final_position
+    assert abs(fine - coarse) < 0.005 * abs(fine)
+
+
+@pytest.mark.parametrize("model,contact", [("rigid", "exact"), ("flexible", "exact"), ("flexible", "discrete")])
+def test_energy_balance(model, contact):
+    """W_in = E_kin + E_el + Σ∫T du + W_damp; the residual is the integrator's O(dt²) error."""
+    d = Drive(actuator_model=model)
+    wf = waveforms.sawtooth(120e-9, F_TEST, d, periods=2)
+    res = dynamics.simulate(d, wf, contact_model=contact, springs=200)
+    bal = res.energy_balance()
+    assert bal["input_work"] > 0 and bal["contact_work"] > 0
+    assert abs(bal["relative_residual"]) < 1e-3
+
+
+def test_divergence_is_reported(monkeypatch):
+    d = one_contact("flexible")
+    wf = waveforms.sawtooth(100e-9, F_TEST, d, periods=1)
+    plan_dt = dynamics.step_plan(d, 3e6, 3e6).stability_limit
+    monkeypatch.setattr(dynamics, "STABILITY_MARGIN", 100.0)  # let an unstable step through
+    with pytest.raises(dynamics.SimulationError, match=r"diverged at integrator step \d+.*time step"):
+        dynamics.simulate(d, wf, dt=5 * plan_dt)
+
+
+def test_bad_inputs():
+    d = one_contact()
+    with pytest.raises(ValueError, match=r"^amplitude = -1e-08 is out of range"):
+        waveforms.sawtooth(-10e-9, F_TEST, d)
+    with pytest.raises(ValueError, match=r"^frequency = -5.0 is out of range"):
+        waveforms.sawtooth(10e-9, -5.0, d)
+    with pytest.raises(ValueError, match=r"monotone in time"):
+        waveforms.piecewise_linear([0, 6e-4, 4e-4, 1e-3], [0, 1e-8, 2e-8, 0], F_TEST, 1, (1e-4, 2e-4), 6e-4)
+    wf = waveforms.sawtooth(10e-9, F_TEST, d)
+    with pytest.raises(ValueError, match=r"^dt = 1e-05 is out of range: .*stable"):
+        dynamics.simulate(one_contact("flexible"), wf, dt=1e-5)
+    with pytest.raises(ValueError, match=r"^contact_model = 'soft'"):
+        dynamics.simulate(d, wf, contact_model="soft")
+    with pytest.raises(ValueError, match=r"^frequency = 400000.0 is out of range"):
+        waveforms.sawtooth(202e-9, 4e5, Drive())
+
+
+def test_summary_keys_and_units():
+    d = Drive(load_cell=True)
+    res = run(d, 150e-9, periods=3)
+    s = res.summary()
+    assert {"final_position_m", "step_sizes_m", "mean_velocity_m_per_s", "generated_force_N"} <= set(s)
+    assert len(s["step_sizes_m"]) == 2
+    assert s["generated_force_N"] == pytest.approx(2.5e4 * res.period_mean_position[-1], rel=1e-12)
