@@ -56,7 +56,10 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, default=Path(__file__).parent / "results" / "dynamics.json")
     args = ap.parse_args(argv)
     rows = [bench(c, m, k, args.repeats) for c, m, k in CONFIGS]
-    header = f"{'contacts':>8} {'actuator':>9} {'contact':>16} {'steps':>9} {'dt/ns':>7} {'ns/step':>8} {'ms/period':>10}"
+    header = (
+        f"{'contacts':>8} {'actuator':>9} {'contact':>16} {'steps':>9} {'dt/ns':>7} "
+        f"{'ns/step':>8} {'ms/period':>10}"
+    )
     print(header)
     for r in rows:
         print(
@@ -64,8 +67,11 @@ def main(argv=None) -> int:
             f"{r['max_step_ns']:>7.2f} {r['ns_per_step']:>8.1f} {r['ms_per_100Hz_period']:>10.2f}"
         )
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    meta = {"machine": platform.processor() or platform.machine(), "python": platform.python_version(),
-            "repeats": args.repeats}
+    meta = {
+        "machine": platform.processor() or platform.machine(),
+        "python": platform.python_version(),
+        "repeats": args.repeats,
+    }
     args.out.write_text(json.dumps({"meta": meta, "rows": rows}, indent=2))
     print(f"written {args.out}")
     return 0

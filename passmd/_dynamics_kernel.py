@@ -41,9 +41,29 @@ STATUS_DIVERGED = 1
 
 @njit(cache=True, error_model="numpy")
 def integrate(
-    seg_t0, seg_t1, seg_x0, seg_x1, seg_n, seg_period, seg_window, seg_mark,
-    runner_mass, load_stiffness, multiplicity, rigid, actuator_mass, actuator_stiffness,
-    actuator_viscosity, params, state, y, record_interval, record, per, energy, position_limit,
+    seg_t0,
+    seg_t1,
+    seg_x0,
+    seg_x1,
+    seg_n,
+    seg_period,
+    seg_window,
+    seg_mark,
+    runner_mass,
+    load_stiffness,
+    multiplicity,
+    rigid,
+    actuator_mass,
+    actuator_stiffness,
+    actuator_viscosity,
+    params,
+    state,
+    y,
+    record_interval,
+    record,
+    per,
+    energy,
+    position_limit,
     velocity_limit,
 ):
     """Integrate over all segments; returns (status, steps done, rows recorded).

@@ -73,8 +73,9 @@ def contact_groups(drive: Drive, share_side_state: bool = True):
     return np.array([forces[0]] * 2 + [forces[1]] * 4), np.ones(6)
 
 
-def step_plan(drive: Drive, contact_stiffness_max: float, total_contact_stiffness: float,
-              resolution: float = 1.0) -> StepPlan:
+def step_plan(
+    drive: Drive, contact_stiffness_max: float, total_contact_stiffness: float, resolution: float = 1.0
+) -> StepPlan:
     """Largest time step from the parameters (flexible: actuator mode; rigid: runner mode).
 
     Parameters
@@ -155,11 +156,13 @@ class SimulationResult:
 
     @property
     def mean_velocity(self) -> float:
-        """Mean runner velocity over the run, from the settled positions of the first and last period (m/s)."""
+        """Mean runner velocity from the settled positions of the first and last period (m/s)."""
         n = self.settled_positions.size
         if n < 2:
             raise ValueError("mean_velocity needs a run of at least 2 periods")
-        return float((self.settled_positions[-1] - self.settled_positions[0]) / ((n - 1) * self.waveform.period))
+        return float(
+            (self.settled_positions[-1] - self.settled_positions[0]) / ((n - 1) * self.waveform.period)
+        )
 
     @property
     def generated_force(self) -> float:
@@ -297,8 +300,15 @@ def simulate(
     E_star, G_star = contact_moduli(drive)
     forces, multiplicity = contact_groups(drive, share_side_state)
     rows = [
-        contact_arrays(contact_model, F, drive.hemisphere_radius, E_star, G_star,
-                       drive.friction_coefficient, springs=springs if contact_model == "discrete" else None)
+        contact_arrays(
+            contact_model,
+            F,
+            drive.hemisphere_radius,
+            E_star,
+            G_star,
+            drive.friction_coefficient,
+            springs=springs if contact_model == "discrete" else None,
+        )
         for F in forces
     ]
     params, state = stack_contacts(rows)
@@ -325,23 +335,38 @@ def simulate(
     start = _time.perf_counter()
     status, steps, n_rec = kern.integrate(
         *segs,
-        drive.runner_mass, drive.effective_load_cell_stiffness, multiplicity.astype(float),
-        drive.actuator_model == "rigid", drive.actuator.mass, drive.actuator.stiffness,
-        drive.actuator.viscosity, params, state, y, record_interval, record, per, energy,
-        1.0, 100.0,
+        drive.runner_mass,
+        drive.effective_load_cell_stiffness,
+        multiplicity.astype(float),
+        drive.actuator_model == "rigid",
+        drive.actuator.mass,
+        drive.actuator.stiffness,
+        drive.actuator.viscosity,
+        params,
+        state,
+        y,
+        record_interval,
+        record,
+        per,
+        energy,
+        1.0,
+        100.0,
     )
     wall = _time.perf_counter() - start
     if status != kern.STATUS_OK:
         raise SimulationError(
             f"simulation diverged at integrator step {steps} (t = {steps * max_step:.3g} s or earlier): "
             f"runner position {y[0]!r} m, velocity {y[1]!r} m/s. Likely cause: a time step too large for "
-            f"the stiffest mode ({plan.stiffest_frequency:.3g} Hz, stable below {plan.stability_limit:.3g} s; "
+            f"the stiffest mode ({plan.stiffest_frequency:.3g} Hz, stable below "
+            f"{plan.stability_limit:.3g} s; "
             f"step used {max_step:.3g} s) or non-physical parameters."
         )
     rec = record[:n_rec]
     window_len = per[:, kern.PER_WINDOW_LENGTH]
     if np.any(window_len <= 0):
-        raise SimulationError("a period has an empty settle window; the waveform's phase marks are inconsistent")
+        raise SimulationError(
+            "a period has an empty settle window; the waveform's phase marks are inconsistent"
+        )
     settled = per[:, kern.PER_WINDOW_INTEGRAL] / window_len + per[:, kern.PER_WINDOW_END_XP]
     duration = per[:, kern.PER_DURATION]
     return SimulationResult(

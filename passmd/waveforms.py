@@ -145,8 +145,14 @@ class Waveform:
     def mirrored(self) -> Waveform:
         """The same waveform with x_p → −x_p (drives the runner the other way)."""
         return Waveform(
-            self.times, -self.positions, self.period, self.periods, self.settle_windows,
-            self.slip_marks, self.kind, self.amplitude,
+            self.times,
+            -self.positions,
+            self.period,
+            self.periods,
+            self.settle_windows,
+            self.slip_marks,
+            self.kind,
+            self.amplitude,
         )
 
 
@@ -223,8 +229,14 @@ def sawtooth(
         windows.append((ws, we))
         marks.append(we)
     return Waveform(
-        np.array(times), np.array(positions), T, periods, np.array(windows), np.array(marks),
-        "sawtooth", A,
+        np.array(times),
+        np.array(positions),
+        T,
+        periods,
+        np.array(windows),
+        np.array(marks),
+        "sawtooth",
+        A,
     )
 
 

@@ -108,7 +108,9 @@ def test_time_step_convergence(model):
     assert abs(fine - coarse) < 0.005 * abs(fine)
 
 
-@pytest.mark.parametrize("model,contact", [("rigid", "exact"), ("flexible", "exact"), ("flexible", "discrete")])
+@pytest.mark.parametrize(
+    "model,contact", [("rigid", "exact"), ("flexible", "exact"), ("flexible", "discrete")]
+)
 def test_energy_balance(model, contact):
     """W_in = E_kin + E_el + Σ∫T du + W_damp; the residual is the integrator's O(dt²) error."""
     d = Drive(actuator_model=model)
