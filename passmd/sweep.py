@@ -42,6 +42,9 @@ __all__ = ["EXECUTORS", "drive_theory_point", "grid", "progress_enabled", "run",
 
 #: Names accepted by ``run(executor=...)``.
 EXECUTORS = ("process", "serial", "dask")
+#: Environment variables giving defaults to arguments a caller leaves at ``None``
+#: (so the book build and ``passmd figure`` can send every sweep to a Dask cluster).
+EXECUTOR_ENV, SCHEDULER_ENV, WORKERS_ENV = "PASSMD_EXECUTOR", "PASSMD_SCHEDULER", "PASSMD_WORKERS"
 
 
 def grid(**axes) -> list[dict]:
@@ -277,11 +280,25 @@ def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> No
             cluster.close()
 
 
+def _resolve(executor, scheduler, workers):
+    """Fill arguments left at None from the environment (explicit arguments win)."""
+    if scheduler is None and executor in (None, "dask"):
+        scheduler = os.environ.get(SCHEDULER_ENV) or None
+    if executor is None:
+        executor = os.environ.get(EXECUTOR_ENV) or ("dask" if scheduler else "process")
+    if workers is None and os.environ.get(WORKERS_ENV):
+        text = os.environ[WORKERS_ENV]
+        if not text.strip().isdigit():
+            raise ValueError(f"{WORKERS_ENV} = {text!r} is not allowed: must be an integer >= 1")
+        workers = int(text)
+    return executor, scheduler, workers
+
+
 def run(
     func: Callable[..., Mapping],
     points: Sequence[Mapping],
     *,
-    executor: str | cf.Executor = "process",
+    executor: str | cf.Executor | None = None,
     scheduler: str | None = None,
     workers: int | None = None,
     cache: bool | Cache | str | os.PathLike = True,
@@ -298,13 +315,16 @@ def run(
         carrying the unit). It must be deterministic: its results are cached.
     points : list of dict
         The grid (see :func:`grid`); each dict is one evaluation's keyword arguments.
-    executor : {"process", "serial", "dask"} or concurrent.futures.Executor
+    executor : {"process", "serial", "dask"} or concurrent.futures.Executor, optional
         Where to run. ``"dask"`` connects to ``scheduler`` or starts a local cluster.
-        A ``scheduler`` address implies ``"dask"``.
+        Default: ``$PASSMD_EXECUTOR``, else ``"dask"`` if a scheduler is known, else
+        ``"process"``.
     scheduler : str, optional
-        Dask scheduler address, e.g. ``"tcp://10.0.0.5:8786"``.
+        Dask scheduler address, e.g. ``"tcp://10.0.0.5:8786"`` (implies ``"dask"``).
+        Default: ``$PASSMD_SCHEDULER`` unless another executor was asked for.
     workers : int, optional
-        Worker processes for ``"process"`` and a local Dask cluster; default all cores.
+        Worker processes for ``"process"`` and a local Dask cluster; default
+        ``$PASSMD_WORKERS``, else all cores.
     cache : bool, Cache or path
         ``True`` (default): the default :class:`~passmd.cache.Cache`; ``False``: no
         caching; a :class:`~passmd.cache.Cache` or a directory to use that one.
@@ -329,8 +349,7 @@ def run(
         The first exception a point raised (with a note naming the point), after the
         points still running finished and were cached.
     """
-    if scheduler is not None and executor == "process":
-        executor = "dask"
+    executor, scheduler, workers = _resolve(executor, scheduler, workers)
     if not isinstance(executor, cf.Executor):
         check_choice("executor", executor, EXECUTORS)
     if not callable(func):

@@ -105,6 +105,16 @@ def test_dask_local_cluster_identical_to_serial(serial_theory):
     pd.testing.assert_frame_equal(frame, serial_theory, check_exact=True)
 
 
+def test_dask_scheduler_address(serial_theory):
+    """An existing cluster reached by its address (threads-only cluster: light on 2 cores)."""
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None) as cluster:
+        frame = sweep.run(sweep.drive_theory_point, THEORY_GRID, scheduler=cluster.scheduler_address,
+                          cache=False)
+    pd.testing.assert_frame_equal(frame, serial_theory, check_exact=True)
+
+
 def test_caller_owned_executor(serial_theory):
     with cf.ThreadPoolExecutor(max_workers=2) as pool:
         frame = sweep.run(sweep.drive_theory_point, THEORY_GRID, executor=pool, cache=False)
@@ -193,6 +203,26 @@ def test_bad_arguments(store):
         sweep.run(not_a_dict, points, executor="serial", cache=store)
     with pytest.raises(ValueError, match="clash with parameter names"):
         sweep.run(clashing, points, executor="serial", cache=False)
+
+
+def test_environment_defaults(monkeypatch):
+    """PASSMD_EXECUTOR / PASSMD_WORKERS / PASSMD_SCHEDULER fill arguments left at None."""
+    double = lambda x: {"y": 2 * x}  # noqa: E731 - not picklable: only the serial executor can run it
+    monkeypatch.setenv("PASSMD_EXECUTOR", "serial")
+    assert sweep.run(double, [{"x": 1}, {"x": 2}], cache=False)["y"].tolist() == [2, 4]
+    monkeypatch.setenv("PASSMD_EXECUTOR", "threads")
+    with pytest.raises(ValueError, match="executor = 'threads' is not allowed"):
+        sweep.run(double, [{"x": 1}], cache=False)
+    monkeypatch.delenv("PASSMD_EXECUTOR")
+    monkeypatch.setenv("PASSMD_WORKERS", "two")
+    with pytest.raises(ValueError, match="PASSMD_WORKERS = 'two' is not allowed"):
+        sweep.run(double, [{"x": 1}], cache=False)
+    monkeypatch.delenv("PASSMD_WORKERS")
+    monkeypatch.setenv("PASSMD_SCHEDULER", "tcp://127.0.0.1:1")
+    # an explicit executor wins over the environment's scheduler
+    assert sweep.run(double, [{"x": 3}], executor="serial", cache=False)["y"].tolist() == [6]
+    with pytest.raises(ValueError, match="needs executor='dask'"):
+        sweep.run(fail_at, [{"x": 1, "bad": 0}], executor="process", scheduler="tcp://127.0.0.1:1")
 
 
 def test_lambda_runs_serially_without_cache():
