@@ -1,0 +1,427 @@
+"""The ledger: claims schema, every check kind on synthetic data, verdicts, registries, regressions.
+
+The checks compare numbers exactly against their tolerances, so synthetic data sit clearly
+inside or outside a tolerance (never within rounding of it).
+"""
+
+import csv
+import math
+import os
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from passmd import ledger, reference
+
+PAPER = Path(os.environ.get("PASSMD_PAPER", "/work/shared/paper/nguyen2018-passmd.md"))
+
+#: Claims the issue requires as a minimum (issue 6, "What to build" 1).
+REQUIRED_CLAIMS = (
+    "fig5a-no-step-below-50nm", "fig5b-rigid-ac-matches-eq7", "fig5b-flexible-ac-matches-eq8",
+    "fig6a-rigid-ac-matches-eq11", "fig6a-rigid-ac-not-eq10", "fig6b-flexible-r1-ac-matches-eq12",
+    "fig6c-flexible-r025-ac-matches-eq12", "fig7a-force-difference-115mn", "fig9a-standard-position-552nm",
+    "fig9a-optimized-position-716nm", "fig9a-step-increase-46.8pct", "fig9b-optimized-faster-below-110khz",
+    "fig9b-max-gain-2.5mm_s", "fig10a-max-velocity-19mm_s", "fig10a-1n-slower",
+    "fig10a-0.1n-stick-lost-above-80khz", "fig10b-r1-faster", "fig10c-youngs-modulus-negligible",
+    "abstract-velocity-gain-15pct",
+)
+
+
+# --------------------------------------------------------------------------------------
+# helpers: a synthetic claims file and a private registry
+# --------------------------------------------------------------------------------------
+
+def _claim(**fields):
+    row = dict.fromkeys(ledger.CLAIM_COLUMNS, "")
+    row.update(figure="x", requires="fig5a", quantity="q", ours_definition="d", source_section="4",
+               source_quote="quote", tolerance_reason="because")
+    row.update(fields)
+    return row
+
+
+def _write(tmp_path, rows, columns=ledger.CLAIM_COLUMNS):
+    path = tmp_path / "claims.csv"
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        writer = csv.DictWriter(fh, fieldnames=list(columns), extrasaction="ignore")
+        writer.writeheader()
+        writer.writerows(rows)
+    return path
+
+
+@pytest.fixture
+def registry(monkeypatch):
+    """Empty extractor and figure registries for the test (the real ones are restored after)."""
+    extractors, figures = {}, {}
+    monkeypatch.setattr(ledger, "_EXTRACTORS", extractors)
+    monkeypatch.setattr(ledger, "_FIGURES", figures)
+    return extractors, figures
+
+
+SYNTHETIC = [
+    _claim(id="val", check="value", paper_value="100", unit="nm", tolerance="0.05", tolerance_kind="rel"),
+    _claim(id="ord", check="ordering", relation=">", unit="mm/s"),
+    _claim(id="thr", check="threshold", relation="switch_below", paper_value="50", unit="nm",
+           tolerance="5", tolerance_kind="abs"),
+    _claim(id="trd", check="trend", relation="increasing", tolerance="0.05", tolerance_kind="rel"),
+    _claim(id="other", check="value", paper_value="1", tolerance="0.1", tolerance_kind="rel",
+           requires="fig9b"),
+]
+
+
+def _register_good(values=None):
+    values = {"val": 103.0, **(values or {})}
+    ledger.register_extractor("val")(lambda results: values["val"])
+    ledger.register_extractor("ord")(lambda results: {"lhs": 2.0, "rhs": 1.0})
+    ledger.register_extractor("thr")(
+        lambda results: {"x": np.arange(0, 100, 10.0), "holds": np.arange(0, 100, 10.0) < 50})
+    ledger.register_extractor("trd")(lambda results: {"x": [1, 2, 3], "y": [1.0, 2.0, 3.0]})
+    ledger.register_extractor("other")(lambda results: 1.0)
+
+
+# --------------------------------------------------------------------------------------
+# claims.csv
+# --------------------------------------------------------------------------------------
+
+def test_real_claims_load_and_contain_the_required_rows():
+    claims = ledger.load_claims()
+    assert claims["id"].is_unique
+    missing = set(REQUIRED_CLAIMS) - set(claims["id"])
+    assert not missing
+    assert set(claims["check"]) == set(ledger.CHECK_KINDS)  # every kind is used
+    # No paper value typed for a curve claim; tolerances stated with a reason everywhere.
+    curve = claims[claims["reference"] != ""]
+    assert (curve["paper_value"] == "").all() and len(curve) == 5
+    assert (claims["tolerance_reason"].str.len() > 10).all()
+
+
+def test_stated_numbers_of_the_issue():
+    """The numbers the paper states, as issue 6 lists them (a typo here would move a claim)."""
+    claims = ledger.load_claims().set_index("id")
+    stated = {
+        "fig5a-no-step-below-50nm": 50, "fig7a-force-difference-115mn": 115,
+        "fig9a-standard-position-552nm": 552, "fig9a-optimized-position-716nm": 716,
+        "fig9a-step-increase-46.8pct": 46.8, "fig9b-optimized-faster-below-110khz": 110,
+        "fig9b-max-gain-2.5mm_s": 2.5, "fig10a-max-velocity-19mm_s": 19,
+        "fig10a-0.1n-stick-lost-above-80khz": 80, "abstract-velocity-gain-15pct": 15,
+    }
+    for claim, value in stated.items():
+        assert claims.at[claim, "paper_value_num"] == value, claim
+
+
+@pytest.mark.skipif(not PAPER.is_file(), reason=f"paper text not available at {PAPER}")
+def test_every_quote_is_in_the_paper():
+    """Quotes are verbatim up to notation: compare letters and digits only (the paper's LaTeX
+    '$u_{x,max,e}^{*}$' and our 'u*_x,max,e' both reduce to 'uxmaxe')."""
+    def letters(text):
+        return re.sub(r"[^0-9a-z]", "", text.lower())
+
+    paper = letters(PAPER.read_text(encoding="utf-8"))
+    claims = ledger.load_claims()
+    absent = [c for c, q in zip(claims["id"], claims["source_quote"], strict=True) if letters(q) not in paper]
+    assert not absent
+
+
+def test_schema_errors_name_the_row_and_the_problem(tmp_path):
+    rows = [
+        _claim(id="bad-kind", check="guess"),
+        _claim(id="dup", check="ordering", relation="<"),
+        _claim(id="dup", check="ordering", relation="<"),
+        _claim(id="no-value", check="value", tolerance="0.1", tolerance_kind="rel"),
+        _claim(id="no-kind", check="trend", relation="increasing", tolerance="0.1"),
+        _claim(id="bad-rel", check="ordering", relation="=="),
+        _claim(id="flag", check="ordering", relation="<", expected_to_differ="yes"),
+        _claim(id="ref", check="value", reference="fig5b_closed_form.csv:nope", tolerance="0.1",
+               tolerance_kind="rel"),
+        _claim(id="cfg", check="ordering", relation="<", preload_N="0.4 N", actuator_model="stiff"),
+        _claim(id="Upper", check="ordering", relation="<", requires="figure5"),
+        _claim(id="quote", check="ordering", relation="<", source_quote=""),
+    ]
+    path = _write(tmp_path, rows)
+    # reference curves are looked up next to the claims file
+    (tmp_path / "fig5b_closed_form.csv").write_text("preload_N,u_x_max_nm\n0.1,1\n")
+    with pytest.raises(ValueError) as info:
+        ledger.load_claims(path)
+    message = str(info.value)
+    for expected in (
+        "row 'bad-kind': check = 'guess' is not allowed",
+        "id 'dup' appears more than once",
+        "row 'no-value': a value claim needs exactly one of paper_value and reference",
+        "row 'no-kind': tolerance_kind = '' is not allowed",
+        "row 'bad-rel': relation = '==' is not allowed",
+        "row 'flag': expected_difference_reason is empty",
+        "row 'ref': reference column 'nope' is not in fig5b_closed_form.csv",
+        "row 'cfg': preload_N = '0.4 N' is not allowed",
+        "row 'cfg': actuator_model = 'stiff' is not allowed",
+        "row 'Upper': id = 'Upper' is not allowed",
+        "row 'Upper': requires = 'figure5' is not allowed",
+        "row 'quote': source_quote is empty",
+    ):
+        assert expected in message
+
+
+def test_missing_columns_and_file(tmp_path):
+    path = _write(tmp_path, [_claim(id="a", check="ordering", relation="<")],
+                  columns=[c for c in ledger.CLAIM_COLUMNS if c != "source_quote"])
+    with pytest.raises(ValueError, match="missing required columns: source_quote"):
+        ledger.load_claims(path)
+    with pytest.raises(FileNotFoundError):
+        ledger.load_claims(tmp_path / "none.csv")
+
+
+# --------------------------------------------------------------------------------------
+# check kinds
+# --------------------------------------------------------------------------------------
+
+def test_value_check_scalar_relative_and_absolute():
+    inside = ledger.check_value(103.0, 100.0, 0.05, "rel")
+    assert inside.passed and inside.abs_deviation == pytest.approx(3.0)
+    assert inside.rel_deviation == pytest.approx(0.03)
+    outside = ledger.check_value(107.0, 100.0, 0.05, "rel")
+    assert not outside.passed and "7 % exceeds the tolerance 5 %" in outside.detail
+    assert ledger.check_value(104.0, 110.0, 5.0, "abs").rel_deviation == pytest.approx(6 / 110)
+    assert not ledger.check_value(104.0, 110.0, 5.0, "abs").passed
+    assert ledger.check_value(106.0, 110.0, 5.0, "abs").passed
+    with pytest.raises(ValueError, match="must be a number"):
+        ledger.check_value([1.0, 2.0], 1.0, 0.1)
+    with pytest.raises(ValueError, match="non-finite"):
+        ledger.check_value(math.nan, 1.0, 0.1)
+
+
+def test_value_check_curve_interpolates_the_reference():
+    curve = (np.array([0.1, 0.2, 0.3]), np.array([10.0, 20.0, 40.0]))
+    # At x = 0.25 the reference is 30 (linear); 31 is 3.3 % off.
+    result = ledger.check_value({"x": [0.1, 0.25], "y": [10.0, 31.0]}, None, 0.05, "rel", curve)
+    assert result.passed and result.rel_deviation == pytest.approx(1 / 30)
+    failing = ledger.check_value({"x": [0.1, 0.25], "y": [10.0, 33.0]}, None, 0.05, "rel", curve)
+    assert not failing.passed and "at x = 0.25" in failing.detail
+    with pytest.raises(ValueError, match="outside the reference curve's range"):
+        ledger.check_value({"x": [0.5], "y": [1.0]}, None, 0.05, "rel", curve)
+    with pytest.raises(ValueError, match="differ in length"):
+        ledger.check_value({"x": [0.1, 0.2], "y": [1.0]}, None, 0.05, "rel", curve)
+
+
+def test_ordering_check():
+    assert ledger.check_ordering({"lhs": 1.0, "rhs": 2.0}, "<").passed
+    assert not ledger.check_ordering({"lhs": 2.0, "rhs": 2.0}, "<").passed  # strict without a margin
+    assert ledger.check_ordering({"lhs": 3.0, "rhs": 2.0}, ">").passed
+    arrays = ledger.check_ordering({"lhs": [3.0, 1.0, 5.0], "rhs": [2.0, 2.0, 2.0]}, ">")
+    assert not arrays.passed and arrays.ours == "2 of 3 hold" and "fails at 1 of 3" in arrays.detail
+    # a relative margin: lhs must exceed rhs by 10 %
+    assert not ledger.check_ordering({"lhs": 1.05, "rhs": 1.0}, ">", 0.1, "rel").passed
+    assert ledger.check_ordering({"lhs": 1.15, "rhs": 1.0}, ">", 0.1, "rel").passed
+    approx = ledger.check_ordering({"lhs": 1.04, "rhs": 1.0}, "approx", 0.05, "rel")
+    assert approx.passed and approx.rel_deviation == pytest.approx(0.04)
+    assert not ledger.check_ordering({"lhs": 1.06, "rhs": 1.0}, "approx", 0.05, "rel").passed
+    with pytest.raises(ValueError, match="keys"):
+        ledger.check_ordering({"left": 1.0}, "<")
+
+
+def test_threshold_check():
+    x = np.arange(0.0, 101.0, 10.0)
+    step_is_zero = x < 50  # zero step below 50 nm, steps above
+    result = ledger.check_threshold({"x": x, "holds": step_is_zero}, "switch_below", 50.0, 5.0, "abs")
+    assert result.passed and result.ours == 50.0 and result.abs_deviation == 0.0
+    # The switch at 70 is outside the ±5 band around 50: the condition still holds above.
+    late = ledger.check_threshold({"x": x, "holds": x < 70}, "switch_below", 50.0, 5.0, "abs")
+    assert not late.passed and "still holds beyond it at x = 60" in late.detail
+    early = ledger.check_threshold({"x": x, "holds": x < 30}, "holds_below", 50.0, 5.0, "abs")
+    assert not early.passed and "fails below the threshold at x = 30" in early.detail
+    # one-sided: failing or holding above the band does not matter
+    always = {"x": x, "holds": np.ones_like(x, bool)}
+    assert ledger.check_threshold(always, "holds_below", 50.0, 5.0, "abs").passed
+    # points inside the band are not judged (60 would fail a 'switch_below' at 55 ± 10)
+    assert ledger.check_threshold({"x": x, "holds": x <= 60}, "switch_below", 55.0, 10.0, "abs").passed
+    above = ledger.check_threshold({"x": x, "holds": x > 80}, "switch_above", 80.0, 5.0, "abs")
+    assert above.passed and above.ours == 80.0
+    with pytest.raises(ledger.NotEvaluable, match="no point below"):
+        ledger.check_threshold({"x": [60.0, 70.0], "holds": [True, True]}, "holds_below", 50.0, 5.0, "abs")
+    with pytest.raises(ledger.NotEvaluable, match="far side"):
+        ledger.check_threshold({"x": [10.0, 20.0], "holds": [True, True]}, "switch_below", 50.0, 5.0, "abs")
+
+
+def test_trend_check():
+    rising = ledger.check_trend({"x": [3, 1, 2], "y": [3.0, 1.0, 2.0]}, "increasing", 0.0)  # sorted by x
+    assert rising.passed and rising.abs_deviation == 0.0
+    noisy = {"x": [1, 2, 3, 4], "y": [0.0, 5.0, 4.8, 10.0]}  # counter-step 0.2 = 2 % of the range 10
+    assert ledger.check_trend(noisy, "increasing", 0.05, "rel").passed
+    assert not ledger.check_trend(noisy, "increasing", 0.01, "rel").passed
+    assert not ledger.check_trend(noisy, "increasing", 0.1, "abs").passed
+    assert not ledger.check_trend({"x": [1, 2], "y": [1.0, 1.0]}, "increasing", 0.0).passed  # flat
+    falling = ledger.check_trend({"x": [1, 2, 3], "y": [3.0, 2.0, 1.0]}, "decreasing", 0.0)
+    assert falling.passed
+    several = {"0.3 N": {"x": [1, 2], "y": [0.0, 1.0]}, "0.8 N": {"x": [1, 2], "y": [1.0, 0.0]}}
+    result = ledger.check_trend(several, "increasing", 0.05)
+    assert not result.passed and "series 0.8 N" in result.detail
+    with pytest.raises(ledger.NotEvaluable):
+        ledger.check_trend({"x": [1], "y": [1.0]}, "increasing", 0.0)
+
+
+def test_curve_deviation_helper():
+    table = reference.load_reference_curve("fig6a_closed_form")
+    x, eq11 = table["preload_N"].to_numpy(), table["u_x_max_e_nm"].to_numpy()
+    assert ledger.curve_deviation(x, 1.02 * eq11, "fig6a_closed_form", "u_x_max_e_nm") == pytest.approx(2.0)
+
+
+# --------------------------------------------------------------------------------------
+# evaluation and verdicts
+# --------------------------------------------------------------------------------------
+
+def test_evaluate_computes_verdicts(tmp_path, registry):
+    claims = ledger.load_claims(_write(tmp_path, SYNTHETIC))
+    _register_good()
+    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}).set_index("claim")
+    assert list(evaluated.reset_index().columns) == list(ledger.LEDGER_COLUMNS)
+    assert evaluated.at["val", "verdict"] == "reproduced within 3 %"
+    assert evaluated.at["val", "paper"] == "100" and evaluated.at["val", "ours"] == 103.0
+    assert evaluated.at["val", "tolerance"] == "5 %"
+    for claim in ("ord", "thr", "trd"):
+        assert evaluated.at[claim, "verdict"] == "reproduced", claim
+    assert evaluated.at["thr", "tolerance"] == "5 nm"
+    assert evaluated.at["other", "status"] == "not evaluated"
+    assert evaluated.at["other", "note"] == "needs results: fig9b"
+    assert ledger.summary(evaluated.reset_index()) == "4 of 5 claims reproduced; 1 not evaluated"
+
+
+def test_failed_and_expected_to_differ_verdicts(tmp_path, registry):
+    rows = [dict(r) for r in SYNTHETIC]
+    rows[1].update(expected_to_differ="yes", expected_difference_reason="our runner is lighter")
+    claims = ledger.load_claims(_write(tmp_path, rows))
+    _register_good({"val": 120.0})
+    registry[0]["ord"] = lambda results: {"lhs": 0.5, "rhs": 1.0}
+    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame(), "fig9b": pd.DataFrame()})
+    evaluated = evaluated.set_index("claim")
+    assert evaluated.at["val", "verdict"] == "not reproduced: deviation 20 % exceeds the tolerance 5 %"
+    assert evaluated.at["val", "status"] == "not reproduced"
+    assert evaluated.at["ord", "verdict"] == "expected to differ: our runner is lighter"
+    assert evaluated.at["ord", "status"] == "expected to differ"
+    assert ledger.summary(evaluated.reset_index()) == (
+        "3 of 5 claims reproduced; 1 not reproduced, 1 expected to differ")
+
+
+def test_expected_to_differ_but_reproduced_says_so(tmp_path, registry):
+    rows = [dict(SYNTHETIC[1], expected_to_differ="yes", expected_difference_reason="r")]
+    ledger.register_extractor("ord")(lambda results: {"lhs": 2.0, "rhs": 1.0})
+    evaluated = ledger.evaluate(ledger.load_claims(_write(tmp_path, rows)), {"fig5a": pd.DataFrame()})
+    assert evaluated.at[0, "status"] == "reproduced"
+    assert "remove the mark" in evaluated.at[0, "note"]
+
+
+def test_missing_extractor_is_an_error_unless_lenient(tmp_path, registry):
+    claims = ledger.load_claims(_write(tmp_path, SYNTHETIC[:2]))
+    ledger.register_extractor("val")(lambda results: 100.0)
+    ledger.register_extractor("typo")(lambda results: 1.0)
+    with pytest.raises(LookupError) as info:
+        ledger.evaluate(claims, {"fig5a": pd.DataFrame()})
+    assert "claim 'ord' has its results but no registered extractor" in str(info.value)
+    assert "unknown claim 'typo'" in str(info.value)
+    lenient = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, strict=False).set_index("claim")
+    assert lenient.at["ord", "note"] == "no extractor registered"
+
+
+def test_extractor_errors_name_the_claim(tmp_path, registry):
+    claims = ledger.load_claims(_write(tmp_path, SYNTHETIC[1:2]))
+    ledger.register_extractor("ord")(lambda results: results["fig5a"]["missing_column"])
+    with pytest.raises(ledger.ExtractorError, match="claim 'ord' \\(ordering check\\)"):
+        ledger.evaluate(claims, {"fig5a": pd.DataFrame()})
+
+
+def test_not_evaluable_from_extractor(tmp_path, registry):
+    claims = ledger.load_claims(_write(tmp_path, SYNTHETIC[:1]))
+
+    @ledger.register_extractor("val")
+    def _coarse(results):
+        raise ledger.NotEvaluable("quick grid has no point at 100 Hz")
+
+    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()})
+    assert evaluated.at[0, "status"] == "not evaluated"
+    assert evaluated.at[0, "note"] == "quick grid has no point at 100 Hz"
+
+
+def test_a_regressing_verdict_fails(tmp_path, registry):
+    """A claim reproduced in the baseline that stops being reproduced must fail the test suite."""
+    claims = ledger.load_claims(_write(tmp_path, SYNTHETIC))
+    _register_good()
+    results = {"fig5a": pd.DataFrame()}
+    baseline_path = tmp_path / "baseline.csv"
+    ledger.write_baseline(ledger.evaluate(claims, results), baseline_path)
+    baseline = ledger.load_baseline(baseline_path)
+    assert baseline["val"] == "reproduced" and baseline["other"] == "not evaluated"
+    ledger.check_no_regressions(ledger.evaluate(claims, results), baseline)  # unchanged: fine
+    registry[0]["val"] = lambda results: 90.0  # the model drifts 10 % away from the paper
+    with pytest.raises(AssertionError, match="val: not reproduced: deviation 10 %"):
+        ledger.check_no_regressions(ledger.evaluate(claims, results), baseline)
+    # losing a figure is a regression too; improving a not-evaluated claim is not
+    registry[0]["val"] = lambda results: 100.0
+    lost = ledger.regressions(ledger.evaluate(claims, {}), baseline)
+    assert set(lost["claim"]) == {"val", "ord", "thr", "trd"}
+
+
+# --------------------------------------------------------------------------------------
+# registries, results, presentation
+# --------------------------------------------------------------------------------------
+
+def test_collect_results_calls_registered_figures(registry):
+    calls = []
+
+    @ledger.register_figure("fig5a")
+    def _fig5a(profile):
+        calls.append(profile)
+        return pd.DataFrame({"amplitude_nm": [1.0]})
+
+    assert list(ledger.collect_results("quick")) == ["fig5a"]
+    assert calls == ["quick"]
+    with pytest.raises(ValueError, match="PASSMD_PROFILE|profile = 'fast'"):
+        ledger.collect_results("fast")
+    with pytest.raises(ValueError, match="are not registered"):
+        ledger.collect_results("quick", figures=["fig9z"])
+    ledger.register_figure("fig5b")(lambda profile: [1, 2])
+    with pytest.raises(TypeError, match="not a DataFrame"):
+        ledger.collect_results("quick", figures=["fig5b"])
+
+
+def test_registration_rules(registry):
+    with pytest.raises(ValueError, match="key = 'Figure 5' is not allowed"):
+        ledger.register_figure("Figure 5")
+    with pytest.raises(ValueError, match="claim_id = 'Bad Id' is not allowed"):
+        ledger.register_extractor("Bad Id")
+
+    def first(results):
+        return 1.0
+
+    def second(results):
+        return 2.0
+
+    ledger.register_extractor("x")(first)
+    ledger.register_extractor("x")(first)  # re-importing a module registers the same function again
+    with pytest.raises(ValueError, match="already registered by .*first"):
+        ledger.register_extractor("x")(second)
+
+
+def test_real_ledger_closed_form_claim_is_reproduced_and_the_rest_wait():
+    claims = ledger.load_claims()
+    results = {"closed_forms": ledger.closed_form_results("quick")}
+    evaluated = ledger.evaluate(claims, results).set_index("claim")
+    assert evaluated.at["fig10b-r1-stiffer-contact", "verdict"] == "reproduced"
+    others = evaluated.drop(index="fig10b-r1-stiffer-contact")
+    assert (others["status"] == "not evaluated").all()
+    assert others["note"].str.startswith("needs results: fig").all()
+
+
+def test_styled_colours_verdicts(tmp_path, registry):
+    claims = ledger.load_claims(_write(tmp_path, SYNTHETIC))
+    _register_good({"val": 150.0})
+    html = ledger.styled(ledger.evaluate(claims, {"fig5a": pd.DataFrame()})).to_html()
+    assert 'class="passmd-ledger"' in html
+    for status in ("reproduced", "not reproduced", "not evaluated"):
+        assert ledger.STATUS_COLOURS[status] in html
+    assert "not reproduced: deviation 50 % exceeds the tolerance 5 %" in html
+
+
+def test_assumptions_table_lists_the_registered_assumptions():
+    table = ledger.assumptions_table()
+    expected = {"actuator_viscosity", "preload_grids", "friction_coefficient_sections_4_1_and_5"}
+    assert expected <= set(table["key"])
+    assert table["rationale"].str.len().min() > 0
