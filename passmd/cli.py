@@ -21,11 +21,14 @@ could not be written). User errors print one line to stderr, never a traceback.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
+import os
 import sys
 import textwrap
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -638,11 +641,73 @@ def _cmd_critical_amplitude(args, out) -> int:
     return 0
 
 
+@contextlib.contextmanager
+def _sweep_environment(args):
+    """Route the figure's sweeps (run deep inside passmd.experiments) through the environment."""
+    from passmd import sweep
+
+    settings = {
+        sweep.EXECUTOR_ENV: args.executor,
+        sweep.SCHEDULER_ENV: args.scheduler,
+        sweep.WORKERS_ENV: None if args.workers is None else str(args.workers),
+        CACHE_DIR_ENV: args.cache_dir,
+    }
+    saved = {key: os.environ.get(key) for key in settings}
+    try:
+        for key, value in settings.items():
+            if value is not None:
+                os.environ[key] = value
+        yield
+    finally:
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
+
+
 def _cmd_figure(args, out) -> int:
-    raise NotAvailableError(
-        f"figure {args.name!r} is {NOT_AVAILABLE}: the paper's figures come with the "
-        "critical-amplitude, force-generation and driving-waveform issues"
-    )
+    from passmd import experiments
+
+    names = experiments.figure_names()
+    if args.name == "list":
+        if args.json:
+            _emit_json({"command": "figure", "figures": names}, out)
+        else:
+            for name in names:
+                out.write(f"{name}  {experiments.figure_spec(name).title}\n")
+            if not names:
+                out.write("no figure is available yet (they come with issues 7-9)\n")
+        return 0
+    if args.name not in names:
+        known = ", ".join(names) if names else "none so far"
+        raise NotAvailableError(
+            f"figure {args.name!r} is {NOT_AVAILABLE} (available: {known}); the paper's figures come "
+            "with the critical-amplitude, force-generation and driving-waveform issues"
+        )
+    if args.workers is not None and args.workers < 1:
+        raise UsageError(f"--workers = {args.workers} is out of range: must be an integer >= 1")
+    with _sweep_environment(args):
+        data = experiments.figure_data(args.name, args.profile)
+    target = Path(args.out)
+    csv_path, png_path = target / f"{args.name}.csv", target / f"{args.name}.png"
+    try:
+        target.mkdir(parents=True, exist_ok=True)
+        data.to_csv(csv_path, index=False)
+        fig = experiments.figure_plot(args.name, data)
+        fig.savefig(png_path, dpi=150)
+    except OSError as exc:
+        raise OutputError(f"cannot write to --out {args.out}: {exc.strerror or exc}") from exc
+    pyplot = sys.modules.get("matplotlib.pyplot")
+    if pyplot is not None:
+        pyplot.close(fig)
+    record = {"command": "figure", "name": args.name, "profile": args.profile, "rows": len(data),
+              "columns": list(map(str, data.columns)), "csv": str(csv_path), "png": str(png_path)}
+    if args.json:
+        _emit_json(record, out)
+    else:
+        out.write(f"{args.name} ({args.profile}): {len(data)} rows -> {csv_path}, {png_path}\n")
+    return 0
 
 
 # --------------------------------------------------------------------------------------
@@ -659,6 +724,7 @@ _THRESHOLD = _Quantity("--threshold", "nm", "S", "a step counts when the mean st
                        _fmt(CLI_STEP_THRESHOLD, "nm"))
 _TOLERANCE = _Quantity("--tolerance", "nm", "W", "stop when the bracket is narrower than this", "0.5 nm")
 
+_JSON_HELP = "print one JSON object (SI units) instead (default: off)"
 _RUN_KEYS = """\
 --json keys (SI units): final_position_m, settled_positions_m, step_sizes_m,
 back_steps_m, mean_velocity_m_per_s (>= 2 periods), periods, frequency_Hz, amplitude_m,
@@ -682,9 +748,11 @@ def _add_simulation_options(parser, default_periods: int) -> None:
 
 def _add_output_options(parser) -> None:
     group = parser.add_argument_group("output")
-    group.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead")
-    group.add_argument("--csv", metavar="FILE", help="write the time series to FILE (CSV, SI units)")
-    group.add_argument("--plot", metavar="FILE", help="plot piezo and runner position to FILE (PNG)")
+    group.add_argument("--json", action="store_true", help=_JSON_HELP)
+    group.add_argument("--csv", metavar="FILE",
+                       help="write the time series to FILE (CSV, SI units) (default: none)")
+    group.add_argument("--plot", metavar="FILE",
+                       help="plot piezo and runner position to FILE (PNG) (default: none)")
     group.add_argument("--max-points", type=int, default=20000, metavar="N",
                        help="samples of the recorded time series (default: 20000)")
 
@@ -711,7 +779,7 @@ def make_parser() -> argparse.ArgumentParser:
         critical_amplitude_flexible_m, analytic_critical_amplitude_m (for --actuator),
         runner_frequency_Hz, actuator_natural_frequency_Hz, drive{...}"""))
     _add_drive_options(p)
-    p.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead")
+    p.add_argument("--json", action="store_true", help=_JSON_HELP)
     p.set_defaults(handler=_cmd_theory)
 
     p = command("critical-amplitude", "simulated and analytic critical amplitude A_c", textwrap.dedent(f"""\
@@ -737,11 +805,12 @@ def make_parser() -> argparse.ArgumentParser:
                        help="discrete MDR contacts with N springs (default: exact contact)")
     group.add_argument("--workers", type=int, default=1, metavar="N",
                        help="amplitudes simulated in parallel per search round (default: 1)")
-    group.add_argument("--analytic-only", action="store_true", help="skip the simulation")
+    group.add_argument("--analytic-only", action="store_true", help="skip the simulation (default: off)")
     group.add_argument("--cache-dir", metavar="DIR",
                        help=f"cache directory (default: ${CACHE_DIR_ENV} or ./{DEFAULT_CACHE_DIR})")
-    group.add_argument("--no-cache", action="store_true", help="do not read or write the cache")
-    p.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead")
+    group.add_argument("--no-cache", action="store_true",
+                       help="do not read or write the cache (default: off)")
+    p.add_argument("--json", action="store_true", help=_JSON_HELP)
     p.set_defaults(handler=_cmd_critical_amplitude)
 
     p = command("run", "one simulation of a driving waveform from rest", _RUN_KEYS +
@@ -749,7 +818,7 @@ def make_parser() -> argparse.ArgumentParser:
     _add_drive_options(p)
     _add_simulation_options(p, default_periods=3)
     p.add_argument("--load-cell", action="store_true",
-                   help="the runner pushes against the load cell (default: free runner)")
+                   help="the runner pushes against the load cell (default: off, free runner)")
     _add_output_options(p)
     p.set_defaults(handler=_cmd_run)
 
@@ -773,19 +842,37 @@ def make_parser() -> argparse.ArgumentParser:
     group = p.add_argument_group("contact")
     _NORMAL_FORCE.add(group)
     group.add_argument("--path", metavar="U1,U2,...",
-                       help="displacements to visit [nm] (required)")
+                       help="displacements to visit [nm] (default: none, required)")
     group.add_argument("--springs", type=int, default=None, metavar="N",
                        help="discrete MDR model with N springs (default: exact, N → ∞)")
     _add_drive_options(p, contact_only=True)
-    p.add_argument("--json", action="store_true", help="print one JSON object (SI units) instead")
+    p.add_argument("--json", action="store_true", help=_JSON_HELP)
     p.set_defaults(handler=_cmd_contact)
 
-    p = command("figure", f"one paper figure's data (CSV) and image (PNG) — {NOT_AVAILABLE}",
-                "The figures come with the critical-amplitude, force-generation and waveform issues.")
-    p.add_argument("name", metavar="NAME", help="figure panel, e.g. fig5a")
-    p.add_argument("--profile", choices=("quick", "paper"), default="quick",
-                   help="resolution profile (default: quick)")
-    p.add_argument("--out", metavar="DIR", default=".", help="output directory (default: .)")
+    p = command("figure", "one paper figure's data (CSV) and image (PNG), as the book makes them",
+                textwrap.dedent(f"""\
+        'passmd figure list' lists the panels available so far; the others are
+        {NOT_AVAILABLE} (they come with the critical-amplitude, force-generation and
+        driving-waveform issues). Sweeps are cached in ./{DEFAULT_CACHE_DIR}/ (or ${CACHE_DIR_ENV}).
+
+        --json keys: name, profile, rows, columns, csv, png (paths written)"""))
+    p.add_argument("name", metavar="NAME",
+                   help="figure panel, e.g. fig5a, or 'list' (default: none, required)")
+    p.add_argument("--profile", choices=("quick", "paper"), default="paper",
+                   help="resolution: quick (CI) or paper (the paper's grids) (default: paper)")
+    p.add_argument("--out", metavar="DIR", default=".",
+                   help="directory for NAME.csv and NAME.png (default: .)")
+    group = p.add_argument_group("sweep execution")
+    group.add_argument("--executor", choices=("process", "serial", "dask"), default=None,
+                       help="process pool, in this process, or Dask (default: process, or dask with "
+                            "--scheduler)")
+    group.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                       help="Dask scheduler, e.g. tcp://10.0.0.5:8786 (default: none)")
+    group.add_argument("--workers", type=int, default=None, metavar="N",
+                       help="worker processes for process/local Dask (default: all cores)")
+    group.add_argument("--cache-dir", metavar="DIR",
+                       help=f"cache directory (default: ${CACHE_DIR_ENV} or ./{DEFAULT_CACHE_DIR})")
+    p.add_argument("--json", action="store_true", help=_JSON_HELP)
     p.set_defaults(handler=_cmd_figure)
     return parser
 

@@ -1,0 +1,445 @@
+"""The ``passmd`` command line, run as a user would.
+
+Most tests call ``passmd.cli.main(argv)`` in-process with stdout captured (same code
+path as the console script, and numba compiles once); a few run the real console
+script and ``python -m passmd`` in a subprocess to check exit codes and that stderr
+carries one line and no traceback.
+
+``--json`` output is compared with the Python API *exactly*: the CLI calls the same
+deterministic functions with the same SI inputs (units are converted by decimal
+multiplication, so "0.25mm" is exactly 0.25e-3), and JSON round-trips floats exactly.
+"""
+
+import contextlib
+import io
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from passmd import cli, sweep
+from passmd.cache import Cache
+from passmd.contact import MDRContact
+from passmd.parameters import ACTUATOR_DAMPING_RATIO, Drive, Material, actuator_for_radius
+from passmd.theory import contact_moduli, drive_theory, runner_frequency
+
+SUBCOMMANDS = ["theory", "critical-amplitude", "run", "force", "contact", "figure"]
+
+
+def run_cli(*argv):
+    """(exit status, stdout) of ``passmd argv`` in this process."""
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):  # argparse writes --help to sys.stdout
+        try:
+            status = cli.main(list(argv))
+        except SystemExit as exc:  # argparse: --help, usage errors
+            status = exc.code
+    return status, out.getvalue()
+
+
+def run_json(*argv):
+    status, text = run_cli(*argv, "--json")
+    assert status == 0, text
+    return json.loads(text)
+
+
+def console(*argv, module=False):
+    """Run the installed console script (or ``python -m passmd``) in a subprocess."""
+    if module:
+        cmd = [sys.executable, "-m", "passmd", *argv]
+    else:
+        cmd = [str(Path(sys.executable).parent / "passmd"), *argv]
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+
+
+# --------------------------------------------------------------------------------------
+# help
+# --------------------------------------------------------------------------------------
+
+
+def option_help(help_text: str) -> dict[str, str]:
+    """Each option's help, wrapped lines joined: {"--preload": "F_p preload [N] ..."}."""
+    blocks: dict[str, str] = {}
+    current = None
+    for line in help_text.splitlines():
+        match = re.match(r"^  (-\S+)(.*)$", line)
+        if match:
+            current = match.group(1).split(",")[0].rstrip(",")
+            if current == "-h":
+                current = "--help"
+            blocks[current] = match.group(2).strip()
+        elif current and line.startswith("      "):
+            blocks[current] += " " + line.strip()
+        else:
+            current = None
+    return blocks
+
+
+@pytest.mark.parametrize("command", SUBCOMMANDS)
+def test_help_names_every_option_with_default(command):
+    status, text = run_cli(command, "--help")
+    assert status == 0
+    blocks = option_help(text)
+    blocks.pop("--help")
+    assert blocks, text
+    for flag, help_line in blocks.items():
+        assert "default:" in help_line, f"{command} {flag}: {help_line}"
+    quantities = {"--preload": "[N]", "--radius": "[mm]", "--mu": "[-]", "--amplitude": "[nm]",
+                  "--frequency": "[kHz]", "--normal-force": "[N]", "--path": "[nm]",
+                  "--runner-modulus": "[GPa]", "--actuator-stiffness": "[N/m]", "--runner-mass": "[g]"}
+    for flag, unit in quantities.items():
+        if flag in blocks:
+            assert unit in blocks[flag], f"{command} {flag}: {blocks[flag]}"
+
+
+def test_help_lists_all_overrides_and_json_keys():
+    _, text = run_cli("run", "--help")
+    blocks = option_help(text)
+    for flag in ["--contacts", "--actuator", "--preload", "--radius", "--mu", "--actuator-stiffness",
+                 "--actuator-mass", "--actuator-viscosity", "--runner-modulus", "--runner-poisson",
+                 "--hemisphere-modulus", "--hemisphere-poisson", "--runner-mass", "--load-cell-stiffness",
+                 "--waveform", "--amplitude", "--frequency", "--periods", "--json", "--csv", "--plot"]:
+        assert flag in blocks, flag
+    for key in ["final_position_m", "step_sizes_m", "mean_velocity_m_per_s", "back_steps_m"]:
+        assert key in text
+    _, text = run_cli("critical-amplitude", "--help")
+    assert "critical_amplitude_m" in text and "analytic_critical_amplitude_m" in text
+    _, text = run_cli("contact", "--help")
+    assert "force_N" in text and "--springs" in option_help(text)
+
+
+# --------------------------------------------------------------------------------------
+# theory
+# --------------------------------------------------------------------------------------
+
+
+def test_theory_json_matches_api():
+    data = run_json("theory")
+    drive = Drive()
+    expected = drive_theory(drive)
+    for key, value in expected.items():
+        assert data[key] == value, key
+    assert data["runner_frequency_Hz"] == runner_frequency(drive)
+    assert data["drive"]["preload_N"] == drive.preload
+    assert data["drive"]["actuator_viscosity_kg_per_s"] == drive.actuator.viscosity
+
+
+@pytest.mark.parametrize("radius", ["0.25mm", "0.25 mm", "0.25", "250um", "2.5e-4m"])
+def test_unit_parsing_of_radius(radius):
+    data = run_json("theory", "--radius", radius, "--preload", "200mN", "--contacts", "1",
+                    "--actuator", "rigid")
+    drive = Drive(hemisphere_radius=0.25e-3, preload=0.2, contacts=1, actuator_model="rigid")
+    assert data["drive"]["hemisphere_radius_m"] == 0.25e-3
+    assert data["drive"]["actuator_stiffness_N_per_m"] == drive.actuator.stiffness  # Table 2 row
+    assert data["analytic_critical_amplitude_m"] == drive_theory(drive)["analytic_critical_amplitude_m"]
+
+
+def test_overrides_reach_the_drive():
+    data = run_json(
+        "theory", "--runner-modulus", "310GPa", "--runner-poisson", "0.3", "--hemisphere-modulus", "400",
+        "--actuator-stiffness", "5e6", "--actuator-mass", "3e-5", "--runner-mass", "5g",
+        "--load-cell-stiffness", "3e4", "--mu", "0.3",
+    )
+    table2 = actuator_for_radius(1e-3)
+    k_p, m_a = 5e6, 3e-8
+    d = data["drive"]
+    assert (d["actuator_stiffness_N_per_m"], d["actuator_mass_kg"]) == (k_p, m_a)
+    # viscosity not given: the assumed damping ratio is kept for the new k_p, m_a
+    assert d["actuator_viscosity_kg_per_s"] == 2 * ACTUATOR_DAMPING_RATIO * math.sqrt(k_p * m_a)
+    assert d["full_stroke_amplitude_m"] == table2.full_stroke_amplitude
+    assert d["runner_mass_kg"] == 5e-3
+    assert (d["load_cell_stiffness_N_per_m"], d["friction_coefficient"]) == (3e4, 0.3)
+    drive = Drive(hemisphere_material=Material(400e9, 0.33), runner_material=Material(310e9, 0.3))
+    assert (data["E_star_Pa"], data["G_star_Pa"]) == contact_moduli(drive)
+    viscous = run_json("theory", "--actuator-viscosity", "0.1 kg/s")
+    assert viscous["drive"]["actuator_viscosity_kg_per_s"] == 0.1
+
+
+def test_theory_human_output_in_display_units():
+    status, text = run_cli("theory", "--contacts", "1")
+    assert status == 0
+    ac = drive_theory(Drive(contacts=1))["critical_amplitude_flexible_m"]
+    assert f"{ac * 1e9:.6g} nm" in text
+    assert "R = 1 mm, F_p = 0.4 N" in text
+
+
+# --------------------------------------------------------------------------------------
+# contact
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("springs", [None, 50])
+def test_contact_json_matches_mdr_contact(springs):
+    extra = [] if springs is None else ["--springs", str(springs)]
+    data = run_json("contact", "--normal-force", "0.3N", "--radius", "0.5mm", "--mu", "0.25",
+                    "--path", "0nm,30nm,-10nm,45nm,0.02um", *extra)
+    E_star, G_star = contact_moduli(Drive())
+    contact = MDRContact(0.3, 0.5e-3, E_star, G_star, 0.25, springs=springs)
+    path = [0.0, 30e-9, -10e-9, 45e-9, 20e-9]
+    assert data["displacement_m"] == path
+    assert data["force_N"] == contact.path(np.array(path)).tolist()
+    assert data["model"] == ("exact" if springs is None else "discrete")
+    assert data["presliding_m"] == contact.presliding
+    assert data["sliding_force_N"] == contact.sliding_force
+
+
+def test_contact_human_output():
+    status, text = run_cli("contact", "--path", "0,30,-10")
+    assert status == 0
+    assert "exact" in text and "μF_N = 0.08 N" in text
+
+
+# --------------------------------------------------------------------------------------
+# run, force (one-contact rigid runs are fast: ~10 ms per 100 Hz period)
+# --------------------------------------------------------------------------------------
+
+
+def simulate_summary(drive, amplitude, frequency, periods, flyback="slew", springs=None):
+    from passmd import dynamics, waveforms
+
+    wave = waveforms.sawtooth(amplitude, frequency, drive, periods=periods, flyback=flyback)
+    result = dynamics.simulate(drive, wave, contact_model="exact" if springs is None else "discrete",
+                               springs=springs or 200)
+    return result.summary()
+
+
+def assert_summary_matches(data, expected):
+    for key, value in expected.items():
+        assert data[key] == value, key
+
+
+def test_run_json_matches_simulate():
+    data = run_json("run", "--contacts", "1", "--actuator", "rigid", "--amplitude", "0.1um",
+                    "--frequency", "200Hz", "--periods", "3", "--preload", "0.3")
+    drive = Drive(contacts=1, actuator_model="rigid", preload=0.3)
+    assert_summary_matches(data, simulate_summary(drive, 100e-9, 200.0, 3))
+    assert data["amplitude_m"] == 100e-9 and data["frequency_Hz"] == 200.0
+    assert len(data["step_sizes_m"]) == 2
+    assert data["mean_velocity_m_per_s"] > 0
+    assert "generated_force_N" not in data
+
+
+def test_run_default_is_paper_drive_at_full_stroke():
+    data = run_json("run", "--periods", "2", "--flyback", "fixed", "--springs", "40")
+    drive = Drive()
+    assert data["amplitude_m"] == drive.actuator.full_stroke_amplitude
+    assert data["frequency_Hz"] == 100.0
+    assert_summary_matches(data, simulate_summary(drive, drive.actuator.full_stroke_amplitude, 100.0, 2,
+                                                  flyback="fixed", springs=40))
+
+
+def test_run_writes_csv_and_png(tmp_path):
+    csv, png = tmp_path / "series.csv", tmp_path / "plot.png"
+    status, text = run_cli("run", "--contacts", "1", "--actuator", "rigid", "--amplitude", "80",
+                           "--periods", "2", "--max-points", "500", "--csv", str(csv), "--plot", str(png))
+    assert status == 0
+    assert "final position" in text and " nm" in text
+    header = csv.read_text().splitlines()[0].split(",")
+    assert header[:3] == ["time_s", "piezo_position_m", "runner_position_m"]
+    assert len(csv.read_text().splitlines()) > 100
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_force_json_matches_simulate_with_load_cell():
+    data = run_json("force", "--contacts", "1", "--actuator", "rigid", "--periods", "4",
+                    "--load-cell-stiffness", "5e4")
+    drive = Drive(contacts=1, actuator_model="rigid", load_cell=True, load_cell_stiffness=5e4)
+    expected = simulate_summary(drive, drive.actuator.full_stroke_amplitude, 100.0, 4)
+    assert_summary_matches(data, expected)
+    assert data["generated_force_N"] == expected["generated_force_N"] > 0
+    assert data["last_step_size_m"] == expected["step_sizes_m"][-1]
+    assert data["drive"]["load_cell"] is True
+
+
+# --------------------------------------------------------------------------------------
+# critical amplitude
+# --------------------------------------------------------------------------------------
+
+
+def test_critical_amplitude_analytic_only():
+    data = run_json("critical-amplitude", "--analytic-only", "--contacts", "6", "--actuator", "rigid")
+    theory = drive_theory(Drive(actuator_model="rigid"))
+    assert data["analytic_critical_amplitude_m"] == theory["critical_amplitude_rigid_m"]
+    assert "critical_amplitude_m" not in data
+
+
+def test_critical_amplitude_search_brackets_the_threshold(tmp_path):
+    """The reported bracket really brackets the threshold (checked by re-simulating its ends)."""
+    args = ["critical-amplitude", "--contacts", "1", "--actuator", "rigid", "--tolerance", "2nm",
+            "--cache-dir", str(tmp_path / "cache")]
+    data = run_json(*args)
+    lo, hi = data["bracket_m"]
+    assert 0 < hi - lo <= 2e-9 and data["critical_amplitude_m"] == 0.5 * (lo + hi)
+    drive = Drive(contacts=1, actuator_model="rigid")
+    point = {"drive": drive, "frequency": 100.0, "periods": 3, "flyback": "slew", "springs": None}
+    at_hi = sweep.sawtooth_point(**point, amplitude=hi)["mean_step_m"]
+    assert at_hi > data["threshold_m"] == 1e-9
+    if lo > 0:
+        assert sweep.sawtooth_point(**point, amplitude=lo)["mean_step_m"] <= 1e-9
+    # every simulation went through the cache: a rerun reads them all back
+    assert len(Cache(tmp_path / "cache").entries()) == data["simulations"]
+    assert run_json(*args) == data
+    assert data["analytic_critical_amplitude_m"] == drive_theory(drive)["critical_amplitude_rigid_m"]
+
+
+def test_critical_amplitude_parallel_search_agrees(tmp_path):
+    serial = cli.critical_amplitude_search(Drive(contacts=1, actuator_model="rigid"), tolerance=2e-9,
+                                           cache=False)
+    parallel = cli.critical_amplitude_search(Drive(contacts=1, actuator_model="rigid"), tolerance=2e-9,
+                                             workers=2, cache=Cache(tmp_path))
+    # different subdivisions of [0, A_max]: both brackets must overlap (same threshold crossing)
+    assert max(serial["bracket_m"][0], parallel["bracket_m"][0]) <= min(serial["bracket_m"][1],
+                                                                        parallel["bracket_m"][1])
+
+
+def test_critical_amplitude_no_step_up_to_full_stroke():
+    """A_c of this drive is ~36 nm (> 1 nm steps): an actuator with a 20 nm stroke never steps."""
+    args = ["critical-amplitude", "--contacts", "1", "--actuator", "rigid", "--full-stroke-amplitude", "20nm",
+            "--no-cache"]
+    data = run_json(*args)
+    assert data["critical_amplitude_m"] is None
+    assert data["simulations"] == 1
+    status, text = run_cli(*args)
+    assert status == 0 and "no step > 1 nm up to the full stroke 20 nm" in text
+
+
+# --------------------------------------------------------------------------------------
+# errors: one line on stderr, exit 2 for usage, 1 for a failed run
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["theory", "--radius", "3N"], "--radius = '3N' has the wrong unit: N is a force, expected a length"),
+        (["theory", "--preload", "1 furlong"], "--preload = '1 furlong' has the wrong unit"),
+        (["theory", "--preload", "abc"], "--preload = 'abc' is not a quantity"),
+        (["theory", "--preload", "-0.4"], "--preload = -0.4 is out of range: must be a finite number > 0"),
+        (["theory", "--mu", "0"], "--mu = 0.0 is out of range"),
+        (["theory", "--runner-poisson", "0.5"], "--runner-poisson = 0.5 is out of range"),
+        (["theory", "--actuator-viscosity", "-1"], "--actuator-viscosity = -1.0 is out of range"),
+        (["theory", "--contacts", "3"], "argument --contacts: invalid choice: 3"),
+        (["theory", "--actuator", "soft"], "argument --actuator: invalid choice: 'soft'"),
+        (["theory", "--bogus", "1"], "unrecognized arguments: --bogus 1"),
+        (["frobnicate"], "invalid choice: 'frobnicate'"),
+        (["contact"], "--path is required"),
+        (["contact", "--path", "0,3N"], "--path = '3N' has the wrong unit"),
+        (["contact", "--path", "0,,3"], "not a comma-separated list"),
+        (["contact", "--path", "0,3", "--springs", "1"], "--springs = 1 is out of range"),
+        (["run", "--amplitude", "300nm"], "--amplitude = 300 nm is out of range: must be <= 202 nm"),
+        (["run", "--amplitude", "-5"], "--amplitude = -5.0 is out of range"),
+        (["run", "--frequency", "300kHz"], "frequency = 300000.0 is out of range"),
+        (["run", "--periods", "0"], "--periods = 0 is out of range"),
+        (["run", "--waveform", "optimized"], "--waveform optimized is not available yet"),
+        (["force", "--waveform", "optimized"], "--waveform optimized is not available yet"),
+        (["critical-amplitude", "--periods", "1"], "a step needs >= 2 periods"),
+        (["figure", "fig0x"], "figure 'fig0x' is not available yet"),
+        (["figure", "fig5a", "--profile", "slow"], "argument --profile: invalid choice: 'slow'"),
+    ],
+)
+def test_usage_errors_exit_2_with_one_line(argv, message, capsys):
+    status, out = run_cli(*argv)
+    err = capsys.readouterr().err
+    assert status == 2
+    assert out == ""
+    assert err.count("\n") == 1 and err.startswith("passmd"), err
+    assert "error: " in err and message in err, err
+
+
+def fake_figure_data(profile):
+    """A stand-in figure: a real sweep (through the environment the CLI sets) plus the settings seen."""
+    frame = sweep.run(sweep.drive_theory_point, sweep.grid(preload=[0.1, 0.2]), progress=False)
+    frame["profile"] = profile
+    frame["executor_seen"] = os.environ.get("PASSMD_EXECUTOR")
+    return frame[["preload", "analytic_critical_amplitude_m", "profile", "executor_seen"]]
+
+
+def fake_figure_plot(data):
+    from matplotlib.figure import Figure
+
+    fig = Figure()
+    fig.add_subplot().plot(data["preload"], data["analytic_critical_amplitude_m"] * 1e9)
+    return fig
+
+
+@pytest.fixture
+def fake_figure(monkeypatch):
+    from passmd import experiments
+
+    spec = experiments.FigureSpec("fig99z", "a stand-in panel", "none", fake_figure_data, fake_figure_plot)
+    monkeypatch.setitem(experiments.FIGURES, "fig99z", spec)
+    monkeypatch.delenv("PASSMD_EXECUTOR", raising=False)
+    return spec
+
+
+def test_figure_writes_csv_and_png_through_the_registry(fake_figure, tmp_path):
+    cache_dir = tmp_path / "cache"
+    data = run_json("figure", "fig99z", "--profile", "quick", "--out", str(tmp_path / "out"),
+                    "--executor", "serial", "--cache-dir", str(cache_dir))
+    assert data["rows"] == 2 and data["profile"] == "quick"
+    csv = Path(data["csv"]).read_text().splitlines()
+    assert csv[0] == "preload,analytic_critical_amplitude_m,profile,executor_seen"
+    assert csv[1].endswith(",quick,serial")  # the sweep saw --executor ...
+    assert len(Cache(cache_dir).entries()) == 2  # ... and --cache-dir
+    assert Path(data["png"]).read_bytes()[:4] == b"\x89PNG"
+    assert "PASSMD_EXECUTOR" not in os.environ  # restored after the command
+    status, text = run_cli("figure", "list")
+    assert status == 0 and "fig99z  a stand-in panel" in text
+
+
+def test_failed_simulation_exits_1(monkeypatch, capsys):
+    from passmd import dynamics
+
+    def diverge(*args, **kwargs):
+        raise dynamics.SimulationError("simulation diverged at integrator step 12")
+
+    monkeypatch.setattr(dynamics, "simulate", diverge)
+    status, out = run_cli("run", "--periods", "1")
+    err = capsys.readouterr().err
+    assert status == 1 and out == ""
+    assert err == "passmd run: error: run failed: simulation diverged at integrator step 12\n"
+
+
+def test_unwritable_output_exits_1(tmp_path, capsys):
+    target = tmp_path / "missing-dir" / "series.csv"
+    status, _ = run_cli("run", "--contacts", "1", "--actuator", "rigid", "--periods", "1",
+                        "--csv", str(target))
+    err = capsys.readouterr().err
+    assert status == 1 and "cannot write --csv" in err and err.count("\n") == 1
+
+
+# --------------------------------------------------------------------------------------
+# the installed console script and python -m passmd
+# --------------------------------------------------------------------------------------
+
+
+def test_console_script_json_and_errors(tmp_path):
+    done = console("theory", "--radius", "0.25mm", "--contacts", "1", "--json")
+    assert done.returncode == 0, done.stderr
+    data = json.loads(done.stdout)
+    assert data["drive"]["hemisphere_radius_m"] == 0.25e-3
+    assert data["analytic_critical_amplitude_m"] == drive_theory(
+        Drive(hemisphere_radius=0.25e-3, contacts=1))["analytic_critical_amplitude_m"]
+
+    bad = console("theory", "--radius", "3N")
+    assert bad.returncode == 2 and bad.stdout == ""
+    assert bad.stderr.count("\n") == 1 and "Traceback" not in bad.stderr
+    assert "--radius = '3N' has the wrong unit" in bad.stderr
+
+    unknown = console("run", "--no-such-option")
+    assert unknown.returncode == 2 and "Traceback" not in unknown.stderr
+    assert unknown.stderr.strip() == "passmd: error: unrecognized arguments: --no-such-option"
+
+
+def test_python_dash_m():
+    done = console("contact", "--path", "0nm,30nm,-10nm,45nm", "--json", module=True)
+    assert done.returncode == 0, done.stderr
+    assert len(json.loads(done.stdout)["force_N"]) == 4
+    assert console("--version", module=True).stdout.startswith("passmd ")
+    assert console(module=True).returncode == 2  # a subcommand is required
