@@ -4,9 +4,9 @@ Three pieces, kept apart so that figure chapters can add to them without editing
 
 * **claims**: ``data/reference/claims.csv``, one row per checkable statement of the paper
   (schema in ``data/reference/README.md``), read and validated by :func:`load_claims`;
-* **figures**: functions ``(profile) -> DataFrame`` registered with :func:`register_figure`
-  under a key such as ``"fig9b"``; :func:`collect_results` imports the experiment modules
-  and calls every registered figure function, so a chapter never lists them;
+* **figures**: the panels registered in :mod:`passmd.experiments` (``fig5a`` … ``fig10c``,
+  shared with the book and the CLI) plus the ledger's own ``closed_forms`` table;
+  :func:`collect_results` computes every available one, so a chapter never lists them;
 * **extractors**: functions ``(results) -> ours`` registered with
   :func:`register_extractor` under a claim id; they turn the result tables into the number,
   pair, curve or series that the claim's check kind needs.
@@ -35,9 +35,7 @@ An extractor raises :class:`NotEvaluable` when the results cannot decide the cla
 
 from __future__ import annotations
 
-import importlib
 import math
-import pkgutil
 import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -46,7 +44,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from passmd import reference
+from passmd import experiments, reference
 from passmd._validation import check_choice
 from passmd.parameters import ASSUMPTIONS
 
@@ -55,7 +53,6 @@ __all__ = [
     "ExtractorError",
     "CLAIMS_PATH",
     "CLAIM_COLUMNS",
-    "EXPERIMENT_MODULES",
     "LEDGER_COLUMNS",
     "PROFILES",
     "RELATIONS",
@@ -72,11 +69,10 @@ __all__ = [
     "curve_deviation",
     "evaluate",
     "extractors",
-    "figure_functions",
+    "result_sources",
     "load_baseline",
     "load_claims",
     "register_extractor",
-    "register_figure",
     "regressions",
     "styled",
     "summary",
@@ -113,10 +109,8 @@ STATUSES = ("reproduced", "not reproduced", "expected to differ", "not evaluated
 #: Columns of :func:`evaluate`'s result.
 LEDGER_COLUMNS = ("claim", "figure", "quantity", "paper", "ours", "unit", "abs_deviation", "rel_deviation",
                   "tolerance", "verdict", "note", "status", "check")
-#: Build profiles passed to figure functions (the same names as ``passmd.publish.PROFILES``).
-PROFILES = ("quick", "paper")
-#: Modules (or packages, imported with all their submodules) that register figures/extractors.
-EXPERIMENT_MODULES = ("passmd.experiments",)
+#: Build profiles passed to figure functions (those of :mod:`passmd.experiments`).
+PROFILES = experiments.PROFILES
 
 _ID = re.compile(r"^[a-z0-9][a-z0-9._-]*$")
 _FIGURE_KEY = re.compile(r"^(fig\d+[a-z]?|closed_forms)$")
@@ -269,19 +263,6 @@ def load_claims(path=None) -> pd.DataFrame:
 # ======================================================================================
 
 _EXTRACTORS: dict[str, Callable] = {}
-_FIGURES: dict[str, Callable] = {}
-
-
-def _register(registry: dict, key: str, func: Callable, what: str) -> Callable:
-    previous = registry.get(key)
-    same = previous is not None and (previous.__module__, previous.__qualname__) == (
-        func.__module__, func.__qualname__)
-    if previous is not None and not same:  # re-importing the same module is fine
-        raise ValueError(
-            f"{what} {key!r} is already registered by {previous.__module__}.{previous.__qualname__}"
-        )
-    registry[key] = func
-    return func
 
 
 def register_extractor(claim_id: str) -> Callable[[Callable], Callable]:
@@ -289,77 +270,64 @@ def register_extractor(claim_id: str) -> Callable[[Callable], Callable]:
 
     ``ours`` must have the form the claim's check kind expects (module docstring) and
     be in the claim's ``unit``. Raise :class:`NotEvaluable` when the results cannot
-    decide the claim.
+    decide the claim. Extractors live next to their figure in the topic modules of
+    :mod:`passmd.experiments`, which are loaded before every evaluation.
     """
     if not isinstance(claim_id, str) or not _ID.match(claim_id):
         raise ValueError(f"claim_id = {claim_id!r} is not allowed: must be a claims.csv id slug")
-    return lambda func: _register(_EXTRACTORS, claim_id, func, "extractor for claim")
 
+    def deco(func: Callable) -> Callable:
+        previous = _EXTRACTORS.get(claim_id)
+        same = previous is not None and (previous.__module__, previous.__qualname__) == (
+            func.__module__, func.__qualname__)
+        if previous is not None and not same:  # re-importing the same module is fine
+            raise ValueError(f"extractor for claim {claim_id!r} is already registered by "
+                             f"{previous.__module__}.{previous.__qualname__}")
+        _EXTRACTORS[claim_id] = func
+        return func
 
-def register_figure(key: str) -> Callable[[Callable], Callable]:
-    """Decorator: register ``func(profile: str) -> DataFrame`` as the result table ``key``.
-
-    ``key`` is the name claims.csv's ``requires`` column uses: ``fig5a`` … ``fig10c``
-    (the same as ``passmd figure <key>``) or ``closed_forms``.
-    """
-    if not isinstance(key, str) or not _FIGURE_KEY.match(key):
-        raise ValueError(f"key = {key!r} is not allowed: must look like 'fig5a' … 'fig10c' or 'closed_forms'")
-    return lambda func: _register(_FIGURES, key, func, "figure")
-
-
-def _import_experiment_modules(modules=EXPERIMENT_MODULES) -> None:
-    """Import the modules that register figures and extractors (packages with submodules).
-
-    A module that does not exist yet is skipped; an error inside an existing one is raised.
-    """
-    for name in modules:
-        try:
-            module = importlib.import_module(name)
-        except ModuleNotFoundError as err:
-            if err.name == name:
-                continue  # not written yet
-            raise
-        for info in pkgutil.walk_packages(getattr(module, "__path__", []), prefix=f"{name}."):
-            importlib.import_module(info.name)
+    return deco
 
 
 def extractors() -> dict[str, Callable]:
-    """The registered extractors ``{claim id: function}`` (after importing the experiments)."""
-    _import_experiment_modules()
+    """The registered extractors ``{claim id: function}``, topic modules loaded first."""
+    experiments.figure_names()  # imports the topic modules, which register their extractors
     return dict(_EXTRACTORS)
 
 
-def figure_functions() -> dict[str, Callable]:
-    """The registered figure functions ``{key: function}`` (after importing the experiments)."""
-    _import_experiment_modules()
-    return dict(_FIGURES)
+def result_sources() -> dict[str, Callable[[str], pd.DataFrame]]:
+    """Every available result table: ``{key: compute(profile) -> DataFrame}``.
+
+    The figure panels registered in :mod:`passmd.experiments` plus ``closed_forms``
+    (the closed-form tables some claims are checked against, computed here).
+    """
+    sources = {name: experiments.figure_spec(name).compute for name in experiments.figure_names()}
+    sources["closed_forms"] = closed_form_results
+    return sources
 
 
 def collect_results(profile: str = "quick", figures=None) -> dict[str, pd.DataFrame]:
-    """Compute the result table of every registered figure: the ledger's single entry point.
+    """Compute every available result table: the ledger's single entry point.
 
     Parameters
     ----------
     profile : str
         ``"quick"`` (CI) or ``"paper"`` (the paper's grids); passed to each figure function.
     figures : iterable of str, optional
-        Only these keys (each must be registered); default all registered figures.
+        Only these keys (each must be available); default all of :func:`result_sources`.
 
     Returns
     -------
     dict
-        ``{key: DataFrame}``. Figures that are not registered are simply absent; their
-        claims are then *not evaluated*.
+        ``{key: DataFrame}``. Figures not registered yet are simply absent; their claims
+        are then *not evaluated*.
     """
     check_choice("profile", profile, PROFILES)
-    available = figure_functions()
+    available = result_sources()
     keys = list(available) if figures is None else list(figures)
     unknown = [k for k in keys if k not in available]
     if unknown:
-        raise ValueError(
-            f"figures = {unknown!r} are not registered: must be among "
-            f"{', '.join(sorted(available)) or 'none'}"
-        )
+        raise ValueError(f"figures = {unknown!r} are not available: must be among {', '.join(available)}")
     results = {}
     for key in keys:
         table = available[key](profile)
@@ -762,9 +730,9 @@ def styled(evaluated: pd.DataFrame):
 def assumptions_table() -> pd.DataFrame:
     """Every registered assumption (``passmd.parameters.ASSUMPTIONS``) as a table.
 
-    Imports the experiment modules first, so assumptions they register are included.
+    Loads the experiments' topic modules first, so assumptions they register are included.
     """
-    _import_experiment_modules()
+    experiments.figure_names()
     return pd.DataFrame(
         [{"key": a.key, "symbol": a.symbol, "value": a.value, "unit": a.unit, "rationale": a.rationale,
           "effect on the results": a.sensitivity} for a in ASSUMPTIONS.values()]
@@ -823,7 +791,6 @@ def check_no_regressions(evaluated: pd.DataFrame, baseline: Mapping[str, str]) -
 # ======================================================================================
 
 
-@register_figure("closed_forms")
 def closed_form_results(profile: str = "quick") -> pd.DataFrame:
     """Closed-form contact stiffness 2aG* per side for R = 1 mm and 0.25 mm (profile-independent)."""
     check_choice("profile", profile, PROFILES)

@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd import ledger, reference
+from passmd import experiments, ledger, reference
 
 PAPER = Path(os.environ.get("PASSMD_PAPER", "/work/shared/paper/nguyen2018-passmd.md"))
 
@@ -53,10 +53,14 @@ def _write(tmp_path, rows, columns=ledger.CLAIM_COLUMNS):
 
 @pytest.fixture
 def registry(monkeypatch):
-    """Empty extractor and figure registries for the test (the real ones are restored after)."""
+    """Empty extractor and figure registries for the test (the real ones are restored after).
+
+    The topic modules are imported first, so they register into the real registries.
+    """
+    experiments.figure_names()
     extractors, figures = {}, {}
     monkeypatch.setattr(ledger, "_EXTRACTORS", extractors)
-    monkeypatch.setattr(ledger, "_FIGURES", figures)
+    monkeypatch.setattr(experiments, "FIGURES", figures)
     return extractors, figures
 
 
@@ -363,28 +367,27 @@ def test_a_regressing_verdict_fails(tmp_path, registry):
 # registries, results, presentation
 # --------------------------------------------------------------------------------------
 
-def test_collect_results_calls_registered_figures(registry):
+def test_collect_results_calls_every_available_figure(registry):
     calls = []
 
-    @ledger.register_figure("fig5a")
     def _fig5a(profile):
         calls.append(profile)
         return pd.DataFrame({"amplitude_nm": [1.0]})
 
-    assert list(ledger.collect_results("quick")) == ["fig5a"]
+    experiments.register_figure("fig5a", title="t", chapter="c", plot=None)(_fig5a)
+    results = ledger.collect_results("quick")
+    assert list(results) == ["fig5a", "closed_forms"]
     assert calls == ["quick"]
-    with pytest.raises(ValueError, match="PASSMD_PROFILE|profile = 'fast'"):
+    with pytest.raises(ValueError, match="profile = 'fast' is not allowed"):
         ledger.collect_results("fast")
-    with pytest.raises(ValueError, match="are not registered"):
+    with pytest.raises(ValueError, match="are not available"):
         ledger.collect_results("quick", figures=["fig9z"])
-    ledger.register_figure("fig5b")(lambda profile: [1, 2])
+    experiments.register_figure("fig5b", title="t", chapter="c", plot=None)(lambda profile: [1, 2])
     with pytest.raises(TypeError, match="not a DataFrame"):
         ledger.collect_results("quick", figures=["fig5b"])
 
 
 def test_registration_rules(registry):
-    with pytest.raises(ValueError, match="key = 'Figure 5' is not allowed"):
-        ledger.register_figure("Figure 5")
     with pytest.raises(ValueError, match="claim_id = 'Bad Id' is not allowed"):
         ledger.register_extractor("Bad Id")
 
