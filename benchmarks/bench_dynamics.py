@@ -1,8 +1,9 @@
 """Speed of the hybrid simulator: ns per integrator step and wall time per 100 Hz period.
 
-Runs each configuration (one/six contacts × rigid/flexible × exact/discrete N = 200) over
-one 100 Hz saw-tooth period at the default (converged) step, repeats, and reports medians.
-numba compilation happens in a warm-up run that is not timed.
+Runs each configuration (one/six contacts × rigid/flexible × exact/discrete N = 200;
+flexible both with the default adaptive step and with the fixed fine step) over one
+100 Hz saw-tooth period (150 nm, 0.4 N, R = 1 mm) at the default, converged step,
+repeats, and reports medians. numba compilation happens in an untimed warm-up run.
 
 Usage::
 
@@ -21,30 +22,34 @@ from passmd import dynamics, waveforms
 from passmd.parameters import Drive
 
 CONFIGS = [
-    (contacts, model, contact)
+    (contacts, model, contact, adaptive)
     for contacts in (1, 6)
     for model in ("rigid", "flexible")
     for contact in ("exact", "discrete")
+    for adaptive in ((True, False) if model == "flexible" else (True,))
 ]
 
 
-def bench(contacts: int, model: str, contact: str, repeats: int, springs: int = 200) -> dict:
+def bench(contacts: int, model: str, contact: str, adaptive: bool, repeats: int, springs: int = 200) -> dict:
     drive = Drive(contacts=contacts, actuator_model=model)
+    kw = dict(contact_model=contact, springs=springs, adaptive=adaptive)
     warm = waveforms.sawtooth(150e-9, 10e3, drive, periods=1)
-    dynamics.simulate(drive, warm, contact_model=contact, springs=springs)  # compile
+    dynamics.simulate(drive, warm, **kw)  # compile
     wf = waveforms.sawtooth(150e-9, 100.0, drive, periods=1)
     walls, steps = [], 0
     for _ in range(repeats):
-        res = dynamics.simulate(drive, wf, contact_model=contact, springs=springs, max_points=2000)
+        res = dynamics.simulate(drive, wf, max_points=2000, **kw)
         walls.append(res.wall_time)
         steps = res.steps
     wall = statistics.median(walls)
     return {
         "contacts": contacts,
         "actuator": model,
+        "step": ("adaptive" if adaptive else "fixed") if model == "flexible" else "fixed",
         "contact_model": contact if contact == "exact" else f"discrete N={springs}",
         "steps_per_period": steps,
-        "max_step_ns": res.max_step * 1e9,
+        "fine_step_ns": res.max_step * 1e9,
+        "coarse_step_ns": res.coarse_step * 1e9,
         "ns_per_step": wall / steps * 1e9,
         "ms_per_100Hz_period": wall * 1e3,
     }
@@ -55,16 +60,18 @@ def main(argv=None) -> int:
     ap.add_argument("--repeats", type=int, default=5, help="timed repeats per configuration (median)")
     ap.add_argument("--out", type=Path, default=Path(__file__).parent / "results" / "dynamics.json")
     args = ap.parse_args(argv)
-    rows = [bench(c, m, k, args.repeats) for c, m, k in CONFIGS]
+    rows = [bench(c, m, k, a, args.repeats) for c, m, k, a in CONFIGS]
     header = (
-        f"{'contacts':>8} {'actuator':>9} {'contact':>16} {'steps':>9} {'dt/ns':>7} "
+        f"{'contacts':>8} {'actuator':>9} {'step':>9} {'contact':>16} {'steps':>9} {'fine/ns':>7} {'coarse/ns':>9} "
         f"{'ns/step':>8} {'ms/period':>10}"
     )
     print(header)
     for r in rows:
         print(
-            f"{r['contacts']:>8} {r['actuator']:>9} {r['contact_model']:>16} {r['steps_per_period']:>9} "
-            f"{r['max_step_ns']:>7.2f} {r['ns_per_step']:>8.1f} {r['ms_per_100Hz_period']:>10.2f}"
+            f"{r['contacts']:>8} {r['actuator']:>9} {r['step']:>9} {r['contact_model']:>16} "
+            f"{r['steps_per_period']:>9}"
+            f"{r['fine_step_ns']:>7.2f} {r['coarse_step_ns']:>9.2f} {r['ns_per_step']:>8.1f} "
+            f"{r['ms_per_100Hz_period']:>10.2f}"
         )
     args.out.parent.mkdir(parents=True, exist_ok=True)
     meta = {

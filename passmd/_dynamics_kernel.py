@@ -7,8 +7,9 @@ Scheme: velocity Verlet (kick–drift–kick) on runner and actuators; the actua
 viscous term −c_p ẋ_a is treated with the trapezoidal rule in the velocity update
 (implicit in v, still explicit overall). The contact memory is updated exactly once
 per step, with the drifted positions, and the contact force is otherwise evaluated
-purely. Steps are uniform inside each piecewise-linear segment of x_p(t), so the
-waveform's corners fall on step boundaries.
+purely. Every corner of x_p(t) falls on a step boundary. With flexible actuators the step
+adapts: fine (resolving the ≈ 3 MHz actuator mode) while the actuators ring, coarse
+(a fraction of the explicit stability limit) while they follow quasi-statically.
 """
 
 from __future__ import annotations
@@ -45,10 +46,13 @@ def integrate(
     seg_t1,
     seg_x0,
     seg_x1,
-    seg_n,
+    seg_fine,
+    seg_coarse,
     seg_period,
     seg_window,
     seg_mark,
+    activity_threshold,
+    quiet_steps,
     runner_mass,
     load_stiffness,
     multiplicity,
@@ -66,10 +70,16 @@ def integrate(
     position_limit,
     velocity_limit,
 ):
-    """Integrate over all segments; returns (status, steps done, rows recorded).
+    """Integrate over all segments; returns (status, steps done, rows recorded, fine steps).
 
     ``y`` = [x_r, v_r, x_a(0..G−1), v_a(0..G−1)] is updated in place. ``record`` rows are
     [t, x_p, x_r, v_r, (x_a, T, slip share) per group].
+
+    Step control (flexible actuators): every segment starts with the fine step
+    ``seg_fine`` (a corner of x_p(t) excites the actuator mode). Once the largest
+    actuator acceleration |ẍ_a| has stayed below ``activity_threshold`` for
+    ``quiet_steps`` fine steps, the step grows to ``seg_coarse``; it falls back to fine
+    as soon as |ẍ_a| exceeds the threshold again. Rigid actuators: ``seg_fine`` only.
     """
     G = multiplicity.shape[0]
     x_r = y[0]
@@ -92,19 +102,19 @@ def integrate(
         T[g] = contact_force_row(params, state, g, u)
         u_old[g] = u
         F += multiplicity[g] * T[g]
-        a_nd[g] = (actuator_stiffness * (x_p - x_a[g]) - T[g]) / actuator_mass
-    a_r = (F - load_stiffness * x_r) / runner_mass
+        a_nd[g] = (actuator_stiffness * (x_p - x_a[g]) - T[g]) * inv_ma
+    a_r = (F - load_stiffness * x_r) * inv_mr
 
     n_rec = 0
     max_rec = record.shape[0]
     next_rec = t
     track = -1
     steps = 0
+    fine_steps = 0
     for s in range(seg_t0.shape[0]):
         k = seg_period[s]
-        n = seg_n[s]
-        dt = (seg_t1[s] - seg_t0[s]) / n
-        vp = (seg_x1[s] - seg_x0[s]) / (seg_t1[s] - seg_t0[s])
+        t_end = seg_t1[s]
+        vp = (seg_x1[s] - seg_x0[s]) / (t_end - seg_t0[s])
         if seg_mark[s]:
             track = k
             per[k, PER_MARK_XR] = x_r
@@ -112,8 +122,11 @@ def integrate(
         in_window = seg_window[s] != 0
         if in_window and track >= 0 and k > track:
             track = -1
-        damp = 1.0 / (1.0 + 0.5 * dt * gam)
-        half_dt2 = 0.5 * dt * dt
+        dt_fine = seg_fine[s]
+        dt_coarse = seg_coarse[s]
+        adaptive = (not rigid) and dt_coarse > dt_fine
+        fine = True
+        quiet = 0
         # segment-local accumulators (kept in registers, written back after the segment)
         acc_xr = 0.0
         acc_f = 0.0
@@ -121,10 +134,23 @@ def integrate(
         acc_in = 0.0
         acc_damp = 0.0
         acc_contact = 0.0
+        acc_t = 0.0
         min_xr = per[track, PER_MIN_XR] if track >= 0 else 0.0
-        for i in range(n):
-            t_new = seg_t0[s] + (i + 1) * dt
-            xp_new = seg_x0[s] + vp * (t_new - seg_t0[s])
+        done = False
+        while not done:
+            dt = dt_fine if fine else dt_coarse
+            remaining = t_end - t
+            if remaining <= dt * 1.000001:
+                dt = remaining
+                t_new = t_end
+                xp_new = seg_x1[s]
+                done = True
+            else:
+                t_new = t + dt
+                xp_new = seg_x0[s] + vp * (t_new - seg_t0[s])
+            if fine:
+                fine_steps += 1
+            half_dt2 = 0.5 * dt * dt
             xr_old = x_r
             F_old = F
             # drift
@@ -153,23 +179,41 @@ def integrate(
             v_r += 0.5 * dt * (a_r + a_r_new)
             a_r = a_r_new
             if not rigid:
+                damp = 1.0 / (1.0 + 0.5 * dt * gam)
+                activity = 0.0
                 for g in range(G):
                     a_new = (actuator_stiffness * (xp_new - x_a[g]) - T[g]) * inv_ma
                     v_old = v_a[g]
                     v_a[g] = (v_old + 0.5 * dt * (a_nd[g] - gam * v_old + a_new)) * damp
                     a_nd[g] = a_new
-                    acc_damp += multiplicity[g] * (v_old * v_old + v_a[g] * v_a[g])
+                    acc_damp += multiplicity[g] * (v_old * v_old + v_a[g] * v_a[g]) * dt
                     # work of the moving piezo base: k_p (x_p − x_a) dx_p, trapezoidal in (x_p − x_a)
-                    acc_in += multiplicity[g] * (stretch_old[g] + xp_new - x_a[g])
+                    acc_in += multiplicity[g] * (stretch_old[g] + xp_new - x_a[g]) * (xp_new - x_p)
+                    acc = abs(a_new - gam * v_a[g])
+                    if acc > activity:
+                        activity = acc
+                if adaptive:
+                    if fine:
+                        if activity < activity_threshold:
+                            quiet += 1
+                            if quiet >= quiet_steps:
+                                fine = False
+                        else:
+                            quiet = 0
+                    elif activity >= activity_threshold:
+                        fine = True
+                        quiet = 0
             # per-period measures
-            acc_xr += xr_old + x_r
-            acc_f += F_old + F
+            acc_xr += (xr_old + x_r) * dt
+            acc_f += (F_old + F) * dt
+            acc_t += dt
             if in_window:
-                acc_win += (xr_old - x_p) + (x_r - xp_new)
+                acc_win += ((xr_old - x_p) + (x_r - xp_new)) * dt
             if x_r < min_xr:
                 min_xr = x_r
             t = t_new
             x_p = xp_new
+            steps += 1
             # divergence (also catches NaN: comparisons with NaN are False)
             ok = abs(x_r) < position_limit and abs(v_r) < velocity_limit
             if not rigid:
@@ -178,7 +222,7 @@ def integrate(
             if not ok:
                 y[0] = x_r
                 y[1] = v_r
-                return STATUS_DIVERGED, steps + i + 1, n_rec
+                return STATUS_DIVERGED, steps, n_rec, fine_steps
             if t >= next_rec and n_rec < max_rec:
                 record[n_rec, 0] = t
                 record[n_rec, 1] = x_p
@@ -191,25 +235,23 @@ def integrate(
                 n_rec += 1
                 while next_rec <= t:
                     next_rec += record_interval
-        steps += n
-        per[k, PER_XR_INTEGRAL] += 0.5 * dt * acc_xr
-        per[k, PER_FRICTION_INTEGRAL] += 0.5 * dt * acc_f
-        per[k, PER_DURATION] += n * dt
+        per[k, PER_XR_INTEGRAL] += 0.5 * acc_xr
+        per[k, PER_FRICTION_INTEGRAL] += 0.5 * acc_f
+        per[k, PER_DURATION] += acc_t
         if in_window:
-            per[k, PER_WINDOW_INTEGRAL] += 0.5 * dt * acc_win
-            per[k, PER_WINDOW_LENGTH] += n * dt
+            per[k, PER_WINDOW_INTEGRAL] += 0.5 * acc_win
+            per[k, PER_WINDOW_LENGTH] += acc_t
+            per[k, PER_WINDOW_END_XP] = seg_x1[s]
         if track >= 0:
             per[track, PER_MIN_XR] = min_xr
         energy[EN_CONTACT] += acc_contact
         if rigid:
             energy[EN_INPUT] += acc_in
         else:
-            energy[EN_INPUT] += actuator_stiffness * 0.5 * vp * dt * acc_in
-            energy[EN_DAMPING] += actuator_viscosity * 0.5 * dt * acc_damp
-        if in_window:
-            per[k, PER_WINDOW_END_XP] = seg_x1[s]
+            energy[EN_INPUT] += actuator_stiffness * 0.5 * acc_in
+            energy[EN_DAMPING] += actuator_viscosity * 0.5 * acc_damp
     y[0] = x_r
     y[1] = v_r
     y[2 : 2 + G] = x_a
     y[2 + G : 2 + 2 * G] = v_a
-    return STATUS_OK, steps, n_rec
+    return STATUS_OK, steps, n_rec, fine_steps

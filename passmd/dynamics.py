@@ -36,8 +36,16 @@ from passmd.parameters import Drive
 from passmd.theory import contact_moduli, normal_forces
 from passmd.waveforms import Waveform
 
-#: Steps per period of the stiffest linearised mode (flexible actuators).
-STEPS_PER_STIFF_PERIOD = 24
+#: Fine steps per period of the stiffest linearised mode (flexible actuators).
+STEPS_PER_STIFF_PERIOD = 96
+#: Coarse step (flexible actuators, while they follow quasi-statically) as ω_max·dt.
+#: Verlet is stable up to 2; 1.5 keeps a 25 % margin (the contact stiffness never exceeds 2aG*).
+COARSE_OMEGA_DT = 1.5
+#: Actuator ringing amplitude (m) below which the coarse step is used; the switch tests
+#: the actuator acceleration against ω_max² times this.
+RINGING_TOLERANCE = 1e-12
+#: Quiet stiff-mode periods (at the fine step) before the step grows.
+QUIET_PERIODS = 2
 #: Steps per period of the runner-on-contacts mode (rigid actuators).
 STEPS_PER_RUNNER_PERIOD = 400
 #: Minimum number of steps on every linear piece of x_p(t) (resolves the fly-back).
@@ -54,9 +62,12 @@ class SimulationError(RuntimeError):
 class StepPlan:
     """How the integrator discretises time for one drive."""
 
-    max_step: float  # largest step (s)
+    max_step: float  # fine step: resolves the stiffest mode (s)
+    coarse_step: float  # step while the actuators do not ring (s); = max_step for rigid actuators
     stiffest_frequency: float  # frequency of the stiffest linearised mode (Hz)
     stability_limit: float  # Verlet stability limit 2/ω of that mode (s)
+    activity_threshold: float  # actuator acceleration that counts as ringing (m/s²)
+    quiet_steps: int  # fine steps below the threshold before the step grows
 
 
 def contact_groups(drive: Drive, share_side_state: bool = True):
@@ -76,7 +87,7 @@ def contact_groups(drive: Drive, share_side_state: bool = True):
 def step_plan(
     drive: Drive, contact_stiffness_max: float, total_contact_stiffness: float, resolution: float = 1.0
 ) -> StepPlan:
-    """Largest time step from the parameters (flexible: actuator mode; rigid: runner mode).
+    """Time steps from the parameters (flexible: actuator mode; rigid: runner mode).
 
     Parameters
     ----------
@@ -92,11 +103,22 @@ def step_plan(
     act = drive.actuator
     if drive.actuator_model == "flexible":
         omega = np.sqrt((act.stiffness + contact_stiffness_max) / act.mass)
-        dt = 2 * np.pi / omega / STEPS_PER_STIFF_PERIOD
+        dt = 2 * np.pi / omega / STEPS_PER_STIFF_PERIOD / resolution
+        coarse = COARSE_OMEGA_DT / omega / resolution
+        threshold = omega**2 * RINGING_TOLERANCE
+        quiet = int(np.ceil(QUIET_PERIODS * STEPS_PER_STIFF_PERIOD * resolution))
     else:
         omega = np.sqrt((total_contact_stiffness + drive.effective_load_cell_stiffness) / drive.runner_mass)
-        dt = 2 * np.pi / omega / STEPS_PER_RUNNER_PERIOD
-    return StepPlan(dt / resolution, float(omega / (2 * np.pi)), float(2.0 / omega))
+        dt = 2 * np.pi / omega / STEPS_PER_RUNNER_PERIOD / resolution
+        coarse, threshold, quiet = dt, 0.0, 0
+    return StepPlan(
+        float(dt),
+        float(max(coarse, dt)),
+        float(omega / (2 * np.pi)),
+        float(2.0 / omega),
+        float(threshold),
+        quiet,
+    )
 
 
 @dataclass
@@ -140,7 +162,9 @@ class SimulationResult:
     period_mean_friction: np.ndarray
     energy: dict
     steps: int
+    fine_steps: int
     max_step: float
+    coarse_step: float
     wall_time: float
     final_state: np.ndarray = field(repr=False)
 
@@ -209,7 +233,9 @@ class SimulationResult:
             "frequency_Hz": float(self.waveform.frequency),
             "amplitude_m": float(self.waveform.amplitude),
             "integrator_steps": int(self.steps),
-            "max_time_step_s": float(self.max_step),
+            "fine_steps": int(self.fine_steps),
+            "fine_time_step_s": float(self.max_step),
+            "coarse_time_step_s": float(self.coarse_step),
         }
         if self.settled_positions.size >= 2:
             out["mean_velocity_m_per_s"] = self.mean_velocity
@@ -234,10 +260,12 @@ class SimulationResult:
         return pd.DataFrame(data)
 
 
-def _segments(waveform: Waveform, max_step: float):
+def _segments(waveform: Waveform, fine_step: float, coarse_step: float):
     t, x = waveform.times, waveform.positions
     t0, t1, x0, x1 = t[:-1], t[1:], x[:-1], x[1:]
-    n = np.maximum(MIN_SEGMENT_STEPS, np.ceil((t1 - t0) / max_step)).astype(np.int64)
+    shortest = (t1 - t0) / MIN_SEGMENT_STEPS
+    fine = np.minimum(fine_step, shortest)
+    coarse = np.minimum(coarse_step, shortest)
     period = np.minimum((t0 / waveform.period + 1e-9).astype(np.int64), waveform.periods - 1)
     starts = waveform.settle_windows[:, 0]
     ends = waveform.settle_windows[:, 1]
@@ -245,7 +273,7 @@ def _segments(waveform: Waveform, max_step: float):
     for ws, we in zip(starts, ends, strict=True):
         window[(t0 >= ws) & (t1 <= we)] = 1
     mark = np.isin(t0, waveform.slip_marks).astype(np.int64)
-    return t0, t1, x0, x1, n, period, window, mark
+    return t0, t1, x0, x1, fine, coarse, period, window, mark
 
 
 def simulate(
@@ -258,6 +286,7 @@ def simulate(
     resolution: float = 1.0,
     max_points: int = 20000,
     share_side_state: bool = True,
+    adaptive: bool = True,
 ) -> SimulationResult:
     """Simulate the drive under a piezo waveform from rest with virgin contacts.
 
@@ -272,14 +301,17 @@ def simulate(
     springs : int
         Number of MDR springs for the discrete model.
     dt : float, optional
-        Largest time step in s; default from :func:`step_plan`. Must stay below the
-        Verlet stability limit of the stiffest mode.
+        Fixed time step in s (no adaptation); default: the steps of :func:`step_plan`.
+        Must stay below the Verlet stability limit of the stiffest mode.
     resolution : float
         Divides the default step (convergence studies); ignored when ``dt`` is given.
     max_points : int
         Number of recorded samples (evenly spaced in time).
     share_side_state : bool
         Six contacts: one state per side (default) or six independent contacts.
+    adaptive : bool
+        Flexible actuators: coarse steps while the actuators do not ring (default);
+        ``False`` integrates with the fine step throughout.
 
     Raises
     ------
@@ -315,6 +347,7 @@ def simulate(
     k_contacts = np.array([contact_stiffness(params[g]) for g in range(len(rows))])
     plan = step_plan(drive, float(k_contacts.max()), float(np.sum(multiplicity * k_contacts)), resolution)
     max_step = plan.max_step
+    coarse_step = plan.coarse_step if adaptive else plan.max_step
     if dt is not None:
         check_positive("dt", dt, "s")
         limit = STABILITY_MARGIN * plan.stability_limit
@@ -323,18 +356,20 @@ def simulate(
                 f"dt = {dt!r} is out of range: the stiffest mode ({plan.stiffest_frequency / 1e6:.3g} MHz) "
                 f"needs dt < {limit:.3g} s for the explicit integrator to stay stable"
             )
-        max_step = float(dt)
+        max_step = coarse_step = float(dt)
 
     G = multiplicity.size
     y = np.zeros(2 + 2 * G)
     record = np.empty((int(max_points), 4 + 3 * G))
     per = np.zeros((waveform.periods, kern.PER_COLUMNS))
     energy = np.zeros(kern.EN_COLUMNS)
-    segs = _segments(waveform, max_step)
+    segs = _segments(waveform, max_step, coarse_step)
     record_interval = waveform.duration / (max_points - 1)
     start = _time.perf_counter()
-    status, steps, n_rec = kern.integrate(
+    status, steps, n_rec, fine_steps = kern.integrate(
         *segs,
+        plan.activity_threshold,
+        plan.quiet_steps,
         drive.runner_mass,
         drive.effective_load_cell_stiffness,
         multiplicity.astype(float),
@@ -355,7 +390,7 @@ def simulate(
     wall = _time.perf_counter() - start
     if status != kern.STATUS_OK:
         raise SimulationError(
-            f"simulation diverged at integrator step {steps} (t = {steps * max_step:.3g} s or earlier): "
+            f"simulation diverged at integrator step {steps}: "
             f"runner position {y[0]!r} m, velocity {y[1]!r} m/s. Likely cause: a time step too large for "
             f"the stiffest mode ({plan.stiffest_frequency:.3g} Hz, stable below "
             f"{plan.stability_limit:.3g} s; "
@@ -391,7 +426,9 @@ def simulate(
             "contact": float(energy[kern.EN_CONTACT]),
         },
         steps=int(steps),
+        fine_steps=int(fine_steps),
         max_step=float(max_step),
+        coarse_step=float(coarse_step),
         wall_time=wall,
         final_state=y.copy(),
     )
