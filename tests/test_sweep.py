@@ -241,3 +241,63 @@ def test_progress_quiet_off_tty_and_in_ci(monkeypatch):
     assert sweep.progress_enabled(True, object())
     monkeypatch.setenv("CI", "true")
     assert not sweep.progress_enabled(None, Tty())
+
+
+SIGINT_SCRIPT = """
+import sys, time
+from passmd import sweep
+from passmd.cache import Cache
+
+
+def slow(x, log):
+    with open(log, "a") as fh:
+        fh.write(f"{x}\\n")
+    time.sleep(0.4)
+    return {"y": x + 0.5}
+
+
+if __name__ == "__main__":
+    cache_dir, log = sys.argv[1], sys.argv[2]
+    points = [{"x": x, "log": log} for x in range(int(sys.argv[3]))]
+    try:
+        frame = sweep.run(slow, points, executor="process", workers=2, cache=Cache(cache_dir))
+    except KeyboardInterrupt:
+        print("interrupted", flush=True)
+        sys.exit(130)
+    print(frame.attrs["sweep"]["computed"], flush=True)
+"""
+
+
+def test_ctrl_c_stops_a_process_pool_sweep_and_rerun_resumes(tmp_path):
+    """A real SIGINT to the whole process group, as a terminal's Ctrl-C sends it."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    script, log, cache_dir = tmp_path / "sweep_script.py", tmp_path / "log.txt", tmp_path / "cache"
+    script.write_text(SIGINT_SCRIPT)
+    n = 20
+    cmd = [sys.executable, str(script), str(cache_dir), str(log), str(n)]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    store = Cache(cache_dir)
+    deadline = time.monotonic() + 60
+    while len(store.entries()) < 2 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert len(store.entries()) >= 2, "the sweep did not get going"
+    os.killpg(proc.pid, signal.SIGINT)
+    out, err = proc.communicate(timeout=30)  # stops promptly: pending points are cancelled
+    assert proc.returncode == 130, err
+    assert out.strip() == "interrupted"
+    assert "Traceback" not in err
+    finished = len(store.entries())
+    assert 2 <= finished < n
+    assert not list(cache_dir.glob("??/*.tmp"))  # no half-written entry
+    started = len(evaluations(log))
+
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert int(done.stdout) == n - finished  # the rerun computed only the missing points
+    assert len(evaluations(log)) == started + n - finished
+    assert len(store.entries()) == n
