@@ -62,8 +62,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     rows = [bench(c, m, k, a, args.repeats) for c, m, k, a in CONFIGS]
     header = (
-        f"{'contacts':>8} {'actuator':>9} {'step':>9} {'contact':>16} {'steps':>9} {'fine/ns':>7} {'coarse/ns':>9} "
-        f"{'ns/step':>8} {'ms/period':>10}"
+        f"{'contacts':>8} {'actuator':>9} {'step':>9} {'contact':>16} {'steps':>9} "
+        f"{'fine/ns':>7} {'coarse/ns':>9} {'ns/step':>8} {'ms/period':>10}"
     )
     print(header)
     for r in rows:
