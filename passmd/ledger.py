@@ -65,6 +65,7 @@ __all__ = [
     "check_threshold",
     "check_trend",
     "check_value",
+    "claims_for",
     "collect_results",
     "curve_deviation",
     "evaluate",
@@ -72,6 +73,7 @@ __all__ = [
     "result_sources",
     "load_baseline",
     "load_claims",
+    "orphan_extractors",
     "register_extractor",
     "regressions",
     "styled",
@@ -623,8 +625,9 @@ def evaluate(
         ``{figure key: DataFrame}``, e.g. from :func:`collect_results`.
     strict : bool
         If True (default), raise ``LookupError`` when a claim's results are present but no
-        extractor is registered for it, or an extractor is registered for an unknown claim.
-        If False, such claims are *not evaluated* with that note.
+        extractor is registered for it. If False, such claims are *not evaluated* with that
+        note. (Extractors registered for ids that are not in claims.csv are reported by
+        :func:`orphan_extractors`.)
 
     Returns
     -------
@@ -635,9 +638,6 @@ def evaluate(
     """
     registered = extractors()
     problems = []
-    if strict:
-        unknown = sorted(set(registered) - set(claims["id"]))
-        problems.extend(f"an extractor is registered for unknown claim {c!r}" for c in unknown)
     rows = []
     for _, claim in claims.iterrows():
         missing = [k for k in claim["requires"].split(";") if k and k not in results]
@@ -681,6 +681,26 @@ def evaluate(
     if problems:
         raise LookupError("ledger evaluation is incomplete:\n  " + "\n  ".join(problems))
     return pd.DataFrame(rows, columns=list(LEDGER_COLUMNS))
+
+
+def claims_for(claims: pd.DataFrame, figures) -> pd.DataFrame:
+    """The claims that need only the given result keys, e.g. a chapter's own ledger rows.
+
+    ``claims_for(load_claims(), ["fig5a", "fig5b"])`` selects the claims whose ``requires``
+    are all among ``fig5a`` and ``fig5b``.
+    """
+    keys = {figures} if isinstance(figures, str) else set(figures)
+    needed = claims["requires"].str.split(";").map(lambda parts: {p for p in parts if p})
+    return claims[needed.map(lambda parts: parts <= keys)].reset_index(drop=True)
+
+
+def orphan_extractors(claims: pd.DataFrame | None = None) -> list[str]:
+    """Ids with a registered extractor but no row in ``claims`` (default: claims.csv).
+
+    A non-empty list means a claim was renamed or an extractor misspelt its id.
+    """
+    ids = set((load_claims() if claims is None else claims)["id"])
+    return sorted(set(extractors()) - ids)
 
 
 def summary(evaluated: pd.DataFrame) -> str:
