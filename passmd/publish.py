@@ -8,6 +8,9 @@
   optionally with the data link.
 * :func:`to_unit` and :func:`format_quantity` convert SI values to the units shown at the
   edges (nm, N, mN, mm, kHz, mm/s, ...); conversions are done by ``pint``.
+* :func:`parameter_frame`, :func:`assumptions_frame` and :func:`implementations` turn the
+  package's own records (parameter sets, the assumptions registry, the functions that
+  implement each equation) into tables, so the book never retypes them.
 
 Markdown is returned as :class:`Markdown`, a ``str`` that Jupyter displays as markdown
 (myst-nb parses it as MyST because the book sets ``nb_render_markdown_format: myst``).
@@ -15,7 +18,11 @@ Markdown is returned as :class:`Markdown`, a ``str`` that Jupyter displays as ma
 
 from __future__ import annotations
 
+import dataclasses
+import importlib
+import inspect
 import os
+import pkgutil
 import re
 from functools import lru_cache
 from pathlib import Path
@@ -25,15 +32,19 @@ import numpy as np
 from passmd._validation import check_choice
 
 __all__ = [
+    "DISPLAY_UNITS",
     "PROFILES",
     "PROFILE_ENV",
     "Markdown",
+    "assumptions_frame",
     "book_root",
     "caption",
     "current_profile",
     "data_link",
     "drive_parameters",
     "format_quantity",
+    "implementations",
+    "parameter_frame",
     "to_unit",
 ]
 
@@ -212,3 +223,139 @@ def caption(text: str, *, drive=None, data=None, name: str | None = None, **extr
     if data is not None:
         parts.append(f"Data: {data_link(data, name)}.")
     return Markdown(" ".join(parts))
+
+
+#: Display units of parameter-table rows whose SI value reads badly (by dotted field name).
+DISPLAY_UNITS = {
+    "hemisphere_radius": "mm",
+    "runner_mass": "g",
+    "hemisphere_material.youngs_modulus": "GPa",
+    "runner_material.youngs_modulus": "GPa",
+    "youngs_modulus": "GPa",
+    "actuator.mass": "g",
+    "mass": "g",
+    "actuator.full_stroke_amplitude": "nm",
+    "full_stroke_amplitude": "nm",
+    "amplifier.slew_rate": "V/µs",
+    "slew_rate": "V/µs",
+}
+
+
+def parameter_frame(*records, labels=None, units=None):
+    """A parameter record (or several side by side) as a table in display units.
+
+    Parameters
+    ----------
+    *records
+        Parameter dataclasses (e.g. two :class:`passmd.parameters.Drive`), read with
+        :func:`passmd.parameters.parameter_table`.
+    labels : list of str, optional
+        Column titles of the records' values; default ``value`` (one record) or
+        ``value 1``, ``value 2``, ...
+    units : dict, optional
+        Dotted field name → display unit; default :data:`DISPLAY_UNITS`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``parameter``, ``symbol``, the value column(s), ``unit``, ``source``.
+    """
+    import pandas as pd
+
+    from passmd.parameters import parameter_table
+
+    if not records:
+        raise ValueError("records is empty: give at least one parameter record")
+    units = DISPLAY_UNITS if units is None else units
+    if labels is None:
+        labels = ["value"] if len(records) == 1 else [f"value {i + 1}" for i in range(len(records))]
+    if len(labels) != len(records):
+        raise ValueError(f"labels = {labels!r} is not allowed: must have one label per record")
+    tables = [parameter_table(record) for record in records]
+    names = [row["name"] for row in tables[0]]
+    if any([row["name"] for row in table] != names for table in tables[1:]):
+        raise ValueError("records are not allowed: they must be of the same type")
+    rows = []
+    for i, name in enumerate(names):
+        first = tables[0][i]
+        unit = units.get(name, first["unit"])
+        row = {"parameter": name, "symbol": first["symbol"]}
+        for label, table in zip(labels, tables, strict=True):
+            value = table[i]["value"]
+            if isinstance(value, (int, float, np.floating)) and not isinstance(value, bool):
+                value = f"{to_unit(value, unit) if unit != first['unit'] else value:.4g}"
+            row[label] = value
+        row["unit"] = unit
+        row["source"] = first["source"]
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def _import_package_modules() -> None:
+    """Import every module of passmd, so each registers its assumptions."""
+    import passmd
+
+    for module in pkgutil.walk_packages(passmd.__path__, prefix="passmd."):
+        if not module.name.endswith("__main__"):  # running it would start the CLI
+            importlib.import_module(module.name)
+
+
+def assumptions_frame():
+    """Every assumption in :data:`passmd.parameters.ASSUMPTIONS` as a table.
+
+    Imports all of passmd first, so assumptions registered by any module are included.
+    """
+    import pandas as pd
+
+    from passmd.parameters import ASSUMPTIONS
+
+    _import_package_modules()
+    return pd.DataFrame([dataclasses.asdict(a) for a in ASSUMPTIONS.values()])
+
+
+def implementations(mapping: dict[str, str | list[str]]):
+    """Table of the code implementing each equation, checked against the package.
+
+    Parameters
+    ----------
+    mapping : dict
+        Equation label (e.g. ``"Eq. (1)"``) → dotted name(s) of the implementing function,
+        class or method (e.g. ``"passmd.theory.normal_forces"``). Every name is imported,
+        so a renamed function fails the book build instead of leaving a stale reference.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``equation``, ``implemented by`` (the dotted name) and ``summary`` (first
+        paragraph of its docstring).
+    """
+    import pandas as pd
+
+    rows = []
+    for equation, names in mapping.items():
+        for dotted in [names] if isinstance(names, str) else names:
+            doc = inspect.getdoc(_resolve(dotted)) or ""
+            rows.append(
+                {
+                    "equation": equation,
+                    "implemented by": dotted,
+                    "summary": doc.split("\n\n")[0].replace("\n", " "),
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+def _resolve(dotted: str):
+    """The object a dotted name such as ``passmd.theory.normal_forces`` refers to."""
+    parts = dotted.split(".")
+    for cut in range(len(parts), 0, -1):
+        try:
+            obj = importlib.import_module(".".join(parts[:cut]))
+        except ModuleNotFoundError:
+            continue
+        for attr in parts[cut:]:
+            if not hasattr(obj, attr):
+                raise ValueError(f"name = {dotted!r} is not defined: {attr!r} not found")
+            obj = getattr(obj, attr)
+        return obj
+    raise ValueError(f"name = {dotted!r} is not defined: no such module")

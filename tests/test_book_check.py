@@ -79,6 +79,7 @@ def test_good_page_has_no_problems():
         ({"traceback_in_text": True}, "traceback"),
         ({"math_rendered": 1}, "not rendered"),
         ({"mathjax_loaded": False}, "MathJax did not load"),
+        ({"math_errors": ["Undefined control sequence \\badmacro"]}, "MathJax error"),
         ({"raw_tex": ["$$ x $$"]}, "raw TeX"),
         ({"fonts_failed": ["MJXTEX"]}, "web font"),
         ({"external_resources": ["https://cdn.example/x.js"]}, "network resource"),
@@ -174,6 +175,7 @@ def test_check_fails_on_missing_figure_and_cell_error(broken_book_results):
     assert any("broken image" in p and "missing_figure.png" in p for p in problems), problems
     assert any("execution error" in p and "deliberate cell error" in p for p in problems), problems
     assert any("ledger table" in p for p in problems), problems
+    assert any("MathJax error" in p and "frac" in p for p in problems), problems
 
 
 @pytest.mark.slow

@@ -147,3 +147,52 @@ def test_caption_needs_data_and_name_together(book):
         publish.caption("x", data=pd.DataFrame({"a": [1]}))
     with pytest.raises(ValueError, match="data and name"):
         publish.caption("x", name="a")
+
+
+# ----------------------------------------------------------------------------- tables
+
+
+def test_parameter_frame_side_by_side_in_display_units():
+    big, small = paper_drive(1e-3), paper_drive(0.25e-3)
+    df = publish.parameter_frame(big, small, labels=["1 mm", "0.25 mm"])
+    assert list(df.columns) == ["parameter", "symbol", "1 mm", "0.25 mm", "unit", "source"]
+    row = df.set_index("parameter")
+    assert row.loc["hemisphere_radius", "unit"] == "mm"
+    assert (row.loc["hemisphere_radius", "1 mm"], row.loc["hemisphere_radius", "0.25 mm"]) == ("1", "0.25")
+    assert row.loc["runner_mass", "1 mm"] == "3" and row.loc["runner_mass", "unit"] == "g"
+    assert row.loc["actuator.stiffness", "0.25 mm"] == "4e+06"  # Table 2, R = 0.25 mm
+    assert row.loc["runner_material.youngs_modulus", "1 mm"] == "210"  # GPa, Table 1
+    assert row.loc["actuator_model", "1 mm"] == "flexible"
+
+
+def test_parameter_frame_rejects_bad_input():
+    with pytest.raises(ValueError, match="records is empty"):
+        publish.parameter_frame()
+    with pytest.raises(ValueError, match="labels"):
+        publish.parameter_frame(paper_drive(), labels=["a", "b"])
+    with pytest.raises(ValueError, match="same type"):
+        publish.parameter_frame(paper_drive(), paper_drive().amplifier)
+
+
+def test_assumptions_frame_holds_every_registered_assumption():
+    from passmd.parameters import ASSUMPTIONS
+
+    df = publish.assumptions_frame()
+    assert list(df.columns) == ["key", "symbol", "value", "unit", "rationale", "sensitivity"]
+    assert set(df["key"]) == set(ASSUMPTIONS)  # after importing every module
+    assert {"actuator_viscosity", "preload_grids"} <= set(df["key"])
+
+
+def test_implementations_resolve_names_and_fail_on_stale_ones():
+    df = publish.implementations({
+        "Eq. (1)": "passmd.theory.normal_forces",
+        "Eq. (6)": ["passmd.contact.MDRContact", "passmd.contact.MDRContact.path"],
+    })
+    assert list(df["implemented by"]) == [
+        "passmd.theory.normal_forces", "passmd.contact.MDRContact", "passmd.contact.MDRContact.path"
+    ]
+    assert "Eq. 1" in df["summary"].iloc[0]
+    with pytest.raises(ValueError, match="'no_such_function' not found"):
+        publish.implementations({"Eq. (1)": "passmd.theory.no_such_function"})
+    with pytest.raises(ValueError, match="no such module"):
+        publish.implementations({"Eq. (1)": "nosuchpackage.f"})

@@ -9,8 +9,8 @@ all network requests blocked) with the system's Chromium driven by selenium, and
 * lacks its ledger table (``table.passmd-ledger`` with at least one row) where expected,
 * shows an execution error or stderr output (myst-nb ``.output.traceback`` / ``.output.stderr``
   blocks, or a Python traceback anywhere in the text),
-* leaves math unrendered (a ``.math`` element without MathJax output, raw ``$$``/``\\(``/``\\[``
-  in the text) or a web font that failed to load,
+* leaves math unrendered (a ``.math`` element without MathJax output, a MathJax error, raw
+  ``$$``/``\\(``/``\\[`` in the text) or a web font that failed to load,
 * tries to load anything from the network (the book must display offline).
 
 What a page must show comes from its ``passmd-expect`` meta tag, set in the chapter's front
@@ -90,6 +90,8 @@ const ledgerSelector = arguments[0];
     traceback_in_text: text.includes('Traceback (most recent call last)'),
     math_total: maths.length,
     math_rendered: maths.filter(m => m.querySelector('mjx-container')).length,
+    math_errors: Array.from(root.querySelectorAll('mjx-merror'))
+      .map(e => (e.getAttribute('data-mjx-error') || e.textContent).slice(0, 120)),
     mathjax_loaded: !!(window.MathJax && MathJax.startup),
     raw_tex: rawTex.slice(0, 5),
     ledger_tables: Array.from(root.querySelectorAll(ledgerSelector))
@@ -176,6 +178,8 @@ def page_problems(facts: dict) -> list[str]:
         missing = facts["math_total"] - facts.get("math_rendered", 0)
         if missing:
             problems.append(f"{missing} of {facts['math_total']} math element(s) not rendered by MathJax")
+    for message in facts.get("math_errors", []):
+        problems.append(f"MathJax error: {message}")
     for snippet in facts.get("raw_tex", []):
         problems.append(f"raw TeX left in the page: {snippet!r}")
     for family in facts.get("fonts_failed", []):
