@@ -104,7 +104,8 @@ def step_plan(
     if drive.actuator_model == "flexible":
         omega = np.sqrt((act.stiffness + contact_stiffness_max) / act.mass)
         dt = 2 * np.pi / omega / STEPS_PER_STIFF_PERIOD / resolution
-        coarse = COARSE_OMEGA_DT / omega / resolution
+        # never beyond COARSE_OMEGA_DT/ω: a resolution < 1 coarsens the fine step only
+        coarse = COARSE_OMEGA_DT / omega / max(resolution, 1.0)
         threshold = omega**2 * RINGING_TOLERANCE
         quiet = int(np.ceil(QUIET_PERIODS * STEPS_PER_STIFF_PERIOD * resolution))
     else:
