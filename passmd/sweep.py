@@ -318,7 +318,8 @@ def run(
     executor : {"process", "serial", "dask"} or concurrent.futures.Executor, optional
         Where to run. ``"dask"`` connects to ``scheduler`` or starts a local cluster.
         Default: ``$PASSMD_EXECUTOR``, else ``"dask"`` if a scheduler is known, else
-        ``"process"``.
+        ``"process"``. A process pool with a single point left to compute evaluates it
+        in this process (no pool start-up for one point).
     scheduler : str, optional
         Dask scheduler address, e.g. ``"tcp://10.0.0.5:8786"`` (implies ``"dask"``).
         Default: ``$PASSMD_SCHEDULER`` unless another executor was asked for.

@@ -10,13 +10,14 @@ import concurrent.futures as cf
 import time
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 
 from passmd import sweep
 from passmd.cache import Cache
 from passmd.parameters import Drive
-from passmd.theory import drive_theory
+from passmd.theory import contact_moduli, drive_theory
 
 
 def logged_square(x, log):
@@ -113,6 +114,32 @@ def test_dask_scheduler_address(serial_theory):
         frame = sweep.run(sweep.drive_theory_point, THEORY_GRID, scheduler=cluster.scheduler_address,
                           cache=False)
     pd.testing.assert_frame_equal(frame, serial_theory, check_exact=True)
+
+
+def contact_path_point(normal_force, springs):
+    """Forces of one MDR contact along a fixed path (a small-array result)."""
+    from passmd.contact import MDRContact
+
+    path = np.array([0.0, 30e-9, -10e-9, 45e-9, 5e-9])
+    E_star, G_star = contact_moduli(Drive())
+    return {"force_N": MDRContact(normal_force, 1e-3, E_star, G_star, 0.2, springs=springs).path(path)}
+
+
+def test_simulations_and_arrays_identical_across_executors():
+    """numba kernels in worker processes give bit-identical results to this process."""
+    drive = Drive(contacts=1, actuator_model="rigid")
+    runs = [{"drive": drive, "amplitude": a, "frequency": 100.0, "periods": 2} for a in (50e-9, 120e-9)]
+    serial = sweep.run(sweep.sawtooth_point, runs, executor="serial", cache=False)
+    pooled = sweep.run(sweep.sawtooth_point, runs, executor="process", workers=2, cache=False)
+    pd.testing.assert_frame_equal(pooled, serial, check_exact=True)
+    assert serial["mean_step_m"].iloc[1] > serial["mean_step_m"].iloc[0]
+
+    paths = sweep.grid(normal_force=[0.2, 0.4], springs=[None, 100])
+    serial = sweep.run(contact_path_point, paths, executor="serial", cache=False)
+    for executor in ("process", "dask"):
+        other = sweep.run(contact_path_point, paths, executor=executor, workers=2, cache=False)
+        for a, b in zip(serial["force_N"], other["force_N"], strict=True):
+            np.testing.assert_array_equal(a, b)
 
 
 def test_caller_owned_executor(serial_theory):
