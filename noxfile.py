@@ -70,6 +70,9 @@ def book(session: nox.Session) -> None:
     # Chapter kernels must use Jupyter's inline backend (with e.g. MPLBACKEND=Agg inherited
     # from the shell, their figures would silently not be displayed).
     env = {"PASSMD_PROFILE": profile, "MPLBACKEND": "module://matplotlib_inline.backend_inline"}
+    # Chapters run in book/; keep the simulation cache at the repository root, shared with
+    # the CLI (`passmd figure` computes the same points), unless the user chose a place.
+    env["PASSMD_CACHE_DIR"] = os.environ.get("PASSMD_CACHE_DIR") or os.path.abspath(".passmd-cache")
     # Validate the profile with the package's own check, and build matplotlib's font cache
     # now: its first-use notice on a fresh machine would otherwise be a stderr warning
     # inside the first chapter and fail the -W build.
