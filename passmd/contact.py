@@ -93,6 +93,7 @@ __all__ = [
     "contact_update",
     "contact_update_row",
     "discrete_indentation",
+    "memory_diagnostics",
     "sliding_force",
     "stack_contacts",
 ]
@@ -287,6 +288,20 @@ def _slip_many(params, state, us):
     for i in range(us.size):
         out[i] = contact_slip_share(params, state, us[i])
     return out
+
+
+def memory_diagnostics(params, state) -> dict:
+    """Reversals recorded, deepest stack and overflows of one exact contact (zeros for discrete).
+
+    ``params``/``state`` are one contact's arrays (a row of :func:`stack_contacts`).
+    """
+    if params[P_MODEL] != EXACT:
+        return {"reversals": 0, "max_depth": 0, "overflows": 0}
+    return {
+        "reversals": int(state[S_REVERSALS]),
+        "max_depth": int(state[S_MAXDEPTH]),
+        "overflows": int(state[S_OVERFLOW]),
+    }
 
 
 class MDRContact:

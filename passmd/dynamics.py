@@ -31,7 +31,7 @@ import numpy as np
 
 from passmd import _dynamics_kernel as kern
 from passmd._validation import check_choice, check_positive, check_range
-from passmd.contact import contact_arrays, contact_stiffness, stack_contacts
+from passmd.contact import contact_arrays, contact_stiffness, memory_diagnostics, stack_contacts
 from passmd.parameters import Drive
 from passmd.theory import contact_moduli, normal_forces
 from passmd.waveforms import Waveform
@@ -167,6 +167,7 @@ class SimulationResult:
     max_step: float
     coarse_step: float
     wall_time: float
+    contact_memory: list = field(repr=False)  # per group: reversals, deepest stack, overflows
     final_state: np.ndarray = field(repr=False)
 
     @property
@@ -235,6 +236,7 @@ class SimulationResult:
             "amplitude_m": float(self.waveform.amplitude),
             "integrator_steps": int(self.steps),
             "fine_steps": int(self.fine_steps),
+            "contact_memory_overflows": int(sum(m["overflows"] for m in self.contact_memory)),
             "fine_time_step_s": float(self.max_step),
             "coarse_time_step_s": float(self.coarse_step),
         }
@@ -431,5 +433,6 @@ def simulate(
         max_step=float(max_step),
         coarse_step=float(coarse_step),
         wall_time=wall,
+        contact_memory=[memory_diagnostics(params[g], state[g]) for g in range(G)],
         final_state=y.copy(),
     )

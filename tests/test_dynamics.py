@@ -165,3 +165,12 @@ def test_default_step_converged_to_005_nm():
     df = convergence_study(resolutions=(1.0, 4.0), step_controls=("adaptive",))
     default = df[df["resolution"] == 1.0]
     assert (default["error_m"].abs() < 0.05e-9).all(), default
+
+
+def test_contact_memory_never_overflows_in_a_100_hz_period():
+    """A 10 ms stick phase of runner micro-vibration records hundreds of nested reversals;
+    the exact contact's stack must hold them (an overflow would forget a minor loop)."""
+    d = Drive(actuator_model="flexible")
+    res = run(d, 150e-9, periods=2, frequency=100.0)
+    assert res.summary()["contact_memory_overflows"] == 0
+    assert max(m["max_depth"] for m in res.contact_memory) > 2
