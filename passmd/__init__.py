@@ -3,14 +3,19 @@
 "Improvements of Piezo-Actuated Stick–Slip Micro-Drives: Modeling and Driving
 Waveform". The package follows the paper's structure:
 
-``parameters``  Tables 1–2, the drive's parameter records and the assumptions
-``theory``      closed forms: Hertz, Cattaneo–Mindlin, Eqs. 1 and 7–14
-``contact``     MDR contact with memory (Eqs. 4–6): discrete springs and exact limit
-``dynamics``    hybrid simulation of runner and actuators (Eqs. 2–3)
-``waveforms``   saw-tooth and optimized (Eq. 15) piezo trajectories
-``experiments`` one function per figure panel, returning tidy data
-``ledger``      the paper's claims against our results
-``cli``         the ``passmd`` command line
+``parameters``     Tables 1–2, the drive's parameter records and the assumptions
+``theory``         closed forms: Hertz, Cattaneo–Mindlin, Eqs. 1 and 7–14
+``contact``        MDR contact with memory (Eqs. 4–6): discrete springs and exact limit
+``mdr_validation`` the MDR contact against Hertz, Cattaneo–Mindlin and Masing
+``dynamics``       hybrid simulation of runner and actuators (Eqs. 2–3)
+``waveforms``      saw-tooth and optimized (Eq. 15) piezo trajectories
+``experiments``    one function per figure panel, returning tidy data (plots in ``plots``)
+``reference``      the paper's closed-form reference curves (data/reference/)
+``ledger``         the paper's claims against our results
+``sweep``          parameter grids in parallel (process pool or Dask), cached (``cache``)
+``units``          quantities with units at the command line
+``publish``        helpers of the book's chapters
+``cli``            the ``passmd`` command line
 """
 
 __version__ = "0.1.0"
