@@ -71,6 +71,7 @@ __all__ = [
     "evaluate",
     "extractors",
     "result_sources",
+    "sources_markdown",
     "load_baseline",
     "load_claims",
     "orphan_extractors",
@@ -588,7 +589,10 @@ def _run_check(claim: Mapping, ours) -> Outcome:
 def _paper_text(claim: Mapping) -> str:
     kind, relation = claim["check"], claim["relation"]
     if kind == "value":
-        return claim["paper_value"] if claim["paper_value"] else f"curve {claim['reference']}"
+        if claim["paper_value"]:
+            return claim["paper_value"]
+        filename, _, column = claim["reference"].partition(":")
+        return f"curve {column} ({filename})"
     if kind == "ordering":
         return f"lhs {_SYMBOL[relation]} rhs"
     if kind == "threshold":
@@ -721,12 +725,15 @@ STATUS_COLOURS = {
 
 
 def styled(evaluated: pd.DataFrame):
-    """A pandas ``Styler`` of the ledger for the book, verdicts coloured by class.
+    """A pandas ``Styler`` of the ledger for the book, claim and verdict coloured by class.
 
     The table carries the HTML class ``passmd-ledger`` (the rendered-book check looks
-    for it); deviations are shown in the claim's unit and in %.
+    for it); deviations are shown in the claim's unit and in %. The verdict comes third, so
+    it is visible on a narrow page.
     """
-    shown = evaluated[[c for c in LEDGER_COLUMNS if c not in ("status", "check")]].copy()
+    order = ["claim", "figure", "verdict", "paper", "ours", "unit", "abs_deviation", "rel_deviation",
+             "tolerance", "quantity", "note"]  # the verdict early: visible without scrolling
+    shown = evaluated[order].copy()
     shown["rel_deviation"] = shown["rel_deviation"] * 100.0
     shown = shown.rename(columns={"rel_deviation": "rel_deviation_%"})
     statuses = evaluated["status"].to_numpy()
@@ -742,9 +749,73 @@ def styled(evaluated: pd.DataFrame):
     return (
         shown.style.hide(axis="index")
         .format(number)
-        .apply(colour, subset=["verdict"])
+        .apply(colour, subset=["claim", "verdict"])
         .set_table_attributes('class="passmd-ledger"')
+        .set_table_styles([
+            {"selector": "td, th", "props": "font-size: 0.8em; vertical-align: top;"},
+            # the long text columns: wide enough to keep rows short
+            *({"selector": f"td.col{order.index(column)}", "props": "min-width: 16em;"}
+              for column in ("quantity", "note")),
+        ])
     )
+
+
+_CONFIG_LABELS = {
+    "contacts": ("contacts", ""), "actuator_model": ("actuators", ""), "radius_mm": ("R", "mm"),
+    "preload_N": ("F_p", "N"), "friction_coefficient": ("μ", ""), "amplitude_nm": ("A", "nm"),
+    "frequency_Hz": ("f", "Hz"), "waveform": ("waveform", ""),
+}
+
+
+def _md_escape(text: str) -> str:
+    """Escape the characters MyST would read as markup (u*_x,max must not turn italic)."""
+    return re.sub(r"([\\`*_\[\]<>$|#])", r"\\\1", text)
+
+
+def _config_text(claim: Mapping) -> str:
+    assumed = {c for c in claim["assumed"].split(";") if c}
+    parts = []
+    for column, (label, unit) in _CONFIG_LABELS.items():
+        value = claim[column]
+        if not value:
+            continue
+        if ":" in value:
+            start, stop, *step = value.split(":")
+            value = f"{start}–{stop}" + (f" in steps of {step[0]}" if step else "")
+        value = value.replace(";", ", ")
+        if value == "grid":
+            shown = f"{label} on the preload grid"
+        else:
+            shown = f"{label} = {value}" + (f" {unit}" if unit else "")
+        parts.append(shown + (" (assumed)" if column in assumed else ""))
+    return "; ".join(parts) if parts else "—"
+
+
+def sources_markdown(claims: pd.DataFrame) -> str:
+    """Each claim's source as MyST markdown: quotation, configuration, tolerance reason, notes.
+
+    Configuration values the paper does not state are marked *(assumed)*.
+    """
+    items = []
+    for _, claim in claims.iterrows():
+        section = claim["source_section"]
+        section = f"Section {section}" if section[:1].isdigit() else section
+        check = claim["check"] + (f" ({claim['relation']})" if claim["relation"] else "")
+        if claim["tolerance"]:
+            check += f", tolerance {_tolerance_text(claim)}"
+        lines = [
+            f"* **{_md_escape(claim['id'])}** (Fig. {_md_escape(claim['figure'])}, {_md_escape(section)}): "
+            f"“{_md_escape(claim['source_quote'])}”",
+            f"  *Configuration:* {_md_escape(_config_text(claim))}.",
+            f"  *Ours:* {_md_escape(claim['ours_definition'])}.",
+            f"  *Check:* {_md_escape(check)}. {_md_escape(claim['tolerance_reason'])}",
+        ]
+        if claim["notes"]:
+            lines.append(f"  *Notes:* {_md_escape(claim['notes'])}")
+        if claim["expected_to_differ"] == "yes":
+            lines.append(f"  *Expected to differ:* {_md_escape(claim['expected_difference_reason'])}")
+        items.append("\n".join(line + "  " if i < len(lines) - 1 else line for i, line in enumerate(lines)))
+    return "\n".join(items) + "\n"
 
 
 def assumptions_table() -> pd.DataFrame:

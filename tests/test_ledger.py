@@ -436,3 +436,13 @@ def test_assumptions_table_lists_the_registered_assumptions():
     expected = {"actuator_viscosity", "preload_grids", "friction_coefficient_sections_4_1_and_5"}
     assert expected <= set(table["key"])
     assert table["rationale"].str.len().min() > 0
+
+
+def test_sources_markdown_escapes_markup_and_marks_assumptions():
+    claims = ledger.load_claims().set_index("id", drop=False)
+    two = claims.loc[["fig6b-flexible-r1-ac-matches-eq12", "fig9a-step-increase-46.8pct"]]
+    text = ledger.sources_markdown(two)
+    assert text.count("\n* **") == 1 and text.startswith("* **fig6b-flexible-r1-ac-matches-eq12**")
+    assert "u\\*\\_x,max,e" in text  # 'u*_x,max,e' must not start italics in MyST
+    assert "μ = 0.2 (assumed)" in text and "F\\_p on the preload grid" in text
+    assert "*Check:* value, tolerance 20 %." in text
