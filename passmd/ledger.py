@@ -397,7 +397,8 @@ def check_value(ours, paper_value=None, tolerance=0.0, tolerance_kind="rel", cur
     """
     check_choice("tolerance_kind", tolerance_kind, TOLERANCE_KINDS)
     if curve is None:
-        value = float(_numbers("ours", ours)[0]) if np.ndim(ours) == 0 else None
+        scalar = not isinstance(ours, (Mapping, str)) and np.ndim(ours) == 0
+        value = float(_numbers("ours", ours)[0]) if scalar else None
         if value is None:
             raise ValueError(f"ours must be a number for a value claim, got {ours!r}")
         expected, got, shown = np.array([paper_value], float), np.array([value]), value

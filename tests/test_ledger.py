@@ -190,6 +190,8 @@ def test_value_check_scalar_relative_and_absolute():
     assert ledger.check_value(106.0, 110.0, 5.0, "abs").passed
     with pytest.raises(ValueError, match="must be a number"):
         ledger.check_value([1.0, 2.0], 1.0, 0.1)
+    with pytest.raises(ValueError, match="must be a number"):
+        ledger.check_value({"x": [1.0], "y": [1.0]}, 1.0, 0.1)  # a curve for a scalar claim
     with pytest.raises(ValueError, match="non-finite"):
         ledger.check_value(math.nan, 1.0, 0.1)
 
