@@ -73,6 +73,7 @@ def test_good_page_has_no_problems():
         ({"has_article": False}, "did not load"),
         ({"images": [{"src": "gone.png", "ok": False, "width": 0}]}, "broken image"),
         ({"images": []}, "0 figure(s) shown"),
+        ({"blank_images": ["a.png"]}, "blank image"),
         ({"ledger_tables": 0}, "ledger table"),
         ({"error_outputs": ["ValueError: x"]}, "execution error"),
         ({"stderr_outputs": ["RuntimeWarning: y"]}, "stderr"),
@@ -176,6 +177,7 @@ def test_check_fails_on_missing_figure_and_cell_error(broken_book_results):
     assert any("execution error" in p and "deliberate cell error" in p for p in problems), problems
     assert any("ledger table" in p for p in problems), problems
     assert any("MathJax error" in p and "frac" in p for p in problems), problems
+    assert any("blank image" in p for p in problems), problems
 
 
 @pytest.mark.slow

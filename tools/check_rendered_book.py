@@ -5,7 +5,8 @@ all network requests blocked) with the system's Chromium driven by selenium, and
 (exit status 1) when a page
 
 * is missing or does not load (no article),
-* shows a broken image (not decoded: ``naturalWidth == 0``) or fewer figures than expected,
+* shows a broken image (not decoded: ``naturalWidth == 0``), a blank one (a single colour),
+  or fewer figures than expected,
 * lacks its ledger table (``table.passmd-ledger`` with at least one row) where expected,
 * shows an execution error or stderr output (myst-nb ``.output.traceback`` / ``.output.stderr``
   blocks, or a Python traceback anywhere in the text),
@@ -158,7 +159,9 @@ def page_problems(facts: dict) -> list[str]:
     broken = [img["src"] for img in images if not img["ok"]]
     for src in broken:
         problems.append(f"broken image (not decoded): {src}")
-    shown = len(images) - len(broken)
+    for src in facts.get("blank_images", []):
+        problems.append(f"blank image (a single colour): {src}")
+    shown = len(images) - len(broken) - len(facts.get("blank_images", []))
     if shown < expect["figures"]:
         problems.append(f"{shown} figure(s) shown, expected at least {expect['figures']}")
     if facts.get("ledger_tables", 0) < expect["ledger"]:
@@ -189,6 +192,24 @@ def page_problems(facts: dict) -> list[str]:
     for line in facts.get("network_errors", []):
         problems.append(f"network access attempted (the book must display offline): {line}")
     return problems
+
+
+def blank_images(page: Path, images: list[dict]) -> list[str]:
+    """``src`` of the decoded images of a page whose file shows a single colour."""
+    from urllib.parse import unquote, urlsplit
+
+    from PIL import Image
+
+    blank = []
+    for img in images:
+        parts = urlsplit(img["src"] or "")
+        if not img["ok"] or parts.scheme or not parts.path:
+            continue  # undecoded (reported already) or not a local file
+        with Image.open(page.parent / unquote(parts.path)) as picture:
+            low, high = picture.convert("L").getextrema()
+        if low == high:
+            blank.append(img["src"])
+    return blank
 
 
 def _driver(user_data_dir: str):
@@ -245,6 +266,7 @@ def check_book(html_dir: str | Path, pages: list[str], screenshots: str | Path |
             driver.get_log("browser")  # drop messages of earlier pages
             driver.get(path.as_uri())
             facts = driver.execute_async_script(PAGE_FACTS_JS, LEDGER_SELECTOR)
+            facts["blank_images"] = blank_images(path, facts["images"])
             facts["network_errors"] = [
                 entry["message"][:200]
                 for entry in driver.get_log("browser")
@@ -272,7 +294,7 @@ def main(argv: list[str] | None = None) -> int:
     failed = 0
     for page, result in results.items():
         facts, problems = result["facts"], result["problems"]
-        figures = sum(img["ok"] for img in facts.get("images", []))
+        figures = sum(img["ok"] for img in facts.get("images", [])) - len(facts.get("blank_images", []))
         status = "FAIL" if problems else "ok"
         print(
             f"[{status}] {page}: {figures} figure(s), {facts.get('ledger_tables', 0)} ledger table(s), "
