@@ -214,10 +214,14 @@ def _run_futures(pool: cf.Executor, func, todo, points, collect: _Collector, *, 
             collect.done(i, result)
     except KeyboardInterrupt:
         _harvest(futures, collect)
-        for future in futures:
-            future.cancel()
         if own and isinstance(pool, cf.ProcessPoolExecutor):
+            # Terminating the workers makes the pool fail its pending futures itself.
+            # Cancelling them first races with that: Python 3.11's executor thread then
+            # calls set_exception on a cancelled future and prints an InvalidStateError.
             _stop_workers(pool)
+        else:
+            for future in futures:
+                future.cancel()
         raise
     except BaseException:
         for future in futures:
@@ -232,10 +236,15 @@ def _run_futures(pool: cf.Executor, func, todo, points, collect: _Collector, *, 
 
 def _run_process(func, todo, points, collect: _Collector, workers) -> None:
     pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint)
+    interrupted = False
     try:
         _run_futures(pool, func, todo, points, collect, own=True)
+    except KeyboardInterrupt:
+        interrupted = True
+        raise
     finally:
-        pool.shutdown(wait=False, cancel_futures=True)
+        # after an interrupt the workers are gone and the pool fails what is left (see above)
+        pool.shutdown(wait=False, cancel_futures=not interrupted)
 
 
 def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> None:
