@@ -74,6 +74,7 @@ def test_good_page_has_no_problems():
         ({"images": [{"src": "gone.png", "ok": False, "width": 0}]}, "broken image"),
         ({"images": []}, "0 figure(s) shown"),
         ({"blank_images": ["a.png"]}, "blank image"),
+        ({"broken_links": ["_downloads/x/fig.csv"]}, "missing file"),
         ({"ledger_tables": 0}, "ledger table"),
         ({"error_outputs": ["ValueError: x"]}, "execution error"),
         ({"stderr_outputs": ["RuntimeWarning: y"]}, "stderr"),
@@ -100,6 +101,16 @@ def test_expectations_come_from_the_page():
     # A page without the meta tag must show at least one figure and one ledger table.
     facts = _good_facts(expect=None, images=[], ledger_tables=0)
     assert len(checker.page_problems(facts)) == 2
+
+
+def test_broken_links_finds_missing_local_targets(tmp_path):
+    page = tmp_path / "chapter.html"
+    page.write_text("<html></html>")
+    (tmp_path / "_downloads").mkdir()
+    (tmp_path / "_downloads" / "ok.csv").write_text("x\n1\n")
+    hrefs = ["_downloads/ok.csv", "_downloads/gone.csv", "#section", "https://doi.org/x",
+             "mailto:a@b.c", "chapter.html#top", "other.html"]
+    assert checker.broken_links(page, hrefs) == ["_downloads/gone.csv", "other.html"]
 
 
 def test_toc_pages_lists_every_file_in_order(tmp_path):

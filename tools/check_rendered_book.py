@@ -12,6 +12,7 @@ all network requests blocked) with the system's Chromium driven by selenium, and
   blocks, or a Python traceback anywhere in the text),
 * leaves math unrendered (a ``.math`` element without MathJax output, a MathJax error, raw
   ``$$``/``\\(``/``\\[`` in the text) or a web font that failed to load,
+* links to a local file that is not in the built book (e.g. a figure's CSV data),
 * tries to load anything from the network (the book must display offline).
 
 What a page must show comes from its ``passmd-expect`` meta tag, set in the chapter's front
@@ -97,6 +98,7 @@ const ledgerSelector = arguments[0];
     raw_tex: rawTex.slice(0, 5),
     ledger_tables: Array.from(root.querySelectorAll(ledgerSelector))
       .filter(t => t.querySelectorAll('tbody tr').length > 0).length,
+    links: Array.from(root.querySelectorAll('a[href]')).map(a => a.getAttribute('href')),
     fonts_failed: Array.from(document.fonts).filter(f => f.status === 'error').map(f => f.family),
     external_resources: performance.getEntriesByType('resource').map(e => e.name)
       .filter(n => !/^(file|data|blob|about):/.test(n)),
@@ -185,6 +187,8 @@ def page_problems(facts: dict) -> list[str]:
         problems.append(f"MathJax error: {message}")
     for snippet in facts.get("raw_tex", []):
         problems.append(f"raw TeX left in the page: {snippet!r}")
+    for href in facts.get("broken_links", []):
+        problems.append(f"link to a missing file: {href}")
     for family in facts.get("fonts_failed", []):
         problems.append(f"web font failed to load: {family}")
     for url in dict.fromkeys(facts.get("external_resources", [])):  # each URL once
@@ -210,6 +214,20 @@ def blank_images(page: Path, images: list[dict]) -> list[str]:
         if low == high:
             blank.append(img["src"])
     return blank
+
+
+def broken_links(page: Path, hrefs: list[str]) -> list[str]:
+    """Local links of a page (relative paths, no scheme) whose target file does not exist."""
+    from urllib.parse import unquote, urlsplit
+
+    broken = []
+    for href in hrefs:
+        parts = urlsplit(href)
+        if parts.scheme or parts.netloc or not parts.path:
+            continue  # external, mailto: or a same-page #anchor
+        if not (page.parent / unquote(parts.path)).exists():
+            broken.append(href)
+    return broken
 
 
 def _driver(user_data_dir: str):
@@ -267,6 +285,7 @@ def check_book(html_dir: str | Path, pages: list[str], screenshots: str | Path |
             driver.get(path.as_uri())
             facts = driver.execute_async_script(PAGE_FACTS_JS, LEDGER_SELECTOR)
             facts["blank_images"] = blank_images(path, facts["images"])
+            facts["broken_links"] = broken_links(path, facts.pop("links", []))
             facts["network_errors"] = [
                 entry["message"][:200]
                 for entry in driver.get_log("browser")
