@@ -381,14 +381,15 @@ register_assumption(
         key="optimized_short_period",
         symbol="t_s, t_a",
         value=(
-            f"the slow ramp keeps ≥ {MIN_RAMP_FRACTION:g}·(T − t_fb) and ≥ A/V_max; t_s is cut to "
-            "the time left, then t_a (at constant V_a)"
+            f"the slow ramp keeps ≥ {MIN_RAMP_FRACTION:g}·(T − t_fb) and ≥ A/V_max; short_period='cut': "
+            "t_s is cut to the time left, then t_a (at constant V_a); 'skip': t_s = 0"
         ),
         unit="s",
         rationale=(
-            "The paper says only that above 110 kHz there is 'not enough time for settling'. "
-            "Cutting the settling first degrades the waveform gracefully into a saw-tooth with a "
-            "fast first segment, never violates the slew-rate limit, and never fails."
+            "The paper says only that above 110 kHz there is 'not enough time for settling' and that "
+            "the optimized waveform's velocity then 'began decreasing'. Cutting the settling time "
+            "(default) is the reading that makes the velocity decrease; skipping it is the "
+            "alternative. Both never violate the slew-rate limit and never fail."
         ),
         sensitivity="Driving-waveform chapter: Fig. 9b and the settling-fits flag per frequency.",
     )
@@ -578,16 +579,22 @@ def optimized_timing(
     *,
     flyback: str = "slew",
     min_ramp_fraction: float = MIN_RAMP_FRACTION,
+    short_period: str = "cut",
 ) -> dict:
     """Fit one optimized period (Fig. 8b) into T = 1/f: the times actually used.
 
     One period runs: hold x_p = 0 for t_s, rise by Δ_a in t_a, slow ramp to A, fly-back to 0
     in t_fb (slew-rate limited like the saw-tooth's). The slow ramp keeps at least
     ``min_ramp_fraction``·(T − t_fb) and at least A/V_max (so no segment is faster than the
-    amplifier allows). When t_s + t_a does not fit in the rest, t_s is cut to what is left
-    (down to 0), then t_a (keeping V_a, so Δ_a shrinks): at high frequencies the waveform
-    turns gracefully into a saw-tooth with a fast first segment (assumption
-    ``optimized_short_period``).
+    amplifier allows). When t_s + t_a does not fit in the rest (assumption
+    ``optimized_short_period``):
+
+    * ``short_period="cut"`` (default): t_s is cut to what is left (down to 0);
+    * ``short_period="skip"``: t_s = 0 (waiting part of a vibration cycle lands at a
+      phase the design did not choose);
+
+    then, if t_a alone does not fit, t_a is cut keeping V_a (so Δ_a shrinks). At high
+    frequencies the waveform turns into a saw-tooth with a fast first segment.
 
     Returns
     -------
@@ -603,6 +610,7 @@ def optimized_timing(
     """
     if not isinstance(design, OptimizedDesign):
         raise ValueError(f"design = {design!r} is not an OptimizedDesign")
+    check_choice("short_period", short_period, ("cut", "skip"))
     a_max = drive.actuator.full_stroke_amplitude
     A = check_range("amplitude", amplitude, 0.0, a_max, lower_open=True, unit="m")
     f = check_positive("frequency", frequency, "Hz")
@@ -627,7 +635,7 @@ def optimized_timing(
     if not acceleration_fits:
         t_a = room
         d_a = design.acceleration_velocity * t_a
-    t_s = min(t_s, room - t_a)
+    t_s = min(t_s, room - t_a) if (settling_fits or short_period == "cut") else 0.0
     return {
         "period_s": T,
         "flyback_time_s": t_fb,
@@ -652,6 +660,7 @@ def optimized(
     flyback: str = "slew",
     settle_fraction: float = SETTLE_FRACTION,
     min_ramp_fraction: float = MIN_RAMP_FRACTION,
+    short_period: str = "cut",
 ) -> Waveform:
     """The optimized driving waveform of Section 5.1 (Fig. 8b, Eq. 15).
 
@@ -687,6 +696,8 @@ def optimized(
     min_ramp_fraction : float
         Share of T − t_fb the slow ramp keeps when t_s + t_a must be cut
         (:func:`optimized_timing`).
+    short_period : {"cut", "skip"}
+        What to do with t_s when t_s + t_a does not fit in a period (:func:`optimized_timing`).
 
     Returns
     -------
@@ -704,7 +715,8 @@ def optimized(
             amplitude, drive, acceleration_velocity=acceleration_velocity, flyback=flyback
         )
     timing = optimized_timing(
-        design, amplitude, frequency, drive, flyback=flyback, min_ramp_fraction=min_ramp_fraction
+        design, amplitude, frequency, drive, flyback=flyback, min_ramp_fraction=min_ramp_fraction,
+        short_period=short_period,
     )
     A, T = float(amplitude), timing["period_s"]
     t_s, t_a = timing["settling_time_s"], timing["acceleration_time_s"]

@@ -147,3 +147,17 @@ def test_optimized_run_from_rest(design, drive):
     res = dynamics.simulate(drive, waveforms.optimized(A, 100.0, drive, periods=3, design=design))
     assert res.settled_positions.shape == (3,)
     assert np.all(np.isfinite(res.settled_positions)) and np.all(res.step_sizes > 0)
+
+
+def test_skip_rule_drops_the_settling_only_when_it_does_not_fit(design, drive):
+    low = waveforms.optimized_timing(design, A, 100.0, drive, short_period="skip")
+    assert low["settling_time_s"] == design.settling_time
+    high = waveforms.optimized_timing(design, A, 110e3, drive, short_period="skip")
+    assert not high["settling_fits"] and high["settling_time_s"] == 0.0
+    wave = waveforms.optimized(A, 110e3, drive, periods=3, design=design, short_period="skip")
+    T = 1.0 / 110e3
+    # no hold: the fast segment starts right at the period start
+    x_end = wave.position(T + design.acceleration_time)
+    assert x_end == pytest.approx(design.acceleration_amplitude, rel=1e-9)
+    with pytest.raises(ValueError, match="short_period"):
+        waveforms.optimized_timing(design, A, 110e3, drive, short_period="wait")
