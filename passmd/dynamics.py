@@ -383,6 +383,7 @@ def simulate(
         params,
         state,
         y,
+        np.zeros((kern.WORK_ROWS, G)),
         record_interval,
         record,
         per,
