@@ -20,13 +20,16 @@ nox.options.sessions = ["lint", "tests"]
 nox.options.reuse_existing_virtualenvs = True
 
 PYTHON = None  # the interpreter nox runs with
+#: One simulation cache for tests and book (keys include a source fingerprint, so a code
+#: change never serves stale results); CI's book build reuses what the tests computed.
+CACHE_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), ".passmd-cache")
 
 
 @nox.session(python=PYTHON)
 def tests(session: nox.Session) -> None:
     """Run the test suite (unit, physics, regression, CLI and ledger tests)."""
     session.install("-e", ".[test]")
-    session.run("pytest", *session.posargs, env={"MPLBACKEND": "Agg"})
+    session.run("pytest", *session.posargs, env={"MPLBACKEND": "Agg", "PASSMD_CACHE_DIR": CACHE_DIR})
 
 
 @nox.session(python=PYTHON)
