@@ -1,0 +1,273 @@
+"""Plots of the critical-amplitude figures (Figs. 5, 6 and the sensitivity panels).
+
+Each function takes the tidy DataFrame of :mod:`passmd.experiments.critical_amplitude`
+and returns a matplotlib Figure: lengths in nm, forces in N, frequencies in Hz, the
+paper's colours where it has them (Fig. 5b: rigid green, flexible black; Fig. 6:
+u_x,max,e red).
+"""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+
+COLOURS = {"rigid": "tab:green", "flexible": "black"}
+SIDE_COLOURS = {1: "tab:blue", 2: "tab:orange", "e": "tab:red"}
+PRIMARY_FREQUENCY = 100.0  # Hz; the primary curves (same as the experiments' DRIVE_FREQUENCY)
+
+
+def _steady(rows: pd.DataFrame, flyback: str, frequency: float | None = PRIMARY_FREQUENCY) -> pd.DataFrame:
+    sel = rows[(rows["protocol"] == "steady") & (rows["flyback"] == flyback)]
+    if frequency is not None:
+        sel = sel[np.isclose(sel["frequency_Hz"], frequency)]
+    return sel.sort_values("preload_N")
+
+
+def _first(rows: pd.DataFrame, flyback: str) -> pd.DataFrame:
+    return rows[(rows["protocol"] == "first") & (rows["flyback"] == flyback)].sort_values("preload_N")
+
+
+def _band(ax, rows: pd.DataFrame, colour: str, label: str) -> None:
+    """Shade min–max of the steady-state A_c over the drive frequencies (slew-rate fly-back)."""
+    steady = _steady(rows, "slew", None)
+    freqs = np.unique(steady["frequency_Hz"])
+    if freqs.size < 2:
+        return
+    spread = steady.groupby("preload_N")["critical_amplitude_nm"].agg(["min", "max"])
+    ax.fill_between(
+        spread.index,
+        spread["min"],
+        spread["max"],
+        color=colour,
+        alpha=0.15,
+        lw=0,
+        label=f"{label}, {freqs.min():g}–{freqs.max():g} Hz",
+    )
+
+
+def _simulated(ax, rows: pd.DataFrame, colour: str, name: str, flexible: bool) -> None:
+    """Draw the simulated A_c of one actuator model: primary, band, first fly-back, fixed fly-back."""
+    main = _steady(rows, "slew")
+    ax.plot(
+        main["preload_N"],
+        main["critical_amplitude_nm"],
+        "o-",
+        color=colour,
+        ms=4,
+        label=f"{name}, steady state {PRIMARY_FREQUENCY:g} Hz",
+    )
+    _band(ax, rows, colour, f"{name}, steady state")
+    first = _first(rows, "slew")
+    ax.plot(
+        first["preload_N"],
+        first["critical_amplitude_nm"],
+        "s",
+        mfc="none",
+        color=colour,
+        ms=5,
+        label=f"{name}, first fly-back",
+    )
+    if flexible:
+        fixed = _steady(rows, "fixed")
+        ax.plot(
+            fixed["preload_N"],
+            fixed["critical_amplitude_nm"],
+            "^--",
+            color=colour,
+            ms=4,
+            lw=0.8,
+            label=f"{name}, steady state, 2 µs fly-back",
+        )
+        first_fixed = _first(rows, "fixed")
+        ax.plot(
+            first_fixed["preload_N"],
+            first_fixed["critical_amplitude_nm"],
+            "x",
+            color=colour,
+            ms=5,
+            label=f"{name}, first fly-back, 2 µs fly-back",
+        )
+
+
+def _closed(ax, rows: pd.DataFrame, column: str, colour: str, label: str, style: str = "--") -> None:
+    curve = rows.drop_duplicates("preload_N").sort_values("preload_N")
+    ax.plot(curve["preload_N"], curve[column], style, color=colour, lw=1.5, label=label)
+
+
+def _finish(fig, ax, title: str, xlabel: str = "preload $F_p$ (N)") -> None:
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("critical amplitude $A_c$ (nm)")
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.set_ylim(bottom=0)
+    ax.legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+
+
+def plot_fig5a(df: pd.DataFrame):
+    """Fig. 5a: step size against actuation amplitude (one contact, 0.4 N, R = 1 mm)."""
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    styles = {
+        ("rigid", "slew"): ("tab:green", "-", "rigid"),
+        ("flexible", "slew"): ("black", "-", "flexible"),
+        ("flexible", "fixed"): ("tab:gray", "-", "flexible, 2 µs fly-back"),
+    }
+    for (model, flyback), rows in df.groupby(["actuator_model", "flyback"], sort=False):
+        colour, style, name = styles[(model, flyback)]
+        rows = rows.sort_values("amplitude_nm")
+        ax.plot(
+            rows["amplitude_nm"],
+            rows["steady_step_nm"],
+            style,
+            color=colour,
+            lw=1.4,
+            label=f"{name}: steady-state step",
+        )
+        ax.plot(
+            rows["amplitude_nm"],
+            rows["first_step_nm"],
+            ":",
+            color=colour,
+            lw=1.0,
+            label=f"{name}: first step",
+        )
+    first = df.iloc[0]
+    ax.axhline(
+        first["threshold_nm"], color="tab:red", lw=0.8, label=f"measurable step {first['threshold_nm']:g} nm"
+    )
+    ax.axvline(first["u_x_max_nm"], color="tab:green", ls="--", lw=0.8, label="$u_{x,max}$ (Eq. 7)")
+    ax.axvline(
+        first["u_x_max_plus_u_x_a_nm"], color="black", ls="--", lw=0.8, label="$u_{x,max} + u_{x,a}$ (Eq. 8)"
+    )
+    ax.set_xlabel("actuation amplitude $A$ (nm)")
+    ax.set_ylabel("step size (nm)")
+    ax.set_title(
+        f"One contact, $F_p$ = {first['preload_N']:g} N, R = 1 mm, {first['frequency_Hz']:g} Hz", fontsize=10
+    )
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+    return fig
+
+
+def plot_fig5b(df: pd.DataFrame):
+    """Fig. 5b: A_c against preload, one contact, rigid (green) and flexible (black), with Eqs. 7, 8."""
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    for model, name in (("rigid", "$A_c$ rigid"), ("flexible", "$A_c$ flexible")):
+        rows = df[df["actuator_model"] == model]
+        if len(rows):
+            _simulated(ax, rows, COLOURS[model], name, model == "flexible")
+    _closed(ax, df, "u_x_max_nm", COLOURS["rigid"], "$u_{x,max}$ (Eq. 7)")
+    _closed(ax, df, "u_x_max_plus_u_x_a_nm", COLOURS["flexible"], "$u_{x,max} + u_{x,a}$ (Eq. 8)")
+    _finish(fig, ax, "One contact, R = 1 mm")
+    return fig
+
+
+def plot_fig6(df: pd.DataFrame):
+    """Fig. 6a/b/c: A_c against preload, six contacts, with Eqs. 10–14."""
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    model = df["actuator_model"].iloc[0]
+    radius = df["radius_mm"].iloc[0]
+    _simulated(ax, df, COLOURS[model], "$A_c$", model == "flexible")
+    if model == "rigid":
+        curves = [
+            ("u_x_max_1_nm", 1, "$u_{x,max,1}$ (Eq. 10)"),
+            ("u_x_max_2_nm", 2, "$u_{x,max,2}$ (Eq. 10)"),
+            ("u_x_max_e_nm", "e", "$u_{x,max,e}$ (Eq. 11)"),
+        ]
+    else:
+        curves = [
+            ("u_x_max_1_star_nm", 1, "$u^*_{x,max,1}$ (Eq. 13)"),
+            ("u_x_max_2_star_nm", 2, "$u^*_{x,max,2}$ (Eq. 13)"),
+            ("u_x_max_e_star_nm", "e", "$u^*_{x,max,e}$ (Eq. 12)"),
+        ]
+    for column, key, label in curves:
+        _closed(ax, df, column, SIDE_COLOURS[key], label)
+    _finish(fig, ax, f"Six contacts, {model} actuators, R = {radius:g} mm")
+    return fig
+
+
+def _two_panels(df: pd.DataFrame):
+    fig, axes = plt.subplots(1, 2, figsize=(9.6, 4.2), sharey=False)
+    return fig, dict(zip((1, 6), axes, strict=True))
+
+
+def plot_viscosity(df: pd.DataFrame):
+    """A_c of flexible actuators against the actuator viscosity c_p (one and six contacts)."""
+    fig, axes = _two_panels(df)
+    styles = {
+        ("steady", "slew"): ("o-", "black", f"steady state {PRIMARY_FREQUENCY:g} Hz"),
+        ("steady", "fixed"): ("^--", "tab:gray", f"steady state {PRIMARY_FREQUENCY:g} Hz, 2 µs fly-back"),
+        ("first", "slew"): ("s:", "tab:purple", "first fly-back"),
+        ("first", "fixed"): ("x:", "tab:brown", "first fly-back, 2 µs fly-back"),
+    }
+    for n, ax in axes.items():
+        rows = df[df["contacts"] == n]
+        for (protocol, flyback), (style, colour, label) in styles.items():
+            sel = rows[(rows["protocol"] == protocol) & (rows["flyback"] == flyback)].sort_values(
+                "actuator_viscosity_kg_per_s"
+            )
+            ax.plot(
+                sel["actuator_viscosity_kg_per_s"],
+                sel["critical_amplitude_nm"],
+                style,
+                color=colour,
+                ms=4,
+                label=label,
+            )
+        if len(rows):
+            eq = "Eq. 8" if n == 1 else "Eq. 12"
+            ax.axhline(rows["closed_form_nm"].iloc[0], color="tab:red", lw=1.2, ls="--", label=eq)
+        ax.set_xscale("log")
+        ax.set_xlabel("actuator viscosity $c_p$ (kg/s)")
+        ax.set_ylabel("critical amplitude $A_c$ (nm)")
+        ax.set_title(f"{'One contact' if n == 1 else 'Six contacts'}, flexible, 0.4 N, R = 1 mm", fontsize=10)
+        ax.set_ylim(bottom=0)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="lower right")
+    fig.tight_layout()
+    return fig
+
+
+def plot_frequency(df: pd.DataFrame):
+    """A_c against the drive frequency (one and six contacts, rigid and flexible, both protocols)."""
+    fig, axes = _two_panels(df)
+    for n, ax in axes.items():
+        rows = df[df["contacts"] == n]
+        for model in ("rigid", "flexible"):
+            sel = rows[rows["actuator_model"] == model].sort_values("frequency_Hz")
+            if not len(sel):
+                continue
+            for protocol, style, label in (
+                ("steady", "o-", "steady state"),
+                ("first", "s:", "first fly-back"),
+            ):
+                part = sel[sel["protocol"] == protocol]
+                ax.plot(
+                    part["frequency_Hz"],
+                    part["critical_amplitude_nm"],
+                    style,
+                    color=COLOURS[model],
+                    ms=4,
+                    mfc=COLOURS[model] if protocol == "steady" else "none",
+                    label=f"$A_c$ {model}, {label}",
+                )
+            eq = {
+                (1, "rigid"): "Eq. 7",
+                (1, "flexible"): "Eq. 8",
+                (6, "rigid"): "Eq. 11",
+                (6, "flexible"): "Eq. 12",
+            }[(n, model)]
+            ax.axhline(sel["closed_form_nm"].iloc[0], color=COLOURS[model], ls="--", lw=1.0, label=eq)
+        ax.set_xscale("log")
+        ax.set_xlabel("drive frequency $f$ (Hz)")
+        ax.set_ylabel("critical amplitude $A_c$ (nm)")
+        ax.set_title(
+            f"{'One contact' if n == 1 else 'Six contacts'}, 0.4 N, R = 1 mm, slew-rate fly-back", fontsize=10
+        )
+        ax.set_ylim(bottom=0)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="lower left")
+    fig.tight_layout()
+    return fig
