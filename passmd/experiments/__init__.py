@@ -28,7 +28,7 @@ from passmd._validation import check_choice
 PROFILES = ("quick", "paper")
 
 #: Topic modules that register figures; each issue adds its module here.
-TOPIC_MODULES: tuple[str, ...] = ("critical_amplitude",)
+TOPIC_MODULES: tuple[str, ...] = ("critical_amplitude", "driving_waveform")
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,157 @@
+"""Plots of the driving-waveform chapter (Figs. 8–10 and the studies beyond the paper).
+
+Each function takes the tidy DataFrame of :mod:`passmd.experiments.driving_waveform` and
+returns a matplotlib Figure; axes in nm, µs/ms, kHz and mm/s.
+"""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+_STATUS_COLOURS = {"full slip": "#d62728", "partial slip": "#ffbb78"}
+_VARIANT_STYLE = {
+    "sawtooth": {"color": "black", "linestyle": "--", "label": "saw-tooth"},
+    "optimized": {"color": "tab:green", "linestyle": "-", "label": "optimized (Eq. 15; t_s cut when short)"},
+    "optimized_skip": {"color": "tab:blue", "linestyle": ":", "label": "optimized (t_s skipped when short)"},
+}
+
+
+def _shade_status(ax, view) -> None:
+    """Shade the time spans of partial and full slip (µs axis)."""
+    t = view["time_us"].to_numpy()
+    status = view["contact_status"].to_numpy()
+    for name, colour in _STATUS_COLOURS.items():
+        on = status == name
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], on.astype(int), [0]])))
+        for start, stop in zip(edges[::2], edges[1::2], strict=True):
+            ax.axvspan(t[start], t[min(stop, t.size - 1)], color=colour, alpha=0.25, lw=0,
+                       label=name if start == edges[0] else None)
+
+
+def _points(ax, points, y="runner_position_nm") -> None:
+    for _, row in points.iterrows():
+        ax.plot(row["time_us"], row[y], "o", ms=9, mfc="white", mec="black", zorder=5)
+        ax.annotate(row["point"], (row["time_us"], row[y]), ha="center", va="center", fontsize=7, zorder=6)
+
+
+def _response(df, title: str):
+    full, zoom, points = (df[df["view"] == v] for v in ("full", "zoom", "point"))
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.8), constrained_layout=True)
+    ax = axes[0]
+    ax.plot(full["time_ms"], full["piezo_position_nm"], "k--", lw=1, label="x_p (hemispheres)")
+    ax.plot(full["time_ms"], full["runner_position_nm"], color="tab:green", lw=1.2, label="x_r (runner)")
+    ax.set(xlabel="time (ms)", ylabel="position (nm)", title=title)
+    ax.legend(fontsize=8)
+    ax = axes[1]
+    _shade_status(ax, zoom)
+    ax.plot(zoom["time_us"], zoom["piezo_position_nm"], "k--", lw=1)
+    ax.plot(zoom["time_us"], zoom["runner_position_nm"], color="tab:green", lw=1.2)
+    _points(ax, points)
+    ax.set(xlabel="time (µs)", ylabel="position (nm)", title="first slip and micro-vibration")
+    ax.legend(fontsize=7, loc="lower right")
+    ax = axes[2]
+    _shade_status(ax, zoom)
+    ax.plot(zoom["time_us"], zoom["slip_share_1"], color="tab:purple", label="side 1 (2 contacts, F_N1)")
+    ax.plot(zoom["time_us"], zoom["slip_share_2"], color="tab:orange", label="side 2 (4 contacts, F_N2)")
+    _points(ax, points, y="slip_share_2")
+    ax.set(xlabel="time (µs)", ylabel="slipping share of the contact", ylim=(-0.05, 1.1),
+           title="contact status")
+    ax.legend(fontsize=7, loc="center right")
+    return fig
+
+
+def plot_fig8a(df):
+    """Fig. 8a: saw-tooth response, zoom on the first slip with points 1–4 and contact status."""
+    return _response(df, "saw-tooth, 100 Hz")
+
+
+def plot_fig8b(df):
+    """Fig. 8b: the optimized waveform with t_s, t_a, Δ_a marked, and the runner's response."""
+    fig = _response(df, "optimized waveform, 100 Hz")
+    ax = fig.axes[1]
+    points = df[df["view"] == "point"].set_index("point")
+    row = df.iloc[0]
+    t4, t5 = points.loc["4", "time_us"], points.loc["5", "time_us"]
+    t1 = t4 - row["settling_time_s"] * 1e6
+    y = points.loc["5", "piezo_position_nm"]
+    ax.annotate("", (t1, -8), (t4, -8), arrowprops={"arrowstyle": "<->"})
+    ax.text(0.5 * (t1 + t4), -6, f"t_s = {row['settling_time_s'] * 1e6:.1f} µs", ha="center", fontsize=8)
+    ax.annotate(f"Δ_a = {row['acceleration_amplitude_m'] * 1e9:.1f} nm in t_a = "
+                f"{row['acceleration_time_s'] * 1e6:.2f} µs", (t5, y), (t5 + 5, y + 25), fontsize=8,
+                arrowprops={"arrowstyle": "->"})
+    return fig
+
+
+def plot_fig9a(df):
+    """Fig. 9a: runner position over three 100 Hz periods for both waveforms."""
+    fig, ax = plt.subplots(figsize=(6.5, 4), constrained_layout=True)
+    colours = {"sawtooth": "black", "optimized": "tab:green"}
+    for waveform, part in df.groupby("waveform", sort=False):
+        full, per = part[part["view"] == "full"], part[part["view"] == "period"]
+        ax.plot(full["time_ms"], full["runner_position_nm"], color=colours[waveform], lw=1.2,
+                label=f"{waveform}: x_r")
+        ax.plot(per["time_ms"], per["settled_position_nm"], "o", color=colours[waveform], ms=5)
+        last = per.iloc[-1]
+        ax.annotate(f"{last['settled_position_nm']:.0f} nm", (last["time_ms"], last["settled_position_nm"]),
+                    (-40, 8), textcoords="offset points", fontsize=8, color=colours[waveform])
+    saw = df[(df["waveform"] == "sawtooth") & (df["view"] == "full")]
+    ax.plot(saw["time_ms"], saw["piezo_position_nm"], ":", color="grey", lw=0.8, label="saw-tooth x_p")
+    ax.set(xlabel="time (ms)", ylabel="runner position (nm)", title="three periods at 100 Hz")
+    ax.legend(fontsize=8)
+    return fig
+
+
+def _velocity_axes(ax, df, key=None, labels=None, variants=("sawtooth", "optimized", "optimized_skip")):
+    groups = [(None, df)] if key is None else list(df.groupby(key, sort=False))
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for i, (value, part) in enumerate(groups):
+        for variant in variants:
+            sel = part[part["variant"] == variant].sort_values("frequency")
+            style = dict(_VARIANT_STYLE[variant])
+            label = style.pop("label")
+            if key is not None:
+                style["color"] = colours[i % len(colours)]
+                label = f"{labels(value)}, {label}"
+            ax.plot(sel["frequency_kHz"], sel["velocity_mm_per_s"], marker=".", ms=4, label=label, **style)
+    ax.axhline(0.0, color="grey", lw=0.5)
+    ax.set(xlabel="driving frequency (kHz)", ylabel="steady velocity (mm/s)")
+
+
+def plot_fig9b(df):
+    """Fig. 9b: steady velocity against frequency for the saw-tooth and the optimized waveform."""
+    fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
+    _velocity_axes(ax, df)
+    opt = df[df["variant"] == "optimized"].sort_values("frequency")
+    fits = opt[opt["settling_fits"].astype(bool)]
+    if len(fits):
+        ax.axvline(fits["frequency_kHz"].max(), color="tab:green", lw=0.8, alpha=0.6)
+        ax.annotate("full t_s fits up to here", (fits["frequency_kHz"].max(), ax.get_ylim()[1]),
+                    (5, -12), textcoords="offset points", fontsize=8, color="tab:green")
+    ax.legend(fontsize=8)
+    ax.set_title("Section 5 drive: R = 1 mm, 0.4 N, 202 nm, rigid")
+    return fig
+
+
+def _fig10(df, key, labels, title):
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.2), sharey=True, constrained_layout=True)
+    for ax, variant in zip(axes, ("optimized", "optimized_skip"), strict=True):
+        _velocity_axes(ax, df, key, labels, variants=("sawtooth", variant))
+        ax.set_title(f"{title}: {_VARIANT_STYLE[variant]['label']}", fontsize=9)
+        ax.legend(fontsize=7)
+    return fig
+
+
+def plot_fig10a(df):
+    """Fig. 10a: velocity against frequency for preloads 0.1, 0.4, 1 N."""
+    return _fig10(df, "preload", lambda p: f"F_p = {p:g} N", "preload")
+
+
+def plot_fig10b(df):
+    """Fig. 10b: velocity against frequency for R = 1 mm and 0.25 mm."""
+    return _fig10(df, "radius_mm", lambda r: f"R = {r:g} mm", "hemisphere radius")
+
+
+def plot_fig10c(df):
+    """Fig. 10c: velocity against frequency for a steel and a molybdenum runner."""
+    return _fig10(df, "runner", str, "runner material")
