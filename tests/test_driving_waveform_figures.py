@@ -14,6 +14,7 @@ import pytest
 from passmd import dynamics, theory, waveforms
 from passmd.experiments import driving_waveform as dw
 from passmd.experiments import figure_data, figure_names, figure_plot
+from passmd.experiments import waveform_studies as studies
 
 PANELS = ("fig8a", "fig8b", "fig9a", "fig9b", "fig10a", "fig10b", "fig10c")
 #: Relative tolerance of positions, velocities and times in the snapshots (see module docstring).
@@ -161,7 +162,7 @@ def test_settling_fits_only_at_low_frequency(quick):
 
 
 def test_numerical_optimum_beats_heuristic_and_sawtooth():
-    table = dw.numerical_optimum("quick")
+    table = studies.numerical_optimum("quick")
     low = table[table["frequency"] == 100.0].iloc[0]
     assert low["velocity_optimum_m_per_s"] > 1.2 * low["velocity_sawtooth_m_per_s"]
     assert np.all(table["velocity_optimum_m_per_s"] > table["velocity_eq15_m_per_s"])
@@ -171,10 +172,10 @@ def test_numerical_optimum_beats_heuristic_and_sawtooth():
 
 
 def test_flexible_study_and_scan_run(quick):
-    flex = dw.flexible_study("quick")
+    flex = studies.flexible_study("quick")
     assert set(flex["actuator_model"]) == {"rigid", "flexible"}
     assert np.all(np.isfinite(flex["velocity_m_per_s"]))
-    scan = dw.settling_scan("quick")
+    scan = studies.settling_scan("quick")
     # Eq. 15's t_s (half a cycle) is where the step is smallest in the scan
     worst = scan.loc[scan["step_nm"].idxmin(), "settling_cycles"]
     assert worst == pytest.approx(scan["eq15_settling_cycles"].iloc[0], abs=0.25)

@@ -23,9 +23,8 @@ t_s, t_a, Δ_a; ``fig9a`` runner position over three 100 Hz periods, both wavefo
 ``fig9b`` steady velocity against frequency, both waveforms; ``fig10a``–``fig10c`` the
 optimized waveform's velocity for three preloads, two radii, two runner materials.
 
-Beyond the paper: :func:`flexible_study` (does the gain survive flexible actuators?),
-:func:`settling_scan` (the step against t_s at 100 Hz) and :func:`numerical_optimum`
-(scipy's differential evolution over t_s, V_a, Δ_a against Eq. 15's heuristic).
+Beyond the paper (flexible actuators, the settling time, a numerical optimum of the
+waveform): :mod:`passmd.experiments.waveform_studies`.
 """
 
 from __future__ import annotations
@@ -144,7 +143,9 @@ def section5_drive(hemisphere_radius: float = 1e-3, preload: float = 0.4, runner
                        runner_material=RUNNERS[runner])
 
 
-def _design(settling_time: float, acceleration_time: float, acceleration_amplitude: float):
+def make_design(settling_time: float, acceleration_time: float,
+                acceleration_amplitude: float) -> waveforms.OptimizedDesign:
+    """An :class:`~passmd.waveforms.OptimizedDesign` from plain sweep parameters."""
     return waveforms.OptimizedDesign(settling_time, acceleration_time, acceleration_amplitude)
 
 
@@ -162,7 +163,8 @@ def design_point(hemisphere_radius: float, preload: float, runner: str, actuator
     return out
 
 
-def _wave(drive, amplitude, frequency, periods, waveform, short_period, design):
+def make_waveform(drive, amplitude, frequency, periods, waveform, short_period, design):
+    """A ``"sawtooth"`` or ``"optimized"`` (with ``design`` and ``short_period``) waveform."""
     if waveform == "sawtooth":
         return waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
     return waveforms.optimized(amplitude, frequency, drive, periods=periods, design=design,
@@ -217,7 +219,7 @@ def velocity_point(hemisphere_radius: float, preload: float, runner: str, actuat
     out = {}
     max_points = 2
     if waveform == "optimized":
-        design = _design(settling_time, acceleration_time, acceleration_amplitude)
+        design = make_design(settling_time, acceleration_time, acceleration_amplitude)
         timing = waveforms.optimized_timing(design, amplitude, frequency, drive, short_period=short_period)
         out.update({k: v for k, v in timing.items() if k != "period_s"})
         duration = periods / frequency
@@ -226,7 +228,7 @@ def velocity_point(hemisphere_radius: float, preload: float, runner: str, actuat
     else:
         design = None
         check_choice("waveform", waveform, ("sawtooth", "optimized"))
-    wave = _wave(drive, amplitude, frequency, periods, waveform, short_period, design)
+    wave = make_waveform(drive, amplitude, frequency, periods, waveform, short_period, design)
     result = dynamics.simulate(drive, wave, max_points=max_points)
     out.update(steady_velocity(result))
     half = periods // 2
@@ -263,9 +265,9 @@ def trace_point(hemisphere_radius: float, preload: float, runner: str, actuator_
     """
     drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
     amplitude = drive.actuator.full_stroke_amplitude
-    design = None if waveform == "sawtooth" else _design(settling_time, acceleration_time,
-                                                        acceleration_amplitude)
-    wave = _wave(drive, amplitude, frequency, periods, waveform, "cut", design)
+    design = None if waveform == "sawtooth" else make_design(
+        settling_time, acceleration_time, acceleration_amplitude)
+    wave = make_waveform(drive, amplitude, frequency, periods, waveform, "cut", design)
     samples = int(math.ceil(wave.duration * theory.runner_frequency(drive) * 200)) + 1
     result = dynamics.simulate(drive, wave, max_points=max(samples, 2000))
     t = result.time
@@ -305,24 +307,6 @@ def trace_point(hemisphere_radius: float, preload: float, runner: str, actuator_
     return out
 
 
-def step_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
-               frequency: float, waveform: str, settling_time: float, acceleration_time: float,
-               acceleration_amplitude: float, periods: int = 3) -> dict:
-    """Fig. 9a protocol: ``periods`` periods from rest; settled positions and their steps.
-
-    Returns ``settled_positions_m``, ``mean_step_m`` (mean over the steps from period 2 on,
-    i.e. across the optimized slips), ``final_position_m`` and ``wall_time_s``.
-    """
-    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
-    amplitude = drive.actuator.full_stroke_amplitude
-    design = None if waveform == "sawtooth" else _design(settling_time, acceleration_time,
-                                                        acceleration_amplitude)
-    wave = _wave(drive, amplitude, frequency, periods, waveform, "cut", design)
-    result = dynamics.simulate(drive, wave, max_points=2)
-    return {"settled_positions_m": result.settled_positions, "mean_step_m": float(np.mean(result.step_sizes)),
-            "final_position_m": result.final_position, "wall_time_s": result.wall_time}
-
-
 # ======================================================================================
 # Tables behind the figures
 # ======================================================================================
@@ -342,7 +326,8 @@ def designs(configs: list[dict]) -> pd.DataFrame:
     return sweep.run(design_point, [dict(c) for c in configs], description="waveform design")
 
 
-def _design_fields(row) -> dict:
+def design_fields(row) -> dict:
+    """The design columns of a :func:`designs` row as the sweep parameters of the point functions."""
     return {"settling_time": float(row["settling_time_s"]),
             "acceleration_time": float(row["acceleration_time_s"]),
             "acceleration_amplitude": float(row["acceleration_amplitude_m"])}
@@ -358,7 +343,7 @@ def velocity_table(configs: list[dict], frequencies) -> pd.DataFrame:
     design_rows = designs(configs)
     points = []
     for c, (_, d) in zip(configs, design_rows.iterrows(), strict=True):
-        fields = _design_fields(d)
+        fields = design_fields(d)
         for waveform, rule in VARIANTS:
             for f in frequencies:
                 points.append({**c, "frequency": float(f), "waveform": waveform, "short_period": rule,
@@ -488,7 +473,7 @@ def fig8b(profile: str = "paper") -> pd.DataFrame:
     _frequencies(profile)
     c = config()
     design = designs([c]).iloc[0]
-    fields = _design_fields(design)
+    fields = design_fields(design)
     T = 1.0 / STEP_FREQUENCY
     t_s, t_a = fields["settling_time"], fields["acceleration_time"]
     trace = _trace(c, STEP_FREQUENCY, 2, "optimized", fields, (T - 5e-6, T + t_s + t_a + 60e-6),
@@ -521,7 +506,7 @@ def fig9a(profile: str = "paper") -> pd.DataFrame:
     """
     _frequencies(profile)
     c = config()
-    fields = _design_fields(designs([c]).iloc[0])
+    fields = design_fields(designs([c]).iloc[0])
     full, _ = _samples(profile)
     parts = []
     for waveform in ("sawtooth", "optimized"):
@@ -775,210 +760,3 @@ def _conclusion_youngs(results):
     radius = abs(float(_fig10b_max(results, 1.0)["velocity_mm_per_s"])
                  - float(_fig10b_max(results, 0.25)["velocity_mm_per_s"]))
     return {"lhs": material, "rhs": min(preload, radius)}
-
-
-# ======================================================================================
-# Beyond the paper: settling time, numerical optimum, flexible actuators
-# ======================================================================================
-
-#: Below this frequency a velocity is measured by Fig. 9a's protocol (3 periods, mean step × f),
-#: above it by the steady-velocity protocol (Hz).
-STEP_PROTOCOL_BELOW = 1e3
-#: Differential-evolution budgets (population size factor, generations) per profile.
-OPTIMIZER_BUDGET = {"paper": (10, 30), "quick": (5, 4)}
-#: Frequencies of the numerical optimisation per profile (Hz), rigid and flexible actuators.
-OPTIMUM_FREQUENCIES = {
-    "paper": {"rigid": (100.0, 1e3, 10e3, 50e3, 110e3), "flexible": (100.0,)},
-    "quick": {"rigid": (100.0, 110e3), "flexible": ()},
-}
-#: Frequencies of the flexible-actuator study per profile (Hz).
-FLEXIBLE_FREQUENCIES = {"paper": (100.0, 1e3, 10e3, 50e3, 110e3), "quick": (100.0, 110e3)}
-#: Points of the settling-time scan over [0, 2/f_s] per profile.
-SCAN_POINTS = {"paper": 41, "quick": 9}
-
-register_assumption(
-    Assumption(
-        key="waveform_optimizer",
-        symbol="t_s, V_a, Δ_a",
-        value=(
-            "scipy differential evolution (seed 0) over t_s ∈ [0, min(1.5/f_s, T/2)], "
-            "V_a ∈ [0.01, 1]·V_max (log), Δ_a ∈ [0.02, 0.95]·A; objective the velocity of the "
-            f"chapter's protocol (< {STEP_PROTOCOL_BELOW / 1e3:g} kHz: 3 periods, mean step × f; "
-            "above: steady)"
-        ),
-        unit="–",
-        rationale=(
-            "The paper's outlook: how much does Eq. 15's heuristic leave on the table? The three "
-            "numbers of Fig. 8b are kept, only chosen by the optimiser instead of Eq. 15; the "
-            "amplifier's slew-rate limit bounds V_a, the period bounds t_s."
-        ),
-        sensitivity="Driving-waveform chapter: the optimum's parameters per frequency.",
-    )
-)
-
-
-def waveform_velocity(drive: Drive, amplitude: float, frequency: float, waveform: str,
-                      design=None, short_period: str = "cut") -> float:
-    """Velocity of one waveform by the chapter's protocol (m/s).
-
-    Below :data:`STEP_PROTOCOL_BELOW`: three periods from rest, mean step (from period 2 on)
-    × f (Fig. 9a); above: the steady velocity (:func:`steady_velocity`).
-    """
-    if frequency < STEP_PROTOCOL_BELOW:
-        wave = _wave(drive, amplitude, frequency, 3, waveform, short_period, design)
-        return float(np.mean(dynamics.simulate(drive, wave, max_points=2).step_sizes) * frequency)
-    wave = _wave(drive, amplitude, frequency, steady_periods(frequency), waveform, short_period, design)
-    return steady_velocity(dynamics.simulate(drive, wave, max_points=2))["velocity_m_per_s"]
-
-
-def optimum_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
-                  frequency: float, settling_time: float, acceleration_time: float,
-                  acceleration_amplitude: float, micro_vibration_frequency: float, popsize: int,
-                  maxiter: int, seed: int = 0) -> dict:
-    """Best (t_s, V_a, Δ_a) for the velocity at one frequency, by differential evolution.
-
-    The given design (Eq. 15, with its measured f_s) is evaluated by the same protocol for
-    comparison, and so is the saw-tooth (assumption ``waveform_optimizer``).
-
-    Returns
-    -------
-    dict
-        ``velocity_sawtooth_m_per_s``, ``velocity_eq15_m_per_s``, ``velocity_optimum_m_per_s``,
-        the optimum's ``optimum_settling_time_s``, ``optimum_acceleration_velocity_m_per_s``,
-        ``optimum_acceleration_amplitude_m``, ``optimum_acceleration_time_s``, ``evaluations``.
-    """
-    from scipy.optimize import differential_evolution
-
-    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
-    amplitude = drive.actuator.full_stroke_amplitude
-    v_max = waveforms.max_piezo_velocity(drive)
-    period = 1.0 / frequency
-    t_s_max = min(1.5 / micro_vibration_frequency, 0.5 * period)
-
-    def unpack(x):
-        t_s, log_va, share = x
-        v_a = v_max * 10.0**log_va
-        d_a = share * amplitude
-        return waveforms.OptimizedDesign(t_s * t_s_max, d_a / v_a, d_a)
-
-    count = [0]
-
-    def objective(x):
-        count[0] += 1
-        return -waveform_velocity(drive, amplitude, frequency, "optimized", unpack(x)) * 1e3
-
-    found = differential_evolution(objective, bounds=[(0.0, 1.0), (-2.0, 0.0), (0.02, 0.95)], seed=seed,
-                                   popsize=int(popsize), maxiter=int(maxiter), polish=False, tol=1e-3)
-    best = unpack(found.x)
-    heuristic = _design(settling_time, acceleration_time, acceleration_amplitude)
-    return {
-        "velocity_sawtooth_m_per_s": waveform_velocity(drive, amplitude, frequency, "sawtooth"),
-        "velocity_eq15_m_per_s": waveform_velocity(drive, amplitude, frequency, "optimized", heuristic),
-        "velocity_optimum_m_per_s": -float(found.fun) / 1e3,
-        "optimum_settling_time_s": best.settling_time,
-        "optimum_acceleration_velocity_m_per_s": best.acceleration_velocity,
-        "optimum_acceleration_amplitude_m": best.acceleration_amplitude,
-        "optimum_acceleration_time_s": best.acceleration_time,
-        "evaluations": count[0],
-    }
-
-
-def numerical_optimum(profile: str = "paper") -> pd.DataFrame:
-    """Differential evolution against Eq. 15's heuristic at a few frequencies (beyond the paper).
-
-    One row per (actuator model, frequency) of :data:`OPTIMUM_FREQUENCIES`, with the
-    velocities of the saw-tooth, the Eq. 15 design and the optimum (m/s and mm/s), the
-    optimum's parameters and the settling time in cycles of f_s.
-    """
-    check_choice("profile", profile, PROFILES)
-    popsize, maxiter = OPTIMIZER_BUDGET[profile]
-    points, cycles = [], []
-    for model, frequencies in OPTIMUM_FREQUENCIES[profile].items():
-        if not frequencies:
-            continue
-        c = config(actuator_model=model)
-        d = designs([c]).iloc[0]
-        for f in frequencies:
-            points.append({**c, "frequency": float(f), **_design_fields(d),
-                           "micro_vibration_frequency": float(d["micro_vibration_frequency_Hz"]),
-                           "popsize": popsize, "maxiter": maxiter})
-            cycles.append(float(d["micro_vibration_frequency_Hz"]))
-    table = sweep.run(optimum_point, points, description="waveform optimisation")
-    table["frequency_kHz"] = table["frequency"] / 1e3
-    for name in ("sawtooth", "eq15", "optimum"):
-        table[f"velocity_{name}_mm_per_s"] = table[f"velocity_{name}_m_per_s"] * 1e3
-    table["optimum_settling_cycles"] = table["optimum_settling_time_s"] * np.array(cycles)
-    table["left_on_table_mm_per_s"] = table["velocity_optimum_mm_per_s"] - table["velocity_eq15_mm_per_s"]
-    return table
-
-
-def settling_scan(profile: str = "paper", acceleration_time: float | None = None,
-                  acceleration_amplitude: float | None = None, actuator_model: str = "rigid") -> pd.DataFrame:
-    """Step at 100 Hz (Fig. 9a protocol) against the settling time t_s ∈ [0, 2/f_s].
-
-    t_a and Δ_a default to the Eq. 15 design; give others (e.g. the numerical optimum's) to
-    scan with them. Adds ``settling_cycles`` (t_s·f_s), ``step_nm`` and the saw-tooth's
-    ``sawtooth_step_nm`` for reference.
-    """
-    check_choice("profile", profile, PROFILES)
-    c = config(actuator_model=actuator_model)
-    d = designs([c]).iloc[0]
-    f_s = float(d["micro_vibration_frequency_Hz"])
-    t_a = float(d["acceleration_time_s"]) if acceleration_time is None else float(acceleration_time)
-    d_a = (float(d["acceleration_amplitude_m"]) if acceleration_amplitude is None
-           else float(acceleration_amplitude))
-    points = [{**c, "frequency": STEP_FREQUENCY, "waveform": "optimized", "settling_time": float(t_s),
-               "acceleration_time": t_a, "acceleration_amplitude": d_a}
-              for t_s in np.linspace(0.0, 2.0 / f_s, SCAN_POINTS[profile])]
-    points.append({**c, "frequency": STEP_FREQUENCY, "waveform": "sawtooth", "settling_time": 0.0,
-                   "acceleration_time": 0.0, "acceleration_amplitude": 0.0})
-    table = sweep.run(step_point, points, description="settling scan")
-    saw = float(table["mean_step_m"].iloc[-1])
-    table = table.iloc[:-1].copy()
-    table["settling_cycles"] = table["settling_time"] * f_s
-    table["settling_time_us"] = table["settling_time"] * 1e6
-    table["step_nm"] = table["mean_step_m"] * 1e9
-    table["sawtooth_step_nm"] = saw * 1e9
-    table["eq15_settling_cycles"] = float(d["settling_time_s"]) * f_s
-    return table
-
-
-def flexible_study(profile: str = "paper") -> pd.DataFrame:
-    """Does the gain survive flexible actuators? (beyond the paper, Section 6's outlook).
-
-    For rigid and flexible actuators (Table 2, ζ assumed), each with the Eq. 15 design made
-    from its own saw-tooth response, and additionally the flexible drive driven with the
-    rigid drive's design: velocity by the chapter's protocol (:func:`waveform_velocity`) at
-    :data:`FLEXIBLE_FREQUENCIES`, for the saw-tooth and both optimized variants.
-    """
-    check_choice("profile", profile, PROFILES)
-    rigid, flexible = config(actuator_model="rigid"), config(actuator_model="flexible")
-    made = designs([rigid, flexible])
-    cases = [(rigid, "rigid", made.iloc[0]), (flexible, "flexible", made.iloc[1]),
-             (flexible, "rigid", made.iloc[0])]
-    points = []
-    for c, source, d in cases:
-        for f in FLEXIBLE_FREQUENCIES[profile]:
-            for waveform, rule in VARIANTS:
-                if waveform == "sawtooth" and source != c["actuator_model"]:
-                    continue
-                points.append({**c, "frequency": float(f), "waveform": waveform, "short_period": rule,
-                               **_design_fields(d), "design_from": source})
-    table = sweep.run(study_point, points, description="flexible study")
-    table["variant"] = np.where(table["waveform"] == "sawtooth", "sawtooth",
-                                np.where(table["short_period"] == "skip", "optimized_skip", "optimized"))
-    table["frequency_kHz"] = table["frequency"] / 1e3
-    table["velocity_mm_per_s"] = table["velocity_m_per_s"] * 1e3
-    return table
-
-
-def study_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str, frequency: float,
-                waveform: str, short_period: str, settling_time: float, acceleration_time: float,
-                acceleration_amplitude: float, design_from: str) -> dict:
-    """Velocity of one case of :func:`flexible_study` (``design_from`` labels the design's drive)."""
-    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
-    design = None if waveform == "sawtooth" else _design(settling_time, acceleration_time,
-                                                        acceleration_amplitude)
-    v = waveform_velocity(drive, drive.actuator.full_stroke_amplitude, frequency, waveform, design,
-                          short_period)
-    return {"velocity_m_per_s": v}
