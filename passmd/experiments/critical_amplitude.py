@@ -391,12 +391,12 @@ def step_point(
     damping_ratio: float = ACTUATOR_DAMPING_RATIO,
     periods: int = STEADY_PERIODS,
 ) -> dict:
-    """First and last step of a saw-tooth run of :func:`paper_drive_for` (one sweep point, m)."""
+    """First and last step (m) and integration time (s) of a saw-tooth run of :func:`paper_drive_for`."""
     if amplitude == 0.0:  # x_p stays 0: nothing moves
-        return {"first_step_m": 0.0, "last_step_m": 0.0}
+        return {"first_step_m": 0.0, "last_step_m": 0.0, "wall_time_s": 0.0}
     drive = paper_drive_for(contacts, actuator_model, hemisphere_radius, preload, damping_ratio)
     out = steady_step(drive, amplitude, frequency, periods=periods, flyback=flyback)
-    return {"first_step_m": out["first_step_m"], "last_step_m": out["last_step_m"]}
+    return {key: out[key] for key in ("first_step_m", "last_step_m", "wall_time_s")}
 
 
 # --------------------------------------------------------------------------------------
@@ -539,6 +539,7 @@ def fig5a(profile: str = "paper") -> pd.DataFrame:
             "threshold_nm": STEP_THRESHOLD * 1e9,
             "u_x_max_nm": closed["u_x_max_nm"],
             "u_x_max_plus_u_x_a_nm": closed["u_x_max_plus_u_x_a_nm"],
+            "wall_time_s": frame["wall_time_s"],
         }
     )
 
