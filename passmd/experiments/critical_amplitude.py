@@ -470,6 +470,7 @@ def _run_searches(points: list[dict], description: str) -> pd.DataFrame:
             "wall_time_s": frame["wall_time_s"],
         }
     )
+    out.attrs["sweep"] = frame.attrs.get("sweep", {})  # points computed / taken from the cache
     return out
 
 
@@ -491,7 +492,9 @@ def _preload_figure(profile: str, contacts: int, radius: float, models, curve: s
     ]
     table = _run_searches(points, curve.split("_")[0])
     closed = reference.closed_form_curves(curve)
-    return table.merge(closed, on="preload_N", how="left", validate="many_to_one")
+    merged = table.merge(closed, on="preload_N", how="left", validate="many_to_one")
+    merged.attrs = table.attrs
+    return merged
 
 
 @register_figure(
@@ -527,7 +530,7 @@ def fig5a(profile: str = "paper") -> pd.DataFrame:
     ]
     frame = sweep.run(step_point, points, description="fig5a")
     closed = reference.closed_form_curves("fig5b_closed_form").set_index("preload_N").loc[preload]
-    return pd.DataFrame(
+    table = pd.DataFrame(
         {
             "actuator_model": frame["actuator_model"],
             "flyback": frame["flyback"],
@@ -542,6 +545,8 @@ def fig5a(profile: str = "paper") -> pd.DataFrame:
             "wall_time_s": frame["wall_time_s"],
         }
     )
+    table.attrs["sweep"] = frame.attrs.get("sweep", {})
+    return table
 
 
 @register_figure(

@@ -12,15 +12,26 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from passmd.parameters import ACTUATOR_DAMPING_RATIO
+
 COLOURS = {"rigid": "tab:green", "flexible": "black"}
 SIDE_COLOURS = {1: "tab:blue", 2: "tab:orange", "e": "tab:red"}
-PRIMARY_FREQUENCY = 100.0  # Hz; the primary curves (same as the experiments' DRIVE_FREQUENCY)
 
 
-def _steady(rows: pd.DataFrame, flyback: str, frequency: float | None = PRIMARY_FREQUENCY) -> pd.DataFrame:
+def _protocol():
+    """(drive frequency of the primary curves, frequency band) of the experiments module.
+
+    Imported when a plot is drawn: the experiments module imports this one to register its plots.
+    """
+    from passmd.experiments.critical_amplitude import DRIVE_FREQUENCY, FREQUENCY_BAND
+
+    return DRIVE_FREQUENCY, FREQUENCY_BAND
+
+
+def _steady(rows: pd.DataFrame, flyback: str, primary: bool = True) -> pd.DataFrame:
     sel = rows[(rows["protocol"] == "steady") & (rows["flyback"] == flyback)]
-    if frequency is not None:
-        sel = sel[np.isclose(sel["frequency_Hz"], frequency)]
+    if primary:
+        sel = sel[np.isclose(sel["frequency_Hz"], _protocol()[0])]
     return sel.sort_values("preload_N")
 
 
@@ -30,7 +41,7 @@ def _first(rows: pd.DataFrame, flyback: str) -> pd.DataFrame:
 
 def _band(ax, rows: pd.DataFrame, colour: str, label: str) -> None:
     """Shade min–max of the steady-state A_c over the drive frequencies (slew-rate fly-back)."""
-    steady = _steady(rows, "slew", None)
+    steady = _steady(rows, "slew", primary=False)
     freqs = np.unique(steady["frequency_Hz"])
     if freqs.size < 2:
         return
@@ -55,7 +66,7 @@ def _simulated(ax, rows: pd.DataFrame, colour: str, name: str, flexible: bool) -
         "o-",
         color=colour,
         ms=4,
-        label=f"{name}, steady state {PRIMARY_FREQUENCY:g} Hz",
+        label=f"{name}, steady state {_protocol()[0]:g} Hz",
     )
     _band(ax, rows, colour, f"{name}, steady state")
     first = _first(rows, "slew")
@@ -106,54 +117,72 @@ def _finish(fig, ax, title: str, xlabel: str = "preload $F_p$ (N)") -> None:
 
 
 def plot_fig5a(df: pd.DataFrame):
-    """Fig. 5a: step size against actuation amplitude (one contact, 0.4 N, R = 1 mm)."""
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    """Fig. 5a: step size against actuation amplitude (one contact, 0.4 N, R = 1 mm).
+
+    Left the paper's full range, right a zoom on the onset (0.5–1.6 × Eq. 8).
+    """
+    fig, axes = plt.subplots(1, 2, figsize=(10.0, 4.4))
     styles = {
-        ("rigid", "slew"): ("tab:green", "-", "rigid"),
-        ("flexible", "slew"): ("black", "-", "flexible"),
-        ("flexible", "fixed"): ("tab:gray", "-", "flexible, 2 µs fly-back"),
+        ("rigid", "slew"): ("tab:green", "rigid"),
+        ("flexible", "slew"): ("black", "flexible"),
+        ("flexible", "fixed"): ("tab:gray", "flexible, 2 µs fly-back"),
     }
-    for (model, flyback), rows in df.groupby(["actuator_model", "flyback"], sort=False):
-        colour, style, name = styles[(model, flyback)]
-        rows = rows.sort_values("amplitude_nm")
-        ax.plot(
-            rows["amplitude_nm"],
-            rows["steady_step_nm"],
-            style,
-            color=colour,
-            lw=1.4,
-            label=f"{name}: steady-state step",
-        )
-        ax.plot(
-            rows["amplitude_nm"],
-            rows["first_step_nm"],
-            ":",
-            color=colour,
-            lw=1.0,
-            label=f"{name}: first step",
-        )
     first = df.iloc[0]
-    ax.axhline(
-        first["threshold_nm"], color="tab:red", lw=0.8, label=f"measurable step {first['threshold_nm']:g} nm"
-    )
-    ax.axvline(first["u_x_max_nm"], color="tab:green", ls="--", lw=0.8, label="$u_{x,max}$ (Eq. 7)")
-    ax.axvline(
-        first["u_x_max_plus_u_x_a_nm"], color="black", ls="--", lw=0.8, label="$u_{x,max} + u_{x,a}$ (Eq. 8)"
-    )
-    ax.set_xlabel("actuation amplitude $A$ (nm)")
-    ax.set_ylabel("step size (nm)")
-    ax.set_title(
+    for ax in axes:
+        for (model, flyback), rows in df.groupby(["actuator_model", "flyback"], sort=False):
+            colour, name = styles[(model, flyback)]
+            rows = rows.sort_values("amplitude_nm")
+            ax.plot(
+                rows["amplitude_nm"],
+                rows["steady_step_nm"],
+                "-",
+                color=colour,
+                lw=1.4,
+                label=f"{name}: steady-state step",
+            )
+            ax.plot(
+                rows["amplitude_nm"],
+                rows["first_step_nm"],
+                ":",
+                color=colour,
+                lw=1.2,
+                label=f"{name}: first step",
+            )
+        ax.axhline(
+            first["threshold_nm"],
+            color="tab:red",
+            lw=0.8,
+            label=f"measurable step {first['threshold_nm']:g} nm",
+        )
+        ax.axvline(first["u_x_max_nm"], color="tab:green", ls="--", lw=0.8, label="$u_{x,max}$ (Eq. 7)")
+        ax.axvline(
+            first["u_x_max_plus_u_x_a_nm"],
+            color="black",
+            ls="--",
+            lw=0.8,
+            label="$u_{x,max} + u_{x,a}$ (Eq. 8)",
+        )
+        ax.set_xlabel("actuation amplitude $A$ (nm)")
+        ax.set_ylabel("step size (nm)")
+        ax.grid(alpha=0.3)
+    eq8 = first["u_x_max_plus_u_x_a_nm"]
+    lo, hi = 0.5 * eq8, 1.6 * eq8
+    near = df[(df["amplitude_nm"] >= lo) & (df["amplitude_nm"] <= hi)]
+    top = max(near[["steady_step_nm", "first_step_nm"]].to_numpy().max(), 1.0) if len(near) else 1.0
+    axes[1].set_xlim(lo, hi)
+    axes[1].set_ylim(-0.1 * top, 1.1 * top)
+    axes[0].set_title(
         f"One contact, $F_p$ = {first['preload_N']:g} N, R = 1 mm, {first['frequency_Hz']:g} Hz", fontsize=10
     )
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, loc="upper left")
+    axes[1].set_title("near the onset", fontsize=10)
+    axes[0].legend(fontsize=7, loc="upper left")
     fig.tight_layout()
     return fig
 
 
 def plot_fig5b(df: pd.DataFrame):
     """Fig. 5b: A_c against preload, one contact, rigid (green) and flexible (black), with Eqs. 7, 8."""
-    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    fig, ax = plt.subplots(figsize=(7.2, 5.2))
     for model, name in (("rigid", "$A_c$ rigid"), ("flexible", "$A_c$ flexible")):
         rows = df[df["actuator_model"] == model]
         if len(rows):
@@ -166,7 +195,7 @@ def plot_fig5b(df: pd.DataFrame):
 
 def plot_fig6(df: pd.DataFrame):
     """Fig. 6a/b/c: A_c against preload, six contacts, with Eqs. 10–14."""
-    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    fig, ax = plt.subplots(figsize=(7.2, 5.2))
     model = df["actuator_model"].iloc[0]
     radius = df["radius_mm"].iloc[0]
     _simulated(ax, df, COLOURS[model], "$A_c$", model == "flexible")
@@ -196,9 +225,10 @@ def _two_panels(df: pd.DataFrame):
 def plot_viscosity(df: pd.DataFrame):
     """A_c of flexible actuators against the actuator viscosity c_p (one and six contacts)."""
     fig, axes = _two_panels(df)
+    f_primary = _protocol()[0]
     styles = {
-        ("steady", "slew"): ("o-", "black", f"steady state {PRIMARY_FREQUENCY:g} Hz"),
-        ("steady", "fixed"): ("^--", "tab:gray", f"steady state {PRIMARY_FREQUENCY:g} Hz, 2 µs fly-back"),
+        ("steady", "slew"): ("o-", "black", f"steady state {f_primary:g} Hz"),
+        ("steady", "fixed"): ("^--", "tab:gray", f"steady state {f_primary:g} Hz, 2 µs fly-back"),
         ("first", "slew"): ("s:", "tab:purple", "first fly-back"),
         ("first", "fixed"): ("x:", "tab:brown", "first fly-back, 2 µs fly-back"),
     }
@@ -218,12 +248,18 @@ def plot_viscosity(df: pd.DataFrame):
             )
         if len(rows):
             eq = "Eq. 8" if n == 1 else "Eq. 12"
-            ax.axhline(rows["closed_form_nm"].iloc[0], color="tab:red", lw=1.2, ls="--", label=eq)
+            closed = rows["closed_form_nm"].iloc[0]
+            ax.axhline(closed, color="tab:red", lw=1.2, ls="--", label=eq)
+            default = rows.loc[
+                np.isclose(rows["damping_ratio"], ACTUATOR_DAMPING_RATIO), "actuator_viscosity_kg_per_s"
+            ]
+            if len(default):
+                ax.axvline(default.iloc[0], color="0.6", lw=0.8, ls=":", label="default $c_p$")
+            ax.set_ylim(0, 1.12 * max(closed, rows["critical_amplitude_nm"].max()))
         ax.set_xscale("log")
         ax.set_xlabel("actuator viscosity $c_p$ (kg/s)")
         ax.set_ylabel("critical amplitude $A_c$ (nm)")
         ax.set_title(f"{'One contact' if n == 1 else 'Six contacts'}, flexible, 0.4 N, R = 1 mm", fontsize=10)
-        ax.set_ylim(bottom=0)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="lower right")
     fig.tight_layout()
@@ -233,8 +269,12 @@ def plot_viscosity(df: pd.DataFrame):
 def plot_frequency(df: pd.DataFrame):
     """A_c against the drive frequency (one and six contacts, rigid and flexible, both protocols)."""
     fig, axes = _two_panels(df)
+    band = _protocol()[1]
     for n, ax in axes.items():
         rows = df[df["contacts"] == n]
+        ax.axvspan(
+            band[0], band[-1], color="0.92", lw=0, label=f"band of Figs. 5b, 6: {band[0]:g}–{band[-1]:g} Hz"
+        )
         for model in ("rigid", "flexible"):
             sel = rows[rows["actuator_model"] == model].sort_values("frequency_Hz")
             if not len(sel):
