@@ -155,3 +155,79 @@ def plot_fig10b(df):
 def plot_fig10c(df):
     """Fig. 10c: velocity against frequency for a steel and a molybdenum runner."""
     return _fig10(df, "runner", str, "runner material")
+
+
+# --------------------------------------------------------------------------------------
+# Beyond the paper (passmd.experiments.waveform_studies)
+# --------------------------------------------------------------------------------------
+
+
+def plot_startup(df):
+    """Velocity period by period from rest at a kHz frequency (steady-velocity protocol)."""
+    fig, ax = plt.subplots(figsize=(6.5, 3.8), constrained_layout=True)
+    for variant, part in df.groupby("variant", sort=False):
+        style = dict(_VARIANT_STYLE[variant])
+        ax.plot(part["time_ms"], part["velocity_mm_per_s"], **style)
+    end = df["time_ms"].max()
+    ax.axvspan(0.5 * end, end, color="0.9", zorder=0, label="averaged (second half)")
+    ax.set(xlabel="time from rest (ms)", ylabel="velocity over one period (mm/s)",
+           title=f"start-up at {1e-3 / (df['time_s'].iloc[1] - df['time_s'].iloc[0]):.0f} kHz")
+    ax.legend(fontsize=8)
+    return fig
+
+
+def plot_settling_scan(scans: dict):
+    """Step at 100 Hz against the settling time, one curve per (label → scan table)."""
+    fig, ax = plt.subplots(figsize=(6.5, 4), constrained_layout=True)
+    for label, df in scans.items():
+        ax.plot(df["settling_cycles"], df["step_nm"], marker=".", label=label)
+    first = next(iter(scans.values()))
+    ax.axhline(first["sawtooth_step_nm"].iloc[0], color="black", ls="--", label="saw-tooth")
+    ax.axvline(first["eq15_settling_cycles"].iloc[0], color="tab:green", lw=0.8, alpha=0.7)
+    ax.annotate("Eq. 15: t_s = 1/(2 f_s)", (first["eq15_settling_cycles"].iloc[0], ax.get_ylim()[1]),
+                (4, -12), textcoords="offset points", fontsize=8, color="tab:green")
+    ax.set(xlabel="settling time t_s · f_s (vibration cycles)", ylabel="step per period, periods 2–3 (nm)",
+           title="step at 100 Hz against the settling time")
+    ax.legend(fontsize=8)
+    return fig
+
+
+def plot_optimum(df):
+    """Saw-tooth, Eq. 15 design and numerical optimum: velocity relative to the saw-tooth."""
+    fig, ax = plt.subplots(figsize=(6.5, 4), constrained_layout=True)
+    rigid = df[df["actuator_model"] == "rigid"].sort_values("frequency")
+    x = np.arange(len(rigid))
+    bars = (("velocity_eq15_mm_per_s", "Eq. 15 design", "tab:green"),
+            ("velocity_optimum_mm_per_s", "numerical optimum", "tab:red"))
+    for offset, (col, label, colour) in zip((-0.2, 0.2), bars, strict=True):
+        ax.bar(x + offset, rigid[col] / rigid["velocity_sawtooth_mm_per_s"], width=0.4, color=colour,
+               label=label)
+    ax.axhline(1.0, color="black", ls="--", lw=1, label="saw-tooth")
+    ax.axhline(0.0, color="grey", lw=0.5)
+    ax.set_xticks(x, [f"{f:g}" for f in rigid["frequency_kHz"]])
+    ax.set(xlabel="driving frequency (kHz)", ylabel="velocity / saw-tooth velocity",
+           title="rigid actuators: Eq. 15 against the optimum of (t_s, V_a, Δ_a)")
+    ax.legend(fontsize=8)
+    return fig
+
+
+def plot_flexible(df):
+    """Velocity relative to each drive's own saw-tooth, rigid and flexible actuators."""
+    fig, ax = plt.subplots(figsize=(6.5, 4), constrained_layout=True)
+    saw = df[df["variant"] == "sawtooth"].set_index(["actuator_model", "frequency"])["velocity_m_per_s"]
+    markers = {"optimized": "o", "optimized_skip": "s"}
+    colours = {("rigid", "rigid"): "tab:blue", ("flexible", "flexible"): "tab:orange",
+               ("flexible", "rigid"): "tab:purple"}
+    for (model, source, variant), part in df[df["variant"] != "sawtooth"].groupby(
+            ["actuator_model", "design_from", "variant"], sort=False):
+        part = part.sort_values("frequency")
+        ratio = part["velocity_m_per_s"].to_numpy() / saw.loc[model].reindex(part["frequency"]).to_numpy()
+        ax.plot(part["frequency_kHz"], ratio, marker=markers[variant], color=colours[(model, source)],
+                ls="-" if variant == "optimized" else ":",
+                label=f"{model} actuators, design from {source}, {variant}")
+    ax.axhline(1.0, color="black", ls="--", lw=1)
+    ax.set_xscale("log")
+    ax.set(xlabel="driving frequency (kHz)", ylabel="velocity / own saw-tooth velocity",
+           title="Eq. 15 waveform with rigid and flexible actuators")
+    ax.legend(fontsize=7)
+    return fig
