@@ -1,0 +1,110 @@
+"""Cost of the driving-waveform chapter: its building blocks (medians of repeated runs) and one
+cold computation of every Fig. 8–10 panel and study at a profile.
+
+Timed blocks (each repeated, median and fastest reported; numba compiles in an untimed warm-up):
+
+* ``design``: :func:`passmd.waveforms.optimized_design` of the Section 5 drive (two 100 Hz
+  saw-tooth periods recorded densely, f_s and V_r measured, Eq. 15);
+* ``steady_sawtooth_<f>`` / ``steady_optimized_<f>``: one steady-velocity point
+  (:func:`passmd.experiments.driving_waveform.velocity_point`) at 1 kHz and 110 kHz;
+* ``step_100hz``: one Fig. 9a protocol run (three 100 Hz periods, rigid actuators).
+
+Then, once, with an empty temporary simulation cache: every panel (``figure_data``) and the
+studies beyond the paper (:mod:`passmd.experiments.waveform_studies`) at ``--profile``,
+as wall time of this process plus its sweep workers.
+
+Usage::
+
+    python benchmarks/bench_driving_waveform.py [--repeats 5] [--profile paper]
+        [--out benchmarks/results/driving_waveform.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import tempfile
+import time
+from pathlib import Path
+
+PANELS = ("fig8a", "fig8b", "fig9a", "fig9b", "fig10a", "fig10b", "fig10c")
+
+
+def _timed(func, repeats: int) -> dict:
+    func()  # warm-up: numba compilation and caches
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        func()
+        times.append(time.perf_counter() - start)
+    return {"median_s": statistics.median(times), "fastest_s": min(times), "repeats": repeats}
+
+
+def blocks(repeats: int) -> dict:
+    from passmd import dynamics, waveforms
+    from passmd.experiments import driving_waveform as dw
+
+    drive = dw.section5_drive()
+    amplitude = drive.actuator.full_stroke_amplitude
+    design = waveforms.optimized_design(amplitude, drive)
+    fields = {"settling_time": design.settling_time, "acceleration_time": design.acceleration_time,
+              "acceleration_amplitude": design.acceleration_amplitude}
+    out = {"design": _timed(lambda: waveforms.optimized_design(amplitude, drive), repeats)}
+    for f in (1e3, 110e3):
+        for waveform, rule in (("sawtooth", ""), ("optimized", "cut")):
+            out[f"steady_{waveform}_{f / 1e3:g}kHz"] = _timed(
+                lambda f=f, w=waveform, r=rule: dw.velocity_point(**dw.config(), frequency=f, waveform=w,
+                                                                  short_period=r, **fields), repeats)
+    wave = waveforms.optimized(amplitude, 100.0, drive, periods=3, design=design)
+    out["step_100hz"] = _timed(lambda: dynamics.simulate(drive, wave, max_points=2), repeats)
+    return out
+
+
+def cold_profile(profile: str) -> dict:
+    """Every panel and study at ``profile`` with an empty simulation cache (one run each)."""
+    with tempfile.TemporaryDirectory(prefix="bench-dw-cache-") as cache:
+        os.environ["PASSMD_CACHE_DIR"] = cache
+        from passmd.experiments import figure_data
+        from passmd.experiments import waveform_studies as studies
+
+        out = {}
+        for name in PANELS:
+            start = time.perf_counter()
+            figure_data(name, profile)
+            out[name] = time.perf_counter() - start
+        for name, call in (("settling_scan", lambda: studies.settling_scan(profile)),
+                           ("numerical_optimum", lambda: studies.numerical_optimum(profile)),
+                           ("flexible_study", lambda: studies.flexible_study(profile)),
+                           ("startup_transient", lambda: studies.startup_transient(110e3))):
+            start = time.perf_counter()
+            call()
+            out[name] = time.perf_counter() - start
+        out["total"] = sum(out.values())
+        return {"profile": profile, "wall_s": out}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--profile", choices=("quick", "paper"), default="paper")
+    parser.add_argument("--out", type=Path, default=Path("benchmarks/results/driving_waveform.json"))
+    args = parser.parse_args()
+    result = {
+        "machine": {"python": platform.python_version(), "processor": platform.processor(),
+                    "cpus": os.cpu_count()},
+        "blocks": blocks(args.repeats),
+        "cold": cold_profile(args.profile),
+    }
+    for name, row in result["blocks"].items():
+        print(f"{name:28s} median {row['median_s'] * 1e3:9.2f} ms   fastest {row['fastest_s'] * 1e3:9.2f} ms")
+    for name, wall in result["cold"]["wall_s"].items():
+        print(f"cold {args.profile:5s} {name:20s} {wall:8.2f} s")
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps(result, indent=2) + "\n")
+
+
+if __name__ == "__main__":
+    main()
