@@ -161,3 +161,12 @@ def test_skip_rule_drops_the_settling_only_when_it_does_not_fit(design, drive):
     assert x_end == pytest.approx(design.acceleration_amplitude, rel=1e-9)
     with pytest.raises(ValueError, match="short_period"):
         waveforms.optimized_timing(design, A, 110e3, drive, short_period="wait")
+
+
+def test_first_period_can_be_optimized_too(design, drive):
+    wave = waveforms.optimized(A, 1e3, drive, periods=2, design=design, first_period="optimized")
+    # from rest: hold for t_s, then the fast rise, in every period including the first
+    assert wave.position(0.999 * design.settling_time) == 0.0
+    t_end = design.settling_time + design.acceleration_time
+    assert wave.position(t_end) == pytest.approx(design.acceleration_amplitude, rel=1e-9)
+    np.testing.assert_allclose(np.diff(wave.settle_windows[:, 1]), 1e-3, rtol=1e-9)
