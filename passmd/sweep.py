@@ -31,7 +31,7 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 import pandas as pd
-from tqdm.auto import tqdm
+from tqdm.std import tqdm  # text bar on a terminal; tqdm.auto warns in notebook kernels without ipywidgets
 
 from passmd._validation import check_choice
 from passmd.cache import Cache
