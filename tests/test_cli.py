@@ -225,6 +225,18 @@ def test_run_json_matches_simulate():
     assert "generated_force_N" not in data
 
 
+def test_run_optimized_waveform_matches_api():
+    """`run --waveform optimized` drives the runner with waveforms.optimized (Eq. 15)."""
+    from passmd import dynamics, waveforms
+
+    data = run_json("run", "--waveform", "optimized", "--actuator", "rigid", "--periods", "3")
+    drive = Drive(actuator_model="rigid")
+    wave = waveforms.optimized(drive.actuator.full_stroke_amplitude, 100.0, drive, periods=3)
+    result = dynamics.simulate(drive, wave)
+    assert data["waveform"] == "optimized"
+    assert data["final_position_m"] == result.final_position  # same code path, bit for bit
+
+
 def test_run_default_is_paper_drive_at_full_stroke():
     data = run_json("run", "--periods", "2", "--flyback", "fixed", "--springs", "40")
     drive = Drive()
@@ -336,8 +348,7 @@ def test_critical_amplitude_no_step_up_to_full_stroke():
         (["run", "--amplitude", "-5"], "--amplitude = -5.0 is out of range"),
         (["run", "--frequency", "300kHz"], "frequency = 300000.0 is out of range"),
         (["run", "--periods", "0"], "--periods = 0 is out of range"),
-        (["run", "--waveform", "optimized"], "--waveform optimized is not available yet"),
-        (["force", "--waveform", "optimized"], "--waveform optimized is not available yet"),
+        (["run", "--waveform", "optimized", "--amplitude", "5nm"], "must be < the actuation amplitude"),
         (["critical-amplitude", "--periods", "1"], "a step needs >= 2 periods"),
         (["figure", "fig0x"], "figure 'fig0x' is not available yet"),
         (["figure", "fig5a", "--profile", "slow"], "argument --profile: invalid choice: 'slow'"),
