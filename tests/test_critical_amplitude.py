@@ -205,6 +205,15 @@ def test_every_panel_is_registered_with_its_chapter():
         assert experiments.figure_spec(name).chapter in ("critical_amplitude_one", "critical_amplitude_six")
 
 
+def test_panels_are_reachable_from_the_command_line(quick, tmp_path, capsys):
+    """`passmd figure NAME --profile quick` draws a panel (its data come from the sweep cache)."""
+    from passmd import cli
+
+    assert cli.main(["figure", "fig6a", "--profile", "quick", "--out", str(tmp_path)]) == 0
+    written = pd.read_csv(tmp_path / "fig6a.csv")
+    assert len(written) == len(quick["fig6a"]) and (tmp_path / "fig6a.png").stat().st_size > 0
+
+
 def test_searches_report_brackets(quick):
     for name in ("fig5b", "fig6a", "fig6b", "fig6c", "fig56_viscosity", "fig56_frequency"):
         table = quick[name]
