@@ -82,11 +82,6 @@ def book(session: nox.Session) -> None:
     # Chapters run in book/; keep the simulation cache at the repository root, shared with
     # the CLI (`passmd figure` computes the same points), unless the user chose a place.
     env["PASSMD_CACHE_DIR"] = os.environ.get("PASSMD_CACHE_DIR") or os.path.abspath(".passmd-cache")
-    # passmd.sweep imports tqdm.auto, which in a Jupyter kernel without ipywidgets warns
-    # "IProgress not found" on stderr (fatal under -W). The book shows no progress bars (they
-    # are off when stderr is not a terminal), so that one message is ignored; nothing else is.
-    warning_filters = [f for f in os.environ.get("PYTHONWARNINGS", "").split(",") if f]
-    env["PYTHONWARNINGS"] = ",".join([*warning_filters, "ignore:IProgress not found"])
     # Validate the profile with the package's own check, and build matplotlib's font cache
     # now: its first-use notice on a fresh machine would otherwise be a stderr warning
     # inside the first chapter and fail the -W build.
