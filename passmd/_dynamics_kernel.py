@@ -70,17 +70,21 @@ def integrate(
     actuator_viscosity,
     params,
     state,
+    sliding,
     y,
     work,
     record_interval,
     record,
     per,
+    peak,
     energy,
     position_limit,
     velocity_limit,
 ):
     """Integrate over all segments; returns (status, steps done, rows recorded, fine steps).
 
+    ``sliding`` holds μF_N of each group; ``peak[k, g]`` receives the largest |T_g|/μF_N from
+    period k's slip mark to the next settle window (1 exactly when the group slid fully).
     ``y`` = [x_r, v_r, x_a(0..G−1), v_a(0..G−1)] is updated in place; ``work`` is scratch
     of shape (WORK_ROWS, G). ``record`` rows are
     [t, x_p, x_r, v_r, (x_a, T, slip share) per group].
@@ -187,6 +191,10 @@ def integrate(
                 T[g] = Tn
                 u_old[g] = u
                 F += multiplicity[g] * Tn
+                if track >= 0:
+                    ratio = abs(Tn) / sliding[g]
+                    if ratio > peak[track, g]:
+                        peak[track, g] = ratio
             # kick
             a_r_new = (F - load_stiffness * x_r) * inv_mr
             v_r += 0.5 * dt * (a_r + a_r_new)

@@ -31,7 +31,13 @@ import numpy as np
 
 from passmd import _dynamics_kernel as kern
 from passmd._validation import check_choice, check_positive, check_range
-from passmd.contact import contact_arrays, contact_stiffness, memory_diagnostics, stack_contacts
+from passmd.contact import (
+    contact_arrays,
+    contact_stiffness,
+    memory_diagnostics,
+    sliding_force,
+    stack_contacts,
+)
 from passmd.parameters import Drive
 from passmd.theory import contact_moduli, normal_forces
 from passmd.waveforms import Waveform
@@ -140,6 +146,10 @@ class SimulationResult:
         settle window (see :mod:`passmd.waveforms`).
     back_steps : ndarray, shape (periods,)
         Largest backward excursion of the runner after each slip edge, ≥ 0.
+    peak_force_ratio : ndarray, shape (periods, groups)
+        Largest |T|/μF_N of one contact of each group from the period's slip edge to the
+        next settle window; exactly 1 when that group slid fully (every integrator step
+        is inspected, not only the recorded samples).
     period_mean_position, period_mean_friction : ndarray, shape (periods,)
         Means over each period of x_r and of the total friction force on the runner.
     energy : dict
@@ -159,6 +169,7 @@ class SimulationResult:
     multiplicity: np.ndarray
     settled_positions: np.ndarray
     back_steps: np.ndarray
+    peak_force_ratio: np.ndarray
     period_mean_position: np.ndarray
     period_mean_friction: np.ndarray
     energy: dict
@@ -365,6 +376,7 @@ def simulate(
     y = np.zeros(2 + 2 * G)
     record = np.empty((int(max_points), 4 + 3 * G))
     per = np.zeros((waveform.periods, kern.PER_COLUMNS))
+    peak = np.zeros((waveform.periods, G))
     energy = np.zeros(kern.EN_COLUMNS)
     segs = _segments(waveform, max_step, coarse_step)
     record_interval = waveform.duration / (max_points - 1)
@@ -382,11 +394,13 @@ def simulate(
         drive.actuator.viscosity,
         params,
         state,
+        np.array([sliding_force(params[g]) for g in range(G)]),
         y,
         np.zeros((kern.WORK_ROWS, G)),
         record_interval,
         record,
         per,
+        peak,
         energy,
         1.0,
         100.0,
@@ -422,6 +436,7 @@ def simulate(
         multiplicity=multiplicity,
         settled_positions=settled,
         back_steps=per[:, kern.PER_MARK_XR] - per[:, kern.PER_MIN_XR],
+        peak_force_ratio=peak,
         period_mean_position=per[:, kern.PER_XR_INTEGRAL] / duration,
         period_mean_friction=per[:, kern.PER_FRICTION_INTEGRAL] / duration,
         energy={

@@ -28,7 +28,7 @@ from passmd._validation import check_choice
 PROFILES = ("quick", "paper")
 
 #: Topic modules that register figures; each issue adds its module here.
-TOPIC_MODULES: tuple[str, ...] = ("critical_amplitude", "driving_waveform")
+TOPIC_MODULES: tuple[str, ...] = ("critical_amplitude", "force_generation", "driving_waveform")
 
 
 @dataclass(frozen=True)
@@ -66,9 +66,9 @@ def figure_names() -> list[str]:
     """Names of every registered figure panel, in paper order."""
     _load_topics()
 
-    def key(n):
+    def key(n):  # paper order: fig5a < fig5b < fig6a < fig10c; names without digits last
         digits = "".join(c for c in n if c.isdigit())
-        return (int(digits), n)
+        return (int(digits) if digits else float("inf"), n)
 
     return sorted(FIGURES, key=key)
 
