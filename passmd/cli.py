@@ -34,44 +34,22 @@ import numpy as np
 
 from passmd import __version__
 from passmd._validation import check_range
-from passmd.cache import CACHE_DIR_ENV, DEFAULT_CACHE_DIR, Cache
+from passmd.cache import CACHE_DIR_ENV, DEFAULT_CACHE_DIR
 from passmd.parameters import (
     ACTUATOR_DAMPING_RATIO,
     Actuator,
     Amplifier,
-    Assumption,
     Drive,
     Material,
     actuator_for_radius,
-    register_assumption,
 )
 from passmd.units import QuantityError, from_si, parse_quantities, parse_quantity
 
-__all__ = ["UsageError", "build_drive", "critical_amplitude_search", "main", "make_parser"]
+__all__ = ["UsageError", "build_drive", "main", "make_parser"]
 
 PROG = "passmd"
 NOT_AVAILABLE = "not available yet"
 
-#: Default "measurable step" threshold of the CLI's critical-amplitude search (m).
-CLI_STEP_THRESHOLD = 1e-9
-
-register_assumption(
-    Assumption(
-        key="cli_critical_amplitude_search",
-        symbol="A_c (CLI)",
-        value=(
-            f"smallest saw-tooth amplitude whose mean step over the run exceeds "
-            f"{CLI_STEP_THRESHOLD * 1e9:g} nm; bisection to 0.5 nm; 100 Hz, 3 periods"
-        ),
-        unit="nm",
-        rationale=(
-            "The paper does not give its protocol for A_c. `passmd critical-amplitude` uses a "
-            "stated, adjustable one (--threshold, --tolerance, --frequency, --periods) and "
-            "reports its bracket; the book's critical-amplitude chapters define and justify theirs."
-        ),
-        sensitivity="CLI output only; every protocol parameter is an option.",
-    )
-)
 
 _DEFAULT = Drive()
 
@@ -540,64 +518,6 @@ def _cmd_force(args, out) -> int:
     return 0
 
 
-def critical_amplitude_search(drive: Drive, *, frequency: float = 100.0, periods: int = 3,
-                              threshold: float = CLI_STEP_THRESHOLD, tolerance: float = 0.5e-9,
-                              flyback: str = "slew", springs: int | None = None, workers: int = 1,
-                              cache=True) -> dict:
-    """Smallest saw-tooth amplitude with a measurable step, by bracketing (k-section) search.
-
-    A point "steps" when the mean of its per-period step sizes exceeds ``threshold``.
-    The bracket starts at [0, A_max] (zero amplitude makes no step); each round
-    simulates ``workers`` amplitudes evenly inside the bracket (in parallel through
-    :func:`passmd.sweep.run`, each cached) and keeps the sub-interval where the step
-    first exceeds the threshold, until the bracket is narrower than ``tolerance``.
-
-    Returns
-    -------
-    dict
-        ``critical_amplitude_m`` (the bracket's midpoint, ``None`` if even A_max makes no
-        step), ``bracket_m``, ``threshold_m``, ``simulations`` and the search settings.
-    """
-    from passmd import sweep
-
-    a_max = drive.actuator.full_stroke_amplitude
-    common = {"drive": drive, "frequency": frequency, "periods": periods, "flyback": flyback,
-              "springs": springs}
-
-    def steps(amplitudes):
-        points = [{**common, "amplitude": float(a)} for a in amplitudes]
-        frame = sweep.run(sweep.sawtooth_point, points, executor="serial" if workers == 1 else "process",
-                          workers=workers, cache=cache, progress=False)
-        return frame["mean_step_m"].to_numpy()
-
-    simulations = 1
-    lo, hi = 0.0, a_max
-    if steps([hi])[0] <= threshold:
-        found = None
-    else:
-        while hi - lo > tolerance:
-            inner = lo + (hi - lo) * np.arange(1, workers + 1) / (workers + 1)
-            moving = steps(inner) > threshold
-            simulations += inner.size
-            if moving.any():
-                j = int(np.argmax(moving))
-                hi = float(inner[j])
-                lo = float(inner[j - 1]) if j > 0 else lo
-            else:
-                lo = float(inner[-1])
-        found = 0.5 * (lo + hi)
-    return {
-        "critical_amplitude_m": found,
-        "bracket_m": [lo, hi],
-        "threshold_m": threshold,
-        "tolerance_m": tolerance,
-        "frequency_Hz": frequency,
-        "periods": periods,
-        "flyback": flyback,
-        "simulations": simulations,
-    }
-
-
 def _cmd_critical_amplitude(args, out) -> int:
     from passmd.theory import drive_theory
 
@@ -611,18 +531,32 @@ def _cmd_critical_amplitude(args, out) -> int:
         "critical_amplitude_flexible_m": theory["critical_amplitude_flexible_m"],
     }
     if not args.analytic_only:
+        from passmd.experiments import critical_amplitude as ca
+
         if args.periods < 2:
             raise UsageError(f"--periods = {args.periods} is out of range: a step needs >= 2 periods")
-        threshold = _THRESHOLD.parse(args) or CLI_STEP_THRESHOLD
-        tolerance = _TOLERANCE.parse(args) or 0.5e-9
-        frequency = _FREQUENCY.parse(args) or _DEFAULT_FREQUENCY
-        if args.workers < 1:
-            raise UsageError(f"--workers = {args.workers} is out of range: must be an integer >= 1")
-        cache = False if args.no_cache else Cache(args.cache_dir) if args.cache_dir else True
-        record.update(critical_amplitude_search(
-            drive, frequency=frequency, periods=args.periods, threshold=threshold, tolerance=tolerance,
-            flyback=args.flyback, springs=_check_springs(args.springs), workers=args.workers, cache=cache,
-        ))
+        threshold = _THRESHOLD.parse(args) or ca.STEP_THRESHOLD
+        tolerance = _TOLERANCE.parse(args) or _DEFAULT_TOLERANCE
+        frequency = _FREQUENCY.parse(args) or ca.DRIVE_FREQUENCY
+        # the book's search (critical-amplitude chapters): one protocol for users and book
+        found = ca.critical_amplitude(
+            drive, protocol=args.protocol, frequency=frequency, flyback=args.flyback,
+            periods=args.periods, threshold=threshold, tolerance=tolerance,
+        )
+        value = found["critical_amplitude_m"]
+        record.update({
+            "critical_amplitude_m": None if math.isnan(value) else value,
+            "bracket_m": [found["bracket_low_m"],
+                          None if math.isnan(found["bracket_high_m"]) else found["bracket_high_m"]],
+            "protocol": args.protocol,
+            "threshold_m": threshold if args.protocol == "steady" else None,
+            "tolerance_m": tolerance,
+            "frequency_Hz": frequency,
+            "periods": args.periods if args.protocol == "steady" else 1,
+            "flyback": args.flyback,
+            "simulations": found["runs"],
+            "wall_time_s": found["wall_time_s"],
+        })
     if args.json:
         _emit_json(record, out)
         return 0
@@ -630,12 +564,16 @@ def _cmd_critical_amplitude(args, out) -> int:
     if not args.analytic_only:
         found = record["critical_amplitude_m"]
         lo, hi = record["bracket_m"]
+        a_max = drive.actuator.full_stroke_amplitude
+        if record["protocol"] == "steady":
+            criterion = (f"last of {record['periods']} steps > {_fmt(record['threshold_m'], 'nm')}")
+        else:
+            criterion = "full sliding of every contact in the first fly-back"
         rows.append(("simulated A_c", f"{_fmt(found, 'nm')}  (bracket {from_si(lo, 'nm'):.4g}–"
                                       f"{from_si(hi, 'nm'):.4g} nm)" if found is not None else
-                     f"no step > {_fmt(record['threshold_m'], 'nm')} up to the full stroke "
-                     f"{_fmt(hi, 'nm')}"))
-        rows.append(("search", f"mean step > {_fmt(record['threshold_m'], 'nm')}, "
-                               f"f = {_fmt(record['frequency_Hz'], 'kHz')}, {record['periods']} periods, "
+                     f"none up to the full stroke {_fmt(a_max, 'nm')} ({criterion})"))
+        rows.append(("search", f"{record['protocol']}: {criterion}, "
+                               f"f = {_fmt(record['frequency_Hz'], 'kHz')}, {record['flyback']} fly-back, "
                                f"{record['simulations']} simulations"))
     eq = "Eq. 7/11" if drive.actuator_model == "rigid" else "Eq. 8/12"
     rows.append((f"analytic A_c ({eq})", _fmt(record["analytic_critical_amplitude_m"], "nm")))
@@ -722,9 +660,12 @@ _AMPLITUDE = _Quantity("--amplitude", "nm", "A", "actuation amplitude",
 _FREQUENCY = _Quantity("--frequency", "kHz", "f", "driving frequency", _fmt(_DEFAULT_FREQUENCY, "kHz"))
 _NORMAL_FORCE = _Quantity("--normal-force", "N", "F_N", "normal force on the contact",
                           _fmt(_DEFAULT.preload, "N"))
-_THRESHOLD = _Quantity("--threshold", "nm", "S", "a step counts when the mean step exceeds this",
-                       _fmt(CLI_STEP_THRESHOLD, "nm"))
-_TOLERANCE = _Quantity("--tolerance", "nm", "W", "stop when the bracket is narrower than this", "0.5 nm")
+# defaults of the book's critical-amplitude search (passmd.experiments.critical_amplitude)
+_DEFAULT_STEADY_PERIODS = 10
+_DEFAULT_TOLERANCE = 0.1e-9
+_THRESHOLD = _Quantity("--threshold", "nm", "S", "steady protocol: a step counts when the last step "
+                       "exceeds this", "0.5 nm")
+_TOLERANCE = _Quantity("--tolerance", "nm", "W", "stop when the bracket is narrower than this", "0.1 nm")
 
 _JSON_HELP = "print one JSON object (SI units) instead (default: off)"
 _RUN_KEYS = """\
@@ -786,34 +727,29 @@ def make_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help=_JSON_HELP)
     p.set_defaults(handler=_cmd_theory)
 
-    p = command("critical-amplitude", "simulated and analytic critical amplitude A_c", textwrap.dedent(f"""\
-        The simulated A_c is the smallest saw-tooth amplitude whose mean step over the
-        run exceeds --threshold, found by a bracketing search on [0, A_max] (the paper
-        gives no protocol; this one is stated, adjustable, and reports its bracket).
-        Simulations are cached in {DEFAULT_CACHE_DIR}/ (or ${CACHE_DIR_ENV}, --cache-dir).
+    p = command("critical-amplitude", "simulated and analytic critical amplitude A_c", textwrap.dedent("""\
+        The simulated A_c comes from the critical-amplitude chapters' search
+        (passmd.experiments.critical_amplitude): bisection on [0, A_max] with one of two
+        protocols, reporting its final bracket. steady: the last step of a run of
+        --periods saw-tooth periods from rest exceeds --threshold; first: every contact
+        slides fully in the first fly-back from virgin contacts.
 
-        --json keys (SI units): critical_amplitude_m (null if no step up to A_max),
+        --json keys (SI units): critical_amplitude_m (null if none up to A_max),
         bracket_m, analytic_critical_amplitude_m, critical_amplitude_rigid_m,
-        critical_amplitude_flexible_m, threshold_m, tolerance_m, frequency_Hz, periods,
-        flyback, simulations, drive{{...}}"""))
+        critical_amplitude_flexible_m, protocol, threshold_m, tolerance_m, frequency_Hz,
+        periods, flyback, simulations, wall_time_s, drive{...}"""))
     _add_drive_options(p)
     group = p.add_argument_group("search")
+    group.add_argument("--protocol", choices=("steady", "first"), default="steady",
+                       help="steady-state A_c or first-fly-back onset (default: steady)")
     _FREQUENCY.add(group)
-    group.add_argument("--periods", type=int, default=3, metavar="N",
-                       help="driving periods per simulation (default: 3)")
+    group.add_argument("--periods", type=int, default=_DEFAULT_STEADY_PERIODS, metavar="N",
+                       help=f"periods of a steady-state run (default: {_DEFAULT_STEADY_PERIODS})")
     _THRESHOLD.add(group)
     _TOLERANCE.add(group)
     group.add_argument("--flyback", choices=("slew", "fixed"), default="slew",
                        help="fly-back duration rule (default: slew)")
-    group.add_argument("--springs", type=int, default=None, metavar="N",
-                       help="discrete MDR contacts with N springs (default: exact contact)")
-    group.add_argument("--workers", type=int, default=1, metavar="N",
-                       help="amplitudes simulated in parallel per search round (default: 1)")
     group.add_argument("--analytic-only", action="store_true", help="skip the simulation (default: off)")
-    group.add_argument("--cache-dir", metavar="DIR",
-                       help=f"cache directory (default: ${CACHE_DIR_ENV} or ./{DEFAULT_CACHE_DIR})")
-    group.add_argument("--no-cache", action="store_true",
-                       help="do not read or write the cache (default: off)")
     p.add_argument("--json", action="store_true", help=_JSON_HELP)
     p.set_defaults(handler=_cmd_critical_amplitude)
 

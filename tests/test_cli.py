@@ -281,44 +281,45 @@ def test_critical_amplitude_analytic_only():
     assert "critical_amplitude_m" not in data
 
 
-def test_critical_amplitude_search_brackets_the_threshold(tmp_path):
-    """The reported bracket really brackets the threshold (checked by re-simulating its ends)."""
-    args = ["critical-amplitude", "--contacts", "1", "--actuator", "rigid", "--tolerance", "2nm",
-            "--cache-dir", str(tmp_path / "cache")]
-    data = run_json(*args)
-    lo, hi = data["bracket_m"]
-    assert 0 < hi - lo <= 2e-9 and data["critical_amplitude_m"] == 0.5 * (lo + hi)
+def test_critical_amplitude_is_the_books_search():
+    """`critical-amplitude` reports what passmd.experiments.critical_amplitude finds, bracket included."""
+    from passmd.experiments import critical_amplitude as ca
+
+    data = run_json("critical-amplitude", "--contacts", "1", "--actuator", "rigid", "--tolerance", "2nm")
     drive = Drive(contacts=1, actuator_model="rigid")
-    point = {"drive": drive, "frequency": 100.0, "periods": 3, "flyback": "slew", "springs": None}
-    at_hi = sweep.sawtooth_point(**point, amplitude=hi)["mean_step_m"]
-    assert at_hi > data["threshold_m"] == 1e-9
-    if lo > 0:
-        assert sweep.sawtooth_point(**point, amplitude=lo)["mean_step_m"] <= 1e-9
-    # every simulation went through the cache: a rerun reads them all back
-    assert len(Cache(tmp_path / "cache").entries()) == data["simulations"]
-    assert run_json(*args) == data
+    found = ca.critical_amplitude(drive, tolerance=2e-9)
+    assert data["critical_amplitude_m"] == found["critical_amplitude_m"]
+    assert data["bracket_m"] == [found["bracket_low_m"], found["bracket_high_m"]]
+    assert 0 < data["bracket_m"][1] - data["bracket_m"][0] <= 2e-9
+    assert data["simulations"] == found["runs"] and data["protocol"] == "steady"
     assert data["analytic_critical_amplitude_m"] == drive_theory(drive)["critical_amplitude_rigid_m"]
 
 
-def test_critical_amplitude_parallel_search_agrees(tmp_path):
-    serial = cli.critical_amplitude_search(Drive(contacts=1, actuator_model="rigid"), tolerance=2e-9,
-                                           cache=False)
-    parallel = cli.critical_amplitude_search(Drive(contacts=1, actuator_model="rigid"), tolerance=2e-9,
-                                             workers=2, cache=Cache(tmp_path))
-    # different subdivisions of [0, A_max]: both brackets must overlap (same threshold crossing)
-    assert max(serial["bracket_m"][0], parallel["bracket_m"][0]) <= min(serial["bracket_m"][1],
-                                                                        parallel["bracket_m"][1])
+def test_critical_amplitude_defaults_are_the_books():
+    from passmd.experiments import critical_amplitude as ca
+
+    assert cli._DEFAULT_STEADY_PERIODS == ca.STEADY_PERIODS
+    data = run_json("critical-amplitude", "--contacts", "1", "--actuator", "rigid", "--tolerance", "5nm")
+    assert data["threshold_m"] == ca.STEP_THRESHOLD and data["frequency_Hz"] == ca.DRIVE_FREQUENCY
 
 
-def test_critical_amplitude_no_step_up_to_full_stroke():
-    """A_c of this drive is ~36 nm (> 1 nm steps): an actuator with a 20 nm stroke never steps."""
-    args = ["critical-amplitude", "--contacts", "1", "--actuator", "rigid", "--full-stroke-amplitude", "20nm",
-            "--no-cache"]
+def test_critical_amplitude_first_flyback_protocol():
+    """First fly-back, one rigid contact: full sliding starts at u_x,max (Eq. 7) within the bracket."""
+    data = run_json("critical-amplitude", "--contacts", "1", "--actuator", "rigid", "--protocol", "first",
+                    "--tolerance", "1nm")
+    lo, hi = data["bracket_m"]
+    u_max = drive_theory(Drive(contacts=1, actuator_model="rigid"))["presliding_m"][0]
+    assert lo - 0.5e-9 <= u_max <= hi + 0.5e-9  # 0.5 nm: the runner's start-up vibration at 100 Hz
+
+
+def test_critical_amplitude_none_up_to_full_stroke():
+    """One rigid contact needs ~40 nm (Eq. 7): an actuator with a 20 nm stroke never steps."""
+    args = ["critical-amplitude", "--contacts", "1", "--actuator", "rigid", "--full-stroke-amplitude", "20nm"]
     data = run_json(*args)
     assert data["critical_amplitude_m"] is None
     assert data["simulations"] == 1
     status, text = run_cli(*args)
-    assert status == 0 and "no step > 1 nm up to the full stroke 20 nm" in text
+    assert status == 0 and "none up to the full stroke 20 nm" in text
 
 
 # --------------------------------------------------------------------------------------
