@@ -52,14 +52,23 @@ from passmd.plots import force_generation as plots
 from passmd.theory import drive_theory, normal_forces
 
 __all__ = [
+    "CYCLE_COMBINATIONS",
     "FORCE_FREQUENCY",
     "MAX_PERIODS",
     "MODELS",
     "PANELS",
+    "PANELS_FULL_STROKE_NM",
+    "PROFILE_SETTINGS",
     "STALL_ABS_TOLERANCE",
     "STALL_REL_TOLERANCE",
     "STALL_WINDOW",
     "cycle_point",
+    "fig7a",
+    "fig7b",
+    "fig7cycle",
+    "fig7freq",
+    "fig7grid",
+    "force_difference",
     "force_drive",
     "force_onset",
     "generated_force",
