@@ -495,23 +495,42 @@ def _cmd_run(args, out) -> int:
 
 
 def _cmd_force(args, out) -> int:
+    from passmd.experiments import force_generation as fg
+
     drive = build_drive(args, load_cell=True)
-    result = _simulate(args, drive)
-    _write_outputs(args, result)
-    summary = _run_summary(result)
-    steps = summary["step_sizes_m"]
-    summary["last_step_size_m"] = steps[-1] if steps else None
+    if args.waveform != "sawtooth":
+        raise UsageError(
+            "--waveform optimized is not supported by force: the stall protocol of the force-generation "
+            "chapter (Section 4.2) drives with the saw-tooth; use `passmd run --waveform optimized "
+            "--load-cell` for one run against the load cell"
+        )
+    if args.springs is not None:
+        raise UsageError("--springs is not supported by force: the stall runs use the exact contact")
+    amplitude, frequency = _waveform_args(args, drive)
+    if args.max_periods < args.periods:
+        raise UsageError(f"--max-periods = {args.max_periods} is out of range: must be >= --periods "
+                         f"({args.periods})")
+    # the force-generation chapter's stall protocol: runs from rest, lengthened until stalled
+    found = fg.generated_force(drive, amplitude, frequency, flyback=args.flyback,
+                               initial_periods=args.periods, max_periods=args.max_periods)
+    if args.csv or args.plot:  # the reported run again, for its time series
+        from passmd import dynamics, waveforms
+
+        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=found["periods"], flyback=args.flyback)
+        _write_outputs(args, dynamics.simulate(drive, wave, max_points=args.max_points))
+    record = {"command": "force", "waveform": "sawtooth", "flyback": args.flyback,
+              "amplitude_m": amplitude, "frequency_Hz": frequency, "drive": drive_record(drive), **found}
     if args.json:
-        _emit_json({"command": "force", "waveform": args.waveform, "flyback": args.flyback,
-                    "drive": drive_record(drive), **summary}, out)
+        _emit_json(record, out)
         return 0
+    state = "stalled" if found["converged"] else f"NOT stalled after {found['periods_simulated']} periods"
     rows = [
-        ("waveform", f"{args.waveform}, A = {_fmt(summary['amplitude_m'], 'nm')}, "
-                     f"f = {_fmt(summary['frequency_Hz'], 'kHz')}, {summary['periods']} periods"),
-        ("generated force k·x̄_r (last period)", _fmt(summary["generated_force_N"], "N")),
-        ("final position", _fmt(summary["final_position_m"], "nm")),
-        ("last step", _fmt(steps[-1], "nm") if steps else "– (one period)"),
-        ("integrator", f"{summary['integrator_steps']} steps, {summary['wall_time_s']:.3g} s"),
+        ("waveform", f"sawtooth, A = {_fmt(amplitude, 'nm')}, f = {_fmt(frequency, 'kHz')}"),
+        ("generated force k·x̄_r", f"{_fmt(found['generated_force_N'], 'N')}  ({state})"),
+        ("run reported", f"{found['periods']} periods from rest; still to come ≈ "
+                         f"{_fmt(found['remaining_force_N'], 'N')}"),
+        ("last step", _fmt(found["last_step_m"], "nm")),
+        ("integration", f"{found['periods_simulated']} periods, {found['wall_time_s']:.3g} s"),
     ]
     _emit_rows(f"passmd force — {_describe(drive)}, load cell k = "
                f"{_fmt(drive.load_cell_stiffness, 'N/m')}", rows, out)
@@ -762,11 +781,19 @@ def make_parser() -> argparse.ArgumentParser:
     _add_output_options(p)
     p.set_defaults(handler=_cmd_run)
 
-    p = command("force", "generated force against the load cell (Section 4.2)", _RUN_KEYS +
-                ",\ngenerated_force_N (k times the mean runner position over the last period),\n"
-                "last_step_size_m (how far the runner still moved in the last period)")
+    p = command("force", "generated force against the load cell at stall (Section 4.2)", textwrap.dedent("""\
+        Runs the saw-tooth from rest with the load cell at its free length and lengthens
+        the run (--periods, doubling up to --max-periods) until the force-generation
+        chapter's stall criterion holds; reports whether it did.
+
+        --json keys (SI units): generated_force_N (k times the mean runner position over the
+        last period), converged, periods, periods_simulated, remaining_force_N,
+        force_spread_N, mean_friction_N, piezo_mean_force_N, last_step_m,
+        net_displacement_m, wall_time_s, cpu_time_s, amplitude_m, frequency_Hz, drive{...}"""))
     _add_drive_options(p)
-    _add_simulation_options(p, default_periods=100)
+    _add_simulation_options(p, default_periods=64)
+    p.add_argument("--max-periods", type=int, default=4096, metavar="N",
+                   help="longest run before a point is reported as not stalled (default: 4096)")
     _add_output_options(p)
     p.set_defaults(handler=_cmd_force)
 

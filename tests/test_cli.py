@@ -258,15 +258,27 @@ def test_run_writes_csv_and_png(tmp_path):
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-def test_force_json_matches_simulate_with_load_cell():
-    data = run_json("force", "--contacts", "1", "--actuator", "rigid", "--periods", "4",
-                    "--load-cell-stiffness", "5e4")
+def test_force_json_is_the_stall_protocol():
+    """`force` reports the force-generation chapter's generated_force, convergence flag included."""
+    from passmd.experiments import force_generation as fg
+
+    data = run_json("force", "--contacts", "1", "--actuator", "rigid", "--load-cell-stiffness", "5e4",
+                    "--amplitude", "120nm")
     drive = Drive(contacts=1, actuator_model="rigid", load_cell=True, load_cell_stiffness=5e4)
-    expected = simulate_summary(drive, drive.actuator.full_stroke_amplitude, 100.0, 4)
-    assert_summary_matches(data, expected)
-    assert data["generated_force_N"] == expected["generated_force_N"] > 0
-    assert data["last_step_size_m"] == expected["step_sizes_m"][-1]
+    expected = fg.generated_force(drive, 120e-9, 100.0)
+    for key in ("generated_force_N", "converged", "periods", "periods_simulated", "remaining_force_N"):
+        assert data[key] == expected[key], key
+    assert data["converged"] is True and data["generated_force_N"] > 0
     assert data["drive"]["load_cell"] is True
+
+
+def test_force_flags_a_run_that_did_not_stall():
+    data = run_json("force", "--contacts", "1", "--actuator", "rigid", "--amplitude", "120nm",
+                    "--periods", "17", "--max-periods", "17")
+    assert data["converged"] is False and data["periods"] == 17
+    status, text = run_cli("force", "--contacts", "1", "--actuator", "rigid", "--amplitude", "120nm",
+                           "--periods", "17", "--max-periods", "17")
+    assert status == 0 and "NOT stalled after 17 periods" in text
 
 
 # --------------------------------------------------------------------------------------
@@ -351,6 +363,9 @@ def test_critical_amplitude_none_up_to_full_stroke():
         (["run", "--periods", "0"], "--periods = 0 is out of range"),
         (["run", "--waveform", "optimized", "--amplitude", "5nm"], "must be < the actuation amplitude"),
         (["critical-amplitude", "--periods", "1"], "a step needs >= 2 periods"),
+        (["force", "--waveform", "optimized"], "--waveform optimized is not supported by force"),
+        (["force", "--springs", "100"], "--springs is not supported by force"),
+        (["force", "--max-periods", "20"], "--max-periods = 20 is out of range"),
         (["figure", "fig0x"], "figure 'fig0x' is not available yet"),
         (["figure", "fig5a", "--profile", "slow"], "argument --profile: invalid choice: 'slow'"),
     ],
