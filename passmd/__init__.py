@@ -8,7 +8,7 @@ Waveform". The package follows the paper's structure:
 ``contact``        MDR contact with memory (Eqs. 4–6): discrete springs and exact limit
 ``mdr_validation`` the MDR contact against Hertz, Cattaneo–Mindlin and Masing
 ``dynamics``       hybrid simulation of runner and actuators (Eqs. 2–3)
-``waveforms``      saw-tooth and optimized (Eq. 15) piezo trajectories
+``waveforms``      saw-tooth and piecewise-linear piezo trajectories (``optimized_waveform``: Eq. 15)
 ``experiments``    one function per figure panel, returning tidy data (plots in ``plots``)
 ``reference``      the paper's closed-form reference curves (data/reference/)
 ``ledger``         the paper's claims against our results

@@ -1,0 +1,456 @@
+"""The optimized driving waveform of Section 5.1 (Fig. 8b, Eq. 15).
+
+After the fly-back the hemispheres wait a settling time t_s = 1/(2 f_s) for the runner's
+micro-vibration to turn forward, then accelerate it within the stick limit,
+(V_a − V_r) t_a = u_x,max, then stop so the runner slips forward. f_s and V_r are measured
+from a simulated saw-tooth response of the same drive. The public names are also reachable
+as ``passmd.waveforms.optimized`` etc. (see :mod:`passmd.waveforms`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from passmd._validation import check_choice, check_positive, check_range
+from passmd.parameters import Assumption, Drive, register_assumption
+from passmd.waveforms import SETTLE_FRACTION, Waveform, flyback_time, piecewise_linear, sawtooth
+
+#: Saw-tooth frequency whose response the optimized waveform is designed from (Fig. 9a's 100 Hz).
+RESPONSE_FREQUENCY = 100.0
+#: Shortest share of T − t_fb that the slow ramp of an optimized period keeps when the settling
+#: time has to be cut (high frequencies).
+MIN_RAMP_FRACTION = 0.5
+#: Recorded samples per period of the linear runner-on-contacts vibration in the design run.
+_SAMPLES_PER_VIBRATION = 200
+
+register_assumption(
+    Assumption(
+        key="optimized_response",
+        symbol="f_s, V_r",
+        value=(
+            f"two saw-tooth periods at {RESPONSE_FREQUENCY:g} Hz from rest; f_s = 1/(z₃ − z₁), z_i the "
+            "zero crossings of ẋ_r − ẋ_p after the first fly-back; V_r = ẋ_r at the end of t_s"
+        ),
+        unit="Hz, m/s",
+        rationale=(
+            "Section 5.1 measures f_s and V_r 'by analyzing the movement of the runner' under the "
+            "saw-tooth (Fig. 8a) without saying at which frequency or how. The first full cycle of "
+            "the free micro-vibration after the slip is the one the waveform exploits; V_r is the "
+            "runner's velocity where the acceleration starts (point 4). The design is made once "
+            "per drive and used at every driving frequency ('when these influencing parameters "
+            "were varied, the input parameters for the optimized waveform were respectively changed')."
+        ),
+        sensitivity="Driving-waveform chapter: step at 100 Hz against t_s over two vibration periods.",
+    )
+)
+register_assumption(
+    Assumption(
+        key="optimized_free_parameter",
+        symbol="V_a, u_x,max",
+        value=(
+            "V_a = amplifier limit A_max·SR/V_pp (0.101 m/s for R = 1 mm); u_x,max = the smallest "
+            "presliding displacement of the contacts (Eq. 10, side 2)"
+        ),
+        unit="m/s, m",
+        rationale=(
+            "Eq. 15 fixes only (V_a − V_r)·t_a = u_x,max; the text asks for the largest V_a that keeps "
+            "the stick condition, which Eq. 15 meets for any V_a, so the largest V_a the amplifier "
+            "can deliver (slew-rate limit) is taken. With rigid actuators every hemisphere moves "
+            "with x_p, so all contacts share u; the side with the smaller normal force slips "
+            "first, hence its u_x,max."
+        ),
+        sensitivity="Driving-waveform chapter: scipy optimisation over t_s, t_a, Δ_a.",
+    )
+)
+register_assumption(
+    Assumption(
+        key="optimized_first_period",
+        symbol="–",
+        value="period 1 is a saw-tooth (ramp 0 → A, fly-back); periods 2… are optimized",
+        unit="–",
+        rationale=(
+            "'Because the optimization was started after the first period' (Section 5.2): there is "
+            "no micro-vibration to exploit before the first slip."
+        ),
+        sensitivity="Only the first period; steps are compared from period 2 on.",
+    )
+)
+register_assumption(
+    Assumption(
+        key="optimized_short_period",
+        symbol="t_s, t_a",
+        value=(
+            f"the slow ramp keeps ≥ {MIN_RAMP_FRACTION:g}·(T − t_fb) and ≥ A/V_max; short_period='cut': "
+            "t_s is cut to the time left, then t_a (at constant V_a); 'skip': t_s = 0"
+        ),
+        unit="s",
+        rationale=(
+            "The paper says only that above 110 kHz there is 'not enough time for settling' and that "
+            "the optimized waveform's velocity then 'began decreasing'. Cutting the settling time "
+            "(default) is the reading that makes the velocity decrease; skipping it is the "
+            "alternative. Both never violate the slew-rate limit and never fail."
+        ),
+        sensitivity="Driving-waveform chapter: Fig. 9b and the settling-fits flag per frequency.",
+    )
+)
+
+
+def max_piezo_velocity(drive: Drive) -> float:
+    """Fastest hemisphere velocity the amplifier allows, V_max = A_max · SR / V_pp (m/s), Section 2."""
+    return drive.actuator.full_stroke_amplitude / drive.amplifier.full_stroke_time
+
+
+@dataclass(frozen=True)
+class OptimizedDesign:
+    """Parameters of the optimized waveform (Eq. 15, Fig. 8b) and what they were derived from.
+
+    Attributes
+    ----------
+    settling_time : float
+        t_s = 1/(2 f_s) in s: hemispheres frozen after the fly-back.
+    acceleration_time : float
+        t_a in s: duration of the fast forward segment.
+    acceleration_amplitude : float
+        Δ_a in m: its amplitude; V_a = Δ_a / t_a.
+    micro_vibration_frequency : float
+        f_s in Hz, measured from the saw-tooth response.
+    runner_velocity : float
+        V_r in m/s, the runner's velocity at the end of t_s in the saw-tooth response.
+    presliding : float
+        u_x,max in m used in Eq. 15.
+    response_frequency : float
+        Frequency (Hz) of the saw-tooth whose response was analysed (0 if given by hand).
+    """
+
+    settling_time: float
+    acceleration_time: float
+    acceleration_amplitude: float
+    micro_vibration_frequency: float = float("nan")
+    runner_velocity: float = 0.0
+    presliding: float = float("nan")
+    response_frequency: float = 0.0
+
+    def __post_init__(self):
+        check_range("settling_time", self.settling_time, 0.0, unit="s")
+        check_positive("acceleration_time", self.acceleration_time, "s")
+        check_positive("acceleration_amplitude", self.acceleration_amplitude, "m")
+
+    @property
+    def acceleration_velocity(self) -> float:
+        """V_a = Δ_a / t_a in m/s."""
+        return self.acceleration_amplitude / self.acceleration_time
+
+    def as_dict(self) -> dict:
+        """Fields and V_a in SI units, keys carrying the unit (JSON-ready)."""
+        return {
+            "settling_time_s": self.settling_time,
+            "acceleration_time_s": self.acceleration_time,
+            "acceleration_amplitude_m": self.acceleration_amplitude,
+            "acceleration_velocity_m_per_s": self.acceleration_velocity,
+            "micro_vibration_frequency_Hz": self.micro_vibration_frequency,
+            "runner_velocity_m_per_s": self.runner_velocity,
+            "presliding_m": self.presliding,
+            "response_frequency_Hz": self.response_frequency,
+        }
+
+
+def micro_vibration_frequency(
+    time, runner_velocity, piezo_velocity, after: float
+) -> tuple[float, np.ndarray]:
+    """Frequency of the runner's micro-vibration after ``after`` (Section 5.1, Fig. 8a).
+
+    The turning points of the runner relative to the hemispheres are the zero crossings
+    z₁, z₂, z₃, … of ẋ_r − ẋ_p after ``after`` (linearly interpolated between samples);
+    f_s = 1 / (z₃ − z₁), the first full cycle.
+
+    Parameters
+    ----------
+    time, runner_velocity, piezo_velocity : array_like
+        Recorded samples (s, m/s, m/s), e.g. of a :class:`passmd.dynamics.SimulationResult`.
+    after : float
+        Start of the free vibration (s), e.g. the end of a fly-back.
+
+    Returns
+    -------
+    (float, ndarray)
+        f_s in Hz and the crossing times (s).
+
+    Raises
+    ------
+    ValueError
+        If fewer than three turning points follow ``after`` (no vibration, e.g. an amplitude
+        below the critical amplitude, or a record too short).
+    """
+    t = np.asarray(time, dtype=float)
+    w = np.asarray(runner_velocity, dtype=float) - np.asarray(piezo_velocity, dtype=float)
+    keep = t > after
+    t, w = t[keep], w[keep]
+    sign = np.sign(w)
+    idx = np.flatnonzero((sign[:-1] != 0) & (sign[:-1] != sign[1:]))
+    crossings = t[idx] - w[idx] * (t[idx + 1] - t[idx]) / (w[idx + 1] - w[idx])
+    if crossings.size < 3:
+        raise ValueError(
+            f"no micro-vibration after t = {after!r} s: found {crossings.size} turning point(s) of the "
+            "runner, need 3 (is the amplitude above the critical amplitude, and the record long enough?)"
+        )
+    return float(1.0 / (crossings[2] - crossings[0])), crossings
+
+
+def optimized_design(
+    amplitude: float,
+    drive: Drive,
+    *,
+    acceleration_velocity: float | None = None,
+    presliding: float | None = None,
+    response_frequency: float = RESPONSE_FREQUENCY,
+    flyback: str = "slew",
+) -> OptimizedDesign:
+    """Derive t_s, t_a and Δ_a of the optimized waveform from a simulated saw-tooth response (Eq. 15).
+
+    Simulates two saw-tooth periods of amplitude A at ``response_frequency`` from rest
+    (Fig. 8a), measures the micro-vibration frequency f_s after the first fly-back
+    (:func:`micro_vibration_frequency`) and the runner velocity V_r at the end of the
+    settling time, and applies Eq. 15::
+
+        t_s = 1 / (2 f_s),     (V_a − V_r) t_a = u_x,max,     Δ_a = V_a t_a.
+
+    Eq. 15 leaves V_a free; it is ``acceleration_velocity``, by default the fastest the
+    amplifier allows (:func:`max_piezo_velocity`, slew-rate limit).
+
+    Parameters
+    ----------
+    amplitude : float
+        Actuation amplitude A in m.
+    drive : Drive
+        The drive (the paper: six contacts, rigid actuators). Its own response is analysed.
+    acceleration_velocity : float, optional
+        V_a in m/s, V_r < V_a ≤ V_max. Default V_max.
+    presliding : float, optional
+        u_x,max in m. Default the smallest presliding displacement of the drive's contacts
+        (Eq. 7 / Eq. 10).
+    response_frequency : float
+        Saw-tooth frequency of the analysed response (Hz).
+    flyback : {"slew", "fixed"}
+        Fly-back rule of that saw-tooth (:func:`flyback_time`).
+
+    Raises
+    ------
+    ValueError
+        Bad input, V_a ≤ V_r, or no micro-vibration in the response.
+    """
+    from passmd import dynamics, theory  # dynamics imports passmd.waveforms: import it lazily
+
+    v_max = max_piezo_velocity(drive)
+    if acceleration_velocity is None:
+        v_a = v_max
+    else:
+        v_a = check_range(
+            "acceleration_velocity", acceleration_velocity, 0.0, v_max, lower_open=True, unit="m/s"
+        )
+    if presliding is None:
+        u_max = float(min(theory.drive_theory(drive)["presliding_m"]))
+    else:
+        u_max = check_positive("presliding", presliding, "m")
+    f_ref = check_positive("response_frequency", response_frequency, "Hz")
+    wave = sawtooth(amplitude, f_ref, drive, periods=2, flyback=flyback)
+    samples = int(np.ceil(wave.duration * theory.runner_frequency(drive) * _SAMPLES_PER_VIBRATION)) + 1
+    result = dynamics.simulate(drive, wave, max_points=max(samples, 1000))
+    flyback_end = wave.period  # the first fly-back ends with the first period
+    f_s, _ = micro_vibration_frequency(
+        result.time, result.runner_velocity, wave.velocity(result.time), flyback_end
+    )
+    t_s = 0.5 / f_s
+    v_r = float(np.interp(flyback_end + t_s, result.time, result.runner_velocity))
+    if not v_a > v_r:
+        raise ValueError(
+            f"acceleration_velocity = {v_a!r} is out of range: must exceed the runner velocity "
+            f"V_r = {v_r:.3g} m/s (Eq. 15)"
+        )
+    t_a = u_max / (v_a - v_r)
+    return OptimizedDesign(t_s, t_a, v_a * t_a, f_s, v_r, u_max, f_ref)
+
+
+def optimized_timing(
+    design: OptimizedDesign,
+    amplitude: float,
+    frequency: float,
+    drive: Drive,
+    *,
+    flyback: str = "slew",
+    min_ramp_fraction: float = MIN_RAMP_FRACTION,
+    short_period: str = "cut",
+) -> dict:
+    """Fit one optimized period (Fig. 8b) into T = 1/f: the times actually used.
+
+    One period runs: hold x_p = 0 for t_s, rise by Δ_a in t_a, slow ramp to A, fly-back to 0
+    in t_fb (slew-rate limited like the saw-tooth's). The slow ramp keeps at least
+    ``min_ramp_fraction``·(T − t_fb) and at least A/V_max (so no segment is faster than the
+    amplifier allows). When t_s + t_a does not fit in the rest (assumption
+    ``optimized_short_period``):
+
+    * ``short_period="cut"`` (default): t_s is cut to what is left (down to 0);
+    * ``short_period="skip"``: t_s = 0 (waiting part of a vibration cycle lands at a
+      phase the design did not choose);
+
+    then, if t_a alone does not fit, t_a is cut keeping V_a (so Δ_a shrinks). At high
+    frequencies the waveform turns into a saw-tooth with a fast first segment.
+
+    Returns
+    -------
+    dict
+        ``period_s``, ``flyback_time_s``, ``settling_time_s``, ``acceleration_time_s``,
+        ``acceleration_amplitude_m``, ``ramp_time_s``, ``settling_fits`` (the full t_s fits),
+        ``acceleration_fits`` (the full t_a fits).
+
+    Raises
+    ------
+    ValueError
+        Bad input, or a fly-back longer than half a period (as :func:`sawtooth`).
+    """
+    if not isinstance(design, OptimizedDesign):
+        raise ValueError(f"design = {design!r} is not an OptimizedDesign")
+    check_choice("short_period", short_period, ("cut", "skip"))
+    a_max = drive.actuator.full_stroke_amplitude
+    A = check_range("amplitude", amplitude, 0.0, a_max, lower_open=True, unit="m")
+    f = check_positive("frequency", frequency, "Hz")
+    frac = check_range("min_ramp_fraction", min_ramp_fraction, 0.0, 1.0, lower_open=True, upper_open=True)
+    T = 1.0 / f
+    t_fb = flyback_time(A, drive, flyback)
+    if t_fb >= 0.5 * T:
+        raise ValueError(
+            f"frequency = {f!r} is out of range: the fly-back of {t_fb * 1e6:.3g} µs must take less than "
+            f"half a period, so frequency must be < {0.5 / t_fb:.6g} Hz"
+        )
+    if design.acceleration_amplitude >= A:
+        raise ValueError(
+            f"acceleration_amplitude = {design.acceleration_amplitude!r} is out of range: must be < the "
+            f"actuation amplitude A = {A!r} m"
+        )
+    ramp_min = max(frac * (T - t_fb), A / max_piezo_velocity(drive))
+    room = T - t_fb - ramp_min  # > 0: t_fb < T/2 and A/V_max <= t_fb (slew) or < 2 µs (fixed)
+    t_s, t_a, d_a = design.settling_time, design.acceleration_time, design.acceleration_amplitude
+    settling_fits = t_s + t_a <= room
+    acceleration_fits = t_a <= room
+    if not acceleration_fits:
+        t_a = room
+        d_a = design.acceleration_velocity * t_a
+    t_s = min(t_s, room - t_a) if (settling_fits or short_period == "cut") else 0.0
+    return {
+        "period_s": T,
+        "flyback_time_s": t_fb,
+        "settling_time_s": t_s,
+        "acceleration_time_s": t_a,
+        "acceleration_amplitude_m": d_a,
+        "ramp_time_s": T - t_fb - t_s - t_a,
+        "settling_fits": bool(settling_fits),
+        "acceleration_fits": bool(acceleration_fits),
+    }
+
+
+def optimized(
+    amplitude: float,
+    frequency: float,
+    drive: Drive,
+    periods: int = 3,
+    *,
+    design: OptimizedDesign | None = None,
+    acceleration_velocity: float | None = None,
+    first_period: str = "sawtooth",
+    flyback: str = "slew",
+    settle_fraction: float = SETTLE_FRACTION,
+    min_ramp_fraction: float = MIN_RAMP_FRACTION,
+    short_period: str = "cut",
+) -> Waveform:
+    """The optimized driving waveform of Section 5.1 (Fig. 8b, Eq. 15).
+
+    Each optimized period: after the fly-back the hemispheres are frozen for the settling
+    time t_s = 1/(2 f_s) while the runner's micro-vibration turns forward, then moved
+    forward by Δ_a in t_a with (V_a − V_r) t_a = u_x,max (sub-phase I), then slowed down to a
+    slow ramp up to A, during which the runner slips forward and is carried (sub-phase II),
+    and flown back to 0. The first period is a saw-tooth (the optimization starts after the
+    first slip, Section 5.2) unless ``first_period="optimized"``.
+
+    Parameters
+    ----------
+    amplitude : float
+        Actuation amplitude A in m.
+    frequency : float
+        Driving frequency f in Hz.
+    drive : Drive
+        The drive; supplies the amplifier/slew-rate limits and, when ``design`` is None, the
+        response the waveform is designed from (:func:`optimized_design`, a short simulation).
+    periods : int
+        Number of periods.
+    design : OptimizedDesign, optional
+        t_s, t_a, Δ_a to use (e.g. designed once per drive and reused over frequencies, or
+        chosen by hand); default :func:`optimized_design` of (A, drive).
+    acceleration_velocity : float, optional
+        V_a for the default design (m/s, ≤ the slew-rate limit); ignored with ``design``.
+    first_period : {"sawtooth", "optimized"}
+        Shape of the first period.
+    flyback : {"slew", "fixed"}
+        Fly-back rule (:func:`flyback_time`).
+    settle_fraction : float
+        Part of each period's slow ramp, at its end, used as the settle window.
+    min_ramp_fraction : float
+        Share of T − t_fb the slow ramp keeps when t_s + t_a must be cut
+        (:func:`optimized_timing`).
+    short_period : {"cut", "skip"}
+        What to do with t_s when t_s + t_a does not fit in a period (:func:`optimized_timing`).
+
+    Returns
+    -------
+    Waveform
+        ``kind="optimized"``; slip marks at the start of each fly-back; settle windows at the
+        end of each (slow) ramp, as for :func:`sawtooth`, so positions compare directly.
+    """
+    check_choice("first_period", first_period, ("sawtooth", "optimized"))
+    frac = check_range("settle_fraction", settle_fraction, 0.0, 1.0, lower_open=True, upper_open=True)
+    if int(periods) != periods or periods < 1:
+        raise ValueError(f"periods = {periods!r} is out of range: must be an integer >= 1")
+    periods = int(periods)
+    if design is None:
+        design = optimized_design(
+            amplitude, drive, acceleration_velocity=acceleration_velocity, flyback=flyback
+        )
+    timing = optimized_timing(
+        design, amplitude, frequency, drive, flyback=flyback, min_ramp_fraction=min_ramp_fraction,
+        short_period=short_period,
+    )
+    A, T = float(amplitude), timing["period_s"]
+    t_s, t_a = timing["settling_time_s"], timing["acceleration_time_s"]
+    d_a = timing["acceleration_amplitude_m"]
+    ramp_end = T - timing["flyback_time_s"]
+    pt = ([0.0, t_s] if t_s > 0 else [0.0]) + [t_s + t_a, ramp_end, T]
+    px = ([0.0, 0.0] if t_s > 0 else [0.0]) + [d_a, A, 0.0]
+    window = (ramp_end - frac * timing["ramp_time_s"], ramp_end)
+    n_opt = periods - 1 if first_period == "sawtooth" else periods
+    parts_t, parts_x, windows, marks = [np.array([0.0])], [np.array([0.0])], [], []
+    offset = 0.0
+    if first_period == "sawtooth":
+        first = sawtooth(A, 1.0 / T, drive, periods=1, flyback=flyback, settle_fraction=frac)
+        parts_t.append(first.times[1:])
+        parts_x.append(first.positions[1:])
+        windows.append(first.settle_windows)
+        marks.append(first.slip_marks)
+        offset = T
+    if n_opt > 0:
+        rest = piecewise_linear(
+            pt, px, 1.0 / T, n_opt, settle_window=window, slip_mark=ramp_end, kind="optimized"
+        )
+        parts_t.append(offset + rest.times[1:])
+        parts_x.append(rest.positions[1:])
+        windows.append(offset + rest.settle_windows)
+        marks.append(offset + rest.slip_marks)
+    return Waveform(
+        np.concatenate(parts_t),
+        np.concatenate(parts_x),
+        T,
+        periods,
+        np.concatenate(windows),
+        np.concatenate(marks),
+        "optimized",
+        A,
+    )
