@@ -46,7 +46,7 @@ import pandas as pd
 
 from passmd import experiments, reference
 from passmd._validation import check_choice
-from passmd.parameters import ASSUMPTIONS
+from passmd.parameters import all_assumptions
 
 __all__ = [
     "CHECK_KINDS",
@@ -822,12 +822,11 @@ def sources_markdown(claims: pd.DataFrame) -> str:
 def assumptions_table() -> pd.DataFrame:
     """Every registered assumption (``passmd.parameters.ASSUMPTIONS``) as a table.
 
-    Loads the experiments' topic modules first, so assumptions they register are included.
+    Imports every module of passmd first, so every assumption registered anywhere is included.
     """
-    experiments.figure_names()
     return pd.DataFrame(
         [{"key": a.key, "symbol": a.symbol, "value": a.value, "unit": a.unit, "rationale": a.rationale,
-          "effect on the results": a.sensitivity} for a in ASSUMPTIONS.values()]
+          "effect on the results": a.sensitivity} for a in all_assumptions().values()]
     )
 
 

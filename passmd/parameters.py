@@ -32,6 +32,7 @@ __all__ = [
     "STEEL",
     "TABLE2_RADII",
     "actuator_for_radius",
+    "all_assumptions",
     "paper_drive",
     "parameter_table",
 ]
@@ -68,6 +69,23 @@ def register_assumption(assumption: Assumption) -> Assumption:
     """Add an assumption to :data:`ASSUMPTIONS` (modules that define one call this)."""
     ASSUMPTIONS[assumption.key] = assumption
     return assumption
+
+
+def all_assumptions() -> dict[str, Assumption]:
+    """:data:`ASSUMPTIONS` after importing every module of passmd.
+
+    Each module registers its own assumptions when it is imported; this makes sure none is
+    missing from a table (the book's assumptions tables call it).
+    """
+    import importlib
+    import pkgutil
+
+    import passmd
+
+    for module in pkgutil.walk_packages(passmd.__path__, prefix="passmd."):
+        if not module.name.endswith("__main__"):  # running it would start the CLI
+            importlib.import_module(module.name)
+    return ASSUMPTIONS
 
 
 register_assumption(

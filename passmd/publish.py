@@ -22,7 +22,6 @@ import dataclasses
 import importlib
 import inspect
 import os
-import pkgutil
 import re
 from functools import lru_cache
 from pathlib import Path
@@ -291,15 +290,6 @@ def parameter_frame(*records, labels=None, units=None):
     return pd.DataFrame(rows)
 
 
-def _import_package_modules() -> None:
-    """Import every module of passmd, so each registers its assumptions."""
-    import passmd
-
-    for module in pkgutil.walk_packages(passmd.__path__, prefix="passmd."):
-        if not module.name.endswith("__main__"):  # running it would start the CLI
-            importlib.import_module(module.name)
-
-
 def assumptions_frame():
     """Every assumption in :data:`passmd.parameters.ASSUMPTIONS` as a table.
 
@@ -307,10 +297,9 @@ def assumptions_frame():
     """
     import pandas as pd
 
-    from passmd.parameters import ASSUMPTIONS
+    from passmd.parameters import all_assumptions
 
-    _import_package_modules()
-    return pd.DataFrame([dataclasses.asdict(a) for a in ASSUMPTIONS.values()])
+    return pd.DataFrame([dataclasses.asdict(a) for a in all_assumptions().values()])
 
 
 def implementations(mapping: dict[str, str | list[str]]):

@@ -109,3 +109,22 @@ def benchmark_table(path: str | Path | None = None) -> pd.DataFrame:
     df = pd.DataFrame(data["rows"])
     df.attrs["meta"] = data.get("meta", {})
     return df
+
+
+def settle_fraction_sensitivity(
+    fractions=(0.1, 0.2, 0.4), amplitude: float = 150e-9, frequency: float = 100.0, periods: int = 4
+) -> pd.DataFrame:
+    """Step sizes for several settle windows (assumption ``settled_position``).
+
+    The settled position averages x_r − x_p over the last ``fraction`` of each stick phase;
+    the table shows how much the mean step of the last ``periods − 1`` periods depends on it.
+    """
+    rows = []
+    for label, contacts, model in CONFIGURATIONS:
+        drive = Drive(contacts=contacts, actuator_model=model)
+        for fraction in fractions:
+            wf = waveforms.sawtooth(amplitude, frequency, drive, periods=periods, settle_fraction=fraction)
+            res = dynamics.simulate(drive, wf, max_points=2)
+            rows.append({"configuration": label, "settle_fraction": float(fraction),
+                         "mean_step_m": float(res.step_sizes.mean())})
+    return pd.DataFrame(rows)
