@@ -201,17 +201,22 @@ def _stop_workers(pool: cf.ProcessPoolExecutor) -> None:
         process.terminate()
 
 
+def _collect_completed(futures: dict, completed, points, collect: _Collector) -> None:
+    """Hand each finished future's result to ``collect`` as ``completed(futures)`` yields it."""
+    for future in completed(futures):
+        i = futures[future]
+        try:
+            result = future.result()
+        except BaseException as exc:
+            _annotate(exc, i, points[i])
+            raise
+        collect.done(i, result)
+
+
 def _run_futures(pool: cf.Executor, func, todo, points, collect: _Collector, *, own: bool) -> None:
     futures = {pool.submit(_call, func, points[i]): i for i in todo}
     try:
-        for future in cf.as_completed(futures):
-            i = futures[future]
-            try:
-                result = future.result()
-            except BaseException as exc:
-                _annotate(exc, i, points[i])
-                raise
-            collect.done(i, result)
+        _collect_completed(futures, cf.as_completed, points, collect)
     except KeyboardInterrupt:
         _harvest(futures, collect)
         if own and isinstance(pool, cf.ProcessPoolExecutor):
@@ -266,14 +271,7 @@ def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> No
     futures = {}
     try:
         futures = {client.submit(_call, func, points[i], pure=False): i for i in todo}
-        for future in as_completed(futures):
-            i = futures[future]
-            try:
-                result = future.result()
-            except BaseException as exc:
-                _annotate(exc, i, points[i])
-                raise
-            collect.done(i, result)
+        _collect_completed(futures, as_completed, points, collect)
     except BaseException:
         for future, i in futures.items():
             if i not in collect.results and future.status == "finished":
