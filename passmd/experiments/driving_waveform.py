@@ -66,6 +66,13 @@ FIG10B_RADII = (1e-3, 0.25e-3)
 #: Waveform variants of Figs. 9b and 10: (waveform, short_period rule).
 VARIANTS = (("sawtooth", ""), ("optimized", "cut"), ("optimized", "skip"))
 
+
+def variant_name(waveform: str, short_period: str) -> str:
+    """Label of a (waveform, short-period rule) pair of :data:`VARIANTS` in tables and plots."""
+    if waveform == "sawtooth":
+        return "sawtooth"
+    return "optimized_skip" if short_period == "skip" else "optimized"
+
 register_assumption(
     Assumption(
         key="frequency_grid",
@@ -349,8 +356,8 @@ def velocity_table(configs: list[dict], frequencies) -> pd.DataFrame:
                 points.append({**c, "frequency": float(f), "waveform": waveform, "short_period": rule,
                                **fields})
     table = sweep.run(velocity_point, points, description="steady velocity")
-    table["variant"] = np.where(table["waveform"] == "sawtooth", "sawtooth",
-                                np.where(table["short_period"] == "skip", "optimized_skip", "optimized"))
+    table["variant"] = [variant_name(w, r)
+                        for w, r in zip(table["waveform"], table["short_period"], strict=True)]
     table["frequency_kHz"] = table["frequency"] / 1e3
     table["velocity_mm_per_s"] = table["velocity_m_per_s"] * 1e3
     table["step_nm"] = table["step_m"] * 1e9

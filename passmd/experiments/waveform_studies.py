@@ -30,6 +30,7 @@ from passmd.experiments.driving_waveform import (
     section5_drive,
     steady_periods,
     steady_velocity,
+    variant_name,
 )
 from passmd.parameters import Assumption, Drive, register_assumption
 
@@ -237,8 +238,8 @@ def flexible_study(profile: str = "paper") -> pd.DataFrame:
                 points.append({**c, "frequency": float(f), "waveform": waveform, "short_period": rule,
                                **design_fields(d), "design_from": source})
     table = sweep.run(study_point, points, description="flexible study")
-    table["variant"] = np.where(table["waveform"] == "sawtooth", "sawtooth",
-                                np.where(table["short_period"] == "skip", "optimized_skip", "optimized"))
+    table["variant"] = [variant_name(w, r)
+                        for w, r in zip(table["waveform"], table["short_period"], strict=True)]
     table["frequency_kHz"] = table["frequency"] / 1e3
     table["velocity_mm_per_s"] = table["velocity_m_per_s"] * 1e3
     return table
@@ -288,8 +289,7 @@ def startup_transient(frequency: float = 110e3) -> pd.DataFrame:
         settled = np.asarray(run["settled_positions_m"])
         k = np.arange(1, means.size)
         parts.append(pd.DataFrame({
-            "variant": "sawtooth" if run["waveform"] == "sawtooth" else (
-                "optimized_skip" if run["short_period"] == "skip" else "optimized"),
+            "variant": variant_name(run["waveform"], run["short_period"]),
             "period": k + 1, "time_s": (k + 1) / frequency,
             "velocity_m_per_s": np.diff(means) * frequency,
             "settled_velocity_m_per_s": np.diff(settled) * frequency,
