@@ -68,8 +68,8 @@ class SimulationError(RuntimeError):
 class StepPlan:
     """How the integrator discretises time for one drive."""
 
-    max_step: float  # fine step: resolves the stiffest mode (s)
-    coarse_step: float  # step while the actuators do not ring (s); = max_step for rigid actuators
+    fine_step: float  # fine step: resolves the stiffest mode (s)
+    coarse_step: float  # step while the actuators do not ring (s); = fine_step for rigid actuators
     stiffest_frequency: float  # frequency of the stiffest linearised mode (Hz)
     stability_limit: float  # Verlet stability limit 2/ω of that mode (s)
     activity_threshold: float  # actuator acceleration that counts as ringing (m/s²)
@@ -175,7 +175,7 @@ class SimulationResult:
     energy: dict
     steps: int
     fine_steps: int
-    max_step: float
+    fine_step: float
     coarse_step: float
     wall_time: float
     contact_memory: list = field(repr=False)  # per group: reversals, deepest stack, overflows
@@ -248,7 +248,7 @@ class SimulationResult:
             "integrator_steps": int(self.steps),
             "fine_steps": int(self.fine_steps),
             "contact_memory_overflows": int(sum(m["overflows"] for m in self.contact_memory)),
-            "fine_time_step_s": float(self.max_step),
+            "fine_time_step_s": float(self.fine_step),
             "coarse_time_step_s": float(self.coarse_step),
         }
         if self.settled_positions.size >= 2:
@@ -360,8 +360,8 @@ def simulate(
     params, state = stack_contacts(rows)
     k_contacts = np.array([contact_stiffness(params[g]) for g in range(len(rows))])
     plan = step_plan(drive, float(k_contacts.max()), float(np.sum(multiplicity * k_contacts)), resolution)
-    max_step = plan.max_step
-    coarse_step = plan.coarse_step if adaptive else plan.max_step
+    fine_step = plan.fine_step
+    coarse_step = plan.coarse_step if adaptive else plan.fine_step
     if dt is not None:
         check_positive("dt", dt, "s")
         limit = STABILITY_MARGIN * plan.stability_limit
@@ -370,7 +370,7 @@ def simulate(
                 f"dt = {dt!r} is out of range: the stiffest mode ({plan.stiffest_frequency / 1e6:.3g} MHz) "
                 f"needs dt < {limit:.3g} s for the explicit integrator to stay stable"
             )
-        max_step = coarse_step = float(dt)
+        fine_step = coarse_step = float(dt)
 
     G = multiplicity.size
     y = np.zeros(2 + 2 * G)
@@ -378,7 +378,7 @@ def simulate(
     per = np.zeros((waveform.periods, kern.PER_COLUMNS))
     peak = np.zeros((waveform.periods, G))
     energy = np.zeros(kern.EN_COLUMNS)
-    segs = _segments(waveform, max_step, coarse_step)
+    segs = _segments(waveform, fine_step, coarse_step)
     record_interval = waveform.duration / (max_points - 1)
     start = _time.perf_counter()
     status, steps, n_rec, fine_steps = kern.integrate(
@@ -412,7 +412,7 @@ def simulate(
             f"runner position {y[0]!r} m, velocity {y[1]!r} m/s. Likely cause: a time step too large for "
             f"the stiffest mode ({plan.stiffest_frequency:.3g} Hz, stable below "
             f"{plan.stability_limit:.3g} s; "
-            f"step used {max_step:.3g} s) or non-physical parameters."
+            f"steps used {fine_step:.3g} s to {coarse_step:.3g} s) or non-physical parameters."
         )
     rec = record[:n_rec]
     window_len = per[:, kern.PER_WINDOW_LENGTH]
@@ -446,7 +446,7 @@ def simulate(
         },
         steps=int(steps),
         fine_steps=int(fine_steps),
-        max_step=float(max_step),
+        fine_step=float(fine_step),
         coarse_step=float(coarse_step),
         wall_time=wall,
         contact_memory=[memory_diagnostics(params[g], state[g]) for g in range(G)],

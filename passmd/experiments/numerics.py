@@ -64,7 +64,7 @@ def convergence_study(
                         "configuration": label,
                         "step_control": control,
                         "resolution": float(r),
-                        "fine_step_s": res.max_step,
+                        "fine_step_s": res.fine_step,
                         "coarse_step_s": res.coarse_step,
                         "steps": res.steps,
                         "final_position_m": res.final_position,
