@@ -18,7 +18,7 @@ from passmd import experiments, ledger, reference
 
 PAPER = Path(os.environ.get("PASSMD_PAPER", "/work/shared/paper/nguyen2018-passmd.md"))
 
-#: Claims the issue requires as a minimum (issue 6, "What to build" 1).
+#: Claims the ledger must hold at minimum: the checkable statements of Sections 3-6 and Figs. 5-10.
 REQUIRED_CLAIMS = (
     "fig5a-no-step-below-50nm", "fig5b-rigid-ac-matches-eq7", "fig5b-flexible-ac-matches-eq8",
     "fig6a-rigid-ac-matches-eq11", "fig6a-rigid-ac-not-eq10", "fig6b-flexible-r1-ac-matches-eq12",
@@ -101,8 +101,8 @@ def test_real_claims_load_and_contain_the_required_rows():
     assert (claims["tolerance_reason"].str.len() > 10).all()
 
 
-def test_stated_numbers_of_the_issue():
-    """The numbers the paper states, as issue 6 lists them (a typo here would move a claim)."""
+def test_stated_numbers_of_the_paper():
+    """The numbers the paper states in its text (a typo here would move a claim)."""
     claims = ledger.load_claims().set_index("id")
     stated = {
         "fig5a-no-step-below-50nm": 50, "fig7a-force-difference-115mn": 115,

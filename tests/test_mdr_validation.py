@@ -17,7 +17,7 @@ from passmd import theory
 from passmd.parameters import Drive
 
 ROUND = 1e-12  # identities that hold to rounding (exact model vs closed forms)
-DISCRETE = 5e-3  # issue 3: discrete within 0.5 % of μF_N for N >= 1000
+DISCRETE = 5e-3  # MDR chapter's acceptance bound: discrete within 0.5 % of μF_N for N >= 1000
 
 DRIVE = Drive()
 F_N = float(theory.normal_forces(DRIVE.preload, DRIVE.contacts)[0])

@@ -27,7 +27,7 @@ from passmd._validation import check_choice
 
 PROFILES = ("quick", "paper")
 
-#: Topic modules that register figures; each issue adds its module here.
+#: Topic modules that register figures: one per chapter of the paper's Sections 3-5.
 TOPIC_MODULES: tuple[str, ...] = ("critical_amplitude", "force_generation", "driving_waveform")
 
 

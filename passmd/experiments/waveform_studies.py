@@ -1,7 +1,7 @@
 """Driving waveform, beyond the paper: settling time, numerical optimum, flexible actuators.
 
-Section 6's outlook asks how the actuators' dynamics affect the new waveform; the issue
-asks how much Eq. 15's heuristic leaves on the table. Built on the figure machinery of
+Section 6's outlook asks how the actuators' dynamics affect the new waveform; a replication
+also has to say how much Eq. 15's heuristic leaves on the table. Built on the figure machinery of
 :mod:`passmd.experiments.driving_waveform` (same drives, designs, protocols and cache):
 
 * :func:`settling_scan` — the 100 Hz step against the settling time t_s;
