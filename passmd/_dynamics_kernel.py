@@ -37,6 +37,33 @@ EN_COLUMNS = 3
 
 STATUS_OK = 0
 STATUS_DIVERGED = 1
+STATUS_PAUSED = 2  # the step limit was reached; call again with the same arrays to go on
+
+# slots of the carry array: everything the integration loop keeps between steps besides
+# ``y`` and ``work``, so that a paused integration resumes bit for bit where it stopped
+C_STARTED = 0  # 0 before the first call (forces and accelerations not yet evaluated)
+C_SEGMENT = 1  # segment in progress
+C_MID = 2  # 1 when paused inside that segment
+C_TIME = 3
+C_XP = 4
+C_AR = 5  # runner acceleration
+C_FORCE = 6  # Σ n_g T_g
+C_NEXT_RECORD = 7
+C_TRACK = 8
+C_RECORDED = 9
+C_STEPS = 10
+C_FINE_STEPS = 11
+C_FINE = 12  # 1 while the fine step is in use
+C_QUIET = 13
+C_ACC_XR = 14  # segment-local accumulators
+C_ACC_F = 15
+C_ACC_WIN = 16
+C_ACC_IN = 17
+C_ACC_DAMP = 18
+C_ACC_CONTACT = 19
+C_ACC_T = 20
+C_MIN_XR = 21
+CARRY_SIZE = 22
 
 
 #: numba options: the kernel allocates nothing (work arrays come from the caller), so it is
@@ -73,6 +100,8 @@ def integrate(
     sliding,
     y,
     work,
+    carry,
+    step_limit,
     record_interval,
     record,
     per,
@@ -81,7 +110,13 @@ def integrate(
     position_limit,
     velocity_limit,
 ):
-    """Integrate over all segments; returns (status, steps done, rows recorded, fine steps).
+    """Integrate over the segments; returns (status, steps done, rows recorded, fine steps).
+
+    Work is bounded: once ``step_limit`` steps (counted from the start of the run) are
+    done, the kernel stores its loop state in ``carry`` (shape (CARRY_SIZE,), zeros
+    before the first call) and returns STATUS_PAUSED; calling it again with the same
+    arrays continues exactly where it stopped, with the same floating-point operations
+    in the same order as an uninterrupted run (the contact memory lives in ``state``).
 
     ``sliding`` holds μF_N of each group; ``peak[k, g]`` receives the largest |T_g|/μF_N from
     period k's slip mark to the next settle window (1 exactly when the group slid fully).
@@ -104,57 +139,113 @@ def integrate(
     u_old = work[3]
     a_nd = work[4]  # actuator acceleration without the damping term
     stretch_old = work[5]  # x_p − x_a at the previous step
-    for g in range(G):
-        x_a[g] = y[2 + g]
-        v_a[g] = y[2 + G + g]
     gam = actuator_viscosity / actuator_mass
     inv_ma = 1.0 / actuator_mass
     inv_mr = 1.0 / runner_mass
-    t = seg_t0[0]
-    x_p = seg_x0[0]
-
-    F = 0.0
-    for g in range(G):
-        u = x_a[g] - x_r
-        T[g] = contact_force_row(params, state, g, u)
-        u_old[g] = u
-        F += multiplicity[g] * T[g]
-        a_nd[g] = (actuator_stiffness * (x_p - x_a[g]) - T[g]) * inv_ma
-    a_r = (F - load_stiffness * x_r) * inv_mr
-
-    n_rec = 0
+    if carry[C_STARTED] == 0.0:
+        for g in range(G):
+            x_a[g] = y[2 + g]
+            v_a[g] = y[2 + G + g]
+        t = seg_t0[0]
+        x_p = seg_x0[0]
+        F = 0.0
+        for g in range(G):
+            u = x_a[g] - x_r
+            T[g] = contact_force_row(params, state, g, u)
+            u_old[g] = u
+            F += multiplicity[g] * T[g]
+            a_nd[g] = (actuator_stiffness * (x_p - x_a[g]) - T[g]) * inv_ma
+        a_r = (F - load_stiffness * x_r) * inv_mr
+        n_rec = 0
+        next_rec = t
+        track = -1
+        steps = 0
+        fine_steps = 0
+        first_segment = 0
+        resume = False
+        carry[C_STARTED] = 1.0
+    else:
+        t = carry[C_TIME]
+        x_p = carry[C_XP]
+        a_r = carry[C_AR]
+        F = carry[C_FORCE]
+        n_rec = int(carry[C_RECORDED])
+        next_rec = carry[C_NEXT_RECORD]
+        track = int(carry[C_TRACK])
+        steps = int(carry[C_STEPS])
+        fine_steps = int(carry[C_FINE_STEPS])
+        first_segment = int(carry[C_SEGMENT])
+        resume = carry[C_MID] != 0.0
     max_rec = record.shape[0]
-    next_rec = t
-    track = -1
-    steps = 0
-    fine_steps = 0
-    for s in range(seg_t0.shape[0]):
+    for s in range(first_segment, seg_t0.shape[0]):
         k = seg_period[s]
         t_end = seg_t1[s]
         vp = (seg_x1[s] - seg_x0[s]) / (t_end - seg_t0[s])
-        if seg_mark[s]:
-            track = k
-            per[k, PER_MARK_XR] = x_r
-            per[k, PER_MIN_XR] = x_r
         in_window = seg_window[s] != 0
-        if in_window and track >= 0 and k > track:
-            track = -1
         dt_fine = seg_fine[s]
         dt_coarse = seg_coarse[s]
         adaptive = (not rigid) and dt_coarse > dt_fine
-        fine = True
-        quiet = 0
-        # segment-local accumulators (kept in registers, written back after the segment)
-        acc_xr = 0.0
-        acc_f = 0.0
-        acc_win = 0.0
-        acc_in = 0.0
-        acc_damp = 0.0
-        acc_contact = 0.0
-        acc_t = 0.0
-        min_xr = per[track, PER_MIN_XR] if track >= 0 else 0.0
+        if resume:
+            resume = False
+            fine = carry[C_FINE] != 0.0
+            quiet = int(carry[C_QUIET])
+            acc_xr = carry[C_ACC_XR]
+            acc_f = carry[C_ACC_F]
+            acc_win = carry[C_ACC_WIN]
+            acc_in = carry[C_ACC_IN]
+            acc_damp = carry[C_ACC_DAMP]
+            acc_contact = carry[C_ACC_CONTACT]
+            acc_t = carry[C_ACC_T]
+            min_xr = carry[C_MIN_XR]
+        else:
+            if seg_mark[s]:
+                track = k
+                per[k, PER_MARK_XR] = x_r
+                per[k, PER_MIN_XR] = x_r
+            if in_window and track >= 0 and k > track:
+                track = -1
+            fine = True
+            quiet = 0
+            # segment-local accumulators (kept in registers, written back after the segment)
+            acc_xr = 0.0
+            acc_f = 0.0
+            acc_win = 0.0
+            acc_in = 0.0
+            acc_damp = 0.0
+            acc_contact = 0.0
+            acc_t = 0.0
+            min_xr = per[track, PER_MIN_XR] if track >= 0 else 0.0
         done = False
         while not done:
+            if steps >= step_limit:
+                # pause: everything the loop carries goes to carry, y and work
+                carry[C_SEGMENT] = s
+                carry[C_MID] = 1.0
+                carry[C_TIME] = t
+                carry[C_XP] = x_p
+                carry[C_AR] = a_r
+                carry[C_FORCE] = F
+                carry[C_NEXT_RECORD] = next_rec
+                carry[C_TRACK] = track
+                carry[C_RECORDED] = n_rec
+                carry[C_STEPS] = steps
+                carry[C_FINE_STEPS] = fine_steps
+                carry[C_FINE] = 1.0 if fine else 0.0
+                carry[C_QUIET] = quiet
+                carry[C_ACC_XR] = acc_xr
+                carry[C_ACC_F] = acc_f
+                carry[C_ACC_WIN] = acc_win
+                carry[C_ACC_IN] = acc_in
+                carry[C_ACC_DAMP] = acc_damp
+                carry[C_ACC_CONTACT] = acc_contact
+                carry[C_ACC_T] = acc_t
+                carry[C_MIN_XR] = min_xr
+                y[0] = x_r
+                y[1] = v_r
+                for g in range(G):
+                    y[2 + g] = x_a[g]
+                    y[2 + G + g] = v_a[g]
+                return STATUS_PAUSED, steps, n_rec, fine_steps
             dt = dt_fine if fine else dt_coarse
             remaining = t_end - t
             if remaining <= dt * 1.000001:
