@@ -63,7 +63,8 @@ C_ACC_DAMP = 18
 C_ACC_CONTACT = 19
 C_ACC_T = 20
 C_MIN_XR = 21
-CARRY_SIZE = 22
+C_QUASI = 22  # 1 while the quasi-static actuator step is in use
+CARRY_SIZE = 23
 
 
 #: numba options: the kernel allocates nothing (work arrays come from the caller), so it is
@@ -72,7 +73,50 @@ CARRY_SIZE = 22
 KERNEL_OPTIONS = {"cache": True, "error_model": "numpy", "_nrt": False}
 
 #: rows of the work array (shape (WORK_ROWS, groups)) the caller allocates
-WORK_ROWS = 6
+WORK_ROWS = 8
+#: quasi-static step: the actuator's force balance is solved to this fraction of S/K
+#: (≈ 6e-15 m; a force error ≤ 1e-6 μF_N)
+QUASI_TOLERANCE = 1e-6
+
+
+@njit(**KERNEL_OPTIONS)
+def quasi_static_position(params, state, g, x_r, center, K, S, guess, slope, tolerance):
+    """Actuator position x of group g in force balance with its contact (m_a neglected).
+
+    Solves h(x) = K (center − x) − T_g(x − x_r) = 0 with the contact's memory as committed
+    (pure evaluations). T_g is non-decreasing in u on every Masing branch and |T_g| ≤ S
+    (μF_N), so h is strictly decreasing, −h' ∈ [K, K + 2aG*], and the root lies in
+    [center − S/K, center + S/K]. From ``guess``, a step with ``slope`` (the previous
+    step's −h', or K), then secant steps kept inside the shrinking bracket (bisection when
+    a step leaves it), until a step is below ``tolerance`` (m). Returns (x, −h' estimate).
+    """
+    lo = center - S / K
+    hi = center + S / K
+    x = min(max(guess, lo), hi)
+    h = K * (center - x) - contact_force_row(params, state, g, x - x_r)
+    x_prev = x
+    h_prev = h
+    for it in range(200):
+        if h == 0.0:
+            return x, slope
+        if h > 0.0:
+            lo = x
+        else:
+            hi = x
+        if it > 0 and h != h_prev:
+            secant = (h_prev - h) / (x - x_prev)
+            if secant >= K:
+                slope = secant
+        x_new = x + h / slope
+        if not (lo <= x_new <= hi):  # (the root is at an end of the bracket in full sliding)
+            x_new = 0.5 * (lo + hi)
+        if abs(x_new - x) <= tolerance or hi - lo <= tolerance:
+            return x_new, slope
+        x_prev = x
+        h_prev = h
+        x = x_new
+        h = K * (center - x) - contact_force_row(params, state, g, x - x_r)
+    return x, slope
 
 
 @njit(**KERNEL_OPTIONS)
@@ -86,8 +130,10 @@ def integrate(
     seg_period,
     seg_window,
     seg_mark,
+    seg_quasi,
     activity_threshold,
     quiet_steps,
+    quasi_static,
     runner_mass,
     load_stiffness,
     multiplicity,
@@ -129,6 +175,13 @@ def integrate(
     actuator acceleration |ẍ_a| has stayed below ``activity_threshold`` for
     ``quiet_steps`` fine steps, the step grows to ``seg_coarse``; it falls back to fine
     as soon as |ẍ_a| exceeds the threshold again. Rigid actuators: ``seg_fine`` only.
+
+    With ``quasi_static`` the quiet phases instead neglect m_a: each step of
+    ``seg_quasi`` (set by the runner's mode) solves the actuator's force balance
+    k_p (x_p − x_a) = c_p ẋ_a + T(x_a − x_r) implicitly (backward Euler in the damping
+    term, :func:`quasi_static_position`), then commits the contact memory once, as the
+    explicit step does. The implied actuator acceleration is checked against the same
+    threshold; above it, the fine explicit step takes over again.
     """
     G = multiplicity.shape[0]
     x_r = y[0]
@@ -139,6 +192,8 @@ def integrate(
     u_old = work[3]
     a_nd = work[4]  # actuator acceleration without the damping term
     stretch_old = work[5]  # x_p − x_a at the previous step
+    xa_old = work[6]  # x_a at the previous step (quasi-static step)
+    slope = work[7]  # last −h' of the quasi-static balance (0: none yet)
     gam = actuator_viscosity / actuator_mass
     inv_ma = 1.0 / actuator_mass
     inv_mr = 1.0 / runner_mass
@@ -184,10 +239,12 @@ def integrate(
         in_window = seg_window[s] != 0
         dt_fine = seg_fine[s]
         dt_coarse = seg_coarse[s]
+        dt_quasi = seg_quasi[s]
         adaptive = (not rigid) and dt_coarse > dt_fine
         if resume:
             resume = False
             fine = carry[C_FINE] != 0.0
+            quasi = carry[C_QUASI] != 0.0
             quiet = int(carry[C_QUIET])
             acc_xr = carry[C_ACC_XR]
             acc_f = carry[C_ACC_F]
@@ -205,6 +262,7 @@ def integrate(
             if in_window and track >= 0 and k > track:
                 track = -1
             fine = True
+            quasi = False
             quiet = 0
             # segment-local accumulators (kept in registers, written back after the segment)
             acc_xr = 0.0
@@ -231,6 +289,7 @@ def integrate(
                 carry[C_STEPS] = steps
                 carry[C_FINE_STEPS] = fine_steps
                 carry[C_FINE] = 1.0 if fine else 0.0
+                carry[C_QUASI] = 1.0 if quasi else 0.0
                 carry[C_QUIET] = quiet
                 carry[C_ACC_XR] = acc_xr
                 carry[C_ACC_F] = acc_f
@@ -246,7 +305,12 @@ def integrate(
                     y[2 + g] = x_a[g]
                     y[2 + G + g] = v_a[g]
                 return STATUS_PAUSED, steps, n_rec, fine_steps
-            dt = dt_fine if fine else dt_coarse
+            if fine:
+                dt = dt_fine
+            elif quasi:
+                dt = dt_quasi
+            else:
+                dt = dt_coarse
             remaining = t_end - t
             if remaining <= dt * 1.000001:
                 dt = remaining
@@ -266,6 +330,20 @@ def integrate(
             if rigid:
                 for g in range(G):
                     x_a[g] = xp_new
+            elif quasi:
+                c_dt = actuator_viscosity / dt
+                K = actuator_stiffness + c_dt
+                for g in range(G):
+                    stretch_old[g] = x_p - x_a[g]
+                    xa_old[g] = x_a[g]
+                    center = (actuator_stiffness * xp_new + c_dt * x_a[g]) / K
+                    # Newton predictor from the last solution: T moves by k_t Δu, k_t = slope − K
+                    sg = max(slope[g], K)
+                    guess = x_a[g] + (K * (center - x_a[g]) - T[g] - (sg - K) * (xr_old - x_r)) / sg
+                    x_a[g], slope[g] = quasi_static_position(
+                        params, state, g, x_r, center, K, sliding[g], guess, sg,
+                        QUASI_TOLERANCE * sliding[g] / K,
+                    )
             else:
                 for g in range(G):
                     stretch_old[g] = x_p - x_a[g]
@@ -290,7 +368,23 @@ def integrate(
             a_r_new = (F - load_stiffness * x_r) * inv_mr
             v_r += 0.5 * dt * (a_r + a_r_new)
             a_r = a_r_new
-            if not rigid:
+            if quasi:
+                activity = 0.0
+                for g in range(G):
+                    v_old = v_a[g]
+                    v_a[g] = (x_a[g] - xa_old[g]) / dt
+                    a_nd[g] = (actuator_stiffness * (xp_new - x_a[g]) - T[g]) * inv_ma
+                    # backward Euler: c_p v_a (x_a − x_a,old) = c_p v_a² dt (halved below)
+                    acc_damp += multiplicity[g] * 2.0 * v_a[g] * v_a[g] * dt
+                    acc_in += multiplicity[g] * (stretch_old[g] + xp_new - x_a[g]) * (xp_new - x_p)
+                    acc = abs(v_a[g] - v_old) / dt
+                    if acc > activity:
+                        activity = acc
+                if activity >= activity_threshold:
+                    fine = True
+                    quasi = False
+                    quiet = 0
+            elif not rigid:
                 damp = 1.0 / (1.0 + 0.5 * dt * gam)
                 activity = 0.0
                 for g in range(G):
@@ -310,6 +404,7 @@ def integrate(
                             quiet += 1
                             if quiet >= quiet_steps:
                                 fine = False
+                                quasi = quasi_static
                         else:
                             quiet = 0
                     elif activity >= activity_threshold:

@@ -54,6 +54,9 @@ RINGING_TOLERANCE = 1e-12
 QUIET_PERIODS = 2
 #: Steps per period of the runner-on-contacts mode (rigid actuators).
 STEPS_PER_RUNNER_PERIOD = 400
+#: Quasi-static actuator step (``quasi_static=True``): steps per period of the
+#: runner-on-contacts mode, as for rigid actuators (the actuator in series only softens it).
+STEPS_PER_QUASI_RUNNER_PERIOD = 400
 #: Minimum number of steps on every linear piece of x_p(t) (resolves the fly-back).
 MIN_SEGMENT_STEPS = 40
 #: Verlet is stable for ω dt < 2; a user step must keep this margin below it.
@@ -94,6 +97,7 @@ class StepPlan:
     stability_limit: float  # Verlet stability limit 2/ω of that mode (s)
     activity_threshold: float  # actuator acceleration that counts as ringing (m/s²)
     quiet_steps: int  # fine steps below the threshold before the step grows
+    quasi_step: float = 0.0  # step of the quasi-static actuator (flexible, quasi_static=True) (s)
 
 
 def contact_groups(drive: Drive, share_side_state: bool = True):
@@ -127,6 +131,8 @@ def step_plan(
         Refinement factor: the step is divided by it (convergence studies).
     """
     act = drive.actuator
+    runner_stiffness = total_contact_stiffness + drive.effective_load_cell_stiffness
+    omega_runner = np.sqrt(runner_stiffness / drive.runner_mass)
     if drive.actuator_model == "flexible":
         omega = np.sqrt((act.stiffness + contact_stiffness_max) / act.mass)
         dt = 2 * np.pi / omega / STEPS_PER_STIFF_PERIOD / resolution
@@ -135,9 +141,10 @@ def step_plan(
         threshold = omega**2 * RINGING_TOLERANCE
         quiet = int(np.ceil(QUIET_PERIODS * STEPS_PER_STIFF_PERIOD * resolution))
     else:
-        omega = np.sqrt((total_contact_stiffness + drive.effective_load_cell_stiffness) / drive.runner_mass)
+        omega = omega_runner
         dt = 2 * np.pi / omega / STEPS_PER_RUNNER_PERIOD / resolution
         coarse, threshold, quiet = dt, 0.0, 0
+    quasi = 2 * np.pi / omega_runner / STEPS_PER_QUASI_RUNNER_PERIOD / resolution
     return StepPlan(
         float(dt),
         float(max(coarse, dt)),
@@ -145,6 +152,7 @@ def step_plan(
         float(2.0 / omega),
         float(threshold),
         quiet,
+        float(max(quasi, dt)),
     )
 
 
@@ -294,7 +302,7 @@ class SimulationResult:
         return pd.DataFrame(data)
 
 
-def _segments(waveform: Waveform, fine_step: float, coarse_step: float):
+def _segments(waveform: Waveform, fine_step: float, coarse_step: float, quasi_step: float | None = None):
     t, x = waveform.times, waveform.positions
     t0, t1, x0, x1 = t[:-1], t[1:], x[:-1], x[1:]
     shortest = (t1 - t0) / MIN_SEGMENT_STEPS
@@ -310,7 +318,8 @@ def _segments(waveform: Waveform, fine_step: float, coarse_step: float):
     inside = (last >= 0) & (t1 <= ends[np.maximum(last, 0)])
     window = inside.astype(np.int64)
     mark = np.isin(t0, waveform.slip_marks).astype(np.int64)
-    return t0, t1, x0, x1, fine, coarse, period, window, mark
+    quasi = np.minimum(coarse_step if quasi_step is None else quasi_step, shortest)
+    return t0, t1, x0, x1, fine, coarse, period, window, mark, quasi
 
 
 def expected_steps(waveform: Waveform, plan: StepPlan, fine_step: float, coarse_step: float) -> np.ndarray:
@@ -427,6 +436,7 @@ def simulate(
     share_side_state: bool = True,
     adaptive: bool = True,
     progress: bool | None = None,
+    quasi_static: bool = False,
 ) -> SimulationResult:
     """Simulate the drive under a piezo waveform from rest with virgin contacts.
 
@@ -452,6 +462,11 @@ def simulate(
     adaptive : bool
         Flexible actuators: coarse steps while the actuators do not ring (default);
         ``False`` integrates with the fine step throughout.
+    quasi_static : bool
+        Flexible actuators, adaptive step: in the quiet phases neglect the actuator mass and
+        solve its force balance implicitly with the runner's step
+        (:func:`passmd._dynamics_kernel.quasi_static_position`) instead of explicit coarse
+        steps (default ``False``: the explicit scheme).
     progress : bool, optional
         Show a progress bar on stderr; default: for runs of more than
         :data:`PROGRESS_MIN_STEPS` expected steps when stderr is a terminal.
@@ -507,6 +522,8 @@ def simulate(
                 f"needs dt < {limit:.3g} s for the explicit integrator to stay stable"
             )
         fine_step = coarse_step = float(dt)
+    quasi = quasi_static and adaptive and dt is None and drive.actuator_model == "flexible"
+    quasi_step = plan.quasi_step if quasi else coarse_step
 
     G = multiplicity.size
     y = np.zeros(2 + 2 * G)
@@ -515,10 +532,10 @@ def simulate(
     peak = np.zeros((waveform.periods, G))
     energy = np.zeros(kern.EN_COLUMNS)
     expected = check_work(
-        drive, waveform, plan, fine_step, coarse_step, float(np.sum(multiplicity * k_contacts)),
-        user_step=dt is not None,
+        drive, waveform, plan, fine_step, quasi_step if quasi else coarse_step,
+        float(np.sum(multiplicity * k_contacts)), user_step=dt is not None,
     )
-    segs = _segments(waveform, fine_step, coarse_step)
+    segs = _segments(waveform, fine_step, coarse_step, quasi_step)
     record_interval = waveform.duration / (max_points - 1)
     work = np.zeros((kern.WORK_ROWS, G))
     carry = np.zeros(kern.CARRY_SIZE)
@@ -532,6 +549,7 @@ def simulate(
                 *segs,
                 plan.activity_threshold,
                 plan.quiet_steps,
+                quasi,
                 drive.runner_mass,
                 drive.effective_load_cell_stiffness,
                 multiplicity.astype(float),
@@ -604,7 +622,7 @@ def simulate(
         steps=int(steps),
         fine_steps=int(fine_steps),
         fine_step=float(fine_step),
-        coarse_step=float(coarse_step),
+        coarse_step=float(quasi_step if quasi else coarse_step),
         wall_time=wall,
         contact_memory=[memory_diagnostics(params[g], state[g]) for g in range(G)],
         final_state=y.copy(),
