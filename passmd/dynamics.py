@@ -576,7 +576,7 @@ def simulate(
                 break
             limit = steps + CHUNK_STEPS
             if bar is not None:
-                bar.update(min(carry[kern.C_TIME] / waveform.period, waveform.periods) - bar.n)
+                bar.update(min(int(carry[kern.C_TIME] / waveform.period), waveform.periods) - bar.n)
     finally:
         if bar is not None:
             bar.close()
