@@ -1,9 +1,17 @@
 """Speed of the hybrid simulator: ns per integrator step and wall time per 100 Hz period.
 
 Runs each configuration (one/six contacts × rigid/flexible × exact/discrete N = 200;
-flexible both with the default adaptive step and with the fixed fine step) over one
+flexible with the default adaptive step, the fixed fine step and the opt-in quasi-static
+actuator step) over one
 100 Hz saw-tooth period (150 nm, 0.4 N, R = 1 mm) at the default, converged step,
 repeats, and reports medians. numba compilation happens in an untimed warm-up run.
+Each row also gives the error of the settled position after 3 periods against the fixed
+fine step (the reference scheme).
+
+Start-up: the median time from launching ``passmd run --periods 1`` to its first
+integrator step (warm: bytecode and numba caches written by an untimed first launch),
+the modules that command imports, and ``python -X importtime`` of the package's
+command-line and dynamics modules. The machine's load average is recorded with the numbers.
 
 Usage::
 
@@ -14,25 +22,99 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import platform
 import statistics
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 from passmd import dynamics, waveforms
 from passmd.parameters import Drive
 
 CONFIGS = [
-    (contacts, model, contact, adaptive)
+    (contacts, model, contact, control)
     for contacts in (1, 6)
     for model in ("rigid", "flexible")
     for contact in ("exact", "discrete")
-    for adaptive in ((True, False) if model == "flexible" else (True,))
+    for control in (("adaptive", "fixed", "quasi-static") if model == "flexible" else ("fixed",))
 ]
 
 
-def bench(contacts: int, model: str, contact: str, adaptive: bool, repeats: int, springs: int = 200) -> dict:
+#: modules the ``run`` command should not need (imported only by other commands)
+HEAVY_MODULES = ("pandas", "matplotlib", "pint", "dask", "distributed", "tqdm")
+
+# launched as ``python -c``: reports (on stderr) the time and the heavy modules loaded when
+# the CLI first enters the integrator, then finishes the command
+_FIRST_STEP = """
+import json, sys, time
+from passmd import _dynamics_kernel as kern, cli
+integrate = kern.integrate
+def announced(*args):
+    heavy = [m for m in json.loads(sys.argv[1]) if m in sys.modules]
+    sys.stderr.write(json.dumps({"ready": time.time(), "heavy": heavy}) + "\\n")
+    sys.stderr.flush()
+    kern.integrate = integrate
+    return integrate(*args)
+kern.integrate = announced
+sys.exit(cli.main(sys.argv[2:]))
+"""
+
+
+def _warm_env() -> dict:
+    env = dict(os.environ)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)  # a warm machine has its bytecode cached
+    return env
+
+
+def startup(repeats: int) -> dict:
+    """Launch-to-first-step time of ``passmd run --periods 1`` (median), modules, importtime."""
+    argv = [sys.executable, "-c", _FIRST_STEP, json.dumps(HEAVY_MODULES), "run", "--periods", "1", "--json"]
+    times, heavy = [], []
+    for i in range(repeats + 1):
+        start = time.time()
+        proc = subprocess.run(argv, capture_output=True, text=True, env=_warm_env(), check=True)
+        report = json.loads(proc.stderr.splitlines()[0])
+        if i:  # the first launch writes the caches
+            times.append(report["ready"] - start)
+        heavy = report["heavy"]
+    imp = subprocess.run(
+        [sys.executable, "-X", "importtime", "-c", "import passmd.cli, passmd.dynamics"],
+        capture_output=True, text=True, env=_warm_env(), check=True,
+    ).stderr
+    cumulative = {}
+    for line in imp.splitlines():
+        parts = [p.strip() for p in line.split("|")]
+        if len(parts) == 3 and parts[2] in ("passmd.cli", "passmd.dynamics", "numpy", "numba"):
+            cumulative[parts[2]] = int(parts[1]) / 1e6
+    return {
+        "command": "passmd run --periods 1",
+        "launch_to_first_step_s": statistics.median(times),
+        "launch_to_first_step_all_s": times,
+        "heavy_modules_imported": heavy,
+        "importtime_cumulative_s": cumulative,
+    }
+
+
+_REFERENCE: dict = {}
+
+
+def settled_error(drive: Drive, kw: dict) -> float:
+    """|settled position after 3 periods − the fixed fine step's| (m), 150 nm at 100 Hz."""
+    wf = waveforms.sawtooth(150e-9, 100.0, drive, periods=3)
+    key = (drive.contacts, drive.actuator_model, kw["contact_model"])
+    if key not in _REFERENCE:
+        fixed = {**kw, "adaptive": False, "quasi_static": False}
+        _REFERENCE[key] = dynamics.simulate(drive, wf, max_points=2, **fixed).final_position
+    res = dynamics.simulate(drive, wf, max_points=2, **kw)
+    return abs(res.final_position - _REFERENCE[key])
+
+
+def bench(contacts: int, model: str, contact: str, control: str, repeats: int, springs: int = 200) -> dict:
     drive = Drive(contacts=contacts, actuator_model=model)
-    kw = dict(contact_model=contact, springs=springs, adaptive=adaptive)
+    kw = dict(contact_model=contact, springs=springs, adaptive=control != "fixed",
+              quasi_static=control == "quasi-static")
     warm = waveforms.sawtooth(150e-9, 10e3, drive, periods=1)
     dynamics.simulate(drive, warm, **kw)  # compile
     wf = waveforms.sawtooth(150e-9, 100.0, drive, periods=1)
@@ -45,13 +127,14 @@ def bench(contacts: int, model: str, contact: str, adaptive: bool, repeats: int,
     return {
         "contacts": contacts,
         "actuator": model,
-        "step": ("adaptive" if adaptive else "fixed") if model == "flexible" else "fixed",
+        "step": control,
         "contact_model": contact if contact == "exact" else f"discrete N={springs}",
         "steps_per_period": steps,
         "fine_step_ns": res.fine_step * 1e9,
         "coarse_step_ns": res.coarse_step * 1e9,
         "ns_per_step": wall / steps * 1e9,
         "ms_per_100Hz_period": wall * 1e3,
+        "error_vs_fixed_fine_nm": settled_error(drive, kw) * 1e9,
     }
 
 
@@ -60,26 +143,36 @@ def main(argv=None) -> int:
     ap.add_argument("--repeats", type=int, default=5, help="timed repeats per configuration (median)")
     ap.add_argument("--out", type=Path, default=Path(__file__).parent / "results" / "dynamics.json")
     args = ap.parse_args(argv)
-    rows = [bench(c, m, k, a, args.repeats) for c, m, k, a in CONFIGS]
+    load_before = os.getloadavg()
+    rows = [bench(c, m, k, control, args.repeats) for c, m, k, control in CONFIGS]
+    start = startup(args.repeats)
     header = (
-        f"{'contacts':>8} {'actuator':>9} {'step':>9} {'contact':>16} {'steps':>9} "
-        f"{'fine/ns':>7} {'coarse/ns':>9} {'ns/step':>8} {'ms/period':>10}"
+        f"{'contacts':>8} {'actuator':>9} {'step':>12} {'contact':>16} {'steps':>9} "
+        f"{'fine/ns':>7} {'coarse/ns':>9} {'ns/step':>8} {'ms/period':>10} {'error/nm':>9}"
     )
     print(header)
     for r in rows:
         print(
-            f"{r['contacts']:>8} {r['actuator']:>9} {r['step']:>9} {r['contact_model']:>16} "
+            f"{r['contacts']:>8} {r['actuator']:>9} {r['step']:>12} {r['contact_model']:>16} "
             f"{r['steps_per_period']:>9}"
             f"{r['fine_step_ns']:>7.2f} {r['coarse_step_ns']:>9.2f} {r['ns_per_step']:>8.1f} "
-            f"{r['ms_per_100Hz_period']:>10.2f}"
+            f"{r['ms_per_100Hz_period']:>10.2f} {r['error_vs_fixed_fine_nm']:>9.2g}"
         )
+    print(f"start-up ({start['command']}): {start['launch_to_first_step_s']:.3f} s to the first step; "
+          f"heavy modules imported: {start['heavy_modules_imported'] or 'none'}")
     args.out.parent.mkdir(parents=True, exist_ok=True)
     meta = {
         "machine": platform.processor() or platform.machine(),
         "python": platform.python_version(),
         "repeats": args.repeats,
+        "cpus": os.cpu_count(),
+        "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()),
+        # 1-, 5-, 15-minute load averages before and after: > 0.5 means the machine was not quiet
+        "load_average_before": list(load_before),
+        "load_average_after": list(os.getloadavg()),
     }
-    args.out.write_text(json.dumps({"meta": meta, "rows": rows}, indent=2))
+    print(f"load average before {load_before}, after {meta['load_average_after']} on {meta['cpus']} CPUs")
+    args.out.write_text(json.dumps({"meta": meta, "rows": rows, "startup": start}, indent=2))
     print(f"written {args.out}")
     return 0
 

@@ -37,6 +37,34 @@ EN_COLUMNS = 3
 
 STATUS_OK = 0
 STATUS_DIVERGED = 1
+STATUS_PAUSED = 2  # the step limit was reached; call again with the same arrays to go on
+
+# slots of the carry array: everything the integration loop keeps between steps besides
+# ``y`` and ``work``, so that a paused integration resumes bit for bit where it stopped
+C_STARTED = 0  # 0 before the first call (forces and accelerations not yet evaluated)
+C_SEGMENT = 1  # segment in progress
+C_MID = 2  # 1 when paused inside that segment
+C_TIME = 3
+C_XP = 4
+C_AR = 5  # runner acceleration
+C_FORCE = 6  # Σ n_g T_g
+C_NEXT_RECORD = 7
+C_TRACK = 8
+C_RECORDED = 9
+C_STEPS = 10
+C_FINE_STEPS = 11
+C_FINE = 12  # 1 while the fine step is in use
+C_QUIET = 13
+C_ACC_XR = 14  # segment-local accumulators
+C_ACC_F = 15
+C_ACC_WIN = 16
+C_ACC_IN = 17
+C_ACC_DAMP = 18
+C_ACC_CONTACT = 19
+C_ACC_T = 20
+C_MIN_XR = 21
+C_QUASI = 22  # 1 while the quasi-static actuator step is in use
+CARRY_SIZE = 23
 
 
 #: numba options: the kernel allocates nothing (work arrays come from the caller), so it is
@@ -45,7 +73,50 @@ STATUS_DIVERGED = 1
 KERNEL_OPTIONS = {"cache": True, "error_model": "numpy", "_nrt": False}
 
 #: rows of the work array (shape (WORK_ROWS, groups)) the caller allocates
-WORK_ROWS = 6
+WORK_ROWS = 8
+#: quasi-static step: the actuator's force balance is solved to this fraction of S/K
+#: (≈ 6e-15 m; a force error ≤ 1e-6 μF_N)
+QUASI_TOLERANCE = 1e-6
+
+
+@njit(**KERNEL_OPTIONS)
+def quasi_static_position(params, state, g, x_r, center, K, S, guess, slope, tolerance):
+    """Actuator position x of group g in force balance with its contact (m_a neglected).
+
+    Solves h(x) = K (center − x) − T_g(x − x_r) = 0 with the contact's memory as committed
+    (pure evaluations). T_g is non-decreasing in u on every Masing branch and |T_g| ≤ S
+    (μF_N), so h is strictly decreasing, −h' ∈ [K, K + 2aG*], and the root lies in
+    [center − S/K, center + S/K]. From ``guess``, a step with ``slope`` (the previous
+    step's −h', or K), then secant steps kept inside the shrinking bracket (bisection when
+    a step leaves it), until a step is below ``tolerance`` (m). Returns (x, −h' estimate).
+    """
+    lo = center - S / K
+    hi = center + S / K
+    x = min(max(guess, lo), hi)
+    h = K * (center - x) - contact_force_row(params, state, g, x - x_r)
+    x_prev = x
+    h_prev = h
+    for it in range(200):
+        if h == 0.0:
+            return x, slope
+        if h > 0.0:
+            lo = x
+        else:
+            hi = x
+        if it > 0 and h != h_prev:
+            secant = (h_prev - h) / (x - x_prev)
+            if secant >= K:
+                slope = secant
+        x_new = x + h / slope
+        if not (lo <= x_new <= hi):  # (the root is at an end of the bracket in full sliding)
+            x_new = 0.5 * (lo + hi)
+        if abs(x_new - x) <= tolerance or hi - lo <= tolerance:
+            return x_new, slope
+        x_prev = x
+        h_prev = h
+        x = x_new
+        h = K * (center - x) - contact_force_row(params, state, g, x - x_r)
+    return x, slope
 
 
 @njit(**KERNEL_OPTIONS)
@@ -59,8 +130,10 @@ def integrate(
     seg_period,
     seg_window,
     seg_mark,
+    seg_quasi,
     activity_threshold,
     quiet_steps,
+    quasi_static,
     runner_mass,
     load_stiffness,
     multiplicity,
@@ -73,6 +146,8 @@ def integrate(
     sliding,
     y,
     work,
+    carry,
+    step_limit,
     record_interval,
     record,
     per,
@@ -81,7 +156,13 @@ def integrate(
     position_limit,
     velocity_limit,
 ):
-    """Integrate over all segments; returns (status, steps done, rows recorded, fine steps).
+    """Integrate over the segments; returns (status, steps done, rows recorded, fine steps).
+
+    Work is bounded: once ``step_limit`` steps (counted from the start of the run) are
+    done, the kernel stores its loop state in ``carry`` (shape (CARRY_SIZE,), zeros
+    before the first call) and returns STATUS_PAUSED; calling it again with the same
+    arrays continues exactly where it stopped, with the same floating-point operations
+    in the same order as an uninterrupted run (the contact memory lives in ``state``).
 
     ``sliding`` holds μF_N of each group; ``peak[k, g]`` receives the largest |T_g|/μF_N from
     period k's slip mark to the next settle window (1 exactly when the group slid fully).
@@ -94,6 +175,13 @@ def integrate(
     actuator acceleration |ẍ_a| has stayed below ``activity_threshold`` for
     ``quiet_steps`` fine steps, the step grows to ``seg_coarse``; it falls back to fine
     as soon as |ẍ_a| exceeds the threshold again. Rigid actuators: ``seg_fine`` only.
+
+    With ``quasi_static`` the quiet phases instead neglect m_a: each step of
+    ``seg_quasi`` (set by the runner's mode) solves the actuator's force balance
+    k_p (x_p − x_a) = c_p ẋ_a + T(x_a − x_r) implicitly (backward Euler in the damping
+    term, :func:`quasi_static_position`), then commits the contact memory once, as the
+    explicit step does. The implied actuator acceleration is checked against the same
+    threshold; above it, the fine explicit step takes over again.
     """
     G = multiplicity.shape[0]
     x_r = y[0]
@@ -104,58 +192,125 @@ def integrate(
     u_old = work[3]
     a_nd = work[4]  # actuator acceleration without the damping term
     stretch_old = work[5]  # x_p − x_a at the previous step
-    for g in range(G):
-        x_a[g] = y[2 + g]
-        v_a[g] = y[2 + G + g]
+    xa_old = work[6]  # x_a at the previous step (quasi-static step)
+    slope = work[7]  # last −h' of the quasi-static balance (0: none yet)
     gam = actuator_viscosity / actuator_mass
     inv_ma = 1.0 / actuator_mass
     inv_mr = 1.0 / runner_mass
-    t = seg_t0[0]
-    x_p = seg_x0[0]
-
-    F = 0.0
-    for g in range(G):
-        u = x_a[g] - x_r
-        T[g] = contact_force_row(params, state, g, u)
-        u_old[g] = u
-        F += multiplicity[g] * T[g]
-        a_nd[g] = (actuator_stiffness * (x_p - x_a[g]) - T[g]) * inv_ma
-    a_r = (F - load_stiffness * x_r) * inv_mr
-
-    n_rec = 0
+    if carry[C_STARTED] == 0.0:
+        for g in range(G):
+            x_a[g] = y[2 + g]
+            v_a[g] = y[2 + G + g]
+        t = seg_t0[0]
+        x_p = seg_x0[0]
+        F = 0.0
+        for g in range(G):
+            u = x_a[g] - x_r
+            T[g] = contact_force_row(params, state, g, u)
+            u_old[g] = u
+            F += multiplicity[g] * T[g]
+            a_nd[g] = (actuator_stiffness * (x_p - x_a[g]) - T[g]) * inv_ma
+        a_r = (F - load_stiffness * x_r) * inv_mr
+        n_rec = 0
+        next_rec = t
+        track = -1
+        steps = 0
+        fine_steps = 0
+        first_segment = 0
+        resume = False
+        carry[C_STARTED] = 1.0
+    else:
+        t = carry[C_TIME]
+        x_p = carry[C_XP]
+        a_r = carry[C_AR]
+        F = carry[C_FORCE]
+        n_rec = int(carry[C_RECORDED])
+        next_rec = carry[C_NEXT_RECORD]
+        track = int(carry[C_TRACK])
+        steps = int(carry[C_STEPS])
+        fine_steps = int(carry[C_FINE_STEPS])
+        first_segment = int(carry[C_SEGMENT])
+        resume = carry[C_MID] != 0.0
     max_rec = record.shape[0]
-    next_rec = t
-    track = -1
-    steps = 0
-    fine_steps = 0
-    for s in range(seg_t0.shape[0]):
+    for s in range(first_segment, seg_t0.shape[0]):
         k = seg_period[s]
         t_end = seg_t1[s]
         vp = (seg_x1[s] - seg_x0[s]) / (t_end - seg_t0[s])
-        if seg_mark[s]:
-            track = k
-            per[k, PER_MARK_XR] = x_r
-            per[k, PER_MIN_XR] = x_r
         in_window = seg_window[s] != 0
-        if in_window and track >= 0 and k > track:
-            track = -1
         dt_fine = seg_fine[s]
         dt_coarse = seg_coarse[s]
+        dt_quasi = seg_quasi[s]
         adaptive = (not rigid) and dt_coarse > dt_fine
-        fine = True
-        quiet = 0
-        # segment-local accumulators (kept in registers, written back after the segment)
-        acc_xr = 0.0
-        acc_f = 0.0
-        acc_win = 0.0
-        acc_in = 0.0
-        acc_damp = 0.0
-        acc_contact = 0.0
-        acc_t = 0.0
-        min_xr = per[track, PER_MIN_XR] if track >= 0 else 0.0
+        if resume:
+            resume = False
+            fine = carry[C_FINE] != 0.0
+            quasi = carry[C_QUASI] != 0.0
+            quiet = int(carry[C_QUIET])
+            acc_xr = carry[C_ACC_XR]
+            acc_f = carry[C_ACC_F]
+            acc_win = carry[C_ACC_WIN]
+            acc_in = carry[C_ACC_IN]
+            acc_damp = carry[C_ACC_DAMP]
+            acc_contact = carry[C_ACC_CONTACT]
+            acc_t = carry[C_ACC_T]
+            min_xr = carry[C_MIN_XR]
+        else:
+            if seg_mark[s]:
+                track = k
+                per[k, PER_MARK_XR] = x_r
+                per[k, PER_MIN_XR] = x_r
+            if in_window and track >= 0 and k > track:
+                track = -1
+            fine = True
+            quasi = False
+            quiet = 0
+            # segment-local accumulators (kept in registers, written back after the segment)
+            acc_xr = 0.0
+            acc_f = 0.0
+            acc_win = 0.0
+            acc_in = 0.0
+            acc_damp = 0.0
+            acc_contact = 0.0
+            acc_t = 0.0
+            min_xr = per[track, PER_MIN_XR] if track >= 0 else 0.0
         done = False
         while not done:
-            dt = dt_fine if fine else dt_coarse
+            if steps >= step_limit:
+                # pause: everything the loop carries goes to carry, y and work
+                carry[C_SEGMENT] = s
+                carry[C_MID] = 1.0
+                carry[C_TIME] = t
+                carry[C_XP] = x_p
+                carry[C_AR] = a_r
+                carry[C_FORCE] = F
+                carry[C_NEXT_RECORD] = next_rec
+                carry[C_TRACK] = track
+                carry[C_RECORDED] = n_rec
+                carry[C_STEPS] = steps
+                carry[C_FINE_STEPS] = fine_steps
+                carry[C_FINE] = 1.0 if fine else 0.0
+                carry[C_QUASI] = 1.0 if quasi else 0.0
+                carry[C_QUIET] = quiet
+                carry[C_ACC_XR] = acc_xr
+                carry[C_ACC_F] = acc_f
+                carry[C_ACC_WIN] = acc_win
+                carry[C_ACC_IN] = acc_in
+                carry[C_ACC_DAMP] = acc_damp
+                carry[C_ACC_CONTACT] = acc_contact
+                carry[C_ACC_T] = acc_t
+                carry[C_MIN_XR] = min_xr
+                y[0] = x_r
+                y[1] = v_r
+                for g in range(G):
+                    y[2 + g] = x_a[g]
+                    y[2 + G + g] = v_a[g]
+                return STATUS_PAUSED, steps, n_rec, fine_steps
+            if fine:
+                dt = dt_fine
+            elif quasi:
+                dt = dt_quasi
+            else:
+                dt = dt_coarse
             remaining = t_end - t
             if remaining <= dt * 1.000001:
                 dt = remaining
@@ -175,6 +330,20 @@ def integrate(
             if rigid:
                 for g in range(G):
                     x_a[g] = xp_new
+            elif quasi:
+                c_dt = actuator_viscosity / dt
+                K = actuator_stiffness + c_dt
+                for g in range(G):
+                    stretch_old[g] = x_p - x_a[g]
+                    xa_old[g] = x_a[g]
+                    center = (actuator_stiffness * xp_new + c_dt * x_a[g]) / K
+                    # Newton predictor from the last solution: T moves by k_t Δu, k_t = slope − K
+                    sg = max(slope[g], K)
+                    guess = x_a[g] + (K * (center - x_a[g]) - T[g] - (sg - K) * (xr_old - x_r)) / sg
+                    x_a[g], slope[g] = quasi_static_position(
+                        params, state, g, x_r, center, K, sliding[g], guess, sg,
+                        QUASI_TOLERANCE * sliding[g] / K,
+                    )
             else:
                 for g in range(G):
                     stretch_old[g] = x_p - x_a[g]
@@ -199,7 +368,23 @@ def integrate(
             a_r_new = (F - load_stiffness * x_r) * inv_mr
             v_r += 0.5 * dt * (a_r + a_r_new)
             a_r = a_r_new
-            if not rigid:
+            if quasi:
+                activity = 0.0
+                for g in range(G):
+                    v_old = v_a[g]
+                    v_a[g] = (x_a[g] - xa_old[g]) / dt
+                    a_nd[g] = (actuator_stiffness * (xp_new - x_a[g]) - T[g]) * inv_ma
+                    # backward Euler: c_p v_a (x_a − x_a,old) = c_p v_a² dt (halved below)
+                    acc_damp += multiplicity[g] * 2.0 * v_a[g] * v_a[g] * dt
+                    acc_in += multiplicity[g] * (stretch_old[g] + xp_new - x_a[g]) * (xp_new - x_p)
+                    acc = abs(v_a[g] - v_old) / dt
+                    if acc > activity:
+                        activity = acc
+                if activity >= activity_threshold:
+                    fine = True
+                    quasi = False
+                    quiet = 0
+            elif not rigid:
                 damp = 1.0 / (1.0 + 0.5 * dt * gam)
                 activity = 0.0
                 for g in range(G):
@@ -219,6 +404,7 @@ def integrate(
                             quiet += 1
                             if quiet >= quiet_steps:
                                 fine = False
+                                quasi = quasi_static
                         else:
                             quiet = 0
                     elif activity >= activity_threshold:

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import gc
 import json
 import math
 import os
@@ -860,6 +861,8 @@ def main(argv=None, out=None) -> int:
         return 1
     except KeyboardInterrupt:
         sys.stderr.write(f"{prog}: interrupted (finished points are kept in the cache)\n")
+        # exit at once: the interpreter's exit-time collection of numba's object graph takes ≈ 1 s
+        gc.freeze()
         return 130
     except ValueError as exc:  # the package's input checks (passmd._validation)
         sys.stderr.write(f"{prog}: error: {exc}\n")

@@ -38,9 +38,9 @@ exact contact itself. :class:`MDRContact` wraps one contact for interactive use.
 from __future__ import annotations
 
 import numbers
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 from numba import njit
 
 from passmd._contact_kernels import (
@@ -77,6 +77,9 @@ from passmd._contact_kernels import (
 from passmd._validation import check_array, check_choice, check_positive, check_range
 from passmd.parameters import Assumption, Drive, register_assumption
 from passmd.theory import contact_moduli, hertz_contact_radius, hertz_indentation, normal_forces
+
+if TYPE_CHECKING:  # pandas is imported where a DataFrame is built (start-up time)
+    import pandas as pd
 
 __all__ = [
     "DEFAULT_CAPACITY",
@@ -471,6 +474,8 @@ class MDRContact:
         slip = u - deflection
         profile = x**2 / self.hemisphere_radius
         normal = np.maximum(self.indentation - profile, 0.0)
+        import pandas as pd
+
         return pd.DataFrame(
             {
                 "position_m": x,

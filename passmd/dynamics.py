@@ -54,14 +54,37 @@ RINGING_TOLERANCE = 1e-12
 QUIET_PERIODS = 2
 #: Steps per period of the runner-on-contacts mode (rigid actuators).
 STEPS_PER_RUNNER_PERIOD = 400
+#: Quasi-static actuator step (``quasi_static=True``): steps per period of the
+#: runner-on-contacts mode, as for rigid actuators (the actuator in series only softens it).
+STEPS_PER_QUASI_RUNNER_PERIOD = 400
 #: Minimum number of steps on every linear piece of x_p(t) (resolves the fly-back).
 MIN_SEGMENT_STEPS = 40
 #: Verlet is stable for ω dt < 2; a user step must keep this margin below it.
 STABILITY_MARGIN = 0.9
+#: Work budget of one simulation in integrator steps (≈ 15–30 min at the 45–90 ns per step
+#: that ``benchmarks/bench_dynamics.py`` measures). A run whose step plan needs more is
+#: refused before it starts, with the option responsible named.
+MAX_STEPS = 2e10
+#: Smallest step, in units of the float spacing of the simulated time t: below it t + dt
+#: rounds to a different step than planned (at 1 spacing, t stops advancing). 2¹⁰ keeps the
+#: rounding of each step below 0.1 % of it.
+MIN_STEP_SPACINGS = 2.0**10
+#: Steps per kernel call: the kernel returns to Python between calls, so Ctrl-C
+#: (KeyboardInterrupt) is honoured within one call (≈ 0.02–0.1 s at 45–200 ns per step)
+#: and the progress bar advances. Results do not depend on it (the kernel resumes exactly).
+CHUNK_STEPS = 500_000
+#: Runs expected to take more steps than this show a progress bar (stderr, terminal only).
+PROGRESS_MIN_STEPS = 5e7
 
 
 class SimulationError(RuntimeError):
     """A simulation diverged or could not be carried out."""
+
+
+class WorkLimitError(ValueError):
+    """A run refused before it starts: its step is below the time resolution or it needs more
+    than :data:`MAX_STEPS` steps. The message names the parameter (and command-line option)
+    responsible."""
 
 
 @dataclass(frozen=True)
@@ -74,6 +97,7 @@ class StepPlan:
     stability_limit: float  # Verlet stability limit 2/ω of that mode (s)
     activity_threshold: float  # actuator acceleration that counts as ringing (m/s²)
     quiet_steps: int  # fine steps below the threshold before the step grows
+    quasi_step: float = 0.0  # step of the quasi-static actuator (flexible, quasi_static=True) (s)
 
 
 def contact_groups(drive: Drive, share_side_state: bool = True):
@@ -107,6 +131,8 @@ def step_plan(
         Refinement factor: the step is divided by it (convergence studies).
     """
     act = drive.actuator
+    runner_stiffness = total_contact_stiffness + drive.effective_load_cell_stiffness
+    omega_runner = np.sqrt(runner_stiffness / drive.runner_mass)
     if drive.actuator_model == "flexible":
         omega = np.sqrt((act.stiffness + contact_stiffness_max) / act.mass)
         dt = 2 * np.pi / omega / STEPS_PER_STIFF_PERIOD / resolution
@@ -115,9 +141,10 @@ def step_plan(
         threshold = omega**2 * RINGING_TOLERANCE
         quiet = int(np.ceil(QUIET_PERIODS * STEPS_PER_STIFF_PERIOD * resolution))
     else:
-        omega = np.sqrt((total_contact_stiffness + drive.effective_load_cell_stiffness) / drive.runner_mass)
+        omega = omega_runner
         dt = 2 * np.pi / omega / STEPS_PER_RUNNER_PERIOD / resolution
         coarse, threshold, quiet = dt, 0.0, 0
+    quasi = 2 * np.pi / omega_runner / STEPS_PER_QUASI_RUNNER_PERIOD / resolution
     return StepPlan(
         float(dt),
         float(max(coarse, dt)),
@@ -125,6 +152,7 @@ def step_plan(
         float(2.0 / omega),
         float(threshold),
         quiet,
+        float(max(quasi, dt)),
     )
 
 
@@ -274,20 +302,126 @@ class SimulationResult:
         return pd.DataFrame(data)
 
 
-def _segments(waveform: Waveform, fine_step: float, coarse_step: float):
+def _segments(waveform: Waveform, fine_step: float, coarse_step: float, quasi_step: float | None = None):
     t, x = waveform.times, waveform.positions
     t0, t1, x0, x1 = t[:-1], t[1:], x[:-1], x[1:]
     shortest = (t1 - t0) / MIN_SEGMENT_STEPS
     fine = np.minimum(fine_step, shortest)
     coarse = np.minimum(coarse_step, shortest)
     period = np.minimum((t0 / waveform.period + 1e-9).astype(np.int64), waveform.periods - 1)
-    starts = waveform.settle_windows[:, 0]
-    ends = waveform.settle_windows[:, 1]
-    window = np.zeros(t0.size, dtype=np.int64)
-    for ws, we in zip(starts, ends, strict=True):
-        window[(t0 >= ws) & (t1 <= we)] = 1
+    # a piece is in a settle window when it lies inside one; the windows are disjoint, so
+    # only the last window starting at or before the piece can hold it (O(n log n))
+    order = np.argsort(waveform.settle_windows[:, 0], kind="stable")
+    starts = waveform.settle_windows[order, 0]
+    ends = waveform.settle_windows[order, 1]
+    last = np.searchsorted(starts, t0, side="right") - 1
+    inside = (last >= 0) & (t1 <= ends[np.maximum(last, 0)])
+    window = inside.astype(np.int64)
     mark = np.isin(t0, waveform.slip_marks).astype(np.int64)
-    return t0, t1, x0, x1, fine, coarse, period, window, mark
+    quasi = np.minimum(coarse_step if quasi_step is None else quasi_step, shortest)
+    return t0, t1, x0, x1, fine, coarse, period, window, mark, quasi
+
+
+def expected_steps(waveform: Waveform, plan: StepPlan, fine_step: float, coarse_step: float) -> np.ndarray:
+    """Integrator steps each linear piece of x_p(t) takes under a step plan (estimate).
+
+    Every piece starts with ``plan.quiet_steps`` fine steps (the corner rings the actuator
+    mode) and continues with the coarse step; rigid actuators and runs without adaptation
+    (``coarse_step == fine_step``) take the fine step throughout. Ringing after slips adds
+    fine steps, so the sum is a lower bound of the work, close to it for saw-tooth runs.
+    """
+    t0, t1, _x0, _x1, fine, coarse = _segments(waveform, fine_step, coarse_step)[:6]
+    duration = t1 - t0
+    n_fine = np.minimum(np.ceil(duration / fine), plan.quiet_steps if coarse_step > fine_step else 0)
+    rest = np.maximum(duration - n_fine * fine, 0.0)
+    return n_fine + np.ceil(rest / coarse)
+
+
+def _step_setter(drive: Drive, plan: StepPlan, total_contact_stiffness: float) -> str:
+    """Which parameters set the step of a plan, named as in the API and on the command line."""
+    if drive.actuator_model == "flexible":
+        act = drive.actuator
+        return (
+            f"the actuator mode ({plan.stiffest_frequency:.3g} Hz) from actuator_mass (--actuator-mass) = "
+            f"{act.mass!r} kg and actuator_stiffness (--actuator-stiffness) = {act.stiffness!r} N/m"
+        )
+    return (
+        f"the runner mode ({plan.stiffest_frequency:.3g} Hz) from runner_mass (--runner-mass) = "
+        f"{drive.runner_mass!r} kg, load_cell_stiffness (--load-cell-stiffness) = "
+        f"{drive.effective_load_cell_stiffness!r} N/m and the contacts' {total_contact_stiffness:.3g} N/m"
+    )
+
+
+def check_work(
+    drive: Drive,
+    waveform: Waveform,
+    plan: StepPlan,
+    fine_step: float,
+    coarse_step: float,
+    total_contact_stiffness: float,
+    user_step: bool = False,
+) -> float:
+    """Refuse a run that cannot advance time or would exceed :data:`MAX_STEPS`; return its steps.
+
+    Raises
+    ------
+    WorkLimitError
+        A step below :data:`MIN_STEP_SPACINGS` float spacings of the simulated time, or an
+        expected number of steps (:func:`expected_steps`) above :data:`MAX_STEPS`; the
+        message names the parameter responsible.
+    """
+    t0, t1, _x0, _x1, fine = _segments(waveform, fine_step, coarse_step)[:5]
+    resolution = MIN_STEP_SPACINGS * np.spacing(t1)
+    worst = int(np.argmin(fine / resolution))
+    if fine[worst] < resolution[worst]:
+        piece = t1[worst] - t0[worst]
+        if user_step:
+            cause = f"dt = {fine_step!r} s"
+        elif piece / MIN_SEGMENT_STEPS < fine_step:
+            cause = (
+                f"the waveform's piece from t = {t0[worst]:.6g} s lasting {piece:.3g} s "
+                f"({MIN_SEGMENT_STEPS} steps per piece; a saw-tooth's fly-back lasts A/A_max·V_pp/SR: "
+                "raise amplitude (--amplitude) or lower slew_rate (--slew-rate))"
+            )
+        else:
+            cause = _step_setter(drive, plan, total_contact_stiffness)
+        raise WorkLimitError(
+            f"time step {fine[worst]:.3g} s is out of range: it must be >= {resolution[worst]:.3g} s "
+            f"({MIN_STEP_SPACINGS:g} float spacings of t = {t1[worst]:.6g} s) for time to advance "
+            f"accurately; it is set by {cause}"
+        )
+    steps = float(np.sum(expected_steps(waveform, plan, fine_step, coarse_step)))
+    if steps > MAX_STEPS:
+        per_period = steps / waveform.periods
+        fit = int(MAX_STEPS // per_period)
+        hint = f"periods (--periods) = {waveform.periods} must be <= {fit}" if fit >= 1 else (
+            f"the step of {fine_step:.3g} s is set by "
+            + (f"dt = {fine_step!r} s" if user_step else _step_setter(drive, plan, total_contact_stiffness))
+        )
+        raise WorkLimitError(
+            f"the run needs ≈ {steps:.3g} integrator steps ({per_period:.3g} per period), more than the "
+            f"budget of {MAX_STEPS:.3g} steps (passmd.dynamics.MAX_STEPS): {hint}"
+        )
+    return steps
+
+
+def _progress_bar(steps: float, waveform: Waveform, progress: bool | None):
+    """A tqdm bar over simulated periods on stderr, for long runs on a terminal only."""
+    if progress is None:
+        import multiprocessing
+        import sys
+
+        progress = (
+            steps >= PROGRESS_MIN_STEPS
+            and sys.stderr is not None
+            and sys.stderr.isatty()
+            and multiprocessing.parent_process() is None
+        )
+    if not progress:
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=waveform.periods, unit="period", leave=False, dynamic_ncols=True)
 
 
 def simulate(
@@ -301,6 +435,8 @@ def simulate(
     max_points: int = 20000,
     share_side_state: bool = True,
     adaptive: bool = True,
+    progress: bool | None = None,
+    quasi_static: bool = False,
 ) -> SimulationResult:
     """Simulate the drive under a piezo waveform from rest with virgin contacts.
 
@@ -326,11 +462,26 @@ def simulate(
     adaptive : bool
         Flexible actuators: coarse steps while the actuators do not ring (default);
         ``False`` integrates with the fine step throughout.
+    quasi_static : bool
+        Flexible actuators, adaptive step: in the quiet phases neglect the actuator mass and
+        solve its force balance implicitly with the runner's step
+        (:func:`passmd._dynamics_kernel.quasi_static_position`) instead of explicit coarse
+        steps (default ``False``: the explicit scheme).
+    progress : bool, optional
+        Show a progress bar on stderr; default: for runs of more than
+        :data:`PROGRESS_MIN_STEPS` expected steps when stderr is a terminal.
+
+    The kernel runs in chunks of :data:`CHUNK_STEPS` steps and returns to Python between
+    them, so a KeyboardInterrupt stops the run within one chunk; results are identical to
+    an uninterrupted run.
 
     Raises
     ------
     ValueError
         Bad input, or a ``dt`` the integrator cannot resolve.
+    WorkLimitError
+        (a ValueError) The step falls below the float resolution of the simulated time, or
+        the run would need more than :data:`MAX_STEPS` steps.
     SimulationError
         The integration diverged (non-finite or runaway state).
     """
@@ -371,6 +522,8 @@ def simulate(
                 f"needs dt < {limit:.3g} s for the explicit integrator to stay stable"
             )
         fine_step = coarse_step = float(dt)
+    quasi = quasi_static and adaptive and dt is None and drive.actuator_model == "flexible"
+    quasi_step = plan.quasi_step if quasi else coarse_step
 
     G = multiplicity.size
     y = np.zeros(2 + 2 * G)
@@ -378,33 +531,55 @@ def simulate(
     per = np.zeros((waveform.periods, kern.PER_COLUMNS))
     peak = np.zeros((waveform.periods, G))
     energy = np.zeros(kern.EN_COLUMNS)
-    segs = _segments(waveform, fine_step, coarse_step)
-    record_interval = waveform.duration / (max_points - 1)
-    start = _time.perf_counter()
-    status, steps, n_rec, fine_steps = kern.integrate(
-        *segs,
-        plan.activity_threshold,
-        plan.quiet_steps,
-        drive.runner_mass,
-        drive.effective_load_cell_stiffness,
-        multiplicity.astype(float),
-        drive.actuator_model == "rigid",
-        drive.actuator.mass,
-        drive.actuator.stiffness,
-        drive.actuator.viscosity,
-        params,
-        state,
-        np.array([sliding_force(params[g]) for g in range(G)]),
-        y,
-        np.zeros((kern.WORK_ROWS, G)),
-        record_interval,
-        record,
-        per,
-        peak,
-        energy,
-        1.0,
-        100.0,
+    expected = check_work(
+        drive, waveform, plan, fine_step, quasi_step if quasi else coarse_step,
+        float(np.sum(multiplicity * k_contacts)), user_step=dt is not None,
     )
+    segs = _segments(waveform, fine_step, coarse_step, quasi_step)
+    record_interval = waveform.duration / (max_points - 1)
+    work = np.zeros((kern.WORK_ROWS, G))
+    carry = np.zeros(kern.CARRY_SIZE)
+    sliding = np.array([sliding_force(params[g]) for g in range(G)])
+    bar = _progress_bar(expected, waveform, progress)
+    start = _time.perf_counter()
+    try:
+        limit = CHUNK_STEPS
+        while True:
+            status, steps, n_rec, fine_steps = kern.integrate(
+                *segs,
+                plan.activity_threshold,
+                plan.quiet_steps,
+                quasi,
+                drive.runner_mass,
+                drive.effective_load_cell_stiffness,
+                multiplicity.astype(float),
+                drive.actuator_model == "rigid",
+                drive.actuator.mass,
+                drive.actuator.stiffness,
+                drive.actuator.viscosity,
+                params,
+                state,
+                sliding,
+                y,
+                work,
+                carry,
+                limit,
+                record_interval,
+                record,
+                per,
+                peak,
+                energy,
+                1.0,
+                100.0,
+            )
+            if status != kern.STATUS_PAUSED:
+                break
+            limit = steps + CHUNK_STEPS
+            if bar is not None:
+                bar.update(min(int(carry[kern.C_TIME] / waveform.period), waveform.periods) - bar.n)
+    finally:
+        if bar is not None:
+            bar.close()
     wall = _time.perf_counter() - start
     if status != kern.STATUS_OK:
         raise SimulationError(
@@ -447,7 +622,7 @@ def simulate(
         steps=int(steps),
         fine_steps=int(fine_steps),
         fine_step=float(fine_step),
-        coarse_step=float(coarse_step),
+        coarse_step=float(quasi_step if quasi else coarse_step),
         wall_time=wall,
         contact_memory=[memory_diagnostics(params[g], state[g]) for g in range(G)],
         final_state=y.copy(),

@@ -15,8 +15,6 @@ import math
 import re
 from decimal import Decimal
 
-import pint
-
 __all__ = [
     "QuantityError",
     "dimension_name",
@@ -43,14 +41,50 @@ _DIMENSION_WORDS = {
 }
 
 
+# SI factors of the display units the package shows and reads bare numbers in, so that
+# formatting output and reading bare numbers need no unit registry (building pint's takes
+# ≈ 0.3–1 s of start-up); tests check each factor against pint's. Any other unit goes to pint.
+_DISPLAY_FACTORS = {
+    "": 1.0,
+    "m": 1.0,
+    "mm": 1e-3,
+    "um": 1e-6,
+    "nm": 1e-9,
+    "s": 1.0,
+    "us": 1e-6,
+    "kg": 1.0,
+    "g": 1e-3,
+    "Hz": 1.0,
+    "kHz": 1e3,
+    "N": 1.0,
+    "mN": 1e-3,
+    "N/m": 1.0,
+    "kg/s": 1.0,
+    "Pa": 1.0,
+    "GPa": 1e9,
+    "V": 1.0,
+    "V/us": 1e6,
+}
+
+
 class QuantityError(ValueError):
     """A quantity that cannot be read, or has the wrong dimension."""
 
 
 @functools.lru_cache(maxsize=1)
-def registry() -> pint.UnitRegistry:
-    """The package's unit registry (built once; building it takes a fraction of a second)."""
+def registry() -> pint.UnitRegistry:  # noqa: F821 - pint is imported on first use
+    """The package's unit registry (built once, on first use; building it takes a fraction of a second)."""
+    import pint
+
     return pint.UnitRegistry()
+
+
+def _si_factor(unit: str) -> float:
+    """SI magnitude of one ``unit`` (``"nm"`` → 1e-9)."""
+    factor = _DISPLAY_FACTORS.get(unit)
+    if factor is None:
+        factor = registry().Quantity(1.0, _unit(unit)).to_base_units().magnitude
+    return factor
 
 
 @functools.cache
@@ -95,7 +129,6 @@ def parse_quantity(text, unit: str, *, name: str = "value") -> float:
         If the text is not a finite number with an optional unit, the unit is
         unknown, or its dimension differs from ``unit``'s.
     """
-    display = _unit(unit)
     shown = f" (a bare number is read in {unit})" if unit else ""
     if isinstance(text, bool):
         raise QuantityError(f"{name} = {text!r} is not a quantity: give a number{shown}")
@@ -112,17 +145,20 @@ def parse_quantity(text, unit: str, *, name: str = "value") -> float:
         number_text, unit_text = match.group(1), match.group(2)
     if not math.isfinite(float(number_text)):
         raise QuantityError(f"{name} = {text!r} is not a finite number")
-    if unit_text:
-        try:
-            given = registry().parse_units(unit_text)
-        except (pint.errors.UndefinedUnitError, pint.errors.DefinitionSyntaxError, ValueError,
-                AttributeError, TypeError) as exc:
-            raise QuantityError(
-                f"{name} = {text!r}: unknown unit {unit_text!r}; expected a {dimension_name(unit)}"
-                f" unit such as {unit or 'a plain number'}"
-            ) from exc
-    else:
-        given = display
+    if not unit_text:
+        # a bare number is in the display unit: no registry needed
+        return float(Decimal(number_text) * Decimal(repr(float(_si_factor(unit)))))
+    import pint
+
+    display = _unit(unit)
+    try:
+        given = registry().parse_units(unit_text)
+    except (pint.errors.UndefinedUnitError, pint.errors.DefinitionSyntaxError, ValueError,
+            AttributeError, TypeError) as exc:
+        raise QuantityError(
+            f"{name} = {text!r}: unknown unit {unit_text!r}; expected a {dimension_name(unit)}"
+            f" unit such as {unit or 'a plain number'}"
+        ) from exc
     if given.dimensionality != display.dimensionality:
         expected = f"a {dimension_name(unit)} such as '1{unit}'" if unit else "a plain number"
         raise QuantityError(
@@ -149,5 +185,4 @@ def parse_quantities(text: str, unit: str, *, name: str = "value") -> list[float
 
 def from_si(value, unit: str):
     """Convert an SI magnitude (scalar or array) to ``unit`` (``from_si(2e-7, "nm")`` → 200)."""
-    factor = registry().Quantity(1.0, _unit(unit)).to_base_units().magnitude
-    return value / factor
+    return value / _si_factor(unit)

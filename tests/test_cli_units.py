@@ -82,3 +82,13 @@ def test_from_si_inverts_parse():
     np.testing.assert_allclose(from_si(np.array([1e3, 2e5]), "kHz"), [1.0, 200.0], rtol=1e-15)
     assert dimension_name("N/m") == "stiffness (force per length)"
     assert dimension_name("mm") == "length"
+
+
+def test_display_factors_are_pints():
+    """Bare numbers and output use a table of display-unit factors (no registry at start-up);
+    each must be exactly the factor pint gives."""
+    from passmd import units
+
+    for unit, factor in units._DISPLAY_FACTORS.items():
+        expected = units.registry().Quantity(1.0, units._unit(unit)).to_base_units().magnitude
+        assert factor == expected, unit

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from passmd import dynamics, theory, waveforms
+from passmd.contact import contact_arrays, contact_stiffness, stack_contacts
 from passmd.parameters import Drive
 
 F_TEST = 1000.0  # Hz: 1 ms periods keep tests fast; the runner mode (~5-11 kHz) settles within
@@ -174,3 +175,125 @@ def test_contact_memory_never_overflows_in_a_100_hz_period():
     res = run(d, 150e-9, periods=2, frequency=100.0)
     assert res.summary()["contact_memory_overflows"] == 0
     assert max(m["max_depth"] for m in res.contact_memory) > 2
+
+
+# --------------------------------------------------------------------------------------
+# bounded work: chunked kernel calls, refusal before the start
+# --------------------------------------------------------------------------------------
+
+FIELDS = ("time", "runner_position", "runner_velocity", "actuator_position", "friction_force",
+          "slip_share", "settled_positions", "back_steps", "peak_force_ratio", "period_mean_position",
+          "period_mean_friction", "final_state")
+
+
+@pytest.mark.parametrize("model", ["rigid", "flexible"])
+@pytest.mark.parametrize("contacts", [1, 6])
+def test_chunked_run_is_bit_identical(monkeypatch, model, contacts):
+    """The kernel pauses every CHUNK_STEPS steps (also inside a waveform piece) and resumes
+    from its carried state: the run must be the uninterrupted run to the last bit."""
+    d = Drive(actuator_model=model, contacts=contacts)
+    wf = waveforms.sawtooth(150e-9, F_TEST, d, periods=3)
+    whole = dynamics.simulate(d, wf, max_points=3000)
+    monkeypatch.setattr(dynamics, "CHUNK_STEPS", 997)  # prime: pauses land everywhere
+    chunked = dynamics.simulate(d, wf, max_points=3000)
+    assert chunked.steps == whole.steps and chunked.fine_steps == whole.fine_steps
+    for name in FIELDS:
+        np.testing.assert_array_equal(getattr(chunked, name), getattr(whole, name), err_msg=name)
+    assert chunked.energy == whole.energy
+    assert chunked.contact_memory == whole.contact_memory
+
+
+def test_expected_steps_match_the_run():
+    """The pre-run estimate is exact for fixed steps and a close lower bound when adaptive."""
+    for model in ("rigid", "flexible"):
+        d = Drive(actuator_model=model)
+        wf = waveforms.sawtooth(202e-9, 100.0, d, periods=1)
+        res = dynamics.simulate(d, wf)
+        E, G = theory.contact_moduli(d)
+        forces, mult = dynamics.contact_groups(d)
+        rows = [contact_arrays("exact", F, d.hemisphere_radius, E, G, d.friction_coefficient) for F in forces]
+        params, _ = stack_contacts(rows)
+        ks = np.array([contact_stiffness(params[g]) for g in range(len(rows))])
+        plan = dynamics.step_plan(d, ks.max(), float(np.sum(mult * ks)))
+        est = dynamics.expected_steps(wf, plan, res.fine_step, res.coarse_step).sum()
+        # rigid: every step is planned; flexible: ringing after the slip adds fine steps (< 2 %)
+        assert est <= res.steps
+        assert est == pytest.approx(res.steps, rel=0.02 if model == "flexible" else 1e-6)
+
+
+def test_run_beyond_the_step_budget_is_refused_before_it_starts(monkeypatch):
+    d = one_contact()
+    wf = waveforms.sawtooth(20e-9, F_TEST, d, periods=3)
+    monkeypatch.setattr(dynamics, "MAX_STEPS", 5000.0)  # ≈ 2070 steps per period: 2 periods fit
+    refused = r"budget of 5e\+03 steps .*\(--periods\) = 3 must be <= 2"
+    with pytest.raises(dynamics.WorkLimitError, match=refused):
+        dynamics.simulate(d, wf)
+    monkeypatch.setattr(dynamics, "MAX_STEPS", 10.0)  # not even one period fits: name the step
+    with pytest.raises(dynamics.WorkLimitError, match=r"runner_mass \(--runner-mass\)"):
+        dynamics.simulate(d, wf)
+
+
+def test_step_below_the_time_resolution_is_refused():
+    d = one_contact()
+    # a 1e-18 m saw-tooth flies back in 1e-17 s: 40 steps of 2.5e-19 s cannot advance t ≈ 1 ms
+    wf = waveforms.sawtooth(1e-18, F_TEST, d, periods=2)
+    with pytest.raises(dynamics.WorkLimitError, match=r"float spacings of t .*--amplitude.*--slew-rate"):
+        dynamics.simulate(d, wf)
+    light = one_contact(runner_mass=1e-33)
+    with pytest.raises(dynamics.WorkLimitError, match=r"runner_mass \(--runner-mass\) = 1e-33"):
+        dynamics.simulate(light, waveforms.sawtooth(20e-9, F_TEST, light, periods=2))
+    flexible = one_contact("flexible")
+    with pytest.raises(dynamics.WorkLimitError, match=r"dt = 1e-22 s"):
+        dynamics.simulate(flexible, waveforms.sawtooth(20e-9, F_TEST, flexible, periods=2), dt=1e-22)
+
+
+def test_progress_bar_on_request(monkeypatch, capsys):
+    d = one_contact()
+    wf = waveforms.sawtooth(20e-9, F_TEST, d, periods=3)
+    monkeypatch.setattr(dynamics, "CHUNK_STEPS", 500)
+    dynamics.simulate(d, wf, progress=True)
+    assert "period" in capsys.readouterr().err
+    dynamics.simulate(d, wf)  # default: a short run, and stderr is not a terminal here
+    assert capsys.readouterr().err == ""
+
+
+# --------------------------------------------------------------------------------------
+# quasi-static actuator step (opt-in)
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("contacts", [1, 6])
+@pytest.mark.parametrize("contact", ["exact", pytest.param("discrete", marks=pytest.mark.slow)])
+def test_quasi_static_step_matches_the_fixed_fine_step(contacts, contact):
+    """Settled position after 3 periods at 100 Hz within 0.05 nm of the fixed fine step
+    (the reference scheme), at the full stroke where the slips are largest."""
+    d = Drive(contacts=contacts, actuator_model="flexible")
+    wf = waveforms.sawtooth(202e-9, 100.0, d, periods=3)
+    ref = dynamics.simulate(d, wf, adaptive=False, contact_model=contact, max_points=2)
+    quasi = dynamics.simulate(d, wf, contact_model=contact, max_points=2, quasi_static=True)
+    assert quasi.steps < ref.steps / 50
+    np.testing.assert_allclose(quasi.settled_positions, ref.settled_positions, rtol=0, atol=0.05e-9)
+    assert abs(quasi.energy_balance()["relative_residual"]) < 1e-4
+
+
+def test_quasi_static_step_chunked_is_bit_identical(monkeypatch):
+    d = Drive(actuator_model="flexible")
+    wf = waveforms.sawtooth(150e-9, F_TEST, d, periods=3)
+    whole = dynamics.simulate(d, wf, max_points=3000, quasi_static=True)
+    monkeypatch.setattr(dynamics, "CHUNK_STEPS", 997)
+    chunked = dynamics.simulate(d, wf, max_points=3000, quasi_static=True)
+    for name in FIELDS:
+        np.testing.assert_array_equal(getattr(chunked, name), getattr(whole, name), err_msg=name)
+    assert chunked.energy == whole.energy
+
+
+def test_quasi_static_step_converges():
+    """Halving the quasi-static step (resolution 2 → 4) shrinks the 3-period error roughly 4×
+    (second order), measured against resolution 8."""
+    d = Drive(contacts=1, actuator_model="flexible")
+    wf = waveforms.sawtooth(150e-9, 100.0, d, periods=3)
+    pos = {r: dynamics.simulate(d, wf, resolution=r, quasi_static=True, max_points=2).final_position
+           for r in (1.0, 2.0, 8.0)}
+    e1, e2 = abs(pos[1.0] - pos[8.0]), abs(pos[2.0] - pos[8.0])
+    assert e1 < 0.05e-9
+    assert e2 < e1 / 2.5  # order > 1.3; Verlet's 2 expected

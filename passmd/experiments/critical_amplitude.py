@@ -88,6 +88,9 @@ FIRST_FLYBACK_HOLD = 20e-6
 FULL_SLIDING_SHARE = 1.0 - 1e-9
 #: Protocols of :func:`critical_amplitude`.
 PROTOCOLS = ("steady", "first")
+#: Narrowest bisection bracket, in float spacings of the upper amplitude: the midpoint of a
+#: narrower bracket rounds onto one of its ends and the halving stops making progress.
+BISECTION_FLOOR_SPACINGS = 16
 
 register_assumption(
     Assumption(
@@ -257,6 +260,8 @@ def bisect_amplitude(moves, upper: float, tolerance: float) -> dict:
     bracket [0, upper] is opened by evaluating ``moves(upper)`` and then halved until it
     is at most ``tolerance`` wide. If ``moves`` switches more than once in the bracket,
     the bisection finds one of the switches; the runs of Fig. 5a show where that matters.
+    ``tolerance`` must be at least :data:`BISECTION_FLOOR_SPACINGS` float spacings of
+    ``upper`` (the resolution of the amplitude), so the halving always ends.
 
     Returns
     -------
@@ -267,6 +272,13 @@ def bisect_amplitude(moves, upper: float, tolerance: float) -> dict:
     """
     lo, hi = 0.0, check_positive("upper", upper, "m")
     check_positive("tolerance", tolerance, "m")
+    floor = BISECTION_FLOOR_SPACINGS * float(np.spacing(hi))
+    if tolerance < floor:
+        raise ValueError(
+            f"tolerance (--tolerance) = {tolerance!r} m is out of range: must be >= {floor:.3g} m, "
+            f"{BISECTION_FLOOR_SPACINGS} float spacings of the amplitude {hi!r} m (a narrower bracket "
+            "cannot be represented)"
+        )
     runs = 1
     if not moves(hi):
         return {

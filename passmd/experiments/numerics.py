@@ -39,7 +39,9 @@ def convergence_study(
 
     For each configuration the finest run is the reference; ``error_m`` is the difference
     to it. Flexible actuators are run with the adaptive step (default) and with the fixed
-    fine step, so the table also shows what the adaptation costs in accuracy.
+    fine step, so the table also shows what the adaptation costs in accuracy; with
+    ``"quasi-static"`` in ``step_controls`` also with the quasi-static actuator step
+    (``simulate(..., quasi_static=True)``).
 
     Returns
     -------
@@ -58,7 +60,8 @@ def convergence_study(
             for r in resolutions:
                 if control == "fixed" and model == "flexible" and r > 2.0:
                     continue  # the fixed fine step at r > 2 costs minutes and adds nothing
-                res = dynamics.simulate(drive, wf, resolution=r, adaptive=control == "adaptive", max_points=2)
+                res = dynamics.simulate(drive, wf, resolution=r, adaptive=control != "fixed",
+                                        quasi_static=control == "quasi-static", max_points=2)
                 rows.append(
                     {
                         "configuration": label,
