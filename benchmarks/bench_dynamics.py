@@ -7,7 +7,7 @@ repeats, and reports medians. numba compilation happens in an untimed warm-up ru
 
 Usage::
 
-    python benchmarks/bench_dynamics.py [--repeats 5] [--out benchmarks/results/dynamics.json]
+    python benchmarks/bench_dynamics.py [--repeats 5] [--out passmd/data/benchmarks/dynamics.json]
 """
 
 from __future__ import annotations
@@ -58,7 +58,7 @@ def bench(contacts: int, model: str, contact: str, adaptive: bool, repeats: int,
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5, help="timed repeats per configuration (median)")
-    ap.add_argument("--out", type=Path, default=Path(__file__).parent / "results" / "dynamics.json")
+    ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parents[1] / "passmd" / "data" / "benchmarks" / "dynamics.json")
     args = ap.parse_args(argv)
     rows = [bench(c, m, k, a, args.repeats) for c, m, k, a in CONFIGS]
     header = (
