@@ -626,7 +626,7 @@ def _sweep_environment(args):
 
 
 def _cmd_figure(args, out) -> int:
-    from passmd import experiments
+    from passmd import experiments, provenance
 
     names = experiments.figure_names()
     if args.name == "list":
@@ -652,9 +652,11 @@ def _cmd_figure(args, out) -> int:
     csv_path, png_path = target / f"{args.name}.csv", target / f"{args.name}.png"
     try:
         target.mkdir(parents=True, exist_ok=True)
-        data.to_csv(csv_path, index=False)
+        with open(csv_path, "w", encoding="utf-8", newline="") as fh:  # '#' lines: version, commit, profile
+            fh.write(provenance.csv_header(args.profile))
+            data.to_csv(fh, index=False, lineterminator="\n")
         fig = experiments.figure_plot(args.name, data)
-        fig.savefig(png_path, dpi=150)
+        fig.savefig(png_path, dpi=150, metadata={"Description": provenance.summary(args.profile)})
     except OSError as exc:
         raise OutputError(f"cannot write to --out {args.out}: {exc.strerror or exc}") from exc
     pyplot = sys.modules.get("matplotlib.pyplot")
@@ -821,6 +823,10 @@ def make_parser() -> argparse.ArgumentParser:
         'passmd figure list' lists the panels available so far; the others are
         {NOT_AVAILABLE} (they come with the critical-amplitude, force-generation and
         driving-waveform issues). Sweeps are cached in ./{DEFAULT_CACHE_DIR}/ (or ${CACHE_DIR_ENV}).
+
+        NAME.csv starts with '#' lines naming the passmd version, git commit and profile
+        (read it with pandas.read_csv(path, comment="#")); NAME.png carries the same in
+        its Description metadata.
 
         --json keys: name, profile, rows, columns, csv, png (paths written)"""))
     p.add_argument("name", metavar="NAME",
