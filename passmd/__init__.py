@@ -23,6 +23,7 @@ Waveform". The package follows the paper's structure:
 #: and CHANGELOG.md name it, and tests/test_packaging.py checks they agree).
 __version__ = "0.1.0"
 
+#: The replicated paper, as cited in the book and the command line's help.
 PAPER_CITATION = (
     "X.-H. Nguyen, T.-H. Mau, I. Meyer, B.-L. Dang, H.-P. Pham, "
     "\"Improvements of Piezo-Actuated Stick–Slip Micro-Drives: Modeling and Driving "

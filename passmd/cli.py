@@ -692,7 +692,7 @@ _JSON_HELP = "print one JSON object (SI units) instead (default: off)"
 _RUN_KEYS = """\
 --json keys (SI units): final_position_m, settled_positions_m, step_sizes_m,
 back_steps_m, mean_velocity_m_per_s (>= 2 periods), periods, frequency_Hz, amplitude_m,
-integrator_steps and the integrator's step sizes (*_time_step_s), wall_time_s, waveform,
+integrator_steps and the integrator's step sizes (keys ending in _time_step_s), wall_time_s, waveform,
 flyback, drive{...}"""
 
 

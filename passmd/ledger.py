@@ -82,6 +82,7 @@ __all__ = [
     "write_baseline",
 ]
 
+#: The claims file, package data: ``passmd/data/reference/claims.csv``.
 CLAIMS_PATH = reference.REFERENCE_DIR / "claims.csv"
 
 #: Columns claims.csv must have (passmd/data/reference/README.md documents each).

@@ -84,6 +84,7 @@ class CurveSpec:
         return f"{self.name}.csv"
 
 
+#: Every reference-curve table by file stem (Figs. 5b, 6a, 6b, 6c).
 CURVES: dict[str, CurveSpec] = {
     spec.name: spec
     for spec in (
