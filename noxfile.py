@@ -1,5 +1,5 @@
 """Sessions: ``tests`` (pytest), ``wheel`` (the built wheel installed and run outside the
-repository), ``book`` (executed Jupyter Book), ``book_check`` (rendered pages in headless
+repository), ``citation`` (CITATION.cff against its schema), ``book`` (executed Jupyter Book), ``book_check`` (rendered pages in headless
 Chromium), ``lint`` (ruff).
 
 Every session installs the package and its dependencies itself; a machine with
@@ -101,6 +101,14 @@ def _build_and_check_wheel(session: nox.Session, repo: str, work: str) -> None:
         session.run(python, "-I", checker, "--repo", repo, external=True,
                     env={"MPLBACKEND": "Agg", "PASSMD_CACHE_DIR": os.path.join(outside, ".passmd-cache"),
                          "PYTHONPATH": ""})
+
+
+@nox.session(python=PYTHON)
+def citation(session: nox.Session) -> None:
+    """Validate CITATION.cff against the Citation File Format schema (cffconvert --validate)."""
+    session.install("cffconvert>=2.0,<3")
+    session.run("cffconvert", "--validate", "--infile", "CITATION.cff")
+    session.run("cffconvert", "--format", "bibtex", "--infile", "CITATION.cff")
 
 
 BOOK_HTML = "book/_build/html"
