@@ -1,6 +1,6 @@
 """Sessions: ``tests`` (pytest), ``wheel`` (the built wheel installed and run outside the
-repository), ``citation`` (CITATION.cff against its schema), ``book`` (executed Jupyter Book), ``book_check`` (rendered pages in headless
-Chromium), ``lint`` (ruff).
+repository), ``citation`` (CITATION.cff against its schema), ``book`` (executed Jupyter
+Book), ``book_check`` (rendered pages in headless Chromium), ``lint`` (ruff).
 
 Every session installs the package and its dependencies itself; a machine with
 Python and nox needs nothing else. uv is used to create the environments when it is

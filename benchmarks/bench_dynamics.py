@@ -58,7 +58,8 @@ def bench(contacts: int, model: str, contact: str, adaptive: bool, repeats: int,
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5, help="timed repeats per configuration (median)")
-    ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parents[1] / "passmd" / "data" / "benchmarks" / "dynamics.json")
+    ap.add_argument("--out", type=Path,
+                    default=Path(__file__).resolve().parents[1] / "passmd/data/benchmarks/dynamics.json")
     args = ap.parse_args(argv)
     rows = [bench(c, m, k, a, args.repeats) for c, m, k, a in CONFIGS]
     header = (

@@ -17,7 +17,7 @@ process does not change its own source.
 from __future__ import annotations
 
 import subprocess
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 
 import passmd
@@ -42,7 +42,7 @@ def _git(args: list[str], cwd: Path) -> str | None:
     return result.stdout.strip() if result.returncode == 0 else None
 
 
-@lru_cache(maxsize=None)
+@cache
 def git_commit(package_dir: str | None = None) -> str:
     """The git commit of the source tree ``passmd`` was imported from.
 

@@ -288,11 +288,14 @@ def _screenshot(driver, target: Path) -> None:
     """
     driver.execute_script("window.scrollTo(0, 0);")
     height = driver.execute_script(
-        "return Math.max(document.documentElement.scrollHeight, document.body ? document.body.scrollHeight : 0);"
+        "return Math.max(document.documentElement.scrollHeight, "
+        "document.body ? document.body.scrollHeight : 0);"
     )
     _set_window(driver, int(min(max(height, WINDOW_HEIGHT), MAX_SCREENSHOT_HEIGHT)))
     try:
-        shot = driver.execute_cdp_cmd("Page.captureScreenshot", {"format": "png", "captureBeyondViewport": False})
+        shot = driver.execute_cdp_cmd(
+            "Page.captureScreenshot", {"format": "png", "captureBeyondViewport": False}
+        )
     finally:
         _set_window(driver, WINDOW_HEIGHT)
     target.write_bytes(base64.b64decode(shot["data"]))

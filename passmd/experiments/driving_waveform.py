@@ -11,11 +11,12 @@ At 100 kHz a period lasts 10 µs, a tenth of the runner's micro-vibration period
 is no stick phase to average over, and from rest the runner needs about a millisecond
 (hundreds of periods) to reach its steady velocity. The velocity reported here is the
 *steady* one: a run of ``max(MIN_PERIODS, f·STEADY_TIME)`` periods from rest, and the
-slope of the runner's period-mean position (:class:`passmd.dynamics.SimulationResult` ``period_mean_position``,
-no stick phase assumed) over the second half of the run. ``velocity_drift`` compares the
-third and fourth quarter to show the run was steady. ``SimulationResult.mean_velocity``
-(settled positions of the first and last period) includes the start-up and is kept as
-``simulator_mean_velocity_m_per_s`` for comparison.
+slope of the runner's period-mean position (``period_mean_position`` of
+:class:`passmd.dynamics.SimulationResult`, no stick phase assumed) over the second half
+of the run. ``velocity_drift`` compares the third and fourth quarter to show the run was
+steady. ``SimulationResult.mean_velocity`` (settled positions of the first and last
+period) includes the start-up and is kept as ``simulator_mean_velocity_m_per_s`` for
+comparison.
 
 Figures (``compute(profile) -> DataFrame``, registered for the book, the CLI and the ledger):
 ``fig8a`` saw-tooth response with contact status; ``fig8b`` the optimized waveform with
