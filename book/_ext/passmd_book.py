@@ -8,6 +8,8 @@
   cached/computed counts to it from inside the chapter's kernel.
 * The ``passmd-sweep-table`` directive is replaced, once every page has been read, by a
   table of those counts per page (so its own position in the reading order does not matter).
+  The logs are cleared when a build starts: the counts are complete because ``nox -s book``
+  builds with ``--all`` (every page read and executed).
 * Docstrings write absolute values as ``|x|`` (plain text, as ``help()`` shows them); for
   the API page the bars are escaped outside inline literals and roles, where
   reStructuredText would read ``|x|`` as a substitution.
