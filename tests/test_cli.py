@@ -418,6 +418,10 @@ def test_figure_writes_csv_and_png_through_the_registry(fake_figure, tmp_path):
     assert csv[4].endswith(",quick,serial")  # the sweep saw --executor ...
     assert len(Cache(cache_dir).entries()) == 2  # ... and --cache-dir
     assert Path(data["png"]).read_bytes()[:4] == b"\x89PNG"
+    from PIL import Image
+
+    with Image.open(data["png"]) as png:  # the image names version, commit and profile too
+        assert png.text["Description"] == provenance.summary("quick")
     assert "PASSMD_EXECUTOR" not in os.environ  # restored after the command
     status, text = run_cli("figure", "list")
     assert status == 0 and "fig99z  a stand-in panel" in text
