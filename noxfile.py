@@ -1,5 +1,6 @@
-"""Sessions: ``tests`` (pytest), ``book`` (executed Jupyter Book), ``book_check``
-(rendered pages in headless Chromium), ``lint`` (ruff), ``benchmarks``.
+"""Sessions: ``tests`` (pytest), ``wheel`` (the built wheel installed and run outside the
+repository), ``citation`` (CITATION.cff against its schema), ``book`` (executed Jupyter
+Book), ``book_check`` (rendered pages in headless Chromium), ``lint`` (ruff).
 
 Every session installs the package and its dependencies itself; a machine with
 Python and nox needs nothing else. uv is used to create the environments when it is
@@ -8,10 +9,13 @@ installed (``pip install nox uv``), plain virtualenv otherwise.
 
 from __future__ import annotations
 
+import glob
 import os
 import shutil
+import subprocess
 import tempfile
 import time
+import zipfile
 
 import nox
 
@@ -37,6 +41,74 @@ def lint(session: nox.Session) -> None:
     """ruff over the package, tests, book helpers, benchmarks and this file."""
     session.install("ruff>=0.6")
     session.run("ruff", "check", ".")
+
+
+@nox.session(python=PYTHON)
+def wheel(session: nox.Session) -> None:
+    """Build the wheel and sdist, install the wheel into a fresh environment and run it.
+
+    The wheel must hold every tracked file of ``passmd/`` (modules and package data) and the
+    LICENSE; installed into a new virtual environment (dependencies from PyPI only), it must
+    run ``tools/check_installed_wheel.py`` from a temporary folder outside the repository:
+    ``passmd --version``, ``passmd theory --json``, the ledger's and reference curves'
+    loaders, and ``passmd figure fig9a --profile quick``. Nothing is installed editable.
+    """
+    repo = os.path.dirname(os.path.abspath(__file__))
+    session.install("build>=1.2", "virtualenv>=20.26")
+    # outside the repository (not in .nox/): nothing of the checkout can be picked up by accident
+    work = tempfile.mkdtemp(prefix="passmd-wheel-")
+    try:
+        _build_and_check_wheel(session, repo, work)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+def _build_and_check_wheel(session: nox.Session, repo: str, work: str) -> None:
+    dist = os.path.join(work, "dist")
+    uv = shutil.which("uv")
+    installer = ["--installer", "uv"] if uv else []
+    # No --sdist/--wheel: build makes the sdist, then the wheel from the unpacked sdist, so a
+    # file missing from the sdist is missing from the wheel too and fails below.
+    session.run("python", "-m", "build", "--outdir", dist, *installer, repo)
+    (wheel_file,) = glob.glob(os.path.join(dist, "passmd-*.whl"))
+    (sdist_file,) = glob.glob(os.path.join(dist, "passmd-*.tar.gz"))
+    session.log(f"built {os.path.basename(wheel_file)} and {os.path.basename(sdist_file)}")
+    tracked = subprocess.run(
+        ["git", "ls-files", "passmd"], cwd=repo, capture_output=True, text=True, check=True
+    ).stdout.split()
+    with zipfile.ZipFile(wheel_file) as archive:
+        names = set(archive.namelist())
+    missing = [path for path in tracked if path not in names]
+    if missing:
+        session.error(f"the wheel lacks {len(missing)} package file(s): {', '.join(missing)}")
+    if not any(name.endswith(".dist-info/licenses/LICENSE") for name in names):
+        session.error("the wheel lacks the LICENSE file")
+    # A fresh environment outside nox's: only the wheel and its dependencies from PyPI.
+    venv = os.path.join(work, "venv")
+    if uv:
+        session.run(uv, "venv", "--quiet", "--python", os.path.join(session.bin, "python"),
+                    venv, external=True)
+        python = os.path.join(venv, "bin", "python")
+        session.run(uv, "pip", "install", "--quiet", "--python", python, wheel_file, external=True)
+    else:
+        session.run("python", "-m", "virtualenv", "--quiet", venv)
+        python = os.path.join(venv, "bin", "python")
+        session.run(python, "-m", "pip", "install", "--quiet", wheel_file, external=True)
+    outside = os.path.join(work, "outside")
+    os.makedirs(outside)
+    checker = os.path.join(repo, "tools", "check_installed_wheel.py")
+    with session.chdir(outside):
+        session.run(python, "-I", checker, "--repo", repo, external=True,
+                    env={"MPLBACKEND": "Agg", "PASSMD_CACHE_DIR": os.path.join(outside, ".passmd-cache"),
+                         "PYTHONPATH": ""})
+
+
+@nox.session(python=PYTHON)
+def citation(session: nox.Session) -> None:
+    """Validate CITATION.cff against the Citation File Format schema (cffconvert --validate)."""
+    session.install("cffconvert>=2.0,<3")
+    session.run("cffconvert", "--validate", "--infile", "CITATION.cff")
+    session.run("cffconvert", "--format", "bibtex", "--infile", "CITATION.cff")
 
 
 BOOK_HTML = "book/_build/html"

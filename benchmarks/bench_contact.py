@@ -10,7 +10,7 @@ untimed warm-up.
 
 Usage::
 
-    python benchmarks/bench_contact.py [--repeats 7] [--out benchmarks/results/contact.json]
+    python benchmarks/bench_contact.py [--repeats 7] [--out passmd/data/benchmarks/contact.json]
 """
 
 from __future__ import annotations
@@ -144,7 +144,8 @@ def _row(model, springs, kernel, calls, times, **extra) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=7, help="timed repeats per case (median reported)")
-    ap.add_argument("--out", type=Path, default=Path(__file__).parent / "results" / "contact.json")
+    ap.add_argument("--out", type=Path,
+                    default=Path(__file__).resolve().parents[1] / "passmd/data/benchmarks/contact.json")
     args = ap.parse_args(argv)
     rows = bench(args.repeats)
     print(f"{'model':>9} {'N':>6} {'kernel':>19} {'path':>12} {'calls':>9} {'ns/call median':>15} "

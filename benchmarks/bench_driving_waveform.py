@@ -16,7 +16,7 @@ as wall time of this process plus its sweep workers.
 Usage::
 
     python benchmarks/bench_driving_waveform.py [--repeats 5] [--profile paper]
-        [--out benchmarks/results/driving_waveform.json]
+        [--out passmd/data/benchmarks/driving_waveform.json]
 """
 
 from __future__ import annotations
@@ -90,7 +90,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--profile", choices=("quick", "paper"), default="paper")
-    parser.add_argument("--out", type=Path, default=Path("benchmarks/results/driving_waveform.json"))
+    parser.add_argument("--out", type=Path, default=Path("passmd/data/benchmarks/driving_waveform.json"))
     args = parser.parse_args()
     result = {
         "machine": {"python": platform.python_version(), "processor": platform.processor(),

@@ -15,7 +15,7 @@ command-line and dynamics modules. The machine's load average is recorded with t
 
 Usage::
 
-    python benchmarks/bench_dynamics.py [--repeats 5] [--out benchmarks/results/dynamics.json]
+    python benchmarks/bench_dynamics.py [--repeats 5] [--out passmd/data/benchmarks/dynamics.json]
 """
 
 from __future__ import annotations
@@ -141,7 +141,8 @@ def bench(contacts: int, model: str, contact: str, control: str, repeats: int, s
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5, help="timed repeats per configuration (median)")
-    ap.add_argument("--out", type=Path, default=Path(__file__).parent / "results" / "dynamics.json")
+    ap.add_argument("--out", type=Path,
+                    default=Path(__file__).resolve().parents[1] / "passmd/data/benchmarks/dynamics.json")
     args = ap.parse_args(argv)
     load_before = os.getloadavg()
     rows = [bench(c, m, k, control, args.repeats) for c, m, k, control in CONFIGS]

@@ -10,16 +10,20 @@ Waveform". The package follows the paper's structure:
 ``dynamics``       hybrid simulation of runner and actuators (Eqs. 2–3)
 ``waveforms``      saw-tooth and piecewise-linear piezo trajectories (``optimized_waveform``: Eq. 15)
 ``experiments``    one function per figure panel, returning tidy data (plots in ``plots``)
-``reference``      the paper's closed-form reference curves (data/reference/)
+``reference``      the paper's closed-form reference curves (passmd/data/reference/, package data)
 ``ledger``         the paper's claims against our results
 ``sweep``          parameter grids in parallel (process pool or Dask), cached (``cache``)
 ``units``          quantities with units at the command line
 ``publish``        helpers of the book's chapters
+``provenance``     version, git commit and profile stamped on figures and CSV files
 ``cli``            the ``passmd`` command line
 """
 
+#: The version: its one source (pyproject.toml reads it, ``dynamic = ["version"]``; CITATION.cff
+#: and CHANGELOG.md name it, and tests/test_packaging.py checks they agree).
 __version__ = "0.1.0"
 
+#: The replicated paper, as cited in the book and the command line's help.
 PAPER_CITATION = (
     "X.-H. Nguyen, T.-H. Mau, I. Meyer, B.-L. Dang, H.-P. Pham, "
     "\"Improvements of Piezo-Actuated Stick–Slip Micro-Drives: Modeling and Driving "

@@ -627,7 +627,7 @@ def _sweep_environment(args):
 
 
 def _cmd_figure(args, out) -> int:
-    from passmd import experiments
+    from passmd import experiments, provenance
 
     names = experiments.figure_names()
     if args.name == "list":
@@ -653,9 +653,11 @@ def _cmd_figure(args, out) -> int:
     csv_path, png_path = target / f"{args.name}.csv", target / f"{args.name}.png"
     try:
         target.mkdir(parents=True, exist_ok=True)
-        data.to_csv(csv_path, index=False)
+        with open(csv_path, "w", encoding="utf-8", newline="") as fh:  # '#' lines: version, commit, profile
+            fh.write(provenance.csv_header(args.profile))
+            data.to_csv(fh, index=False, lineterminator="\n")
         fig = experiments.figure_plot(args.name, data)
-        fig.savefig(png_path, dpi=150)
+        fig.savefig(png_path, dpi=150, metadata={"Description": provenance.summary(args.profile)})
     except OSError as exc:
         raise OutputError(f"cannot write to --out {args.out}: {exc.strerror or exc}") from exc
     pyplot = sys.modules.get("matplotlib.pyplot")
@@ -691,7 +693,7 @@ _JSON_HELP = "print one JSON object (SI units) instead (default: off)"
 _RUN_KEYS = """\
 --json keys (SI units): final_position_m, settled_positions_m, step_sizes_m,
 back_steps_m, mean_velocity_m_per_s (>= 2 periods), periods, frequency_Hz, amplitude_m,
-integrator_steps and the integrator's step sizes (*_time_step_s), wall_time_s, waveform,
+integrator_steps and the integrator's step sizes (keys ending in _time_step_s), wall_time_s, waveform,
 flyback, drive{...}"""
 
 
@@ -822,6 +824,10 @@ def make_parser() -> argparse.ArgumentParser:
         'passmd figure list' lists the panels available so far; the others are
         {NOT_AVAILABLE} (they come with the critical-amplitude, force-generation and
         driving-waveform issues). Sweeps are cached in ./{DEFAULT_CACHE_DIR}/ (or ${CACHE_DIR_ENV}).
+
+        NAME.csv starts with '#' lines naming the passmd version, git commit and profile
+        (read it with pandas.read_csv(path, comment="#")); NAME.png carries the same in
+        its Description metadata.
 
         --json keys: name, profile, rows, columns, csv, png (paths written)"""))
     p.add_argument("name", metavar="NAME",

@@ -206,7 +206,7 @@ def contact_arrays(model, normal_force, radius, E_star, G_star, mu, springs=None
     -------
     params, state : numpy.ndarray
         1-D float64 arrays (layout in :mod:`passmd._contact_kernels`); ``params[0]`` is
-        the model code :data:`EXACT` or :data:`DISCRETE`.
+        the model code ``EXACT`` or ``DISCRETE`` (module constants).
     """
     check_choice("model", model, ("exact", "discrete"))
     F = check_positive("normal_force", normal_force, "N")

@@ -2,8 +2,8 @@
 
 Three pieces, kept apart so that figure chapters can add to them without editing this file:
 
-* **claims**: ``data/reference/claims.csv``, one row per checkable statement of the paper
-  (schema in ``data/reference/README.md``), read and validated by :func:`load_claims`;
+* **claims**: ``passmd/data/reference/claims.csv``, one row per checkable statement of the paper
+  (schema in ``passmd/data/reference/README.md``), read and validated by :func:`load_claims`;
 * **figures**: the panels registered in :mod:`passmd.experiments` (``fig5a`` … ``fig10c``,
   shared with the book and the CLI) plus the ledger's own ``closed_forms`` table;
   :func:`collect_results` computes every available one, so a chapter never lists them;
@@ -82,9 +82,10 @@ __all__ = [
     "write_baseline",
 ]
 
+#: The claims file, package data: ``passmd/data/reference/claims.csv``.
 CLAIMS_PATH = reference.REFERENCE_DIR / "claims.csv"
 
-#: Columns claims.csv must have (data/reference/README.md documents each).
+#: Columns claims.csv must have (passmd/data/reference/README.md documents each).
 CLAIM_COLUMNS = (
     "id", "figure", "requires", "quantity", "ours_definition",
     "contacts", "actuator_model", "radius_mm", "preload_N", "friction_coefficient",
@@ -225,7 +226,7 @@ def load_claims(path=None) -> pd.DataFrame:
     Parameters
     ----------
     path : path-like, optional
-        Default :data:`CLAIMS_PATH` (``data/reference/claims.csv``). Reference curves
+        Default :data:`CLAIMS_PATH` (``passmd/data/reference/claims.csv``). Reference curves
         named in the ``reference`` column are looked up next to it.
 
     Returns

@@ -37,7 +37,7 @@ def spring_picture(drive: Drive | None = None, springs: int = 41, turn: float = 
     Returns
     -------
     pandas.DataFrame
-        :meth:`MDRContact.spring_states` columns plus ``displacement_m`` (the u shown)
+        :meth:`passmd.contact.MDRContact.spring_states` columns plus ``displacement_m`` (the u shown)
         and ``turn_m`` (where the loading turned).
     """
     check_range("turn", turn, 0.0, 1.0, lower_open=True)

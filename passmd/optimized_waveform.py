@@ -233,7 +233,7 @@ def optimized_design(
     response_frequency : float
         Saw-tooth frequency of the analysed response (Hz).
     flyback : {"slew", "fixed"}
-        Fly-back rule of that saw-tooth (:func:`flyback_time`).
+        Fly-back rule of that saw-tooth (:func:`~passmd.waveforms.flyback_time`).
 
     Raises
     ------
@@ -307,7 +307,7 @@ def optimized_timing(
     Raises
     ------
     ValueError
-        Bad input, or a fly-back longer than half a period (as :func:`sawtooth`).
+        Bad input, or a fly-back longer than half a period (as :func:`~passmd.waveforms.sawtooth`).
     """
     if not isinstance(design, OptimizedDesign):
         raise ValueError(f"design = {design!r} is not an OptimizedDesign")
@@ -391,7 +391,7 @@ def optimized(
     first_period : {"sawtooth", "optimized"}
         Shape of the first period.
     flyback : {"slew", "fixed"}
-        Fly-back rule (:func:`flyback_time`).
+        Fly-back rule (:func:`~passmd.waveforms.flyback_time`).
     settle_fraction : float
         Part of each period's slow ramp, at its end, used as the settle window.
     min_ramp_fraction : float
@@ -404,7 +404,7 @@ def optimized(
     -------
     Waveform
         ``kind="optimized"``; slip marks at the start of each fly-back; settle windows at the
-        end of each (slow) ramp, as for :func:`sawtooth`, so positions compare directly.
+        end of each (slow) ramp, as for :func:`~passmd.waveforms.sawtooth`, so positions compare directly.
     """
     check_choice("first_period", first_period, ("sawtooth", "optimized"))
     frac = check_range("settle_fraction", settle_fraction, 0.0, 1.0, lower_open=True, upper_open=True)

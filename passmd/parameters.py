@@ -62,6 +62,8 @@ class Assumption:
 #: c_p = 2 ζ sqrt(k_p m_a). Table 2's "Viscosity Factor" column was lost.
 ACTUATOR_DAMPING_RATIO = 0.05
 
+#: Every registered assumption by key (modules add theirs when imported;
+#: :func:`all_assumptions` imports them all).
 ASSUMPTIONS: dict[str, Assumption] = {}
 
 

@@ -5,7 +5,8 @@
 * :func:`data_link` writes a figure's data as CSV into the book's ``_generated/data/``
   folder and returns MyST markdown linking to it (Sphinx copies the file into the HTML).
 * :func:`caption` builds a figure caption naming the parameters the figure was run with,
-  optionally with the data link.
+  the ``passmd`` version, git commit and profile (:mod:`passmd.provenance`), optionally
+  with the data link. The CSV files carry the same three facts as ``#`` header lines.
 * :func:`to_unit` and :func:`format_quantity` convert SI values to the units shown at the
   edges (nm, N, mN, mm, kHz, mm/s, ...); conversions are done by ``pint``.
 * :func:`parameter_frame`, :func:`assumptions_frame` and :func:`implementations` turn the
@@ -28,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from passmd import provenance
 from passmd._validation import check_choice
 
 __all__ = [
@@ -96,6 +98,9 @@ def book_root(start: str | os.PathLike | None = None) -> Path:
 def data_link(df, name: str, *, label: str | None = None, root=None) -> Markdown:
     """Write ``df`` as ``<book>/_generated/data/<name>.csv`` and return a MyST download link.
 
+    The file starts with ``#`` lines naming the ``passmd`` version, git commit and profile
+    (:func:`passmd.provenance.csv_header`); read it with ``pandas.read_csv(path, comment="#")``.
+
     Parameters
     ----------
     df : pandas.DataFrame
@@ -125,7 +130,9 @@ def data_link(df, name: str, *, label: str | None = None, root=None) -> Markdown
     folder.mkdir(parents=True, exist_ok=True)
     target = folder / f"{name}.csv"
     tmp = target.with_name(f".{target.name}.{os.getpid()}.tmp")
-    df.to_csv(tmp, index=False)
+    with open(tmp, "w", encoding="utf-8", newline="") as fh:
+        fh.write(provenance.csv_header(current_profile()))
+        df.to_csv(fh, index=False, lineterminator="\n")
     os.replace(tmp, target)  # atomic: a reader never sees a half-written file
     text = label if label is not None else target.name
     return Markdown(f"{{download}}`{text} </{_DATA_SUBDIR.as_posix()}/{target.name}>`")
@@ -209,7 +216,8 @@ def caption(text: str, *, drive=None, data=None, name: str | None = None, **extr
     Returns
     -------
     Markdown
-        ``**Figure.** text Run with: R = 1 mm, ...; profile: paper. Data: <link>``
+        ``**Figure.** text Run with: R = 1 mm, .... Made by passmd 0.1.0, commit <hash>,
+        profile paper. Data: <link>``
     """
     if (data is None) != (name is None):
         raise ValueError("data and name must be given together (name is the CSV file stem)")
@@ -217,8 +225,9 @@ def caption(text: str, *, drive=None, data=None, name: str | None = None, **extr
     params.update({key: str(value) for key, value in extra.items()})
     parts = [f"**Figure.** {text.strip()}"]
     listed = [f"{key} = {value}" for key, value in params.items()]
-    listed.append(f"profile: {current_profile()}")
-    parts.append("Run with: " + ", ".join(listed) + ".")
+    if listed:
+        parts.append("Run with: " + ", ".join(listed) + ".")
+    parts.append(f"Made by {provenance.summary(current_profile())}.")
     if data is not None:
         parts.append(f"Data: {data_link(data, name)}.")
     return Markdown(" ".join(parts))

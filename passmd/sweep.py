@@ -16,12 +16,17 @@ it completes, so an interrupted sweep (Ctrl-C, a failing point, a killed job) ke
 every finished point and a rerun recomputes only the rest. A progress bar (points
 done, rate, ETA) is shown on a terminal and kept quiet when stderr is not a TTY or the
 ``CI`` environment variable is set.
+
+When ``$PASSMD_SWEEP_LOG`` names a file, every sweep appends one JSON line to it (the
+function, and how many points were taken from the cache and how many computed): the book's
+execution-statistics page sums them per chapter.
 """
 
 from __future__ import annotations
 
 import concurrent.futures as cf
 import itertools
+import json
 import logging
 import os
 import pickle
@@ -45,6 +50,8 @@ EXECUTORS = ("process", "serial", "dask")
 #: Environment variables giving defaults to arguments a caller leaves at ``None``
 #: (so the book build and ``passmd figure`` can send every sweep to a Dask cluster).
 EXECUTOR_ENV, SCHEDULER_ENV, WORKERS_ENV = "PASSMD_EXECUTOR", "PASSMD_SCHEDULER", "PASSMD_WORKERS"
+#: File each sweep appends its record (``df.attrs["sweep"]``) to as one JSON line; unset: none.
+SWEEP_LOG_ENV = "PASSMD_SWEEP_LOG"
 
 
 def grid(**axes) -> list[dict]:
@@ -418,4 +425,16 @@ def run(
         "computed": len(collect.results),
         "function": label,
     }
+    _log_sweep(frame.attrs["sweep"])
     return frame
+
+
+def _log_sweep(record: dict) -> None:
+    """Append ``record`` as one JSON line to ``$PASSMD_SWEEP_LOG`` (if set).
+
+    One ``write`` of a short line in append mode: lines of concurrent writers do not mix.
+    """
+    path = os.environ.get(SWEEP_LOG_ENV)
+    if path:
+        with open(path, "a", encoding="utf-8") as fh:
+            fh.write(json.dumps(record) + "\n")

@@ -43,6 +43,8 @@ def _good_facts(**changes) -> dict:
         "fonts_failed": [],
         "external_resources": [],
         "network_errors": [],
+        "window_width": 1280,
+        "page_width": 1280,
     }
     facts.update(changes)
     return facts
@@ -87,6 +89,7 @@ def test_good_page_has_no_problems():
         ({"external_resources": ["https://cdn.example/x.js"]}, "network resource"),
         ({"network_errors": ["net::ERR_BLOCKED_BY_CLIENT"]}, "network access"),
         ({"expect": "figures=many"}, "passmd-expect"),
+        ({"page_width": 1650, "window_width": 1280}, "scrolls horizontally"),
     ],
 )
 def test_each_defect_is_a_problem(changes, fragment):
@@ -189,6 +192,35 @@ def test_check_fails_on_missing_figure_and_cell_error(broken_book_results):
     assert any("ledger table" in p for p in problems), problems
     assert any("MathJax error" in p and "frac" in p for p in problems), problems
     assert any("blank image" in p for p in problems), problems
+    assert any("scrolls horizontally" in p and "1280 px window" in p for p in problems), problems
+    assert not any("scrolls horizontally" in p for p in results["good"]["problems"])
+
+
+@pytest.mark.slow
+def test_screenshot_shows_what_a_reader_sees(broken_book_results, tmp_path):
+    # The full-page screenshot, cut to the window's height, must be the window itself: same
+    # width, and no sideways shift (the page once appeared shifted by about a fifth).
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    _, _, book = broken_book_results
+    profile = tmp_path / "chromium"
+    profile.mkdir()
+    driver = checker._driver(str(profile))
+    try:
+        driver.get((book / "_build" / "html" / "good.html").as_uri())
+        driver.execute_async_script(checker.PAGE_FACTS_JS, checker.LEDGER_SELECTOR)  # fonts, images, math
+        window = np.asarray(Image.open(io.BytesIO(driver.get_screenshot_as_png())).convert("L"), dtype=float)
+        checker._screenshot(driver, tmp_path / "good.png")
+    finally:
+        driver.quit()
+    full = np.asarray(Image.open(tmp_path / "good.png").convert("L"), dtype=float)
+    assert window.shape[1] == full.shape[1] == checker.WINDOW_WIDTH
+    rows = min(window.shape[0], full.shape[0]) - 50  # leave the bottom edge (the sticky footer area)
+    differing = np.mean(np.abs(window[:rows] - full[:rows]) > 16)
+    assert differing < 0.01, f"{differing:.1%} of the pixels differ from the window's view"
 
 
 @pytest.mark.slow

@@ -6,7 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd import publish
+import passmd
+from passmd import provenance, publish
 from passmd.parameters import paper_drive
 
 
@@ -56,10 +57,15 @@ def test_book_root_falls_back_to_start(tmp_path):
 
 def test_data_link_writes_csv_and_returns_download_role(book, monkeypatch):
     monkeypatch.chdir(book / "part")
+    monkeypatch.setenv(publish.PROFILE_ENV, "quick")
     df = pd.DataFrame({"amplitude_nm": [10.0, 20.5], "step_nm": [0.0, 3.25]})
     link = publish.data_link(df, "fig5a")
     target = book / "_generated" / "data" / "fig5a.csv"
-    pd.testing.assert_frame_equal(pd.read_csv(target), df)
+    pd.testing.assert_frame_equal(pd.read_csv(target, comment="#"), df)
+    # the header names version, commit and profile, as the caption does
+    header = target.read_text(encoding="utf-8").splitlines()[:3]
+    assert header == [f"# passmd_version: {passmd.__version__}",
+                      f"# git_commit: {provenance.git_commit()}", "# profile: quick"]
     assert link == "{download}`fig5a.csv </_generated/data/fig5a.csv>`"
     assert link._repr_markdown_() == str(link)
     assert [p.name for p in target.parent.iterdir()] == ["fig5a.csv"]  # no temporary file left
@@ -136,7 +142,8 @@ def test_caption_lists_parameters_profile_and_data(book, monkeypatch):
     text = publish.caption("Critical amplitude (Fig. 5b).", drive=paper_drive(), data=df, name="fig5b",
                            frequency="100 Hz")
     assert text.startswith("**Figure.** Critical amplitude (Fig. 5b).")
-    for part in ("R = 1 mm", "F_p = 0.4 N", "frequency = 100 Hz", "profile: quick",
+    for part in ("R = 1 mm", "F_p = 0.4 N", "frequency = 100 Hz",
+                 f"Made by passmd {passmd.__version__}, commit {provenance.git_commit()}, profile quick.",
                  "{download}`fig5b.csv </_generated/data/fig5b.csv>`"):
         assert part in text
     assert (book / "_generated" / "data" / "fig5b.csv").is_file()

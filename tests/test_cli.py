@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from passmd import cli, sweep
+import passmd
+from passmd import cli, provenance, sweep
 from passmd.cache import Cache
 from passmd.contact import MDRContact
 from passmd.parameters import ACTUATOR_DAMPING_RATIO, Drive, Material, actuator_for_radius
@@ -411,10 +412,16 @@ def test_figure_writes_csv_and_png_through_the_registry(fake_figure, tmp_path):
                     "--executor", "serial", "--cache-dir", str(cache_dir))
     assert data["rows"] == 2 and data["profile"] == "quick"
     csv = Path(data["csv"]).read_text().splitlines()
-    assert csv[0] == "preload,analytic_critical_amplitude_m,profile,executor_seen"
-    assert csv[1].endswith(",quick,serial")  # the sweep saw --executor ...
+    assert csv[:3] == [f"# passmd_version: {passmd.__version__}",  # provenance header
+                       f"# git_commit: {provenance.git_commit()}", "# profile: quick"]
+    assert csv[3] == "preload,analytic_critical_amplitude_m,profile,executor_seen"
+    assert csv[4].endswith(",quick,serial")  # the sweep saw --executor ...
     assert len(Cache(cache_dir).entries()) == 2  # ... and --cache-dir
     assert Path(data["png"]).read_bytes()[:4] == b"\x89PNG"
+    from PIL import Image
+
+    with Image.open(data["png"]) as png:  # the image names version, commit and profile too
+        assert png.text["Description"] == provenance.summary("quick")
     assert "PASSMD_EXECUTOR" not in os.environ  # restored after the command
     status, text = run_cli("figure", "list")
     assert status == 0 and "fig99z  a stand-in panel" in text

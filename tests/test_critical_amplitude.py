@@ -210,7 +210,7 @@ def test_panels_are_reachable_from_the_command_line(quick, tmp_path, capsys):
     from passmd import cli
 
     assert cli.main(["figure", "fig6a", "--profile", "quick", "--out", str(tmp_path)]) == 0
-    written = pd.read_csv(tmp_path / "fig6a.csv")
+    written = pd.read_csv(tmp_path / "fig6a.csv", comment="#")  # "#" lines: version, commit, profile
     assert len(written) == len(quick["fig6a"]) and (tmp_path / "fig6a.png").stat().st_size > 0
 
 

@@ -1,4 +1,4 @@
-"""Closed-form reference curves in data/reference/: regenerated, hand-checked, discriminating.
+"""Closed-form reference curves in passmd/data/reference/: regenerated, hand-checked, discriminating.
 
 Tolerances:
 * committed files vs a fresh computation: the files hold 10 significant digits
@@ -147,3 +147,16 @@ def test_tangential_stiffness_grows_with_radius():
     wide = table.pivot_table(index=["preload_N", "side"], columns="radius_mm",
                              values="tangential_stiffness_N_per_m")
     np.testing.assert_allclose(wide[1.0] / wide[0.25], 4 ** (1 / 3), rtol=1e-12)
+
+
+def test_writing_needs_a_folder_and_the_data_is_package_data():
+    # The package never writes into its installation: no default target folder.
+    with pytest.raises(ValueError, match="directory = None"):
+        reference.write_reference_curves(None)
+    # The committed tables are read through importlib.resources, from inside the package.
+    from importlib import resources
+
+    packaged = resources.files("passmd") / "data" / "reference"
+    assert Path(str(packaged)) == reference.REFERENCE_DIR
+    assert {spec.filename for spec in reference.CURVES.values()} | {"claims.csv"} <= {
+        entry.name for entry in packaged.iterdir()}

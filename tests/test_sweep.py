@@ -7,6 +7,7 @@ exactly (check_exact), not within a tolerance.
 """
 
 import concurrent.futures as cf
+import json
 import time
 from pathlib import Path
 
@@ -98,6 +99,20 @@ def test_process_pool_identical_to_serial(serial_theory, store):
     again = sweep.run(sweep.drive_theory_point, THEORY_GRID, executor="process", workers=2, cache=store)
     pd.testing.assert_frame_equal(again, serial_theory, check_exact=True)
     assert again.attrs["sweep"] == {**frame.attrs["sweep"], "cached": len(THEORY_GRID), "computed": 0}
+
+
+def test_sweep_log_records_cached_and_computed_points(store, tmp_path, monkeypatch):
+    # The book's execution-statistics page sums these lines per chapter.
+    log = tmp_path / "sweeps.jsonl"
+    monkeypatch.setenv(sweep.SWEEP_LOG_ENV, str(log))
+    sweep.run(sweep.drive_theory_point, THEORY_GRID[:3], executor="serial", cache=store)
+    sweep.run(sweep.drive_theory_point, THEORY_GRID[:4], executor="serial", cache=store)
+    lines = [json.loads(line) for line in log.read_text().splitlines()]
+    assert [(r["cached"], r["computed"], r["points"]) for r in lines] == [(0, 3, 3), (3, 1, 4)]
+    assert lines[0]["function"] == "drive_theory_point"
+    monkeypatch.delenv(sweep.SWEEP_LOG_ENV)
+    sweep.run(sweep.drive_theory_point, THEORY_GRID[:1], executor="serial", cache=store)
+    assert len(log.read_text().splitlines()) == 2  # unset: nothing written
 
 
 def test_dask_local_cluster_identical_to_serial(serial_theory):

@@ -13,11 +13,14 @@ all network requests blocked) with the system's Chromium driven by selenium, and
 * leaves math unrendered (a ``.math`` element without MathJax output, a MathJax error, raw
   ``$$``/``\\(``/``\\[`` in the text) or a web font that failed to load,
 * links to a local file that is not in the built book (e.g. a figure's CSV data),
-* tries to load anything from the network (the book must display offline).
+* tries to load anything from the network (the book must display offline),
+* scrolls horizontally in a window :data:`WINDOW_WIDTH` px wide (content wider than the window).
 
 What a page must show comes from its ``passmd-expect`` meta tag, set in the chapter's front
 matter (``myst: html_meta: passmd-expect: "figures=2 ledger=1"``); pages without it must have
-at least one figure and one ledger table. A full-page screenshot of every page is saved.
+at least one figure and one ledger table. A full-page screenshot of every page is saved: the
+page laid out in a window of :data:`WINDOW_WIDTH` px, as tall as the page, so the picture is
+what a reader scrolling down that window sees (no horizontal shift, nothing cut at the edges).
 
 Usage: ``python tools/check_rendered_book.py book/_build/html --toc book/_toc.yml
 --screenshots artifacts/screenshots`` (``nox -s book_check`` runs this).
@@ -45,7 +48,14 @@ CHROMIUM_FLAGS = (
     "--disable-component-update",
     "--disable-sync",
     "--window-size=1280,1000",
+    # overlay scrollbars: the window and the full-page screenshot lay the page out at the
+    # same width (a classic scrollbar takes 15 px from the window but not from the capture)
+    "--hide-scrollbars",
 )
+#: Width and height (CSS px) of the window pages are laid out in, set exactly through the
+#: DevTools protocol (the --window-size of headless Chromium does not fix the viewport).
+WINDOW_WIDTH = 1280
+WINDOW_HEIGHT = 1000
 #: What a page must show when it has no ``passmd-expect`` meta tag.
 DEFAULT_EXPECT = {"figures": 1, "ledger": 1}
 LEDGER_SELECTOR = "table.passmd-ledger"
@@ -99,6 +109,9 @@ const ledgerSelector = arguments[0];
     ledger_tables: Array.from(root.querySelectorAll(ledgerSelector))
       .filter(t => t.querySelectorAll('tbody tr').length > 0).length,
     links: Array.from(root.querySelectorAll('a[href]')).map(a => a.getAttribute('href')),
+    window_width: window.innerWidth,
+    viewport_width: document.documentElement.clientWidth,
+    page_width: Math.max(document.documentElement.scrollWidth, document.body ? document.body.scrollWidth : 0),
     fonts_failed: Array.from(document.fonts).filter(f => f.status === 'error').map(f => f.family),
     external_resources: performance.getEntriesByType('resource').map(e => e.name)
       .filter(n => !/^(file|data|blob|about):/.test(n)),
@@ -189,6 +202,12 @@ def page_problems(facts: dict) -> list[str]:
         problems.append(f"raw TeX left in the page: {snippet!r}")
     for href in facts.get("broken_links", []):
         problems.append(f"link to a missing file: {href}")
+    visible = facts.get("viewport_width") or facts.get("window_width")
+    if visible and facts.get("page_width", 0) > visible + 1:
+        problems.append(
+            f"page scrolls horizontally: content {facts['page_width']} px wide in a "
+            f"{facts['window_width']} px window"
+        )
     for family in facts.get("fonts_failed", []):
         problems.append(f"web font failed to load: {family}")
     for url in dict.fromkeys(facts.get("external_resources", [])):  # each URL once
@@ -247,22 +266,38 @@ def _driver(user_data_dir: str):
     driver.execute_cdp_cmd("Network.enable", {})
     blocked = ["http://*", "https://*", "ws://*", "wss://*", "ftp://*"]
     driver.execute_cdp_cmd("Network.setBlockedURLs", {"urls": blocked})
+    _set_window(driver, WINDOW_HEIGHT)
     return driver
 
 
-def _screenshot(driver, target: Path) -> None:
-    metrics = driver.execute_cdp_cmd("Page.getLayoutMetrics", {})
-    size = metrics.get("cssContentSize") or metrics["contentSize"]
-    clip = {
-        "x": 0,
-        "y": 0,
-        "width": size["width"],
-        "height": min(size["height"], MAX_SCREENSHOT_HEIGHT),
-        "scale": 1,
-    }
-    shot = driver.execute_cdp_cmd(
-        "Page.captureScreenshot", {"format": "png", "captureBeyondViewport": True, "clip": clip}
+def _set_window(driver, height: int) -> None:
+    """Lay pages out in a window ``WINDOW_WIDTH`` px wide and ``height`` px tall (CSS px)."""
+    driver.execute_cdp_cmd(
+        "Emulation.setDeviceMetricsOverride",
+        {"width": WINDOW_WIDTH, "height": height, "deviceScaleFactor": 1, "mobile": False},
     )
+
+
+def _screenshot(driver, target: Path) -> None:
+    """Save the whole page as a reader of a ``WINDOW_WIDTH`` px window sees it.
+
+    The window is made as tall as the page (up to ``MAX_SCREENSHOT_HEIGHT``) and the
+    viewport captured as it is: the page keeps its layout and horizontal position. (A clip
+    of the full content size with ``captureBeyondViewport`` re-lays the page out at another
+    size, which shifted the picture sideways against what a reader sees.)
+    """
+    driver.execute_script("window.scrollTo(0, 0);")
+    height = driver.execute_script(
+        "return Math.max(document.documentElement.scrollHeight, "
+        "document.body ? document.body.scrollHeight : 0);"
+    )
+    _set_window(driver, int(min(max(height, WINDOW_HEIGHT), MAX_SCREENSHOT_HEIGHT)))
+    try:
+        shot = driver.execute_cdp_cmd(
+            "Page.captureScreenshot", {"format": "png", "captureBeyondViewport": False}
+        )
+    finally:
+        _set_window(driver, WINDOW_HEIGHT)
     target.write_bytes(base64.b64decode(shot["data"]))
 
 

@@ -690,7 +690,7 @@ def fig56_frequency(profile: str = "paper") -> pd.DataFrame:
 
 
 # --------------------------------------------------------------------------------------
-# Ledger extractors (claims of Section 4.1, data/reference/claims.csv)
+# Ledger extractors (claims of Section 4.1, passmd/data/reference/claims.csv)
 # --------------------------------------------------------------------------------------
 
 

@@ -2,8 +2,8 @@
 
 Section 5 drives the six-contact drive with rigid actuators (R = 1 mm, F_p = 0.4 N,
 A = 202 nm, μ = 0.2 assumed) with the standard saw-tooth and with the optimized waveform
-of Eq. 15 (:func:`passmd.waveforms.optimized`), designed once per drive from its own
-100 Hz saw-tooth response (:func:`passmd.waveforms.optimized_design`).
+of Eq. 15 (:func:`passmd.optimized_waveform.optimized`), designed once per drive from its own
+100 Hz saw-tooth response (:func:`passmd.optimized_waveform.optimized_design`).
 
 Mean velocity at kHz frequencies
 --------------------------------
@@ -11,11 +11,12 @@ At 100 kHz a period lasts 10 µs, a tenth of the runner's micro-vibration period
 is no stick phase to average over, and from rest the runner needs about a millisecond
 (hundreds of periods) to reach its steady velocity. The velocity reported here is the
 *steady* one: a run of ``max(MIN_PERIODS, f·STEADY_TIME)`` periods from rest, and the
-slope of the runner's period-mean position (:attr:`SimulationResult.period_mean_position`,
-no stick phase assumed) over the second half of the run. ``velocity_drift`` compares the
-third and fourth quarter to show the run was steady. ``SimulationResult.mean_velocity``
-(settled positions of the first and last period) includes the start-up and is kept as
-``simulator_mean_velocity_m_per_s`` for comparison.
+slope of the runner's period-mean position (``period_mean_position`` of
+:class:`passmd.dynamics.SimulationResult`, no stick phase assumed) over the second half
+of the run. ``velocity_drift`` compares the third and fourth quarter to show the run was
+steady. ``SimulationResult.mean_velocity`` (settled positions of the first and last
+period) includes the start-up and is kept as ``simulator_mean_velocity_m_per_s`` for
+comparison.
 
 Figures (``compute(profile) -> DataFrame``, registered for the book, the CLI and the ledger):
 ``fig8a`` saw-tooth response with contact status; ``fig8b`` the optimized waveform with
@@ -152,14 +153,14 @@ def section5_drive(hemisphere_radius: float = 1e-3, preload: float = 0.4, runner
 
 def make_design(settling_time: float, acceleration_time: float,
                 acceleration_amplitude: float) -> waveforms.OptimizedDesign:
-    """An :class:`~passmd.waveforms.OptimizedDesign` from plain sweep parameters."""
+    """An :class:`~passmd.optimized_waveform.OptimizedDesign` from plain sweep parameters."""
     return waveforms.OptimizedDesign(settling_time, acceleration_time, acceleration_amplitude)
 
 
 def design_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str) -> dict:
-    """Eq. 15 design of a drive at its full amplitude (:func:`passmd.waveforms.optimized_design`).
+    """Eq. 15 design of a drive at its full amplitude (:func:`passmd.optimized_waveform.optimized_design`).
 
-    Returns the design's :meth:`~passmd.waveforms.OptimizedDesign.as_dict` plus the amplitude
+    Returns the design's :meth:`~passmd.optimized_waveform.OptimizedDesign.as_dict` plus the amplitude
     and the linear runner-on-contacts frequency (:func:`passmd.theory.runner_frequency`).
     """
     drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
@@ -217,7 +218,7 @@ def velocity_point(hemisphere_radius: float, preload: float, runner: str, actuat
         ``velocity_m_per_s``, ``velocity_drift``, ``step_m`` (velocity / f),
         ``back_step_m`` (mean over the second half), ``periods``,
         ``simulator_mean_velocity_m_per_s``, ``wall_time_s`` and, for the optimized
-        waveform, the times actually used (:func:`passmd.waveforms.optimized_timing`),
+        waveform, the times actually used (:func:`passmd.optimized_waveform.optimized_timing`),
         ``max_slip_share_acceleration`` and ``stick_during_acceleration``.
     """
     drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
@@ -267,7 +268,7 @@ def trace_point(hemisphere_radius: float, preload: float, runner: str, actuator_
     resampled on two uniform grids: the whole run (``full_*``) and ``[zoom_start,
     zoom_end]`` (``zoom_*``). Also returns the per-period measures, the micro-vibration
     frequency f_s after the first fly-back (saw-tooth) or after the first acceleration
-    (optimized), measured as in the design (:func:`passmd.waveforms.micro_vibration_frequency`),
+    (optimized), measured as in the design (:func:`passmd.optimized_waveform.micro_vibration_frequency`),
     and the first three turning points of the runner after the first fly-back.
     """
     drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)

@@ -7,11 +7,13 @@ tidy DataFrame in SI units.
 from __future__ import annotations
 
 import json
+from importlib import resources
 from pathlib import Path
 
 import pandas as pd
 
 from passmd import dynamics, waveforms
+from passmd._validation import check_choice
 from passmd.parameters import Drive
 
 #: Configurations the numerics are shown for: (label, contacts, actuator model).
@@ -99,16 +101,48 @@ def energy_balance_table(
     return pd.DataFrame(rows)
 
 
+#: Benchmark results shipped with the package (``passmd/data/benchmarks/<name>.json``).
+BENCHMARKS = ("contact", "driving_waveform", "dynamics")
+
+
+def benchmark_results(name: str, path: str | Path | None = None) -> dict:
+    """One benchmark script's last results (``benchmarks/bench_<name>.py``), as stored.
+
+    Parameters
+    ----------
+    name : {"contact", "driving_waveform", "dynamics"}
+        The benchmark.
+    path : path-like, optional
+        A results file to read instead of the one installed with the package
+        (``passmd/data/benchmarks/<name>.json``, package data, which the benchmark
+        scripts write by default when run from the repository).
+
+    Returns
+    -------
+    dict
+        ``{"meta": {...}, "rows": [...]}`` as the script wrote it.
+    """
+    check_choice("name", name, BENCHMARKS)
+    if path is None:
+        resource = resources.files("passmd") / "data" / "benchmarks" / f"{name}.json"
+        if not resource.is_file():
+            raise FileNotFoundError(
+                f"{resource} is missing: run `python benchmarks/bench_{name}.py` in the repository"
+            )
+        return json.loads(resource.read_text(encoding="utf-8"))
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"{path} is missing: run `python benchmarks/bench_{name}.py --out {path}`")
+    return json.loads(path.read_text(encoding="utf-8"))
+
+
 def benchmark_table(path: str | Path | None = None) -> pd.DataFrame:
     """The speed benchmark's last results (``benchmarks/bench_dynamics.py``), as a table.
 
-    Raises ``FileNotFoundError`` naming the command to run when the results are missing.
+    Reads :func:`benchmark_results` ``("dynamics", path)``; ``df.attrs["meta"]`` holds the
+    machine and settings it was measured with.
     """
-    default = Path(__file__).resolve().parents[2] / "benchmarks" / "results" / "dynamics.json"
-    path = Path(path) if path else default
-    if not path.exists():
-        raise FileNotFoundError(f"{path} is missing: run `python benchmarks/bench_dynamics.py` first")
-    data = json.loads(path.read_text())
+    data = benchmark_results("dynamics", path)
     df = pd.DataFrame(data["rows"])
     df.attrs["meta"] = data.get("meta", {})
     return df

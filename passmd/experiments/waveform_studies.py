@@ -94,7 +94,7 @@ def waveform_velocity(drive: Drive, amplitude: float, frequency: float, waveform
     """Velocity of one waveform by the chapter's protocol (m/s).
 
     Below :data:`STEP_PROTOCOL_BELOW`: three periods from rest, mean step (from period 2 on)
-    × f (Fig. 9a); above: the steady velocity (:func:`steady_velocity`).
+    × f (Fig. 9a); above: the steady velocity (:func:`passmd.experiments.driving_waveform.steady_velocity`).
     """
     if frequency < STEP_PROTOCOL_BELOW:
         wave = make_waveform(drive, amplitude, frequency, 3, waveform, short_period, design)

@@ -1,0 +1,125 @@
+"""Sphinx extension of the passmd book: provenance footer and per-chapter sweep statistics.
+
+* The footer (``html_theme_options["extra_footer"]``) gets the ``passmd`` version, git
+  commit and profile of the build (:func:`passmd.provenance.summary`), the same line every
+  figure caption carries.
+* Before each page is read (and its notebook executed), ``$PASSMD_SWEEP_LOG`` is pointed at
+  a file of that page in the build folder; :func:`passmd.sweep.run` appends every sweep's
+  cached/computed counts to it from inside the chapter's kernel.
+* The ``passmd-sweep-table`` directive is replaced, once every page has been read, by a
+  table of those counts per page (so its own position in the reading order does not matter).
+  The logs are cleared when a build starts: the counts are complete because ``nox -s book``
+  builds with ``--all`` (every page read and executed).
+* Docstrings write absolute values as ``|x|`` (plain text, as ``help()`` shows them); for
+  the API page the bars are escaped outside inline literals and roles, where
+  reStructuredText would read ``|x|`` as a substitution.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+from pathlib import Path
+
+from docutils import nodes
+from sphinx.util.docutils import SphinxDirective
+
+SWEEP_LOG_ENV = "PASSMD_SWEEP_LOG"
+
+
+def _log_dir(app) -> Path:
+    return Path(app.outdir).parent / "passmd-sweeps"
+
+
+def _add_footer(app, config) -> None:
+    from passmd import provenance
+    from passmd.publish import current_profile
+
+    options = dict(config.html_theme_options or {})
+    footer = options.get("extra_footer", "")
+    stamp = provenance.summary(current_profile())
+    options["extra_footer"] = f"{footer}<br/>Made by {stamp}." if footer else f"Made by {stamp}."
+    config.html_theme_options = options
+
+
+def _clear_logs(app) -> None:
+    folder = _log_dir(app)
+    folder.mkdir(parents=True, exist_ok=True)
+    for old in folder.glob("*.jsonl"):
+        old.unlink()
+
+
+def _point_log_at_page(app, docname: str, source: list[str]) -> None:
+    os.environ[SWEEP_LOG_ENV] = str(_log_dir(app) / (docname.replace("/", "__") + ".jsonl"))
+
+
+class sweep_table_placeholder(nodes.General, nodes.Element):
+    """Replaced by the sweep-statistics table at ``doctree-resolved``."""
+
+
+class SweepTable(SphinxDirective):
+    """``passmd-sweep-table``: per page, the sweeps run and the points cached or computed."""
+
+    def run(self):
+        return [sweep_table_placeholder()]
+
+
+def _table(rows: list[list[str]], header: list[str]) -> nodes.table:
+    table = nodes.table(classes=["passmd-sweep-table"])
+    group = nodes.tgroup(cols=len(header))
+    table += group
+    group.extend(nodes.colspec(colwidth=1) for _ in header)
+    head, body = nodes.thead(), nodes.tbody()
+    for cells, parent in [(header, head)] + [(row, body) for row in rows]:
+        line = nodes.row()
+        for cell in cells:
+            entry = nodes.entry()
+            entry += nodes.paragraph(text=cell)
+            line += entry
+        parent += line
+    group += head
+    group += body
+    return table
+
+
+def _fill_tables(app, doctree, docname: str) -> None:
+    placeholders = list(doctree.findall(sweep_table_placeholder))
+    if not placeholders:
+        return
+    rows, totals = [], [0, 0, 0]
+    for docname_of_page in sorted(app.env.found_docs):
+        path = _log_dir(app) / (docname_of_page.replace("/", "__") + ".jsonl")
+        if not path.is_file():
+            continue
+        records = [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines() if line]
+        counts = [len(records), sum(r["cached"] for r in records), sum(r["computed"] for r in records)]
+        totals = [a + b for a, b in zip(totals, counts, strict=True)]
+        title = app.env.titles.get(docname_of_page)
+        rows.append([title.astext() if title is not None else docname_of_page, *map(str, counts)])
+    rows.append(["all pages", *map(str, totals)])
+    header = ["page", "sweeps", "points from the cache", "points computed"]
+    for placeholder in placeholders:
+        placeholder.replace_self(_table(rows, header))
+
+
+_BACKTICK_SPAN = re.compile(r"(`[^`]*`)")
+
+
+def _escape_bars(app, what, name, obj, options, lines: list[str]) -> None:
+    for i, line in enumerate(lines):
+        if "|" not in line:
+            continue
+        parts = _BACKTICK_SPAN.split(line)  # odd items: `...` spans (literals, roles, math)
+        lines[i] = "".join(part if k % 2 else part.replace("|", "\\|") for k, part in enumerate(parts))
+
+
+def setup(app):
+    app.connect("autodoc-process-docstring", _escape_bars)
+    app.connect("config-inited", _add_footer)
+    app.connect("builder-inited", _clear_logs)
+    app.connect("source-read", _point_log_at_page)
+    app.connect("doctree-resolved", _fill_tables)
+    app.add_node(sweep_table_placeholder)
+    app.add_directive("passmd-sweep-table", SweepTable)
+    return {"version": "1", "parallel_read_safe": False, "parallel_write_safe": True}

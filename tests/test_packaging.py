@@ -1,0 +1,63 @@
+"""Packaging: one source for the version, license and citation files, package data declared.
+
+The installed wheel itself is exercised by ``nox -s wheel``; CITATION.cff is validated
+against the Citation File Format schema by ``nox -s citation`` (cffconvert --validate).
+"""
+
+from __future__ import annotations
+
+import re
+from importlib import metadata
+from pathlib import Path
+
+import pytest
+import yaml
+
+import passmd
+
+ROOT = Path(__file__).resolve().parents[1]
+tomllib = pytest.importorskip("tomllib")  # Python >= 3.11
+
+
+@pytest.fixture(scope="module")
+def pyproject() -> dict:
+    return tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+
+
+def test_version_has_one_source(pyproject):
+    project = pyproject["project"]
+    assert "version" not in project and "version" in project["dynamic"]
+    assert pyproject["tool"]["setuptools"]["dynamic"]["version"] == {"attr": "passmd.__version__"}
+    assert metadata.version("passmd") == passmd.__version__  # the installed metadata agrees
+    source = (ROOT / "passmd" / "__init__.py").read_text(encoding="utf-8")
+    assert len(re.findall(r"^__version__ = ", source, flags=re.M)) == 1
+
+
+def test_license_expression_needs_setuptools_77(pyproject):
+    assert pyproject["project"]["license"] == "MIT"
+    assert any(re.fullmatch(r"setuptools>=(7[7-9]|[89]\d|\d{3,})(\.\d+)*", req)
+               for req in pyproject["build-system"]["requires"])
+    assert (ROOT / "LICENSE").read_text(encoding="utf-8").startswith("MIT License")
+    assert pyproject["project"]["license-files"] == ["LICENSE"]
+    assert pyproject["project"]["authors"] and pyproject["project"]["classifiers"]
+
+
+def test_citation_and_changelog_name_this_version():
+    cff = yaml.safe_load((ROOT / "CITATION.cff").read_text(encoding="utf-8"))
+    assert cff["version"] == passmd.__version__
+    assert cff["type"] == "software" and cff["license"] == "MIT"
+    (paper,) = cff["references"]
+    assert paper["doi"] == "10.3390/coatings8020062"  # the replicated paper (passmd.PAPER_CITATION)
+    assert paper["doi"] in passmd.PAPER_CITATION
+    changelog = (ROOT / "CHANGELOG.md").read_text(encoding="utf-8")
+    assert f"## [{passmd.__version__}]" in changelog and "## [Unreleased]" in changelog
+
+
+def test_package_data_is_declared_for_every_data_file(pyproject):
+    patterns = pyproject["tool"]["setuptools"]["package-data"]["passmd"]
+    package = ROOT / "passmd"
+    data_files = [p for p in (package / "data").rglob("*") if p.is_file() and "__pycache__" not in p.parts]
+    assert data_files
+    for path in data_files:
+        relative = path.relative_to(package)
+        assert any(relative.match(pattern) for pattern in patterns), f"{relative} is not package data"

@@ -1,0 +1,23 @@
+"""Write the paper's closed-form reference curves (Figs. 5b, 6a–c) into passmd/data/reference/.
+
+Usage: ``python tools/make_reference_curves.py [--out DIR]``. The tables are computed by
+:func:`passmd.reference.closed_form_curves` (Eqs. 1, 7–14 of Nguyen et al. 2018 via
+``passmd.theory``) on ``passmd.parameters.PRELOAD_GRIDS``; ``tests/test_reference.py``
+fails if the committed files and a fresh computation disagree. The default target is the
+repository's reference data folder (package data of ``passmd``), found from this file's
+location, never the installed package.
+"""
+
+import argparse
+from pathlib import Path
+
+from passmd.reference import write_reference_curves
+
+REPOSITORY_REFERENCE_DIR = Path(__file__).resolve().parents[1] / "passmd" / "data" / "reference"
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--out", type=Path, default=REPOSITORY_REFERENCE_DIR,
+                        help=f"target folder (default: {REPOSITORY_REFERENCE_DIR})")
+    for path in write_reference_curves(parser.parse_args().out):
+        print("wrote", path)
