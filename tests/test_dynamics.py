@@ -101,7 +101,7 @@ def test_linear_limit_flexible_two_mass_oscillator():
 
 @pytest.mark.parametrize("model", ["rigid", "flexible"])
 def test_time_step_convergence(model):
-    """Halving the step changes the 3-period step size by < 0.5 % (the model chapter's convergence requirement)."""
+    """Halving the step changes the 3-period step size by < 0.5 % (model chapter: convergence shown)."""
     d = Drive(contacts=1, actuator_model=model)
     wf = waveforms.sawtooth(120e-9, F_TEST, d, periods=3)
     coarse = dynamics.simulate(d, wf).final_position
