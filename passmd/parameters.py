@@ -366,8 +366,9 @@ class PlausibleRange:
     soft_low: float | None
     soft_high: float | None
     hard_high: float | None
-    reason: str
+    reason: str  # why the soft limits (and, unless hard_reason says otherwise, the hard ones)
     hard_low_open: bool = True  # a hard lower bound of 0 is excluded (positive quantities)
+    hard_reason: str = ""  # why the hard limits, when it differs from ``reason``
 
     def check(self, name: str, value, *, allow_extrapolation: bool = False, shown: str | None = None,
               scale: float = 1.0, unit: str | None = None, hint: str = "allow_extrapolation=True") -> float:
@@ -381,8 +382,11 @@ class PlausibleRange:
         u = f" {unit}" if unit and unit != "–" else ""
 
         def refuse(limit: str, kind: str, extra: str = "") -> ValueError:
+            why = self.hard_reason if kind == "hard limit" and self.hard_reason else self.reason
+            if kind == "hard limit" and lo == 0.0 and limit.startswith(">"):
+                why = "a physical quantity of this kind is positive"
             return ValueError(f"{label} = {v / scale:.10g}{u} is out of range: must be {limit} "
-                              f"({kind}: {self.reason}){extra}")
+                              f"({kind}: {why}){extra}")
 
         lo, hi = self.hard_low, self.hard_high
         if lo is not None and (v <= lo if self.hard_low_open else v < lo):
@@ -426,15 +430,19 @@ PLAUSIBLE_RANGES: dict[str, PlausibleRange] = {
         "–", 0.0, None, 10.0, None,
         "c_p up to ten times critical damping of the bare actuator (the default is ζ = 0.05)",
         hard_low_open=False),
-    "actuator.full_stroke_amplitude": PlausibleRange("m", 0.0, 0.96e-9, 20.2e-6, None,
-                                                     "Table 2's 96–202 nm, " + _TWO_DECADES),
+    "actuator.full_stroke_amplitude": PlausibleRange(
+        "m", 0.0, 0.96e-9, 20.2e-6, 10.0, "Table 2's 96–202 nm, " + _TWO_DECADES,
+        hard_reason="beyond 10 m of travel, double-precision rounding of positions (2.2e-16 relative) "
+        "exceeds 1e-6 of the ~10 nm presliding displacement"),
     "amplifier.peak_to_peak_voltage": PlausibleRange("V", 0.0, 3.0, 3e4, None,
                                                      "Section 2's 300 V_pp, " + _TWO_DECADES),
     "amplifier.slew_rate": PlausibleRange("V/s", 0.0, 1.5e6, 1.5e10, None,
                                           "Section 2's 150 V/µs, " + _TWO_DECADES),
-    "frequency": PlausibleRange("Hz", 0.0, 100.0, 1e6, None,
-                                "the paper drives at 1–100 kHz (Sections 4–5); one to two decades "
-                                "either side"),
+    "frequency": PlausibleRange(
+        "Hz", 1e-3, 100.0, 1e6, None,
+        "the paper drives at 1–100 kHz (Sections 4–5), one to two decades either side",
+        hard_reason="below 1 mHz a period is too long for its µs fly-back to stay resolvable in "
+        "double-precision time"),
 }
 #: Hard limit on the Hertz contact radius: a <= R/10. Hertz's half-space solution and the
 #: MDR both assume a contact small against the sphere (K.L. Johnson, Contact Mechanics, §4.2).
