@@ -77,6 +77,15 @@ def check_nonnegative(name: str, value, unit: str = "") -> float:
     return check_range(name, value, 0.0, unit=unit)
 
 
+def check_count(name: str, value, minimum: int = 1) -> int:
+    """Return ``int(value)`` if it is an integer >= ``minimum`` (booleans are not counts)."""
+    integral = isinstance(value, (int, np.integer)) or (
+        isinstance(value, (float, np.floating)) and math.isfinite(value) and float(value).is_integer())
+    if isinstance(value, (bool, np.bool_)) or not integral or value < minimum:
+        raise ValueError(f"{name} = {value!r} is out of range: must be an integer >= {minimum}")
+    return int(value)
+
+
 def check_choice(name: str, value, choices) -> str:
     """Return ``value`` if it is one of ``choices``."""
     if value not in choices:
