@@ -339,16 +339,29 @@ def _check_results(record: dict) -> dict:
 
 
 def _check_run_bounds(summary: dict, drive: Drive, amplitude: float) -> None:
-    """A runner cannot move farther than the friction drive allows (Section 3, Eqs. 7–14).
+    """A runner cannot move farther than the friction drive allows (Section 3, Eqs. 1, 7–14).
 
-    The runner is moved only by the contacts' friction; in one period it can neither pass
-    the contact tips' stroke ``A`` nor lag or lead them by more than the contacts' elastic
-    play (presliding u_x,max, Eq. 7/10, plus the actuator deformation u_x,a, Eq. 9/14). A
-    step is therefore at most ``A + 2 (u_x,max + u_x,a)``; the check allows twice that
-    (inertial over-travel after the fly-back) and the final position ``periods`` such steps.
+    Work bound (rigorous): the runner starts at rest and the only force pushing it is the
+    contacts' friction, at most μ Σ F_N (Eq. 1; the load cell only pulls it back), so after
+    a run of duration t it is within μ Σ F_N t² / (2 m_r) of its start.
+
+    Stroke bound: in one period the runner can neither pass the contact tips' stroke ``A``
+    nor lag or lead them by more than the contacts' elastic play (presliding u_x,max,
+    Eq. 7/10, plus the actuator deformation u_x,a, Eq. 9/14); a step is at most
+    ``A + 2 (u_x,max + u_x,a)``. The check allows twice that (inertial over-travel after the
+    fly-back), and the final position ``periods`` such steps.
     """
-    from passmd.theory import drive_theory
+    from passmd.theory import drive_theory, normal_forces
 
+    forces = normal_forces(drive.preload, drive.contacts)
+    total_normal = float(forces[0]) if drive.contacts == 1 else float(2 * forces[0] + 4 * forces[1])
+    duration = summary["periods"] / summary["frequency_Hz"]
+    reach = drive.friction_coefficient * total_normal * duration**2 / (2.0 * drive.runner_mass)
+    final = abs(float(summary["final_position_m"]))
+    if final > reach * (1 + 1e-9) + 1e-15:
+        raise ResultError(f"final position {final:.4g} m is farther than friction can push the runner in "
+                          f"{duration:.4g} s (mu*sum(F_N)*t^2/(2 m_r) = {reach:.4g} m): the result is not "
+                          "trustworthy")
     theory = drive_theory(drive)
     play = max(theory["presliding_m"]) + (max(theory["actuator_deformation_m"])
                                           if drive.actuator_model == "flexible" else 0.0)
@@ -358,7 +371,6 @@ def _check_run_bounds(summary: dict, drive: Drive, amplitude: float) -> None:
     if worst > step_limit:
         raise ResultError(f"a step of {worst:.4g} m exceeds what the stroke and the contacts' play allow "
                           f"({step_limit:.4g} m per period): the result is not trustworthy")
-    final = abs(float(summary["final_position_m"]))
     if final > summary["periods"] * step_limit:
         raise ResultError(f"final position {final:.4g} m exceeds {summary['periods']} periods of the largest "
                           f"possible step ({step_limit:.4g} m): the result is not trustworthy")
