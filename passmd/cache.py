@@ -394,7 +394,7 @@ class Cache:
         except FileNotFoundError:
             return _MISS
         except OSError as exc:  # unreadable (permissions, a directory in the way): a miss
-            self._report_unusable(f"cannot read {path}: {exc.strerror or exc}")
+            self._report_unusable(f"cannot read the cache {self.directory}: {exc.strerror or exc}")
             return _MISS
         try:
             _, value = decode_entry(data, key)

@@ -925,7 +925,8 @@ def _cmd_figure(args, out) -> int:
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers = {args.workers} is out of range: must be an integer >= 1")
     if not args.out.strip():
-        raise UsageError(f"--out = {args.out!r} is not a directory name (use --out . for the working directory)")
+        raise UsageError(f"--out = {args.out!r} is not a directory name "
+                         "(use --out . for the working directory)")
     if Path(args.out).exists() and not Path(args.out).is_dir():
         raise OutputError(f"cannot write to --out {args.out}: it is not a directory")
     if args.cache_dir is not None and not args.cache_dir.strip():

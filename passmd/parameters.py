@@ -497,7 +497,8 @@ def check_plausible(drive: Drive, *, allow_extrapolation: bool = False) -> None:
     """
     r = PLAUSIBLE_RANGES
     kw = {"allow_extrapolation": allow_extrapolation}
-    for name in ("hemisphere_radius", "preload", "friction_coefficient", "runner_mass", "load_cell_stiffness"):
+    for name in ("hemisphere_radius", "preload", "friction_coefficient", "runner_mass",
+                 "load_cell_stiffness"):
         r[name].check(name, getattr(drive, name), **kw)
     for which in ("hemisphere_material", "runner_material"):
         material = getattr(drive, which)

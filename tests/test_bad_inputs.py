@@ -57,7 +57,8 @@ def run_process(argv, *, env=None, stdout=subprocess.PIPE, text=True, shell_pipe
     """``python -m passmd argv`` in a subprocess (encodings, full disks, closed pipes)."""
     full_env = {**os.environ, "MPLBACKEND": "Agg", **(env or {})}
     if shell_pipe:
-        cmd = f"{sys.executable} -m passmd {' '.join(argv)} | {shell_pipe}; echo \"status=${{PIPESTATUS[0]}}\" >&2"
+        status = 'echo "status=${PIPESTATUS[0]}" >&2'
+        cmd = f"{sys.executable} -m passmd {' '.join(argv)} | {shell_pipe}; {status}"
         return subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, env=full_env, timeout=120)
     return subprocess.run([sys.executable, "-m", "passmd", *argv], stdout=stdout, stderr=subprocess.PIPE,
                           text=text, env=full_env, timeout=120)
@@ -125,7 +126,8 @@ NAMED_CASES = {
     "slew rate 3e13": (["run", "--slew-rate", "3e13"], 2, "--slew-rate"),
     "load cell stiffness 1e30": (["force", "--load-cell-stiffness", "1e30"], 2, "--load-cell-stiffness"),
     "runner mass 1e-30": (["run", "--runner-mass", "1e-30"], 2, "--runner-mass"),
-    "tiny tolerance, analytic only": (["critical-amplitude", "--analytic-only", "--tolerance", "1e-30"], 0, ""),
+    "tiny tolerance, analytic only": (["critical-amplitude", "--analytic-only", "--tolerance", "1e-30"], 0,
+                                      ""),
 }
 
 
@@ -217,7 +219,8 @@ full_disk = pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /d
 
 
 @full_disk
-@pytest.mark.parametrize("argv", [["theory"], ["theory", "--json"], ["contact", "--path", "0,30nm", "--json"]])
+@pytest.mark.parametrize("argv", [["theory"], ["theory", "--json"],
+                                  ["contact", "--path", "0,30nm", "--json"]])
 def test_full_disk_on_stdout_is_one_line_exit_1(argv):
     with open("/dev/full", "w") as full:
         done = run_process(argv, stdout=full)
@@ -278,11 +281,11 @@ values = st.one_of(
 )
 QUANTITY_FLAGS = [q.flag for q in cli._DRIVE_QUANTITIES]
 COMMANDS = {
-    "theory": (QUANTITY_FLAGS, ["--json", "--allow-extrapolation"], {"--contacts": ["1", "6", "3", "x"],
-                                                                     "--actuator": ["rigid", "flexible", "x"]}),
+    "theory": (QUANTITY_FLAGS, ["--json", "--allow-extrapolation"],
+               {"--contacts": ["1", "6", "3", "x"], "--actuator": ["rigid", "flexible", "x"]}),
     "contact": (["--radius", "--mu", "--normal-force", *cli._MATERIAL_FLAGS, "--springs"],
-                ["--json", "--allow-extrapolation"], {"--path": ["0,30nm,-10nm", "0", "1e30", "nan", "", "0,,1",
-                                                                 "0,1e-300,3N"]}),
+                ["--json", "--allow-extrapolation"],
+                {"--path": ["0,30nm,-10nm", "0", "1e30", "nan", "", "0,,1", "0,1e-300,3N"]}),
     "critical-amplitude": (QUANTITY_FLAGS + ["--frequency", "--threshold", "--tolerance", "--periods"],
                            ["--json", "--analytic-only", "--allow-extrapolation"],
                            {"--protocol": ["steady", "first", "x"], "--flyback": ["slew", "fixed", "x"],
@@ -295,7 +298,8 @@ COMMANDS = {
     "force": (QUANTITY_FLAGS + ["--amplitude", "--frequency", "--periods", "--max-periods", "--max-points"],
               ["--json", "--allow-extrapolation"], {"--waveform": ["sawtooth", "optimized"]}),
     "figure": ([], ["--json"], {"--profile": ["quick", "paper", "x"], "--out": ["", "out", ".", "/dev/null"],
-                                "--executor": ["serial", "process", "x"], "--workers": ["0", "2", "-1", "x"]}),
+                                "--executor": ["serial", "process", "x"],
+                                "--workers": ["0", "2", "-1", "x"]}),
 }
 
 

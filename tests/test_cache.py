@@ -156,7 +156,7 @@ def test_a_sweep_recomputes_a_corrupt_entry_with_one_warning(store):
     assert third.attrs["sweep"]["cached"] == 2  # the recomputed entry was written back
 
 
-@pytest.mark.parametrize("how", ["read-only", "a file", "disk full"])
+@pytest.mark.parametrize("how", ["read-only", "a file", "disk full", "no permission"])
 def test_unwritable_cache_warns_once_and_keeps_the_result(tmp_path, monkeypatch, how):
     from passmd import sweep
 
@@ -169,11 +169,16 @@ def test_unwritable_cache_warns_once_and_keeps_the_result(tmp_path, monkeypatch,
         directory.chmod(0o500)
     elif how == "a file":
         directory.write_text("I am a file")
-    else:
+    elif how == "disk full":
         def full(*args, **kwargs):
             raise OSError(28, "No space left on device")
 
         monkeypatch.setattr(cache_module.os, "fsync", full)
+    else:  # another user's directory, also when the tests run as root
+        def denied(*args, **kwargs):
+            raise PermissionError(13, "Permission denied")
+
+        monkeypatch.setattr(cache_module.tempfile, "mkstemp", denied)
     store = Cache(directory)
     points = [{"x": float(x)} for x in range(4)]
     try:

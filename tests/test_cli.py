@@ -419,6 +419,51 @@ def test_figure_writes_csv_and_png_through_the_registry(fake_figure, tmp_path):
     assert status == 0 and "fig99z  a stand-in panel" in text
 
 
+@pytest.mark.parametrize("how", ["a file", "read-only"])
+def test_figure_with_an_unwritable_cache_keeps_its_result(fake_figure, tmp_path, monkeypatch, capsys, how):
+    """The cache cannot be written: one warning line, the figure is still computed and written."""
+    from passmd import cache as cache_module
+
+    monkeypatch.setattr(cache_module, "_REPORTED_UNWRITABLE", set())
+    cache_dir = tmp_path / "cache"
+    if how == "a file":
+        cache_dir.write_text("not a directory")
+    else:
+        if os.geteuid() == 0:
+            pytest.skip("root writes into read-only directories")
+        cache_dir.mkdir()
+        cache_dir.chmod(0o500)
+    try:
+        status, text = run_cli("figure", "fig99z", "--profile", "quick", "--out", str(tmp_path / "out"),
+                               "--executor", "serial", "--cache-dir", str(cache_dir), "--json")
+    finally:
+        if cache_dir.is_dir():
+            cache_dir.chmod(0o700)
+    err = capsys.readouterr().err
+    assert status == 0, err
+    assert err.count("\n") == 1 and re.search("warning: cannot (read|write) the cache", err), err
+    assert (tmp_path / "out" / "fig99z.csv").read_text().count("\n") == 3  # header + 2 rows
+
+
+def test_cache_command_info_prune_clear(tmp_path):
+    from passmd import sweep as sweep_module
+    from passmd.cache import Cache
+
+    cache_dir = tmp_path / "cache"
+    sweep_module.run(sweep_module.drive_theory_point, sweep_module.grid(preload=[0.1, 0.2]),
+                     executor="serial", cache=Cache(cache_dir), progress=False)
+    old = Cache(cache_dir, fingerprint="f" * 64)
+    old.put(old.key(sweep_module.drive_theory_point, {"preload": 0.3}), {"x": 1.0})
+    info = run_json("cache", "info", "--cache-dir", str(cache_dir))
+    assert (info["entries"], info["current_code"], info["other_code"]) == (3, 2, 1)
+    assert info["functions"] == {"passmd.sweep:drive_theory_point": 2, "?": 1}
+    assert run_json("cache", "prune", "--cache-dir", str(cache_dir))["removed"] == 1
+    status, text = run_cli("cache", "info", "--cache-dir", str(cache_dir))
+    assert status == 0 and "2 (2 of the current code, 0 of other code versions" in text
+    assert run_json("cache", "clear", "--cache-dir", str(cache_dir))["removed"] == 2
+    assert Cache(cache_dir).entries() == []
+
+
 def test_failed_simulation_exits_1(monkeypatch, capsys):
     from passmd import dynamics
 
