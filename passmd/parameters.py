@@ -444,6 +444,22 @@ PLAUSIBLE_RANGES: dict[str, PlausibleRange] = {
         hard_reason="below 1 mHz a period is too long for its µs fly-back to stay resolvable in "
         "double-precision time"),
 }
+register_assumption(
+    Assumption(
+        key="plausible_ranges",
+        symbol="–",
+        value="soft: two decades around Tables 1–2, μ ≤ 1, p0 ≤ 10 GPa; hard: a ≤ R/10, positive quantities",
+        unit="–",
+        rationale=(
+            "The paper gives the model's parameters, not where it stops applying. Hard limits follow "
+            "from its physics (Hertz/MDR need a ≤ R/10); soft limits keep inputs within two decades of "
+            "the tabulated values, where the model was checked (PLAUSIBLE_RANGES gives each reason)."
+        ),
+        sensitivity="None of the paper's figures (all inside the soft limits); other inputs are refused "
+                    "unless allow_extrapolation / --allow-extrapolation.",
+    )
+)
+
 #: Hard limit on the Hertz contact radius: a <= R/10. Hertz's half-space solution and the
 #: MDR both assume a contact small against the sphere (K.L. Johnson, Contact Mechanics, §4.2).
 CONTACT_RADIUS_RATIO_LIMIT = 0.1
