@@ -150,7 +150,7 @@ class _Quantity:
             scale = 1.0 / from_si(1.0, self.unit) if self.unit else 1.0
             PLAUSIBLE_RANGES[self.plausible].check(
                 self.flag, value, allow_extrapolation=bool(getattr(args, "allow_extrapolation", False)),
-                scale=scale, unit=self.unit, hint="--allow-extrapolation")
+                shown=self.flag, scale=scale, unit=self.unit, hint="--allow-extrapolation")
             return value
         shown = float(f"{from_si(value, self.unit):.12g}")
         check_range(self.flag, shown, self.lower, self.upper, lower_open=self.lower_open,
@@ -881,6 +881,8 @@ def _cmd_cache(args, out) -> int:
     from passmd.cache import Cache
 
     store = Cache(args.cache_dir or None)
+    if store.directory.exists() and not store.directory.is_dir():
+        raise OutputError(f"the cache {store.directory} is not a directory")
     if args.action == "info":
         record = store.info()
     elif args.action == "clear":

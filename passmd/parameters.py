@@ -385,7 +385,8 @@ class PlausibleRange:
             why = self.hard_reason if kind == "hard limit" and self.hard_reason else self.reason
             if kind == "hard limit" and lo == 0.0 and limit.startswith(">"):
                 why = "a physical quantity of this kind is positive"
-            return ValueError(f"{label} = {v / scale:.10g}{u} is out of range: must be {limit} "
+            shown_value = f"{v / scale:.10g}{u}" if shown else repr(value)  # CLI: display unit
+            return ValueError(f"{label} = {shown_value} is out of range: must be {limit} "
                               f"({kind}: {why}){extra}")
 
         lo, hi = self.hard_low, self.hard_high

@@ -123,9 +123,9 @@ def test_theory_rejects_bad_arrays():
 
 
 @pytest.mark.parametrize("changes, match", [
-    ({"friction_coefficient": 2.0}, "friction_coefficient = 2 is out of range: must be <= 1"),
-    ({"runner_mass": 1e30}, "runner_mass = 1e\\+30 kg is out of range: must be <= 0.3 kg"),
-    ({"preload": 1e-30}, "preload = 1e-30 N is out of range: must be >= 0.001 N"),
+    ({"friction_coefficient": 2.0}, "friction_coefficient = 2.0 is out of range: must be <= 1"),
+    ({"runner_mass": 1e30}, "runner_mass = 1e\\+30 is out of range: must be <= 0.3 kg"),
+    ({"preload": 1e-30}, "preload = 1e-30 is out of range: must be >= 0.001 N"),
     ({"load_cell_stiffness": 1e30}, "load_cell_stiffness"),
     ({"hemisphere_material": Material(0.5e9, 0.33)}, "hemisphere_material.youngs_modulus"),
     ({"amplifier": Amplifier(slew_rate=3e19)}, "amplifier.slew_rate"),
