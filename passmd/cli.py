@@ -916,7 +916,7 @@ def _cmd_figure(args, out) -> int:
             for name in names:
                 out.write(f"{name}  {experiments.figure_spec(name).title}\n")
             if not names:
-                out.write("no figure is available yet (they come with issues 7-9)\n")
+                out.write("no figure is available\n")
         return 0
     if not re.fullmatch(r"[a-z0-9_]+", args.name):
         raise UsageError(f"figure {args.name!r} is not a figure name: a panel such as fig5a, or 'list' "
@@ -1108,9 +1108,8 @@ def make_parser() -> argparse.ArgumentParser:
 
     p = command("figure", "one paper figure's data (CSV) and image (PNG), as the book makes them",
                 textwrap.dedent(f"""\
-        'passmd figure list' lists the panels available so far; the others are
-        {NOT_AVAILABLE} (they come with the critical-amplitude, force-generation and
-        driving-waveform issues). Sweeps are cached in ./{DEFAULT_CACHE_DIR}/ (or ${CACHE_DIR_ENV}).
+        'passmd figure list' lists the panels; any other name is refused. Sweeps are
+        cached in ./{DEFAULT_CACHE_DIR}/ (or ${CACHE_DIR_ENV}); see 'passmd cache --help'.
 
         --json keys: name, profile, rows, columns, csv, png (paths written)"""))
     p.add_argument("name", metavar="NAME",

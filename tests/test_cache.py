@@ -288,3 +288,17 @@ def test_default_directory(tmp_path, monkeypatch):
     assert Cache().directory == (tmp_path / "elsewhere").resolve()
     with pytest.raises(ValueError, match="is not a directory"):
         code_fingerprint(tmp_path / "missing")
+
+
+def test_cached_rerun_is_bit_identical(store):
+    """A sweep served from the cache returns exactly the computed values (floats by bits)."""
+    from passmd import sweep
+
+    points = sweep.grid(preload=[0.1, 0.37, 1.0], contacts=[1, 6])
+    cold = sweep.run(sweep.drive_theory_point, points, executor="serial", cache=store, progress=False)
+    warm = sweep.run(sweep.drive_theory_point, points, executor="serial", cache=store, progress=False)
+    assert warm.attrs["sweep"]["cached"] == len(points)
+    pd.testing.assert_frame_equal(cold, warm, check_exact=True)
+    for column in cold.columns:
+        for a, b in zip(cold[column], warm[column], strict=True):
+            assert repr(a) == repr(b) and type(a) is type(b), column
