@@ -351,12 +351,10 @@ def _check_run_bounds(summary: dict, drive: Drive, amplitude: float) -> None:
     ``A + 2 (u_x,max + u_x,a)``. The check allows twice that (inertial over-travel after the
     fly-back), and the final position ``periods`` such steps.
     """
-    from passmd.theory import drive_theory, normal_forces
+    from passmd.theory import drive_theory
 
-    forces = normal_forces(drive.preload, drive.contacts)
-    total_normal = float(forces[0]) if drive.contacts == 1 else float(2 * forces[0] + 4 * forces[1])
     duration = summary["periods"] / summary["frequency_Hz"]
-    reach = drive.friction_coefficient * total_normal * duration**2 / (2.0 * drive.runner_mass)
+    reach = _friction_limit(drive) * duration**2 / (2.0 * drive.runner_mass)
     final = abs(float(summary["final_position_m"]))
     if final > reach * (1 + 1e-9) + 1e-15:
         raise ResultError(f"final position {final:.4g} m is farther than friction can push the runner in "
@@ -696,6 +694,28 @@ def _run_summary(result) -> dict:
     return summary
 
 
+def _friction_limit(drive: Drive) -> float:
+    """μ Σ F_N: the largest friction force all contacts together can exert (Eq. 1)."""
+    from passmd.theory import normal_forces
+
+    forces = normal_forces(drive.preload, drive.contacts)
+    total = float(forces[0]) if drive.contacts == 1 else float(2 * forces[0] + 4 * forces[1])
+    return drive.friction_coefficient * total
+
+
+def _check_force_bound(found: dict, drive: Drive) -> None:
+    """At stall the load cell's mean force is held by friction: |F| <= μ Σ F_N (Section 4.2).
+
+    Averaged over a period the runner's inertia contributes m_r Δv / T, negligible at stall;
+    5 % of margin covers it.
+    """
+    limit = _friction_limit(drive)
+    force = abs(float(found["generated_force_N"]))
+    if force > 1.05 * limit:
+        raise ResultError(f"generated force {force:.4g} N exceeds what friction can hold (mu*sum(F_N) = "
+                          f"{limit:.4g} N): the result is not trustworthy")
+
+
 def _cmd_run(args, out) -> int:
     drive = build_drive(args, load_cell=bool(args.load_cell))
     _waveform_args(args, drive)  # every option checked before anything runs
@@ -752,6 +772,7 @@ def _cmd_force(args, out) -> int:
         text = re.sub(r"\binitial_periods\b", "--periods", str(exc))
         raise UsageError(re.sub(r"\bmax_periods\b", "--max-periods", text)) from exc
     _check_results(found)
+    _check_force_bound(found, drive)
     if args.csv or args.plot:  # the reported run again, for its time series
         from passmd import dynamics, waveforms
 

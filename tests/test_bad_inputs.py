@@ -123,6 +123,7 @@ NAMED_CASES = {
     "amplitude a hair above the stroke": (["run", "--amplitude", "202.0000001nm"], 2,
                                           "--amplitude = 202.0000001 nm is out of range: must be <= 202 nm"),
     "force periods name the option": (["force", "--periods", "1", "--max-periods", "2"], 2, "--periods"),
+    "periods written 1e8": (["run", "--periods", "1e8"], 2, "invalid int value: '1e8'"),
     "slew rate 3e13": (["run", "--slew-rate", "3e13"], 2, "--slew-rate"),
     "load cell stiffness 1e30": (["force", "--load-cell-stiffness", "1e30"], 2, "--load-cell-stiffness"),
     "runner mass 1e-30": (["run", "--runner-mass", "1e-30"], 2, "--runner-mass"),
@@ -131,14 +132,20 @@ NAMED_CASES = {
 }
 
 
+@pytest.mark.parametrize("json_flag", [False, True], ids=["as written", "json toggled"])
 @pytest.mark.parametrize("name", sorted(NAMED_CASES))
-def test_named_case(name):
+def test_named_case(name, json_flag):
+    """The same outcome with and without --json."""
     argv, status, message = NAMED_CASES[name]
+    if json_flag:
+        argv = [a for a in argv if a != "--json"] if "--json" in argv else [*argv, "--json"]
     got, out, err, caught = run_main(argv)
     assert got == status, (name, err)
     assert not [w for w in caught if issubclass(w.category, RuntimeWarning)]
     if status == 0:
         assert err == ""
+        if "--json" in argv:
+            _finite_json(out)
         return
     assert out == ""
     assert_one_line(err)
@@ -229,13 +236,17 @@ def test_full_disk_on_stdout_is_one_line_exit_1(argv):
     assert "No space left on device" in done.stderr
 
 
-def test_closed_pipe_exits_quietly():
-    done = run_process(["contact", "--path", PATH_20000], shell_pipe="head -1")
-    assert done.stdout.startswith("passmd contact")
-    assert done.stderr.strip() == "status=141", done.stderr  # nothing but our own status line
+@pytest.mark.parametrize("json_flag", [[], ["--json"]])
+def test_closed_pipe_exits_quietly(json_flag):
+    done = run_process(["contact", "--path", PATH_20000, *json_flag], shell_pipe="head -1")
+    assert done.stdout.startswith("{" if json_flag else "passmd contact")
+    # nothing on stderr but the shell's status line: 141 when the write met the closed pipe,
+    # 0 when the whole output fit into the pipe before ``head`` went away (a race)
+    assert done.stderr.strip() in ("status=141", "status=0"), done.stderr
 
 
-@pytest.mark.parametrize("argv", [["theory"], ["contact", "--path", "0,30nm"], ["theory", "--help"]])
+@pytest.mark.parametrize("argv", [["theory"], ["contact", "--path", "0,30nm"], ["theory", "--help"],
+                                  ["theory", "--json"]])
 def test_ascii_console_gets_ascii_symbols(argv):
     done = run_process(argv, env={"PYTHONIOENCODING": "ascii"})
     assert done.returncode == 0, done.stderr
