@@ -197,6 +197,7 @@ def test_missing_dask_names_the_extra(tmp_path):
     (lambda: Drive(contacts=6.0), "contacts = 6.0 is not allowed"),
     (lambda: Drive(friction_coefficient=1e200), "friction_coefficient"),
     (lambda: Material(210e9, 0.33, name=5), "name = 5"),
+    (lambda: __import__("passmd.contact").contact.MDRContact(1e30, 1e-3, 1.5e11, 1.2e11, 0.2), "contact radius"),
 ])
 def test_named_library_cases(build, match):
     with pytest.raises(ValueError, match=match):
