@@ -30,6 +30,7 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from passmd import cli
+from passmd.contact import MDRContact
 from passmd.parameters import Actuator, Amplifier, Drive, Material
 
 README = Path(__file__).resolve().parents[1] / "README.md"
@@ -197,7 +198,7 @@ def test_missing_dask_names_the_extra(tmp_path):
     (lambda: Drive(contacts=6.0), "contacts = 6.0 is not allowed"),
     (lambda: Drive(friction_coefficient=1e200), "friction_coefficient"),
     (lambda: Material(210e9, 0.33, name=5), "name = 5"),
-    (lambda: __import__("passmd.contact").contact.MDRContact(1e30, 1e-3, 1.5e11, 1.2e11, 0.2), "contact radius"),
+    (lambda: MDRContact(1e30, 1e-3, 1.5e11, 1.2e11, 0.2), "contact radius"),
 ])
 def test_named_library_cases(build, match):
     with pytest.raises(ValueError, match=match):
