@@ -28,7 +28,6 @@ stand-ins are printed.
 from __future__ import annotations
 
 import argparse
-import codecs
 import contextlib
 import importlib.util
 import json
@@ -44,6 +43,16 @@ from pathlib import Path
 import numpy as np
 
 from passmd import __version__
+from passmd._cli_streams import (
+    Out,
+    PipeClosed,
+    StdoutError,
+    available_memory,
+    one_line_warnings,
+    silence_stdout,
+    use_ascii_fallback,
+)
+from passmd._result_bounds import ResultError, check_force_bound, check_run_bounds
 from passmd._validation import check_range
 from passmd.cache import CACHE_DIR_ENV, DEFAULT_CACHE_DIR, CacheWarning
 from passmd.parameters import (
@@ -80,10 +89,6 @@ class UsageError(ValueError):
 
 class NotAvailableError(UsageError):
     """A name (figure panel) the package does not provide (exit status 2)."""
-
-
-class ResultError(RuntimeError):
-    """A result failed its finiteness or plausibility check (exit status 1)."""
 
 
 class MissingDependencyError(RuntimeError):
@@ -338,108 +343,8 @@ def _check_results(record: dict) -> dict:
     return record
 
 
-def _check_run_bounds(summary: dict, drive: Drive, amplitude: float) -> None:
-    """A runner cannot move farther than the friction drive allows (Section 3, Eqs. 1, 7–14).
-
-    Work bound (rigorous): the runner starts at rest and the only force pushing it is the
-    contacts' friction, at most μ Σ F_N (Eq. 1; the load cell only pulls it back), so after
-    a run of duration t it is within μ Σ F_N t² / (2 m_r) of its start.
-
-    Stroke bound: in one period the runner can neither pass the contact tips' stroke ``A``
-    nor lag or lead them by more than the contacts' elastic play (presliding u_x,max,
-    Eq. 7/10, plus the actuator deformation u_x,a, Eq. 9/14); a step is at most
-    ``A + 2 (u_x,max + u_x,a)``. The check allows twice that (inertial over-travel after the
-    fly-back), and the final position ``periods`` such steps.
-    """
-    from passmd.theory import drive_theory
-
-    duration = summary["periods"] / summary["frequency_Hz"]
-    reach = _friction_limit(drive) * duration**2 / (2.0 * drive.runner_mass)
-    final = abs(float(summary["final_position_m"]))
-    if final > reach * (1 + 1e-9) + 1e-15:
-        raise ResultError(f"final position {final:.4g} m is farther than friction can push the runner in "
-                          f"{duration:.4g} s (mu*sum(F_N)*t^2/(2 m_r) = {reach:.4g} m): the result is not "
-                          "trustworthy")
-    theory = drive_theory(drive)
-    play = max(theory["presliding_m"]) + (max(theory["actuator_deformation_m"])
-                                          if drive.actuator_model == "flexible" else 0.0)
-    step_limit = 2.0 * (amplitude + 2.0 * play)
-    steps = list(summary.get("step_sizes_m") or []) + list(summary.get("back_steps_m") or [])
-    worst = max((abs(float(x)) for x in steps), default=0.0)
-    if worst > step_limit:
-        raise ResultError(f"a step of {worst:.4g} m exceeds what the stroke and the contacts' play allow "
-                          f"({step_limit:.4g} m per period): the result is not trustworthy")
-    if final > summary["periods"] * step_limit:
-        raise ResultError(f"final position {final:.4g} m exceeds {summary['periods']} periods of the largest "
-                          f"possible step ({step_limit:.4g} m): the result is not trustworthy")
-
-
 def _emit_json(payload: dict, out) -> None:
     out.write(json.dumps(_plain(payload), indent=2, allow_nan=False) + "\n")
-
-
-#: ASCII stand-ins for the symbols of the human output (consoles that cannot encode them).
-_ASCII = {"μ": "mu", "µ": "u", "×": "x", "–": "-", "—": "-", "…": "...", "→": "->", "≈": "~",
-          "√": "sqrt", "ζ": "zeta", "Δ": "Delta", "·": "*", "≥": ">=", "≤": "<=", "−": "-", "∞": "inf",
-          "ν": "nu", "x̄": "mean x", "\u0304": "", "’": "'", "²": "^2", "³": "^3", "°": " deg"}
-
-
-def _ascii_fallback(exc):
-    """codecs error handler ``passmd-ascii``: symbols to ASCII stand-ins, others to '?'."""
-    if not isinstance(exc, UnicodeEncodeError):
-        raise exc
-    text = exc.object[exc.start:exc.end]
-    return "".join(_ASCII.get(ch, "?") for ch in text), exc.end
-
-
-codecs.register_error("passmd-ascii", _ascii_fallback)
-
-
-def _use_ascii_fallback(stream) -> None:
-    """Make ``stream`` print ASCII stand-ins for characters its encoding cannot encode."""
-    encoding = getattr(stream, "encoding", None)
-    reconfigure = getattr(stream, "reconfigure", None)
-    if not encoding or reconfigure is None:
-        return
-    try:
-        "μ×–→…≈".encode(encoding)
-    except (UnicodeEncodeError, LookupError):
-        with contextlib.suppress(Exception):
-            reconfigure(errors="passmd-ascii")
-
-
-class _StdoutError(OSError):
-    """Writing the command's output (not an output file) failed."""
-
-
-class _PipeClosed(Exception):
-    """The reader of standard output went away (``| head``)."""
-
-
-class _Out:
-    """The command's output stream; tells a closed pipe and a failing write apart."""
-
-    def __init__(self, stream):
-        self.stream = stream
-
-    def write(self, text: str) -> int:
-        try:
-            return self.stream.write(text)
-        except BrokenPipeError as exc:
-            raise _PipeClosed() from exc
-        except OSError as exc:
-            raise _StdoutError(exc.errno, exc.strerror or str(exc)) from exc
-
-    def flush(self) -> None:
-        flush = getattr(self.stream, "flush", None)
-        if flush is None:
-            return
-        try:
-            flush()
-        except BrokenPipeError as exc:
-            raise _PipeClosed() from exc
-        except OSError as exc:
-            raise _StdoutError(exc.errno, exc.strerror or str(exc)) from exc
 
 
 def _emit_rows(title: str, rows: list[tuple[str, str]], out) -> None:
@@ -588,28 +493,13 @@ _BYTES_PER_SAMPLE = 4 * 8 * (4 + 3 * 6)
 _BYTES_PER_PERIOD = 8 * 64
 
 
-def _available_memory() -> int | None:
-    """Memory available to this process in bytes (``MemAvailable``), None if unknown."""
-    try:
-        with open("/proc/meminfo") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        pass
-    try:
-        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):
-        return None
-
-
 def _check_memory(args, periods_flag: str = "--periods") -> None:
     """Refuse a run whose records would not fit in memory (estimated before allocating)."""
     if args.max_points < 2:
         raise UsageError(f"--max-points = {args.max_points} is out of range: must be an integer >= 2")
     periods = max(args.periods, getattr(args, "max_periods", 0) or 0)
     need = args.max_points * _BYTES_PER_SAMPLE + periods * _BYTES_PER_PERIOD
-    available = _available_memory()
+    available = available_memory()
     if available is not None and need > available // 2:
         raise UsageError(
             f"--max-points = {args.max_points} with {periods_flag} = {periods} needs about "
@@ -694,28 +584,6 @@ def _run_summary(result) -> dict:
     return summary
 
 
-def _friction_limit(drive: Drive) -> float:
-    """μ Σ F_N: the largest friction force all contacts together can exert (Eq. 1)."""
-    from passmd.theory import normal_forces
-
-    forces = normal_forces(drive.preload, drive.contacts)
-    total = float(forces[0]) if drive.contacts == 1 else float(2 * forces[0] + 4 * forces[1])
-    return drive.friction_coefficient * total
-
-
-def _check_force_bound(found: dict, drive: Drive) -> None:
-    """At stall the load cell's mean force is held by friction: |F| <= μ Σ F_N (Section 4.2).
-
-    Averaged over a period the runner's inertia contributes m_r Δv / T, negligible at stall;
-    5 % of margin covers it.
-    """
-    limit = _friction_limit(drive)
-    force = abs(float(found["generated_force_N"]))
-    if force > 1.05 * limit:
-        raise ResultError(f"generated force {force:.4g} N exceeds what friction can hold (mu*sum(F_N) = "
-                          f"{limit:.4g} N): the result is not trustworthy")
-
-
 def _cmd_run(args, out) -> int:
     drive = build_drive(args, load_cell=bool(args.load_cell))
     _waveform_args(args, drive)  # every option checked before anything runs
@@ -724,7 +592,7 @@ def _cmd_run(args, out) -> int:
     _check_output_paths(args)
     result = _simulate(args, drive)
     summary = _check_results(_run_summary(result))
-    _check_run_bounds(summary, drive, float(summary["amplitude_m"]))
+    check_run_bounds(summary, drive, float(summary["amplitude_m"]))
     _write_outputs(args, result)
     if args.json:
         _emit_json({"command": "run", "waveform": args.waveform, "flyback": args.flyback,
@@ -772,7 +640,7 @@ def _cmd_force(args, out) -> int:
         text = re.sub(r"\binitial_periods\b", "--periods", str(exc))
         raise UsageError(re.sub(r"\bmax_periods\b", "--max-periods", text)) from exc
     _check_results(found)
-    _check_force_bound(found, drive)
+    check_force_bound(found, drive)
     if args.csv or args.plot:  # the reported run again, for its time series
         from passmd import dynamics, waveforms
 
@@ -1170,24 +1038,6 @@ def make_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _one_line_warnings(prog: str):
-    """``warnings.showwarning`` printing ``prog: warning: message`` on one line."""
-
-    def show(message, category, filename, lineno, file=None, line=None):
-        text = " ".join(str(message).split())
-        sys.stderr.write(f"{prog}: warning: {text}\n")
-
-    return show
-
-
-def _silence_stdout() -> None:
-    """Point file descriptor 1 at /dev/null so the interpreter's final flush cannot fail."""
-    with contextlib.suppress(OSError, ValueError, AttributeError):
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        os.close(devnull)
-
-
 def main(argv=None, out=None) -> int:
     """Run the command line; return the exit status (0 ok, 2 usage error, 1 failed run).
 
@@ -1195,36 +1045,36 @@ def main(argv=None, out=None) -> int:
     """
     to_stdout = out is None
     for stream in (sys.stdout, sys.stderr):
-        _use_ascii_fallback(stream)
-    out = _Out(sys.stdout if out is None else out)
+        use_ascii_fallback(stream)
+    out = Out(sys.stdout if out is None else out)
     parser = make_parser()
     try:
         args = parser.parse_args(argv)
     except BrokenPipeError:  # --help piped into head
-        _silence_stdout()
+        silence_stdout()
         return 141
     prog = f"{PROG} {args.command}"
     with warnings.catch_warnings():
         # cache problems: one line each; numerical warnings: the results are checked instead
-        warnings.showwarning = _one_line_warnings(prog)
+        warnings.showwarning = one_line_warnings(prog)
         warnings.simplefilter("always", CacheWarning)
         warnings.simplefilter("ignore", RuntimeWarning)
         with np.errstate(all="ignore"):
             return _dispatch(args, out, prog, to_stdout)
 
 
-def _dispatch(args, out: _Out, prog: str, to_stdout: bool) -> int:
+def _dispatch(args, out: Out, prog: str, to_stdout: bool) -> int:
     try:
         status = args.handler(args, out)
         out.flush()
         return status
-    except _PipeClosed:
+    except PipeClosed:
         if to_stdout:
-            _silence_stdout()
+            silence_stdout()
         return 141
-    except _StdoutError as exc:
+    except StdoutError as exc:
         if to_stdout:
-            _silence_stdout()
+            silence_stdout()
         sys.stderr.write(f"{prog}: error: cannot write the output: {exc.strerror or exc}\n")
         return 1
     except (UsageError, QuantityError) as exc:
