@@ -115,8 +115,7 @@ def parse_quantity(text, unit: str, *, name: str = "value") -> float:
     if unit_text:
         try:
             given = registry().parse_units(unit_text)
-        except (pint.errors.UndefinedUnitError, pint.errors.DefinitionSyntaxError, ValueError,
-                AttributeError, TypeError) as exc:
+        except Exception as exc:  # pint's parser raises many kinds (even AssertionError for '0:')
             raise QuantityError(
                 f"{name} = {text!r}: unknown unit {unit_text!r}; expected a {dimension_name(unit)}"
                 f" unit such as {unit or 'a plain number'}"

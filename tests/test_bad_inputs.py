@@ -124,6 +124,7 @@ NAMED_CASES = {
     "amplitude a hair above the stroke": (["run", "--amplitude", "202.0000001nm"], 2,
                                           "--amplitude = 202.0000001 nm is out of range: must be <= 202 nm"),
     "force periods name the option": (["force", "--periods", "1", "--max-periods", "2"], 2, "--periods"),
+    "unit text that trips the unit parser": (["theory", "--preload", "0:"], 2, "unknown unit ':'"),
     "periods written 1e8": (["run", "--periods", "1e8"], 2, "invalid int value: '1e8'"),
     "slew rate 3e13": (["run", "--slew-rate", "3e13"], 2, "--slew-rate"),
     "load cell stiffness 1e30": (["force", "--load-cell-stiffness", "1e30"], 2, "--load-cell-stiffness"),
