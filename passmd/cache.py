@@ -28,8 +28,9 @@ entry can run code when it is read (pickles could). A value of any other type (a
 DataFrame, an object array, an arbitrary class) is refused with a ``TypeError`` when
 it is stored; convert it where it is produced.
 
-An entry whose magic line, checksum, header or key does not check out (corrupt,
-truncated, foreign or misplaced) is reported once with a :class:`CacheWarning`,
+An entry whose magic line, checksum, header, key or (when the caller names it, as
+:func:`passmd.sweep.run` does) function does not check out (corrupt, truncated, foreign
+or misplaced) is reported once with a :class:`CacheWarning`,
 removed, and treated as a miss, so the caller recomputes it. Entries are written
 atomically: to a temporary file in the same directory, flushed to disk, then moved into
 place with :func:`os.replace`; an interrupted write leaves either no entry or the
@@ -379,15 +380,18 @@ class Cache:
         """File of an entry: ``<directory>/<key[:2]>/<key>.pmc``."""
         return self.directory / key[:2] / f"{key}{ENTRY_SUFFIX}"
 
-    def get(self, key: str, default=None):
-        """The stored value, or ``default`` on a miss (absent or unusable entry)."""
-        value = self._load(key)
+    def get(self, key: str, default=None, *, function: str | None = None):
+        """The stored value, or ``default`` on a miss (absent or unusable entry).
+
+        ``function`` given: an entry written for another function is unusable too.
+        """
+        value = self._load(key, function)
         return default if value is _MISS else value
 
     def __contains__(self, key: str) -> bool:
         return self._load(key) is not _MISS
 
-    def _load(self, key: str):
+    def _load(self, key: str, function: str | None = None):
         path = self.path(key)
         try:
             data = path.read_bytes()
@@ -397,7 +401,9 @@ class Cache:
             self._report_unusable(f"cannot read the cache {self.directory}: {exc.strerror or exc}")
             return _MISS
         try:
-            _, value = decode_entry(data, key)
+            header, value = decode_entry(data, key)
+            if function is not None and header.get("function") not in (function, ""):
+                raise CorruptEntry(f"written by {header.get('function')!r}, not {function!r}")
         except CorruptEntry as exc:
             self._discard(path, str(exc))
             return _MISS

@@ -381,7 +381,7 @@ def run(
     cached: dict[int, dict] = {}
     if store is not None:
         for i, key in enumerate(keys):
-            value = store.get(key)
+            value = store.get(key, function=function_name(func))
             if isinstance(value, Mapping):
                 cached[i] = dict(value)
     todo = [i for i in range(len(points)) if i not in cached]

@@ -302,3 +302,14 @@ def test_cached_rerun_is_bit_identical(store):
     for column in cold.columns:
         for a, b in zip(cold[column], warm[column], strict=True):
             assert repr(a) == repr(b) and type(a) is type(b), column
+
+
+def test_entry_of_another_function_is_recomputed(store):
+    """Right key, well-formed, but written by another function: foreign content is not served."""
+    from passmd import sweep
+
+    key = store.key(point_function, {"x": 1.0})
+    store.put(key, {"full_time_s": 1.0}, function="somewhere:else")
+    with pytest.warns(cache_module.CacheWarning, match="written by 'somewhere:else'"):
+        frame = sweep.run(point_function, [{"x": 1.0}], executor="serial", cache=store, progress=False)
+    assert frame["y"].tolist() == [1.0] and frame.attrs["sweep"]["computed"] == 1
