@@ -105,6 +105,10 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message):  # noqa: D401 - argparse API
         self.exit(2, f"{self.prog}: error: {message}\n")
 
+    def _print_message(self, message, file=None):  # argparse would swallow a failed write
+        if message:
+            (file or sys.stderr).write(message)
+
 
 class _Formatter(argparse.RawDescriptionHelpFormatter):
     def __init__(self, prog):
@@ -1053,6 +1057,22 @@ def main(argv=None, out=None) -> int:
     except BrokenPipeError:  # --help piped into head
         silence_stdout()
         return 141
+    except OSError as err:  # --help > /dev/full
+        silence_stdout()
+        sys.stderr.write(f"{PROG}: error: cannot write the output: {err.strerror or err}\n")
+        return 1
+    except SystemExit as exc:  # --help, --version: what argparse printed must reach the file
+        if exc.code == 0 and to_stdout:
+            try:
+                sys.stdout.flush()
+            except BrokenPipeError:
+                silence_stdout()
+                return 141
+            except OSError as err:
+                silence_stdout()
+                sys.stderr.write(f"{PROG}: error: cannot write the output: {err.strerror or err}\n")
+                return 1
+        raise
     prog = f"{PROG} {args.command}"
     with warnings.catch_warnings():
         # cache problems: one line each; numerical warnings: the results are checked instead

@@ -229,8 +229,8 @@ full_disk = pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /d
 
 
 @full_disk
-@pytest.mark.parametrize("argv", [["theory"], ["theory", "--json"],
-                                  ["contact", "--path", "0,30nm", "--json"]])
+@pytest.mark.parametrize("argv", [["theory"], ["theory", "--json"], ["contact", "--path", "0,30nm", "--json"],
+                                  ["--help"], ["run", "--help"], ["--version"]])
 def test_full_disk_on_stdout_is_one_line_exit_1(argv):
     with open("/dev/full", "w") as full:
         done = run_process(argv, stdout=full)
