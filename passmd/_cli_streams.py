@@ -7,6 +7,7 @@
   (full disk) :class:`StdoutError` (one error line, exit 1).
 * :func:`one_line_warnings` prints a warning as one ``prog: warning: ...`` line.
 * :func:`available_memory` lets a command refuse a run before allocating it.
+* :func:`write_atomically` writes an output file completely or not at all.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import os
 import sys
 
 __all__ = ["Out", "PipeClosed", "StdoutError", "available_memory", "one_line_warnings", "silence_stdout",
-           "use_ascii_fallback"]
+           "use_ascii_fallback", "write_atomically"]
 
 #: ASCII stand-ins for the symbols of the human output (consoles that cannot encode them).
 _ASCII = {"μ": "mu", "µ": "u", "×": "x", "–": "-", "—": "-", "…": "...", "→": "->", "≈": "~",
@@ -115,3 +116,32 @@ def available_memory() -> int | None:
     except (ValueError, OSError, AttributeError):
         return None
 
+
+
+def write_atomically(path, write) -> None:
+    """Call ``write(temporary_path)`` and move the file into place only when it is complete.
+
+    An interrupted or failed write (Ctrl-C, full disk) leaves no partial ``path`` and no
+    temporary file; the error propagates.
+    """
+    import tempfile
+    from pathlib import Path
+
+    target = Path(path)
+    if target.exists() and not target.is_file():  # a device such as /dev/null: write directly
+        write(str(target))
+        return
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}-", suffix=".part" + target.suffix,
+                               dir=target.parent if str(target.parent) else ".")
+    os.close(fd)
+    mask = os.umask(0)
+    os.umask(mask)
+    try:
+        os.chmod(tmp, 0o666 & ~mask)  # as a plainly created file (mkstemp makes it private)
+        write(tmp)
+        os.replace(tmp, target)
+        tmp = None
+    finally:
+        if tmp is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)

@@ -51,6 +51,7 @@ from passmd._cli_streams import (
     one_line_warnings,
     silence_stdout,
     use_ascii_fallback,
+    write_atomically,
 )
 from passmd._result_bounds import ResultError, check_force_bound, check_run_bounds
 from passmd._validation import check_range
@@ -557,7 +558,8 @@ def _simulate(args, drive):
 def _write_outputs(args, result) -> None:
     if args.csv:
         try:
-            result.to_frame().to_csv(args.csv, index=False)
+            frame = result.to_frame()
+            write_atomically(args.csv, lambda tmp: frame.to_csv(tmp, index=False))
         except OSError as exc:
             raise OutputError(f"cannot write --csv {args.csv}: {exc.strerror or exc}") from exc
     if args.plot:
@@ -573,7 +575,8 @@ def _write_outputs(args, result) -> None:
         ax.legend()
         ax.set_title(_describe(result.drive), fontsize=9)
         try:
-            fig.savefig(args.plot, dpi=150)
+            fmt = Path(args.plot).suffix.lstrip(".").lower()
+            write_atomically(args.plot, lambda tmp: fig.savefig(tmp, dpi=150, format=fmt))
         except OSError as exc:
             raise OutputError(f"cannot write --plot {args.plot}: {exc.strerror or exc}") from exc
 
@@ -834,9 +837,9 @@ def _cmd_figure(args, out) -> int:
     csv_path, png_path = target / f"{args.name}.csv", target / f"{args.name}.png"
     try:
         target.mkdir(parents=True, exist_ok=True)
-        data.to_csv(csv_path, index=False)
+        write_atomically(csv_path, lambda tmp: data.to_csv(tmp, index=False))
         fig = experiments.figure_plot(args.name, data)
-        fig.savefig(png_path, dpi=150)
+        write_atomically(png_path, lambda tmp: fig.savefig(tmp, dpi=150, format="png"))
     except OSError as exc:
         raise OutputError(f"cannot write to --out {args.out}: {exc.strerror or exc}") from exc
     pyplot = sys.modules.get("matplotlib.pyplot")

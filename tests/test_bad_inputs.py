@@ -438,3 +438,28 @@ def test_readme_counts_what_this_file_tries():
     assert f"{os.environ.get('PASSMD_FUZZ_EXAMPLES', '250')} command lines per run over six" in section
     assert len({argv[0] for argv, _, _ in NAMED_CASES.values()}) >= 5
     assert len(COMMANDS) == 6
+
+
+def test_output_files_are_complete_or_absent(tmp_path):
+    """A write that fails half-way (full disk, Ctrl-C) leaves neither a partial file nor a temporary."""
+    from passmd._cli_streams import write_atomically
+
+    target = tmp_path / "series.csv"
+
+    def half_then_fail(tmp):
+        Path(tmp).write_text("time_s,x_m\n0.0,")
+        raise OSError(28, "No space left on device")
+
+    with pytest.raises(OSError, match="No space"):
+        write_atomically(target, half_then_fail)
+    assert list(tmp_path.iterdir()) == []
+    write_atomically(target, lambda tmp: Path(tmp).write_text("time_s\n0.0\n"))
+    assert target.read_text() == "time_s\n0.0\n"
+    assert oct(target.stat().st_mode & 0o777) == oct(0o666 & ~_umask())
+    assert [p.name for p in tmp_path.iterdir()] == ["series.csv"]
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
