@@ -20,7 +20,7 @@ def _describe(lower, upper, lower_open, upper_open) -> str:
         parts.append(f"{'>' if lower_open else '>='} {lower:g}")
     if upper is not None:
         parts.append(f"{'<' if upper_open else '<='} {upper:g}")
-    return " and ".join(parts) if parts else "finite"
+    return " and ".join(parts)
 
 
 def check_range(
@@ -50,10 +50,11 @@ def check_range(
         Unit shown in the error message.
     """
     rng = _describe(lower, upper, lower_open, upper_open)
+    rng = f" {rng}" if rng else ""
     suffix = f" ({unit})" if unit else ""
     if isinstance(value, bool) or not isinstance(value, (Real, np.floating, np.integer)):
         raise ValueError(
-            f"{name} = {value!r} is not a number: must be a finite number {rng}{suffix}"
+            f"{name} = {value!r} is not a number: must be a finite number{rng}{suffix}"
         )
     v = float(value)
     bad = not math.isfinite(v)
@@ -62,7 +63,7 @@ def check_range(
     if not bad and upper is not None:
         bad = v >= upper if upper_open else v > upper
     if bad:
-        raise ValueError(f"{name} = {value!r} is out of range: must be a finite number {rng}{suffix}")
+        raise ValueError(f"{name} = {value!r} is out of range: must be a finite number{rng}{suffix}")
     return v
 
 
@@ -74,6 +75,15 @@ def check_positive(name: str, value, unit: str = "") -> float:
 def check_nonnegative(name: str, value, unit: str = "") -> float:
     """Return ``float(value)`` if it is finite and >= 0."""
     return check_range(name, value, 0.0, unit=unit)
+
+
+def check_count(name: str, value, minimum: int = 1) -> int:
+    """Return ``int(value)`` if it is an integer >= ``minimum`` (booleans are not counts)."""
+    integral = isinstance(value, (int, np.integer)) or (
+        isinstance(value, (float, np.floating)) and math.isfinite(value) and float(value).is_integer())
+    if isinstance(value, (bool, np.bool_)) or not integral or value < minimum:
+        raise ValueError(f"{name} = {value!r} is out of range: must be an integer >= {minimum}")
+    return int(value)
 
 
 def check_choice(name: str, value, choices) -> str:
@@ -90,6 +100,7 @@ def check_array(name: str, values, lower=None, upper=None, *, lower_open=False, 
     if arr.size == 0:
         return arr
     rng = _describe(lower, upper, lower_open, False)
+    rng = f" {rng}" if rng else ""
     suffix = f" ({unit})" if unit else ""
     bad = ~np.isfinite(arr)
     if lower is not None:
@@ -100,6 +111,6 @@ def check_array(name: str, values, lower=None, upper=None, *, lower_open=False, 
         first = float(arr.flat[int(np.flatnonzero(bad.ravel())[0])])
         raise ValueError(
             f"{name} contains {first:g}, which is out of range: every element must be a "
-            f"finite number {rng}{suffix}"
+            f"finite number{rng}{suffix}"
         )
     return arr

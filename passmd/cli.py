@@ -7,15 +7,22 @@ Subcommands::
     passmd run                  one simulation of a driving waveform
     passmd force                generated force against the load cell
     passmd contact              tangential force of one MDR contact along a path
-    passmd figure               one paper figure's data and image (not available yet)
+    passmd figure               one paper figure's data and image
+    passmd cache                the on-disk simulation cache: info, clear, prune
 
 Quantities accept units (``0.4N``, ``1mm``, ``0.25 mm``, ``202nm``, ``100kHz``,
 ``310GPa``); a bare number is read in the unit ``--help`` shows. Human output uses nm,
 N, mm and kHz; ``--json`` prints one JSON object in SI units whose keys carry the unit.
 
 Exit status: 0 success, 2 usage error (unknown option, wrong unit, out-of-range value,
-capability not available yet), 1 failed run (the simulation diverged, an output file
-could not be written). User errors print one line to stderr, never a traceback.
+contradicting options), 1 failed run (the simulation diverged, a result failed its
+finiteness/plausibility check, an output could not be written, an optional dependency
+is missing, not enough memory), 130 interrupted (Ctrl-C), 141 standard output closed
+(a pipe reader such as ``head`` went away; nothing is printed, as Unix tools do).
+Errors print one line to stderr, never a traceback. Parameter ranges come from
+:data:`passmd.parameters.PLAUSIBLE_RANGES`; ``--allow-extrapolation`` lifts their soft
+limits. On a console that cannot encode the output's symbols (μ, ×, –, →), ASCII
+stand-ins are printed.
 """
 
 from __future__ import annotations
@@ -23,26 +30,42 @@ from __future__ import annotations
 import argparse
 import contextlib
 import gc
+import importlib.util
 import json
 import math
 import os
+import re
 import sys
 import textwrap
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from passmd import __version__
+from passmd._cli_streams import (
+    Out,
+    PipeClosed,
+    StdoutError,
+    available_memory,
+    one_line_warnings,
+    silence_stdout,
+    use_ascii_fallback,
+    write_atomically,
+)
+from passmd._result_bounds import ResultError, check_force_bound, check_run_bounds
 from passmd._validation import check_range
-from passmd.cache import CACHE_DIR_ENV, DEFAULT_CACHE_DIR
+from passmd.cache import CACHE_DIR_ENV, DEFAULT_CACHE_DIR, CacheWarning
 from passmd.parameters import (
     ACTUATOR_DAMPING_RATIO,
+    PLAUSIBLE_RANGES,
     Actuator,
     Amplifier,
     Drive,
     Material,
     actuator_for_radius,
+    check_contact_plausible,
 )
 from passmd.units import QuantityError, from_si, parse_quantities, parse_quantity
 
@@ -67,7 +90,15 @@ class UsageError(ValueError):
 
 
 class NotAvailableError(UsageError):
-    """A capability that later issues add (exit status 2)."""
+    """A name (figure panel) the package does not provide (exit status 2)."""
+
+
+class MissingDependencyError(RuntimeError):
+    """An optional dependency is not installed (exit status 1)."""
+
+
+#: Optional dependencies: importable module -> the passmd extra that installs it.
+OPTIONAL_EXTRAS = {"distributed": "dask", "dask": "dask"}
 
 
 class _Parser(argparse.ArgumentParser):
@@ -75,6 +106,10 @@ class _Parser(argparse.ArgumentParser):
 
     def error(self, message):  # noqa: D401 - argparse API
         self.exit(2, f"{self.prog}: error: {message}\n")
+
+    def _print_message(self, message, file=None):  # argparse would swallow a failed write
+        if message:
+            (file or sys.stderr).write(message)
 
 
 class _Formatter(argparse.RawDescriptionHelpFormatter):
@@ -100,6 +135,8 @@ class _Quantity:
     lower_open: bool = True
     upper: float | None = None
     upper_open: bool = False
+    #: key of passmd.parameters.PLAUSIBLE_RANGES checked instead of lower/upper
+    plausible: str | None = None
 
     @property
     def dest(self) -> str:
@@ -120,6 +157,12 @@ class _Quantity:
         if raw is None:
             return None
         value = parse_quantity(raw, self.unit, name=self.flag)
+        if self.plausible is not None:
+            scale = 1.0 / from_si(1.0, self.unit) if self.unit else 1.0
+            PLAUSIBLE_RANGES[self.plausible].check(
+                self.flag, value, allow_extrapolation=bool(getattr(args, "allow_extrapolation", False)),
+                shown=self.flag, scale=scale, unit=self.unit, hint="--allow-extrapolation")
+            return value
         shown = float(f"{from_si(value, self.unit):.12g}")
         check_range(self.flag, shown, self.lower, self.upper, lower_open=self.lower_open,
                     upper_open=self.upper_open, unit=self.unit or "–")
@@ -133,34 +176,42 @@ def _fmt(value_si: float, unit: str) -> str:
 _ACT = _DEFAULT.actuator
 _AT_R = f"at {_fmt(_DEFAULT.hemisphere_radius, 'mm')}"
 _DRIVE_QUANTITIES = (
-    _Quantity("--preload", "N", "F_p", "preload", _fmt(_DEFAULT.preload, "N")),
-    _Quantity("--radius", "mm", "R", "hemisphere radius", _fmt(_DEFAULT.hemisphere_radius, "mm")),
-    _Quantity("--mu", "", "mu", "friction coefficient", f"{_DEFAULT.friction_coefficient:g}"),
-    _Quantity("--runner-mass", "g", "m_r", "runner mass", _fmt(_DEFAULT.runner_mass, "g")),
+    _Quantity("--preload", "N", "F_p", "preload", _fmt(_DEFAULT.preload, "N"), plausible="preload"),
+    _Quantity("--radius", "mm", "R", "hemisphere radius", _fmt(_DEFAULT.hemisphere_radius, "mm"),
+              plausible="hemisphere_radius"),
+    _Quantity("--mu", "", "mu", "friction coefficient", f"{_DEFAULT.friction_coefficient:g}",
+              plausible="friction_coefficient"),
+    _Quantity("--runner-mass", "g", "m_r", "runner mass", _fmt(_DEFAULT.runner_mass, "g"),
+              plausible="runner_mass"),
     _Quantity("--load-cell-stiffness", "N/m", "k", "load cell stiffness",
-              _fmt(_DEFAULT.load_cell_stiffness, "N/m")),
+              _fmt(_DEFAULT.load_cell_stiffness, "N/m"), plausible="load_cell_stiffness"),
     _Quantity("--hemisphere-modulus", "GPa", "E_1", "Young's modulus of the hemispheres",
-              _fmt(_DEFAULT.hemisphere_material.youngs_modulus, "GPa") + " (ruby)"),
+              _fmt(_DEFAULT.hemisphere_material.youngs_modulus, "GPa") + " (ruby)",
+              plausible="material.youngs_modulus"),
     _Quantity("--hemisphere-poisson", "", "nu_1", "Poisson's ratio of the hemispheres",
               f"{_DEFAULT.hemisphere_material.poissons_ratio:g}", -1.0, True, 0.5, True),
     _Quantity("--runner-modulus", "GPa", "E_2", "Young's modulus of the runner",
-              _fmt(_DEFAULT.runner_material.youngs_modulus, "GPa") + " (steel)"),
+              _fmt(_DEFAULT.runner_material.youngs_modulus, "GPa") + " (steel)",
+              plausible="material.youngs_modulus"),
     _Quantity("--runner-poisson", "", "nu_2", "Poisson's ratio of the runner",
               f"{_DEFAULT.runner_material.poissons_ratio:g}", -1.0, True, 0.5, True),
     _Quantity("--actuator-stiffness", "N/m", "k_p", "actuator stiffness",
-              f"Table 2 for --radius, {_fmt(_ACT.stiffness, 'N/m')} {_AT_R}"),
+              f"Table 2 for --radius, {_fmt(_ACT.stiffness, 'N/m')} {_AT_R}", plausible="actuator.stiffness"),
     _Quantity("--actuator-mass", "g", "m_a", "actuator mass",
-              f"Table 2 for --radius, {_fmt(_ACT.mass, 'g')} {_AT_R}"),
+              f"Table 2 for --radius, {_fmt(_ACT.mass, 'g')} {_AT_R}", plausible="actuator.mass"),
     _Quantity("--actuator-viscosity", "kg/s", "c_p", "actuator viscosity",
               f"2ζ√(k_p m_a) with ζ = {ACTUATOR_DAMPING_RATIO:g}, {_fmt(_ACT.viscosity, 'kg/s')} {_AT_R}",
               0.0, False),
     _Quantity("--full-stroke-amplitude", "nm", "A_max", "actuation amplitude at the full voltage",
-              f"Table 2 for --radius, {_fmt(_ACT.full_stroke_amplitude, 'nm')} {_AT_R}"),
+              f"Table 2 for --radius, {_fmt(_ACT.full_stroke_amplitude, 'nm')} {_AT_R}",
+              plausible="actuator.full_stroke_amplitude"),
     _Quantity("--amplifier-voltage", "V", "V_pp", "amplifier peak-to-peak voltage",
-              _fmt(_DEFAULT.amplifier.peak_to_peak_voltage, "V")),
+              _fmt(_DEFAULT.amplifier.peak_to_peak_voltage, "V"), plausible="amplifier.peak_to_peak_voltage"),
     _Quantity("--slew-rate", "V/us", "SR", "amplifier slew rate",
-              _fmt(_DEFAULT.amplifier.slew_rate, "V/us")),
+              _fmt(_DEFAULT.amplifier.slew_rate, "V/us"), plausible="amplifier.slew_rate"),
 )
+#: Options of the actuators' dynamics, which rigid actuators do not have.
+_ACTUATOR_DYNAMICS = ("--actuator-stiffness", "--actuator-mass", "--actuator-viscosity")
 _Q = {q.flag: q for q in _DRIVE_QUANTITIES}
 
 _MATERIAL_FLAGS = ("--hemisphere-modulus", "--hemisphere-poisson", "--runner-modulus", "--runner-poisson")
@@ -178,6 +229,9 @@ def _add_drive_options(parser, *, contact_only: bool = False) -> None:
         if contact_only and q.flag not in ("--radius", "--mu", *_MATERIAL_FLAGS):
             continue
         q.add(group)
+    group.add_argument("--allow-extrapolation", action="store_true",
+                       help="accept parameters outside the plausible ranges around Tables 1–2 (soft limits; "
+                            "hard limits, where the model breaks, stay) (default: off)")
 
 
 def _material(base: Material, modulus, poisson) -> Material:
@@ -197,6 +251,14 @@ def build_drive(args, **fixed) -> Drive:
     viscosity, unless given, is 2ζ√(k_p m_a) of the final k_p and m_a.
     """
     v = {flag: q.parse(args) for flag, q in _Q.items() if hasattr(args, q.dest)}
+    if getattr(args, "actuator", None) == "rigid":
+        given = [flag for flag in _ACTUATOR_DYNAMICS if v.get(flag) is not None]
+        if given:
+            raise UsageError(f"{given[0]} contradicts --actuator rigid: ideally rigid actuators have no "
+                             "stiffness, mass or viscosity (use --actuator flexible, or drop the option)")
+    if v.get("--load-cell-stiffness") is not None and not fixed.get("load_cell", False):
+        raise UsageError("--load-cell-stiffness has no effect here: the runner is free (no load cell); "
+                         "use it with `passmd force` or `passmd run --load-cell`")
     radius = v.get("--radius") or _DEFAULT.hemisphere_radius
     base = actuator_for_radius(radius)
     k_p = v.get("--actuator-stiffness") or base.stiffness
@@ -224,6 +286,7 @@ def build_drive(args, **fixed) -> Drive:
                                      v.get("--runner-poisson")),
         "actuator": actuator,
         "amplifier": amplifier,
+        "allow_extrapolation": bool(getattr(args, "allow_extrapolation", False)),
     }
     if hasattr(args, "contacts"):
         fields["contacts"] = args.contacts
@@ -262,21 +325,28 @@ def drive_record(drive: Drive) -> dict:
 # --------------------------------------------------------------------------------------
 
 
-def _plain(obj):
-    """JSON-ready: numpy scalars/arrays to Python, non-finite floats refused."""
+def _plain(obj, where: str = "result"):
+    """JSON-ready: numpy scalars/arrays to Python; a non-finite float is a :class:`ResultError`."""
     if isinstance(obj, dict):
-        return {str(k): _plain(v) for k, v in obj.items()}
+        return {str(k): _plain(v, str(k)) for k, v in obj.items()}
     if isinstance(obj, (list, tuple, np.ndarray)):
-        return [_plain(x) for x in (obj.tolist() if isinstance(obj, np.ndarray) else obj)]
+        return [_plain(x, where) for x in (obj.tolist() if isinstance(obj, np.ndarray) else obj)]
     if isinstance(obj, (np.bool_, bool)):
         return bool(obj)
     if isinstance(obj, (np.integer, int)):
         return int(obj)
     if isinstance(obj, (np.floating, float)):
         if not math.isfinite(float(obj)):
-            raise RuntimeError(f"internal error: non-finite value {obj!r} in the output")
+            raise ResultError(f"result {where} = {float(obj)!r} is not finite: the configuration is outside "
+                              "what the model can compute")
         return float(obj)
     return obj
+
+
+def _check_results(record: dict) -> dict:
+    """Every number of a command's record finite (same check with and without ``--json``)."""
+    _plain(record)
+    return record
 
 
 def _emit_json(payload: dict, out) -> None:
@@ -327,6 +397,7 @@ def _cmd_theory(args, out) -> int:
     result = drive_theory(drive)
     result["runner_frequency_Hz"] = runner_frequency(drive)
     result["actuator_natural_frequency_Hz"] = drive.actuator.natural_frequency
+    _check_results(result)
     if args.json:
         _emit_json({"command": "theory", "drive": drive_record(drive), **result}, out)
         return 0
@@ -359,6 +430,8 @@ def _cmd_contact(args, out) -> int:
     springs = _check_springs(args.springs)
     drive = build_drive(args)
     E_star, G_star = contact_moduli(drive)
+    check_contact_plausible(normal, drive.hemisphere_radius, E_star, names="--normal-force, --radius",
+                            allow_extrapolation=args.allow_extrapolation, hint="--allow-extrapolation")
     contact = MDRContact(normal, drive.hemisphere_radius, E_star, G_star, drive.friction_coefficient,
                          springs=springs)
     forces = contact.path(np.array(path))
@@ -377,6 +450,7 @@ def _cmd_contact(args, out) -> int:
         "displacement_m": path,
         "force_N": forces,
     }
+    _check_results(record)
     if args.json:
         _emit_json(record, out)
         return 0
@@ -409,13 +483,59 @@ def _waveform_args(args, drive):
     amplitude = a_max if amplitude is None else amplitude
     if amplitude > a_max * (1 + 1e-12):
         raise UsageError(
-            f"--amplitude = {from_si(amplitude, 'nm'):.6g} nm is out of range: must be <= "
-            f"{from_si(a_max, 'nm'):.6g} nm, the actuator's full stroke (--full-stroke-amplitude)"
+            f"--amplitude = {from_si(amplitude, 'nm'):.10g} nm is out of range: must be <= "
+            f"{from_si(a_max, 'nm'):.10g} nm, the actuator's full stroke (--full-stroke-amplitude)"
         )
     frequency = _FREQUENCY.parse(args) or _DEFAULT_FREQUENCY
     if args.periods < 1:
         raise UsageError(f"--periods = {args.periods} is out of range: must be an integer >= 1")
     return min(amplitude, a_max), frequency
+
+
+#: Bytes per recorded sample (time, piezo/runner positions and velocities, per-group
+#: contact columns, with the DataFrame/plot copies) and per period (waveform breakpoints,
+#: per-period measures) used to estimate a run's memory before allocating it.
+_BYTES_PER_SAMPLE = 4 * 8 * (4 + 3 * 6)
+_BYTES_PER_PERIOD = 8 * 64
+
+
+def _check_memory(args, periods_flag: str = "--periods") -> None:
+    """Refuse a run whose records would not fit in memory (estimated before allocating)."""
+    if args.max_points < 2:
+        raise UsageError(f"--max-points = {args.max_points} is out of range: must be an integer >= 2")
+    periods = max(args.periods, getattr(args, "max_periods", 0) or 0)
+    need = args.max_points * _BYTES_PER_SAMPLE + periods * _BYTES_PER_PERIOD
+    available = available_memory()
+    if available is not None and need > available // 2:
+        raise UsageError(
+            f"--max-points = {args.max_points} with {periods_flag} = {periods} needs about "
+            f"{need / 2**30:.3g} GiB, more than half the {available / 2**30:.3g} GiB available: "
+            "lower --max-points or the number of periods"
+        )
+
+
+#: Image formats --plot can write (matplotlib's Agg/PDF/SVG/PS backends).
+_PLOT_FORMATS = ("png", "pdf", "svg", "ps", "eps", "jpg", "jpeg", "tif", "tiff", "webp")
+
+
+def _check_output_paths(args) -> None:
+    """--csv/--plot: a file name in an existing directory, a known image format (before running)."""
+    for flag, name in (("--csv", args.csv), ("--plot", args.plot)):
+        if name is None:
+            continue
+        if not name.strip():
+            raise UsageError(f"{flag} = {name!r} is not a file name")
+        target = Path(name)
+        if target.is_dir():
+            raise UsageError(f"{flag} = {name!r} is a directory: give a file name")
+        parent = target.parent if str(target.parent) else Path(".")
+        if not parent.is_dir():
+            raise OutputError(f"cannot write {flag} {name}: directory {str(parent)!r} does not exist")
+    if args.plot is not None:
+        suffix = Path(args.plot).suffix.lower().lstrip(".")
+        if suffix not in _PLOT_FORMATS:
+            raise UsageError(f"--plot = {args.plot!r} has {'no' if not suffix else 'an unknown'} image "
+                             f"extension: must end in one of {', '.join('.' + f for f in _PLOT_FORMATS)}")
 
 
 def _simulate(args, drive):
@@ -439,7 +559,8 @@ def _simulate(args, drive):
 def _write_outputs(args, result) -> None:
     if args.csv:
         try:
-            result.to_frame().to_csv(args.csv, index=False)
+            frame = result.to_frame()
+            write_atomically(args.csv, lambda tmp: frame.to_csv(tmp, index=False))
         except OSError as exc:
             raise OutputError(f"cannot write --csv {args.csv}: {exc.strerror or exc}") from exc
     if args.plot:
@@ -455,7 +576,8 @@ def _write_outputs(args, result) -> None:
         ax.legend()
         ax.set_title(_describe(result.drive), fontsize=9)
         try:
-            fig.savefig(args.plot, dpi=150)
+            fmt = Path(args.plot).suffix.lstrip(".").lower()
+            write_atomically(args.plot, lambda tmp: fig.savefig(tmp, dpi=150, format=fmt))
         except OSError as exc:
             raise OutputError(f"cannot write --plot {args.plot}: {exc.strerror or exc}") from exc
 
@@ -472,9 +594,14 @@ def _run_summary(result) -> dict:
 
 def _cmd_run(args, out) -> int:
     drive = build_drive(args, load_cell=bool(args.load_cell))
+    _waveform_args(args, drive)  # every option checked before anything runs
+    _check_springs(args.springs)
+    _check_memory(args)
+    _check_output_paths(args)
     result = _simulate(args, drive)
+    summary = _check_results(_run_summary(result))
+    check_run_bounds(summary, drive, float(summary["amplitude_m"]))
     _write_outputs(args, result)
-    summary = _run_summary(result)
     if args.json:
         _emit_json({"command": "run", "waveform": args.waveform, "flyback": args.flyback,
                     "drive": drive_record(drive), **summary}, out)
@@ -511,9 +638,17 @@ def _cmd_force(args, out) -> int:
     if args.max_periods < args.periods:
         raise UsageError(f"--max-periods = {args.max_periods} is out of range: must be >= --periods "
                          f"({args.periods})")
+    _check_memory(args, "--max-periods")
+    _check_output_paths(args)
     # the force-generation chapter's stall protocol: runs from rest, lengthened until stalled
-    found = fg.generated_force(drive, amplitude, frequency, flyback=args.flyback,
-                               initial_periods=args.periods, max_periods=args.max_periods)
+    try:
+        found = fg.generated_force(drive, amplitude, frequency, flyback=args.flyback,
+                                   initial_periods=args.periods, max_periods=args.max_periods)
+    except ValueError as exc:  # name the command's options, not the library's parameters
+        text = re.sub(r"\binitial_periods\b", "--periods", str(exc))
+        raise UsageError(re.sub(r"\bmax_periods\b", "--max-periods", text)) from exc
+    _check_results(found)
+    check_force_bound(found, drive)
     if args.csv or args.plot:  # the reported run again, for its time series
         from passmd import dynamics, waveforms
 
@@ -550,14 +685,18 @@ def _cmd_critical_amplitude(args, out) -> int:
         "critical_amplitude_rigid_m": theory["critical_amplitude_rigid_m"],
         "critical_amplitude_flexible_m": theory["critical_amplitude_flexible_m"],
     }
-    if not args.analytic_only:
-        from passmd.experiments import critical_amplitude as ca
+    from passmd.experiments import critical_amplitude as ca
 
-        if args.periods < 2:
-            raise UsageError(f"--periods = {args.periods} is out of range: a step needs >= 2 periods")
-        threshold = _THRESHOLD.parse(args) or ca.STEP_THRESHOLD
-        tolerance = _TOLERANCE.parse(args) or _DEFAULT_TOLERANCE
-        frequency = _FREQUENCY.parse(args) or ca.DRIVE_FREQUENCY
+    # every option is checked, whether or not --analytic-only skips the search
+    if args.periods < 2:
+        raise UsageError(f"--periods = {args.periods} is out of range: a step needs >= 2 periods")
+    if args.threshold is not None and args.protocol == "first":
+        raise UsageError("--threshold contradicts --protocol first: the first-fly-back protocol has no "
+                         "step threshold (use --protocol steady, or drop --threshold)")
+    threshold = _THRESHOLD.parse(args) or ca.STEP_THRESHOLD
+    tolerance = _TOLERANCE.parse(args) or _DEFAULT_TOLERANCE
+    frequency = _FREQUENCY.parse(args) or ca.DRIVE_FREQUENCY
+    if not args.analytic_only:
         # the book's search (critical-amplitude chapters): one protocol for users and book
         found = ca.critical_amplitude(
             drive, protocol=args.protocol, frequency=frequency, flyback=args.flyback,
@@ -577,6 +716,7 @@ def _cmd_critical_amplitude(args, out) -> int:
             "simulations": found["runs"],
             "wall_time_s": found["wall_time_s"],
         })
+    _check_results(record)
     if args.json:
         _emit_json(record, out)
         return 0
@@ -626,6 +766,42 @@ def _sweep_environment(args):
                 os.environ[key] = value
 
 
+def _require_executor(executor, scheduler) -> None:
+    """Dask needs the optional ``distributed`` package: say which extra installs it."""
+    if (executor == "dask" or (executor in (None, "") and scheduler)) \
+            and importlib.util.find_spec("distributed") is None:
+        raise MissingDependencyError("the Dask executor needs the 'distributed' package, which is not "
+                                     "installed: pip install 'passmd[dask]'")
+
+
+def _cmd_cache(args, out) -> int:
+    from passmd.cache import Cache
+
+    store = Cache(args.cache_dir or None)
+    if store.directory.exists() and not store.directory.is_dir():
+        raise OutputError(f"the cache {store.directory} is not a directory")
+    if args.action == "info":
+        record = store.info()
+    elif args.action == "clear":
+        record = {"directory": str(store.directory), "removed": store.clear()}
+    else:
+        record = {"directory": str(store.directory), "removed": store.prune()}
+    if args.json:
+        _emit_json({"command": "cache", "action": args.action, **record}, out)
+        return 0
+    if args.action != "info":
+        out.write(f"{args.action}: removed {record['removed']} file(s) from {record['directory']}\n")
+        return 0
+    rows = [("directory", record["directory"]),
+            ("entries", f"{record['entries']} ({record['current_code']} of the current code, "
+                        f"{record['other_code']} of other code versions: 'passmd cache prune' removes them)"),
+            ("size", f"{record['bytes'] / 2**20:.3g} MiB"),
+            ("unreadable / leftovers", f"{record['unreadable']} / {record['leftovers']}")]
+    rows += [(f"  {name}", str(n)) for name, n in sorted(record["functions"].items())]
+    _emit_rows("passmd cache", rows, out)
+    return 0
+
+
 def _cmd_figure(args, out) -> int:
     from passmd import experiments, provenance
 
@@ -637,27 +813,40 @@ def _cmd_figure(args, out) -> int:
             for name in names:
                 out.write(f"{name}  {experiments.figure_spec(name).title}\n")
             if not names:
-                out.write("no figure is available yet (they come with issues 7-9)\n")
+                out.write("no figure is available\n")
         return 0
+    if not re.fullmatch(r"[a-z0-9_]+", args.name):
+        raise UsageError(f"figure {args.name!r} is not a figure name: a panel such as fig5a, or 'list' "
+                         f"(available: {', '.join(names)})")
     if args.name not in names:
-        known = ", ".join(names) if names else "none so far"
-        raise NotAvailableError(
-            f"figure {args.name!r} is {NOT_AVAILABLE} (available: {known}); the paper's figures come "
-            "with the critical-amplitude, force-generation and driving-waveform issues"
-        )
+        known = ", ".join(names) if names else "none"
+        raise NotAvailableError(f"figure {args.name!r} is {NOT_AVAILABLE} (available: {known})")
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers = {args.workers} is out of range: must be an integer >= 1")
+    if not args.out.strip():
+        raise UsageError(f"--out = {args.out!r} is not a directory name "
+                         "(use --out . for the working directory)")
+    if Path(args.out).exists() and not Path(args.out).is_dir():
+        raise OutputError(f"cannot write to --out {args.out}: it is not a directory")
+    if args.cache_dir is not None and not args.cache_dir.strip():
+        raise UsageError(f"--cache-dir = {args.cache_dir!r} is not a directory name")
+    _require_executor(args.executor or os.environ.get("PASSMD_EXECUTOR"), args.scheduler
+                      or os.environ.get("PASSMD_SCHEDULER"))
     with _sweep_environment(args):
         data = experiments.figure_data(args.name, args.profile)
     target = Path(args.out)
     csv_path, png_path = target / f"{args.name}.csv", target / f"{args.name}.png"
     try:
         target.mkdir(parents=True, exist_ok=True)
-        with open(csv_path, "w", encoding="utf-8", newline="") as fh:  # '#' lines: version, commit, profile
-            fh.write(provenance.csv_header(args.profile))
-            data.to_csv(fh, index=False, lineterminator="\n")
+        def _write_csv(tmp):  # '#' lines: version, commit, profile
+            with open(tmp, "w", encoding="utf-8", newline="") as fh:
+                fh.write(provenance.csv_header(args.profile))
+                data.to_csv(fh, index=False, lineterminator="\n")
+
+        write_atomically(csv_path, _write_csv)
         fig = experiments.figure_plot(args.name, data)
-        fig.savefig(png_path, dpi=150, metadata={"Description": provenance.summary(args.profile)})
+        write_atomically(png_path, lambda tmp: fig.savefig(
+            tmp, dpi=150, format="png", metadata={"Description": provenance.summary(args.profile)}))
     except OSError as exc:
         raise OutputError(f"cannot write to --out {args.out}: {exc.strerror or exc}") from exc
     pyplot = sys.modules.get("matplotlib.pyplot")
@@ -679,9 +868,10 @@ def _cmd_figure(args, out) -> int:
 _DEFAULT_FREQUENCY = 100.0
 _AMPLITUDE = _Quantity("--amplitude", "nm", "A", "actuation amplitude",
                        "the full stroke, --full-stroke-amplitude", 0.0, False)
-_FREQUENCY = _Quantity("--frequency", "kHz", "f", "driving frequency", _fmt(_DEFAULT_FREQUENCY, "kHz"))
+_FREQUENCY = _Quantity("--frequency", "kHz", "f", "driving frequency", _fmt(_DEFAULT_FREQUENCY, "kHz"),
+                       plausible="frequency")
 _NORMAL_FORCE = _Quantity("--normal-force", "N", "F_N", "normal force on the contact",
-                          _fmt(_DEFAULT.preload, "N"))
+                          _fmt(_DEFAULT.preload, "N"), plausible="preload")
 # defaults of the book's critical-amplitude search (passmd.experiments.critical_amplitude)
 _DEFAULT_STEADY_PERIODS = 10
 _DEFAULT_TOLERANCE = 0.1e-9
@@ -821,9 +1011,8 @@ def make_parser() -> argparse.ArgumentParser:
 
     p = command("figure", "one paper figure's data (CSV) and image (PNG), as the book makes them",
                 textwrap.dedent(f"""\
-        'passmd figure list' lists the panels available so far; the others are
-        {NOT_AVAILABLE} (they come with the critical-amplitude, force-generation and
-        driving-waveform issues). Sweeps are cached in ./{DEFAULT_CACHE_DIR}/ (or ${CACHE_DIR_ENV}).
+        'passmd figure list' lists the panels; any other name is refused. Sweeps are
+        cached in ./{DEFAULT_CACHE_DIR}/ (or ${CACHE_DIR_ENV}); see 'passmd cache --help'.
 
         NAME.csv starts with '#' lines naming the passmd version, git commit and profile
         (read it with pandas.read_csv(path, comment="#")); NAME.png carries the same in
@@ -848,17 +1037,80 @@ def make_parser() -> argparse.ArgumentParser:
                        help=f"cache directory (default: ${CACHE_DIR_ENV} or ./{DEFAULT_CACHE_DIR})")
     p.add_argument("--json", action="store_true", help=_JSON_HELP)
     p.set_defaults(handler=_cmd_figure)
+
+    p = command("cache", "the on-disk simulation cache: summary, empty it, or prune old entries",
+                textwrap.dedent(f"""\
+        info: entries (of the current code and of older code versions), size, entries per
+        function. clear: remove every entry. prune: remove entries of other code versions
+        (their code fingerprint differs, so they can never be served), unreadable entries
+        and leftovers. Entries are checksummed data (JSON header + raw array bytes), never
+        code; see passmd.cache for the format. Directory: ${CACHE_DIR_ENV} or ./{DEFAULT_CACHE_DIR}.
+
+        --json keys: action, directory, and entries, bytes, current_code, other_code,
+        unreadable, leftovers, functions (info) or removed (clear, prune)"""))
+    p.add_argument("action", choices=("info", "clear", "prune"), help="what to do (default: none, required)")
+    p.add_argument("--cache-dir", metavar="DIR",
+                   help=f"cache directory (default: ${CACHE_DIR_ENV} or ./{DEFAULT_CACHE_DIR})")
+    p.add_argument("--json", action="store_true", help=_JSON_HELP)
+    p.set_defaults(handler=_cmd_cache)
     return parser
 
 
 def main(argv=None, out=None) -> int:
-    """Run the command line; return the exit status (0 ok, 2 usage error, 1 failed run)."""
-    out = sys.stdout if out is None else out
+    """Run the command line; return the exit status (0 ok, 2 usage error, 1 failed run).
+
+    130 on Ctrl-C, 141 when standard output was closed by its reader (nothing printed).
+    """
+    to_stdout = out is None
+    for stream in (sys.stdout, sys.stderr):
+        use_ascii_fallback(stream)
+    out = Out(sys.stdout if out is None else out)
     parser = make_parser()
-    args = parser.parse_args(argv)
-    prog = f"{PROG} {args.command}"
     try:
-        return args.handler(args, out)
+        args = parser.parse_args(argv)
+    except BrokenPipeError:  # --help piped into head
+        silence_stdout()
+        return 141
+    except OSError as err:  # --help > /dev/full
+        silence_stdout()
+        sys.stderr.write(f"{PROG}: error: cannot write the output: {err.strerror or err}\n")
+        return 1
+    except SystemExit as exc:  # --help, --version: what argparse printed must reach the file
+        if exc.code == 0 and to_stdout:
+            try:
+                sys.stdout.flush()
+            except BrokenPipeError:
+                silence_stdout()
+                return 141
+            except OSError as err:
+                silence_stdout()
+                sys.stderr.write(f"{PROG}: error: cannot write the output: {err.strerror or err}\n")
+                return 1
+        raise
+    prog = f"{PROG} {args.command}"
+    with warnings.catch_warnings():
+        # cache problems: one line each; numerical warnings: the results are checked instead
+        warnings.showwarning = one_line_warnings(prog)
+        warnings.simplefilter("always", CacheWarning)
+        warnings.simplefilter("ignore", RuntimeWarning)
+        with np.errstate(all="ignore"):
+            return _dispatch(args, out, prog, to_stdout)
+
+
+def _dispatch(args, out: Out, prog: str, to_stdout: bool) -> int:
+    try:
+        status = args.handler(args, out)
+        out.flush()
+        return status
+    except PipeClosed:
+        if to_stdout:
+            silence_stdout()
+        return 141
+    except StdoutError as exc:
+        if to_stdout:
+            silence_stdout()
+        sys.stderr.write(f"{prog}: error: cannot write the output: {exc.strerror or exc}\n")
+        return 1
     except (UsageError, QuantityError) as exc:
         sys.stderr.write(f"{prog}: error: {exc}\n")
         return 2
@@ -866,15 +1118,38 @@ def main(argv=None, out=None) -> int:
         sys.stderr.write(f"{prog}: error: {exc}\n")
         return 1
     except KeyboardInterrupt:
-        sys.stderr.write(f"{prog}: interrupted (finished points are kept in the cache)\n")
+        kept = " (finished points are kept in the cache)" if args.command == "figure" else ""
+        sys.stderr.write(f"{prog}: interrupted{kept}\n")
         # exit at once: the interpreter's exit-time collection of numba's object graph takes ≈ 1 s
         gc.freeze()
         return 130
     except ValueError as exc:  # the package's input checks (passmd._validation)
         sys.stderr.write(f"{prog}: error: {exc}\n")
         return 2
+    except (ResultError, MissingDependencyError) as exc:
+        sys.stderr.write(f"{prog}: error: {exc}\n")
+        return 1
     except RuntimeError as exc:  # passmd.dynamics.SimulationError and other failed runs
         sys.stderr.write(f"{prog}: error: run failed: {exc}\n")
+        return 1
+    except ModuleNotFoundError as exc:
+        extra = OPTIONAL_EXTRAS.get((exc.name or "").split(".")[0])
+        hint = f"pip install 'passmd[{extra}]'" if extra else "reinstall passmd with its dependencies"
+        sys.stderr.write(f"{prog}: error: the package {exc.name!r} is not installed: {hint}\n")
+        return 1
+    except MemoryError:
+        sys.stderr.write(f"{prog}: error: not enough memory for this run (lower --max-points or the "
+                         "number of periods)\n")
+        return 1
+    except OSError as exc:  # e.g. the cache or an output directory vanished under the run
+        where = f" ({exc.filename})" if getattr(exc, "filename", None) else ""
+        sys.stderr.write(f"{prog}: error: {exc.strerror or exc}{where}\n")
+        return 1
+    except Exception as exc:  # a bug: one line, the traceback on request
+        if os.environ.get("PASSMD_DEBUG"):
+            raise
+        sys.stderr.write(f"{prog}: error: internal error: {type(exc).__name__}: {exc} "
+                         "(set PASSMD_DEBUG=1 for the traceback)\n")
         return 1
 
 

@@ -75,7 +75,7 @@ from passmd._contact_kernels import (
     sliding_force,
 )
 from passmd._validation import check_array, check_choice, check_positive, check_range
-from passmd.parameters import Assumption, Drive, register_assumption
+from passmd.parameters import Assumption, Drive, check_contact_plausible, register_assumption
 from passmd.theory import contact_moduli, hertz_contact_radius, hertz_indentation, normal_forces
 
 if TYPE_CHECKING:  # pandas is imported where a DataFrame is built (start-up time)
@@ -336,6 +336,9 @@ class MDRContact:
         self.params, self.state = contact_arrays(
             self.model, normal_force, radius, E_star, G_star, mu, springs, capacity
         )
+        # Hertz and the MDR need a contact small against the sphere (hard limit a <= R/10)
+        check_contact_plausible(normal_force, radius, E_star, names="normal_force, radius, E_star",
+                                allow_extrapolation=True)
         self.springs = None if springs is None else int(springs)
         self.friction_coefficient = float(mu)
         self.hemisphere_radius = float(radius)

@@ -20,6 +20,12 @@ from passmd._validation import check_choice, check_positive, check_range
 
 __all__ = [
     "ACTUATOR_DAMPING_RATIO",
+    "CONTACT_RADIUS_RATIO_LIMIT",
+    "HERTZ_PRESSURE_LIMIT",
+    "PLAUSIBLE_RANGES",
+    "PlausibleRange",
+    "check_contact_plausible",
+    "check_plausible",
     "ASSUMPTIONS",
     "Actuator",
     "Amplifier",
@@ -159,6 +165,8 @@ class Material:
     name: str = ""  # label for tables and plots
 
     def __post_init__(self):
+        if not isinstance(self.name, str):
+            raise ValueError(f"name = {self.name!r} is not allowed: must be a str")
         check_positive("youngs_modulus", self.youngs_modulus, "Pa")
         check_range(
             "poissons_ratio", self.poissons_ratio, -1.0, 0.5, lower_open=True, upper_open=True
@@ -293,12 +301,18 @@ class Drive:
         default=None, metadata=_meta("k_p, m_a, c_p", "", "Table 2")
     )  # None: Table 2 actuator for hemisphere_radius
     amplifier: Amplifier = field(default_factory=Amplifier, metadata=_meta("", "", "Section 2"))
+    #: Lift the soft limits of :data:`PLAUSIBLE_RANGES` (never the hard ones), for exploring.
+    allow_extrapolation: bool = False
 
     def __post_init__(self):
+        if not isinstance(self.allow_extrapolation, bool):
+            raise ValueError(f"allow_extrapolation = {self.allow_extrapolation!r} is not allowed: "
+                             "must be True or False")
         check_positive("hemisphere_radius", self.hemisphere_radius, "m")
         check_positive("preload", self.preload, "N")
         check_positive("friction_coefficient", self.friction_coefficient, "–")
-        if self.contacts not in (1, 6) or isinstance(self.contacts, bool):
+        if not isinstance(self.contacts, (int, np.integer)) or isinstance(self.contacts, (bool, np.bool_)) \
+                or self.contacts not in (1, 6):
             raise ValueError(f"contacts = {self.contacts!r} is not allowed: must be one of 1, 6")
         check_choice("actuator_model", self.actuator_model, ("rigid", "flexible"))
         check_positive("runner_mass", self.runner_mass, "kg")
@@ -312,6 +326,11 @@ class Drive:
             object.__setattr__(self, "actuator", actuator_for_radius(self.hemisphere_radius))
         elif not isinstance(self.actuator, Actuator):
             raise ValueError(f"actuator = {self.actuator!r} is not an Actuator")
+        if not isinstance(self.amplifier, Amplifier):
+            raise ValueError(f"amplifier = {self.amplifier!r} is not an Amplifier")
+        if isinstance(self.contacts, np.integer):
+            object.__setattr__(self, "contacts", int(self.contacts))
+        check_plausible(self, allow_extrapolation=self.allow_extrapolation)
 
     def replace(self, **changes) -> Drive:
         """A copy with some fields changed (validated again).
@@ -327,6 +346,194 @@ class Drive:
     def effective_load_cell_stiffness(self) -> float:
         """k if the load cell is engaged, else 0 (free runner)."""
         return self.load_cell_stiffness if self.load_cell else 0.0
+
+
+# --------------------------------------------------------------------------------------
+# Plausible ranges (one place): hard limits where the model's physics breaks, soft limits
+# around Tables 1–2 where it was checked. Library and CLI both check against this table.
+# --------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class PlausibleRange:
+    """Where a parameter keeps the model valid.
+
+    ``hard_*``: outside, the model does not apply (never lifted). ``soft_*``: the decades
+    around Tables 1–2 the model was checked in; ``allow_extrapolation=True`` (CLI
+    ``--allow-extrapolation``) lifts them for exploration. ``None`` leaves a side open.
+    """
+
+    unit: str
+    hard_low: float | None
+    soft_low: float | None
+    soft_high: float | None
+    hard_high: float | None
+    reason: str  # why the soft limits (and, unless hard_reason says otherwise, the hard ones)
+    hard_low_open: bool = True  # a hard lower bound of 0 is excluded (positive quantities)
+    hard_reason: str = ""  # why the hard limits, when it differs from ``reason``
+
+    def check(self, name: str, value, *, allow_extrapolation: bool = False, shown: str | None = None,
+              scale: float = 1.0, unit: str | None = None, hint: str = "allow_extrapolation=True") -> float:
+        """``float(value)`` if plausible, else ``ValueError`` naming the value, limit and why.
+
+        ``shown``/``scale``/``unit`` let the CLI report an option in its display unit
+        (``value`` and the bounds are divided by ``scale``).
+        """
+        v = check_range(name, value, unit=self.unit)  # a finite real number
+        label, unit = (shown or name), (self.unit if unit is None else unit)
+        u = f" {unit}" if unit and unit != "–" else ""
+
+        def refuse(limit: str, kind: str, extra: str = "") -> ValueError:
+            why = self.hard_reason if kind == "hard limit" and self.hard_reason else self.reason
+            if kind == "hard limit" and lo == 0.0 and limit.startswith(">"):
+                why = "a physical quantity of this kind is positive"
+            shown_value = f"{v / scale:.10g}{u}" if shown else repr(value)  # CLI: display unit
+            return ValueError(f"{label} = {shown_value} is out of range: must be {limit} "
+                              f"({kind}: {why}){extra}")
+
+        lo, hi = self.hard_low, self.hard_high
+        if lo is not None and (v <= lo if self.hard_low_open else v < lo):
+            raise refuse(f"{'>' if self.hard_low_open else '>='} {lo / scale:g}{u}", "hard limit")
+        if hi is not None and v > hi:
+            raise refuse(f"<= {hi / scale:g}{u}", "hard limit")
+        if not allow_extrapolation:
+            if self.soft_low is not None and v < self.soft_low:
+                raise refuse(f">= {self.soft_low / scale:g}{u}", "plausible range",
+                             f"; {hint} goes beyond it")
+            if self.soft_high is not None and v > self.soft_high:
+                raise refuse(f"<= {self.soft_high / scale:g}{u}", "plausible range",
+                             f"; {hint} goes beyond it")
+        return v
+
+
+_TWO_DECADES = "two decades either side of Tables 1–2, where the model was checked"
+#: Ranges of the drive's parameters (SI). Keys: Drive fields, ``actuator.*``,
+#: ``amplifier.*``, ``material.*`` (both materials), and the waveform's ``frequency``.
+PLAUSIBLE_RANGES: dict[str, PlausibleRange] = {
+    "hemisphere_radius": PlausibleRange("m", 0.0, 10e-6, 100e-3, None,
+                                        "Table 2's 0.25–1 mm, " + _TWO_DECADES),
+    "preload": PlausibleRange("N", 0.0, 1e-3, 100.0, None, "Section 4's 0.1–1 N, " + _TWO_DECADES),
+    "friction_coefficient": PlausibleRange(
+        "–", 0.0, 0.01, 1.0, None,
+        "dry friction of ruby on steel is 0.1–0.3 (Table 1: 0.2, earlier work 0.3); beyond 1 the "
+        "Cattaneo–Mindlin traction of a Hertz contact is no longer a small perturbation"),
+    "runner_mass": PlausibleRange("kg", 0.0, 3e-5, 0.3, None, "Table 1's 3 g, " + _TWO_DECADES),
+    "load_cell_stiffness": PlausibleRange("N/m", 0.0, 250.0, 2.5e6, None,
+                                          "Table 1's 2.5e4 N/m, " + _TWO_DECADES),
+    "material.youngs_modulus": PlausibleRange(
+        "Pa", 0.0, 1e9, 1.2e12, None,
+        "engineering solids from polymers (1 GPa) to diamond (1.2 TPa); Table 1: 210–370 GPa"),
+    "material.poissons_ratio": PlausibleRange(
+        "–", -1.0, 0.0, 0.5, 0.5, "isotropic elasticity needs -1 < ν < 0.5; Table 1: 0.33"),
+    "actuator.stiffness": PlausibleRange("N/m", 0.0, 4e4, 6.5e8, None,
+                                         "Table 2's 4–6.5e6 N/m, " + _TWO_DECADES),
+    "actuator.mass": PlausibleRange("kg", 0.0, 1.1e-10, 2.2e-6, None,
+                                    "Table 2's 1.1–2.2e-8 kg (as printed), " + _TWO_DECADES),
+    "actuator.damping_ratio": PlausibleRange(
+        "–", 0.0, None, 10.0, None,
+        "c_p up to ten times critical damping of the bare actuator (the default is ζ = 0.05)",
+        hard_low_open=False),
+    "actuator.full_stroke_amplitude": PlausibleRange(
+        "m", 0.0, 0.96e-9, 20.2e-6, 10.0, "Table 2's 96–202 nm, " + _TWO_DECADES,
+        hard_reason="beyond 10 m of travel, double-precision rounding of positions (2.2e-16 relative) "
+        "exceeds 1e-6 of the ~10 nm presliding displacement"),
+    "amplifier.peak_to_peak_voltage": PlausibleRange("V", 0.0, 3.0, 3e4, None,
+                                                     "Section 2's 300 V_pp, " + _TWO_DECADES),
+    "amplifier.slew_rate": PlausibleRange("V/s", 0.0, 1.5e6, 1.5e10, None,
+                                          "Section 2's 150 V/µs, " + _TWO_DECADES),
+    "frequency": PlausibleRange(
+        "Hz", 1e-3, 1.0, 1e6, None,
+        "the paper drives from 100 Hz (Fig. 9a) to 130 kHz (Fig. 9b); two decades below, one above",
+        hard_reason="below 1 mHz a period is too long for its µs fly-back to stay resolvable in "
+        "double-precision time"),
+}
+register_assumption(
+    Assumption(
+        key="plausible_ranges",
+        symbol="–",
+        value="soft: two decades around Tables 1–2, μ ≤ 1, p0 ≤ 10 GPa; hard: a ≤ R/10, positive quantities",
+        unit="–",
+        rationale=(
+            "The paper gives the model's parameters, not where it stops applying. Hard limits follow "
+            "from its physics (Hertz/MDR need a ≤ R/10); soft limits keep inputs within two decades of "
+            "the tabulated values, where the model was checked (PLAUSIBLE_RANGES gives each reason)."
+        ),
+        sensitivity="None of the paper's figures (all inside the soft limits); other inputs are refused "
+                    "unless allow_extrapolation / --allow-extrapolation.",
+    )
+)
+
+#: Hard limit on the Hertz contact radius: a <= R/10. Hertz's half-space solution and the
+#: MDR both assume a contact small against the sphere (K.L. Johnson, Contact Mechanics, §4.2).
+CONTACT_RADIUS_RATIO_LIMIT = 0.1
+#: Soft limit on the peak Hertz pressure p0 = 3 F_N / (2π a²): 10 GPa. Hardened bearing steel
+#: first yields at p0 ≈ 1.6 Y ≈ 3 GPa and ruby's compressive strength is 2–3 GPa; the paper's
+#: own grids reach 2.9 GPa (R = 0.25 mm, F_p = 0.5 N). Beyond 10 GPa the contact is far outside
+#: the elastic regime the Hertz/MDR model describes.
+HERTZ_PRESSURE_LIMIT = 10e9
+
+
+def _hertz(normal_force: float, radius: float, E_star: float) -> tuple[float, float]:
+    """(a, p0) of a Hertz contact (a = (3 F R / 4E*)^(1/3), p0 = 3F / (2π a²))."""
+    a = (3.0 * normal_force * radius / (4.0 * E_star)) ** (1.0 / 3.0)
+    return a, 3.0 * normal_force / (2.0 * np.pi * a * a)
+
+
+def check_contact_plausible(normal_force: float, radius: float, E_star: float, *,
+                            allow_extrapolation: bool = False, names: str = "normal_force, radius",
+                            hint: str = "allow_extrapolation=True") -> None:
+    """Refuse a contact outside Hertz's assumptions: a > R/10 (hard), p0 > 10 GPa (soft).
+
+    Raises
+    ------
+    ValueError
+        Naming the parameters (``names``), the contact radius or pressure and the limit.
+    """
+    with np.errstate(all="ignore"):
+        a, p0 = _hertz(float(normal_force), float(radius), float(E_star))
+    ratio = a / radius
+    if not np.isfinite(ratio) or ratio > CONTACT_RADIUS_RATIO_LIMIT:
+        raise ValueError(
+            f"{names}: the Hertz contact radius a = {a:.4g} m is {ratio:.3g} R; must be <= "
+            f"{CONTACT_RADIUS_RATIO_LIMIT:g} R (hard limit: Hertz and the MDR need a contact small "
+            "against the sphere)"
+        )
+    if not allow_extrapolation and not p0 <= HERTZ_PRESSURE_LIMIT:
+        raise ValueError(
+            f"{names}: the peak Hertz pressure p0 = {p0 / 1e9:.4g} GPa is out of range: must be <= "
+            f"{HERTZ_PRESSURE_LIMIT / 1e9:g} GPa (plausible range: beyond it ruby and steel are far "
+            f"outside the elastic regime the model describes); {hint} goes beyond it"
+        )
+
+
+def check_plausible(drive: Drive, *, allow_extrapolation: bool = False) -> None:
+    """Check every parameter of a drive against :data:`PLAUSIBLE_RANGES` and the contact limits.
+
+    Raises
+    ------
+    ValueError
+        The first parameter outside its range, naming it, its value, the limit and why.
+    """
+    r = PLAUSIBLE_RANGES
+    kw = {"allow_extrapolation": allow_extrapolation}
+    for name in ("hemisphere_radius", "preload", "friction_coefficient", "runner_mass",
+                 "load_cell_stiffness"):
+        r[name].check(name, getattr(drive, name), **kw)
+    for which in ("hemisphere_material", "runner_material"):
+        material = getattr(drive, which)
+        r["material.youngs_modulus"].check(f"{which}.youngs_modulus", material.youngs_modulus, **kw)
+        r["material.poissons_ratio"].check(f"{which}.poissons_ratio", material.poissons_ratio, **kw)
+    act, amp = drive.actuator, drive.amplifier
+    for name in ("stiffness", "mass", "damping_ratio", "full_stroke_amplitude"):
+        r[f"actuator.{name}"].check(f"actuator.{name}", getattr(act, name), **kw)
+    for name in ("peak_to_peak_voltage", "slew_rate"):
+        r[f"amplifier.{name}"].check(f"amplifier.{name}", getattr(amp, name), **kw)
+    from passmd.theory import contact_moduli  # theory imports this module
+
+    E_star, _ = contact_moduli(drive)
+    largest = drive.preload if drive.contacts == 1 else drive.preload / (2.0 * np.sin(np.pi / 4))  # Eq. 1
+    check_contact_plausible(largest, drive.hemisphere_radius, E_star, names="preload, hemisphere_radius, "
+                            "materials", **kw)
 
 
 #: Preload grids of the critical-amplitude figures (assumption ``preload_grids``).

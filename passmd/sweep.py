@@ -39,7 +39,7 @@ import pandas as pd
 from tqdm.std import tqdm  # text bar on a terminal; tqdm.auto warns in notebook kernels without ipywidgets
 
 from passmd._validation import check_choice
-from passmd.cache import Cache
+from passmd.cache import Cache, function_name
 from passmd.parameters import Drive
 from passmd.theory import drive_theory
 
@@ -165,8 +165,8 @@ class _Collector:
             raise ValueError(
                 f"result keys {clash} of points[{index}] clash with parameter names; rename them"
             )
-        if self.cache is not None:
-            self.cache.put(self.keys[index], result)
+        if self.cache is not None:  # an unwritable cache warns once and the result is kept
+            self.cache.put(self.keys[index], result, function=function_name(self.func))
         self.results[index] = result
         self.bar.update(1)
 
@@ -388,7 +388,7 @@ def run(
     cached: dict[int, dict] = {}
     if store is not None:
         for i, key in enumerate(keys):
-            value = store.get(key)
+            value = store.get(key, function=function_name(func))
             if isinstance(value, Mapping):
                 cached[i] = dict(value)
     todo = [i for i in range(len(points)) if i not in cached]

@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from passmd._validation import check_choice, check_positive, check_range
-from passmd.parameters import Assumption, Drive, register_assumption
+from passmd._validation import check_choice, check_count, check_positive, check_range
+from passmd.parameters import PLAUSIBLE_RANGES, Assumption, Drive, register_assumption
 
 #: Fraction of the stick phase (at its end) over which the settled position is averaged.
 SETTLE_FRACTION = 0.2
@@ -105,8 +105,7 @@ class Waveform:
                 f"times[{i}] = {t[i]!r}"
             )
         check_positive("period", self.period, "s")
-        if int(self.periods) != self.periods or self.periods < 1:
-            raise ValueError(f"periods = {self.periods!r} is out of range: must be an integer >= 1")
+        check_count("periods", self.periods)
         w = np.asarray(self.settle_windows, dtype=float).reshape(-1, 2)
         m = np.asarray(self.slip_marks, dtype=float).reshape(-1)
         if w.shape[0] != self.periods or m.shape[0] != self.periods:
@@ -203,10 +202,10 @@ def sawtooth(
     """
     a_max = drive.actuator.full_stroke_amplitude
     A = check_range("amplitude", amplitude, 0.0, a_max, unit="m")
-    f = check_positive("frequency", frequency, "Hz")
+    f = PLAUSIBLE_RANGES["frequency"].check("frequency", frequency,
+                                            allow_extrapolation=drive.allow_extrapolation)
     frac = check_range("settle_fraction", settle_fraction, 0.0, 1.0, lower_open=True, upper_open=True)
-    if int(periods) != periods or periods < 1:
-        raise ValueError(f"periods = {periods!r} is out of range: must be an integer >= 1")
+    periods = check_count("periods", periods)
     periods = int(periods)
     T = 1.0 / f
     t_fb = flyback_time(A, drive, flyback)
@@ -283,8 +282,7 @@ def piecewise_linear(
         raise ValueError(
             f"period_positions[0] = {px[0]!r} != period_positions[-1] = {px[-1]!r}: not periodic"
         )
-    if int(periods) != periods or periods < 1:
-        raise ValueError(f"periods = {periods!r} is out of range: must be an integer >= 1")
+    periods = check_count("periods", periods)
     ws, we = (check_range("settle_window", v, 0.0, T, unit="s") for v in settle_window)
     if not ws < we:
         raise ValueError(f"settle_window = {settle_window!r} is not allowed: start must be < end")

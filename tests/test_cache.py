@@ -56,20 +56,156 @@ def test_canonical_types():
         canonical(object())
 
 
-def test_put_get_roundtrip(store):
+def test_put_get_roundtrip_is_bit_exact(store):
     key = store.key(point_function, {"x": 1})
     assert store.get(key) is None
     assert key not in store
-    frame = pd.DataFrame({"u_m": [0.0, 1e-9]})
-    store.put(key, {"frame": frame, "array": np.array([1.0, 2.0]), "scalar": 3.5})
-    value = store.get(key)
-    pd.testing.assert_frame_equal(value["frame"], frame)
-    np.testing.assert_array_equal(value["array"], [1.0, 2.0])
-    assert value["scalar"] == 3.5
+    array = np.array([1.0, -0.0, np.nextafter(1.0, 2.0), 1e-308 / 3, np.inf, np.nan])
+    value = {"array": array, "scalar": 0.1 + 0.2, "np_scalar": np.float64(2.0 / 3.0), "n": 7,
+             "big": 2**70, "flag": True, "np_flag": np.bool_(False), "label": "µ", "none": None,
+             "steps_m": [1e-9, 2e-9], "pair": (1, 2.5), "nested": {"ints": np.arange(3, dtype=np.int32)}}
+    store.put(key, value)
+    back = store.get(key)
+    assert list(back) == list(value)
+    assert back["array"].dtype == array.dtype and back["array"].tobytes() == array.tobytes()
+    assert back["array"].flags.writeable
+    assert float.hex(back["scalar"]) == float.hex(value["scalar"]) and type(back["scalar"]) is float
+    assert type(back["np_scalar"]) is np.float64 and back["np_scalar"] == value["np_scalar"]
+    assert back["n"] == 7 and type(back["n"]) is int and back["big"] == 2**70
+    assert back["flag"] is True and type(back["np_flag"]) is np.bool_
+    assert back["label"] == "µ" and back["none"] is None
+    assert back["steps_m"] == [1e-9, 2e-9] and back["pair"] == (1, 2.5)
+    assert back["nested"]["ints"].dtype == np.int32
     assert key in store
     assert store.entries() == [store.path(key)]
     assert store.clear() == 1
     assert key not in store
+
+
+@pytest.mark.parametrize("value", [
+    {"frame": pd.DataFrame({"u_m": [0.0, 1e-9]})},
+    {"objects": np.array([object()], dtype=object)},
+    {1: 2.0},
+    {"thing": object()},
+])
+def test_values_the_format_cannot_store_are_refused(store, value):
+    key = store.key(point_function, {"x": 1})
+    with pytest.raises(TypeError, match="cannot cache"):
+        store.put(key, value)
+    assert not store.path(key).exists()
+
+
+def test_no_entry_can_run_code_when_read(store, tmp_path):
+    """A pickle that runs a command when unpickled is never unpickled."""
+    import pickle
+
+    marker = tmp_path / "pwned"
+
+    class Exploit:
+        def __reduce__(self):
+            return (os.system, (f"touch {marker}",))
+
+    key = store.key(point_function, {"x": 9})
+    store.path(key).parent.mkdir(parents=True)
+    store.path(key).write_bytes(pickle.dumps({"key": key, "value": Exploit()}))
+    with pytest.warns(cache_module.CacheWarning, match="not a passmd cache entry"):
+        assert store.get(key, "miss") == "miss"
+    assert not marker.exists()
+    assert not store.path(key).exists()  # removed
+    # the entry format itself is JSON + raw bytes: nothing in it is callable
+    store.put(key, {"y": np.arange(3.0)})
+    data = store.path(key).read_bytes()
+    assert data.startswith(cache_module.MAGIC) and b"pickle" not in data
+
+
+def test_flipped_byte_is_detected_removed_and_recomputed(store):
+    key = store.key(point_function, {"x": 8})
+    store.put(key, {"position_m": np.linspace(0, 1e-6, 50)})
+    data = bytearray(store.path(key).read_bytes())
+    data[-17] ^= 0x40  # one bit inside the stored array
+    store.path(key).write_bytes(bytes(data))
+    with pytest.warns(cache_module.CacheWarning, match="checksum mismatch") as record:
+        assert store.get(key, "miss") == "miss"
+    assert len(record) == 1  # reported once
+    assert not store.path(key).exists()
+
+
+def test_scalar_in_the_header_is_covered_by_the_checksum(store):
+    key = store.key(point_function, {"x": 8})
+    store.put(key, {"full_time_s": 0.25})
+    data = store.path(key).read_bytes()
+    hexed = float.hex(0.25).encode()
+    store.path(key).write_bytes(data.replace(hexed, float.hex(0.5).encode()))
+    with pytest.warns(cache_module.CacheWarning, match="checksum"):
+        assert key not in store
+
+
+def test_a_sweep_recomputes_a_corrupt_entry_with_one_warning(store):
+    from passmd import sweep
+
+    points = [{"x": 1.0}, {"x": 2.0}]
+    first = sweep.run(point_function, points, executor="serial", cache=store, progress=False)
+    victim = store.path(store.key(point_function, points[0]))
+    victim.write_bytes(victim.read_bytes()[:-3])  # truncated
+    with pytest.warns(cache_module.CacheWarning) as record:
+        again = sweep.run(point_function, points, executor="serial", cache=store, progress=False)
+    assert len(record) == 1 and "unusable" in str(record[0].message)
+    assert again.attrs["sweep"]["computed"] == 1
+    pd.testing.assert_frame_equal(first, again)
+    third = sweep.run(point_function, points, executor="serial", cache=store, progress=False)
+    assert third.attrs["sweep"]["cached"] == 2  # the recomputed entry was written back
+
+
+@pytest.mark.parametrize("how", ["read-only", "a file", "disk full", "no permission"])
+def test_unwritable_cache_warns_once_and_keeps_the_result(tmp_path, monkeypatch, how):
+    from passmd import sweep
+
+    monkeypatch.setattr(cache_module, "_REPORTED_UNWRITABLE", set())
+    directory = tmp_path / "cache"
+    if how == "read-only":
+        if os.geteuid() == 0:
+            pytest.skip("root writes into read-only directories")
+        directory.mkdir()
+        directory.chmod(0o500)
+    elif how == "a file":
+        directory.write_text("I am a file")
+    elif how == "disk full":
+        def full(*args, **kwargs):
+            raise OSError(28, "No space left on device")
+
+        monkeypatch.setattr(cache_module.os, "fsync", full)
+    else:  # another user's directory, also when the tests run as root
+        def denied(*args, **kwargs):
+            raise PermissionError(13, "Permission denied")
+
+        monkeypatch.setattr(cache_module.tempfile, "mkstemp", denied)
+    store = Cache(directory)
+    points = [{"x": float(x)} for x in range(4)]
+    try:
+        with pytest.warns(cache_module.CacheWarning, match="continuing without the cache") as record:
+            frame = sweep.run(point_function, points, executor="serial", cache=store, progress=False)
+    finally:
+        if how == "read-only":
+            directory.chmod(0o700)
+    assert len(record) == 1
+    assert frame["y"].tolist() == [0.0, 1.0, 2.0, 3.0]
+    if directory.is_dir():
+        assert not list(directory.glob("??/*"))  # no entry, no temporary file left behind
+
+
+def test_prune_and_info(store, tmp_path):
+    old = Cache(store.directory, fingerprint="0" * 64)
+    old.put(old.key(point_function, {"x": 1}), {"y": 1}, function="tests:point_function")
+    store.put(store.key(point_function, {"x": 2}), {"y": 2}, function="tests:point_function")
+    legacy = store.directory / "ab" / ("ab" + "0" * 62 + ".pkl")
+    legacy.parent.mkdir(parents=True, exist_ok=True)
+    legacy.write_bytes(b"\x80\x05old pickle")
+    info = store.info()
+    assert (info["entries"], info["current_code"], info["other_code"], info["leftovers"]) == (2, 1, 1, 1)
+    assert info["functions"] == {"tests:point_function": 2}
+    assert store.prune() == 2  # the other fingerprint's entry and the pickle
+    assert store.info()["entries"] == 1 and not legacy.exists()
+    assert store.get(store.key(point_function, {"x": 2})) == {"y": 2}
 
 
 def test_interrupted_write_leaves_no_entry(store, monkeypatch):
@@ -102,12 +238,14 @@ def test_killed_write_leftover_is_ignored(store):
     assert store.get(key) == {"y": 3}
 
 
-@pytest.mark.parametrize("content", [b"", b"\x80\x05garbage", b"not a pickle at all"])
+@pytest.mark.parametrize("content", [b"", b"\x80\x05garbage", b"not a pickle at all",
+                                     b"PASSMD-CACHE 1\n", b"PASSMD-CACHE 1\nabc 5\n{}"])
 def test_corrupt_entry_is_a_miss(store, content):
     key = store.key(point_function, {"x": 4})
     store.path(key).parent.mkdir(parents=True)
     store.path(key).write_bytes(content)
-    assert store.get(key, "miss") == "miss"
+    with pytest.warns(cache_module.CacheWarning, match="unusable"):
+        assert store.get(key, "miss") == "miss"
     store.put(key, {"y": 4})  # recomputed value overwrites it
     assert store.get(key) == {"y": 4}
 
@@ -118,7 +256,9 @@ def test_entry_under_wrong_key_is_a_miss(store):
     store.put(key_a, {"y": 5})
     store.path(key_b).parent.mkdir(parents=True, exist_ok=True)
     shutil.copy(store.path(key_a), store.path(key_b))  # a misplaced file is not trusted
-    assert key_b not in store
+    with pytest.warns(cache_module.CacheWarning, match="another key"):
+        assert key_b not in store
+    assert not store.path(key_b).exists() and store.get(key_a) == {"y": 5}
 
 
 def test_source_change_changes_fingerprint(tmp_path):
@@ -148,3 +288,28 @@ def test_default_directory(tmp_path, monkeypatch):
     assert Cache().directory == (tmp_path / "elsewhere").resolve()
     with pytest.raises(ValueError, match="is not a directory"):
         code_fingerprint(tmp_path / "missing")
+
+
+def test_cached_rerun_is_bit_identical(store):
+    """A sweep served from the cache returns exactly the computed values (floats by bits)."""
+    from passmd import sweep
+
+    points = sweep.grid(preload=[0.1, 0.37, 1.0], contacts=[1, 6])
+    cold = sweep.run(sweep.drive_theory_point, points, executor="serial", cache=store, progress=False)
+    warm = sweep.run(sweep.drive_theory_point, points, executor="serial", cache=store, progress=False)
+    assert warm.attrs["sweep"]["cached"] == len(points)
+    pd.testing.assert_frame_equal(cold, warm, check_exact=True)
+    for column in cold.columns:
+        for a, b in zip(cold[column], warm[column], strict=True):
+            assert repr(a) == repr(b) and type(a) is type(b), column
+
+
+def test_entry_of_another_function_is_recomputed(store):
+    """Right key, well-formed, but written by another function: foreign content is not served."""
+    from passmd import sweep
+
+    key = store.key(point_function, {"x": 1.0})
+    store.put(key, {"full_time_s": 1.0}, function="somewhere:else")
+    with pytest.warns(cache_module.CacheWarning, match="written by 'somewhere:else'"):
+        frame = sweep.run(point_function, [{"x": 1.0}], executor="serial", cache=store, progress=False)
+    assert frame["y"].tolist() == [1.0] and frame.attrs["sweep"]["computed"] == 1

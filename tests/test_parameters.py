@@ -8,11 +8,16 @@ import pytest
 from passmd import theory
 from passmd.parameters import (
     ASSUMPTIONS,
+    MOLYBDENUM,
+    PLAUSIBLE_RANGES,
+    PRELOAD_GRIDS,
+    STEEL,
     Actuator,
     Amplifier,
     Drive,
     Material,
     actuator_for_radius,
+    check_plausible,
     paper_drive,
     parameter_table,
 )
@@ -110,3 +115,57 @@ def test_theory_rejects_bad_arrays():
         theory.normal_forces(np.array([0.1, np.nan]))
     with pytest.raises(ValueError, match=r"^preload contains -0.1"):
         theory.normal_forces([-0.1])
+
+
+# --------------------------------------------------------------------------------------
+# Plausible ranges (PLAUSIBLE_RANGES): hard limits never lifted, soft ones on request
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("changes, match", [
+    ({"friction_coefficient": 2.0}, "friction_coefficient = 2.0 is out of range: must be <= 1"),
+    ({"runner_mass": 1e30}, "runner_mass = 1e\\+30 is out of range: must be <= 0.3 kg"),
+    ({"preload": 1e-30}, "preload = 1e-30 is out of range: must be >= 0.001 N"),
+    ({"load_cell_stiffness": 1e30}, "load_cell_stiffness"),
+    ({"hemisphere_material": Material(0.5e9, 0.33)}, "hemisphere_material.youngs_modulus"),
+    ({"amplifier": Amplifier(slew_rate=3e19)}, "amplifier.slew_rate"),
+])
+def test_soft_limits_refuse_and_can_be_lifted(changes, match):
+    with pytest.raises(ValueError, match=match):
+        Drive(**changes)
+    assert Drive(**changes, allow_extrapolation=True)  # exploring beyond Tables 1–2
+
+
+@pytest.mark.parametrize("changes", [
+    {"hemisphere_radius": 1e-30},  # the contact would be larger than the sphere
+    {"preload": 1e6},
+    {"hemisphere_material": Material(1e-21, 0.33)},
+])
+def test_hard_limits_are_never_lifted(changes):
+    with pytest.raises(ValueError, match="hard limit"):
+        Drive(**changes, allow_extrapolation=True)
+
+
+@pytest.mark.parametrize("changes, match", [
+    ({"contacts": 6.0}, "contacts = 6.0 is not allowed"),
+    ({"contacts": True}, "contacts = True is not allowed"),
+    ({"amplifier": "x"}, "amplifier = 'x' is not an Amplifier"),
+    ({"allow_extrapolation": 1}, "allow_extrapolation = 1 is not allowed"),
+])
+def test_constructors_check_types(changes, match):
+    with pytest.raises(ValueError, match=match):
+        Drive(**changes)
+
+
+def test_every_paper_configuration_is_inside_the_soft_limits():
+    """Tables 1–2 radii over the preload grids, both runner materials, both actuator models."""
+    for radius, grid in PRELOAD_GRIDS.items():
+        for preload in grid:
+            for runner in (STEEL, MOLYBDENUM):
+                for contacts in (1, 6):
+                    drive = paper_drive(radius, float(preload), runner_material=runner, contacts=contacts,
+                                        friction_coefficient=0.3)
+                    check_plausible(drive)  # no allow_extrapolation needed
+    assert set(PLAUSIBLE_RANGES) >= {"preload", "friction_coefficient", "runner_mass", "frequency"}
+    for rng in PLAUSIBLE_RANGES.values():
+        assert rng.reason  # every limit says why

@@ -1,0 +1,465 @@
+"""Bad and odd inputs: a table of named cases and a suite that generates its own.
+
+Contract (README, "Reliability"): whatever the input, ``passmd`` ends in one of
+
+* exit 0 with a finite result (``--json``: one JSON object whose numbers are all finite),
+* exit 2 (usage error) or exit 1 (failed run) with exactly one line on stderr,
+* exit 130 on Ctrl-C, 141 (nothing printed) when its standard output is closed,
+
+never a traceback and never a RuntimeWarning; the library raises ``ValueError`` for bad
+parameters (never ``TypeError``/``AttributeError`` later).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+from unittest import mock
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, event, given, settings
+from hypothesis import strategies as st
+
+from passmd import cli
+from passmd.contact import MDRContact
+from passmd.parameters import Actuator, Amplifier, Drive, Material
+
+README = Path(__file__).resolve().parents[1] / "README.md"
+PATH_20000 = ",".join(f"{i % 40}nm" for i in range(20000))
+
+
+def run_main(argv, env=None):
+    """(status, stdout, stderr, warnings) of ``passmd argv`` in this process."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.ExitStack() as stack:
+        stack.enter_context(contextlib.redirect_stdout(out))
+        stack.enter_context(contextlib.redirect_stderr(err))
+        caught = stack.enter_context(warnings.catch_warnings(record=True))
+        warnings.simplefilter("always")
+        if env:
+            stack.enter_context(mock.patch.dict(os.environ, env))
+        try:
+            status = cli.main(list(argv))
+        except SystemExit as exc:  # argparse
+            status = exc.code
+    return status, out.getvalue(), err.getvalue(), list(caught)
+
+
+def run_process(argv, *, env=None, stdout=subprocess.PIPE, text=True, shell_pipe=None):
+    """``python -m passmd argv`` in a subprocess (encodings, full disks, closed pipes)."""
+    full_env = {**os.environ, "MPLBACKEND": "Agg", **(env or {})}
+    if shell_pipe:
+        status = 'echo "status=${PIPESTATUS[0]}" >&2'
+        cmd = f"{sys.executable} -m passmd {' '.join(argv)} | {shell_pipe}; {status}"
+        return subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, env=full_env, timeout=120)
+    return subprocess.run([sys.executable, "-m", "passmd", *argv], stdout=stdout, stderr=subprocess.PIPE,
+                          text=text, env=full_env, timeout=120)
+
+
+def assert_one_line(err: str):
+    assert err.count("\n") == 1 and err.startswith("passmd"), err
+    assert "Traceback" not in err
+
+
+# --------------------------------------------------------------------------------------
+# Named cases: inputs once found to misbehave, each with the outcome it must have now
+# (status, a piece of the one stderr line). Counted in the README's reliability section.
+# --------------------------------------------------------------------------------------
+
+NAMED_CASES = {
+    "huge mu": (["theory", "--mu", "1e200"], 2, "--mu = 1e+200 is out of range: must be <= 1"),
+    "huge mu, json": (["theory", "--mu", "1e200", "--json"], 2, "--mu = 1e+200"),
+    "huge mu, extrapolating": (["theory", "--mu", "1e200", "--allow-extrapolation"], 1, "is not finite"),
+    "huge mu, extrapolating, json": (["theory", "--mu", "1e200", "--allow-extrapolation", "--json"], 1,
+                                     "is not finite"),
+    "huge stroke": (["run", "--actuator", "rigid", "--periods", "2", "--full-stroke-amplitude", "1e30",
+                     "--json"], 2, "--full-stroke-amplitude = 1e+30 nm is out of range"),
+    "huge stroke, extrapolating": (["run", "--full-stroke-amplitude", "1e30", "--allow-extrapolation"], 2,
+                                   "hard limit"),
+    "huge runner mass": (["run", "--runner-mass", "1e30", "--json"], 2, "--runner-mass = 1e+30 g"),
+    "tiny preload": (["run", "--preload", "1e-30"], 2, "--preload = 1e-30 N is out of range"),
+    "tiny radius": (["run", "--radius", "1e-30"], 2, "--radius = 1e-30 mm is out of range"),
+    "tiny radius, extrapolating": (["theory", "--radius", "1e-30", "--allow-extrapolation"], 2,
+                                   "contact radius"),
+    "tiny hemisphere modulus": (["run", "--hemisphere-modulus", "1e-30"], 2, "--hemisphere-modulus"),
+    "tiny modulus, extrapolating": (["theory", "--hemisphere-modulus", "1e-30", "--allow-extrapolation",
+                                     "--json"], 2, "hard limit"),
+    "huge contact force": (["contact", "--normal-force", "1e30", "--path", "0,1"], 2, "--normal-force"),
+    "huge contact force, extrapolating": (["contact", "--normal-force", "1e30", "--path", "0,1",
+                                           "--allow-extrapolation", "--json"], 2, "contact radius"),
+    "a billion samples": (["run", "--max-points", "1000000000"], 2, "GiB"),
+    "a hundred million periods": (["run", "--periods", "100000000", "--json"], 2, "GiB"),
+    "analytic-only checks its options": (["critical-amplitude", "--analytic-only", "--periods", "-5",
+                                          "--tolerance", "-1", "--frequency", "nan"], 2, "--periods = -5"),
+    "analytic-only tolerance": (["critical-amplitude", "--analytic-only", "--tolerance", "-1"], 2,
+                                "--tolerance = -1.0 is out of range"),
+    "analytic-only frequency": (["critical-amplitude", "--analytic-only", "--frequency", "nan"], 2,
+                                "--frequency = 'nan'"),
+    "threshold without steady": (["critical-amplitude", "--protocol", "first", "--threshold", "1"], 2,
+                                 "--threshold contradicts --protocol first"),
+    "rigid with actuator stiffness": (["theory", "--actuator", "rigid", "--actuator-stiffness", "5e6"], 2,
+                                      "--actuator-stiffness contradicts --actuator rigid"),
+    "rigid with absurd actuator stiffness": (["theory", "--actuator", "rigid", "--actuator-stiffness", "1"],
+                                             2, "--actuator-stiffness"),
+    "load cell stiffness without load cell": (["run", "--load-cell-stiffness", "3e4"], 2,
+                                              "--load-cell-stiffness has no effect"),
+    "plot into a device": (["run", "--plot", "/dev/full"], 2, "no image extension"),
+    "plot, unknown format": (["run", "--plot", "out.xyz"], 2, "unknown image extension"),
+    "csv into a missing directory": (["run", "--csv", "/nonexistent-dir/x.csv"], 1, "does not exist"),
+    "empty figure directory": (["figure", "fig5a", "--out", ""], 2, "--out = '' is not a directory name"),
+    "figure name is a path": (["figure", "../../etc/passwd"], 2, "is not a figure name"),
+    "unknown figure": (["figure", "fig0x"], 2, "figure 'fig0x' is not available"),
+    "frequency 1e-30": (["run", "--frequency", "1e-30"], 2, "--frequency = 1e-30 kHz is out of range"),
+    "frequency 1e-30, extrapolating": (["run", "--frequency", "1e-30", "--allow-extrapolation"], 2,
+                                       "hard limit"),
+    "amplitude a hair above the stroke": (["run", "--amplitude", "202.0000001nm"], 2,
+                                          "--amplitude = 202.0000001 nm is out of range: must be <= 202 nm"),
+    "force periods name the option": (["force", "--periods", "1", "--max-periods", "2"], 2, "--periods"),
+    "unit text that trips the unit parser": (["theory", "--preload", "0:"], 2, "unknown unit ':'"),
+    "periods written 1e8": (["run", "--periods", "1e8"], 2, "invalid int value: '1e8'"),
+    "slew rate 3e13": (["run", "--slew-rate", "3e13"], 2, "--slew-rate"),
+    "load cell stiffness 1e30": (["force", "--load-cell-stiffness", "1e30"], 2, "--load-cell-stiffness"),
+    "runner mass 1e-30": (["run", "--runner-mass", "1e-30"], 2, "--runner-mass"),
+    "tiny tolerance, analytic only": (["critical-amplitude", "--analytic-only", "--tolerance", "1e-30"], 0,
+                                      ""),
+}
+
+
+@pytest.mark.parametrize("json_flag", [False, True], ids=["as written", "json toggled"])
+@pytest.mark.parametrize("name", sorted(NAMED_CASES))
+def test_named_case(name, json_flag):
+    """The same outcome with and without --json."""
+    argv, status, message = NAMED_CASES[name]
+    if json_flag:
+        argv = [a for a in argv if a != "--json"] if "--json" in argv else [*argv, "--json"]
+    got, out, err, caught = run_main(argv)
+    assert got == status, (name, err)
+    assert not [w for w in caught if issubclass(w.category, RuntimeWarning)]
+    if status == 0:
+        assert err == ""
+        if "--json" in argv:
+            _finite_json(out)
+        return
+    assert out == ""
+    assert_one_line(err)
+    assert message in err, err
+    assert "initial_periods" not in err and "finite number finite" not in err
+
+
+def test_force_does_not_name_internal_parameters():
+    _, _, err, _ = run_main(["force", "--periods", "1", "--max-periods", "2"])
+    assert "initial_periods" not in err and "max_periods" not in err
+
+
+def test_runner_that_cannot_move_is_not_reported_as_moved():
+    """m_r = 1e30 kg (only with --allow-extrapolation): friction cannot move it by 20 nm."""
+    status, out, err, _ = run_main(["run", "--runner-mass", "1e30", "--allow-extrapolation", "--periods", "1",
+                                    "--json"])
+    if status == 0:  # a correct result: the runner stays within the work bound
+        data = json.loads(out)
+        assert abs(data["final_position_m"]) < 1e-20
+    else:
+        assert status == 1 and "farther than friction can push the runner" in err
+        assert_one_line(err)
+
+
+def test_interrupted_run_does_not_claim_a_cache():
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    with mock.patch.object(cli, "_simulate", interrupted):
+        status, _, err, _ = run_main(["run"])
+    assert status == 130 and err == "passmd run: interrupted\n"
+
+
+def test_missing_dask_names_the_extra(tmp_path):
+    real = cli.importlib.util.find_spec
+
+    def find_spec(name, *args):
+        return None if name == "distributed" else real(name, *args)
+
+    with mock.patch.object(cli.importlib.util, "find_spec", find_spec):
+        status, _, err, _ = run_main(["figure", "fig5a", "--executor", "dask", "--out", str(tmp_path)])
+    assert status == 1
+    assert_one_line(err)
+    assert "pip install 'passmd[dask]'" in err
+
+
+@pytest.mark.parametrize("build, match", [
+    (lambda: Drive(amplifier="x"), "amplifier = 'x' is not an Amplifier"),
+    (lambda: Drive(contacts=6.0), "contacts = 6.0 is not allowed"),
+    (lambda: Drive(friction_coefficient=1e200), "friction_coefficient"),
+    (lambda: Material(210e9, 0.33, name=5), "name = 5"),
+    (lambda: MDRContact(1e30, 1e-3, 1.5e11, 1.2e11, 0.2), "contact radius"),
+])
+def test_named_library_cases(build, match):
+    with pytest.raises(ValueError, match=match):
+        build()
+
+
+def test_sawtooth_periods_is_a_count():
+    from passmd import waveforms
+
+    with pytest.raises(ValueError, match="periods = True"):
+        waveforms.sawtooth(100e-9, 100.0, Drive(), periods=True)
+
+
+def test_validation_messages_read_well():
+    from passmd._validation import check_range
+
+    with pytest.raises(ValueError) as info:
+        check_range("x", float("nan"))
+    assert str(info.value) == "x = nan is out of range: must be a finite number"
+
+
+# --------------------------------------------------------------------------------------
+# Output paths: full disk, closed pipe, ASCII console (real processes)
+# --------------------------------------------------------------------------------------
+
+full_disk = pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
+
+
+@full_disk
+@pytest.mark.parametrize("argv", [["theory"], ["theory", "--json"], ["contact", "--path", "0,30nm", "--json"],
+                                  ["--help"], ["run", "--help"], ["--version"]])
+def test_full_disk_on_stdout_is_one_line_exit_1(argv):
+    with open("/dev/full", "w") as full:
+        done = run_process(argv, stdout=full)
+    assert done.returncode == 1, done.stderr
+    assert_one_line(done.stderr)
+    assert "No space left on device" in done.stderr
+
+
+@pytest.mark.parametrize("json_flag", [[], ["--json"]])
+def test_closed_pipe_exits_quietly(json_flag):
+    done = run_process(["contact", "--path", PATH_20000, *json_flag], shell_pipe="head -1")
+    assert done.stdout.startswith("{" if json_flag else "passmd contact")
+    # nothing on stderr but the shell's status line: 141 when the write met the closed pipe,
+    # 0 when the whole output fit into the pipe before ``head`` went away (a race)
+    assert done.stderr.strip() in ("status=141", "status=0"), done.stderr
+
+
+@pytest.mark.parametrize("argv", [["theory"], ["contact", "--path", "0,30nm"], ["theory", "--help"],
+                                  ["theory", "--json"]])
+def test_ascii_console_gets_ascii_symbols(argv):
+    done = run_process(argv, env={"PYTHONIOENCODING": "ascii"})
+    assert done.returncode == 0, done.stderr
+    assert done.stderr == ""
+    assert done.stdout.isascii()
+    if argv == ["theory"]:
+        assert "mu = 0.2" in done.stdout
+
+
+def test_ascii_console_error_message():
+    done = run_process(["theory", "--mu", "2"], env={"PYTHONIOENCODING": "ascii"})
+    assert done.returncode == 2
+    assert_one_line(done.stderr)
+    assert "Cattaneo-Mindlin" in done.stderr
+
+
+# --------------------------------------------------------------------------------------
+# Generated inputs (hypothesis) over the CLI's option grammar and the constructors
+# --------------------------------------------------------------------------------------
+
+
+class _Reached(BaseException):
+    """Raised by stand-ins of the long computations: the input passed every check."""
+
+
+def _reached(*args, **kwargs):
+    raise _Reached
+
+
+UNITS = ["", "N", "mN", "nm", "um", "mm", "m", "g", "kg", "GPa", "Pa", "kHz", "Hz", "V", "V/us", "N/m",
+         "kg/s", "s", "furlong"]
+ODD = ["nan", "inf", "-inf", "", " ", "1e309", "-0", "0", "abc", "1e-320", "0x10", "1,2", "µ", "--", "1e",
+       "3N", "1 furlong", "+", "1_000", "٣"]
+numbers = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.floats(min_value=1e-3, max_value=1e3),
+    st.integers(min_value=-10**12, max_value=10**12),
+)
+values = st.one_of(
+    st.builds(lambda x, u: f"{x!r}{u}", numbers, st.sampled_from(UNITS)),
+    st.sampled_from(ODD),
+    st.text(max_size=8),
+)
+QUANTITY_FLAGS = [q.flag for q in cli._DRIVE_QUANTITIES]
+COMMANDS = {
+    "theory": (QUANTITY_FLAGS, ["--json", "--allow-extrapolation"],
+               {"--contacts": ["1", "6", "3", "x"], "--actuator": ["rigid", "flexible", "x"]}),
+    "contact": (["--radius", "--mu", "--normal-force", *cli._MATERIAL_FLAGS, "--springs"],
+                ["--json", "--allow-extrapolation"],
+                {"--path": ["0,30nm,-10nm", "0", "1e30", "nan", "", "0,,1", "0,1e-300,3N"]}),
+    "critical-amplitude": (QUANTITY_FLAGS + ["--frequency", "--threshold", "--tolerance", "--periods"],
+                           ["--json", "--analytic-only", "--allow-extrapolation"],
+                           {"--protocol": ["steady", "first", "x"], "--flyback": ["slew", "fixed", "x"],
+                            "--actuator": ["rigid", "flexible"]}),
+    "run": (QUANTITY_FLAGS + ["--amplitude", "--frequency", "--periods", "--springs", "--max-points"],
+            ["--json", "--load-cell", "--allow-extrapolation"],
+            {"--waveform": ["sawtooth", "optimized", "x"], "--flyback": ["slew", "fixed"],
+             "--plot": ["p.png", "p", "p.xyz", "", "/dev/full", "missing/p.png"],
+             "--csv": ["r.csv", "", "missing/r.csv", "."], "--actuator": ["rigid", "flexible"]}),
+    "force": (QUANTITY_FLAGS + ["--amplitude", "--frequency", "--periods", "--max-periods", "--max-points"],
+              ["--json", "--allow-extrapolation"], {"--waveform": ["sawtooth", "optimized"]}),
+    "figure": ([], ["--json"], {"--profile": ["quick", "paper", "x"], "--out": ["", "out", ".", "/dev/null"],
+                                "--executor": ["serial", "process", "x"],
+                                "--workers": ["0", "2", "-1", "x"]}),
+}
+
+
+@st.composite
+def command_lines(draw):
+    command = draw(st.sampled_from(sorted(COMMANDS)))
+    quantities, flags, choices = COMMANDS[command]
+    argv = [command]
+    if command == "figure":
+        argv.append(draw(st.one_of(st.sampled_from(["fig5a", "fig9b", "list", "fig0x", "../x", ""]),
+                                   st.text(max_size=6))))
+    for flag in draw(st.lists(st.sampled_from(quantities), max_size=4, unique=True)) if quantities else []:
+        argv += [flag, draw(values)] if not flag.endswith(("periods", "springs", "max-points")) else \
+            [flag, draw(st.one_of(st.integers(-5, 10**10).map(str), values))]
+    for flag in draw(st.lists(st.sampled_from(sorted(choices)), max_size=3, unique=True)):
+        argv += [flag, draw(st.sampled_from(choices[flag]))]
+    argv += draw(st.lists(st.sampled_from(flags), max_size=len(flags), unique=True))
+    return argv
+
+
+def _finite_json(text: str):
+    def refuse(constant):
+        raise AssertionError(f"non-finite {constant} in the JSON output")
+
+    data = json.loads(text, parse_constant=refuse)
+
+    def walk(x):
+        if isinstance(x, float):
+            assert math.isfinite(x)
+        elif isinstance(x, dict):
+            for v in x.values():
+                walk(v)
+        elif isinstance(x, list):
+            for v in x:
+                walk(v)
+
+    walk(data)
+    return data
+
+
+@pytest.fixture(scope="module")
+def scratch(tmp_path_factory):
+    """A working directory (and cache) of its own: generated paths never touch the project."""
+    path = tmp_path_factory.mktemp("fuzz")
+    before = os.getcwd()
+    os.chdir(path)
+    try:
+        yield path
+    finally:
+        os.chdir(before)
+
+
+@settings(max_examples=int(os.environ.get("PASSMD_FUZZ_EXAMPLES", "250")), deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(argv=command_lines())
+def test_generated_command_lines_end_cleanly(scratch, argv):
+    from passmd import experiments
+    from passmd.experiments import critical_amplitude, force_generation
+
+    # the long computations are replaced by a marker: reaching them means every check passed
+    with mock.patch.object(cli, "_simulate", _reached), \
+            mock.patch.object(critical_amplitude, "critical_amplitude", _reached), \
+            mock.patch.object(force_generation, "generated_force", _reached), \
+            mock.patch.object(experiments, "figure_data", _reached):
+        try:
+            status, out, err, caught = run_main(argv, env={"PASSMD_CACHE_DIR": str(scratch / "cache")})
+        except _Reached:
+            event(f"{argv[0]}: every check passed")
+            return
+    event(f"{argv[0]}: exit {status}")
+    assert not [w for w in caught if issubclass(w.category, RuntimeWarning)], argv
+    assert "Traceback" not in err, (argv, err)
+    assert status in (0, 1, 2), (argv, status, err)
+    if status == 0:
+        assert err == "", (argv, err)
+        if "--json" in argv:
+            _finite_json(out)
+    else:
+        assert err.count("\n") == 1 and err.startswith("passmd"), (argv, err)
+        assert "internal error" not in err, (argv, err)
+
+
+anything = st.one_of(
+    st.none(), st.booleans(), st.integers(-10, 10), st.floats(allow_nan=True, allow_infinity=True),
+    st.floats(min_value=1e-12, max_value=1e12), st.text(max_size=4),
+    st.lists(st.floats(min_value=0, max_value=1), max_size=2),
+    st.sampled_from([np.float64(0.4), np.int64(6), np.bool_(True), np.array([1.0]), "rigid", "flexible"]),
+)
+DRIVE_FIELDS = ["hemisphere_radius", "preload", "friction_coefficient", "contacts", "actuator_model",
+                "runner_mass", "load_cell_stiffness", "load_cell", "hemisphere_material", "runner_material",
+                "actuator", "amplifier", "allow_extrapolation"]
+
+
+@settings(max_examples=int(os.environ.get("PASSMD_FUZZ_EXAMPLES", "250")), deadline=None)
+@given(kwargs=st.dictionaries(st.sampled_from(DRIVE_FIELDS), anything, max_size=4))
+def test_generated_drives_are_valid_or_a_value_error(kwargs):
+    try:
+        drive = Drive(**kwargs)
+    except ValueError as exc:
+        assert re.match(r"^[\w.,\s]+", str(exc)), exc
+        return
+    assert isinstance(drive.contacts, int) and drive.contacts in (1, 6)
+    assert isinstance(drive.amplifier, Amplifier) and isinstance(drive.actuator, Actuator)
+
+
+@settings(max_examples=int(os.environ.get("PASSMD_FUZZ_EXAMPLES", "250")), deadline=None)
+@given(record=st.sampled_from([Material, Actuator, Amplifier]), args=st.lists(anything, max_size=4))
+def test_generated_records_are_valid_or_a_value_error(record, args):
+    try:
+        record(*args)
+    except ValueError:
+        pass
+    except TypeError as exc:  # only a wrong number of arguments
+        assert "argument" in str(exc), exc
+
+
+def test_readme_counts_what_this_file_tries():
+    """The README's reliability section states how many named cases and generated examples run."""
+    text = README.read_text()
+    section = text[text.index("## Reliability"):]
+    assert f"* {len(NAMED_CASES)} named command lines" in section
+    assert f"{os.environ.get('PASSMD_FUZZ_EXAMPLES', '250')} command lines per run over six" in section
+    assert len({argv[0] for argv, _, _ in NAMED_CASES.values()}) >= 5
+    assert len(COMMANDS) == 6
+
+
+def test_output_files_are_complete_or_absent(tmp_path):
+    """A write that fails half-way (full disk, Ctrl-C) leaves neither a partial file nor a temporary."""
+    from passmd._cli_streams import write_atomically
+
+    target = tmp_path / "series.csv"
+
+    def half_then_fail(tmp):
+        Path(tmp).write_text("time_s,x_m\n0.0,")
+        raise OSError(28, "No space left on device")
+
+    with pytest.raises(OSError, match="No space"):
+        write_atomically(target, half_then_fail)
+    assert list(tmp_path.iterdir()) == []
+    write_atomically(target, lambda tmp: Path(tmp).write_text("time_s\n0.0\n"))
+    assert target.read_text() == "time_s\n0.0\n"
+    assert oct(target.stat().st_mode & 0o777) == oct(0o666 & ~_umask())
+    assert [p.name for p in tmp_path.iterdir()] == ["series.csv"]
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
