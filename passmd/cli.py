@@ -8,6 +8,7 @@ Subcommands::
     passmd force                generated force against the load cell
     passmd contact              tangential force of one MDR contact along a path
     passmd figure               one paper figure's data and image (not available yet)
+    passmd ledger               the replication ledger: every claim's computed category
 
 Quantities accept units (``0.4N``, ``1mm``, ``0.25 mm``, ``202nm``, ``100kHz``,
 ``310GPa``); a bare number is read in the unit ``--help`` shows. Human output uses nm,
@@ -625,6 +626,36 @@ def _sweep_environment(args):
                 os.environ[key] = value
 
 
+def _cmd_ledger(args, out) -> int:
+    """Every claim of the paper with its computed category, values and evidence (Section 4-6)."""
+    from passmd import ledger
+
+    if args.workers is not None and args.workers < 1:
+        raise UsageError(f"--workers = {args.workers} is out of range: must be an integer >= 1")
+    with _sweep_environment(args):
+        evaluated = ledger.evaluate(ledger.load_claims(), ledger.collect_results(args.profile))
+    if args.write_baseline:
+        header = (f"ledger categories, {args.profile} profile; produced by\n"
+                  f"passmd ledger --profile {args.profile} --write-baseline {args.write_baseline}")
+        try:
+            ledger.write_baseline(evaluated, args.write_baseline, header=header)
+        except OSError as exc:
+            raise OutputError(f"cannot write --write-baseline {args.write_baseline}: "
+                              f"{exc.strerror or exc}") from exc
+    counts = {s: int((evaluated["status"] == s).sum()) for s in ledger.STATUSES}
+    if args.json:
+        _emit_json({"command": "ledger", "profile": args.profile, "summary": ledger.summary(evaluated),
+                    "counts": counts, "claims": ledger.records(evaluated)}, out)
+        return 0
+    out.write(f"passmd ledger — profile {args.profile}: {ledger.summary(evaluated)}\n")
+    for row in evaluated.itertuples():
+        basis = " (closed form)" if row.basis == "closed form" else ""
+        out.write(f"\n{row.claim}: {row.status}{basis}\n  {row.verdict}\n")
+        for item in (e for e in row.evidence.split(" | ") if e):
+            out.write(f"  - {item}\n")
+    return 0
+
+
 def _cmd_figure(args, out) -> int:
     from passmd import experiments
 
@@ -841,6 +872,31 @@ def make_parser() -> argparse.ArgumentParser:
                        help=f"cache directory (default: ${CACHE_DIR_ENV} or ./{DEFAULT_CACHE_DIR})")
     p.add_argument("--json", action="store_true", help=_JSON_HELP)
     p.set_defaults(handler=_cmd_figure)
+
+    p = command("ledger", "the replication ledger: every claim's computed category and evidence",
+                textwrap.dedent(f"""\
+        Computes (or reads from the cache the book uses, ./{DEFAULT_CACHE_DIR}/ or ${CACHE_DIR_ENV})
+        every figure's results at --profile and evaluates every claim of
+        data/reference/claims.csv over the declared readings of passmd.readings.
+
+        --json keys: profile, summary, counts{{category: n}}, claims[{{claim, category, basis,
+        verdict, evidence[], reason, depends_on[], readings{{reading: state}}, fraction_holds,
+        best_reading, tolerance, check, paper_<SI unit>, ours_<SI unit>, ours_text,
+        abs_deviation_<SI unit>, rel_deviation (fraction)}}]"""))
+    p.add_argument("--profile", choices=("quick", "paper"), default="quick",
+                   help="resolution: quick (CI) or paper (the paper's grids) (default: quick)")
+    p.add_argument("--write-baseline", metavar="CSV", default=None,
+                   help="also write the categories as a baseline CSV (default: none)")
+    group = p.add_argument_group("sweep execution")
+    group.add_argument("--executor", choices=("process", "serial", "dask"), default=None,
+                       help="process pool, in this process, or Dask (default: process)")
+    group.add_argument("--scheduler", metavar="ADDRESS", default=None, help="Dask scheduler (default: none)")
+    group.add_argument("--workers", type=int, default=None, metavar="N",
+                       help="worker processes (default: all cores)")
+    group.add_argument("--cache-dir", metavar="DIR",
+                       help=f"cache directory (default: ${CACHE_DIR_ENV} or ./{DEFAULT_CACHE_DIR})")
+    p.add_argument("--json", action="store_true", help=_JSON_HELP)
+    p.set_defaults(handler=_cmd_ledger)
     return parser
 
 

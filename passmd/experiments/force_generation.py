@@ -46,7 +46,7 @@ from passmd import dynamics, sweep, waveforms
 from passmd._validation import check_choice, check_positive, check_range
 from passmd.experiments import PROFILES, register_figure
 from passmd.experiments.critical_amplitude import critical_amplitude
-from passmd.ledger import NotEvaluable, register_extractor
+from passmd.ledger import ClaimFails, NotEvaluable, register_extractor
 from passmd.parameters import PRELOAD_GRIDS, Assumption, Drive, paper_drive, register_assumption
 from passmd.plots import force_generation as plots
 from passmd.theory import drive_theory, normal_forces
@@ -759,8 +759,11 @@ def _fig7_onsets(results) -> dict:
             onset = {}
             for model in (_EARLIER, _THIS):
                 rows = _model_rows(table, model, preload)
-                if rows.empty or not np.isfinite(rows["onset_nm"].iloc[0]):
-                    raise NotEvaluable(f"{name}: no onset for {model} at {preload:g} N")
+                if rows.empty:
+                    raise NotEvaluable(f"{name}: no runs for {model} at {preload:g} N")
+                if not np.isfinite(rows["onset_nm"].iloc[0]):
+                    raise ClaimFails(f"{name}: no force generation up to the full stroke for {model} at "
+                                     f"{preload:g} N")
                 onset[model] = float(rows["onset_nm"].iloc[0])
             lhs.append(onset[_EARLIER])
             rhs.append(onset[_THIS])
