@@ -131,7 +131,7 @@ LEDGER_COLUMNS = ("claim", "figure", "quantity", "paper", "ours", "unit", "abs_d
 PROFILES = experiments.PROFILES
 
 _ID = re.compile(r"^[a-z0-9][a-z0-9._-]*$")
-_FIGURE_KEY = re.compile(r"^(fig\d+[a-z]?|closed_forms)$")
+_FIGURE_KEY = re.compile(r"^(fig\d+[a-z_]*|closed_forms)$")
 _NUMBER = r"[-+]?(\d+(\.\d*)?|\.\d+)([eE][-+]?\d+)?"
 _CONFIG_VALUE = re.compile(rf"^({_NUMBER}(;{_NUMBER})*|{_NUMBER}:{_NUMBER}(:{_NUMBER})?|grid)$")
 _WORDS = {"actuator_model": ("rigid", "flexible"), "waveform": ("sawtooth", "optimized")}

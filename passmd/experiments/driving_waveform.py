@@ -750,6 +750,11 @@ def _fig9b_step_decreases(results):
     return {"x": saw["frequency_kHz"].to_numpy(), "y": saw["step_nm"].to_numpy()}
 
 
+@register_extractor("fig9b-sawtooth-velocity-16.5mm_s-at-110khz")
+def _fig9b_sawtooth_110(results):
+    return float(at_frequency(_series(results["fig9b"], "sawtooth"), PAPER_MAXIMUM_KHZ)["velocity_mm_per_s"])
+
+
 @register_extractor("fig9b-no-time-to-settle-above-110khz")
 def _fig9b_settling(results):
     opt = _series(results["fig9b"], "optimized")
@@ -799,6 +804,15 @@ def _fig10a_stick(results):
     part = _series(results["fig10a"], "optimized", preload=0.1)
     return {"x": part["frequency_kHz"].to_numpy(),
             "holds": part["stick_during_acceleration"].to_numpy(dtype=float)}
+
+
+@register_extractor("fig10a-0.1n-maximum-at-or-below-80khz", depends_on=("short_period",))
+def _fig10a_01n_at_80(results, reading):
+    part = _fig10a_part(results, 0.1, reading)
+    above = part["frequency_kHz"][part["frequency_kHz"] > 80.0 + 1e-9]
+    if above.empty:
+        raise NotEvaluable("the frequency grid has no point above 80 kHz")
+    return {"lhs": float(reachable_maximum(part)["frequency_kHz"]), "rhs": float(above.min())}
 
 
 @register_extractor("fig10a-0.1n-slightly-slower", depends_on=("short_period",))
