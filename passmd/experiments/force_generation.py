@@ -729,8 +729,8 @@ def _fig7a_difference(results, reading) -> float:
         if "fig7freq" not in results:
             raise NotEvaluable("needs results: fig7freq")
         table = results["fig7freq"]
-        diff = force_difference(table[np.isclose(table["frequency_Hz"], frequency)
-                                      & np.isclose(table["radius_mm"], 1.0)].assign(amplitude_fraction=1.0), 0.8)
+        rows = table[np.isclose(table["frequency_Hz"], frequency) & np.isclose(table["radius_mm"], 1.0)]
+        diff = force_difference(rows.assign(amplitude_fraction=1.0), 0.8)
     full = diff[np.isclose(diff["amplitude_nm"], PANELS_FULL_STROKE_NM["fig7a"])]
     if full.empty:
         raise NotEvaluable(f"no stalled pair of runs at 202 nm and 0.8 N at {frequency:g} Hz")
@@ -754,8 +754,8 @@ def _causes(results) -> dict:
 @register_evidence("sec4-2-friction-and-actuator-dynamics-cause-discrepancy")
 def _causes_evidence(results) -> list:
     lhs = _causes(results)["lhs"]
-    return [f"μ 0.3 → 0.2 with rigid actuators lowers F_gen by {lhs[0]:.4g} mN; rigid → flexible actuators at "
-            f"μ = 0.2 lowers it by {lhs[1]:.4g} mN (together {lhs.sum():.4g} mN; 202 nm, 0.8 N, R = 1 mm)"]
+    return [f"μ 0.3 → 0.2 with rigid actuators lowers F_gen by {lhs[0]:.4g} mN; rigid → flexible actuators "
+            f"at μ = 0.2 lowers it by {lhs[1]:.4g} mN (together {lhs.sum():.4g} mN; 202 nm, 0.8 N, R = 1 mm)"]
 
 
 @register_extractor("sec4-2-other-preloads-same-trend")
