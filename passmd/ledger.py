@@ -1146,7 +1146,8 @@ def assumptions_table() -> pd.DataFrame:
 
 #: SI name and factor of each claim unit, for machine-readable output (keys carry the SI unit).
 SI_UNITS = {"nm": ("m", 1e-9), "mm/s": ("m_per_s", 1e-3), "kHz": ("Hz", 1e3), "mN": ("N", 1e-3),
-            "N/m": ("N_per_m", 1.0), "%": ("percent", 1.0), "": ("", 1.0)}
+            "N/m": ("N_per_m", 1.0), "%": ("percent", 1.0), "µs": ("s", 1e-6), "periods": ("periods", 1.0),
+            "": ("", 1.0)}
 
 
 def records(evaluated: pd.DataFrame) -> list[dict]:

@@ -625,13 +625,35 @@ def _fig8a_back_step(results):
     return {"lhs": float(results["fig8a"]["first_back_step_m"].iloc[0]) * 1e9, "rhs": 0.0}
 
 
+def optimized_period_timing(results) -> dict:
+    """Timing of the runner in the optimized period of Fig. 8b (µs), from the zoomed trace.
+
+    ``flyback_end`` (point 4 minus t_s), ``reversal`` (the runner's backward extreme between
+    points 2 and 5, Section 5.1's point 3), ``point4`` (end of t_s, start of t_a), ``t_s`` and
+    the design's ``f_s`` (Hz). Inconclusive when the trace or the points are missing.
+    """
+    table = results["fig8b"]
+    points = table[table["view"] == "point"].set_index("point")
+    zoom = table[table["view"] == "zoom"].sort_values("time_us")
+    if zoom.empty or not {"2", "4", "5"} <= set(points.index.astype(str)):
+        raise NotEvaluable("the Fig. 8b trace or its points 2, 4 and 5 are missing")
+    points.index = points.index.astype(str)
+    t2, t4, t5 = (float(points.at[p, "time_us"]) for p in ("2", "4", "5"))
+    t_s = float(points.at["4", "settling_time_s"]) * 1e6
+    window = zoom[(zoom["time_us"] >= t2) & (zoom["time_us"] <= t5)]
+    if len(window) < 3:
+        raise NotEvaluable("fewer than three trace samples between points 2 and 5")
+    reversal = float(window.loc[window["runner_position_nm"].idxmin(), "time_us"])
+    return {"flyback_end": t4 - t_s, "reversal": reversal, "point4": t4, "t_s": t_s,
+            "f_s": float(points.at["4", "micro_vibration_frequency_Hz"])}
+
+
 @register_extractor("sec5-response-to-optimized-similar")
 def _response_similar(results):
-    # f_s is the runner-on-contacts vibration, set by the drive and not by the waveform: comparing it
-    # between the two runs passes for almost any waveform, so it cannot discriminate.
-    raise NotEvaluable("the micro-vibration frequency f_s cannot discriminate (it is set by the runner "
-                       "on its contacts, not by the waveform); the timing of the runner's response under the "
-                       "optimized waveform that Eq. 15 assumes is not measured by the result tables")
+    # The design premise: under the optimized waveform the runner reverses (point 3) after the
+    # half vibration period t_s = 1/(2 f_s) that the saw-tooth response predicts.
+    timing = optimized_period_timing(results)
+    return {"lhs": timing["reversal"] - timing["flyback_end"], "rhs": timing["t_s"]}
 
 
 @register_evidence("sec5-response-to-optimized-similar")
@@ -640,6 +662,19 @@ def _response_similar_evidence(results):
            for w in ("optimized", "sawtooth")}
     return [f"f_s: {f_s['optimized']:.4g} kHz (optimized run) against {f_s['sawtooth']:.4g} kHz "
             "(saw-tooth run)"]
+
+
+@register_extractor("sec5-1-acceleration-starts-at-velocity-maximum")
+def _acceleration_phase(results):
+    timing = optimized_period_timing(results)
+    return (timing["point4"] - timing["reversal"]) * 1e-6 * timing["f_s"]
+
+
+@register_evidence("sec5-1-acceleration-starts-at-velocity-maximum")
+def _acceleration_phase_evidence(results):
+    t = optimized_period_timing(results)
+    return [f"fly-back ends at {t['flyback_end']:.2f} µs, the runner reverses at {t['reversal']:.2f} µs, "
+            f"t_s ends (point 4) at {t['point4']:.2f} µs; f_s = {t['f_s'] / 1e3:.4g} kHz"]
 
 
 @register_extractor("fig9a-standard-position-552nm")
