@@ -879,7 +879,8 @@ def assumption_map(evaluated: pd.DataFrame) -> pd.DataFrame:
 
     One row per claim that depends on at least one axis; one column per evaluated reading
     (``"defaults"`` and ``"<axis label> = <value>"``); cells ``holds``, ``fails``,
-    ``inconclusive``, or empty where the claim does not depend on that axis.
+    ``inconclusive``, or empty where the claim does not depend on that axis. Then ``holds at``
+    (readings where it holds, of those evaluated) and ``best reading`` (where it holds best).
     """
     points = pd.DataFrame(evaluated.attrs.get("points", []),
                           columns=["claim", "reading", "state", "detail"])
@@ -890,7 +891,12 @@ def assumption_map(evaluated: pd.DataFrame) -> pd.DataFrame:
     columns = ["defaults"] + [r for r in dict.fromkeys(points["reading"]) if r != "defaults"]
     table = points.pivot(index="claim", columns="reading", values="state").reindex(columns=columns)
     order = [c for c in evaluated["claim"] if c in table.index]
-    return table.loc[order].fillna("").reset_index()
+    table = table.loc[order].fillna("").reset_index()
+    summary_ = evaluated.set_index("claim").loc[order]
+    table["holds at"] = [f"{int(h)} of {int(n)}" for h, n in zip(summary_["holds_at"], summary_["readings"],
+                                                                   strict=True)]
+    table["best reading"] = summary_["best_reading"].to_numpy()
+    return table
 
 
 def claims_for(claims: pd.DataFrame, figures) -> pd.DataFrame:
@@ -1056,7 +1062,7 @@ def assumption_map_styled(evaluated: pd.DataFrame):
     stays inside the content column.
     """
     table = assumption_map(evaluated)
-    readings_ = [c for c in table.columns if c != "claim"]
+    readings_ = [c for c in table.columns if c not in ("claim", "holds at", "best reading")]
     symbols = {"holds": "✓", "fails": "✗", "inconclusive": "?", "": ""}
     shown = table.rename(columns={r: f"R{i}" for i, r in enumerate(readings_)})
     for i in range(len(readings_)):

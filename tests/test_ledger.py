@@ -344,8 +344,10 @@ def test_another_reading_and_uncovered_readings(tmp_path, registry):
     assert evaluated.at["ord", "status"] == "inconclusive"
     assert "not covered: fly-back rule = fixed (no fixed fly-back runs)" in evaluated.at["ord", "verdict"]
     table = ledger.assumption_map(evaluated.reset_index())
-    assert list(table.columns) == ["claim", "defaults", "fly-back rule = fixed"]
-    assert table.set_index("claim").loc["val"].tolist() == ["fails", "holds"]
+    assert list(table.columns) == ["claim", "defaults", "fly-back rule = fixed", "holds at", "best reading"]
+    row = table.set_index("claim").loc["val"].tolist()
+    assert row == ["fails", "holds", "1 of 2", "fly-back rule = fixed"]
+    assert "R1: fly-back rule = fixed" in ledger.assumption_map_styled(evaluated.reset_index()).to_html()
 
 
 def test_unknown_assumption_axis_is_refused(registry):
