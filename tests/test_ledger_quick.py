@@ -22,7 +22,8 @@ import pytest
 
 from passmd import ledger
 
-BASELINES = {"quick": Path(__file__).with_name("ledger_baseline_quick.csv")}
+BASELINES = {profile: Path(__file__).with_name(f"ledger_baseline_{profile}.csv")
+             for profile in ledger.PROFILES}
 
 
 @pytest.mark.slow
@@ -39,3 +40,19 @@ def test_quick_ledger_keeps_every_category():
     assert ledger.orphan_extractors(claims) == [], "extractors registered for ids not in claims.csv"
     # The claim computed from closed forms needs no figure: it must always be reproduced.
     assert baseline["fig10b-r1-stiffer-contact"] == "reproduced"
+
+
+def test_profiles_agree_or_quick_is_inconclusive():
+    """Every claim the quick baseline decides has the same category in the paper baseline."""
+    quick, paper = (ledger.load_baseline(BASELINES[p]) for p in ("quick", "paper"))
+    assert set(quick) == set(paper), "the two baselines list different claims"
+    disagree = [f"{claim}: quick {quick[claim]!r}, paper {paper[claim]!r}" for claim in quick
+                if quick[claim] != "inconclusive" and quick[claim] != paper[claim]]
+    assert not disagree, "profiles disagree:\n  " + "\n  ".join(disagree)
+
+
+def test_baselines_say_how_they_were_made():
+    for profile, path in BASELINES.items():
+        header = [line for line in path.read_text(encoding="utf-8").splitlines() if line.startswith("#")]
+        assert any(profile in line for line in header), f"{path.name} does not name its profile"
+        assert any("produced" in line for line in header), f"{path.name} does not say how it was made"

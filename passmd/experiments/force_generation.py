@@ -772,7 +772,16 @@ def _other_preloads(results) -> dict:
         this.append(float(pair[1]["generated_force_mN"].iloc[0]))
     if not earlier:
         raise NotEvaluable("no full-stroke runs on the preload grids")
-    return {"lhs": np.array(earlier), "rhs": np.array(this)}
+    lhs, rhs = np.array(earlier), np.array(this)
+    # 'other preload levels' means every preload: a pass needs all of them, a failure needs one
+    computed = {(round(r, 9), round(p, 9)) for r, p in zip(full["radius_mm"], full["preload_N"], strict=True)}
+    missing = [(r * 1e3, p) for r, grid in PRELOAD_GRIDS.items() for p in grid
+               if (round(r * 1e3, 9), round(float(p), 9)) not in computed]
+    if missing and np.all(lhs > rhs):
+        raise NotEvaluable(f"holds at the {len(lhs)} preloads computed on this profile; "
+                           f"{len(missing)} preloads of the grids are not computed, e.g. "
+                           f"{missing[0][1]:g} N at R = {missing[0][0]:g} mm")
+    return {"lhs": lhs, "rhs": rhs}
 
 
 def _trend(results, name: str) -> dict:
