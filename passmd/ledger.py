@@ -385,7 +385,7 @@ def collect_results(profile: str = "quick", figures=None) -> dict[str, pd.DataFr
     -------
     dict
         ``{key: DataFrame}``. Figures not registered yet are simply absent; their claims
-        are then *not evaluated*.
+        are then *inconclusive*.
     """
     check_choice("profile", profile, PROFILES)
     available = result_sources()
