@@ -8,6 +8,7 @@ Subcommands::
     passmd force                generated force against the load cell
     passmd contact              tangential force of one MDR contact along a path
     passmd figure               one paper figure's data and image
+    passmd ledger               the replication ledger: every claim's computed category
     passmd cache                the on-disk simulation cache: info, clear, prune
 
 Quantities accept units (``0.4N``, ``1mm``, ``0.25 mm``, ``202nm``, ``100kHz``,
@@ -774,6 +775,16 @@ def _require_executor(executor, scheduler) -> None:
                                      "installed: pip install 'passmd[dask]'")
 
 
+def _check_sweep_options(args) -> None:
+    """The sweep options of ``figure`` and ``ledger``: workers, cache directory, executor."""
+    if args.workers is not None and args.workers < 1:
+        raise UsageError(f"--workers = {args.workers} is out of range: must be an integer >= 1")
+    if args.cache_dir is not None and not args.cache_dir.strip():
+        raise UsageError(f"--cache-dir = {args.cache_dir!r} is not a directory name")
+    _require_executor(args.executor or os.environ.get("PASSMD_EXECUTOR"), args.scheduler
+                      or os.environ.get("PASSMD_SCHEDULER"))
+
+
 def _cmd_cache(args, out) -> int:
     from passmd.cache import Cache
 
@@ -802,6 +813,35 @@ def _cmd_cache(args, out) -> int:
     return 0
 
 
+def _cmd_ledger(args, out) -> int:
+    """Every claim of the paper with its computed category, values and evidence (Section 4-6)."""
+    from passmd import ledger
+
+    _check_sweep_options(args)
+    with _sweep_environment(args):
+        evaluated = ledger.evaluate(ledger.load_claims(), ledger.collect_results(args.profile))
+    if args.write_baseline:
+        header = (f"ledger categories, {args.profile} profile; produced by\n"
+                  f"passmd ledger --profile {args.profile} --write-baseline {args.write_baseline}")
+        try:
+            ledger.write_baseline(evaluated, args.write_baseline, header=header)
+        except OSError as exc:
+            raise OutputError(f"cannot write --write-baseline {args.write_baseline}: "
+                              f"{exc.strerror or exc}") from exc
+    counts = {s: int((evaluated["status"] == s).sum()) for s in ledger.STATUSES}
+    if args.json:
+        _emit_json({"command": "ledger", "profile": args.profile, "summary": ledger.summary(evaluated),
+                    "counts": counts, "claims": ledger.records(evaluated)}, out)
+        return 0
+    out.write(f"passmd ledger — profile {args.profile}: {ledger.summary(evaluated)}\n")
+    for row in evaluated.itertuples():
+        basis = " (closed form)" if row.basis == "closed form" else ""
+        out.write(f"\n{row.claim}: {row.status}{basis}\n  {row.verdict}\n")
+        for item in (e for e in row.evidence.split(" | ") if e):
+            out.write(f"  - {item}\n")
+    return 0
+
+
 def _cmd_figure(args, out) -> int:
     from passmd import experiments, provenance
 
@@ -821,17 +861,12 @@ def _cmd_figure(args, out) -> int:
     if args.name not in names:
         known = ", ".join(names) if names else "none"
         raise NotAvailableError(f"figure {args.name!r} is {NOT_AVAILABLE} (available: {known})")
-    if args.workers is not None and args.workers < 1:
-        raise UsageError(f"--workers = {args.workers} is out of range: must be an integer >= 1")
+    _check_sweep_options(args)
     if not args.out.strip():
         raise UsageError(f"--out = {args.out!r} is not a directory name "
                          "(use --out . for the working directory)")
     if Path(args.out).exists() and not Path(args.out).is_dir():
         raise OutputError(f"cannot write to --out {args.out}: it is not a directory")
-    if args.cache_dir is not None and not args.cache_dir.strip():
-        raise UsageError(f"--cache-dir = {args.cache_dir!r} is not a directory name")
-    _require_executor(args.executor or os.environ.get("PASSMD_EXECUTOR"), args.scheduler
-                      or os.environ.get("PASSMD_SCHEDULER"))
     with _sweep_environment(args):
         data = experiments.figure_data(args.name, args.profile)
     target = Path(args.out)
@@ -1053,6 +1088,31 @@ def make_parser() -> argparse.ArgumentParser:
                    help=f"cache directory (default: ${CACHE_DIR_ENV} or ./{DEFAULT_CACHE_DIR})")
     p.add_argument("--json", action="store_true", help=_JSON_HELP)
     p.set_defaults(handler=_cmd_cache)
+
+    p = command("ledger", "the replication ledger: every claim's computed category and evidence",
+                textwrap.dedent(f"""\
+        Computes (or reads from the cache the book uses, ./{DEFAULT_CACHE_DIR}/ or ${CACHE_DIR_ENV})
+        every figure's results at --profile and evaluates every claim of
+        passmd/data/reference/claims.csv over the declared readings of passmd.readings.
+
+        --json keys: profile, summary, counts{{category: n}}, claims[{{claim, category, basis,
+        verdict, evidence[], reason, depends_on[], readings{{reading: state}}, fraction_holds,
+        best_reading, tolerance, check, paper_<SI unit>, ours_<SI unit>, ours_text,
+        abs_deviation_<SI unit>, rel_deviation (fraction)}}]"""))
+    p.add_argument("--profile", choices=("quick", "paper"), default="quick",
+                   help="resolution: quick (CI) or paper (the paper's grids) (default: quick)")
+    p.add_argument("--write-baseline", metavar="CSV", default=None,
+                   help="also write the categories as a baseline CSV (default: none)")
+    group = p.add_argument_group("sweep execution")
+    group.add_argument("--executor", choices=("process", "serial", "dask"), default=None,
+                       help="process pool, in this process, or Dask (default: process)")
+    group.add_argument("--scheduler", metavar="ADDRESS", default=None, help="Dask scheduler (default: none)")
+    group.add_argument("--workers", type=int, default=None, metavar="N",
+                       help="worker processes (default: all cores)")
+    group.add_argument("--cache-dir", metavar="DIR",
+                       help=f"cache directory (default: ${CACHE_DIR_ENV} or ./{DEFAULT_CACHE_DIR})")
+    p.add_argument("--json", action="store_true", help=_JSON_HELP)
+    p.set_defaults(handler=_cmd_ledger)
     return parser
 
 

@@ -11,10 +11,12 @@ Three pieces, kept apart so that figure chapters can add to them without editing
   :func:`register_extractor` under a claim id; they turn the result tables into the number,
   pair, curve or series that the claim's check kind needs.
 
-:func:`evaluate` runs the checks and computes every verdict (``reproduced``,
-``reproduced within X %``, ``not reproduced: …``, ``expected to differ: …``,
-``not evaluated``); :func:`summary` and :func:`styled` present them in the book, and
-:func:`regressions` compares them with a committed baseline in the tests.
+:func:`evaluate` runs the checks over the readings of the assumption space
+(:mod:`passmd.readings`) and computes every claim's category: ``reproduced``,
+``reproduced under another reading``, ``not reproduced`` or ``inconclusive``, with its
+evidence; no category is typed in. :func:`summary`, :func:`headline_markdown`,
+:func:`styled`, :func:`details_markdown` and :func:`assumption_map` present them in the book,
+and :func:`check_categories` compares them with a committed baseline in the tests.
 
 What ``ours`` must be for each check kind
 -----------------------------------------
@@ -29,8 +31,10 @@ What ``ours`` must be for each check kind
 ``trend``
     ``{'x': array, 'y': array}`` or ``{label: {'x': array, 'y': array}, ...}``.
 
-An extractor raises :class:`NotEvaluable` when the results cannot decide the claim
-(e.g. the quick profile's grid has no point where the claim speaks).
+An extractor raises :class:`NotEvaluable` (alias :data:`Inconclusive`) when the results
+cannot decide the claim (e.g. the quick profile's grid has no point where the claim speaks,
+an extremum lies at the grid's edge), and :class:`ClaimFails` when they decide it against the
+paper outright (a total failure is *not reproduced*).
 """
 
 from __future__ import annotations
@@ -44,7 +48,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from passmd import experiments, reference
+from passmd import experiments, readings, reference
 from passmd._validation import check_choice
 from passmd.parameters import all_assumptions
 
@@ -60,7 +64,19 @@ __all__ = [
     "NotEvaluable",
     "Outcome",
     "assumptions_table",
-    "check_no_regressions",
+    "category_changes",
+    "check_categories",
+    "ClaimFails",
+    "Inconclusive",
+    "assumption_map",
+    "assumption_map_styled",
+    "category_anchor",
+    "claim_anchor",
+    "depends_on",
+    "details_markdown",
+    "headline_markdown",
+    "register_evidence",
+    "records",
     "check_ordering",
     "check_threshold",
     "check_trend",
@@ -76,7 +92,6 @@ __all__ = [
     "load_claims",
     "orphan_extractors",
     "register_extractor",
-    "regressions",
     "styled",
     "summary",
     "write_baseline",
@@ -91,8 +106,7 @@ CLAIM_COLUMNS = (
     "contacts", "actuator_model", "radius_mm", "preload_N", "friction_coefficient",
     "amplitude_nm", "frequency_Hz", "waveform", "assumed",
     "paper_value", "unit", "reference", "check", "relation", "tolerance", "tolerance_kind",
-    "tolerance_reason", "source_section", "source_quote", "notes",
-    "expected_to_differ", "expected_difference_reason",
+    "tolerance_reason", "source_section", "source_quote", "notes", "reason",
 )
 CONFIGURATION_COLUMNS = (
     "contacts", "actuator_model", "radius_mm", "preload_N", "friction_coefficient",
@@ -109,22 +123,40 @@ RELATIONS = {
 }
 TOLERANCE_KINDS = ("rel", "abs")
 #: Verdict classes, in the order the summary lists them.
-STATUSES = ("reproduced", "not reproduced", "expected to differ", "not evaluated")
+STATUSES = ("reproduced", "reproduced under another reading", "not reproduced", "inconclusive")
 #: Columns of :func:`evaluate`'s result.
 LEDGER_COLUMNS = ("claim", "figure", "quantity", "paper", "ours", "unit", "abs_deviation", "rel_deviation",
-                  "tolerance", "verdict", "note", "status", "check")
+                  "tolerance", "status", "verdict", "evidence", "reason", "basis", "check", "depends_on",
+                  "readings", "holds_at", "fraction_holds", "best_reading", "note")
 #: Build profiles passed to figure functions (those of :mod:`passmd.experiments`).
 PROFILES = experiments.PROFILES
 
 _ID = re.compile(r"^[a-z0-9][a-z0-9._-]*$")
-_FIGURE_KEY = re.compile(r"^(fig\d+[a-z]?|closed_forms)$")
+_FIGURE_KEY = re.compile(r"^(fig\d+[a-z_]*|closed_forms)$")
 _NUMBER = r"[-+]?(\d+(\.\d*)?|\.\d+)([eE][-+]?\d+)?"
 _CONFIG_VALUE = re.compile(rf"^({_NUMBER}(;{_NUMBER})*|{_NUMBER}:{_NUMBER}(:{_NUMBER})?|grid)$")
 _WORDS = {"actuator_model": ("rigid", "flexible"), "waveform": ("sawtooth", "optimized")}
 
 
 class NotEvaluable(Exception):
-    """Raised by an extractor or a check when the results cannot decide a claim."""
+    """Raised by an extractor or a check when the results cannot decide a claim.
+
+    The claim is then *inconclusive* at that reading (an extremum at the edge of the grid,
+    non-finite values, a run that did not converge, a reading the tables hold no run for);
+    the message says what is missing.
+    """
+
+
+#: The name the verdict taxonomy uses for :class:`NotEvaluable`.
+Inconclusive = NotEvaluable
+
+
+class ClaimFails(Exception):
+    """Raised by an extractor when the results decide the claim *against* the paper outright.
+
+    A total failure (e.g. no step up to the full stroke, no turning point where the paper
+    locates one) is *not reproduced*, never "not evaluated"; the message is the evidence.
+    """
 
 
 class ExtractorError(ValueError):
@@ -200,10 +232,6 @@ def _row_errors(row: Mapping[str, str], reference_dir: Path) -> list[str]:
         errors.append("paper_value is empty: a threshold claim needs the threshold x")
     if kind in ("ordering", "trend") and row["paper_value"]:
         bad("paper_value", f"empty for a {kind} claim")
-    if row["expected_to_differ"] not in ("", "yes"):
-        bad("expected_to_differ", "'yes' or empty")
-    if row["expected_to_differ"] == "yes" and not row["expected_difference_reason"].strip():
-        errors.append("expected_difference_reason is empty: required when expected_to_differ is 'yes'")
     return errors
 
 
@@ -267,18 +295,28 @@ def load_claims(path=None) -> pd.DataFrame:
 # ======================================================================================
 
 _EXTRACTORS: dict[str, Callable] = {}
+_DEPENDS: dict[str, tuple[str, ...]] = {}
+_EVIDENCE: dict[str, Callable] = {}
 
 
-def register_extractor(claim_id: str) -> Callable[[Callable], Callable]:
-    """Decorator: register ``func(results: dict[str, DataFrame]) -> ours`` for a claim.
+def register_extractor(claim_id: str, depends_on=()) -> Callable[[Callable], Callable]:
+    """Decorator: register ``func(results, [reading]) -> ours`` for a claim.
 
     ``ours`` must have the form the claim's check kind expects (module docstring) and
     be in the claim's ``unit``. Raise :class:`NotEvaluable` when the results cannot
-    decide the claim. Extractors live next to their figure in the topic modules of
+    decide the claim (inconclusive) and :class:`ClaimFails` when they decide it against
+    the paper outright. Extractors live next to their figure in the topic modules of
     :mod:`passmd.experiments`, which are loaded before every evaluation.
+
+    ``depends_on`` names the axes of :data:`passmd.readings.AXES` the claim's result
+    depends on; the function then takes a second argument ``reading`` (``{axis: value}``)
+    and is evaluated at every reading of :func:`passmd.readings.design`.
     """
     if not isinstance(claim_id, str) or not _ID.match(claim_id):
         raise ValueError(f"claim_id = {claim_id!r} is not allowed: must be a claims.csv id slug")
+    depends = tuple(depends_on)
+    for key in depends:
+        readings.axis(key)  # ValueError naming the declared axes
 
     def deco(func: Callable) -> Callable:
         previous = _EXTRACTORS.get(claim_id)
@@ -288,9 +326,33 @@ def register_extractor(claim_id: str) -> Callable[[Callable], Callable]:
             raise ValueError(f"extractor for claim {claim_id!r} is already registered by "
                              f"{previous.__module__}.{previous.__qualname__}")
         _EXTRACTORS[claim_id] = func
+        _DEPENDS[claim_id] = depends
         return func
 
     return deco
+
+
+def register_evidence(claim_id: str) -> Callable[[Callable], Callable]:
+    """Decorator: register ``func(results) -> list[str]`` of computed evidence for a claim.
+
+    Each string states one evaluated quantity with its value (e.g. "first-fly-back onset
+    within 0.4 % of Eq. 7"); the ledger shows them beside every claim that is not
+    reproduced. Raise :class:`NotEvaluable` when the results hold no data for them.
+    """
+    if not isinstance(claim_id, str) or not _ID.match(claim_id):
+        raise ValueError(f"claim_id = {claim_id!r} is not allowed: must be a claims.csv id slug")
+
+    def deco(func: Callable) -> Callable:
+        _EVIDENCE[claim_id] = func
+        return func
+
+    return deco
+
+
+def depends_on(claim_id: str) -> tuple[str, ...]:
+    """The assumption axes a claim's extractor reads (empty: evaluated at the defaults only)."""
+    extractors()
+    return _DEPENDS.get(claim_id, ())
 
 
 def extractors() -> dict[str, Callable]:
@@ -324,7 +386,7 @@ def collect_results(profile: str = "quick", figures=None) -> dict[str, pd.DataFr
     -------
     dict
         ``{key: DataFrame}``. Figures not registered yet are simply absent; their claims
-        are then *not evaluated*.
+        are then *inconclusive*.
     """
     check_choice("profile", profile, PROFILES)
     available = result_sources()
@@ -355,6 +417,7 @@ class Outcome:
     abs_deviation: float = math.nan
     rel_deviation: float = math.nan
     detail: str = ""  # why it failed (or what was found)
+    score: float = math.nan  # how far from holding: <= 1 holds (value, trend), 0 holds (others)
 
 
 def _fmt(x) -> str:
@@ -362,11 +425,26 @@ def _fmt(x) -> str:
 
 
 def _numbers(name: str, values, *, boolean: bool = False) -> np.ndarray:
-    array = np.atleast_1d(np.asarray(values, dtype=bool if boolean else float))
-    if array.ndim != 1 or array.size == 0:
-        raise ValueError(f"{name} must be a non-empty 1-d array, got shape {array.shape}")
-    if not boolean and not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} contains non-finite values: {array}")
+    """A non-empty 1-d float (or bool) array; non-finite data make the claim inconclusive.
+
+    A NaN never counts as "holds": a boolean input given as numbers must be 0 or 1 and finite.
+    """
+    raw = np.atleast_1d(np.asarray(values))
+    if raw.ndim != 1 or raw.size == 0:
+        raise ValueError(f"{name} must be a non-empty 1-d array, got shape {raw.shape}")
+    if boolean and raw.dtype == bool:
+        return raw
+    try:
+        array = raw.astype(float)
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"{name} must be numeric, got {raw!r}") from err
+    if not np.all(np.isfinite(array)):
+        raise NotEvaluable(f"{name} has non-finite values at {int((~np.isfinite(array)).sum())} of "
+                           f"{array.size} point(s)")
+    if boolean:
+        if not np.all((array == 0) | (array == 1)):
+            raise ValueError(f"{name} must be booleans, got {raw!r}")
+        return array.astype(bool)
     return array
 
 
@@ -424,13 +502,15 @@ def check_value(ours, paper_value=None, tolerance=0.0, tolerance_kind="rel", cur
     abs_dev = float(deviation.max())
     rel_dev = float(np.nanmax(relative)) if np.any(np.isfinite(relative)) else math.nan
     where = f" at x = {_fmt(float(x[worst]))}" if curve is not None else ""
-    detail = f"deviation {_fmt(float(deviation[worst]))}{where}"
-    if not passed:
-        limit = f"{tolerance * 100:g} %" if tolerance_kind == "rel" else _fmt(tolerance)
-        rel_worst = relative[worst]
-        shown_dev = f"{rel_worst * 100:.3g} %" if tolerance_kind == "rel" else _fmt(float(deviation[worst]))
-        detail = f"deviation {shown_dev}{where} exceeds the tolerance {limit}"
-    return Outcome(passed, shown, abs_dev, rel_dev, detail)
+    limit = f"{tolerance * 100:g} %" if tolerance_kind == "rel" else _fmt(tolerance)
+    rel_worst = relative[worst]
+    shown_dev = f"{rel_worst * 100:.3g} %" if tolerance_kind == "rel" else _fmt(float(deviation[worst]))
+    verb = "within" if passed else "exceeds"
+    detail = f"deviation {shown_dev}{where} {verb} the tolerance {limit}"
+    allowed = _allowance(tolerance, tolerance_kind, expected)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(allowed > 0, deviation / allowed, np.where(deviation > 0, np.inf, 0.0))
+    return Outcome(passed, shown, abs_dev, rel_dev, detail, float(ratio.max()))
 
 
 _SYMBOL = {"<": "<", ">": ">", "approx": "≈"}
@@ -468,7 +548,7 @@ def check_ordering(ours, relation, tolerance=None, tolerance_kind="rel") -> Outc
         bad = int(np.flatnonzero(~ok)[0])
         detail = (f"lhs {symbol} rhs fails at {int((~ok).sum())} of {ok.size} point(s), e.g. "
                   f"{_fmt(float(lhs[bad]))} vs {_fmt(float(rhs[bad]))}")
-    return Outcome(bool(ok.all()), shown, abs_dev, rel_dev, detail)
+    return Outcome(bool(ok.all()), shown, abs_dev, rel_dev, detail, float((~ok).mean()))
 
 
 def check_threshold(ours, relation, threshold, tolerance=0.0, tolerance_kind="abs") -> Outcome:
@@ -511,7 +591,10 @@ def check_threshold(ours, relation, threshold, tolerance=0.0, tolerance_kind="ab
     shown = observed if math.isfinite(observed) else f"holds over {_fmt(x[0])}–{_fmt(x[-1])}"
     detail = "; ".join(problems) if problems else (
         f"switch observed at x = {_fmt(observed)}" if math.isfinite(observed) else "holds at every point")
-    return Outcome(not problems, shown, abs_dev, abs_dev / abs(threshold) if threshold else math.nan, detail)
+    judged = side | (other if switch else np.zeros_like(side))
+    wrong = (side & ~holds) | ((other & holds) if switch else np.zeros_like(side))
+    return Outcome(not problems, shown, abs_dev, abs_dev / abs(threshold) if threshold else math.nan, detail,
+                   float(wrong.sum() / max(int(judged.sum()), 1)))
 
 
 def check_trend(ours, relation, tolerance=0.0, tolerance_kind="rel") -> Outcome:
@@ -529,7 +612,7 @@ def check_trend(ours, relation, tolerance=0.0, tolerance_kind="rel") -> Outcome:
     else:
         raise ValueError(f"ours must be {{'x', 'y'}} or {{label: {{'x', 'y'}}}}, got {ours!r}")
     sign = 1.0 if relation == "increasing" else -1.0
-    worst, worst_rel, problems, points = 0.0, 0.0, [], 0
+    worst, worst_rel, problems, points, failing = 0.0, 0.0, [], 0, 0
     for label, data in series.items():
         x = _numbers(f"ours[{label!r}]['x']", _mapping("series", data, ("x", "y"))["x"])
         y = _numbers(f"ours[{label!r}]['y']", data["y"])
@@ -545,6 +628,7 @@ def check_trend(ours, relation, tolerance=0.0, tolerance_kind="rel") -> Outcome:
         worst = max(worst, counter)
         worst_rel = max(worst_rel, counter / spread if spread > 0 else 0.0)
         name = f"series {label}: " if label else ""
+        failing += int(counter > allowance or sign * (y[-1] - y[0]) <= allowance)
         if counter > allowance:
             problems.append(f"{name}steps against the trend by {_fmt(counter)} > allowance {_fmt(allowance)}")
         if sign * (y[-1] - y[0]) <= allowance:
@@ -552,7 +636,7 @@ def check_trend(ours, relation, tolerance=0.0, tolerance_kind="rel") -> Outcome:
                             f"from first {_fmt(float(y[0]))}")
     shown = f"{relation} over {points} points" if not problems else f"largest counter-step {_fmt(worst)}"
     detail = "; ".join(problems) if problems else f"largest counter-step {_fmt(worst)}"
-    return Outcome(not problems, shown, worst, worst_rel, detail)
+    return Outcome(not problems, shown, worst, worst_rel, detail, failing / len(series))
 
 
 def curve_deviation(x, y, curve: str, column: str) -> float:
@@ -614,14 +698,114 @@ def _passed_verdict(claim: Mapping, outcome: Outcome) -> str:
     quantitative = claim["check"] == "value" or claim["relation"] == "approx"
     if quantitative and math.isfinite(outcome.rel_deviation):
         percent = max(1, math.ceil(round(outcome.rel_deviation * 100, 9)))
-        return f"reproduced within {percent} %"
-    return "reproduced"
+        return f"within {percent} %"
+    return "holds"
+
+
+@dataclass(frozen=True)
+class PointResult:
+    """One claim at one reading: ``holds``, ``fails`` or ``inconclusive``, with what was found."""
+
+    reading: dict
+    state: str  # "holds", "fails", "inconclusive"
+    outcome: Outcome | None
+    detail: str
+
+
+def _evaluate_point(claim: Mapping, func: Callable, depends: tuple, results, reading: dict) -> PointResult:
+    try:
+        ours = func(results, reading) if depends else func(results)
+        outcome = _run_check(claim, ours)
+    except NotEvaluable as reason:
+        return PointResult(reading, "inconclusive", None, str(reason))
+    except ClaimFails as reason:
+        return PointResult(reading, "fails", None, str(reason))
+    except Exception as err:
+        raise ExtractorError(f"claim {claim['id']!r} ({claim['check']} check) at "
+                             f"{readings.describe(reading)}: {err!r}") from err
+    state = "holds" if outcome.passed else "fails"
+    return PointResult(reading, state, outcome, outcome.detail)
+
+
+def _best(points: list[PointResult]) -> PointResult | None:
+    """The reading where the claim holds best: a holding one with the smallest deviation, else the
+    failing one closest to holding (smallest score)."""
+    decided = [p for p in points if p.state != "inconclusive"]
+    if not decided:
+        return None
+
+    def key(p):
+        score = p.outcome.score if p.outcome is not None and math.isfinite(p.outcome.score) else math.inf
+        return (p.state != "holds", score)
+
+    return min(decided, key=key)
+
+
+def _categorise(points: list[PointResult]) -> tuple[str, str]:
+    """Category and a one-line verdict from the claim's results over its readings."""
+    default, others = points[0], points[1:]
+    holding = [p for p in others if p.state == "holds"]
+    open_ = [p for p in others if p.state == "inconclusive"]
+    if default.state == "holds":
+        return "reproduced", "holds at the defaults"
+    if default.state == "inconclusive":
+        also = (f"; holds at {', '.join(readings.describe(p.reading) for p in holding)}" if holding else "")
+        return "inconclusive", f"at the defaults: {default.detail}{also}"
+    if holding:
+        return ("reproduced under another reading",
+                "holds at " + "; and at ".join(readings.describe(p.reading) for p in holding))
+    if open_:
+        return ("inconclusive", "fails at the defaults; not covered: "
+                + "; ".join(f"{readings.describe(p.reading)} ({p.detail})" for p in open_))
+    if others:
+        return "not reproduced", f"fails at all {len(points)} readings"
+    return "not reproduced", "fails at the defaults (no other reading declared for it)"
+
+
+def _evidence(claim: Mapping, points: list[PointResult], results) -> list[str]:
+    """Computed evidence: the check at every reading, then the claim's registered evidence."""
+    lines = []
+    for p in points:
+        shown = "" if p.outcome is None else f"ours {_shown(p.outcome.ours)}{_unit(claim)}; "
+        lines.append(f"{readings.describe(p.reading)}: {p.state} ({shown}{p.detail})")
+    func = _EVIDENCE.get(claim["id"])
+    if func is not None:
+        try:
+            lines.extend(func(results))
+        except NotEvaluable as reason:
+            lines.append(f"evidence not available on these results: {reason}")
+        except KeyError as missing:
+            lines.append(f"evidence needs results: {missing}")
+    return lines
+
+
+def _shown(value) -> str:
+    return _fmt(value) if isinstance(value, float) else str(value)
+
+
+def _unit(claim: Mapping) -> str:
+    return f" {claim['unit']}" if claim["unit"] and claim["check"] == "value" else ""
 
 
 def evaluate(
     claims: pd.DataFrame, results: Mapping[str, pd.DataFrame], *, strict: bool = True
 ) -> pd.DataFrame:
-    """Evaluate every claim against the result tables.
+    """Evaluate every claim against the result tables, over its readings of the assumption space.
+
+    Each claim is checked at every reading of :func:`passmd.readings.design` for the axes its
+    extractor depends on (the defaults first). Its category is computed from those checks:
+
+    * ``reproduced``: the check holds at the defaults;
+    * ``reproduced under another reading``: it fails at the defaults and holds at a named
+      non-default reading;
+    * ``not reproduced``: it fails at every reading evaluated (a total failure, e.g. no step up
+      to the full stroke, is a failure);
+    * ``inconclusive``: the data cannot decide at the defaults (an extremum at the grid's edge,
+      non-finite values, missing results), or it fails there and some reading is not covered
+      while none holds.
+
+    NaN never counts as holding (:class:`NotEvaluable`). Claims whose ``requires`` are only
+    ``closed_forms`` have ``basis`` "closed form" and are not simulation results.
 
     Parameters
     ----------
@@ -631,62 +815,89 @@ def evaluate(
         ``{figure key: DataFrame}``, e.g. from :func:`collect_results`.
     strict : bool
         If True (default), raise ``LookupError`` when a claim's results are present but no
-        extractor is registered for it. If False, such claims are *not evaluated* with that
-        note. (Extractors registered for ids that are not in claims.csv are reported by
-        :func:`orphan_extractors`.)
+        extractor is registered for it. If False, such claims are *inconclusive* with that note.
 
     Returns
     -------
     pandas.DataFrame
-        Columns :data:`LEDGER_COLUMNS`: ``paper`` and ``ours`` as shown (number or text),
+        Columns :data:`LEDGER_COLUMNS`: ``paper`` and ``ours`` (at the defaults) as shown,
         ``abs_deviation`` (in ``unit``) and ``rel_deviation`` (fraction) where defined,
-        ``verdict`` (computed text), ``status`` (one of :data:`STATUSES`).
+        ``status`` (the category, one of :data:`STATUSES`), ``verdict`` (one computed line),
+        ``evidence`` (computed lines, ``" | "``-separated), ``reason`` (claims.csv's human
+        reason), ``basis``, ``readings`` (evaluated), ``holds_at`` (how many hold),
+        ``fraction_holds``, ``best_reading``, ``depends_on``.
     """
     registered = extractors()
-    problems = []
-    rows = []
+    problems, rows, point_rows = [], [], []
     for _, claim in claims.iterrows():
-        missing = [k for k in claim["requires"].split(";") if k and k not in results]
-        outcome, status, note = None, None, ""
+        needed = [k for k in claim["requires"].split(";") if k]
+        missing = [k for k in needed if k not in results]
+        basis = "closed form" if set(needed) <= {"closed_forms"} else "simulation"
+        depends = _DEPENDS.get(claim["id"], ())
+        points: list[PointResult] = []
         if missing:
-            status, note = "not evaluated", "needs results: " + ", ".join(missing)
+            status, verdict, evidence = "inconclusive", "needs results: " + ", ".join(missing), []
         elif claim["id"] not in registered:
             if strict:
                 problems.append(f"claim {claim['id']!r} has its results but no registered extractor")
-            status, note = "not evaluated", "no extractor registered"
+            status, verdict, evidence = "inconclusive", "no extractor registered", []
         else:
-            try:
-                ours = registered[claim["id"]](results)
-                outcome = _run_check(claim, ours)
-            except NotEvaluable as reason:
-                status, note = "not evaluated", str(reason)
-            except Exception as err:
-                raise ExtractorError(f"claim {claim['id']!r} ({claim['check']} check): {err!r}") from err
-        flagged = claim["expected_to_differ"] == "yes"
-        if outcome is None:
-            verdict = "not evaluated"
-        elif outcome.passed:
-            status, verdict, note = "reproduced", _passed_verdict(claim, outcome), outcome.detail
-            if flagged:
-                note += "; marked expected to differ but reproduced: remove the mark"
-        elif flagged:
-            status = "expected to differ"
-            verdict = f"expected to differ: {claim['expected_difference_reason']}"
-            note = outcome.detail
-        else:
-            status, verdict, note = "not reproduced", f"not reproduced: {outcome.detail}", outcome.detail
+            func = registered[claim["id"]]
+            points = [_evaluate_point(claim, func, depends, results, r) for r in readings.design(depends)]
+            status, verdict = _categorise(points)
+            if status == "reproduced":
+                verdict = _passed_verdict(claim, points[0].outcome) + " at the defaults"
+            evidence = _evidence(claim, points, results)
+            point_rows.extend({"claim": claim["id"], "reading": readings.describe(p.reading),
+                               "state": p.state, "detail": p.detail} for p in points)
+        default = points[0].outcome if points else None
+        decided = [p for p in points if p.state != "inconclusive"]
+        best = _best(points)
         rows.append({
             "claim": claim["id"], "figure": claim["figure"], "quantity": claim["quantity"],
-            "paper": _paper_text(claim), "ours": "—" if outcome is None else outcome.ours,
+            "paper": _paper_text(claim), "ours": "—" if default is None else default.ours,
             "unit": claim["unit"],
-            "abs_deviation": math.nan if outcome is None else outcome.abs_deviation,
-            "rel_deviation": math.nan if outcome is None else outcome.rel_deviation,
-            "tolerance": _tolerance_text(claim), "verdict": verdict, "note": note, "status": status,
-            "check": claim["check"],
+            "abs_deviation": math.nan if default is None else default.abs_deviation,
+            "rel_deviation": math.nan if default is None else default.rel_deviation,
+            "tolerance": _tolerance_text(claim), "status": status, "verdict": verdict,
+            "evidence": " | ".join(evidence), "reason": claim["reason"], "basis": basis,
+            "check": claim["check"], "depends_on": ";".join(depends), "readings": len(points),
+            "holds_at": sum(p.state == "holds" for p in points),
+            "fraction_holds": (sum(p.state == "holds" for p in decided) / len(decided)
+                               if decided else math.nan),
+            "best_reading": "—" if best is None else readings.describe(best.reading),
+            "note": points[0].detail if points else verdict,
         })
     if problems:
         raise LookupError("ledger evaluation is incomplete:\n  " + "\n  ".join(problems))
-    return pd.DataFrame(rows, columns=list(LEDGER_COLUMNS))
+    table = pd.DataFrame(rows, columns=list(LEDGER_COLUMNS))
+    table.attrs["points"] = point_rows
+    return table
+
+
+def assumption_map(evaluated: pd.DataFrame) -> pd.DataFrame:
+    """The claims × readings map of an :func:`evaluate` result.
+
+    One row per claim that depends on at least one axis; one column per evaluated reading
+    (``"defaults"`` and ``"<axis label> = <value>"``); cells ``holds``, ``fails``,
+    ``inconclusive``, or empty where the claim does not depend on that axis. Then ``holds at``
+    (readings where it holds, of those evaluated) and ``best reading`` (where it holds best).
+    """
+    points = pd.DataFrame(evaluated.attrs.get("points", []),
+                          columns=["claim", "reading", "state", "detail"])
+    varied = points.groupby("claim")["reading"].transform("size") > 1
+    points = points[varied]
+    if points.empty:
+        return pd.DataFrame(columns=["claim"])
+    columns = ["defaults"] + [r for r in dict.fromkeys(points["reading"]) if r != "defaults"]
+    table = points.pivot(index="claim", columns="reading", values="state").reindex(columns=columns)
+    order = [c for c in evaluated["claim"] if c in table.index]
+    table = table.loc[order].fillna("").reset_index()
+    summary_ = evaluated.set_index("claim").loc[order]
+    table["holds at"] = [f"{int(h)} of {int(n)}" for h, n in zip(summary_["holds_at"], summary_["readings"],
+                                                                   strict=True)]
+    table["best reading"] = summary_["best_reading"].to_numpy()
+    return table
 
 
 def claims_for(claims: pd.DataFrame, figures) -> pd.DataFrame:
@@ -710,56 +921,167 @@ def orphan_extractors(claims: pd.DataFrame | None = None) -> list[str]:
 
 
 def summary(evaluated: pd.DataFrame) -> str:
-    """One line such as ``"11 of 14 claims reproduced; 3 not evaluated"``."""
+    """One line such as ``"11 of 40 claims reproduced (1 a closed-form identity); 3 inconclusive"``.
+
+    Closed-form identities are counted apart: they are not simulation results.
+    """
     counts = evaluated["status"].value_counts()
+    closed = int(((evaluated["status"] == "reproduced") & (evaluated["basis"] == "closed form")).sum())
     text = f"{int(counts.get('reproduced', 0))} of {len(evaluated)} claims reproduced"
+    if closed:
+        text += f" ({closed} of them a closed-form identity, not a simulation)"
     others = [f"{int(counts[s])} {s}" for s in STATUSES[1:] if counts.get(s, 0)]
     return text + ("; " + ", ".join(others) if others else "")
 
 
-#: Background colours of the verdict classes in :func:`styled`.
+def category_anchor(status: str) -> str:
+    """The anchor of a category's list in the replication report, e.g. ``ledger-not-reproduced``."""
+    check_choice("status", status, STATUSES)
+    return "ledger-" + status.replace(" ", "-")
+
+
+def claim_anchor(claim_id: str) -> str:
+    """The anchor of a claim's details in the replication report."""
+    return "claim-" + re.sub(r"[^a-z0-9-]", "-", claim_id)
+
+
+def headline_markdown(evaluated: pd.DataFrame, page: str = "replication_report", *, ref: bool = False) -> str:
+    """The per-category counts as MyST markdown, each linking to that category's claims.
+
+    Links go to the targets :func:`details_markdown` writes: ``{ref}`` roles when ``ref`` is
+    true (the book), markdown links to ``page.md#anchor`` otherwise.
+    """
+    counts = evaluated["status"].value_counts()
+    parts = []
+    for status in STATUSES:
+        n = int(counts.get(status, 0))
+        label = f"{n} {status}"
+        if n and ref:
+            label = f"{{ref}}`{label} <{category_anchor(status)}>`"
+        elif n:
+            label = f"[{label}]({page}.md#{category_anchor(status)})"
+        parts.append(label)
+    closed = int(((evaluated["status"] == "reproduced") & (evaluated["basis"] == "closed form")).sum())
+    note = f" ({closed} of the reproduced a closed-form identity, not a simulation)" if closed else ""
+    return f"{len(evaluated)} claims: " + ", ".join(parts) + note
+
+
+#: Background colours of the categories in :func:`styled`.
 STATUS_COLOURS = {
     "reproduced": "#d4edda",
+    "reproduced under another reading": "#d1ecf1",
     "not reproduced": "#f8d7da",
-    "expected to differ": "#fff3cd",
-    "not evaluated": "#e9ecef",
+    "inconclusive": "#e9ecef",
 }
 
 
-def styled(evaluated: pd.DataFrame):
-    """A pandas ``Styler`` of the ledger for the book, claim and verdict coloured by class.
+def styled(evaluated: pd.DataFrame, *, links: bool = False):
+    """A pandas ``Styler`` of the ledger for the book: one short line per claim.
 
-    The table carries the HTML class ``passmd-ledger`` (the rendered-book check looks
-    for it); deviations are shown in the claim's unit and in %. The verdict comes third, so
-    it is visible on a narrow page.
+    Columns: claim, figure, paper, ours, category (coloured badge). Details (quote, reason,
+    evidence, readings) are in :func:`details_markdown`; with ``links=True`` each claim links
+    to its details on the same page. The table carries the HTML class ``passmd-ledger`` (the
+    rendered-book check looks for it) and wraps inside the content column.
     """
-    order = ["claim", "figure", "verdict", "paper", "ours", "unit", "abs_deviation", "rel_deviation",
-             "tolerance", "quantity", "note"]  # the verdict early: visible without scrolling
-    shown = evaluated[order].copy()
-    shown["rel_deviation"] = shown["rel_deviation"] * 100.0
-    shown = shown.rename(columns={"rel_deviation": "rel_deviation_%"})
+    shown = evaluated[["claim", "figure", "paper", "ours", "status"]].copy()
+    shown["ours"] = [_fmt(v) if isinstance(v, (float, np.floating)) else str(v) for v in shown["ours"]]
+    if links:
+        shown["claim"] = [f'<a href="#{claim_anchor(c)}">{c}</a>' for c in evaluated["claim"]]
+    shown["status"] = [s + (" (closed form)" if b == "closed form" else "")
+                       for s, b in zip(evaluated["status"], evaluated["basis"], strict=True)]
+    shown = shown.rename(columns={"status": "category"})
     statuses = evaluated["status"].to_numpy()
 
     def colour(column):
         return [f"background-color: {STATUS_COLOURS[s]}" for s in statuses]
 
-    def number(value):
-        if isinstance(value, (int, float, np.floating)) and not isinstance(value, bool):
-            return "—" if not math.isfinite(value) else f"{value:.4g}"
-        return str(value)
-
     return (
         shown.style.hide(axis="index")
-        .format(number)
-        .apply(colour, subset=["claim", "verdict"])
+        .apply(colour, subset=["category"])
         .set_table_attributes('class="passmd-ledger"')
         .set_table_styles([
-            {"selector": "td, th", "props": "font-size: 0.8em; vertical-align: top;"},
-            # the long text columns: wide enough to keep rows short
-            *({"selector": f"td.col{order.index(column)}", "props": "min-width: 16em;"}
-              for column in ("quantity", "note")),
+            {"selector": "", "props": "table-layout: fixed; width: 100%; max-width: 100%;"},
+            {"selector": "td, th", "props": "font-size: 0.8em; vertical-align: top; overflow-wrap: anywhere; "
+                                            "word-break: break-word; white-space: normal;"},
         ])
     )
+
+
+def details_markdown(evaluated: pd.DataFrame, claims: pd.DataFrame) -> str:
+    """Per claim, a collapsed block with an anchor: verdict, quote, evidence, reason and source.
+
+    Claims are grouped by category; each group starts with the target of
+    :func:`category_anchor` (so the intro's headline can link to it) and each claim with the
+    target of :func:`claim_anchor` (the ledger table links to it). The blocks are dropdown
+    admonitions: closed until the reader opens them.
+    """
+    by_id = claims.set_index("id")
+    blocks = []
+    for status in STATUSES:
+        rows = evaluated[evaluated["status"] == status]
+        blocks.append(f"({category_anchor(status)})=\n**{status.capitalize()}: {len(rows)}**\n")
+        for row in rows.itertuples():
+            claim = by_id.loc[row.claim]
+            section = claim["source_section"]
+            section = f"Section {section}" if section[:1].isdigit() else section
+            check = claim["check"] + (f" ({claim['relation']})" if claim["relation"] else "")
+            if claim["tolerance"]:
+                check += f", tolerance {_tolerance_text(claim)}"
+            basis = " (closed form)" if row.basis == "closed form" else ""
+            lines = [f"({claim_anchor(row.claim)})=",
+                     "```{admonition} " + f"{_md_escape(row.claim)}: {status}{basis}",
+                     ":class: dropdown",
+                     "",
+                     f"*Paper* ({_md_escape(section)}): “{_md_escape(claim['source_quote'])}”", "",
+                     f"*Verdict (computed):* {_md_escape(row.verdict)}.", ""]
+            if row.basis == "closed form":
+                lines += ["*Basis:* a closed-form identity, not a simulation result.", ""]
+            if row.evidence:
+                lines.append("*Evidence (computed):*")
+                lines.append("")
+                lines += [f"- {_md_escape(item)}" for item in row.evidence.split(" | ")]
+                lines.append("")
+            if row.depends_on:
+                lines += [f"*Readings:* holds at {row.holds_at} of {row.readings}; best: "
+                          f"{_md_escape(row.best_reading)}.", ""]
+            if row.reason and status != "reproduced":
+                lines += [f"*Reason (our reading of the evidence):* {_md_escape(row.reason)}", ""]
+            lines += [f"*Configuration:* {_md_escape(_config_text(claim))}. "
+                      f"*Ours:* {_md_escape(claim['ours_definition'])}. "
+                      f"*Check:* {_md_escape(check)}. {_md_escape(claim['tolerance_reason'])}"]
+            if claim["notes"]:
+                lines += ["", f"*Notes:* {_md_escape(claim['notes'])}"]
+            lines.append("```")
+            blocks.append("\n".join(lines) + "\n")
+    return "\n".join(blocks)
+
+
+def assumption_map_styled(evaluated: pd.DataFrame):
+    """:func:`assumption_map` as a compact coloured table (✓ holds, ✗ fails, ? inconclusive).
+
+    The columns are numbered readings; the caption lists what each number means, so the table
+    stays inside the content column.
+    """
+    table = assumption_map(evaluated)
+    readings_ = [c for c in table.columns if c not in ("claim", "holds at", "best reading")]
+    symbols = {"holds": "✓", "fails": "✗", "inconclusive": "?", "": ""}
+    shown = table.rename(columns={r: f"R{i}" for i, r in enumerate(readings_)})
+    for i in range(len(readings_)):
+        shown[f"R{i}"] = shown[f"R{i}"].map(symbols)
+    colours = {"✓": STATUS_COLOURS["reproduced"], "✗": STATUS_COLOURS["not reproduced"],
+               "?": STATUS_COLOURS["inconclusive"], "": ""}
+    caption = "; ".join(f"R{i}: {r}" for i, r in enumerate(readings_))
+    return (shown.style.hide(axis="index")
+            .map(lambda v: f"background-color: {colours[v]}" if colours.get(v) else "",
+                 subset=[f"R{i}" for i in range(len(readings_))])
+            .set_caption("✓ holds, ✗ fails, ? inconclusive, blank: the claim does not depend on it. "
+                         f"{caption}.")
+            .set_table_attributes('class="passmd-assumption-map"')
+            .set_table_styles([
+                {"selector": "", "props": "table-layout: fixed; width: 100%; max-width: 100%;"},
+                {"selector": "td, th, caption", "props": "font-size: 0.8em; overflow-wrap: anywhere; "
+                                                         "white-space: normal;"},
+            ]))
 
 
 _CONFIG_LABELS = {
@@ -814,8 +1136,6 @@ def sources_markdown(claims: pd.DataFrame) -> str:
         ]
         if claim["notes"]:
             lines.append(f"  *Notes:* {_md_escape(claim['notes'])}")
-        if claim["expected_to_differ"] == "yes":
-            lines.append(f"  *Expected to differ:* {_md_escape(claim['expected_difference_reason'])}")
         items.append("\n".join(line + "  " if i < len(lines) - 1 else line for i, line in enumerate(lines)))
     return "\n".join(items) + "\n"
 
@@ -831,51 +1151,96 @@ def assumptions_table() -> pd.DataFrame:
     )
 
 
+#: SI name and factor of each claim unit, for machine-readable output (keys carry the SI unit).
+SI_UNITS = {"nm": ("m", 1e-9), "mm/s": ("m_per_s", 1e-3), "kHz": ("Hz", 1e3), "mN": ("N", 1e-3),
+            "N/m": ("N_per_m", 1.0), "%": ("percent", 1.0), "µs": ("s", 1e-6), "periods": ("periods", 1.0),
+            "": ("", 1.0)}
+
+
+def records(evaluated: pd.DataFrame) -> list[dict]:
+    """The ledger as plain records with SI keys (``passmd ledger --json``).
+
+    Per claim: ``claim``, ``category``, ``basis``, ``verdict``, ``evidence`` (list),
+    ``reason``, ``depends_on`` (list), ``readings`` (``{reading: state}``), ``fraction_holds``,
+    ``best_reading``, ``tolerance`` (as shown), and, where numeric, ``paper_<si>``,
+    ``ours_<si>`` and ``abs_deviation_<si>`` in SI units (e.g. ``ours_m``, ``paper_m_per_s``),
+    ``rel_deviation`` as a fraction. Non-numeric values are null, with ``ours_text`` as shown.
+    """
+    points = pd.DataFrame(evaluated.attrs.get("points", []), columns=["claim", "reading", "state", "detail"])
+    out = []
+    for row in evaluated.itertuples():
+        si, factor = SI_UNITS.get(row.unit, (re.sub(r"[^A-Za-z0-9]+", "_", row.unit), 1.0))
+        suffix = f"_{si}" if si else ""
+
+        def number(value, factor=factor):
+            if isinstance(value, (int, float, np.floating)) and not isinstance(value, bool):
+                return float(value) * factor if math.isfinite(value) else None
+            return None
+
+        paper = number(float(row.paper)) if _is_number(str(row.paper)) else None
+        mine = points[points["claim"] == row.claim]
+        out.append({
+            "claim": row.claim, "figure": row.figure, "category": row.status, "basis": row.basis,
+            "verdict": row.verdict, "evidence": [e for e in row.evidence.split(" | ") if e],
+            "reason": row.reason, "depends_on": [d for d in row.depends_on.split(";") if d],
+            "readings": dict(zip(mine["reading"], mine["state"], strict=True)),
+            "fraction_holds": None if not math.isfinite(row.fraction_holds) else float(row.fraction_holds),
+            "best_reading": row.best_reading, "tolerance": row.tolerance, "check": row.check,
+            f"paper{suffix}": paper, f"ours{suffix}": number(row.ours), "ours_text": _shown(row.ours),
+            f"abs_deviation{suffix}": number(row.abs_deviation),
+            "rel_deviation": None if not math.isfinite(row.rel_deviation) else float(row.rel_deviation),
+        })
+    return out
+
+
 # ======================================================================================
 # Baseline (regression tests)
 # ======================================================================================
 
 
 def load_baseline(path) -> dict[str, str]:
-    """``{claim id: status}`` from a baseline CSV written by :func:`write_baseline`."""
-    table = pd.read_csv(path, dtype=str, keep_default_na=False)
+    """``{claim id: category}`` from a baseline CSV written by :func:`write_baseline`."""
+    table = pd.read_csv(path, dtype=str, keep_default_na=False, comment="#")
     return dict(zip(table["claim"], table["status"], strict=True))
 
 
-def write_baseline(evaluated: pd.DataFrame, path) -> None:
-    """Write the claims' statuses as a baseline CSV (``claim,status``), atomically."""
+def write_baseline(evaluated: pd.DataFrame, path, header: str = "") -> None:
+    """Write the claims' categories as a baseline CSV (``claim,status``), atomically.
+
+    ``header`` (e.g. the command and date that produced it) is written as ``#`` comment lines.
+    """
     path = Path(path)
     tmp = path.with_name(f".{path.name}.tmp")
-    evaluated[["claim", "status"]].to_csv(tmp, index=False, lineterminator="\n")
+    with open(tmp, "w", encoding="utf-8", newline="") as fh:
+        for line in header.splitlines():
+            fh.write(f"# {line}\n")
+        evaluated[["claim", "status"]].to_csv(fh, index=False, lineterminator="\n")
     tmp.replace(path)
 
 
-def regressions(evaluated: pd.DataFrame, baseline: Mapping[str, str]) -> pd.DataFrame:
-    """Claims reproduced in ``baseline`` that no longer are (or that disappeared).
+def category_changes(evaluated: pd.DataFrame, baseline: Mapping[str, str]) -> pd.DataFrame:
+    """Every claim whose category differs from ``baseline`` (or that appeared or disappeared).
 
-    Returns the regressed rows of ``evaluated`` (claims missing from it appear with
-    status ``"missing"``), with a column ``baseline``.
+    Columns ``claim``, ``baseline``, ``now`` (``"missing"`` where absent) and ``verdict``.
     """
-    current = evaluated.set_index("claim")
+    current = dict(zip(evaluated["claim"], evaluated["status"], strict=True))
+    verdicts = dict(zip(evaluated["claim"], evaluated["verdict"], strict=True))
     rows = []
-    for claim, before in baseline.items():
-        if before != "reproduced":
-            continue
-        if claim not in current.index:
-            rows.append({"claim": claim, "status": "missing", "verdict": "claim no longer in the ledger",
-                         "baseline": before})
-        elif current.at[claim, "status"] != "reproduced":
-            rows.append({"claim": claim, "status": current.at[claim, "status"],
-                         "verdict": current.at[claim, "verdict"], "baseline": before})
-    return pd.DataFrame(rows, columns=["claim", "status", "verdict", "baseline"])
+    for claim in list(baseline) + [c for c in current if c not in baseline]:
+        before, now = baseline.get(claim, "missing"), current.get(claim, "missing")
+        if before != now:
+            rows.append({"claim": claim, "baseline": before, "now": now,
+                         "verdict": verdicts.get(claim, "claim no longer in the ledger")})
+    return pd.DataFrame(rows, columns=["claim", "baseline", "now", "verdict"])
 
 
-def check_no_regressions(evaluated: pd.DataFrame, baseline: Mapping[str, str]) -> None:
-    """Raise ``AssertionError`` listing every claim that regressed from ``reproduced``."""
-    regressed = regressions(evaluated, baseline)
-    if len(regressed):
-        lines = [f"{r.claim}: {r.verdict}" for r in regressed.itertuples()]
-        raise AssertionError(f"{len(lines)} claim(s) regressed from 'reproduced':\n  " + "\n  ".join(lines))
+def check_categories(evaluated: pd.DataFrame, baseline: Mapping[str, str]) -> None:
+    """Raise ``AssertionError`` with a readable diff when any claim changed category."""
+    changed = category_changes(evaluated, baseline)
+    if len(changed):
+        lines = [f"{r.claim}: {r.baseline} -> {r.now} ({r.verdict})" for r in changed.itertuples()]
+        raise AssertionError(f"{len(lines)} claim(s) changed category against the baseline:\n  "
+                             + "\n  ".join(lines))
 
 
 # ======================================================================================

@@ -78,6 +78,7 @@ def test_good_page_has_no_problems():
         ({"blank_images": ["a.png"]}, "blank image"),
         ({"broken_links": ["_downloads/x/fig.csv"]}, "missing file"),
         ({"ledger_tables": 0}, "ledger table"),
+        ({"ledger_overflow": [420]}, "420 px wider than the content column"),
         ({"error_outputs": ["ValueError: x"]}, "execution error"),
         ({"stderr_outputs": ["RuntimeWarning: y"]}, "stderr"),
         ({"traceback_in_text": True}, "traceback"),

@@ -284,9 +284,11 @@ def test_ledger_rows_of_figs_5_and_6(quick):
     claims = ledger.claims_for(ledger.load_claims(), keys)
     assert len(claims) == 8
     evaluated = ledger.evaluate(claims, {k: quick[k] for k in keys})
-    assert (evaluated["status"] != "not evaluated").all(), evaluated[["claim", "note"]]
-    unexplained = evaluated[evaluated["status"] == "not reproduced"]
-    assert unexplained.empty, unexplained[["claim", "verdict"]].to_string()
+    # every row is decided at the defaults (the quick grid lacks only the 50/200 Hz readings)
+    assert not evaluated["verdict"].str.startswith("at the defaults").any(), evaluated[["claim", "verdict"]]
     status = dict(zip(evaluated["claim"], evaluated["status"], strict=True))
+    # the fixed 2 µs fly-back reading moves Fig. 5a's onset to 50 nm and Fig. 6b's A_c onto Eq. 12
+    assert status["fig5a-no-step-below-50nm"] == "reproduced under another reading"
+    assert status["fig6b-flexible-r1-ac-matches-eq12"] == "reproduced under another reading"
     assert status["fig6a-rigid-ac-matches-eq11"] == "reproduced"
     assert status["fig6a-rigid-ac-not-eq10"] == "reproduced"

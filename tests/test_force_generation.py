@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd import ledger
+from passmd import ledger, readings
 from passmd.experiments import figure_data, figure_names, figure_plot
 from passmd.experiments import force_generation as fg
 
@@ -227,16 +227,18 @@ def test_ledger_rows_of_fig7(quick):
         "fig7b-discrepancy-grows-with-amplitude", "fig7-critical-amplitude-both-models",
     }
     evaluated = ledger.evaluate(claims, {k: quick[k] for k in keys})
-    assert (evaluated["status"] != "not evaluated").all(), evaluated[["claim", "note"]]
+    assert (evaluated["status"] != "inconclusive").all(), evaluated[["claim", "verdict"]]
     status = dict(zip(evaluated["claim"], evaluated["status"], strict=True))
     assert status["fig7a-force-difference-115mn"] == "reproduced"
     # the quick grid (0, 0.2, 0.7, 1.0 × A_max) has an amplitude between the two onsets at 0.3 N (fig7a)
     # and at 0.4 N (fig7b): the difference dips there, as on the paper grid (see the chapter)
-    assert status["fig7a-discrepancy-grows-with-amplitude"] == "expected to differ"
-    assert status["fig7b-discrepancy-grows-with-amplitude"] == "expected to differ"
-    assert status["fig7-critical-amplitude-both-models"] == "expected to differ"
-    unexplained = evaluated[evaluated["status"] == "not reproduced"]
-    assert unexplained.empty, unexplained[["claim", "verdict"]].to_string()
+    assert status["fig7a-discrepancy-grows-with-amplitude"] == "not reproduced"
+    assert status["fig7b-discrepancy-grows-with-amplitude"] == "not reproduced"
+    assert status["fig7-critical-amplitude-both-models"] == "not reproduced"
+    # each of them shows the evaluated check beside it
+    assert evaluated.set_index("claim").loc[
+        ["fig7a-discrepancy-grows-with-amplitude", "fig7-critical-amplitude-both-models"], "evidence"
+    ].str.contains("fails").all()
 
 
 def test_force_difference_extractor_uses_only_stalled_pairs(quick):
@@ -244,4 +246,4 @@ def test_force_difference_extractor_uses_only_stalled_pairs(quick):
     full = np.isclose(table["amplitude_fraction"], 1.0) & np.isclose(table["preload_N"], 0.8)
     table.loc[full & (table["actuator_model"] == "flexible"), "converged"] = False
     with pytest.raises(ledger.NotEvaluable):
-        ledger.extractors()["fig7a-force-difference-115mn"]({"fig7a": table})
+        ledger.extractors()["fig7a-force-difference-115mn"]({"fig7a": table}, readings.default_reading())

@@ -60,6 +60,8 @@ def registry(monkeypatch):
     experiments.figure_names()
     extractors, figures = {}, {}
     monkeypatch.setattr(ledger, "_EXTRACTORS", extractors)
+    monkeypatch.setattr(ledger, "_DEPENDS", {})
+    monkeypatch.setattr(ledger, "_EVIDENCE", {})
     monkeypatch.setattr(experiments, "FIGURES", figures)
     return extractors, figures
 
@@ -110,6 +112,7 @@ def test_stated_numbers_of_the_paper():
         "fig9a-step-increase-46.8pct": 46.8, "fig9b-optimized-faster-below-110khz": 110,
         "fig9b-max-gain-2.5mm_s": 2.5, "fig10a-max-velocity-19mm_s": 19,
         "fig10a-0.1n-stick-lost-above-80khz": 80, "abstract-velocity-gain-15pct": 15,
+        "fig9b-sawtooth-velocity-16.5mm_s-at-110khz": 19 - 2.5,  # implied: Fig. 10a's 19 minus the 2.5 gain
     }
     for claim, value in stated.items():
         assert claims.at[claim, "paper_value_num"] == value, claim
@@ -136,7 +139,6 @@ def test_schema_errors_name_the_row_and_the_problem(tmp_path):
         _claim(id="no-value", check="value", tolerance="0.1", tolerance_kind="rel"),
         _claim(id="no-kind", check="trend", relation="increasing", tolerance="0.1"),
         _claim(id="bad-rel", check="ordering", relation="=="),
-        _claim(id="flag", check="ordering", relation="<", expected_to_differ="yes"),
         _claim(id="ref", check="value", reference="fig5b_closed_form.csv:nope", tolerance="0.1",
                tolerance_kind="rel"),
         _claim(id="cfg", check="ordering", relation="<", preload_N="0.4 N", actuator_model="stiff"),
@@ -155,7 +157,6 @@ def test_schema_errors_name_the_row_and_the_problem(tmp_path):
         "row 'no-value': a value claim needs exactly one of paper_value and reference",
         "row 'no-kind': tolerance_kind = '' is not allowed",
         "row 'bad-rel': relation = '==' is not allowed",
-        "row 'flag': expected_difference_reason is empty",
         "row 'ref': reference column 'nope' is not in fig5b_closed_form.csv",
         "row 'cfg': preload_N = '0.4 N' is not allowed",
         "row 'cfg': actuator_model = 'stiff' is not allowed",
@@ -192,7 +193,7 @@ def test_value_check_scalar_relative_and_absolute():
         ledger.check_value([1.0, 2.0], 1.0, 0.1)
     with pytest.raises(ValueError, match="must be a number"):
         ledger.check_value({"x": [1.0], "y": [1.0]}, 1.0, 0.1)  # a curve for a scalar claim
-    with pytest.raises(ValueError, match="non-finite"):
+    with pytest.raises(ledger.NotEvaluable, match="non-finite"):  # inconclusive, never a pass
         ledger.check_value(math.nan, 1.0, 0.1)
 
 
@@ -246,6 +247,12 @@ def test_threshold_check():
         ledger.check_threshold({"x": [60.0, 70.0], "holds": [True, True]}, "holds_below", 50.0, 5.0, "abs")
     with pytest.raises(ledger.NotEvaluable, match="far side"):
         ledger.check_threshold({"x": [10.0, 20.0], "holds": [True, True]}, "switch_below", 50.0, 5.0, "abs")
+    # NaN never counts as holding: a boolean read from a column with gaps is inconclusive
+    with pytest.raises(ledger.NotEvaluable, match="non-finite"):
+        ledger.check_threshold({"x": [10.0, 20.0, 60.0], "holds": [1.0, np.nan, 0.0]}, "switch_below", 50.0,
+                               5.0, "abs")
+    with pytest.raises(ValueError, match="must be booleans"):
+        ledger.check_threshold({"x": [10.0, 60.0], "holds": [0.5, 0.0]}, "switch_below", 50.0, 5.0, "abs")
 
 
 def test_trend_check():
@@ -275,44 +282,77 @@ def test_curve_deviation_helper():
 # evaluation and verdicts
 # --------------------------------------------------------------------------------------
 
-def test_evaluate_computes_verdicts(tmp_path, registry):
+def test_evaluate_computes_categories(tmp_path, registry):
     claims = ledger.load_claims(_write(tmp_path, SYNTHETIC))
     _register_good()
     evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}).set_index("claim")
     assert list(evaluated.reset_index().columns) == list(ledger.LEDGER_COLUMNS)
-    assert evaluated.at["val", "verdict"] == "reproduced within 3 %"
+    assert evaluated.at["val", "verdict"] == "within 3 % at the defaults"
     assert evaluated.at["val", "paper"] == "100" and evaluated.at["val", "ours"] == 103.0
     assert evaluated.at["val", "tolerance"] == "5 %"
-    for claim in ("ord", "thr", "trd"):
-        assert evaluated.at[claim, "verdict"] == "reproduced", claim
+    for claim in ("val", "ord", "thr", "trd"):
+        assert evaluated.at[claim, "status"] == "reproduced", claim
     assert evaluated.at["thr", "tolerance"] == "5 nm"
-    assert evaluated.at["other", "status"] == "not evaluated"
-    assert evaluated.at["other", "note"] == "needs results: fig9b"
-    assert ledger.summary(evaluated.reset_index()) == "4 of 5 claims reproduced; 1 not evaluated"
+    # results that are missing leave the claim inconclusive, naming what is missing
+    assert evaluated.at["other", "status"] == "inconclusive"
+    assert evaluated.at["other", "verdict"] == "needs results: fig9b"
+    assert ledger.summary(evaluated.reset_index()) == "4 of 5 claims reproduced; 1 inconclusive"
 
 
-def test_failed_and_expected_to_differ_verdicts(tmp_path, registry):
+def test_failures_are_not_reproduced_with_their_evidence(tmp_path, registry):
     rows = [dict(r) for r in SYNTHETIC]
-    rows[1].update(expected_to_differ="yes", expected_difference_reason="our runner is lighter")
+    rows[1].update(reason="our runner is lighter")
     claims = ledger.load_claims(_write(tmp_path, rows))
     _register_good({"val": 120.0})
     registry[0]["ord"] = lambda results: {"lhs": 0.5, "rhs": 1.0}
+
+    def total_failure(results):
+        raise ledger.ClaimFails("no step up to the full stroke")
+
+    registry[0]["thr"] = total_failure
     evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame(), "fig9b": pd.DataFrame()})
     evaluated = evaluated.set_index("claim")
-    assert evaluated.at["val", "verdict"] == "not reproduced: deviation 20 % exceeds the tolerance 5 %"
     assert evaluated.at["val", "status"] == "not reproduced"
-    assert evaluated.at["ord", "verdict"] == "expected to differ: our runner is lighter"
-    assert evaluated.at["ord", "status"] == "expected to differ"
-    assert ledger.summary(evaluated.reset_index()) == (
-        "3 of 5 claims reproduced; 1 not reproduced, 1 expected to differ")
+    assert "deviation 20 % exceeds the tolerance 5 %" in evaluated.at["val", "evidence"]
+    assert evaluated.at["ord", "status"] == "not reproduced"
+    assert evaluated.at["ord", "reason"] == "our runner is lighter"  # a human reason, never the category
+    assert evaluated.at["thr", "status"] == "not reproduced"  # a total failure is a failure
+    assert "no step up to the full stroke" in evaluated.at["thr", "evidence"]
+    assert ledger.summary(evaluated.reset_index()) == "2 of 5 claims reproduced; 3 not reproduced"
 
 
-def test_expected_to_differ_but_reproduced_says_so(tmp_path, registry):
-    rows = [dict(SYNTHETIC[1], expected_to_differ="yes", expected_difference_reason="r")]
-    ledger.register_extractor("ord")(lambda results: {"lhs": 2.0, "rhs": 1.0})
-    evaluated = ledger.evaluate(ledger.load_claims(_write(tmp_path, rows)), {"fig5a": pd.DataFrame()})
-    assert evaluated.at[0, "status"] == "reproduced"
-    assert "remove the mark" in evaluated.at[0, "note"]
+def test_another_reading_and_uncovered_readings(tmp_path, registry):
+    """A claim that fails at the defaults but holds at a declared alternative names that reading;
+    one whose alternatives are not in the tables is inconclusive, not 'not reproduced'."""
+    claims = ledger.load_claims(_write(tmp_path, SYNTHETIC[:2]))
+
+    @ledger.register_extractor("val", depends_on=("flyback",))
+    def _val(results, reading):
+        return 100.0 if reading["flyback"] == "fixed" else 130.0
+
+    @ledger.register_extractor("ord", depends_on=("flyback",))
+    def _ord(results, reading):
+        if reading["flyback"] == "fixed":
+            raise ledger.NotEvaluable("no fixed fly-back runs")
+        return {"lhs": 0.5, "rhs": 1.0}
+
+    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}).set_index("claim")
+    assert evaluated.at["val", "status"] == "reproduced under another reading"
+    assert evaluated.at["val", "verdict"] == "holds at fly-back rule = fixed"
+    assert evaluated.at["val", "best_reading"] == "fly-back rule = fixed"
+    assert evaluated.at["val", "fraction_holds"] == 0.5
+    assert evaluated.at["ord", "status"] == "inconclusive"
+    assert "not covered: fly-back rule = fixed (no fixed fly-back runs)" in evaluated.at["ord", "verdict"]
+    table = ledger.assumption_map(evaluated.reset_index())
+    assert list(table.columns) == ["claim", "defaults", "fly-back rule = fixed", "holds at", "best reading"]
+    row = table.set_index("claim").loc["val"].tolist()
+    assert row == ["fails", "holds", "1 of 2", "fly-back rule = fixed"]
+    assert "R1: fly-back rule = fixed" in ledger.assumption_map_styled(evaluated.reset_index()).to_html()
+
+
+def test_unknown_assumption_axis_is_refused(registry):
+    with pytest.raises(ValueError, match="assumption axis = 'colour' is not declared"):
+        ledger.register_extractor("x", depends_on=("colour",))
 
 
 def test_missing_extractor_is_an_error_unless_lenient(tmp_path, registry):
@@ -322,7 +362,8 @@ def test_missing_extractor_is_an_error_unless_lenient(tmp_path, registry):
     with pytest.raises(LookupError, match="claim 'ord' has its results but no registered extractor"):
         ledger.evaluate(claims, {"fig5a": pd.DataFrame()})
     lenient = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, strict=False).set_index("claim")
-    assert lenient.at["ord", "note"] == "no extractor registered"
+    assert lenient.at["ord", "verdict"] == "no extractor registered"
+    assert lenient.at["ord", "status"] == "inconclusive"
     assert ledger.orphan_extractors(claims) == ["typo"]
 
 
@@ -350,27 +391,28 @@ def test_not_evaluable_from_extractor(tmp_path, registry):
         raise ledger.NotEvaluable("quick grid has no point at 100 Hz")
 
     evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()})
-    assert evaluated.at[0, "status"] == "not evaluated"
-    assert evaluated.at[0, "note"] == "quick grid has no point at 100 Hz"
+    assert evaluated.at[0, "status"] == "inconclusive"
+    assert evaluated.at[0, "verdict"] == "at the defaults: quick grid has no point at 100 Hz"
 
 
-def test_a_regressing_verdict_fails(tmp_path, registry):
-    """A claim reproduced in the baseline that stops being reproduced must fail the test suite."""
+def test_any_category_change_fails_with_a_readable_diff(tmp_path, registry):
+    """Every change of category against the baseline fails, not only a lost 'reproduced'."""
     claims = ledger.load_claims(_write(tmp_path, SYNTHETIC))
     _register_good()
     results = {"fig5a": pd.DataFrame()}
     baseline_path = tmp_path / "baseline.csv"
-    ledger.write_baseline(ledger.evaluate(claims, results), baseline_path)
+    ledger.write_baseline(ledger.evaluate(claims, results), baseline_path, header="made by a test\non a day")
+    assert baseline_path.read_text().startswith("# made by a test\n# on a day\nclaim,status\n")
     baseline = ledger.load_baseline(baseline_path)
-    assert baseline["val"] == "reproduced" and baseline["other"] == "not evaluated"
-    ledger.check_no_regressions(ledger.evaluate(claims, results), baseline)  # unchanged: fine
+    assert baseline["val"] == "reproduced" and baseline["other"] == "inconclusive"
+    ledger.check_categories(ledger.evaluate(claims, results), baseline)  # unchanged: fine
     registry[0]["val"] = lambda results: 90.0  # the model drifts 10 % away from the paper
-    with pytest.raises(AssertionError, match="val: not reproduced: deviation 10 %"):
-        ledger.check_no_regressions(ledger.evaluate(claims, results), baseline)
-    # losing a figure is a regression too; improving a not-evaluated claim is not
+    with pytest.raises(AssertionError, match="val: reproduced -> not reproduced"):
+        ledger.check_categories(ledger.evaluate(claims, results), baseline)
+    # an inconclusive claim that becomes decidable is a change too (review it, then record it)
     registry[0]["val"] = lambda results: 100.0
-    lost = ledger.regressions(ledger.evaluate(claims, {}), baseline)
-    assert set(lost["claim"]) == {"val", "ord", "thr", "trd"}
+    changed = ledger.category_changes(ledger.evaluate(claims, {**results, "fig9b": pd.DataFrame()}), baseline)
+    assert changed[["claim", "baseline", "now"]].values.tolist() == [["other", "inconclusive", "reproduced"]]
 
 
 # --------------------------------------------------------------------------------------
@@ -413,24 +455,34 @@ def test_registration_rules(registry):
         ledger.register_extractor("x")(second)
 
 
-def test_real_ledger_closed_form_claim_is_reproduced_and_the_rest_wait():
+def test_real_ledger_closed_form_claim_is_labelled_and_the_rest_wait():
     claims = ledger.load_claims()
     results = {"closed_forms": ledger.closed_form_results("quick")}
     evaluated = ledger.evaluate(claims, results).set_index("claim")
-    assert evaluated.at["fig10b-r1-stiffer-contact", "verdict"] == "reproduced"
+    assert evaluated.at["fig10b-r1-stiffer-contact", "status"] == "reproduced"
+    assert evaluated.at["fig10b-r1-stiffer-contact", "basis"] == "closed form"
     others = evaluated.drop(index="fig10b-r1-stiffer-contact")
-    assert (others["status"] == "not evaluated").all()
-    assert others["note"].str.startswith("needs results: fig").all()
+    assert (others["status"] == "inconclusive").all()
+    assert others["verdict"].str.startswith("needs results: fig").all()
+    text = ledger.summary(evaluated.reset_index())
+    assert text.startswith("1 of ") and "(1 of them a closed-form identity, not a simulation)" in text
 
 
-def test_styled_colours_verdicts(tmp_path, registry):
+def test_styled_one_line_per_claim_and_details(tmp_path, registry):
     claims = ledger.load_claims(_write(tmp_path, SYNTHETIC))
     _register_good({"val": 150.0})
-    html = ledger.styled(ledger.evaluate(claims, {"fig5a": pd.DataFrame()})).to_html()
-    assert 'class="passmd-ledger"' in html
-    for status in ("reproduced", "not reproduced", "not evaluated"):
+    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()})
+    html = ledger.styled(evaluated, links=True).to_html()
+    assert 'class="passmd-ledger"' in html and 'href="#claim-val"' in html
+    for status in ("reproduced", "not reproduced", "inconclusive"):
         assert ledger.STATUS_COLOURS[status] in html
-    assert "not reproduced: deviation 50 % exceeds the tolerance 5 %" in html
+    assert "exceeds the tolerance" not in html  # details live in the collapsible blocks
+    details = ledger.details_markdown(evaluated, claims)
+    assert "(ledger-not-reproduced)=" in details and "(claim-val)=" in details
+    assert "deviation 50 % exceeds the tolerance 5 %" in details
+    headline = ledger.headline_markdown(evaluated)
+    assert "[1 not reproduced](replication_report.md#ledger-not-reproduced)" in headline
+    assert "0 reproduced under another reading" in headline
 
 
 def test_assumptions_table_lists_the_registered_assumptions():
@@ -448,3 +500,36 @@ def test_sources_markdown_escapes_markup_and_marks_assumptions():
     assert "u\\*\\_x,max,e" in text  # 'u*_x,max,e' must not start italics in MyST
     assert "μ = 0.2 (assumed)" in text and "F\\_p on the preload grid" in text
     assert "*Check:* value, tolerance 20 %." in text
+
+
+def test_ledger_command_prints_categories_and_si_json(monkeypatch, capsys):
+    """`passmd ledger --json` gives every claim's computed category with SI keys."""
+    import io
+    import json
+
+    from passmd import cli
+
+    calls = []
+
+    def closed_forms_only(profile):
+        calls.append(profile)
+        return {"closed_forms": ledger.closed_form_results(profile)}
+
+    monkeypatch.setattr(ledger, "collect_results", closed_forms_only)
+    out = io.StringIO()
+    assert cli.main(["ledger", "--profile", "paper", "--json"], out=out) == 0
+    payload = json.loads(out.getvalue())
+    assert calls == ["paper"] and payload["profile"] == "paper"
+    claims = {c["claim"]: c for c in payload["claims"]}
+    assert set(claims) == set(ledger.load_claims()["id"])
+    stiffer = claims["fig10b-r1-stiffer-contact"]
+    assert stiffer["category"] == "reproduced" and stiffer["basis"] == "closed form"
+    assert stiffer["readings"] == {"defaults": "holds"} and stiffer["evidence"]
+    waiting = claims["fig9a-standard-position-552nm"]
+    assert waiting["category"] == "inconclusive" and waiting["paper_m"] == pytest.approx(552e-9)
+    assert sum(payload["counts"].values()) == len(claims)
+    text = io.StringIO()
+    assert cli.main(["ledger"], out=text) == 0
+    assert "fig10b-r1-stiffer-contact: reproduced (closed form)" in text.getvalue()
+    assert cli.main(["ledger", "--workers", "0"], out=io.StringIO()) == 2
+    assert "--workers = 0 is out of range" in capsys.readouterr().err

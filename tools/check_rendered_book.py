@@ -108,6 +108,9 @@ const ledgerSelector = arguments[0];
     raw_tex: rawTex.slice(0, 5),
     ledger_tables: Array.from(root.querySelectorAll(ledgerSelector))
       .filter(t => t.querySelectorAll('tbody tr').length > 0).length,
+    ledger_overflow: Array.from(root.querySelectorAll(ledgerSelector))
+      .map(t => Math.round(t.getBoundingClientRect().width - root.getBoundingClientRect().width))
+      .filter(excess => excess > 1),
     links: Array.from(root.querySelectorAll('a[href]')).map(a => a.getAttribute('href')),
     window_width: window.innerWidth,
     viewport_width: document.documentElement.clientWidth,
@@ -184,6 +187,8 @@ def page_problems(facts: dict) -> list[str]:
             f"{facts.get('ledger_tables', 0)} ledger table(s) ({LEDGER_SELECTOR} with rows), "
             f"expected at least {expect['ledger']}"
         )
+    for excess in facts.get("ledger_overflow", []):
+        problems.append(f"a ledger table is {excess} px wider than the content column")
     for message in facts.get("error_outputs", []):
         problems.append(f"execution error shown: {message}")
     for message in facts.get("stderr_outputs", []):

@@ -47,7 +47,7 @@ import pandas as pd
 from passmd import dynamics, reference, sweep, waveforms
 from passmd._validation import check_choice, check_positive, check_range
 from passmd.experiments import PROFILES, register_figure
-from passmd.ledger import NotEvaluable, curve_deviation, register_extractor
+from passmd.ledger import ClaimFails, NotEvaluable, curve_deviation, register_extractor
 from passmd.parameters import (
     ACTUATOR_DAMPING_RATIO,
     PRELOAD_GRIDS,
@@ -694,64 +694,89 @@ def fig56_frequency(profile: str = "paper") -> pd.DataFrame:
 # --------------------------------------------------------------------------------------
 
 
-def primary(table: pd.DataFrame, actuator_model: str | None = None) -> pd.DataFrame:
-    """The rows of the primary protocol: steady state, :data:`DRIVE_FREQUENCY`, slew-rate fly-back."""
+def primary(table: pd.DataFrame, actuator_model: str | None = None, reading=None) -> pd.DataFrame:
+    """The rows of one reading of the A_c protocol (default: steady state, :data:`DRIVE_FREQUENCY`,
+    slew-rate fly-back).
+
+    ``reading`` is a ledger reading (:mod:`passmd.readings`): its ``ac_protocol``,
+    ``flyback`` and ``drive_frequency_s4`` select the rows. The fly-back rule applies to flexible
+    actuators only (the rigid runs use the slew-rate fly-back). Raises
+    :class:`passmd.ledger.NotEvaluable` when the table holds no run at that reading and
+    :class:`passmd.ledger.ClaimFails` when a preload makes no step up to the full stroke.
+    """
+    protocol, flyback, frequency = "steady", "slew", DRIVE_FREQUENCY
+    if reading is not None:
+        protocol, flyback = reading["ac_protocol"], reading["flyback"]
+        frequency = float(reading["drive_frequency_s4"])
+    if actuator_model == "rigid":
+        flyback = "slew"
     rows = table[
-        (table["protocol"] == "steady")
-        & (table["flyback"] == "slew")
-        & np.isclose(table["frequency_Hz"], DRIVE_FREQUENCY)
+        (table["protocol"] == protocol)
+        & (table["flyback"] == flyback)
+        & np.isclose(table["frequency_Hz"], frequency)
     ]
     if actuator_model is not None:
         rows = rows[rows["actuator_model"] == actuator_model]
     rows = rows.sort_values("preload_N")
+    if rows.empty:
+        raise NotEvaluable(f"no {protocol} A_c runs with the {flyback} fly-back at {frequency:g} Hz "
+                           "on this grid")
     if rows["critical_amplitude_nm"].isna().any():
-        raise NotEvaluable("no step up to the full stroke at some preload (A_c above A_max)")
+        where = rows.loc[rows["critical_amplitude_nm"].isna(), "preload_N"].tolist()
+        raise ClaimFails(f"no step up to the full stroke at {', '.join(f'{p:g}' for p in where)} N "
+                         "(A_c above A_max)")
     return rows
 
 
-def _curve(results, key: str, actuator_model: str) -> dict:
-    rows = primary(results[key], actuator_model)
+def _curve(results, key: str, actuator_model: str, reading=None) -> dict:
+    rows = primary(results[key], actuator_model, reading)
     return {"x": rows["preload_N"].to_numpy(), "y": rows["critical_amplitude_nm"].to_numpy()}
 
 
-@register_extractor("fig5a-no-step-below-50nm")
-def _fig5a_no_step(results) -> dict:
+#: Axes of passmd.readings the A_c curves depend on (rigid actuators: not the fly-back rule).
+_RIGID_AXES = ("ac_protocol", "drive_frequency_s4")
+_FLEXIBLE_AXES = ("flyback", "ac_protocol", "drive_frequency_s4")
+
+
+@register_extractor("fig5a-no-step-below-50nm", depends_on=("flyback",))
+def _fig5a_no_step(results, reading) -> dict:
     table = results["fig5a"]
-    rows = table[(table["actuator_model"] == "flexible") & (table["flyback"] == "slew")].sort_values(
-        "amplitude_nm"
-    )
-    return {
-        "x": rows["amplitude_nm"].to_numpy(),
-        "holds": (rows["steady_step_nm"] <= rows["threshold_nm"]).to_numpy(),
-    }
+    rows = table[(table["actuator_model"] == "flexible") & (table["flyback"] == reading["flyback"])]
+    rows = rows.sort_values("amplitude_nm")
+    if rows.empty:
+        raise NotEvaluable(f"no flexible runs with the {reading['flyback']} fly-back")
+    step = rows["steady_step_nm"].to_numpy(dtype=float)
+    holds = np.where(np.isfinite(step), step <= rows["threshold_nm"].to_numpy(dtype=float), np.nan)
+    return {"x": rows["amplitude_nm"].to_numpy(), "holds": holds}
 
 
-@register_extractor("fig5b-rigid-ac-matches-eq7")
-def _fig5b_rigid(results) -> dict:
-    return _curve(results, "fig5b", "rigid")
+@register_extractor("fig5b-rigid-ac-matches-eq7", depends_on=_RIGID_AXES)
+def _fig5b_rigid(results, reading) -> dict:
+    return _curve(results, "fig5b", "rigid", reading)
 
 
-@register_extractor("fig5b-flexible-ac-matches-eq8")
-def _fig5b_flexible(results) -> dict:
-    return _curve(results, "fig5b", "flexible")
+@register_extractor("fig5b-flexible-ac-matches-eq8", depends_on=_FLEXIBLE_AXES)
+def _fig5b_flexible(results, reading) -> dict:
+    return _curve(results, "fig5b", "flexible", reading)
 
 
-@register_extractor("fig5b-flexible-above-rigid")
-def _fig5b_order(results) -> dict:
-    rigid, flexible = _curve(results, "fig5b", "rigid"), _curve(results, "fig5b", "flexible")
+@register_extractor("fig5b-flexible-above-rigid", depends_on=_FLEXIBLE_AXES)
+def _fig5b_order(results, reading) -> dict:
+    rigid = _curve(results, "fig5b", "rigid", reading)
+    flexible = _curve(results, "fig5b", "flexible", reading)
     if not np.array_equal(rigid["x"], flexible["x"]):
         raise NotEvaluable("rigid and flexible A_c are not on the same preloads")
     return {"lhs": flexible["y"], "rhs": rigid["y"]}
 
 
-@register_extractor("fig6a-rigid-ac-matches-eq11")
-def _fig6a_eq11(results) -> dict:
-    return _curve(results, "fig6a", "rigid")
+@register_extractor("fig6a-rigid-ac-matches-eq11", depends_on=_RIGID_AXES)
+def _fig6a_eq11(results, reading) -> dict:
+    return _curve(results, "fig6a", "rigid", reading)
 
 
-@register_extractor("fig6a-rigid-ac-not-eq10")
-def _fig6a_not_eq10(results) -> dict:
-    c = _curve(results, "fig6a", "rigid")
+@register_extractor("fig6a-rigid-ac-not-eq10", depends_on=_RIGID_AXES)
+def _fig6a_not_eq10(results, reading) -> dict:
+    c = _curve(results, "fig6a", "rigid", reading)
     own = curve_deviation(c["x"], c["y"], "fig6a_closed_form", "u_x_max_e_nm")
     sides = min(
         curve_deviation(c["x"], c["y"], "fig6a_closed_form", column)
@@ -760,11 +785,11 @@ def _fig6a_not_eq10(results) -> dict:
     return {"lhs": own, "rhs": sides}
 
 
-@register_extractor("fig6b-flexible-r1-ac-matches-eq12")
-def _fig6b_eq12(results) -> dict:
-    return _curve(results, "fig6b", "flexible")
+@register_extractor("fig6b-flexible-r1-ac-matches-eq12", depends_on=_FLEXIBLE_AXES)
+def _fig6b_eq12(results, reading) -> dict:
+    return _curve(results, "fig6b", "flexible", reading)
 
 
-@register_extractor("fig6c-flexible-r025-ac-matches-eq12")
-def _fig6c_eq12(results) -> dict:
-    return _curve(results, "fig6c", "flexible")
+@register_extractor("fig6c-flexible-r025-ac-matches-eq12", depends_on=_FLEXIBLE_AXES)
+def _fig6c_eq12(results, reading) -> dict:
+    return _curve(results, "fig6c", "flexible", reading)

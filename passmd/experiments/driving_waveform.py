@@ -38,7 +38,7 @@ import pandas as pd
 from passmd import dynamics, sweep, theory, waveforms
 from passmd._validation import check_choice
 from passmd.experiments import PROFILES, register_figure
-from passmd.ledger import NotEvaluable, register_extractor
+from passmd.ledger import ClaimFails, NotEvaluable, register_evidence, register_extractor
 from passmd.parameters import MOLYBDENUM, STEEL, Assumption, Drive, paper_drive, register_assumption
 from passmd.plots import driving_waveform as plots
 
@@ -581,9 +581,44 @@ def _series(table: pd.DataFrame, variant: str, **where) -> pd.DataFrame:
     return part
 
 
+def _optimized(reading) -> str:
+    """The optimized variant of a ledger reading (axis ``short_period`` of passmd.readings)."""
+    return variant_name("optimized", reading["short_period"])
+
+
 def reachable_maximum(part: pd.DataFrame) -> pd.Series:
-    """The row of the largest steady velocity of one series (assumption ``controllable_frequency``)."""
-    return part.loc[part["velocity_m_per_s"].idxmax()]
+    """The row of the largest steady velocity of one series (assumption ``controllable_frequency``).
+
+    A maximum must be interior: when the largest velocity lies at either end of the frequency
+    grid, the grid does not locate a reachable maximum and the claim is inconclusive
+    (:class:`passmd.ledger.NotEvaluable`).
+    """
+    best = range_maximum(part)
+    f = part["frequency_kHz"].to_numpy()
+    if np.isclose(best["frequency_kHz"], f.min()) or np.isclose(best["frequency_kHz"], f.max()):
+        raise NotEvaluable(
+            f"no interior maximum: the largest velocity ({best['velocity_mm_per_s']:.3g} mm/s) lies at the "
+            f"grid's edge, {best['frequency_kHz']:g} kHz of {f.min():g}–{f.max():g} kHz")
+    return best
+
+
+def range_maximum(part: pd.DataFrame) -> pd.Series:
+    """The row of the largest steady velocity over the whole frequency grid (edges included)."""
+    if not np.all(np.isfinite(part["velocity_mm_per_s"].to_numpy(dtype=float))):
+        raise NotEvaluable("non-finite velocities on the frequency grid")
+    return part.loc[part["velocity_mm_per_s"].idxmax()]
+
+
+def at_frequency(part: pd.DataFrame, frequency_kHz: float) -> pd.Series:
+    """The row of a series at a grid frequency (kHz); inconclusive when the grid lacks it."""
+    rows = part[np.isclose(part["frequency_kHz"], frequency_kHz)]
+    if rows.empty:
+        raise NotEvaluable(f"the frequency grid has no point at {frequency_kHz:g} kHz")
+    return rows.iloc[0]
+
+
+#: Frequency at which Section 5.2 reads the reachable maximal velocity at 0.4 N (kHz).
+PAPER_MAXIMUM_KHZ = 110.0
 
 
 @register_extractor("fig8a-back-step")
@@ -591,11 +626,56 @@ def _fig8a_back_step(results):
     return {"lhs": float(results["fig8a"]["first_back_step_m"].iloc[0]) * 1e9, "rhs": 0.0}
 
 
+def optimized_period_timing(results) -> dict:
+    """Timing of the runner in the optimized period of Fig. 8b (µs), from the zoomed trace.
+
+    ``flyback_end`` (point 4 minus t_s), ``reversal`` (the runner's backward extreme between
+    points 2 and 5, Section 5.1's point 3), ``point4`` (end of t_s, start of t_a), ``t_s`` and
+    the design's ``f_s`` (Hz). Inconclusive when the trace or the points are missing.
+    """
+    table = results["fig8b"]
+    points = table[table["view"] == "point"].set_index("point")
+    zoom = table[table["view"] == "zoom"].sort_values("time_us")
+    if zoom.empty or not {"2", "4", "5"} <= set(points.index.astype(str)):
+        raise NotEvaluable("the Fig. 8b trace or its points 2, 4 and 5 are missing")
+    points.index = points.index.astype(str)
+    t2, t4, t5 = (float(points.at[p, "time_us"]) for p in ("2", "4", "5"))
+    t_s = float(points.at["4", "settling_time_s"]) * 1e6
+    window = zoom[(zoom["time_us"] >= t2) & (zoom["time_us"] <= t5)]
+    if len(window) < 3:
+        raise NotEvaluable("fewer than three trace samples between points 2 and 5")
+    reversal = float(window.loc[window["runner_position_nm"].idxmin(), "time_us"])
+    return {"flyback_end": t4 - t_s, "reversal": reversal, "point4": t4, "t_s": t_s,
+            "f_s": float(points.at["4", "micro_vibration_frequency_Hz"])}
+
+
 @register_extractor("sec5-response-to-optimized-similar")
 def _response_similar(results):
+    # The design premise: under the optimized waveform the runner reverses (point 3) after the
+    # half vibration period t_s = 1/(2 f_s) that the saw-tooth response predicts.
+    timing = optimized_period_timing(results)
+    return {"lhs": timing["reversal"] - timing["flyback_end"], "rhs": timing["t_s"]}
+
+
+@register_evidence("sec5-response-to-optimized-similar")
+def _response_similar_evidence(results):
     f_s = {w: float(_fig9a_run(results, w)["micro_vibration_frequency_Hz"].iloc[0]) / 1e3
            for w in ("optimized", "sawtooth")}
-    return {"lhs": f_s["optimized"], "rhs": f_s["sawtooth"]}
+    return [f"f_s: {f_s['optimized']:.4g} kHz (optimized run) against {f_s['sawtooth']:.4g} kHz "
+            "(saw-tooth run)"]
+
+
+@register_extractor("sec5-1-acceleration-starts-at-velocity-maximum")
+def _acceleration_phase(results):
+    timing = optimized_period_timing(results)
+    return (timing["point4"] - timing["reversal"]) * 1e-6 * timing["f_s"]
+
+
+@register_evidence("sec5-1-acceleration-starts-at-velocity-maximum")
+def _acceleration_phase_evidence(results):
+    t = optimized_period_timing(results)
+    return [f"fly-back ends at {t['flyback_end']:.2f} µs, the runner reverses at {t['reversal']:.2f} µs, "
+            f"t_s ends (point 4) at {t['point4']:.2f} µs; f_s = {t['f_s'] / 1e3:.4g} kHz"]
 
 
 @register_extractor("fig9a-standard-position-552nm")
@@ -622,48 +702,77 @@ def _fig9a_step_larger(results):
     return {"lhs": steps["optimized"], "rhs": steps["sawtooth"]}
 
 
-def _fig9b_pair(results):
+def _fig9b_pair(results, reading):
     table = results["fig9b"]
-    saw, opt = _series(table, "sawtooth"), _series(table, "optimized")
+    saw, opt = _series(table, "sawtooth"), _series(table, _optimized(reading))
     return saw["frequency_kHz"].to_numpy(), saw["velocity_mm_per_s"].to_numpy(), opt
 
 
-@register_extractor("fig9b-optimized-faster-below-110khz")
-def _fig9b_faster(results):
-    f, v_saw, opt = _fig9b_pair(results)
+@register_extractor("fig9b-optimized-faster-below-110khz", depends_on=("short_period",))
+def _fig9b_faster(results, reading):
+    f, v_saw, opt = _fig9b_pair(results, reading)
     return {"x": f, "holds": opt["velocity_mm_per_s"].to_numpy() > v_saw}
 
 
-def _largest_gain(results):
-    f, v_saw, opt = _fig9b_pair(results)
-    below = f <= 110.0
+def _largest_gain(results, reading):
+    f, v_saw, opt = _fig9b_pair(results, reading)
+    below = f <= PAPER_MAXIMUM_KHZ
     gain = opt["velocity_mm_per_s"].to_numpy()[below] - v_saw[below]
     i = int(np.argmax(gain))
     return gain[i], v_saw[below][i]
 
 
-@register_extractor("fig9b-max-gain-2.5mm_s")
-def _fig9b_max_gain(results):
-    return float(_largest_gain(results)[0])
+@register_extractor("fig9b-max-gain-2.5mm_s", depends_on=("short_period",))
+def _fig9b_max_gain(results, reading):
+    return float(_largest_gain(results, reading)[0])
 
 
-@register_extractor("abstract-velocity-gain-15pct")
-def _velocity_gain_pct(results):
-    gain, v_saw = _largest_gain(results)
+@register_extractor("abstract-velocity-gain-15pct", depends_on=("short_period",))
+def _velocity_gain_pct(results, reading):
+    gain, v_saw = _largest_gain(results, reading)
     return float(100.0 * gain / v_saw)
 
 
 def _above(results, variant):
     part = _series(results["fig9b"], variant)
-    part = part[part["frequency_kHz"] >= 110.0 - 1e-9]
+    part = part[part["frequency_kHz"] >= PAPER_MAXIMUM_KHZ - 1e-9]
     if len(part) < 2:
         raise NotEvaluable("fewer than two grid frequencies at or above 110 kHz")
     return {"x": part["frequency_kHz"].to_numpy(), "y": part["velocity_mm_per_s"].to_numpy()}
 
 
-@register_extractor("fig9b-optimized-decreases-above-110khz")
-def _fig9b_opt_decreases(results):
-    return _above(results, "optimized")
+def turning_point(part: pd.DataFrame, where_kHz: float) -> pd.DataFrame:
+    """The part of a velocity series from its turning point on, when it rises and then falls there.
+
+    "Began decreasing above X" needs a rise before the fall and the turning point (the largest
+    velocity) within one grid step of X. Raises :class:`passmd.ledger.ClaimFails` naming the
+    located turning point otherwise, and :class:`passmd.ledger.NotEvaluable` when fewer than
+    two grid points follow it.
+    """
+    f = part["frequency_kHz"].to_numpy()
+    v = part["velocity_mm_per_s"].to_numpy(dtype=float)
+    if not np.all(np.isfinite(v)):
+        raise NotEvaluable("non-finite velocities on the frequency grid")
+    i = int(np.argmax(v))
+    if i == len(f) - 1:
+        raise ClaimFails(f"the velocity still rises at the grid's last point ({f[i]:g} kHz): it never "
+                         "begins decreasing")
+    if i == 0:
+        raise ClaimFails(f"no rise before the fall: the velocity is largest at the grid's first point "
+                         f"({f[0]:g} kHz, {v[0]:.3g} mm/s) and {v[-1]:.3g} mm/s at {f[-1]:g} kHz")
+    step = min(f[i] - f[i - 1], f[i + 1] - f[i])
+    if abs(f[i] - where_kHz) > step:
+        raise ClaimFails(f"the velocity turns at {f[i]:g} kHz ({v[i]:.3g} mm/s), not within one grid step "
+                         f"({step:g} kHz) of {where_kHz:g} kHz")
+    return part.iloc[i:]
+
+
+@register_extractor("fig9b-optimized-decreases-above-110khz", depends_on=("short_period",))
+def _fig9b_opt_decreases(results, reading):
+    after = turning_point(_series(results["fig9b"], _optimized(reading)), PAPER_MAXIMUM_KHZ)
+    if len(after) < 2:
+        raise NotEvaluable("fewer than two grid frequencies from the turning point on")
+    return {"x": after["frequency_kHz"].to_numpy(), "y": after["velocity_mm_per_s"].to_numpy()}
 
 
 @register_extractor("fig9b-standard-increases-above-110khz")
@@ -677,94 +786,151 @@ def _fig9b_step_decreases(results):
     return {"x": saw["frequency_kHz"].to_numpy(), "y": saw["step_nm"].to_numpy()}
 
 
+@register_extractor("fig9b-sawtooth-velocity-16.5mm_s-at-110khz")
+def _fig9b_sawtooth_110(results):
+    return float(at_frequency(_series(results["fig9b"], "sawtooth"), PAPER_MAXIMUM_KHZ)["velocity_mm_per_s"])
+
+
 @register_extractor("fig9b-no-time-to-settle-above-110khz")
 def _fig9b_settling(results):
     opt = _series(results["fig9b"], "optimized")
-    return {"x": opt["frequency_kHz"].to_numpy(), "holds": opt["settling_fits"].astype(bool).to_numpy()}
+    return {"x": opt["frequency_kHz"].to_numpy(), "holds": opt["settling_fits"].to_numpy(dtype=float)}
 
 
-def _fig10a_max(results, preload):
-    return reachable_maximum(_series(results["fig10a"], "optimized", preload=preload))
+def _fig10a_part(results, preload, reading):
+    return _series(results["fig10a"], _optimized(reading), preload=preload)
 
 
-@register_extractor("fig10a-max-velocity-19mm_s")
-def _fig10a_vmax(results):
-    return float(_fig10a_max(results, 0.4)["velocity_mm_per_s"])
+def _fig10a_max(results, preload, reading):
+    return reachable_maximum(_fig10a_part(results, preload, reading))
 
 
-@register_extractor("fig10a-max-velocity-at-110khz")
-def _fig10a_fmax(results):
-    return float(_fig10a_max(results, 0.4)["frequency_kHz"])
+@register_extractor("fig10a-max-velocity-19mm_s", depends_on=("short_period",))
+def _fig10a_vmax(results, reading):
+    # the largest velocity over the paper's whole frequency range: below 19 mm/s everywhere is a failure
+    return float(range_maximum(_fig10a_part(results, 0.4, reading))["velocity_mm_per_s"])
 
 
-@register_extractor("fig10a-1n-slower")
-def _fig10a_1n_slower(results):
-    return {"lhs": float(_fig10a_max(results, 1.0)["velocity_mm_per_s"]),
-            "rhs": float(_fig10a_max(results, 0.4)["velocity_mm_per_s"])}
+@register_extractor("fig10a-max-velocity-at-110khz", depends_on=("short_period",))
+def _fig10a_fmax(results, reading):
+    # where over the paper's range the velocity is largest; at a grid edge that is not 110 kHz either
+    return float(range_maximum(_fig10a_part(results, 0.4, reading))["frequency_kHz"])
 
 
-@register_extractor("fig10a-1n-larger-back-step")
-def _fig10a_1n_back(results):
-    return {"lhs": float(_fig10a_max(results, 1.0)["back_step_nm"]),
-            "rhs": float(_fig10a_max(results, 0.4)["back_step_nm"])}
+@register_extractor("fig10a-1n-slower", depends_on=("short_period",))
+def _fig10a_1n_slower(results, reading):
+    return {"lhs": float(_fig10a_max(results, 1.0, reading)["velocity_mm_per_s"]),
+            "rhs": float(_fig10a_max(results, 0.4, reading)["velocity_mm_per_s"])}
 
 
-@register_extractor("fig10a-0.1n-smaller-back-step")
-def _fig10a_01n_back(results):
-    return {"lhs": float(_fig10a_max(results, 0.1)["back_step_nm"]),
-            "rhs": float(_fig10a_max(results, 0.4)["back_step_nm"])}
+@register_extractor("fig10a-1n-larger-back-step", depends_on=("short_period",))
+def _fig10a_1n_back(results, reading):
+    return {"lhs": float(_fig10a_max(results, 1.0, reading)["back_step_nm"]),
+            "rhs": float(_fig10a_max(results, 0.4, reading)["back_step_nm"])}
+
+
+@register_extractor("fig10a-0.1n-smaller-back-step", depends_on=("short_period",))
+def _fig10a_01n_back(results, reading):
+    return {"lhs": float(_fig10a_max(results, 0.1, reading)["back_step_nm"]),
+            "rhs": float(_fig10a_max(results, 0.4, reading)["back_step_nm"])}
 
 
 @register_extractor("fig10a-0.1n-stick-lost-above-80khz")
 def _fig10a_stick(results):
     part = _series(results["fig10a"], "optimized", preload=0.1)
     return {"x": part["frequency_kHz"].to_numpy(),
-            "holds": part["stick_during_acceleration"].astype(bool).to_numpy()}
+            "holds": part["stick_during_acceleration"].to_numpy(dtype=float)}
 
 
-@register_extractor("fig10a-0.1n-slightly-slower")
-def _fig10a_01n_slower(results):
-    return {"lhs": float(_fig10a_max(results, 0.1)["velocity_mm_per_s"]),
-            "rhs": float(_fig10a_max(results, 0.4)["velocity_mm_per_s"])}
+@register_extractor("fig10a-0.1n-maximum-at-or-below-80khz", depends_on=("short_period",))
+def _fig10a_01n_at_80(results, reading):
+    part = _fig10a_part(results, 0.1, reading)
+    above = part["frequency_kHz"][part["frequency_kHz"] > 80.0 + 1e-9]
+    if above.empty:
+        raise NotEvaluable("the frequency grid has no point above 80 kHz")
+    return {"lhs": float(reachable_maximum(part)["frequency_kHz"]), "rhs": float(above.min())}
 
 
-def _fig10b_max(results, radius_mm):
-    return reachable_maximum(_series(results["fig10b"], "optimized", radius_mm=radius_mm))
+@register_extractor("fig10a-0.1n-slightly-slower", depends_on=("short_period",))
+def _fig10a_01n_slower(results, reading):
+    return {"lhs": float(_fig10a_max(results, 0.1, reading)["velocity_mm_per_s"]),
+            "rhs": float(_fig10a_max(results, 0.4, reading)["velocity_mm_per_s"])}
 
 
-@register_extractor("fig10b-r1-faster")
-def _fig10b_faster(results):
-    return {"lhs": float(_fig10b_max(results, 1.0)["velocity_mm_per_s"]),
-            "rhs": float(_fig10b_max(results, 0.25)["velocity_mm_per_s"])}
+def _fig10b_max(results, radius_mm, reading):
+    return reachable_maximum(_series(results["fig10b"], _optimized(reading), radius_mm=radius_mm))
 
 
-@register_extractor("fig10b-r1-higher-max-frequency")
-def _fig10b_frequency(results):
-    return {"lhs": float(_fig10b_max(results, 1.0)["frequency_kHz"]),
-            "rhs": float(_fig10b_max(results, 0.25)["frequency_kHz"])}
+@register_extractor("fig10b-r1-faster", depends_on=("short_period",))
+def _fig10b_faster(results, reading):
+    return {"lhs": float(_fig10b_max(results, 1.0, reading)["velocity_mm_per_s"]),
+            "rhs": float(_fig10b_max(results, 0.25, reading)["velocity_mm_per_s"])}
 
 
-@register_extractor("fig10b-r1-smaller-back-step")
-def _fig10b_back(results):
-    return {"lhs": float(_fig10b_max(results, 1.0)["back_step_nm"]),
-            "rhs": float(_fig10b_max(results, 0.25)["back_step_nm"])}
+@register_extractor("fig10b-r1-higher-max-frequency", depends_on=("short_period",))
+def _fig10b_frequency(results, reading):
+    return {"lhs": float(_fig10b_max(results, 1.0, reading)["frequency_kHz"]),
+            "rhs": float(_fig10b_max(results, 0.25, reading)["frequency_kHz"])}
 
 
-def _fig10c_max(results, runner):
-    best = reachable_maximum(_series(results["fig10c"], "optimized", runner=runner))
+@register_extractor("fig10b-r1-smaller-back-step", depends_on=("short_period",))
+def _fig10b_back(results, reading):
+    return {"lhs": float(_fig10b_max(results, 1.0, reading)["back_step_nm"]),
+            "rhs": float(_fig10b_max(results, 0.25, reading)["back_step_nm"])}
+
+
+def _fig10c_max(results, runner, reading):
+    best = reachable_maximum(_series(results["fig10c"], _optimized(reading), runner=runner))
     return float(best["velocity_mm_per_s"])
 
 
-@register_extractor("fig10c-youngs-modulus-negligible")
-def _fig10c_negligible(results):
-    return {"lhs": _fig10c_max(results, "molybdenum"), "rhs": _fig10c_max(results, "steel")}
+@register_extractor("fig10c-youngs-modulus-negligible", depends_on=("short_period",))
+def _fig10c_negligible(results, reading):
+    return {"lhs": _fig10c_max(results, "molybdenum", reading), "rhs": _fig10c_max(results, "steel", reading)}
 
 
-@register_extractor("conclusion-youngs-modulus-weaker-than-preload-and-radius")
-def _conclusion_youngs(results):
-    material = abs(_fig10c_max(results, "molybdenum") - _fig10c_max(results, "steel"))
-    preload = abs(float(_fig10a_max(results, 1.0)["velocity_mm_per_s"])
-                  - float(_fig10a_max(results, 0.4)["velocity_mm_per_s"]))
-    radius = abs(float(_fig10b_max(results, 1.0)["velocity_mm_per_s"])
-                 - float(_fig10b_max(results, 0.25)["velocity_mm_per_s"]))
+@register_extractor("conclusion-youngs-modulus-weaker-than-preload-and-radius", depends_on=("short_period",))
+def _conclusion_youngs(results, reading):
+    material = abs(_fig10c_max(results, "molybdenum", reading) - _fig10c_max(results, "steel", reading))
+    preload = abs(float(_fig10a_max(results, 1.0, reading)["velocity_mm_per_s"])
+                  - float(_fig10a_max(results, 0.4, reading)["velocity_mm_per_s"]))
+    radius = abs(float(_fig10b_max(results, 1.0, reading)["velocity_mm_per_s"])
+                 - float(_fig10b_max(results, 0.25, reading)["velocity_mm_per_s"]))
     return {"lhs": material, "rhs": min(preload, radius)}
+
+
+# Evidence where the paper makes the Fig. 10 claims: at its reachable maximum, 110 kHz.
+
+def _at_paper_maximum(table, column, label, **where):
+    row = at_frequency(_series(table, "optimized", **where), PAPER_MAXIMUM_KHZ)
+    return float(row[column]), label
+
+
+def _evidence_110(results, key, column, unit, pairs):
+    out = []
+    for where in pairs:
+        value, _ = _at_paper_maximum(results[key], column, "", **where)
+        name = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}" for k, v in where.items())
+        out.append(f"{column.replace('_mm_per_s', '').replace('_nm', '').replace('_', ' ')} at "
+                   f"{PAPER_MAXIMUM_KHZ:g} kHz, {name}: {value:.4g} {unit} "
+                   "(Eq. 15 waveform, settling time cut)")
+    return out
+
+
+def _register_fig10_evidence(claim_id, key, column, unit, pairs):
+    register_evidence(claim_id)(lambda results: _evidence_110(results, key, column, unit, pairs))
+
+
+for _claim, _key, _column, _unit, _pairs in (
+    ("fig10a-1n-slower", "fig10a", "velocity_mm_per_s", "mm/s", ({"preload": 1.0}, {"preload": 0.4})),
+    ("fig10a-1n-larger-back-step", "fig10a", "back_step_nm", "nm", ({"preload": 1.0}, {"preload": 0.4})),
+    ("fig10a-0.1n-smaller-back-step", "fig10a", "back_step_nm", "nm", ({"preload": 0.1}, {"preload": 0.4})),
+    ("fig10a-0.1n-slightly-slower", "fig10a", "velocity_mm_per_s", "mm/s",
+     ({"preload": 0.1}, {"preload": 0.4})),
+    ("fig10b-r1-faster", "fig10b", "velocity_mm_per_s", "mm/s", ({"radius_mm": 1.0}, {"radius_mm": 0.25})),
+    ("fig10b-r1-smaller-back-step", "fig10b", "back_step_nm", "nm",
+     ({"radius_mm": 1.0}, {"radius_mm": 0.25})),
+    ("fig10c-youngs-modulus-negligible", "fig10c", "velocity_mm_per_s", "mm/s",
+     ({"runner": "molybdenum"}, {"runner": "steel"})),
+):
+    _register_fig10_evidence(_claim, _key, _column, _unit, _pairs)

@@ -46,7 +46,7 @@ from passmd import dynamics, sweep, waveforms
 from passmd._validation import check_choice, check_positive, check_range
 from passmd.experiments import PROFILES, register_figure
 from passmd.experiments.critical_amplitude import critical_amplitude
-from passmd.ledger import NotEvaluable, register_extractor
+from passmd.ledger import ClaimFails, NotEvaluable, register_evidence, register_extractor
 from passmd.parameters import PRELOAD_GRIDS, Assumption, Drive, paper_drive, register_assumption
 from passmd.plots import force_generation as plots
 from passmd.theory import drive_theory, normal_forces
@@ -720,13 +720,68 @@ def force_difference(table: pd.DataFrame, preload: float) -> pd.DataFrame:
     })
 
 
-@register_extractor("fig7a-force-difference-115mn")
-def _fig7a_difference(results) -> float:
-    diff = force_difference(results["fig7a"], 0.8)
+@register_extractor("fig7a-force-difference-115mn", depends_on=("force_frequency",))
+def _fig7a_difference(results, reading) -> float:
+    frequency = float(reading["force_frequency"])
+    if np.isclose(frequency, FORCE_FREQUENCY):
+        diff = force_difference(results["fig7a"], 0.8)
+    else:  # the frequency panel holds the full-stroke runs at the other frequencies
+        if "fig7freq" not in results:
+            raise NotEvaluable("needs results: fig7freq")
+        table = results["fig7freq"]
+        rows = table[np.isclose(table["frequency_Hz"], frequency) & np.isclose(table["radius_mm"], 1.0)]
+        diff = force_difference(rows.assign(amplitude_fraction=1.0), 0.8)
     full = diff[np.isclose(diff["amplitude_nm"], PANELS_FULL_STROKE_NM["fig7a"])]
     if full.empty:
-        raise NotEvaluable("no stalled pair of runs at 202 nm and 0.8 N")
+        raise NotEvaluable(f"no stalled pair of runs at 202 nm and 0.8 N at {frequency:g} Hz")
     return float(full["difference_mN"].iloc[0])
+
+
+@register_extractor("sec4-2-friction-and-actuator-dynamics-cause-discrepancy")
+def _causes(results) -> dict:
+    cycle = results["fig7cycle"]
+    force = {}
+    for model, mu in (("rigid", 0.3), ("rigid", 0.2), ("flexible", 0.2)):
+        rows = cycle[(cycle["actuator_model"] == model) & np.isclose(cycle["friction_coefficient"], mu)]
+        if rows.empty:
+            raise NotEvaluable(f"no stall period of {model} actuators with μ = {mu:g}")
+        force[model, mu] = float(rows["generated_force_mN"].iloc[0])
+    friction = force["rigid", 0.3] - force["rigid", 0.2]
+    actuators = force["rigid", 0.2] - force["flexible", 0.2]
+    return {"lhs": np.array([friction, actuators]), "rhs": np.zeros(2)}
+
+
+@register_evidence("sec4-2-friction-and-actuator-dynamics-cause-discrepancy")
+def _causes_evidence(results) -> list:
+    lhs = _causes(results)["lhs"]
+    return [f"μ 0.3 → 0.2 with rigid actuators lowers F_gen by {lhs[0]:.4g} mN; rigid → flexible actuators "
+            f"at μ = 0.2 lowers it by {lhs[1]:.4g} mN (together {lhs.sum():.4g} mN; 202 nm, 0.8 N, R = 1 mm)"]
+
+
+@register_extractor("sec4-2-other-preloads-same-trend")
+def _other_preloads(results) -> dict:
+    grid = results["fig7grid"]
+    full = grid[np.isclose(grid["amplitude_fraction"], 1.0)]
+    earlier, this = [], []
+    for (radius, preload), rows in full.groupby(["radius_mm", "preload_N"]):
+        pair = [rows[(rows["actuator_model"] == m) & np.isclose(rows["friction_coefficient"], mu)]
+                for m, mu in (_EARLIER, _THIS)]
+        if any(p.empty or not bool(p["converged"].iloc[0]) for p in pair):
+            raise NotEvaluable(f"no stalled pair of runs at R = {radius:g} mm, {preload:g} N")
+        earlier.append(float(pair[0]["generated_force_mN"].iloc[0]))
+        this.append(float(pair[1]["generated_force_mN"].iloc[0]))
+    if not earlier:
+        raise NotEvaluable("no full-stroke runs on the preload grids")
+    lhs, rhs = np.array(earlier), np.array(this)
+    # 'other preload levels' means every preload: a pass needs all of them, a failure needs one
+    computed = {(round(r, 9), round(p, 9)) for r, p in zip(full["radius_mm"], full["preload_N"], strict=True)}
+    missing = [(r * 1e3, p) for r, grid in PRELOAD_GRIDS.items() for p in grid
+               if (round(r * 1e3, 9), round(float(p), 9)) not in computed]
+    if missing and np.all(lhs > rhs):
+        raise NotEvaluable(f"holds at the {len(lhs)} preloads computed on this profile; "
+                           f"{len(missing)} preloads of the grids are not computed, e.g. "
+                           f"{missing[0][1]:g} N at R = {missing[0][0]:g} mm")
+    return {"lhs": lhs, "rhs": rhs}
 
 
 def _trend(results, name: str) -> dict:
@@ -759,8 +814,11 @@ def _fig7_onsets(results) -> dict:
             onset = {}
             for model in (_EARLIER, _THIS):
                 rows = _model_rows(table, model, preload)
-                if rows.empty or not np.isfinite(rows["onset_nm"].iloc[0]):
-                    raise NotEvaluable(f"{name}: no onset for {model} at {preload:g} N")
+                if rows.empty:
+                    raise NotEvaluable(f"{name}: no runs for {model} at {preload:g} N")
+                if not np.isfinite(rows["onset_nm"].iloc[0]):
+                    raise ClaimFails(f"{name}: no force generation up to the full stroke for {model} at "
+                                     f"{preload:g} N")
                 onset[model] = float(rows["onset_nm"].iloc[0])
             lhs.append(onset[_EARLIER])
             rhs.append(onset[_THIS])

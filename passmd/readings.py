@@ -1,0 +1,174 @@
+"""The assumption space of the ledger: what the paper leaves open, and the readings we evaluate.
+
+The paper leaves some inputs of its claims unstated (the fly-back rule, how the critical
+amplitude was read off the runs, the drive frequency of Section 4, the actuator damping lost
+from Table 2, μ in Sections 4.1 and 5, what Eq. 15 does when t_s does not fit into a period).
+Each is declared here once as an :class:`Axis`: its default (the value the rest of the book
+uses), the values of its plausible range that we evaluate, the whole range in words, and the
+source of that range.
+
+A *reading* is one point of that space: ``{axis key: value}``. The ledger evaluates every claim
+at the readings of its :func:`design` (one-at-a-time: the defaults, then each evaluated
+alternative of each axis the claim depends on, the others at their defaults). An extractor
+declares the axes it reads with ``register_extractor(id, depends_on=(...))`` and receives the
+reading as its ``reading`` argument; when the result tables hold no run at that reading it
+raises :class:`passmd.ledger.NotEvaluable`, and that point counts as not covered.
+
+Axes declared with no evaluated alternative are listed in the report as open: the ledger cannot
+yet say whether a claim's verdict moves along them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+
+import pandas as pd
+
+__all__ = ["AXES", "Axis", "axis", "default_reading", "design", "describe", "space_table"]
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One assumption the paper leaves open, as the ledger varies it."""
+
+    key: str  # name used in readings, extractors and the book
+    label: str  # short label for tables
+    default: object  # the value every chapter uses (the documented default)
+    alternatives: tuple  # other values the ledger evaluates (each must be in the result tables)
+    unit: str  # display unit of the values ('' for words)
+    plausible_range: str  # the whole plausible range, in words
+    source: str  # where that range comes from
+    assumption_key: str = ""  # the key of the matching passmd.parameters assumption, if any
+
+    def values(self) -> tuple:
+        return (self.default, *self.alternatives)
+
+    def show(self, value) -> str:
+        text = f"{value:g}" if isinstance(value, float) else str(value)
+        return f"{text} {self.unit}".strip()
+
+
+#: Every declared axis, in the order the report shows them.
+AXES: dict[str, Axis] = {
+    a.key: a
+    for a in (
+        Axis(
+            key="flyback",
+            label="fly-back rule",
+            default="slew",
+            alternatives=("fixed",),
+            unit="",
+            plausible_range="slew-rate limited (150 V/µs over 300 V_pp: 2 µs for the full stroke, less for "
+            "smaller amplitudes) or a fixed fly-back of 1–2 µs at every amplitude",
+            source="Section 2 states the amplifier's 150 V/µs and 300 V_pp but not the fly-back of the "
+            "simulated saw-tooth; 'fixed' is the full-stroke 2 µs at every amplitude",
+            assumption_key="flyback_duration",
+        ),
+        Axis(
+            key="ac_protocol",
+            label="how A_c is read",
+            default="steady",
+            alternatives=("first",),
+            unit="",
+            plausible_range="steady state of continued operation (last step of a 10-period run) or the "
+            "onset of full sliding in the first fly-back from virgin contacts",
+            source="Section 1 defines A_c by 'no measurable step'; Section 4.1 compares it with "
+            "quasi-static onsets (Eqs. 7–12) without saying how it was read off the runs",
+            assumption_key="critical_amplitude_protocol",
+        ),
+        Axis(
+            key="drive_frequency_s4",
+            label="drive frequency, Section 4.1",
+            default=100.0,
+            alternatives=(50.0, 200.0),
+            unit="Hz",
+            plausible_range="a band around 100 Hz (50–200 Hz)",
+            source="Section 4.1 does not state it; 100 Hz is Section 5.2's saw-tooth frequency (Fig. 9a)",
+            assumption_key="critical_amplitude_protocol",
+        ),
+        Axis(
+            key="short_period",
+            label="Eq. 15 when t_s does not fit",
+            default="cut",
+            alternatives=("skip",),
+            unit="",
+            plausible_range="cut the settling time t_s to the time left in the period, or skip it (t_s = 0)",
+            source="Section 5.2 says only that above 110 kHz there is 'not enough time for settling'",
+            assumption_key="optimized_short_period",
+        ),
+        Axis(
+            key="damping_ratio",
+            label="actuator damping ratio ζ",
+            default=0.05,
+            alternatives=(),
+            unit="",
+            plausible_range="0.005–0.5 (a decade either side of a lightly damped piezo stack, Q = 10)",
+            source="Table 2's viscosity column c_p is lost in the available text",
+            assumption_key="actuator_viscosity",
+        ),
+        Axis(
+            key="force_frequency",
+            label="drive frequency, Section 4.2",
+            default=100.0,
+            alternatives=(1000.0,),
+            unit="Hz",
+            plausible_range="90 Hz – 1.1 kHz",
+            source="Section 4.2 does not state the saw-tooth frequency of the force runs",
+            assumption_key="force_frequency",
+        ),
+        Axis(
+            key="friction_coefficient",
+            label="μ in Sections 4.1 and 5",
+            default=0.2,
+            alternatives=(),
+            unit="",
+            plausible_range="0.2–0.3 (Section 4.2's measured 0.2 and the earlier model's 0.3)",
+            source="Sections 4.1 and 5 do not state μ; Section 4.2 uses 0.2 (Lübke [24]) and 0.3 ([12])",
+        ),
+    )
+}
+
+
+def axis(key: str) -> Axis:
+    """The declared axis ``key``; ``ValueError`` naming the declared ones otherwise."""
+    if key not in AXES:
+        raise ValueError(f"assumption axis = {key!r} is not declared: must be one of {', '.join(AXES)}")
+    return AXES[key]
+
+
+def default_reading() -> dict:
+    """``{axis key: default}`` for every declared axis."""
+    return {key: a.default for key, a in AXES.items()}
+
+
+def design(depends_on: Iterable[str]) -> list[dict]:
+    """The readings a claim depending on ``depends_on`` is evaluated at.
+
+    One-at-a-time design: the defaults first, then every evaluated alternative of each axis in
+    ``depends_on`` with every other axis at its default. Each reading is a full
+    ``{axis key: value}`` dict.
+    """
+    base = default_reading()
+    points = [base]
+    for key in depends_on:
+        for value in axis(key).alternatives:
+            points.append({**base, key: value})
+    return points
+
+
+def describe(reading: Mapping, *, only_changed: bool = True) -> str:
+    """A reading in words, e.g. ``"fly-back rule = fixed"``; ``"defaults"`` when nothing changed."""
+    parts = [f"{AXES[k].label} = {AXES[k].show(v)}" for k, v in reading.items()
+             if k in AXES and (not only_changed or v != AXES[k].default)]
+    return "; ".join(parts) if parts else "defaults"
+
+
+def space_table() -> pd.DataFrame:
+    """Every declared axis: default, evaluated alternatives, plausible range and its source."""
+    return pd.DataFrame([
+        {"assumption": a.label, "key": a.key, "default": a.show(a.default),
+         "evaluated alternatives": ", ".join(a.show(v) for v in a.alternatives) or "none yet",
+         "plausible range": a.plausible_range, "source": a.source}
+        for a in AXES.values()
+    ])
