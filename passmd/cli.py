@@ -949,6 +949,20 @@ def _add_output_options(parser) -> None:
                        help="samples of the recorded time series (default: 20000)")
 
 
+def _add_sweep_options(parser) -> None:
+    """Options of the commands that run figure sweeps (``figure``, ``ledger``); see passmd.sweep."""
+    group = parser.add_argument_group("sweep execution")
+    group.add_argument("--executor", choices=("process", "serial", "dask"), default=None,
+                       help="process pool, in this process, or Dask (default: process, or dask with "
+                            "--scheduler)")
+    group.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                       help="Dask scheduler, e.g. tcp://10.0.0.5:8786 (default: none)")
+    group.add_argument("--workers", type=int, default=None, metavar="N",
+                       help="worker processes for process/local Dask (default: all cores)")
+    group.add_argument("--cache-dir", metavar="DIR",
+                       help=f"cache directory (default: ${CACHE_DIR_ENV} or ./{DEFAULT_CACHE_DIR})")
+
+
 def make_parser() -> argparse.ArgumentParser:
     """The ``passmd`` argument parser (all subcommands)."""
     parser = _Parser(
@@ -1060,16 +1074,7 @@ def make_parser() -> argparse.ArgumentParser:
                    help="resolution: quick (CI) or paper (the paper's grids) (default: paper)")
     p.add_argument("--out", metavar="DIR", default=".",
                    help="directory for NAME.csv and NAME.png (default: .)")
-    group = p.add_argument_group("sweep execution")
-    group.add_argument("--executor", choices=("process", "serial", "dask"), default=None,
-                       help="process pool, in this process, or Dask (default: process, or dask with "
-                            "--scheduler)")
-    group.add_argument("--scheduler", metavar="ADDRESS", default=None,
-                       help="Dask scheduler, e.g. tcp://10.0.0.5:8786 (default: none)")
-    group.add_argument("--workers", type=int, default=None, metavar="N",
-                       help="worker processes for process/local Dask (default: all cores)")
-    group.add_argument("--cache-dir", metavar="DIR",
-                       help=f"cache directory (default: ${CACHE_DIR_ENV} or ./{DEFAULT_CACHE_DIR})")
+    _add_sweep_options(p)
     p.add_argument("--json", action="store_true", help=_JSON_HELP)
     p.set_defaults(handler=_cmd_figure)
 
@@ -1103,14 +1108,7 @@ def make_parser() -> argparse.ArgumentParser:
                    help="resolution: quick (CI) or paper (the paper's grids) (default: quick)")
     p.add_argument("--write-baseline", metavar="CSV", default=None,
                    help="also write the categories as a baseline CSV (default: none)")
-    group = p.add_argument_group("sweep execution")
-    group.add_argument("--executor", choices=("process", "serial", "dask"), default=None,
-                       help="process pool, in this process, or Dask (default: process)")
-    group.add_argument("--scheduler", metavar="ADDRESS", default=None, help="Dask scheduler (default: none)")
-    group.add_argument("--workers", type=int, default=None, metavar="N",
-                       help="worker processes (default: all cores)")
-    group.add_argument("--cache-dir", metavar="DIR",
-                       help=f"cache directory (default: ${CACHE_DIR_ENV} or ./{DEFAULT_CACHE_DIR})")
+    _add_sweep_options(p)
     p.add_argument("--json", action="store_true", help=_JSON_HELP)
     p.set_defaults(handler=_cmd_ledger)
     return parser
