@@ -51,7 +51,9 @@ def wheel(session: nox.Session) -> None:
     LICENSE; installed into a new virtual environment (dependencies from PyPI only), it must
     run ``tools/check_installed_wheel.py`` from a temporary folder outside the repository:
     ``passmd --version``, ``passmd theory --json``, the ledger's and reference curves'
-    loaders, and ``passmd figure fig9a --profile quick``. Nothing is installed editable.
+    loaders, ``passmd ledger --profile quick --json`` (reading the simulation cache the tests
+    filled, ``CACHE_DIR``) and ``passmd figure fig9a --profile quick``. Nothing is installed
+    editable.
     """
     repo = os.path.dirname(os.path.abspath(__file__))
     session.install("build>=1.2", "virtualenv>=20.26")
@@ -98,7 +100,7 @@ def _build_and_check_wheel(session: nox.Session, repo: str, work: str) -> None:
     os.makedirs(outside)
     checker = os.path.join(repo, "tools", "check_installed_wheel.py")
     with session.chdir(outside):
-        session.run(python, "-I", checker, "--repo", repo, external=True,
+        session.run(python, "-I", checker, "--repo", repo, "--ledger-cache", CACHE_DIR, external=True,
                     env={"MPLBACKEND": "Agg", "PASSMD_CACHE_DIR": os.path.join(outside, ".passmd-cache"),
                          "PYTHONPATH": ""})
 

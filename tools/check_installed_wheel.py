@@ -9,8 +9,10 @@ runs, each must exit with 0:
 * ``passmd --version`` (prints the metadata's version);
 * ``passmd theory --json`` (closed forms);
 * the ledger's loader: ``passmd.ledger.load_claims()`` and every reference curve of
-  ``passmd.reference.CURVES``, plus the benchmark results the book reads
-  (the command line has no ledger command yet);
+  ``passmd.reference.CURVES``, plus the benchmark results the book reads;
+* ``passmd ledger --profile quick --json`` (every claim's computed category; with
+  ``--ledger-cache DIR`` it reads the simulation cache the test session filled, whose keys
+  hold for the installed package too: they hash the same source files);
 * ``passmd figure fig9a --profile quick`` (a paper figure's CSV and PNG, with provenance).
 
 Usage: ``python tools/check_installed_wheel.py --repo /path/to/repository``.
@@ -39,6 +41,8 @@ def _run(*args: str) -> str:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--repo", type=Path, required=True, help="the repository (must not be imported from)")
+    parser.add_argument("--ledger-cache", type=Path, default=None,
+                        help="simulation cache for the ledger command (default: $PASSMD_CACHE_DIR)")
     args = parser.parse_args(argv)
     repo = args.repo.resolve()
 
@@ -67,6 +71,13 @@ def main(argv: list[str] | None = None) -> int:
         print(f"reference.load_reference_curve({name!r}): {len(table)} rows")
     for name in numerics.BENCHMARKS:
         print(f"numerics.benchmark_results({name!r}): keys {', '.join(numerics.benchmark_results(name))}")
+
+    cache = ["--cache-dir", str(args.ledger_cache)] if args.ledger_cache else []
+    ledger_out = json.loads(_run(exe, "ledger", "--profile", "quick", "--json", *cache))
+    if len(ledger_out["claims"]) != len(claims):
+        evaluated = len(ledger_out["claims"])
+        raise SystemExit(f"FAILED: passmd ledger evaluated {evaluated} of {len(claims)} claims")
+    print(f"passmd ledger --profile quick: {ledger_out['summary']}")
 
     figure = json.loads(_run(exe, "figure", "fig9a", "--profile", "quick", "--json"))
     header = Path(figure["csv"]).read_text(encoding="utf-8").splitlines()[:3]
