@@ -1,4 +1,4 @@
-"""Trust in the integrator: time-step convergence, energy balance, cost (model chapter).
+"""Trust in the integrator: time-step convergence, energy balance, the rigid Coulomb limit, cost.
 
 These are not paper figures; they back every figure's numbers. Each function returns a
 tidy DataFrame in SI units.
