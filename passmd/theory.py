@@ -192,3 +192,95 @@ def runner_frequency(drive: Drive) -> float:
     )
     k_total += drive.effective_load_cell_stiffness
     return float(np.sqrt(k_total / drive.runner_mass) / (2 * np.pi))
+
+
+def friction_limit(drive: Drive) -> float:
+    """Total Coulomb friction limit μ Σ F_N of all contacts on the runner (N, Eq. 1).
+
+    Six contacts: μ (2 F_N1 + 4 F_N2) = 2√2 μ F_p; one contact: μ F_p.
+    """
+    forces = normal_forces(drive.preload, drive.contacts)
+    multiplicity = (1,) if drive.contacts == 1 else (2, 4)
+    return float(drive.friction_coefficient * sum(m * float(F) for m, F in zip(multiplicity, forces,
+                                                                                  strict=True)))
+
+
+def coulomb_sawtooth_step(amplitude, frequency, flyback_time, friction_force, runner_mass):
+    """Step per period of a rigid-actuator saw-tooth drive with Coulomb friction.
+
+    The limit of the drive of Eqs. 2–6 when the contact stiffness goes to infinity: the
+    presliding (Eq. 7) vanishes and every contact becomes a rigid Coulomb contact, so the
+    drive is the idealised inertia (stick–slip) drive of M. Hunstig, "Piezoelectric
+    Inertia Motors—A Critical Review of History, Concepts, Design, Applications, and
+    Perspectives", Actuators 6 (2017) 7, Sections 2–3 (see also M. Hunstig, T. Hemsel,
+    W. Sextro, Sens. Actuators A 200 (2013) 90, the paper's ref. 21). The closed form
+    below is derived here for the saw-tooth of :func:`passmd.waveforms.sawtooth`.
+
+    Assumptions: rigid actuators (the hemispheres follow x_p exactly); one runner of mass
+    m_r, no load cell; Coulomb friction with one coefficient for sticking and sliding,
+    total limit F_c = μ Σ F_N, so the runner's friction acceleration is at most
+    a = F_c / m_r; no presliding, no elastic play; x_p(t) a saw-tooth of amplitude A,
+    period T = 1/f: a linear ramp 0 → A of duration t_r = T − t_f (velocity
+    v_r = A / t_r) and a linear fly-back A → 0 of duration t_f (velocity v_f = −A / t_f),
+    with t_f < t_r; periodic steady state.
+
+    Derivation. On a linear piece x_p has zero acceleration, so a runner moving with the
+    piezo needs no friction force and sticks. At each corner the piezo velocity jumps
+    while the runner's cannot: the runner slips and friction, of magnitude F_c against
+    the relative velocity, changes its velocity at the rate a until it matches the
+    piezo's, when it sticks again. Start a period at the corner ramp → fly-back with the
+    runner stuck (velocity v_r). Its relative velocity v − v_f = v_r − v_f − a t > 0
+    falls linearly; two cases:
+
+    1. a t_f < v_r − v_f, i.e. a t_f² < A + v_r t_f = A T / t_r: the runner slides
+       through the whole fly-back, relative slip (v_r − v_f) t_f − a t_f²/2, and leaves
+       it at v_r − a t_f < v_r. On the ramp it is accelerated at +a and re-sticks after
+       exactly t_f (< t_r), relative slip −a t_f²/2. Net step per period (x_p returns
+       to where it started, so the step is the total relative slip)::
+
+           s = (v_r − v_f) t_f − a t_f² = A T / t_r − a t_f²  (> 0 in this case).
+
+    2. a t_f ≥ v_r − v_f: the runner reaches v_f after t* = (v_r − v_f)/a ≤ t_f and
+       sticks for the rest of the fly-back (relative slip (v_r − v_f)²/(2a)). At the
+       corner back to the ramp the jump v_f → v_r is the same size, the slip lasts t*
+       again and is (v_r − v_f)²/(2a) backwards: s = 0, the runner only follows.
+
+    Both cases together: s = max(A T / t_r − a t_f², 0), continuous at the boundary.
+    The first, from rest, corner (0 → v_r) only offsets the runner by −v_r²/(2a) and
+    the runner sticks again after v_r/a; from the first fly-back on every period is the
+    steady state above. For t_f → 0 the step tends to A (the ideal saw-tooth).
+
+    Parameters
+    ----------
+    amplitude : array_like
+        Saw-tooth amplitude A in m, ≥ 0.
+    frequency : array_like
+        Driving frequency f = 1/T in Hz, > 0.
+    flyback_time : array_like
+        Fly-back duration t_f in s, 0 < t_f < T/2 (so that t_f < t_r).
+    friction_force : array_like
+        Total Coulomb friction limit F_c = μ Σ F_N in N, > 0 (:func:`friction_limit`).
+    runner_mass : array_like
+        Runner mass m_r in kg, > 0.
+
+    Returns
+    -------
+    ndarray
+        Net runner step per period s in m (forward, in the ramp's direction), ≥ 0.
+    """
+    A = check_array("amplitude", amplitude, 0.0, unit="m")
+    f = check_array("frequency", frequency, 0.0, lower_open=True, unit="Hz")
+    t_f = check_array("flyback_time", flyback_time, 0.0, lower_open=True, unit="s")
+    F_c = check_array("friction_force", friction_force, 0.0, lower_open=True, unit="N")
+    m_r = check_array("runner_mass", runner_mass, 0.0, lower_open=True, unit="kg")
+    T = 1.0 / f
+    if np.any(t_f >= 0.5 * T):
+        bad = np.broadcast_arrays(t_f, T)
+        i = int(np.flatnonzero((bad[0] >= 0.5 * bad[1]).ravel())[0])
+        raise ValueError(
+            f"flyback_time = {float(bad[0].ravel()[i])!r} is out of range: must be < half the period "
+            f"{float(0.5 * bad[1].ravel()[i])!r} s (the runner must re-stick on the ramp)"
+        )
+    t_r = T - t_f
+    a = F_c / m_r
+    return np.maximum(A * T / t_r - a * t_f**2, 0.0)

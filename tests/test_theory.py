@@ -142,3 +142,77 @@ def test_runner_frequency_matches_stiffness_sum():
     out = theory.drive_theory(d)
     k = 2 * out["tangential_stiffness_N_per_m"][0] + 4 * out["tangential_stiffness_N_per_m"][1]
     assert theory.runner_frequency(d) == pytest.approx(np.sqrt(k / 3e-3) / (2 * np.pi), rel=EXACT)
+
+
+def test_coulomb_sawtooth_step_by_hand():
+    """A = 100 nm, f = 1 kHz (T = 1 ms), F_c = 0.3 N, m_r = 3 g, so a = F_c/m_r = 100 m/s².
+
+    t_f = 20 µs: t_r = 980 µs, A T/t_r = 100·1000/980 = 102.041 nm, a t_f² = 100·4e-10 m
+    = 40 nm → s = 62.0408 nm (case 1: a t_f² < A T/t_r, the runner slides all fly-back).
+    t_f = 40 µs: A T/t_r = 100/0.96 = 104.167 nm < a t_f² = 160 nm → s = 0 (case 2).
+    """
+    s = theory.coulomb_sawtooth_step(100e-9, 1e3, [20e-6, 40e-6], 0.3, 3e-3)
+    assert s[0] == pytest.approx(62.0408e-9, rel=HAND)
+    assert s[1] == 0.0
+
+
+def test_coulomb_sawtooth_step_limits_and_bad_input():
+    """t_f → 0 recovers the ideal saw-tooth's full step A; the two cases meet continuously."""
+    A, f, F, m = 150e-9, 100.0, 0.2263, 3e-3
+    assert theory.coulomb_sawtooth_step(A, f, 1e-12, F, m) == pytest.approx(A, rel=1e-9)
+    # boundary a t_f² = A T/t_r, solved for t_f by bisection: the step is 0 there from both sides
+    lo, hi = 1e-9, 0.4 / f
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if theory.coulomb_sawtooth_step(A, f, mid, F, m) > 0 else (lo, mid)
+    assert theory.coulomb_sawtooth_step(A, f, lo, F, m) < 1e-6 * A
+    with pytest.raises(ValueError, match="flyback_time"):
+        theory.coulomb_sawtooth_step(A, f, 0.5 / f, F, m)
+    with pytest.raises(ValueError, match="runner_mass"):
+        theory.coulomb_sawtooth_step(A, f, 1e-6, F, -1.0)
+
+
+def _coulomb_runner_ode(amplitude, n_period, n_flyback, dt, accel, periods=3):
+    """Brute force: the rigid Coulomb runner under the saw-tooth, integrated step by step.
+
+    Time stepping for set-valued Coulomb friction (Moreau's velocity update): each step the
+    friction can change the runner's velocity by at most a·dt; if that reaches the piezo
+    velocity the runner sticks (v = v_p), otherwise it slides (v ← v ∓ a·dt). Positions are
+    advanced with the mean velocity of the step, exact while sliding or sticking; the corners
+    of x_p fall on step boundaries. Vectorised over parameter sets (one per array element),
+    each with its own fly-back of ``n_flyback`` steps at the end of a period of ``n_period``.
+    Returns x_r − x_p at the end of every ramp (shape (periods, sets); the runner is stuck).
+    """
+    n_ramp = n_period - n_flyback
+    v_ramp, v_fly = amplitude / (n_ramp * dt), -amplitude / (n_flyback * dt)
+    x = np.zeros(n_flyback.shape)  # x_r − x_p (x_p returns to 0 every period)
+    v = np.zeros(n_flyback.shape)  # runner velocity, from rest
+    ends = np.empty((periods, n_flyback.size))
+    for k in range(periods):
+        for n in range(n_period):
+            v_p = np.where(n < n_ramp, v_ramp, v_fly)
+            w = v - v_p
+            v_new = np.where(np.abs(w) <= accel * dt, v_p, v - np.sign(w) * accel * dt)
+            x += (0.5 * (v + v_new) - v_p) * dt
+            v = v_new
+            ends[k] = np.where(n == n_ramp - 1, x, ends[k])
+    return ends
+
+
+def test_coulomb_sawtooth_step_against_brute_force_ode():
+    """The closed form against the integrated rigid Coulomb ODE, in both cases.
+
+    Parameter sets: a = 100 m/s², A = 100 nm, T = 1 ms at dt = 50 ns (20 000 steps per period);
+    fly-backs from 2 µs to 100 µs span case 1 (step > 0) and case 2 (no step). The step is
+    x_r − x_p at the end of the third ramp minus the second (both stuck). Tolerance: the scheme
+    is exact while sliding or sticking; only a step in which the runner re-sticks errs, by at
+    most a·dt²/2 (the slip ends inside the step), and a period has two re-sticks: a·dt².
+    """
+    dt, n_period, accel = 50e-9, 20_000, 100.0
+    n_fly = np.array([40, 200, 400, 600, 800, 1000, 2000])
+    A = np.full(n_fly.shape, 100e-9)
+    ends = _coulomb_runner_ode(A, n_period, n_fly, dt, accel)
+    steps = ends[2] - ends[1]
+    expected = theory.coulomb_sawtooth_step(A, 1.0 / (n_period * dt), n_fly * dt, accel * 3e-3, 3e-3)
+    assert np.any(expected == 0.0) and np.any(expected > 0.5 * A)  # both cases are exercised
+    np.testing.assert_allclose(steps, expected, rtol=0, atol=accel * dt**2)

@@ -1,4 +1,4 @@
-"""Trust in the integrator: time-step convergence, energy balance, cost (model chapter).
+"""Trust in the integrator: time-step convergence, energy balance, the rigid Coulomb limit, cost.
 
 These are not paper figures; they back every figure's numbers. Each function returns a
 tidy DataFrame in SI units.
@@ -10,11 +10,12 @@ import json
 from importlib import resources
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
-from passmd import dynamics, waveforms
-from passmd._validation import check_choice
-from passmd.parameters import Drive
+from passmd import dynamics, theory, waveforms
+from passmd._validation import check_choice, check_count, check_range
+from passmd.parameters import Amplifier, Drive, Material
 
 #: Configurations the numerics are shown for: (label, contacts, actuator model).
 CONFIGURATIONS = (
@@ -164,4 +165,132 @@ def settle_fraction_sensitivity(
             res = dynamics.simulate(drive, wf, max_points=2)
             rows.append({"configuration": label, "settle_fraction": float(fraction),
                          "mean_step_m": float(res.step_sizes.mean())})
+    return pd.DataFrame(rows)
+
+
+#: Factors the contact moduli E* and G* are multiplied by in :func:`rigid_coulomb_limit`.
+#: The rigid drive's step is 2π/ω_runner/400 with ω_runner² ∝ Σ 2aG* ∝ scale^(2/3), so the
+#: cost per period grows only as scale^(1/3): the largest factor costs 16 times the first.
+STIFFNESS_SCALES = (1.0, 4.0, 16.0, 64.0, 256.0, 1024.0, 4096.0)
+
+#: Rate at which the simulated step approaches the Coulomb limit: |difference| ∝ scale^(−rate).
+#: Scaling both materials' E (ν fixed) scales E* and G* by the factor k. The contact law of
+#: every contact is self-similar, F = μF_N Φ(u / u_x,max) (Cattaneo–Mindlin, Masing), with the
+#: one length u_x,max = μ (E*/G*) d and the Hertz indentation d ∝ E*^(−2/3) (Eq. 7), so
+#: u_x,max ∝ k^(−2/3) (not 1/k: the contact radius shrinks as E* grows, and the tangential
+#: stiffness 2aG* grows only as k^(2/3)). The drive's departure from rigid Coulomb friction
+#: (presliding at the corners, the elastic offset and micro-vibration after re-sticking) is
+#: first order in that length.
+EXPECTED_COULOMB_RATE = 2.0 / 3.0
+
+
+def stiffened_drive(drive: Drive, scale: float) -> Drive:
+    """The drive with both materials' Young's moduli (so E* and G*) multiplied by ``scale``.
+
+    Poisson's ratios are kept, so E*/G* is unchanged and E*, G* scale exactly by ``scale``
+    (:func:`passmd.theory.contact_moduli`). Stiffer than diamond is outside the plausible
+    range of Young's moduli, and the peak Hertz pressure grows as scale^(2/3), so the copy has
+    ``allow_extrapolation=True`` (the hard limits, e.g. a ≤ R/10, still apply).
+    """
+    k = check_range("scale", scale, 0.0, lower_open=True)
+    h, r = drive.hemisphere_material, drive.runner_material
+    return drive.replace(
+        hemisphere_material=Material(h.youngs_modulus * k, h.poissons_ratio, h.name),
+        runner_material=Material(r.youngs_modulus * k, r.poissons_ratio, r.name),
+        actuator=drive.actuator,
+        allow_extrapolation=True,
+    )
+
+
+def rigid_coulomb_limit(
+    amplitude: float = 150e-9,
+    frequency: float = 100.0,
+    scales=STIFFNESS_SCALES,
+    contacts=(6, 1),
+    slow_flyback_loss: float = 0.5,
+    periods: int = 4,
+    preload: float = 0.4,
+    hemisphere_radius: float = 1e-3,
+    resolution: float = 1.0,
+) -> pd.DataFrame:
+    """Simulated step of the rigid-actuator drive against its infinitely stiff Coulomb limit.
+
+    For each number of contacts and two fly-backs the contact moduli E*, G* are multiplied by
+    each of ``scales`` (:func:`stiffened_drive`) and the saw-tooth drive is simulated with rigid
+    actuators (:func:`passmd.dynamics.simulate`); its step (the last period's, the first
+    carries the start from virgin contacts) is compared with the closed form of the rigid
+    Coulomb drive, :func:`passmd.theory.coulomb_sawtooth_step` with μΣF_N
+    (:func:`passmd.theory.friction_limit`), which the stiffness does not change.
+
+    The two fly-backs: the paper's amplifier (150 V/µs, so t_f ≈ 1.5 µs at 150 nm), where the
+    Coulomb loss a t_f² is a fraction of a nanometre and the limit is ≈ A; and a slow fly-back
+    whose slew rate is chosen so that a t_f² = ``slow_flyback_loss`` · A, where the limit is
+    far below A and the formula's fly-back term is tested. ``resolution`` divides the
+    integrator's default step (:func:`passmd.dynamics.simulate`), to show that the gap is the
+    model's and not the time step's.
+
+    Returns
+    -------
+    DataFrame
+        Columns ``configuration, contacts, flyback, scale, E_star_Pa, presliding_m`` (the
+        rigid-actuator critical amplitude, Eq. 7 / Eq. 11, the elastic play that the limit
+        removes), ``flyback_time_s, integrator_steps, simulated_step_m, coulomb_step_m,
+        difference_m`` (simulated − Coulomb).
+    """
+    A = check_range("amplitude", amplitude, 0.0, lower_open=True, unit="m")
+    loss = check_range("slow_flyback_loss", slow_flyback_loss, 0.0, 1.0, lower_open=True, upper_open=True)
+    periods = check_count("periods", periods, minimum=2)
+    rows = []
+    for n in contacts:
+        base = Drive(hemisphere_radius=hemisphere_radius, preload=preload, contacts=n,
+                     actuator_model="rigid", allow_extrapolation=True)
+        F_c = theory.friction_limit(base)
+        accel = F_c / base.runner_mass
+        # slow fly-back: a t_f² = loss · A, t_f = (A / A_max) · V_pp / SR solved for SR
+        t_slow = np.sqrt(loss * A / accel)
+        amp = base.amplifier
+        slow_rate = amp.peak_to_peak_voltage * A / base.actuator.full_stroke_amplitude / t_slow
+        flybacks = (("paper slew rate", amp), ("slow", Amplifier(amp.peak_to_peak_voltage, slow_rate)))
+        for label, amplifier in flybacks:
+            for k in scales:
+                drive = stiffened_drive(base.replace(amplifier=amplifier, actuator=base.actuator), k)
+                wf = waveforms.sawtooth(A, frequency, drive, periods=periods)
+                t_f = waveforms.flyback_time(A, drive)
+                limit = float(theory.coulomb_sawtooth_step(A, frequency, t_f, F_c, drive.runner_mass))
+                res = dynamics.simulate(drive, wf, max_points=2, resolution=resolution)
+                step = float(res.step_sizes[-1])
+                rows.append({
+                    "configuration": f"{'six contacts' if n == 6 else 'one contact'}, {label} fly-back",
+                    "contacts": int(n),
+                    "flyback": label,
+                    "scale": float(k),
+                    "E_star_Pa": theory.contact_moduli(drive)[0],
+                    "presliding_m": theory.drive_theory(drive)["critical_amplitude_rigid_m"],
+                    "flyback_time_s": float(t_f),
+                    "integrator_steps": int(res.steps),
+                    "simulated_step_m": step,
+                    "coulomb_step_m": limit,
+                    "difference_m": step - limit,
+                })
+    return pd.DataFrame(rows)
+
+
+def coulomb_limit_rates(table: pd.DataFrame) -> pd.DataFrame:
+    """Observed convergence rate of each configuration of :func:`rigid_coulomb_limit`.
+
+    The rate is minus the least-squares slope of log|difference| against log(scale); the
+    expected rate is :data:`EXPECTED_COULOMB_RATE`.
+
+    Returns
+    -------
+    DataFrame
+        Columns ``configuration, rate, expected_rate, largest_difference_m,
+        smallest_difference_m``.
+    """
+    rows = []
+    for label, g in table.groupby("configuration", sort=False):
+        slope = np.polyfit(np.log(g["scale"]), np.log(np.abs(g["difference_m"])), 1)[0]
+        rows.append({"configuration": label, "rate": float(-slope), "expected_rate": EXPECTED_COULOMB_RATE,
+                     "largest_difference_m": float(np.abs(g["difference_m"]).max()),
+                     "smallest_difference_m": float(np.abs(g["difference_m"]).min())})
     return pd.DataFrame(rows)
