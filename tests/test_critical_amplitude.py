@@ -7,6 +7,8 @@ locked with pytest-regressions; the physics tests run single searches at F_p = 0
 from __future__ import annotations
 
 import math
+import re
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -203,6 +205,16 @@ def test_every_panel_is_registered_with_its_chapter():
     for name in PANELS:
         assert name in names
         assert experiments.figure_spec(name).chapter in ("critical_amplitude_one", "critical_amplitude_six")
+
+
+def test_figures_are_listed_in_the_books_order():
+    """Study panels of Figs. 5-6 (fig56_*) come after fig6c and before fig7a, as in the book."""
+    toc = (Path(__file__).resolve().parents[1] / "book" / "_toc.yml").read_text()
+    files = re.findall(r"^\s*- file: (\w+)", toc, flags=re.M)
+    assert [f for f in files if f in experiments.CHAPTERS] == list(experiments.CHAPTERS)
+    names = experiments.figure_names()
+    assert names.index("fig6c") < names.index("fig56_frequency") < names.index("fig7a")
+    assert names.index("fig9b") < names.index("fig10a")
 
 
 def test_panels_are_reachable_from_the_command_line(quick, tmp_path, capsys):

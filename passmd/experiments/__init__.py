@@ -29,6 +29,11 @@ PROFILES = ("quick", "paper")
 
 #: Topic modules that register figures: one per chapter of the paper's Sections 3-5.
 TOPIC_MODULES: tuple[str, ...] = ("critical_amplitude", "force_generation", "driving_waveform")
+#: The book's figure chapters in reading order (book/_toc.yml), which is the paper's order:
+#: a study panel such as ``fig56_frequency`` follows the panels of its chapter.
+CHAPTERS: tuple[str, ...] = (
+    "critical_amplitude_one", "critical_amplitude_six", "force_generation", "driving_waveform",
+)
 
 
 @dataclass(frozen=True)
@@ -66,9 +71,11 @@ def figure_names() -> list[str]:
     """Names of every registered figure panel, in paper order."""
     _load_topics()
 
-    def key(n):  # paper order: fig5a < fig5b < fig6a < fig10c; names without digits last
+    def key(n):  # chapter by chapter as in the book, then fig5a < fig5b < ... < fig10c
+        chapter = FIGURES[n].chapter
+        position = CHAPTERS.index(chapter) if chapter in CHAPTERS else len(CHAPTERS)
         digits = "".join(c for c in n if c.isdigit())
-        return (int(digits) if digits else float("inf"), n)
+        return (position, int(digits) if digits else float("inf"), n)
 
     return sorted(FIGURES, key=key)
 
