@@ -72,11 +72,6 @@ def check_positive(name: str, value, unit: str = "") -> float:
     return check_range(name, value, 0.0, lower_open=True, unit=unit)
 
 
-def check_nonnegative(name: str, value, unit: str = "") -> float:
-    """Return ``float(value)`` if it is finite and >= 0."""
-    return check_range(name, value, 0.0, unit=unit)
-
-
 def check_count(name: str, value, minimum: int = 1) -> int:
     """Return ``int(value)`` if it is an integer >= ``minimum`` (booleans are not counts)."""
     integral = isinstance(value, (int, np.integer)) or (

@@ -319,9 +319,6 @@ def trace_point(hemisphere_radius: float, preload: float, runner: str, actuator_
 # Tables behind the figures
 # ======================================================================================
 
-_CONFIG = ("hemisphere_radius", "preload", "runner", "actuator_model")
-
-
 def config(hemisphere_radius: float = 1e-3, preload: float = 0.4, runner: str = "steel",
            actuator_model: str = "rigid") -> dict:
     """A drive configuration as plain sweep parameters (see :func:`section5_drive`)."""
