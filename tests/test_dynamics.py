@@ -239,7 +239,8 @@ def test_step_below_the_time_resolution_is_refused():
     wf = waveforms.sawtooth(1e-18, F_TEST, d, periods=2)
     with pytest.raises(dynamics.WorkLimitError, match=r"float spacings of t .*--amplitude.*--slew-rate"):
         dynamics.simulate(d, wf)
-    light = one_contact(runner_mass=1e-33)
+    # far outside the plausible runner masses on purpose: the work limit must still name it
+    light = one_contact(runner_mass=1e-33, allow_extrapolation=True)
     with pytest.raises(dynamics.WorkLimitError, match=r"runner_mass \(--runner-mass\) = 1e-33"):
         dynamics.simulate(light, waveforms.sawtooth(20e-9, F_TEST, light, periods=2))
     flexible = one_contact("flexible")
