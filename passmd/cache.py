@@ -21,7 +21,7 @@ Each entry is one file ``<directory>/<key[:2]>/<key>.pmc``::
 
 The JSON header holds the key, the function's name, the code fingerprint, the creation
 time and the stored value as a tree of typed nodes: ``None``, booleans, integers,
-strings, floats (as :meth:`float.hex`, exact to the bit), lists, tuples, dicts with
+strings, floats (as ``float.hex``, exact to the bit), lists, tuples, dicts with
 string keys, and NumPy arrays or NumPy scalars (dtype, shape and a slice of the
 payload; numeric dtypes only). Reading parses JSON and copies bytes into arrays: no
 entry can run code when it is read (pickles could). A value of any other type (a

@@ -260,7 +260,7 @@ def bisect_amplitude(moves, upper: float, tolerance: float) -> dict:
     bracket [0, upper] is opened by evaluating ``moves(upper)`` and then halved until it
     is at most ``tolerance`` wide. If ``moves`` switches more than once in the bracket,
     the bisection finds one of the switches; the runs of Fig. 5a show where that matters.
-    ``tolerance`` must be at least :data:`BISECTION_FLOOR_SPACINGS` float spacings of
+    ``tolerance`` must be at least ``BISECTION_FLOOR_SPACINGS`` float spacings of
     ``upper`` (the resolution of the amplitude), so the halving always ends.
 
     Returns
