@@ -153,7 +153,8 @@ AXES: dict[str, Axis] = {
                       "fig9b-sawtooth-velocity-16.5mm_s-at-110khz",
                       "fig10a-0.1n-maximum-at-or-below-80khz",
                       "sec5-1-acceleration-starts-at-velocity-maximum",
-                      "sec5-1-stick-during-acceleration", "sec5-1-spring-deformed-to-ux-max-after-flyback"),
+                      "sec5-1-stick-during-acceleration", "sec5-1-spring-deformed-to-ux-max-after-flyback",
+                      "sec5-1-fastest-at-end-of-acceleration"),
             open_reason="Section 4.1's closed forms (Eqs. 7–14) are committed as reference curves at "
             "μ = 0.2 only; the Fig. 8 traces and the resolved fly-back window are computed at μ = 0.2 "
             "only (not extended yet); the frequency sweeps of Figs. 9b and 10 would double in cost. "
