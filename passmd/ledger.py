@@ -88,7 +88,9 @@ __all__ = [
     "extractors",
     "result_sources",
     "sources_markdown",
+    "claim_readings",
     "load_baseline",
+    "load_baseline_readings",
     "load_claims",
     "orphan_extractors",
     "register_extractor",
@@ -1204,17 +1206,43 @@ def load_baseline(path) -> dict[str, str]:
     return dict(zip(table["claim"], table["status"], strict=True))
 
 
-def write_baseline(evaluated: pd.DataFrame, path, header: str = "") -> None:
-    """Write the claims' categories as a baseline CSV (``claim,status``), atomically.
+#: Separator of the readings in a baseline's ``readings`` column.
+READINGS_SEPARATOR = " | "
 
-    ``header`` (e.g. the command and date that produced it) is written as ``#`` comment lines.
+
+def claim_readings(claim_id: str) -> tuple[str, ...]:
+    """The readings a claim is evaluated at now, in words (:func:`passmd.readings.describe`)."""
+    return tuple(readings.describe(r) for r in readings.design(depends_on(claim_id)))
+
+
+def load_baseline_readings(path) -> dict[str, tuple[str, ...]]:
+    """``{claim id: readings}`` recorded in a baseline CSV (its ``readings`` column).
+
+    Empty when the baseline records no readings: the readings its categories were computed at
+    are then unknown, and no claim of it can be compared reading for reading.
+    """
+    table = pd.read_csv(path, dtype=str, keep_default_na=False, comment="#")
+    if "readings" not in table:
+        return {}
+    return {claim: tuple(text.split(READINGS_SEPARATOR))
+            for claim, text in zip(table["claim"], table["readings"], strict=True)}
+
+
+def write_baseline(evaluated: pd.DataFrame, path, header: str = "") -> None:
+    """Write the claims' categories as a baseline CSV (``claim,status,readings``), atomically.
+
+    ``readings`` lists the readings each category was computed at (:func:`claim_readings`), so
+    that two baselines are compared only where they evaluated the same readings. ``header``
+    (e.g. the command and date that produced it) is written as ``#`` comment lines.
     """
     path = Path(path)
+    table = evaluated[["claim", "status"]].copy()
+    table["readings"] = [READINGS_SEPARATOR.join(claim_readings(c)) for c in table["claim"]]
     tmp = path.with_name(f".{path.name}.tmp")
     with open(tmp, "w", encoding="utf-8", newline="") as fh:
         for line in header.splitlines():
             fh.write(f"# {line}\n")
-        evaluated[["claim", "status"]].to_csv(fh, index=False, lineterminator="\n")
+        table.to_csv(fh, index=False, lineterminator="\n")
     tmp.replace(path)
 
 

@@ -15,7 +15,9 @@ reading as its ``reading`` argument; when the result tables hold no run at that 
 raises :class:`passmd.ledger.NotEvaluable`, and that point counts as not covered.
 
 Axes declared with no evaluated alternative are listed in the report as open: the ledger cannot
-yet say whether a claim's verdict moves along them.
+yet say whether a claim's verdict moves along them. An axis with alternatives can still be open for
+some claims it applies to (``Axis.open_for``, with its reason): their result tables hold no run at
+the alternatives, so they are evaluated at the default only.
 """
 
 from __future__ import annotations
@@ -40,6 +42,8 @@ class Axis:
     plausible_range: str  # the whole plausible range, in words
     source: str  # where that range comes from
     assumption_key: str = ""  # the key of the matching passmd.parameters assumption, if any
+    open_for: tuple = ()  # claim ids the axis applies to but whose result tables lack its alternatives
+    open_reason: str = ""  # why those claims are not evaluated along the axis
 
     def values(self) -> tuple:
         return (self.default, *self.alternatives)
@@ -101,11 +105,18 @@ AXES: dict[str, Axis] = {
             key="damping_ratio",
             label="actuator damping ratio ζ",
             default=0.05,
-            alternatives=(),
+            alternatives=(0.005, 0.5),  # the ends of the plausible range
             unit="",
             plausible_range="0.005–0.5 (a decade either side of a lightly damped piezo stack, Q = 10)",
             source="Table 2's viscosity column c_p is lost in the available text",
             assumption_key="actuator_viscosity",
+            open_for=("fig5a-no-step-below-50nm", "fig7a-force-difference-115mn",
+                      "fig7a-discrepancy-grows-with-amplitude", "fig7b-discrepancy-grows-with-amplitude",
+                      "fig7-critical-amplitude-both-models",
+                      "sec4-2-friction-and-actuator-dynamics-cause-discrepancy",
+                      "sec4-2-other-preloads-same-trend"),
+            open_reason="Fig. 5a's amplitude grid and the Section 4.2 force runs are computed at the "
+            "default ζ only; the A_c searches of Figs. 5b, 6b and 6c run at both ends of the range",
         ),
         Axis(
             key="force_frequency",
@@ -121,10 +132,33 @@ AXES: dict[str, Axis] = {
             key="friction_coefficient",
             label="μ in Sections 4.1 and 5",
             default=0.2,
-            alternatives=(),
+            alternatives=(0.3,),  # the value Section 4.2 says [12] used
             unit="",
             plausible_range="0.2–0.3 (Section 4.2's measured 0.2 and the earlier model's 0.3)",
             source="Sections 4.1 and 5 do not state μ; Section 4.2 uses 0.2 (Lübke [24]) and 0.3 ([12])",
+            open_for=("fig5a-no-step-below-50nm", "fig5b-rigid-ac-matches-eq7",
+                      "fig5b-flexible-ac-matches-eq8", "fig5b-flexible-above-rigid",
+                      "fig6a-rigid-ac-matches-eq11", "fig6a-rigid-ac-not-eq10",
+                      "fig6b-flexible-r1-ac-matches-eq12", "fig6c-flexible-r025-ac-matches-eq12",
+                      "fig8a-back-step", "sec5-response-to-optimized-similar",
+                      "fig9b-optimized-faster-below-110khz", "fig9b-max-gain-2.5mm_s",
+                      "fig9b-optimized-decreases-above-110khz", "fig9b-standard-increases-above-110khz",
+                      "fig9b-step-decreases-with-frequency", "fig9b-no-time-to-settle-above-110khz",
+                      "abstract-velocity-gain-15pct", "fig10a-max-velocity-19mm_s",
+                      "fig10a-max-velocity-at-110khz", "fig10a-1n-slower", "fig10a-1n-larger-back-step",
+                      "fig10a-0.1n-smaller-back-step", "fig10a-0.1n-stick-lost-above-80khz",
+                      "fig10a-0.1n-slightly-slower", "fig10b-r1-faster", "fig10b-r1-higher-max-frequency",
+                      "fig10b-r1-smaller-back-step", "fig10c-youngs-modulus-negligible",
+                      "conclusion-youngs-modulus-weaker-than-preload-and-radius",
+                      "fig9b-sawtooth-velocity-16.5mm_s-at-110khz",
+                      "fig10a-0.1n-maximum-at-or-below-80khz",
+                      "sec5-1-acceleration-starts-at-velocity-maximum",
+                      "sec5-1-stick-during-acceleration", "sec5-1-spring-deformed-to-ux-max-after-flyback",
+                      "sec5-1-fastest-at-end-of-acceleration"),
+            open_reason="Section 4.1's closed forms (Eqs. 7–14) are committed as reference curves at "
+            "μ = 0.2 only; the Fig. 8 traces and the resolved fly-back window are computed at μ = 0.2 "
+            "only (not extended yet); the frequency sweeps of Figs. 9b and 10 would double in cost. "
+            "Only the Fig. 9a runs are repeated at μ = 0.3",
         ),
     )
 }
@@ -165,10 +199,13 @@ def describe(reading: Mapping, *, only_changed: bool = True) -> str:
 
 
 def space_table() -> pd.DataFrame:
-    """Every declared axis: default, evaluated alternatives, plausible range and its source."""
+    """Every declared axis: default, evaluated alternatives, plausible range, its source, and the
+    claims it applies to that are not evaluated along it (``open for``, with the reason)."""
     return pd.DataFrame([
         {"assumption": a.label, "key": a.key, "default": a.show(a.default),
          "evaluated alternatives": ", ".join(a.show(v) for v in a.alternatives) or "none yet",
-         "plausible range": a.plausible_range, "source": a.source}
+         "plausible range": a.plausible_range, "source": a.source,
+         "open for": (f"{len(a.open_for)} claims ({', '.join(a.open_for)}): {a.open_reason}"
+                      if a.open_for else "")}
         for a in AXES.values()
     ])

@@ -69,6 +69,7 @@ def test_fig9a_snapshot(quick, dataframe_regression):
     locked = _numeric(periods, ("period", "settled_position_m", "back_step_m",
                                 "micro_vibration_frequency_Hz"))
     locked["optimized"] = (periods["waveform"] == "optimized").to_numpy().astype(float)
+    locked["friction_coefficient"] = periods["friction_coefficient"].to_numpy(dtype=float)
     dataframe_regression.check(locked, default_tolerance={"rtol": RTOL, "atol": ATOL["m"]},
                                tolerances=_tolerances(locked.columns))
 
@@ -107,7 +108,7 @@ def test_eq15_waveform_makes_a_smaller_step_at_100hz(quick):
     are already close to full sliding, and Δ_a ≈ u_x,max pushes them over it). This test locks
     that finding; if the model changes so that the heuristic wins, the chapter must change.
     """
-    periods = quick["fig9a"][quick["fig9a"]["view"] == "period"]
+    periods = dw.at_section5_friction(quick["fig9a"][quick["fig9a"]["view"] == "period"])
     step = {w: np.mean(np.diff(p.sort_values("period")["settled_position_m"].to_numpy()))
             for w, p in periods.groupby("waveform")}
     assert step["optimized"] < step["sawtooth"]
@@ -213,3 +214,17 @@ def test_turning_point_needs_a_rise_then_a_fall_where_the_paper_puts_it():
         dw.turning_point(_velocity_series([1, 20, 110, 130], [0.2, 3.0, 20.0, 25.0]), 110.0)
     with pytest.raises(ClaimFails, match="turns at 60 kHz"):
         dw.turning_point(_velocity_series([1, 60, 100, 110, 130], [0.2, 9.0, 5.0, 4.0, 3.0]), 110.0)
+
+
+def test_flyback_window_resolves_the_acceleration():
+    """``fig8b_window`` (ledger rows of Section 5.1's stick condition): t_a, about 0.2 µs and shorter
+    than the default step, holds at least ten records, and every phase of the window is present."""
+    frame = figure_data("fig8b_window", "quick")
+    row = frame.iloc[0]
+    t_a = row["acceleration_end_s"] - row["acceleration_start_s"]
+    # records fall on integration steps: at most one step (t_a / 20) off the nominal t_a / 10
+    assert row["record_spacing_s"] <= 1.5 * t_a / dw.WINDOW_SAMPLES_PER_ACCELERATION
+    counts = frame["phase"].value_counts()
+    assert counts["acceleration"] >= dw.WINDOW_SAMPLES_PER_ACCELERATION - 1
+    assert {"before", "flyback", "settling", "after"} <= set(counts.index)
+    assert figure_plot("fig8b_window", frame).axes

@@ -402,7 +402,9 @@ def test_any_category_change_fails_with_a_readable_diff(tmp_path, registry):
     results = {"fig5a": pd.DataFrame()}
     baseline_path = tmp_path / "baseline.csv"
     ledger.write_baseline(ledger.evaluate(claims, results), baseline_path, header="made by a test\non a day")
-    assert baseline_path.read_text().startswith("# made by a test\n# on a day\nclaim,status\n")
+    assert baseline_path.read_text().startswith("# made by a test\n# on a day\nclaim,status,readings\n")
+    # the readings each category was computed at (these synthetic claims depend on no axis)
+    assert ledger.load_baseline_readings(baseline_path)["val"] == ("defaults",)
     baseline = ledger.load_baseline(baseline_path)
     assert baseline["val"] == "reproduced" and baseline["other"] == "inconclusive"
     ledger.check_categories(ledger.evaluate(claims, results), baseline)  # unchanged: fine
@@ -533,3 +535,36 @@ def test_ledger_command_prints_categories_and_si_json(monkeypatch, capsys):
     assert "fig10b-r1-stiffer-contact: reproduced (closed form)" in text.getvalue()
     assert cli.main(["ledger", "--workers", "0"], out=io.StringIO()) == 2
     assert "--workers = 0 is out of range" in capsys.readouterr().err
+
+
+def test_open_claims_of_each_axis_are_exactly_those_not_evaluated_along_it():
+    """An axis with alternatives is still open for the claims it applies to whose extractor does not
+    read it. μ applies to every claim that assumes it (claims.csv ``assumed``); the actuator damping
+    ratio ζ to every claim with a flexible actuator. ``Axis.open_for`` must list exactly the rest, so
+    the report never calls a claim covered along an axis it was not evaluated at."""
+    from passmd import readings
+
+    claims = ledger.load_claims()
+    applies = {
+        "friction_coefficient": set(claims.loc[claims["assumed"].str.split(";").map(
+            lambda cols: "friction_coefficient" in cols), "id"]),
+        "damping_ratio": set(claims.loc[claims["actuator_model"].str.split(";").map(
+            lambda models: "flexible" in models), "id"]),
+    }
+    for key, ids in applies.items():
+        evaluated = {c for c in ids if key in ledger.depends_on(c)}
+        assert evaluated, f"no claim is evaluated along {key}"
+        assert set(readings.axis(key).open_for) == ids - evaluated, key
+        assert readings.axis(key).alternatives and readings.axis(key).open_reason, key
+    table = readings.space_table().set_index("key")
+    assert table.at["damping_ratio", "open for"].startswith("7 claims")
+
+
+def test_baseline_readings_of_a_claim_along_several_axes(tmp_path):
+    """A baseline records every reading of a claim's design; one without the column records none."""
+    readings_ = ledger.claim_readings("fig6b-flexible-r1-ac-matches-eq12")
+    assert readings_[0] == "defaults" and "actuator damping ratio ζ = 0.005" in readings_
+    path = tmp_path / "old.csv"
+    path.write_text("# made before readings were recorded\nclaim,status\nval,reproduced\n", encoding="utf-8")
+    assert ledger.load_baseline_readings(path) == {}
+    assert ledger.load_baseline(path) == {"val": "reproduced"}

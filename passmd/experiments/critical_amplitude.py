@@ -44,7 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from passmd import dynamics, reference, sweep, waveforms
+from passmd import dynamics, readings, reference, sweep, waveforms
 from passmd._validation import check_choice, check_positive, check_range
 from passmd.experiments import PROFILES, register_figure
 from passmd.ledger import ClaimFails, NotEvaluable, curve_deviation, register_extractor
@@ -450,12 +450,20 @@ def _settings(profile: str) -> ProfileSettings:
 
 
 def _protocols(actuator_model: str, frequencies) -> list[dict]:
-    """The (protocol, fly-back, frequency) combinations drawn for an actuator model."""
+    """The (protocol, fly-back, frequency[, ζ]) combinations drawn for an actuator model.
+
+    Flexible actuators are also searched at the evaluated alternatives of the ledger's axis
+    ``damping_ratio`` (:mod:`passmd.readings`; Table 2's c_p is lost), steady state with the
+    slew-rate fly-back at :data:`DRIVE_FREQUENCY`; every other row uses
+    :data:`~passmd.parameters.ACTUATOR_DAMPING_RATIO`.
+    """
     combos = [{"protocol": "steady", "flyback": "slew", "frequency": float(f)} for f in frequencies]
     combos.append({"protocol": "first", "flyback": "slew", "frequency": DRIVE_FREQUENCY})
-    if actuator_model == "flexible":  # the fly-back rule only matters for flexible actuators
+    if actuator_model == "flexible":  # the fly-back rule and ζ only matter for flexible actuators
         combos.append({"protocol": "steady", "flyback": "fixed", "frequency": DRIVE_FREQUENCY})
         combos.append({"protocol": "first", "flyback": "fixed", "frequency": DRIVE_FREQUENCY})
+        combos.extend({"protocol": "steady", "flyback": "slew", "frequency": DRIVE_FREQUENCY,
+                       "damping_ratio": float(z)} for z in readings.axis("damping_ratio").alternatives)
     return combos
 
 
@@ -696,31 +704,34 @@ def fig56_frequency(profile: str = "paper") -> pd.DataFrame:
 
 def primary(table: pd.DataFrame, actuator_model: str | None = None, reading=None) -> pd.DataFrame:
     """The rows of one reading of the A_c protocol (default: steady state, :data:`DRIVE_FREQUENCY`,
-    slew-rate fly-back).
+    slew-rate fly-back, ζ = :data:`~passmd.parameters.ACTUATOR_DAMPING_RATIO`).
 
     ``reading`` is a ledger reading (:mod:`passmd.readings`): its ``ac_protocol``,
-    ``flyback`` and ``drive_frequency_s4`` select the rows. The fly-back rule applies to flexible
-    actuators only (the rigid runs use the slew-rate fly-back). Raises
+    ``flyback``, ``drive_frequency_s4`` and ``damping_ratio`` select the rows. The fly-back
+    rule and ζ apply to flexible actuators only (the rigid runs use the slew-rate fly-back). Raises
     :class:`passmd.ledger.NotEvaluable` when the table holds no run at that reading and
     :class:`passmd.ledger.ClaimFails` when a preload makes no step up to the full stroke.
     """
     protocol, flyback, frequency = "steady", "slew", DRIVE_FREQUENCY
+    zeta = ACTUATOR_DAMPING_RATIO
     if reading is not None:
         protocol, flyback = reading["ac_protocol"], reading["flyback"]
         frequency = float(reading["drive_frequency_s4"])
-    if actuator_model == "rigid":
-        flyback = "slew"
+        zeta = float(reading.get("damping_ratio", zeta))
+    if actuator_model == "rigid":  # no actuator dynamics: neither the fly-back rule nor ζ applies
+        flyback, zeta = "slew", ACTUATOR_DAMPING_RATIO
     rows = table[
         (table["protocol"] == protocol)
         & (table["flyback"] == flyback)
         & np.isclose(table["frequency_Hz"], frequency)
+        & np.isclose(table["damping_ratio"], zeta, rtol=1e-9, atol=0)
     ]
     if actuator_model is not None:
         rows = rows[rows["actuator_model"] == actuator_model]
     rows = rows.sort_values("preload_N")
     if rows.empty:
         raise NotEvaluable(f"no {protocol} A_c runs with the {flyback} fly-back at {frequency:g} Hz "
-                           "on this grid")
+                           f"and ζ = {zeta:g} on this grid")
     if rows["critical_amplitude_nm"].isna().any():
         where = rows.loc[rows["critical_amplitude_nm"].isna(), "preload_N"].tolist()
         raise ClaimFails(f"no step up to the full stroke at {', '.join(f'{p:g}' for p in where)} N "
@@ -733,9 +744,9 @@ def _curve(results, key: str, actuator_model: str, reading=None) -> dict:
     return {"x": rows["preload_N"].to_numpy(), "y": rows["critical_amplitude_nm"].to_numpy()}
 
 
-#: Axes of passmd.readings the A_c curves depend on (rigid actuators: not the fly-back rule).
+#: Axes of passmd.readings the A_c curves depend on (rigid actuators: neither the fly-back rule nor ζ).
 _RIGID_AXES = ("ac_protocol", "drive_frequency_s4")
-_FLEXIBLE_AXES = ("flyback", "ac_protocol", "drive_frequency_s4")
+_FLEXIBLE_AXES = ("flyback", "ac_protocol", "drive_frequency_s4", "damping_ratio")
 
 
 @register_extractor("fig5a-no-step-below-50nm", depends_on=("flyback",))

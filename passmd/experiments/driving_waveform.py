@@ -35,7 +35,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from passmd import dynamics, sweep, theory, waveforms
+from passmd import dynamics, readings, sweep, theory, waveforms
 from passmd._validation import check_choice
 from passmd.experiments import PROFILES, register_figure
 from passmd.ledger import ClaimFails, NotEvaluable, register_evidence, register_extractor
@@ -64,6 +64,10 @@ RUNNERS = {"steel": STEEL, "molybdenum": MOLYBDENUM}
 #: Preloads of Fig. 10a (N) and radii of Fig. 10b (m).
 FIG10A_PRELOADS = (0.1, 0.4, 1.0)
 FIG10B_RADII = (1e-3, 0.25e-3)
+#: μ of Section 5 (not stated there): the default of the ledger's axis ``friction_coefficient``.
+SECTION5_FRICTION = float(readings.axis("friction_coefficient").default)
+#: μ of the Fig. 9a runs: the default and the ledger's evaluated alternatives (Section 4.2's 0.3).
+FIG9A_FRICTION = tuple(float(mu) for mu in readings.axis("friction_coefficient").values())
 #: Waveform variants of Figs. 9b and 10: (waveform, short_period rule).
 VARIANTS = (("sawtooth", ""), ("optimized", "cut"), ("optimized", "skip"))
 
@@ -140,15 +144,16 @@ register_assumption(
 
 
 def section5_drive(hemisphere_radius: float = 1e-3, preload: float = 0.4, runner: str = "steel",
-                   actuator_model: str = "rigid") -> Drive:
+                   actuator_model: str = "rigid", friction_coefficient: float = SECTION5_FRICTION) -> Drive:
     """The drive of Section 5: six contacts, Table 1–2 parameters, free runner, μ = 0.2.
 
     ``runner`` names the runner material (``"steel"``, Table 1, or ``"molybdenum"``,
-    Fig. 10c); ``actuator_model`` is ``"rigid"`` in the paper.
+    Fig. 10c); ``actuator_model`` is ``"rigid"`` in the paper. ``friction_coefficient`` is
+    Section 5's unstated μ (ledger axis ``friction_coefficient``, :mod:`passmd.readings`).
     """
     check_choice("runner", runner, tuple(RUNNERS))
     return paper_drive(hemisphere_radius, preload, actuator_model=actuator_model,
-                       runner_material=RUNNERS[runner])
+                       runner_material=RUNNERS[runner], friction_coefficient=friction_coefficient)
 
 
 def make_design(settling_time: float, acceleration_time: float,
@@ -157,13 +162,14 @@ def make_design(settling_time: float, acceleration_time: float,
     return waveforms.OptimizedDesign(settling_time, acceleration_time, acceleration_amplitude)
 
 
-def design_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str) -> dict:
+def design_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
+                 friction_coefficient: float = SECTION5_FRICTION) -> dict:
     """Eq. 15 design of a drive at its full amplitude (:func:`passmd.optimized_waveform.optimized_design`).
 
     Returns the design's :meth:`~passmd.optimized_waveform.OptimizedDesign.as_dict` plus the amplitude
     and the linear runner-on-contacts frequency (:func:`passmd.theory.runner_frequency`).
     """
-    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
+    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model, friction_coefficient)
     amplitude = drive.actuator.full_stroke_amplitude
     out = waveforms.optimized_design(amplitude, drive).as_dict()
     out["amplitude_m"] = amplitude
@@ -261,7 +267,8 @@ def velocity_point(hemisphere_radius: float, preload: float, runner: str, actuat
 def trace_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
                 frequency: float, periods: int, waveform: str, settling_time: float,
                 acceleration_time: float, acceleration_amplitude: float, zoom_start: float,
-                zoom_end: float, full_samples: int, zoom_samples: int) -> dict:
+                zoom_end: float, full_samples: int, zoom_samples: int,
+                friction_coefficient: float = SECTION5_FRICTION) -> dict:
     """Time series of one run from rest, for the time-domain figures (Figs. 8, 9a).
 
     The run is recorded at ≥ 200 samples per linear runner-vibration period and returned
@@ -271,7 +278,7 @@ def trace_point(hemisphere_radius: float, preload: float, runner: str, actuator_
     (optimized), measured as in the design (:func:`passmd.optimized_waveform.micro_vibration_frequency`),
     and the first three turning points of the runner after the first fly-back.
     """
-    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
+    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model, friction_coefficient)
     amplitude = drive.actuator.full_stroke_amplitude
     design = None if waveform == "sawtooth" else make_design(
         settling_time, acceleration_time, acceleration_amplitude)
@@ -498,6 +505,91 @@ def fig8b(profile: str = "paper") -> pd.DataFrame:
     return _display(frame)
 
 
+#: Integration refinement of the fly-back window run: the default rigid step (1/400 of the runner's
+#: linear vibration period, about 0.23 µs) is longer than t_a (about 0.2 µs); divided by this the
+#: acceleration spans ~20 (quick) or ~40 (paper) steps.
+WINDOW_RESOLUTION = {"quick": 20.0, "paper": 40.0}
+#: Record spacing of the fly-back window run: t_a / this (evenly spaced over the whole run).
+WINDOW_SAMPLES_PER_ACCELERATION = 10
+#: The window kept: from this long before the fly-back to this long after the end of t_a (s);
+#: 30 µs after t_a covers more than a quarter of the runner's ~10 kHz micro-vibration.
+WINDOW_BEFORE, WINDOW_AFTER = 2e-6, 30e-6
+
+
+def window_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
+                 settling_time: float, acceleration_time: float, acceleration_amplitude: float,
+                 resolution: float, samples_per_acceleration: int) -> dict:
+    """Fig. 8b's run (100 Hz, period 1 saw-tooth, period 2 optimized) resolved inside t_a.
+
+    The run is integrated with the step divided by ``resolution`` and recorded every
+    t_a / ``samples_per_acceleration``; only the window from :data:`WINDOW_BEFORE` before the
+    fly-back to :data:`WINDOW_AFTER` after the end of t_a is returned (time series ``time_s``,
+    ``runner_velocity_m_per_s``, ``runner_position_m``, ``piezo_position_m``, ``slip_share_<g>``),
+    with the fly-back start and end, the start and end of t_a (s) and the largest record
+    spacing inside t_a (``record_spacing_s``; records fall on integration steps).
+    """
+    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
+    amplitude = drive.actuator.full_stroke_amplitude
+    design = make_design(settling_time, acceleration_time, acceleration_amplitude)
+    wave = make_waveform(drive, amplitude, STEP_FREQUENCY, 2, "optimized", "cut", design)
+    timing = waveforms.optimized_timing(design, amplitude, STEP_FREQUENCY, drive)
+    period = 1.0 / STEP_FREQUENCY
+    flyback = waveforms.flyback_time(amplitude, drive)
+    start_a = period + timing["settling_time_s"]
+    end_a = start_a + timing["acceleration_time_s"]
+    points = int(math.ceil(wave.duration * samples_per_acceleration / timing["acceleration_time_s"])) + 1
+    result = dynamics.simulate(drive, wave, resolution=resolution, max_points=points)
+    t = result.time
+    keep = (t >= period - flyback - WINDOW_BEFORE) & (t <= end_a + WINDOW_AFTER)
+    inside = t[(t >= start_a) & (t <= end_a)]
+    if inside.size < 2:
+        raise dynamics.SimulationError("fewer than two recorded samples inside the acceleration t_a")
+    out = {"time_s": t[keep], "runner_velocity_m_per_s": result.runner_velocity[keep],
+           "runner_position_m": result.runner_position[keep], "piezo_position_m": result.piezo_position[keep],
+           "flyback_start_s": period - flyback, "flyback_end_s": period, "acceleration_start_s": start_a,
+           "acceleration_end_s": end_a, "record_spacing_s": float(np.max(np.diff(inside))),
+           "wall_time_s": result.wall_time}
+    for g in range(result.multiplicity.size):
+        out[f"slip_share_{g + 1}"] = result.slip_share[g][keep]
+    return out
+
+
+@register_figure("fig8b_window", title="Fig. 8b's fly-back and acceleration t_a, resolved in time",
+                 chapter=CHAPTER, plot=plots.plot_fig8b_window)
+def fig8b_window(profile: str = "paper") -> pd.DataFrame:
+    """The fly-back and the acceleration t_a of Fig. 8b's optimized period, resolved inside t_a.
+
+    One run of the Section 5 drive (0.4 N, 100 Hz, its own Eq. 15 design) integrated with the
+    step divided by :data:`WINDOW_RESOLUTION` and recorded every t_a /
+    :data:`WINDOW_SAMPLES_PER_ACCELERATION` (:func:`window_point`). Columns: ``time_s``,
+    ``time_us``, runner and piezo positions (nm) and velocity, ``slip_share_1`` and
+    ``slip_share_2``, ``phase`` (``flyback``, ``settling``, ``acceleration``, ``after``) and
+    the constant phase times (s) and record spacing.
+    """
+    check_choice("profile", profile, PROFILES)
+    c = config()
+    fields = design_fields(designs([c]).iloc[0])
+    point = {**c, **fields, "resolution": WINDOW_RESOLUTION[profile],
+             "samples_per_acceleration": WINDOW_SAMPLES_PER_ACCELERATION}
+    run = sweep.run(window_point, [point], description="fly-back window").iloc[0].to_dict()
+    t = np.asarray(run["time_s"])
+    frame = pd.DataFrame({"time_s": t, "time_us": t * 1e6})
+    for name in ("runner_velocity_m_per_s", "runner_position_m", "piezo_position_m", "slip_share_1",
+                 "slip_share_2"):
+        frame[name] = np.asarray(run[name])
+    frame["runner_position_nm"] = frame["runner_position_m"] * 1e9
+    frame["piezo_position_nm"] = frame["piezo_position_m"] * 1e9
+    marks = {k: float(run[k]) for k in ("flyback_start_s", "flyback_end_s", "acceleration_start_s",
+                                       "acceleration_end_s", "record_spacing_s")}
+    frame["phase"] = np.select(
+        [t < marks["flyback_start_s"], t <= marks["flyback_end_s"], t < marks["acceleration_start_s"],
+         t <= marks["acceleration_end_s"]], ["before", "flyback", "settling", "acceleration"], "after")
+    for key, value in marks.items():
+        frame[key] = value
+    frame["wall_time_s"] = float(run["wall_time_s"])
+    return frame
+
+
 @register_figure("fig9a", title="Runner position over three 100 Hz periods, saw-tooth and optimized",
                  chapter=CHAPTER, plot=plots.plot_fig9a)
 def fig9a(profile: str = "paper") -> pd.DataFrame:
@@ -508,25 +600,38 @@ def fig9a(profile: str = "paper") -> pd.DataFrame:
     ``final_position_m`` (settled position after three periods) and
     ``micro_vibration_frequency_Hz`` (after the first fly-back for the saw-tooth, after the
     first acceleration for the optimized waveform).
+
+    ``friction_coefficient`` tags each run: μ = 0.2 (the figure) and the evaluated alternatives
+    of the ledger's axis ``friction_coefficient`` (:data:`FIG9A_FRICTION`), each with its own
+    Eq. 15 design.
     """
     _frequencies(profile)
-    c = config()
-    fields = design_fields(designs([c]).iloc[0])
     full, _ = _samples(profile)
     parts = []
-    for waveform in ("sawtooth", "optimized"):
-        trace = _trace(c, STEP_FREQUENCY, 3, waveform, fields, (0.0, 1e-3), full, 2)
-        series = _series_frame(trace, "full", 2)
-        settled = np.asarray(trace["settled_positions_m"])
-        per = pd.DataFrame({"view": "period", "period": np.arange(1, settled.size + 1),
-                            "time_s": np.arange(1, settled.size + 1) / STEP_FREQUENCY,
-                            "settled_position_m": settled, "back_step_m": np.asarray(trace["back_steps_m"])})
-        frame = pd.concat([series, per], ignore_index=True)
-        frame["waveform"] = waveform
-        frame["final_position_m"] = float(settled[-1])
-        frame["micro_vibration_frequency_Hz"] = float(trace["micro_vibration_frequency_Hz"])
-        parts.append(frame)
+    for mu in FIG9A_FRICTION:
+        c = {**config(), "friction_coefficient": mu}
+        fields = design_fields(designs([c]).iloc[0])
+        for waveform in ("sawtooth", "optimized"):
+            trace = _trace(c, STEP_FREQUENCY, 3, waveform, fields, (0.0, 1e-3), full, 2)
+            series = _series_frame(trace, "full", 2)
+            settled = np.asarray(trace["settled_positions_m"])
+            per = pd.DataFrame({"view": "period", "period": np.arange(1, settled.size + 1),
+                                "time_s": np.arange(1, settled.size + 1) / STEP_FREQUENCY,
+                                "settled_position_m": settled,
+                                "back_step_m": np.asarray(trace["back_steps_m"])})
+            frame = pd.concat([series, per], ignore_index=True)
+            frame["waveform"] = waveform
+            frame["friction_coefficient"] = mu
+            frame["final_position_m"] = float(settled[-1])
+            frame["micro_vibration_frequency_Hz"] = float(trace["micro_vibration_frequency_Hz"])
+            parts.append(frame)
     return _display(pd.concat(parts, ignore_index=True))
+
+
+def at_section5_friction(frame: pd.DataFrame, friction_coefficient: float = SECTION5_FRICTION
+                         ) -> pd.DataFrame:
+    """The rows of a table tagged with ``friction_coefficient`` at one μ (default: Section 5's 0.2)."""
+    return frame[np.isclose(frame["friction_coefficient"], friction_coefficient, rtol=1e-9, atol=0)]
 
 
 @register_figure("fig9b", title="Steady velocity against driving frequency, saw-tooth and optimized",
@@ -562,9 +667,14 @@ def fig10c(profile: str = "paper") -> pd.DataFrame:
 # ======================================================================================
 
 
-def _fig9a_run(results, waveform: str) -> pd.DataFrame:
-    table = results["fig9a"]
-    return table[(table["waveform"] == waveform) & (table["view"] == "period")].sort_values("period")
+def _fig9a_run(results, waveform: str, reading=None) -> pd.DataFrame:
+    """Fig. 9a's per-period rows of one waveform at a ledger reading's μ (default 0.2)."""
+    mu = SECTION5_FRICTION if reading is None else float(reading["friction_coefficient"])
+    table = at_section5_friction(results["fig9a"], mu)
+    rows = table[(table["waveform"] == waveform) & (table["view"] == "period")].sort_values("period")
+    if rows.empty:
+        raise NotEvaluable(f"no Fig. 9a {waveform} run at μ = {mu:g}")
+    return rows
 
 
 def _series(table: pd.DataFrame, variant: str, **where) -> pd.DataFrame:
@@ -675,27 +785,103 @@ def _acceleration_phase_evidence(results):
             f"t_s ends (point 4) at {t['point4']:.2f} µs; f_s = {t['f_s'] / 1e3:.4g} kHz"]
 
 
-@register_extractor("fig9a-standard-position-552nm")
-def _fig9a_standard(results):
-    return float(_fig9a_run(results, "sawtooth")["settled_position_m"].iloc[-1]) * 1e9
+def _window_phase(results, phases: tuple[str, ...]) -> pd.DataFrame:
+    """Rows of the resolved fly-back window (``fig8b_window``) in the given phases.
+
+    Inconclusive when a phase holds fewer than :data:`WINDOW_SAMPLES_PER_ACCELERATION` // 2
+    samples: the record then cannot resolve it.
+    """
+    table = results["fig8b_window"]
+    rows = table[table["phase"].isin(phases)]
+    for phase in phases:
+        n = int((rows["phase"] == phase).sum())
+        if n < WINDOW_SAMPLES_PER_ACCELERATION // 2:
+            raise NotEvaluable(f"only {n} recorded samples in the {phase} phase of the fly-back window")
+    return rows
 
 
-@register_extractor("fig9a-optimized-position-716nm")
-def _fig9a_optimized(results):
-    return float(_fig9a_run(results, "optimized")["settled_position_m"].iloc[-1]) * 1e9
+@register_extractor("sec5-1-stick-during-acceleration")
+def _stick_during_acceleration(results):
+    # Section 5.1 chooses V_a so that the runner still sticks during t_a: no contact group may
+    # reach full sliding (slip share 1) between points 4 and 5.
+    rows = _window_phase(results, ("acceleration",))
+    share = float(rows[["slip_share_1", "slip_share_2"]].to_numpy().max())
+    return {"lhs": share, "rhs": FULL_SLIDING_SHARE}
 
 
-@register_extractor("fig9a-step-increase-46.8pct")
-def _fig9a_increase(results):
-    std = _fig9a_run(results, "sawtooth")["settled_position_m"].to_numpy()
-    opt = _fig9a_run(results, "optimized")["settled_position_m"].to_numpy()
+@register_evidence("sec5-1-stick-during-acceleration")
+def _stick_during_acceleration_evidence(results):
+    rows = _window_phase(results, ("settling", "acceleration"))
+    end_settling = rows[rows["phase"] == "settling"].iloc[-1]
+    acc = rows[rows["phase"] == "acceleration"]
+    first_full = acc.loc[acc[["slip_share_1", "slip_share_2"]].max(axis=1) >= FULL_SLIDING_SHARE, "time_s"]
+    start = float(acc["acceleration_start_s"].iloc[0])
+    lines = [f"slip shares at the end of t_s: side 1 {end_settling['slip_share_1']:.2f}, side 2 "
+             f"{end_settling['slip_share_2']:.2f}"]
+    if len(first_full):
+        lines.append(f"a contact group slides fully {(float(first_full.iloc[0]) - start) * 1e9:.0f} ns into "
+                     f"t_a = {(float(acc['acceleration_end_s'].iloc[0]) - start) * 1e9:.0f} ns")
+    return lines
+
+
+@register_extractor("sec5-1-spring-deformed-to-ux-max-after-flyback")
+def _deformed_to_ux_max(results):
+    # The contact's tangential displacement reaches u_x,max exactly when the whole contact slides
+    # (slip share 1); every contact group must get there between the fly-back and the end of t_s.
+    rows = _window_phase(results, ("flyback", "settling"))
+    return float(rows[["slip_share_1", "slip_share_2"]].max(axis=0).min())
+
+
+@register_extractor("sec5-1-fastest-at-end-of-acceleration")
+def _fastest_at_point5(results):
+    # Section 5.1: at point 5 (end of t_a) the runner has its highest velocity. The time of the
+    # runner's largest forward velocity from point 4 to the end of the window, after point 5, in
+    # units of t_a; a maximum at the window's last sample does not locate it (inconclusive).
+    rows = _window_phase(results, ("acceleration", "after"))
+    v = rows["runner_velocity_m_per_s"].to_numpy()
+    k = int(np.argmax(v))
+    if k == v.size - 1:
+        raise NotEvaluable("the runner's velocity is largest at the last sample of the window")
+    row = rows.iloc[0]
+    t_a = float(row["acceleration_end_s"] - row["acceleration_start_s"])
+    return (float(rows["time_s"].iloc[k]) - float(row["acceleration_end_s"])) / t_a
+
+
+@register_evidence("sec5-1-fastest-at-end-of-acceleration")
+def _fastest_at_point5_evidence(results):
+    rows = _window_phase(results, ("acceleration", "after"))
+    acc = rows[rows["phase"] == "acceleration"]
+    k = int(np.argmax(rows["runner_velocity_m_per_s"].to_numpy()))
+    return [f"runner velocity at point 5: {acc['runner_velocity_m_per_s'].iloc[-1] * 1e3:.3f} mm/s; largest, "
+            f"{rows['runner_velocity_m_per_s'].iloc[k] * 1e3:.3f} mm/s, "
+            f"{(rows['time_s'].iloc[k] - acc['acceleration_end_s'].iloc[0]) * 1e6:.2f} µs after point 5"]
+
+
+#: Axis of passmd.readings the Fig. 9a claims depend on: Section 5's unstated μ.
+_FIG9A_AXES = ("friction_coefficient",)
+
+
+@register_extractor("fig9a-standard-position-552nm", depends_on=_FIG9A_AXES)
+def _fig9a_standard(results, reading):
+    return float(_fig9a_run(results, "sawtooth", reading)["settled_position_m"].iloc[-1]) * 1e9
+
+
+@register_extractor("fig9a-optimized-position-716nm", depends_on=_FIG9A_AXES)
+def _fig9a_optimized(results, reading):
+    return float(_fig9a_run(results, "optimized", reading)["settled_position_m"].iloc[-1]) * 1e9
+
+
+@register_extractor("fig9a-step-increase-46.8pct", depends_on=_FIG9A_AXES)
+def _fig9a_increase(results, reading):
+    std = _fig9a_run(results, "sawtooth", reading)["settled_position_m"].to_numpy()
+    opt = _fig9a_run(results, "optimized", reading)["settled_position_m"].to_numpy()
     return 100.0 * (opt[-1] - std[-1]) / (std[-1] - std[0])
 
 
-@register_extractor("fig9a-optimized-step-larger")
-def _fig9a_step_larger(results):
-    steps = {w: float(np.mean(np.diff(_fig9a_run(results, w)["settled_position_m"].to_numpy()))) * 1e9
-             for w in ("optimized", "sawtooth")}
+@register_extractor("fig9a-optimized-step-larger", depends_on=_FIG9A_AXES)
+def _fig9a_step_larger(results, reading):
+    steps = {w: float(np.mean(np.diff(_fig9a_run(results, w, reading)["settled_position_m"].to_numpy())))
+             * 1e9 for w in ("optimized", "sawtooth")}
     return {"lhs": steps["optimized"], "rhs": steps["sawtooth"]}
 
 

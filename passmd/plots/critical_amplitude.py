@@ -58,7 +58,12 @@ def _band(ax, rows: pd.DataFrame, colour: str, label: str) -> None:
 
 
 def _simulated(ax, rows: pd.DataFrame, colour: str, name: str, flexible: bool) -> None:
-    """Draw the simulated A_c of one actuator model: primary, band, first fly-back, fixed fly-back."""
+    """Draw the simulated A_c of one actuator model: primary, band, first fly-back, fixed fly-back.
+
+    Only the rows at the default actuator damping ratio: the ledger's ζ readings are not drawn.
+    """
+    if "damping_ratio" in rows:
+        rows = rows[np.isclose(rows["damping_ratio"], ACTUATOR_DAMPING_RATIO, rtol=1e-9, atol=0)]
     main = _steady(rows, "slew")
     ax.plot(
         main["preload_N"],

@@ -83,8 +83,32 @@ def plot_fig8b(df):
     return fig
 
 
+def plot_fig8b_window(df):
+    """Fig. 8b's fly-back and acceleration resolved in time: runner velocity and contact slip shares."""
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.6), constrained_layout=True)
+    t = df["time_us"]
+    row = df.iloc[0]
+    for ax in axes:
+        ax.axvspan(row["flyback_start_s"] * 1e6, row["flyback_end_s"] * 1e6, color="grey", alpha=0.2,
+                   lw=0, label="fly-back")
+        ax.axvspan(row["acceleration_start_s"] * 1e6, row["acceleration_end_s"] * 1e6, color="tab:green",
+                   alpha=0.3, lw=0, label="t_a")
+        ax.set_xlabel("time (µs)")
+    axes[0].plot(t, df["runner_velocity_m_per_s"] * 1e3, color="tab:green", lw=1)
+    axes[0].set(ylabel="runner velocity (mm/s)", title="runner")
+    axes[1].plot(t, df["slip_share_1"], color="tab:purple", label="side 1 (2 contacts)")
+    axes[1].plot(t, df["slip_share_2"], color="tab:orange", label="side 2 (4 contacts)")
+    axes[1].set(ylabel="slipping share of the contact", ylim=(-0.05, 1.1), title="contact status")
+    axes[1].legend(fontsize=7)
+    return fig
+
+
 def plot_fig9a(df):
-    """Fig. 9a: runner position over three 100 Hz periods for both waveforms."""
+    """Fig. 9a: runner position over three 100 Hz periods for both waveforms (μ = 0.2 runs only)."""
+    if "friction_coefficient" in df:
+        from passmd.experiments.driving_waveform import at_section5_friction
+
+        df = at_section5_friction(df)
     fig, ax = plt.subplots(figsize=(6.5, 4), constrained_layout=True)
     colours = {"sawtooth": "black", "optimized": "tab:green"}
     for waveform, part in df.groupby("waveform", sort=False):
