@@ -1,0 +1,90 @@
+"""The run configuration: how a computation runs, never what it computes.
+
+A :class:`RunConfig` travels explicitly from an entry point (the command line, the book,
+a test) down to the sweeps and the cache. Environment variables are read once, at the
+edge, by :meth:`RunConfig.from_environment`; nothing in the package writes them.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+__all__ = ["ENVIRONMENT", "PROFILES", "RunConfig"]
+
+#: Resolution profiles: ``quick`` (CI regression tests, minutes for everything) and
+#: ``paper`` (the paper's grids, the book's default).
+PROFILES = ("quick", "paper")
+
+#: The environment variables an entry point may read, by field of :class:`RunConfig`.
+ENVIRONMENT = {
+    "profile": "PASSMD_PROFILE",
+    "executor": "PASSMD_EXECUTOR",
+    "scheduler": "PASSMD_SCHEDULER",
+    "workers": "PASSMD_WORKERS",
+    "cache_dir": "PASSMD_CACHE_DIR",
+}
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    """How to run: resolution profile, parallel executor and result cache.
+
+    Parameters
+    ----------
+    profile : str
+        ``"quick"`` or ``"paper"`` (:data:`PROFILES`): which grids the figures use.
+    executor : str or None
+        ``"serial"``, ``"process"`` or ``"dask"``; None: ``"dask"`` when a scheduler is
+        given, else ``"process"``.
+    scheduler : str or None
+        Address of a running dask scheduler (``executor="dask"`` only).
+    workers : int or None
+        Parallel workers; None: one per CPU.
+    cache_dir : Path or None
+        Directory of the result cache; None: ``./.passmd-cache``.
+    """
+
+    profile: str = "paper"
+    executor: str | None = None
+    scheduler: str | None = None
+    workers: int | None = None
+    cache_dir: Path | None = None
+
+    def __post_init__(self):
+        if self.profile not in PROFILES:
+            raise ValueError(f"profile = {self.profile!r} is not allowed: must be one of {', '.join(PROFILES)}")
+        if self.workers is not None and (isinstance(self.workers, bool) or not isinstance(self.workers, int)
+                                         or self.workers < 1):
+            raise ValueError(f"workers = {self.workers!r} is not allowed: must be an integer >= 1")
+        if self.cache_dir is not None:
+            object.__setattr__(self, "cache_dir", Path(self.cache_dir).expanduser().resolve())
+
+    @classmethod
+    def from_environment(cls, environ: Mapping[str, str] | None = None, **overrides) -> RunConfig:
+        """Read :data:`ENVIRONMENT` once (at an entry point); explicit ``overrides`` win.
+
+        Empty variables count as unset. ``ValueError`` names the variable and its value.
+        """
+        environ = os.environ if environ is None else environ
+        fields = {}
+        for field, name in ENVIRONMENT.items():
+            text = (environ.get(name) or "").strip()
+            if not text:
+                continue
+            if field == "workers":
+                if not text.isdigit() or int(text) < 1:
+                    raise ValueError(f"{name} = {text!r} is not allowed: must be an integer >= 1")
+                fields[field] = int(text)
+            elif field == "profile" and text not in PROFILES:
+                raise ValueError(f"{name} = {text!r} is not allowed: must be one of {', '.join(PROFILES)}")
+            else:
+                fields[field] = text
+        fields.update({k: v for k, v in overrides.items() if v is not None})
+        return cls(**fields)
+
+    def with_profile(self, profile: str) -> RunConfig:
+        """The same configuration at another resolution profile."""
+        return replace(self, profile=profile)
