@@ -40,6 +40,7 @@ from tqdm.std import tqdm  # text bar on a terminal; tqdm.auto warns in notebook
 
 from passmd._validation import check_choice
 from passmd.cache import Cache, function_name
+from passmd.config import RunConfig
 from passmd.parameters import Drive
 from passmd.theory import drive_theory
 
@@ -318,6 +319,7 @@ def run(
     cache: bool | Cache | str | os.PathLike = True,
     progress: bool | None = None,
     description: str | None = None,
+    config: RunConfig | None = None,
 ) -> pd.DataFrame:
     """Evaluate ``func(**point)`` over a grid of points, in parallel and cached.
 
@@ -347,6 +349,10 @@ def run(
         Force the progress bar on or off; default: on a TTY unless ``$CI`` is set.
     description : str, optional
         Label of the progress bar (default the function's name).
+    config : RunConfig, optional
+        The run configuration an entry point passed down: its executor, scheduler,
+        workers and cache directory fill the arguments above that were left at their
+        defaults (explicit arguments win).
 
     Returns
     -------
@@ -364,6 +370,12 @@ def run(
         The first exception a point raised (with a note naming the point), after the
         points still running finished and were cached.
     """
+    if config is not None:
+        executor = config.executor if executor is None else executor
+        scheduler = config.scheduler if scheduler is None else scheduler
+        workers = config.workers if workers is None else workers
+        if cache is True and config.cache_dir is not None:
+            cache = config.cache_dir
     executor, scheduler, workers = _resolve(executor, scheduler, workers)
     if not isinstance(executor, cf.Executor):
         check_choice("executor", executor, EXECUTORS)

@@ -1,0 +1,12 @@
+"""The figure table: every figure the book shows, by name.
+
+Name → compute function (run configuration → tidy DataFrame), plot function
+(DataFrame → matplotlib Figure), book chapter and the claims its data decides. The book,
+``passmd figure`` and the ledger all go through :func:`figure_data` and :func:`figure_plot`.
+"""
+
+from __future__ import annotations
+
+from passmd.experiments import figure_data, figure_names, figure_plot, figure_spec
+
+__all__ = ["figure_data", "figure_names", "figure_plot", "figure_spec"]
