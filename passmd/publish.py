@@ -38,6 +38,7 @@ __all__ = [
     "PROFILE_ENV",
     "Markdown",
     "assumptions_frame",
+    "book_config",
     "book_root",
     "caption",
     "current_profile",
@@ -46,6 +47,9 @@ __all__ = [
     "format_quantity",
     "implementations",
     "parameter_frame",
+    "put",
+    "put_text",
+    "show_table",
     "to_unit",
 ]
 
@@ -357,3 +361,43 @@ def _resolve(dotted: str):
             obj = getattr(obj, attr)
         return obj
     raise ValueError(f"name = {dotted!r} is not defined: no such module")
+
+
+# --------------------------------------------------------------------------------------
+# Glue for the chapters (one definition instead of one per chapter)
+# --------------------------------------------------------------------------------------
+
+
+def book_config():
+    """The book's run configuration: the environment read once, at the book's edge.
+
+    ``nox -s book -- --profile quick`` sets ``PASSMD_PROFILE``; the cache directory,
+    executor and workers come from their variables too (:data:`passmd.config.ENVIRONMENT`).
+    """
+    from passmd.config import RunConfig
+
+    return RunConfig.from_environment()
+
+
+def put(name: str, value) -> None:
+    """Glue a number for the text as a plain Python number (so format specs apply)."""
+    from myst_nb import glue
+
+    glue(name, np.asarray(value).item(), display=False)
+
+
+def put_text(name: str, text: str) -> None:
+    """Glue a short markdown text for the ``{glue:md}`` role."""
+    from myst_nb import glue
+
+    glue(name, Markdown(text), display=False)
+
+
+def show_table(df, formats: dict | None = None) -> None:
+    """Display a table without its index; numbers with 4 significant digits unless ``formats`` says."""
+    from IPython.display import display
+
+    style = df.style.hide(axis="index").format("{:.4g}", subset=list(df.select_dtypes("number").columns))
+    for column, spec in (formats or {}).items():
+        style = style.format(spec, subset=[column])
+    display(style)
