@@ -302,7 +302,10 @@ class SimulationResult:
         return pd.DataFrame(data)
 
 
-def _segments(waveform: Waveform, fine_step: float, coarse_step: float, quasi_step: float | None = None):
+def _segments(
+    waveform: Waveform, fine_step: float, coarse_step: float, quasi_step: float | None = None
+) -> kern.Segments:
+    """The linear pieces of x_p(t) with their steps (capped at 1/MIN_SEGMENT_STEPS of the piece)."""
     t, x = waveform.times, waveform.positions
     t0, t1, x0, x1 = t[:-1], t[1:], x[:-1], x[1:]
     shortest = (t1 - t0) / MIN_SEGMENT_STEPS
@@ -319,7 +322,7 @@ def _segments(waveform: Waveform, fine_step: float, coarse_step: float, quasi_st
     window = inside.astype(np.int64)
     mark = np.isin(t0, waveform.slip_marks).astype(np.int64)
     quasi = np.minimum(coarse_step if quasi_step is None else quasi_step, shortest)
-    return t0, t1, x0, x1, fine, coarse, period, window, mark, quasi
+    return kern.Segments(t0, t1, x0, x1, fine, coarse, period, window, mark, quasi)
 
 
 def expected_steps(waveform: Waveform, plan: StepPlan, fine_step: float, coarse_step: float) -> np.ndarray:
@@ -330,11 +333,11 @@ def expected_steps(waveform: Waveform, plan: StepPlan, fine_step: float, coarse_
     (``coarse_step == fine_step``) take the fine step throughout. Ringing after slips adds
     fine steps, so the sum is a lower bound of the work, close to it for saw-tooth runs.
     """
-    t0, t1, _x0, _x1, fine, coarse = _segments(waveform, fine_step, coarse_step)[:6]
-    duration = t1 - t0
-    n_fine = np.minimum(np.ceil(duration / fine), plan.quiet_steps if coarse_step > fine_step else 0)
-    rest = np.maximum(duration - n_fine * fine, 0.0)
-    return n_fine + np.ceil(rest / coarse)
+    seg = _segments(waveform, fine_step, coarse_step)
+    duration = seg.t1 - seg.t0
+    n_fine = np.minimum(np.ceil(duration / seg.fine), plan.quiet_steps if coarse_step > fine_step else 0)
+    rest = np.maximum(duration - n_fine * seg.fine, 0.0)
+    return n_fine + np.ceil(rest / seg.coarse)
 
 
 def _step_setter(drive: Drive, plan: StepPlan, total_contact_stiffness: float) -> str:
@@ -370,7 +373,8 @@ def check_work(
         expected number of steps (:func:`expected_steps`) above :data:`MAX_STEPS`; the
         message names the parameter responsible.
     """
-    t0, t1, _x0, _x1, fine = _segments(waveform, fine_step, coarse_step)[:5]
+    seg = _segments(waveform, fine_step, coarse_step)
+    t0, t1, fine = seg.t0, seg.t1, seg.fine
     resolution = MIN_STEP_SPACINGS * np.spacing(t1)
     worst = int(np.argmin(fine / resolution))
     if fine[worst] < resolution[worst]:
@@ -535,42 +539,30 @@ def simulate(
         drive, waveform, plan, fine_step, quasi_step if quasi else coarse_step,
         float(np.sum(multiplicity * k_contacts)), user_step=dt is not None,
     )
-    segs = _segments(waveform, fine_step, coarse_step, quasi_step)
-    record_interval = waveform.duration / (max_points - 1)
-    work = np.zeros((kern.WORK_ROWS, G))
-    carry = np.zeros(kern.CARRY_SIZE)
+    segments = _segments(waveform, fine_step, coarse_step, quasi_step)
+    mechanics = kern.Mechanics(
+        drive.runner_mass,
+        drive.effective_load_cell_stiffness,
+        multiplicity.astype(float),
+        drive.actuator_model == "rigid",
+        drive.actuator.mass,
+        drive.actuator.stiffness,
+        drive.actuator.viscosity,
+    )
+    control = kern.StepControl(
+        plan.activity_threshold, plan.quiet_steps, quasi, waveform.duration / (max_points - 1)
+    )
     sliding = np.array([sliding_force(params[g]) for g in range(G)])
+    contacts = kern.Contacts(params, state, sliding)
+    carry = np.zeros(kern.CARRY_SIZE)
+    buffers = kern.Buffers(y, np.zeros((kern.WORK_ROWS, G)), carry, record, per, peak, energy)
     bar = _progress_bar(expected, waveform, progress)
     start = _time.perf_counter()
     try:
         limit = CHUNK_STEPS
         while True:
             status, steps, n_rec, fine_steps = kern.integrate(
-                *segs,
-                plan.activity_threshold,
-                plan.quiet_steps,
-                quasi,
-                drive.runner_mass,
-                drive.effective_load_cell_stiffness,
-                multiplicity.astype(float),
-                drive.actuator_model == "rigid",
-                drive.actuator.mass,
-                drive.actuator.stiffness,
-                drive.actuator.viscosity,
-                params,
-                state,
-                sliding,
-                y,
-                work,
-                carry,
-                limit,
-                record_interval,
-                record,
-                per,
-                peak,
-                energy,
-                1.0,
-                100.0,
+                segments, mechanics, control, contacts, buffers, limit
             )
             if status != kern.STATUS_PAUSED:
                 break

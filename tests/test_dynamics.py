@@ -131,6 +131,30 @@ def test_divergence_is_reported(monkeypatch):
         dynamics.simulate(d, wf, dt=5 * plan_dt)
 
 
+def test_kernel_wrapper_refuses_a_wrong_array_naming_it(monkeypatch):
+    """The compiled loop does no bounds checks: its Python wrapper checks every array first."""
+    from passmd import _dynamics_kernel as kern
+
+    seen = []
+    integrate = kern.integrate
+
+    def capture(*args):
+        seen.append(args)
+        return integrate(*args)
+
+    monkeypatch.setattr(kern, "integrate", capture)
+    run(one_contact(), 50e-9, periods=1)
+    segments, mechanics, control, contacts, buffers, limit = seen[0]
+    narrow = buffers._replace(per=np.zeros((1, kern.PER_COLUMNS - 1)))
+    with pytest.raises(ValueError, match=r"buffers\.per has shape \(1, 7\), must be \(1, 8\)"):
+        integrate(segments, mechanics, control, contacts, narrow, limit)
+    ints = segments._replace(t0=segments.t0.astype(np.int64))
+    with pytest.raises(ValueError, match=r"segments\.t0 must be a C-contiguous float64 array"):
+        integrate(ints, mechanics, control, contacts, buffers, limit)
+    with pytest.raises(ValueError, match=r"mechanics = \(1\.0,\) is not a Mechanics"):
+        integrate(segments, (1.0,), control, contacts, buffers, limit)
+
+
 def test_bad_inputs():
     d = one_contact()
     with pytest.raises(ValueError, match=r"^amplitude = -1e-08 is out of range"):
