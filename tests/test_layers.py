@@ -22,6 +22,7 @@ KERNEL_PATH = (
     "passmd._contact_kernels",
     "passmd.waveforms",
     "passmd.optimized_waveform",
+    "passmd.time_steps",
     "passmd.dynamics",
     "passmd._dynamics_kernel",
 )
