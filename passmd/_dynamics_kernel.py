@@ -8,6 +8,12 @@ and recording), :class:`Contacts` (the contact rows of :mod:`passmd.contact`) an
 :class:`Buffers` (state and outputs, written in place). :func:`integrate`, a Python
 wrapper, checks their shapes and types before it enters the compiled loop.
 
+The array layouts (column and slot indices), the argument records and the compiled loop
+stay in this one module on purpose: numba compiles the indices into the loop as
+constants and its on-disk cache (``cache=True``) is invalidated only when this file
+changes, so a layout kept in another module could change without the cached loop
+noticing.
+
 Scheme: velocity Verlet (kick–drift–kick) on runner and actuators; the actuator's
 viscous term −c_p ẋ_a is treated with the trapezoidal rule in the velocity update
 (implicit in v, still explicit overall). The contact memory is updated exactly once
