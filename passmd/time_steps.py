@@ -45,6 +45,7 @@ MAX_STEPS = 2e10
 #: rounding of each step below 0.1 % of it.
 MIN_STEP_SPACINGS = 2.0**10
 
+
 class WorkLimitError(ValueError):
     """A run refused before it starts: its step is below the time resolution or it needs more
     than :data:`MAX_STEPS` steps. The message names the parameter (and command-line option)
@@ -115,6 +116,8 @@ def segments(
     shortest = (t1 - t0) / MIN_SEGMENT_STEPS
     fine = np.minimum(fine_step, shortest)
     coarse = np.minimum(coarse_step, shortest)
+    # period of each piece: its start over T, nudged up by 1e-9 so that a start k·T that
+    # rounds to just below k still counts as period k
     period = np.minimum((t0 / waveform.period + 1e-9).astype(np.int64), waveform.periods - 1)
     # a piece is in a settle window when it lies inside one; the windows are disjoint, so
     # only the last window starting at or before the piece can hold it (O(n log n))
