@@ -6,8 +6,11 @@ one of them must load neither pandas nor matplotlib (seconds of start-up in each
 of a parallel sweep) and no module of a higher layer (protocols, experiments, figures,
 plots, ledger, presentation, command line): the package is layered one way, core at the
 bottom. Each import runs in a fresh interpreter, so nothing another test imported counts.
+Imports inside functions count too: the sources are read for every import statement.
 """
 
+import ast
+import importlib.util
 import json
 import subprocess
 import sys
@@ -63,3 +66,36 @@ def test_core_module_imports_no_pandas_matplotlib_or_higher_layer(module):
     assert heavy == [], f"importing {module} loads {heavy}"
     assert module in loaded  # the probe imported what it should
     assert set(loaded) <= CORE, f"importing {module} loads higher layers: {sorted(set(loaded) - CORE)}"
+
+
+def _imported_passmd_modules(tree: ast.Module) -> set[str]:
+    """Every passmd module an import statement anywhere in ``tree`` names (functions included)."""
+    names = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names.update(a.name for a in node.names if a.name.split(".")[0] == "passmd")
+        elif isinstance(node, ast.ImportFrom) and node.module and node.module.split(".")[0] == "passmd":
+            names.add(node.module)
+            if node.module == "passmd":  # from passmd import dynamics, ...
+                names.update(f"passmd.{a.name}" for a in node.names)
+    return names
+
+
+@pytest.mark.parametrize("module", KERNEL_PATH)
+def test_core_module_source_names_no_higher_layer(module):
+    """No import statement of a core module, not even one inside a function, reaches up."""
+    path = importlib.util.find_spec(module).origin
+    with open(path, encoding="utf-8") as source:
+        names = _imported_passmd_modules(ast.parse(source.read()))
+    assert names <= CORE, f"{module} imports higher layers: {sorted(names - CORE)}"
+
+
+@pytest.mark.parametrize("module", ["passmd.waveforms", "passmd.optimized_waveform"])
+def test_waveform_constructors_never_reach_the_simulator(module):
+    """Waveforms are pure constructors (Eq. 15's design from a simulated response lives in
+    passmd.protocols.eq15): their modules import nothing of the simulator."""
+    path = importlib.util.find_spec(module).origin
+    with open(path, encoding="utf-8") as source:
+        names = _imported_passmd_modules(ast.parse(source.read()))
+    simulator = {"passmd.dynamics", "passmd._dynamics_kernel", "passmd.time_steps", "passmd.contact"}
+    assert not names & simulator, f"{module} imports {sorted(names & simulator)}"
