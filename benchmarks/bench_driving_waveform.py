@@ -3,7 +3,7 @@ cold computation of every Fig. 8–10 panel and study at a profile.
 
 Timed blocks (each repeated, median and fastest reported; numba compiles in an untimed warm-up):
 
-* ``design``: :func:`passmd.waveforms.optimized_design` of the Section 5 drive (two 100 Hz
+* ``design``: :func:`passmd.protocols.eq15.optimized_design` of the Section 5 drive (two 100 Hz
   saw-tooth periods recorded densely, f_s and V_r measured, Eq. 15);
 * ``steady_sawtooth_<f>`` / ``steady_optimized_<f>``: one steady-velocity point
   (:func:`passmd.experiments.driving_waveform.velocity_point`) at 1 kHz and 110 kHz;
@@ -44,21 +44,22 @@ def _timed(func, repeats: int) -> dict:
 
 
 def blocks(repeats: int) -> dict:
-    from passmd import dynamics, waveforms
+    from passmd import dynamics, optimized_waveform
     from passmd.experiments import driving_waveform as dw
+    from passmd.protocols import eq15
 
     drive = dw.section5_drive()
     amplitude = drive.actuator.full_stroke_amplitude
-    design = waveforms.optimized_design(amplitude, drive)
+    design = eq15.optimized_design(amplitude, drive)
     fields = {"settling_time": design.settling_time, "acceleration_time": design.acceleration_time,
               "acceleration_amplitude": design.acceleration_amplitude}
-    out = {"design": _timed(lambda: waveforms.optimized_design(amplitude, drive), repeats)}
+    out = {"design": _timed(lambda: eq15.optimized_design(amplitude, drive), repeats)}
     for f in (1e3, 110e3):
         for waveform, rule in (("sawtooth", ""), ("optimized", "cut")):
             out[f"steady_{waveform}_{f / 1e3:g}kHz"] = _timed(
                 lambda f=f, w=waveform, r=rule: dw.velocity_point(**dw.config(), frequency=f, waveform=w,
                                                                   short_period=r, **fields), repeats)
-    wave = waveforms.optimized(amplitude, 100.0, drive, periods=3, design=design)
+    wave = optimized_waveform.optimized(amplitude, 100.0, drive, periods=3, design=design)
     out["step_100hz"] = _timed(lambda: dynamics.simulate(drive, wave, max_points=2), repeats)
     return out
 

@@ -46,17 +46,18 @@ CONFIGS = [
 HEAVY_MODULES = ("pandas", "matplotlib", "pint", "dask", "distributed", "tqdm")
 
 # launched as ``python -c``: reports (on stderr) the time and the heavy modules loaded when
-# the CLI first enters the integrator, then finishes the command
+# the CLI first enters the integrator (the checking wrapper ``_dynamics_kernel.integrate``,
+# which passmd.dynamics looks up at call time), then finishes the command
 _FIRST_STEP = """
 import json, sys, time
 from passmd import _dynamics_kernel as kern, cli
 integrate = kern.integrate
-def announced(*args):
+def announced(*args, **kwargs):
     heavy = [m for m in json.loads(sys.argv[1]) if m in sys.modules]
     sys.stderr.write(json.dumps({"ready": time.time(), "heavy": heavy}) + "\\n")
     sys.stderr.flush()
     kern.integrate = integrate
-    return integrate(*args)
+    return integrate(*args, **kwargs)
 kern.integrate = announced
 sys.exit(cli.main(sys.argv[2:]))
 """

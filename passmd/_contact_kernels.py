@@ -89,6 +89,10 @@ def _exact_core(params, state, u, commit):
     branch joins the virgin curve's mirror point −u_1 (virgin base) or full sliding
     after 2u_max (sliding base). Decisions compare displacements only, never forces,
     so round-off cannot reorder the stack.
+
+    One function of ≈ 120 lines on purpose: it runs once per contact group and integrator
+    step, and the stack walk, the branch choice and the commit share a dozen local values
+    that helpers would pass back and forth on every call.
     """
     f_s = params[P_SLIDING]
     u_max = params[P_UMAX]

@@ -1,7 +1,18 @@
 """numba kernel of the hybrid simulation (Eqs. 2–3 with the MDR contacts in the loop).
 
-Only :mod:`passmd.dynamics` calls this; it validates, allocates and interprets. The
-kernel takes plain arrays and scalars.
+Only :mod:`passmd.dynamics` calls this; it allocates and interprets. The compiled kernel
+takes five NamedTuples of scalars and arrays (numba compiles NamedTuples, not
+dataclasses): :class:`Segments` (the linear pieces of x_p(t) and their steps),
+:class:`Mechanics` (masses, stiffnesses, damping), :class:`StepControl` (step adaptation
+and recording), :class:`Contacts` (the contact rows of :mod:`passmd.contact`) and
+:class:`Buffers` (state and outputs, written in place). :func:`integrate`, a Python
+wrapper, checks their shapes and types before it enters the compiled loop.
+
+The array layouts (column and slot indices), the argument records and the compiled loop
+stay in this one module on purpose: numba compiles the indices into the loop as
+constants and its on-disk cache (``cache=True``) is invalidated only when this file
+changes, so a layout kept in another module could change without the cached loop
+noticing.
 
 Scheme: velocity Verlet (kick–drift–kick) on runner and actuators; the actuator's
 viscous term −c_p ẋ_a is treated with the trapezoidal rule in the velocity update
@@ -14,6 +25,9 @@ adapts: fine (resolving the ≈ 3 MHz actuator mode) while the actuators ring, c
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
+import numpy as np
 from numba import njit
 
 from passmd.contact import contact_force_row, contact_slip_share_row, contact_update_row
@@ -77,6 +91,76 @@ WORK_ROWS = 8
 #: quasi-static step: the actuator's force balance is solved to this fraction of S/K
 #: (≈ 6e-15 m; a force error ≤ 1e-6 μF_N)
 QUASI_TOLERANCE = 1e-6
+#: quasi-static step: most secant/bisection iterations of one force balance (the bracket
+#: halves at least every other iteration, so 200 is far beyond the ≈ 50 that reach the
+#: float resolution of S/K)
+QUASI_MAX_ITERATIONS = 200
+#: A step that would leave less than this fraction of itself before the end of a linear
+#: piece of x_p(t) is stretched to end on the piece's corner (no sliver steps from rounding).
+LAST_STEP_STRETCH = 1.000001
+#: Divergence: the run stops (STATUS_DIVERGED) once |x_r| or an actuator's stretch
+#: |x_a − x_p| reaches this (m). The drive's travel is a few µm, so 1 m is a runaway.
+POSITION_LIMIT = 1.0
+#: Divergence: the run stops once |v_r| or |v_a| reaches this (m/s). The amplifier moves the
+#: hemispheres at most A_max·SR/V_pp ≈ 0.1 m/s, so 100 m/s is a runaway. (Comparisons with
+#: NaN are False, so a NaN state stops the run too.)
+VELOCITY_LIMIT = 100.0
+
+
+class Segments(NamedTuple):
+    """The linear pieces of x_p(t), one entry per piece (built by :mod:`passmd.dynamics`)."""
+
+    t0: np.ndarray  # start time (s)
+    t1: np.ndarray  # end time (s)
+    x0: np.ndarray  # x_p at the start (m)
+    x1: np.ndarray  # x_p at the end (m)
+    fine: np.ndarray  # fine step (s)
+    coarse: np.ndarray  # coarse step while the actuators do not ring (s)
+    period: np.ndarray  # int64: period the piece belongs to
+    window: np.ndarray  # int64: 1 when the piece lies in its period's settle window
+    mark: np.ndarray  # int64: 1 when the piece starts at a slip mark
+    quasi: np.ndarray  # step of the quasi-static actuator (s)
+
+
+class Mechanics(NamedTuple):
+    """Masses, stiffnesses and damping of Eqs. 2–3 (SI units)."""
+
+    runner_mass: float  # m_r
+    load_stiffness: float  # k of the load cell (0 without it)
+    multiplicity: np.ndarray  # float: contacts n_g per group
+    rigid: bool  # rigid actuators: x_a = x_p
+    actuator_mass: float  # m_a
+    actuator_stiffness: float  # k_p
+    actuator_viscosity: float  # c_p
+
+
+class StepControl(NamedTuple):
+    """Step adaptation (flexible actuators) and recording."""
+
+    activity_threshold: float  # |ẍ_a| above which the actuators ring (m/s²)
+    quiet_steps: int  # fine steps below the threshold before the step grows
+    quasi_static: bool  # quiet phases use the quasi-static actuator step
+    record_interval: float  # time between recorded samples (s)
+
+
+class Contacts(NamedTuple):
+    """The contact groups: rows of :func:`passmd.contact.stack_contacts` and μF_N per group."""
+
+    params: np.ndarray
+    state: np.ndarray  # contact memory, updated in place
+    sliding: np.ndarray  # μF_N of one contact of each group (N)
+
+
+class Buffers(NamedTuple):
+    """State and outputs, all written in place (see :func:`integrate` for the layouts)."""
+
+    y: np.ndarray  # (2 + 2G,): [x_r, v_r, x_a(0..G−1), v_a(0..G−1)]
+    work: np.ndarray  # (WORK_ROWS, G): scratch carried between calls
+    carry: np.ndarray  # (CARRY_SIZE,): loop state of a paused run, zeros before the first call
+    record: np.ndarray  # (samples, 4 + 3G): [t, x_p, x_r, v_r, (x_a, T, slip share) per group]
+    per: np.ndarray  # (periods, PER_COLUMNS): per-period accumulators
+    peak: np.ndarray  # (periods, G): largest |T_g|/μF_N after each slip mark
+    energy: np.ndarray  # (EN_COLUMNS,): energy accumulators
 
 
 @njit(**KERNEL_OPTIONS)
@@ -96,7 +180,7 @@ def quasi_static_position(params, state, g, x_r, center, K, S, guess, slope, tol
     h = K * (center - x) - contact_force_row(params, state, g, x - x_r)
     x_prev = x
     h_prev = h
-    for it in range(200):
+    for it in range(QUASI_MAX_ITERATIONS):
         if h == 0.0:
             return x, slope
         if h > 0.0:
@@ -119,56 +203,88 @@ def quasi_static_position(params, state, g, x_r, center, K, S, guess, slope, tol
     return x, slope
 
 
+def integrate(segments: Segments, mechanics: Mechanics, control: StepControl, contacts: Contacts,
+              buffers: Buffers, step_limit: int):
+    """Check the kernel's arguments, then run :func:`_integrate` (see there for what it does).
+
+    Returns (status, steps done, rows recorded, fine steps).
+
+    Raises
+    ------
+    ValueError
+        An argument of the wrong type, dtype or shape, naming it: the compiled loop does
+        no bounds checks, so a wrong shape would read or write outside an array.
+    """
+    _check_arguments(segments, mechanics, control, contacts, buffers, step_limit)
+    return _integrate(segments, mechanics, control, contacts, buffers, int(step_limit))
+
+
+def _check_array(name, value, shape, dtype=np.float64):
+    """ValueError unless ``value`` is a C-contiguous array of ``dtype`` and ``shape`` (None: any)."""
+    if not isinstance(value, np.ndarray) or value.dtype != dtype or not value.flags.c_contiguous:
+        raise ValueError(f"{name} must be a C-contiguous {np.dtype(dtype).name} array, got {value!r:.80}")
+    wanted = tuple("*" if n is None else n for n in shape)
+    if len(value.shape) != len(shape) or any(
+        n is not None and m != n for m, n in zip(value.shape, shape, strict=True)
+    ):
+        raise ValueError(f"{name} has shape {value.shape}, must be {wanted}")
+
+
+def _check_arguments(segments, mechanics, control, contacts, buffers, step_limit):
+    """Types and shapes of :func:`integrate`'s arguments (ValueError naming the first bad one)."""
+    for name, value, kind in (("segments", segments, Segments), ("mechanics", mechanics, Mechanics),
+                              ("control", control, StepControl), ("contacts", contacts, Contacts),
+                              ("buffers", buffers, Buffers)):
+        if not isinstance(value, kind):
+            raise ValueError(f"{name} = {value!r:.80} is not a {kind.__name__}")
+    n = segments.t0.shape[0] if isinstance(segments.t0, np.ndarray) else -1
+    if n < 1:
+        raise ValueError("segments.t0 must be a non-empty array")
+    for field in Segments._fields:
+        dtype = np.int64 if field in ("period", "window", "mark") else np.float64
+        _check_array(f"segments.{field}", getattr(segments, field), (n,), dtype)
+    G = mechanics.multiplicity.shape[0] if isinstance(mechanics.multiplicity, np.ndarray) else 0
+    if G < 1:
+        raise ValueError("mechanics.multiplicity must be a non-empty array")
+    _check_array("mechanics.multiplicity", mechanics.multiplicity, (G,))
+    _check_array("contacts.params", contacts.params, (G, None))
+    _check_array("contacts.state", contacts.state, (G, None))
+    _check_array("contacts.sliding", contacts.sliding, (G,))
+    periods = int(segments.period.max()) + 1
+    _check_array("buffers.y", buffers.y, (2 + 2 * G,))
+    _check_array("buffers.work", buffers.work, (WORK_ROWS, G))
+    _check_array("buffers.carry", buffers.carry, (CARRY_SIZE,))
+    _check_array("buffers.record", buffers.record, (None, 4 + 3 * G))
+    _check_array("buffers.per", buffers.per, (periods, PER_COLUMNS))
+    _check_array("buffers.peak", buffers.peak, (periods, G))
+    _check_array("buffers.energy", buffers.energy, (EN_COLUMNS,))
+    if buffers.record.shape[0] < 1:
+        raise ValueError("buffers.record must have at least one row")
+    if int(step_limit) != step_limit or step_limit < 0:
+        raise ValueError(f"step_limit = {step_limit!r} is out of range: must be an integer >= 0")
+
+
 @njit(**KERNEL_OPTIONS)
-def integrate(
-    seg_t0,
-    seg_t1,
-    seg_x0,
-    seg_x1,
-    seg_fine,
-    seg_coarse,
-    seg_period,
-    seg_window,
-    seg_mark,
-    seg_quasi,
-    activity_threshold,
-    quiet_steps,
-    quasi_static,
-    runner_mass,
-    load_stiffness,
-    multiplicity,
-    rigid,
-    actuator_mass,
-    actuator_stiffness,
-    actuator_viscosity,
-    params,
-    state,
-    sliding,
-    y,
-    work,
-    carry,
-    step_limit,
-    record_interval,
-    record,
-    per,
-    peak,
-    energy,
-    position_limit,
-    velocity_limit,
-):
+def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     """Integrate over the segments; returns (status, steps done, rows recorded, fine steps).
 
-    Work is bounded: once ``step_limit`` steps (counted from the start of the run) are
-    done, the kernel stores its loop state in ``carry`` (shape (CARRY_SIZE,), zeros
-    before the first call) and returns STATUS_PAUSED; calling it again with the same
-    arrays continues exactly where it stopped, with the same floating-point operations
-    in the same order as an uninterrupted run (the contact memory lives in ``state``).
+    One function of ≈ 280 lines, not several small ones, on purpose: the step loop keeps
+    about twenty scalars (time, accelerations, step-control flags, the per-segment
+    accumulators) in registers across every step; helpers would pass them back and forth
+    on every one of the 10⁶–10⁹ steps of a run, or keep them in memory.
 
-    ``sliding`` holds μF_N of each group; ``peak[k, g]`` receives the largest |T_g|/μF_N from
-    period k's slip mark to the next settle window (1 exactly when the group slid fully).
-    ``y`` = [x_r, v_r, x_a(0..G−1), v_a(0..G−1)] is updated in place; ``work`` is scratch
-    of shape (WORK_ROWS, G). ``record`` rows are
-    [t, x_p, x_r, v_r, (x_a, T, slip share) per group].
+    Work is bounded: once ``step_limit`` steps (counted from the start of the run) are
+    done, the kernel stores its loop state in ``buffers.carry`` (zeros before the first
+    call) and returns STATUS_PAUSED; calling it again with the same arrays continues
+    exactly where it stopped, with the same floating-point operations in the same order as
+    an uninterrupted run (the contact memory lives in ``contacts.state``).
+
+    ``contacts.sliding`` holds μF_N of each group; ``peak[k, g]`` receives the largest
+    |T_g|/μF_N from period k's slip mark to the next settle window (1 exactly when the group
+    slid fully). ``y`` = [x_r, v_r, x_a(0..G−1), v_a(0..G−1)]: the actuator entries are read
+    on the first call and written when the run ends (in between they live in ``work``,
+    scratch of shape (WORK_ROWS, G)); x_r and v_r are written whenever the kernel returns.
+    ``record`` rows are [t, x_p, x_r, v_r, (x_a, T, slip share) per group].
 
     Step control (flexible actuators): every segment starts with the fine step
     ``seg_fine`` (a corner of x_p(t) excites the actuator mode). Once the largest
@@ -183,6 +299,14 @@ def integrate(
     explicit step does. The implied actuator acceleration is checked against the same
     threshold; above it, the fine explicit step takes over again.
     """
+    seg_t0, seg_t1, seg_x0, seg_x1, seg_fine, seg_coarse, seg_period, seg_window, seg_mark, seg_quasi = (
+        segments
+    )
+    runner_mass, load_stiffness, multiplicity, rigid = mechanics[:4]
+    actuator_mass, actuator_stiffness, actuator_viscosity = mechanics[4:]
+    activity_threshold, quiet_steps, quasi_static, record_interval = control
+    params, state, sliding = contacts
+    y, work, carry, record, per, peak, energy = buffers
     G = multiplicity.shape[0]
     x_r = y[0]
     v_r = y[1]
@@ -301,9 +425,6 @@ def integrate(
                 carry[C_MIN_XR] = min_xr
                 y[0] = x_r
                 y[1] = v_r
-                for g in range(G):
-                    y[2 + g] = x_a[g]
-                    y[2 + G + g] = v_a[g]
                 return STATUS_PAUSED, steps, n_rec, fine_steps
             if fine:
                 dt = dt_fine
@@ -312,7 +433,7 @@ def integrate(
             else:
                 dt = dt_coarse
             remaining = t_end - t
-            if remaining <= dt * 1.000001:
+            if remaining <= dt * LAST_STEP_STRETCH:
                 dt = remaining
                 t_new = t_end
                 xp_new = seg_x1[s]
@@ -422,10 +543,10 @@ def integrate(
             x_p = xp_new
             steps += 1
             # divergence (also catches NaN: comparisons with NaN are False)
-            ok = abs(x_r) < position_limit and abs(v_r) < velocity_limit
+            ok = abs(x_r) < POSITION_LIMIT and abs(v_r) < VELOCITY_LIMIT
             if not rigid:
                 for g in range(G):
-                    ok = ok and abs(x_a[g] - x_p) < position_limit and abs(v_a[g]) < velocity_limit
+                    ok = ok and abs(x_a[g] - x_p) < POSITION_LIMIT and abs(v_a[g]) < VELOCITY_LIMIT
             if not ok:
                 y[0] = x_r
                 y[1] = v_r

@@ -540,14 +540,17 @@ def _check_output_paths(args) -> None:
 
 
 def _simulate(args, drive):
-    from passmd import dynamics, waveforms
+    from passmd import dynamics, optimized_waveform, waveforms
+    from passmd.protocols import eq15
 
     amplitude, frequency = _waveform_args(args, drive)
     springs = _check_springs(args.springs)
     if args.waveform == "optimized":
         # Eq. 15, designed from this drive's own simulated saw-tooth response (first period a
         # saw-tooth, as in the paper); a ValueError (e.g. Δ_a ≥ A) is a usage error
-        wave = waveforms.optimized(amplitude, frequency, drive, periods=args.periods, flyback=args.flyback)
+        design = eq15.optimized_design(amplitude, drive, flyback=args.flyback)
+        wave = optimized_waveform.optimized(amplitude, frequency, drive, periods=args.periods,
+                                            flyback=args.flyback, design=design)
     else:
         wave = waveforms.sawtooth(amplitude, frequency, drive, periods=args.periods, flyback=args.flyback)
     result = dynamics.simulate(

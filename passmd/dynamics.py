@@ -17,9 +17,9 @@ damping term, uniform steps inside each linear piece of x_p(t). Why this scheme:
 stiff mode (actuator on k_p plus the contact's 2aG*, ≈ 3 MHz) is lightly damped and
 oscillatory; an explicit symplectic scheme neither damps it artificially nor drifts in
 energy, costs one contact evaluation per step, and keeps the contact's memory update
-exactly once per step. The step follows from the parameters: a fixed number of steps per
-period of the stiffest mode (flexible) or of the runner-on-contacts mode (rigid), and a
-minimum number of steps on every waveform edge.
+exactly once per step. The step follows from the parameters (:mod:`passmd.time_steps`): a
+fixed number of steps per period of the stiffest mode (flexible) or of the
+runner-on-contacts mode (rigid), and a minimum number of steps on every waveform edge.
 """
 
 from __future__ import annotations
@@ -40,35 +40,11 @@ from passmd.contact import (
 )
 from passmd.parameters import Drive
 from passmd.theory import contact_moduli, normal_forces
+from passmd.time_steps import StepPlan, check_work, segments, step_plan
 from passmd.waveforms import Waveform
 
-#: Fine steps per period of the stiffest linearised mode (flexible actuators).
-STEPS_PER_STIFF_PERIOD = 96
-#: Coarse step (flexible actuators, while they follow quasi-statically) as ω_max·dt.
-#: Verlet is stable up to 2; 1.5 keeps a 25 % margin (the contact stiffness never exceeds 2aG*).
-COARSE_OMEGA_DT = 1.5
-#: Actuator ringing amplitude (m) below which the coarse step is used; the switch tests
-#: the actuator acceleration against ω_max² times this.
-RINGING_TOLERANCE = 1e-12
-#: Quiet stiff-mode periods (at the fine step) before the step grows.
-QUIET_PERIODS = 2
-#: Steps per period of the runner-on-contacts mode (rigid actuators).
-STEPS_PER_RUNNER_PERIOD = 400
-#: Quasi-static actuator step (``quasi_static=True``): steps per period of the
-#: runner-on-contacts mode, as for rigid actuators (the actuator in series only softens it).
-STEPS_PER_QUASI_RUNNER_PERIOD = 400
-#: Minimum number of steps on every linear piece of x_p(t) (resolves the fly-back).
-MIN_SEGMENT_STEPS = 40
 #: Verlet is stable for ω dt < 2; a user step must keep this margin below it.
 STABILITY_MARGIN = 0.9
-#: Work budget of one simulation in integrator steps (≈ 15–30 min at the 45–90 ns per step
-#: that ``benchmarks/bench_dynamics.py`` measures). A run whose step plan needs more is
-#: refused before it starts, with the option responsible named.
-MAX_STEPS = 2e10
-#: Smallest step, in units of the float spacing of the simulated time t: below it t + dt
-#: rounds to a different step than planned (at 1 spacing, t stops advancing). 2¹⁰ keeps the
-#: rounding of each step below 0.1 % of it.
-MIN_STEP_SPACINGS = 2.0**10
 #: Steps per kernel call: the kernel returns to Python between calls, so Ctrl-C
 #: (KeyboardInterrupt) is honoured within one call (≈ 0.02–0.1 s at 45–200 ns per step)
 #: and the progress bar advances. Results do not depend on it (the kernel resumes exactly).
@@ -79,25 +55,6 @@ PROGRESS_MIN_STEPS = 5e7
 
 class SimulationError(RuntimeError):
     """A simulation diverged or could not be carried out."""
-
-
-class WorkLimitError(ValueError):
-    """A run refused before it starts: its step is below the time resolution or it needs more
-    than :data:`MAX_STEPS` steps. The message names the parameter (and command-line option)
-    responsible."""
-
-
-@dataclass(frozen=True)
-class StepPlan:
-    """How the integrator discretises time for one drive."""
-
-    fine_step: float  # fine step: resolves the stiffest mode (s)
-    coarse_step: float  # step while the actuators do not ring (s); = fine_step for rigid actuators
-    stiffest_frequency: float  # frequency of the stiffest linearised mode (Hz)
-    stability_limit: float  # Verlet stability limit 2/ω of that mode (s)
-    activity_threshold: float  # actuator acceleration that counts as ringing (m/s²)
-    quiet_steps: int  # fine steps below the threshold before the step grows
-    quasi_step: float = 0.0  # step of the quasi-static actuator (flexible, quasi_static=True) (s)
 
 
 def contact_groups(drive: Drive, share_side_state: bool = True):
@@ -112,48 +69,6 @@ def contact_groups(drive: Drive, share_side_state: bool = True):
     if share_side_state:
         return np.array(forces), np.array([2.0, 4.0])
     return np.array([forces[0]] * 2 + [forces[1]] * 4), np.ones(6)
-
-
-def step_plan(
-    drive: Drive, contact_stiffness_max: float, total_contact_stiffness: float, resolution: float = 1.0
-) -> StepPlan:
-    """Time steps from the parameters (flexible: actuator mode; rigid: runner mode).
-
-    Parameters
-    ----------
-    drive : Drive
-        The drive.
-    contact_stiffness_max : float
-        Largest tangential stiffness 2aG* of one contact (N/m).
-    total_contact_stiffness : float
-        Σ n_g 2aG*_g over all contacts (N/m).
-    resolution : float
-        Refinement factor: the step is divided by it (convergence studies).
-    """
-    act = drive.actuator
-    runner_stiffness = total_contact_stiffness + drive.effective_load_cell_stiffness
-    omega_runner = np.sqrt(runner_stiffness / drive.runner_mass)
-    if drive.actuator_model == "flexible":
-        omega = np.sqrt((act.stiffness + contact_stiffness_max) / act.mass)
-        dt = 2 * np.pi / omega / STEPS_PER_STIFF_PERIOD / resolution
-        # never beyond COARSE_OMEGA_DT/ω: a resolution < 1 coarsens the fine step only
-        coarse = COARSE_OMEGA_DT / omega / max(resolution, 1.0)
-        threshold = omega**2 * RINGING_TOLERANCE
-        quiet = int(np.ceil(QUIET_PERIODS * STEPS_PER_STIFF_PERIOD * resolution))
-    else:
-        omega = omega_runner
-        dt = 2 * np.pi / omega / STEPS_PER_RUNNER_PERIOD / resolution
-        coarse, threshold, quiet = dt, 0.0, 0
-    quasi = 2 * np.pi / omega_runner / STEPS_PER_QUASI_RUNNER_PERIOD / resolution
-    return StepPlan(
-        float(dt),
-        float(max(coarse, dt)),
-        float(omega / (2 * np.pi)),
-        float(2.0 / omega),
-        float(threshold),
-        quiet,
-        float(max(quasi, dt)),
-    )
 
 
 @dataclass
@@ -302,109 +217,6 @@ class SimulationResult:
         return pd.DataFrame(data)
 
 
-def _segments(waveform: Waveform, fine_step: float, coarse_step: float, quasi_step: float | None = None):
-    t, x = waveform.times, waveform.positions
-    t0, t1, x0, x1 = t[:-1], t[1:], x[:-1], x[1:]
-    shortest = (t1 - t0) / MIN_SEGMENT_STEPS
-    fine = np.minimum(fine_step, shortest)
-    coarse = np.minimum(coarse_step, shortest)
-    period = np.minimum((t0 / waveform.period + 1e-9).astype(np.int64), waveform.periods - 1)
-    # a piece is in a settle window when it lies inside one; the windows are disjoint, so
-    # only the last window starting at or before the piece can hold it (O(n log n))
-    order = np.argsort(waveform.settle_windows[:, 0], kind="stable")
-    starts = waveform.settle_windows[order, 0]
-    ends = waveform.settle_windows[order, 1]
-    last = np.searchsorted(starts, t0, side="right") - 1
-    inside = (last >= 0) & (t1 <= ends[np.maximum(last, 0)])
-    window = inside.astype(np.int64)
-    mark = np.isin(t0, waveform.slip_marks).astype(np.int64)
-    quasi = np.minimum(coarse_step if quasi_step is None else quasi_step, shortest)
-    return t0, t1, x0, x1, fine, coarse, period, window, mark, quasi
-
-
-def expected_steps(waveform: Waveform, plan: StepPlan, fine_step: float, coarse_step: float) -> np.ndarray:
-    """Integrator steps each linear piece of x_p(t) takes under a step plan (estimate).
-
-    Every piece starts with ``plan.quiet_steps`` fine steps (the corner rings the actuator
-    mode) and continues with the coarse step; rigid actuators and runs without adaptation
-    (``coarse_step == fine_step``) take the fine step throughout. Ringing after slips adds
-    fine steps, so the sum is a lower bound of the work, close to it for saw-tooth runs.
-    """
-    t0, t1, _x0, _x1, fine, coarse = _segments(waveform, fine_step, coarse_step)[:6]
-    duration = t1 - t0
-    n_fine = np.minimum(np.ceil(duration / fine), plan.quiet_steps if coarse_step > fine_step else 0)
-    rest = np.maximum(duration - n_fine * fine, 0.0)
-    return n_fine + np.ceil(rest / coarse)
-
-
-def _step_setter(drive: Drive, plan: StepPlan, total_contact_stiffness: float) -> str:
-    """Which parameters set the step of a plan, named as in the API and on the command line."""
-    if drive.actuator_model == "flexible":
-        act = drive.actuator
-        return (
-            f"the actuator mode ({plan.stiffest_frequency:.3g} Hz) from actuator_mass (--actuator-mass) = "
-            f"{act.mass!r} kg and actuator_stiffness (--actuator-stiffness) = {act.stiffness!r} N/m"
-        )
-    return (
-        f"the runner mode ({plan.stiffest_frequency:.3g} Hz) from runner_mass (--runner-mass) = "
-        f"{drive.runner_mass!r} kg, load_cell_stiffness (--load-cell-stiffness) = "
-        f"{drive.effective_load_cell_stiffness!r} N/m and the contacts' {total_contact_stiffness:.3g} N/m"
-    )
-
-
-def check_work(
-    drive: Drive,
-    waveform: Waveform,
-    plan: StepPlan,
-    fine_step: float,
-    coarse_step: float,
-    total_contact_stiffness: float,
-    user_step: bool = False,
-) -> float:
-    """Refuse a run that cannot advance time or would exceed :data:`MAX_STEPS`; return its steps.
-
-    Raises
-    ------
-    WorkLimitError
-        A step below :data:`MIN_STEP_SPACINGS` float spacings of the simulated time, or an
-        expected number of steps (:func:`expected_steps`) above :data:`MAX_STEPS`; the
-        message names the parameter responsible.
-    """
-    t0, t1, _x0, _x1, fine = _segments(waveform, fine_step, coarse_step)[:5]
-    resolution = MIN_STEP_SPACINGS * np.spacing(t1)
-    worst = int(np.argmin(fine / resolution))
-    if fine[worst] < resolution[worst]:
-        piece = t1[worst] - t0[worst]
-        if user_step:
-            cause = f"dt = {fine_step!r} s"
-        elif piece / MIN_SEGMENT_STEPS < fine_step:
-            cause = (
-                f"the waveform's piece from t = {t0[worst]:.6g} s lasting {piece:.3g} s "
-                f"({MIN_SEGMENT_STEPS} steps per piece; a saw-tooth's fly-back lasts A/A_max·V_pp/SR: "
-                "raise amplitude (--amplitude) or lower slew_rate (--slew-rate))"
-            )
-        else:
-            cause = _step_setter(drive, plan, total_contact_stiffness)
-        raise WorkLimitError(
-            f"time step {fine[worst]:.3g} s is out of range: it must be >= {resolution[worst]:.3g} s "
-            f"({MIN_STEP_SPACINGS:g} float spacings of t = {t1[worst]:.6g} s) for time to advance "
-            f"accurately; it is set by {cause}"
-        )
-    steps = float(np.sum(expected_steps(waveform, plan, fine_step, coarse_step)))
-    if steps > MAX_STEPS:
-        per_period = steps / waveform.periods
-        fit = int(MAX_STEPS // per_period)
-        hint = f"periods (--periods) = {waveform.periods} must be <= {fit}" if fit >= 1 else (
-            f"the step of {fine_step:.3g} s is set by "
-            + (f"dt = {fine_step!r} s" if user_step else _step_setter(drive, plan, total_contact_stiffness))
-        )
-        raise WorkLimitError(
-            f"the run needs ≈ {steps:.3g} integrator steps ({per_period:.3g} per period), more than the "
-            f"budget of {MAX_STEPS:.3g} steps (passmd.dynamics.MAX_STEPS): {hint}"
-        )
-    return steps
-
-
 def _progress_bar(steps: float, waveform: Waveform, progress: bool | None):
     """A tqdm bar over simulated periods on stderr, for long runs on a terminal only."""
     if progress is None:
@@ -451,7 +263,8 @@ def simulate(
     springs : int
         Number of MDR springs for the discrete model.
     dt : float, optional
-        Fixed time step in s (no adaptation); default: the steps of :func:`step_plan`.
+        Fixed time step in s (no adaptation); default: the steps of
+        :func:`passmd.time_steps.step_plan`.
         Must stay below the Verlet stability limit of the stiffest mode.
     resolution : float
         Divides the default step (convergence studies); ignored when ``dt`` is given.
@@ -479,9 +292,9 @@ def simulate(
     ------
     ValueError
         Bad input, or a ``dt`` the integrator cannot resolve.
-    WorkLimitError
+    passmd.time_steps.WorkLimitError
         (a ValueError) The step falls below the float resolution of the simulated time, or
-        the run would need more than :data:`MAX_STEPS` steps.
+        the run would need more than :data:`passmd.time_steps.MAX_STEPS` steps.
     SimulationError
         The integration diverged (non-finite or runaway state).
     """
@@ -494,6 +307,72 @@ def simulate(
     if int(max_points) != max_points or max_points < 2:
         raise ValueError(f"max_points = {max_points!r} is out of range: must be an integer >= 2")
 
+    params, state, multiplicity = _contact_rows(drive, contact_model, springs, share_side_state)
+    k_contacts = np.array([contact_stiffness(params[g]) for g in range(multiplicity.size)])
+    total_stiffness = float(np.sum(multiplicity * k_contacts))
+    plan = step_plan(drive, float(k_contacts.max()), total_stiffness, resolution)
+    fine_step, coarse_step, quasi, quasi_step = _steps(drive, plan, dt, adaptive, quasi_static)
+    expected = check_work(
+        drive, waveform, plan, fine_step, quasi_step if quasi else coarse_step,
+        total_stiffness, user_step=dt is not None,
+    )
+    G = multiplicity.size
+    buffers = kern.Buffers(
+        y=np.zeros(2 + 2 * G),
+        work=np.zeros((kern.WORK_ROWS, G)),
+        carry=np.zeros(kern.CARRY_SIZE),
+        record=np.empty((int(max_points), 4 + 3 * G)),
+        per=np.zeros((waveform.periods, kern.PER_COLUMNS)),
+        peak=np.zeros((waveform.periods, G)),
+        energy=np.zeros(kern.EN_COLUMNS),
+    )
+    arguments = (
+        segments(waveform, fine_step, coarse_step, quasi_step),
+        kern.Mechanics(
+            drive.runner_mass,
+            drive.effective_load_cell_stiffness,
+            multiplicity.astype(float),
+            drive.actuator_model == "rigid",
+            drive.actuator.mass,
+            drive.actuator.stiffness,
+            drive.actuator.viscosity,
+        ),
+        kern.StepControl(
+            plan.activity_threshold, plan.quiet_steps, quasi, waveform.duration / (max_points - 1)
+        ),
+        kern.Contacts(params, state, np.array([sliding_force(params[g]) for g in range(G)])),
+        buffers,
+    )
+    start = _time.perf_counter()
+    status, steps, n_rec, fine_steps = _integrate_in_chunks(arguments, waveform, expected, progress)
+    wall = _time.perf_counter() - start
+    y = buffers.y
+    if status != kern.STATUS_OK:
+        raise SimulationError(
+            f"simulation diverged at integrator step {steps}: "
+            f"runner position {y[0]!r} m, velocity {y[1]!r} m/s. Likely cause: a time step too large for "
+            f"the stiffest mode ({plan.stiffest_frequency:.3g} Hz, stable below "
+            f"{plan.stability_limit:.3g} s; "
+            f"steps used {fine_step:.3g} s to {coarse_step:.3g} s) or non-physical parameters."
+        )
+    return SimulationResult(
+        drive=drive,
+        waveform=waveform,
+        contact_model=contact_model,
+        multiplicity=multiplicity,
+        **_measures(buffers, n_rec),
+        steps=int(steps),
+        fine_steps=int(fine_steps),
+        fine_step=float(fine_step),
+        coarse_step=float(quasi_step if quasi else coarse_step),
+        wall_time=wall,
+        contact_memory=[memory_diagnostics(params[g], state[g]) for g in range(G)],
+    )
+
+
+def _contact_rows(drive: Drive, contact_model: str, springs: int, share_side_state: bool):
+    """Contact parameters and state of every group (:func:`passmd.contact.stack_contacts`) and
+    the groups' multiplicities (:func:`contact_groups`)."""
     E_star, G_star = contact_moduli(drive)
     forces, multiplicity = contact_groups(drive, share_side_state)
     rows = [
@@ -509,8 +388,15 @@ def simulate(
         for F in forces
     ]
     params, state = stack_contacts(rows)
-    k_contacts = np.array([contact_stiffness(params[g]) for g in range(len(rows))])
-    plan = step_plan(drive, float(k_contacts.max()), float(np.sum(multiplicity * k_contacts)), resolution)
+    return params, state, multiplicity
+
+
+def _steps(drive: Drive, plan: StepPlan, dt: float | None, adaptive: bool, quasi_static: bool):
+    """(fine step, coarse step, quasi-static flag, quasi-static step) of a run (s).
+
+    A user ``dt`` replaces both steps and must keep :data:`STABILITY_MARGIN` below the
+    Verlet stability limit of the stiffest mode.
+    """
     fine_step = plan.fine_step
     coarse_step = plan.coarse_step if adaptive else plan.fine_step
     if dt is not None:
@@ -524,72 +410,35 @@ def simulate(
         fine_step = coarse_step = float(dt)
     quasi = quasi_static and adaptive and dt is None and drive.actuator_model == "flexible"
     quasi_step = plan.quasi_step if quasi else coarse_step
+    return fine_step, coarse_step, quasi, quasi_step
 
-    G = multiplicity.size
-    y = np.zeros(2 + 2 * G)
-    record = np.empty((int(max_points), 4 + 3 * G))
-    per = np.zeros((waveform.periods, kern.PER_COLUMNS))
-    peak = np.zeros((waveform.periods, G))
-    energy = np.zeros(kern.EN_COLUMNS)
-    expected = check_work(
-        drive, waveform, plan, fine_step, quasi_step if quasi else coarse_step,
-        float(np.sum(multiplicity * k_contacts)), user_step=dt is not None,
-    )
-    segs = _segments(waveform, fine_step, coarse_step, quasi_step)
-    record_interval = waveform.duration / (max_points - 1)
-    work = np.zeros((kern.WORK_ROWS, G))
-    carry = np.zeros(kern.CARRY_SIZE)
-    sliding = np.array([sliding_force(params[g]) for g in range(G)])
+
+def _integrate_in_chunks(arguments: tuple, waveform: Waveform, expected: float, progress: bool | None):
+    """Run the kernel :data:`CHUNK_STEPS` steps at a time (Ctrl-C is honoured between chunks).
+
+    Returns the kernel's (status, steps, rows recorded, fine steps) of the last call.
+    """
+    carry = arguments[-1].carry
     bar = _progress_bar(expected, waveform, progress)
-    start = _time.perf_counter()
     try:
         limit = CHUNK_STEPS
         while True:
-            status, steps, n_rec, fine_steps = kern.integrate(
-                *segs,
-                plan.activity_threshold,
-                plan.quiet_steps,
-                quasi,
-                drive.runner_mass,
-                drive.effective_load_cell_stiffness,
-                multiplicity.astype(float),
-                drive.actuator_model == "rigid",
-                drive.actuator.mass,
-                drive.actuator.stiffness,
-                drive.actuator.viscosity,
-                params,
-                state,
-                sliding,
-                y,
-                work,
-                carry,
-                limit,
-                record_interval,
-                record,
-                per,
-                peak,
-                energy,
-                1.0,
-                100.0,
-            )
+            status, steps, n_rec, fine_steps = kern.integrate(*arguments, limit)
             if status != kern.STATUS_PAUSED:
-                break
+                return status, steps, n_rec, fine_steps
             limit = steps + CHUNK_STEPS
             if bar is not None:
                 bar.update(min(int(carry[kern.C_TIME] / waveform.period), waveform.periods) - bar.n)
     finally:
         if bar is not None:
             bar.close()
-    wall = _time.perf_counter() - start
-    if status != kern.STATUS_OK:
-        raise SimulationError(
-            f"simulation diverged at integrator step {steps}: "
-            f"runner position {y[0]!r} m, velocity {y[1]!r} m/s. Likely cause: a time step too large for "
-            f"the stiffest mode ({plan.stiffest_frequency:.3g} Hz, stable below "
-            f"{plan.stability_limit:.3g} s; "
-            f"steps used {fine_step:.3g} s to {coarse_step:.3g} s) or non-physical parameters."
-        )
-    rec = record[:n_rec]
+
+
+def _measures(buffers: kern.Buffers, n_rec: int) -> dict:
+    """The recorded series, per-period measures, energies and final state of a finished run
+    (fields of :class:`SimulationResult`)."""
+    per, energy = buffers.per, buffers.energy
+    rec = buffers.record[:n_rec]
     window_len = per[:, kern.PER_WINDOW_LENGTH]
     if np.any(window_len <= 0):
         raise SimulationError(
@@ -597,10 +446,7 @@ def simulate(
         )
     settled = per[:, kern.PER_WINDOW_INTEGRAL] / window_len + per[:, kern.PER_WINDOW_END_XP]
     duration = per[:, kern.PER_DURATION]
-    return SimulationResult(
-        drive=drive,
-        waveform=waveform,
-        contact_model=contact_model,
+    return dict(
         time=rec[:, 0].copy(),
         piezo_position=rec[:, 1].copy(),
         runner_position=rec[:, 2].copy(),
@@ -608,10 +454,9 @@ def simulate(
         actuator_position=rec[:, 4::3].T.copy(),
         friction_force=rec[:, 5::3].T.copy(),
         slip_share=rec[:, 6::3].T.copy(),
-        multiplicity=multiplicity,
         settled_positions=settled,
         back_steps=per[:, kern.PER_MARK_XR] - per[:, kern.PER_MIN_XR],
-        peak_force_ratio=peak,
+        peak_force_ratio=buffers.peak,
         period_mean_position=per[:, kern.PER_XR_INTEGRAL] / duration,
         period_mean_friction=per[:, kern.PER_FRICTION_INTEGRAL] / duration,
         energy={
@@ -619,11 +464,5 @@ def simulate(
             "damping": float(energy[kern.EN_DAMPING]),
             "contact": float(energy[kern.EN_CONTACT]),
         },
-        steps=int(steps),
-        fine_steps=int(fine_steps),
-        fine_step=float(fine_step),
-        coarse_step=float(quasi_step if quasi else coarse_step),
-        wall_time=wall,
-        contact_memory=[memory_diagnostics(params[g], state[g]) for g in range(G)],
-        final_state=y.copy(),
+        final_state=buffers.y.copy(),
     )

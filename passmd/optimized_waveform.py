@@ -2,9 +2,11 @@
 
 After the fly-back the hemispheres wait a settling time t_s = 1/(2 f_s) for the runner's
 micro-vibration to turn forward, then accelerate it within the stick limit,
-(V_a − V_r) t_a = u_x,max, then stop so the runner slips forward. f_s and V_r are measured
-from a simulated saw-tooth response of the same drive. The public names are also reachable
-as ``passmd.waveforms.optimized`` etc. (see :mod:`passmd.waveforms`).
+(V_a − V_r) t_a = u_x,max, then stop so the runner slips forward.
+
+This module builds the waveform from a given design (:class:`OptimizedDesign`) and never
+simulates. The design from a simulated saw-tooth response of the drive (f_s and V_r
+measured, Eq. 15 applied) is :func:`passmd.protocols.eq15.optimized_design`.
 """
 
 from __future__ import annotations
@@ -14,16 +16,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from passmd._validation import check_choice, check_positive, check_range
+from passmd.defaults import PROTOCOL
 from passmd.parameters import Assumption, Drive, register_assumption
 from passmd.waveforms import SETTLE_FRACTION, Waveform, flyback_time, piecewise_linear, sawtooth
 
-#: Saw-tooth frequency whose response the optimized waveform is designed from (Fig. 9a's 100 Hz).
-RESPONSE_FREQUENCY = 100.0
+#: Saw-tooth frequency whose response the optimized waveform is designed from (Fig. 9a's 100 Hz,
+#: the protocol's driving frequency; :func:`passmd.protocols.eq15.optimized_design`).
+RESPONSE_FREQUENCY = PROTOCOL.drive_frequency
 #: Shortest share of T − t_fb that the slow ramp of an optimized period keeps when the settling
 #: time has to be cut (high frequencies).
 MIN_RAMP_FRACTION = 0.5
-#: Recorded samples per period of the linear runner-on-contacts vibration in the design run.
-_SAMPLES_PER_VIBRATION = 200
 
 register_assumption(
     Assumption(
@@ -156,122 +158,6 @@ class OptimizedDesign:
         }
 
 
-def micro_vibration_frequency(
-    time, runner_velocity, piezo_velocity, after: float
-) -> tuple[float, np.ndarray]:
-    """Frequency of the runner's micro-vibration after ``after`` (Section 5.1, Fig. 8a).
-
-    The turning points of the runner relative to the hemispheres are the zero crossings
-    z₁, z₂, z₃, … of ẋ_r − ẋ_p after ``after`` (linearly interpolated between samples);
-    f_s = 1 / (z₃ − z₁), the first full cycle.
-
-    Parameters
-    ----------
-    time, runner_velocity, piezo_velocity : array_like
-        Recorded samples (s, m/s, m/s), e.g. of a :class:`passmd.dynamics.SimulationResult`.
-    after : float
-        Start of the free vibration (s), e.g. the end of a fly-back.
-
-    Returns
-    -------
-    (float, ndarray)
-        f_s in Hz and the crossing times (s).
-
-    Raises
-    ------
-    ValueError
-        If fewer than three turning points follow ``after`` (no vibration, e.g. an amplitude
-        below the critical amplitude, or a record too short).
-    """
-    t = np.asarray(time, dtype=float)
-    w = np.asarray(runner_velocity, dtype=float) - np.asarray(piezo_velocity, dtype=float)
-    keep = t > after
-    t, w = t[keep], w[keep]
-    sign = np.sign(w)
-    idx = np.flatnonzero((sign[:-1] != 0) & (sign[:-1] != sign[1:]))
-    crossings = t[idx] - w[idx] * (t[idx + 1] - t[idx]) / (w[idx + 1] - w[idx])
-    if crossings.size < 3:
-        raise ValueError(
-            f"no micro-vibration after t = {after!r} s: found {crossings.size} turning point(s) of the "
-            "runner, need 3 (is the amplitude above the critical amplitude, and the record long enough?)"
-        )
-    return float(1.0 / (crossings[2] - crossings[0])), crossings
-
-
-def optimized_design(
-    amplitude: float,
-    drive: Drive,
-    *,
-    acceleration_velocity: float | None = None,
-    presliding: float | None = None,
-    response_frequency: float = RESPONSE_FREQUENCY,
-    flyback: str = "slew",
-) -> OptimizedDesign:
-    """Derive t_s, t_a and Δ_a of the optimized waveform from a simulated saw-tooth response (Eq. 15).
-
-    Simulates two saw-tooth periods of amplitude A at ``response_frequency`` from rest
-    (Fig. 8a), measures the micro-vibration frequency f_s after the first fly-back
-    (:func:`micro_vibration_frequency`) and the runner velocity V_r at the end of the
-    settling time, and applies Eq. 15::
-
-        t_s = 1 / (2 f_s),     (V_a − V_r) t_a = u_x,max,     Δ_a = V_a t_a.
-
-    Eq. 15 leaves V_a free; it is ``acceleration_velocity``, by default the fastest the
-    amplifier allows (:func:`max_piezo_velocity`, slew-rate limit).
-
-    Parameters
-    ----------
-    amplitude : float
-        Actuation amplitude A in m.
-    drive : Drive
-        The drive (the paper: six contacts, rigid actuators). Its own response is analysed.
-    acceleration_velocity : float, optional
-        V_a in m/s, V_r < V_a ≤ V_max. Default V_max.
-    presliding : float, optional
-        u_x,max in m. Default the smallest presliding displacement of the drive's contacts
-        (Eq. 7 / Eq. 10).
-    response_frequency : float
-        Saw-tooth frequency of the analysed response (Hz).
-    flyback : {"slew", "fixed"}
-        Fly-back rule of that saw-tooth (:func:`~passmd.waveforms.flyback_time`).
-
-    Raises
-    ------
-    ValueError
-        Bad input, V_a ≤ V_r, or no micro-vibration in the response.
-    """
-    from passmd import dynamics, theory  # dynamics imports passmd.waveforms: import it lazily
-
-    v_max = max_piezo_velocity(drive)
-    if acceleration_velocity is None:
-        v_a = v_max
-    else:
-        v_a = check_range(
-            "acceleration_velocity", acceleration_velocity, 0.0, v_max, lower_open=True, unit="m/s"
-        )
-    if presliding is None:
-        u_max = float(min(theory.drive_theory(drive)["presliding_m"]))
-    else:
-        u_max = check_positive("presliding", presliding, "m")
-    f_ref = check_positive("response_frequency", response_frequency, "Hz")
-    wave = sawtooth(amplitude, f_ref, drive, periods=2, flyback=flyback)
-    samples = int(np.ceil(wave.duration * theory.runner_frequency(drive) * _SAMPLES_PER_VIBRATION)) + 1
-    result = dynamics.simulate(drive, wave, max_points=max(samples, 1000))
-    flyback_end = wave.period  # the first fly-back ends with the first period
-    f_s, _ = micro_vibration_frequency(
-        result.time, result.runner_velocity, wave.velocity(result.time), flyback_end
-    )
-    t_s = 0.5 / f_s
-    v_r = float(np.interp(flyback_end + t_s, result.time, result.runner_velocity))
-    if not v_a > v_r:
-        raise ValueError(
-            f"acceleration_velocity = {v_a!r} is out of range: must exceed the runner velocity "
-            f"V_r = {v_r:.3g} m/s (Eq. 15)"
-        )
-    t_a = u_max / (v_a - v_r)
-    return OptimizedDesign(t_s, t_a, v_a * t_a, f_s, v_r, u_max, f_ref)
-
-
 def optimized_timing(
     design: OptimizedDesign,
     amplitude: float,
@@ -356,7 +242,6 @@ def optimized(
     periods: int = 3,
     *,
     design: OptimizedDesign | None = None,
-    acceleration_velocity: float | None = None,
     first_period: str = "sawtooth",
     flyback: str = "slew",
     settle_fraction: float = SETTLE_FRACTION,
@@ -379,15 +264,13 @@ def optimized(
     frequency : float
         Driving frequency f in Hz.
     drive : Drive
-        The drive; supplies the amplifier/slew-rate limits and, when ``design`` is None, the
-        response the waveform is designed from (:func:`optimized_design`, a short simulation).
+        The drive; supplies the amplifier/slew-rate limits.
     periods : int
         Number of periods.
-    design : OptimizedDesign, optional
-        t_s, t_a, Δ_a to use (e.g. designed once per drive and reused over frequencies, or
-        chosen by hand); default :func:`optimized_design` of (A, drive).
-    acceleration_velocity : float, optional
-        V_a for the default design (m/s, ≤ the slew-rate limit); ignored with ``design``.
+    design : OptimizedDesign
+        t_s, t_a, Δ_a to use (required): designed from the drive's simulated response by
+        :func:`passmd.protocols.eq15.optimized_design` (e.g. once per drive and reused over
+        frequencies) or chosen by hand.
     first_period : {"sawtooth", "optimized"}
         Shape of the first period.
     flyback : {"slew", "fixed"}
@@ -405,16 +288,23 @@ def optimized(
     Waveform
         ``kind="optimized"``; slip marks at the start of each fly-back; settle windows at the
         end of each (slow) ramp, as for :func:`~passmd.waveforms.sawtooth`, so positions compare directly.
+
+    Raises
+    ------
+    ValueError
+        No ``design`` (this function never simulates), or bad input.
     """
+    if design is None:
+        raise ValueError(
+            "design = None is not allowed: the optimized waveform is built from an OptimizedDesign; "
+            "derive one from the drive's simulated saw-tooth response with "
+            "passmd.protocols.eq15.optimized_design(amplitude, drive) or give t_s, t_a, Δ_a by hand"
+        )
     check_choice("first_period", first_period, ("sawtooth", "optimized"))
     frac = check_range("settle_fraction", settle_fraction, 0.0, 1.0, lower_open=True, upper_open=True)
     if int(periods) != periods or periods < 1:
         raise ValueError(f"periods = {periods!r} is out of range: must be an integer >= 1")
     periods = int(periods)
-    if design is None:
-        design = optimized_design(
-            amplitude, drive, acceleration_velocity=acceleration_velocity, flyback=flyback
-        )
     timing = optimized_timing(
         design, amplitude, frequency, drive, flyback=flyback, min_ramp_fraction=min_ramp_fraction,
         short_period=short_period,

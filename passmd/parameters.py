@@ -17,6 +17,7 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 
 from passmd._validation import check_choice, check_positive, check_range
+from passmd.theory import contact_moduli
 
 __all__ = [
     "ACTUATOR_DAMPING_RATIO",
@@ -528,8 +529,6 @@ def check_plausible(drive: Drive, *, allow_extrapolation: bool = False) -> None:
         r[f"actuator.{name}"].check(f"actuator.{name}", getattr(act, name), **kw)
     for name in ("peak_to_peak_voltage", "slew_rate"):
         r[f"amplifier.{name}"].check(f"amplifier.{name}", getattr(amp, name), **kw)
-    from passmd.theory import contact_moduli  # theory imports this module
-
     E_star, _ = contact_moduli(drive)
     largest = drive.preload if drive.contacts == 1 else drive.preload / (2.0 * np.sin(np.pi / 4))  # Eq. 1
     check_contact_plausible(largest, drive.hemisphere_radius, E_star, names="preload, hemisphere_radius, "

@@ -16,10 +16,14 @@ Every function is vectorised (NumPy broadcasting) and uses SI units.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from passmd._validation import check_array
-from passmd.parameters import Drive
+
+if TYPE_CHECKING:  # the closed forms read a drive's fields; parameters imports this module
+    from passmd.parameters import Drive
 
 SIN45 = np.sin(np.pi / 4)
 

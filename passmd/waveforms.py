@@ -10,6 +10,9 @@ period the phase marks the measures of :mod:`passmd.dynamics` need:
 
 Conventions (decided here, documented in the model chapter): the run starts at t = 0
 at rest with virgin contacts and x_p = 0, with the slow ramp first.
+
+Constructors here are pure: they take parameters and never simulate. The optimized
+waveform of Section 5.1 (Fig. 8b, Eq. 15) is :mod:`passmd.optimized_waveform`.
 """
 
 from __future__ import annotations
@@ -309,26 +312,3 @@ def piecewise_linear(
     amplitude = float(np.max(np.abs(px)))
     return Waveform(times, np.array(positions), T, int(periods), windows, marks, kind, amplitude)
 
-
-#: Names of :mod:`passmd.optimized_waveform` reachable from here (``waveforms.optimized``
-#: beside ``waveforms.sawtooth``), loaded on first use: that module builds on this one.
-_OPTIMIZED_NAMES = frozenset(
-    {
-        "MIN_RAMP_FRACTION",
-        "RESPONSE_FREQUENCY",
-        "OptimizedDesign",
-        "max_piezo_velocity",
-        "micro_vibration_frequency",
-        "optimized",
-        "optimized_design",
-        "optimized_timing",
-    }
-)
-
-
-def __getattr__(name):  # PEP 562
-    if name in _OPTIMIZED_NAMES:
-        from passmd import optimized_waveform
-
-        return getattr(optimized_waveform, name)
-    raise AttributeError(f"module 'passmd.waveforms' has no attribute {name!r}")

@@ -226,12 +226,15 @@ def test_run_json_matches_simulate():
 
 
 def test_run_optimized_waveform_matches_api():
-    """`run --waveform optimized` drives the runner with waveforms.optimized (Eq. 15)."""
-    from passmd import dynamics, waveforms
+    """`run --waveform optimized` drives the runner with the Eq. 15 waveform designed from the drive."""
+    from passmd import dynamics, optimized_waveform
+    from passmd.protocols import eq15
 
     data = run_json("run", "--waveform", "optimized", "--actuator", "rigid", "--periods", "3")
     drive = Drive(actuator_model="rigid")
-    wave = waveforms.optimized(drive.actuator.full_stroke_amplitude, 100.0, drive, periods=3)
+    amplitude = drive.actuator.full_stroke_amplitude
+    design = eq15.optimized_design(amplitude, drive)
+    wave = optimized_waveform.optimized(amplitude, 100.0, drive, periods=3, design=design)
     result = dynamics.simulate(drive, wave)
     assert data["waveform"] == "optimized"
     assert data["final_position_m"] == result.final_position  # same code path, bit for bit

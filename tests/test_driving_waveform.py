@@ -1,4 +1,4 @@
-"""The optimized driving waveform of Section 5 (passmd.waveforms.optimized and its design).
+"""The optimized driving waveform of Section 5 (passmd.optimized_waveform) and its Eq. 15 design.
 
 The paper's case: six contacts, rigid actuators, R = 1 mm, F_p = 0.4 N, μ = 0.2, A = 202 nm.
 Rigid runs are cheap (≈ 0.2 µs steps), so the design (two 100 Hz saw-tooth periods) is
@@ -9,7 +9,15 @@ import numpy as np
 import pytest
 
 from passmd import dynamics, theory, waveforms
+from passmd.optimized_waveform import (
+    MIN_RAMP_FRACTION,
+    OptimizedDesign,
+    max_piezo_velocity,
+    optimized,
+    optimized_timing,
+)
 from passmd.parameters import paper_drive
+from passmd.protocols import eq15
 
 A = 202e-9  # m, the paper's full amplitude for R = 1 mm
 
@@ -21,7 +29,7 @@ def drive():
 
 @pytest.fixture(scope="module")
 def design(drive):
-    return waveforms.optimized_design(A, drive)
+    return eq15.optimized_design(A, drive)
 
 
 def _slopes(wave):
@@ -32,7 +40,7 @@ def test_micro_vibration_frequency_of_a_sine():
     t = np.linspace(0.0, 1e-3, 20001)
     f = 12345.0
     v = np.cos(2 * np.pi * f * t)
-    f_s, crossings = waveforms.micro_vibration_frequency(t, v, np.zeros_like(t), after=1e-5)
+    f_s, crossings = eq15.micro_vibration_frequency(t, v, np.zeros_like(t), after=1e-5)
     # linear interpolation of zero crossings of a 81-samples-per-cycle cosine: error ~(Δt ω)²/24 ≈ 1e-4
     assert f_s == pytest.approx(f, rel=1e-4)
     assert crossings[0] > 1e-5
@@ -41,7 +49,7 @@ def test_micro_vibration_frequency_of_a_sine():
 def test_micro_vibration_needs_three_turning_points():
     t = np.linspace(0.0, 1e-3, 1001)
     with pytest.raises(ValueError, match="no micro-vibration"):
-        waveforms.micro_vibration_frequency(t, np.ones_like(t), np.zeros_like(t), after=0.0)
+        eq15.micro_vibration_frequency(t, np.ones_like(t), np.zeros_like(t), after=0.0)
 
 
 def test_design_applies_eq15(design, drive):
@@ -51,7 +59,7 @@ def test_design_applies_eq15(design, drive):
     assert lhs == pytest.approx(design.presliding, rel=1e-12)
     assert design.presliding == pytest.approx(min(theory.drive_theory(drive)["presliding_m"]), rel=1e-12)
     # default free parameter: V_a at the amplifier's slew-rate limit
-    assert design.acceleration_velocity == pytest.approx(waveforms.max_piezo_velocity(drive), rel=1e-12)
+    assert design.acceleration_velocity == pytest.approx(max_piezo_velocity(drive), rel=1e-12)
 
 
 def test_measured_micro_vibration_frequency_against_linear_estimate(design, drive):
@@ -70,13 +78,13 @@ def test_measured_micro_vibration_frequency_against_linear_estimate(design, driv
 
 @pytest.mark.parametrize("frequency", [100.0, 1e3, 10e3, 50e3, 110e3, 130e3])
 def test_optimized_waveform_honours_slew_rate_and_period(design, drive, frequency):
-    wave = waveforms.optimized(A, frequency, drive, periods=4, design=design)
+    wave = optimized(A, frequency, drive, periods=4, design=design)
     T = 1.0 / frequency
     assert wave.kind == "optimized"
     assert wave.period == pytest.approx(T, rel=1e-15)
     assert wave.duration == pytest.approx(4 * T, rel=1e-12)
     # relative 1e-9: the fly-back and acceleration sit exactly at the limit, up to rounding
-    assert np.max(np.abs(_slopes(wave))) <= waveforms.max_piezo_velocity(drive) * (1 + 1e-9)
+    assert np.max(np.abs(_slopes(wave))) <= max_piezo_velocity(drive) * (1 + 1e-9)
     assert np.all(wave.positions >= 0.0) and np.max(wave.positions) == pytest.approx(A, rel=1e-12)
     # every period starts at x_p = 0 and its fly-back starts at x_p = A, one per period
     np.testing.assert_allclose(wave.position(np.arange(5) * T), 0.0, atol=1e-6 * A)
@@ -86,7 +94,7 @@ def test_optimized_waveform_honours_slew_rate_and_period(design, drive, frequenc
 
 
 def test_first_period_is_a_sawtooth(design, drive):
-    opt = waveforms.optimized(A, 100.0, drive, periods=3, design=design)
+    opt = optimized(A, 100.0, drive, periods=3, design=design)
     saw = waveforms.sawtooth(A, 100.0, drive, periods=3)
     t = np.linspace(0.0, 0.01, 1001)
     np.testing.assert_allclose(opt.position(t), saw.position(t), rtol=0, atol=1e-6 * A)
@@ -99,9 +107,9 @@ def test_first_period_is_a_sawtooth(design, drive):
 
 
 def test_settling_fits_at_low_frequency_only(design, drive):
-    low = waveforms.optimized_timing(design, A, 100.0, drive)
+    low = optimized_timing(design, A, 100.0, drive)
     assert low["settling_fits"] and low["settling_time_s"] == design.settling_time
-    high = waveforms.optimized_timing(design, A, 110e3, drive)
+    high = optimized_timing(design, A, 110e3, drive)
     # documented behaviour: the settling time is cut to what is left, nothing fails
     assert not high["settling_fits"]
     assert 0.0 <= high["settling_time_s"] < design.settling_time
@@ -109,62 +117,61 @@ def test_settling_fits_at_low_frequency_only(design, drive):
     T = high["period_s"]
     parts = ("flyback_time_s", "settling_time_s", "acceleration_time_s", "ramp_time_s")
     assert sum(high[k] for k in parts) == pytest.approx(T, rel=1e-12)
-    assert high["ramp_time_s"] >= waveforms.MIN_RAMP_FRACTION * (T - high["flyback_time_s"]) * (1 - 1e-12)
+    assert high["ramp_time_s"] >= MIN_RAMP_FRACTION * (T - high["flyback_time_s"]) * (1 - 1e-12)
 
 
 def test_long_acceleration_is_cut_not_failed(drive):
-    slow = waveforms.OptimizedDesign(
+    slow = OptimizedDesign(
         settling_time=50e-6, acceleration_time=40e-6, acceleration_amplitude=80e-9
     )
-    timing = waveforms.optimized_timing(slow, A, 50e3, drive)
+    timing = optimized_timing(slow, A, 50e3, drive)
     assert not timing["acceleration_fits"] and timing["settling_time_s"] == 0.0
     # V_a is kept, so the amplitude shrinks with the time
     v_a = timing["acceleration_amplitude_m"] / timing["acceleration_time_s"]
     assert v_a == pytest.approx(2e-3, rel=1e-12)
-    wave = waveforms.optimized(A, 50e3, drive, periods=2, design=slow)
-    assert np.max(np.abs(_slopes(wave))) <= waveforms.max_piezo_velocity(drive) * (1 + 1e-9)
+    wave = optimized(A, 50e3, drive, periods=2, design=slow)
+    assert np.max(np.abs(_slopes(wave))) <= max_piezo_velocity(drive) * (1 + 1e-9)
 
 
 def test_bad_inputs(design, drive):
     with pytest.raises(ValueError, match="acceleration_velocity"):
-        waveforms.optimized_design(A, drive, acceleration_velocity=0.2)
+        eq15.optimized_design(A, drive, acceleration_velocity=0.2)
     with pytest.raises(ValueError, match="first_period"):
-        waveforms.optimized(A, 100.0, drive, design=design, first_period="ramp")
+        optimized(A, 100.0, drive, design=design, first_period="ramp")
     with pytest.raises(ValueError, match="frequency"):
-        waveforms.optimized(A, 300e3, drive, design=design)
+        optimized(A, 300e3, drive, design=design)
     with pytest.raises(ValueError, match="acceleration_amplitude"):
-        waveforms.optimized(10e-9, 100.0, drive, design=design)
+        optimized(10e-9, 100.0, drive, design=design)
 
 
-def test_default_design_is_made_from_the_drive(design, drive):
-    wave = waveforms.optimized(A, 100.0, drive, periods=2)
-    again = waveforms.optimized(A, 100.0, drive, periods=2, design=design)
-    np.testing.assert_array_equal(wave.times, again.times)
-    np.testing.assert_array_equal(wave.positions, again.positions)
+def test_waveform_needs_a_design(drive):
+    """Building the waveform never simulates: without a design it is refused, naming it."""
+    with pytest.raises(ValueError, match="design = None"):
+        optimized(A, 100.0, drive, periods=2)
 
 
 def test_optimized_run_from_rest(design, drive):
-    res = dynamics.simulate(drive, waveforms.optimized(A, 100.0, drive, periods=3, design=design))
+    res = dynamics.simulate(drive, optimized(A, 100.0, drive, periods=3, design=design))
     assert res.settled_positions.shape == (3,)
     assert np.all(np.isfinite(res.settled_positions)) and np.all(res.step_sizes > 0)
 
 
 def test_skip_rule_drops_the_settling_only_when_it_does_not_fit(design, drive):
-    low = waveforms.optimized_timing(design, A, 100.0, drive, short_period="skip")
+    low = optimized_timing(design, A, 100.0, drive, short_period="skip")
     assert low["settling_time_s"] == design.settling_time
-    high = waveforms.optimized_timing(design, A, 110e3, drive, short_period="skip")
+    high = optimized_timing(design, A, 110e3, drive, short_period="skip")
     assert not high["settling_fits"] and high["settling_time_s"] == 0.0
-    wave = waveforms.optimized(A, 110e3, drive, periods=3, design=design, short_period="skip")
+    wave = optimized(A, 110e3, drive, periods=3, design=design, short_period="skip")
     T = 1.0 / 110e3
     # no hold: the fast segment starts right at the period start
     x_end = wave.position(T + design.acceleration_time)
     assert x_end == pytest.approx(design.acceleration_amplitude, rel=1e-9)
     with pytest.raises(ValueError, match="short_period"):
-        waveforms.optimized_timing(design, A, 110e3, drive, short_period="wait")
+        optimized_timing(design, A, 110e3, drive, short_period="wait")
 
 
 def test_first_period_can_be_optimized_too(design, drive):
-    wave = waveforms.optimized(A, 1e3, drive, periods=2, design=design, first_period="optimized")
+    wave = optimized(A, 1e3, drive, periods=2, design=design, first_period="optimized")
     # from rest: hold for t_s, then the fast rise, in every period including the first
     assert wave.position(0.999 * design.settling_time) == 0.0
     t_end = design.settling_time + design.acceleration_time

@@ -15,6 +15,8 @@ from passmd import dynamics, theory, waveforms
 from passmd.experiments import driving_waveform as dw
 from passmd.experiments import figure_data, figure_names, figure_plot
 from passmd.experiments import waveform_studies as studies
+from passmd.optimized_waveform import OptimizedDesign, max_piezo_velocity, optimized
+from passmd.protocols import eq15
 
 PANELS = ("fig8a", "fig8b", "fig9a", "fig9b", "fig10a", "fig10b", "fig10c")
 #: Relative tolerance of positions, velocities and times in the snapshots (see module docstring).
@@ -124,11 +126,11 @@ def test_carrying_the_runner_then_stopping_beats_the_sawtooth():
     conservative floor for hand-picked numbers (the optimiser finds ≈ +50 %)."""
     drive = dw.section5_drive()
     amplitude = drive.actuator.full_stroke_amplitude
-    design = waveforms.optimized_design(amplitude, drive)
-    carry = waveforms.OptimizedDesign(0.75 / design.micro_vibration_frequency, 0.9 * amplitude / 3e-3,
-                                      0.9 * amplitude)
+    design = eq15.optimized_design(amplitude, drive)
+    carry = OptimizedDesign(0.75 / design.micro_vibration_frequency, 0.9 * amplitude / 3e-3,
+                            0.9 * amplitude)
     saw = dynamics.simulate(drive, waveforms.sawtooth(amplitude, 100.0, drive, periods=3))
-    opt = dynamics.simulate(drive, waveforms.optimized(amplitude, 100.0, drive, periods=3, design=carry))
+    opt = dynamics.simulate(drive, optimized(amplitude, 100.0, drive, periods=3, design=carry))
     assert np.mean(opt.step_sizes) > 1.2 * np.mean(saw.step_sizes)
 
 
@@ -168,7 +170,7 @@ def test_numerical_optimum_beats_heuristic_and_sawtooth():
     assert low["velocity_optimum_m_per_s"] > 1.2 * low["velocity_sawtooth_m_per_s"]
     assert np.all(table["velocity_optimum_m_per_s"] > table["velocity_eq15_m_per_s"])
     # every optimum respects the amplifier
-    v_max = waveforms.max_piezo_velocity(dw.section5_drive())
+    v_max = max_piezo_velocity(dw.section5_drive())
     assert np.all(table["optimum_acceleration_velocity_m_per_s"] <= v_max * (1 + 1e-12))
 
 

@@ -7,7 +7,7 @@ physics checked does not depend on the drive frequency being the paper's.
 import numpy as np
 import pytest
 
-from passmd import dynamics, theory, waveforms
+from passmd import dynamics, theory, time_steps, waveforms
 from passmd.contact import contact_arrays, contact_stiffness, stack_contacts
 from passmd.parameters import Drive
 
@@ -125,10 +125,34 @@ def test_energy_balance(model, contact):
 def test_divergence_is_reported(monkeypatch):
     d = one_contact("flexible")
     wf = waveforms.sawtooth(100e-9, F_TEST, d, periods=1)
-    plan_dt = dynamics.step_plan(d, 3e6, 3e6).stability_limit
+    plan_dt = time_steps.step_plan(d, 3e6, 3e6).stability_limit
     monkeypatch.setattr(dynamics, "STABILITY_MARGIN", 100.0)  # let an unstable step through
     with pytest.raises(dynamics.SimulationError, match=r"diverged at integrator step \d+.*time step"):
         dynamics.simulate(d, wf, dt=5 * plan_dt)
+
+
+def test_kernel_wrapper_refuses_a_wrong_array_naming_it(monkeypatch):
+    """The compiled loop does no bounds checks: its Python wrapper checks every array first."""
+    from passmd import _dynamics_kernel as kern
+
+    seen = []
+    integrate = kern.integrate
+
+    def capture(*args):
+        seen.append(args)
+        return integrate(*args)
+
+    monkeypatch.setattr(kern, "integrate", capture)
+    run(one_contact(), 50e-9, periods=1)
+    segments, mechanics, control, contacts, buffers, limit = seen[0]
+    narrow = buffers._replace(per=np.zeros((1, kern.PER_COLUMNS - 1)))
+    with pytest.raises(ValueError, match=r"buffers\.per has shape \(1, 7\), must be \(1, 8\)"):
+        integrate(segments, mechanics, control, contacts, narrow, limit)
+    ints = segments._replace(t0=segments.t0.astype(np.int64))
+    with pytest.raises(ValueError, match=r"segments\.t0 must be a C-contiguous float64 array"):
+        integrate(ints, mechanics, control, contacts, buffers, limit)
+    with pytest.raises(ValueError, match=r"mechanics = \(1\.0,\) is not a Mechanics"):
+        integrate(segments, (1.0,), control, contacts, buffers, limit)
 
 
 def test_bad_inputs():
@@ -214,8 +238,8 @@ def test_expected_steps_match_the_run():
         rows = [contact_arrays("exact", F, d.hemisphere_radius, E, G, d.friction_coefficient) for F in forces]
         params, _ = stack_contacts(rows)
         ks = np.array([contact_stiffness(params[g]) for g in range(len(rows))])
-        plan = dynamics.step_plan(d, ks.max(), float(np.sum(mult * ks)))
-        est = dynamics.expected_steps(wf, plan, res.fine_step, res.coarse_step).sum()
+        plan = time_steps.step_plan(d, ks.max(), float(np.sum(mult * ks)))
+        est = time_steps.expected_steps(wf, plan, res.fine_step, res.coarse_step).sum()
         # rigid: every step is planned; flexible: ringing after the slip adds fine steps (< 2 %)
         assert est <= res.steps
         assert est == pytest.approx(res.steps, rel=0.02 if model == "flexible" else 1e-6)
@@ -224,12 +248,12 @@ def test_expected_steps_match_the_run():
 def test_run_beyond_the_step_budget_is_refused_before_it_starts(monkeypatch):
     d = one_contact()
     wf = waveforms.sawtooth(20e-9, F_TEST, d, periods=3)
-    monkeypatch.setattr(dynamics, "MAX_STEPS", 5000.0)  # ≈ 2070 steps per period: 2 periods fit
+    monkeypatch.setattr(time_steps, "MAX_STEPS", 5000.0)  # ≈ 2070 steps per period: 2 periods fit
     refused = r"budget of 5e\+03 steps .*\(--periods\) = 3 must be <= 2"
-    with pytest.raises(dynamics.WorkLimitError, match=refused):
+    with pytest.raises(time_steps.WorkLimitError, match=refused):
         dynamics.simulate(d, wf)
-    monkeypatch.setattr(dynamics, "MAX_STEPS", 10.0)  # not even one period fits: name the step
-    with pytest.raises(dynamics.WorkLimitError, match=r"runner_mass \(--runner-mass\)"):
+    monkeypatch.setattr(time_steps, "MAX_STEPS", 10.0)  # not even one period fits: name the step
+    with pytest.raises(time_steps.WorkLimitError, match=r"runner_mass \(--runner-mass\)"):
         dynamics.simulate(d, wf)
 
 
@@ -237,13 +261,13 @@ def test_step_below_the_time_resolution_is_refused():
     d = one_contact()
     # a 1e-18 m saw-tooth flies back in 1e-17 s: 40 steps of 2.5e-19 s cannot advance t ≈ 1 ms
     wf = waveforms.sawtooth(1e-18, F_TEST, d, periods=2)
-    with pytest.raises(dynamics.WorkLimitError, match=r"float spacings of t .*--amplitude.*--slew-rate"):
+    with pytest.raises(time_steps.WorkLimitError, match=r"float spacings of t .*--amplitude.*--slew-rate"):
         dynamics.simulate(d, wf)
     light = one_contact(runner_mass=1e-33, allow_extrapolation=True)  # past the plausible range on purpose
-    with pytest.raises(dynamics.WorkLimitError, match=r"runner_mass \(--runner-mass\) = 1e-33"):
+    with pytest.raises(time_steps.WorkLimitError, match=r"runner_mass \(--runner-mass\) = 1e-33"):
         dynamics.simulate(light, waveforms.sawtooth(20e-9, F_TEST, light, periods=2))
     flexible = one_contact("flexible")
-    with pytest.raises(dynamics.WorkLimitError, match=r"dt = 1e-22 s"):
+    with pytest.raises(time_steps.WorkLimitError, match=r"dt = 1e-22 s"):
         dynamics.simulate(flexible, waveforms.sawtooth(20e-9, F_TEST, flexible, periods=2), dt=1e-22)
 
 

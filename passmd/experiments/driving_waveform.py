@@ -3,7 +3,7 @@
 Section 5 drives the six-contact drive with rigid actuators (R = 1 mm, F_p = 0.4 N,
 A = 202 nm, μ = 0.2 assumed) with the standard saw-tooth and with the optimized waveform
 of Eq. 15 (:func:`passmd.optimized_waveform.optimized`), designed once per drive from its own
-100 Hz saw-tooth response (:func:`passmd.optimized_waveform.optimized_design`).
+100 Hz saw-tooth response (:func:`passmd.protocols.eq15.optimized_design`).
 
 Mean velocity at kHz frequencies
 --------------------------------
@@ -35,12 +35,13 @@ import math
 import numpy as np
 import pandas as pd
 
-from passmd import dynamics, readings, sweep, theory, waveforms
+from passmd import dynamics, optimized_waveform, readings, sweep, theory, waveforms
 from passmd._validation import check_choice
 from passmd.experiments import PROFILES, register_figure
 from passmd.ledger import ClaimFails, NotEvaluable, register_evidence, register_extractor
 from passmd.parameters import MOLYBDENUM, STEEL, Assumption, Drive, paper_drive, register_assumption
 from passmd.plots import driving_waveform as plots
+from passmd.protocols import eq15
 
 CHAPTER = "driving_waveform"
 #: Driving frequency of Figs. 8 and 9a (Hz).
@@ -157,21 +158,21 @@ def section5_drive(hemisphere_radius: float = 1e-3, preload: float = 0.4, runner
 
 
 def make_design(settling_time: float, acceleration_time: float,
-                acceleration_amplitude: float) -> waveforms.OptimizedDesign:
+                acceleration_amplitude: float) -> optimized_waveform.OptimizedDesign:
     """An :class:`~passmd.optimized_waveform.OptimizedDesign` from plain sweep parameters."""
-    return waveforms.OptimizedDesign(settling_time, acceleration_time, acceleration_amplitude)
+    return optimized_waveform.OptimizedDesign(settling_time, acceleration_time, acceleration_amplitude)
 
 
 def design_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
                  friction_coefficient: float = SECTION5_FRICTION) -> dict:
-    """Eq. 15 design of a drive at its full amplitude (:func:`passmd.optimized_waveform.optimized_design`).
+    """Eq. 15 design of a drive at its full amplitude (:func:`passmd.protocols.eq15.optimized_design`).
 
     Returns the design's :meth:`~passmd.optimized_waveform.OptimizedDesign.as_dict` plus the amplitude
     and the linear runner-on-contacts frequency (:func:`passmd.theory.runner_frequency`).
     """
     drive = section5_drive(hemisphere_radius, preload, runner, actuator_model, friction_coefficient)
     amplitude = drive.actuator.full_stroke_amplitude
-    out = waveforms.optimized_design(amplitude, drive).as_dict()
+    out = eq15.optimized_design(amplitude, drive).as_dict()
     out["amplitude_m"] = amplitude
     out["linear_frequency_Hz"] = theory.runner_frequency(drive)
     return out
@@ -181,8 +182,8 @@ def make_waveform(drive, amplitude, frequency, periods, waveform, short_period, 
     """A ``"sawtooth"`` or ``"optimized"`` (with ``design`` and ``short_period``) waveform."""
     if waveform == "sawtooth":
         return waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
-    return waveforms.optimized(amplitude, frequency, drive, periods=periods, design=design,
-                               short_period=short_period)
+    return optimized_waveform.optimized(amplitude, frequency, drive, periods=periods, design=design,
+                                        short_period=short_period)
 
 
 def steady_periods(frequency: float, steady_time: float = STEADY_TIME, min_periods: int = MIN_PERIODS) -> int:
@@ -234,7 +235,8 @@ def velocity_point(hemisphere_radius: float, preload: float, runner: str, actuat
     max_points = 2
     if waveform == "optimized":
         design = make_design(settling_time, acceleration_time, acceleration_amplitude)
-        timing = waveforms.optimized_timing(design, amplitude, frequency, drive, short_period=short_period)
+        timing = optimized_waveform.optimized_timing(design, amplitude, frequency, drive,
+                                                     short_period=short_period)
         out.update({k: v for k, v in timing.items() if k != "period_s"})
         duration = periods / frequency
         spacing = timing["acceleration_time_s"] / SAMPLES_PER_ACCELERATION
@@ -275,7 +277,7 @@ def trace_point(hemisphere_radius: float, preload: float, runner: str, actuator_
     resampled on two uniform grids: the whole run (``full_*``) and ``[zoom_start,
     zoom_end]`` (``zoom_*``). Also returns the per-period measures, the micro-vibration
     frequency f_s after the first fly-back (saw-tooth) or after the first acceleration
-    (optimized), measured as in the design (:func:`passmd.optimized_waveform.micro_vibration_frequency`),
+    (optimized), measured as in the design (:func:`passmd.protocols.eq15.micro_vibration_frequency`),
     and the first three turning points of the runner after the first fly-back.
     """
     drive = section5_drive(hemisphere_radius, preload, runner, actuator_model, friction_coefficient)
@@ -291,10 +293,10 @@ def trace_point(hemisphere_radius: float, preload: float, runner: str, actuator_
     if waveform == "sawtooth":
         after = period
     else:
-        timing = waveforms.optimized_timing(design, amplitude, frequency, drive)
+        timing = optimized_waveform.optimized_timing(design, amplitude, frequency, drive)
         after = period + timing["settling_time_s"] + timing["acceleration_time_s"]
-    f_s, _ = waveforms.micro_vibration_frequency(t, result.runner_velocity, v_p, after)
-    _, turning = waveforms.micro_vibration_frequency(t, result.runner_velocity, v_p, period)
+    f_s, _ = eq15.micro_vibration_frequency(t, result.runner_velocity, v_p, after)
+    _, turning = eq15.micro_vibration_frequency(t, result.runner_velocity, v_p, period)
     out = {
         "settled_positions_m": result.settled_positions,
         "back_steps_m": result.back_steps,
@@ -532,7 +534,7 @@ def window_point(hemisphere_radius: float, preload: float, runner: str, actuator
     amplitude = drive.actuator.full_stroke_amplitude
     design = make_design(settling_time, acceleration_time, acceleration_amplitude)
     wave = make_waveform(drive, amplitude, STEP_FREQUENCY, 2, "optimized", "cut", design)
-    timing = waveforms.optimized_timing(design, amplitude, STEP_FREQUENCY, drive)
+    timing = optimized_waveform.optimized_timing(design, amplitude, STEP_FREQUENCY, drive)
     period = 1.0 / STEP_FREQUENCY
     flyback = waveforms.flyback_time(amplitude, drive)
     start_a = period + timing["settling_time_s"]

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from passmd import dynamics, sweep, waveforms
+from passmd import dynamics, optimized_waveform, sweep
 from passmd._validation import check_choice
 from passmd.experiments import PROFILES
 from passmd.experiments.driving_waveform import (
@@ -124,7 +124,7 @@ def optimum_point(hemisphere_radius: float, preload: float, runner: str, actuato
 
     drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
     amplitude = drive.actuator.full_stroke_amplitude
-    v_max = waveforms.max_piezo_velocity(drive)
+    v_max = optimized_waveform.max_piezo_velocity(drive)
     period = 1.0 / frequency
     t_s_max = min(1.5 / micro_vibration_frequency, 0.5 * period)
 
@@ -132,7 +132,7 @@ def optimum_point(hemisphere_radius: float, preload: float, runner: str, actuato
         t_s, log_va, share = x
         v_a = v_max * 10.0**log_va
         d_a = share * amplitude
-        return waveforms.OptimizedDesign(t_s * t_s_max, d_a / v_a, d_a)
+        return optimized_waveform.OptimizedDesign(t_s * t_s_max, d_a / v_a, d_a)
 
     count = [0]
 
