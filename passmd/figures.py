@@ -7,6 +7,17 @@ Name → compute function (run configuration → tidy DataFrame), plot function
 
 from __future__ import annotations
 
-from passmd.experiments import figure_data, figure_names, figure_plot, figure_spec
+from passmd.experiments import (
+    critical_amplitude,
+    driving_waveform,
+    figure_data,
+    figure_names,
+    figure_plot,
+    figure_spec,
+    force_generation,
+)
 
-__all__ = ["figure_data", "figure_names", "figure_plot", "figure_spec"]
+__all__ = ["CLAIM_MODULES", "figure_data", "figure_names", "figure_plot", "figure_spec"]
+
+#: The modules holding the claim extractors of the figures (tagged with passmd.checks.extractor).
+CLAIM_MODULES = (critical_amplitude, force_generation, driving_waveform)
