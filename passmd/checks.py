@@ -7,7 +7,7 @@ paper and returns an :class:`Outcome`. :func:`check_claim` runs the check a clai
 Extractors are plain functions ``(results[, reading]) -> ours`` living next to their figure in
 :mod:`passmd.experiments`; :func:`extractor` and :func:`evidence` only tag them with their claim
 id (nothing is registered at import), and :func:`collect_claim_functions` finds the tagged
-functions of the modules it is given (the ledger passes :data:`passmd.figures.CLAIM_MODULES`).
+functions of the modules it is given (the ledger passes ``passmd.figures.CLAIM_MODULES``).
 
 What ``ours`` must be for each check kind
 -----------------------------------------

@@ -4,11 +4,11 @@ Three pieces meet here:
 
 * **claims**: ``passmd/data/reference/claims.csv``, read and validated by
   :func:`passmd.claims.load_claims`;
-* **results**: the figure table of :mod:`passmd.figures` (``fig5a`` … ``fig10c``, shared with
+* **results**: the figure table of ``passmd.figures`` (``fig5a`` … ``fig10c``, shared with
   the book and the CLI) plus the ledger's own ``closed_forms`` table; :func:`collect_results`
   computes every one for a run configuration, so a chapter never lists them;
 * **extractors**: functions ``(results[, reading]) -> ours`` tagged with
-  :func:`passmd.checks.extractor` in the modules :data:`passmd.figures.CLAIM_MODULES` lists
+  :func:`passmd.checks.extractor` in the modules ``passmd.figures.CLAIM_MODULES`` lists
   (and the closed-form one here); they turn the result tables into what the claim's check
   needs (:mod:`passmd.checks` says what, for each check kind).
 
@@ -26,7 +26,6 @@ import math
 import re
 import sys
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -34,19 +33,9 @@ import pandas as pd
 
 from passmd import figures as figure_table
 from passmd import readings, reference
-from passmd.checks import (
-    ORDERING_SYMBOLS,
-    ClaimFails,
-    ClaimFunctions,
-    ExtractorError,
-    NotEvaluable,
-    Outcome,
-    check_claim,
-    collect_claim_functions,
-    extractor,
-    format_number,
-)
-from passmd.claims import is_number, load_claims, tolerance_text
+from passmd._verdicts import NO_EXTRACTOR, claim_row, shown
+from passmd.checks import ClaimFunctions, collect_claim_functions, extractor
+from passmd.claims import is_number, load_claims
 from passmd.config import RunConfig
 
 __all__ = [
@@ -85,7 +74,7 @@ LEDGER_COLUMNS = ("claim", "figure", "quantity", "paper", "ours", "unit", "abs_d
 
 
 def claim_modules() -> tuple:
-    """The modules holding claim extractors: :data:`passmd.figures.CLAIM_MODULES` and this one
+    """The modules holding claim extractors: ``passmd.figures.CLAIM_MODULES`` and this one
     (the closed-form claim's extractor)."""
     return (*figure_table.CLAIM_MODULES, sys.modules[__name__])
 
@@ -120,7 +109,7 @@ def _figure_source(name: str) -> Callable[[RunConfig], pd.DataFrame]:
 def result_sources() -> dict[str, Callable[[RunConfig], pd.DataFrame]]:
     """Every available result table: ``{key: compute(config) -> DataFrame}``.
 
-    The figures of :mod:`passmd.figures` (in the table's order) plus ``closed_forms``
+    The figures of ``passmd.figures`` (in the table's order) plus ``closed_forms``
     (the closed-form tables some claims are checked against, :func:`closed_form_results`).
     """
     sources = {name: _figure_source(name) for name in figure_table.figure_names()}
@@ -163,155 +152,6 @@ def collect_results(config: RunConfig, figures: Iterable[str] | None = None) -> 
 # ======================================================================================
 # Evaluation
 # ======================================================================================
-
-
-def _paper_text(claim: Mapping) -> str:
-    kind, relation = claim["check"], claim["relation"]
-    if kind == "value":
-        if claim["paper_value"]:
-            return claim["paper_value"]
-        filename, _, column = claim["reference"].partition(":")
-        return f"curve {column} ({filename})"
-    if kind == "ordering":
-        return f"lhs {ORDERING_SYMBOLS[relation]} rhs"
-    if kind == "threshold":
-        return f"{relation.replace('_', ' ')} {claim['paper_value']}"
-    return relation
-
-
-def _passed_verdict(claim: Mapping, outcome: Outcome) -> str:
-    quantitative = claim["check"] == "value" or claim["relation"] == "approx"
-    if quantitative and math.isfinite(outcome.rel_deviation):
-        percent = max(1, math.ceil(round(outcome.rel_deviation * 100, 9)))
-        return f"within {percent} %"
-    return "holds"
-
-
-@dataclass(frozen=True)
-class PointResult:
-    """One claim at one reading: ``holds``, ``fails`` or ``inconclusive``, with what was found."""
-
-    reading: dict
-    state: str  # "holds", "fails", "inconclusive"
-    outcome: Outcome | None
-    detail: str
-
-
-def _evaluate_point(claim: Mapping, func: Callable, depends: tuple, results, reading: dict) -> PointResult:
-    try:
-        ours = func(results, reading) if depends else func(results)
-        outcome = check_claim(claim, ours)
-    except NotEvaluable as reason:
-        return PointResult(reading, "inconclusive", None, str(reason))
-    except ClaimFails as reason:
-        return PointResult(reading, "fails", None, str(reason))
-    except Exception as err:
-        raise ExtractorError(f"claim {claim['id']!r} ({claim['check']} check) at "
-                             f"{readings.describe(reading)}: {err!r}") from err
-    state = "holds" if outcome.passed else "fails"
-    return PointResult(reading, state, outcome, outcome.detail)
-
-
-def _best(points: list[PointResult]) -> PointResult | None:
-    """The reading where the claim holds best: a holding one with the smallest deviation, else the
-    failing one closest to holding (smallest score)."""
-    decided = [p for p in points if p.state != "inconclusive"]
-    if not decided:
-        return None
-
-    def key(p):
-        score = p.outcome.score if p.outcome is not None and math.isfinite(p.outcome.score) else math.inf
-        return (p.state != "holds", score)
-
-    return min(decided, key=key)
-
-
-def _categorise(points: list[PointResult]) -> tuple[str, str]:
-    """Category and a one-line verdict from the claim's results over its readings."""
-    default, others = points[0], points[1:]
-    holding = [p for p in others if p.state == "holds"]
-    open_ = [p for p in others if p.state == "inconclusive"]
-    if default.state == "holds":
-        return "reproduced", "holds at the defaults"
-    if default.state == "inconclusive":
-        also = (f"; holds at {', '.join(readings.describe(p.reading) for p in holding)}" if holding else "")
-        return "inconclusive", f"at the defaults: {default.detail}{also}"
-    if holding:
-        return ("reproduced under another reading",
-                "holds at " + "; and at ".join(readings.describe(p.reading) for p in holding))
-    if open_:
-        return ("inconclusive", "fails at the defaults; not covered: "
-                + "; ".join(f"{readings.describe(p.reading)} ({p.detail})" for p in open_))
-    if others:
-        return "not reproduced", f"fails at all {len(points)} readings"
-    return "not reproduced", "fails at the defaults (no other reading declared for it)"
-
-
-def _evidence(claim: Mapping, points: list[PointResult], results, func: Callable | None) -> list[str]:
-    """Computed evidence: the check at every reading, then the claim's own evidence function."""
-    lines = []
-    for p in points:
-        shown = "" if p.outcome is None else f"ours {_shown(p.outcome.ours)}{_unit(claim)}; "
-        lines.append(f"{readings.describe(p.reading)}: {p.state} ({shown}{p.detail})")
-    if func is not None:
-        try:
-            lines.extend(func(results))
-        except NotEvaluable as reason:
-            lines.append(f"evidence not available on these results: {reason}")
-        except KeyError as missing:
-            lines.append(f"evidence needs results: {missing}")
-    return lines
-
-
-def _shown(value) -> str:
-    return format_number(value) if isinstance(value, float) else str(value)
-
-
-def _unit(claim: Mapping) -> str:
-    return f" {claim['unit']}" if claim["unit"] and claim["check"] == "value" else ""
-
-
-#: The verdict of a claim whose results are present but no extractor is tagged for it.
-_NO_EXTRACTOR = "no extractor registered"
-
-
-def _evaluate_claim(claim: Mapping, results, functions: ClaimFunctions) -> tuple[dict, list[PointResult]]:
-    """One claim's ledger row (:data:`LEDGER_COLUMNS`) and its points (empty when not evaluated)."""
-    needed = [k for k in claim["requires"].split(";") if k]
-    missing = [k for k in needed if k not in results]
-    basis = "closed form" if set(needed) <= {"closed_forms"} else "simulation"
-    depends = functions.depends_on.get(claim["id"], ())
-    points: list[PointResult] = []
-    if missing:
-        status, verdict, evidence = "inconclusive", "needs results: " + ", ".join(missing), []
-    elif claim["id"] not in functions.extractors:
-        status, verdict, evidence = "inconclusive", _NO_EXTRACTOR, []
-    else:
-        func = functions.extractors[claim["id"]]
-        points = [_evaluate_point(claim, func, depends, results, r) for r in readings.design(depends)]
-        status, verdict = _categorise(points)
-        if status == "reproduced":
-            verdict = _passed_verdict(claim, points[0].outcome) + " at the defaults"
-        evidence = _evidence(claim, points, results, functions.evidence.get(claim["id"]))
-    default = points[0].outcome if points else None
-    decided = [p for p in points if p.state != "inconclusive"]
-    best = _best(points)
-    row = {
-        "claim": claim["id"], "figure": claim["figure"], "quantity": claim["quantity"],
-        "paper": _paper_text(claim), "ours": "—" if default is None else default.ours,
-        "unit": claim["unit"],
-        "abs_deviation": math.nan if default is None else default.abs_deviation,
-        "rel_deviation": math.nan if default is None else default.rel_deviation,
-        "tolerance": tolerance_text(claim), "status": status, "verdict": verdict,
-        "evidence": " | ".join(evidence), "reason": claim["reason"], "basis": basis,
-        "check": claim["check"], "depends_on": ";".join(depends), "readings": len(points),
-        "holds_at": sum(p.state == "holds" for p in points),
-        "fraction_holds": (sum(p.state == "holds" for p in decided) / len(decided)
-                           if decided else math.nan),
-        "best_reading": "—" if best is None else readings.describe(best.reading),
-        "note": points[0].detail if points else verdict,
-    }
-    return row, points
 
 
 def evaluate(
@@ -360,9 +200,9 @@ def evaluate(
         Columns :data:`LEDGER_COLUMNS`: ``paper`` and ``ours`` (at the defaults) as shown,
         ``abs_deviation`` (in ``unit``) and ``rel_deviation`` (fraction) where defined,
         ``status`` (the category, one of :data:`passmd.claims.STATUSES`), ``verdict`` (one
-        computed line), ``evidence`` (computed lines, ``" | "``-separated), ``reason`` (claims.csv's human
-        reason), ``basis``, ``readings`` (evaluated), ``holds_at`` (how many hold),
-        ``fraction_holds``, ``best_reading``, ``depends_on``.
+        computed line), ``evidence`` (computed lines, ``" | "``-separated), ``reason``
+        (claims.csv's human reason), ``basis``, ``readings`` (evaluated), ``holds_at`` (how
+        many hold), ``fraction_holds``, ``best_reading``, ``depends_on``.
     """
     if results is None:
         if config is None:
@@ -372,8 +212,8 @@ def evaluate(
     functions = claim_functions(modules)
     problems, rows, point_rows = [], [], []
     for _, claim in claims.iterrows():
-        row, points = _evaluate_claim(claim, results, functions)
-        if strict and row["verdict"] == _NO_EXTRACTOR:
+        row, points = claim_row(claim, results, functions)
+        if strict and row["verdict"] == NO_EXTRACTOR:
             problems.append(f"claim {claim['id']!r} has its results but no registered extractor")
         rows.append(row)
         point_rows.extend({"claim": claim["id"], "reading": readings.describe(p.reading),
@@ -465,7 +305,7 @@ def records(evaluated: pd.DataFrame) -> list[dict]:
             "readings": dict(zip(mine["reading"], mine["state"], strict=True)),
             "fraction_holds": None if not math.isfinite(row.fraction_holds) else float(row.fraction_holds),
             "best_reading": row.best_reading, "tolerance": row.tolerance, "check": row.check,
-            f"paper{suffix}": paper, f"ours{suffix}": number(row.ours), "ours_text": _shown(row.ours),
+            f"paper{suffix}": paper, f"ours{suffix}": number(row.ours), "ours_text": shown(row.ours),
             f"abs_deviation{suffix}": number(row.abs_deviation),
             "rel_deviation": None if not math.isfinite(row.rel_deviation) else float(row.rel_deviation),
         })

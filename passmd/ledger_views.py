@@ -167,7 +167,7 @@ def details_markdown(evaluated: pd.DataFrame, claims: pd.DataFrame) -> str:
 
 
 def assumption_map_styled(evaluated: pd.DataFrame):
-    """:func:`assumption_map` as a compact coloured table (✓ holds, ✗ fails, ? inconclusive).
+    """:func:`passmd.ledger.assumption_map` as a compact coloured table (✓ holds, ✗ fails, ? inconclusive).
 
     The columns are numbered readings; the caption lists what each number means, so the table
     stays inside the content column.
