@@ -818,11 +818,13 @@ def _cmd_cache(args, out) -> int:
 
 def _cmd_ledger(args, out) -> int:
     """Every claim of the paper with its computed category, values and evidence (Section 4-6)."""
-    from passmd import ledger
+    from passmd import ledger, ledger_views
+    from passmd.claims import STATUSES
+    from passmd.config import RunConfig
 
     _check_sweep_options(args)
     with _sweep_environment(args):
-        evaluated = ledger.evaluate(ledger.load_claims(), ledger.collect_results(args.profile))
+        evaluated = ledger.evaluate(config=RunConfig(profile=args.profile))
     if args.write_baseline:
         header = (f"ledger categories, {args.profile} profile; produced by\n"
                   f"passmd ledger --profile {args.profile} --write-baseline {args.write_baseline}")
@@ -831,12 +833,12 @@ def _cmd_ledger(args, out) -> int:
         except OSError as exc:
             raise OutputError(f"cannot write --write-baseline {args.write_baseline}: "
                               f"{exc.strerror or exc}") from exc
-    counts = {s: int((evaluated["status"] == s).sum()) for s in ledger.STATUSES}
+    counts = {s: int((evaluated["status"] == s).sum()) for s in STATUSES}
     if args.json:
-        _emit_json({"command": "ledger", "profile": args.profile, "summary": ledger.summary(evaluated),
+        _emit_json({"command": "ledger", "profile": args.profile, "summary": ledger_views.summary(evaluated),
                     "counts": counts, "claims": ledger.records(evaluated)}, out)
         return 0
-    out.write(f"passmd ledger — profile {args.profile}: {ledger.summary(evaluated)}\n")
+    out.write(f"passmd ledger — profile {args.profile}: {ledger_views.summary(evaluated)}\n")
     for row in evaluated.itertuples():
         basis = " (closed form)" if row.basis == "closed form" else ""
         out.write(f"\n{row.claim}: {row.status}{basis}\n  {row.verdict}\n")

@@ -10,9 +10,9 @@ source of that range.
 A *reading* is one point of that space: ``{axis key: value}``. The ledger evaluates every claim
 at the readings of its :func:`design` (one-at-a-time: the defaults, then each evaluated
 alternative of each axis the claim depends on, the others at their defaults). An extractor
-declares the axes it reads with ``register_extractor(id, depends_on=(...))`` and receives the
+declares the axes it reads with ``passmd.checks.extractor(id, depends_on=(...))`` and receives the
 reading as its ``reading`` argument; when the result tables hold no run at that reading it
-raises :class:`passmd.ledger.NotEvaluable`, and that point counts as not covered.
+raises :class:`passmd.checks.NotEvaluable`, and that point counts as not covered.
 
 Axes declared with no evaluated alternative are listed in the report as open: the ledger cannot
 yet say whether a claim's verdict moves along them. An axis with alternatives can still be open for

@@ -195,7 +195,7 @@ def _velocity_series(f_kHz, v):
 
 
 def test_reachable_maximum_must_be_interior():
-    from passmd.ledger import NotEvaluable
+    from passmd.checks import NotEvaluable
 
     inside = _velocity_series([1, 50, 110, 130], [0.1, 10.0, 19.0, 12.0])
     assert dw.reachable_maximum(inside)["frequency_kHz"] == 110.0
@@ -206,7 +206,7 @@ def test_reachable_maximum_must_be_interior():
 
 
 def test_turning_point_needs_a_rise_then_a_fall_where_the_paper_puts_it():
-    from passmd.ledger import ClaimFails
+    from passmd.checks import ClaimFails
 
     rise_fall = _velocity_series([1, 60, 105, 110, 115, 130], [0.1, 8.0, 18.0, 19.0, 18.5, 15.0])
     assert dw.turning_point(rise_fall, 110.0)["frequency_kHz"].tolist() == [110.0, 115.0, 130.0]

@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd import ledger, readings
+from passmd import checks, ledger, readings
 from passmd.experiments import figure_data, figure_names, figure_plot
 from passmd.experiments import force_generation as fg
 
@@ -245,5 +245,5 @@ def test_force_difference_extractor_uses_only_stalled_pairs(quick):
     table = quick["fig7a"].copy()
     full = np.isclose(table["amplitude_fraction"], 1.0) & np.isclose(table["preload_N"], 0.8)
     table.loc[full & (table["actuator_model"] == "flexible"), "converged"] = False
-    with pytest.raises(ledger.NotEvaluable):
+    with pytest.raises(checks.NotEvaluable):
         ledger.extractors()["fig7a-force-difference-115mn"]({"fig7a": table}, readings.default_reading())

@@ -1,4 +1,4 @@
-"""The ledger: claims schema, every check kind on synthetic data, verdicts, registries, regressions.
+"""The ledger: claims schema, every check kind on synthetic data, verdicts, extractor tags, regressions.
 
 The checks compare numbers exactly against their tolerances, so synthetic data sit clearly
 inside or outside a tolerance (never within rounding of it).
@@ -8,14 +8,20 @@ import csv
 import math
 import os
 import re
+import subprocess
+import sys
+import types
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from passmd import experiments, ledger, reference
+from passmd import checks, figures, ledger, ledger_views, reference
+from passmd.claims import CHECK_KINDS, CLAIM_COLUMNS, load_claims
+from passmd.config import RunConfig
 
+QUICK, PAPER_PROFILE = RunConfig(profile="quick"), RunConfig(profile="paper")
 PAPER = Path(os.environ.get("PASSMD_PAPER", "/work/shared/paper/nguyen2018-passmd.md"))
 
 #: Claims the ledger must hold at minimum: the checkable statements of Sections 3-6 and Figs. 5-10.
@@ -31,18 +37,18 @@ REQUIRED_CLAIMS = (
 
 
 # --------------------------------------------------------------------------------------
-# helpers: a synthetic claims file and a private registry
+# helpers: a synthetic claims file and a module of tagged extractors
 # --------------------------------------------------------------------------------------
 
 def _claim(**fields):
-    row = dict.fromkeys(ledger.CLAIM_COLUMNS, "")
+    row = dict.fromkeys(CLAIM_COLUMNS, "")
     row.update(figure="x", requires="fig5a", quantity="q", ours_definition="d", source_section="4",
                source_quote="quote", tolerance_reason="because")
     row.update(fields)
     return row
 
 
-def _write(tmp_path, rows, columns=ledger.CLAIM_COLUMNS):
+def _write(tmp_path, rows, columns=CLAIM_COLUMNS):
     path = tmp_path / "claims.csv"
     with open(path, "w", newline="", encoding="utf-8") as fh:
         writer = csv.DictWriter(fh, fieldnames=list(columns), extrasaction="ignore")
@@ -51,19 +57,10 @@ def _write(tmp_path, rows, columns=ledger.CLAIM_COLUMNS):
     return path
 
 
-@pytest.fixture
-def registry(monkeypatch):
-    """Empty extractor and figure registries for the test (the real ones are restored after).
-
-    The topic modules are imported first, so they register into the real registries.
-    """
-    experiments.figure_names()
-    extractors, figures = {}, {}
-    monkeypatch.setattr(ledger, "_EXTRACTORS", extractors)
-    monkeypatch.setattr(ledger, "_DEPENDS", {})
-    monkeypatch.setattr(ledger, "_EVIDENCE", {})
-    monkeypatch.setattr(experiments, "FIGURES", figures)
-    return extractors, figures
+def _tag(module, claim_id, func, depends_on=()):
+    """Put ``func`` into ``module`` as the extractor of ``claim_id`` (replacing an earlier one)."""
+    setattr(module, "extract_" + re.sub(r"\W", "_", claim_id), checks.extractor(claim_id, depends_on)(func))
+    return module
 
 
 SYNTHETIC = [
@@ -77,14 +74,16 @@ SYNTHETIC = [
 ]
 
 
-def _register_good(values=None):
+def _good_module(values=None):
+    """A module whose extractors make every synthetic claim hold (``values`` overrides 'val')."""
     values = {"val": 103.0, **(values or {})}
-    ledger.register_extractor("val")(lambda results: values["val"])
-    ledger.register_extractor("ord")(lambda results: {"lhs": 2.0, "rhs": 1.0})
-    ledger.register_extractor("thr")(
-        lambda results: {"x": np.arange(0, 100, 10.0), "holds": np.arange(0, 100, 10.0) < 50})
-    ledger.register_extractor("trd")(lambda results: {"x": [1, 2, 3], "y": [1.0, 2.0, 3.0]})
-    ledger.register_extractor("other")(lambda results: 1.0)
+    module = types.ModuleType("synthetic_claims")
+    _tag(module, "val", lambda results: values["val"])
+    _tag(module, "ord", lambda results: {"lhs": 2.0, "rhs": 1.0})
+    _tag(module, "thr", lambda results: {"x": np.arange(0, 100, 10.0), "holds": np.arange(0, 100, 10.0) < 50})
+    _tag(module, "trd", lambda results: {"x": [1, 2, 3], "y": [1.0, 2.0, 3.0]})
+    _tag(module, "other", lambda results: 1.0)
+    return module
 
 
 # --------------------------------------------------------------------------------------
@@ -92,11 +91,11 @@ def _register_good(values=None):
 # --------------------------------------------------------------------------------------
 
 def test_real_claims_load_and_contain_the_required_rows():
-    claims = ledger.load_claims()
+    claims = load_claims()
     assert claims["id"].is_unique
     missing = set(REQUIRED_CLAIMS) - set(claims["id"])
     assert not missing
-    assert set(claims["check"]) == set(ledger.CHECK_KINDS)  # every kind is used
+    assert set(claims["check"]) == set(CHECK_KINDS)  # every kind is used
     # No paper value typed for a curve claim; tolerances stated with a reason everywhere.
     curve = claims[claims["reference"] != ""]
     assert (curve["paper_value"] == "").all() and len(curve) == 5
@@ -105,7 +104,7 @@ def test_real_claims_load_and_contain_the_required_rows():
 
 def test_stated_numbers_of_the_paper():
     """The numbers the paper states in its text (a typo here would move a claim)."""
-    claims = ledger.load_claims().set_index("id")
+    claims = load_claims().set_index("id")
     stated = {
         "fig5a-no-step-below-50nm": 50, "fig7a-force-difference-115mn": 115,
         "fig9a-standard-position-552nm": 552, "fig9a-optimized-position-716nm": 716,
@@ -126,7 +125,7 @@ def test_every_quote_is_in_the_paper():
         return re.sub(r"[^0-9a-z]", "", text.lower())
 
     paper = letters(PAPER.read_text(encoding="utf-8"))
-    claims = ledger.load_claims()
+    claims = load_claims()
     absent = [c for c, q in zip(claims["id"], claims["source_quote"], strict=True) if letters(q) not in paper]
     assert not absent
 
@@ -149,7 +148,7 @@ def test_schema_errors_name_the_row_and_the_problem(tmp_path):
     # reference curves are looked up next to the claims file
     (tmp_path / "fig5b_closed_form.csv").write_text("preload_N,u_x_max_nm\n0.1,1\n")
     with pytest.raises(ValueError) as info:
-        ledger.load_claims(path)
+        load_claims(path)
     message = str(info.value)
     for expected in (
         "row 'bad-kind': check = 'guess' is not allowed",
@@ -169,11 +168,11 @@ def test_schema_errors_name_the_row_and_the_problem(tmp_path):
 
 def test_missing_columns_and_file(tmp_path):
     path = _write(tmp_path, [_claim(id="a", check="ordering", relation="<")],
-                  columns=[c for c in ledger.CLAIM_COLUMNS if c != "source_quote"])
+                  columns=[c for c in CLAIM_COLUMNS if c != "source_quote"])
     with pytest.raises(ValueError, match="missing required columns: source_quote"):
-        ledger.load_claims(path)
+        load_claims(path)
     with pytest.raises(FileNotFoundError):
-        ledger.load_claims(tmp_path / "none.csv")
+        load_claims(tmp_path / "none.csv")
 
 
 # --------------------------------------------------------------------------------------
@@ -181,111 +180,111 @@ def test_missing_columns_and_file(tmp_path):
 # --------------------------------------------------------------------------------------
 
 def test_value_check_scalar_relative_and_absolute():
-    inside = ledger.check_value(103.0, 100.0, 0.05, "rel")
+    inside = checks.check_value(103.0, 100.0, 0.05, "rel")
     assert inside.passed and inside.abs_deviation == pytest.approx(3.0)
     assert inside.rel_deviation == pytest.approx(0.03)
-    outside = ledger.check_value(107.0, 100.0, 0.05, "rel")
+    outside = checks.check_value(107.0, 100.0, 0.05, "rel")
     assert not outside.passed and "7 % exceeds the tolerance 5 %" in outside.detail
-    assert ledger.check_value(104.0, 110.0, 5.0, "abs").rel_deviation == pytest.approx(6 / 110)
-    assert not ledger.check_value(104.0, 110.0, 5.0, "abs").passed
-    assert ledger.check_value(106.0, 110.0, 5.0, "abs").passed
+    assert checks.check_value(104.0, 110.0, 5.0, "abs").rel_deviation == pytest.approx(6 / 110)
+    assert not checks.check_value(104.0, 110.0, 5.0, "abs").passed
+    assert checks.check_value(106.0, 110.0, 5.0, "abs").passed
     with pytest.raises(ValueError, match="must be a number"):
-        ledger.check_value([1.0, 2.0], 1.0, 0.1)
+        checks.check_value([1.0, 2.0], 1.0, 0.1)
     with pytest.raises(ValueError, match="must be a number"):
-        ledger.check_value({"x": [1.0], "y": [1.0]}, 1.0, 0.1)  # a curve for a scalar claim
-    with pytest.raises(ledger.NotEvaluable, match="non-finite"):  # inconclusive, never a pass
-        ledger.check_value(math.nan, 1.0, 0.1)
+        checks.check_value({"x": [1.0], "y": [1.0]}, 1.0, 0.1)  # a curve for a scalar claim
+    with pytest.raises(checks.NotEvaluable, match="non-finite"):  # inconclusive, never a pass
+        checks.check_value(math.nan, 1.0, 0.1)
 
 
 def test_value_check_curve_interpolates_the_reference():
     curve = (np.array([0.1, 0.2, 0.3]), np.array([10.0, 20.0, 40.0]))
     # At x = 0.25 the reference is 30 (linear); 31 is 3.3 % off.
-    result = ledger.check_value({"x": [0.1, 0.25], "y": [10.0, 31.0]}, None, 0.05, "rel", curve)
+    result = checks.check_value({"x": [0.1, 0.25], "y": [10.0, 31.0]}, None, 0.05, "rel", curve)
     assert result.passed and result.rel_deviation == pytest.approx(1 / 30)
-    failing = ledger.check_value({"x": [0.1, 0.25], "y": [10.0, 33.0]}, None, 0.05, "rel", curve)
+    failing = checks.check_value({"x": [0.1, 0.25], "y": [10.0, 33.0]}, None, 0.05, "rel", curve)
     assert not failing.passed and "at x = 0.25" in failing.detail
     with pytest.raises(ValueError, match="outside the reference curve's range"):
-        ledger.check_value({"x": [0.5], "y": [1.0]}, None, 0.05, "rel", curve)
+        checks.check_value({"x": [0.5], "y": [1.0]}, None, 0.05, "rel", curve)
     with pytest.raises(ValueError, match="differ in length"):
-        ledger.check_value({"x": [0.1, 0.2], "y": [1.0]}, None, 0.05, "rel", curve)
+        checks.check_value({"x": [0.1, 0.2], "y": [1.0]}, None, 0.05, "rel", curve)
 
 
 def test_ordering_check():
-    assert ledger.check_ordering({"lhs": 1.0, "rhs": 2.0}, "<").passed
-    assert not ledger.check_ordering({"lhs": 2.0, "rhs": 2.0}, "<").passed  # strict without a margin
-    assert ledger.check_ordering({"lhs": 3.0, "rhs": 2.0}, ">").passed
-    arrays = ledger.check_ordering({"lhs": [3.0, 1.0, 5.0], "rhs": [2.0, 2.0, 2.0]}, ">")
+    assert checks.check_ordering({"lhs": 1.0, "rhs": 2.0}, "<").passed
+    assert not checks.check_ordering({"lhs": 2.0, "rhs": 2.0}, "<").passed  # strict without a margin
+    assert checks.check_ordering({"lhs": 3.0, "rhs": 2.0}, ">").passed
+    arrays = checks.check_ordering({"lhs": [3.0, 1.0, 5.0], "rhs": [2.0, 2.0, 2.0]}, ">")
     assert not arrays.passed and arrays.ours == "2 of 3 hold" and "fails at 1 of 3" in arrays.detail
     # a relative margin: lhs must exceed rhs by 10 %
-    assert not ledger.check_ordering({"lhs": 1.05, "rhs": 1.0}, ">", 0.1, "rel").passed
-    assert ledger.check_ordering({"lhs": 1.15, "rhs": 1.0}, ">", 0.1, "rel").passed
-    approx = ledger.check_ordering({"lhs": 1.04, "rhs": 1.0}, "approx", 0.05, "rel")
+    assert not checks.check_ordering({"lhs": 1.05, "rhs": 1.0}, ">", 0.1, "rel").passed
+    assert checks.check_ordering({"lhs": 1.15, "rhs": 1.0}, ">", 0.1, "rel").passed
+    approx = checks.check_ordering({"lhs": 1.04, "rhs": 1.0}, "approx", 0.05, "rel")
     assert approx.passed and approx.rel_deviation == pytest.approx(0.04)
-    assert not ledger.check_ordering({"lhs": 1.06, "rhs": 1.0}, "approx", 0.05, "rel").passed
+    assert not checks.check_ordering({"lhs": 1.06, "rhs": 1.0}, "approx", 0.05, "rel").passed
     with pytest.raises(ValueError, match="keys"):
-        ledger.check_ordering({"left": 1.0}, "<")
+        checks.check_ordering({"left": 1.0}, "<")
 
 
 def test_threshold_check():
     x = np.arange(0.0, 101.0, 10.0)
     step_is_zero = x < 50  # zero step below 50 nm, steps above
-    result = ledger.check_threshold({"x": x, "holds": step_is_zero}, "switch_below", 50.0, 5.0, "abs")
+    result = checks.check_threshold({"x": x, "holds": step_is_zero}, "switch_below", 50.0, 5.0, "abs")
     assert result.passed and result.ours == 50.0 and result.abs_deviation == 0.0
     # The switch at 70 is outside the ±5 band around 50: the condition still holds above.
-    late = ledger.check_threshold({"x": x, "holds": x < 70}, "switch_below", 50.0, 5.0, "abs")
+    late = checks.check_threshold({"x": x, "holds": x < 70}, "switch_below", 50.0, 5.0, "abs")
     assert not late.passed and "still holds beyond it at x = 60" in late.detail
-    early = ledger.check_threshold({"x": x, "holds": x < 30}, "holds_below", 50.0, 5.0, "abs")
+    early = checks.check_threshold({"x": x, "holds": x < 30}, "holds_below", 50.0, 5.0, "abs")
     assert not early.passed and "fails below the threshold at x = 30" in early.detail
     # one-sided: failing or holding above the band does not matter
     always = {"x": x, "holds": np.ones_like(x, bool)}
-    assert ledger.check_threshold(always, "holds_below", 50.0, 5.0, "abs").passed
+    assert checks.check_threshold(always, "holds_below", 50.0, 5.0, "abs").passed
     # points inside the band are not judged (60 would fail a 'switch_below' at 55 ± 10)
-    assert ledger.check_threshold({"x": x, "holds": x <= 60}, "switch_below", 55.0, 10.0, "abs").passed
-    above = ledger.check_threshold({"x": x, "holds": x > 80}, "switch_above", 80.0, 5.0, "abs")
+    assert checks.check_threshold({"x": x, "holds": x <= 60}, "switch_below", 55.0, 10.0, "abs").passed
+    above = checks.check_threshold({"x": x, "holds": x > 80}, "switch_above", 80.0, 5.0, "abs")
     assert above.passed and above.ours == 80.0
-    with pytest.raises(ledger.NotEvaluable, match="no point below"):
-        ledger.check_threshold({"x": [60.0, 70.0], "holds": [True, True]}, "holds_below", 50.0, 5.0, "abs")
-    with pytest.raises(ledger.NotEvaluable, match="far side"):
-        ledger.check_threshold({"x": [10.0, 20.0], "holds": [True, True]}, "switch_below", 50.0, 5.0, "abs")
+    with pytest.raises(checks.NotEvaluable, match="no point below"):
+        checks.check_threshold({"x": [60.0, 70.0], "holds": [True, True]}, "holds_below", 50.0, 5.0, "abs")
+    with pytest.raises(checks.NotEvaluable, match="far side"):
+        checks.check_threshold({"x": [10.0, 20.0], "holds": [True, True]}, "switch_below", 50.0, 5.0, "abs")
     # NaN never counts as holding: a boolean read from a column with gaps is inconclusive
-    with pytest.raises(ledger.NotEvaluable, match="non-finite"):
-        ledger.check_threshold({"x": [10.0, 20.0, 60.0], "holds": [1.0, np.nan, 0.0]}, "switch_below", 50.0,
+    with pytest.raises(checks.NotEvaluable, match="non-finite"):
+        checks.check_threshold({"x": [10.0, 20.0, 60.0], "holds": [1.0, np.nan, 0.0]}, "switch_below", 50.0,
                                5.0, "abs")
     with pytest.raises(ValueError, match="must be booleans"):
-        ledger.check_threshold({"x": [10.0, 60.0], "holds": [0.5, 0.0]}, "switch_below", 50.0, 5.0, "abs")
+        checks.check_threshold({"x": [10.0, 60.0], "holds": [0.5, 0.0]}, "switch_below", 50.0, 5.0, "abs")
 
 
 def test_trend_check():
-    rising = ledger.check_trend({"x": [3, 1, 2], "y": [3.0, 1.0, 2.0]}, "increasing", 0.0)  # sorted by x
+    rising = checks.check_trend({"x": [3, 1, 2], "y": [3.0, 1.0, 2.0]}, "increasing", 0.0)  # sorted by x
     assert rising.passed and rising.abs_deviation == 0.0
     noisy = {"x": [1, 2, 3, 4], "y": [0.0, 5.0, 4.8, 10.0]}  # counter-step 0.2 = 2 % of the range 10
-    assert ledger.check_trend(noisy, "increasing", 0.05, "rel").passed
-    assert not ledger.check_trend(noisy, "increasing", 0.01, "rel").passed
-    assert not ledger.check_trend(noisy, "increasing", 0.1, "abs").passed
-    assert not ledger.check_trend({"x": [1, 2], "y": [1.0, 1.0]}, "increasing", 0.0).passed  # flat
-    falling = ledger.check_trend({"x": [1, 2, 3], "y": [3.0, 2.0, 1.0]}, "decreasing", 0.0)
+    assert checks.check_trend(noisy, "increasing", 0.05, "rel").passed
+    assert not checks.check_trend(noisy, "increasing", 0.01, "rel").passed
+    assert not checks.check_trend(noisy, "increasing", 0.1, "abs").passed
+    assert not checks.check_trend({"x": [1, 2], "y": [1.0, 1.0]}, "increasing", 0.0).passed  # flat
+    falling = checks.check_trend({"x": [1, 2, 3], "y": [3.0, 2.0, 1.0]}, "decreasing", 0.0)
     assert falling.passed
     several = {"0.3 N": {"x": [1, 2], "y": [0.0, 1.0]}, "0.8 N": {"x": [1, 2], "y": [1.0, 0.0]}}
-    result = ledger.check_trend(several, "increasing", 0.05)
+    result = checks.check_trend(several, "increasing", 0.05)
     assert not result.passed and "series 0.8 N" in result.detail
-    with pytest.raises(ledger.NotEvaluable):
-        ledger.check_trend({"x": [1], "y": [1.0]}, "increasing", 0.0)
+    with pytest.raises(checks.NotEvaluable):
+        checks.check_trend({"x": [1], "y": [1.0]}, "increasing", 0.0)
 
 
 def test_curve_deviation_helper():
     table = reference.load_reference_curve("fig6a_closed_form")
     x, eq11 = table["preload_N"].to_numpy(), table["u_x_max_e_nm"].to_numpy()
-    assert ledger.curve_deviation(x, 1.02 * eq11, "fig6a_closed_form", "u_x_max_e_nm") == pytest.approx(2.0)
+    assert checks.curve_deviation(x, 1.02 * eq11, "fig6a_closed_form", "u_x_max_e_nm") == pytest.approx(2.0)
 
 
 # --------------------------------------------------------------------------------------
 # evaluation and verdicts
 # --------------------------------------------------------------------------------------
 
-def test_evaluate_computes_categories(tmp_path, registry):
-    claims = ledger.load_claims(_write(tmp_path, SYNTHETIC))
-    _register_good()
-    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}).set_index("claim")
+def test_evaluate_computes_categories(tmp_path):
+    claims = load_claims(_write(tmp_path, SYNTHETIC))
+    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[_good_module()])
+    evaluated = evaluated.set_index("claim")
     assert list(evaluated.reset_index().columns) == list(ledger.LEDGER_COLUMNS)
     assert evaluated.at["val", "verdict"] == "within 3 % at the defaults"
     assert evaluated.at["val", "paper"] == "100" and evaluated.at["val", "ours"] == 103.0
@@ -296,21 +295,36 @@ def test_evaluate_computes_categories(tmp_path, registry):
     # results that are missing leave the claim inconclusive, naming what is missing
     assert evaluated.at["other", "status"] == "inconclusive"
     assert evaluated.at["other", "verdict"] == "needs results: fig9b"
-    assert ledger.summary(evaluated.reset_index()) == "4 of 5 claims reproduced; 1 inconclusive"
+    assert ledger_views.summary(evaluated.reset_index()) == "4 of 5 claims reproduced; 1 inconclusive"
 
 
-def test_failures_are_not_reproduced_with_their_evidence(tmp_path, registry):
+def test_evaluate_computes_the_results_from_a_config_when_none_are_given(tmp_path, monkeypatch):
+    claims = load_claims(_write(tmp_path, SYNTHETIC[:1]))
+    configs = []
+
+    def collect(config):
+        configs.append(config)
+        return {"fig5a": pd.DataFrame()}
+
+    monkeypatch.setattr(ledger, "collect_results", collect)
+    evaluated = ledger.evaluate(claims, config=QUICK, modules=[_good_module()])
+    assert configs == [QUICK] and evaluated.at[0, "status"] == "reproduced"
+    with pytest.raises(ValueError, match="needs results or a config"):
+        ledger.evaluate(claims, modules=[_good_module()])
+
+
+def test_failures_are_not_reproduced_with_their_evidence(tmp_path):
     rows = [dict(r) for r in SYNTHETIC]
     rows[1].update(reason="our runner is lighter")
-    claims = ledger.load_claims(_write(tmp_path, rows))
-    _register_good({"val": 120.0})
-    registry[0]["ord"] = lambda results: {"lhs": 0.5, "rhs": 1.0}
+    claims = load_claims(_write(tmp_path, rows))
+    module = _good_module({"val": 120.0})
+    _tag(module, "ord", lambda results: {"lhs": 0.5, "rhs": 1.0})
 
     def total_failure(results):
-        raise ledger.ClaimFails("no step up to the full stroke")
+        raise checks.ClaimFails("no step up to the full stroke")
 
-    registry[0]["thr"] = total_failure
-    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame(), "fig9b": pd.DataFrame()})
+    _tag(module, "thr", total_failure)
+    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame(), "fig9b": pd.DataFrame()}, modules=[module])
     evaluated = evaluated.set_index("claim")
     assert evaluated.at["val", "status"] == "not reproduced"
     assert "deviation 20 % exceeds the tolerance 5 %" in evaluated.at["val", "evidence"]
@@ -318,25 +332,46 @@ def test_failures_are_not_reproduced_with_their_evidence(tmp_path, registry):
     assert evaluated.at["ord", "reason"] == "our runner is lighter"  # a human reason, never the category
     assert evaluated.at["thr", "status"] == "not reproduced"  # a total failure is a failure
     assert "no step up to the full stroke" in evaluated.at["thr", "evidence"]
-    assert ledger.summary(evaluated.reset_index()) == "2 of 5 claims reproduced; 3 not reproduced"
+    assert ledger_views.summary(evaluated.reset_index()) == "2 of 5 claims reproduced; 3 not reproduced"
 
 
-def test_another_reading_and_uncovered_readings(tmp_path, registry):
+def test_evidence_functions_follow_the_checks(tmp_path):
+    """A claim's evidence lists the check at each reading, then its evidence function's lines; an
+    evidence function without data says so instead of failing the ledger."""
+    claims = load_claims(_write(tmp_path, SYNTHETIC[:2]))
+    module = _good_module()
+    module.val_evidence = checks.evidence("val")(lambda results: ["step 103 nm at 100 Hz"])
+
+    @checks.evidence("ord")
+    def ord_evidence(results):
+        raise checks.NotEvaluable("no runs at 100 Hz")
+
+    module.ord_evidence = ord_evidence
+    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module]).set_index("claim")
+    assert evaluated.at["val", "evidence"].split(" | ") == [
+        "defaults: holds (ours 103 nm; deviation 3 % within the tolerance 5 %)", "step 103 nm at 100 Hz"]
+    assert evaluated.at["ord", "evidence"].endswith(
+        "evidence not available on these results: no runs at 100 Hz")
+
+
+def test_another_reading_and_uncovered_readings(tmp_path):
     """A claim that fails at the defaults but holds at a declared alternative names that reading;
     one whose alternatives are not in the tables is inconclusive, not 'not reproduced'."""
-    claims = ledger.load_claims(_write(tmp_path, SYNTHETIC[:2]))
+    claims = load_claims(_write(tmp_path, SYNTHETIC[:2]))
+    module = types.ModuleType("synthetic_claims")
 
-    @ledger.register_extractor("val", depends_on=("flyback",))
+    @checks.extractor("val", depends_on=("flyback",))
     def _val(results, reading):
         return 100.0 if reading["flyback"] == "fixed" else 130.0
 
-    @ledger.register_extractor("ord", depends_on=("flyback",))
+    @checks.extractor("ord", depends_on=("flyback",))
     def _ord(results, reading):
         if reading["flyback"] == "fixed":
-            raise ledger.NotEvaluable("no fixed fly-back runs")
+            raise checks.NotEvaluable("no fixed fly-back runs")
         return {"lhs": 0.5, "rhs": 1.0}
 
-    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}).set_index("claim")
+    module._val, module._ord = _val, _ord
+    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module]).set_index("claim")
     assert evaluated.at["val", "status"] == "reproduced under another reading"
     assert evaluated.at["val", "verdict"] == "holds at fly-back rule = fixed"
     assert evaluated.at["val", "best_reading"] == "fly-back rule = fixed"
@@ -347,28 +382,32 @@ def test_another_reading_and_uncovered_readings(tmp_path, registry):
     assert list(table.columns) == ["claim", "defaults", "fly-back rule = fixed", "holds at", "best reading"]
     row = table.set_index("claim").loc["val"].tolist()
     assert row == ["fails", "holds", "1 of 2", "fly-back rule = fixed"]
-    assert "R1: fly-back rule = fixed" in ledger.assumption_map_styled(evaluated.reset_index()).to_html()
+    html = ledger_views.assumption_map_styled(evaluated.reset_index()).to_html()
+    assert "R1: fly-back rule = fixed" in html
+    assert ledger.depends_on("val", modules=[module]) == ("flyback",)
+    assert ledger.claim_readings("val", modules=[module]) == ("defaults", "fly-back rule = fixed")
 
 
-def test_unknown_assumption_axis_is_refused(registry):
+def test_unknown_assumption_axis_is_refused():
     with pytest.raises(ValueError, match="assumption axis = 'colour' is not declared"):
-        ledger.register_extractor("x", depends_on=("colour",))
+        checks.extractor("x", depends_on=("colour",))
 
 
-def test_missing_extractor_is_an_error_unless_lenient(tmp_path, registry):
-    claims = ledger.load_claims(_write(tmp_path, SYNTHETIC[:2]))
-    ledger.register_extractor("val")(lambda results: 100.0)
-    ledger.register_extractor("typo")(lambda results: 1.0)
+def test_missing_extractor_is_an_error_unless_lenient(tmp_path):
+    claims = load_claims(_write(tmp_path, SYNTHETIC[:2]))
+    module = _tag(_tag(types.ModuleType("synthetic_claims"), "val", lambda results: 100.0),
+                  "typo", lambda results: 1.0)
     with pytest.raises(LookupError, match="claim 'ord' has its results but no registered extractor"):
-        ledger.evaluate(claims, {"fig5a": pd.DataFrame()})
-    lenient = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, strict=False).set_index("claim")
+        ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
+    lenient = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, strict=False, modules=[module])
+    lenient = lenient.set_index("claim")
     assert lenient.at["ord", "verdict"] == "no extractor registered"
     assert lenient.at["ord", "status"] == "inconclusive"
-    assert ledger.orphan_extractors(claims) == ["typo"]
+    assert ledger.orphan_extractors(claims, modules=[module]) == ["typo"]
 
 
 def test_claims_for_selects_a_chapters_rows():
-    claims = ledger.load_claims()
+    claims = load_claims()
     fig5 = ledger.claims_for(claims, ["fig5a", "fig5b"])
     assert set(fig5["figure"]) == {"5a", "5b"} and len(fig5) == 4
     # a claim needing fig7a and fig7b belongs to a chapter that has both
@@ -376,128 +415,169 @@ def test_claims_for_selects_a_chapters_rows():
     assert "fig7-critical-amplitude-both-models" in set(ledger.claims_for(claims, ["fig7a", "fig7b"])["id"])
 
 
-def test_extractor_errors_name_the_claim(tmp_path, registry):
-    claims = ledger.load_claims(_write(tmp_path, SYNTHETIC[1:2]))
-    ledger.register_extractor("ord")(lambda results: results["fig5a"]["missing_column"])
-    with pytest.raises(ledger.ExtractorError, match="claim 'ord' \\(ordering check\\)"):
-        ledger.evaluate(claims, {"fig5a": pd.DataFrame()})
+def test_extractor_errors_name_the_claim(tmp_path):
+    claims = load_claims(_write(tmp_path, SYNTHETIC[1:2]))
+    module = _tag(types.ModuleType("synthetic_claims"), "ord",
+                  lambda results: results["fig5a"]["missing_column"])
+    with pytest.raises(checks.ExtractorError, match="claim 'ord' \\(ordering check\\)"):
+        ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
 
 
-def test_not_evaluable_from_extractor(tmp_path, registry):
-    claims = ledger.load_claims(_write(tmp_path, SYNTHETIC[:1]))
+def test_not_evaluable_from_extractor(tmp_path):
+    claims = load_claims(_write(tmp_path, SYNTHETIC[:1]))
 
-    @ledger.register_extractor("val")
     def _coarse(results):
-        raise ledger.NotEvaluable("quick grid has no point at 100 Hz")
+        raise checks.NotEvaluable("quick grid has no point at 100 Hz")
 
-    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()})
+    module = _tag(types.ModuleType("synthetic_claims"), "val", _coarse)
+    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
     assert evaluated.at[0, "status"] == "inconclusive"
     assert evaluated.at[0, "verdict"] == "at the defaults: quick grid has no point at 100 Hz"
 
 
-def test_any_category_change_fails_with_a_readable_diff(tmp_path, registry):
+def test_any_category_change_fails_with_a_readable_diff(tmp_path):
     """Every change of category against the baseline fails, not only a lost 'reproduced'."""
-    claims = ledger.load_claims(_write(tmp_path, SYNTHETIC))
-    _register_good()
+    claims = load_claims(_write(tmp_path, SYNTHETIC))
+    module = _good_module()
     results = {"fig5a": pd.DataFrame()}
     baseline_path = tmp_path / "baseline.csv"
-    ledger.write_baseline(ledger.evaluate(claims, results), baseline_path, header="made by a test\non a day")
+    ledger.write_baseline(ledger.evaluate(claims, results, modules=[module]), baseline_path,
+                          header="made by a test\non a day")
     assert baseline_path.read_text().startswith("# made by a test\n# on a day\nclaim,status,readings\n")
     # the readings each category was computed at (these synthetic claims depend on no axis)
     assert ledger.load_baseline_readings(baseline_path)["val"] == ("defaults",)
     baseline = ledger.load_baseline(baseline_path)
     assert baseline["val"] == "reproduced" and baseline["other"] == "inconclusive"
-    ledger.check_categories(ledger.evaluate(claims, results), baseline)  # unchanged: fine
-    registry[0]["val"] = lambda results: 90.0  # the model drifts 10 % away from the paper
+    ledger.check_categories(ledger.evaluate(claims, results, modules=[module]), baseline)  # unchanged: fine
+    _tag(module, "val", lambda results: 90.0)  # the model drifts 10 % away from the paper
     with pytest.raises(AssertionError, match="val: reproduced -> not reproduced"):
-        ledger.check_categories(ledger.evaluate(claims, results), baseline)
+        ledger.check_categories(ledger.evaluate(claims, results, modules=[module]), baseline)
     # an inconclusive claim that becomes decidable is a change too (review it, then record it)
-    registry[0]["val"] = lambda results: 100.0
-    changed = ledger.category_changes(ledger.evaluate(claims, {**results, "fig9b": pd.DataFrame()}), baseline)
+    _tag(module, "val", lambda results: 100.0)
+    changed = ledger.category_changes(
+        ledger.evaluate(claims, {**results, "fig9b": pd.DataFrame()}, modules=[module]), baseline)
     assert changed[["claim", "baseline", "now"]].values.tolist() == [["other", "inconclusive", "reproduced"]]
 
 
 # --------------------------------------------------------------------------------------
-# registries, results, presentation
+# extractor tags, results, presentation
 # --------------------------------------------------------------------------------------
 
-def test_collect_results_calls_every_available_figure(registry):
+def test_collect_results_calls_every_figure_of_the_table(monkeypatch):
     calls = []
 
-    def _fig5a(profile):
+    def _fig5a(profile):  # lead: receives the RunConfig itself once compute(config) is merged
         calls.append(profile)
         return pd.DataFrame({"amplitude_nm": [1.0]})
 
-    experiments.register_figure("fig5a", title="t", chapter="c", plot=None)(_fig5a)
-    results = ledger.collect_results("quick")
+    table = {"fig5a": types.SimpleNamespace(compute=_fig5a)}
+    monkeypatch.setattr(figures, "figure_names", lambda: list(table))
+    monkeypatch.setattr(figures, "figure_spec", lambda name: table[name])
+    results = ledger.collect_results(QUICK)
     assert list(results) == ["fig5a", "closed_forms"]
     assert calls == ["quick"]
-    with pytest.raises(ValueError, match="profile = 'fast' is not allowed"):
-        ledger.collect_results("fast")
+    pd.testing.assert_frame_equal(results["closed_forms"], reference.tangential_stiffness_table())
+    with pytest.raises(TypeError, match="config = 'quick' is not allowed: must be a passmd.config.RunConfig"):
+        ledger.collect_results("quick")
     with pytest.raises(ValueError, match="are not available"):
-        ledger.collect_results("quick", figures=["fig9z"])
-    experiments.register_figure("fig5b", title="t", chapter="c", plot=None)(lambda profile: [1, 2])
+        ledger.collect_results(QUICK, figures=["fig9z"])
+    table["fig5b"] = types.SimpleNamespace(compute=lambda profile: [1, 2])
     with pytest.raises(TypeError, match="not a DataFrame"):
-        ledger.collect_results("quick", figures=["fig5b"])
+        ledger.collect_results(QUICK, figures=["fig5b"])
 
 
-def test_registration_rules(registry):
+def test_tags_only_mark_the_function():
     with pytest.raises(ValueError, match="claim_id = 'Bad Id' is not allowed"):
-        ledger.register_extractor("Bad Id")
+        checks.extractor("Bad Id")
+    with pytest.raises(ValueError, match="claim_id = 3 is not allowed"):
+        checks.evidence(3)
 
+    def first(results, reading):
+        return 1.0
+
+    assert checks.extractor("x", depends_on=["flyback"])(first) is first
+    assert (first.claim_extractor, first.claim_depends_on) == ("x", ("flyback",))
+    assert "x" not in ledger.extractors()  # tagging registers nothing anywhere
+
+
+def test_collect_claim_functions_finds_each_claim_once():
     def first(results):
         return 1.0
 
     def second(results):
         return 2.0
 
-    ledger.register_extractor("x")(first)
-    ledger.register_extractor("x")(first)  # re-importing a module registers the same function again
-    with pytest.raises(ValueError, match="already registered by .*first"):
-        ledger.register_extractor("x")(second)
+    def lines(results):
+        return ["a line"]
+
+    one = types.SimpleNamespace(first=checks.extractor("x")(first), helper=len, number=3)
+    # the same function reached twice (imported into a second module) counts once
+    found = checks.collect_claim_functions([one, types.SimpleNamespace(alias=first)])
+    assert dict(found.extractors) == {"x": first} and dict(found.depends_on) == {"x": ()}
+    # functions made in a loop are found in a module-level tuple
+    made = types.SimpleNamespace(EVIDENCE=(checks.evidence("x")(lines), "not a function"))
+    assert dict(checks.collect_claim_functions([one, made]).evidence) == {"x": lines}
+    two = types.SimpleNamespace(second=checks.extractor("x")(second))
+    with pytest.raises(ValueError, match="claim 'x' is claimed twice .*first and .*second"):
+        checks.collect_claim_functions([one, two])
+
+
+def test_real_extractors_live_in_the_figures_claim_modules():
+    """Every extractor of the package is found in passmd.figures.CLAIM_MODULES (and the ledger's own
+    closed-form one), and the experiments do not import the ledger (the layers are one-way)."""
+    found = ledger.claim_functions()
+    homes = {f.__module__ for f in found.extractors.values()}
+    assert homes == {m.__name__ for m in figures.CLAIM_MODULES} | {"passmd.ledger"}
+    assert found.extractors["fig10b-r1-stiffer-contact"].__module__ == "passmd.ledger"
+    assert found.depends_on["fig5a-no-step-below-50nm"] == ("flyback",)
+    assert {"fig10a-1n-slower", "sec5-response-to-optimized-similar"} <= set(found.evidence)
+    assert ledger.orphan_extractors() == []
+    code = ("import sys; import " + ", ".join(m.__name__ for m in figures.CLAIM_MODULES)
+            + "; print(sorted(m for m in sys.modules if m.startswith('passmd.ledger')))")
+    imported = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert imported.stdout.strip() == "[]"
 
 
 def test_real_ledger_closed_form_claim_is_labelled_and_the_rest_wait():
-    claims = ledger.load_claims()
-    results = {"closed_forms": ledger.closed_form_results("quick")}
+    claims = load_claims()
+    results = {"closed_forms": ledger.closed_form_results(QUICK)}
     evaluated = ledger.evaluate(claims, results).set_index("claim")
     assert evaluated.at["fig10b-r1-stiffer-contact", "status"] == "reproduced"
     assert evaluated.at["fig10b-r1-stiffer-contact", "basis"] == "closed form"
     others = evaluated.drop(index="fig10b-r1-stiffer-contact")
     assert (others["status"] == "inconclusive").all()
     assert others["verdict"].str.startswith("needs results: fig").all()
-    text = ledger.summary(evaluated.reset_index())
+    text = ledger_views.summary(evaluated.reset_index())
     assert text.startswith("1 of ") and "(1 of them a closed-form identity, not a simulation)" in text
 
 
-def test_styled_one_line_per_claim_and_details(tmp_path, registry):
-    claims = ledger.load_claims(_write(tmp_path, SYNTHETIC))
-    _register_good({"val": 150.0})
-    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()})
-    html = ledger.styled(evaluated, links=True).to_html()
+def test_styled_one_line_per_claim_and_details(tmp_path):
+    claims = load_claims(_write(tmp_path, SYNTHETIC))
+    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[_good_module({"val": 150.0})])
+    html = ledger_views.styled(evaluated, links=True).to_html()
     assert 'class="passmd-ledger"' in html and 'href="#claim-val"' in html
     for status in ("reproduced", "not reproduced", "inconclusive"):
-        assert ledger.STATUS_COLOURS[status] in html
+        assert ledger_views.STATUS_COLOURS[status] in html
     assert "exceeds the tolerance" not in html  # details live in the collapsible blocks
-    details = ledger.details_markdown(evaluated, claims)
+    details = ledger_views.details_markdown(evaluated, claims)
     assert "(ledger-not-reproduced)=" in details and "(claim-val)=" in details
     assert "deviation 50 % exceeds the tolerance 5 %" in details
-    headline = ledger.headline_markdown(evaluated)
+    headline = ledger_views.headline_markdown(evaluated)
     assert "[1 not reproduced](replication_report.md#ledger-not-reproduced)" in headline
     assert "0 reproduced under another reading" in headline
 
 
 def test_assumptions_table_lists_the_registered_assumptions():
-    table = ledger.assumptions_table()
+    table = ledger_views.assumptions_table()
     expected = {"actuator_viscosity", "preload_grids", "friction_coefficient_sections_4_1_and_5"}
     assert expected <= set(table["key"])
     assert table["rationale"].str.len().min() > 0
 
 
 def test_sources_markdown_escapes_markup_and_marks_assumptions():
-    claims = ledger.load_claims().set_index("id", drop=False)
+    claims = load_claims().set_index("id", drop=False)
     two = claims.loc[["fig6b-flexible-r1-ac-matches-eq12", "fig9a-step-increase-46.8pct"]]
-    text = ledger.sources_markdown(two)
+    text = ledger_views.sources_markdown(two)
     assert text.count("\n* **") == 1 and text.startswith("* **fig6b-flexible-r1-ac-matches-eq12**")
     assert "u\\*\\_x,max,e" in text  # 'u*_x,max,e' must not start italics in MyST
     assert "μ = 0.2 (assumed)" in text and "F\\_p on the preload grid" in text
@@ -513,9 +593,9 @@ def test_ledger_command_prints_categories_and_si_json(monkeypatch, capsys):
 
     calls = []
 
-    def closed_forms_only(profile):
-        calls.append(profile)
-        return {"closed_forms": ledger.closed_form_results(profile)}
+    def closed_forms_only(config):
+        calls.append(config.profile)
+        return {"closed_forms": ledger.closed_form_results(config)}
 
     monkeypatch.setattr(ledger, "collect_results", closed_forms_only)
     out = io.StringIO()
@@ -523,7 +603,7 @@ def test_ledger_command_prints_categories_and_si_json(monkeypatch, capsys):
     payload = json.loads(out.getvalue())
     assert calls == ["paper"] and payload["profile"] == "paper"
     claims = {c["claim"]: c for c in payload["claims"]}
-    assert set(claims) == set(ledger.load_claims()["id"])
+    assert set(claims) == set(load_claims()["id"])
     stiffer = claims["fig10b-r1-stiffer-contact"]
     assert stiffer["category"] == "reproduced" and stiffer["basis"] == "closed form"
     assert stiffer["readings"] == {"defaults": "holds"} and stiffer["evidence"]
@@ -544,7 +624,7 @@ def test_open_claims_of_each_axis_are_exactly_those_not_evaluated_along_it():
     the report never calls a claim covered along an axis it was not evaluated at."""
     from passmd import readings
 
-    claims = ledger.load_claims()
+    claims = load_claims()
     applies = {
         "friction_coefficient": set(claims.loc[claims["assumed"].str.split(";").map(
             lambda cols: "friction_coefficient" in cols), "id"]),

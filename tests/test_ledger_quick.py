@@ -4,7 +4,7 @@
 category (claim, status) on the two profiles, with the command and date that produced them in
 their ``#`` header. The quick test fails with a readable diff when any claim changes category
 (in either direction), when a figure's results exist but one of its claims has no extractor
-(``evaluate(strict=True)``), and when an extractor is registered for an id that is not in
+(``evaluate(strict=True)``), and when an extractor is tagged for an id that is not in
 claims.csv. After reviewing a change, record it with
 
     PASSMD_UPDATE_LEDGER_BASELINE=1 pytest tests/test_ledger_quick.py
@@ -22,15 +22,17 @@ from pathlib import Path
 import pytest
 
 from passmd import ledger
+from passmd.claims import load_claims
+from passmd.config import PROFILES, RunConfig
 
 BASELINES = {profile: Path(__file__).with_name(f"ledger_baseline_{profile}.csv")
-             for profile in ledger.PROFILES}
+             for profile in PROFILES}
 
 
 @pytest.mark.slow
 def test_quick_ledger_keeps_every_category():
-    claims = ledger.load_claims()
-    evaluated = ledger.evaluate(claims, ledger.collect_results("quick"), strict=True)
+    claims = load_claims()
+    evaluated = ledger.evaluate(claims, ledger.collect_results(RunConfig(profile="quick")), strict=True)
     if os.environ.get("PASSMD_UPDATE_LEDGER_BASELINE") == "1":
         header = (f"ledger categories, quick profile; produced {datetime.date.today().isoformat()} by\n"
                   "PASSMD_UPDATE_LEDGER_BASELINE=1 pytest tests/test_ledger_quick.py")
@@ -38,7 +40,7 @@ def test_quick_ledger_keeps_every_category():
     baseline = ledger.load_baseline(BASELINES["quick"])
     assert set(baseline) == set(claims["id"]), "the baseline and claims.csv list different claims"
     ledger.check_categories(evaluated, baseline)
-    assert ledger.orphan_extractors(claims) == [], "extractors registered for ids not in claims.csv"
+    assert ledger.orphan_extractors(claims) == [], "extractors tagged for ids not in claims.csv"
     # The claim computed from closed forms needs no figure: it must always be reproduced.
     assert baseline["fig10b-r1-stiffer-contact"] == "reproduced"
 
@@ -96,7 +98,7 @@ def test_claims_not_recorded_on_the_paper_profile_are_exactly_the_new_readings()
             assert new and all("ζ" in r or "μ" in r for r in new), (claim, why)
             assert not set(paper_readings[claim]) - set(ledger.claim_readings(claim)), (claim, why)
         else:
-            assert ledger.load_claims().set_index("id").at[claim, "requires"] == "fig8b_window", (claim, why)
+            assert load_claims().set_index("id").at[claim, "requires"] == "fig8b_window", (claim, why)
 
 
 def test_baselines_say_how_they_were_made():

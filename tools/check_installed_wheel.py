@@ -8,7 +8,7 @@ runs, each must exit with 0:
 
 * ``passmd --version`` (prints the metadata's version);
 * ``passmd theory --json`` (closed forms);
-* the ledger's loader: ``passmd.ledger.load_claims()`` and every reference curve of
+* the claims loader: ``passmd.claims.load_claims()`` and every reference curve of
   ``passmd.reference.CURVES``, plus the benchmark results the book reads;
 * ``passmd ledger --profile quick --json`` (every claim's computed category; with
   ``--ledger-cache DIR`` it reads the simulation cache the test session filled, whose keys
@@ -47,7 +47,8 @@ def main(argv: list[str] | None = None) -> int:
     repo = args.repo.resolve()
 
     import passmd
-    from passmd import ledger, provenance, reference
+    from passmd import provenance, reference
+    from passmd.claims import CLAIMS_PATH, load_claims
     from passmd.experiments import numerics
 
     location = Path(passmd.__file__).resolve()
@@ -64,8 +65,8 @@ def main(argv: list[str] | None = None) -> int:
     theory = json.loads(_run(exe, "theory", "--json"))
     print("theory keys:", ", ".join(sorted(theory)[:6]), "...")
 
-    claims = ledger.load_claims()
-    print(f"ledger.load_claims(): {len(claims)} claims from {ledger.CLAIMS_PATH}")
+    claims = load_claims()
+    print(f"claims.load_claims(): {len(claims)} claims from {CLAIMS_PATH}")
     for name in reference.CURVES:
         table = reference.load_reference_curve(name)
         print(f"reference.load_reference_curve({name!r}): {len(table)} rows")

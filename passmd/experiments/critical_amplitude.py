@@ -46,8 +46,8 @@ import pandas as pd
 
 from passmd import dynamics, readings, reference, sweep, waveforms
 from passmd._validation import check_choice, check_positive, check_range
+from passmd.checks import ClaimFails, NotEvaluable, curve_deviation, extractor
 from passmd.experiments import PROFILES, register_figure
-from passmd.ledger import ClaimFails, NotEvaluable, curve_deviation, register_extractor
 from passmd.parameters import (
     ACTUATOR_DAMPING_RATIO,
     PRELOAD_GRIDS,
@@ -749,7 +749,7 @@ _RIGID_AXES = ("ac_protocol", "drive_frequency_s4")
 _FLEXIBLE_AXES = ("flyback", "ac_protocol", "drive_frequency_s4", "damping_ratio")
 
 
-@register_extractor("fig5a-no-step-below-50nm", depends_on=("flyback",))
+@extractor("fig5a-no-step-below-50nm", depends_on=("flyback",))
 def _fig5a_no_step(results, reading) -> dict:
     table = results["fig5a"]
     rows = table[(table["actuator_model"] == "flexible") & (table["flyback"] == reading["flyback"])]
@@ -761,17 +761,17 @@ def _fig5a_no_step(results, reading) -> dict:
     return {"x": rows["amplitude_nm"].to_numpy(), "holds": holds}
 
 
-@register_extractor("fig5b-rigid-ac-matches-eq7", depends_on=_RIGID_AXES)
+@extractor("fig5b-rigid-ac-matches-eq7", depends_on=_RIGID_AXES)
 def _fig5b_rigid(results, reading) -> dict:
     return _curve(results, "fig5b", "rigid", reading)
 
 
-@register_extractor("fig5b-flexible-ac-matches-eq8", depends_on=_FLEXIBLE_AXES)
+@extractor("fig5b-flexible-ac-matches-eq8", depends_on=_FLEXIBLE_AXES)
 def _fig5b_flexible(results, reading) -> dict:
     return _curve(results, "fig5b", "flexible", reading)
 
 
-@register_extractor("fig5b-flexible-above-rigid", depends_on=_FLEXIBLE_AXES)
+@extractor("fig5b-flexible-above-rigid", depends_on=_FLEXIBLE_AXES)
 def _fig5b_order(results, reading) -> dict:
     rigid = _curve(results, "fig5b", "rigid", reading)
     flexible = _curve(results, "fig5b", "flexible", reading)
@@ -780,12 +780,12 @@ def _fig5b_order(results, reading) -> dict:
     return {"lhs": flexible["y"], "rhs": rigid["y"]}
 
 
-@register_extractor("fig6a-rigid-ac-matches-eq11", depends_on=_RIGID_AXES)
+@extractor("fig6a-rigid-ac-matches-eq11", depends_on=_RIGID_AXES)
 def _fig6a_eq11(results, reading) -> dict:
     return _curve(results, "fig6a", "rigid", reading)
 
 
-@register_extractor("fig6a-rigid-ac-not-eq10", depends_on=_RIGID_AXES)
+@extractor("fig6a-rigid-ac-not-eq10", depends_on=_RIGID_AXES)
 def _fig6a_not_eq10(results, reading) -> dict:
     c = _curve(results, "fig6a", "rigid", reading)
     own = curve_deviation(c["x"], c["y"], "fig6a_closed_form", "u_x_max_e_nm")
@@ -796,11 +796,11 @@ def _fig6a_not_eq10(results, reading) -> dict:
     return {"lhs": own, "rhs": sides}
 
 
-@register_extractor("fig6b-flexible-r1-ac-matches-eq12", depends_on=_FLEXIBLE_AXES)
+@extractor("fig6b-flexible-r1-ac-matches-eq12", depends_on=_FLEXIBLE_AXES)
 def _fig6b_eq12(results, reading) -> dict:
     return _curve(results, "fig6b", "flexible", reading)
 
 
-@register_extractor("fig6c-flexible-r025-ac-matches-eq12", depends_on=_FLEXIBLE_AXES)
+@extractor("fig6c-flexible-r025-ac-matches-eq12", depends_on=_FLEXIBLE_AXES)
 def _fig6c_eq12(results, reading) -> dict:
     return _curve(results, "fig6c", "flexible", reading)

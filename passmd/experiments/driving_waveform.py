@@ -37,8 +37,8 @@ import pandas as pd
 
 from passmd import dynamics, optimized_waveform, readings, sweep, theory, waveforms
 from passmd._validation import check_choice
+from passmd.checks import ClaimFails, NotEvaluable, evidence, extractor
 from passmd.experiments import PROFILES, register_figure
-from passmd.ledger import ClaimFails, NotEvaluable, register_evidence, register_extractor
 from passmd.parameters import MOLYBDENUM, STEEL, Assumption, Drive, paper_drive, register_assumption
 from passmd.plots import driving_waveform as plots
 from passmd.protocols import eq15
@@ -730,7 +730,7 @@ def at_frequency(part: pd.DataFrame, frequency_kHz: float) -> pd.Series:
 PAPER_MAXIMUM_KHZ = 110.0
 
 
-@register_extractor("fig8a-back-step")
+@extractor("fig8a-back-step")
 def _fig8a_back_step(results):
     return {"lhs": float(results["fig8a"]["first_back_step_m"].iloc[0]) * 1e9, "rhs": 0.0}
 
@@ -758,7 +758,7 @@ def optimized_period_timing(results) -> dict:
             "f_s": float(points.at["4", "micro_vibration_frequency_Hz"])}
 
 
-@register_extractor("sec5-response-to-optimized-similar")
+@extractor("sec5-response-to-optimized-similar")
 def _response_similar(results):
     # The design premise: under the optimized waveform the runner reverses (point 3) after the
     # half vibration period t_s = 1/(2 f_s) that the saw-tooth response predicts.
@@ -766,7 +766,7 @@ def _response_similar(results):
     return {"lhs": timing["reversal"] - timing["flyback_end"], "rhs": timing["t_s"]}
 
 
-@register_evidence("sec5-response-to-optimized-similar")
+@evidence("sec5-response-to-optimized-similar")
 def _response_similar_evidence(results):
     f_s = {w: float(_fig9a_run(results, w)["micro_vibration_frequency_Hz"].iloc[0]) / 1e3
            for w in ("optimized", "sawtooth")}
@@ -774,13 +774,13 @@ def _response_similar_evidence(results):
             "(saw-tooth run)"]
 
 
-@register_extractor("sec5-1-acceleration-starts-at-velocity-maximum")
+@extractor("sec5-1-acceleration-starts-at-velocity-maximum")
 def _acceleration_phase(results):
     timing = optimized_period_timing(results)
     return (timing["point4"] - timing["reversal"]) * 1e-6 * timing["f_s"]
 
 
-@register_evidence("sec5-1-acceleration-starts-at-velocity-maximum")
+@evidence("sec5-1-acceleration-starts-at-velocity-maximum")
 def _acceleration_phase_evidence(results):
     t = optimized_period_timing(results)
     return [f"fly-back ends at {t['flyback_end']:.2f} µs, the runner reverses at {t['reversal']:.2f} µs, "
@@ -802,7 +802,7 @@ def _window_phase(results, phases: tuple[str, ...]) -> pd.DataFrame:
     return rows
 
 
-@register_extractor("sec5-1-stick-during-acceleration")
+@extractor("sec5-1-stick-during-acceleration")
 def _stick_during_acceleration(results):
     # Section 5.1 chooses V_a so that the runner still sticks during t_a: no contact group may
     # reach full sliding (slip share 1) between points 4 and 5.
@@ -811,7 +811,7 @@ def _stick_during_acceleration(results):
     return {"lhs": share, "rhs": FULL_SLIDING_SHARE}
 
 
-@register_evidence("sec5-1-stick-during-acceleration")
+@evidence("sec5-1-stick-during-acceleration")
 def _stick_during_acceleration_evidence(results):
     rows = _window_phase(results, ("settling", "acceleration"))
     end_settling = rows[rows["phase"] == "settling"].iloc[-1]
@@ -826,7 +826,7 @@ def _stick_during_acceleration_evidence(results):
     return lines
 
 
-@register_extractor("sec5-1-spring-deformed-to-ux-max-after-flyback")
+@extractor("sec5-1-spring-deformed-to-ux-max-after-flyback")
 def _deformed_to_ux_max(results):
     # The contact's tangential displacement reaches u_x,max exactly when the whole contact slides
     # (slip share 1); every contact group must get there between the fly-back and the end of t_s.
@@ -834,7 +834,7 @@ def _deformed_to_ux_max(results):
     return float(rows[["slip_share_1", "slip_share_2"]].max(axis=0).min())
 
 
-@register_extractor("sec5-1-fastest-at-end-of-acceleration")
+@extractor("sec5-1-fastest-at-end-of-acceleration")
 def _fastest_at_point5(results):
     # Section 5.1: at point 5 (end of t_a) the runner has its highest velocity. The time of the
     # runner's largest forward velocity from point 4 to the end of the window, after point 5, in
@@ -849,7 +849,7 @@ def _fastest_at_point5(results):
     return (float(rows["time_s"].iloc[k]) - float(row["acceleration_end_s"])) / t_a
 
 
-@register_evidence("sec5-1-fastest-at-end-of-acceleration")
+@evidence("sec5-1-fastest-at-end-of-acceleration")
 def _fastest_at_point5_evidence(results):
     rows = _window_phase(results, ("acceleration", "after"))
     acc = rows[rows["phase"] == "acceleration"]
@@ -863,24 +863,24 @@ def _fastest_at_point5_evidence(results):
 _FIG9A_AXES = ("friction_coefficient",)
 
 
-@register_extractor("fig9a-standard-position-552nm", depends_on=_FIG9A_AXES)
+@extractor("fig9a-standard-position-552nm", depends_on=_FIG9A_AXES)
 def _fig9a_standard(results, reading):
     return float(_fig9a_run(results, "sawtooth", reading)["settled_position_m"].iloc[-1]) * 1e9
 
 
-@register_extractor("fig9a-optimized-position-716nm", depends_on=_FIG9A_AXES)
+@extractor("fig9a-optimized-position-716nm", depends_on=_FIG9A_AXES)
 def _fig9a_optimized(results, reading):
     return float(_fig9a_run(results, "optimized", reading)["settled_position_m"].iloc[-1]) * 1e9
 
 
-@register_extractor("fig9a-step-increase-46.8pct", depends_on=_FIG9A_AXES)
+@extractor("fig9a-step-increase-46.8pct", depends_on=_FIG9A_AXES)
 def _fig9a_increase(results, reading):
     std = _fig9a_run(results, "sawtooth", reading)["settled_position_m"].to_numpy()
     opt = _fig9a_run(results, "optimized", reading)["settled_position_m"].to_numpy()
     return 100.0 * (opt[-1] - std[-1]) / (std[-1] - std[0])
 
 
-@register_extractor("fig9a-optimized-step-larger", depends_on=_FIG9A_AXES)
+@extractor("fig9a-optimized-step-larger", depends_on=_FIG9A_AXES)
 def _fig9a_step_larger(results, reading):
     steps = {w: float(np.mean(np.diff(_fig9a_run(results, w, reading)["settled_position_m"].to_numpy())))
              * 1e9 for w in ("optimized", "sawtooth")}
@@ -893,7 +893,7 @@ def _fig9b_pair(results, reading):
     return saw["frequency_kHz"].to_numpy(), saw["velocity_mm_per_s"].to_numpy(), opt
 
 
-@register_extractor("fig9b-optimized-faster-below-110khz", depends_on=("short_period",))
+@extractor("fig9b-optimized-faster-below-110khz", depends_on=("short_period",))
 def _fig9b_faster(results, reading):
     f, v_saw, opt = _fig9b_pair(results, reading)
     return {"x": f, "holds": opt["velocity_mm_per_s"].to_numpy() > v_saw}
@@ -907,12 +907,12 @@ def _largest_gain(results, reading):
     return gain[i], v_saw[below][i]
 
 
-@register_extractor("fig9b-max-gain-2.5mm_s", depends_on=("short_period",))
+@extractor("fig9b-max-gain-2.5mm_s", depends_on=("short_period",))
 def _fig9b_max_gain(results, reading):
     return float(_largest_gain(results, reading)[0])
 
 
-@register_extractor("abstract-velocity-gain-15pct", depends_on=("short_period",))
+@extractor("abstract-velocity-gain-15pct", depends_on=("short_period",))
 def _velocity_gain_pct(results, reading):
     gain, v_saw = _largest_gain(results, reading)
     return float(100.0 * gain / v_saw)
@@ -952,7 +952,7 @@ def turning_point(part: pd.DataFrame, where_kHz: float) -> pd.DataFrame:
     return part.iloc[i:]
 
 
-@register_extractor("fig9b-optimized-decreases-above-110khz", depends_on=("short_period",))
+@extractor("fig9b-optimized-decreases-above-110khz", depends_on=("short_period",))
 def _fig9b_opt_decreases(results, reading):
     after = turning_point(_series(results["fig9b"], _optimized(reading)), PAPER_MAXIMUM_KHZ)
     if len(after) < 2:
@@ -960,23 +960,23 @@ def _fig9b_opt_decreases(results, reading):
     return {"x": after["frequency_kHz"].to_numpy(), "y": after["velocity_mm_per_s"].to_numpy()}
 
 
-@register_extractor("fig9b-standard-increases-above-110khz")
+@extractor("fig9b-standard-increases-above-110khz")
 def _fig9b_std_increases(results):
     return _above(results, "sawtooth")
 
 
-@register_extractor("fig9b-step-decreases-with-frequency")
+@extractor("fig9b-step-decreases-with-frequency")
 def _fig9b_step_decreases(results):
     saw = _series(results["fig9b"], "sawtooth")
     return {"x": saw["frequency_kHz"].to_numpy(), "y": saw["step_nm"].to_numpy()}
 
 
-@register_extractor("fig9b-sawtooth-velocity-16.5mm_s-at-110khz")
+@extractor("fig9b-sawtooth-velocity-16.5mm_s-at-110khz")
 def _fig9b_sawtooth_110(results):
     return float(at_frequency(_series(results["fig9b"], "sawtooth"), PAPER_MAXIMUM_KHZ)["velocity_mm_per_s"])
 
 
-@register_extractor("fig9b-no-time-to-settle-above-110khz")
+@extractor("fig9b-no-time-to-settle-above-110khz")
 def _fig9b_settling(results):
     opt = _series(results["fig9b"], "optimized")
     return {"x": opt["frequency_kHz"].to_numpy(), "holds": opt["settling_fits"].to_numpy(dtype=float)}
@@ -990,44 +990,44 @@ def _fig10a_max(results, preload, reading):
     return reachable_maximum(_fig10a_part(results, preload, reading))
 
 
-@register_extractor("fig10a-max-velocity-19mm_s", depends_on=("short_period",))
+@extractor("fig10a-max-velocity-19mm_s", depends_on=("short_period",))
 def _fig10a_vmax(results, reading):
     # the largest velocity over the paper's whole frequency range: below 19 mm/s everywhere is a failure
     return float(range_maximum(_fig10a_part(results, 0.4, reading))["velocity_mm_per_s"])
 
 
-@register_extractor("fig10a-max-velocity-at-110khz", depends_on=("short_period",))
+@extractor("fig10a-max-velocity-at-110khz", depends_on=("short_period",))
 def _fig10a_fmax(results, reading):
     # where over the paper's range the velocity is largest; at a grid edge that is not 110 kHz either
     return float(range_maximum(_fig10a_part(results, 0.4, reading))["frequency_kHz"])
 
 
-@register_extractor("fig10a-1n-slower", depends_on=("short_period",))
+@extractor("fig10a-1n-slower", depends_on=("short_period",))
 def _fig10a_1n_slower(results, reading):
     return {"lhs": float(_fig10a_max(results, 1.0, reading)["velocity_mm_per_s"]),
             "rhs": float(_fig10a_max(results, 0.4, reading)["velocity_mm_per_s"])}
 
 
-@register_extractor("fig10a-1n-larger-back-step", depends_on=("short_period",))
+@extractor("fig10a-1n-larger-back-step", depends_on=("short_period",))
 def _fig10a_1n_back(results, reading):
     return {"lhs": float(_fig10a_max(results, 1.0, reading)["back_step_nm"]),
             "rhs": float(_fig10a_max(results, 0.4, reading)["back_step_nm"])}
 
 
-@register_extractor("fig10a-0.1n-smaller-back-step", depends_on=("short_period",))
+@extractor("fig10a-0.1n-smaller-back-step", depends_on=("short_period",))
 def _fig10a_01n_back(results, reading):
     return {"lhs": float(_fig10a_max(results, 0.1, reading)["back_step_nm"]),
             "rhs": float(_fig10a_max(results, 0.4, reading)["back_step_nm"])}
 
 
-@register_extractor("fig10a-0.1n-stick-lost-above-80khz")
+@extractor("fig10a-0.1n-stick-lost-above-80khz")
 def _fig10a_stick(results):
     part = _series(results["fig10a"], "optimized", preload=0.1)
     return {"x": part["frequency_kHz"].to_numpy(),
             "holds": part["stick_during_acceleration"].to_numpy(dtype=float)}
 
 
-@register_extractor("fig10a-0.1n-maximum-at-or-below-80khz", depends_on=("short_period",))
+@extractor("fig10a-0.1n-maximum-at-or-below-80khz", depends_on=("short_period",))
 def _fig10a_01n_at_80(results, reading):
     part = _fig10a_part(results, 0.1, reading)
     above = part["frequency_kHz"][part["frequency_kHz"] > 80.0 + 1e-9]
@@ -1036,7 +1036,7 @@ def _fig10a_01n_at_80(results, reading):
     return {"lhs": float(reachable_maximum(part)["frequency_kHz"]), "rhs": float(above.min())}
 
 
-@register_extractor("fig10a-0.1n-slightly-slower", depends_on=("short_period",))
+@extractor("fig10a-0.1n-slightly-slower", depends_on=("short_period",))
 def _fig10a_01n_slower(results, reading):
     return {"lhs": float(_fig10a_max(results, 0.1, reading)["velocity_mm_per_s"]),
             "rhs": float(_fig10a_max(results, 0.4, reading)["velocity_mm_per_s"])}
@@ -1046,19 +1046,19 @@ def _fig10b_max(results, radius_mm, reading):
     return reachable_maximum(_series(results["fig10b"], _optimized(reading), radius_mm=radius_mm))
 
 
-@register_extractor("fig10b-r1-faster", depends_on=("short_period",))
+@extractor("fig10b-r1-faster", depends_on=("short_period",))
 def _fig10b_faster(results, reading):
     return {"lhs": float(_fig10b_max(results, 1.0, reading)["velocity_mm_per_s"]),
             "rhs": float(_fig10b_max(results, 0.25, reading)["velocity_mm_per_s"])}
 
 
-@register_extractor("fig10b-r1-higher-max-frequency", depends_on=("short_period",))
+@extractor("fig10b-r1-higher-max-frequency", depends_on=("short_period",))
 def _fig10b_frequency(results, reading):
     return {"lhs": float(_fig10b_max(results, 1.0, reading)["frequency_kHz"]),
             "rhs": float(_fig10b_max(results, 0.25, reading)["frequency_kHz"])}
 
 
-@register_extractor("fig10b-r1-smaller-back-step", depends_on=("short_period",))
+@extractor("fig10b-r1-smaller-back-step", depends_on=("short_period",))
 def _fig10b_back(results, reading):
     return {"lhs": float(_fig10b_max(results, 1.0, reading)["back_step_nm"]),
             "rhs": float(_fig10b_max(results, 0.25, reading)["back_step_nm"])}
@@ -1069,12 +1069,12 @@ def _fig10c_max(results, runner, reading):
     return float(best["velocity_mm_per_s"])
 
 
-@register_extractor("fig10c-youngs-modulus-negligible", depends_on=("short_period",))
+@extractor("fig10c-youngs-modulus-negligible", depends_on=("short_period",))
 def _fig10c_negligible(results, reading):
     return {"lhs": _fig10c_max(results, "molybdenum", reading), "rhs": _fig10c_max(results, "steel", reading)}
 
 
-@register_extractor("conclusion-youngs-modulus-weaker-than-preload-and-radius", depends_on=("short_period",))
+@extractor("conclusion-youngs-modulus-weaker-than-preload-and-radius", depends_on=("short_period",))
 def _conclusion_youngs(results, reading):
     material = abs(_fig10c_max(results, "molybdenum", reading) - _fig10c_max(results, "steel", reading))
     preload = abs(float(_fig10a_max(results, 1.0, reading)["velocity_mm_per_s"])
@@ -1102,11 +1102,12 @@ def _evidence_110(results, key, column, unit, pairs):
     return out
 
 
-def _register_fig10_evidence(claim_id, key, column, unit, pairs):
-    register_evidence(claim_id)(lambda results: _evidence_110(results, key, column, unit, pairs))
+def _fig10_evidence(claim_id, key, column, unit, pairs):
+    return evidence(claim_id)(lambda results: _evidence_110(results, key, column, unit, pairs))
 
 
-for _claim, _key, _column, _unit, _pairs in (
+#: The evidence functions of the Fig. 10 claims, one per claim (found by passmd.checks).
+_FIG10_EVIDENCE = tuple(_fig10_evidence(*spec) for spec in (
     ("fig10a-1n-slower", "fig10a", "velocity_mm_per_s", "mm/s", ({"preload": 1.0}, {"preload": 0.4})),
     ("fig10a-1n-larger-back-step", "fig10a", "back_step_nm", "nm", ({"preload": 1.0}, {"preload": 0.4})),
     ("fig10a-0.1n-smaller-back-step", "fig10a", "back_step_nm", "nm", ({"preload": 0.1}, {"preload": 0.4})),
@@ -1117,5 +1118,4 @@ for _claim, _key, _column, _unit, _pairs in (
      ({"radius_mm": 1.0}, {"radius_mm": 0.25})),
     ("fig10c-youngs-modulus-negligible", "fig10c", "velocity_mm_per_s", "mm/s",
      ({"runner": "molybdenum"}, {"runner": "steel"})),
-):
-    _register_fig10_evidence(_claim, _key, _column, _unit, _pairs)
+))

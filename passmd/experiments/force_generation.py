@@ -44,9 +44,9 @@ import pandas as pd
 
 from passmd import dynamics, sweep, waveforms
 from passmd._validation import check_choice, check_positive, check_range
+from passmd.checks import ClaimFails, NotEvaluable, evidence, extractor
 from passmd.experiments import PROFILES, register_figure
 from passmd.experiments.critical_amplitude import critical_amplitude
-from passmd.ledger import ClaimFails, NotEvaluable, register_evidence, register_extractor
 from passmd.parameters import PRELOAD_GRIDS, Assumption, Drive, paper_drive, register_assumption
 from passmd.plots import force_generation as plots
 from passmd.theory import drive_theory, normal_forces
@@ -720,7 +720,7 @@ def force_difference(table: pd.DataFrame, preload: float) -> pd.DataFrame:
     })
 
 
-@register_extractor("fig7a-force-difference-115mn", depends_on=("force_frequency",))
+@extractor("fig7a-force-difference-115mn", depends_on=("force_frequency",))
 def _fig7a_difference(results, reading) -> float:
     frequency = float(reading["force_frequency"])
     if np.isclose(frequency, FORCE_FREQUENCY):
@@ -737,7 +737,7 @@ def _fig7a_difference(results, reading) -> float:
     return float(full["difference_mN"].iloc[0])
 
 
-@register_extractor("sec4-2-friction-and-actuator-dynamics-cause-discrepancy")
+@extractor("sec4-2-friction-and-actuator-dynamics-cause-discrepancy")
 def _causes(results) -> dict:
     cycle = results["fig7cycle"]
     force = {}
@@ -751,14 +751,14 @@ def _causes(results) -> dict:
     return {"lhs": np.array([friction, actuators]), "rhs": np.zeros(2)}
 
 
-@register_evidence("sec4-2-friction-and-actuator-dynamics-cause-discrepancy")
+@evidence("sec4-2-friction-and-actuator-dynamics-cause-discrepancy")
 def _causes_evidence(results) -> list:
     lhs = _causes(results)["lhs"]
     return [f"μ 0.3 → 0.2 with rigid actuators lowers F_gen by {lhs[0]:.4g} mN; rigid → flexible actuators "
             f"at μ = 0.2 lowers it by {lhs[1]:.4g} mN (together {lhs.sum():.4g} mN; 202 nm, 0.8 N, R = 1 mm)"]
 
 
-@register_extractor("sec4-2-other-preloads-same-trend")
+@extractor("sec4-2-other-preloads-same-trend")
 def _other_preloads(results) -> dict:
     grid = results["fig7grid"]
     full = grid[np.isclose(grid["amplitude_fraction"], 1.0)]
@@ -795,17 +795,17 @@ def _trend(results, name: str) -> dict:
     return out
 
 
-@register_extractor("fig7a-discrepancy-grows-with-amplitude")
+@extractor("fig7a-discrepancy-grows-with-amplitude")
 def _fig7a_trend(results) -> dict:
     return _trend(results, "fig7a")
 
 
-@register_extractor("fig7b-discrepancy-grows-with-amplitude")
+@extractor("fig7b-discrepancy-grows-with-amplitude")
 def _fig7b_trend(results) -> dict:
     return _trend(results, "fig7b")
 
 
-@register_extractor("fig7-critical-amplitude-both-models")
+@extractor("fig7-critical-amplitude-both-models")
 def _fig7_onsets(results) -> dict:
     lhs, rhs = [], []
     for name in ("fig7a", "fig7b"):
