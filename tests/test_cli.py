@@ -447,6 +447,19 @@ def test_figure_writes_csv_and_png_through_the_registry(fake_figure, tmp_path):
     assert status == 0 and "fig99z  a stand-in panel" in text
 
 
+def test_figure_reads_the_environment_once_and_its_options_win(fake_figure, tmp_path, monkeypatch):
+    """PASSMD_EXECUTOR / PASSMD_CACHE_DIR reach the figure through the RunConfig; options replace them."""
+    monkeypatch.setenv("PASSMD_EXECUTOR", "serial")
+    monkeypatch.setenv("PASSMD_CACHE_DIR", str(tmp_path / "env-cache"))
+    data = run_json("figure", "fig99z", "--profile", "quick", "--out", str(tmp_path / "a"))
+    assert Path(data["csv"]).read_text().splitlines()[4].endswith(",quick,serial")
+    assert len(Cache(tmp_path / "env-cache").entries()) == 2
+    data = run_json("figure", "fig99z", "--profile", "quick", "--out", str(tmp_path / "b"),
+                    "--executor", "process", "--workers", "2", "--cache-dir", str(tmp_path / "option-cache"))
+    assert Path(data["csv"]).read_text().splitlines()[4].endswith(",quick,process")
+    assert len(Cache(tmp_path / "option-cache").entries()) == 2
+
+
 @pytest.mark.parametrize("how", ["a file", "read-only"])
 def test_figure_with_an_unwritable_cache_keeps_its_result(fake_figure, tmp_path, monkeypatch, capsys, how):
     """The cache cannot be written: one warning line, the figure is still computed and written."""

@@ -32,8 +32,8 @@ the cache.
 Modules: :mod:`~passmd.cli.parser` (the parser), :mod:`~passmd.cli.app` (dispatch and exit
 status), :mod:`~passmd.cli.options` and :mod:`~passmd.cli.drive` (quantity options, the
 drive they describe), :mod:`~passmd.cli.output` (human and JSON output),
-:mod:`~passmd.cli.streams` (standard streams), :mod:`passmd.cli.commands` (one module per
-command).
+:mod:`~passmd.cli.streams` (standard streams), :mod:`~passmd.cli.configuration` (the
+RunConfig of ``figure`` and ``ledger``), :mod:`passmd.cli.commands` (one module per command).
 """
 
 from __future__ import annotations

@@ -8,7 +8,7 @@ import textwrap
 from pathlib import Path
 
 from passmd.cache import DEFAULT_CACHE_DIR
-from passmd.cli.commands.sweeps import call_with_config, run_config
+from passmd.cli.configuration import call_with_config, run_config
 from passmd.cli.errors import NotAvailableError, OutputError, UsageError
 from passmd.cli.options import add_sweep_options
 from passmd.cli.output import JSON_HELP, emit_json

@@ -5,7 +5,7 @@ from __future__ import annotations
 import textwrap
 
 from passmd.cache import DEFAULT_CACHE_DIR
-from passmd.cli.commands.sweeps import call_with_config, run_config
+from passmd.cli.configuration import call_with_config, run_config
 from passmd.cli.errors import OutputError
 from passmd.cli.options import add_sweep_options
 from passmd.cli.output import JSON_HELP, emit_json
