@@ -451,9 +451,13 @@ def test_figure_reads_the_environment_once_and_its_options_win(fake_figure, tmp_
     """PASSMD_EXECUTOR / PASSMD_CACHE_DIR reach the figure through the RunConfig; options replace them."""
     monkeypatch.setenv("PASSMD_EXECUTOR", "serial")
     monkeypatch.setenv("PASSMD_CACHE_DIR", str(tmp_path / "env-cache"))
-    data = run_json("figure", "fig99z", "--profile", "quick", "--out", str(tmp_path / "a"))
+    monkeypatch.setenv("PASSMD_SWEEP_LOG", str(tmp_path / "sweeps.jsonl"))
+    monkeypatch.setenv("PASSMD_PROFILE", "slow")  # not read: --profile gives the profile
+    monkeypatch.setenv("PASSMD_WORKERS", "two")  # not read: --workers gives the workers
+    data = run_json("figure", "fig99z", "--profile", "quick", "--workers", "1", "--out", str(tmp_path / "a"))
     assert Path(data["csv"]).read_text().splitlines()[4].endswith(",quick,serial")
     assert len(Cache(tmp_path / "env-cache").entries()) == 2
+    assert json.loads((tmp_path / "sweeps.jsonl").read_text())["computed"] == 2
     data = run_json("figure", "fig99z", "--profile", "quick", "--out", str(tmp_path / "b"),
                     "--executor", "process", "--workers", "2", "--cache-dir", str(tmp_path / "option-cache"))
     assert Path(data["csv"]).read_text().splitlines()[4].endswith(",quick,process")
