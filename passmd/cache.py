@@ -38,8 +38,10 @@ complete one. A cache that cannot be written (read-only, not a directory, owned 
 another user, disk full) is reported once per directory with a :class:`CacheWarning`
 and the caller goes on without caching: the computed result is never lost.
 
-The directory is ``.passmd-cache/`` in the current working directory unless the
-environment variable ``PASSMD_CACHE_DIR`` (or an explicit ``directory``) says otherwise.
+The directory is ``.passmd-cache/`` in the current working directory unless the caller
+names another (``Cache(directory)``; entry points take it from the run configuration,
+:class:`passmd.config.RunConfig`, whose ``cache_dir`` comes from ``$PASSMD_CACHE_DIR`` or
+``--cache-dir``; this module reads no environment variable).
 ``passmd cache info|clear|prune`` shows, empties or prunes it (prune: entries of other
 code fingerprints, unreadable entries and leftovers of the former pickle format).
 """
@@ -61,7 +63,6 @@ from pathlib import Path
 import numpy as np
 
 __all__ = [
-    "CACHE_DIR_ENV",
     "DEFAULT_CACHE_DIR",
     "ENTRY_SUFFIX",
     "Cache",
@@ -75,8 +76,6 @@ __all__ = [
     "function_name",
 ]
 
-#: Environment variable overriding the cache directory.
-CACHE_DIR_ENV = "PASSMD_CACHE_DIR"
 #: Cache directory (relative to the current working directory) when nothing overrides it.
 DEFAULT_CACHE_DIR = ".passmd-cache"
 #: File suffix of an entry.
@@ -101,9 +100,8 @@ class CorruptEntry(ValueError):
 
 
 def default_cache_dir() -> Path:
-    """``$PASSMD_CACHE_DIR`` if set, else ``./.passmd-cache`` (absolute)."""
-    env = os.environ.get(CACHE_DIR_ENV)
-    return Path(env if env else DEFAULT_CACHE_DIR).expanduser().resolve()
+    """``./.passmd-cache`` of the current working directory (absolute)."""
+    return Path(DEFAULT_CACHE_DIR).resolve()
 
 
 def code_fingerprint(package_dir: str | os.PathLike | None = None) -> str:

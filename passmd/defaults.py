@@ -22,6 +22,17 @@ class ProtocolDefaults(NamedTuple):
     springs: int = 200
     #: Contacts on the two sides of the runner in the six-contact drive (Section 2).
     contacts_per_side: tuple[int, int] = (2, 4)
+    #: Step threshold S of the steady-state critical-amplitude search: a step counts when the
+    #: last step of a run exceeds it (ours; Section 4.1 does not define "a step") [m].
+    step_threshold: float = 0.5e-9
+    #: Saw-tooth periods of one steady-state run of that search; its last step counts.
+    steady_periods: int = 10
+    #: The search stops when its bisection bracket is narrower than this [m].
+    search_tolerance: float = 0.1e-9
+    #: Periods of the first stall run of the force protocol (Section 4.2), doubled until stalled.
+    stall_periods: int = 64
+    #: Longest stall run before a point is reported as not stalled (periods).
+    stall_max_periods: int = 4096
 
 
 #: The defaults every protocol uses unless the caller says otherwise.

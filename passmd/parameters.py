@@ -39,6 +39,7 @@ __all__ = [
     "STEEL",
     "TABLE2_RADII",
     "actuator_for_radius",
+    "actuator_viscosity",
     "all_assumptions",
     "paper_drive",
     "parameter_table",
@@ -244,9 +245,14 @@ def actuator_for_radius(
     return Actuator(
         stiffness=k_p,
         mass=m_a,
-        viscosity=2.0 * zeta * np.sqrt(k_p * m_a),
+        viscosity=actuator_viscosity(k_p, m_a, zeta),
         full_stroke_amplitude=a_max,
     )
+
+
+def actuator_viscosity(stiffness: float, mass: float, damping_ratio: float = ACTUATOR_DAMPING_RATIO) -> float:
+    """Viscosity c_p = 2 ζ √(k_p m_a) of an actuator (Eq. 3) whose bare damping ratio is ζ."""
+    return 2.0 * damping_ratio * np.sqrt(stiffness * mass)
 
 
 @dataclass(frozen=True)

@@ -15,11 +15,14 @@ Every finished point is written to the on-disk cache (:mod:`passmd.cache`) as so
 it completes, so an interrupted sweep (Ctrl-C, a failing point, a killed job) keeps
 every finished point and a rerun recomputes only the rest. A progress bar (points
 done, rate, ETA) is shown on a terminal and kept quiet when stderr is not a TTY or the
-``CI`` environment variable is set.
+run configuration says so (``RunConfig.progress``, off on CI).
 
-When ``$PASSMD_SWEEP_LOG`` names a file, every sweep appends one JSON line to it (the
-function, and how many points were taken from the cache and how many computed): the book's
-execution-statistics page sums them per chapter.
+How a sweep runs comes from its arguments or the :class:`~passmd.config.RunConfig` an entry
+point passes down; this module reads no environment variable. Without either: a process pool
+over all cores and the cache in ``./.passmd-cache``. When the configuration names a
+``sweep_log`` file, every sweep appends one JSON line to it (the function, and how many
+points were taken from the cache and how many computed): the book's execution-statistics
+page sums them per chapter.
 """
 
 from __future__ import annotations
@@ -34,25 +37,17 @@ import signal
 import sys
 from collections.abc import Callable, Mapping, Sequence
 
-import numpy as np
 import pandas as pd
 from tqdm.std import tqdm  # text bar on a terminal; tqdm.auto warns in notebook kernels without ipywidgets
 
 from passmd._validation import check_choice
 from passmd.cache import Cache, function_name
 from passmd.config import RunConfig
-from passmd.parameters import Drive
-from passmd.theory import drive_theory
 
-__all__ = ["EXECUTORS", "drive_theory_point", "grid", "progress_enabled", "run", "sawtooth_point"]
+__all__ = ["EXECUTORS", "grid", "progress_enabled", "run"]
 
 #: Names accepted by ``run(executor=...)``.
 EXECUTORS = ("process", "serial", "dask")
-#: Environment variables giving defaults to arguments a caller leaves at ``None``
-#: (so the book build and ``passmd figure`` can send every sweep to a Dask cluster).
-EXECUTOR_ENV, SCHEDULER_ENV, WORKERS_ENV = "PASSMD_EXECUTOR", "PASSMD_SCHEDULER", "PASSMD_WORKERS"
-#: File each sweep appends its record (``df.attrs["sweep"]``) to as one JSON line; unset: none.
-SWEEP_LOG_ENV = "PASSMD_SWEEP_LOG"
 
 
 def grid(**axes) -> list[dict]:
@@ -72,44 +67,11 @@ def grid(**axes) -> list[dict]:
     return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*values)]
 
 
-def drive_theory_point(**drive_fields) -> dict:
-    """Closed forms (:func:`passmd.theory.drive_theory`) of ``Drive(**drive_fields)``.
-
-    A cheap, deterministic point function for sweeps over drive parameters, e.g. the
-    analytic critical amplitude (Eqs. 7–8, 11–12) over a preload grid.
-    """
-    return drive_theory(Drive(**drive_fields))
-
-
-def sawtooth_point(drive: Drive, amplitude: float, frequency: float, periods: int = 3,
-                   flyback: str = "slew", springs: int | None = None) -> dict:
-    """Measures of one saw-tooth run from rest (:func:`passmd.dynamics.simulate`).
-
-    Returns the run's :meth:`~passmd.dynamics.SimulationResult.summary` (SI, keys
-    carrying the unit; without ``periods``, which is a parameter) plus ``mean_step_m``,
-    the mean of the per-period step sizes (needs ``periods >= 2``). ``springs`` None:
-    exact MDR contacts, else N discrete springs.
-    """
-    from passmd import dynamics, waveforms  # the simulator is only needed by this point function
-
-    wave = waveforms.sawtooth(amplitude, frequency, drive, periods=periods, flyback=flyback)
-    result = dynamics.simulate(drive, wave, contact_model="exact" if springs is None else "discrete",
-                               springs=200 if springs is None else springs, max_points=2)
-    summary = result.summary()
-    del summary["periods"]  # an input of the point, already a column
-    if result.step_sizes.size == 0:
-        raise ValueError(f"periods = {periods!r} is out of range: a step size needs periods >= 2")
-    summary["mean_step_m"] = float(np.mean(result.step_sizes))
-    return summary
-
-
 def progress_enabled(progress: bool | None = None, stream=None) -> bool:
-    """Whether to show a progress bar: ``progress`` if given, else TTY and not ``$CI``."""
+    """Whether to show a progress bar: ``progress`` if given, else whether ``stream`` is a TTY."""
     if progress is not None:
         return bool(progress)
     stream = sys.stderr if stream is None else stream
-    if os.environ.get("CI"):
-        return False
     isatty = getattr(stream, "isatty", None)
     return bool(isatty and isatty())
 
@@ -295,20 +257,6 @@ def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> No
             cluster.close()
 
 
-def _resolve(executor, scheduler, workers):
-    """Fill arguments left at None from the environment (explicit arguments win)."""
-    if scheduler is None and executor in (None, "dask"):
-        scheduler = os.environ.get(SCHEDULER_ENV) or None
-    if executor is None:
-        executor = os.environ.get(EXECUTOR_ENV) or ("dask" if scheduler else "process")
-    if workers is None and os.environ.get(WORKERS_ENV):
-        text = os.environ[WORKERS_ENV]
-        if not text.strip().isdigit():
-            raise ValueError(f"{WORKERS_ENV} = {text!r} is not allowed: must be an integer >= 1")
-        workers = int(text)
-    return executor, scheduler, workers
-
-
 def run(
     func: Callable[..., Mapping],
     points: Sequence[Mapping],
@@ -333,26 +281,29 @@ def run(
         The grid (see :func:`grid`); each dict is one evaluation's keyword arguments.
     executor : {"process", "serial", "dask"} or concurrent.futures.Executor, optional
         Where to run. ``"dask"`` connects to ``scheduler`` or starts a local cluster.
-        Default: ``$PASSMD_EXECUTOR``, else ``"dask"`` if a scheduler is known, else
-        ``"process"``. A process pool with a single point left to compute evaluates it
+        Default: the configuration's executor, else ``"dask"`` if a scheduler is known,
+        else ``"process"``. A process pool with a single point left to compute evaluates it
         in this process (no pool start-up for one point).
     scheduler : str, optional
         Dask scheduler address, e.g. ``"tcp://10.0.0.5:8786"`` (implies ``"dask"``).
-        Default: ``$PASSMD_SCHEDULER`` unless another executor was asked for.
+        Default: the configuration's scheduler unless another executor was asked for.
     workers : int, optional
-        Worker processes for ``"process"`` and a local Dask cluster; default
-        ``$PASSMD_WORKERS``, else all cores.
+        Worker processes for ``"process"`` and a local Dask cluster; default the
+        configuration's workers, else all cores.
     cache : bool, Cache or path
-        ``True`` (default): the default :class:`~passmd.cache.Cache`; ``False``: no
-        caching; a :class:`~passmd.cache.Cache` or a directory to use that one.
+        ``True`` (default): the cache in the configuration's ``cache_dir``, else in
+        ``./.passmd-cache``; ``False``: no caching; a :class:`~passmd.cache.Cache` or a
+        directory to use that one.
     progress : bool, optional
-        Force the progress bar on or off; default: on a TTY unless ``$CI`` is set.
+        Force the progress bar on or off; default: the configuration's ``progress``, else
+        on a TTY.
     description : str, optional
         Label of the progress bar (default the function's name).
     config : RunConfig, optional
         The run configuration an entry point passed down: its executor, scheduler,
-        workers and cache directory fill the arguments above that were left at their
-        defaults (explicit arguments win).
+        workers, cache directory and progress fill the arguments above that were left at
+        their defaults (explicit arguments win); its ``sweep_log`` receives the sweep's
+        record. None: ``RunConfig()`` (process pool over all cores, no log).
 
     Returns
     -------
@@ -370,39 +321,17 @@ def run(
         The first exception a point raised (with a note naming the point), after the
         points still running finished and were cached.
     """
-    if config is not None:
-        executor = config.executor if executor is None else executor
-        scheduler = config.scheduler if scheduler is None else scheduler
-        workers = config.workers if workers is None else workers
-        if cache is True and config.cache_dir is not None:
-            cache = config.cache_dir
-    executor, scheduler, workers = _resolve(executor, scheduler, workers)
-    if not isinstance(executor, cf.Executor):
-        check_choice("executor", executor, EXECUTORS)
-    if not callable(func):
-        raise ValueError(f"func = {func!r} is not callable")
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
-        raise ValueError(f"workers = {workers!r} is out of range: must be an integer >= 1")
-    if scheduler is not None and executor != "dask":
-        raise ValueError(f"scheduler = {scheduler!r} needs executor='dask', not {executor!r}")
+    config = RunConfig() if config is None else config
+    executor, scheduler, workers = _execution(executor, scheduler, workers, config)
+    if cache is True and config.cache_dir is not None:
+        cache = config.cache_dir
+    progress = config.progress if progress is None else progress
+    _check_arguments(func, executor, scheduler, workers)
     points = _check_points(points)
     store = _make_cache(cache)
-    if executor != "serial":
-        try:
-            pickle.dumps(func)
-        except Exception as exc:
-            raise ValueError(
-                f"func = {func!r} cannot be sent to worker processes ({exc}); use a top-level "
-                "function or executor='serial'"
-            ) from exc
-
+    _check_picklable(func, executor)
     keys = [store.key(func, p) for p in points] if store is not None else [None] * len(points)
-    cached: dict[int, dict] = {}
-    if store is not None:
-        for i, key in enumerate(keys):
-            value = store.get(key, function=function_name(func))
-            if isinstance(value, Mapping):
-                cached[i] = dict(value)
+    cached = _cached(store, func, keys)
     todo = [i for i in range(len(points)) if i not in cached]
 
     label = description or getattr(func, "__name__", "sweep")
@@ -418,14 +347,7 @@ def run(
     collect = _Collector(func, points, keys, store, bar)
     try:
         if todo:
-            if isinstance(executor, cf.Executor):
-                _run_futures(executor, func, todo, points, collect, own=False)
-            elif executor == "serial" or (len(todo) == 1 and scheduler is None and executor == "process"):
-                _run_serial(func, todo, points, collect)
-            elif executor == "process":
-                _run_process(func, todo, points, collect, workers)
-            else:
-                _run_dask(func, todo, points, collect, workers, scheduler)
+            _execute(executor, func, todo, points, collect, workers, scheduler)
     finally:
         bar.close()
 
@@ -437,16 +359,70 @@ def run(
         "computed": len(collect.results),
         "function": label,
     }
-    _log_sweep(frame.attrs["sweep"])
+    if config.sweep_log is not None:
+        _log_sweep(frame.attrs["sweep"], config.sweep_log)
     return frame
 
 
-def _log_sweep(record: dict) -> None:
-    """Append ``record`` as one JSON line to ``$PASSMD_SWEEP_LOG`` (if set).
+def _check_arguments(func, executor, scheduler, workers) -> None:
+    if not isinstance(executor, cf.Executor):
+        check_choice("executor", executor, EXECUTORS)
+    if not callable(func):
+        raise ValueError(f"func = {func!r} is not callable")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise ValueError(f"workers = {workers!r} is out of range: must be an integer >= 1")
+    if scheduler is not None and executor != "dask":
+        raise ValueError(f"scheduler = {scheduler!r} needs executor='dask', not {executor!r}")
+
+
+def _check_picklable(func, executor) -> None:
+    if executor != "serial":
+        try:
+            pickle.dumps(func)
+        except Exception as exc:
+            raise ValueError(
+                f"func = {func!r} cannot be sent to worker processes ({exc}); use a top-level "
+                "function or executor='serial'"
+            ) from exc
+
+
+def _cached(store: Cache | None, func, keys) -> dict[int, dict]:
+    """The points whose results the cache holds, by index."""
+    cached: dict[int, dict] = {}
+    if store is not None:
+        for i, key in enumerate(keys):
+            value = store.get(key, function=function_name(func))
+            if isinstance(value, Mapping):
+                cached[i] = dict(value)
+    return cached
+
+
+def _execute(executor, func, todo, points, collect: _Collector, workers, scheduler) -> None:
+    if isinstance(executor, cf.Executor):
+        _run_futures(executor, func, todo, points, collect, own=False)
+    elif executor == "serial" or (len(todo) == 1 and scheduler is None and executor == "process"):
+        _run_serial(func, todo, points, collect)
+    elif executor == "process":
+        _run_process(func, todo, points, collect, workers)
+    else:
+        _run_dask(func, todo, points, collect, workers, scheduler)
+
+
+def _execution(executor, scheduler, workers, config: RunConfig):
+    """Fill arguments left at None from the run configuration (explicit arguments win)."""
+    if scheduler is None and executor in (None, "dask"):
+        scheduler = config.scheduler
+    if executor is None:
+        executor = config.executor or ("dask" if scheduler else "process")
+    if workers is None:
+        workers = config.workers
+    return executor, scheduler, workers
+
+
+def _log_sweep(record: dict, path) -> None:
+    """Append ``record`` as one JSON line to the file ``path``.
 
     One ``write`` of a short line in append mode: lines of concurrent writers do not mix.
     """
-    path = os.environ.get(SWEEP_LOG_ENV)
-    if path:
-        with open(path, "a", encoding="utf-8") as fh:
-            fh.write(json.dumps(record) + "\n")
+    with open(path, "a", encoding="utf-8") as fh:
+        fh.write(json.dumps(record) + "\n")

@@ -13,6 +13,7 @@ parameters (never ``TypeError``/``AttributeError`` later).
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import io
 import json
 import math
@@ -30,6 +31,8 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from passmd import cli
+from passmd.cli import options
+from passmd.cli.commands import run as run_command
 from passmd.contact import MDRContact
 from passmd.parameters import Actuator, Amplifier, Drive, Material
 
@@ -176,18 +179,18 @@ def test_interrupted_run_does_not_claim_a_cache():
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    with mock.patch.object(cli, "_simulate", interrupted):
+    with mock.patch.object(run_command, "simulate", interrupted):
         status, _, err, _ = run_main(["run"])
     assert status == 130 and err == "passmd run: interrupted\n"
 
 
 def test_missing_dask_names_the_extra(tmp_path):
-    real = cli.importlib.util.find_spec
+    real = importlib.util.find_spec
 
     def find_spec(name, *args):
         return None if name == "distributed" else real(name, *args)
 
-    with mock.patch.object(cli.importlib.util, "find_spec", find_spec):
+    with mock.patch.object(importlib.util, "find_spec", find_spec):
         status, _, err, _ = run_main(["figure", "fig5a", "--executor", "dask", "--out", str(tmp_path)])
     assert status == 1
     assert_one_line(err)
@@ -293,11 +296,11 @@ values = st.one_of(
     st.sampled_from(ODD),
     st.text(max_size=8),
 )
-QUANTITY_FLAGS = [q.flag for q in cli._DRIVE_QUANTITIES]
+QUANTITY_FLAGS = [q.flag for q in options.DRIVE_QUANTITIES]
 COMMANDS = {
     "theory": (QUANTITY_FLAGS, ["--json", "--allow-extrapolation"],
                {"--contacts": ["1", "6", "3", "x"], "--actuator": ["rigid", "flexible", "x"]}),
-    "contact": (["--radius", "--mu", "--normal-force", *cli._MATERIAL_FLAGS, "--springs"],
+    "contact": (["--radius", "--mu", "--normal-force", *options.MATERIAL_FLAGS, "--springs"],
                 ["--json", "--allow-extrapolation"],
                 {"--path": ["0,30nm,-10nm", "0", "1e30", "nan", "", "0,,1", "0,1e-300,3N"]}),
     "critical-amplitude": (QUANTITY_FLAGS + ["--frequency", "--threshold", "--tolerance", "--periods"],
@@ -370,14 +373,14 @@ def scratch(tmp_path_factory):
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(argv=command_lines())
 def test_generated_command_lines_end_cleanly(scratch, argv):
-    from passmd import experiments
+    from passmd import figures
     from passmd.experiments import critical_amplitude, force_generation
 
     # the long computations are replaced by a marker: reaching them means every check passed
-    with mock.patch.object(cli, "_simulate", _reached), \
+    with mock.patch.object(run_command, "simulate", _reached), \
             mock.patch.object(critical_amplitude, "critical_amplitude", _reached), \
             mock.patch.object(force_generation, "generated_force", _reached), \
-            mock.patch.object(experiments, "figure_data", _reached):
+            mock.patch.object(figures, "figure_data", _reached):
         try:
             status, out, err, caught = run_main(argv, env={"PASSMD_CACHE_DIR": str(scratch / "cache")})
         except _Reached:
@@ -442,7 +445,7 @@ def test_readme_counts_what_this_file_tries():
 
 def test_output_files_are_complete_or_absent(tmp_path):
     """A write that fails half-way (full disk, Ctrl-C) leaves neither a partial file nor a temporary."""
-    from passmd._cli_streams import write_atomically
+    from passmd.cli.streams import write_atomically
 
     target = tmp_path / "series.csv"
 

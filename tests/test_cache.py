@@ -11,6 +11,7 @@ import pytest
 import passmd
 from passmd import cache as cache_module
 from passmd.cache import Cache, canonical, code_fingerprint, default_cache_dir
+from passmd.config import RunConfig
 from passmd.parameters import Drive
 
 
@@ -280,23 +281,26 @@ def test_source_change_changes_fingerprint(tmp_path):
 
 
 def test_default_directory(tmp_path, monkeypatch):
-    monkeypatch.delenv("PASSMD_CACHE_DIR", raising=False)
     monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("PASSMD_CACHE_DIR", os.fspath(tmp_path / "elsewhere"))  # read by entry points only
     assert default_cache_dir() == tmp_path.resolve() / ".passmd-cache"
     assert Cache().directory == tmp_path.resolve() / ".passmd-cache"
-    monkeypatch.setenv("PASSMD_CACHE_DIR", os.fspath(tmp_path / "elsewhere"))
-    assert Cache().directory == (tmp_path / "elsewhere").resolve()
+    # an entry point's run configuration names the directory; the cache takes it from there
+    config = RunConfig.from_environment()
+    assert Cache(config.cache_dir).directory == (tmp_path / "elsewhere").resolve()
     with pytest.raises(ValueError, match="is not a directory"):
         code_fingerprint(tmp_path / "missing")
 
 
 def test_cached_rerun_is_bit_identical(store):
     """A sweep served from the cache returns exactly the computed values (floats by bits)."""
+    from sweep_points import drive_theory_point
+
     from passmd import sweep
 
     points = sweep.grid(preload=[0.1, 0.37, 1.0], contacts=[1, 6])
-    cold = sweep.run(sweep.drive_theory_point, points, executor="serial", cache=store, progress=False)
-    warm = sweep.run(sweep.drive_theory_point, points, executor="serial", cache=store, progress=False)
+    cold = sweep.run(drive_theory_point, points, executor="serial", cache=store, progress=False)
+    warm = sweep.run(drive_theory_point, points, executor="serial", cache=store, progress=False)
     assert warm.attrs["sweep"]["cached"] == len(points)
     pd.testing.assert_frame_equal(cold, warm, check_exact=True)
     for column in cold.columns:

@@ -11,6 +11,7 @@ multiplication, so "0.25mm" is exactly 0.25e-3), and JSON round-trips floats exa
 """
 
 import contextlib
+import inspect
 import io
 import json
 import math
@@ -22,11 +23,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from sweep_points import drive_theory_point
 
 import passmd
 from passmd import cli, provenance, sweep
 from passmd.cache import Cache
 from passmd.contact import MDRContact
+from passmd.defaults import PROTOCOL
 from passmd.parameters import ACTUATOR_DAMPING_RATIO, Drive, Material, actuator_for_radius
 from passmd.theory import contact_moduli, drive_theory, runner_frequency
 
@@ -313,9 +316,21 @@ def test_critical_amplitude_is_the_books_search():
 def test_critical_amplitude_defaults_are_the_books():
     from passmd.experiments import critical_amplitude as ca
 
-    assert cli._DEFAULT_STEADY_PERIODS == ca.STEADY_PERIODS
+    # the CLI's defaults are the protocol record's; the book's search must use the same values
+    assert (PROTOCOL.steady_periods, PROTOCOL.step_threshold) == (ca.STEADY_PERIODS, ca.STEP_THRESHOLD)
     data = run_json("critical-amplitude", "--contacts", "1", "--actuator", "rigid", "--tolerance", "5nm")
     assert data["threshold_m"] == ca.STEP_THRESHOLD and data["frequency_Hz"] == ca.DRIVE_FREQUENCY
+    tolerance = inspect.signature(ca.critical_amplitude).parameters["tolerance"].default
+    assert tolerance == PROTOCOL.search_tolerance and ca.DRIVE_FREQUENCY == PROTOCOL.drive_frequency
+
+
+def test_force_defaults_are_the_stall_protocols():
+    from passmd.experiments import force_generation as fg
+
+    assert (PROTOCOL.stall_periods, PROTOCOL.stall_max_periods) == (fg.INITIAL_PERIODS, fg.MAX_PERIODS)
+    help_text = option_help(run_cli("force", "--help")[1])
+    assert f"(default: {fg.INITIAL_PERIODS})" in help_text["--periods"]
+    assert f"(default: {fg.MAX_PERIODS})" in help_text["--max-periods"]
 
 
 def test_critical_amplitude_first_flyback_protocol():
@@ -382,15 +397,15 @@ def test_usage_errors_exit_2_with_one_line(argv, message, capsys):
     assert "error: " in err and message in err, err
 
 
-def fake_figure_data(profile):
-    """A stand-in figure: a real sweep (through the environment the CLI sets) plus the settings seen."""
-    frame = sweep.run(sweep.drive_theory_point, sweep.grid(preload=[0.1, 0.2]), progress=False)
-    frame["profile"] = profile
-    frame["executor_seen"] = os.environ.get("PASSMD_EXECUTOR")
+def fake_figure_data(name, config):
+    """A stand-in figure: a real sweep run at the configuration the CLI passes, plus what it saw."""
+    frame = sweep.run(drive_theory_point, sweep.grid(preload=[0.1, 0.2]), progress=False, config=config)
+    frame["profile"] = config.profile
+    frame["executor_seen"] = config.executor
     return frame[["preload", "analytic_critical_amplitude_m", "profile", "executor_seen"]]
 
 
-def fake_figure_plot(data):
+def fake_figure_plot(name, data):
     from matplotlib.figure import Figure
 
     fig = Figure()
@@ -400,10 +415,16 @@ def fake_figure_plot(data):
 
 @pytest.fixture
 def fake_figure(monkeypatch):
-    from passmd import experiments
+    """The figure table holds one stand-in panel, fig99z (computed at a RunConfig)."""
+    from types import SimpleNamespace
 
-    spec = experiments.FigureSpec("fig99z", "a stand-in panel", "none", fake_figure_data, fake_figure_plot)
-    monkeypatch.setitem(experiments.FIGURES, "fig99z", spec)
+    from passmd import figures
+
+    spec = SimpleNamespace(name="fig99z", title="a stand-in panel")
+    monkeypatch.setattr(figures, "figure_names", lambda: ["fig99z"])
+    monkeypatch.setattr(figures, "figure_spec", lambda name: spec)
+    monkeypatch.setattr(figures, "figure_data", fake_figure_data)
+    monkeypatch.setattr(figures, "figure_plot", fake_figure_plot)
     monkeypatch.delenv("PASSMD_EXECUTOR", raising=False)
     return spec
 
@@ -424,9 +445,26 @@ def test_figure_writes_csv_and_png_through_the_registry(fake_figure, tmp_path):
 
     with Image.open(data["png"]) as png:  # the image names version, commit and profile too
         assert png.text["Description"] == provenance.summary("quick")
-    assert "PASSMD_EXECUTOR" not in os.environ  # restored after the command
+    assert "PASSMD_EXECUTOR" not in os.environ  # the command writes no environment variable
     status, text = run_cli("figure", "list")
     assert status == 0 and "fig99z  a stand-in panel" in text
+
+
+def test_figure_reads_the_environment_once_and_its_options_win(fake_figure, tmp_path, monkeypatch):
+    """PASSMD_EXECUTOR / PASSMD_CACHE_DIR reach the figure through the RunConfig; options replace them."""
+    monkeypatch.setenv("PASSMD_EXECUTOR", "serial")
+    monkeypatch.setenv("PASSMD_CACHE_DIR", str(tmp_path / "env-cache"))
+    monkeypatch.setenv("PASSMD_SWEEP_LOG", str(tmp_path / "sweeps.jsonl"))
+    monkeypatch.setenv("PASSMD_PROFILE", "slow")  # not read: --profile gives the profile
+    monkeypatch.setenv("PASSMD_WORKERS", "two")  # not read: --workers gives the workers
+    data = run_json("figure", "fig99z", "--profile", "quick", "--workers", "1", "--out", str(tmp_path / "a"))
+    assert Path(data["csv"]).read_text().splitlines()[4].endswith(",quick,serial")
+    assert len(Cache(tmp_path / "env-cache").entries()) == 2
+    assert json.loads((tmp_path / "sweeps.jsonl").read_text())["computed"] == 2
+    data = run_json("figure", "fig99z", "--profile", "quick", "--out", str(tmp_path / "b"),
+                    "--executor", "process", "--workers", "2", "--cache-dir", str(tmp_path / "option-cache"))
+    assert Path(data["csv"]).read_text().splitlines()[4].endswith(",quick,process")
+    assert len(Cache(tmp_path / "option-cache").entries()) == 2
 
 
 @pytest.mark.parametrize("how", ["a file", "read-only"])
@@ -457,17 +495,14 @@ def test_figure_with_an_unwritable_cache_keeps_its_result(fake_figure, tmp_path,
 
 
 def test_cache_command_info_prune_clear(tmp_path):
-    from passmd import sweep as sweep_module
-    from passmd.cache import Cache
-
     cache_dir = tmp_path / "cache"
-    sweep_module.run(sweep_module.drive_theory_point, sweep_module.grid(preload=[0.1, 0.2]),
-                     executor="serial", cache=Cache(cache_dir), progress=False)
+    sweep.run(drive_theory_point, sweep.grid(preload=[0.1, 0.2]), executor="serial", cache=Cache(cache_dir),
+              progress=False)
     old = Cache(cache_dir, fingerprint="f" * 64)
-    old.put(old.key(sweep_module.drive_theory_point, {"preload": 0.3}), {"x": 1.0})
+    old.put(old.key(drive_theory_point, {"preload": 0.3}), {"x": 1.0})
     info = run_json("cache", "info", "--cache-dir", str(cache_dir))
     assert (info["entries"], info["current_code"], info["other_code"]) == (3, 2, 1)
-    assert info["functions"] == {"passmd.sweep:drive_theory_point": 2, "?": 1}
+    assert info["functions"] == {"sweep_points:drive_theory_point": 2, "?": 1}
     assert run_json("cache", "prune", "--cache-dir", str(cache_dir))["removed"] == 1
     status, text = run_cli("cache", "info", "--cache-dir", str(cache_dir))
     assert status == 0 and "2 (2 of the current code, 0 of other code versions" in text

@@ -61,3 +61,41 @@ def test_package_data_is_declared_for_every_data_file(pyproject):
     for path in data_files:
         relative = path.relative_to(package)
         assert any(relative.match(pattern) for pattern in patterns), f"{relative} is not package data"
+
+
+def _environment_uses(path: Path) -> tuple[list[str], list[str]]:
+    """(writes, reads) of the process environment in one source file, as ``file:line``."""
+    import ast
+
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    writes, reads = [], []
+
+    def is_environ(node) -> bool:
+        return isinstance(node, ast.Attribute) and node.attr == "environ" \
+            and isinstance(node.value, ast.Name) and node.value.id == "os"
+
+    for node in ast.walk(tree):
+        where = f"{path.relative_to(ROOT)}:{getattr(node, 'lineno', '?')}"
+        if isinstance(node, (ast.Assign, ast.AugAssign, ast.Delete)):
+            targets = node.targets if isinstance(node, (ast.Assign, ast.Delete)) else [node.target]
+            if any(isinstance(t, ast.Subscript) and is_environ(t.value) for t in targets):
+                writes.append(where)
+        elif isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute):
+            if is_environ(node.func.value) and node.func.attr in ("update", "pop", "setdefault", "clear"):
+                writes.append(where)
+            elif isinstance(node.func.value, ast.Name) and node.func.value.id == "os" \
+                    and node.func.attr in ("putenv", "unsetenv"):
+                writes.append(where)
+        if is_environ(node) or (isinstance(node, ast.Attribute) and node.attr == "getenv"):
+            reads.append(where)
+    return writes, reads
+
+
+def test_the_package_never_writes_the_environment_and_the_engine_never_reads_it():
+    """Entry points read the environment once into a RunConfig and pass it down (passmd.config)."""
+    writes = []
+    for path in sorted((ROOT / "passmd").rglob("*.py")):
+        writes += _environment_uses(path)[0]
+    assert writes == []
+    for engine in ("sweep.py", "cache.py"):
+        assert _environment_uses(ROOT / "passmd" / engine)[1] == [], engine

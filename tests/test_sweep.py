@@ -14,9 +14,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from sweep_points import drive_theory_point, sawtooth_point
 
 from passmd import sweep
 from passmd.cache import Cache
+from passmd.config import RunConfig
 from passmd.parameters import Drive
 from passmd.theory import contact_moduli, drive_theory
 
@@ -72,7 +74,7 @@ THEORY_GRID = sweep.grid(
 
 @pytest.fixture(scope="module")
 def serial_theory():
-    return sweep.run(sweep.drive_theory_point, THEORY_GRID, executor="serial", cache=False)
+    return sweep.run(drive_theory_point, THEORY_GRID, executor="serial", cache=False)
 
 
 def test_grid_is_row_major():
@@ -93,31 +95,31 @@ def test_serial_matches_python_api(serial_theory):
 
 
 def test_process_pool_identical_to_serial(serial_theory, store):
-    frame = sweep.run(sweep.drive_theory_point, THEORY_GRID, executor="process", workers=2, cache=store)
+    frame = sweep.run(drive_theory_point, THEORY_GRID, executor="process", workers=2, cache=store)
     pd.testing.assert_frame_equal(frame, serial_theory, check_exact=True)
     assert frame.attrs["sweep"]["computed"] == len(THEORY_GRID)
-    again = sweep.run(sweep.drive_theory_point, THEORY_GRID, executor="process", workers=2, cache=store)
+    again = sweep.run(drive_theory_point, THEORY_GRID, executor="process", workers=2, cache=store)
     pd.testing.assert_frame_equal(again, serial_theory, check_exact=True)
     assert again.attrs["sweep"] == {**frame.attrs["sweep"], "cached": len(THEORY_GRID), "computed": 0}
 
 
-def test_sweep_log_records_cached_and_computed_points(store, tmp_path, monkeypatch):
+def test_sweep_log_records_cached_and_computed_points(store, tmp_path):
     # The book's execution-statistics page sums these lines per chapter.
     log = tmp_path / "sweeps.jsonl"
-    monkeypatch.setenv(sweep.SWEEP_LOG_ENV, str(log))
-    sweep.run(sweep.drive_theory_point, THEORY_GRID[:3], executor="serial", cache=store)
-    sweep.run(sweep.drive_theory_point, THEORY_GRID[:4], executor="serial", cache=store)
+    config = RunConfig(sweep_log=log)
+    sweep.run(drive_theory_point, THEORY_GRID[:3], executor="serial", cache=store, config=config)
+    sweep.run(drive_theory_point, THEORY_GRID[:4], executor="serial", cache=store, config=config)
     lines = [json.loads(line) for line in log.read_text().splitlines()]
     assert [(r["cached"], r["computed"], r["points"]) for r in lines] == [(0, 3, 3), (3, 1, 4)]
     assert lines[0]["function"] == "drive_theory_point"
-    monkeypatch.delenv(sweep.SWEEP_LOG_ENV)
-    sweep.run(sweep.drive_theory_point, THEORY_GRID[:1], executor="serial", cache=store)
-    assert len(log.read_text().splitlines()) == 2  # unset: nothing written
+    sweep.run(drive_theory_point, THEORY_GRID[:1], executor="serial", cache=store)
+    sweep.run(drive_theory_point, THEORY_GRID[:1], executor="serial", cache=store, config=RunConfig())
+    assert len(log.read_text().splitlines()) == 2  # no sweep_log: nothing written
 
 
 def test_dask_local_cluster_identical_to_serial(serial_theory):
     """Dask LocalCluster with 2 worker *processes* (processes=True; starts in ~2 s here)."""
-    frame = sweep.run(sweep.drive_theory_point, THEORY_GRID, executor="dask", workers=2, cache=False)
+    frame = sweep.run(drive_theory_point, THEORY_GRID, executor="dask", workers=2, cache=False)
     pd.testing.assert_frame_equal(frame, serial_theory, check_exact=True)
 
 
@@ -126,7 +128,7 @@ def test_dask_scheduler_address(serial_theory):
     from distributed import LocalCluster
 
     with LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None) as cluster:
-        frame = sweep.run(sweep.drive_theory_point, THEORY_GRID, scheduler=cluster.scheduler_address,
+        frame = sweep.run(drive_theory_point, THEORY_GRID, scheduler=cluster.scheduler_address,
                           cache=False)
     pd.testing.assert_frame_equal(frame, serial_theory, check_exact=True)
 
@@ -144,8 +146,8 @@ def test_simulations_and_arrays_identical_across_executors():
     """numba kernels in worker processes give bit-identical results to this process."""
     drive = Drive(contacts=1, actuator_model="rigid")
     runs = [{"drive": drive, "amplitude": a, "frequency": 100.0, "periods": 2} for a in (50e-9, 120e-9)]
-    serial = sweep.run(sweep.sawtooth_point, runs, executor="serial", cache=False)
-    pooled = sweep.run(sweep.sawtooth_point, runs, executor="process", workers=2, cache=False)
+    serial = sweep.run(sawtooth_point, runs, executor="serial", cache=False)
+    pooled = sweep.run(sawtooth_point, runs, executor="process", workers=2, cache=False)
     pd.testing.assert_frame_equal(pooled, serial, check_exact=True)
     assert serial["mean_step_m"].iloc[1] > serial["mean_step_m"].iloc[0]
 
@@ -159,7 +161,7 @@ def test_simulations_and_arrays_identical_across_executors():
 
 def test_caller_owned_executor(serial_theory):
     with cf.ThreadPoolExecutor(max_workers=2) as pool:
-        frame = sweep.run(sweep.drive_theory_point, THEORY_GRID, executor=pool, cache=False)
+        frame = sweep.run(drive_theory_point, THEORY_GRID, executor=pool, cache=False)
         assert pool.submit(int, "3").result() == 3  # not shut down by run()
     pd.testing.assert_frame_equal(frame, serial_theory, check_exact=True)
 
@@ -247,24 +249,35 @@ def test_bad_arguments(store):
         sweep.run(clashing, points, executor="serial", cache=False)
 
 
-def test_environment_defaults(monkeypatch):
-    """PASSMD_EXECUTOR / PASSMD_WORKERS / PASSMD_SCHEDULER fill arguments left at None."""
+def test_run_configuration_fills_the_defaults(tmp_path):
+    """The RunConfig's executor / workers / scheduler / cache fill arguments left at None."""
     double = lambda x: {"y": 2 * x}  # noqa: E731 - not picklable: only the serial executor can run it
-    monkeypatch.setenv("PASSMD_EXECUTOR", "serial")
-    assert sweep.run(double, [{"x": 1}, {"x": 2}], cache=False)["y"].tolist() == [2, 4]
-    monkeypatch.setenv("PASSMD_EXECUTOR", "threads")
+    assert sweep.run(double, [{"x": 1}, {"x": 2}], cache=False,
+                     config=RunConfig(executor="serial"))["y"].tolist() == [2, 4]
     with pytest.raises(ValueError, match="executor = 'threads' is not allowed"):
-        sweep.run(double, [{"x": 1}], cache=False)
-    monkeypatch.delenv("PASSMD_EXECUTOR")
-    monkeypatch.setenv("PASSMD_WORKERS", "two")
-    with pytest.raises(ValueError, match="PASSMD_WORKERS = 'two' is not allowed"):
-        sweep.run(double, [{"x": 1}], cache=False)
-    monkeypatch.delenv("PASSMD_WORKERS")
-    monkeypatch.setenv("PASSMD_SCHEDULER", "tcp://127.0.0.1:1")
-    # an explicit executor wins over the environment's scheduler
-    assert sweep.run(double, [{"x": 3}], executor="serial", cache=False)["y"].tolist() == [6]
+        sweep.run(double, [{"x": 1}], cache=False, config=RunConfig(executor="threads"))
+    config = RunConfig(executor="serial", cache_dir=tmp_path / "configured")
+    sweep.run(drive_theory_point, THEORY_GRID[:2], config=config)
+    assert len(Cache(tmp_path / "configured").entries()) == 2
+    # an explicit executor wins over the configuration's scheduler
+    with_scheduler = RunConfig(scheduler="tcp://127.0.0.1:1")
+    assert sweep.run(double, [{"x": 3}], executor="serial", cache=False,
+                     config=with_scheduler)["y"].tolist() == [6]
     with pytest.raises(ValueError, match="needs executor='dask'"):
         sweep.run(fail_at, [{"x": 1, "bad": 0}], executor="process", scheduler="tcp://127.0.0.1:1")
+
+
+def test_the_environment_does_not_steer_a_sweep(tmp_path, monkeypatch):
+    """Only entry points read PASSMD_*: a sweep without a configuration runs with the defaults."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("PASSMD_EXECUTOR", "threads")
+    monkeypatch.setenv("PASSMD_WORKERS", "two")
+    monkeypatch.setenv("PASSMD_CACHE_DIR", str(tmp_path / "elsewhere"))
+    monkeypatch.setenv("PASSMD_SWEEP_LOG", str(tmp_path / "log.jsonl"))
+    frame = sweep.run(drive_theory_point, THEORY_GRID[:2], executor="serial")
+    assert frame.attrs["sweep"]["computed"] == 2
+    assert len(Cache(tmp_path / ".passmd-cache").entries()) == 2
+    assert not (tmp_path / "elsewhere").exists() and not (tmp_path / "log.jsonl").exists()
 
 
 def test_lambda_runs_serially_without_cache():
@@ -272,17 +285,18 @@ def test_lambda_runs_serially_without_cache():
     assert frame["y"].tolist() == [2, 4]
 
 
-def test_progress_quiet_off_tty_and_in_ci(monkeypatch):
+def test_progress_quiet_off_tty_and_in_ci():
     class Tty:
         def isatty(self):
             return True
 
-    monkeypatch.delenv("CI", raising=False)
     assert sweep.progress_enabled(None, Tty())
     assert not sweep.progress_enabled(None, object())
     assert sweep.progress_enabled(True, object())
-    monkeypatch.setenv("CI", "true")
-    assert not sweep.progress_enabled(None, Tty())
+    assert not sweep.progress_enabled(False, Tty())
+    # $CI reaches the sweeps through the entry point's run configuration
+    assert RunConfig.from_environment({"CI": "true"}).progress is False
+    assert RunConfig.from_environment({}).progress is None
 
 
 SIGINT_SCRIPT = """

@@ -1,0 +1,125 @@
+"""Running the command line: parse, dispatch to the subcommand, map failures to exit status."""
+
+from __future__ import annotations
+
+import gc
+import os
+import sys
+import warnings
+
+import numpy as np
+
+from passmd._result_bounds import ResultError
+from passmd.cache import CacheWarning
+from passmd.cli.errors import OPTIONAL_EXTRAS, MissingDependencyError, OutputError, UsageError
+from passmd.cli.parser import PROG, make_parser
+from passmd.cli.streams import (
+    Out,
+    PipeClosed,
+    StdoutError,
+    one_line_warnings,
+    silence_stdout,
+    use_ascii_fallback,
+)
+from passmd.units import QuantityError
+
+__all__ = ["main"]
+
+
+def _cannot_write(err: OSError) -> int:
+    silence_stdout()
+    sys.stderr.write(f"{PROG}: error: cannot write the output: {err.strerror or err}\n")
+    return 1
+
+
+def _parse(parser, argv, to_stdout: bool):
+    """(args, None), or (None, exit status) when --help/--version output could not be written."""
+    try:
+        return parser.parse_args(argv), None
+    except BrokenPipeError:  # --help piped into head
+        silence_stdout()
+        return None, 141
+    except OSError as err:  # --help > /dev/full
+        return None, _cannot_write(err)
+    except SystemExit as exc:  # --help, --version: what argparse printed must reach the file
+        if exc.code == 0 and to_stdout:
+            try:
+                sys.stdout.flush()
+            except BrokenPipeError:
+                silence_stdout()
+                return None, 141
+            except OSError as err:
+                return None, _cannot_write(err)
+        raise
+
+
+def main(argv=None, out=None) -> int:
+    """Run the command line; return the exit status (0 ok, 2 usage error, 1 failed run).
+
+    130 on Ctrl-C, 141 when standard output was closed by its reader (nothing printed).
+    """
+    to_stdout = out is None
+    for stream in (sys.stdout, sys.stderr):
+        use_ascii_fallback(stream)
+    out = Out(sys.stdout if out is None else out)
+    args, status = _parse(make_parser(), argv, to_stdout)
+    if args is None:
+        return status
+    prog = f"{PROG} {args.command}"
+    with warnings.catch_warnings():
+        # cache problems: one line each; numerical warnings: the results are checked instead
+        warnings.showwarning = one_line_warnings(prog)
+        warnings.simplefilter("always", CacheWarning)
+        warnings.simplefilter("ignore", RuntimeWarning)
+        with np.errstate(all="ignore"):
+            return _dispatch(args, out, prog, to_stdout)
+
+
+def _error(prog: str, text: str, status: int) -> int:
+    sys.stderr.write(f"{prog}: error: {text}\n")
+    return status
+
+
+def _dispatch(args, out: Out, prog: str, to_stdout: bool) -> int:  # noqa: C901 - one except per failure
+    try:
+        status = args.handler(args, out)
+        out.flush()
+        return status
+    except PipeClosed:
+        if to_stdout:
+            silence_stdout()
+        return 141
+    except StdoutError as exc:
+        if to_stdout:
+            silence_stdout()
+        return _error(prog, f"cannot write the output: {exc.strerror or exc}", 1)
+    except (UsageError, QuantityError) as exc:
+        return _error(prog, str(exc), 2)
+    except OutputError as exc:
+        return _error(prog, str(exc), 1)
+    except KeyboardInterrupt:
+        kept = " (finished points are kept in the cache)" if args.command == "figure" else ""
+        sys.stderr.write(f"{prog}: interrupted{kept}\n")
+        # exit at once: the interpreter's exit-time collection of numba's object graph takes ≈ 1 s
+        gc.freeze()
+        return 130
+    except ValueError as exc:  # the package's input checks (passmd._validation)
+        return _error(prog, str(exc), 2)
+    except (ResultError, MissingDependencyError) as exc:
+        return _error(prog, str(exc), 1)
+    except RuntimeError as exc:  # passmd.dynamics.SimulationError and other failed runs
+        return _error(prog, f"run failed: {exc}", 1)
+    except ModuleNotFoundError as exc:
+        extra = OPTIONAL_EXTRAS.get((exc.name or "").split(".")[0])
+        hint = f"pip install 'passmd[{extra}]'" if extra else "reinstall passmd with its dependencies"
+        return _error(prog, f"the package {exc.name!r} is not installed: {hint}", 1)
+    except MemoryError:
+        return _error(prog, "not enough memory for this run (lower --max-points or the number of periods)", 1)
+    except OSError as exc:  # e.g. the cache or an output directory vanished under the run
+        where = f" ({exc.filename})" if getattr(exc, "filename", None) else ""
+        return _error(prog, f"{exc.strerror or exc}{where}", 1)
+    except Exception as exc:  # a bug: one line, the traceback on request
+        if os.environ.get("PASSMD_DEBUG"):
+            raise
+        return _error(prog, f"internal error: {type(exc).__name__}: {exc} (set PASSMD_DEBUG=1 for the "
+                            "traceback)", 1)

@@ -1,0 +1,122 @@
+"""``passmd critical-amplitude``: the simulated and the analytic critical amplitude A_c."""
+
+from __future__ import annotations
+
+import math
+import textwrap
+
+from passmd.cli.drive import build_drive
+from passmd.cli.errors import UsageError
+from passmd.cli.options import FREQUENCY, THRESHOLD, TOLERANCE, add_drive_options
+from passmd.cli.output import JSON_HELP, check_results, describe, drive_record, emit_json, emit_rows, fmt
+from passmd.defaults import PROTOCOL
+from passmd.units import from_si
+
+__all__ = ["add_parser", "run_critical_amplitude"]
+
+_EPILOG = textwrap.dedent("""\
+    The simulated A_c comes from the critical-amplitude chapters' search
+    (passmd.experiments.critical_amplitude): bisection on [0, A_max] with one of two
+    protocols, reporting its final bracket. steady: the last step of a run of
+    --periods saw-tooth periods from rest exceeds --threshold; first: every contact
+    slides fully in the first fly-back from virgin contacts.
+
+    --json keys (SI units): critical_amplitude_m (null if none up to A_max),
+    bracket_m, analytic_critical_amplitude_m, critical_amplitude_rigid_m,
+    critical_amplitude_flexible_m, protocol, threshold_m, tolerance_m, frequency_Hz,
+    periods, flyback, simulations, wall_time_s, drive{...}""")
+
+
+def add_parser(command) -> None:
+    p = command("critical-amplitude", "simulated and analytic critical amplitude A_c", _EPILOG)
+    add_drive_options(p)
+    group = p.add_argument_group("search")
+    group.add_argument("--protocol", choices=("steady", "first"), default="steady",
+                       help="steady-state A_c or first-fly-back onset (default: steady)")
+    FREQUENCY.add(group)
+    group.add_argument("--periods", type=int, default=PROTOCOL.steady_periods, metavar="N",
+                       help=f"periods of a steady-state run (default: {PROTOCOL.steady_periods})")
+    THRESHOLD.add(group)
+    TOLERANCE.add(group)
+    group.add_argument("--flyback", choices=("slew", "fixed"), default="slew",
+                       help="fly-back duration rule (default: slew)")
+    group.add_argument("--analytic-only", action="store_true", help="skip the simulation (default: off)")
+    p.add_argument("--json", action="store_true", help=JSON_HELP)
+    p.set_defaults(handler=run_critical_amplitude)
+
+
+def _search(args, drive) -> dict:
+    """The simulated A_c of the book's search (every option checked, searched unless --analytic-only)."""
+    from passmd.experiments import critical_amplitude as ca
+
+    if args.periods < 2:
+        raise UsageError(f"--periods = {args.periods} is out of range: a step needs >= 2 periods")
+    if args.threshold is not None and args.protocol == "first":
+        raise UsageError("--threshold contradicts --protocol first: the first-fly-back protocol has no "
+                         "step threshold (use --protocol steady, or drop --threshold)")
+    threshold = THRESHOLD.parse_or(args, PROTOCOL.step_threshold)
+    tolerance = TOLERANCE.parse_or(args, PROTOCOL.search_tolerance)
+    frequency = FREQUENCY.parse_or(args, PROTOCOL.drive_frequency)
+    if args.analytic_only:
+        return {}
+    # the book's search (critical-amplitude chapters): one protocol for users and book
+    found = ca.critical_amplitude(
+        drive, protocol=args.protocol, frequency=frequency, flyback=args.flyback,
+        periods=args.periods, threshold=threshold, tolerance=tolerance,
+    )
+    value = found["critical_amplitude_m"]
+    return {
+        "critical_amplitude_m": None if math.isnan(value) else value,
+        "bracket_m": [found["bracket_low_m"],
+                      None if math.isnan(found["bracket_high_m"]) else found["bracket_high_m"]],
+        "protocol": args.protocol,
+        "threshold_m": threshold if args.protocol == "steady" else None,
+        "tolerance_m": tolerance,
+        "frequency_Hz": frequency,
+        "periods": args.periods if args.protocol == "steady" else 1,
+        "flyback": args.flyback,
+        "simulations": found["runs"],
+        "wall_time_s": found["wall_time_s"],
+    }
+
+
+def run_critical_amplitude(args, out) -> int:
+    from passmd.theory import drive_theory
+
+    drive = build_drive(args)
+    theory = drive_theory(drive)
+    record = {
+        "command": "critical-amplitude",
+        "drive": drive_record(drive),
+        "analytic_critical_amplitude_m": theory["analytic_critical_amplitude_m"],
+        "critical_amplitude_rigid_m": theory["critical_amplitude_rigid_m"],
+        "critical_amplitude_flexible_m": theory["critical_amplitude_flexible_m"],
+        **_search(args, drive),
+    }
+    check_results(record)
+    if args.json:
+        emit_json(record, out)
+        return 0
+    rows = [] if args.analytic_only else _search_rows(record, drive)
+    eq = "Eq. 7/11" if drive.actuator_model == "rigid" else "Eq. 8/12"
+    rows.append((f"analytic A_c ({eq})", fmt(record["analytic_critical_amplitude_m"], "nm")))
+    emit_rows(f"passmd critical-amplitude — {describe(drive)}", rows, out)
+    return 0
+
+
+def _search_rows(record: dict, drive) -> list[tuple[str, str]]:
+    found = record["critical_amplitude_m"]
+    lo, hi = record["bracket_m"]
+    a_max = drive.actuator.full_stroke_amplitude
+    if record["protocol"] == "steady":
+        criterion = f"last of {record['periods']} steps > {fmt(record['threshold_m'], 'nm')}"
+    else:
+        criterion = "full sliding of every contact in the first fly-back"
+    return [
+        ("simulated A_c", f"{fmt(found, 'nm')}  (bracket {from_si(lo, 'nm'):.4g}–"
+                          f"{from_si(hi, 'nm'):.4g} nm)" if found is not None else
+         f"none up to the full stroke {fmt(a_max, 'nm')} ({criterion})"),
+        ("search", f"{record['protocol']}: {criterion}, "
+                   f"f = {fmt(record['frequency_Hz'], 'kHz')}, {record['flyback']} fly-back, "
+                   f"{record['simulations']} simulations"),
+    ]

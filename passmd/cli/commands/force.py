@@ -1,0 +1,94 @@
+"""``passmd force``: the generated force against the load cell at stall (Section 4.2)."""
+
+from __future__ import annotations
+
+import re
+import textwrap
+
+from passmd._result_bounds import check_force_bound
+from passmd.cli.commands.run import check_memory, check_output_paths, waveform_args, write_outputs
+from passmd.cli.drive import build_drive
+from passmd.cli.errors import UsageError
+from passmd.cli.options import add_drive_options, add_output_options, add_simulation_options
+from passmd.cli.output import check_results, describe, drive_record, emit_json, emit_rows, fmt
+from passmd.defaults import PROTOCOL
+
+__all__ = ["add_parser", "run_force"]
+
+_EPILOG = textwrap.dedent("""\
+    Runs the saw-tooth from rest with the load cell at its free length and lengthens
+    the run (--periods, doubling up to --max-periods) until the force-generation
+    chapter's stall criterion holds; reports whether it did.
+
+    --json keys (SI units): generated_force_N (k times the mean runner position over the
+    last period), converged, periods, periods_simulated, remaining_force_N,
+    force_spread_N, mean_friction_N, piezo_mean_force_N, last_step_m,
+    net_displacement_m, wall_time_s, cpu_time_s, amplitude_m, frequency_Hz, drive{...}""")
+
+
+def add_parser(command) -> None:
+    p = command("force", "generated force against the load cell at stall (Section 4.2)", _EPILOG)
+    add_drive_options(p)
+    add_simulation_options(p, default_periods=PROTOCOL.stall_periods)
+    p.add_argument("--max-periods", type=int, default=PROTOCOL.stall_max_periods, metavar="N",
+                   help="longest run before a point is reported as not stalled "
+                        f"(default: {PROTOCOL.stall_max_periods})")
+    add_output_options(p)
+    p.set_defaults(handler=run_force)
+
+
+def _check_options(args, drive):
+    """(amplitude, frequency) in SI; the options the stall protocol does not take are refused."""
+    if args.waveform != "sawtooth":
+        raise UsageError(
+            "--waveform optimized is not supported by force: the stall protocol of the force-generation "
+            "chapter (Section 4.2) drives with the saw-tooth; use `passmd run --waveform optimized "
+            "--load-cell` for one run against the load cell"
+        )
+    if args.springs is not None:
+        raise UsageError("--springs is not supported by force: the stall runs use the exact contact")
+    amplitude, frequency = waveform_args(args, drive)
+    if args.max_periods < args.periods:
+        raise UsageError(f"--max-periods = {args.max_periods} is out of range: must be >= --periods "
+                         f"({args.periods})")
+    check_memory(args, "--max-periods")
+    check_output_paths(args)
+    return amplitude, frequency
+
+
+def run_force(args, out) -> int:
+    from passmd.experiments import force_generation as fg
+
+    drive = build_drive(args, load_cell=True)
+    amplitude, frequency = _check_options(args, drive)
+    # the force-generation chapter's stall protocol: runs from rest, lengthened until stalled
+    try:
+        found = fg.generated_force(drive, amplitude, frequency, flyback=args.flyback,
+                                   initial_periods=args.periods, max_periods=args.max_periods)
+    except ValueError as exc:  # name the command's options, not the library's parameters
+        text = re.sub(r"\binitial_periods\b", "--periods", str(exc))
+        raise UsageError(re.sub(r"\bmax_periods\b", "--max-periods", text)) from exc
+    check_results(found)
+    check_force_bound(found, drive)
+    if args.csv or args.plot:  # the reported run again, for its time series
+        from passmd import dynamics, waveforms
+
+        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=found["periods"], flyback=args.flyback)
+        write_outputs(args, dynamics.simulate(drive, wave, max_points=args.max_points))
+    record = {"command": "force", "waveform": "sawtooth", "flyback": args.flyback,
+              "amplitude_m": amplitude, "frequency_Hz": frequency, "drive": drive_record(drive), **found}
+    if args.json:
+        emit_json(record, out)
+        return 0
+    state = "stalled" if found["converged"] else f"NOT stalled after {found['periods_simulated']} periods"
+    rows = [
+        ("waveform", f"sawtooth, A = {fmt(amplitude, 'nm')}, f = {fmt(frequency, 'kHz')}"),
+        ("generated force k·x̄_r", f"{fmt(found['generated_force_N'], 'N')}  ({state})"),
+        ("run reported", f"{found['periods']} periods from rest; still to come ≈ "
+                         f"{fmt(found['remaining_force_N'], 'N')}"),
+        ("last step", fmt(found["last_step_m"], "nm")),
+        ("integration", f"{found['periods_simulated']} periods, {found['wall_time_s']:.3g} s"),
+    ]
+    emit_rows(f"passmd force — {describe(drive)}, load cell k = "
+              f"{fmt(drive.load_cell_stiffness, 'N/m')}", rows, out)
+    return 0

@@ -1,0 +1,67 @@
+"""``passmd ledger``: the replication ledger: every claim's computed category and evidence."""
+
+from __future__ import annotations
+
+import textwrap
+
+from passmd.cache import DEFAULT_CACHE_DIR
+from passmd.cli.configuration import run_config
+from passmd.cli.errors import OutputError
+from passmd.cli.options import add_sweep_options
+from passmd.cli.output import JSON_HELP, emit_json
+from passmd.claims import STATUSES
+from passmd.config import ENVIRONMENT, PROFILES
+
+__all__ = ["add_parser", "run_ledger"]
+
+_EPILOG = textwrap.dedent(f"""\
+    Computes (or reads from the cache the book uses, ./{DEFAULT_CACHE_DIR}/ or ${ENVIRONMENT['cache_dir']})
+    every figure's results at --profile and evaluates every claim of
+    passmd/data/reference/claims.csv over the declared readings of passmd.readings.
+
+    --json keys: profile, summary, counts{{category: n}}, claims[{{claim, category, basis,
+    verdict, evidence[], reason, depends_on[], readings{{reading: state}}, fraction_holds,
+    best_reading, tolerance, check, paper_<SI unit>, ours_<SI unit>, ours_text,
+    abs_deviation_<SI unit>, rel_deviation (fraction)}}]""")
+
+
+def add_parser(command) -> None:
+    p = command("ledger", "the replication ledger: every claim's computed category and evidence", _EPILOG)
+    p.add_argument("--profile", choices=PROFILES, default="quick",
+                   help="resolution: quick (CI) or paper (the paper's grids) (default: quick)")
+    p.add_argument("--write-baseline", metavar="CSV", default=None,
+                   help="also write the categories as a baseline CSV (default: none)")
+    add_sweep_options(p)
+    p.add_argument("--json", action="store_true", help=JSON_HELP)
+    p.set_defaults(handler=run_ledger)
+
+
+def _write_baseline(ledger, evaluated, args) -> None:
+    header = (f"ledger categories, {args.profile} profile; produced by\n"
+              f"passmd ledger --profile {args.profile} --write-baseline {args.write_baseline}")
+    try:
+        ledger.write_baseline(evaluated, args.write_baseline, header=header)
+    except OSError as exc:
+        raise OutputError(f"cannot write --write-baseline {args.write_baseline}: "
+                          f"{exc.strerror or exc}") from exc
+
+
+def run_ledger(args, out) -> int:
+    """Every claim of the paper with its computed category, values and evidence (Sections 4–6)."""
+    from passmd import ledger, ledger_views
+
+    evaluated = ledger.evaluate(config=run_config(args))
+    if args.write_baseline:
+        _write_baseline(ledger, evaluated, args)
+    counts = {s: int((evaluated["status"] == s).sum()) for s in STATUSES}
+    if args.json:
+        emit_json({"command": "ledger", "profile": args.profile, "summary": ledger_views.summary(evaluated),
+                   "counts": counts, "claims": ledger.records(evaluated)}, out)
+        return 0
+    out.write(f"passmd ledger — profile {args.profile}: {ledger_views.summary(evaluated)}\n")
+    for row in evaluated.itertuples():
+        basis = " (closed form)" if row.basis == "closed form" else ""
+        out.write(f"\n{row.claim}: {row.status}{basis}\n  {row.verdict}\n")
+        for item in (e for e in row.evidence.split(" | ") if e):
+            out.write(f"  - {item}\n")
+    return 0

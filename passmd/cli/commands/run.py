@@ -1,0 +1,180 @@
+"""``passmd run``: one simulation of a driving waveform from rest; the checks ``force`` shares."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from passmd._result_bounds import check_run_bounds
+from passmd.cli.commands.contact import check_springs
+from passmd.cli.drive import build_drive
+from passmd.cli.errors import OutputError, UsageError
+from passmd.cli.options import (
+    AMPLITUDE,
+    FREQUENCY,
+    add_drive_options,
+    add_output_options,
+    add_simulation_options,
+)
+from passmd.cli.output import check_results, describe, drive_record, emit_json, emit_rows, fmt, nm
+from passmd.cli.streams import available_memory, write_atomically
+from passmd.defaults import PROTOCOL
+from passmd.units import from_si
+
+__all__ = ["add_parser", "check_memory", "check_output_paths", "run_run", "simulate", "waveform_args",
+           "write_outputs"]
+
+_RUN_KEYS = """\
+--json keys (SI units): final_position_m, settled_positions_m, step_sizes_m,
+back_steps_m, mean_velocity_m_per_s (>= 2 periods), periods, frequency_Hz, amplitude_m,
+integrator_steps and the integrator's step sizes (keys ending in _time_step_s), wall_time_s, waveform,
+flyback, drive{...}"""
+
+#: Bytes per recorded sample (time, piezo/runner positions and velocities, per-group
+#: contact columns, with the DataFrame/plot copies) and per period (waveform breakpoints,
+#: per-period measures) used to estimate a run's memory before allocating it.
+_BYTES_PER_SAMPLE = 4 * 8 * (4 + 3 * 6)
+_BYTES_PER_PERIOD = 8 * 64
+
+#: Image formats --plot can write (matplotlib's Agg/PDF/SVG/PS backends).
+_PLOT_FORMATS = ("png", "pdf", "svg", "ps", "eps", "jpg", "jpeg", "tif", "tiff", "webp")
+
+
+def add_parser(command) -> None:
+    p = command("run", "one simulation of a driving waveform from rest", _RUN_KEYS +
+                ", generated_force_N (with --load-cell)")
+    add_drive_options(p)
+    add_simulation_options(p, default_periods=3)
+    p.add_argument("--load-cell", action="store_true",
+                   help="the runner pushes against the load cell (default: off, free runner)")
+    add_output_options(p)
+    p.set_defaults(handler=run_run)
+
+
+def waveform_args(args, drive):
+    """(amplitude, frequency) in SI after the display-unit checks."""
+    a_max = drive.actuator.full_stroke_amplitude
+    amplitude = AMPLITUDE.parse_or(args, a_max)
+    if amplitude > a_max * (1 + 1e-12):
+        raise UsageError(
+            f"--amplitude = {from_si(amplitude, 'nm'):.10g} nm is out of range: must be <= "
+            f"{from_si(a_max, 'nm'):.10g} nm, the actuator's full stroke (--full-stroke-amplitude)"
+        )
+    frequency = FREQUENCY.parse_or(args, PROTOCOL.drive_frequency)
+    if args.periods < 1:
+        raise UsageError(f"--periods = {args.periods} is out of range: must be an integer >= 1")
+    return min(amplitude, a_max), frequency
+
+
+def check_memory(args, periods_flag: str = "--periods") -> None:
+    """Refuse a run whose records would not fit in memory (estimated before allocating)."""
+    if args.max_points < 2:
+        raise UsageError(f"--max-points = {args.max_points} is out of range: must be an integer >= 2")
+    periods = max(args.periods, getattr(args, "max_periods", 0) or 0)
+    need = args.max_points * _BYTES_PER_SAMPLE + periods * _BYTES_PER_PERIOD
+    available = available_memory()
+    if available is not None and need > available // 2:
+        raise UsageError(
+            f"--max-points = {args.max_points} with {periods_flag} = {periods} needs about "
+            f"{need / 2**30:.3g} GiB, more than half the {available / 2**30:.3g} GiB available: "
+            "lower --max-points or the number of periods"
+        )
+
+
+def check_output_paths(args) -> None:
+    """--csv/--plot: a file name in an existing directory, a known image format (before running)."""
+    for flag, name in (("--csv", args.csv), ("--plot", args.plot)):
+        if name is None:
+            continue
+        if not name.strip():
+            raise UsageError(f"{flag} = {name!r} is not a file name")
+        target = Path(name)
+        if target.is_dir():
+            raise UsageError(f"{flag} = {name!r} is a directory: give a file name")
+        parent = target.parent if str(target.parent) else Path(".")
+        if not parent.is_dir():
+            raise OutputError(f"cannot write {flag} {name}: directory {str(parent)!r} does not exist")
+    if args.plot is not None:
+        suffix = Path(args.plot).suffix.lower().lstrip(".")
+        if suffix not in _PLOT_FORMATS:
+            raise UsageError(f"--plot = {args.plot!r} has {'no' if not suffix else 'an unknown'} image "
+                             f"extension: must end in one of {', '.join('.' + f for f in _PLOT_FORMATS)}")
+
+
+def simulate(args, drive):
+    """The run the options describe (the saw-tooth or the optimized waveform of Eq. 15)."""
+    from passmd import dynamics, optimized_waveform, waveforms
+    from passmd.protocols import eq15
+
+    amplitude, frequency = waveform_args(args, drive)
+    springs = check_springs(args.springs)
+    if args.waveform == "optimized":
+        # Eq. 15, designed from this drive's own simulated saw-tooth response (first period a
+        # saw-tooth, as in the paper); a ValueError (e.g. Δ_a ≥ A) is a usage error
+        design = eq15.optimized_design(amplitude, drive, flyback=args.flyback)
+        wave = optimized_waveform.optimized(amplitude, frequency, drive, periods=args.periods,
+                                            flyback=args.flyback, design=design)
+    else:
+        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=args.periods, flyback=args.flyback)
+    return dynamics.simulate(
+        drive, wave, contact_model="exact" if springs is None else "discrete",
+        springs=PROTOCOL.springs if springs is None else springs, max_points=args.max_points,
+    )
+
+
+def write_outputs(args, result) -> None:
+    """The time series to --csv and the positions' plot to --plot, each written atomically."""
+    if args.csv:
+        try:
+            frame = result.to_frame()
+            write_atomically(args.csv, lambda tmp: frame.to_csv(tmp, index=False))
+        except OSError as exc:
+            raise OutputError(f"cannot write --csv {args.csv}: {exc.strerror or exc}") from exc
+    if args.plot:
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(7, 4), layout="constrained")
+        ax = fig.add_subplot()
+        t_ms = result.time * 1e3
+        ax.plot(t_ms, from_si(result.piezo_position, "nm"), label="piezo x_p", lw=0.8)
+        ax.plot(t_ms, from_si(result.runner_position, "nm"), label="runner x_r", lw=0.8)
+        ax.set_xlabel("time [ms]")
+        ax.set_ylabel("position [nm]")
+        ax.legend()
+        ax.set_title(describe(result.drive), fontsize=9)
+        try:
+            fmt_ = Path(args.plot).suffix.lstrip(".").lower()
+            write_atomically(args.plot, lambda tmp: fig.savefig(tmp, dpi=150, format=fmt_))
+        except OSError as exc:
+            raise OutputError(f"cannot write --plot {args.plot}: {exc.strerror or exc}") from exc
+
+
+def run_run(args, out) -> int:
+    drive = build_drive(args, load_cell=bool(args.load_cell))
+    waveform_args(args, drive)  # every option checked before anything runs
+    check_springs(args.springs)
+    check_memory(args)
+    check_output_paths(args)
+    result = simulate(args, drive)
+    summary = result.summary()
+    summary["wall_time_s"] = float(result.wall_time)
+    check_results(summary)
+    check_run_bounds(summary, drive, float(summary["amplitude_m"]))
+    write_outputs(args, result)
+    if args.json:
+        emit_json({"command": "run", "waveform": args.waveform, "flyback": args.flyback,
+                   "drive": drive_record(drive), **summary}, out)
+        return 0
+    rows = [
+        ("waveform", f"{args.waveform}, A = {fmt(summary['amplitude_m'], 'nm')}, "
+                     f"f = {fmt(summary['frequency_Hz'], 'kHz')}, {summary['periods']} periods"),
+        ("final position", fmt(summary["final_position_m"], "nm")),
+        ("step per period", nm(summary["step_sizes_m"]) if summary["step_sizes_m"] else "– (one period)"),
+        ("back-step per period", nm(summary["back_steps_m"])),
+    ]
+    if "mean_velocity_m_per_s" in summary:
+        rows.append(("mean velocity", f"{summary['mean_velocity_m_per_s'] * 1e3:.6g} mm/s"))
+    if "generated_force_N" in summary:
+        rows.append(("generated force", fmt(summary["generated_force_N"], "N")))
+    rows.append(("integrator", f"{summary['integrator_steps']} steps, {summary['wall_time_s']:.3g} s"))
+    emit_rows(f"passmd run — {describe(drive)}", rows, out)
+    return 0

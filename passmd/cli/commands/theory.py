@@ -1,0 +1,61 @@
+"""``passmd theory``: the closed forms of a drive configuration (Eqs. 1, 4, 7–14)."""
+
+from __future__ import annotations
+
+import textwrap
+
+from passmd.cli.drive import build_drive
+from passmd.cli.options import add_drive_options
+from passmd.cli.output import (
+    JSON_HELP,
+    check_results,
+    describe,
+    drive_record,
+    emit_json,
+    emit_rows,
+    fmt,
+    sides,
+)
+
+_EPILOG = textwrap.dedent("""\
+    --json keys (SI units): E_star_Pa, G_star_Pa, normal_force_N, contact_radius_m,
+    indentation_m, tangential_stiffness_N_per_m, presliding_m, actuator_deformation_m
+    (per side: [side 1, side 2] for six contacts), critical_amplitude_rigid_m,
+    critical_amplitude_flexible_m, analytic_critical_amplitude_m (for --actuator),
+    runner_frequency_Hz, actuator_natural_frequency_Hz, drive{...}""")
+
+
+def add_parser(command) -> None:
+    p = command("theory", "closed forms of a drive configuration (Eqs. 1, 4, 7–14)", _EPILOG)
+    add_drive_options(p)
+    p.add_argument("--json", action="store_true", help=JSON_HELP)
+    p.set_defaults(handler=run_theory)
+
+
+def run_theory(args, out) -> int:
+    from passmd.theory import drive_theory, runner_frequency
+
+    drive = build_drive(args)
+    result = drive_theory(drive)
+    result["runner_frequency_Hz"] = runner_frequency(drive)
+    result["actuator_natural_frequency_Hz"] = drive.actuator.natural_frequency
+    check_results(result)
+    if args.json:
+        emit_json({"command": "theory", "drive": drive_record(drive), **result}, out)
+        return 0
+    rows = [
+        ("E* (Eq. 4)", fmt(result["E_star_Pa"], "GPa")),
+        ("G* (Eq. 4)", fmt(result["G_star_Pa"], "GPa")),
+        ("normal force per contact F_N (Eq. 1)", sides(result["normal_force_N"], "N")),
+        ("Hertz contact radius a", sides(result["contact_radius_m"], "mm")),
+        ("indentation d", sides(result["indentation_m"], "nm")),
+        ("tangential stiffness 2aG*", sides(result["tangential_stiffness_N_per_m"], "N/m")),
+        ("presliding u_x,max (Eq. 7/10)", sides(result["presliding_m"], "nm")),
+        ("actuator deformation u_x,a (Eq. 9/14)", sides(result["actuator_deformation_m"], "nm")),
+        ("A_c, rigid actuators (Eq. 7/11)", fmt(result["critical_amplitude_rigid_m"], "nm")),
+        ("A_c, flexible actuators (Eq. 8/12)", fmt(result["critical_amplitude_flexible_m"], "nm")),
+        ("runner-on-contacts frequency", fmt(result["runner_frequency_Hz"], "kHz")),
+        ("bare actuator frequency", fmt(result["actuator_natural_frequency_Hz"], "kHz")),
+    ]
+    emit_rows(f"passmd theory — {describe(drive)}", rows, out)
+    return 0

@@ -1,0 +1,51 @@
+"""The run configuration of the commands that run figure sweeps (``figure``, ``ledger``).
+
+The environment is read once, here at the edge (:meth:`passmd.config.RunConfig.from_environment`),
+and the command's options replace what it says; the resulting :class:`~passmd.config.RunConfig`
+is passed down to the figure table, the ledger and the cache. Nothing is written to the
+environment.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import inspect
+
+from passmd.cli.errors import MissingDependencyError, UsageError
+from passmd.config import RunConfig
+
+__all__ = ["call_with_config", "run_config"]
+
+
+def _require_executor(config: RunConfig) -> None:
+    """Dask needs the optional ``distributed`` package: say which extra installs it."""
+    if (config.executor == "dask" or (config.executor is None and config.scheduler)) \
+            and importlib.util.find_spec("distributed") is None:
+        raise MissingDependencyError("the Dask executor needs the 'distributed' package, which is not "
+                                     "installed: pip install 'passmd[dask]'")
+
+
+def run_config(args) -> RunConfig:
+    """The environment's run configuration, replaced by the options ``figure``/``ledger`` were given."""
+    if args.workers is not None and args.workers < 1:
+        raise UsageError(f"--workers = {args.workers} is out of range: must be an integer >= 1")
+    if args.cache_dir is not None and not args.cache_dir.strip():
+        raise UsageError(f"--cache-dir = {args.cache_dir!r} is not a directory name")
+    config = RunConfig.from_environment(profile=args.profile, executor=args.executor,
+                                        scheduler=args.scheduler, workers=args.workers,
+                                        cache_dir=args.cache_dir)
+    _require_executor(config)
+    return config
+
+
+def call_with_config(func, *args, config: RunConfig):
+    """``func(*args, config)``: a figure-table or ledger function run at the configuration.
+
+    While a function still takes the resolution profile instead (its sweeps then run with
+    the defaults of :func:`passmd.sweep.run`), it gets ``config.profile``.
+    """
+    # lead: once passmd.figures.figure_data(name, config) and ledger.collect_results(config)
+    # take the RunConfig (dev/figA, dev/ledger), call them directly and delete this function.
+    if "config" in inspect.signature(func).parameters:
+        return func(*args, config)
+    return func(*args, config.profile)
