@@ -496,6 +496,12 @@ def check_contact_plausible(normal_force: float, radius: float, E_star: float, *
     ValueError
         Naming the parameters (``names``), the contact radius or pressure and the limit.
     """
+    a = (3.0 * float(normal_force) * float(radius) / (4.0 * float(E_star))) ** (1.0 / 3.0)
+    if not a > 0.0:  # the product underflows below the smallest double: no contact to model
+        raise ValueError(
+            f"{names}: the Hertz contact radius a = (3 F R / 4E*)^(1/3) = {a:.4g} m underflows; "
+            "must be > 0 (hard limit: double precision)"
+        )
     with np.errstate(all="ignore"):
         a, p0 = _hertz(float(normal_force), float(radius), float(E_star))
     ratio = a / radius

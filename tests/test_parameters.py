@@ -169,3 +169,11 @@ def test_every_paper_configuration_is_inside_the_soft_limits():
     assert set(PLAUSIBLE_RANGES) >= {"preload", "friction_coefficient", "runner_mass", "frequency"}
     for rng in PLAUSIBLE_RANGES.values():
         assert rng.reason  # every limit says why
+
+
+def test_contact_radius_underflow_is_refused_with_the_parameters_named():
+    """A preload so small that (3 F R / 4E*)^(1/3) underflows to 0 has no contact to model."""
+    from passmd.parameters import check_contact_plausible
+
+    with pytest.raises(ValueError, match=r"preload: the Hertz contact radius .* underflows"):
+        check_contact_plausible(1e-320, 1e-3, 1e11, allow_extrapolation=True, names="preload")
