@@ -21,6 +21,8 @@ from functools import cache
 from pathlib import Path
 
 import passmd
+from passmd._validation import check_choice
+from passmd.config import PROFILES
 
 __all__ = ["UNKNOWN", "UNCOMMITTED", "csv_header", "git_commit", "stamp", "summary"]
 
@@ -74,9 +76,6 @@ def git_commit(package_dir: str | None = None) -> str:
 
 def stamp(profile: str) -> dict[str, str]:
     """``{"passmd_version", "git_commit", "profile"}`` of a result made on ``profile``."""
-    from passmd._validation import check_choice
-    from passmd.publish import PROFILES
-
     return {
         "passmd_version": passmd.__version__,
         "git_commit": git_commit(),
