@@ -1,67 +1,54 @@
 """Force generation against the load cell: Fig. 7 (Section 4.2).
 
-The runner starts at rest, touching the load cell (a linear spring k, Table 1) at its free
-length, with virgin contacts, and is driven by a saw-tooth until its steps stall: the load
-cell then pushes back, on average over a period, as hard as the contacts carry the runner
-forward. The force at stall is the *generated force* F_gen = k·x̄_r, x̄_r the runner's mean
-position over the last period (:attr:`passmd.dynamics.SimulationResult.generated_force`).
-By momentum balance over a periodic (stalled) cycle it equals the mean total friction
-force on the runner; the tests check that.
+The measurement itself — runs from rest against the load cell until the steps stall, the
+stall criterion and the onset of force generation — is the protocol of
+:mod:`passmd.protocols.stall`. This module runs it over the grids of the figures (through
+the sweep engine, cached) and reads the figures' data for the chapter and the ledger. By
+momentum balance over a periodic (stalled) cycle F_gen equals the mean total friction force
+on the runner; the tests check that.
 
-Stall criterion (registered assumption ``force_stall_criterion``)
-    F_n is k times the runner's mean position over period n. Near stall each step is a
-    fixed fraction of the previous one (the step shrinks in proportion to the force still
-    missing), so F_n approaches its limit geometrically. With D₁ and D₂ the changes of F
-    over the two halves of the last :data:`STALL_WINDOW` periods, the rise still to come
-    is estimated as the geometric tail D₂·r/(1 − r), r = D₂/D₁; the run has stalled when
-    that tail and the spread of F over the window are both below the tolerance
-    max(:data:`STALL_ABS_TOLERANCE`, :data:`STALL_REL_TOLERANCE`·F). A run that has not
-    stalled is repeated from rest with more periods (predicted from the geometric rate),
-    up to :data:`MAX_PERIODS`; if it still has not stalled the point is returned with
-    ``converged = False``, drawn as such and never used by the ledger.
-
-Onset of force generation
-    The runner generates force only if it steps at all from the free length, so the onset
-    is the critical amplitude of the drive with the load cell engaged, found exactly as in
-    the critical-amplitude chapters (:func:`passmd.experiments.critical_amplitude.critical_amplitude`,
-    steady-state protocol at the same frequency).
-
-Figures (registered in :mod:`passmd.experiments`): ``fig7a`` (R = 1 mm, 0.3 and 0.8 N),
-``fig7b`` (R = 0.25 mm, 0.2 and 0.4 N), each with the earlier model (rigid actuators,
-μ = 0.3, [12]) and this paper's (flexible, μ = 0.2); ``fig7grid`` (every preload of both
-radii); ``fig7freq`` (F_gen against the drive frequency) and ``fig7cycle`` (one period at
-stall, rigid/flexible × μ = 0.2/0.3, the physics of the difference).
+Figures: ``fig7a`` (R = 1 mm, 0.3 and 0.8 N), ``fig7b`` (R = 0.25 mm, 0.2 and 0.4 N), each
+with the earlier model (rigid actuators, μ = 0.3, [12]) and this paper's (flexible, μ = 0.2);
+``fig7grid`` (every preload of both radii); ``fig7freq`` (F_gen against the drive frequency)
+and ``fig7cycle`` (one period at stall, rigid/flexible × μ = 0.2/0.3, the physics of the
+difference). Each compute function takes the run configuration
+(:class:`passmd.config.RunConfig`) and returns a tidy DataFrame in display units.
 """
 
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
-from passmd import dynamics, sweep, waveforms
-from passmd._validation import check_choice, check_positive, check_range
-from passmd.experiments import PROFILES, register_figure
-from passmd.experiments.critical_amplitude import critical_amplitude
+from passmd import sweep
+from passmd._validation import check_choice, check_range
+from passmd.config import PROFILES, RunConfig
+from passmd.defaults import PROTOCOL
 from passmd.ledger import ClaimFails, NotEvaluable, register_evidence, register_extractor
 from passmd.parameters import PRELOAD_GRIDS, Assumption, Drive, paper_drive, register_assumption
-from passmd.plots import force_generation as plots
-from passmd.theory import drive_theory, normal_forces
+from passmd.protocols import stall
+from passmd.protocols.stall import (
+    MAX_PERIODS,
+    STALL_ABS_TOLERANCE,
+    STALL_REL_TOLERANCE,
+    STALL_WINDOW,
+    force_onset,
+    generated_force,
+    stall_cycle,
+)
+from passmd.theory import drive_theory, normal_forces, runner_frequency
 
 __all__ = [
     "CYCLE_COMBINATIONS",
     "FORCE_FREQUENCY",
-    "MAX_PERIODS",
     "MODELS",
+    "ONSET_TOLERANCE",
     "PANELS",
     "PANELS_FULL_STROKE_NM",
     "PROFILE_SETTINGS",
-    "STALL_ABS_TOLERANCE",
-    "STALL_REL_TOLERANCE",
-    "STALL_WINDOW",
     "cycle_point",
     "fig7a",
     "fig7b",
@@ -70,29 +57,15 @@ __all__ = [
     "fig7grid",
     "force_difference",
     "force_drive",
-    "force_onset",
-    "generated_force",
     "onset_point",
-    "stall_cycle",
-    "stall_estimate",
     "stall_point",
 ]
 
 #: Saw-tooth frequency of every force run (Hz): Section 5.2's 100 Hz (Fig. 9a), as in the
 #: critical-amplitude chapters (assumption ``force_frequency``).
-FORCE_FREQUENCY = 100.0
-#: Periods over which the stall criterion looks at the force (two halves of 8).
-STALL_WINDOW = 16
-#: Absolute stall tolerance on the remaining rise and on the spread of F_gen (N).
-STALL_ABS_TOLERANCE = 0.2e-3
-#: Relative stall tolerance (fraction of F_gen).
-STALL_REL_TOLERANCE = 2e-3
-#: Periods of the first run of a point.
-INITIAL_PERIODS = 64
-#: Most periods a point may take.
-MAX_PERIODS = 4096
-#: Width of the final bracket of the onset (critical-amplitude) search (m).
-ONSET_TOLERANCE = {"quick": 0.5e-9, "paper": 0.2e-9}
+FORCE_FREQUENCY = PROTOCOL.drive_frequency
+#: Width of the final bracket of the onset (critical-amplitude) search per profile (m).
+ONSET_TOLERANCE = {"quick": 0.5e-9, "paper": stall.ONSET_TOLERANCE}
 
 #: (actuator model, μ, label): the earlier model of [12] and this paper's.
 MODELS = (
@@ -131,7 +104,7 @@ PROFILE_SETTINGS = {
         panel_fractions=tuple(i / 10 for i in range(11)),
         grid_fractions=(0.5, 1.0),
         grid_preloads={r: tuple(float(p) for p in grid) for r, grid in PRELOAD_GRIDS.items()},
-        frequencies=(90.0, 100.0, 110.0, 200.0, 500.0, 900.0, 1000.0, 1100.0),
+        frequencies=(90.0, FORCE_FREQUENCY, 110.0, 200.0, 500.0, 900.0, 1000.0, 1100.0),
         cycle_samples=2000,
         cycle_preload=0.8,
     ),
@@ -190,170 +163,6 @@ register_assumption(
 )
 
 
-def stall_estimate(forces, window: int = STALL_WINDOW) -> dict:
-    """Remaining rise and spread of a per-period force series (the stall criterion).
-
-    Parameters
-    ----------
-    forces : array_like
-        F_n, one value per period (N).
-    window : int
-        Number of last periods examined (even, >= 4).
-
-    Returns
-    -------
-    dict
-        ``remaining_N``: estimated rise still to come (``inf`` while the force grows at
-        an undiminished rate); ``spread_N``: max − min over the window; ``ratio``:
-        D₂/D₁ of the two half-windows (nan when undefined).
-    """
-    f = np.asarray(forces, dtype=float)
-    if int(window) != window or window < 4 or window % 2:
-        raise ValueError(f"window = {window!r} is out of range: must be an even integer >= 4")
-    if f.ndim != 1 or f.size < window + 1:
-        return {"remaining_N": math.inf, "spread_N": math.inf, "ratio": math.nan}
-    half = window // 2
-    d1 = f[-1 - half] - f[-1 - window]
-    d2 = f[-1] - f[-1 - half]
-    spread = float(np.ptp(f[-1 - window :]))
-    if d2 == 0.0:
-        return {"remaining_N": 0.0, "spread_N": spread, "ratio": 0.0 if d1 != 0 else math.nan}
-    if d1 == 0.0:
-        return {"remaining_N": math.inf, "spread_N": spread, "ratio": math.nan}
-    ratio = d2 / d1
-    if ratio < 0:  # oscillating about the stall level: bounded by the last swing
-        remaining = max(abs(d1), abs(d2))
-    elif ratio < 1:  # geometric approach
-        remaining = abs(d2) * ratio / (1.0 - ratio)
-    else:  # not slowing down
-        remaining = math.inf
-    return {"remaining_N": float(remaining), "spread_N": spread, "ratio": float(ratio)}
-
-
-def _stalled(estimate: dict, force: float, abs_tol: float, rel_tol: float) -> bool:
-    tol = max(abs_tol, rel_tol * abs(force))
-    return estimate["remaining_N"] <= tol and estimate["spread_N"] <= tol
-
-
-def _next_periods(periods: int, estimate: dict, force: float, window: int, abs_tol: float, rel_tol: float,
-                  max_periods: int) -> int:
-    """Periods of the next (longer) run from rest.
-
-    In the geometric approach the per-period factor q = r^(1/half) predicts how many more
-    periods bring the remaining rise below half the tolerance; the next run asks for that
-    with a 25 % margin, at least 1.5× and at most 4× the current run. Before the approach
-    is geometric (the force still rises at an undiminished rate) the run is doubled.
-    """
-    ratio = estimate["ratio"]
-    if 0.0 < ratio < 1.0 and math.isfinite(estimate["remaining_N"]) and estimate["remaining_N"] > 0:
-        q = ratio ** (1.0 / (window // 2))
-        tol = max(abs_tol, rel_tol * abs(force))
-        more = math.log(0.5 * tol / estimate["remaining_N"]) / math.log(q)
-        wanted = math.ceil(1.25 * (periods + max(more, 0.0)))
-        wanted = min(max(wanted, math.ceil(1.5 * periods)), 4 * periods)
-    else:
-        wanted = 2 * periods
-    return int(min(max_periods, window * math.ceil(wanted / window)))
-
-
-def generated_force(
-    drive: Drive,
-    amplitude: float,
-    frequency: float,
-    *,
-    flyback: str = "slew",
-    initial_periods: int = INITIAL_PERIODS,
-    max_periods: int = MAX_PERIODS,
-    abs_tolerance: float = STALL_ABS_TOLERANCE,
-    rel_tolerance: float = STALL_REL_TOLERANCE,
-    window: int = STALL_WINDOW,
-) -> dict:
-    """Generated force at stall: saw-tooth runs from rest against the load cell (Section 4.2).
-
-    Parameters
-    ----------
-    drive : Drive
-        The drive; the load cell is engaged whatever ``drive.load_cell`` says.
-    amplitude : float
-        Actuation amplitude A (m).
-    frequency : float
-        Driving frequency f (Hz).
-    flyback : {"slew", "fixed"}
-        Fly-back rule of :func:`passmd.waveforms.sawtooth`.
-    initial_periods, max_periods : int
-        Periods of the first run, doubled until stall or until ``max_periods``.
-    abs_tolerance, rel_tolerance : float
-        Stall tolerance max(abs, rel·F_gen) (N, fraction) on the remaining rise and the
-        spread of the per-period force (see the module docstring).
-    window : int
-        Periods examined by the stall criterion.
-
-    Returns
-    -------
-    dict
-        SI values, keys carrying the unit: ``generated_force_N`` (k·x̄_r over the last
-        period), ``converged`` (stall criterion met), ``periods`` (of the run reported),
-        ``periods_simulated`` (all runs together), ``remaining_force_N`` (estimated rise
-        still to come), ``force_spread_N`` (over the window), ``mean_friction_N`` (mean
-        total friction on the runner over the last period), ``piezo_mean_force_N`` (k times
-        the mean piezo position x̄_p, what the load cell reads if the runner only follows
-        the piezo), ``last_step_m``, ``net_displacement_m`` (x̄_r − x̄_p over the last
-        period), ``wall_time_s`` (integration time of all runs), ``cpu_time_s`` (CPU time of
-        the whole call).
-
-    Raises
-    ------
-    ValueError
-        Bad input (names the parameter, its value and the allowed range).
-    passmd.dynamics.SimulationError
-        A run diverged.
-    """
-    cpu = time.process_time()
-    if not isinstance(drive, Drive):
-        raise ValueError(f"drive = {drive!r} is not a Drive")
-    check_positive("frequency", frequency, "Hz")
-    check_choice("flyback", flyback, ("slew", "fixed"))
-    check_positive("abs_tolerance", abs_tolerance, "N")
-    check_range("rel_tolerance", rel_tolerance, 0.0, 1.0, upper_open=True)
-    for name, value in (("initial_periods", initial_periods), ("max_periods", max_periods)):
-        if isinstance(value, bool) or int(value) != value or value < window + 1:
-            raise ValueError(f"{name} = {value!r} is out of range: must be an integer >= {window + 1}")
-    if max_periods < initial_periods:
-        raise ValueError(f"max_periods = {max_periods!r} is out of range: must be >= initial_periods "
-                         f"= {initial_periods!r}")
-    drive = drive if drive.load_cell else drive.replace(load_cell=True)
-    k = drive.load_cell_stiffness
-    periods, simulated, wall = int(initial_periods), 0, 0.0
-    while True:
-        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=periods, flyback=flyback)
-        result = dynamics.simulate(drive, wave, max_points=2)
-        simulated += periods
-        wall += result.wall_time
-        forces = k * result.period_mean_position
-        estimate = stall_estimate(forces, window)
-        converged = _stalled(estimate, float(forces[-1]), abs_tolerance, rel_tolerance)
-        if converged or periods >= max_periods:
-            break
-        periods = _next_periods(periods, estimate, float(forces[-1]), window, abs_tolerance, rel_tolerance,
-                                int(max_periods))
-    T = wave.period
-    piezo_mean = float(np.mean(wave.position(np.linspace((periods - 1) * T, periods * T, 4001))))
-    return {
-        "generated_force_N": float(forces[-1]),
-        "converged": bool(converged),
-        "periods": int(periods),
-        "periods_simulated": int(simulated),
-        "remaining_force_N": estimate["remaining_N"],
-        "force_spread_N": estimate["spread_N"],
-        "mean_friction_N": float(result.period_mean_friction[-1]),
-        "piezo_mean_force_N": k * piezo_mean,
-        "last_step_m": float(result.step_sizes[-1]),
-        "net_displacement_m": float(result.period_mean_position[-1] - piezo_mean),
-        "wall_time_s": float(wall),
-        "cpu_time_s": float(time.process_time() - cpu),
-    }
-
-
 def force_drive(
     hemisphere_radius: float, preload: float, actuator_model: str, friction_coefficient: float
 ) -> Drive:
@@ -365,20 +174,6 @@ def force_drive(
         friction_coefficient=friction_coefficient,
         load_cell=True,
     )
-
-
-def force_onset(drive: Drive, frequency: float = FORCE_FREQUENCY, tolerance: float = 0.2e-9) -> dict:
-    """Onset of force generation: the critical amplitude with the load cell engaged (m).
-
-    Calls :func:`passmd.experiments.critical_amplitude.critical_amplitude` (steady-state
-    protocol) on ``drive`` with its load cell engaged. Returns its dict
-    (``critical_amplitude_m`` — ``None`` if even the full stroke makes no step —,
-    ``bracket_low_m``, ``bracket_high_m``, ``runs``, ``wall_time_s``).
-    """
-    if not isinstance(drive, Drive):
-        raise ValueError(f"drive = {drive!r} is not a Drive")
-    return critical_amplitude(drive if drive.load_cell else drive.replace(load_cell=True),
-                              frequency=frequency, tolerance=tolerance)
 
 
 # --------------------------------------------------------------------------------------
@@ -420,77 +215,6 @@ def onset_point(
     return out
 
 
-def stall_cycle(
-    drive: Drive, amplitude: float, frequency: float, periods: int, samples_per_period: int = 2000
-) -> dict:
-    """One period at stall, from the fly-back that starts it: time series and measures.
-
-    Runs ``periods`` saw-tooth periods from rest (the count :func:`generated_force` needed to
-    stall) recording ``samples_per_period`` samples per period, and keeps the window from the
-    fly-back of period ``periods − 1`` to that of the last period.
-
-    Returns
-    -------
-    dict
-        Arrays (SI) ``time_s`` (since the fly-back), ``piezo_m``, ``runner_m`` (x_r − x̄_r),
-        ``load_cell_N`` (k·x_r), ``friction_N`` (total on the runner), and per contact group
-        (side 1: two contacts at F_N1, side 2: four at F_N2) ``friction_side{1,2}_N``,
-        ``deflection_side{1,2}_m`` (x_p − x_a), ``slip_share_side{1,2}``; scalars
-        ``generated_force_N``, ``sliding_capacity_N`` (Σ μF_N), ``back_slide_m`` (largest
-        backward excursion of the runner after the fly-back, from every integrator step),
-        ``deflection_before_flyback_side{1,2}_m`` (x_p − x_a at the last sample before it),
-        ``full_slip_time_s`` (time every contact slides, to the sample spacing),
-        ``mean_slip_share_side{1,2}`` (over the period), ``sample_spacing_s``. The first
-        sample is the last one before the fly-back (negative time).
-    """
-    if not isinstance(drive, Drive) or drive.contacts != 6:
-        raise ValueError(f"drive = {drive!r} is not allowed: must be a six-contact Drive")
-    if isinstance(periods, bool) or int(periods) != periods or periods < 2:
-        raise ValueError(f"periods = {periods!r} is out of range: must be an integer >= 2")
-    if isinstance(samples_per_period, bool) or int(samples_per_period) != samples_per_period \
-            or samples_per_period < 100:
-        raise ValueError(
-            f"samples_per_period = {samples_per_period!r} is out of range: must be an integer >= 100"
-        )
-    drive = drive if drive.load_cell else drive.replace(load_cell=True)
-    wave = waveforms.sawtooth(amplitude, frequency, drive, periods=int(periods))
-    result = dynamics.simulate(drive, wave, max_points=int(periods) * int(samples_per_period) + 1)
-    start, end = wave.slip_marks[-2], wave.slip_marks[-1]
-    spacing = float(result.time[1] - result.time[0])
-    first = int(np.searchsorted(result.time, start, side="right")) - 1  # last sample before the fly-back
-    last = int(np.searchsorted(result.time, end, side="right"))
-    sel = slice(first, last)
-    t = result.time[sel] - start
-    k = drive.load_cell_stiffness
-    x_r = result.runner_position[sel]
-    x_p = result.piezo_position[sel]
-    n = result.multiplicity
-    friction = result.friction_force[:, sel] * n[:, None]
-    deflection = x_p[None, :] - result.actuator_position[:, sel]
-    slip = result.slip_share[:, sel]
-    forces = np.asarray(normal_forces(drive.preload, 6), dtype=float)
-    capacity = float(drive.friction_coefficient * np.sum(n * forces))
-    out = {
-        "time_s": t,
-        "piezo_m": x_p,
-        "runner_m": x_r - float(np.mean(x_r[1:])),
-        "load_cell_N": k * x_r,
-        "friction_N": friction.sum(axis=0),
-        "generated_force_N": float(result.generated_force),
-        "sliding_capacity_N": capacity,
-        "back_slide_m": float(result.back_steps[-2]),
-        "full_slip_time_s": float(np.count_nonzero(np.all(slip[:, 1:] >= 1.0 - 1e-9, axis=0)) * spacing),
-        "sample_spacing_s": spacing,
-    }
-    for g, side in enumerate(("side1", "side2")):
-        out[f"friction_{side}_N"] = friction[g]
-        out[f"deflection_{side}_m"] = deflection[g]
-        out[f"slip_share_{side}"] = slip[g]
-        out[f"deflection_before_flyback_{side}_m"] = float(deflection[g, 0])
-        out[f"mean_slip_share_{side}"] = float(np.mean(slip[g, 1:]))
-    return out
-
-
 def cycle_point(
     hemisphere_radius: float,
     preload: float,
@@ -517,9 +241,9 @@ def _settings(profile: str) -> ProfileSettings:
     return PROFILE_SETTINGS[check_choice("profile", profile, PROFILES)]
 
 
-def _stall_frame(points: list[dict], description: str) -> pd.DataFrame:
+def _stall_frame(points: list[dict], description: str, config: RunConfig) -> pd.DataFrame:
     """Stall runs through the sweep engine; tidy frame in display units (nm, mN)."""
-    f = sweep.run(stall_point, points, description=description)
+    f = sweep.run(stall_point, points, description=description, config=config)
     labels = {(m, mu): label for m, mu, label in MODELS}
     return pd.DataFrame(
         {
@@ -547,13 +271,13 @@ def _stall_frame(points: list[dict], description: str) -> pd.DataFrame:
     )
 
 
-def _onset_frame(curves: list[tuple], profile: str) -> pd.DataFrame:
+def _onset_frame(curves: list[tuple], config: RunConfig) -> pd.DataFrame:
     points = [
         {"hemisphere_radius": r, "preload": float(p), "actuator_model": m, "friction_coefficient": mu,
-         "frequency": FORCE_FREQUENCY, "tolerance": ONSET_TOLERANCE[profile]}
+         "frequency": FORCE_FREQUENCY, "tolerance": ONSET_TOLERANCE[config.profile]}
         for r, p, m, mu in curves
     ]
-    f = sweep.run(onset_point, points, description="fig7 onsets")
+    f = sweep.run(onset_point, points, description="fig7 onsets", config=config)
     return pd.DataFrame(
         {
             "radius_mm": f["hemisphere_radius"] * 1e3,
@@ -569,7 +293,7 @@ def _onset_frame(curves: list[tuple], profile: str) -> pd.DataFrame:
     )
 
 
-def _curves_frame(radius_preloads: dict, fractions, profile: str, panel: str) -> pd.DataFrame:
+def _curves_frame(radius_preloads: dict, fractions, config: RunConfig, panel: str) -> pd.DataFrame:
     """F_gen against amplitude for every (radius, preload, model), with each curve's onset."""
     curves = [(r, float(p), m, mu) for r, preloads in radius_preloads.items() for p in preloads
               for m, mu, _ in MODELS]
@@ -578,52 +302,44 @@ def _curves_frame(radius_preloads: dict, fractions, profile: str, panel: str) ->
          "amplitude_fraction": float(a), "frequency": FORCE_FREQUENCY}
         for r, p, m, mu in curves for a in fractions
     ]
-    stalls = _stall_frame(points, panel)
-    onsets = _onset_frame(curves, profile)
+    stalls = _stall_frame(points, panel, config)
+    onsets = _onset_frame(curves, config)
     keys = ["radius_mm", "preload_N", "actuator_model", "friction_coefficient"]
     frame = stalls.merge(onsets, on=keys, how="left", validate="many_to_one")
     frame.insert(0, "panel", panel)
     return frame
 
 
-def _panel(name: str, profile: str) -> pd.DataFrame:
+def _panel(name: str, config: RunConfig) -> pd.DataFrame:
     radius, preloads = PANELS[name]
-    return _curves_frame({radius: preloads}, _settings(profile).panel_fractions, profile, name)
+    return _curves_frame({radius: preloads}, _settings(config.profile).panel_fractions, config, name)
 
 
-@register_figure("fig7a", title="Generated force against amplitude, R = 1 mm, 0.3 and 0.8 N",
-                 chapter="force_generation", plot=plots.plot_panel)
-def fig7a(profile: str = "paper") -> pd.DataFrame:
+def fig7a(config: RunConfig) -> pd.DataFrame:
     """Fig. 7a: F_gen against A (0–202 nm), R = 1 mm, F_p = 0.3 and 0.8 N, both models (mN, nm)."""
-    return _panel("fig7a", profile)
+    return _panel("fig7a", config)
 
 
-@register_figure("fig7b", title="Generated force against amplitude, R = 0.25 mm, 0.2 and 0.4 N",
-                 chapter="force_generation", plot=plots.plot_panel)
-def fig7b(profile: str = "paper") -> pd.DataFrame:
+def fig7b(config: RunConfig) -> pd.DataFrame:
     """Fig. 7b: F_gen against A (0–96 nm), R = 0.25 mm, F_p = 0.2 and 0.4 N, both models (mN, nm)."""
-    return _panel("fig7b", profile)
+    return _panel("fig7b", config)
 
 
-@register_figure("fig7grid", title="Generated force for every preload of both radii (beyond the paper)",
-                 chapter="force_generation", plot=plots.plot_grid)
-def fig7grid(profile: str = "paper") -> pd.DataFrame:
+def fig7grid(config: RunConfig) -> pd.DataFrame:
     """F_gen against A for the full preload grids of both radii, both models, with onsets."""
-    s = _settings(profile)
-    return _curves_frame(s.grid_preloads, s.grid_fractions, profile, "grid")
+    s = _settings(config.profile)
+    return _curves_frame(s.grid_preloads, s.grid_fractions, config, "grid")
 
 
-@register_figure("fig7freq", title="Generated force at full amplitude against the drive frequency",
-                 chapter="force_generation", plot=plots.plot_frequency)
-def fig7freq(profile: str = "paper") -> pd.DataFrame:
+def fig7freq(config: RunConfig) -> pd.DataFrame:
     """F_gen at A_max against the saw-tooth frequency, each panel's higher preload, both models."""
-    s = _settings(profile)
+    s = _settings(config.profile)
     points = [
         {"hemisphere_radius": radius, "preload": float(max(preloads)), "actuator_model": m,
          "friction_coefficient": mu, "amplitude_fraction": 1.0, "frequency": float(f)}
         for radius, preloads in PANELS.values() for m, mu, _ in MODELS for f in s.frequencies
     ]
-    return _stall_frame(points, "fig7freq")
+    return _stall_frame(points, "fig7freq", config)
 
 
 #: Actuator model × μ of the stall-cycle figure: the two models and the two crossings.
@@ -633,29 +349,27 @@ CYCLE_COMBINATIONS = (("rigid", 0.3), ("rigid", 0.2), ("flexible", 0.3), ("flexi
 CYCLE_DRIVE = (1.0e-3, 1.0)
 
 
-@register_figure("fig7cycle", title="One period at stall, rigid/flexible × μ = 0.3/0.2, R = 1 mm, A_max",
-                 chapter="force_generation", plot=plots.plot_cycle)
-def fig7cycle(profile: str = "paper") -> pd.DataFrame:
+def fig7cycle(config: RunConfig) -> pd.DataFrame:
     """One stall period of the four actuator-model × μ combinations (tidy, one row per sample).
 
     Per-run measures (``generated_force_mN``, ``back_slide_nm``, ...) repeat on every row of
     their run.
     """
-    s = _settings(profile)
+    s = _settings(config.profile)
     radius, fraction = CYCLE_DRIVE
     preload = s.cycle_preload
     base = {"hemisphere_radius": radius, "preload": preload, "amplitude_fraction": fraction,
             "frequency": FORCE_FREQUENCY}
     combos = [{**base, "actuator_model": m, "friction_coefficient": mu} for m, mu in CYCLE_COMBINATIONS]
-    stalls = sweep.run(stall_point, combos, description="fig7cycle stall")
+    stalls = sweep.run(stall_point, combos, description="fig7cycle stall", config=config)
     if not stalls["converged"].all():
         bad = stalls.loc[~stalls["converged"], ["actuator_model", "friction_coefficient"]]
         raise RuntimeError(f"stall-cycle runs did not stall: {bad.to_dict('records')}")
     points = [{**c, "periods": int(p), "samples_per_period": s.cycle_samples}
               for c, p in zip(combos, stalls["periods"], strict=True)]
-    cycles = sweep.run(cycle_point, points, description="fig7cycle")
+    cycles = sweep.run(cycle_point, points, description="fig7cycle", config=config)
     frames = []
-    for (_, row), stall in zip(cycles.iterrows(), stalls.itertuples(), strict=True):
+    for (_, row), stalled in zip(cycles.iterrows(), stalls.itertuples(), strict=True):
         n = len(row["time_s"])
         frame = {
             "actuator_model": [row["actuator_model"]] * n,
@@ -682,7 +396,7 @@ def fig7cycle(profile: str = "paper") -> pd.DataFrame:
             ("mean_slip_share_side2", 1.0, "mean_slip_share_side2"),
         ):
             frame[name] = row[key] * factor
-        frame["periods"] = int(stall.periods)
+        frame["periods"] = int(stalled.periods)
         frames.append(pd.DataFrame(frame))
     out = pd.concat(frames, ignore_index=True)
     out.insert(0, "amplitude_nm", float(stalls["amplitude_m"].iloc[0]) * 1e9)
@@ -823,3 +537,245 @@ def _fig7_onsets(results) -> dict:
             lhs.append(onset[_EARLIER])
             rhs.append(onset[_THIS])
     return {"lhs": np.array(lhs), "rhs": np.array(rhs)}
+
+
+# --------------------------------------------------------------------------------------
+# Facts the chapter reads from the figures' data (display units: nm, mN, Hz)
+# --------------------------------------------------------------------------------------
+
+
+#: Columns of the figure data that are timings of this machine, left out of the published data.
+TIMING_COLUMNS = ("cpu_time_s", "onset_cpu_time_s")
+
+
+def published(frame: pd.DataFrame) -> pd.DataFrame:
+    """A figure's data as the book publishes it: without the machine's timings."""
+    return frame.drop(columns=list(TIMING_COLUMNS), errors="ignore")
+
+
+def stall_protocol_facts() -> dict:
+    """The stall protocol's settings in the chapter's units: drive frequency (Hz), window and half
+    window (periods), absolute (mN) and relative (%) tolerance, first and largest run (periods)."""
+    return {"f_drive": FORCE_FREQUENCY, "window": stall.STALL_WINDOW, "half_window": stall.STALL_WINDOW // 2,
+            "abs_tol_mN": stall.STALL_ABS_TOLERANCE * 1e3, "rel_tol_pct": stall.STALL_REL_TOLERANCE * 100,
+            "max_periods": stall.MAX_PERIODS, "initial_periods": stall.INITIAL_PERIODS}
+
+
+def model_curve(frame: pd.DataFrame, model: tuple, preload: float) -> pd.DataFrame:
+    """The rows of one (actuator model, μ) at one preload, sorted by amplitude."""
+    sel = frame[(frame["actuator_model"] == model[0]) & np.isclose(frame["friction_coefficient"], model[1])
+                & np.isclose(frame["preload_N"], preload)]
+    return sel.sort_values("amplitude_nm")
+
+
+def drive_facts(preload: float = max(PANELS["fig7a"][1])) -> dict:
+    """Load-cell stiffness k (N/m), the runner's swing on the load cell alone (Hz) and its linear
+    frequency on the contacts (kHz) for the Fig. 7a drive (R = 1 mm, flexible, μ = 0.2)."""
+    drive = force_drive(PANELS["fig7a"][0], preload, *_THIS)
+    k = drive.load_cell_stiffness
+    return {"k": k, "f_load_cell": float(np.sqrt(k / drive.runner_mass) / (2 * np.pi)),
+            "f_runner_kHz": runner_frequency(drive) / 1e3}
+
+
+def stall_summary(frames) -> dict:
+    """Points, stalled points and the least and most periods over the given figure frames."""
+    panels = pd.concat(list(frames))
+    return {"n_points": len(panels), "n_converged": int(panels["converged"].sum()),
+            "periods_min": int(panels["periods"].min()), "periods_max": int(panels["periods"].max())}
+
+
+def full_stroke_row(frame: pd.DataFrame, model: tuple, preload: float) -> pd.Series:
+    """The run of one model at one preload at the largest amplitude of the frame."""
+    return model_curve(frame, model, preload).iloc[-1]
+
+
+def full_stroke_facts(fig7a: pd.DataFrame, paper_difference_mN: float) -> dict:
+    """Fig. 7a at its higher preload and the full stroke: both models' forces (mN), the runner travel
+    F_gen/k of this paper's model (µm), its periods and following force (mN), and the difference of
+    the two models against the paper's (``paper_difference_mN``, the 115 mN claim)."""
+    preload = max(PANELS["fig7a"][1])
+    k = drive_facts(preload)["k"]
+    this, earlier = full_stroke_row(fig7a, _THIS, preload), full_stroke_row(fig7a, _EARLIER, preload)
+    diff = force_difference(fig7a, preload)
+    at_full = diff[np.isclose(diff["amplitude_nm"], PANELS_FULL_STROKE_NM["fig7a"])]
+    difference = at_full["difference_mN"].iloc[0]
+    return {
+        "F_full_flex_mN": this["generated_force_mN"], "F_full_rigid_mN": earlier["generated_force_mN"],
+        "x_full_um": this["generated_force_mN"] * 1e-3 / k * 1e6, "periods_full_flex": int(this["periods"]),
+        "piezo_full_mN": this["piezo_mean_force_mN"], "diff_full_mN": difference,
+        "diff_full_dev_pct": 100 * abs(difference - paper_difference_mN) / paper_difference_mN,
+    }
+
+
+def band_difference(fig7freq: pd.DataFrame, low: float = 80.0, high: float = 120.0,
+                    radius_mm: float = PANELS["fig7a"][0] * 1e3) -> pd.Series:
+    """F_gen(rigid) − F_gen(flexible) at the full stroke at each frequency in [low, high] Hz (mN)."""
+    band = fig7freq[np.isclose(fig7freq["radius_mm"], radius_mm) & (fig7freq["frequency_Hz"] >= low)
+                    & (fig7freq["frequency_Hz"] <= high)]
+    pivot = band.pivot_table(index="frequency_Hz", columns="actuator_model", values="generated_force_mN")
+    return pivot["rigid"] - pivot["flexible"]
+
+
+def panel_full_stroke(frame: pd.DataFrame, name: str) -> dict:
+    """F_gen of both models at the full stroke for each preload of a Fig. 7 panel (mN), keyed
+    ``"<preload>_rigid"``/``"<preload>_flexible"`` with the preload written without its dot."""
+    out = {}
+    for preload in PANELS[name][1]:
+        tag = f"{preload:g}".replace(".", "")
+        out[f"{tag}_rigid"] = full_stroke_row(frame, _EARLIER, preload)["generated_force_mN"]
+        out[f"{tag}_flex"] = full_stroke_row(frame, _THIS, preload)["generated_force_mN"]
+    return out
+
+
+def panel_differences(data: dict) -> dict:
+    """:func:`force_difference` of every preload of both Fig. 7 panels, keyed ``"<panel> <preload> N"``."""
+    return {f"{name} {p:g} N": force_difference(data[name], p) for name in PANELS for p in PANELS[name][1]}
+
+
+def difference_table(differences: dict) -> pd.DataFrame:
+    """The :func:`panel_differences` as one table, each row tagged with its ``series`` key."""
+    return pd.concat([d.assign(series=key) for key, d in differences.items()])
+
+
+def onset_table(panels: pd.DataFrame) -> pd.DataFrame:
+    """Simulated and closed-form (Eq. 11 rigid, Eq. 12 flexible) onsets of each curve (nm)."""
+    return (panels.drop_duplicates(["radius_mm", "preload_N", "actuator_model", "friction_coefficient"])
+            [["radius_mm", "preload_N", "actuator_model", "friction_coefficient", "onset_nm",
+              "analytic_onset_nm"]])
+
+
+def onset_ratios(onsets: pd.DataFrame) -> dict:
+    """How far the rigid model's onset lies above the flexible one's (%), simulated and closed form."""
+    wide = onsets.pivot_table(index=["radius_mm", "preload_N"], columns="actuator_model",
+                              values=["onset_nm", "analytic_onset_nm"])
+    sim = (wide[("onset_nm", "rigid")] / wide[("onset_nm", "flexible")] - 1) * 100
+    eq = (wide[("analytic_onset_nm", "rigid")] / wide[("analytic_onset_nm", "flexible")] - 1) * 100
+    return {"onset_ratio_min": sim.min(), "onset_ratio_max": sim.max(), "eq_ratio_min": eq.min(),
+            "eq_ratio_max": eq.max()}
+
+
+def difference_above_onsets(data: dict, differences: dict) -> dict:
+    """The model difference from the amplitude where both models generate force on, per preload,
+    as ``{"x": amplitudes_nm, "y": differences_mN}`` for :func:`passmd.ledger.check_trend`."""
+    above = {}
+    for key, d in differences.items():
+        name, p = key.split()[0], float(key.split()[1])
+        rows = data[name][np.isclose(data[name]["preload_N"], p)]
+        part = d[d["amplitude_nm"] >= rows["onset_nm"].max()]
+        above[key] = {"x": part["amplitude_nm"].to_numpy(), "y": part["difference_mN"].to_numpy()}
+    return above
+
+
+def _cycle_runs(cycle: pd.DataFrame) -> pd.DataFrame:
+    return cycle.drop_duplicates(["actuator_model", "friction_coefficient"]).set_index(
+        ["actuator_model", "friction_coefficient"])
+
+
+def deflection_swing(cycle: pd.DataFrame, model: str, mu: float, side: int) -> float:
+    """Deflection swing of an actuator in the fly-back (nm): from T/k_p (measured before the
+    fly-back) to −μF_N/k_p (sliding contact); zero for rigid actuators."""
+    if model == "rigid":
+        return 0.0
+    preload = float(cycle["preload_N"].iloc[0])
+    forces = np.asarray(normal_forces(preload, 6), dtype=float)
+    k_p = force_drive(CYCLE_DRIVE[0], preload, "flexible", 0.2).actuator.stiffness
+    before = _cycle_runs(cycle).loc[(model, mu), f"deflection_before_flyback_side{side}_nm"]
+    return before + mu * forces[side - 1] / k_p * 1e9
+
+
+def cycle_measures(cycle: pd.DataFrame) -> pd.DataFrame:
+    """One row per run of the stall-cycle figure: F_gen against Σ μF_N, deflections, back-slide, slip."""
+    runs = _cycle_runs(cycle)
+    return pd.DataFrame({
+        "actuator": [m for m, _ in runs.index],
+        "μ": [mu for _, mu in runs.index],
+        "F_gen [mN]": runs["generated_force_mN"].to_numpy(),
+        "Σ μF_N [mN]": runs["sliding_capacity_mN"].to_numpy(),
+        "F_gen / Σ μF_N": (runs["generated_force_mN"] / runs["sliding_capacity_mN"]).to_numpy(),
+        "T/k_p before fly-back, side 1 / 2 [nm]": [
+            f"{a:.1f} / {b:.1f}" for a, b in zip(runs["deflection_before_flyback_side1_nm"],
+                                                 runs["deflection_before_flyback_side2_nm"], strict=True)],
+        "swing T/k_p + μF_N/k_p, side 1 / 2 [nm]": [
+            f"{deflection_swing(cycle, m, mu, 1):.1f} / {deflection_swing(cycle, m, mu, 2):.1f}"
+            for m, mu in runs.index],
+        "back-slide [nm]": runs["back_slide_nm"].to_numpy(),
+        "full sliding [µs]": runs["full_slip_time_us"].to_numpy(),
+        "mean slip share, side 1 / 2": [
+            f"{a:.3f} / {b:.3f}" for a, b in zip(runs["mean_slip_share_side1"], runs["mean_slip_share_side2"],
+                                                 strict=True)],
+    })
+
+
+def cycle_facts(cycle: pd.DataFrame) -> dict:
+    """Stall forces of the four combinations (mN), the effect of μ and of the actuators' flexibility,
+    F_gen / Σ μF_N of the rigid runs, the largest mean slip share (%), sample spacing (µs), preload
+    (N) and amplitude (nm) of the stall-cycle figure."""
+    runs = _cycle_runs(cycle)
+    force = runs["generated_force_mN"]
+    ratio = runs["generated_force_mN"] / runs["sliding_capacity_mN"]
+    return {
+        "F_r03": force[("rigid", 0.3)], "F_r02": force[("rigid", 0.2)],
+        "F_f03": force[("flexible", 0.3)], "F_f02": force[("flexible", 0.2)],
+        "mu_effect_rigid": force[("rigid", 0.3)] - force[("rigid", 0.2)],
+        "mu_effect_flex": force[("flexible", 0.3)] - force[("flexible", 0.2)],
+        "flex_effect_03": force[("rigid", 0.3)] - force[("flexible", 0.3)],
+        "flex_effect_02": force[("rigid", 0.2)] - force[("flexible", 0.2)],
+        "ratio_r03": ratio[("rigid", 0.3)], "ratio_r02": ratio[("rigid", 0.2)],
+        "spacing_us": float(cycle["sample_spacing_us"].iloc[0]),
+        "cycle_preload": float(cycle["preload_N"].iloc[0]),
+        "slip_max_pct": 100 * float(
+            runs[["mean_slip_share_side1", "mean_slip_share_side2"]].to_numpy().max()),
+        "a_full": float(cycle["amplitude_nm"].iloc[0]),
+    }
+
+
+def equivalent_stroke(fig7a: pd.DataFrame, cycle: pd.DataFrame) -> dict:
+    """The amplitude at which the rigid μ = 0.3 drive of Fig. 7a stalls at the flexible μ = 0.3 stall
+    force of the cycle figure (interpolated between stalled amplitudes above the onset; nan when the
+    curve does not bracket it monotonically), the stroke lost (nm) against the swing of each side
+    (:func:`deflection_swing`), and whether loss and side-1 swing agree within 25 %."""
+    preload = float(cycle["preload_N"].iloc[0])
+    curve = model_curve(fig7a, _EARLIER, preload)
+    curve = curve[curve["converged"] & (curve["amplitude_nm"] >= curve["onset_nm"])]
+    target = _cycle_runs(cycle)["generated_force_mN"][("flexible", 0.3)]
+    monotone = bool(np.all(np.diff(curve["generated_force_mN"].to_numpy()) > 0))
+    inside = curve["generated_force_mN"].min() <= target <= curve["generated_force_mN"].max()
+    a_eq = (float(np.interp(target, curve["generated_force_mN"], curve["amplitude_nm"]))
+            if monotone and inside else math.nan)
+    a_full = float(cycle["amplitude_nm"].iloc[0])
+    swing1, swing2 = deflection_swing(cycle, "flexible", 0.3, 1), deflection_swing(cycle, "flexible", 0.3, 2)
+    loss = a_full - a_eq
+    return {"a_eq_nm": a_eq, "a_full_nm": a_full, "loss_nm": loss, "swing1_nm": swing1, "swing2_nm": swing2,
+            "agrees": bool(abs(loss - swing1) <= 0.25 * swing1), "curve_points": len(curve)}
+
+
+def grid_facts(grid: pd.DataFrame) -> dict:
+    """At the grid's largest amplitude: at how many of the preloads the earlier model generates more
+    force, the exceptions ``under`` as (radius mm, preload N), and how many grid points stalled."""
+    top = grid[np.isclose(grid["amplitude_fraction"], grid["amplitude_fraction"].max())]
+    wide = top.pivot_table(index=["radius_mm", "preload_N"], columns="actuator_model",
+                           values="generated_force_mN")
+    over = wide["rigid"] > wide["flexible"]
+    return {"n_over": int(over.sum()), "n_all": len(over), "under": list(wide[~over].index),
+            "grid_converged": int(grid["converged"].sum()), "grid_points": len(grid)}
+
+
+def frequency_spread(fig7freq: pd.DataFrame, low: float, high: float) -> dict:
+    """Largest relative spread of F_gen over the frequencies in [low, high] Hz, per radius and model.
+
+    ``spread_pct`` (max − min over the mean, %), ``frequencies`` (how many lie in the band) and
+    the band's lowest and highest frequency ``low_Hz``, ``high_Hz``.
+    """
+    sel = fig7freq[(fig7freq["frequency_Hz"] >= low) & (fig7freq["frequency_Hz"] <= high)]
+    forces = sel.groupby(["radius_mm", "actuator_model"])["generated_force_mN"]
+    rel = forces.agg(lambda v: np.ptp(v) / np.mean(v))
+    return {"spread_pct": 100 * rel.max(), "frequencies": sel["frequency_Hz"].nunique(),
+            "low_Hz": sel["frequency_Hz"].min(), "high_Hz": sel["frequency_Hz"].max()}
+
+
+def stall_cpu_seconds(data: dict) -> float:
+    """CPU time of the stall runs and onset searches of the Fig. 7 tables (s; onsets once per table)."""
+    cpu = sum(float(data[n]["cpu_time_s"].sum()) for n in ("fig7a", "fig7b", "fig7grid", "fig7freq"))
+    cpu += sum(float(data[n]["onset_cpu_time_s"].drop_duplicates().sum())
+               for n in ("fig7a", "fig7b", "fig7grid"))
+    return cpu
