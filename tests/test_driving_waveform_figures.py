@@ -15,6 +15,7 @@ from passmd import dynamics, theory, waveforms
 from passmd.config import RunConfig
 from passmd.defaults import PROTOCOL
 from passmd.experiments import driving_waveform as dw
+from passmd.experiments import waveform_facts as wf
 from passmd.experiments import waveform_studies as studies
 from passmd.plots import driving_waveform as plots
 
@@ -252,18 +253,18 @@ def test_flyback_window_resolves_the_acceleration():
 def test_design_facts_and_table(quick):
     drive = dw.section5_drive()
     design = dw.designs([dw.section5_fields()], QUICK).iloc[0]
-    facts = dw.design_facts(design, drive)
+    facts = wf.design_facts(design, drive)
     assert facts["f_ratio"] == pytest.approx(facts["f_s_kHz"] / facts["f_lin_kHz"], rel=1e-12)
     assert facts["A_nm"] == pytest.approx(drive.actuator.full_stroke_amplitude * 1e9, rel=1e-12)
     # a_f = μ ΣF_N / m_r over two contacts at F_N1 and four at F_N2 (Eq. 1)
     f_n = theory.drive_theory(drive)["normal_force_N"]
     assert facts["a_f"] == pytest.approx(0.2 * (2 * f_n[0] + 4 * f_n[1]) / drive.runner_mass, rel=1e-12)
-    table = dw.design_table(design)
+    table = wf.design_table(design)
     assert table.set_index("unit").loc["µs", "value"].tolist() == [facts["t_s_us"], facts["t_a_us"]]
 
 
 def test_fig8a_facts_follow_the_points(quick):
-    facts = dw.fig8a_facts(quick["fig8a"], dw.section5_drive())
+    facts = wf.fig8a_facts(quick["fig8a"], dw.section5_drive())
     # the runner reverses before it moves forward fastest, both within the micro-vibration's first cycle
     assert 0 < facts["t3_after_us"] < facts["t4_after_us"] < 1e3 / 5.0
     assert facts["back_step_nm"] > 0
@@ -271,14 +272,14 @@ def test_fig8a_facts_follow_the_points(quick):
 
 
 def test_acceleration_slip_and_window_facts(quick):
-    slip = dw.acceleration_slip(quick["fig9b"])
+    slip = wf.acceleration_slip(quick["fig9b"])
     fits = quick["fig9b"][(quick["fig9b"]["variant"] == "optimized") & quick["fig9b"]["settling_fits"]]
     assert slip["frequencies_kHz"] == list(fits["frequency_kHz"])
     window = pd.DataFrame({"phase": ["flyback", "settling", "acceleration", "acceleration", "after"],
                            "slip_share_1": [1.0, 0.5, 0.2, 0.3, 1.0],
                            "slip_share_2": [0.7, 0.9, 0.1, 1.0, 0.0],
                            "record_spacing_s": 2e-8})
-    facts = dw.window_facts(window)
+    facts = wf.window_facts(window)
     assert facts["window_flyback_share"] == 0.9 and not facts["flyback_full"]
     assert facts["window_acceleration_share"] == 1.0 and facts["acceleration_full"]
     assert facts["window_spacing_ns"] == pytest.approx(20.0)
@@ -287,7 +288,7 @@ def test_acceleration_slip_and_window_facts(quick):
 def test_fig9a_facts_agree_with_the_ledger(quick):
     from passmd import ledger, readings
 
-    facts = dw.fig9a_facts(quick["fig9a"])
+    facts = wf.fig9a_facts(quick["fig9a"])
     extract = ledger.extractors()
     reading = readings.default_reading()
     assert facts["x3_saw_nm"] == pytest.approx(extract["fig9a-standard-position-552nm"](
@@ -295,14 +296,14 @@ def test_fig9a_facts_agree_with_the_ledger(quick):
     assert facts["increase_pct"] == pytest.approx(extract["fig9a-step-increase-46.8pct"](
         {"fig9a": quick["fig9a"]}, reading), rel=1e-12)
     # the paper's own numbers: (716 − 552)/(552 − 202) = 46.9 %, its reported 46.8 % within rounding
-    assert dw.step_increase_pct(552.0, 716.0, 202.0) == pytest.approx(46.857, abs=1e-3)
+    assert wf.step_increase_pct(552.0, 716.0, 202.0) == pytest.approx(46.857, abs=1e-3)
 
 
 def test_startup_and_fig9b_facts(quick):
     table = quick["fig9b"]
-    start = dw.startup_facts(table)
+    start = wf.startup_facts(table)
     assert start["max_drift_pct"] < 0.5  # as test_velocity_runs_are_steady_and_consistent
-    facts = dw.fig9b_facts(table, dw.designs([dw.section5_fields()], QUICK).iloc[0], dw.section5_drive())
+    facts = wf.fig9b_facts(table, dw.designs([dw.section5_fields()], QUICK).iloc[0], dw.section5_drive())
     # t_s would fit at 110 kHz only with f_s ≥ 1 / (2 t_s,max): above the measured f_s by the factor's root
     assert facts["f_s_needed_kHz"] == pytest.approx(0.5e-3 / (facts["t_s_room_us"] * 1e-6), rel=1e-12)
     assert facts["stiffness_factor"] > 1
@@ -313,33 +314,33 @@ def test_startup_and_fig9b_facts(quick):
 
 
 def test_reachable_table_and_stick_lost(quick):
-    table = dw.reachable_table(quick["fig10a"], "preload")
+    table = wf.reachable_table(quick["fig10a"], "preload")
     assert len(table) == len(dw.FIG10A_PRELOADS) * 3
     best = table[(table["preload"] == 0.4) & (table["variant"] == "sawtooth")].iloc[0]
     f10a = quick["fig10a"]
     saw = f10a[(f10a["variant"] == "sawtooth") & np.isclose(f10a["preload"], 0.4)]
     assert best["max velocity (mm/s)"] == saw["velocity_mm_per_s"].max()
-    lost = dw.stick_lost(quick["fig10a"])
+    lost = wf.stick_lost(quick["fig10a"])
     assert set(lost["with_full_settling"]) <= set(lost["all"])
 
 
 def test_optimum_and_flexible_facts():
     optimum = studies.numerical_optimum(QUICK)
     design = dw.designs([dw.section5_fields()], QUICK).iloc[0]
-    a_f = dw.friction_acceleration(dw.section5_drive())
-    facts = studies.optimum_facts(optimum, design, a_f)
-    low = studies.optimum_at(optimum)
+    a_f = wf.friction_acceleration(dw.section5_drive())
+    facts = wf.optimum_facts(optimum, design, a_f)
+    low = wf.optimum_at(optimum)
     assert low["frequency"] == dw.STEP_FREQUENCY and low["actuator_model"] == "rigid"
     assert facts["opt_gain_100"] > 20  # the optimum beats the saw-tooth (test above: by > 20 %)
     t_a = design["acceleration_time_s"]
     assert facts["ta_ratio"] == pytest.approx(facts["opt_ta_us"] * 1e-6 / t_a, rel=1e-12)
     assert facts["slide_nm"] == pytest.approx((facts["opt_va_mm_s"] * 1e-3) ** 2 / (2 * a_f) * 1e9, rel=1e-12)
-    shown = studies.optimum_table(optimum)
+    shown = wf.optimum_table(optimum)
     assert shown["V_a (mm/s)"].iloc[0] == pytest.approx(facts["opt_va_mm_s"], rel=1e-12)
-    carried = studies.carried_steps(optimum)
+    carried = wf.carried_steps(optimum)
     assert carried["actuators"].tolist() == ["rigid", "flexible"]
     assert carried.iloc[0]["gain (%)"] > 20
     flexible = dw.designs([dw.section5_fields(actuator_model="flexible")], QUICK).iloc[0]
-    flex = studies.flexible_facts(optimum, flexible, carried, dw.section5_drive())
+    flex = wf.flexible_facts(optimum, flexible, carried, dw.section5_drive())
     assert np.isnan(flex["flex_opt_gain"])  # the quick profile does not optimise flexible actuators
-    assert flex["f_s_flex_kHz"] < dw.design_facts(design, dw.section5_drive())["f_s_kHz"]
+    assert flex["f_s_flex_kHz"] < wf.design_facts(design, dw.section5_drive())["f_s_kHz"]

@@ -16,6 +16,7 @@ import pytest
 from passmd import ledger, readings
 from passmd.config import RunConfig
 from passmd.defaults import PROTOCOL
+from passmd.experiments import force_facts as ff
 from passmd.experiments import force_generation as fg
 from passmd.plots import force_generation as fg_plots
 from passmd.protocols import stall
@@ -263,33 +264,33 @@ def test_onset_is_the_protocol_frequency_by_default():
 
 
 def test_model_curve_selects_one_model_and_preload_sorted(quick):
-    curve = fg.model_curve(quick["fig7a"], THIS, 0.8)
+    curve = ff.model_curve(quick["fig7a"], THIS, 0.8)
     assert set(curve["actuator_model"]) == {"flexible"} and np.allclose(curve["friction_coefficient"], 0.2)
     assert np.allclose(curve["preload_N"], 0.8)
     assert np.all(np.diff(curve["amplitude_nm"].to_numpy()) > 0)
-    assert fg.full_stroke_row(quick["fig7a"], THIS, 0.8)["amplitude_nm"] == curve["amplitude_nm"].max()
+    assert ff.full_stroke_row(quick["fig7a"], THIS, 0.8)["amplitude_nm"] == curve["amplitude_nm"].max()
 
 
 def test_stall_summary_counts_the_panels(quick):
-    summary = fg.stall_summary([quick["fig7a"], quick["fig7b"]])
+    summary = ff.stall_summary([quick["fig7a"], quick["fig7b"]])
     assert summary["n_points"] == len(quick["fig7a"]) + len(quick["fig7b"])
     assert summary["n_converged"] == summary["n_points"]  # every quick point stalls (snapshot test)
     assert stall.STALL_WINDOW < summary["periods_min"] <= summary["periods_max"] <= stall.MAX_PERIODS
 
 
 def test_full_stroke_facts_agree_with_the_115mn_extractor(quick):
-    facts = fg.full_stroke_facts(quick["fig7a"], paper_difference_mN=100.0)
+    facts = ff.full_stroke_facts(quick["fig7a"], paper_difference_mN=100.0)
     extracted = ledger.extractors()["fig7a-force-difference-115mn"]({"fig7a": quick["fig7a"]},
                                                                     readings.default_reading())
     assert facts["diff_full_mN"] == pytest.approx(extracted, rel=1e-12)
     assert facts["F_full_rigid_mN"] - facts["F_full_flex_mN"] == pytest.approx(extracted, rel=1e-12)
     assert facts["diff_full_dev_pct"] == pytest.approx(abs(extracted - 100.0), rel=1e-12)
-    k = fg.drive_facts()["k"]
+    k = ff.drive_facts()["k"]
     assert facts["x_full_um"] == pytest.approx(facts["F_full_flex_mN"] * 1e-3 / k * 1e6, rel=1e-12)
 
 
 def test_drive_facts_of_the_load_cell():
-    facts = fg.drive_facts()
+    facts = ff.drive_facts()
     drive = fg.force_drive(1e-3, 0.8, "flexible", 0.2)
     assert facts["k"] == drive.load_cell_stiffness
     swing = np.sqrt(drive.load_cell_stiffness / drive.runner_mass) / (2 * np.pi)
@@ -299,7 +300,7 @@ def test_drive_facts_of_the_load_cell():
 
 
 def test_band_difference_is_rigid_minus_flexible(quick):
-    band = fg.band_difference(quick["fig7freq"])
+    band = ff.band_difference(quick["fig7freq"])
     assert list(band.index) == [PROTOCOL.drive_frequency]  # the quick grid has one frequency near 100 Hz
     rows = quick["fig7freq"]
     rows = rows[np.isclose(rows["radius_mm"], 1.0)
@@ -309,9 +310,9 @@ def test_band_difference_is_rigid_minus_flexible(quick):
 
 
 def test_panel_full_stroke_and_differences(quick):
-    forces = fg.panel_full_stroke(quick["fig7b"], "fig7b")
+    forces = ff.panel_full_stroke(quick["fig7b"], "fig7b")
     assert set(forces) == {"02_rigid", "02_flex", "04_rigid", "04_flex"}
-    diffs = fg.panel_differences(quick)
+    diffs = ff.panel_differences(quick)
     assert set(diffs) == {"fig7a 0.3 N", "fig7a 0.8 N", "fig7b 0.2 N", "fig7b 0.4 N"}
     last = diffs["fig7b 0.4 N"].iloc[-1]["difference_mN"]
     assert last == pytest.approx(forces["04_rigid"] - forces["04_flex"], rel=1e-12)
@@ -322,7 +323,7 @@ def test_onset_ratios_of_a_table():
                            "actuator_model": ["rigid", "flexible"] * 2,
                            "friction_coefficient": [0.3, 0.2] * 2, "onset_nm": [30.0, 20.0, 60.0, 50.0],
                            "analytic_onset_nm": [33.0, 30.0, 66.0, 55.0]})
-    ratios = fg.onset_ratios(onsets)
+    ratios = ff.onset_ratios(onsets)
     assert ratios["onset_ratio_min"] == pytest.approx(20.0)
     assert ratios["onset_ratio_max"] == pytest.approx(50.0)
     assert ratios["eq_ratio_min"] == pytest.approx(10.0)
@@ -331,9 +332,9 @@ def test_onset_ratios_of_a_table():
 
 def test_onset_table_and_difference_above_onsets(quick):
     panels = pd.concat([quick["fig7a"], quick["fig7b"]])
-    onsets = fg.onset_table(panels)
+    onsets = ff.onset_table(panels)
     assert len(onsets) == 8  # 4 preloads × 2 models
-    above = fg.difference_above_onsets(quick, fg.panel_differences(quick))
+    above = ff.difference_above_onsets(quick, ff.panel_differences(quick))
     for key, series in above.items():
         name, preload = key.split()[0], float(key.split()[1])
         top = onsets[np.isclose(onsets["preload_N"], preload)
@@ -357,29 +358,29 @@ def test_deflection_swing_adds_the_sliding_friction():
     from passmd.theory import normal_forces
 
     cycle = _cycle(100.0)
-    assert fg.deflection_swing(cycle, "rigid", 0.3, 1) == 0.0
+    assert ff.deflection_swing(cycle, "rigid", 0.3, 1) == 0.0
     k_p = fg.force_drive(1e-3, 0.8, "flexible", 0.2).actuator.stiffness
     f_n = np.asarray(normal_forces(0.8, 6))
-    assert fg.deflection_swing(cycle, "flexible", 0.3, 2) == pytest.approx(2.0 + 0.3 * f_n[1] / k_p * 1e9)
+    assert ff.deflection_swing(cycle, "flexible", 0.3, 2) == pytest.approx(2.0 + 0.3 * f_n[1] / k_p * 1e9)
 
 
 def test_cycle_facts_separate_the_two_causes():
-    facts = fg.cycle_facts(_cycle(100.0))
+    facts = ff.cycle_facts(_cycle(100.0))
     assert facts["mu_effect_rigid"] == pytest.approx(30.0) and facts["mu_effect_flex"] == pytest.approx(20.0)
     assert facts["flex_effect_03"] == pytest.approx(50.0) and facts["flex_effect_02"] == pytest.approx(40.0)
     assert facts["ratio_r03"] == pytest.approx(0.5) and facts["slip_max_pct"] == pytest.approx(2.0)
-    assert len(fg.cycle_measures(_cycle(100.0))) == 4
+    assert len(ff.cycle_measures(_cycle(100.0))) == 4
 
 
 def test_equivalent_stroke_interpolates_the_rigid_curve():
     fig7a = pd.DataFrame({"actuator_model": "rigid", "friction_coefficient": 0.3, "preload_N": 0.8,
                           "amplitude_nm": [0.0, 50.0, 100.0, 202.0], "converged": True, "onset_nm": 30.0,
                           "generated_force_mN": [1.0, 40.0, 100.0, 150.0]})
-    out = fg.equivalent_stroke(fig7a, _cycle(70.0))
+    out = ff.equivalent_stroke(fig7a, _cycle(70.0))
     assert out["curve_points"] == 3
     assert out["a_eq_nm"] == pytest.approx(75.0) and out["loss_nm"] == pytest.approx(127.0)
     # a target outside the curve is not extrapolated
-    assert math.isnan(fg.equivalent_stroke(fig7a, _cycle(200.0))["a_eq_nm"])
+    assert math.isnan(ff.equivalent_stroke(fig7a, _cycle(200.0))["a_eq_nm"])
 
 
 def test_grid_facts_name_the_exceptions():
@@ -387,7 +388,7 @@ def test_grid_facts_name_the_exceptions():
                          "actuator_model": ["rigid", "flexible"] * 2, "amplitude_fraction": 1.0,
                          "generated_force_mN": [50.0, 40.0, 10.0, 12.0],
                          "converged": [True, True, True, False]})
-    facts = fg.grid_facts(grid)
+    facts = ff.grid_facts(grid)
     assert (facts["n_over"], facts["n_all"]) == (1, 2)
     assert facts["under"] == [(0.25, 0.4)]
     assert (facts["grid_converged"], facts["grid_points"]) == (3, 4)
@@ -397,24 +398,24 @@ def test_frequency_spread_is_the_largest_relative_range():
     freq = pd.DataFrame({"radius_mm": 1.0, "actuator_model": ["rigid"] * 3 + ["flexible"] * 3,
                          "frequency_Hz": [90.0, 100.0, 1000.0] * 2,
                          "generated_force_mN": [90.0, 110.0, 50.0, 99.0, 101.0, 60.0]})
-    spread = fg.frequency_spread(freq, 80.0, 120.0)
+    spread = ff.frequency_spread(freq, 80.0, 120.0)
     assert spread["frequencies"] == 2 and spread["spread_pct"] == pytest.approx(20.0)
     assert (spread["low_Hz"], spread["high_Hz"]) == (90.0, 100.0)
 
 
 def test_protocol_facts_and_published_data(quick):
-    facts = fg.stall_protocol_facts()
+    facts = ff.stall_protocol_facts()
     assert facts["f_drive"] == PROTOCOL.drive_frequency and 2 * facts["half_window"] == stall.STALL_WINDOW
     assert facts["abs_tol_mN"] == pytest.approx(stall.STALL_ABS_TOLERANCE * 1e3)
     assert facts["initial_periods"] <= facts["max_periods"]
-    shown = fg.published(quick["fig7a"])
-    assert not set(fg.TIMING_COLUMNS) & set(shown.columns)
-    assert len(shown.columns) == len(quick["fig7a"].columns) - len(fg.TIMING_COLUMNS)
-    table = fg.difference_table(fg.panel_differences(quick))
-    assert set(table["series"]) == set(fg.panel_differences(quick))
+    shown = ff.published(quick["fig7a"])
+    assert not set(ff.TIMING_COLUMNS) & set(shown.columns)
+    assert len(shown.columns) == len(quick["fig7a"].columns) - len(ff.TIMING_COLUMNS)
+    table = ff.difference_table(ff.panel_differences(quick))
+    assert set(table["series"]) == set(ff.panel_differences(quick))
 
 
 def test_stall_cpu_seconds_counts_onsets_once(quick):
     data = {name: quick[name].assign(cpu_time_s=1.0, onset_cpu_time_s=2.0) for name in FIGURES}
     expected = sum(len(data[n]) for n in ("fig7a", "fig7b", "fig7grid", "fig7freq")) + 2.0 * 3
-    assert fg.stall_cpu_seconds(data) == pytest.approx(expected)
+    assert ff.stall_cpu_seconds(data) == pytest.approx(expected)
