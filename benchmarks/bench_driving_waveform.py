@@ -57,8 +57,9 @@ def blocks(repeats: int) -> dict:
     for f in (1e3, 110e3):
         for waveform, rule in (("sawtooth", ""), ("optimized", "cut")):
             out[f"steady_{waveform}_{f / 1e3:g}kHz"] = _timed(
-                lambda f=f, w=waveform, r=rule: dw.velocity_point(**dw.config(), frequency=f, waveform=w,
-                                                                  short_period=r, **fields), repeats)
+                lambda f=f, w=waveform, r=rule: dw.velocity_point(**dw.section5_fields(), frequency=f,
+                                                                  waveform=w, short_period=r, **fields),
+                repeats)
     wave = optimized_waveform.optimized(amplitude, 100.0, drive, periods=3, design=design)
     out["step_100hz"] = _timed(lambda: dynamics.simulate(drive, wave, max_points=2), repeats)
     return out

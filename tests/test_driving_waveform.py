@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from passmd import dynamics, theory, waveforms
+from passmd.defaults import PROTOCOL
 from passmd.optimized_waveform import (
     MIN_RAMP_FRACTION,
     OptimizedDesign,
@@ -20,6 +21,8 @@ from passmd.parameters import paper_drive
 from passmd.protocols import eq15
 
 A = 202e-9  # m, the paper's full amplitude for R = 1 mm
+#: The saw-tooth frequency of the design and of Fig. 9a (Hz).
+F_STEP = PROTOCOL.drive_frequency
 
 
 @pytest.fixture(scope="module")
@@ -76,7 +79,7 @@ def test_measured_micro_vibration_frequency_against_linear_estimate(design, driv
     assert np.sqrt(2.0 / 3.0) <= ratio <= 1.01
 
 
-@pytest.mark.parametrize("frequency", [100.0, 1e3, 10e3, 50e3, 110e3, 130e3])
+@pytest.mark.parametrize("frequency", [F_STEP, 1e3, 10e3, 50e3, 110e3, 130e3])
 def test_optimized_waveform_honours_slew_rate_and_period(design, drive, frequency):
     wave = optimized(A, frequency, drive, periods=4, design=design)
     T = 1.0 / frequency
@@ -94,8 +97,8 @@ def test_optimized_waveform_honours_slew_rate_and_period(design, drive, frequenc
 
 
 def test_first_period_is_a_sawtooth(design, drive):
-    opt = optimized(A, 100.0, drive, periods=3, design=design)
-    saw = waveforms.sawtooth(A, 100.0, drive, periods=3)
+    opt = optimized(A, F_STEP, drive, periods=3, design=design)
+    saw = waveforms.sawtooth(A, F_STEP, drive, periods=3)
     t = np.linspace(0.0, 0.01, 1001)
     np.testing.assert_allclose(opt.position(t), saw.position(t), rtol=0, atol=1e-6 * A)
     np.testing.assert_allclose(opt.settle_windows[0], saw.settle_windows[0], rtol=1e-12)
@@ -107,7 +110,7 @@ def test_first_period_is_a_sawtooth(design, drive):
 
 
 def test_settling_fits_at_low_frequency_only(design, drive):
-    low = optimized_timing(design, A, 100.0, drive)
+    low = optimized_timing(design, A, F_STEP, drive)
     assert low["settling_fits"] and low["settling_time_s"] == design.settling_time
     high = optimized_timing(design, A, 110e3, drive)
     # documented behaviour: the settling time is cut to what is left, nothing fails
@@ -137,27 +140,27 @@ def test_bad_inputs(design, drive):
     with pytest.raises(ValueError, match="acceleration_velocity"):
         eq15.optimized_design(A, drive, acceleration_velocity=0.2)
     with pytest.raises(ValueError, match="first_period"):
-        optimized(A, 100.0, drive, design=design, first_period="ramp")
+        optimized(A, F_STEP, drive, design=design, first_period="ramp")
     with pytest.raises(ValueError, match="frequency"):
         optimized(A, 300e3, drive, design=design)
     with pytest.raises(ValueError, match="acceleration_amplitude"):
-        optimized(10e-9, 100.0, drive, design=design)
+        optimized(10e-9, F_STEP, drive, design=design)
 
 
 def test_waveform_needs_a_design(drive):
     """Building the waveform never simulates: without a design it is refused, naming it."""
     with pytest.raises(ValueError, match="design = None"):
-        optimized(A, 100.0, drive, periods=2)
+        optimized(A, F_STEP, drive, periods=2)
 
 
 def test_optimized_run_from_rest(design, drive):
-    res = dynamics.simulate(drive, optimized(A, 100.0, drive, periods=3, design=design))
+    res = dynamics.simulate(drive, optimized(A, F_STEP, drive, periods=3, design=design))
     assert res.settled_positions.shape == (3,)
     assert np.all(np.isfinite(res.settled_positions)) and np.all(res.step_sizes > 0)
 
 
 def test_skip_rule_drops_the_settling_only_when_it_does_not_fit(design, drive):
-    low = optimized_timing(design, A, 100.0, drive, short_period="skip")
+    low = optimized_timing(design, A, F_STEP, drive, short_period="skip")
     assert low["settling_time_s"] == design.settling_time
     high = optimized_timing(design, A, 110e3, drive, short_period="skip")
     assert not high["settling_fits"] and high["settling_time_s"] == 0.0
@@ -177,3 +180,40 @@ def test_first_period_can_be_optimized_too(design, drive):
     t_end = design.settling_time + design.acceleration_time
     assert wave.position(t_end) == pytest.approx(design.acceleration_amplitude, rel=1e-9)
     np.testing.assert_allclose(np.diff(wave.settle_windows[:, 1]), 1e-3, rtol=1e-9)
+
+
+# --------------------------------------------------------------------------------------
+# The velocity protocol (passmd.protocols.velocity)
+# --------------------------------------------------------------------------------------
+
+
+def test_steady_periods_cover_the_steady_time():
+    from passmd.protocols import velocity
+
+    assert velocity.steady_periods(F_STEP) == velocity.MIN_PERIODS
+    assert velocity.steady_periods(110e3) == 550  # 5 ms at 110 kHz, exactly (no rounding up by 1e-9 noise)
+
+
+def test_steady_velocity_reads_the_second_half():
+    from types import SimpleNamespace
+
+    from passmd.protocols import velocity
+
+    period = 1e-5
+    n = np.arange(40)
+    means = np.where(n < 20, 0.0, (n - 20) * 2e-9)  # still at first, then 2 nm per period
+    result = SimpleNamespace(period_mean_position=means, waveform=SimpleNamespace(period=period))
+    out = velocity.steady_velocity(result)
+    assert out["velocity_m_per_s"] == pytest.approx(2e-9 / period, rel=1e-12)
+    assert out["velocity_drift"] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_waveform_velocity_below_the_step_protocol_is_mean_step_times_f(drive, design):
+    from passmd.protocols import velocity
+
+    steps = velocity.step_run(drive, A, F_STEP, "optimized", design)
+    v = velocity.waveform_velocity(drive, A, F_STEP, "optimized", design)
+    assert v == pytest.approx(steps["mean_step_m"] * F_STEP, rel=1e-12)
+    assert steps["settled_positions_m"].shape == (velocity.STEP_PERIODS,)
+    with pytest.raises(ValueError, match="waveform"):
+        velocity.steady_run(drive, A, 1e3, "triangle", "cut")

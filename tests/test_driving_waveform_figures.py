@@ -12,13 +12,18 @@ import pandas as pd
 import pytest
 
 from passmd import dynamics, theory, waveforms
+from passmd.config import RunConfig
+from passmd.defaults import PROTOCOL
 from passmd.experiments import driving_waveform as dw
-from passmd.experiments import figure_data, figure_names, figure_plot
+from passmd.experiments import waveform_facts as wf
 from passmd.experiments import waveform_studies as studies
 from passmd.optimized_waveform import OptimizedDesign, max_piezo_velocity, optimized
+from passmd.plots import driving_waveform as plots
 from passmd.protocols import eq15
 
 PANELS = ("fig8a", "fig8b", "fig9a", "fig9b", "fig10a", "fig10b", "fig10c")
+#: The quick profile, as the tests run every panel.
+QUICK = RunConfig(profile="quick")
 #: Relative tolerance of positions, velocities and times in the snapshots (see module docstring).
 RTOL = 1e-6
 #: Absolute floors: 1e-12 m (1 pm) for positions, 1e-9 m/s for velocities, 1e-6 for slip shares,
@@ -28,7 +33,7 @@ ATOL = {"m": 1e-12, "m_per_s": 1e-9, "share": 1e-6, "Hz": 1e-3, "N": 1e-9}
 
 @pytest.fixture(scope="module")
 def quick():
-    return {name: figure_data(name, "quick") for name in PANELS}
+    return {name: getattr(dw, name)(QUICK) for name in PANELS}
 
 
 def _tolerances(columns):
@@ -91,11 +96,19 @@ def test_velocity_snapshot(quick, name, dataframe_regression):
                                tolerances=_tolerances(locked.columns))
 
 
-def test_every_panel_is_registered_and_plots(quick):
-    assert set(PANELS) <= set(figure_names())
+def test_every_panel_plots(quick):
     for name in PANELS:
-        fig = figure_plot(name, quick[name])
+        fig = getattr(plots, f"plot_{name}")(quick[name])
         assert fig.axes, name
+
+
+def test_fig9a_plot_shows_section5_friction_only(quick):
+    frame = quick["fig9a"]
+    assert set(frame.loc[frame["section5_friction"], "friction_coefficient"]) == {dw.SECTION5_FRICTION}
+    assert len(dw.FIG9A_FRICTION) > 1 and not frame["section5_friction"].all()
+    fig = plots.plot_fig9a(frame)
+    # one runner trace and one set of settled positions per waveform, plus the piezo: μ = 0.2 runs only
+    assert len(fig.axes[0].lines) == 2 * 2 + 1
 
 
 # --------------------------------------------------------------------------------------
@@ -129,8 +142,8 @@ def test_carrying_the_runner_then_stopping_beats_the_sawtooth():
     design = eq15.optimized_design(amplitude, drive)
     carry = OptimizedDesign(0.75 / design.micro_vibration_frequency, 0.9 * amplitude / 3e-3,
                             0.9 * amplitude)
-    saw = dynamics.simulate(drive, waveforms.sawtooth(amplitude, 100.0, drive, periods=3))
-    opt = dynamics.simulate(drive, optimized(amplitude, 100.0, drive, periods=3, design=carry))
+    saw = dynamics.simulate(drive, waveforms.sawtooth(amplitude, dw.STEP_FREQUENCY, drive, periods=3))
+    opt = dynamics.simulate(drive, optimized(amplitude, dw.STEP_FREQUENCY, drive, periods=3, design=carry))
     assert np.mean(opt.step_sizes) > 1.2 * np.mean(saw.step_sizes)
 
 
@@ -138,7 +151,8 @@ def test_micro_vibration_to_linear_frequency_ratio_is_universal_for_rigid_drives
     """After a full slide the swing back is a Masing branch from full sliding; with the
     amplitude well above u_x,max its shape scales with u_x,max and μF_N, so f_s / f_lin is the
     same for every preload and radius (the start velocity, a_f·t_fb, is ~1 % of the swing's)."""
-    table = dw.designs([dw.config(preload=p) for p in (0.1, 1.0)] + [dw.config(hemisphere_radius=0.25e-3)])
+    table = dw.designs([dw.section5_fields(preload=p) for p in (0.1, 1.0)]
+                       + [dw.section5_fields(hemisphere_radius=0.25e-3)], QUICK)
     ratio = table["micro_vibration_frequency_Hz"] / table["linear_frequency_Hz"]
     assert ratio.max() - ratio.min() < 2e-3  # 0.2 %: the residual start-velocity effect
     assert np.sqrt(2 / 3) < ratio.min() and ratio.max() < 1.0
@@ -165,8 +179,8 @@ def test_settling_fits_only_at_low_frequency(quick):
 
 
 def test_numerical_optimum_beats_heuristic_and_sawtooth():
-    table = studies.numerical_optimum("quick")
-    low = table[table["frequency"] == 100.0].iloc[0]
+    table = studies.numerical_optimum(QUICK)
+    low = table[table["frequency"] == PROTOCOL.drive_frequency].iloc[0]
     assert low["velocity_optimum_m_per_s"] > 1.2 * low["velocity_sawtooth_m_per_s"]
     assert np.all(table["velocity_optimum_m_per_s"] > table["velocity_eq15_m_per_s"])
     # every optimum respects the amplifier
@@ -175,10 +189,10 @@ def test_numerical_optimum_beats_heuristic_and_sawtooth():
 
 
 def test_flexible_study_and_scan_run(quick):
-    flex = studies.flexible_study("quick")
+    flex = studies.flexible_study(QUICK)
     assert set(flex["actuator_model"]) == {"rigid", "flexible"}
     assert np.all(np.isfinite(flex["velocity_m_per_s"]))
-    scan = studies.settling_scan("quick")
+    scan = studies.settling_scan(QUICK)
     # Eq. 15's t_s (half a cycle) is where the step is smallest in the scan
     worst = scan.loc[scan["step_nm"].idxmin(), "settling_cycles"]
     assert worst == pytest.approx(scan["eq15_settling_cycles"].iloc[0], abs=0.25)
@@ -221,7 +235,7 @@ def test_turning_point_needs_a_rise_then_a_fall_where_the_paper_puts_it():
 def test_flyback_window_resolves_the_acceleration():
     """``fig8b_window`` (ledger rows of Section 5.1's stick condition): t_a, about 0.2 µs and shorter
     than the default step, holds at least ten records, and every phase of the window is present."""
-    frame = figure_data("fig8b_window", "quick")
+    frame = dw.fig8b_window(QUICK)
     row = frame.iloc[0]
     t_a = row["acceleration_end_s"] - row["acceleration_start_s"]
     # records fall on integration steps: at most one step (t_a / 20) off the nominal t_a / 10
@@ -229,4 +243,105 @@ def test_flyback_window_resolves_the_acceleration():
     counts = frame["phase"].value_counts()
     assert counts["acceleration"] >= dw.WINDOW_SAMPLES_PER_ACCELERATION - 1
     assert {"before", "flyback", "settling", "after"} <= set(counts.index)
-    assert figure_plot("fig8b_window", frame).axes
+    assert plots.plot_fig8b_window(frame).axes
+
+
+# --------------------------------------------------------------------------------------
+# Facts the chapter reads
+# --------------------------------------------------------------------------------------
+
+
+def test_design_facts_and_table(quick):
+    drive = dw.section5_drive()
+    design = dw.designs([dw.section5_fields()], QUICK).iloc[0]
+    facts = wf.design_facts(design, drive)
+    assert facts["f_ratio"] == pytest.approx(facts["f_s_kHz"] / facts["f_lin_kHz"], rel=1e-12)
+    assert facts["A_nm"] == pytest.approx(drive.actuator.full_stroke_amplitude * 1e9, rel=1e-12)
+    # a_f = μ ΣF_N / m_r over two contacts at F_N1 and four at F_N2 (Eq. 1)
+    f_n = theory.drive_theory(drive)["normal_force_N"]
+    assert facts["a_f"] == pytest.approx(0.2 * (2 * f_n[0] + 4 * f_n[1]) / drive.runner_mass, rel=1e-12)
+    table = wf.design_table(design)
+    assert table.set_index("unit").loc["µs", "value"].tolist() == [facts["t_s_us"], facts["t_a_us"]]
+
+
+def test_fig8a_facts_follow_the_points(quick):
+    facts = wf.fig8a_facts(quick["fig8a"], dw.section5_drive())
+    # the runner reverses before it moves forward fastest, both within the micro-vibration's first cycle
+    assert 0 < facts["t3_after_us"] < facts["t4_after_us"] < 1e3 / 5.0
+    assert facts["back_step_nm"] > 0
+    assert 0 <= facts["share3_side1"] <= facts["share3_side2"] <= 1
+
+
+def test_acceleration_slip_and_window_facts(quick):
+    slip = wf.acceleration_slip(quick["fig9b"])
+    fits = quick["fig9b"][(quick["fig9b"]["variant"] == "optimized") & quick["fig9b"]["settling_fits"]]
+    assert slip["frequencies_kHz"] == list(fits["frequency_kHz"])
+    window = pd.DataFrame({"phase": ["flyback", "settling", "acceleration", "acceleration", "after"],
+                           "slip_share_1": [1.0, 0.5, 0.2, 0.3, 1.0],
+                           "slip_share_2": [0.7, 0.9, 0.1, 1.0, 0.0],
+                           "record_spacing_s": 2e-8})
+    facts = wf.window_facts(window)
+    assert facts["window_flyback_share"] == 0.9 and not facts["flyback_full"]
+    assert facts["window_acceleration_share"] == 1.0 and facts["acceleration_full"]
+    assert facts["window_spacing_ns"] == pytest.approx(20.0)
+
+
+def test_fig9a_facts_agree_with_the_ledger(quick):
+    from passmd import ledger, readings
+
+    facts = wf.fig9a_facts(quick["fig9a"])
+    extract = ledger.extractors()
+    reading = readings.default_reading()
+    assert facts["x3_saw_nm"] == pytest.approx(extract["fig9a-standard-position-552nm"](
+        {"fig9a": quick["fig9a"]}, reading), rel=1e-12)
+    assert facts["increase_pct"] == pytest.approx(extract["fig9a-step-increase-46.8pct"](
+        {"fig9a": quick["fig9a"]}, reading), rel=1e-12)
+    # the paper's own numbers: (716 − 552)/(552 − 202) = 46.9 %, its reported 46.8 % within rounding
+    assert wf.step_increase_pct(552.0, 716.0, 202.0) == pytest.approx(46.857, abs=1e-3)
+
+
+def test_startup_and_fig9b_facts(quick):
+    table = quick["fig9b"]
+    start = wf.startup_facts(table)
+    assert start["max_drift_pct"] < 0.5  # as test_velocity_runs_are_steady_and_consistent
+    facts = wf.fig9b_facts(table, dw.designs([dw.section5_fields()], QUICK).iloc[0], dw.section5_drive())
+    # t_s would fit at 110 kHz only with f_s ≥ 1 / (2 t_s,max): above the measured f_s by the factor's root
+    assert facts["f_s_needed_kHz"] == pytest.approx(0.5e-3 / (facts["t_s_room_us"] * 1e-6), rel=1e-12)
+    assert facts["stiffness_factor"] > 1
+    assert facts["fit_limit_kHz"] < dw.PAPER_MAXIMUM_KHZ
+    saw = table[table["variant"] == "sawtooth"].set_index("frequency")
+    assert facts["saw_step_1k"] == saw.loc[1e3, "step_nm"]
+    assert facts["saw_step_130k"] == saw.loc[130e3, "step_nm"]
+
+
+def test_reachable_table_and_stick_lost(quick):
+    table = wf.reachable_table(quick["fig10a"], "preload")
+    assert len(table) == len(dw.FIG10A_PRELOADS) * 3
+    best = table[(table["preload"] == 0.4) & (table["variant"] == "sawtooth")].iloc[0]
+    f10a = quick["fig10a"]
+    saw = f10a[(f10a["variant"] == "sawtooth") & np.isclose(f10a["preload"], 0.4)]
+    assert best["max velocity (mm/s)"] == saw["velocity_mm_per_s"].max()
+    lost = wf.stick_lost(quick["fig10a"])
+    assert set(lost["with_full_settling"]) <= set(lost["all"])
+
+
+def test_optimum_and_flexible_facts():
+    optimum = studies.numerical_optimum(QUICK)
+    design = dw.designs([dw.section5_fields()], QUICK).iloc[0]
+    a_f = wf.friction_acceleration(dw.section5_drive())
+    facts = wf.optimum_facts(optimum, design, a_f)
+    low = wf.optimum_at(optimum)
+    assert low["frequency"] == dw.STEP_FREQUENCY and low["actuator_model"] == "rigid"
+    assert facts["opt_gain_100"] > 20  # the optimum beats the saw-tooth (test above: by > 20 %)
+    t_a = design["acceleration_time_s"]
+    assert facts["ta_ratio"] == pytest.approx(facts["opt_ta_us"] * 1e-6 / t_a, rel=1e-12)
+    assert facts["slide_nm"] == pytest.approx((facts["opt_va_mm_s"] * 1e-3) ** 2 / (2 * a_f) * 1e9, rel=1e-12)
+    shown = wf.optimum_table(optimum)
+    assert shown["V_a (mm/s)"].iloc[0] == pytest.approx(facts["opt_va_mm_s"], rel=1e-12)
+    carried = wf.carried_steps(optimum)
+    assert carried["actuators"].tolist() == ["rigid", "flexible"]
+    assert carried.iloc[0]["gain (%)"] > 20
+    flexible = dw.designs([dw.section5_fields(actuator_model="flexible")], QUICK).iloc[0]
+    flex = wf.flexible_facts(optimum, flexible, carried, dw.section5_drive())
+    assert np.isnan(flex["flex_opt_gain"])  # the quick profile does not optimise flexible actuators
+    assert flex["f_s_flex_kHz"] < wf.design_facts(design, dw.section5_drive())["f_s_kHz"]

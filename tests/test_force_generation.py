@@ -14,20 +14,28 @@ import pandas as pd
 import pytest
 
 from passmd import checks, ledger, readings
-from passmd.experiments import figure_data, figure_names, figure_plot
+from passmd.config import RunConfig
+from passmd.defaults import PROTOCOL
+from passmd.experiments import force_facts as ff
 from passmd.experiments import force_generation as fg
+from passmd.plots import force_generation as fg_plots
+from passmd.protocols import stall
 
 RTOL = 1e-6
 #: Absolute floor for forces in mN and lengths in nm (1e-9 of the unit): below anything read.
 ATOL = 1e-9
 FIGURES = ("fig7a", "fig7b", "fig7grid", "fig7freq", "fig7cycle")
+#: The plot of each figure (the figure table pairs them the same way).
+PLOTS = {"fig7a": fg_plots.plot_panel, "fig7b": fg_plots.plot_panel, "fig7grid": fg_plots.plot_grid,
+         "fig7freq": fg_plots.plot_frequency, "fig7cycle": fg_plots.plot_cycle}
 #: Columns that are timings (machine dependent) and therefore not locked.
 TIMINGS = ("cpu_time_s", "onset_cpu_time_s")
 
 
 @pytest.fixture(scope="module")
 def quick():
-    return {name: figure_data(name, "quick") for name in FIGURES}
+    config = RunConfig(profile="quick")
+    return {name: getattr(fg, name)(config) for name in FIGURES}
 
 
 # --------------------------------------------------------------------------------------
@@ -41,57 +49,57 @@ def test_stall_estimate_geometric_tail_is_exact():
     q, f_inf = 0.97, 0.3
     n = np.arange(200)
     forces = f_inf * (1 - q**n)
-    est = fg.stall_estimate(forces, window=16)
+    est = stall.stall_estimate(forces, window=16)
     assert est["remaining_N"] == pytest.approx(f_inf * q ** n[-1], rel=1e-9)
     assert est["ratio"] == pytest.approx(q**8, rel=1e-12)
 
 
 def test_stall_estimate_cases():
-    assert fg.stall_estimate(np.full(40, 0.1))["remaining_N"] == 0.0  # flat: stalled
-    assert math.isinf(fg.stall_estimate(np.linspace(0, 1, 40))["remaining_N"])  # steady rise: not stalled
+    assert stall.stall_estimate(np.full(40, 0.1))["remaining_N"] == 0.0  # flat: stalled
+    assert math.isinf(stall.stall_estimate(np.linspace(0, 1, 40))["remaining_N"])  # steady rise: not stalled
     swing = np.full(41, 0.2)  # last window: up by 4e-5 over its first half, down by 3e-5 over its second
     swing[-9:] += 4e-5
     swing[-1] -= 3e-5
-    est = fg.stall_estimate(swing, window=16)
+    est = stall.stall_estimate(swing, window=16)
     assert est["ratio"] < 0 and est["remaining_N"] == pytest.approx(4e-5, rel=1e-9)  # bounded by the swing
-    assert math.isinf(fg.stall_estimate(np.ones(10))["remaining_N"])  # shorter than the window
+    assert math.isinf(stall.stall_estimate(np.ones(10))["remaining_N"])  # shorter than the window
     with pytest.raises(ValueError, match="window"):
-        fg.stall_estimate(np.ones(40), window=5)
+        stall.stall_estimate(np.ones(40), window=5)
 
 
 @pytest.mark.parametrize(
     "kwargs, match",
     [
         ({"frequency": 0.0}, "frequency"),
-        ({"frequency": 100.0, "flyback": "slow"}, "flyback"),
-        ({"frequency": 100.0, "initial_periods": 8}, "initial_periods"),
-        ({"frequency": 100.0, "initial_periods": 64, "max_periods": 32}, "max_periods"),
-        ({"frequency": 100.0, "abs_tolerance": -1.0}, "abs_tolerance"),
-        ({"frequency": 100.0, "rel_tolerance": 1.5}, "rel_tolerance"),
+        ({"frequency": PROTOCOL.drive_frequency, "flyback": "slow"}, "flyback"),
+        ({"frequency": PROTOCOL.drive_frequency, "initial_periods": 8}, "initial_periods"),
+        ({"frequency": PROTOCOL.drive_frequency, "initial_periods": 64, "max_periods": 32}, "max_periods"),
+        ({"frequency": PROTOCOL.drive_frequency, "abs_tolerance": -1.0}, "abs_tolerance"),
+        ({"frequency": PROTOCOL.drive_frequency, "rel_tolerance": 1.5}, "rel_tolerance"),
     ],
 )
 def test_generated_force_rejects_bad_input(kwargs, match):
     drive = fg.force_drive(1e-3, 0.3, "rigid", 0.3)
     with pytest.raises(ValueError, match=match):
-        fg.generated_force(drive, 100e-9, **kwargs)
+        stall.generated_force(drive, 100e-9, **kwargs)
 
 
 def test_bad_drive_and_amplitude_are_named():
     with pytest.raises(ValueError, match="drive"):
-        fg.generated_force("drive", 100e-9, 100.0)
+        stall.generated_force("drive", 100e-9, PROTOCOL.drive_frequency)
     with pytest.raises(ValueError, match="amplitude_fraction"):
-        fg.stall_point(1e-3, 0.3, "rigid", 0.3, 1.5, 100.0)
+        fg.stall_point(1e-3, 0.3, "rigid", 0.3, 1.5, PROTOCOL.drive_frequency)
     with pytest.raises(ValueError, match="amplitude"):
-        fg.generated_force(fg.force_drive(1e-3, 0.3, "rigid", 0.3), 300e-9, 100.0)
+        stall.generated_force(fg.force_drive(1e-3, 0.3, "rigid", 0.3), 300e-9, PROTOCOL.drive_frequency)
 
 
 def test_a_run_that_has_not_stalled_is_flagged():
     # 17 periods cannot bring 0.3 N, 202 nm to stall (it needs ~200): reported, but flagged.
     drive = fg.force_drive(1e-3, 0.3, "rigid", 0.3)
-    out = fg.generated_force(drive, 202e-9, 100.0, initial_periods=17, max_periods=17)
+    out = stall.generated_force(drive, 202e-9, PROTOCOL.drive_frequency, initial_periods=17, max_periods=17)
     assert out["converged"] is False
     assert out["periods"] == 17 and out["periods_simulated"] == 17
-    assert out["remaining_force_N"] > fg.STALL_REL_TOLERANCE * out["generated_force_N"]
+    assert out["remaining_force_N"] > stall.STALL_REL_TOLERANCE * out["generated_force_N"]
 
 
 # --------------------------------------------------------------------------------------
@@ -102,7 +110,7 @@ def test_a_run_that_has_not_stalled_is_flagged():
 @pytest.fixture(scope="module")
 def stalled():
     """Both models at R = 1 mm, 0.3 N, full stroke (the cheapest stalls of Fig. 7a)."""
-    return {(m, mu): fg.generated_force(fg.force_drive(1e-3, 0.3, m, mu), 202e-9, fg.FORCE_FREQUENCY)
+    return {(m, mu): stall.generated_force(fg.force_drive(1e-3, 0.3, m, mu), 202e-9, fg.FORCE_FREQUENCY)
             for m, mu, _ in fg.MODELS}
 
 
@@ -123,16 +131,16 @@ def test_earlier_model_generates_more_force_at_full_stroke(stalled):
 
 def test_force_is_zero_below_onset_and_grows_above():
     drive = fg.force_drive(1e-3, 0.3, "rigid", 0.3)
-    onset = fg.force_onset(drive, tolerance=0.5e-9)["critical_amplitude_m"]
+    onset = stall.force_onset(drive, tolerance=0.5e-9)["critical_amplitude_m"]
     # The onset is near Eq. 11 at μ = 0.3 (30 nm): a sanity bound, not the claim (that is the ledger's).
     assert 20e-9 < onset < 40e-9
-    below = [fg.generated_force(drive, a, fg.FORCE_FREQUENCY) for a in (0.0, 0.5 * onset)]
+    below = [stall.generated_force(drive, a, fg.FORCE_FREQUENCY) for a in (0.0, 0.5 * onset)]
     for out in below:
         assert out["converged"]
         # No stepping: the load cell only follows the piezo's mean position; the difference is the
         # contacts' elastic give (well under 1 nm × k = 0.025 mN), 0.05 mN asserted.
         assert abs(out["generated_force_N"] - out["piezo_mean_force_N"]) < 0.05e-3
-    above = [fg.generated_force(drive, a, fg.FORCE_FREQUENCY) for a in (1.3 * onset, 0.6 * 202e-9, 202e-9)]
+    above = [stall.generated_force(drive, a, fg.FORCE_FREQUENCY) for a in (1.3 * onset, 0.6 * 202e-9, 202e-9)]
     forces = [out["generated_force_N"] for out in above]
     assert all(out["converged"] for out in above)
     assert forces[0] - above[0]["piezo_mean_force_N"] > 1e-3  # clearly generating force above onset
@@ -141,10 +149,10 @@ def test_force_is_zero_below_onset_and_grows_above():
 
 def test_stall_cycle_is_the_stalled_state():
     drive = fg.force_drive(1e-3, 0.3, "rigid", 0.3)
-    stall = fg.generated_force(drive, 202e-9, fg.FORCE_FREQUENCY)
-    cycle = fg.stall_cycle(drive, 202e-9, fg.FORCE_FREQUENCY, stall["periods"], 500)
+    stalled = stall.generated_force(drive, 202e-9, fg.FORCE_FREQUENCY)
+    cycle = stall.stall_cycle(drive, 202e-9, fg.FORCE_FREQUENCY, stalled["periods"], 500)
     # Same run from rest, only recorded: the same force to the last digit (deterministic).
-    assert cycle["generated_force_N"] == pytest.approx(stall["generated_force_N"], rel=1e-12)
+    assert cycle["generated_force_N"] == pytest.approx(stalled["generated_force_N"], rel=1e-12)
     assert cycle["generated_force_N"] < cycle["sliding_capacity_N"]
     assert cycle["time_s"][0] < 0 <= cycle["time_s"][1]
     # mean of the friction samples over the period ≈ the load-cell force (momentum balance, sampled)
@@ -155,12 +163,6 @@ def test_stall_cycle_is_the_stalled_state():
 # --------------------------------------------------------------------------------------
 # Registry, quick-profile snapshots and plots
 # --------------------------------------------------------------------------------------
-
-
-def test_figures_are_registered():
-    names = figure_names()
-    for name in FIGURES:
-        assert name in names
 
 
 def _locked(frame: pd.DataFrame) -> pd.DataFrame:
@@ -195,7 +197,7 @@ def test_quick_cycle_snapshot(quick, dataframe_regression):
 
 @pytest.mark.parametrize("name", FIGURES)
 def test_plots_draw(quick, name):
-    fig = figure_plot(name, quick[name])
+    fig = PLOTS[name](quick[name])
     assert fig.axes
     import matplotlib.pyplot as plt
 
@@ -247,3 +249,173 @@ def test_force_difference_extractor_uses_only_stalled_pairs(quick):
     table.loc[full & (table["actuator_model"] == "flexible"), "converged"] = False
     with pytest.raises(checks.NotEvaluable):
         ledger.extractors()["fig7a-force-difference-115mn"]({"fig7a": table}, readings.default_reading())
+
+
+# --------------------------------------------------------------------------------------
+# Facts the chapter reads
+# --------------------------------------------------------------------------------------
+
+EARLIER, THIS = fg.MODELS[0][:2], fg.MODELS[1][:2]
+
+
+def test_onset_is_the_protocol_frequency_by_default():
+    assert fg.FORCE_FREQUENCY == PROTOCOL.drive_frequency
+    assert fg.ONSET_TOLERANCE["paper"] == stall.ONSET_TOLERANCE
+
+
+def test_model_curve_selects_one_model_and_preload_sorted(quick):
+    curve = ff.model_curve(quick["fig7a"], THIS, 0.8)
+    assert set(curve["actuator_model"]) == {"flexible"} and np.allclose(curve["friction_coefficient"], 0.2)
+    assert np.allclose(curve["preload_N"], 0.8)
+    assert np.all(np.diff(curve["amplitude_nm"].to_numpy()) > 0)
+    assert ff.full_stroke_row(quick["fig7a"], THIS, 0.8)["amplitude_nm"] == curve["amplitude_nm"].max()
+
+
+def test_stall_summary_counts_the_panels(quick):
+    summary = ff.stall_summary([quick["fig7a"], quick["fig7b"]])
+    assert summary["n_points"] == len(quick["fig7a"]) + len(quick["fig7b"])
+    assert summary["n_converged"] == summary["n_points"]  # every quick point stalls (snapshot test)
+    assert stall.STALL_WINDOW < summary["periods_min"] <= summary["periods_max"] <= stall.MAX_PERIODS
+
+
+def test_full_stroke_facts_agree_with_the_115mn_extractor(quick):
+    facts = ff.full_stroke_facts(quick["fig7a"], paper_difference_mN=100.0)
+    extracted = ledger.extractors()["fig7a-force-difference-115mn"]({"fig7a": quick["fig7a"]},
+                                                                    readings.default_reading())
+    assert facts["diff_full_mN"] == pytest.approx(extracted, rel=1e-12)
+    assert facts["F_full_rigid_mN"] - facts["F_full_flex_mN"] == pytest.approx(extracted, rel=1e-12)
+    assert facts["diff_full_dev_pct"] == pytest.approx(abs(extracted - 100.0), rel=1e-12)
+    k = ff.drive_facts()["k"]
+    assert facts["x_full_um"] == pytest.approx(facts["F_full_flex_mN"] * 1e-3 / k * 1e6, rel=1e-12)
+
+
+def test_drive_facts_of_the_load_cell():
+    facts = ff.drive_facts()
+    drive = fg.force_drive(1e-3, 0.8, "flexible", 0.2)
+    assert facts["k"] == drive.load_cell_stiffness
+    swing = np.sqrt(drive.load_cell_stiffness / drive.runner_mass) / (2 * np.pi)
+    assert facts["f_load_cell"] == pytest.approx(swing, rel=1e-12)
+    # the runner on the load cell alone swings far slower than on its contacts (~0.5 kHz against ~10 kHz)
+    assert 10 * facts["f_load_cell"] < 1e3 * facts["f_runner_kHz"]
+
+
+def test_band_difference_is_rigid_minus_flexible(quick):
+    band = ff.band_difference(quick["fig7freq"])
+    assert list(band.index) == [PROTOCOL.drive_frequency]  # the quick grid has one frequency near 100 Hz
+    rows = quick["fig7freq"]
+    rows = rows[np.isclose(rows["radius_mm"], 1.0)
+                & np.isclose(rows["frequency_Hz"], PROTOCOL.drive_frequency)]
+    forces = rows.set_index("actuator_model")["generated_force_mN"]
+    assert band.iloc[0] == pytest.approx(forces["rigid"] - forces["flexible"], rel=1e-12)
+
+
+def test_panel_full_stroke_and_differences(quick):
+    forces = ff.panel_full_stroke(quick["fig7b"], "fig7b")
+    assert set(forces) == {"02_rigid", "02_flex", "04_rigid", "04_flex"}
+    diffs = ff.panel_differences(quick)
+    assert set(diffs) == {"fig7a 0.3 N", "fig7a 0.8 N", "fig7b 0.2 N", "fig7b 0.4 N"}
+    last = diffs["fig7b 0.4 N"].iloc[-1]["difference_mN"]
+    assert last == pytest.approx(forces["04_rigid"] - forces["04_flex"], rel=1e-12)
+
+
+def test_onset_ratios_of_a_table():
+    onsets = pd.DataFrame({"radius_mm": [1.0] * 4, "preload_N": [0.3, 0.3, 0.8, 0.8],
+                           "actuator_model": ["rigid", "flexible"] * 2,
+                           "friction_coefficient": [0.3, 0.2] * 2, "onset_nm": [30.0, 20.0, 60.0, 50.0],
+                           "analytic_onset_nm": [33.0, 30.0, 66.0, 55.0]})
+    ratios = ff.onset_ratios(onsets)
+    assert ratios["onset_ratio_min"] == pytest.approx(20.0)
+    assert ratios["onset_ratio_max"] == pytest.approx(50.0)
+    assert ratios["eq_ratio_min"] == pytest.approx(10.0)
+    assert ratios["eq_ratio_max"] == pytest.approx(20.0)
+
+
+def test_onset_table_and_difference_above_onsets(quick):
+    panels = pd.concat([quick["fig7a"], quick["fig7b"]])
+    onsets = ff.onset_table(panels)
+    assert len(onsets) == 8  # 4 preloads × 2 models
+    above = ff.difference_above_onsets(quick, ff.panel_differences(quick))
+    for key, series in above.items():
+        name, preload = key.split()[0], float(key.split()[1])
+        top = onsets[np.isclose(onsets["preload_N"], preload)
+                     & np.isclose(onsets["radius_mm"], fg.PANELS[name][0] * 1e3)]["onset_nm"].max()
+        assert np.all(series["x"] >= top) and len(series["x"]) == len(series["y"])
+
+
+def _cycle(force_mN: float, before_nm=(1.0, 2.0)) -> pd.DataFrame:
+    rows = []
+    for (model, mu), force in zip(fg.CYCLE_COMBINATIONS, (150.0, 120.0, force_mN, 80.0), strict=True):
+        rows.append({"radius_mm": 1.0, "preload_N": 0.8, "amplitude_nm": 202.0, "actuator_model": model,
+                     "friction_coefficient": mu, "generated_force_mN": force, "sliding_capacity_mN": 300.0,
+                     "deflection_before_flyback_side1_nm": 0.0 if model == "rigid" else before_nm[0],
+                     "deflection_before_flyback_side2_nm": 0.0 if model == "rigid" else before_nm[1],
+                     "back_slide_nm": 5.0, "full_slip_time_us": 10.0, "mean_slip_share_side1": 0.01,
+                     "mean_slip_share_side2": 0.02, "sample_spacing_us": 5.0})
+    return pd.DataFrame(rows)
+
+
+def test_deflection_swing_adds_the_sliding_friction():
+    from passmd.theory import normal_forces
+
+    cycle = _cycle(100.0)
+    assert ff.deflection_swing(cycle, "rigid", 0.3, 1) == 0.0
+    k_p = fg.force_drive(1e-3, 0.8, "flexible", 0.2).actuator.stiffness
+    f_n = np.asarray(normal_forces(0.8, 6))
+    assert ff.deflection_swing(cycle, "flexible", 0.3, 2) == pytest.approx(2.0 + 0.3 * f_n[1] / k_p * 1e9)
+
+
+def test_cycle_facts_separate_the_two_causes():
+    facts = ff.cycle_facts(_cycle(100.0))
+    assert facts["mu_effect_rigid"] == pytest.approx(30.0) and facts["mu_effect_flex"] == pytest.approx(20.0)
+    assert facts["flex_effect_03"] == pytest.approx(50.0) and facts["flex_effect_02"] == pytest.approx(40.0)
+    assert facts["ratio_r03"] == pytest.approx(0.5) and facts["slip_max_pct"] == pytest.approx(2.0)
+    assert len(ff.cycle_measures(_cycle(100.0))) == 4
+
+
+def test_equivalent_stroke_interpolates_the_rigid_curve():
+    fig7a = pd.DataFrame({"actuator_model": "rigid", "friction_coefficient": 0.3, "preload_N": 0.8,
+                          "amplitude_nm": [0.0, 50.0, 100.0, 202.0], "converged": True, "onset_nm": 30.0,
+                          "generated_force_mN": [1.0, 40.0, 100.0, 150.0]})
+    out = ff.equivalent_stroke(fig7a, _cycle(70.0))
+    assert out["curve_points"] == 3
+    assert out["a_eq_nm"] == pytest.approx(75.0) and out["loss_nm"] == pytest.approx(127.0)
+    # a target outside the curve is not extrapolated
+    assert math.isnan(ff.equivalent_stroke(fig7a, _cycle(200.0))["a_eq_nm"])
+
+
+def test_grid_facts_name_the_exceptions():
+    grid = pd.DataFrame({"radius_mm": [1.0, 1.0, 0.25, 0.25], "preload_N": [0.3, 0.3, 0.4, 0.4],
+                         "actuator_model": ["rigid", "flexible"] * 2, "amplitude_fraction": 1.0,
+                         "generated_force_mN": [50.0, 40.0, 10.0, 12.0],
+                         "converged": [True, True, True, False]})
+    facts = ff.grid_facts(grid)
+    assert (facts["n_over"], facts["n_all"]) == (1, 2)
+    assert facts["under"] == [(0.25, 0.4)]
+    assert (facts["grid_converged"], facts["grid_points"]) == (3, 4)
+
+
+def test_frequency_spread_is_the_largest_relative_range():
+    freq = pd.DataFrame({"radius_mm": 1.0, "actuator_model": ["rigid"] * 3 + ["flexible"] * 3,
+                         "frequency_Hz": [90.0, 100.0, 1000.0] * 2,
+                         "generated_force_mN": [90.0, 110.0, 50.0, 99.0, 101.0, 60.0]})
+    spread = ff.frequency_spread(freq, 80.0, 120.0)
+    assert spread["frequencies"] == 2 and spread["spread_pct"] == pytest.approx(20.0)
+    assert (spread["low_Hz"], spread["high_Hz"]) == (90.0, 100.0)
+
+
+def test_protocol_facts_and_published_data(quick):
+    facts = ff.stall_protocol_facts()
+    assert facts["f_drive"] == PROTOCOL.drive_frequency and 2 * facts["half_window"] == stall.STALL_WINDOW
+    assert facts["abs_tol_mN"] == pytest.approx(stall.STALL_ABS_TOLERANCE * 1e3)
+    assert facts["initial_periods"] <= facts["max_periods"]
+    shown = ff.published(quick["fig7a"])
+    assert not set(ff.TIMING_COLUMNS) & set(shown.columns)
+    assert len(shown.columns) == len(quick["fig7a"].columns) - len(ff.TIMING_COLUMNS)
+    table = ff.difference_table(ff.panel_differences(quick))
+    assert set(table["series"]) == set(ff.panel_differences(quick))
+
+
+def test_stall_cpu_seconds_counts_onsets_once(quick):
+    data = {name: quick[name].assign(cpu_time_s=1.0, onset_cpu_time_s=2.0) for name in FIGURES}
+    expected = sum(len(data[n]) for n in ("fig7a", "fig7b", "fig7grid", "fig7freq")) + 2.0 * 3
+    assert ff.stall_cpu_seconds(data) == pytest.approx(expected)

@@ -5,27 +5,20 @@ A = 202 nm, μ = 0.2 assumed) with the standard saw-tooth and with the optimized
 of Eq. 15 (:func:`passmd.optimized_waveform.optimized`), designed once per drive from its own
 100 Hz saw-tooth response (:func:`passmd.protocols.eq15.optimized_design`).
 
-Mean velocity at kHz frequencies
---------------------------------
-At 100 kHz a period lasts 10 µs, a tenth of the runner's micro-vibration period: there
-is no stick phase to average over, and from rest the runner needs about a millisecond
-(hundreds of periods) to reach its steady velocity. The velocity reported here is the
-*steady* one: a run of ``max(MIN_PERIODS, f·STEADY_TIME)`` periods from rest, and the
-slope of the runner's period-mean position (``period_mean_position`` of
-:class:`passmd.dynamics.SimulationResult`, no stick phase assumed) over the second half
-of the run. ``velocity_drift`` compares the third and fourth quarter to show the run was
-steady. ``SimulationResult.mean_velocity`` (settled positions of the first and last
-period) includes the start-up and is kept as ``simulator_mean_velocity_m_per_s`` for
-comparison.
+The velocities are measured by the protocol of :mod:`passmd.protocols.velocity` (the
+*steady* velocity at kHz frequencies, the steps at 100 Hz); ``SimulationResult.mean_velocity``
+(settled positions of the first and last period) includes the start-up and is kept as
+``simulator_mean_velocity_m_per_s`` for comparison.
 
-Figures (``compute(profile) -> DataFrame``, registered for the book, the CLI and the ledger):
+Figures (``compute(config: RunConfig) -> DataFrame``, in the figure table of :mod:`passmd.figures`):
 ``fig8a`` saw-tooth response with contact status; ``fig8b`` the optimized waveform with
 t_s, t_a, Δ_a; ``fig9a`` runner position over three 100 Hz periods, both waveforms;
 ``fig9b`` steady velocity against frequency, both waveforms; ``fig10a``–``fig10c`` the
 optimized waveform's velocity for three preloads, two radii, two runner materials.
 
 Beyond the paper (flexible actuators, the settling time, a numerical optimum of the
-waveform): :mod:`passmd.experiments.waveform_studies`.
+waveform): :mod:`passmd.experiments.waveform_studies`; the numbers the chapter reads from both:
+:mod:`passmd.experiments.waveform_facts`.
 """
 
 from __future__ import annotations
@@ -38,28 +31,26 @@ import pandas as pd
 from passmd import dynamics, optimized_waveform, readings, sweep, theory, waveforms
 from passmd._validation import check_choice
 from passmd.checks import ClaimFails, NotEvaluable, evidence, extractor
-from passmd.experiments import PROFILES, register_figure
+from passmd.config import PROFILES, RunConfig
+from passmd.defaults import PROTOCOL
 from passmd.parameters import MOLYBDENUM, STEEL, Assumption, Drive, paper_drive, register_assumption
-from passmd.plots import driving_waveform as plots
 from passmd.protocols import eq15
+from passmd.protocols.velocity import (
+    FULL_SLIDING_SHARE,
+    MIN_PERIODS,
+    STEADY_TIME,
+    STEP_PERIODS,
+    make_waveform,
+    steady_run,
+)
 
-CHAPTER = "driving_waveform"
 #: Driving frequency of Figs. 8 and 9a (Hz).
-STEP_FREQUENCY = 100.0
+STEP_FREQUENCY = PROTOCOL.drive_frequency
 #: Fig. 9b/10 frequency grids (Hz): the paper's "1 to 130 kHz with a step of 5 kHz".
 FREQUENCIES = {
     "paper": np.array([1e3] + [5e3 * k for k in range(1, 27)]),
     "quick": np.array([1e3, 20e3, 60e3, 100e3, 110e3, 120e3, 130e3]),
 }
-#: Simulated time of a steady-velocity run (s) and its least number of periods.
-STEADY_TIME = 5e-3
-MIN_PERIODS = 20
-#: Record spacing inside the acceleration segment: a slip share sample every t_a / this.
-SAMPLES_PER_ACCELERATION = 8
-#: Largest record of a steady run (rows); bounds memory at low frequencies.
-MAX_RECORD = 300_000
-#: Slip share counted as full sliding (the exact MDR contact reports exactly 1).
-FULL_SLIDING_SHARE = 1.0 - 1e-9
 #: Runner materials of Fig. 10c.
 RUNNERS = {"steel": STEEL, "molybdenum": MOLYBDENUM}
 #: Preloads of Fig. 10a (N) and radii of Fig. 10b (m).
@@ -178,92 +169,17 @@ def design_point(hemisphere_radius: float, preload: float, runner: str, actuator
     return out
 
 
-def make_waveform(drive, amplitude, frequency, periods, waveform, short_period, design):
-    """A ``"sawtooth"`` or ``"optimized"`` (with ``design`` and ``short_period``) waveform."""
-    if waveform == "sawtooth":
-        return waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
-    return optimized_waveform.optimized(amplitude, frequency, drive, periods=periods, design=design,
-                                        short_period=short_period)
-
-
-def steady_periods(frequency: float, steady_time: float = STEADY_TIME, min_periods: int = MIN_PERIODS) -> int:
-    """Periods of a steady-velocity run: ``max(min_periods, ceil(f · steady_time))``."""
-    return int(max(min_periods, math.ceil(frequency * steady_time - 1e-9)))
-
-
-def steady_velocity(result) -> dict:
-    """Steady velocity from the period-mean positions of a run's second half (m/s).
-
-    Returns ``velocity_m_per_s`` (slope between the period means at n/2 and n − 1) and
-    ``velocity_drift`` (velocity over the fourth quarter minus that over the third, over
-    |velocity|; 0 for a steady run).
-    """
-    means = result.period_mean_position
-    n = means.size
-    period = result.waveform.period
-    half = n // 2
-    quarter = max(1, (n - 1 - half) // 2)
-    v = (means[-1] - means[half]) / ((n - 1 - half) * period)
-    v3 = (means[half + quarter] - means[half]) / (quarter * period)
-    v4 = (means[-1] - means[-1 - quarter]) / (quarter * period)
-    drift = (v4 - v3) / abs(v) if v != 0 else math.inf
-    return {"velocity_m_per_s": float(v), "velocity_drift": float(drift)}
-
-
 def velocity_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
                    frequency: float, waveform: str, short_period: str, settling_time: float,
                    acceleration_time: float, acceleration_amplitude: float) -> dict:
-    """Steady velocity of one drive, waveform and frequency (module docstring).
+    """Steady velocity of one Section 5 drive, waveform and frequency at the full amplitude.
 
-    The design fields are ignored for the saw-tooth. For the optimized waveform the run is
-    recorded densely enough to sample the slip share inside every acceleration segment
-    (assumption ``stick_during_acceleration``).
-
-    Returns
-    -------
-    dict
-        ``velocity_m_per_s``, ``velocity_drift``, ``step_m`` (velocity / f),
-        ``back_step_m`` (mean over the second half), ``periods``,
-        ``simulator_mean_velocity_m_per_s``, ``wall_time_s`` and, for the optimized
-        waveform, the times actually used (:func:`passmd.optimized_waveform.optimized_timing`),
-        ``max_slip_share_acceleration`` and ``stick_during_acceleration``.
+    :func:`passmd.protocols.velocity.steady_run`; the design fields are ignored for the saw-tooth.
     """
     drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
-    amplitude = drive.actuator.full_stroke_amplitude
-    periods = steady_periods(frequency)
-    out = {}
-    max_points = 2
-    if waveform == "optimized":
-        design = make_design(settling_time, acceleration_time, acceleration_amplitude)
-        timing = optimized_waveform.optimized_timing(design, amplitude, frequency, drive,
-                                                     short_period=short_period)
-        out.update({k: v for k, v in timing.items() if k != "period_s"})
-        duration = periods / frequency
-        spacing = timing["acceleration_time_s"] / SAMPLES_PER_ACCELERATION
-        max_points = int(min(MAX_RECORD, math.ceil(duration / spacing) + 1))
-    else:
-        design = None
-        check_choice("waveform", waveform, ("sawtooth", "optimized"))
-    wave = make_waveform(drive, amplitude, frequency, periods, waveform, short_period, design)
-    result = dynamics.simulate(drive, wave, max_points=max_points)
-    out.update(steady_velocity(result))
-    half = periods // 2
-    out["step_m"] = out["velocity_m_per_s"] / frequency
-    out["back_step_m"] = float(np.mean(result.back_steps[half:]))
-    out["periods"] = periods
-    out["simulator_mean_velocity_m_per_s"] = result.mean_velocity
-    out["wall_time_s"] = result.wall_time
-    if waveform == "optimized":
-        start = np.arange(half, periods) / frequency + timing["settling_time_s"]
-        t = result.time
-        k = np.searchsorted(start, t, side="right") - 1
-        inside = (k >= 0) & (t <= start[np.clip(k, 0, None)] + timing["acceleration_time_s"])
-        if not np.any(inside):
-            raise dynamics.SimulationError("no recorded sample falls inside an acceleration segment")
-        share = float(result.slip_share[:, inside].max())
-        out["max_slip_share_acceleration"] = share
-        out["stick_during_acceleration"] = bool(share < FULL_SLIDING_SHARE)
-    return out
+    design = None if waveform != "optimized" else make_design(settling_time, acceleration_time,
+                                                               acceleration_amplitude)
+    return steady_run(drive, drive.actuator.full_stroke_amplitude, frequency, waveform, short_period, design)
 
 
 def trace_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
@@ -328,16 +244,16 @@ def trace_point(hemisphere_radius: float, preload: float, runner: str, actuator_
 # Tables behind the figures
 # ======================================================================================
 
-def config(hemisphere_radius: float = 1e-3, preload: float = 0.4, runner: str = "steel",
-           actuator_model: str = "rigid") -> dict:
+def section5_fields(hemisphere_radius: float = 1e-3, preload: float = 0.4, runner: str = "steel",
+                    actuator_model: str = "rigid") -> dict:
     """A drive configuration as plain sweep parameters (see :func:`section5_drive`)."""
     return {"hemisphere_radius": float(hemisphere_radius), "preload": float(preload), "runner": runner,
             "actuator_model": actuator_model}
 
 
-def designs(configs: list[dict]) -> pd.DataFrame:
-    """Eq. 15 design of each configuration (:func:`design_point`), one row each, cached."""
-    return sweep.run(design_point, [dict(c) for c in configs], description="waveform design")
+def designs(drives: list[dict], config: RunConfig) -> pd.DataFrame:
+    """Eq. 15 design of each drive (:func:`section5_fields`, :func:`design_point`), one row each, cached."""
+    return sweep.run(design_point, [dict(c) for c in drives], description="waveform design", config=config)
 
 
 def design_fields(row) -> dict:
@@ -347,22 +263,22 @@ def design_fields(row) -> dict:
             "acceleration_amplitude": float(row["acceleration_amplitude_m"])}
 
 
-def velocity_table(configs: list[dict], frequencies) -> pd.DataFrame:
+def velocity_table(drives: list[dict], frequencies, config: RunConfig) -> pd.DataFrame:
     """Steady velocity of every configuration × waveform variant (:data:`VARIANTS`) × frequency.
 
     Each configuration's optimized waveform is its own Eq. 15 design. Adds display
     columns (``frequency_kHz``, ``velocity_mm_per_s``, ``step_nm``, ``back_step_nm``,
     ``radius_mm``) and ``variant`` (``sawtooth``, ``optimized``, ``optimized_skip``).
     """
-    design_rows = designs(configs)
+    design_rows = designs(drives, config)
     points = []
-    for c, (_, d) in zip(configs, design_rows.iterrows(), strict=True):
+    for c, (_, d) in zip(drives, design_rows.iterrows(), strict=True):
         fields = design_fields(d)
         for waveform, rule in VARIANTS:
             for f in frequencies:
                 points.append({**c, "frequency": float(f), "waveform": waveform, "short_period": rule,
                                **fields})
-    table = sweep.run(velocity_point, points, description="steady velocity")
+    table = sweep.run(velocity_point, points, description="steady velocity", config=config)
     table["variant"] = [variant_name(w, r)
                         for w, r in zip(table["waveform"], table["short_period"], strict=True)]
     table["frequency_kHz"] = table["frequency"] / 1e3
@@ -381,11 +297,11 @@ def _frequencies(profile: str) -> np.ndarray:
 
 
 def _trace(c: dict, frequency: float, periods: int, waveform: str, fields: dict, zoom: tuple[float, float],
-           full_samples: int, zoom_samples: int) -> dict:
+           full_samples: int, zoom_samples: int, config: RunConfig) -> dict:
     point = {**c, "frequency": float(frequency), "periods": int(periods), "waveform": waveform, **fields,
              "zoom_start": float(zoom[0]), "zoom_end": float(zoom[1]), "full_samples": int(full_samples),
              "zoom_samples": int(zoom_samples)}
-    return sweep.run(trace_point, [point], description="trace").iloc[0].to_dict()
+    return sweep.run(trace_point, [point], description="trace", config=config).iloc[0].to_dict()
 
 
 def _status(shares: np.ndarray) -> np.ndarray:
@@ -440,12 +356,11 @@ def _display(frame: pd.DataFrame) -> pd.DataFrame:
 
 
 def _samples(profile: str) -> tuple[int, int]:
+    check_choice("profile", profile, PROFILES)
     return (400, 300) if profile == "quick" else (2000, 1500)
 
 
-@register_figure("fig8a", title="Runner response to two saw-tooth periods, with the contact status",
-                 chapter=CHAPTER, plot=plots.plot_fig8a)
-def fig8a(profile: str = "paper") -> pd.DataFrame:
+def fig8a(config: RunConfig) -> pd.DataFrame:
     """Saw-tooth response (100 Hz, two periods, Section 5 drive) with the contact status.
 
     Views: ``full`` (both periods), ``zoom`` (the first fly-back and the micro-vibration
@@ -453,12 +368,11 @@ def fig8a(profile: str = "paper") -> pd.DataFrame:
     reversal, fastest forward motion). Constant columns: ``first_back_step_m`` and the
     measured ``micro_vibration_frequency_Hz``.
     """
-    _frequencies(profile)
-    c = config()
+    c = section5_fields()
     T = 1.0 / STEP_FREQUENCY
     trace = _trace(c, STEP_FREQUENCY, 2, "sawtooth", {"settling_time": 0.0, "acceleration_time": 0.0,
                                                     "acceleration_amplitude": 0.0},
-                   (T - 10e-6, T + 250e-6), *_samples(profile))
+                   (T - 10e-6, T + 250e-6), *_samples(config.profile), config)
     series = pd.concat([_series_frame(trace, "full", 2), _series_frame(trace, "zoom", 2)], ignore_index=True)
     z1, z2 = trace["turning_times_s"][0], trace["turning_times_s"][1]
     zoom = series[series["view"] == "zoom"]
@@ -472,9 +386,7 @@ def fig8a(profile: str = "paper") -> pd.DataFrame:
     return _display(frame)
 
 
-@register_figure("fig8b", title="The optimized waveform (Eq. 15) with t_s, t_a and Δ_a",
-                 chapter=CHAPTER, plot=plots.plot_fig8b)
-def fig8b(profile: str = "paper") -> pd.DataFrame:
+def fig8b(config: RunConfig) -> pd.DataFrame:
     """The optimized waveform of the Section 5 drive and the runner's response (100 Hz).
 
     Period 1 is a saw-tooth, period 2 optimized. Views ``full``, ``zoom`` (the fly-back,
@@ -484,14 +396,13 @@ def fig8b(profile: str = "paper") -> pd.DataFrame:
     ``acceleration_velocity_m_per_s``, ``micro_vibration_frequency_Hz``,
     ``runner_velocity_m_per_s``, ``presliding_m``, ``linear_frequency_Hz``).
     """
-    _frequencies(profile)
-    c = config()
-    design = designs([c]).iloc[0]
+    c = section5_fields()
+    design = designs([c], config).iloc[0]
     fields = design_fields(design)
     T = 1.0 / STEP_FREQUENCY
     t_s, t_a = fields["settling_time"], fields["acceleration_time"]
     trace = _trace(c, STEP_FREQUENCY, 2, "optimized", fields, (T - 5e-6, T + t_s + t_a + 60e-6),
-                   *_samples(profile))
+                   *_samples(config.profile), config)
     series = pd.concat([_series_frame(trace, "full", 2), _series_frame(trace, "zoom", 2)], ignore_index=True)
     z1 = trace["turning_times_s"][0]
     zoom = series[series["view"] == "zoom"]
@@ -556,9 +467,7 @@ def window_point(hemisphere_radius: float, preload: float, runner: str, actuator
     return out
 
 
-@register_figure("fig8b_window", title="Fig. 8b's fly-back and acceleration t_a, resolved in time",
-                 chapter=CHAPTER, plot=plots.plot_fig8b_window)
-def fig8b_window(profile: str = "paper") -> pd.DataFrame:
+def fig8b_window(config: RunConfig) -> pd.DataFrame:
     """The fly-back and the acceleration t_a of Fig. 8b's optimized period, resolved inside t_a.
 
     One run of the Section 5 drive (0.4 N, 100 Hz, its own Eq. 15 design) integrated with the
@@ -568,12 +477,11 @@ def fig8b_window(profile: str = "paper") -> pd.DataFrame:
     ``slip_share_2``, ``phase`` (``flyback``, ``settling``, ``acceleration``, ``after``) and
     the constant phase times (s) and record spacing.
     """
-    check_choice("profile", profile, PROFILES)
-    c = config()
-    fields = design_fields(designs([c]).iloc[0])
-    point = {**c, **fields, "resolution": WINDOW_RESOLUTION[profile],
+    c = section5_fields()
+    fields = design_fields(designs([c], config).iloc[0])
+    point = {**c, **fields, "resolution": WINDOW_RESOLUTION[config.profile],
              "samples_per_acceleration": WINDOW_SAMPLES_PER_ACCELERATION}
-    run = sweep.run(window_point, [point], description="fly-back window").iloc[0].to_dict()
+    run = sweep.run(window_point, [point], description="fly-back window", config=config).iloc[0].to_dict()
     t = np.asarray(run["time_s"])
     frame = pd.DataFrame({"time_s": t, "time_us": t * 1e6})
     for name in ("runner_velocity_m_per_s", "runner_position_m", "piezo_position_m", "slip_share_1",
@@ -592,9 +500,7 @@ def fig8b_window(profile: str = "paper") -> pd.DataFrame:
     return frame
 
 
-@register_figure("fig9a", title="Runner position over three 100 Hz periods, saw-tooth and optimized",
-                 chapter=CHAPTER, plot=plots.plot_fig9a)
-def fig9a(profile: str = "paper") -> pd.DataFrame:
+def fig9a(config: RunConfig) -> pd.DataFrame:
     """Three 100 Hz periods from rest with both waveforms (Section 5 drive, Fig. 9a).
 
     Views per ``waveform``: ``full`` (time series), ``period`` (``period`` 1–3 with
@@ -607,14 +513,13 @@ def fig9a(profile: str = "paper") -> pd.DataFrame:
     of the ledger's axis ``friction_coefficient`` (:data:`FIG9A_FRICTION`), each with its own
     Eq. 15 design.
     """
-    _frequencies(profile)
-    full, _ = _samples(profile)
+    full, _ = _samples(config.profile)
     parts = []
     for mu in FIG9A_FRICTION:
-        c = {**config(), "friction_coefficient": mu}
-        fields = design_fields(designs([c]).iloc[0])
+        c = {**section5_fields(), "friction_coefficient": mu}
+        fields = design_fields(designs([c], config).iloc[0])
         for waveform in ("sawtooth", "optimized"):
-            trace = _trace(c, STEP_FREQUENCY, 3, waveform, fields, (0.0, 1e-3), full, 2)
+            trace = _trace(c, STEP_FREQUENCY, STEP_PERIODS, waveform, fields, (0.0, 1e-3), full, 2, config)
             series = _series_frame(trace, "full", 2)
             settled = np.asarray(trace["settled_positions_m"])
             per = pd.DataFrame({"view": "period", "period": np.arange(1, settled.size + 1),
@@ -624,6 +529,7 @@ def fig9a(profile: str = "paper") -> pd.DataFrame:
             frame = pd.concat([series, per], ignore_index=True)
             frame["waveform"] = waveform
             frame["friction_coefficient"] = mu
+            frame["section5_friction"] = mu == SECTION5_FRICTION
             frame["final_position_m"] = float(settled[-1])
             frame["micro_vibration_frequency_Hz"] = float(trace["micro_vibration_frequency_Hz"])
             parts.append(frame)
@@ -636,32 +542,26 @@ def at_section5_friction(frame: pd.DataFrame, friction_coefficient: float = SECT
     return frame[np.isclose(frame["friction_coefficient"], friction_coefficient, rtol=1e-9, atol=0)]
 
 
-@register_figure("fig9b", title="Steady velocity against driving frequency, saw-tooth and optimized",
-                 chapter=CHAPTER, plot=plots.plot_fig9b)
-def fig9b(profile: str = "paper") -> pd.DataFrame:
+def fig9b(config: RunConfig) -> pd.DataFrame:
     """Steady velocity of the Section 5 drive over the frequency grid, every waveform variant."""
-    return velocity_table([config()], _frequencies(profile))
+    return velocity_table([section5_fields()], _frequencies(config.profile), config)
 
 
-@register_figure("fig10a", title="Velocity of the optimized waveform for preloads 0.1, 0.4, 1 N",
-                 chapter=CHAPTER, plot=plots.plot_fig10a)
-def fig10a(profile: str = "paper") -> pd.DataFrame:
+def fig10a(config: RunConfig) -> pd.DataFrame:
     """Steady velocity against frequency for F_p = 0.1, 0.4, 1 N (R = 1 mm, steel)."""
-    return velocity_table([config(preload=p) for p in FIG10A_PRELOADS], _frequencies(profile))
+    return velocity_table([section5_fields(preload=p) for p in FIG10A_PRELOADS], _frequencies(config.profile),
+                          config)
 
 
-@register_figure("fig10b", title="Velocity of the optimized waveform for R = 1 mm and 0.25 mm",
-                 chapter=CHAPTER, plot=plots.plot_fig10b)
-def fig10b(profile: str = "paper") -> pd.DataFrame:
+def fig10b(config: RunConfig) -> pd.DataFrame:
     """Steady velocity against frequency for R = 1 mm (A = 202 nm) and 0.25 mm (A = 96 nm), 0.4 N."""
-    return velocity_table([config(hemisphere_radius=r) for r in FIG10B_RADII], _frequencies(profile))
+    return velocity_table([section5_fields(hemisphere_radius=r) for r in FIG10B_RADII],
+                          _frequencies(config.profile), config)
 
 
-@register_figure("fig10c", title="Velocity of the optimized waveform, steel and molybdenum runner",
-                 chapter=CHAPTER, plot=plots.plot_fig10c)
-def fig10c(profile: str = "paper") -> pd.DataFrame:
+def fig10c(config: RunConfig) -> pd.DataFrame:
     """Steady velocity against frequency for a steel (210 GPa) and a molybdenum (310 GPa) runner."""
-    return velocity_table([config(runner=r) for r in RUNNERS], _frequencies(profile))
+    return velocity_table([section5_fields(runner=r) for r in RUNNERS], _frequencies(config.profile), config)
 
 
 # ======================================================================================

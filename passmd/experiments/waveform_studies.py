@@ -17,54 +17,47 @@ import numpy as np
 import pandas as pd
 
 from passmd import dynamics, optimized_waveform, sweep
-from passmd._validation import check_choice
-from passmd.experiments import PROFILES
+from passmd.config import RunConfig
 from passmd.experiments.driving_waveform import (
     STEP_FREQUENCY,
     VARIANTS,
-    config,
     design_fields,
     designs,
     make_design,
-    make_waveform,
     section5_drive,
-    steady_periods,
-    steady_velocity,
+    section5_fields,
     variant_name,
 )
-from passmd.parameters import Assumption, Drive, register_assumption
+from passmd.parameters import Assumption, register_assumption
+from passmd.protocols.velocity import (
+    STEP_PERIODS,
+    STEP_PROTOCOL_BELOW,
+    make_waveform,
+    steady_periods,
+    step_run,
+    waveform_velocity,
+)
 
 
 def step_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
                frequency: float, waveform: str, settling_time: float, acceleration_time: float,
-               acceleration_amplitude: float, periods: int = 3) -> dict:
-    """Fig. 9a protocol: ``periods`` periods from rest; settled positions and their steps.
-
-    Returns ``settled_positions_m``, ``mean_step_m`` (mean over the steps from period 2 on,
-    i.e. across the optimized slips), ``final_position_m`` and ``wall_time_s``.
-    """
+               acceleration_amplitude: float, periods: int = STEP_PERIODS) -> dict:
+    """Fig. 9a protocol (:func:`passmd.protocols.velocity.step_run`), Section 5 drive, full amplitude."""
     drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
-    amplitude = drive.actuator.full_stroke_amplitude
     design = None if waveform == "sawtooth" else make_design(
         settling_time, acceleration_time, acceleration_amplitude)
-    wave = make_waveform(drive, amplitude, frequency, periods, waveform, "cut", design)
-    result = dynamics.simulate(drive, wave, max_points=2)
-    return {"settled_positions_m": result.settled_positions, "mean_step_m": float(np.mean(result.step_sizes)),
-            "final_position_m": result.final_position, "wall_time_s": result.wall_time}
+    return step_run(drive, drive.actuator.full_stroke_amplitude, frequency, waveform, design, periods)
 
 
-#: Below this frequency a velocity is measured by Fig. 9a's protocol (3 periods, mean step × f),
-#: above it by the steady-velocity protocol (Hz).
-STEP_PROTOCOL_BELOW = 1e3
 #: Differential-evolution budgets (population size factor, generations) per profile.
 OPTIMIZER_BUDGET = {"paper": (10, 30), "quick": (5, 4)}
 #: Frequencies of the numerical optimisation per profile (Hz), rigid and flexible actuators.
 OPTIMUM_FREQUENCIES = {
-    "paper": {"rigid": (100.0, 1e3, 10e3, 50e3, 110e3), "flexible": (100.0,)},
-    "quick": {"rigid": (100.0, 110e3), "flexible": ()},
+    "paper": {"rigid": (STEP_FREQUENCY, 1e3, 10e3, 50e3, 110e3), "flexible": (STEP_FREQUENCY,)},
+    "quick": {"rigid": (STEP_FREQUENCY, 110e3), "flexible": ()},
 }
 #: Frequencies of the flexible-actuator study per profile (Hz).
-FLEXIBLE_FREQUENCIES = {"paper": (100.0, 1e3, 10e3, 50e3, 110e3), "quick": (100.0, 110e3)}
+FLEXIBLE_FREQUENCIES = {"paper": (STEP_FREQUENCY, 1e3, 10e3, 50e3, 110e3), "quick": (STEP_FREQUENCY, 110e3)}
 #: Points of the settling-time scan over [0, 2/f_s] per profile.
 SCAN_POINTS = {"paper": 41, "quick": 9}
 
@@ -87,21 +80,6 @@ register_assumption(
         sensitivity="Driving-waveform chapter: the optimum's parameters per frequency.",
     )
 )
-
-
-def waveform_velocity(drive: Drive, amplitude: float, frequency: float, waveform: str,
-                      design=None, short_period: str = "cut") -> float:
-    """Velocity of one waveform by the chapter's protocol (m/s).
-
-    Below :data:`STEP_PROTOCOL_BELOW`: three periods from rest, mean step (from period 2 on)
-    × f (Fig. 9a); above: the steady velocity (:func:`passmd.experiments.driving_waveform.steady_velocity`).
-    """
-    if frequency < STEP_PROTOCOL_BELOW:
-        wave = make_waveform(drive, amplitude, frequency, 3, waveform, short_period, design)
-        return float(np.mean(dynamics.simulate(drive, wave, max_points=2).step_sizes) * frequency)
-    periods = steady_periods(frequency)
-    wave = make_waveform(drive, amplitude, frequency, periods, waveform, short_period, design)
-    return steady_velocity(dynamics.simulate(drive, wave, max_points=2))["velocity_m_per_s"]
 
 
 def optimum_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
@@ -156,27 +134,26 @@ def optimum_point(hemisphere_radius: float, preload: float, runner: str, actuato
     }
 
 
-def numerical_optimum(profile: str = "paper") -> pd.DataFrame:
+def numerical_optimum(config: RunConfig) -> pd.DataFrame:
     """Differential evolution against Eq. 15's heuristic at a few frequencies (beyond the paper).
 
     One row per (actuator model, frequency) of :data:`OPTIMUM_FREQUENCIES`, with the
     velocities of the saw-tooth, the Eq. 15 design and the optimum (m/s and mm/s), the
     optimum's parameters and the settling time in cycles of f_s.
     """
-    check_choice("profile", profile, PROFILES)
-    popsize, maxiter = OPTIMIZER_BUDGET[profile]
+    popsize, maxiter = OPTIMIZER_BUDGET[config.profile]
     points, cycles = [], []
-    for model, frequencies in OPTIMUM_FREQUENCIES[profile].items():
+    for model, frequencies in OPTIMUM_FREQUENCIES[config.profile].items():
         if not frequencies:
             continue
-        c = config(actuator_model=model)
-        d = designs([c]).iloc[0]
+        c = section5_fields(actuator_model=model)
+        d = designs([c], config).iloc[0]
         for f in frequencies:
             points.append({**c, "frequency": float(f), **design_fields(d),
                            "micro_vibration_frequency": float(d["micro_vibration_frequency_Hz"]),
                            "popsize": popsize, "maxiter": maxiter})
             cycles.append(float(d["micro_vibration_frequency_Hz"]))
-    table = sweep.run(optimum_point, points, description="waveform optimisation")
+    table = sweep.run(optimum_point, points, description="waveform optimisation", config=config)
     table["frequency_kHz"] = table["frequency"] / 1e3
     for name in ("sawtooth", "eq15", "optimum"):
         table[f"velocity_{name}_mm_per_s"] = table[f"velocity_{name}_m_per_s"] * 1e3
@@ -185,7 +162,7 @@ def numerical_optimum(profile: str = "paper") -> pd.DataFrame:
     return table
 
 
-def settling_scan(profile: str = "paper", acceleration_time: float | None = None,
+def settling_scan(config: RunConfig, acceleration_time: float | None = None,
                   acceleration_amplitude: float | None = None, actuator_model: str = "rigid") -> pd.DataFrame:
     """Step at 100 Hz (Fig. 9a protocol) against the settling time t_s ∈ [0, 2/f_s].
 
@@ -193,19 +170,18 @@ def settling_scan(profile: str = "paper", acceleration_time: float | None = None
     scan with them. Adds ``settling_cycles`` (t_s·f_s), ``step_nm`` and the saw-tooth's
     ``sawtooth_step_nm`` for reference.
     """
-    check_choice("profile", profile, PROFILES)
-    c = config(actuator_model=actuator_model)
-    d = designs([c]).iloc[0]
+    c = section5_fields(actuator_model=actuator_model)
+    d = designs([c], config).iloc[0]
     f_s = float(d["micro_vibration_frequency_Hz"])
     t_a = float(d["acceleration_time_s"]) if acceleration_time is None else float(acceleration_time)
     d_a = (float(d["acceleration_amplitude_m"]) if acceleration_amplitude is None
            else float(acceleration_amplitude))
     points = [{**c, "frequency": STEP_FREQUENCY, "waveform": "optimized", "settling_time": float(t_s),
                "acceleration_time": t_a, "acceleration_amplitude": d_a}
-              for t_s in np.linspace(0.0, 2.0 / f_s, SCAN_POINTS[profile])]
+              for t_s in np.linspace(0.0, 2.0 / f_s, SCAN_POINTS[config.profile])]
     points.append({**c, "frequency": STEP_FREQUENCY, "waveform": "sawtooth", "settling_time": 0.0,
                    "acceleration_time": 0.0, "acceleration_amplitude": 0.0})
-    table = sweep.run(step_point, points, description="settling scan")
+    table = sweep.run(step_point, points, description="settling scan", config=config)
     saw = float(table["mean_step_m"].iloc[-1])
     table = table.iloc[:-1].copy()
     table["settling_cycles"] = table["settling_time"] * f_s
@@ -216,28 +192,28 @@ def settling_scan(profile: str = "paper", acceleration_time: float | None = None
     return table
 
 
-def flexible_study(profile: str = "paper") -> pd.DataFrame:
+def flexible_study(config: RunConfig) -> pd.DataFrame:
     """Does the gain survive flexible actuators? (beyond the paper, Section 6's outlook).
 
     For rigid and flexible actuators (Table 2, ζ assumed), each with the Eq. 15 design made
     from its own saw-tooth response, and additionally the flexible drive driven with the
-    rigid drive's design: velocity by the chapter's protocol (:func:`waveform_velocity`) at
-    :data:`FLEXIBLE_FREQUENCIES`, for the saw-tooth and both optimized variants.
+    rigid drive's design: velocity by the chapter's protocol
+    (:func:`passmd.protocols.velocity.waveform_velocity`) at :data:`FLEXIBLE_FREQUENCIES`, for the
+    saw-tooth and both optimized variants.
     """
-    check_choice("profile", profile, PROFILES)
-    rigid, flexible = config(actuator_model="rigid"), config(actuator_model="flexible")
-    made = designs([rigid, flexible])
+    rigid, flexible = section5_fields(actuator_model="rigid"), section5_fields(actuator_model="flexible")
+    made = designs([rigid, flexible], config)
     cases = [(rigid, "rigid", made.iloc[0]), (flexible, "flexible", made.iloc[1]),
              (flexible, "rigid", made.iloc[0])]
     points = []
     for c, source, d in cases:
-        for f in FLEXIBLE_FREQUENCIES[profile]:
+        for f in FLEXIBLE_FREQUENCIES[config.profile]:
             for waveform, rule in VARIANTS:
                 if waveform == "sawtooth" and source != c["actuator_model"]:
                     continue
                 points.append({**c, "frequency": float(f), "waveform": waveform, "short_period": rule,
                                **design_fields(d), "design_from": source})
-    table = sweep.run(study_point, points, description="flexible study")
+    table = sweep.run(study_point, points, description="flexible study", config=config)
     table["variant"] = [variant_name(w, r)
                         for w, r in zip(table["waveform"], table["short_period"], strict=True)]
     table["frequency_kHz"] = table["frequency"] / 1e3
@@ -271,18 +247,18 @@ def startup_point(hemisphere_radius: float, preload: float, runner: str, actuato
             "settled_positions_m": result.settled_positions}
 
 
-def startup_transient(frequency: float = 110e3) -> pd.DataFrame:
+def startup_transient(config: RunConfig, frequency: float = 110e3) -> pd.DataFrame:
     """The runner's velocity period by period from rest at ``frequency`` (Section 5 drive).
 
     One row per period and waveform variant: ``time_s`` (end of the period), ``velocity_m_per_s``
     (difference of consecutive period-mean positions over T) and ``settled_velocity_m_per_s``
     (the same from the settled positions, which assume a stick phase).
     """
-    c = config()
-    fields = design_fields(designs([c]).iloc[0])
+    c = section5_fields()
+    fields = design_fields(designs([c], config).iloc[0])
     points = [{**c, "frequency": float(frequency), "waveform": w, "short_period": r, **fields}
               for w, r in VARIANTS]
-    runs = sweep.run(startup_point, points, description="start-up")
+    runs = sweep.run(startup_point, points, description="start-up", config=config)
     parts = []
     for _, run in runs.iterrows():
         means = np.asarray(run["period_mean_position_m"])

@@ -9,6 +9,11 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
+from passmd.defaults import PROTOCOL
+
+#: The saw-tooth frequency of Figs. 8, 9a and the settling scan, as the titles show it.
+_STEP_HZ = f"{PROTOCOL.drive_frequency:g} Hz"
+
 _STATUS_COLOURS = {"full slip": "#d62728", "partial slip": "#ffbb78"}
 _VARIANT_STYLE = {
     "sawtooth": {"color": "black", "linestyle": "--", "label": "saw-tooth"},
@@ -63,12 +68,12 @@ def _response(df, title: str):
 
 def plot_fig8a(df):
     """Fig. 8a: saw-tooth response, zoom on the first slip with points 1–4 and contact status."""
-    return _response(df, "saw-tooth, 100 Hz")
+    return _response(df, f"saw-tooth, {_STEP_HZ}")
 
 
 def plot_fig8b(df):
     """Fig. 8b: the optimized waveform with t_s, t_a, Δ_a marked, and the runner's response."""
-    fig = _response(df, "optimized waveform, 100 Hz")
+    fig = _response(df, f"optimized waveform, {_STEP_HZ}")
     ax = fig.axes[1]
     points = df[df["view"] == "point"].set_index("point")
     row = df.iloc[0]
@@ -104,11 +109,13 @@ def plot_fig8b_window(df):
 
 
 def plot_fig9a(df):
-    """Fig. 9a: runner position over three 100 Hz periods for both waveforms (μ = 0.2 runs only)."""
-    if "friction_coefficient" in df:
-        from passmd.experiments.driving_waveform import at_section5_friction
+    """Fig. 9a: runner position over three 100 Hz periods for both waveforms.
 
-        df = at_section5_friction(df)
+    Only the runs the data marks ``section5_friction`` (Section 5's μ) are drawn; the others are
+    the ledger's alternative readings of μ.
+    """
+    if "section5_friction" in df:
+        df = df[df["section5_friction"].astype(bool)]
     fig, ax = plt.subplots(figsize=(6.5, 4), constrained_layout=True)
     colours = {"sawtooth": "black", "optimized": "tab:green"}
     for waveform, part in df.groupby("waveform", sort=False):
@@ -121,7 +128,7 @@ def plot_fig9a(df):
                     (-40, 8), textcoords="offset points", fontsize=8, color=colours[waveform])
     saw = df[(df["waveform"] == "sawtooth") & (df["view"] == "full")]
     ax.plot(saw["time_ms"], saw["piezo_position_nm"], ":", color="grey", lw=0.8, label="saw-tooth x_p")
-    ax.set(xlabel="time (ms)", ylabel="runner position (nm)", title="three periods at 100 Hz")
+    ax.set(xlabel="time (ms)", ylabel="runner position (nm)", title=f"three periods at {_STEP_HZ}")
     ax.legend(fontsize=8)
     return fig
 
@@ -211,7 +218,7 @@ def plot_settling_scan(scans: dict):
     ax.annotate("Eq. 15: t_s = 1/(2 f_s)", (first["eq15_settling_cycles"].iloc[0], ax.get_ylim()[1]),
                 (4, -12), textcoords="offset points", fontsize=8, color="tab:green")
     ax.set(xlabel="settling time t_s · f_s (vibration cycles)", ylabel="step per period, periods 2–3 (nm)",
-           title="step at 100 Hz against the settling time")
+           title=f"step at {_STEP_HZ} against the settling time")
     ax.legend(fontsize=8)
     return fig
 

@@ -5,11 +5,11 @@ from __future__ import annotations
 import textwrap
 
 from passmd.cache import DEFAULT_CACHE_DIR
+from passmd.claims import STATUSES
 from passmd.cli.configuration import run_config
 from passmd.cli.errors import OutputError
 from passmd.cli.options import add_sweep_options
 from passmd.cli.output import JSON_HELP, emit_json
-from passmd.claims import STATUSES
 from passmd.config import ENVIRONMENT, PROFILES
 
 __all__ = ["add_parser", "run_ledger"]

@@ -1,0 +1,318 @@
+"""The stall criterion and the onset of force generation (Section 4.2), as functions of a drive.
+
+The runner starts at rest, touching the load cell (a linear spring k, Table 1) at its free
+length, with virgin contacts, and is driven by a saw-tooth until its steps stall: the load
+cell then pushes back, on average over a period, as hard as the contacts carry the runner
+forward. The force at stall is the *generated force* F_gen = k·x̄_r, x̄_r the runner's mean
+position over the last period (:attr:`passmd.dynamics.SimulationResult.generated_force`).
+
+Stall criterion (assumption ``force_stall_criterion``)
+    F_n is k times the runner's mean position over period n. Near stall each step is a
+    fixed fraction of the previous one (the step shrinks in proportion to the force still
+    missing), so F_n approaches its limit geometrically. With D₁ and D₂ the changes of F
+    over the two halves of the last :data:`STALL_WINDOW` periods, the rise still to come
+    is estimated as the geometric tail D₂·r/(1 − r), r = D₂/D₁; the run has stalled when
+    that tail and the spread of F over the window are both below the tolerance
+    max(:data:`STALL_ABS_TOLERANCE`, :data:`STALL_REL_TOLERANCE`·F). A run that has not
+    stalled is repeated from rest with more periods (predicted from the geometric rate),
+    up to :data:`MAX_PERIODS`; if it still has not stalled the result says
+    ``converged = False``.
+
+Onset of force generation (assumption ``force_onset``)
+    The runner generates force only if it steps at all from the free length, so the onset
+    is the critical amplitude of the drive with the load cell engaged, found by the
+    critical-amplitude search (steady-state protocol at the same frequency).
+
+Everything here takes a :class:`~passmd.parameters.Drive` and SI values; it knows nothing
+of figures, grids or the ledger.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from passmd import dynamics, waveforms
+from passmd._validation import check_choice, check_positive, check_range
+from passmd.defaults import PROTOCOL
+from passmd.experiments.critical_amplitude import critical_amplitude
+from passmd.parameters import Drive
+from passmd.theory import normal_forces
+
+__all__ = [
+    "INITIAL_PERIODS",
+    "MAX_PERIODS",
+    "ONSET_TOLERANCE",
+    "STALL_ABS_TOLERANCE",
+    "STALL_REL_TOLERANCE",
+    "STALL_WINDOW",
+    "force_onset",
+    "generated_force",
+    "stall_cycle",
+    "stall_estimate",
+]
+
+#: Periods over which the stall criterion looks at the force (two halves of 8).
+STALL_WINDOW = 16
+#: Absolute stall tolerance on the remaining rise and on the spread of F_gen (N).
+STALL_ABS_TOLERANCE = 0.2e-3
+#: Relative stall tolerance (fraction of F_gen).
+STALL_REL_TOLERANCE = 2e-3
+#: Periods of the first run of a point.
+INITIAL_PERIODS = 64
+#: Most periods a point may take.
+MAX_PERIODS = 4096
+#: Default width of the final bracket of the onset (critical-amplitude) search (m).
+ONSET_TOLERANCE = 0.2e-9
+
+
+def stall_estimate(forces, window: int = STALL_WINDOW) -> dict:
+    """Remaining rise and spread of a per-period force series (the stall criterion).
+
+    Parameters
+    ----------
+    forces : array_like
+        F_n, one value per period (N).
+    window : int
+        Number of last periods examined (even, >= 4).
+
+    Returns
+    -------
+    dict
+        ``remaining_N``: estimated rise still to come (``inf`` while the force grows at
+        an undiminished rate); ``spread_N``: max − min over the window; ``ratio``:
+        D₂/D₁ of the two half-windows (nan when undefined).
+    """
+    f = np.asarray(forces, dtype=float)
+    if int(window) != window or window < 4 or window % 2:
+        raise ValueError(f"window = {window!r} is out of range: must be an even integer >= 4")
+    if f.ndim != 1 or f.size < window + 1:
+        return {"remaining_N": math.inf, "spread_N": math.inf, "ratio": math.nan}
+    half = window // 2
+    d1 = f[-1 - half] - f[-1 - window]
+    d2 = f[-1] - f[-1 - half]
+    spread = float(np.ptp(f[-1 - window :]))
+    if d2 == 0.0:
+        return {"remaining_N": 0.0, "spread_N": spread, "ratio": 0.0 if d1 != 0 else math.nan}
+    if d1 == 0.0:
+        return {"remaining_N": math.inf, "spread_N": spread, "ratio": math.nan}
+    ratio = d2 / d1
+    if ratio < 0:  # oscillating about the stall level: bounded by the last swing
+        remaining = max(abs(d1), abs(d2))
+    elif ratio < 1:  # geometric approach
+        remaining = abs(d2) * ratio / (1.0 - ratio)
+    else:  # not slowing down
+        remaining = math.inf
+    return {"remaining_N": float(remaining), "spread_N": spread, "ratio": float(ratio)}
+
+
+def _stalled(estimate: dict, force: float, abs_tol: float, rel_tol: float) -> bool:
+    tol = max(abs_tol, rel_tol * abs(force))
+    return estimate["remaining_N"] <= tol and estimate["spread_N"] <= tol
+
+
+def _next_periods(periods: int, estimate: dict, force: float, window: int, abs_tol: float, rel_tol: float,
+                  max_periods: int) -> int:
+    """Periods of the next (longer) run from rest.
+
+    In the geometric approach the per-period factor q = r^(1/half) predicts how many more
+    periods bring the remaining rise below half the tolerance; the next run asks for that
+    with a 25 % margin, at least 1.5× and at most 4× the current run. Before the approach
+    is geometric (the force still rises at an undiminished rate) the run is doubled.
+    """
+    ratio = estimate["ratio"]
+    if 0.0 < ratio < 1.0 and math.isfinite(estimate["remaining_N"]) and estimate["remaining_N"] > 0:
+        q = ratio ** (1.0 / (window // 2))
+        tol = max(abs_tol, rel_tol * abs(force))
+        more = math.log(0.5 * tol / estimate["remaining_N"]) / math.log(q)
+        wanted = math.ceil(1.25 * (periods + max(more, 0.0)))
+        wanted = min(max(wanted, math.ceil(1.5 * periods)), 4 * periods)
+    else:
+        wanted = 2 * periods
+    return int(min(max_periods, window * math.ceil(wanted / window)))
+
+
+def generated_force(
+    drive: Drive,
+    amplitude: float,
+    frequency: float,
+    *,
+    flyback: str = "slew",
+    initial_periods: int = INITIAL_PERIODS,
+    max_periods: int = MAX_PERIODS,
+    abs_tolerance: float = STALL_ABS_TOLERANCE,
+    rel_tolerance: float = STALL_REL_TOLERANCE,
+    window: int = STALL_WINDOW,
+) -> dict:
+    """Generated force at stall: saw-tooth runs from rest against the load cell (Section 4.2).
+
+    Parameters
+    ----------
+    drive : Drive
+        The drive; the load cell is engaged whatever ``drive.load_cell`` says.
+    amplitude : float
+        Actuation amplitude A (m).
+    frequency : float
+        Driving frequency f (Hz).
+    flyback : {"slew", "fixed"}
+        Fly-back rule of :func:`passmd.waveforms.sawtooth`.
+    initial_periods, max_periods : int
+        Periods of the first run, doubled until stall or until ``max_periods``.
+    abs_tolerance, rel_tolerance : float
+        Stall tolerance max(abs, rel·F_gen) (N, fraction) on the remaining rise and the
+        spread of the per-period force (see the module docstring).
+    window : int
+        Periods examined by the stall criterion.
+
+    Returns
+    -------
+    dict
+        SI values, keys carrying the unit: ``generated_force_N`` (k·x̄_r over the last
+        period), ``converged`` (stall criterion met), ``periods`` (of the run reported),
+        ``periods_simulated`` (all runs together), ``remaining_force_N`` (estimated rise
+        still to come), ``force_spread_N`` (over the window), ``mean_friction_N`` (mean
+        total friction on the runner over the last period), ``piezo_mean_force_N`` (k times
+        the mean piezo position x̄_p, what the load cell reads if the runner only follows
+        the piezo), ``last_step_m``, ``net_displacement_m`` (x̄_r − x̄_p over the last
+        period), ``wall_time_s`` (integration time of all runs), ``cpu_time_s`` (CPU time of
+        the whole call).
+
+    Raises
+    ------
+    ValueError
+        Bad input (names the parameter, its value and the allowed range).
+    passmd.dynamics.SimulationError
+        A run diverged.
+    """
+    cpu = time.process_time()
+    if not isinstance(drive, Drive):
+        raise ValueError(f"drive = {drive!r} is not a Drive")
+    check_positive("frequency", frequency, "Hz")
+    check_choice("flyback", flyback, ("slew", "fixed"))
+    check_positive("abs_tolerance", abs_tolerance, "N")
+    check_range("rel_tolerance", rel_tolerance, 0.0, 1.0, upper_open=True)
+    for name, value in (("initial_periods", initial_periods), ("max_periods", max_periods)):
+        if isinstance(value, bool) or int(value) != value or value < window + 1:
+            raise ValueError(f"{name} = {value!r} is out of range: must be an integer >= {window + 1}")
+    if max_periods < initial_periods:
+        raise ValueError(f"max_periods = {max_periods!r} is out of range: must be >= initial_periods "
+                         f"= {initial_periods!r}")
+    drive = drive if drive.load_cell else drive.replace(load_cell=True)
+    k = drive.load_cell_stiffness
+    periods, simulated, wall = int(initial_periods), 0, 0.0
+    while True:
+        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=periods, flyback=flyback)
+        result = dynamics.simulate(drive, wave, max_points=2)
+        simulated += periods
+        wall += result.wall_time
+        forces = k * result.period_mean_position
+        estimate = stall_estimate(forces, window)
+        converged = _stalled(estimate, float(forces[-1]), abs_tolerance, rel_tolerance)
+        if converged or periods >= max_periods:
+            break
+        periods = _next_periods(periods, estimate, float(forces[-1]), window, abs_tolerance, rel_tolerance,
+                                int(max_periods))
+    T = wave.period
+    piezo_mean = float(np.mean(wave.position(np.linspace((periods - 1) * T, periods * T, 4001))))
+    return {
+        "generated_force_N": float(forces[-1]),
+        "converged": bool(converged),
+        "periods": int(periods),
+        "periods_simulated": int(simulated),
+        "remaining_force_N": estimate["remaining_N"],
+        "force_spread_N": estimate["spread_N"],
+        "mean_friction_N": float(result.period_mean_friction[-1]),
+        "piezo_mean_force_N": k * piezo_mean,
+        "last_step_m": float(result.step_sizes[-1]),
+        "net_displacement_m": float(result.period_mean_position[-1] - piezo_mean),
+        "wall_time_s": float(wall),
+        "cpu_time_s": float(time.process_time() - cpu),
+    }
+
+
+def force_onset(drive: Drive, frequency: float = PROTOCOL.drive_frequency,
+                tolerance: float = ONSET_TOLERANCE) -> dict:
+    """Onset of force generation: the critical amplitude with the load cell engaged (m).
+
+    Calls :func:`passmd.experiments.critical_amplitude.critical_amplitude` (steady-state
+    protocol) on ``drive`` with its load cell engaged. Returns its dict
+    (``critical_amplitude_m`` — ``None`` if even the full stroke makes no step —,
+    ``bracket_low_m``, ``bracket_high_m``, ``runs``, ``wall_time_s``).
+    """
+    if not isinstance(drive, Drive):
+        raise ValueError(f"drive = {drive!r} is not a Drive")
+    return critical_amplitude(drive if drive.load_cell else drive.replace(load_cell=True),
+                              frequency=frequency, tolerance=tolerance)
+
+
+def stall_cycle(
+    drive: Drive, amplitude: float, frequency: float, periods: int, samples_per_period: int = 2000
+) -> dict:
+    """One period at stall, from the fly-back that starts it: time series and measures.
+
+    Runs ``periods`` saw-tooth periods from rest (the count :func:`generated_force` needed to
+    stall) recording ``samples_per_period`` samples per period, and keeps the window from the
+    fly-back of period ``periods − 1`` to that of the last period.
+
+    Returns
+    -------
+    dict
+        Arrays (SI) ``time_s`` (since the fly-back), ``piezo_m``, ``runner_m`` (x_r − x̄_r),
+        ``load_cell_N`` (k·x_r), ``friction_N`` (total on the runner), and per contact group
+        (side 1: two contacts at F_N1, side 2: four at F_N2) ``friction_side{1,2}_N``,
+        ``deflection_side{1,2}_m`` (x_p − x_a), ``slip_share_side{1,2}``; scalars
+        ``generated_force_N``, ``sliding_capacity_N`` (Σ μF_N), ``back_slide_m`` (largest
+        backward excursion of the runner after the fly-back, from every integrator step),
+        ``deflection_before_flyback_side{1,2}_m`` (x_p − x_a at the last sample before it),
+        ``full_slip_time_s`` (time every contact slides, to the sample spacing),
+        ``mean_slip_share_side{1,2}`` (over the period), ``sample_spacing_s``. The first
+        sample is the last one before the fly-back (negative time).
+    """
+    if not isinstance(drive, Drive) or drive.contacts != 6:
+        raise ValueError(f"drive = {drive!r} is not allowed: must be a six-contact Drive")
+    if isinstance(periods, bool) or int(periods) != periods or periods < 2:
+        raise ValueError(f"periods = {periods!r} is out of range: must be an integer >= 2")
+    if isinstance(samples_per_period, bool) or int(samples_per_period) != samples_per_period \
+            or samples_per_period < 100:
+        raise ValueError(
+            f"samples_per_period = {samples_per_period!r} is out of range: must be an integer >= 100"
+        )
+    drive = drive if drive.load_cell else drive.replace(load_cell=True)
+    wave = waveforms.sawtooth(amplitude, frequency, drive, periods=int(periods))
+    result = dynamics.simulate(drive, wave, max_points=int(periods) * int(samples_per_period) + 1)
+    start, end = wave.slip_marks[-2], wave.slip_marks[-1]
+    spacing = float(result.time[1] - result.time[0])
+    first = int(np.searchsorted(result.time, start, side="right")) - 1  # last sample before the fly-back
+    last = int(np.searchsorted(result.time, end, side="right"))
+    sel = slice(first, last)
+    t = result.time[sel] - start
+    k = drive.load_cell_stiffness
+    x_r = result.runner_position[sel]
+    x_p = result.piezo_position[sel]
+    n = result.multiplicity
+    friction = result.friction_force[:, sel] * n[:, None]
+    deflection = x_p[None, :] - result.actuator_position[:, sel]
+    slip = result.slip_share[:, sel]
+    forces = np.asarray(normal_forces(drive.preload, 6), dtype=float)
+    capacity = float(drive.friction_coefficient * np.sum(n * forces))
+    out = {
+        "time_s": t,
+        "piezo_m": x_p,
+        "runner_m": x_r - float(np.mean(x_r[1:])),
+        "load_cell_N": k * x_r,
+        "friction_N": friction.sum(axis=0),
+        "generated_force_N": float(result.generated_force),
+        "sliding_capacity_N": capacity,
+        "back_slide_m": float(result.back_steps[-2]),
+        "full_slip_time_s": float(np.count_nonzero(np.all(slip[:, 1:] >= 1.0 - 1e-9, axis=0)) * spacing),
+        "sample_spacing_s": spacing,
+    }
+    for g, side in enumerate(("side1", "side2")):
+        out[f"friction_{side}_N"] = friction[g]
+        out[f"deflection_{side}_m"] = deflection[g]
+        out[f"slip_share_{side}"] = slip[g]
+        out[f"deflection_before_flyback_{side}_m"] = float(deflection[g, 0])
+        out[f"mean_slip_share_{side}"] = float(np.mean(slip[g, 1:]))
+    return out
