@@ -38,9 +38,14 @@ def tests(session: nox.Session) -> None:
 
 @nox.session(python=PYTHON)
 def lint(session: nox.Session) -> None:
-    """ruff over the package, tests, book helpers, benchmarks and this file."""
-    session.install("ruff>=0.6")
+    """ruff over the package, tests, book helpers, benchmarks and this file; the layer contracts.
+
+    ``lint-imports`` checks the import-linter contracts of ``pyproject.toml`` (the package's
+    layers and no import cycle) on the source tree; it imports nothing of the package.
+    """
+    session.install("ruff>=0.6", "import-linter>=2.16")
     session.run("ruff", "check", ".")
+    session.run("lint-imports", "--no-cache")
 
 
 @nox.session(python=PYTHON)

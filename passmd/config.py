@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 __all__ = ["ENVIRONMENT", "PROFILES", "RunConfig"]
@@ -102,7 +102,3 @@ class RunConfig:
             else:
                 fields[field] = text
         return cls(**fields, **overrides)
-
-    def with_profile(self, profile: str) -> RunConfig:
-        """The same configuration at another resolution profile."""
-        return replace(self, profile=profile)

@@ -38,6 +38,7 @@ from passmd.contact import (
     sliding_force,
     stack_contacts,
 )
+from passmd.defaults import PROTOCOL
 from passmd.parameters import Drive
 from passmd.theory import contact_moduli, normal_forces
 from passmd.time_steps import StepPlan, check_work, segments, step_plan
@@ -66,9 +67,10 @@ def contact_groups(drive: Drive, share_side_state: bool = True):
     forces = [float(f) for f in normal_forces(drive.preload, drive.contacts)]
     if drive.contacts == 1:
         return np.array(forces), np.array([1.0])
+    per_side = PROTOCOL.contacts_per_side
     if share_side_state:
-        return np.array(forces), np.array([2.0, 4.0])
-    return np.array([forces[0]] * 2 + [forces[1]] * 4), np.ones(6)
+        return np.array(forces), np.array(per_side, dtype=float)
+    return np.array([forces[0]] * per_side[0] + [forces[1]] * per_side[1]), np.ones(sum(per_side))
 
 
 @dataclass

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from passmd._validation import check_array
+from passmd.defaults import PROTOCOL
 
 if TYPE_CHECKING:  # the closed forms read a drive's fields; parameters imports this module
     from passmd.parameters import Drive
@@ -189,7 +190,7 @@ def runner_frequency(drive: Drive) -> float:
     """
     E_star, G_star = contact_moduli(drive)
     forces = normal_forces(drive.preload, drive.contacts)
-    multiplicity = (1,) if drive.contacts == 1 else (2, 4)
+    multiplicity = (1,) if drive.contacts == 1 else PROTOCOL.contacts_per_side
     k_total = sum(
         m * float(tangential_stiffness(F, drive.hemisphere_radius, E_star, G_star))
         for m, F in zip(multiplicity, forces, strict=True)
@@ -204,7 +205,7 @@ def friction_limit(drive: Drive) -> float:
     Six contacts: μ (2 F_N1 + 4 F_N2) = 2√2 μ F_p; one contact: μ F_p.
     """
     forces = normal_forces(drive.preload, drive.contacts)
-    multiplicity = (1,) if drive.contacts == 1 else (2, 4)
+    multiplicity = (1,) if drive.contacts == 1 else PROTOCOL.contacts_per_side
     return float(drive.friction_coefficient * sum(m * float(F) for m, F in zip(multiplicity, forces,
                                                                                   strict=True)))
 
