@@ -60,10 +60,10 @@ STALL_WINDOW = 16
 STALL_ABS_TOLERANCE = 0.2e-3
 #: Relative stall tolerance (fraction of F_gen).
 STALL_REL_TOLERANCE = 2e-3
-#: Periods of the first run of a point.
-INITIAL_PERIODS = 64
-#: Most periods a point may take.
-MAX_PERIODS = 4096
+#: Periods of the first run of a point (the protocol default).
+INITIAL_PERIODS = PROTOCOL.stall_periods
+#: Most periods a point may take (the protocol default).
+MAX_PERIODS = PROTOCOL.stall_max_periods
 #: Default width of the final bracket of the onset (critical-amplitude) search (m).
 ONSET_TOLERANCE = 0.2e-9
 
