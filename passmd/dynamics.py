@@ -243,7 +243,7 @@ def simulate(
     waveform: Waveform,
     *,
     contact_model: str = "exact",
-    springs: int = 200,
+    springs: int = PROTOCOL.springs,
     dt: float | None = None,
     resolution: float = 1.0,
     max_points: int = 20000,
