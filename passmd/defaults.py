@@ -22,6 +22,9 @@ class ProtocolDefaults(NamedTuple):
     springs: int = 200
     #: Contacts on the two sides of the runner in the six-contact drive (Section 2).
     contacts_per_side: tuple[int, int] = (2, 4)
+    #: Drive frequencies over which the spread of the steady-state critical amplitude is
+    #: drawn as a band (Section 4.1; the band brackets ``drive_frequency``) [Hz].
+    critical_amplitude_band: tuple[float, ...] = (50.0, 100.0, 200.0)
 
 
 #: The defaults every protocol uses unless the caller says otherwise.

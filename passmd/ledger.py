@@ -50,7 +50,7 @@ import pandas as pd
 
 from passmd import experiments, readings, reference
 from passmd._validation import check_choice
-from passmd.parameters import all_assumptions
+from passmd.config import PROFILES
 
 __all__ = [
     "CHECK_KINDS",
@@ -130,8 +130,6 @@ STATUSES = ("reproduced", "reproduced under another reading", "not reproduced", 
 LEDGER_COLUMNS = ("claim", "figure", "quantity", "paper", "ours", "unit", "abs_deviation", "rel_deviation",
                   "tolerance", "status", "verdict", "evidence", "reason", "basis", "check", "depends_on",
                   "readings", "holds_at", "fraction_holds", "best_reading", "note")
-#: Build profiles passed to figure functions (those of :mod:`passmd.experiments`).
-PROFILES = experiments.PROFILES
 
 _ID = re.compile(r"^[a-z0-9][a-z0-9._-]*$")
 _FIGURE_KEY = re.compile(r"^(fig\d+[a-z_]*|closed_forms)$")
@@ -1147,6 +1145,8 @@ def assumptions_table() -> pd.DataFrame:
 
     Imports every module of passmd first, so every assumption registered anywhere is included.
     """
+    from passmd.assumptions import all_assumptions  # imports the experiment modules, which import this one
+
     return pd.DataFrame(
         [{"key": a.key, "symbol": a.symbol, "value": a.value, "unit": a.unit, "rationale": a.rationale,
           "effect on the results": a.sensitivity} for a in all_assumptions().values()]

@@ -304,13 +304,10 @@ def parameter_frame(*records, labels=None, units=None):
 
 
 def assumptions_frame():
-    """Every assumption in :data:`passmd.parameters.ASSUMPTIONS` as a table.
-
-    Imports all of passmd first, so assumptions registered by any module are included.
-    """
+    """Every assumption of :func:`passmd.assumptions.all_assumptions` as a table, in its order."""
     import pandas as pd
 
-    from passmd.parameters import all_assumptions
+    from passmd.assumptions import all_assumptions
 
     return pd.DataFrame([dataclasses.asdict(a) for a in all_assumptions().values()])
 

@@ -181,12 +181,12 @@ def test_parameter_frame_rejects_bad_input():
         publish.parameter_frame(paper_drive(), paper_drive().amplifier)
 
 
-def test_assumptions_frame_holds_every_registered_assumption():
-    from passmd.parameters import ASSUMPTIONS
+def test_assumptions_frame_holds_every_assumption_in_the_tables_order():
+    from passmd.assumptions import all_assumptions
 
     df = publish.assumptions_frame()
     assert list(df.columns) == ["key", "symbol", "value", "unit", "rationale", "sensitivity"]
-    assert set(df["key"]) == set(ASSUMPTIONS)  # after importing every module
+    assert list(df["key"]) == list(all_assumptions())
     assert {"actuator_viscosity", "preload_grids"} <= set(df["key"])
 
 

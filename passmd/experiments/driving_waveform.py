@@ -37,10 +37,9 @@ import pandas as pd
 
 from passmd import dynamics, readings, sweep, theory, waveforms
 from passmd._validation import check_choice
-from passmd.experiments import PROFILES, register_figure
+from passmd.config import PROFILES
 from passmd.ledger import ClaimFails, NotEvaluable, register_evidence, register_extractor
-from passmd.parameters import MOLYBDENUM, STEEL, Assumption, Drive, paper_drive, register_assumption
-from passmd.plots import driving_waveform as plots
+from passmd.parameters import MOLYBDENUM, STEEL, Assumption, Drive, paper_drive
 
 CHAPTER = "driving_waveform"
 #: Driving frequency of Figs. 8 and 9a (Hz).
@@ -78,7 +77,7 @@ def variant_name(waveform: str, short_period: str) -> str:
         return "sawtooth"
     return "optimized_skip" if short_period == "skip" else "optimized"
 
-register_assumption(
+ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
         key="frequency_grid",
         symbol="f",
@@ -89,9 +88,7 @@ register_assumption(
             "1, 6, 11, … or 1, 5, 10, …; the second contains the 80 and 110 kHz the text names."
         ),
         sensitivity="Only where a threshold falls between grid points (±5 kHz).",
-    )
-)
-register_assumption(
+    ),
     Assumption(
         key="steady_velocity",
         symbol="v̄",
@@ -106,9 +103,7 @@ register_assumption(
             "from rest to its steady velocity; the steady velocity is what a user of the drive sees."
         ),
         sensitivity="Driving-waveform chapter: third against fourth quarter of each run (velocity_drift).",
-    )
-)
-register_assumption(
+    ),
     Assumption(
         key="controllable_frequency",
         symbol="f_max",
@@ -120,9 +115,7 @@ register_assumption(
             "criterion of its own."
         ),
         sensitivity="Fig. 10b's ordering of maximal controllable frequencies only.",
-    )
-)
-register_assumption(
+    ),
     Assumption(
         key="stick_during_acceleration",
         symbol="–",
@@ -134,7 +127,7 @@ register_assumption(
             "slip of runner and hemisphere."
         ),
         sensitivity="Fig. 10a's 0.1 N stick threshold.",
-    )
+    ),
 )
 
 
@@ -441,8 +434,6 @@ def _samples(profile: str) -> tuple[int, int]:
     return (400, 300) if profile == "quick" else (2000, 1500)
 
 
-@register_figure("fig8a", title="Runner response to two saw-tooth periods, with the contact status",
-                 chapter=CHAPTER, plot=plots.plot_fig8a)
 def fig8a(profile: str = "paper") -> pd.DataFrame:
     """Saw-tooth response (100 Hz, two periods, Section 5 drive) with the contact status.
 
@@ -470,8 +461,6 @@ def fig8a(profile: str = "paper") -> pd.DataFrame:
     return _display(frame)
 
 
-@register_figure("fig8b", title="The optimized waveform (Eq. 15) with t_s, t_a and Δ_a",
-                 chapter=CHAPTER, plot=plots.plot_fig8b)
 def fig8b(profile: str = "paper") -> pd.DataFrame:
     """The optimized waveform of the Section 5 drive and the runner's response (100 Hz).
 
@@ -554,8 +543,6 @@ def window_point(hemisphere_radius: float, preload: float, runner: str, actuator
     return out
 
 
-@register_figure("fig8b_window", title="Fig. 8b's fly-back and acceleration t_a, resolved in time",
-                 chapter=CHAPTER, plot=plots.plot_fig8b_window)
 def fig8b_window(profile: str = "paper") -> pd.DataFrame:
     """The fly-back and the acceleration t_a of Fig. 8b's optimized period, resolved inside t_a.
 
@@ -590,8 +577,6 @@ def fig8b_window(profile: str = "paper") -> pd.DataFrame:
     return frame
 
 
-@register_figure("fig9a", title="Runner position over three 100 Hz periods, saw-tooth and optimized",
-                 chapter=CHAPTER, plot=plots.plot_fig9a)
 def fig9a(profile: str = "paper") -> pd.DataFrame:
     """Three 100 Hz periods from rest with both waveforms (Section 5 drive, Fig. 9a).
 
@@ -634,29 +619,21 @@ def at_section5_friction(frame: pd.DataFrame, friction_coefficient: float = SECT
     return frame[np.isclose(frame["friction_coefficient"], friction_coefficient, rtol=1e-9, atol=0)]
 
 
-@register_figure("fig9b", title="Steady velocity against driving frequency, saw-tooth and optimized",
-                 chapter=CHAPTER, plot=plots.plot_fig9b)
 def fig9b(profile: str = "paper") -> pd.DataFrame:
     """Steady velocity of the Section 5 drive over the frequency grid, every waveform variant."""
     return velocity_table([config()], _frequencies(profile))
 
 
-@register_figure("fig10a", title="Velocity of the optimized waveform for preloads 0.1, 0.4, 1 N",
-                 chapter=CHAPTER, plot=plots.plot_fig10a)
 def fig10a(profile: str = "paper") -> pd.DataFrame:
     """Steady velocity against frequency for F_p = 0.1, 0.4, 1 N (R = 1 mm, steel)."""
     return velocity_table([config(preload=p) for p in FIG10A_PRELOADS], _frequencies(profile))
 
 
-@register_figure("fig10b", title="Velocity of the optimized waveform for R = 1 mm and 0.25 mm",
-                 chapter=CHAPTER, plot=plots.plot_fig10b)
 def fig10b(profile: str = "paper") -> pd.DataFrame:
     """Steady velocity against frequency for R = 1 mm (A = 202 nm) and 0.25 mm (A = 96 nm), 0.4 N."""
     return velocity_table([config(hemisphere_radius=r) for r in FIG10B_RADII], _frequencies(profile))
 
 
-@register_figure("fig10c", title="Velocity of the optimized waveform, steel and molybdenum runner",
-                 chapter=CHAPTER, plot=plots.plot_fig10c)
 def fig10c(profile: str = "paper") -> pd.DataFrame:
     """Steady velocity against frequency for a steel (210 GPa) and a molybdenum (310 GPa) runner."""
     return velocity_table([config(runner=r) for r in RUNNERS], _frequencies(profile))

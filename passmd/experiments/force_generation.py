@@ -44,11 +44,10 @@ import pandas as pd
 
 from passmd import dynamics, sweep, waveforms
 from passmd._validation import check_choice, check_positive, check_range
-from passmd.experiments import PROFILES, register_figure
-from passmd.experiments.critical_amplitude import critical_amplitude
+from passmd.config import PROFILES
 from passmd.ledger import ClaimFails, NotEvaluable, register_evidence, register_extractor
-from passmd.parameters import PRELOAD_GRIDS, Assumption, Drive, paper_drive, register_assumption
-from passmd.plots import force_generation as plots
+from passmd.parameters import PRELOAD_GRIDS, Assumption, Drive, paper_drive
+from passmd.protocols.critical_amplitude import critical_amplitude
 from passmd.theory import drive_theory, normal_forces
 
 __all__ = [
@@ -137,7 +136,7 @@ PROFILE_SETTINGS = {
     ),
 }
 
-register_assumption(
+ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
         key="force_frequency",
         symbol="f",
@@ -152,9 +151,7 @@ register_assumption(
             "several times more from one frequency to the next."
         ),
         sensitivity="Force chapter: F_gen at full amplitude from 90 Hz to 1.1 kHz (fig7freq).",
-    )
-)
-register_assumption(
+    ),
     Assumption(
         key="force_stall_criterion",
         symbol="F_gen",
@@ -172,9 +169,7 @@ register_assumption(
             "slow. The tolerance is far below the force's own scatter with the drive frequency."
         ),
         sensitivity="Force chapter: periods used and the estimated remaining rise of every point.",
-    )
-)
-register_assumption(
+    ),
     Assumption(
         key="force_onset",
         symbol="A_c (load cell)",
@@ -186,7 +181,7 @@ register_assumption(
             "it is found with the critical-amplitude chapters' protocol, load cell engaged."
         ),
         sensitivity="Force chapter: F_gen just below the onset is the load cell following the piezo.",
-    )
+    ),
 )
 
 
@@ -591,30 +586,22 @@ def _panel(name: str, profile: str) -> pd.DataFrame:
     return _curves_frame({radius: preloads}, _settings(profile).panel_fractions, profile, name)
 
 
-@register_figure("fig7a", title="Generated force against amplitude, R = 1 mm, 0.3 and 0.8 N",
-                 chapter="force_generation", plot=plots.plot_panel)
 def fig7a(profile: str = "paper") -> pd.DataFrame:
     """Fig. 7a: F_gen against A (0–202 nm), R = 1 mm, F_p = 0.3 and 0.8 N, both models (mN, nm)."""
     return _panel("fig7a", profile)
 
 
-@register_figure("fig7b", title="Generated force against amplitude, R = 0.25 mm, 0.2 and 0.4 N",
-                 chapter="force_generation", plot=plots.plot_panel)
 def fig7b(profile: str = "paper") -> pd.DataFrame:
     """Fig. 7b: F_gen against A (0–96 nm), R = 0.25 mm, F_p = 0.2 and 0.4 N, both models (mN, nm)."""
     return _panel("fig7b", profile)
 
 
-@register_figure("fig7grid", title="Generated force for every preload of both radii (beyond the paper)",
-                 chapter="force_generation", plot=plots.plot_grid)
 def fig7grid(profile: str = "paper") -> pd.DataFrame:
     """F_gen against A for the full preload grids of both radii, both models, with onsets."""
     s = _settings(profile)
     return _curves_frame(s.grid_preloads, s.grid_fractions, profile, "grid")
 
 
-@register_figure("fig7freq", title="Generated force at full amplitude against the drive frequency",
-                 chapter="force_generation", plot=plots.plot_frequency)
 def fig7freq(profile: str = "paper") -> pd.DataFrame:
     """F_gen at A_max against the saw-tooth frequency, each panel's higher preload, both models."""
     s = _settings(profile)
@@ -633,8 +620,6 @@ CYCLE_COMBINATIONS = (("rigid", 0.3), ("rigid", 0.2), ("flexible", 0.3), ("flexi
 CYCLE_DRIVE = (1.0e-3, 1.0)
 
 
-@register_figure("fig7cycle", title="One period at stall, rigid/flexible × μ = 0.3/0.2, R = 1 mm, A_max",
-                 chapter="force_generation", plot=plots.plot_cycle)
 def fig7cycle(profile: str = "paper") -> pd.DataFrame:
     """One stall period of the four actuator-model × μ combinations (tidy, one row per sample).
 

@@ -18,7 +18,7 @@ import pandas as pd
 
 from passmd import dynamics, sweep, waveforms
 from passmd._validation import check_choice
-from passmd.experiments import PROFILES
+from passmd.config import PROFILES
 from passmd.experiments.driving_waveform import (
     STEP_FREQUENCY,
     VARIANTS,
@@ -32,7 +32,7 @@ from passmd.experiments.driving_waveform import (
     steady_velocity,
     variant_name,
 )
-from passmd.parameters import Assumption, Drive, register_assumption
+from passmd.parameters import Assumption, Drive
 
 
 def step_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
@@ -68,7 +68,7 @@ FLEXIBLE_FREQUENCIES = {"paper": (100.0, 1e3, 10e3, 50e3, 110e3), "quick": (100.
 #: Points of the settling-time scan over [0, 2/f_s] per profile.
 SCAN_POINTS = {"paper": 41, "quick": 9}
 
-register_assumption(
+ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
         key="waveform_optimizer",
         symbol="t_s, V_a, Δ_a",
@@ -85,7 +85,7 @@ register_assumption(
             "amplifier's slew-rate limit bounds V_a, the period bounds t_s."
         ),
         sensitivity="Driving-waveform chapter: the optimum's parameters per frequency.",
-    )
+    ),
 )
 
 

@@ -1,6 +1,6 @@
 """Plots of the critical-amplitude figures (Figs. 5, 6 and the sensitivity panels).
 
-Each function takes the tidy DataFrame of :mod:`passmd.experiments.critical_amplitude`
+Each function takes the tidy DataFrame of a Section 4.1 figure (:mod:`passmd.figures`)
 and returns a matplotlib Figure: lengths in nm, forces in N, frequencies in Hz, the
 paper's colours where it has them (Fig. 5b: rigid green, flexible black; Fig. 6:
 u_x,max,e red).
@@ -12,26 +12,17 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from passmd.defaults import PROTOCOL
 from passmd.parameters import ACTUATOR_DAMPING_RATIO
 
 COLOURS = {"rigid": "tab:green", "flexible": "black"}
 SIDE_COLOURS = {1: "tab:blue", 2: "tab:orange", "e": "tab:red"}
 
 
-def _protocol():
-    """(drive frequency of the primary curves, frequency band) of the experiments module.
-
-    Imported when a plot is drawn: the experiments module imports this one to register its plots.
-    """
-    from passmd.experiments.critical_amplitude import DRIVE_FREQUENCY, FREQUENCY_BAND
-
-    return DRIVE_FREQUENCY, FREQUENCY_BAND
-
-
 def _steady(rows: pd.DataFrame, flyback: str, primary: bool = True) -> pd.DataFrame:
     sel = rows[(rows["protocol"] == "steady") & (rows["flyback"] == flyback)]
     if primary:
-        sel = sel[np.isclose(sel["frequency_Hz"], _protocol()[0])]
+        sel = sel[np.isclose(sel["frequency_Hz"], PROTOCOL.drive_frequency)]
     return sel.sort_values("preload_N")
 
 
@@ -71,7 +62,7 @@ def _simulated(ax, rows: pd.DataFrame, colour: str, name: str, flexible: bool) -
         "o-",
         color=colour,
         ms=4,
-        label=f"{name}, steady state {_protocol()[0]:g} Hz",
+        label=f"{name}, steady state {PROTOCOL.drive_frequency:g} Hz",
     )
     _band(ax, rows, colour, f"{name}, steady state")
     first = _first(rows, "slew")
@@ -230,7 +221,7 @@ def _two_panels(df: pd.DataFrame):
 def plot_viscosity(df: pd.DataFrame):
     """A_c of flexible actuators against the actuator viscosity c_p (one and six contacts)."""
     fig, axes = _two_panels(df)
-    f_primary = _protocol()[0]
+    f_primary = PROTOCOL.drive_frequency
     styles = {
         ("steady", "slew"): ("o-", "black", f"steady state {f_primary:g} Hz"),
         ("steady", "fixed"): ("^--", "tab:gray", f"steady state {f_primary:g} Hz, 2 µs fly-back"),
@@ -274,7 +265,7 @@ def plot_viscosity(df: pd.DataFrame):
 def plot_frequency(df: pd.DataFrame):
     """A_c against the drive frequency (one and six contacts, rigid and flexible, both protocols)."""
     fig, axes = _two_panels(df)
-    band = _protocol()[1]
+    band = PROTOCOL.critical_amplitude_band
     for n, ax in axes.items():
         rows = df[df["contacts"] == n]
         ax.axvspan(
