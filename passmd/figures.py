@@ -18,10 +18,13 @@ from typing import NamedTuple
 import pandas as pd
 
 from passmd.config import RunConfig
-from passmd.experiments import critical_amplitude, driving_waveform, force_generation
+from passmd.experiments import critical_amplitude, driving_waveform, force_generation, mdr, model, numerics
 from passmd.plots import critical_amplitude as ca_plots
 from passmd.plots import driving_waveform as dw_plots
 from passmd.plots import force_generation as fg_plots
+from passmd.plots import mdr as mdr_plots
+from passmd.plots import model as model_plots
+from passmd.plots import numerics as numerics_plots
 
 __all__ = [
     "CLAIM_MODULES", "FIGURES", "FigureSpec", "figure_data", "figure_names", "figure_plot", "figure_spec",
@@ -40,6 +43,33 @@ class FigureSpec(NamedTuple):
 
 #: Every figure of the book, in the book's chapter order (book/_toc.yml).
 FIGURES: tuple[FigureSpec, ...] = (
+    # Sections 2-3, the model (book/model.md)
+    FigureSpec("model_sawtooth", "Saw-tooth piezo position x_p(t) at full stroke (Figs. 1d, 3c)",
+               "model", model.model_sawtooth, model_plots.plot_sawtooth),
+    FigureSpec("model_free_body", "Free-body diagram of the macroscopic model, Eqs. 2-3 (Fig. 3a, schematic)",
+               "model", model.model_free_body, model_plots.plot_free_body),
+    FigureSpec("model_cross_section", "Cross-section of the runner with the normal forces of Eq. 1 (Fig. 3b)",
+               "model", model.model_cross_section, model_plots.plot_cross_section),
+    FigureSpec("model_mdr_loop", "The 1-D MDR contact and its force loop, exact and 50 springs (Fig. 4)",
+               "model", model.model_mdr_loop, model_plots.plot_mdr_loop),
+    # Integrator (book/model_numerics.md)
+    FigureSpec("model_convergence", "Time-step convergence of the runner position after three periods",
+               "model_numerics", numerics.model_convergence, numerics_plots.plot_convergence),
+    FigureSpec("model_coulomb_limit", "Simulated step against the rigid Coulomb limit, stiffened contacts",
+               "model_numerics", numerics.model_coulomb_limit, numerics_plots.plot_coulomb_limit),
+    # The MDR contact (book/mdr_validation.md)
+    FigureSpec("mdr_springs", "Springs of the discrete MDR contact after loading and unloading (Fig. 4b)",
+               "mdr_validation", mdr.mdr_springs, mdr_plots.plot_springs),
+    FigureSpec("mdr_normal", "MDR normal force against Hertz", "mdr_validation", mdr.mdr_normal,
+               mdr_plots.plot_normal),
+    FigureSpec("mdr_virgin", "Virgin tangential loading against Cattaneo-Mindlin", "mdr_validation",
+               mdr.mdr_virgin, mdr_plots.plot_virgin),
+    FigureSpec("mdr_hysteresis", "Major and nested minor hysteresis loop against Masing", "mdr_validation",
+               mdr.mdr_hysteresis, mdr_plots.plot_hysteresis),
+    FigureSpec("mdr_convergence", "Deviation of the discrete MDR contact from the exact one against N",
+               "mdr_validation", mdr.mdr_convergence, mdr_plots.plot_convergence),
+    FigureSpec("mdr_cost", "Cost per contact update against the number of springs (benchmark)",
+               "mdr_validation", mdr.mdr_cost, mdr_plots.plot_cost),
     # Section 4.1, one contact (book/critical_amplitude_one.md)
     FigureSpec("fig5a", "Step size against actuation amplitude, one contact, 0.4 N, R = 1 mm",
                "critical_amplitude_one", critical_amplitude.fig5a, ca_plots.plot_fig5a),

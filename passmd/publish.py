@@ -312,6 +312,35 @@ def assumptions_frame():
     return pd.DataFrame([dataclasses.asdict(a) for a in all_assumptions().values()])
 
 
+#: Characters MyST would read as markup in plain text.
+_MARKUP = "\\`*_[]$<>|#"
+
+
+def escape_markdown(text: str) -> str:
+    """``text`` with every character MyST reads as markup escaped by a backslash."""
+    for char in _MARKUP:
+        text = text.replace(char, "\\" + char)
+    return text
+
+
+def assumption_list(frame=None) -> Markdown:
+    """The assumptions (:func:`assumptions_frame`, or ``frame``) as a markdown list.
+
+    One item per assumption: key, ``symbol = value unit`` (symbol and unit left out when
+    they are empty or a dash), rationale and where its effect is shown; text escaped.
+    """
+    frame = assumptions_frame() if frame is None else frame
+    e = escape_markdown
+    return Markdown("\n".join(
+        f"- **{e(row.key)}** ("
+        + (f"{e(row.symbol)} = " if row.symbol not in ("", "–", "-") else "")
+        + e(row.value)
+        + (f" {e(row.unit)}" if row.unit not in ("", "–") else "")
+        + f"). {e(row.rationale)} *Where its effect is shown:* {e(row.sensitivity)}"
+        for row in frame.itertuples()
+    ))
+
+
 def implementations(mapping: dict[str, str | list[str]]):
     """Table of the code implementing each equation, checked against the package.
 

@@ -15,6 +15,7 @@ import pandas as pd
 
 from passmd import dynamics, theory, waveforms
 from passmd._validation import check_choice, check_count, check_range
+from passmd.config import RunConfig
 from passmd.parameters import Amplifier, Drive, Material
 
 #: Configurations the numerics are shown for: (label, contacts, actuator model).
@@ -294,3 +295,28 @@ def coulomb_limit_rates(table: pd.DataFrame) -> pd.DataFrame:
                      "largest_difference_m": float(np.abs(g["difference_m"]).max()),
                      "smallest_difference_m": float(np.abs(g["difference_m"]).min())})
     return pd.DataFrame(rows)
+
+
+# --------------------------------------------------------------------------------------
+# Figures of the numerics section (rows of passmd.figures)
+# --------------------------------------------------------------------------------------
+
+#: Step controls of the convergence figure (flexible actuators; rigid ones use the fixed step).
+CONVERGENCE_STEP_CONTROLS = ("adaptive", "fixed", "quasi-static")
+#: Saw-tooth of the rigid-Coulomb-limit figure: amplitude (m), frequency (Hz), periods (the last step counts).
+COULOMB_RUN = {"amplitude": 150e-9, "frequency": 100.0, "periods": 4}
+
+
+def model_convergence(config: RunConfig) -> pd.DataFrame:
+    """:func:`convergence_study` over the profile's :data:`RESOLUTIONS` and every step control."""
+    return convergence_study(resolutions=RESOLUTIONS[config.profile], step_controls=CONVERGENCE_STEP_CONTROLS)
+
+
+def model_coulomb_limit(config: RunConfig) -> pd.DataFrame:
+    """:func:`rigid_coulomb_limit` of :data:`COULOMB_RUN`, with each configuration's fitted
+    ``rate`` and the ``expected_rate`` (:func:`coulomb_limit_rates`) as columns."""
+    table = rigid_coulomb_limit(**COULOMB_RUN)
+    rates = coulomb_limit_rates(table).set_index("configuration")
+    table["rate"] = table["configuration"].map(rates["rate"])
+    table["expected_rate"] = EXPECTED_COULOMB_RATE
+    return table
