@@ -32,7 +32,7 @@ def test_every_figure_a_chapter_draws_is_in_the_table():
 
 
 def test_unknown_figure_names_the_known_ones():
-    with pytest.raises(ValueError, match="figure = .fig99z. is not available: must be one of model_sawtooth, "):
+    with pytest.raises(ValueError, match="figure = .fig99z. is not available: must be one of model_sawtooth"):
         figures.figure_spec("fig99z")
 
 

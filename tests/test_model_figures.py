@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from passmd import figures, publish, theory
 from passmd.config import RunConfig
 from passmd.defaults import PROTOCOL
-from passmd.experiments import mdr, model
+from passmd.experiments import mdr, model, numerics
 
 QUICK = RunConfig(profile="quick")
 CHEAP = (
@@ -95,3 +96,74 @@ def test_assumption_list_escapes_markup():
     text = publish.assumption_list()
     assert text.count("\n- ") + 1 == len(publish.assumptions_frame())
     assert "*Where its effect is shown:*" in text
+
+
+def test_mdr_facts_come_from_the_figure_data():
+    normal = mdr.mdr_normal(QUICK)
+    facts = mdr.normal_facts(normal)
+    # the midpoint rule's error falls with N: 20 springs worst, 1000 best, at every depth
+    assert facts["normal_err_20"] > facts["normal_err_100"] > facts["normal_err_1000"] > 0
+    assert facts["normal_err_end_1000"] <= facts["normal_err_1000"]
+    virgin = mdr.virgin_facts(mdr.mdr_virgin(QUICK))
+    assert virgin["virgin_err_exact"] < 1e-12  # rounding: the exact contact is Cattaneo-Mindlin
+    assert virgin["virgin_err_20"] > virgin["virgin_err_1000"]
+    loop = mdr.hysteresis_facts(mdr.mdr_hysteresis(QUICK))
+    assert loop["loop_err_exact"] < 1e-12 and loop["loop_err_1000"] < 0.5  # % of μF_N
+    cost = mdr.cost_facts(mdr.mdr_cost(QUICK))
+    assert cost["ring_depth"] >= 1 and cost["per_spring_ns"] > 0 and cost["cost_ratio_1000"] > 1
+    contact = mdr.contact_facts()
+    assert contact["sliding_force_mN"] == pytest.approx(0.2 * contact["normal_force_N"] * 1e3, rel=1e-12)
+
+
+def test_convergence_facts_on_a_second_order_table():
+    """Synthetic errors falling exactly as h²: the fitted order is 2, the savings the step ratios."""
+    rows = []
+    for label in ("six contacts, flexible", "one contact, rigid"):
+        controls = ("adaptive", "fixed", "quasi-static") if "flexible" in label else ("fixed",)
+        for control in controls:
+            for r in (0.5, 1.0, 2.0, 4.0):
+                steps = {"adaptive": 100, "fixed": 1000, "quasi-static": 20}[control] * r
+                rows.append(
+                    {
+                        "configuration": label,
+                        "step_control": control,
+                        "resolution": r,
+                        "steps": steps,
+                        "final_position_m": 1e-6,
+                        "error_m": 1e-10 * r**-2.0,
+                    }
+                )
+    facts = numerics.convergence_facts(pd.DataFrame(rows))
+    assert facts["conv_order"] == pytest.approx(2.0, rel=1e-9)
+    assert facts["quasi_order"] == pytest.approx(2.0, rel=1e-9)
+    assert facts["conv_max_err_nm"] == pytest.approx(0.1, rel=1e-9)
+    assert facts["adaptive_saving"] == pytest.approx(10.0) and facts["quasi_saving"] == pytest.approx(5.0)
+    assert facts["adaptive_vs_fixed_nm"] == 0.0
+
+
+def test_settle_and_coulomb_texts():
+    sens = pd.DataFrame(
+        {
+            "configuration": ["a", "a", "b", "b"],
+            "settle_fraction": [0.1, 0.4] * 2,
+            "mean_step_m": [100e-9, 101e-9, 50e-9, 50e-9],
+        }
+    )
+    facts = numerics.settle_facts(sens)
+    assert facts["settle_spread_nm"] == pytest.approx(1.0) and facts["settle_spread_rel"] == pytest.approx(
+        100 / 100.5
+    )
+    gaps = pd.DataFrame(
+        {"configuration": ["c"] * 3, "scale": [1.0, 4.0, 16.0], "difference_m": [-3e-9, -1e-9, -2e-9]}
+    )
+    assert numerics.coulomb_side(gaps) == "below"
+    assert numerics.coulomb_rising_gaps(gaps) == ["c: 1.000 nm at k = 4 → 2.000 nm at k = 16"]
+
+
+def test_step_plan_and_benchmark_facts():
+    plan = numerics.step_plan_table()
+    assert list(plan["configuration"]) == [c[0] for c in numerics.CONFIGURATIONS]
+    assert (plan["fine step (ns)"] < plan["stability limit 2/ω (ns)"]).all()
+    facts = numerics.benchmark_facts(numerics.benchmark_table())
+    assert facts["bench_six_flex_ms"] > 0 and facts["bench_fixed_ns"] > 0
+    assert facts["target_ms_per_period"] == numerics.TARGET_MS_PER_PERIOD
