@@ -73,6 +73,8 @@ FIGURES: tuple[FigureSpec, ...] = (
     # Section 4.1, one contact (book/critical_amplitude_one.md)
     FigureSpec("fig5a", "Step size against actuation amplitude, one contact, 0.4 N, R = 1 mm",
                "critical_amplitude_one", critical_amplitude.fig5a, ca_plots.plot_fig5a),
+    FigureSpec("fig5_flyback_steps", "Step across each fly-back of a run from rest, rigid, 0.4 N, R = 1 mm",
+               "critical_amplitude_one", critical_amplitude.fig5_flyback_steps, ca_plots.plot_flyback_steps),
     FigureSpec("fig5b", "Critical amplitude against preload, one contact, R = 1 mm",
                "critical_amplitude_one", critical_amplitude.fig5b, ca_plots.plot_fig5b),
     # Section 4.1, six contacts (book/critical_amplitude_six.md)

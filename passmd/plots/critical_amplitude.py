@@ -307,3 +307,20 @@ def plot_frequency(df: pd.DataFrame):
         ax.legend(fontsize=7, loc="lower left")
     fig.tight_layout()
     return fig
+
+
+def plot_flyback_steps(df: pd.DataFrame):
+    """Step across each fly-back of a run from rest, one line per amplitude, with δ."""
+    fig, ax = plt.subplots(figsize=(6.4, 3.8))
+    for amplitude, rows in df.groupby("amplitude_nm", sort=False):
+        ax.plot(rows["flyback"], rows["step_nm"], "o-", ms=4, label=f"A = {amplitude:.1f} nm")
+    first = df.iloc[0]
+    ax.axhline(first["threshold_nm"], color="tab:red", lw=0.8, label="measurable step δ")
+    ax.set_xlabel("fly-back number")
+    ax.set_ylabel("step across the fly-back (nm)")
+    ax.set_title(f"Rigid actuator, one contact, 0.4 N: steady-state A_c = {first['steady_ac_nm']:.1f} nm, "
+                 f"u_x,max = {first['u_x_max_nm']:.1f} nm", fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig
