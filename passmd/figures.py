@@ -18,7 +18,15 @@ from typing import NamedTuple
 import pandas as pd
 
 from passmd.config import RunConfig
-from passmd.experiments import critical_amplitude, driving_waveform, force_generation, mdr, model, numerics
+from passmd.experiments import (
+    critical_amplitude,
+    critical_amplitude_facts,
+    driving_waveform,
+    force_generation,
+    mdr,
+    model,
+    numerics,
+)
 from passmd.plots import critical_amplitude as ca_plots
 from passmd.plots import driving_waveform as dw_plots
 from passmd.plots import force_generation as fg_plots
@@ -74,7 +82,8 @@ FIGURES: tuple[FigureSpec, ...] = (
     FigureSpec("fig5a", "Step size against actuation amplitude, one contact, 0.4 N, R = 1 mm",
                "critical_amplitude_one", critical_amplitude.fig5a, ca_plots.plot_fig5a),
     FigureSpec("fig5_flyback_steps", "Step across each fly-back of a run from rest, rigid, 0.4 N, R = 1 mm",
-               "critical_amplitude_one", critical_amplitude.fig5_flyback_steps, ca_plots.plot_flyback_steps),
+               "critical_amplitude_one", critical_amplitude_facts.fig5_flyback_steps,
+               ca_plots.plot_flyback_steps),
     FigureSpec("fig5b", "Critical amplitude against preload, one contact, R = 1 mm",
                "critical_amplitude_one", critical_amplitude.fig5b, ca_plots.plot_fig5b),
     # Section 4.1, six contacts (book/critical_amplitude_six.md)

@@ -18,6 +18,7 @@ from passmd import figures, ledger, waveforms
 from passmd.config import RunConfig
 from passmd.defaults import PROTOCOL
 from passmd.experiments import critical_amplitude as ca
+from passmd.experiments import critical_amplitude_facts as ca_facts
 from passmd.protocols import critical_amplitude as search
 from passmd.theory import drive_theory, runner_frequency
 
@@ -318,63 +319,64 @@ def test_ledger_rows_of_figs_5_and_6(quick):
 def test_step_onset_is_where_the_step_stays_above_the_threshold():
     rows = pd.DataFrame({"amplitude_nm": [0.0, 10.0, 20.0, 30.0, 40.0],
                          "steady_step_nm": [0.0, 0.6, 0.1, 0.7, 1.5], "threshold_nm": 0.5})
-    assert ca.step_onset(rows) == 30.0  # 10 nm is above δ once, but the step falls back
-    assert math.isnan(ca.step_onset(rows.assign(steady_step_nm=0.0)))
+    assert ca_facts.step_onset(rows) == 30.0  # 10 nm is above δ once, but the step falls back
+    assert math.isnan(ca_facts.step_onset(rows.assign(steady_step_nm=0.0)))
 
 
 def test_fig5a_facts(quick):
-    facts = ca.fig5a_facts(quick["fig5a"])
-    assert facts["onset_rigid"] <= facts["eq7_04"] + 20  # the quick grid's 20 nm step
-    assert facts["onset_flex_fixed"] >= facts["onset_flex_slew"]  # the slew-rate fly-back rings the actuator
-    assert facts["eq8_04"] > facts["eq7_04"]
-    assert facts["slope_rigid"] == pytest.approx(1.0, abs=0.2)  # ~1 nm of step per nm of amplitude
+    found = ca_facts.fig5a_facts(quick["fig5a"])
+    assert found["onset_rigid"] <= found["eq7_04"] + 20  # the quick grid's 20 nm step
+    assert found["onset_flex_fixed"] >= found["onset_flex_slew"]  # the slew-rate fly-back rings the actuator
+    assert found["eq8_04"] > found["eq7_04"]
+    assert found["slope_rigid"] == pytest.approx(1.0, abs=0.2)  # ~1 nm of step per nm of amplitude
 
 
 def test_deviations_from_the_closed_forms(quick):
     closed = {"rigid": "u_x_max_nm", "flexible": "u_x_max_plus_u_x_a_nm"}
-    dev = ca.closed_form_deviations(quick["fig5b"], closed)
-    largest, mean = ca.series_deviation(dev, "rigid", "first", "slew")
+    dev = ca_facts.closed_form_deviations(quick["fig5b"], closed)
+    largest, mean = ca_facts.series_deviation(dev, "rigid", "first", "slew")
     assert largest < 2.0 and abs(mean) <= largest  # first-fly-back onset of a rigid actuator: Eq. 7
-    assert ca.side_of(-3.25) == "3.2 % below" and ca.side_of(1.0) == "1.0 % above"
-    assert math.isnan(ca.band_spread(quick["fig5b"], "rigid"))  # the quick profile runs 100 Hz only
-    six = ca.deviation_table(quick["fig6a"], {"Eq. 11": "u_x_max_e_nm", "Eq. 10, side 1": "u_x_max_1_nm"})
-    assert ca.deviation_at(six, "steady", "slew", "Eq. 11: largest |dev| (%)") < ca.deviation_at(
+    assert ca_facts.side_of(-3.25) == "3.2 % below" and ca_facts.side_of(1.0) == "1.0 % above"
+    assert math.isnan(ca_facts.band_spread(quick["fig5b"], "rigid"))  # the quick profile runs 100 Hz only
+    columns = {"Eq. 11": "u_x_max_e_nm", "Eq. 10, side 1": "u_x_max_1_nm"}
+    six = ca_facts.deviation_table(quick["fig6a"], columns)
+    assert ca_facts.deviation_at(six, "steady", "slew", "Eq. 11: largest |dev| (%)") < ca_facts.deviation_at(
         six, "steady", "slew", "Eq. 10, side 1: largest |dev| (%)")
 
 
 def test_spans_and_values_of_the_sensitivity_panels(quick):
     freq = quick["fig56_frequency"]
-    low, high = ca.ac_span(freq, 6, "first", actuator_model="rigid")
-    assert low <= high and ca.ac_range(freq, 6, "first", actuator_model="rigid") == high - low
-    at_drive = ca.ac_at(freq, 6, "rigid", "steady", PROTOCOL.drive_frequency)
+    low, high = ca_facts.ac_span(freq, 6, "first", actuator_model="rigid")
+    assert low <= high and ca_facts.ac_range(freq, 6, "first", actuator_model="rigid") == high - low
+    at_drive = ca_facts.ac_at(freq, 6, "rigid", "steady", PROTOCOL.drive_frequency)
     primary = ca.primary(freq, "rigid").query("contacts == 6")
     assert low > 0 and at_drive == float(primary["critical_amplitude_nm"].iloc[0])
     visc = quick["fig56_viscosity"]
-    lo, hi = ca.ac_span(visc, 6, "steady", flyback="fixed")
+    lo, hi = ca_facts.ac_span(visc, 6, "steady", flyback="fixed")
     assert 0 < lo <= hi
 
 
 def test_slew_and_protocol_facts():
-    slew = ca.slew_facts()
+    slew = ca_facts.slew_facts()
     # 2 µs full-stroke time over A_max: 202 nm (R = 1 mm) and 96 nm (R = 0.25 mm)
     assert slew["ns_per_nm_b"] == pytest.approx(2000 / 202, rel=1e-9)
     assert slew["ns_per_nm_c"] == pytest.approx(2000 / 96, rel=1e-9)
-    facts = ca.protocol_facts(RunConfig(profile="quick"))
-    assert facts["tol_nm"] == pytest.approx(0.5) and facts["periods"] == search.STEADY_PERIODS
-    assert facts["flyback_us_40"] == pytest.approx(40 / 202 * 2, rel=1e-9)
-    assert ca.band_text(RunConfig(profile="paper"))["band_here"] == "as in this build"
+    found = ca_facts.protocol_facts(RunConfig(profile="quick"))
+    assert found["tol_nm"] == pytest.approx(0.5) and found["periods"] == search.STEADY_PERIODS
+    assert found["flyback_us_40"] == pytest.approx(40 / 202 * 2, rel=1e-9)
+    assert ca_facts.band_text(RunConfig(profile="paper"))["band_here"] == "as in this build"
 
 
 def test_continued_operation_strains_the_sides_against_each_other(quick):
     """Below the steady-state A_c the two sides end every period pushing against each other."""
-    prestrain = ca.side_prestrain(quick["fig56_frequency"])
+    prestrain = ca_facts.side_prestrain(quick["fig56_frequency"])
     assert len(prestrain) == search.STEADY_PERIODS
     last = prestrain.iloc[-1]
     assert last["side 1: T_1 / μF_N1"] < 0 < last["side 2: T_2 / μF_N2"]
 
 
 def test_flyback_steps_ratchet_below_eq7():
-    steps = ca.fig5_flyback_steps(RunConfig(profile="quick"))
+    steps = ca_facts.fig5_flyback_steps(RunConfig(profile="quick"))
     first = steps.iloc[0]
     assert first["steady_ac_nm"] < first["u_x_max_nm"]
     below = steps[steps["amplitude_nm"] == steps["amplitude_nm"].unique()[0]]
