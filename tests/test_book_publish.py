@@ -203,3 +203,25 @@ def test_implementations_resolve_names_and_fail_on_stale_ones():
         publish.implementations({"Eq. (1)": "passmd.theory.no_such_function"})
     with pytest.raises(ValueError, match="no such module"):
         publish.implementations({"Eq. (1)": "nosuchpackage.f"})
+
+
+#: Chapters whose code cells only glue results of tested package functions.
+GLUE_ONLY_CHAPTERS = ("model", "model_numerics", "mdr_validation", "critical_amplitude_one",
+                      "critical_amplitude_six", "execution_statistics")
+
+
+@pytest.mark.parametrize("chapter", GLUE_ONLY_CHAPTERS)
+def test_chapters_define_no_functions(chapter):
+    """Analysis belongs in the package, where a test reaches it; a chapter only calls and glues."""
+    import ast
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "book" / f"{chapter}.md").read_text()
+    cells = re.findall(r"```\{code-cell\}[^\n]*\n(.*?)```", text, flags=re.S)
+    assert cells, chapter
+    for cell in cells:
+        code = "\n".join(line for line in cell.splitlines() if not line.startswith(":tags:"))
+        defined = [node for node in ast.walk(ast.parse(code))
+                   if isinstance(node, (ast.FunctionDef, ast.Lambda, ast.ClassDef))]
+        assert not defined, f"{chapter}: {[getattr(n, 'name', 'lambda') for n in defined]}"
