@@ -5,8 +5,8 @@ closed forms: Eq. 7 (one contact, rigid actuator), Eq. 8 (one contact, flexible)
 (six contacts, rigid) and Eq. 12 (six contacts, flexible). The search itself (both
 protocols, the bisection, the step threshold) is :mod:`passmd.protocols.critical_amplitude`;
 this module runs it over the preload grids of a resolution profile through
-:mod:`passmd.sweep`, and holds the claim extractors of Section 4.1 and the small facts
-the chapters quote.
+:mod:`passmd.sweep` and holds the claim extractors of Section 4.1; the facts the chapters
+quote are :mod:`passmd.experiments.critical_amplitude_facts`.
 
 Figures (rows of :mod:`passmd.figures`): ``fig5a`` (step vs amplitude), ``fig5b`` (one
 contact, A_c vs preload), ``fig6a``–``fig6c`` (six contacts), and two sensitivity panels
