@@ -419,6 +419,15 @@ def put_text(name: str, text: str) -> None:
     glue(name, Markdown(text), display=False)
 
 
+def put_all(facts: dict) -> None:
+    """Glue every entry of ``facts``: text with :func:`put_text`, numbers with :func:`put`."""
+    for name, value in facts.items():
+        if isinstance(value, str):
+            put_text(name, value)
+        else:
+            put(name, value)
+
+
 def show_table(df, formats: dict | None = None) -> None:
     """Display a table without its index; numbers with 4 significant digits unless ``formats`` says."""
     from IPython.display import display

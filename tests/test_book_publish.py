@@ -225,3 +225,11 @@ def test_chapters_define_no_functions(chapter):
         defined = [node for node in ast.walk(ast.parse(code))
                    if isinstance(node, (ast.FunctionDef, ast.Lambda, ast.ClassDef))]
         assert not defined, f"{chapter}: {[getattr(n, 'name', 'lambda') for n in defined]}"
+
+
+def test_put_all_glues_numbers_and_text(monkeypatch):
+    glued = {}
+    monkeypatch.setattr(publish, "put", lambda name, value: glued.__setitem__(name, ("number", value)))
+    monkeypatch.setattr(publish, "put_text", lambda name, text: glued.__setitem__(name, ("text", text)))
+    publish.put_all({"a": 1.5, "b": "below"})
+    assert glued == {"a": ("number", 1.5), "b": ("text", "below")}

@@ -386,3 +386,28 @@ def test_flyback_steps_ratchet_below_eq7():
     fig = figures.figure_plot("fig5_flyback_steps", steps)
     assert fig.axes[0].has_data()
     plt.close(fig)
+
+
+def test_paragraph_facts_of_both_chapters(quick):
+    """Every fact function the chapters glue returns finite numbers or a sentence, on the quick data."""
+    quick_config = RunConfig(profile="quick")
+    found = ca_facts.fig5b_facts(quick["fig5b"], quick_config)
+    assert found["first_rigid_max"] < 2.0 and found["steady_rigid_mean"].endswith(("below", "above"))
+    assert "quick profile runs 100 Hz only" in found["band_rigid"]
+    columns = {"Eq. 11": "u_x_max_e_nm", "Eq. 10, side 1": "u_x_max_1_nm", "Eq. 10, side 2": "u_x_max_2_nm"}
+    six = ca_facts.fig6a_facts(ca_facts.deviation_table(quick["fig6a"], columns), quick_config)
+    assert six["a_e"] < min(six["a_1"], six["a_2"]) and six["a_band"].startswith("(the quick profile")
+    flexible = {"Eq. 12": "u_x_max_e_star_nm", "Eq. 13, side 1": "u_x_max_1_star_nm"}
+    dev6 = pd.concat([ca_facts.deviation_table(quick[n], flexible).assign(figure=n)
+                      for n in ("fig6b", "fig6c")])
+    bc = ca_facts.fig6bc_facts(dev6)
+    assert set(bc) == {f"{k}_{s}" for k in "bc" for s in ("slew", "fixed", "first_fixed")}
+    visc = ca_facts.viscosity_facts(quick["fig56_viscosity"])
+    assert visc["v6_fixed_lo"] <= visc["v6_fixed_hi"] and visc["eq8_04"] > visc["eq12_04"]
+    freq = ca_facts.frequency_facts(quick["fig56_frequency"], quick_config)
+    assert freq["f_hi"] == 1000.0 and freq["first_span"] >= 0
+    assert freq["first_band"].endswith("Figs. 5b and 6.)")
+    table = pd.DataFrame({"side 1: T_1 / μF_N1": [-0.1], "side 2: T_2 / μF_N2": [0.1]})
+    table.attrs["amplitude_nm"] = 23.9
+    expected = {"prestrain_amplitude": 23.9, "prestrain_1": -0.1, "prestrain_2": 0.1}
+    assert ca_facts.prestrain_facts(table) == expected

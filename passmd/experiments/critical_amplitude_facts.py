@@ -279,3 +279,110 @@ def ac_range(table: pd.DataFrame, contacts: int, protocol: str, **selection) -> 
     """Width max − min (nm) of :func:`ac_span` of the same series."""
     low, high = ac_span(table, contacts, protocol, **selection)
     return high - low
+
+
+# --------------------------------------------------------------------------------------
+# What each paragraph of the chapters quotes (numbers, and short texts for {glue:md})
+# --------------------------------------------------------------------------------------
+
+
+def fig5b_facts(fig5b_table: pd.DataFrame, config: RunConfig) -> dict:
+    """Deviations of Fig. 5b's series from Eqs. 7 and 8, the band's spread and the fixed fly-back's order."""
+    dev = closed_form_deviations(fig5b_table, {"rigid": "u_x_max_nm", "flexible": "u_x_max_plus_u_x_a_nm"})
+    band = PROFILE_SETTINGS["paper"].frequencies
+    spread = band_spread(fig5b_table, "rigid")
+    fixed = fig5b_table[(fig5b_table["protocol"] == "steady") & (fig5b_table["flyback"] == "fixed")]
+    fixed = fixed.sort_values("preload_N")["critical_amplitude_nm"].to_numpy()
+    rigid = primary(fig5b_table, "rigid")["critical_amplitude_nm"].to_numpy()
+    if spread == spread:
+        band_rigid = f"Between {band[0]:g} and {band[-1]:g} Hz it moves by up to {spread:.0f} % of its value."
+    else:
+        band_rigid = (f"(The {config.profile} profile runs {PROTOCOL.drive_frequency:g} Hz only; the paper "
+                      "profile shows how much it moves with the drive frequency.)")
+    return {
+        "first_rigid_max": series_deviation(dev, "rigid", "first", "slew")[0],
+        "first_fixed_max": series_deviation(dev, "flexible", "first", "fixed")[0],
+        "first_slew_max": series_deviation(dev, "flexible", "first", "slew")[0],
+        "steady_rigid_max": series_deviation(dev, "rigid", "steady", "slew")[0],
+        "steady_rigid_mean": side_of(series_deviation(dev, "rigid", "steady", "slew")[1]),
+        "steady_slew_max": series_deviation(dev, "flexible", "steady", "slew")[0],
+        "steady_fixed_max": series_deviation(dev, "flexible", "steady", "fixed")[0],
+        "steady_fixed_mean": side_of(series_deviation(dev, "flexible", "steady", "fixed")[1]),
+        "band_rigid": band_rigid,
+        "fixed_above_rigid": "at every preload" if np.all(fixed > rigid) else "not at every preload",
+    }
+
+
+def fig6a_facts(dev6a: pd.DataFrame, config: RunConfig) -> dict:
+    """Largest deviations of Fig. 6a's steady state from Eqs. 11 and 10, of its first-fly-back onset
+    from side 1's Eq. 10, and over the profile's drive frequencies (text)."""
+    column = "Eq. 11: largest |dev| (%)"
+    frequencies = PROFILE_SETTINGS[config.profile].frequencies
+    band = [deviation_at(dev6a, "steady", "slew", column, f) for f in frequencies]
+    return {
+        "a_e": deviation_at(dev6a, "steady", "slew", column),
+        "a_1": deviation_at(dev6a, "steady", "slew", "Eq. 10, side 1: largest |dev| (%)"),
+        "a_2": deviation_at(dev6a, "steady", "slew", "Eq. 10, side 2: largest |dev| (%)"),
+        "a_first_1": deviation_at(dev6a, "first", "slew", "Eq. 10, side 1: largest |dev| (%)"),
+        "a_band": (f"and at most {max(band):.1f} % at any drive frequency of the band" if len(band) > 1
+                   else f"(the {config.profile} profile runs {PROTOCOL.drive_frequency:g} Hz only)"),
+    }
+
+
+def fig6bc_facts(dev6: pd.DataFrame) -> dict:
+    """Largest deviations of Figs. 6b (``b_``) and 6c (``c_``) from Eq. 12 and, for the first-fly-back
+    onset with the fixed fly-back, from side 1's Eq. 13."""
+    found = {}
+    for key, name in (("b", "fig6b"), ("c", "fig6c")):
+        dev = dev6[dev6["figure"] == name]
+        found[f"{key}_slew"] = deviation_at(dev, "steady", "slew", "Eq. 12: largest |dev| (%)")
+        found[f"{key}_fixed"] = deviation_at(dev, "steady", "fixed", "Eq. 12: largest |dev| (%)")
+        found[f"{key}_first_fixed"] = deviation_at(dev, "first", "fixed", "Eq. 13, side 1: largest |dev| (%)")
+    return found
+
+
+def prestrain_facts(prestrain: pd.DataFrame) -> dict:
+    """Amplitude (nm) of :func:`side_prestrain` and each side's force over its sliding force in the
+    last period."""
+    return {
+        "prestrain_amplitude": prestrain.attrs["amplitude_nm"],
+        "prestrain_1": prestrain["side 1: T_1 / μF_N1"].iloc[-1],
+        "prestrain_2": prestrain["side 2: T_2 / μF_N2"].iloc[-1],
+    }
+
+
+def viscosity_facts(visc: pd.DataFrame) -> dict:
+    """Ranges of A_c (nm) over the viscosity panel and the closed forms Eq. 12 (six) and Eq. 8 (one)."""
+    found = {}
+    series = {"v6_slew": (6, "steady", "slew"), "v6_fixed": (6, "steady", "fixed"),
+              "v1_first_fixed": (1, "first", "fixed")}
+    for key, (contacts, protocol, flyback) in series.items():
+        found[f"{key}_lo"], found[f"{key}_hi"] = ac_span(visc, contacts, protocol, flyback=flyback)
+    found["eq12_04"] = float(visc[visc["contacts"] == 6]["closed_form_nm"].iloc[0])
+    found["eq8_04"] = float(visc[visc["contacts"] == 1]["closed_form_nm"].iloc[0])
+    return found
+
+
+def frequency_facts(freq: pd.DataFrame, config: RunConfig) -> dict:
+    """How far the first-fly-back onset moves over all frequencies and within the paper's band (text),
+    and the six-contact steady-state A_c at the highest and at the drive frequency (nm)."""
+    settings = PROFILE_SETTINGS[config.profile]
+    band = PROFILE_SETTINGS["paper"].frequencies
+    f_hi = max(settings.sensitivity_frequencies)
+    series = [(n, m) for n in (1, 6) for m in ("rigid", "flexible")]
+    in_band = [f for f in settings.sensitivity_frequencies if band[0] <= f <= band[-1]]
+    if len(in_band) > 1:
+        span_band = max(ac_range(freq, n, "first", actuator_model=m, band=(band[0], band[-1]))
+                        for n, m in series)
+        first_band = f"Between {band[0]:g} and {band[-1]:g} Hz it moves by at most {span_band:.1f} nm."
+    else:
+        first_band = f"(The {config.profile} profile has only one frequency in the band of Figs. 5b and 6.)"
+    return {
+        "f_hi": f_hi,
+        "first_span": max(ac_range(freq, n, "first", actuator_model=m) for n, m in series),
+        "first_band": first_band,
+        "six_rigid_hi": ac_at(freq, 6, "rigid", "steady", f_hi),
+        "six_rigid_primary": ac_at(freq, 6, "rigid", "steady", PROTOCOL.drive_frequency),
+        "six_flex_hi": ac_at(freq, 6, "flexible", "steady", f_hi),
+        "six_flex_primary": ac_at(freq, 6, "flexible", "steady", PROTOCOL.drive_frequency),
+    }
