@@ -15,6 +15,7 @@ import pandas as pd
 from passmd import mdr_validation as mv
 from passmd.config import RunConfig
 from passmd.contact import MDRContact
+from passmd.defaults import PROTOCOL
 from passmd.experiments.numerics import benchmark_results
 from passmd.parameters import Drive
 from passmd.units import from_si
@@ -158,8 +159,9 @@ def hysteresis_facts(loop: pd.DataFrame) -> dict:
     }
 
 
-def convergence_facts(conv: pd.DataFrame, default_springs: int) -> dict:
-    """Fitted order, the largest deviation (%) at 1000 springs and at ``default_springs``."""
+def convergence_facts(conv: pd.DataFrame, default_springs: int = PROTOCOL.springs) -> dict:
+    """Fitted order, the largest deviation (%) at 1000 springs and at ``default_springs`` (the
+    discrete contact's default number of springs, ``PROTOCOL.springs``)."""
     at_default = mv.convergence_validation(Drive(), springs=(default_springs,))["max_error_rel"].iloc[0]
     return {
         "conv_order": conv["fitted_order"].iloc[0],
