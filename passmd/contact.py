@@ -75,7 +75,7 @@ from passmd._contact_kernels import (
     sliding_force,
 )
 from passmd._validation import check_array, check_choice, check_positive, check_range
-from passmd.parameters import Assumption, Drive, check_contact_plausible, register_assumption
+from passmd.parameters import Assumption, Drive, check_contact_plausible
 from passmd.theory import contact_moduli, hertz_contact_radius, hertz_indentation, normal_forces
 
 if TYPE_CHECKING:  # pandas is imported where a DataFrame is built (start-up time)
@@ -107,7 +107,7 @@ DEFAULT_CAPACITY = 1024
 MAX_SPRINGS = 10_000_000
 MIN_CAPACITY, MAX_CAPACITY = 8, 10_000_000
 
-register_assumption(
+ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
         key="mdr_spring_layout",
         symbol="x_i, N",
@@ -120,9 +120,7 @@ register_assumption(
             "exactly μF_N at every N; the discrete model converges to the exact one."
         ),
         sensitivity="MDR validation chapter: error vs N (convergence order) and cost vs N.",
-    )
-)
-register_assumption(
+    ),
     Assumption(
         key="reversal_stack_capacity",
         symbol="–",
@@ -134,7 +132,7 @@ register_assumption(
             "loop's height; overflows are counted in the contact state and reported."
         ),
         sensitivity="None while the reported overflow count is zero (the usual case).",
-    )
+    ),
 )
 
 

@@ -33,6 +33,9 @@ class ProtocolDefaults(NamedTuple):
     stall_periods: int = 64
     #: Longest stall run before a point is reported as not stalled (periods).
     stall_max_periods: int = 4096
+    #: Drive frequencies over which the spread of the steady-state critical amplitude is
+    #: drawn as a band (Section 4.1; the band brackets ``drive_frequency``) [Hz].
+    critical_amplitude_band: tuple[float, ...] = (50.0, 100.0, 200.0)
 
 
 #: The defaults every protocol uses unless the caller says otherwise.

@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from passmd import readings, reference
+from passmd import figures, readings, reference
 from passmd._verdicts import NO_EXTRACTOR, claim_row, shown
 from passmd.checks import ClaimFunctions, collect_claim_functions, extractor
 from passmd.claims import is_number, load_claims
@@ -72,18 +72,10 @@ LEDGER_COLUMNS = ("claim", "figure", "quantity", "paper", "ours", "unit", "abs_d
 # ======================================================================================
 
 
-def _figure_table():
-    """``passmd.figures``, imported when first needed, as the figure modules were before: their
-    import registers their assumptions, and the book lists those in registration order."""
-    from passmd import figures  # lead: a module-level import once passmd.assumptions lists them
-
-    return figures
-
-
 def claim_modules() -> tuple:
     """The modules holding claim extractors: ``passmd.figures.CLAIM_MODULES`` and this one
     (the closed-form claim's extractor)."""
-    return (*_figure_table().CLAIM_MODULES, sys.modules[__name__])
+    return (*figures.CLAIM_MODULES, sys.modules[__name__])
 
 
 def claim_functions(modules: Iterable | None = None) -> ClaimFunctions:
@@ -109,8 +101,7 @@ def _check_config(config) -> RunConfig:
 
 
 def _figure_source(name: str) -> Callable[[RunConfig], pd.DataFrame]:
-    compute = _figure_table().figure_spec(name).compute
-    return lambda config: compute(config.profile)  # lead: becomes compute(config) after merge
+    return figures.figure_spec(name).compute
 
 
 def result_sources() -> dict[str, Callable[[RunConfig], pd.DataFrame]]:
@@ -119,7 +110,7 @@ def result_sources() -> dict[str, Callable[[RunConfig], pd.DataFrame]]:
     The figures of ``passmd.figures`` (in the table's order) plus ``closed_forms``
     (the closed-form tables some claims are checked against, :func:`closed_form_results`).
     """
-    sources = {name: _figure_source(name) for name in _figure_table().figure_names()}
+    sources = {name: _figure_source(name) for name in figures.figure_names()}
     sources["closed_forms"] = closed_form_results
     return sources
 

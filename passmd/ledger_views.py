@@ -14,10 +14,10 @@ import numpy as np
 import pandas as pd
 
 from passmd._validation import check_choice
+from passmd.assumptions import all_assumptions
 from passmd.checks import format_number
 from passmd.claims import STATUSES, tolerance_text
 from passmd.ledger import assumption_map
-from passmd.parameters import all_assumptions
 
 __all__ = [
     "STATUS_COLOURS",
@@ -263,9 +263,8 @@ def sources_markdown(claims: pd.DataFrame) -> str:
 def assumptions_table() -> pd.DataFrame:
     """Every assumption where the paper is silent, as the book's table.
 
-    Imports every module of passmd first, so every assumption registered anywhere is included.
+    The assumptions are those of :func:`passmd.assumptions.all_assumptions`, in its order.
     """
-    # lead: after dev/figA merges, the assumptions come from passmd.assumptions.all_assumptions()
     return pd.DataFrame(
         [{"key": a.key, "symbol": a.symbol, "value": a.value, "unit": a.unit, "rationale": a.rationale,
           "effect on the results": a.sensitivity} for a in all_assumptions().values()]

@@ -17,7 +17,7 @@ import numpy as np
 
 from passmd._validation import check_choice, check_positive, check_range
 from passmd.defaults import PROTOCOL
-from passmd.parameters import Assumption, Drive, register_assumption
+from passmd.parameters import Assumption, Drive
 from passmd.waveforms import SETTLE_FRACTION, Waveform, flyback_time, piecewise_linear, sawtooth
 
 #: Saw-tooth frequency whose response the optimized waveform is designed from (Fig. 9a's 100 Hz,
@@ -27,7 +27,7 @@ RESPONSE_FREQUENCY = PROTOCOL.drive_frequency
 #: time has to be cut (high frequencies).
 MIN_RAMP_FRACTION = 0.5
 
-register_assumption(
+ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
         key="optimized_response",
         symbol="f_s, V_r",
@@ -45,9 +45,7 @@ register_assumption(
             "were varied, the input parameters for the optimized waveform were respectively changed')."
         ),
         sensitivity="Driving-waveform chapter: step at 100 Hz against t_s over two vibration periods.",
-    )
-)
-register_assumption(
+    ),
     Assumption(
         key="optimized_free_parameter",
         symbol="V_a, u_x,max",
@@ -64,9 +62,7 @@ register_assumption(
             "first, hence its u_x,max."
         ),
         sensitivity="Driving-waveform chapter: scipy optimisation over t_s, t_a, Δ_a.",
-    )
-)
-register_assumption(
+    ),
     Assumption(
         key="optimized_first_period",
         symbol="–",
@@ -77,9 +73,7 @@ register_assumption(
             "no micro-vibration to exploit before the first slip."
         ),
         sensitivity="Only the first period; steps are compared from period 2 on.",
-    )
-)
-register_assumption(
+    ),
     Assumption(
         key="optimized_short_period",
         symbol="t_s, t_a",
@@ -95,7 +89,7 @@ register_assumption(
             "alternative. Both never violate the slew-rate limit and never fail."
         ),
         sensitivity="Driving-waveform chapter: Fig. 9b and the settling-fits flag per frequency.",
-    )
+    ),
 )
 
 

@@ -40,7 +40,6 @@ __all__ = [
     "TABLE2_RADII",
     "actuator_for_radius",
     "actuator_viscosity",
-    "all_assumptions",
     "paper_drive",
     "parameter_table",
 ]
@@ -69,88 +68,6 @@ class Assumption:
 #: Damping ratio ζ of the bare actuator used to derive the viscosity
 #: c_p = 2 ζ sqrt(k_p m_a). Table 2's "Viscosity Factor" column was lost.
 ACTUATOR_DAMPING_RATIO = 0.05
-
-#: Every registered assumption by key (modules add theirs when imported;
-#: :func:`all_assumptions` imports them all).
-ASSUMPTIONS: dict[str, Assumption] = {}
-
-
-def register_assumption(assumption: Assumption) -> Assumption:
-    """Add an assumption to :data:`ASSUMPTIONS` (modules that define one call this)."""
-    ASSUMPTIONS[assumption.key] = assumption
-    return assumption
-
-
-def all_assumptions() -> dict[str, Assumption]:
-    """:data:`ASSUMPTIONS` after importing every module of passmd.
-
-    Each module registers its own assumptions when it is imported; this makes sure none is
-    missing from a table (the book's assumptions tables call it).
-    """
-    import importlib
-    import pkgutil
-
-    import passmd
-
-    for module in pkgutil.walk_packages(passmd.__path__, prefix="passmd."):
-        if not module.name.endswith("__main__"):  # running it would start the CLI
-            importlib.import_module(module.name)
-    return ASSUMPTIONS
-
-
-register_assumption(
-    Assumption(
-        key="actuator_viscosity",
-        symbol="c_p",
-        value=f"2·ζ·√(k_p m_a), ζ = {ACTUATOR_DAMPING_RATIO:g}",
-        unit="kg/s",
-        rationale=(
-            "Table 2's 'Viscosity Factor' column is lost in the available text. A bare "
-            "piezo actuator is lightly damped; ζ = 0.05 (Q = 10) is a typical order."
-        ),
-        sensitivity="Critical-amplitude chapters: A_c over a decade of c_p either side.",
-    )
-)
-register_assumption(
-    Assumption(
-        key="preload_grids",
-        symbol="F_p",
-        value="R = 1 mm: 0.1–1.0 N; R = 0.25 mm: 0.1–0.5 N; step 0.1 N",
-        unit="N",
-        rationale=(
-            "Table 2's 'Preload Range' column is lost; its header gives the 0.1 N step. "
-            "The ranges are those the text uses (Figs. 7 and 10: 0.1, 0.3, 0.4, 0.8, 1 N "
-            "for R = 1 mm; 0.2, 0.4 N for R = 0.25 mm)."
-        ),
-        sensitivity="Only the extent of the Fig. 5b/6 grids; no result depends on it.",
-    )
-)
-register_assumption(
-    Assumption(
-        key="molybdenum_poisson",
-        symbol="ν_2 (Mo)",
-        value="0.33",
-        unit="–",
-        rationale=(
-            "Section 5.2 gives only E_2 = 310 (printed 'MPa', a typo for GPa given "
-            "Table 1) for molybdenum; ν is kept at Table 1's 0.33 so only E changes."
-        ),
-        sensitivity="Fig. 10c only.",
-    )
-)
-register_assumption(
-    Assumption(
-        key="actuator_other_radii",
-        symbol="k_p(R), m_a(R), A_max(R)",
-        value="linear in R between Table 2's rows, constant outside",
-        unit="–",
-        rationale=(
-            "Table 2 gives actuators for R = 0.25 mm and 1 mm only. Other radii (CLI "
-            "sizing) interpolate; the paper's figures use the tabulated radii only."
-        ),
-        sensitivity="None of the paper's figures; CLI results at other radii.",
-    )
-)
 
 
 # --------------------------------------------------------------------------------------
@@ -454,7 +371,52 @@ PLAUSIBLE_RANGES: dict[str, PlausibleRange] = {
         hard_reason="below 1 mHz a period is too long for its µs fly-back to stay resolvable in "
         "double-precision time"),
 }
-register_assumption(
+ASSUMPTIONS: tuple[Assumption, ...] = (
+    Assumption(
+        key="actuator_viscosity",
+        symbol="c_p",
+        value=f"2·ζ·√(k_p m_a), ζ = {ACTUATOR_DAMPING_RATIO:g}",
+        unit="kg/s",
+        rationale=(
+            "Table 2's 'Viscosity Factor' column is lost in the available text. A bare "
+            "piezo actuator is lightly damped; ζ = 0.05 (Q = 10) is a typical order."
+        ),
+        sensitivity="Critical-amplitude chapters: A_c over a decade of c_p either side.",
+    ),
+    Assumption(
+        key="preload_grids",
+        symbol="F_p",
+        value="R = 1 mm: 0.1–1.0 N; R = 0.25 mm: 0.1–0.5 N; step 0.1 N",
+        unit="N",
+        rationale=(
+            "Table 2's 'Preload Range' column is lost; its header gives the 0.1 N step. "
+            "The ranges are those the text uses (Figs. 7 and 10: 0.1, 0.3, 0.4, 0.8, 1 N "
+            "for R = 1 mm; 0.2, 0.4 N for R = 0.25 mm)."
+        ),
+        sensitivity="Only the extent of the Fig. 5b/6 grids; no result depends on it.",
+    ),
+    Assumption(
+        key="molybdenum_poisson",
+        symbol="ν_2 (Mo)",
+        value="0.33",
+        unit="–",
+        rationale=(
+            "Section 5.2 gives only E_2 = 310 (printed 'MPa', a typo for GPa given "
+            "Table 1) for molybdenum; ν is kept at Table 1's 0.33 so only E changes."
+        ),
+        sensitivity="Fig. 10c only.",
+    ),
+    Assumption(
+        key="actuator_other_radii",
+        symbol="k_p(R), m_a(R), A_max(R)",
+        value="linear in R between Table 2's rows, constant outside",
+        unit="–",
+        rationale=(
+            "Table 2 gives actuators for R = 0.25 mm and 1 mm only. Other radii (CLI "
+            "sizing) interpolate; the paper's figures use the tabulated radii only."
+        ),
+        sensitivity="None of the paper's figures; CLI results at other radii.",
+    ),
     Assumption(
         key="plausible_ranges",
         symbol="–",
@@ -467,7 +429,7 @@ register_assumption(
         ),
         sensitivity="None of the paper's figures (all inside the soft limits); other inputs are refused "
                     "unless allow_extrapolation / --allow-extrapolation.",
-    )
+    ),
 )
 
 #: Hard limit on the Hertz contact radius: a <= R/10. Hertz's half-space solution and the

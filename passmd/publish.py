@@ -304,15 +304,41 @@ def parameter_frame(*records, labels=None, units=None):
 
 
 def assumptions_frame():
-    """Every assumption in :data:`passmd.parameters.ASSUMPTIONS` as a table.
-
-    Imports all of passmd first, so assumptions registered by any module are included.
-    """
+    """Every assumption of :func:`passmd.assumptions.all_assumptions` as a table, in its order."""
     import pandas as pd
 
-    from passmd.parameters import all_assumptions
+    from passmd.assumptions import all_assumptions
 
     return pd.DataFrame([dataclasses.asdict(a) for a in all_assumptions().values()])
+
+
+#: Characters MyST would read as markup in plain text.
+_MARKUP = "\\`*_[]$<>|#"
+
+
+def escape_markdown(text: str) -> str:
+    """``text`` with every character MyST reads as markup escaped by a backslash."""
+    for char in _MARKUP:
+        text = text.replace(char, "\\" + char)
+    return text
+
+
+def assumption_list(frame=None) -> Markdown:
+    """The assumptions (:func:`assumptions_frame`, or ``frame``) as a markdown list.
+
+    One item per assumption: key, ``symbol = value unit`` (symbol and unit left out when
+    they are empty or a dash), rationale and where its effect is shown; text escaped.
+    """
+    frame = assumptions_frame() if frame is None else frame
+    e = escape_markdown
+    return Markdown("\n".join(
+        f"- **{e(row.key)}** ("
+        + (f"{e(row.symbol)} = " if row.symbol not in ("", "–", "-") else "")
+        + e(row.value)
+        + (f" {e(row.unit)}" if row.unit not in ("", "–") else "")
+        + f"). {e(row.rationale)} *Where its effect is shown:* {e(row.sensitivity)}"
+        for row in frame.itertuples()
+    ))
 
 
 def implementations(mapping: dict[str, str | list[str]]):
@@ -391,6 +417,15 @@ def put_text(name: str, text: str) -> None:
     from myst_nb import glue
 
     glue(name, Markdown(text), display=False)
+
+
+def put_all(facts: dict) -> None:
+    """Glue every entry of ``facts``: text with :func:`put_text`, numbers with :func:`put`."""
+    for name, value in facts.items():
+        if isinstance(value, str):
+            put_text(name, value)
+        else:
+            put(name, value)
 
 
 def show_table(df, formats: dict | None = None) -> None:

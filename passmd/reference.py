@@ -27,7 +27,7 @@ import pandas as pd
 
 from passmd import theory
 from passmd._validation import check_choice
-from passmd.parameters import PRELOAD_GRIDS, Assumption, paper_drive, register_assumption
+from passmd.parameters import PRELOAD_GRIDS, Assumption, paper_drive
 
 __all__ = [
     "CURVES",
@@ -48,7 +48,7 @@ REFERENCE_DIR = Path(os.fspath(resources.files("passmd") / "data" / "reference")
 #: μ of the Section 4.1 reference curves: the paper does not state it there.
 REFERENCE_FRICTION_COEFFICIENT = 0.2
 
-register_assumption(
+ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
         key="friction_coefficient_sections_4_1_and_5",
         symbol="μ",
@@ -63,7 +63,7 @@ register_assumption(
             "Every closed form of Eqs. 7–14 is proportional to μ, so μ = 0.3 would raise all "
             "reference curves of Figs. 5b and 6a–c by 50 %."
         ),
-    )
+    ),
 )
 
 _NM = 1e9  # m → nm

@@ -22,12 +22,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from passmd._validation import check_choice, check_count, check_positive, check_range
-from passmd.parameters import PLAUSIBLE_RANGES, Assumption, Drive, register_assumption
+from passmd.parameters import PLAUSIBLE_RANGES, Assumption, Drive
 
 #: Fraction of the stick phase (at its end) over which the settled position is averaged.
 SETTLE_FRACTION = 0.2
 
-register_assumption(
+ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
         key="settled_position",
         symbol="x̄_r",
@@ -40,9 +40,7 @@ register_assumption(
             "a step is the change of that position from one period to the next."
         ),
         sensitivity="Model chapter: step sizes for settle fractions 0.1–0.4.",
-    )
-)
-register_assumption(
+    ),
     Assumption(
         key="flyback_duration",
         symbol="t_fb",
@@ -54,7 +52,7 @@ register_assumption(
             "moves the critical amplitude by several nm."
         ),
         sensitivity="Critical-amplitude chapters: A_c with both fly-back rules.",
-    )
+    ),
 )
 
 

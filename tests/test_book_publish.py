@@ -181,12 +181,12 @@ def test_parameter_frame_rejects_bad_input():
         publish.parameter_frame(paper_drive(), paper_drive().amplifier)
 
 
-def test_assumptions_frame_holds_every_registered_assumption():
-    from passmd.parameters import ASSUMPTIONS
+def test_assumptions_frame_holds_every_assumption_in_the_tables_order():
+    from passmd.assumptions import all_assumptions
 
     df = publish.assumptions_frame()
     assert list(df.columns) == ["key", "symbol", "value", "unit", "rationale", "sensitivity"]
-    assert set(df["key"]) == set(ASSUMPTIONS)  # after importing every module
+    assert list(df["key"]) == list(all_assumptions())
     assert {"actuator_viscosity", "preload_grids"} <= set(df["key"])
 
 
@@ -203,3 +203,33 @@ def test_implementations_resolve_names_and_fail_on_stale_ones():
         publish.implementations({"Eq. (1)": "passmd.theory.no_such_function"})
     with pytest.raises(ValueError, match="no such module"):
         publish.implementations({"Eq. (1)": "nosuchpackage.f"})
+
+
+#: Chapters whose code cells only glue results of tested package functions.
+GLUE_ONLY_CHAPTERS = ("model", "model_numerics", "mdr_validation", "critical_amplitude_one",
+                      "critical_amplitude_six", "execution_statistics")
+
+
+@pytest.mark.parametrize("chapter", GLUE_ONLY_CHAPTERS)
+def test_chapters_define_no_functions(chapter):
+    """Analysis belongs in the package, where a test reaches it; a chapter only calls and glues."""
+    import ast
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "book" / f"{chapter}.md").read_text()
+    cells = re.findall(r"```\{code-cell\}[^\n]*\n(.*?)```", text, flags=re.S)
+    assert cells, chapter
+    for cell in cells:
+        code = "\n".join(line for line in cell.splitlines() if not line.startswith(":tags:"))
+        defined = [node for node in ast.walk(ast.parse(code))
+                   if isinstance(node, (ast.FunctionDef, ast.Lambda, ast.ClassDef))]
+        assert not defined, f"{chapter}: {[getattr(n, 'name', 'lambda') for n in defined]}"
+
+
+def test_put_all_glues_numbers_and_text(monkeypatch):
+    glued = {}
+    monkeypatch.setattr(publish, "put", lambda name, value: glued.__setitem__(name, ("number", value)))
+    monkeypatch.setattr(publish, "put_text", lambda name, text: glued.__setitem__(name, ("text", text)))
+    publish.put_all({"a": 1.5, "b": "below"})
+    assert glued == {"a": ("number", 1.5), "b": ("text", "below")}

@@ -14,8 +14,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd import experiments, ledger, waveforms
+from passmd import figures, ledger, waveforms
+from passmd.config import RunConfig
+from passmd.defaults import PROTOCOL
 from passmd.experiments import critical_amplitude as ca
+from passmd.experiments import critical_amplitude_facts as ca_facts
+from passmd.protocols import critical_amplitude as search
 from passmd.theory import drive_theory, runner_frequency
 
 PANELS = ("fig5a", "fig5b", "fig6a", "fig6b", "fig6c", "fig56_viscosity", "fig56_frequency")
@@ -26,7 +30,7 @@ LABELS = ("actuator_model", "protocol", "flyback")  # the text columns of the fi
 @pytest.fixture(scope="module")
 def quick():
     """Quick data of every panel (computed once; the sweep cache makes reruns cheap)."""
-    return {name: experiments.figure_data(name, "quick") for name in PANELS}
+    return {name: figures.figure_data(name, RunConfig(profile="quick")) for name in PANELS}
 
 
 # --------------------------------------------------------------------------------------
@@ -42,7 +46,7 @@ def test_bisection_brackets_the_switch_and_counts_runs():
         calls.append(a)
         return a >= switch
 
-    out = ca.bisect_amplitude(moves, 202e-9, 0.1e-9)
+    out = search.bisect_amplitude(moves, 202e-9, 0.1e-9)
     assert out["bracket_low_m"] < switch <= out["bracket_high_m"]
     assert out["bracket_high_m"] - out["bracket_low_m"] <= 0.1e-9
     assert out["critical_amplitude_m"] == pytest.approx(0.5 * (out["bracket_low_m"] + out["bracket_high_m"]))
@@ -52,7 +56,7 @@ def test_bisection_brackets_the_switch_and_counts_runs():
 
 
 def test_bisection_without_motion_at_full_stroke_reports_nan():
-    out = ca.bisect_amplitude(lambda a: False, 96e-9, 0.5e-9)
+    out = search.bisect_amplitude(lambda a: False, 96e-9, 0.5e-9)
     assert math.isnan(out["critical_amplitude_m"]) and math.isnan(out["bracket_high_m"])
     assert out["bracket_low_m"] == 96e-9 and out["runs"] == 1
 
@@ -71,19 +75,19 @@ def test_bisection_without_motion_at_full_stroke_reports_nan():
 def test_bad_search_input_names_the_parameter(kwargs, name):
     drive = ca.paper_drive_for(1, "rigid", 1e-3, 0.4)
     with pytest.raises(ValueError, match=name):
-        ca.critical_amplitude(drive, **kwargs)
+        search.critical_amplitude(drive, **kwargs)
 
 
 def test_bad_first_flyback_input_names_the_parameter():
     drive = ca.paper_drive_for(1, "rigid", 1e-3, 0.4)
     with pytest.raises(ValueError, match="amplitude"):
-        ca.first_flyback_slip(drive, 0.0)
+        search.first_flyback_slip(drive, 0.0)
     with pytest.raises(ValueError, match="amplitude"):
-        ca.first_flyback_slip(drive, 1e-6)  # beyond the 202 nm full stroke
+        search.first_flyback_slip(drive, 1e-6)  # beyond the 202 nm full stroke
     with pytest.raises(ValueError, match="frequency"):
-        ca.first_flyback_slip(drive, 40e-9, frequency=2e6)  # 0.4 µs fly-back > half a 0.5 µs period
+        search.first_flyback_slip(drive, 40e-9, frequency=2e6)  # 0.4 µs fly-back > half a 0.5 µs period
     with pytest.raises(ValueError, match="profile"):
-        ca.fig5b("fast")
+        ca.fig5b(RunConfig(profile="fast"))
 
 
 # --------------------------------------------------------------------------------------
@@ -106,10 +110,10 @@ def test_one_contact_rigid_first_flyback_onset_is_eq7():
     """
     drive = ca.paper_drive_for(1, "rigid", 1e-3, 0.4)
     eq7 = drive_theory(drive)["critical_amplitude_rigid_m"]
-    out = ca.critical_amplitude(drive, protocol="first", tolerance=TOLERANCE)
+    out = search.critical_amplitude(drive, protocol="first", tolerance=TOLERANCE)
     t_fb = waveforms.flyback_time(eq7, drive)
     pull = 0.5 * drive.friction_coefficient * drive.preload / drive.runner_mass * t_fb**2
-    allowed = TOLERANCE / 2 + _startup_vibration(drive, eq7, ca.DRIVE_FREQUENCY) + pull
+    allowed = TOLERANCE / 2 + _startup_vibration(drive, eq7, PROTOCOL.drive_frequency) + pull
     assert abs(out["critical_amplitude_m"] - eq7) <= allowed
     assert allowed / eq7 < 0.01  # i.e. Eq. 7 within 1 %
 
@@ -123,10 +127,10 @@ def test_one_contact_flexible_quasistatic_first_flyback_onset_is_eq8():
     """
     drive = ca.paper_drive_for(1, "flexible", 1e-3, 0.4)
     eq8 = drive_theory(drive)["critical_amplitude_flexible_m"]
-    out = ca.critical_amplitude(drive, protocol="first", flyback="fixed", tolerance=TOLERANCE)
+    out = search.critical_amplitude(drive, protocol="first", flyback="fixed", tolerance=TOLERANCE)
     omega_a = np.sqrt(drive.actuator.stiffness / drive.actuator.mass)
     ringing = eq8 / drive.amplifier.full_stroke_time / omega_a
-    allowed = TOLERANCE / 2 + _startup_vibration(drive, eq8, ca.DRIVE_FREQUENCY) + ringing
+    allowed = TOLERANCE / 2 + _startup_vibration(drive, eq8, PROTOCOL.drive_frequency) + ringing
     assert abs(out["critical_amplitude_m"] - eq8) <= allowed
     assert allowed / eq8 < 0.035
 
@@ -134,8 +138,8 @@ def test_one_contact_flexible_quasistatic_first_flyback_onset_is_eq8():
 def test_slew_rate_flyback_rings_the_actuator_and_lowers_the_onset():
     """A fly-back shorter than the actuator period (slew rate, 0.4 µs vs 0.33 µs) lowers A_c below Eq. 8."""
     drive = ca.paper_drive_for(1, "flexible", 1e-3, 0.4)
-    slew = ca.critical_amplitude(drive, protocol="first", flyback="slew", tolerance=0.5e-9)
-    fixed = ca.critical_amplitude(drive, protocol="first", flyback="fixed", tolerance=0.5e-9)
+    slew = search.critical_amplitude(drive, protocol="first", flyback="slew", tolerance=0.5e-9)
+    fixed = search.critical_amplitude(drive, protocol="first", flyback="fixed", tolerance=0.5e-9)
     assert slew["critical_amplitude_m"] < fixed["critical_amplitude_m"] - 2e-9
 
 
@@ -143,8 +147,8 @@ def test_six_contacts_rigid_first_flyback_onset_follows_the_stiffer_side():
     """From virgin contacts all six slide only when the more loaded side 1 does: u_x,max,1 (Eq. 10)."""
     drive = ca.paper_drive_for(6, "rigid", 1e-3, 0.4)
     u1, u2 = drive_theory(drive)["presliding_m"]
-    out = ca.critical_amplitude(drive, protocol="first", tolerance=TOLERANCE)
-    allowed = TOLERANCE / 2 + _startup_vibration(drive, u1, ca.DRIVE_FREQUENCY) + 0.05e-9
+    out = search.critical_amplitude(drive, protocol="first", tolerance=TOLERANCE)
+    allowed = TOLERANCE / 2 + _startup_vibration(drive, u1, PROTOCOL.drive_frequency) + 0.05e-9
     assert abs(out["critical_amplitude_m"] - u1) <= allowed  # 0.05 nm: runner motion in t_fb
 
 
@@ -164,15 +168,15 @@ def test_six_contacts_rigid_steady_state_is_closest_to_eq11(quick):
 def test_steady_state_runs_are_long_enough(quick):
     """Ten periods: below A_c the start-up creep has decayed under δ; above it the step has converged."""
     rows = quick["fig56_frequency"]
-    rows = rows[(rows["protocol"] == "steady") & np.isclose(rows["frequency_Hz"], ca.DRIVE_FREQUENCY)]
+    rows = rows[(rows["protocol"] == "steady") & np.isclose(rows["frequency_Hz"], PROTOCOL.drive_frequency)]
     assert len(rows) == 4
     for row in rows.itertuples():
         drive = ca.paper_drive_for(row.contacts, row.actuator_model, 1e-3, row.preload_N)
-        below = ca.steady_step(drive, 0.8 * row.critical_amplitude_nm / NM)
-        above = ca.steady_step(drive, 1.2 * row.critical_amplitude_nm / NM)
+        below = search.steady_step(drive, 0.8 * row.critical_amplitude_nm / NM)
+        above = search.steady_step(drive, 1.2 * row.critical_amplitude_nm / NM)
         assert abs(below["last_step_m"]) < 0.2e-9, row
         steps = np.array(above["steps_m"])
-        assert steps[-1] > ca.STEP_THRESHOLD and abs(steps[-1] - steps[-2]) < 0.01e-9, row
+        assert steps[-1] > search.STEP_THRESHOLD and abs(steps[-1] - steps[-2]) < 0.01e-9, row
 
 
 def test_first_flyback_onset_does_not_depend_on_low_drive_frequencies(quick):
@@ -180,8 +184,8 @@ def test_first_flyback_onset_does_not_depend_on_low_drive_frequencies(quick):
     rows = quick["fig56_frequency"]
     first = rows[rows["protocol"] == "first"]
     drive = ca.paper_drive_for(1, "rigid", 1e-3, 0.4)
-    a = ca.critical_amplitude(drive, protocol="first", frequency=50.0, tolerance=0.5e-9)
-    b = ca.critical_amplitude(drive, protocol="first", frequency=200.0, tolerance=0.5e-9)
+    a = search.critical_amplitude(drive, protocol="first", frequency=50.0, tolerance=0.5e-9)
+    b = search.critical_amplitude(drive, protocol="first", frequency=200.0, tolerance=0.5e-9)
     vib = _startup_vibration(drive, 40e-9, 200.0) + _startup_vibration(drive, 40e-9, 50.0)
     assert abs(a["critical_amplitude_m"] - b["critical_amplitude_m"]) <= 0.5e-9 + vib
     assert len(first) > 0
@@ -189,8 +193,8 @@ def test_first_flyback_onset_does_not_depend_on_low_drive_frequencies(quick):
 
 def test_larger_threshold_gives_larger_steady_amplitude():
     drive = ca.paper_drive_for(1, "rigid", 1e-3, 0.4)
-    small = ca.critical_amplitude(drive, threshold=0.5e-9, tolerance=0.2e-9)
-    large = ca.critical_amplitude(drive, threshold=3e-9, tolerance=0.2e-9)
+    small = search.critical_amplitude(drive, threshold=0.5e-9, tolerance=0.2e-9)
+    large = search.critical_amplitude(drive, threshold=3e-9, tolerance=0.2e-9)
     # above the onset the step grows ~1 nm per nm: 2.5 nm more threshold, ~2.5 nm more A_c
     assert large["critical_amplitude_m"] - small["critical_amplitude_m"] == pytest.approx(2.5e-9, abs=0.6e-9)
 
@@ -200,19 +204,20 @@ def test_larger_threshold_gives_larger_steady_amplitude():
 # --------------------------------------------------------------------------------------
 
 
-def test_every_panel_is_registered_with_its_chapter():
-    names = experiments.figure_names()
+def test_every_panel_is_in_the_figure_table_with_its_chapter():
+    names = figures.figure_names()
     for name in PANELS:
         assert name in names
-        assert experiments.figure_spec(name).chapter in ("critical_amplitude_one", "critical_amplitude_six")
+        assert figures.figure_spec(name).chapter in ("critical_amplitude_one", "critical_amplitude_six")
 
 
 def test_figures_are_listed_in_the_books_order():
-    """Study panels of Figs. 5-6 (fig56_*) come after fig6c and before fig7a, as in the book."""
+    """Chapters follow book/_toc.yml; study panels of Figs. 5-6 (fig56_*) come after fig6c, before fig7a."""
     toc = (Path(__file__).resolve().parents[1] / "book" / "_toc.yml").read_text()
     files = re.findall(r"^\s*- file: (\w+)", toc, flags=re.M)
-    assert [f for f in files if f in experiments.CHAPTERS] == list(experiments.CHAPTERS)
-    names = experiments.figure_names()
+    names = figures.figure_names()
+    positions = [files.index(figures.figure_spec(name).chapter) for name in names]
+    assert positions == sorted(positions)
     assert names.index("fig6c") < names.index("fig56_frequency") < names.index("fig7a")
     assert names.index("fig9b") < names.index("fig10a")
 
@@ -260,7 +265,7 @@ def test_plots_draw_every_panel(quick, name):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig = experiments.figure_plot(name, quick[name])
+    fig = figures.figure_plot(name, quick[name])
     assert fig.axes and all(ax.has_data() for ax in fig.axes)
     plt.close(fig)
 
@@ -304,3 +309,105 @@ def test_ledger_rows_of_figs_5_and_6(quick):
     assert status["fig6b-flexible-r1-ac-matches-eq12"] == "reproduced under another reading"
     assert status["fig6a-rigid-ac-matches-eq11"] == "reproduced"
     assert status["fig6a-rigid-ac-not-eq10"] == "reproduced"
+
+
+# --------------------------------------------------------------------------------------
+# Facts the chapters quote, from the figure data
+# --------------------------------------------------------------------------------------
+
+
+def test_step_onset_is_where_the_step_stays_above_the_threshold():
+    rows = pd.DataFrame({"amplitude_nm": [0.0, 10.0, 20.0, 30.0, 40.0],
+                         "steady_step_nm": [0.0, 0.6, 0.1, 0.7, 1.5], "threshold_nm": 0.5})
+    assert ca_facts.step_onset(rows) == 30.0  # 10 nm is above δ once, but the step falls back
+    assert math.isnan(ca_facts.step_onset(rows.assign(steady_step_nm=0.0)))
+
+
+def test_fig5a_facts(quick):
+    found = ca_facts.fig5a_facts(quick["fig5a"])
+    assert found["onset_rigid"] <= found["eq7_04"] + 20  # the quick grid's 20 nm step
+    assert found["onset_flex_fixed"] >= found["onset_flex_slew"]  # the slew-rate fly-back rings the actuator
+    assert found["eq8_04"] > found["eq7_04"]
+    assert found["slope_rigid"] == pytest.approx(1.0, abs=0.2)  # ~1 nm of step per nm of amplitude
+
+
+def test_deviations_from_the_closed_forms(quick):
+    closed = {"rigid": "u_x_max_nm", "flexible": "u_x_max_plus_u_x_a_nm"}
+    dev = ca_facts.closed_form_deviations(quick["fig5b"], closed)
+    largest, mean = ca_facts.series_deviation(dev, "rigid", "first", "slew")
+    assert largest < 2.0 and abs(mean) <= largest  # first-fly-back onset of a rigid actuator: Eq. 7
+    assert ca_facts.side_of(-3.25) == "3.2 % below" and ca_facts.side_of(1.0) == "1.0 % above"
+    assert math.isnan(ca_facts.band_spread(quick["fig5b"], "rigid"))  # the quick profile runs 100 Hz only
+    columns = {"Eq. 11": "u_x_max_e_nm", "Eq. 10, side 1": "u_x_max_1_nm"}
+    six = ca_facts.deviation_table(quick["fig6a"], columns)
+    assert ca_facts.deviation_at(six, "steady", "slew", "Eq. 11: largest |dev| (%)") < ca_facts.deviation_at(
+        six, "steady", "slew", "Eq. 10, side 1: largest |dev| (%)")
+
+
+def test_spans_and_values_of_the_sensitivity_panels(quick):
+    freq = quick["fig56_frequency"]
+    low, high = ca_facts.ac_span(freq, 6, "first", actuator_model="rigid")
+    assert low <= high and ca_facts.ac_range(freq, 6, "first", actuator_model="rigid") == high - low
+    at_drive = ca_facts.ac_at(freq, 6, "rigid", "steady", PROTOCOL.drive_frequency)
+    primary = ca.primary(freq, "rigid").query("contacts == 6")
+    assert low > 0 and at_drive == float(primary["critical_amplitude_nm"].iloc[0])
+    visc = quick["fig56_viscosity"]
+    lo, hi = ca_facts.ac_span(visc, 6, "steady", flyback="fixed")
+    assert 0 < lo <= hi
+
+
+def test_slew_and_protocol_facts():
+    slew = ca_facts.slew_facts()
+    # 2 µs full-stroke time over A_max: 202 nm (R = 1 mm) and 96 nm (R = 0.25 mm)
+    assert slew["ns_per_nm_b"] == pytest.approx(2000 / 202, rel=1e-9)
+    assert slew["ns_per_nm_c"] == pytest.approx(2000 / 96, rel=1e-9)
+    found = ca_facts.protocol_facts(RunConfig(profile="quick"))
+    assert found["tol_nm"] == pytest.approx(0.5) and found["periods"] == search.STEADY_PERIODS
+    assert found["flyback_us_40"] == pytest.approx(40 / 202 * 2, rel=1e-9)
+    assert ca_facts.band_text(RunConfig(profile="paper"))["band_here"] == "as in this build"
+
+
+def test_continued_operation_strains_the_sides_against_each_other(quick):
+    """Below the steady-state A_c the two sides end every period pushing against each other."""
+    prestrain = ca_facts.side_prestrain(quick["fig56_frequency"])
+    assert len(prestrain) == search.STEADY_PERIODS
+    last = prestrain.iloc[-1]
+    assert last["side 1: T_1 / μF_N1"] < 0 < last["side 2: T_2 / μF_N2"]
+
+
+def test_flyback_steps_ratchet_below_eq7():
+    steps = ca_facts.fig5_flyback_steps(RunConfig(profile="quick"))
+    first = steps.iloc[0]
+    assert first["steady_ac_nm"] < first["u_x_max_nm"]
+    below = steps[steps["amplitude_nm"] == steps["amplitude_nm"].unique()[0]]
+    assert below["step_nm"].iloc[-1] < first["threshold_nm"]  # 2 nm below A_c: no steady step
+    import matplotlib.pyplot as plt
+
+    fig = figures.figure_plot("fig5_flyback_steps", steps)
+    assert fig.axes[0].has_data()
+    plt.close(fig)
+
+
+def test_paragraph_facts_of_both_chapters(quick):
+    """Every fact function the chapters glue returns finite numbers or a sentence, on the quick data."""
+    quick_config = RunConfig(profile="quick")
+    found = ca_facts.fig5b_facts(quick["fig5b"], quick_config)
+    assert found["first_rigid_max"] < 2.0 and found["steady_rigid_mean"].endswith(("below", "above"))
+    assert "quick profile runs 100 Hz only" in found["band_rigid"]
+    columns = {"Eq. 11": "u_x_max_e_nm", "Eq. 10, side 1": "u_x_max_1_nm", "Eq. 10, side 2": "u_x_max_2_nm"}
+    six = ca_facts.fig6a_facts(ca_facts.deviation_table(quick["fig6a"], columns), quick_config)
+    assert six["a_e"] < min(six["a_1"], six["a_2"]) and six["a_band"].startswith("(the quick profile")
+    flexible = {"Eq. 12": "u_x_max_e_star_nm", "Eq. 13, side 1": "u_x_max_1_star_nm"}
+    dev6 = pd.concat([ca_facts.deviation_table(quick[n], flexible).assign(figure=n)
+                      for n in ("fig6b", "fig6c")])
+    bc = ca_facts.fig6bc_facts(dev6)
+    assert set(bc) == {f"{k}_{s}" for k in "bc" for s in ("slew", "fixed", "first_fixed")}
+    visc = ca_facts.viscosity_facts(quick["fig56_viscosity"])
+    assert visc["v6_fixed_lo"] <= visc["v6_fixed_hi"] and visc["eq8_04"] > visc["eq12_04"]
+    freq = ca_facts.frequency_facts(quick["fig56_frequency"], quick_config)
+    assert freq["f_hi"] == 1000.0 and freq["first_span"] >= 0
+    assert freq["first_band"].endswith("Figs. 5b and 6.)")
+    table = pd.DataFrame({"side 1: T_1 / μF_N1": [-0.1], "side 2: T_2 / μF_N2": [0.1]})
+    table.attrs["amplitude_nm"] = 23.9
+    expected = {"prestrain_amplitude": 23.9, "prestrain_1": -0.1, "prestrain_2": 0.1}
+    assert ca_facts.prestrain_facts(table) == expected

@@ -466,8 +466,8 @@ def test_any_category_change_fails_with_a_readable_diff(tmp_path):
 def test_collect_results_calls_every_figure_of_the_table(monkeypatch):
     calls = []
 
-    def _fig5a(profile):  # lead: receives the RunConfig itself once compute(config) is merged
-        calls.append(profile)
+    def _fig5a(config):
+        calls.append(config)
         return pd.DataFrame({"amplitude_nm": [1.0]})
 
     table = {"fig5a": types.SimpleNamespace(compute=_fig5a)}
@@ -475,13 +475,13 @@ def test_collect_results_calls_every_figure_of_the_table(monkeypatch):
     monkeypatch.setattr(figures, "figure_spec", lambda name: table[name])
     results = ledger.collect_results(QUICK)
     assert list(results) == ["fig5a", "closed_forms"]
-    assert calls == ["quick"]
+    assert calls == [QUICK]
     pd.testing.assert_frame_equal(results["closed_forms"], reference.tangential_stiffness_table())
     with pytest.raises(TypeError, match="config = 'quick' is not allowed: must be a passmd.config.RunConfig"):
         ledger.collect_results("quick")
     with pytest.raises(ValueError, match="are not available"):
         ledger.collect_results(QUICK, figures=["fig9z"])
-    table["fig5b"] = types.SimpleNamespace(compute=lambda profile: [1, 2])
+    table["fig5b"] = types.SimpleNamespace(compute=lambda config: [1, 2])
     with pytest.raises(TypeError, match="not a DataFrame"):
         ledger.collect_results(QUICK, figures=["fig5b"])
 

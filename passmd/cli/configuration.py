@@ -9,12 +9,11 @@ environment.
 from __future__ import annotations
 
 import importlib.util
-import inspect
 
 from passmd.cli.errors import MissingDependencyError, UsageError
 from passmd.config import RunConfig
 
-__all__ = ["call_with_config", "run_config"]
+__all__ = ["run_config"]
 
 
 def _require_executor(config: RunConfig) -> None:
@@ -36,16 +35,3 @@ def run_config(args) -> RunConfig:
                                         cache_dir=args.cache_dir)
     _require_executor(config)
     return config
-
-
-def call_with_config(func, *args, config: RunConfig):
-    """``func(*args, config)``: a figure-table or ledger function run at the configuration.
-
-    While a function still takes the resolution profile instead (its sweeps then run with
-    the defaults of :func:`passmd.sweep.run`), it gets ``config.profile``.
-    """
-    # lead: once passmd.figures.figure_data(name, config) and ledger.collect_results(config)
-    # take the RunConfig (dev/figA, dev/ledger), call them directly and delete this function.
-    if "config" in inspect.signature(func).parameters:
-        return func(*args, config)
-    return func(*args, config.profile)

@@ -33,7 +33,7 @@ from passmd._validation import check_choice
 from passmd.checks import ClaimFails, NotEvaluable, evidence, extractor
 from passmd.config import PROFILES, RunConfig
 from passmd.defaults import PROTOCOL
-from passmd.parameters import MOLYBDENUM, STEEL, Assumption, Drive, paper_drive, register_assumption
+from passmd.parameters import MOLYBDENUM, STEEL, Assumption, Drive, paper_drive
 from passmd.protocols import eq15
 from passmd.protocols.velocity import (
     FULL_SLIDING_SHARE,
@@ -70,7 +70,7 @@ def variant_name(waveform: str, short_period: str) -> str:
         return "sawtooth"
     return "optimized_skip" if short_period == "skip" else "optimized"
 
-register_assumption(
+ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
         key="frequency_grid",
         symbol="f",
@@ -81,9 +81,7 @@ register_assumption(
             "1, 6, 11, … or 1, 5, 10, …; the second contains the 80 and 110 kHz the text names."
         ),
         sensitivity="Only where a threshold falls between grid points (±5 kHz).",
-    )
-)
-register_assumption(
+    ),
     Assumption(
         key="steady_velocity",
         symbol="v̄",
@@ -98,9 +96,7 @@ register_assumption(
             "from rest to its steady velocity; the steady velocity is what a user of the drive sees."
         ),
         sensitivity="Driving-waveform chapter: third against fourth quarter of each run (velocity_drift).",
-    )
-)
-register_assumption(
+    ),
     Assumption(
         key="controllable_frequency",
         symbol="f_max",
@@ -112,9 +108,7 @@ register_assumption(
             "criterion of its own."
         ),
         sensitivity="Fig. 10b's ordering of maximal controllable frequencies only.",
-    )
-)
-register_assumption(
+    ),
     Assumption(
         key="stick_during_acceleration",
         symbol="–",
@@ -126,7 +120,7 @@ register_assumption(
             "slip of runner and hemisphere."
         ),
         sensitivity="Fig. 10a's 0.1 N stick threshold.",
-    )
+    ),
 )
 
 

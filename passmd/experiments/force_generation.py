@@ -28,7 +28,7 @@ from passmd._validation import check_choice, check_range
 from passmd.checks import ClaimFails, NotEvaluable, evidence, extractor
 from passmd.config import PROFILES, RunConfig
 from passmd.defaults import PROTOCOL
-from passmd.parameters import PRELOAD_GRIDS, Assumption, Drive, paper_drive, register_assumption
+from passmd.parameters import PRELOAD_GRIDS, Assumption, Drive, paper_drive
 from passmd.protocols import stall
 from passmd.protocols.stall import (
     MAX_PERIODS,
@@ -110,7 +110,7 @@ PROFILE_SETTINGS = {
     ),
 }
 
-register_assumption(
+ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
         key="force_frequency",
         symbol="f",
@@ -125,9 +125,7 @@ register_assumption(
             "several times more from one frequency to the next."
         ),
         sensitivity="Force chapter: F_gen at full amplitude from 90 Hz to 1.1 kHz (fig7freq).",
-    )
-)
-register_assumption(
+    ),
     Assumption(
         key="force_stall_criterion",
         symbol="F_gen",
@@ -145,9 +143,7 @@ register_assumption(
             "slow. The tolerance is far below the force's own scatter with the drive frequency."
         ),
         sensitivity="Force chapter: periods used and the estimated remaining rise of every point.",
-    )
-)
-register_assumption(
+    ),
     Assumption(
         key="force_onset",
         symbol="A_c (load cell)",
@@ -159,7 +155,7 @@ register_assumption(
             "it is found with the critical-amplitude chapters' protocol, load cell engaged."
         ),
         sensitivity="Force chapter: F_gen just below the onset is the load cell following the piezo.",
-    )
+    ),
 )
 
 

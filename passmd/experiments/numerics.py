@@ -13,9 +13,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from passmd import dynamics, theory, waveforms
+from passmd import dynamics, theory, time_steps, waveforms
 from passmd._validation import check_choice, check_count, check_range
+from passmd.config import RunConfig
 from passmd.parameters import Amplifier, Drive, Material
+from passmd.units import from_si
 
 #: Configurations the numerics are shown for: (label, contacts, actuator model).
 CONFIGURATIONS = (
@@ -294,3 +296,159 @@ def coulomb_limit_rates(table: pd.DataFrame) -> pd.DataFrame:
                      "largest_difference_m": float(np.abs(g["difference_m"]).max()),
                      "smallest_difference_m": float(np.abs(g["difference_m"]).min())})
     return pd.DataFrame(rows)
+
+
+# --------------------------------------------------------------------------------------
+# Figures of the numerics section (rows of passmd.figures)
+# --------------------------------------------------------------------------------------
+
+#: Step controls of the convergence figure (flexible actuators; rigid ones use the fixed step).
+CONVERGENCE_STEP_CONTROLS = ("adaptive", "fixed", "quasi-static")
+#: Saw-tooth of the rigid-Coulomb-limit figure: amplitude (m), frequency (Hz), periods (the last step counts).
+COULOMB_RUN = {"amplitude": 150e-9, "frequency": 100.0, "periods": 4}
+
+
+def model_convergence(config: RunConfig) -> pd.DataFrame:
+    """:func:`convergence_study` over the profile's :data:`RESOLUTIONS` and every step control."""
+    return convergence_study(resolutions=RESOLUTIONS[config.profile], step_controls=CONVERGENCE_STEP_CONTROLS)
+
+
+def model_coulomb_limit(config: RunConfig) -> pd.DataFrame:
+    """:func:`rigid_coulomb_limit` of :data:`COULOMB_RUN`, with each configuration's fitted
+    ``rate`` and the ``expected_rate`` (:func:`coulomb_limit_rates`) as columns."""
+    table = rigid_coulomb_limit(**COULOMB_RUN)
+    rates = coulomb_limit_rates(table).set_index("configuration")
+    table["rate"] = table["configuration"].map(rates["rate"])
+    table["expected_rate"] = EXPECTED_COULOMB_RATE
+    return table
+
+
+# --------------------------------------------------------------------------------------
+# Facts the numerics section quotes (glue names -> numbers), each from its table
+# --------------------------------------------------------------------------------------
+
+
+def step_plan_table() -> pd.DataFrame:
+    """The integrator's steps (:func:`passmd.time_steps.step_plan`) for each of :data:`CONFIGURATIONS`.
+
+    Columns: ``configuration``, stiffest mode (kHz), stability limit 2/ω, fine and coarse step (ns).
+    """
+    rows = []
+    for label, contacts, model in CONFIGURATIONS:
+        drive = Drive(contacts=contacts, actuator_model=model)
+        k_max = theory.drive_theory(drive)["tangential_stiffness_N_per_m"]
+        _, mult = dynamics.contact_groups(drive)
+        plan = time_steps.step_plan(drive, max(k_max), float(np.dot(mult, k_max)))
+        rows.append({
+            "configuration": label,
+            "stiffest mode (kHz)": from_si(plan.stiffest_frequency, "kHz"),
+            "stability limit 2/ω (ns)": from_si(plan.stability_limit, "ns"),
+            "fine step (ns)": from_si(plan.fine_step, "ns"),
+            "coarse step (ns)": from_si(plan.coarse_step, "ns"),
+        })
+    return pd.DataFrame(rows)
+
+
+def fitted_convergence_order(rows: pd.DataFrame) -> float:
+    """Order p of |error| ∝ h^p: least-squares slope over the runs at the default step or finer."""
+    fit = rows[(rows["error_m"] != 0) & (rows["resolution"] >= 1.0)]
+    return float(-np.polyfit(np.log(fit["resolution"]), np.log(np.abs(fit["error_m"])), 1)[0])
+
+
+def convergence_facts(conv: pd.DataFrame) -> dict:
+    """Orders, largest errors at the default step (nm), adaptive-vs-fixed difference (nm) and the
+    step savings of the adaptive and quasi-static steps for six flexible contacts
+    (:func:`model_convergence`)."""
+    explicit = conv[conv["step_control"] != "quasi-static"]
+    default = explicit[explicit["resolution"] == 1.0]
+    quasi = conv[conv["step_control"] == "quasi-static"]
+    adaptive = conv[conv["step_control"] == "adaptive"]
+    adaptive = adaptive.set_index(["configuration", "resolution"])["final_position_m"]
+    fixed = conv[(conv["step_control"] == "fixed") & conv["configuration"].str.contains("flexible")]
+    fixed = fixed.set_index(["configuration", "resolution"])["final_position_m"]
+    steps = conv[conv["resolution"] == 1.0].set_index(["configuration", "step_control"])["steps"]
+    six = "six contacts, flexible"
+    return {
+        "conv_order": fitted_convergence_order(explicit),
+        "quasi_order": fitted_convergence_order(quasi),
+        "quasi_max_err_nm": float(np.abs(quasi[quasi["resolution"] == 1.0]["error_m"]).max() * 1e9),
+        "conv_max_err_nm": float(np.abs(default["error_m"]).max() * 1e9),
+        "adaptive_vs_fixed_nm": float(np.abs(adaptive.reindex(fixed.index) - fixed).max() * 1e9),
+        "adaptive_saving": float(steps[(six, "fixed")] / steps[(six, "adaptive")]),
+        "quasi_saving": float(steps[(six, "adaptive")] / steps[(six, "quasi-static")]),
+    }
+
+
+def settle_facts(sens: pd.DataFrame) -> dict:
+    """Largest spread of the mean step over the settle windows: nm and % of the mean
+    (:func:`settle_fraction_sensitivity`)."""
+    spread = sens.groupby("configuration")["mean_step_m"].agg(lambda v: v.max() - v.min())
+    mean = sens.groupby("configuration")["mean_step_m"].mean()
+    return {"settle_spread_nm": float(spread.max() * 1e9),
+            "settle_spread_rel": float((spread / mean).max() * 100)}
+
+
+def coulomb_facts(coulomb: pd.DataFrame, refined: pd.DataFrame) -> dict:
+    """Numbers the Coulomb-limit paragraph quotes, from :func:`model_coulomb_limit` and the same
+    run at half the time step (``refined``): gaps (nm, % of A_c), fly-back times (µs), rates."""
+    k = np.array(sorted(coulomb["scale"].unique()))
+    by = coulomb.set_index(["configuration", "scale"])
+    paper, slow = "six contacts, paper slew rate fly-back", "six contacts, slow fly-back"
+    change = np.abs(refined["difference_m"] - coulomb["difference_m"])
+    slow_tf = coulomb[coulomb["flyback"] == "slow"]["flyback_time_s"]
+    return {
+        "cl_scale_max": float(k[-1]),
+        "cl_refined_nm": float(change.max() * 1e9),
+        "cl_refined_rel": float((change / np.abs(coulomb["difference_m"])).max() * 100),
+        "cl_tf_paper_us": float(by.loc[(paper, k[0]), "flyback_time_s"] * 1e6),
+        "cl_tf_slow_min_us": float(slow_tf.min() * 1e6),
+        "cl_tf_slow_max_us": float(slow_tf.max() * 1e6),
+        "cl_six_paper_limit_nm": float(by.loc[(paper, k[0]), "coulomb_step_m"] * 1e9),
+        "cl_six_paper_gap0_nm": float(-by.loc[(paper, k[0]), "difference_m"] * 1e9),
+        "cl_six_paper_gap0_ratio": float(-by.loc[(paper, k[0]), "difference_m"]
+                                         / by.loc[(paper, k[0]), "presliding_m"] * 100),
+        "cl_six_paper_gap_last_nm": float(-by.loc[(paper, k[-1]), "difference_m"] * 1e9),
+        "cl_six_slow_limit_nm": float(by.loc[(slow, k[0]), "coulomb_step_m"] * 1e9),
+        "cl_six_slow_gap_last_nm": float(abs(by.loc[(slow, k[-1]), "difference_m"]) * 1e9),
+        "cl_rate_min": float(coulomb["rate"].min()),
+        "cl_rate_max": float(coulomb["rate"].max()),
+        "cl_expected": float(EXPECTED_COULOMB_RATE),
+    }
+
+
+def coulomb_side(coulomb: pd.DataFrame) -> str:
+    """Where the simulated steps lie against the Coulomb limit: "below" or "on both sides of"."""
+    return "below" if (coulomb["difference_m"] < 0).all() else "on both sides of"
+
+
+def coulomb_rising_gaps(coulomb: pd.DataFrame) -> list[str]:
+    """Each place where the gap to the Coulomb limit grows from one stiffness factor to the next."""
+    rising = []
+    for label, g in coulomb.groupby("configuration", sort=False):
+        ordered = g.sort_values("scale")
+        gap = np.abs(ordered["difference_m"].to_numpy())
+        scales = ordered["scale"].to_numpy()
+        rising += [f"{label}: {gap[i] * 1e9:.3f} nm at k = {scales[i]:g} → {gap[i + 1] * 1e9:.3f} nm at "
+                   f"k = {scales[i + 1]:g}" for i in np.flatnonzero(np.diff(gap) >= 0)]
+    return rising
+
+
+#: Speed targets of the integrator: ms per 100 Hz period of the six-contact flexible drive
+#: (adaptive step, exact contact) and ns per fixed step (exact contact).
+TARGET_MS_PER_PERIOD, TARGET_NS_PER_STEP = 20.0, 25.0
+
+
+def benchmark_facts(bench: pd.DataFrame) -> dict:
+    """The speed numbers the performance paragraph quotes, from :func:`benchmark_table`:
+    ms per 100 Hz period (six flexible contacts, adaptive, exact), the largest ns per fixed
+    step (exact), the machine's load average, and the targets."""
+    six_flex = bench[(bench["contacts"] == 6) & (bench["actuator"] == "flexible")
+                     & (bench["step"] == "adaptive") & (bench["contact_model"] == "exact")].iloc[0]
+    fixed_exact = bench[(bench["step"] == "fixed") & (bench["contact_model"] == "exact")]
+    return {
+        "bench_six_flex_ms": float(six_flex["ms_per_100Hz_period"]),
+        "bench_fixed_ns": float(fixed_exact["ns_per_step"].max()),
+        "bench_load": float(bench.attrs["meta"].get("load_average_before", [float("nan")])[0]),
+        "target_ms_per_period": TARGET_MS_PER_PERIOD,
+        "target_ns_per_step": TARGET_NS_PER_STEP,
+    }

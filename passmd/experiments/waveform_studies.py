@@ -28,7 +28,7 @@ from passmd.experiments.driving_waveform import (
     section5_fields,
     variant_name,
 )
-from passmd.parameters import Assumption, register_assumption
+from passmd.parameters import Assumption
 from passmd.protocols.velocity import (
     STEP_PERIODS,
     STEP_PROTOCOL_BELOW,
@@ -61,7 +61,7 @@ FLEXIBLE_FREQUENCIES = {"paper": (STEP_FREQUENCY, 1e3, 10e3, 50e3, 110e3), "quic
 #: Points of the settling-time scan over [0, 2/f_s] per profile.
 SCAN_POINTS = {"paper": 41, "quick": 9}
 
-register_assumption(
+ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
         key="waveform_optimizer",
         symbol="t_s, V_a, Δ_a",
@@ -78,7 +78,7 @@ register_assumption(
             "amplifier's slew-rate limit bounds V_a, the period bounds t_s."
         ),
         sensitivity="Driving-waveform chapter: the optimum's parameters per frequency.",
-    )
+    ),
 )
 
 

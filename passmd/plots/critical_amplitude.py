@@ -1,6 +1,6 @@
 """Plots of the critical-amplitude figures (Figs. 5, 6 and the sensitivity panels).
 
-Each function takes the tidy DataFrame of :mod:`passmd.experiments.critical_amplitude`
+Each function takes the tidy DataFrame of a Section 4.1 figure (:mod:`passmd.figures`)
 and returns a matplotlib Figure: lengths in nm, forces in N, frequencies in Hz, the
 paper's colours where it has them (Fig. 5b: rigid green, flexible black; Fig. 6:
 u_x,max,e red).
@@ -12,26 +12,17 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from passmd.defaults import PROTOCOL
 from passmd.parameters import ACTUATOR_DAMPING_RATIO
 
 COLOURS = {"rigid": "tab:green", "flexible": "black"}
 SIDE_COLOURS = {1: "tab:blue", 2: "tab:orange", "e": "tab:red"}
 
 
-def _protocol():
-    """(drive frequency of the primary curves, frequency band) of the experiments module.
-
-    Imported when a plot is drawn: the experiments module imports this one to register its plots.
-    """
-    from passmd.experiments.critical_amplitude import DRIVE_FREQUENCY, FREQUENCY_BAND
-
-    return DRIVE_FREQUENCY, FREQUENCY_BAND
-
-
 def _steady(rows: pd.DataFrame, flyback: str, primary: bool = True) -> pd.DataFrame:
     sel = rows[(rows["protocol"] == "steady") & (rows["flyback"] == flyback)]
     if primary:
-        sel = sel[np.isclose(sel["frequency_Hz"], _protocol()[0])]
+        sel = sel[np.isclose(sel["frequency_Hz"], PROTOCOL.drive_frequency)]
     return sel.sort_values("preload_N")
 
 
@@ -71,7 +62,7 @@ def _simulated(ax, rows: pd.DataFrame, colour: str, name: str, flexible: bool) -
         "o-",
         color=colour,
         ms=4,
-        label=f"{name}, steady state {_protocol()[0]:g} Hz",
+        label=f"{name}, steady state {PROTOCOL.drive_frequency:g} Hz",
     )
     _band(ax, rows, colour, f"{name}, steady state")
     first = _first(rows, "slew")
@@ -230,7 +221,7 @@ def _two_panels(df: pd.DataFrame):
 def plot_viscosity(df: pd.DataFrame):
     """A_c of flexible actuators against the actuator viscosity c_p (one and six contacts)."""
     fig, axes = _two_panels(df)
-    f_primary = _protocol()[0]
+    f_primary = PROTOCOL.drive_frequency
     styles = {
         ("steady", "slew"): ("o-", "black", f"steady state {f_primary:g} Hz"),
         ("steady", "fixed"): ("^--", "tab:gray", f"steady state {f_primary:g} Hz, 2 µs fly-back"),
@@ -274,7 +265,7 @@ def plot_viscosity(df: pd.DataFrame):
 def plot_frequency(df: pd.DataFrame):
     """A_c against the drive frequency (one and six contacts, rigid and flexible, both protocols)."""
     fig, axes = _two_panels(df)
-    band = _protocol()[1]
+    band = PROTOCOL.critical_amplitude_band
     for n, ax in axes.items():
         rows = df[df["contacts"] == n]
         ax.axvspan(
@@ -314,5 +305,22 @@ def plot_frequency(df: pd.DataFrame):
         ax.set_ylim(bottom=0)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="lower left")
+    fig.tight_layout()
+    return fig
+
+
+def plot_flyback_steps(df: pd.DataFrame):
+    """Step across each fly-back of a run from rest, one line per amplitude, with δ."""
+    fig, ax = plt.subplots(figsize=(6.4, 3.8))
+    for amplitude, rows in df.groupby("amplitude_nm", sort=False):
+        ax.plot(rows["flyback"], rows["step_nm"], "o-", ms=4, label=f"A = {amplitude:.1f} nm")
+    first = df.iloc[0]
+    ax.axhline(first["threshold_nm"], color="tab:red", lw=0.8, label="measurable step δ")
+    ax.set_xlabel("fly-back number")
+    ax.set_ylabel("step across the fly-back (nm)")
+    ax.set_title(f"Rigid actuator, one contact, 0.4 N: steady-state A_c = {first['steady_ac_nm']:.1f} nm, "
+                 f"u_x,max = {first['u_x_max_nm']:.1f} nm", fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
     fig.tight_layout()
     return fig

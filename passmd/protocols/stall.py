@@ -37,8 +37,8 @@ import numpy as np
 from passmd import dynamics, waveforms
 from passmd._validation import check_choice, check_positive, check_range
 from passmd.defaults import PROTOCOL
-from passmd.experiments.critical_amplitude import critical_amplitude
 from passmd.parameters import Drive
+from passmd.protocols.critical_amplitude import critical_amplitude
 from passmd.theory import normal_forces
 
 __all__ = [

@@ -8,7 +8,7 @@ import textwrap
 from pathlib import Path
 
 from passmd.cache import DEFAULT_CACHE_DIR
-from passmd.cli.configuration import call_with_config, run_config
+from passmd.cli.configuration import run_config
 from passmd.cli.errors import NotAvailableError, OutputError, UsageError
 from passmd.cli.options import add_sweep_options
 from passmd.cli.output import JSON_HELP, emit_json
@@ -104,7 +104,7 @@ def run_figure(args, out) -> int:
     _check_name(args, names)
     config = run_config(args)
     _check_out(args)
-    data = call_with_config(figures.figure_data, args.name, config=config)
+    data = figures.figure_data(args.name, config)
     csv_path, png_path = _write(figures, provenance, args, data)
     record = {"command": "figure", "name": args.name, "profile": args.profile, "rows": len(data),
               "columns": list(map(str, data.columns)), "csv": str(csv_path), "png": str(png_path)}

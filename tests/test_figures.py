@@ -1,0 +1,68 @@
+"""The figure table: names, chapters, lookup errors, and the layers it joins."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from passmd import figures
+from passmd.config import RunConfig
+
+BOOK = Path(__file__).resolve().parents[1] / "book"
+
+
+def test_names_are_unique_and_in_table_order():
+    names = figures.figure_names()
+    assert names == [spec.name for spec in figures.FIGURES]
+    assert len(set(names)) == len(names)
+
+
+def test_every_figure_a_chapter_draws_is_in_the_table():
+    """A chapter draws figures only through figure_plot, with names that the table holds for it."""
+    for spec in figures.FIGURES:
+        assert (BOOK / f"{spec.chapter}.md").exists(), spec
+    for chapter in BOOK.glob("*.md"):
+        text = chapter.read_text()
+        for name in re.findall(r"figure_plot\(\"(\w+)\"", text):
+            assert figures.figure_spec(name).chapter == chapter.stem, (chapter.name, name)
+
+
+def test_unknown_figure_names_the_known_ones():
+    with pytest.raises(ValueError, match="figure = .fig99z. is not available: must be one of model_sawtooth"):
+        figures.figure_spec("fig99z")
+
+
+def test_figure_data_takes_a_run_configuration():
+    with pytest.raises(ValueError, match="config = 'quick' is not a RunConfig"):
+        figures.figure_data("fig5a", "quick")
+    with pytest.raises(ValueError, match="profile = 'fast'"):
+        figures.figure_data("fig5a", RunConfig(profile="fast"))
+
+
+def test_claim_modules_are_the_experiment_modules_with_extractors():
+    """Every experiment module that tags a claim extractor is listed, and only those."""
+    package = Path(figures.__file__).parent / "experiments"
+    tagged = {f"passmd.experiments.{path.stem}" for path in package.glob("*.py")
+              if re.search(r"^@(register_)?extractor\(", path.read_text(), flags=re.M)}
+    assert {module.__name__ for module in figures.CLAIM_MODULES} == tagged
+
+
+@pytest.mark.parametrize("module", ["passmd.experiments.critical_amplitude",
+                                    "passmd.protocols.critical_amplitude"])
+def test_computing_loads_no_plotting(module):
+    """Experiments and protocols never import passmd.plots (the figure table joins them)."""
+    code = (f"import sys, {module}; "
+            "print(any(m.startswith(('matplotlib', 'passmd.plots')) for m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
+def test_plots_do_not_import_experiments():
+    code = ("import sys, passmd.plots.critical_amplitude; "
+            "print(any(m.startswith('passmd.experiments') for m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
