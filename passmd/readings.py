@@ -27,6 +27,8 @@ from dataclasses import dataclass
 
 import pandas as pd
 
+from passmd.defaults import PROTOCOL
+
 __all__ = ["AXES", "Axis", "axis", "default_reading", "design", "describe", "space_table"]
 
 
@@ -84,7 +86,7 @@ AXES: dict[str, Axis] = {
         Axis(
             key="drive_frequency_s4",
             label="drive frequency, Section 4.1",
-            default=100.0,
+            default=PROTOCOL.drive_frequency,
             alternatives=(50.0, 200.0),
             unit="Hz",
             plausible_range="a band around 100 Hz (50–200 Hz)",
@@ -121,7 +123,7 @@ AXES: dict[str, Axis] = {
         Axis(
             key="force_frequency",
             label="drive frequency, Section 4.2",
-            default=100.0,
+            default=PROTOCOL.drive_frequency,
             alternatives=(1000.0,),
             unit="Hz",
             plausible_range="90 Hz – 1.1 kHz",

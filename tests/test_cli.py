@@ -314,23 +314,23 @@ def test_critical_amplitude_is_the_books_search():
 
 
 def test_critical_amplitude_defaults_are_the_books():
-    from passmd.experiments import critical_amplitude as ca
+    from passmd.protocols import critical_amplitude as ca
 
     # the CLI's defaults are the protocol record's; the book's search must use the same values
     assert (PROTOCOL.steady_periods, PROTOCOL.step_threshold) == (ca.STEADY_PERIODS, ca.STEP_THRESHOLD)
     data = run_json("critical-amplitude", "--contacts", "1", "--actuator", "rigid", "--tolerance", "5nm")
-    assert data["threshold_m"] == ca.STEP_THRESHOLD and data["frequency_Hz"] == ca.DRIVE_FREQUENCY
+    assert data["threshold_m"] == ca.STEP_THRESHOLD and data["frequency_Hz"] == PROTOCOL.drive_frequency
     tolerance = inspect.signature(ca.critical_amplitude).parameters["tolerance"].default
-    assert tolerance == PROTOCOL.search_tolerance and ca.DRIVE_FREQUENCY == PROTOCOL.drive_frequency
+    assert tolerance == PROTOCOL.search_tolerance
 
 
 def test_force_defaults_are_the_stall_protocols():
-    from passmd.experiments import force_generation as fg
+    from passmd.protocols import stall
 
-    assert (PROTOCOL.stall_periods, PROTOCOL.stall_max_periods) == (fg.INITIAL_PERIODS, fg.MAX_PERIODS)
+    assert (PROTOCOL.stall_periods, PROTOCOL.stall_max_periods) == (stall.INITIAL_PERIODS, stall.MAX_PERIODS)
     help_text = option_help(run_cli("force", "--help")[1])
-    assert f"(default: {fg.INITIAL_PERIODS})" in help_text["--periods"]
-    assert f"(default: {fg.MAX_PERIODS})" in help_text["--max-periods"]
+    assert f"(default: {stall.INITIAL_PERIODS})" in help_text["--periods"]
+    assert f"(default: {stall.MAX_PERIODS})" in help_text["--max-periods"]
 
 
 def test_critical_amplitude_first_flyback_protocol():

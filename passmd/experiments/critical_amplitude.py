@@ -140,15 +140,15 @@ PROFILE_SETTINGS = {
         tolerance=0.5e-9,
         amplitude_step=20e-9,
         damping_ratios=(0.005, 0.05, 0.5),
-        sensitivity_frequencies=(100.0, 1000.0),
+        sensitivity_frequencies=(PROTOCOL.drive_frequency, 1000.0),
     ),
     "paper": ProfileSettings(
         preloads={r: tuple(float(p) for p in grid) for r, grid in PRELOAD_GRIDS.items()},
         frequencies=PROTOCOL.critical_amplitude_band,
-        tolerance=0.1e-9,
+        tolerance=PROTOCOL.search_tolerance,
         amplitude_step=1e-9,
         damping_ratios=tuple(float(z) for z in ACTUATOR_DAMPING_RATIO * np.logspace(-1, 1, 5)),
-        sensitivity_frequencies=(20.0, 50.0, 100.0, 200.0, 500.0, 1000.0),
+        sensitivity_frequencies=(20.0, 50.0, PROTOCOL.drive_frequency, 200.0, 500.0, 1000.0),
     ),
 }
 

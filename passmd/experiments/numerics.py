@@ -16,6 +16,7 @@ import pandas as pd
 from passmd import dynamics, theory, time_steps, waveforms
 from passmd._validation import check_choice, check_count, check_range
 from passmd.config import RunConfig
+from passmd.defaults import PROTOCOL
 from passmd.parameters import Amplifier, Drive, Material
 from passmd.units import from_si
 
@@ -33,7 +34,7 @@ RESOLUTIONS = {"quick": (0.5, 1.0, 2.0, 4.0), "paper": (0.25, 0.5, 1.0, 2.0, 4.0
 
 def convergence_study(
     amplitude: float = 150e-9,
-    frequency: float = 100.0,
+    frequency: float = PROTOCOL.drive_frequency,
     periods: int = 3,
     resolutions=RESOLUTIONS["quick"],
     preload: float = 0.4,
@@ -152,7 +153,8 @@ def benchmark_table(path: str | Path | None = None) -> pd.DataFrame:
 
 
 def settle_fraction_sensitivity(
-    fractions=(0.1, 0.2, 0.4), amplitude: float = 150e-9, frequency: float = 100.0, periods: int = 4
+    fractions=(0.1, 0.2, 0.4), amplitude: float = 150e-9, frequency: float = PROTOCOL.drive_frequency,
+    periods: int = 4,
 ) -> pd.DataFrame:
     """Step sizes for several settle windows (assumption ``settled_position``).
 
@@ -206,7 +208,7 @@ def stiffened_drive(drive: Drive, scale: float) -> Drive:
 
 def rigid_coulomb_limit(
     amplitude: float = 150e-9,
-    frequency: float = 100.0,
+    frequency: float = PROTOCOL.drive_frequency,
     scales=STIFFNESS_SCALES,
     contacts=(6, 1),
     slow_flyback_loss: float = 0.5,
@@ -305,7 +307,7 @@ def coulomb_limit_rates(table: pd.DataFrame) -> pd.DataFrame:
 #: Step controls of the convergence figure (flexible actuators; rigid ones use the fixed step).
 CONVERGENCE_STEP_CONTROLS = ("adaptive", "fixed", "quasi-static")
 #: Saw-tooth of the rigid-Coulomb-limit figure: amplitude (m), frequency (Hz), periods (the last step counts).
-COULOMB_RUN = {"amplitude": 150e-9, "frequency": 100.0, "periods": 4}
+COULOMB_RUN = {"amplitude": 150e-9, "frequency": PROTOCOL.drive_frequency, "periods": 4}
 
 
 def model_convergence(config: RunConfig) -> pd.DataFrame:

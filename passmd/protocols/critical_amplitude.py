@@ -53,10 +53,10 @@ __all__ = [
     "steady_step",
 ]
 
-#: "Measurable step" of the steady-state search (m).
-STEP_THRESHOLD = 0.5e-9
-#: Periods of a steady-state run; the last of its steps counts.
-STEADY_PERIODS = 10
+#: "Measurable step" of the steady-state search (m; the protocol default).
+STEP_THRESHOLD = PROTOCOL.step_threshold
+#: Periods of a steady-state run; the last of its steps counts (the protocol default).
+STEADY_PERIODS = PROTOCOL.steady_periods
 #: Time after the first fly-back during which slip is still looked for (actuator ringing) (s).
 FIRST_FLYBACK_HOLD = 20e-6
 #: |T|/μF_N counted as full sliding (the exact MDR contact gives exactly μF_N when sliding).
@@ -258,7 +258,7 @@ def critical_amplitude(
     flyback: str = "slew",
     periods: int = STEADY_PERIODS,
     threshold: float = STEP_THRESHOLD,
-    tolerance: float = 0.1e-9,
+    tolerance: float = PROTOCOL.search_tolerance,
 ) -> dict:
     """Simulated critical amplitude A_c of a drive (protocols: see the module docstring).
 
