@@ -30,6 +30,10 @@ import tempfile
 import time
 from pathlib import Path
 
+from passmd.config import RunConfig
+from passmd.experiments import waveform_studies as studies
+from passmd.figures import figure_data
+
 PANELS = ("fig8a", "fig8b", "fig9a", "fig9b", "fig10a", "fig10b", "fig10c")
 
 
@@ -68,19 +72,16 @@ def blocks(repeats: int) -> dict:
 def cold_profile(profile: str) -> dict:
     """Every panel and study at ``profile`` with an empty simulation cache (one run each)."""
     with tempfile.TemporaryDirectory(prefix="bench-dw-cache-") as cache:
-        os.environ["PASSMD_CACHE_DIR"] = cache
-        from passmd.experiments import figure_data
-        from passmd.experiments import waveform_studies as studies
-
+        config = RunConfig(profile=profile, cache_dir=cache)
         out = {}
         for name in PANELS:
             start = time.perf_counter()
-            figure_data(name, profile)
+            figure_data(name, config)
             out[name] = time.perf_counter() - start
-        for name, call in (("settling_scan", lambda: studies.settling_scan(profile)),
-                           ("numerical_optimum", lambda: studies.numerical_optimum(profile)),
-                           ("flexible_study", lambda: studies.flexible_study(profile)),
-                           ("startup_transient", lambda: studies.startup_transient(110e3))):
+        for name, call in (("settling_scan", lambda: studies.settling_scan(config)),
+                           ("numerical_optimum", lambda: studies.numerical_optimum(config)),
+                           ("flexible_study", lambda: studies.flexible_study(config)),
+                           ("startup_transient", lambda: studies.startup_transient(config, 110e3))):
             start = time.perf_counter()
             call()
             out[name] = time.perf_counter() - start
