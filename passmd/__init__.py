@@ -3,20 +3,27 @@
 "Improvements of Piezo-Actuated Stick–Slip Micro-Drives: Modeling and Driving
 Waveform". The package follows the paper's structure:
 
-``parameters``     Tables 1–2, the drive's parameter records and the assumptions
-``theory``         closed forms: Hertz, Cattaneo–Mindlin, Eqs. 1 and 7–14
-``contact``        MDR contact with memory (Eqs. 4–6): discrete springs and exact limit
-``mdr_validation`` the MDR contact against Hertz, Cattaneo–Mindlin and Masing
-``dynamics``       hybrid simulation of runner and actuators (Eqs. 2–3)
-``waveforms``      saw-tooth and piecewise-linear piezo trajectories (``optimized_waveform``: Eq. 15)
-``experiments``    one function per figure panel, returning tidy data (plots in ``plots``)
-``reference``      the paper's closed-form reference curves (passmd/data/reference/, package data)
-``ledger``         the paper's claims against our results
-``sweep``          parameter grids in parallel (process pool or Dask), cached (``cache``)
-``units``          quantities with units at the command line
-``publish``        helpers of the book's chapters
-``provenance``     version, git commit and profile stamped on figures and CSV files
-``cli``            the ``passmd`` command line
+Layers, from the model up (README, "Architecture"):
+
+core
+    ``parameters`` (Tables 1–2, drive records), ``defaults`` (protocol defaults), ``config``
+    (run configuration), ``theory`` (Hertz, Cattaneo–Mindlin, Eqs. 1 and 7–14), ``contact``
+    (MDR contact with memory, Eqs. 4–6), ``waveforms`` and ``optimized_waveform`` (saw-tooth,
+    Eq. 15), ``dynamics`` and ``time_steps`` (runner and actuators, Eqs. 2–3), ``reference``,
+    ``readings``, ``cache``, ``units``, ``provenance``
+protocols
+    ``protocols`` (critical-amplitude search, stall criterion, step and velocity, Eq. 15
+    design), ``sweep`` (parallel, cached grids), ``claims`` and ``checks`` (the ledger's
+    schema and checks), ``mdr_validation``
+plots
+    ``plots`` (a figure's data to a matplotlib figure)
+figures
+    ``figures`` (the figure table), ``experiments`` (compute functions, claim extractors,
+    chapter facts), ``ledger`` (claims against results), ``assumptions``
+presentation
+    ``publish`` (the chapters' glue), ``ledger_views``
+entry points
+    ``cli`` (the ``passmd`` command line), ``__main__``
 """
 
 #: The version: its one source (pyproject.toml reads it, ``dynamic = ["version"]``; CITATION.cff
