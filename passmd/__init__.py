@@ -1,9 +1,8 @@
 """passmd: reproducible replication of Nguyen et al. (2018), Coatings 8, 62.
 
 "Improvements of Piezo-Actuated Stick–Slip Micro-Drives: Modeling and Driving
-Waveform". The package follows the paper's structure:
-
-Layers, from the model up (README, "Architecture"):
+Waveform". Its modules follow the paper's structure, in layers from the model up (README,
+"Architecture"):
 
 core
     ``parameters`` (Tables 1–2, drive records), ``defaults`` (protocol defaults), ``config``
