@@ -22,10 +22,13 @@ from passmd.experiments import (
     critical_amplitude,
     critical_amplitude_facts,
     driving_waveform,
+    force_facts,
     force_generation,
     mdr,
     model,
     numerics,
+    waveform_facts,
+    waveform_studies,
 )
 from passmd.plots import critical_amplitude as ca_plots
 from passmd.plots import driving_waveform as dw_plots
@@ -102,6 +105,9 @@ FIGURES: tuple[FigureSpec, ...] = (
                "force_generation", force_generation.fig7a, fg_plots.plot_panel),
     FigureSpec("fig7b", "Generated force against amplitude, R = 0.25 mm, 0.2 and 0.4 N",
                "force_generation", force_generation.fig7b, fg_plots.plot_panel),
+    FigureSpec("fig7_difference", "F_gen(rigid, μ = 0.3) − F_gen(flexible, μ = 0.2) against amplitude, "
+               "each preload of Fig. 7", "force_generation", force_facts.fig7_difference,
+               fg_plots.plot_fig7_difference),
     FigureSpec("fig7cycle", "One period at stall, rigid/flexible × μ = 0.3/0.2, R = 1 mm, A_max",
                "force_generation", force_generation.fig7cycle, fg_plots.plot_cycle),
     FigureSpec("fig7freq", "Generated force at full amplitude against the drive frequency",
@@ -117,6 +123,8 @@ FIGURES: tuple[FigureSpec, ...] = (
                "driving_waveform", driving_waveform.fig8b_window, dw_plots.plot_fig8b_window),
     FigureSpec("fig9a", "Runner position over three 100 Hz periods, saw-tooth and optimized",
                "driving_waveform", driving_waveform.fig9a, dw_plots.plot_fig9a),
+    FigureSpec("study_startup", "Velocity period by period from rest at 110 kHz (steady-velocity protocol)",
+               "driving_waveform", waveform_studies.startup_transient, dw_plots.plot_startup),
     FigureSpec("fig9b", "Steady velocity against driving frequency, saw-tooth and optimized",
                "driving_waveform", driving_waveform.fig9b, dw_plots.plot_fig9b),
     FigureSpec("fig10a", "Velocity of the optimized waveform for preloads 0.1, 0.4, 1 N",
@@ -125,6 +133,15 @@ FIGURES: tuple[FigureSpec, ...] = (
                "driving_waveform", driving_waveform.fig10b, dw_plots.plot_fig10b),
     FigureSpec("fig10c", "Velocity of the optimized waveform, steel and molybdenum runner",
                "driving_waveform", driving_waveform.fig10c, dw_plots.plot_fig10c),
+    FigureSpec("study_settling_scan", "Step at 100 Hz against the settling time, Eq. 15's and the optimum's "
+               "acceleration (beyond the paper)", "driving_waveform", waveform_facts.settling_scans,
+               dw_plots.plot_settling_scans),
+    FigureSpec("study_optimum", "Velocity of Eq. 15's design and of a numerical optimum relative to the "
+               "saw-tooth (beyond the paper)", "driving_waveform", waveform_studies.numerical_optimum,
+               dw_plots.plot_optimum),
+    FigureSpec("study_flexible", "Gain of the optimized waveform with rigid and flexible actuators "
+               "(beyond the paper)", "driving_waveform", waveform_studies.flexible_study,
+               dw_plots.plot_flexible),
 )
 
 #: The experiment modules whose functions carry claim extractors (Sections 4.1, 4.2, 5).

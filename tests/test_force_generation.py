@@ -411,8 +411,18 @@ def test_protocol_facts_and_published_data(quick):
     shown = ff.published(quick["fig7a"])
     assert not set(ff.TIMING_COLUMNS) & set(shown.columns)
     assert len(shown.columns) == len(quick["fig7a"].columns) - len(ff.TIMING_COLUMNS)
-    table = ff.difference_table(ff.panel_differences(quick))
-    assert set(table["series"]) == set(ff.panel_differences(quick))
+
+def test_difference_figure_holds_every_preload_with_the_onsets(quick):
+    """The fig7_difference table: the panel differences of every preload, the onsets shading them."""
+    table = ff.fig7_difference(RunConfig(profile="quick"))
+    differences = ff.panel_differences(quick)
+    keys = {f"{p} {x:g} N" for p, x in zip(table["panel"], table["preload_N"], strict=True)}
+    assert keys <= set(differences)
+    for key, diff in differences.items():
+        name, preload = key.split()[0], float(key.split()[1])
+        rows = table[(table["panel"] == name) & (table["preload_N"] == preload)]
+        np.testing.assert_array_equal(rows["difference_mN"].to_numpy(), diff["difference_mN"].to_numpy())
+        assert (rows["onset_low_nm"] <= rows["onset_high_nm"]).all()
 
 
 def test_stall_cpu_seconds_counts_onsets_once(quick):

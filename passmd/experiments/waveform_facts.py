@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from passmd import theory, waveforms
+from passmd.config import RunConfig
 from passmd.experiments.driving_waveform import (
     FIG10A_PRELOADS,
     FULL_SLIDING_SHARE,
@@ -23,7 +24,7 @@ from passmd.experiments.driving_waveform import (
     range_maximum,
     section5_fields,
 )
-from passmd.experiments.waveform_studies import step_point
+from passmd.experiments.waveform_studies import numerical_optimum, settling_scan, step_point
 from passmd.parameters import Drive
 
 
@@ -261,3 +262,20 @@ def flexible_facts(optimum: pd.DataFrame, flexible_design: pd.Series, carried: p
                                  / flexible.iloc[0]["velocity_sawtooth_m_per_s"] - 1)
                           if len(flexible) else float("nan")),
     }
+
+
+def settling_scans(config: RunConfig) -> pd.DataFrame:
+    """Step at 100 Hz against the settling time, with Eq. 15's acceleration and with the optimum's.
+
+    The two :func:`~passmd.experiments.waveform_studies.settling_scan` tables, tagged with a
+    ``series`` label: Eq. 15's t_a and Δ_a, and the acceleration time and amplitude of the
+    numerical optimum at 100 Hz (:func:`optimum_at`).
+    """
+    low = optimum_at(numerical_optimum(config))
+    scans = {
+        "Eq. 15's t_a, Δ_a": settling_scan(config),
+        "optimum's V_a, Δ_a (100 Hz)": settling_scan(config, low["optimum_acceleration_time_s"],
+                                                     low["optimum_acceleration_amplitude_m"]),
+    }
+    return pd.concat([scan.assign(series=label) for label, scan in scans.items()], ignore_index=True)
+

@@ -223,6 +223,12 @@ def plot_settling_scan(scans: dict):
     return fig
 
 
+def plot_settling_scans(df):
+    """:func:`plot_settling_scan` of the tidy table of
+    :func:`passmd.experiments.waveform_facts.settling_scans` (one curve per ``series``)."""
+    return plot_settling_scan({label: part for label, part in df.groupby("series", sort=False)})
+
+
 def plot_optimum(df):
     """Saw-tooth, Eq. 15 design and numerical optimum: velocity relative to the saw-tooth."""
     fig, ax = plt.subplots(figsize=(6.5, 4), constrained_layout=True)

@@ -197,30 +197,27 @@ def plot_cycle(df: pd.DataFrame, zoom_us: float = 400.0):
     return fig
 
 
-def plot_difference(panels: dict[str, pd.DataFrame], differences: dict[str, pd.DataFrame]):
+def plot_fig7_difference(df: pd.DataFrame):
     """F_gen(rigid, μ = 0.3) − F_gen(flexible, μ = 0.2) against A, one axes per panel.
 
-    ``differences`` maps ``"<panel> <preload> N"`` to a frame with ``amplitude_nm`` and
-    ``difference_mN`` (:func:`passmd.experiments.force_generation.force_difference`);
-    ``panels`` gives each panel's data, from which the two models' onsets are shaded.
+    ``df`` is :func:`passmd.experiments.force_facts.fig7_difference`: one curve per preload,
+    the amplitudes between the two models' onsets shaded.
     """
-    names = list(panels)
+    names = list(dict.fromkeys(df["panel"]))
     fig, axes = plt.subplots(1, len(names), figsize=(5.2 * len(names), 3.8), layout="constrained",
                              squeeze=False)
     colours = plt.get_cmap("tab10")
     for ax, name in zip(axes[0], names, strict=True):
-        frame = panels[name]
-        for i, preload in enumerate(sorted(frame["preload_N"].unique())):
-            diff = differences[f"{name} {preload:g} N"]
+        panel = df[df["panel"] == name]
+        for i, (preload, diff) in enumerate(panel.groupby("preload_N", sort=True)):
             ax.plot(diff["amplitude_nm"], diff["difference_mN"], "o-", color=colours(i), ms=4,
                     label=f"F_p = {preload:g} N")
-            rows = frame[np.isclose(frame["preload_N"], preload)]
-            onsets = rows.drop_duplicates(["actuator_model", "friction_coefficient"])["onset_nm"]
-            ax.axvspan(float(onsets.min()), float(onsets.max()), color=colours(i), alpha=0.12, lw=0)
+            ax.axvspan(float(diff["onset_low_nm"].iloc[0]), float(diff["onset_high_nm"].iloc[0]),
+                       color=colours(i), alpha=0.12, lw=0)
         ax.axhline(0.0, color="k", lw=0.8)
         ax.set_xlabel("actuation amplitude A [nm]")
         ax.set_ylabel("F_gen(rigid, μ = 0.3) − F_gen(flexible, μ = 0.2) [mN]")
-        ax.set_title(f"{name}: R = {float(frame['radius_mm'].iloc[0]):g} mm (shaded: between the onsets)",
+        ax.set_title(f"{name}: R = {float(panel['radius_mm'].iloc[0]):g} mm (shaded: between the onsets)",
                      fontsize=9)
         ax.legend(fontsize=8)
         ax.grid(alpha=0.3)
