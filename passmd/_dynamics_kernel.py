@@ -277,7 +277,11 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     done, the kernel stores its loop state in ``buffers.carry`` (zeros before the first
     call) and returns STATUS_PAUSED; calling it again with the same arrays continues
     exactly where it stopped, with the same floating-point operations in the same order as
-    an uninterrupted run (the contact memory lives in ``contacts.state``).
+    an uninterrupted run (the contact memory lives in ``contacts.state``). A run that has
+    integrated all its segments stores its loop state the same way (between two segments) and
+    returns STATUS_OK; calling it again with the segments extended by more pieces (and ``per``
+    and ``peak`` by their periods, the same arrays longer) continues the run with the new
+    pieces, as if they had been there from the start.
 
     ``contacts.sliding`` holds μF_N of each group; ``peak[k, g]`` receives the largest
     |T_g|/μF_N from period k's slip mark to the next settle window (1 exactly when the group
@@ -578,6 +582,19 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
         else:
             energy[EN_INPUT] += actuator_stiffness * 0.5 * acc_in
             energy[EN_DAMPING] += actuator_viscosity * 0.5 * acc_damp
+    # done: the loop state goes to carry as at a pause between two segments, so that a call
+    # with these segments followed by more (the same arrays, longer) continues the run
+    carry[C_SEGMENT] = seg_t0.shape[0]
+    carry[C_MID] = 0.0
+    carry[C_TIME] = t
+    carry[C_XP] = x_p
+    carry[C_AR] = a_r
+    carry[C_FORCE] = F
+    carry[C_NEXT_RECORD] = next_rec
+    carry[C_TRACK] = track
+    carry[C_RECORDED] = n_rec
+    carry[C_STEPS] = steps
+    carry[C_FINE_STEPS] = fine_steps
     y[0] = x_r
     y[1] = v_r
     for g in range(G):

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from passmd import _dynamics_kernel as kern
-from passmd._validation import check_choice, check_positive, check_range
+from passmd._validation import check_choice, check_count, check_positive, check_range
 from passmd.contact import (
     contact_arrays,
     contact_stiffness,
@@ -288,7 +288,7 @@ def simulate(
 
     The kernel runs in chunks of :data:`CHUNK_STEPS` steps and returns to Python between
     them, so a KeyboardInterrupt stops the run within one chunk; results are identical to
-    an uninterrupted run.
+    an uninterrupted run. This is a :class:`Simulation` run through all periods at once.
 
     Raises
     ------
@@ -300,37 +300,81 @@ def simulate(
     SimulationError
         The integration diverged (non-finite or runaway state).
     """
-    if not isinstance(drive, Drive):
-        raise ValueError(f"drive = {drive!r} is not a Drive")
-    if not isinstance(waveform, Waveform):
-        raise ValueError(f"waveform = {waveform!r} is not a Waveform")
-    check_choice("contact_model", contact_model, ("exact", "discrete"))
-    check_range("resolution", resolution, 0.0, lower_open=True)
-    if int(max_points) != max_points or max_points < 2:
-        raise ValueError(f"max_points = {max_points!r} is out of range: must be an integer >= 2")
+    run = Simulation(
+        drive, waveform, contact_model=contact_model, springs=springs, dt=dt, resolution=resolution,
+        max_points=max_points, share_side_state=share_side_state, adaptive=adaptive, progress=progress,
+        quasi_static=quasi_static,
+    )
+    run.run_to(waveform.periods)
+    return run.result()
 
-    params, state, multiplicity = _contact_rows(drive, contact_model, springs, share_side_state)
-    k_contacts = np.array([contact_stiffness(params[g]) for g in range(multiplicity.size)])
-    total_stiffness = float(np.sum(multiplicity * k_contacts))
-    plan = step_plan(drive, float(k_contacts.max()), total_stiffness, resolution)
-    fine_step, coarse_step, quasi, quasi_step = _steps(drive, plan, dt, adaptive, quasi_static)
-    expected = check_work(
-        drive, waveform, plan, fine_step, quasi_step if quasi else coarse_step,
-        total_stiffness, user_step=dt is not None,
-    )
-    G = multiplicity.size
-    buffers = kern.Buffers(
-        y=np.zeros(2 + 2 * G),
-        work=np.zeros((kern.WORK_ROWS, G)),
-        carry=np.zeros(kern.CARRY_SIZE),
-        record=np.empty((int(max_points), 4 + 3 * G)),
-        per=np.zeros((waveform.periods, kern.PER_COLUMNS)),
-        peak=np.zeros((waveform.periods, G)),
-        energy=np.zeros(kern.EN_COLUMNS),
-    )
-    arguments = (
-        segments(waveform, fine_step, coarse_step, quasi_step),
-        kern.Mechanics(
+
+class Simulation:
+    """The drive under a piezo waveform from rest with virgin contacts, integrated period by period.
+
+    :meth:`run_to` integrates up to the end of a given period, :meth:`result` returns the
+    measures of the periods integrated so far. Running the first n periods of ``waveform``
+    and stopping is the same floating-point computation as :func:`simulate` on those n
+    periods alone (:meth:`leading_periods`) whenever the step pieces of the n-period
+    waveform are the first pieces of the longer one (true of :func:`passmd.waveforms.sawtooth`,
+    whose breakpoints of period k do not depend on the number of periods): the result is
+    then that run's, but for the recorded samples, which are spaced over the whole
+    ``waveform``. So a protocol that decides after n periods whether it needs more continues
+    the run instead of repeating it from rest.
+
+    Parameters are those of :func:`simulate`; the run is refused
+    (:func:`passmd.time_steps.check_work`) period count by period count, as :func:`simulate`
+    would refuse the shorter waveform.
+    """
+
+    def __init__(
+        self,
+        drive: Drive,
+        waveform: Waveform,
+        *,
+        contact_model: str = "exact",
+        springs: int = PROTOCOL.springs,
+        dt: float | None = None,
+        resolution: float = 1.0,
+        max_points: int = 20000,
+        share_side_state: bool = True,
+        adaptive: bool = True,
+        progress: bool | None = None,
+        quasi_static: bool = False,
+    ):
+        if not isinstance(drive, Drive):
+            raise ValueError(f"drive = {drive!r} is not a Drive")
+        if not isinstance(waveform, Waveform):
+            raise ValueError(f"waveform = {waveform!r} is not a Waveform")
+        check_choice("contact_model", contact_model, ("exact", "discrete"))
+        check_range("resolution", resolution, 0.0, lower_open=True)
+        if int(max_points) != max_points or max_points < 2:
+            raise ValueError(f"max_points = {max_points!r} is out of range: must be an integer >= 2")
+
+        params, state, multiplicity = _contact_rows(drive, contact_model, springs, share_side_state)
+        k_contacts = np.array([contact_stiffness(params[g]) for g in range(multiplicity.size)])
+        self._total_stiffness = float(np.sum(multiplicity * k_contacts))
+        self._plan = plan = step_plan(drive, float(k_contacts.max()), self._total_stiffness, resolution)
+        self._fine_step, coarse_step, quasi, quasi_step = _steps(drive, plan, dt, adaptive, quasi_static)
+        self._coarse_step = quasi_step if quasi else coarse_step
+        self._user_step = dt is not None
+        self.drive, self.waveform, self.contact_model = drive, waveform, contact_model
+        self._multiplicity, self._params, self._state = multiplicity, params, state
+        self._progress = progress
+        G = multiplicity.size
+        self._buffers = kern.Buffers(
+            y=np.zeros(2 + 2 * G),
+            work=np.zeros((kern.WORK_ROWS, G)),
+            carry=np.zeros(kern.CARRY_SIZE),
+            record=np.empty((int(max_points), 4 + 3 * G)),
+            per=np.zeros((waveform.periods, kern.PER_COLUMNS)),
+            peak=np.zeros((waveform.periods, G)),
+            energy=np.zeros(kern.EN_COLUMNS),
+        )
+        self._segments = segments(waveform, self._fine_step, coarse_step, quasi_step)
+        # pieces of the first n periods: the first _ends[n − 1] (a piece's period never decreases)
+        self._ends = np.searchsorted(self._segments.period, np.arange(1, waveform.periods + 1), side="left")
+        self._mechanics = kern.Mechanics(
             drive.runner_mass,
             drive.effective_load_cell_stiffness,
             multiplicity.astype(float),
@@ -338,38 +382,102 @@ def simulate(
             drive.actuator.mass,
             drive.actuator.stiffness,
             drive.actuator.viscosity,
-        ),
-        kern.StepControl(
-            plan.activity_threshold, plan.quiet_steps, quasi, waveform.duration / (max_points - 1)
-        ),
-        kern.Contacts(params, state, np.array([sliding_force(params[g]) for g in range(G)])),
-        buffers,
-    )
-    start = _time.perf_counter()
-    status, steps, n_rec, fine_steps = _integrate_in_chunks(arguments, waveform, expected, progress)
-    wall = _time.perf_counter() - start
-    y = buffers.y
-    if status != kern.STATUS_OK:
-        raise SimulationError(
-            f"simulation diverged at integrator step {steps}: "
-            f"runner position {y[0]!r} m, velocity {y[1]!r} m/s. Likely cause: a time step too large for "
-            f"the stiffest mode ({plan.stiffest_frequency:.3g} Hz, stable below "
-            f"{plan.stability_limit:.3g} s; "
-            f"steps used {fine_step:.3g} s to {coarse_step:.3g} s) or non-physical parameters."
         )
-    return SimulationResult(
-        drive=drive,
-        waveform=waveform,
-        contact_model=contact_model,
-        multiplicity=multiplicity,
-        **_measures(buffers, n_rec),
-        steps=int(steps),
-        fine_steps=int(fine_steps),
-        fine_step=float(fine_step),
-        coarse_step=float(quasi_step if quasi else coarse_step),
-        wall_time=wall,
-        contact_memory=[memory_diagnostics(params[g], state[g]) for g in range(G)],
-    )
+        self._control = kern.StepControl(
+            plan.activity_threshold, plan.quiet_steps, quasi, waveform.duration / (max_points - 1)
+        )
+        self._contacts = kern.Contacts(params, state, np.array([sliding_force(params[g]) for g in range(G)]))
+        self.periods_done = 0
+        self.wall_time = 0.0
+        self._counts = (0, 0, 0)  # integrator steps, rows recorded, fine steps
+        self._failed = False
+
+    def leading_periods(self, periods: int) -> Waveform:
+        """The waveform cut after its first ``periods`` periods (the whole one for all of them)."""
+        periods = check_count("periods", periods)
+        if periods > self.waveform.periods:
+            raise ValueError(f"periods = {periods!r} is out of range: the waveform has "
+                             f"{self.waveform.periods} periods")
+        w = self.waveform
+        if periods == w.periods:
+            return w
+        end = int(self._ends[periods - 1])
+        return Waveform(w.times[: end + 1], w.positions[: end + 1], w.period, periods,
+                        w.settle_windows[:periods], w.slip_marks[:periods], w.kind, w.amplitude)
+
+    def run_to(self, periods: int) -> None:
+        """Integrate up to the end of period ``periods`` (counted from 1; no-op if already there).
+
+        Raises
+        ------
+        ValueError
+            ``periods`` beyond the waveform's, or a simulation that already failed.
+        passmd.time_steps.WorkLimitError
+            The first ``periods`` periods are a run :func:`simulate` would refuse.
+        SimulationError
+            The integration diverged (the simulation cannot go on).
+        """
+        if self._failed:
+            raise SimulationError("the simulation diverged earlier and cannot go on")
+        leading = self.leading_periods(periods)
+        if leading.periods <= self.periods_done:
+            return
+        expected = check_work(
+            self.drive, leading, self._plan, self._fine_step, self._coarse_step, self._total_stiffness,
+            user_step=self._user_step,
+        )
+        n, end = leading.periods, int(self._ends[leading.periods - 1])
+        b = self._buffers
+        arguments = (
+            kern.Segments(*(column[:end] for column in self._segments)),
+            self._mechanics,
+            self._control,
+            self._contacts,
+            b._replace(per=b.per[:n], peak=b.peak[:n]),
+        )
+        start = _time.perf_counter()
+        try:
+            status, steps, n_rec, fine_steps = _integrate_in_chunks(
+                arguments, leading, expected, self._progress
+            )
+        finally:
+            self.wall_time += _time.perf_counter() - start
+        if status != kern.STATUS_OK:
+            self._failed = True
+            y, plan = b.y, self._plan
+            raise SimulationError(
+                f"simulation diverged at integrator step {steps}: "
+                f"runner position {y[0]!r} m, velocity {y[1]!r} m/s. Likely cause: a time step too large for "
+                f"the stiffest mode ({plan.stiffest_frequency:.3g} Hz, stable below "
+                f"{plan.stability_limit:.3g} s; "
+                f"steps used {self._fine_step:.3g} s to {self._coarse_step:.3g} s) or non-physical "
+                "parameters."
+            )
+        self._counts = (steps, n_rec, fine_steps)
+        self.periods_done = n
+
+    def result(self) -> SimulationResult:
+        """Measures of the periods integrated so far; ``waveform`` is :meth:`leading_periods` of them.
+
+        The arrays are copies: running on does not change a result already returned.
+        """
+        if self.periods_done < 1:
+            raise ValueError("result() needs at least one integrated period: call run_to first")
+        steps, n_rec, fine_steps = self._counts
+        G = self._multiplicity.size
+        return SimulationResult(
+            drive=self.drive,
+            waveform=self.leading_periods(self.periods_done),
+            contact_model=self.contact_model,
+            multiplicity=self._multiplicity,
+            **_measures(self._buffers, self.periods_done, n_rec),
+            steps=int(steps),
+            fine_steps=int(fine_steps),
+            fine_step=float(self._fine_step),
+            coarse_step=float(self._coarse_step),
+            wall_time=self.wall_time,
+            contact_memory=[memory_diagnostics(self._params[g], self._state[g]) for g in range(G)],
+        )
 
 
 def _contact_rows(drive: Drive, contact_model: str, springs: int, share_side_state: bool):
@@ -436,10 +544,10 @@ def _integrate_in_chunks(arguments: tuple, waveform: Waveform, expected: float, 
             bar.close()
 
 
-def _measures(buffers: kern.Buffers, n_rec: int) -> dict:
-    """The recorded series, per-period measures, energies and final state of a finished run
-    (fields of :class:`SimulationResult`)."""
-    per, energy = buffers.per, buffers.energy
+def _measures(buffers: kern.Buffers, periods: int, n_rec: int) -> dict:
+    """The recorded series, measures of the first ``periods`` periods, energies and state of a
+    run stopped after them (fields of :class:`SimulationResult`)."""
+    per, energy = buffers.per[:periods], buffers.energy
     rec = buffers.record[:n_rec]
     window_len = per[:, kern.PER_WINDOW_LENGTH]
     if np.any(window_len <= 0):
@@ -458,7 +566,7 @@ def _measures(buffers: kern.Buffers, n_rec: int) -> dict:
         slip_share=rec[:, 6::3].T.copy(),
         settled_positions=settled,
         back_steps=per[:, kern.PER_MARK_XR] - per[:, kern.PER_MIN_XR],
-        peak_force_ratio=buffers.peak,
+        peak_force_ratio=buffers.peak[:periods].copy(),
         period_mean_position=per[:, kern.PER_XR_INTEGRAL] / duration,
         period_mean_friction=per[:, kern.PER_FRICTION_INTEGRAL] / duration,
         energy={

@@ -227,6 +227,70 @@ def test_chunked_run_is_bit_identical(monkeypatch, model, contacts):
     assert chunked.contact_memory == whole.contact_memory
 
 
+#: Per-period measures and end state of a run (the recorded samples are spaced over the whole
+#: waveform, so they differ between a run stopped early and a shorter waveform).
+PERIOD_FIELDS = ("settled_positions", "back_steps", "peak_force_ratio", "period_mean_position",
+                 "period_mean_friction", "final_state")
+
+
+@pytest.mark.parametrize("model, contacts, quasi", [("rigid", 1, False), ("rigid", 6, False),
+                                                    ("flexible", 1, False), ("flexible", 6, False),
+                                                    ("flexible", 6, True)])
+def test_continued_simulation_is_the_shorter_run(monkeypatch, model, contacts, quasi):
+    """A saw-tooth run stopped after n periods is the n-period run to the last bit, and running
+    on (in several calls, with pauses anywhere) gives the run of the whole waveform."""
+    monkeypatch.setattr(dynamics, "CHUNK_STEPS", 997)  # pauses also inside pieces
+    d = Drive(actuator_model=model, contacts=contacts)
+    wave = waveforms.sawtooth(150e-9, F_TEST, d, periods=5)
+    sim = dynamics.Simulation(d, wave, max_points=3000, quasi_static=quasi)
+    sim.run_to(2)
+    early = sim.result()
+    kept = {name: getattr(early, name).copy() for name in PERIOD_FIELDS}
+    short = dynamics.simulate(d, waveforms.sawtooth(150e-9, F_TEST, d, periods=2), max_points=3000,
+                              quasi_static=quasi)
+    np.testing.assert_array_equal(early.waveform.times, short.waveform.times)
+    np.testing.assert_array_equal(early.waveform.positions, short.waveform.positions)
+    np.testing.assert_array_equal(early.waveform.settle_windows, short.waveform.settle_windows)
+    assert early.waveform.periods == 2 and early.waveform.amplitude == short.waveform.amplitude
+    assert (early.steps, early.fine_steps) == (short.steps, short.fine_steps)
+    for name in PERIOD_FIELDS:
+        np.testing.assert_array_equal(getattr(early, name), getattr(short, name), err_msg=name)
+    assert early.energy == short.energy and early.contact_memory == short.contact_memory
+    sim.run_to(3)
+    sim.run_to(3)  # already there: nothing to do
+    sim.run_to(5)
+    whole = dynamics.simulate(d, wave, max_points=3000, quasi_static=quasi)
+    continued = sim.result()
+    assert continued.waveform is wave and continued.steps == whole.steps
+    for name in FIELDS:
+        np.testing.assert_array_equal(getattr(continued, name), getattr(whole, name), err_msg=name)
+    assert continued.energy == whole.energy
+    for name, value in kept.items():  # a result returned earlier does not change
+        np.testing.assert_array_equal(getattr(early, name), value, err_msg=name)
+
+
+def test_continued_simulation_bad_use():
+    d = one_contact()
+    sim = dynamics.Simulation(d, waveforms.sawtooth(50e-9, F_TEST, d, periods=3))
+    with pytest.raises(ValueError, match=r"call run_to first"):
+        sim.result()
+    with pytest.raises(ValueError, match=r"^periods = 4 is out of range: the waveform has 3 periods"):
+        sim.run_to(4)
+    with pytest.raises(ValueError, match=r"^periods = 0 is out of range"):
+        sim.run_to(0)
+
+
+def test_continued_simulation_is_refused_as_the_shorter_run(monkeypatch):
+    """The step budget applies to the periods asked for, as to a waveform of that length."""
+    d = one_contact()
+    monkeypatch.setattr(time_steps, "MAX_STEPS", 5000.0)  # ≈ 2070 steps per period: 2 periods fit
+    sim = dynamics.Simulation(d, waveforms.sawtooth(20e-9, F_TEST, d, periods=3))
+    sim.run_to(2)
+    with pytest.raises(time_steps.WorkLimitError, match=r"\(--periods\) = 3 must be <= 2"):
+        sim.run_to(3)
+    assert sim.periods_done == 2
+
+
 def test_expected_steps_match_the_run():
     """The pre-run estimate is exact for fixed steps and a close lower bound when adaptive."""
     for model in ("rigid", "flexible"):

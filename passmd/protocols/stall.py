@@ -14,9 +14,11 @@ Stall criterion (assumption ``force_stall_criterion``)
     is estimated as the geometric tail D₂·r/(1 − r), r = D₂/D₁; the run has stalled when
     that tail and the spread of F over the window are both below the tolerance
     max(:data:`STALL_ABS_TOLERANCE`, :data:`STALL_REL_TOLERANCE`·F). A run that has not
-    stalled is repeated from rest with more periods (predicted from the geometric rate),
-    up to :data:`MAX_PERIODS`; if it still has not stalled the result says
-    ``converged = False``.
+    stalled is lengthened (by a number of periods predicted from the geometric rate) up to
+    :data:`MAX_PERIODS`; if it still has not stalled the result says ``converged = False``.
+    A longer run from rest begins with the shorter one (the saw-tooth's first periods do not
+    depend on how many follow), so the run is continued, not repeated: the criterion sees
+    the forces of a run of each length from rest, and each period is integrated once.
 
 Onset of force generation (assumption ``force_onset``)
     The runner generates force only if it steps at all from the free length, so the onset
@@ -115,7 +117,7 @@ def _stalled(estimate: dict, force: float, abs_tol: float, rel_tol: float) -> bo
 
 def _next_periods(periods: int, estimate: dict, force: float, window: int, abs_tol: float, rel_tol: float,
                   max_periods: int) -> int:
-    """Periods of the next (longer) run from rest.
+    """Periods of the next (longer) run.
 
     In the geometric approach the per-period factor q = r^(1/half) predicts how many more
     periods bring the remaining rise below half the tolerance; the next run asks for that
@@ -159,7 +161,7 @@ def generated_force(
     flyback : {"slew", "fixed"}
         Fly-back rule of :func:`passmd.waveforms.sawtooth`.
     initial_periods, max_periods : int
-        Periods of the first run, doubled until stall or until ``max_periods``.
+        Periods of the first run, lengthened until stall or until ``max_periods``.
     abs_tolerance, rel_tolerance : float
         Stall tolerance max(abs, rel·F_gen) (N, fraction) on the remaining rise and the
         spread of the per-period force (see the module docstring).
@@ -171,13 +173,14 @@ def generated_force(
     dict
         SI values, keys carrying the unit: ``generated_force_N`` (k·x̄_r over the last
         period), ``converged`` (stall criterion met), ``periods`` (of the run reported),
-        ``periods_simulated`` (all runs together), ``remaining_force_N`` (estimated rise
-        still to come), ``force_spread_N`` (over the window), ``mean_friction_N`` (mean
+        ``periods_simulated`` (periods integrated: the run is continued, so ``periods``),
+        ``remaining_force_N`` (estimated rise still to come), ``force_spread_N`` (over the
+        window), ``mean_friction_N`` (mean
         total friction on the runner over the last period), ``piezo_mean_force_N`` (k times
         the mean piezo position x̄_p, what the load cell reads if the runner only follows
         the piezo), ``last_step_m``, ``net_displacement_m`` (x̄_r − x̄_p over the last
-        period), ``wall_time_s`` (integration time of all runs), ``cpu_time_s`` (CPU time of
-        the whole call).
+        period), ``wall_time_s`` (integration time), ``cpu_time_s`` (CPU time of the whole
+        call).
 
     Raises
     ------
@@ -201,12 +204,15 @@ def generated_force(
                          f"= {initial_periods!r}")
     drive = drive if drive.load_cell else drive.replace(load_cell=True)
     k = drive.load_cell_stiffness
-    periods, simulated, wall = int(initial_periods), 0, 0.0
+    # One run continued period by period: its first n periods are the run of n periods from
+    # rest (the saw-tooth's breakpoints of period j do not depend on the number of periods),
+    # so each check sees the forces a run of that length from rest would give.
+    longest = waveforms.sawtooth(amplitude, frequency, drive, periods=int(max_periods), flyback=flyback)
+    run = dynamics.Simulation(drive, longest, max_points=2)
+    periods = int(initial_periods)
     while True:
-        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=periods, flyback=flyback)
-        result = dynamics.simulate(drive, wave, max_points=2)
-        simulated += periods
-        wall += result.wall_time
+        run.run_to(periods)
+        result = run.result()
         forces = k * result.period_mean_position
         estimate = stall_estimate(forces, window)
         converged = _stalled(estimate, float(forces[-1]), abs_tolerance, rel_tolerance)
@@ -214,20 +220,21 @@ def generated_force(
             break
         periods = _next_periods(periods, estimate, float(forces[-1]), window, abs_tolerance, rel_tolerance,
                                 int(max_periods))
+    wave = result.waveform
     T = wave.period
     piezo_mean = float(np.mean(wave.position(np.linspace((periods - 1) * T, periods * T, 4001))))
     return {
         "generated_force_N": float(forces[-1]),
         "converged": bool(converged),
         "periods": int(periods),
-        "periods_simulated": int(simulated),
+        "periods_simulated": int(run.periods_done),
         "remaining_force_N": estimate["remaining_N"],
         "force_spread_N": estimate["spread_N"],
         "mean_friction_N": float(result.period_mean_friction[-1]),
         "piezo_mean_force_N": k * piezo_mean,
         "last_step_m": float(result.step_sizes[-1]),
         "net_displacement_m": float(result.period_mean_position[-1] - piezo_mean),
-        "wall_time_s": float(wall),
+        "wall_time_s": float(result.wall_time),
         "cpu_time_s": float(time.process_time() - cpu),
     }
 
