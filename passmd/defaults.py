@@ -29,7 +29,8 @@ class ProtocolDefaults(NamedTuple):
     steady_periods: int = 10
     #: The search stops when its bisection bracket is narrower than this [m].
     search_tolerance: float = 0.1e-9
-    #: Periods of the first stall run of the force protocol (Section 4.2), doubled until stalled.
+    #: Periods after which the force protocol (Section 4.2) first checks for stall; the run is
+    #: then lengthened until it stalls.
     stall_periods: int = 64
     #: Longest stall run before a point is reported as not stalled (periods).
     stall_max_periods: int = 4096

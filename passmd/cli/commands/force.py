@@ -17,7 +17,7 @@ __all__ = ["add_parser", "run_force"]
 
 _EPILOG = textwrap.dedent("""\
     Runs the saw-tooth from rest with the load cell at its free length and lengthens
-    the run (--periods, doubling up to --max-periods) until the force-generation
+    the run (from --periods, by 1.5 to 4 times, up to --max-periods) until the force-generation
     chapter's stall criterion holds; reports whether it did.
 
     --json keys (SI units): generated_force_N (k times the mean runner position over the
