@@ -374,12 +374,12 @@ def scratch(tmp_path_factory):
 @given(argv=command_lines())
 def test_generated_command_lines_end_cleanly(scratch, argv):
     from passmd import figures
-    from passmd.experiments import critical_amplitude, force_generation
+    from passmd.protocols import critical_amplitude, stall
 
     # the long computations are replaced by a marker: reaching them means every check passed
     with mock.patch.object(run_command, "simulate", _reached), \
             mock.patch.object(critical_amplitude, "critical_amplitude", _reached), \
-            mock.patch.object(force_generation, "generated_force", _reached), \
+            mock.patch.object(stall, "generated_force", _reached), \
             mock.patch.object(figures, "figure_data", _reached):
         try:
             status, out, err, caught = run_main(argv, env={"PASSMD_CACHE_DIR": str(scratch / "cache")})

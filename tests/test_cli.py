@@ -266,12 +266,12 @@ def test_run_writes_csv_and_png(tmp_path):
 
 def test_force_json_is_the_stall_protocol():
     """`force` reports the force-generation chapter's generated_force, convergence flag included."""
-    from passmd.experiments import force_generation as fg
+    from passmd.protocols import stall
 
     data = run_json("force", "--contacts", "1", "--actuator", "rigid", "--load-cell-stiffness", "5e4",
                     "--amplitude", "120nm")
     drive = Drive(contacts=1, actuator_model="rigid", load_cell=True, load_cell_stiffness=5e4)
-    expected = fg.generated_force(drive, 120e-9, 100.0)
+    expected = stall.generated_force(drive, 120e-9, PROTOCOL.drive_frequency)
     for key in ("generated_force_N", "converged", "periods", "periods_simulated", "remaining_force_N"):
         assert data[key] == expected[key], key
     assert data["converged"] is True and data["generated_force_N"] > 0

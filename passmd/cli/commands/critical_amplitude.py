@@ -16,7 +16,7 @@ __all__ = ["add_parser", "run_critical_amplitude"]
 
 _EPILOG = textwrap.dedent("""\
     The simulated A_c comes from the critical-amplitude chapters' search
-    (passmd.experiments.critical_amplitude): bisection on [0, A_max] with one of two
+    (passmd.protocols.critical_amplitude): bisection on [0, A_max] with one of two
     protocols, reporting its final bracket. steady: the last step of a run of
     --periods saw-tooth periods from rest exceeds --threshold; first: every contact
     slides fully in the first fly-back from virgin contacts.
@@ -47,7 +47,7 @@ def add_parser(command) -> None:
 
 def _search(args, drive) -> dict:
     """The simulated A_c of the book's search (every option checked, searched unless --analytic-only)."""
-    from passmd.experiments import critical_amplitude as ca
+    from passmd.protocols import critical_amplitude as ca
 
     if args.periods < 2:
         raise UsageError(f"--periods = {args.periods} is out of range: a step needs >= 2 periods")

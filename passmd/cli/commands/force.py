@@ -57,14 +57,14 @@ def _check_options(args, drive):
 
 
 def run_force(args, out) -> int:
-    from passmd.experiments import force_generation as fg
+    from passmd.protocols import stall
 
     drive = build_drive(args, load_cell=True)
     amplitude, frequency = _check_options(args, drive)
     # the force-generation chapter's stall protocol: runs from rest, lengthened until stalled
     try:
-        found = fg.generated_force(drive, amplitude, frequency, flyback=args.flyback,
-                                   initial_periods=args.periods, max_periods=args.max_periods)
+        found = stall.generated_force(drive, amplitude, frequency, flyback=args.flyback,
+                                      initial_periods=args.periods, max_periods=args.max_periods)
     except ValueError as exc:  # name the command's options, not the library's parameters
         text = re.sub(r"\binitial_periods\b", "--periods", str(exc))
         raise UsageError(re.sub(r"\bmax_periods\b", "--max-periods", text)) from exc
