@@ -2,7 +2,7 @@
 
 Every value cites where it comes from in Nguyen et al. (2018) (Table 1, Table 2,
 Section 2). Where the paper is silent, the value is an *assumption*: it is defined
-once in this module, listed in :data:`ASSUMPTIONS`, and shown in the book's
+once in this module, listed in ``ASSUMPTIONS``, and shown in the book's
 assumptions table.
 
 All quantities are SI (m, kg, s, N, Pa). Records are frozen dataclasses validated
@@ -150,7 +150,7 @@ def actuator_for_radius(
     ----------
     hemisphere_radius : float
         R in m. Table 2 rows (0.25 mm, 1 mm) are exact; other radii interpolate
-        linearly and are clamped outside (an assumption, see :data:`ASSUMPTIONS`).
+        linearly and are clamped outside (an assumption, see ``ASSUMPTIONS``).
     damping_ratio : float
         ζ of the bare actuator; c_p = 2 ζ √(k_p m_a).
     """

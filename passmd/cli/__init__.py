@@ -29,11 +29,11 @@ stand-ins are printed.
 (``PASSMD_*``, read once here) replaced by the options given, passed down to the sweeps and
 the cache.
 
-Modules: :mod:`~passmd.cli.parser` (the parser), :mod:`~passmd.cli.app` (dispatch and exit
-status), :mod:`~passmd.cli.options` and :mod:`~passmd.cli.drive` (quantity options, the
-drive they describe), :mod:`~passmd.cli.output` (human and JSON output),
-:mod:`~passmd.cli.streams` (standard streams), :mod:`~passmd.cli.configuration` (the
-RunConfig of ``figure`` and ``ledger``), :mod:`passmd.cli.commands` (one module per command).
+Modules: ``passmd.cli.parser`` (the parser), ``passmd.cli.app`` (dispatch and exit
+status), ``passmd.cli.options`` and ``passmd.cli.drive`` (quantity options, the
+drive they describe), ``passmd.cli.output`` (human and JSON output),
+``passmd.cli.streams`` (standard streams), ``passmd.cli.configuration`` (the
+RunConfig of ``figure`` and ``ledger``), ``passmd.cli.commands`` (one module per command).
 """
 
 from __future__ import annotations

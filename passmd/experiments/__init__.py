@@ -4,7 +4,7 @@ Each topic module turns the protocols of :mod:`passmd.protocols` into the tidy D
 the paper's figures, one compute function ``compute(config: RunConfig) -> DataFrame`` per
 panel, and holds the claim extractors of its section and the small tested functions whose
 results the chapters quote. The figure table that names every panel, its chapter and its
-plot is :mod:`passmd.figures`; nothing here imports :mod:`passmd.plots`.
+plot is :mod:`passmd.figures`; nothing here imports ``passmd.plots``.
 
 Profiles (:data:`passmd.config.PROFILES`): ``quick`` (CI regression tests, minutes for
 everything) and ``paper`` (the paper's grids; the book's default). Each topic module

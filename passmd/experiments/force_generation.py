@@ -185,7 +185,7 @@ def stall_point(
     amplitude_fraction: float,
     frequency: float,
 ) -> dict:
-    """:func:`generated_force` of the Fig. 7 drive at ``amplitude_fraction`` × A_max."""
+    """:func:`~passmd.protocols.stall.generated_force` of the Fig. 7 drive at ``amplitude_fraction`` × A_max."""
     drive = force_drive(hemisphere_radius, preload, actuator_model, friction_coefficient)
     fraction = check_range("amplitude_fraction", amplitude_fraction, 0.0, 1.0)
     amplitude = fraction * drive.actuator.full_stroke_amplitude
@@ -202,7 +202,7 @@ def onset_point(
     frequency: float,
     tolerance: float,
 ) -> dict:
-    """:func:`force_onset` of the Fig. 7 drive, plus the closed form (Eq. 11 or 12) in m."""
+    """:func:`~passmd.protocols.stall.force_onset` of the Fig. 7 drive, plus the closed form (Eq. 11 or 12) in m."""
     drive = force_drive(hemisphere_radius, preload, actuator_model, friction_coefficient)
     out = force_onset(drive, frequency, tolerance)
     if out["critical_amplitude_m"] is None:
@@ -221,7 +221,7 @@ def cycle_point(
     periods: int,
     samples_per_period: int,
 ) -> dict:
-    """:func:`stall_cycle` of the Fig. 7 drive at ``amplitude_fraction`` × A_max."""
+    """:func:`~passmd.protocols.stall.stall_cycle` of the Fig. 7 drive at ``amplitude_fraction`` × A_max."""
     drive = force_drive(hemisphere_radius, preload, actuator_model, friction_coefficient)
     fraction = check_range("amplitude_fraction", amplitude_fraction, 0.0, 1.0)
     return stall_cycle(drive, fraction * drive.actuator.full_stroke_amplitude, frequency, int(periods),

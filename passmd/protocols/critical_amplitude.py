@@ -3,7 +3,7 @@
 Below a critical amplitude A_c a saw-tooth moves the runner by "no measurable step" — the
 runner "only oscillates around its initial position without step generation" (Section 1).
 The paper does not say how A_c was read off its simulations; the protocol below is ours
-(:data:`ASSUMPTIONS`), and the critical-amplitude chapters show how much each choice moves
+(``ASSUMPTIONS``), and the critical-amplitude chapters show how much each choice moves
 the result.
 
 Two critical amplitudes, both found by bisection on the amplitude

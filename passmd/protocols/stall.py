@@ -243,7 +243,7 @@ def force_onset(drive: Drive, frequency: float = PROTOCOL.drive_frequency,
                 tolerance: float = ONSET_TOLERANCE) -> dict:
     """Onset of force generation: the critical amplitude with the load cell engaged (m).
 
-    Calls :func:`passmd.experiments.critical_amplitude.critical_amplitude` (steady-state
+    Calls :func:`passmd.protocols.critical_amplitude.critical_amplitude` (steady-state
     protocol) on ``drive`` with its load cell engaged. Returns its dict
     (``critical_amplitude_m`` — ``None`` if even the full stroke makes no step —,
     ``bracket_low_m``, ``bracket_high_m``, ``runs``, ``wall_time_s``).
