@@ -84,7 +84,8 @@ def critical_amplitude_point(
     periods: int = STEADY_PERIODS,
     threshold: float = STEP_THRESHOLD,
 ) -> dict:
-    """:func:`~passmd.protocols.critical_amplitude.critical_amplitude` of :func:`paper_drive_for` (one sweep point, SI results)."""
+    """The A_c search (:func:`~passmd.protocols.critical_amplitude.critical_amplitude`) of
+    :func:`paper_drive_for`: one sweep point, SI results."""
     drive = paper_drive_for(contacts, actuator_model, hemisphere_radius, preload, damping_ratio)
     return critical_amplitude(
         drive,

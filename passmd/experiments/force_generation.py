@@ -185,7 +185,8 @@ def stall_point(
     amplitude_fraction: float,
     frequency: float,
 ) -> dict:
-    """:func:`~passmd.protocols.stall.generated_force` of the Fig. 7 drive at ``amplitude_fraction`` × A_max."""
+    """:func:`~passmd.protocols.stall.generated_force`
+    of the Fig. 7 drive at ``amplitude_fraction`` × A_max."""
     drive = force_drive(hemisphere_radius, preload, actuator_model, friction_coefficient)
     fraction = check_range("amplitude_fraction", amplitude_fraction, 0.0, 1.0)
     amplitude = fraction * drive.actuator.full_stroke_amplitude
@@ -202,7 +203,8 @@ def onset_point(
     frequency: float,
     tolerance: float,
 ) -> dict:
-    """:func:`~passmd.protocols.stall.force_onset` of the Fig. 7 drive, plus the closed form (Eq. 11 or 12) in m."""
+    """:func:`~passmd.protocols.stall.force_onset`
+    of the Fig. 7 drive, plus the closed form (Eq. 11 or 12) in m."""
     drive = force_drive(hemisphere_radius, preload, actuator_model, friction_coefficient)
     out = force_onset(drive, frequency, tolerance)
     if out["critical_amplitude_m"] is None:
