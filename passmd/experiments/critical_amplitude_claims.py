@@ -1,10 +1,11 @@
 """Claim extractors of Section 4.1: the critical amplitude A_c of Figs. 5 and 6.
 
-Decides the ledger's Section 4.1 rows (``passmd/data/reference/claims.csv``): no steady step
-below 50 nm in Fig. 5a (a threshold over the amplitude grid), the simulated A_c against the
-closed forms Eq. 7 and Eq. 8 (Fig. 5b, one contact), Eq. 11 (Fig. 6a) and Eq. 12 (Figs. 6b,
-6c, six contacts) as value checks of the curve A_c(F_p), flexible above rigid (Fig. 5b) and
-Eq. 11 closer than Eq. 10's one-sided forms (Fig. 6a) as orderings.
+Decides the ledger's Section 4.1 rows (``passmd/data/reference/claims.csv``): no measurable
+steady step below the critical amplitude in Fig. 5a (a threshold over the amplitude grid); the
+simulated A_c against the closed forms Eq. 7 and Eq. 8 (Fig. 5b, one contact), Eq. 11 (Fig. 6a)
+and Eq. 12 (Figs. 6b, 6c, six contacts), each a value check of the curve A_c(F_p); flexible
+above rigid (Fig. 5b) and A_c closer to Eq. 11's u_x,max,e than to either form of Eq. 10
+(Fig. 6a, deviations from :func:`passmd.checks.curve_deviation`) as orderings.
 
 Each extractor reads the figure tables of :mod:`passmd.experiments.critical_amplitude` at one
 ledger reading (:mod:`passmd.readings`: the A_c protocol, the fly-back rule, the drive

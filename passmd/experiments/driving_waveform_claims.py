@@ -7,10 +7,10 @@ back step, the optimized response's reversal after t_s, t_a starting at the runn
 maximum, stick during t_a, the contacts deformed to u_x,max after the fly-back and the runner
 fastest at the end of t_a. Section 5.2, from Fig. 9a's three periods (at the ledger's reading of
 μ) and the steady velocities of Figs. 9b and 10 (at its reading of the short-period rule of the
-optimized waveform): final positions and step increase, the velocity gain and the frequencies
-where the velocity turns, the reachable maxima of Fig. 10 and their orderings over preload,
-radius and runner material. Evidence functions add the numbers behind an ordering (Fig. 10 at
-the paper's 110 kHz).
+optimized waveform): final positions and step increase, the velocity gain, the saw-tooth's
+step and velocity, the frequencies where the velocity turns and where t_s no longer fits, the
+reachable maxima of Fig. 10 and their orderings over preload, radius and runner material.
+Evidence functions add the numbers behind an ordering (Fig. 10: at the paper's 110 kHz).
 
 Each extractor reads the figure tables of :mod:`passmd.experiments.driving_waveform` and returns
 what :mod:`passmd.checks` compares with the paper; a grid that cannot locate what a claim names

@@ -4,9 +4,10 @@ Decides the ledger's Section 4.2 rows (``passmd/data/reference/claims.csv``): th
 difference between the earlier model of [12] (rigid actuators, μ = 0.3) and this paper's
 (flexible actuators, μ = 0.2) at the full stroke and 0.8 N (a value, at the ledger's reading of
 the force-run frequency), the growth of that difference with the amplitude in Figs. 7a and 7b
-(trends), the same ordering at every other preload of the grids, the onset of force generation
-of both models (orderings) and the split of the difference into its friction and actuator parts
-from one stall period (``fig7cycle``; with its evidence).
+(trends), the earlier model above this paper's at every preload of both grids (an ordering),
+the onsets of force generation of both models (compared over the four preloads of Figs. 7a
+and 7b) and the split of the difference into its friction and actuator parts from one stall
+period (``fig7cycle``; with its evidence).
 
 Each extractor reads the figure tables of :mod:`passmd.experiments.force_generation` (stalled
 runs only, through :func:`~passmd.experiments.force_generation.force_difference` and
