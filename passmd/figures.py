@@ -20,10 +20,13 @@ import pandas as pd
 from passmd.config import RunConfig
 from passmd.experiments import (
     critical_amplitude,
+    critical_amplitude_claims,
     critical_amplitude_facts,
     driving_waveform,
+    driving_waveform_claims,
     force_facts,
     force_generation,
+    force_generation_claims,
     mdr,
     model,
     numerics,
@@ -145,7 +148,8 @@ FIGURES: tuple[FigureSpec, ...] = (
 )
 
 #: The experiment modules whose functions carry claim extractors (Sections 4.1, 4.2, 5).
-CLAIM_MODULES: tuple[ModuleType, ...] = (critical_amplitude, force_generation, driving_waveform)
+CLAIM_MODULES: tuple[ModuleType, ...] = (critical_amplitude_claims, force_generation_claims,
+                                         driving_waveform_claims)
 
 _BY_NAME = {spec.name: spec for spec in FIGURES}
 

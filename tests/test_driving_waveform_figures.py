@@ -15,6 +15,7 @@ from passmd import dynamics, theory, waveforms
 from passmd.config import RunConfig
 from passmd.defaults import PROTOCOL
 from passmd.experiments import driving_waveform as dw
+from passmd.experiments import driving_waveform_claims as dw_claims
 from passmd.experiments import waveform_facts as wf
 from passmd.experiments import waveform_studies as studies
 from passmd.optimized_waveform import OptimizedDesign, max_piezo_velocity, optimized
@@ -212,10 +213,10 @@ def test_reachable_maximum_must_be_interior():
     from passmd.checks import NotEvaluable
 
     inside = _velocity_series([1, 50, 110, 130], [0.1, 10.0, 19.0, 12.0])
-    assert dw.reachable_maximum(inside)["frequency_kHz"] == 110.0
+    assert dw_claims.reachable_maximum(inside)["frequency_kHz"] == 110.0
     at_edge = _velocity_series([1, 50, 110, 130], [0.2, 0.1, -1.0, -2.0])
     with pytest.raises(NotEvaluable, match="grid's edge, 1 kHz"):
-        dw.reachable_maximum(at_edge)
+        dw_claims.reachable_maximum(at_edge)
     assert dw.range_maximum(at_edge)["frequency_kHz"] == 1.0  # the largest over the range is still defined
 
 
@@ -223,13 +224,13 @@ def test_turning_point_needs_a_rise_then_a_fall_where_the_paper_puts_it():
     from passmd.checks import ClaimFails
 
     rise_fall = _velocity_series([1, 60, 105, 110, 115, 130], [0.1, 8.0, 18.0, 19.0, 18.5, 15.0])
-    assert dw.turning_point(rise_fall, 110.0)["frequency_kHz"].tolist() == [110.0, 115.0, 130.0]
+    assert dw_claims.turning_point(rise_fall, 110.0)["frequency_kHz"].tolist() == [110.0, 115.0, 130.0]
     with pytest.raises(ClaimFails, match="no rise before the fall"):
-        dw.turning_point(_velocity_series([1, 20, 110, 130], [0.2, -0.1, -4.0, -6.0]), 110.0)
+        dw_claims.turning_point(_velocity_series([1, 20, 110, 130], [0.2, -0.1, -4.0, -6.0]), 110.0)
     with pytest.raises(ClaimFails, match="never begins decreasing"):
-        dw.turning_point(_velocity_series([1, 20, 110, 130], [0.2, 3.0, 20.0, 25.0]), 110.0)
+        dw_claims.turning_point(_velocity_series([1, 20, 110, 130], [0.2, 3.0, 20.0, 25.0]), 110.0)
     with pytest.raises(ClaimFails, match="turns at 60 kHz"):
-        dw.turning_point(_velocity_series([1, 60, 100, 110, 130], [0.2, 9.0, 5.0, 4.0, 3.0]), 110.0)
+        dw_claims.turning_point(_velocity_series([1, 60, 100, 110, 130], [0.2, 9.0, 5.0, 4.0, 3.0]), 110.0)
 
 
 def test_flyback_window_resolves_the_acceleration():

@@ -5,8 +5,9 @@ closed forms: Eq. 7 (one contact, rigid actuator), Eq. 8 (one contact, flexible)
 (six contacts, rigid) and Eq. 12 (six contacts, flexible). The search itself (both
 protocols, the bisection, the step threshold) is :mod:`passmd.protocols.critical_amplitude`;
 this module runs it over the preload grids of a resolution profile through
-:mod:`passmd.sweep` and holds the claim extractors of Section 4.1; the facts the chapters
-quote are :mod:`passmd.experiments.critical_amplitude_facts`.
+:mod:`passmd.sweep`; the claim extractors of Section 4.1 are
+:mod:`passmd.experiments.critical_amplitude_claims`, the facts the chapters quote
+:mod:`passmd.experiments.critical_amplitude_facts`.
 
 Figures (rows of :mod:`passmd.figures`): ``fig5a`` (step vs amplitude), ``fig5b`` (one
 contact, A_c vs preload), ``fig6a``–``fig6c`` (six contacts), and two sensitivity panels
@@ -22,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from passmd import readings, reference, sweep
-from passmd.checks import ClaimFails, NotEvaluable, curve_deviation, extractor
+from passmd.checks import ClaimFails, NotEvaluable
 from passmd.config import RunConfig
 from passmd.defaults import PROTOCOL
 from passmd.parameters import ACTUATOR_DAMPING_RATIO, PRELOAD_GRIDS, Drive, actuator_for_radius
@@ -365,7 +366,7 @@ def fig56_frequency(config: RunConfig) -> pd.DataFrame:
 
 
 # --------------------------------------------------------------------------------------
-# Ledger extractors (claims of Section 4.1, passmd/data/reference/claims.csv)
+# One reading of the A_c protocol (the chapters' facts and the ledger's claims)
 # --------------------------------------------------------------------------------------
 
 
@@ -404,71 +405,3 @@ def primary(table: pd.DataFrame, actuator_model: str | None = None, reading=None
         raise ClaimFails(f"no step up to the full stroke at {', '.join(f'{p:g}' for p in where)} N "
                          "(A_c above A_max)")
     return rows
-
-
-def _curve(results, key: str, actuator_model: str, reading=None) -> dict:
-    rows = primary(results[key], actuator_model, reading)
-    return {"x": rows["preload_N"].to_numpy(), "y": rows["critical_amplitude_nm"].to_numpy()}
-
-
-#: Axes of passmd.readings the A_c curves depend on (rigid actuators: neither the fly-back rule nor ζ).
-_RIGID_AXES = ("ac_protocol", "drive_frequency_s4")
-_FLEXIBLE_AXES = ("flyback", "ac_protocol", "drive_frequency_s4", "damping_ratio")
-
-
-@extractor("fig5a-no-step-below-50nm", depends_on=("flyback",))
-def _fig5a_no_step(results, reading) -> dict:
-    table = results["fig5a"]
-    rows = table[(table["actuator_model"] == "flexible") & (table["flyback"] == reading["flyback"])]
-    rows = rows.sort_values("amplitude_nm")
-    if rows.empty:
-        raise NotEvaluable(f"no flexible runs with the {reading['flyback']} fly-back")
-    step = rows["steady_step_nm"].to_numpy(dtype=float)
-    holds = np.where(np.isfinite(step), step <= rows["threshold_nm"].to_numpy(dtype=float), np.nan)
-    return {"x": rows["amplitude_nm"].to_numpy(), "holds": holds}
-
-
-@extractor("fig5b-rigid-ac-matches-eq7", depends_on=_RIGID_AXES)
-def _fig5b_rigid(results, reading) -> dict:
-    return _curve(results, "fig5b", "rigid", reading)
-
-
-@extractor("fig5b-flexible-ac-matches-eq8", depends_on=_FLEXIBLE_AXES)
-def _fig5b_flexible(results, reading) -> dict:
-    return _curve(results, "fig5b", "flexible", reading)
-
-
-@extractor("fig5b-flexible-above-rigid", depends_on=_FLEXIBLE_AXES)
-def _fig5b_order(results, reading) -> dict:
-    rigid = _curve(results, "fig5b", "rigid", reading)
-    flexible = _curve(results, "fig5b", "flexible", reading)
-    if not np.array_equal(rigid["x"], flexible["x"]):
-        raise NotEvaluable("rigid and flexible A_c are not on the same preloads")
-    return {"lhs": flexible["y"], "rhs": rigid["y"]}
-
-
-@extractor("fig6a-rigid-ac-matches-eq11", depends_on=_RIGID_AXES)
-def _fig6a_eq11(results, reading) -> dict:
-    return _curve(results, "fig6a", "rigid", reading)
-
-
-@extractor("fig6a-rigid-ac-not-eq10", depends_on=_RIGID_AXES)
-def _fig6a_not_eq10(results, reading) -> dict:
-    c = _curve(results, "fig6a", "rigid", reading)
-    own = curve_deviation(c["x"], c["y"], "fig6a_closed_form", "u_x_max_e_nm")
-    sides = min(
-        curve_deviation(c["x"], c["y"], "fig6a_closed_form", column)
-        for column in ("u_x_max_1_nm", "u_x_max_2_nm")
-    )
-    return {"lhs": own, "rhs": sides}
-
-
-@extractor("fig6b-flexible-r1-ac-matches-eq12", depends_on=_FLEXIBLE_AXES)
-def _fig6b_eq12(results, reading) -> dict:
-    return _curve(results, "fig6b", "flexible", reading)
-
-
-@extractor("fig6c-flexible-r025-ac-matches-eq12", depends_on=_FLEXIBLE_AXES)
-def _fig6c_eq12(results, reading) -> dict:
-    return _curve(results, "fig6c", "flexible", reading)
-

@@ -3,8 +3,9 @@
 The measurement itself — runs from rest against the load cell until the steps stall, the
 stall criterion and the onset of force generation — is the protocol of
 :mod:`passmd.protocols.stall`. This module runs it over the grids of the figures (through
-the sweep engine, cached) and reads the figures' data for the ledger; the numbers the chapter
-reads are :mod:`passmd.experiments.force_facts`. By momentum balance over a periodic (stalled)
+the sweep engine, cached); the ledger's claims on the figures' data are
+:mod:`passmd.experiments.force_generation_claims`, the numbers the chapter reads
+:mod:`passmd.experiments.force_facts`. By momentum balance over a periodic (stalled)
 cycle F_gen equals the mean total friction force on the runner; the tests check that.
 
 Figures: ``fig7a`` (R = 1 mm, 0.3 and 0.8 N), ``fig7b`` (R = 0.25 mm, 0.2 and 0.4 N), each
@@ -25,7 +26,6 @@ import pandas as pd
 
 from passmd import sweep
 from passmd._validation import check_choice, check_range
-from passmd.checks import ClaimFails, NotEvaluable, evidence, extractor
 from passmd.config import PROFILES, RunConfig
 from passmd.defaults import PROTOCOL
 from passmd.parameters import PRELOAD_GRIDS, Assumption, Drive, paper_drive
@@ -57,6 +57,7 @@ __all__ = [
     "fig7grid",
     "force_difference",
     "force_drive",
+    "model_rows",
     "onset_point",
     "stall_point",
 ]
@@ -404,13 +405,14 @@ def fig7cycle(config: RunConfig) -> pd.DataFrame:
 
 
 # --------------------------------------------------------------------------------------
-# Ledger extractors (claims.csv ids)
+# The two models compared (the chapter's facts and the ledger's claims)
 # --------------------------------------------------------------------------------------
 
 _EARLIER, _THIS = (MODELS[0][0], MODELS[0][1]), (MODELS[1][0], MODELS[1][1])
 
 
-def _model_rows(table: pd.DataFrame, model: tuple, preload: float) -> pd.DataFrame:
+def model_rows(table: pd.DataFrame, model: tuple, preload: float) -> pd.DataFrame:
+    """The rows of one (actuator model, μ) at one preload, indexed by amplitude fraction."""
     rows = table[(table["actuator_model"] == model[0]) & np.isclose(table["friction_coefficient"], model[1])
                  & np.isclose(table["preload_N"], preload)]
     return rows.set_index("amplitude_fraction").sort_index()
@@ -421,7 +423,7 @@ def force_difference(table: pd.DataFrame, preload: float) -> pd.DataFrame:
 
     Only amplitudes where both runs stalled; columns ``amplitude_nm``, ``difference_mN``.
     """
-    earlier, this = _model_rows(table, _EARLIER, preload), _model_rows(table, _THIS, preload)
+    earlier, this = model_rows(table, _EARLIER, preload), model_rows(table, _THIS, preload)
     common = earlier.index.intersection(this.index)
     ok = earlier.loc[common, "converged"].to_numpy() & this.loc[common, "converged"].to_numpy()
     common = common[ok]
@@ -430,108 +432,3 @@ def force_difference(table: pd.DataFrame, preload: float) -> pd.DataFrame:
         "difference_mN": (earlier.loc[common, "generated_force_mN"]
                           - this.loc[common, "generated_force_mN"]).to_numpy(),
     })
-
-
-@extractor("fig7a-force-difference-115mn", depends_on=("force_frequency",))
-def _fig7a_difference(results, reading) -> float:
-    frequency = float(reading["force_frequency"])
-    if np.isclose(frequency, FORCE_FREQUENCY):
-        diff = force_difference(results["fig7a"], 0.8)
-    else:  # the frequency panel holds the full-stroke runs at the other frequencies
-        if "fig7freq" not in results:
-            raise NotEvaluable("needs results: fig7freq")
-        table = results["fig7freq"]
-        rows = table[np.isclose(table["frequency_Hz"], frequency) & np.isclose(table["radius_mm"], 1.0)]
-        diff = force_difference(rows.assign(amplitude_fraction=1.0), 0.8)
-    full = diff[np.isclose(diff["amplitude_nm"], PANELS_FULL_STROKE_NM["fig7a"])]
-    if full.empty:
-        raise NotEvaluable(f"no stalled pair of runs at 202 nm and 0.8 N at {frequency:g} Hz")
-    return float(full["difference_mN"].iloc[0])
-
-
-@extractor("sec4-2-friction-and-actuator-dynamics-cause-discrepancy")
-def _causes(results) -> dict:
-    cycle = results["fig7cycle"]
-    force = {}
-    for model, mu in (("rigid", 0.3), ("rigid", 0.2), ("flexible", 0.2)):
-        rows = cycle[(cycle["actuator_model"] == model) & np.isclose(cycle["friction_coefficient"], mu)]
-        if rows.empty:
-            raise NotEvaluable(f"no stall period of {model} actuators with μ = {mu:g}")
-        force[model, mu] = float(rows["generated_force_mN"].iloc[0])
-    friction = force["rigid", 0.3] - force["rigid", 0.2]
-    actuators = force["rigid", 0.2] - force["flexible", 0.2]
-    return {"lhs": np.array([friction, actuators]), "rhs": np.zeros(2)}
-
-
-@evidence("sec4-2-friction-and-actuator-dynamics-cause-discrepancy")
-def _causes_evidence(results) -> list:
-    lhs = _causes(results)["lhs"]
-    return [f"μ 0.3 → 0.2 with rigid actuators lowers F_gen by {lhs[0]:.4g} mN; rigid → flexible actuators "
-            f"at μ = 0.2 lowers it by {lhs[1]:.4g} mN (together {lhs.sum():.4g} mN; 202 nm, 0.8 N, R = 1 mm)"]
-
-
-@extractor("sec4-2-other-preloads-same-trend")
-def _other_preloads(results) -> dict:
-    grid = results["fig7grid"]
-    full = grid[np.isclose(grid["amplitude_fraction"], 1.0)]
-    earlier, this = [], []
-    for (radius, preload), rows in full.groupby(["radius_mm", "preload_N"]):
-        pair = [rows[(rows["actuator_model"] == m) & np.isclose(rows["friction_coefficient"], mu)]
-                for m, mu in (_EARLIER, _THIS)]
-        if any(p.empty or not bool(p["converged"].iloc[0]) for p in pair):
-            raise NotEvaluable(f"no stalled pair of runs at R = {radius:g} mm, {preload:g} N")
-        earlier.append(float(pair[0]["generated_force_mN"].iloc[0]))
-        this.append(float(pair[1]["generated_force_mN"].iloc[0]))
-    if not earlier:
-        raise NotEvaluable("no full-stroke runs on the preload grids")
-    lhs, rhs = np.array(earlier), np.array(this)
-    # 'other preload levels' means every preload: a pass needs all of them, a failure needs one
-    computed = {(round(r, 9), round(p, 9)) for r, p in zip(full["radius_mm"], full["preload_N"], strict=True)}
-    missing = [(r * 1e3, p) for r, grid in PRELOAD_GRIDS.items() for p in grid
-               if (round(r * 1e3, 9), round(float(p), 9)) not in computed]
-    if missing and np.all(lhs > rhs):
-        raise NotEvaluable(f"holds at the {len(lhs)} preloads computed on this profile; "
-                           f"{len(missing)} preloads of the grids are not computed, e.g. "
-                           f"{missing[0][1]:g} N at R = {missing[0][0]:g} mm")
-    return {"lhs": lhs, "rhs": rhs}
-
-
-def _trend(results, name: str) -> dict:
-    table = results[name]
-    out = {}
-    for preload in PANELS[name][1]:
-        diff = force_difference(table, preload)
-        if len(diff) < 2:
-            raise NotEvaluable(f"{name}: fewer than two stalled amplitudes at {preload:g} N")
-        out[f"{preload:g} N"] = {"x": diff["amplitude_nm"].to_numpy(), "y": diff["difference_mN"].to_numpy()}
-    return out
-
-
-@extractor("fig7a-discrepancy-grows-with-amplitude")
-def _fig7a_trend(results) -> dict:
-    return _trend(results, "fig7a")
-
-
-@extractor("fig7b-discrepancy-grows-with-amplitude")
-def _fig7b_trend(results) -> dict:
-    return _trend(results, "fig7b")
-
-
-@extractor("fig7-critical-amplitude-both-models")
-def _fig7_onsets(results) -> dict:
-    lhs, rhs = [], []
-    for name in ("fig7a", "fig7b"):
-        table = results[name]
-        for preload in PANELS[name][1]:
-            onset = {}
-            for model in (_EARLIER, _THIS):
-                rows = _model_rows(table, model, preload)
-                if rows.empty:
-                    raise NotEvaluable(f"{name}: no runs for {model} at {preload:g} N")
-                if not np.isfinite(rows["onset_nm"].iloc[0]):
-                    raise ClaimFails(f"{name}: no force generation up to the full stroke for {model} at "
-                                     f"{preload:g} N")
-                onset[model] = float(rows["onset_nm"].iloc[0])
-            lhs.append(onset[_EARLIER])
-            rhs.append(onset[_THIS])
-    return {"lhs": np.array(lhs), "rhs": np.array(rhs)}
