@@ -36,6 +36,7 @@ from passmd.protocols.critical_amplitude import (
 )
 
 __all__ = [
+    "FIG5A_DRIVE",
     "PROFILE_SETTINGS",
     "critical_amplitude_point",
     "fig56_frequency",
@@ -135,6 +136,10 @@ class ProfileSettings:
     sensitivity_frequencies: tuple  # drive frequencies of the frequency panel (Hz)
 
 
+#: Hemisphere radius (m) and preload (N) of Fig. 5a (Section 4.1), also used by the
+#: damping and drive-frequency sensitivity figures.
+FIG5A_DRIVE = (1.0e-3, 0.4)
+
 PROFILE_SETTINGS = {
     "quick": ProfileSettings(
         preloads={1.0e-3: (0.2, 0.6, 1.0), 0.25e-3: (0.2, 0.4)},
@@ -232,7 +237,7 @@ def fig5a(config: RunConfig) -> pd.DataFrame:
     stroke in the profile's step. Lengths in nm.
     """
     s = _settings(config)
-    radius, preload = 1.0e-3, 0.4
+    radius, preload = FIG5A_DRIVE
     a_max = actuator_for_radius(radius).full_stroke_amplitude
     amplitudes = np.round(np.arange(0.0, a_max * (1 + 1e-9), s.amplitude_step), 15)
     series = [("rigid", "slew"), ("flexible", "slew"), ("flexible", "fixed")]
@@ -306,7 +311,7 @@ def fig56_viscosity(config: RunConfig) -> pd.DataFrame:
     (one contact) or Eq. 12 (six), which do not depend on c_p.
     """
     s = _settings(config)
-    radius, preload = 1.0e-3, 0.4
+    radius, preload = FIG5A_DRIVE
     points = [
         {
             "contacts": n,
@@ -339,7 +344,7 @@ def fig56_frequency(config: RunConfig) -> pd.DataFrame:
     ``closed_form_nm`` is Eq. 7/8 (one contact) or Eq. 11/12 (six).
     """
     s = _settings(config)
-    radius, preload = 1.0e-3, 0.4
+    radius, preload = FIG5A_DRIVE
     points = [
         {
             "contacts": n,
@@ -377,8 +382,8 @@ def primary(table: pd.DataFrame, actuator_model: str | None = None, reading=None
     ``reading`` is a ledger reading (:mod:`passmd.readings`): its ``ac_protocol``,
     ``flyback``, ``drive_frequency_s4`` and ``damping_ratio`` select the rows. The fly-back
     rule and ζ apply to flexible actuators only (the rigid runs use the slew-rate fly-back). Raises
-    :class:`passmd.ledger.NotEvaluable` when the table holds no run at that reading and
-    :class:`passmd.ledger.ClaimFails` when a preload makes no step up to the full stroke.
+    :class:`passmd.checks.NotEvaluable` when the table holds no run at that reading and
+    :class:`passmd.checks.ClaimFails` when a preload makes no step up to the full stroke.
     """
     protocol, flyback, frequency = "steady", "slew", PROTOCOL.drive_frequency
     zeta = ACTUATOR_DAMPING_RATIO

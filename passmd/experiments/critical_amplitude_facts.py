@@ -13,7 +13,7 @@ import pandas as pd
 
 from passmd.config import RunConfig
 from passmd.defaults import PROTOCOL
-from passmd.experiments.critical_amplitude import PROFILE_SETTINGS, paper_drive_for, primary
+from passmd.experiments.critical_amplitude import FIG5A_DRIVE, PROFILE_SETTINGS, paper_drive_for, primary
 from passmd.parameters import ACTUATOR_DAMPING_RATIO, actuator_for_radius
 from passmd.protocols.critical_amplitude import (
     STEADY_PERIODS,
@@ -47,7 +47,7 @@ def fig5_flyback_steps(config: RunConfig) -> pd.DataFrame:
     """
     from passmd.theory import drive_theory
 
-    rigid = paper_drive_for(1, "rigid", 1e-3, 0.4)
+    rigid = paper_drive_for(1, "rigid", *FIG5A_DRIVE)
     u_max = drive_theory(rigid)["critical_amplitude_rigid_m"]
     steady_ac = critical_amplitude(rigid, tolerance=FLYBACK_STEPS_TOLERANCE)["critical_amplitude_m"]
     amplitudes = [steady_ac - 2e-9, 0.5 * (steady_ac + u_max), u_max - 0.2e-9, u_max + 3e-9]
@@ -72,7 +72,7 @@ def protocol_facts(config: RunConfig) -> dict:
     :data:`EXAMPLE_FLYBACK_AMPLITUDE` (µs), ζ, the mass factor (m_r + m_a)/m_r − 1 of Eq. 9 and
     the amplifier's full-stroke time (µs).
     """
-    drive = paper_drive_for(1, "flexible", 1e-3, 0.4)
+    drive = paper_drive_for(1, "flexible", *FIG5A_DRIVE)
     actuator = drive.actuator
     f_mode = np.sqrt(actuator.stiffness / actuator.mass) / (2 * np.pi)
     return {
@@ -216,7 +216,7 @@ def side_prestrain(frequency_table: pd.DataFrame, fraction: float = 0.97) -> pd.
     from passmd import dynamics, waveforms
     from passmd.theory import drive_theory
 
-    rigid = paper_drive_for(6, "rigid", 1e-3, 0.4)
+    rigid = paper_drive_for(6, "rigid", *FIG5A_DRIVE)
     steady = primary(frequency_table, "rigid")
     steady_ac = float(steady[steady["contacts"] == 6]["critical_amplitude_nm"].iloc[0]) * 1e-9
     amplitude = fraction * steady_ac

@@ -67,7 +67,7 @@ def reachable_maximum(part: pd.DataFrame) -> pd.Series:
 
     A maximum must be interior: when the largest velocity lies at either end of the frequency
     grid, the grid does not locate a reachable maximum and the claim is inconclusive
-    (:class:`passmd.ledger.NotEvaluable`).
+    (:class:`passmd.checks.NotEvaluable`).
     """
     best = range_maximum(part)
     f = part["frequency_kHz"].to_numpy()
@@ -286,8 +286,8 @@ def turning_point(part: pd.DataFrame, where_kHz: float) -> pd.DataFrame:
     """The part of a velocity series from its turning point on, when it rises and then falls there.
 
     "Began decreasing above X" needs a rise before the fall and the turning point (the largest
-    velocity) within one grid step of X. Raises :class:`passmd.ledger.ClaimFails` naming the
-    located turning point otherwise, and :class:`passmd.ledger.NotEvaluable` when fewer than
+    velocity) within one grid step of X. Raises :class:`passmd.checks.ClaimFails` naming the
+    located turning point otherwise, and :class:`passmd.checks.NotEvaluable` when fewer than
     two grid points follow it.
     """
     f = part["frequency_kHz"].to_numpy()

@@ -17,10 +17,11 @@ import pandas as pd
 from passmd.config import RunConfig
 from passmd.experiments.force_generation import (
     CYCLE_DRIVE,
+    EARLIER,
     FORCE_FREQUENCY,
-    MODELS,
     PANELS,
     PANELS_FULL_STROKE_NM,
+    THIS,
     fig7a,
     fig7b,
     force_difference,
@@ -28,10 +29,6 @@ from passmd.experiments.force_generation import (
 )
 from passmd.protocols import stall
 from passmd.theory import normal_forces, runner_frequency
-
-#: The earlier model of [12] (rigid actuators, μ = 0.3) and this paper's (flexible, μ = 0.2).
-EARLIER, THIS = MODELS[0][:2], MODELS[1][:2]
-
 
 #: Columns of the figure data that are timings of this machine, left out of the published data.
 TIMING_COLUMNS = ("cpu_time_s", "onset_cpu_time_s")

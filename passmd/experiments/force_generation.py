@@ -43,12 +43,14 @@ from passmd.theory import drive_theory
 
 __all__ = [
     "CYCLE_COMBINATIONS",
+    "EARLIER",
     "FORCE_FREQUENCY",
     "MODELS",
     "ONSET_TOLERANCE",
     "PANELS",
     "PANELS_FULL_STROKE_NM",
     "PROFILE_SETTINGS",
+    "THIS",
     "cycle_point",
     "fig7a",
     "fig7b",
@@ -408,7 +410,8 @@ def fig7cycle(config: RunConfig) -> pd.DataFrame:
 # The two models compared (the chapter's facts and the ledger's claims)
 # --------------------------------------------------------------------------------------
 
-_EARLIER, _THIS = (MODELS[0][0], MODELS[0][1]), (MODELS[1][0], MODELS[1][1])
+#: The earlier model of [12] (rigid actuators, μ = 0.3) and this paper's (flexible, μ = 0.2).
+EARLIER, THIS = MODELS[0][:2], MODELS[1][:2]
 
 
 def model_rows(table: pd.DataFrame, model: tuple, preload: float) -> pd.DataFrame:
@@ -423,7 +426,7 @@ def force_difference(table: pd.DataFrame, preload: float) -> pd.DataFrame:
 
     Only amplitudes where both runs stalled; columns ``amplitude_nm``, ``difference_mN``.
     """
-    earlier, this = model_rows(table, _EARLIER, preload), model_rows(table, _THIS, preload)
+    earlier, this = model_rows(table, EARLIER, preload), model_rows(table, THIS, preload)
     common = earlier.index.intersection(this.index)
     ok = earlier.loc[common, "converged"].to_numpy() & this.loc[common, "converged"].to_numpy()
     common = common[ok]

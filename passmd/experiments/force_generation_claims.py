@@ -20,11 +20,12 @@ from __future__ import annotations
 import numpy as np
 
 from passmd.checks import ClaimFails, NotEvaluable, evidence, extractor
-from passmd.experiments.force_facts import EARLIER, THIS
 from passmd.experiments.force_generation import (
+    EARLIER,
     FORCE_FREQUENCY,
     PANELS,
     PANELS_FULL_STROKE_NM,
+    THIS,
     force_difference,
     model_rows,
 )

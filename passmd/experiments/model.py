@@ -16,6 +16,7 @@ from passmd import theory
 from passmd.config import RunConfig
 from passmd.contact import MDRContact
 from passmd.defaults import PROTOCOL
+from passmd.experiments.critical_amplitude import FIG5A_DRIVE
 from passmd.parameters import Drive, paper_drive
 from passmd.units import from_si
 from passmd.waveforms import flyback_time, sawtooth
@@ -36,7 +37,7 @@ __all__ = [
 ]
 
 #: Hemisphere radius R (m) and preload F_p (N) of the model chapter's drive (Table 2, Fig. 5a).
-MODEL_RADIUS, MODEL_PRELOAD = 1.0e-3, 0.4
+MODEL_RADIUS, MODEL_PRELOAD = FIG5A_DRIVE
 #: Periods of the saw-tooth drawn for Figs. 1d and 3c.
 SAWTOOTH_PERIODS = 3
 #: Discrete springs of the force loop drawn against the exact contact (Fig. 4b).
