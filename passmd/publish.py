@@ -34,6 +34,7 @@ from passmd._validation import check_choice
 
 __all__ = [
     "DISPLAY_UNITS",
+    "NUMBER_WORDS",
     "PROFILES",
     "PROFILE_ENV",
     "Markdown",
@@ -57,6 +58,9 @@ __all__ = [
 PROFILES = ("quick", "paper")
 #: Environment variable holding the profile; unset means ``paper``.
 PROFILE_ENV = "PASSMD_PROFILE"
+#: Small counts as the prose spells them (``NUMBER_WORDS[3]`` is "three"), so a chapter glues a
+#: count it reads from a record without changing its wording.
+NUMBER_WORDS = ("zero", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten")
 
 _DATA_SUBDIR = Path("_generated") / "data"
 _NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")

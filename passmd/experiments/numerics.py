@@ -99,7 +99,7 @@ def energy_balance_table(
         drive = Drive(contacts=contacts, actuator_model=model)
         wf = waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
         for contact in ("exact", "discrete"):
-            res = dynamics.simulate(drive, wf, contact_model=contact, springs=200, max_points=2)
+            res = dynamics.simulate(drive, wf, contact_model=contact, springs=PROTOCOL.springs, max_points=2)
             bal = res.energy_balance()
             rows.append({"configuration": label, "contact_model": contact, **bal})
     return pd.DataFrame(rows)
