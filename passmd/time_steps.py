@@ -19,6 +19,10 @@ from passmd._dynamics_kernel import Segments
 from passmd.parameters import Drive
 from passmd.waveforms import Waveform
 
+#: Accuracy the default steps are chosen for: the settled runner position after three 100 Hz
+#: periods within this of a run with much finer steps (m); the model-numerics chapter shows it.
+CONVERGED_ACCURACY = 0.05e-9
+
 #: Fine steps per period of the stiffest linearised mode (flexible actuators).
 STEPS_PER_STIFF_PERIOD = 96
 #: Coarse step (flexible actuators, while they follow quasi-statically) as ω_max·dt.

@@ -189,7 +189,7 @@ def test_default_step_converged_to_005_nm():
 
     df = convergence_study(resolutions=(1.0, 4.0), step_controls=("adaptive",))
     default = df[df["resolution"] == 1.0]
-    assert (default["error_m"].abs() < 0.05e-9).all(), default
+    assert (default["error_m"].abs() < time_steps.CONVERGED_ACCURACY).all(), default
 
 
 def test_contact_memory_never_overflows_in_a_100_hz_period():

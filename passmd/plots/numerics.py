@@ -6,10 +6,12 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from passmd.time_steps import CONVERGED_ACCURACY
+
 __all__ = ["CONVERGED_STEP_NM", "plot_convergence", "plot_coulomb_limit"]
 
-#: Position error drawn as the convergence target (the benchmark's "converged accuracy") (nm).
-CONVERGED_STEP_NM = 0.05
+#: Position error drawn as the convergence target (:data:`passmd.time_steps.CONVERGED_ACCURACY`) (nm).
+CONVERGED_STEP_NM = CONVERGED_ACCURACY * 1e9
 
 
 def plot_convergence(df: pd.DataFrame):
