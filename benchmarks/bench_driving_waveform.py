@@ -31,6 +31,7 @@ import time
 from pathlib import Path
 
 from passmd.config import RunConfig
+from passmd.defaults import PROTOCOL
 from passmd.experiments import waveform_studies as studies
 from passmd.figures import figure_data
 
@@ -64,7 +65,7 @@ def blocks(repeats: int) -> dict:
                 lambda f=f, w=waveform, r=rule: dw.velocity_point(**dw.section5_fields(), frequency=f,
                                                                   waveform=w, short_period=r, **fields),
                 repeats)
-    wave = optimized_waveform.optimized(amplitude, 100.0, drive, periods=3, design=design)
+    wave = optimized_waveform.optimized(amplitude, PROTOCOL.drive_frequency, drive, periods=3, design=design)
     out["step_100hz"] = _timed(lambda: dynamics.simulate(drive, wave, max_points=2), repeats)
     return out
 

@@ -31,6 +31,7 @@ import time
 from pathlib import Path
 
 from passmd import dynamics, waveforms
+from passmd.defaults import PROTOCOL
 from passmd.parameters import Drive
 
 CONFIGS = [
@@ -103,7 +104,7 @@ _REFERENCE: dict = {}
 
 def settled_error(drive: Drive, kw: dict) -> float:
     """|settled position after 3 periods − the fixed fine step's| (m), 150 nm at 100 Hz."""
-    wf = waveforms.sawtooth(150e-9, 100.0, drive, periods=3)
+    wf = waveforms.sawtooth(150e-9, PROTOCOL.drive_frequency, drive, periods=3)
     key = (drive.contacts, drive.actuator_model, kw["contact_model"])
     if key not in _REFERENCE:
         fixed = {**kw, "adaptive": False, "quasi_static": False}
@@ -118,7 +119,7 @@ def bench(contacts: int, model: str, contact: str, control: str, repeats: int, s
               quasi_static=control == "quasi-static")
     warm = waveforms.sawtooth(150e-9, 10e3, drive, periods=1)
     dynamics.simulate(drive, warm, **kw)  # compile
-    wf = waveforms.sawtooth(150e-9, 100.0, drive, periods=1)
+    wf = waveforms.sawtooth(150e-9, PROTOCOL.drive_frequency, drive, periods=1)
     walls, steps = [], 0
     for _ in range(repeats):
         res = dynamics.simulate(drive, wf, max_points=2000, **kw)

@@ -181,7 +181,7 @@ def cost_facts(cost: pd.DataFrame) -> dict:
         "cost_exact_ns": exact_ns,
         "cost_exact_ring_ns": exact.loc[exact["path"] == "ring-down", "ns_per_call_median"].iloc[0],
         "ring_depth": int(exact.loc[exact["path"] == "ring-down", "max_depth"].iloc[0]),
-        "cost_200_ns": disc.loc[disc["springs"] == 200, "ns_per_call_median"].iloc[0],
+        "cost_200_ns": disc.loc[disc["springs"] == PROTOCOL.springs, "ns_per_call_median"].iloc[0],
         "cost_ratio_1000": disc.loc[disc["springs"] == 1000, "ns_per_call_median"].iloc[0] / exact_ns,
         "per_spring_ns": np.polyfit(disc["springs"], disc["ns_per_call_median"], 1)[0],
     }
