@@ -59,11 +59,17 @@ sys.exit(cli.main(sys.argv[1:]))
 """
 
 
+def _default_sigint():  # runs in the child before exec
+    """Ctrl-C as a terminal delivers it: a test run started in the background (``cmd &``)
+    inherits an ignored SIGINT, and Python then installs no KeyboardInterrupt handler."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def test_ctrl_c_stops_a_long_run_with_exit_130_and_no_partial_file(tmp_path):
     csv = tmp_path / "series.csv"
     proc = subprocess.Popen(
         [sys.executable, "-c", _RUNNER, "run", "--periods", "100000", "--csv", str(csv)],
-        stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True,
+        stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True, preexec_fn=_default_sigint,
     )
     try:
         assert proc.stderr.readline() == "KERNEL\n"

@@ -335,8 +335,10 @@ def test_ctrl_c_stops_a_process_pool_sweep_and_rerun_resumes(tmp_path):
     script.write_text(SIGINT_SCRIPT)
     n = 20
     cmd = [sys.executable, str(script), str(cache_dir), str(log), str(n)]
+    # the default SIGINT, as under a terminal (a background job inherits an ignored one)
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
+                            start_new_session=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     store = Cache(cache_dir)
     deadline = time.monotonic() + 60
     while len(store.entries()) < 2 and time.monotonic() < deadline:
