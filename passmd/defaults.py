@@ -13,11 +13,15 @@ from typing import NamedTuple
 __all__ = ["PROTOCOL", "ProtocolDefaults"]
 
 
+#: Driving frequency f of the saw-tooth in Sections 4.1, 4.2 and 5.1 [Hz].
+_DRIVE_FREQUENCY = 100.0
+
+
 class ProtocolDefaults(NamedTuple):
     """Defaults of the simulation protocols (SI units)."""
 
     #: Driving frequency f of the saw-tooth in Sections 4.1, 4.2 and 5.1 [Hz].
-    drive_frequency: float = 100.0
+    drive_frequency: float = _DRIVE_FREQUENCY
     #: Springs N of the discrete MDR contact (converged in the MDR-validation chapter).
     springs: int = 200
     #: Contacts on the two sides of the runner in the six-contact drive (Section 2).
@@ -36,7 +40,8 @@ class ProtocolDefaults(NamedTuple):
     stall_max_periods: int = 4096
     #: Drive frequencies over which the spread of the steady-state critical amplitude is
     #: drawn as a band (Section 4.1; the band brackets ``drive_frequency``) [Hz].
-    critical_amplitude_band: tuple[float, ...] = (50.0, 100.0, 200.0)
+    critical_amplitude_band: tuple[float, ...] = (0.5 * _DRIVE_FREQUENCY, _DRIVE_FREQUENCY,
+                                                  2.0 * _DRIVE_FREQUENCY)
 
 
 #: The defaults every protocol uses unless the caller says otherwise.
