@@ -264,6 +264,24 @@ def _check_arguments(segments, mechanics, control, contacts, buffers, step_limit
         raise ValueError(f"step_limit = {step_limit!r} is out of range: must be an integer >= 0")
 
 
+@njit(inline="always", **KERNEL_OPTIONS)
+def _save_position(carry, segment, mid, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps):
+    """Where the loop stands (segment, time, piezo position, runner acceleration, force,
+    recording and step counters) into ``carry``: at a pause and at the end of a call alike,
+    so that a later call resumes or extends the run bit for bit."""
+    carry[C_SEGMENT] = segment
+    carry[C_MID] = mid
+    carry[C_TIME] = t
+    carry[C_XP] = x_p
+    carry[C_AR] = a_r
+    carry[C_FORCE] = F
+    carry[C_NEXT_RECORD] = next_rec
+    carry[C_TRACK] = track
+    carry[C_RECORDED] = n_rec
+    carry[C_STEPS] = steps
+    carry[C_FINE_STEPS] = fine_steps
+
+
 @njit(**KERNEL_OPTIONS)
 def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     """Integrate over the segments; returns (status, steps done, rows recorded, fine steps).
@@ -405,17 +423,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
         while not done:
             if steps >= step_limit:
                 # pause: everything the loop carries goes to carry, y and work
-                carry[C_SEGMENT] = s
-                carry[C_MID] = 1.0
-                carry[C_TIME] = t
-                carry[C_XP] = x_p
-                carry[C_AR] = a_r
-                carry[C_FORCE] = F
-                carry[C_NEXT_RECORD] = next_rec
-                carry[C_TRACK] = track
-                carry[C_RECORDED] = n_rec
-                carry[C_STEPS] = steps
-                carry[C_FINE_STEPS] = fine_steps
+                _save_position(carry, s, 1.0, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps)
                 carry[C_FINE] = 1.0 if fine else 0.0
                 carry[C_QUASI] = 1.0 if quasi else 0.0
                 carry[C_QUIET] = quiet
@@ -584,17 +592,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
             energy[EN_DAMPING] += actuator_viscosity * 0.5 * acc_damp
     # done: the loop state goes to carry as at a pause between two segments, so that a call
     # with these segments followed by more (the same arrays, longer) continues the run
-    carry[C_SEGMENT] = seg_t0.shape[0]
-    carry[C_MID] = 0.0
-    carry[C_TIME] = t
-    carry[C_XP] = x_p
-    carry[C_AR] = a_r
-    carry[C_FORCE] = F
-    carry[C_NEXT_RECORD] = next_rec
-    carry[C_TRACK] = track
-    carry[C_RECORDED] = n_rec
-    carry[C_STEPS] = steps
-    carry[C_FINE_STEPS] = fine_steps
+    _save_position(carry, seg_t0.shape[0], 0.0, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps)
     y[0] = x_r
     y[1] = v_r
     for g in range(G):
