@@ -14,13 +14,32 @@ constants and its on-disk cache (``cache=True``) is invalidated only when this f
 changes, so a layout kept in another module could change without the cached loop
 noticing.
 
-Scheme: velocity Verlet (kick–drift–kick) on runner and actuators; the actuator's
-viscous term −c_p ẋ_a is treated with the trapezoidal rule in the velocity update
-(implicit in v, still explicit overall). The contact memory is updated exactly once
-per step, with the drifted positions, and the contact force is otherwise evaluated
-purely. Every corner of x_p(t) falls on a step boundary. With flexible actuators the step
-adapts: fine (resolving the ≈ 3 MHz actuator mode) while the actuators ring, coarse
-(a fraction of the explicit stability limit) while they follow quasi-statically.
+Schemes. Fine and coarse steps: velocity Verlet (kick–drift–kick) on runner and
+actuators; the actuator's viscous term −c_p ẋ_a is treated with the trapezoidal rule in
+the velocity update (implicit in v, still explicit overall). With flexible actuators the
+step adapts: fine (resolving the ≈ 3 MHz actuator mode) while the actuators ring, coarse
+(a fraction of the explicit stability limit) or quasi-static (m_a neglected, the
+actuator's force balance solved per step) while they follow.
+
+Error-controlled steps (``StepControl.error_tolerance`` > 0; rigid actuators, and the
+quasi-static phases of flexible ones): the runner's force splits into a linear spring K
+(``Mechanics.linear_stiffness``: the contacts' initial tangent stiffness, in series with
+k_p for flexible actuators) to x_p, plus the load cell, and the rest g. The linear part is
+integrated exactly by the variation-of-constants formula (an exponential or
+"trigonometric" integrator; Hairer, Lubich & Wanner, Geometric Numerical Integration,
+Ch. XIII), g with its rate extrapolated from the last step in the position and linear over
+the step in the velocity. So the ≈ 11 kHz micro-vibration sets no step; what does is the
+local position error estimate dt²/6 |Δg − ġ dt|, checked against the tolerance with the
+forces at the drifted position (pure evaluations): a step above it is rejected and retried
+shorter, and the next step follows the usual controller (fourth root, safety factor,
+bounded growth). A reversal of a contact's displacement u inside a step is an event: the
+extremum of the quadratic through u's value and rate at the start and its value at the end
+is committed first, so the Masing branch turns there and not at a step boundary. Samples
+inside such a step are interpolated (cubic Hermite in x_r).
+
+In every scheme the contact memory is updated exactly once per accepted step (twice when
+a reversal falls inside it), with the drifted positions, and the contact force is
+otherwise evaluated purely. Every corner of x_p(t) falls on a step boundary.
 """
 
 from __future__ import annotations
@@ -78,7 +97,11 @@ C_ACC_CONTACT = 19
 C_ACC_T = 20
 C_MIN_XR = 21
 C_QUASI = 22  # 1 while the quasi-static actuator step is in use
-CARRY_SIZE = 23
+C_CONTROLLED = 23  # 1 while the error-controlled step is in use
+C_STEP = 24  # the error-controlled step (s)
+C_REJECTED = 25  # error-controlled steps rejected (counted in the steps too)
+C_GRATE = 26  # rate of g over the last error-controlled step (m/s³)
+CARRY_SIZE = 27
 
 
 #: numba options: the kernel allocates nothing (work arrays come from the caller), so it is
@@ -87,7 +110,7 @@ CARRY_SIZE = 23
 KERNEL_OPTIONS = {"cache": True, "error_model": "numpy", "_nrt": False}
 
 #: rows of the work array (shape (WORK_ROWS, groups)) the caller allocates
-WORK_ROWS = 8
+WORK_ROWS = 10
 #: quasi-static step: the actuator's force balance is solved to this fraction of S/K
 #: (≈ 6e-15 m; a force error ≤ 1e-6 μF_N)
 QUASI_TOLERANCE = 1e-6
@@ -105,6 +128,12 @@ POSITION_LIMIT = 1.0
 #: hemispheres at most A_max·SR/V_pp ≈ 0.1 m/s, so 100 m/s is a runaway. (Comparisons with
 #: NaN are False, so a NaN state stops the run too.)
 VELOCITY_LIMIT = 100.0
+#: Error-controlled step: the next step is this fraction of the one the estimate allows
+#: (the usual safety factor of step-size controllers, Hairer, Nørsett & Wanner, Sect. II.4).
+STEP_SAFETY = 0.9
+#: Error-controlled step: largest growth and shrink factors from one step to the next.
+STEP_GROWTH = 1.5
+STEP_SHRINK = 0.2
 
 
 class Segments(NamedTuple):
@@ -119,7 +148,8 @@ class Segments(NamedTuple):
     period: np.ndarray  # int64: period the piece belongs to
     window: np.ndarray  # int64: 1 when the piece lies in its period's settle window
     mark: np.ndarray  # int64: 1 when the piece starts at a slip mark
-    quasi: np.ndarray  # step of the quasi-static actuator (s)
+    quasi: np.ndarray  # step of the quasi-static actuator; first error-controlled step (s)
+    longest: np.ndarray  # longest error-controlled step (s)
 
 
 class Mechanics(NamedTuple):
@@ -132,6 +162,7 @@ class Mechanics(NamedTuple):
     actuator_mass: float  # m_a
     actuator_stiffness: float  # k_p
     actuator_viscosity: float  # c_p
+    linear_stiffness: float  # K: part of Σ n_g T_g the error-controlled step integrates exactly (N/m)
 
 
 class StepControl(NamedTuple):
@@ -141,6 +172,7 @@ class StepControl(NamedTuple):
     quiet_steps: int  # fine steps below the threshold before the step grows
     quasi_static: bool  # quiet phases use the quasi-static actuator step
     record_interval: float  # time between recorded samples (s)
+    error_tolerance: float  # local position error per step of the runner (m); 0: uniform steps
 
 
 class Contacts(NamedTuple):
@@ -265,10 +297,10 @@ def _check_arguments(segments, mechanics, control, contacts, buffers, step_limit
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
-def _save_position(carry, segment, mid, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps):
+def _save_position(carry, segment, mid, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps, dt_ctrl):
     """Where the loop stands (segment, time, piezo position, runner acceleration, force,
-    recording and step counters) into ``carry``: at a pause and at the end of a call alike,
-    so that a later call resumes or extends the run bit for bit."""
+    recording and step counters, error-controlled step) into ``carry``: at a pause and at the
+    end of a call alike, so that a later call resumes or extends the run bit for bit."""
     carry[C_SEGMENT] = segment
     carry[C_MID] = mid
     carry[C_TIME] = t
@@ -280,6 +312,7 @@ def _save_position(carry, segment, mid, t, x_p, a_r, F, next_rec, track, n_rec, 
     carry[C_RECORDED] = n_rec
     carry[C_STEPS] = steps
     carry[C_FINE_STEPS] = fine_steps
+    carry[C_STEP] = dt_ctrl
 
 
 @njit(**KERNEL_OPTIONS)
@@ -320,13 +353,30 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     term, :func:`quasi_static_position`), then commits the contact memory once, as the
     explicit step does. The implied actuator acceleration is checked against the same
     threshold; above it, the fine explicit step takes over again.
+
+    With ``error_tolerance`` > 0 the quasi-static phases (flexible) and every step (rigid)
+    are error-controlled (module docstring): the first such step of a quasi-static phase is
+    ``seg_quasi``, then each step follows from the last one's error estimate, at most
+    ``seg_longest``; rigid actuators carry the step from piece to piece. Rejected steps count
+    in ``steps`` (and in ``carry[C_REJECTED]``).
     """
-    seg_t0, seg_t1, seg_x0, seg_x1, seg_fine, seg_coarse, seg_period, seg_window, seg_mark, seg_quasi = (
-        segments
-    )
+    (seg_t0, seg_t1, seg_x0, seg_x1, seg_fine, seg_coarse, seg_period, seg_window, seg_mark, seg_quasi,
+     seg_longest) = segments
     runner_mass, load_stiffness, multiplicity, rigid = mechanics[:4]
-    actuator_mass, actuator_stiffness, actuator_viscosity = mechanics[4:]
-    activity_threshold, quiet_steps, quasi_static, record_interval = control
+    actuator_mass, actuator_stiffness, actuator_viscosity, linear_stiffness = mechanics[4:]
+    # error-controlled step: the runner on the linear spring K to x_p (and the load cell)
+    # oscillates at Ω about z = β x_p; the variation-of-constants formula integrates that part
+    # exactly, with the rest of the force, g = a + Ω² (x_r − z), constant over the step in x_r
+    # and linear in v_r (both exact for a constant g)
+    omega2 = (linear_stiffness + load_stiffness) / runner_mass
+    omega = np.sqrt(omega2)
+    beta = linear_stiffness / (linear_stiffness + load_stiffness) if linear_stiffness > 0.0 else 0.0
+    dt_trig = -1.0
+    cs = sn = one_minus_cos = 0.0
+    activity_threshold, quiet_steps, quasi_static, record_interval, error_tolerance = control
+    control_on = error_tolerance > 0.0
+    # error estimates below this need no root: the step grows by the largest factor
+    small_error = error_tolerance * (STEP_SAFETY / STEP_GROWTH) ** 4
     params, state, sliding = contacts
     y, work, carry, record, per, peak, energy = buffers
     G = multiplicity.shape[0]
@@ -340,6 +390,8 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     stretch_old = work[5]  # x_p − x_a at the previous step
     xa_old = work[6]  # x_a at the previous step (quasi-static step)
     slope = work[7]  # last −h' of the quasi-static balance (0: none yet)
+    T_old = work[8]  # T at the start of the step (samples inside an error-controlled step)
+    share = work[9]  # slip share at the end of the step (samples inside an error-controlled step)
     gam = actuator_viscosity / actuator_mass
     inv_ma = 1.0 / actuator_mass
     inv_mr = 1.0 / runner_mass
@@ -364,6 +416,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
         fine_steps = 0
         first_segment = 0
         resume = False
+        dt_ctrl = seg_fine[0]
         carry[C_STARTED] = 1.0
     else:
         t = carry[C_TIME]
@@ -377,6 +430,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
         fine_steps = int(carry[C_FINE_STEPS])
         first_segment = int(carry[C_SEGMENT])
         resume = carry[C_MID] != 0.0
+        dt_ctrl = carry[C_STEP]
     max_rec = record.shape[0]
     for s in range(first_segment, seg_t0.shape[0]):
         k = seg_period[s]
@@ -386,11 +440,14 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
         dt_fine = seg_fine[s]
         dt_coarse = seg_coarse[s]
         dt_quasi = seg_quasi[s]
+        dt_longest = seg_longest[s]
         adaptive = (not rigid) and dt_coarse > dt_fine
         if resume:
             resume = False
             fine = carry[C_FINE] != 0.0
             quasi = carry[C_QUASI] != 0.0
+            controlled = carry[C_CONTROLLED] != 0.0
+            g_rate = carry[C_GRATE]
             quiet = int(carry[C_QUIET])
             acc_xr = carry[C_ACC_XR]
             acc_f = carry[C_ACC_F]
@@ -407,8 +464,13 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                 per[k, PER_MIN_XR] = x_r
             if in_window and track >= 0 and k > track:
                 track = -1
-            fine = True
+            # every piece starts with the fine step (its corner excites the actuator mode);
+            # rigid actuators under error control go on with the controlled step (a corner
+            # changes the rate of g, and the error estimate adapts to it)
+            fine = not (rigid and control_on)
             quasi = False
+            controlled = rigid and control_on
+            g_rate = 0.0  # (x_p's rate changes at the corner: g's rate is not known)
             quiet = 0
             # segment-local accumulators (kept in registers, written back after the segment)
             acc_xr = 0.0
@@ -423,9 +485,12 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
         while not done:
             if steps >= step_limit:
                 # pause: everything the loop carries goes to carry, y and work
-                _save_position(carry, s, 1.0, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps)
+                _save_position(carry, s, 1.0, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps,
+                               dt_ctrl)
                 carry[C_FINE] = 1.0 if fine else 0.0
                 carry[C_QUASI] = 1.0 if quasi else 0.0
+                carry[C_CONTROLLED] = 1.0 if controlled else 0.0
+                carry[C_GRATE] = g_rate
                 carry[C_QUIET] = quiet
                 carry[C_ACC_XR] = acc_xr
                 carry[C_ACC_F] = acc_f
@@ -440,6 +505,8 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                 return STATUS_PAUSED, steps, n_rec, fine_steps
             if fine:
                 dt = dt_fine
+            elif controlled:
+                dt = min(dt_ctrl, dt_longest)
             elif quasi:
                 dt = dt_quasi
             else:
@@ -457,15 +524,31 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                 fine_steps += 1
             half_dt2 = 0.5 * dt * dt
             xr_old = x_r
+            vr_old = v_r
             F_old = F
             # drift
-            x_r += dt * v_r + half_dt2 * a_r
+            if controlled and omega > 0.0:
+                y0 = x_r - beta * x_p
+                w0 = v_r - beta * vp
+                ag0 = a_r + omega2 * y0
+                if dt != dt_trig:  # (steps repeat at the longest step: their sines are kept)
+                    dt_trig = dt
+                    sh = np.sin(0.5 * dt * omega)
+                    ch = np.cos(0.5 * dt * omega)
+                    cs = 1.0 - 2.0 * sh * sh
+                    sn = 2.0 * sh * ch
+                    one_minus_cos = 2.0 * sh * sh / omega2  # (1 − cos hΩ)/Ω², without cancellation
+                    sine_excess = (dt * omega - sn) / (omega2 * omega)  # (hΩ − sin hΩ)/Ω³
+                x_r = cs * y0 + sn / omega * w0 + one_minus_cos * ag0 + sine_excess * g_rate + beta * xp_new
+            else:
+                x_r += dt * v_r + half_dt2 * a_r
             if rigid:
                 for g in range(G):
                     x_a[g] = xp_new
             elif quasi:
                 c_dt = actuator_viscosity / dt
                 K = actuator_stiffness + c_dt
+                F_trial = 0.0  # Σ n_g T_g at the solved balance, T_g = K (center − x_a,g)
                 for g in range(G):
                     stretch_old[g] = x_p - x_a[g]
                     xa_old[g] = x_a[g]
@@ -477,19 +560,75 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                         params, state, g, x_r, center, K, sliding[g], guess, sg,
                         QUASI_TOLERANCE * sliding[g] / K,
                     )
+                    F_trial += multiplicity[g] * K * (center - x_a[g])
             else:
                 for g in range(G):
                     stretch_old[g] = x_p - x_a[g]
                     x_a[g] += dt * v_a[g] + half_dt2 * (a_nd[g] - gam * v_a[g])
+            if controlled:
+                # local position error of the drift, dt³ x'''/6 with x''' ≈ Δa/dt, from the
+                # forces at the drifted positions with the memory as committed (pure; the
+                # quasi-static balance has them already)
+                if rigid:
+                    F_trial = 0.0
+                    for g in range(G):
+                        F_trial += multiplicity[g] * contact_force_row(params, state, g, x_a[g] - x_r)
+                # (the trigonometric step: of g only, its linear part is exact)
+                da = (F_trial - load_stiffness * x_r) * inv_mr - a_r
+                if omega > 0.0:
+                    # g extrapolated at its last rate: the error is of its change of rate, O(dt⁴)
+                    da += omega2 * (x_r - beta * xp_new - y0) - g_rate * dt
+                err = abs(da) * dt * dt / 6.0
+                factor = STEP_GROWTH
+                if err > small_error:
+                    allowed = STEP_SAFETY * np.sqrt(np.sqrt(error_tolerance / err))  # local error ∝ dt⁴
+                    factor = min(STEP_GROWTH, max(STEP_SHRINK, allowed))
+                if err > error_tolerance and dt > dt_fine:
+                    # rejected: back to the start of the step, to retry with a shorter one
+                    x_r = xr_old
+                    for g in range(G):
+                        x_a[g] = x_p if rigid else xa_old[g]
+                    dt_ctrl = max(dt * factor, dt_fine)
+                    done = False
+                    steps += 1
+                    carry[C_REJECTED] += 1.0
+                    continue
+                if not done:
+                    dt_ctrl = min(dt * factor, dt_longest)
             # contact forces, memory committed once per step
             F = 0.0
             for g in range(G):
                 u = x_a[g] - x_r
+                T_start = T[g]
+                T_old[g] = T_start
+                if controlled:
+                    # a reversal of u inside the step is an event: the extremum of the quadratic
+                    # through u at the start (value and rate) and at the end is committed first,
+                    # so the Masing branch turns at it, not at the last step boundary
+                    # rate of u at the start, times dt (quasi-static actuator: from its balance,
+                    # k_p (v_p − v_a) = k_t (v_a − v_r), k_t the contact's tangent stiffness
+                    # that the last balance solve found)
+                    if rigid:
+                        du0 = (vp - v_r) * dt
+                    else:
+                        du0 = actuator_stiffness * (vp - v_r) * dt / max(slope[g] - K + actuator_stiffness,
+                                                                          actuator_stiffness)
+                    excess = u - u_old[g] - du0  # curvature term of the quadratic, times dt²
+                    if du0 * (du0 + 2.0 * excess) < 0.0:  # the rate changes sign inside the step
+                        u_ext = u_old[g] - du0 * du0 / (4.0 * excess)
+                        T_ext = contact_update_row(params, state, g, u_ext)
+                        acc_contact += multiplicity[g] * 0.5 * (T[g] + T_ext) * (u_ext - u_old[g])
+                        T[g] = T_ext
+                        u_old[g] = u_ext
+                        if track >= 0:
+                            ratio = abs(T_ext) / sliding[g]
+                            if ratio > peak[track, g]:
+                                peak[track, g] = ratio
                 Tn = contact_update_row(params, state, g, u)
                 w = multiplicity[g] * 0.5 * (T[g] + Tn)
                 acc_contact += w * (u - u_old[g])
                 if rigid:
-                    acc_in += w * (xp_new - x_p)
+                    acc_in += multiplicity[g] * 0.5 * (T_start + Tn) * (xp_new - x_p)
                 T[g] = Tn
                 u_old[g] = u
                 F += multiplicity[g] * Tn
@@ -499,7 +638,12 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                         peak[track, g] = ratio
             # kick
             a_r_new = (F - load_stiffness * x_r) * inv_mr
-            v_r += 0.5 * dt * (a_r + a_r_new)
+            if controlled and omega > 0.0:
+                ag1 = a_r_new + omega2 * (x_r - beta * xp_new)
+                g_rate = (ag1 - ag0) / dt
+                v_r = -omega * sn * y0 + cs * w0 + sn / omega * ag0 + one_minus_cos * g_rate + beta * vp
+            else:
+                v_r += 0.5 * dt * (a_r + a_r_new)
             a_r = a_r_new
             if quasi:
                 activity = 0.0
@@ -516,6 +660,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                 if activity >= activity_threshold:
                     fine = True
                     quasi = False
+                    controlled = False
                     quiet = 0
             elif not rigid:
                 damp = 1.0 / (1.0 + 0.5 * dt * gam)
@@ -538,6 +683,9 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                             if quiet >= quiet_steps:
                                 fine = False
                                 quasi = quasi_static
+                                controlled = quasi_static and control_on
+                                dt_ctrl = dt_quasi
+                                g_rate = 0.0
                         else:
                             quiet = 0
                     elif activity >= activity_threshold:
@@ -551,6 +699,8 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                 acc_win += ((xr_old - x_p) + (x_r - xp_new)) * dt
             if x_r < min_xr:
                 min_xr = x_r
+            t_old = t
+            xp_old = x_p
             t = t_new
             x_p = xp_new
             steps += 1
@@ -563,7 +713,30 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                 y[0] = x_r
                 y[1] = v_r
                 return STATUS_DIVERGED, steps, n_rec, fine_steps
-            if t >= next_rec and n_rec < max_rec:
+            if controlled and next_rec <= t and n_rec < max_rec:
+                # samples at their own times inside a long step: cubic Hermite in x_r (from
+                # the positions and velocities at both ends), linear in x_p, x_a and T; the
+                # slip share of the step's end
+                for g in range(G):
+                    share[g] = contact_slip_share_row(params, state, g, x_a[g] - x_r)
+                while next_rec <= t and n_rec < max_rec:
+                    th = (next_rec - t_old) / dt
+                    th2 = th * th
+                    th3 = th2 * th
+                    record[n_rec, 0] = next_rec
+                    record[n_rec, 1] = xp_old + th * (x_p - xp_old)
+                    record[n_rec, 2] = ((2.0 * th3 - 3.0 * th2 + 1.0) * xr_old + (3.0 * th2 - 2.0 * th3) * x_r
+                                        + ((th3 - 2.0 * th2 + th) * vr_old + (th3 - th2) * v_r) * dt)
+                    record[n_rec, 3] = (6.0 * (th2 - th) * (xr_old - x_r) / dt + (3.0 * th2 - 4.0 * th + 1.0)
+                                        * vr_old + (3.0 * th2 - 2.0 * th) * v_r)
+                    for g in range(G):
+                        xa0 = xp_old if rigid else xa_old[g]
+                        record[n_rec, 4 + 3 * g] = xa0 + th * (x_a[g] - xa0)
+                        record[n_rec, 5 + 3 * g] = T_old[g] + th * (T[g] - T_old[g])
+                        record[n_rec, 6 + 3 * g] = share[g]
+                    n_rec += 1
+                    next_rec += record_interval
+            elif t >= next_rec and n_rec < max_rec:
                 record[n_rec, 0] = t
                 record[n_rec, 1] = x_p
                 record[n_rec, 2] = x_r
@@ -592,7 +765,8 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
             energy[EN_DAMPING] += actuator_viscosity * 0.5 * acc_damp
     # done: the loop state goes to carry as at a pause between two segments, so that a call
     # with these segments followed by more (the same arrays, longer) continues the run
-    _save_position(carry, seg_t0.shape[0], 0.0, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps)
+    _save_position(carry, seg_t0.shape[0], 0.0, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps,
+                   dt_ctrl)
     y[0] = x_r
     y[1] = v_r
     for g in range(G):

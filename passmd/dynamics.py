@@ -12,14 +12,19 @@ T_g is the MDR friction force of one contact of group g (Eqs. 4–6, :mod:`passm
 with memory. Sign convention: u = x_a − x_r; +T acts on the runner, −T on the actuator
 (the paper's Eq. 2 writes the same with F_f = T).
 
-Integrator (see :mod:`passmd._dynamics_kernel`): velocity Verlet with a trapezoidal
-damping term, uniform steps inside each linear piece of x_p(t). Why this scheme: the
-stiff mode (actuator on k_p plus the contact's 2aG*, ≈ 3 MHz) is lightly damped and
-oscillatory; an explicit symplectic scheme neither damps it artificially nor drifts in
-energy, costs one contact evaluation per step, and keeps the contact's memory update
-exactly once per step. The step follows from the parameters (:mod:`passmd.time_steps`): a
-fixed number of steps per period of the stiffest mode (flexible) or of the
-runner-on-contacts mode (rigid), and a minimum number of steps on every waveform edge.
+Integrator (see :mod:`passmd._dynamics_kernel`). While flexible actuators ring (after each
+corner of x_p(t)): velocity Verlet with a trapezoidal damping term at a fixed number of steps
+per period of the stiff mode (actuator on k_p plus the contact's 2aG*, ≈ 3 MHz), which an
+explicit symplectic scheme neither damps artificially nor lets drift in energy. Everywhere
+else (rigid actuators throughout; flexible ones once the ringing has decayed, with m_a
+neglected and the actuator's force balance solved per step) the step is error-controlled:
+the runner's linear oscillation on its contacts (≈ 11 kHz) is integrated exactly, only the
+rest of the force limits the step, a step whose local error estimate exceeds
+:data:`passmd.time_steps.LOCAL_ERROR_TOLERANCE` is rejected and retried shorter, and a
+reversal of a contact's displacement inside a step is committed at its interpolated
+extremum. Every corner of x_p(t) falls on a step boundary, and the contact memory is
+committed once per accepted step. ``error_control=False`` selects the explicit adaptive
+scheme of earlier versions (:mod:`passmd.time_steps`).
 """
 
 from __future__ import annotations
@@ -41,7 +46,7 @@ from passmd.contact import (
 from passmd.defaults import PROTOCOL
 from passmd.parameters import Drive
 from passmd.theory import contact_moduli, normal_forces
-from passmd.time_steps import StepPlan, check_work, segments, step_plan
+from passmd.time_steps import LOCAL_ERROR_TOLERANCE, StepPlan, check_work, segments, step_plan
 from passmd.waveforms import Waveform
 
 #: Verlet is stable for ω dt < 2; a user step must keep this margin below it.
@@ -118,13 +123,14 @@ class SimulationResult:
     period_mean_position: np.ndarray
     period_mean_friction: np.ndarray
     energy: dict
-    steps: int
+    steps: int  # integrator steps, rejected error-controlled steps included
     fine_steps: int
     fine_step: float
     coarse_step: float
     wall_time: float
     contact_memory: list = field(repr=False)  # per group: reversals, deepest stack, overflows
     final_state: np.ndarray = field(repr=False)
+    rejected_steps: int = 0  # error-controlled steps rejected and retried shorter
 
     @property
     def step_sizes(self) -> np.ndarray:
@@ -251,6 +257,7 @@ def simulate(
     adaptive: bool = True,
     progress: bool | None = None,
     quasi_static: bool = False,
+    error_control: bool = True,
 ) -> SimulationResult:
     """Simulate the drive under a piezo waveform from rest with virgin contacts.
 
@@ -269,19 +276,29 @@ def simulate(
         :func:`passmd.time_steps.step_plan`.
         Must stay below the Verlet stability limit of the stiffest mode.
     resolution : float
-        Divides the default step (convergence studies); ignored when ``dt`` is given.
+        Divides the default step (convergence studies); with ``error_control`` it divides the
+        error tolerance by ``resolution``⁴ instead (the controlled step scales as its fourth
+        root); ignored when ``dt`` is given.
     max_points : int
         Number of recorded samples (evenly spaced in time).
     share_side_state : bool
         Six contacts: one state per side (default) or six independent contacts.
     adaptive : bool
-        Flexible actuators: coarse steps while the actuators do not ring (default);
-        ``False`` integrates with the fine step throughout.
+        Adapt the step (default); ``False`` integrates with the fine step throughout (the
+        reference scheme of the convergence studies).
     quasi_static : bool
         Flexible actuators, adaptive step: in the quiet phases neglect the actuator mass and
-        solve its force balance implicitly with the runner's step
-        (:func:`passmd._dynamics_kernel.quasi_static_position`) instead of explicit coarse
-        steps (default ``False``: the explicit scheme).
+        solve its force balance implicitly (:func:`passmd._dynamics_kernel.quasi_static_position`)
+        instead of explicit coarse steps. Implied by ``error_control``; without it the runner's
+        step is the fixed :data:`passmd.time_steps.STEPS_PER_QUASI_RUNNER_PERIOD` per period.
+    error_control : bool
+        The default scheme: rigid actuators, and flexible ones once their ringing after a corner
+        of x_p(t) has decayed (quasi-static actuator), take steps chosen by a local error
+        estimate of the runner's position (:data:`passmd.time_steps.LOCAL_ERROR_TOLERANCE`),
+        with the runner's linear oscillation on its contacts integrated exactly, rejected steps
+        retried shorter, and every reversal of a contact's displacement committed at its
+        interpolated extremum (see :mod:`passmd._dynamics_kernel`). ``False``: the explicit
+        adaptive step (or, with ``quasi_static``, the quasi-static step at a fixed runner step).
     progress : bool, optional
         Show a progress bar on stderr; default: for runs of more than
         :data:`PROGRESS_MIN_STEPS` expected steps when stderr is a terminal.
@@ -303,7 +320,7 @@ def simulate(
     run = Simulation(
         drive, waveform, contact_model=contact_model, springs=springs, dt=dt, resolution=resolution,
         max_points=max_points, share_side_state=share_side_state, adaptive=adaptive, progress=progress,
-        quasi_static=quasi_static,
+        quasi_static=quasi_static, error_control=error_control,
     )
     run.run_to(waveform.periods)
     return run.result()
@@ -341,6 +358,7 @@ class Simulation:
         adaptive: bool = True,
         progress: bool | None = None,
         quasi_static: bool = False,
+        error_control: bool = True,
     ):
         if not isinstance(drive, Drive):
             raise ValueError(f"drive = {drive!r} is not a Drive")
@@ -355,6 +373,8 @@ class Simulation:
         k_contacts = np.array([contact_stiffness(params[g]) for g in range(multiplicity.size)])
         self._total_stiffness = float(np.sum(multiplicity * k_contacts))
         self._plan = plan = step_plan(drive, float(k_contacts.max()), self._total_stiffness, resolution)
+        # (the error-controlled step of flexible actuators is the quasi-static one)
+        quasi_static = quasi_static or error_control
         self._fine_step, coarse_step, quasi, quasi_step = _steps(drive, plan, dt, adaptive, quasi_static)
         self._coarse_step = quasi_step if quasi else coarse_step
         self._user_step = dt is not None
@@ -371,7 +391,9 @@ class Simulation:
             peak=np.zeros((waveform.periods, G)),
             energy=np.zeros(kern.EN_COLUMNS),
         )
-        self._segments = segments(waveform, self._fine_step, coarse_step, quasi_step)
+        controlled = error_control and adaptive and dt is None and (quasi or drive.actuator_model == "rigid")
+        self._segments = segments(waveform, self._fine_step, coarse_step, quasi_step,
+                                  plan.longest_step if controlled else None)
         # pieces of the first n periods: the first _ends[n − 1] (a piece's period never decreases)
         self._ends = np.searchsorted(self._segments.period, np.arange(1, waveform.periods + 1), side="left")
         self._mechanics = kern.Mechanics(
@@ -382,9 +404,11 @@ class Simulation:
             drive.actuator.mass,
             drive.actuator.stiffness,
             drive.actuator.viscosity,
+            _linear_stiffness(drive, multiplicity, k_contacts) if controlled else 0.0,
         )
         self._control = kern.StepControl(
-            plan.activity_threshold, plan.quiet_steps, quasi, waveform.duration / (max_points - 1)
+            plan.activity_threshold, plan.quiet_steps, quasi, waveform.duration / (max_points - 1),
+            LOCAL_ERROR_TOLERANCE / resolution**4 if controlled else 0.0,
         )
         self._contacts = kern.Contacts(params, state, np.array([sliding_force(params[g]) for g in range(G)]))
         self.periods_done = 0
@@ -477,6 +501,7 @@ class Simulation:
             coarse_step=float(self._coarse_step),
             wall_time=self.wall_time,
             contact_memory=[memory_diagnostics(self._params[g], self._state[g]) for g in range(G)],
+            rejected_steps=int(self._buffers.carry[kern.C_REJECTED]),
         )
 
 
@@ -499,6 +524,15 @@ def _contact_rows(drive: Drive, contact_model: str, springs: int, share_side_sta
     ]
     params, state = stack_contacts(rows)
     return params, state, multiplicity
+
+
+def _linear_stiffness(drive: Drive, multiplicity: np.ndarray, k_contacts: np.ndarray) -> float:
+    """Σ n_g k_g: the contacts' initial tangent stiffness, in series with k_p for flexible actuators
+    (N/m); the part of the runner's force the error-controlled step integrates exactly."""
+    if drive.actuator_model == "flexible":
+        k_p = drive.actuator.stiffness
+        k_contacts = k_p * k_contacts / (k_p + k_contacts)
+    return float(np.sum(multiplicity * k_contacts))
 
 
 def _steps(drive: Drive, plan: StepPlan, dt: float | None, adaptive: bool, quasi_static: bool):

@@ -38,6 +38,12 @@ STEPS_PER_RUNNER_PERIOD = 400
 #: Quasi-static actuator step (``quasi_static=True``): steps per period of the
 #: runner-on-contacts mode, as for rigid actuators (the actuator in series only softens it).
 STEPS_PER_QUASI_RUNNER_PERIOD = 400
+#: Error-controlled step (rigid actuators, or the quasi-static actuator step): local position
+#: error of the runner allowed per step (m).
+LOCAL_ERROR_TOLERANCE = 3e-14
+#: Longest error-controlled step as ω_runner·dt: Verlet is stable up to 2 on the runner mode
+#: (the runner on all contacts at their largest tangent stiffness, and the load cell).
+LONGEST_OMEGA_DT = 1.5
 #: Minimum number of steps on every linear piece of x_p(t) (resolves the fly-back).
 MIN_SEGMENT_STEPS = 40
 #: Work budget of one simulation in integrator steps (≈ 15–30 min at the 45–90 ns per step
@@ -67,6 +73,7 @@ class StepPlan:
     activity_threshold: float  # actuator acceleration that counts as ringing (m/s²)
     quiet_steps: int  # fine steps below the threshold before the step grows
     quasi_step: float = 0.0  # step of the quasi-static actuator (flexible, quasi_static=True) (s)
+    longest_step: float = 0.0  # longest error-controlled step (s)
 
 
 def step_plan(
@@ -108,11 +115,13 @@ def step_plan(
         float(threshold),
         quiet,
         float(max(quasi, dt)),
+        float(LONGEST_OMEGA_DT / omega_runner),
     )
 
 
 def segments(
-    waveform: Waveform, fine_step: float, coarse_step: float, quasi_step: float | None = None
+    waveform: Waveform, fine_step: float, coarse_step: float, quasi_step: float | None = None,
+    longest_step: float | None = None,
 ) -> Segments:
     """The linear pieces of x_p(t) with their steps (capped at 1/MIN_SEGMENT_STEPS of the piece)."""
     t, x = waveform.times, waveform.positions
@@ -133,7 +142,8 @@ def segments(
     window = inside.astype(np.int64)
     mark = np.isin(t0, waveform.slip_marks).astype(np.int64)
     quasi = np.minimum(coarse_step if quasi_step is None else quasi_step, shortest)
-    return Segments(t0, t1, x0, x1, fine, coarse, period, window, mark, quasi)
+    longest = np.minimum(coarse_step if longest_step is None else max(longest_step, fine_step), shortest)
+    return Segments(t0, t1, x0, x1, fine, coarse, period, window, mark, quasi, longest)
 
 
 def expected_steps(waveform: Waveform, plan: StepPlan, fine_step: float, coarse_step: float) -> np.ndarray:
@@ -143,6 +153,9 @@ def expected_steps(waveform: Waveform, plan: StepPlan, fine_step: float, coarse_
     mode) and continues with the coarse step; rigid actuators and runs without adaptation
     (``coarse_step == fine_step``) take the fine step throughout. Ringing after slips adds
     fine steps, so the sum is a lower bound of the work, close to it for saw-tooth runs.
+    Error-controlled runs are estimated with the steps they would take without the control
+    (the fine step for rigid actuators, the quasi-static step for flexible ones): an upper
+    estimate, which their controlled steps undercut several-fold on saw-tooth runs.
     """
     seg = segments(waveform, fine_step, coarse_step)
     duration = seg.t1 - seg.t0
