@@ -1,12 +1,15 @@
 """Speed of the hybrid simulator: ns per integrator step and wall time per 100 Hz period.
 
-Runs each configuration (one/six contacts × rigid/flexible × exact/discrete N = 200;
-flexible with the default adaptive step, the fixed fine step and the opt-in quasi-static
-actuator step) over one
-100 Hz saw-tooth period (150 nm, 0.4 N, R = 1 mm) at the default, converged step,
-repeats, and reports medians. numba compilation happens in an untimed warm-up run.
-Each row also gives the error of the settled position after 3 periods against the fixed
-fine step (the reference scheme).
+Runs each configuration (one/six contacts × rigid/flexible × exact/discrete N = 200) with
+each step control: the default error-controlled step ("controlled"), the fixed fine step
+(the reference scheme) and, for flexible actuators, the explicit adaptive step and the
+quasi-static actuator step at a fixed runner step (the schemes before the error control,
+``simulate(..., error_control=False)``). Each run is three 100 Hz saw-tooth periods (150 nm,
+0.4 N, R = 1 mm: the first from rest, two after a slip), repeated; the medians of the wall
+time give ms per period (wall / 3) and ns per integrator step (rejected error-controlled
+steps included). numba compilation happens in an untimed warm-up run. Each row also gives
+the largest difference of the settled positions of the three periods from the fixed fine
+step's.
 
 Start-up: the median time from launching ``passmd run --periods 1`` to its first
 integrator step (warm: bytecode and numba caches written by an untimed first launch),
@@ -39,8 +42,19 @@ CONFIGS = [
     for contacts in (1, 6)
     for model in ("rigid", "flexible")
     for contact in ("exact", "discrete")
-    for control in (("adaptive", "fixed", "quasi-static") if model == "flexible" else ("fixed",))
+    # the fixed fine step first: it is the reference of the others' error
+    for control in (("fixed", "controlled", "adaptive", "quasi-static") if model == "flexible"
+                    else ("fixed", "controlled"))
 ]
+#: Keyword arguments of :func:`passmd.dynamics.simulate` for each step control.
+CONTROLS = {
+    "controlled": {},
+    "adaptive": {"error_control": False},
+    "quasi-static": {"error_control": False, "quasi_static": True},
+    "fixed": {"adaptive": False},
+}
+#: 100 Hz periods of each timed run (the first from rest, the others after a slip).
+PERIODS = 3
 
 
 #: modules the ``run`` command should not need (imported only by other commands)
@@ -102,42 +116,46 @@ def startup(repeats: int) -> dict:
 _REFERENCE: dict = {}
 
 
-def settled_error(drive: Drive, kw: dict) -> float:
-    """|settled position after 3 periods − the fixed fine step's| (m), 150 nm at 100 Hz."""
-    wf = waveforms.sawtooth(150e-9, PROTOCOL.drive_frequency, drive, periods=3)
-    key = (drive.contacts, drive.actuator_model, kw["contact_model"])
-    if key not in _REFERENCE:
-        fixed = {**kw, "adaptive": False, "quasi_static": False}
-        _REFERENCE[key] = dynamics.simulate(drive, wf, max_points=2, **fixed).final_position
-    res = dynamics.simulate(drive, wf, max_points=2, **kw)
-    return abs(res.final_position - _REFERENCE[key])
-
-
 def bench(contacts: int, model: str, contact: str, control: str, repeats: int, springs: int = 200) -> dict:
     drive = Drive(contacts=contacts, actuator_model=model)
-    kw = dict(contact_model=contact, springs=springs, adaptive=control != "fixed",
-              quasi_static=control == "quasi-static")
+    kw = dict(contact_model=contact, springs=springs, **CONTROLS[control])
     warm = waveforms.sawtooth(150e-9, 10e3, drive, periods=1)
     dynamics.simulate(drive, warm, **kw)  # compile
-    wf = waveforms.sawtooth(150e-9, PROTOCOL.drive_frequency, drive, periods=1)
-    walls, steps = [], 0
+    wf = waveforms.sawtooth(150e-9, PROTOCOL.drive_frequency, drive, periods=PERIODS)
+    walls = []
     for _ in range(repeats):
         res = dynamics.simulate(drive, wf, max_points=2000, **kw)
         walls.append(res.wall_time)
-        steps = res.steps
+    if control == "fixed":
+        _REFERENCE[(contacts, model, contact)] = res.settled_positions
+    reference = _REFERENCE[(contacts, model, contact)]
     wall = statistics.median(walls)
     return {
         "contacts": contacts,
         "actuator": model,
         "step": control,
         "contact_model": contact if contact == "exact" else f"discrete N={springs}",
-        "steps_per_period": steps,
+        "steps_per_period": res.steps / PERIODS,
+        "rejected_per_period": res.rejected_steps / PERIODS,
         "fine_step_ns": res.fine_step * 1e9,
         "coarse_step_ns": res.coarse_step * 1e9,
-        "ns_per_step": wall / steps * 1e9,
-        "ms_per_100Hz_period": wall * 1e3,
-        "error_vs_fixed_fine_nm": settled_error(drive, kw) * 1e9,
+        "ns_per_step": wall / res.steps * 1e9,
+        "ms_per_100Hz_period": wall / PERIODS * 1e3,
+        "error_vs_fixed_fine_nm": float(abs(res.settled_positions - reference).max()) * 1e9,
     }
+
+
+def markdown(rows: list) -> str:
+    """The rows as the README's Markdown table."""
+    lines = ["| contacts | actuators | step control | contact model | steps per period (rejected) "
+             "| ns per step | ms per 100 Hz period | error vs fixed fine step (nm) |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['contacts']} | {r['actuator']} | {r['step']} | {r['contact_model']} "
+                     f"| {r['steps_per_period']:.0f} ({r['rejected_per_period']:.0f}) "
+                     f"| {r['ns_per_step']:.1f} | {r['ms_per_100Hz_period']:.2f} "
+                     f"| {r['error_vs_fixed_fine_nm']:.4f} |")
+    return "\n".join(lines)
 
 
 def main(argv=None) -> int:
@@ -149,18 +167,7 @@ def main(argv=None) -> int:
     load_before = os.getloadavg()
     rows = [bench(c, m, k, control, args.repeats) for c, m, k, control in CONFIGS]
     start = startup(args.repeats)
-    header = (
-        f"{'contacts':>8} {'actuator':>9} {'step':>12} {'contact':>16} {'steps':>9} "
-        f"{'fine/ns':>7} {'coarse/ns':>9} {'ns/step':>8} {'ms/period':>10} {'error/nm':>9}"
-    )
-    print(header)
-    for r in rows:
-        print(
-            f"{r['contacts']:>8} {r['actuator']:>9} {r['step']:>12} {r['contact_model']:>16} "
-            f"{r['steps_per_period']:>9}"
-            f"{r['fine_step_ns']:>7.2f} {r['coarse_step_ns']:>9.2f} {r['ns_per_step']:>8.1f} "
-            f"{r['ms_per_100Hz_period']:>10.2f} {r['error_vs_fixed_fine_nm']:>9.2g}"
-        )
+    print(markdown(rows))
     print(f"start-up ({start['command']}): {start['launch_to_first_step_s']:.3f} s to the first step; "
           f"heavy modules imported: {start['heavy_modules_imported'] or 'none'}")
     args.out.parent.mkdir(parents=True, exist_ok=True)

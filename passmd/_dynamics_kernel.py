@@ -129,10 +129,12 @@ POSITION_LIMIT = 1.0
 #: NaN are False, so a NaN state stops the run too.)
 VELOCITY_LIMIT = 100.0
 #: Error-controlled step: the next step is this fraction of the one the estimate allows
-#: (the usual safety factor of step-size controllers, Hairer, Nørsett & Wanner, Sect. II.4).
-STEP_SAFETY = 0.9
+#: (the safety factor of step-size controllers, Hairer, Nørsett & Wanner, Sect. II.4).
+#: With 0.8 and the growth below, one step in 15 is rejected on a 100 Hz saw-tooth (0.9 and
+#: 1.5: one in 5, and more steps in all).
+STEP_SAFETY = 0.8
 #: Error-controlled step: largest growth and shrink factors from one step to the next.
-STEP_GROWTH = 1.5
+STEP_GROWTH = 1.25
 STEP_SHRINK = 0.2
 
 
