@@ -149,9 +149,11 @@ print(json.dumps({"status": status, **loaded}))
 
 
 def test_run_command_loads_no_heavy_module(tmp_path):
-    """``passmd run`` (one period of a one-contact rigid drive: a cheap run) loads no heavy
-    module, neither before its first integrator step nor up to its printed result."""
-    argv = ["run", "--periods", "1", "--contacts", "1", "--actuator", "rigid", "--max-points", "2", "--json"]
+    """``passmd run`` (one period of a one-contact rigid drive: a cheap run; a quantity with its
+    unit) loads no heavy module, neither before its first integrator step nor up to its printed
+    result."""
+    argv = ["run", "--periods", "1", "--contacts", "1", "--actuator", "rigid", "--frequency", "100Hz",
+            "--max-points", "2", "--json"]
     done = subprocess.run(
         [sys.executable, "-c", _RUN_PROBE, json.dumps(HEAVY), *argv],
         capture_output=True, text=True, check=True, cwd=tmp_path,
