@@ -578,6 +578,26 @@ def test_other_commands_run_with_the_collector_and_a_disabled_one_stays_off(monk
         gc.enable()
 
 
+_EXIT_PROBE = """
+import atexit, contextlib, gc, io, sys
+# registered before the command: atexit runs it after the command's own exit callbacks
+atexit.register(lambda: sys.stderr.write(f"frozen at exit: {gc.get_freeze_count() > 0}\\n"))
+from passmd import cli
+with contextlib.redirect_stdout(io.StringIO()):
+    status = cli.main(["theory"])
+sys.stderr.write(f"frozen after main: {gc.get_freeze_count() > 0}\\n")
+sys.exit(status)
+"""
+
+
+def test_the_exit_collection_is_skipped():
+    """The interpreter's last collection, through all the command loaded, is skipped (the objects
+    are frozen at exit, not before: a caller that goes on keeps collecting them)."""
+    done = subprocess.run([sys.executable, "-c", _EXIT_PROBE], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.splitlines() == ["frozen after main: False", "frozen at exit: True"]
+
+
 def test_unwritable_output_exits_1(tmp_path, capsys):
     target = tmp_path / "missing-dir" / "series.csv"
     status, _ = run_cli("run", "--contacts", "1", "--actuator", "rigid", "--periods", "1",

@@ -58,8 +58,10 @@ def main(argv=None, out=None) -> int:
     """Run the command line; return the exit status (0 ok, 2 usage error, 1 failed run).
 
     130 on Ctrl-C, 141 when standard output was closed by its reader (nothing printed).
-    Automatic garbage collection is paused while the command starts (:mod:`passmd.cli.startup`).
+    Automatic garbage collection is paused while the command starts, and skipped at the
+    interpreter's exit (:mod:`passmd.cli.startup`).
     """
+    startup.skip_exit_collection()
     startup.pause()
     try:
         return _main(argv, out)
