@@ -553,7 +553,7 @@ def test_run_pauses_the_collector_until_its_simulation_has_run(monkeypatch, tmp_
                         "--csv", str(tmp_path / "series.csv"))
     assert status == 0
     assert enabled == {"simulation": False, "outputs": True}
-    assert gc.isenabled()
+    assert gc.isenabled() and gc.get_freeze_count() == 0  # nothing left frozen for the caller
 
 
 def test_other_commands_run_with_the_collector_and_a_disabled_one_stays_off(monkeypatch):

@@ -8,9 +8,10 @@ step; ``startup`` in ``benchmarks/bench_dynamics.py`` measures that time).
 
 :func:`pause` stops automatic collection when :func:`passmd.cli.main` starts; :func:`resume`
 turns it back on before a command's handler runs, or, for a command whose parser sets
-``resumes_collector`` (``run``), when the handler calls it after its simulation. Reference
-counting frees memory as usual while collection is paused; only reference cycles wait for
-the next collection. A collector the caller had turned off stays off.
+``resumes_collector`` (``run``), when the handler calls it after its simulation, and moves
+what was allocated meanwhile into the oldest generation. Reference counting frees memory
+as usual while collection is paused; only reference cycles wait for the next full
+collection. A collector the caller had turned off stays off.
 
 At exit the interpreter collects once more, through everything the command loaded: about
 0.2 s after ``passmd run`` has printed its result. :func:`skip_exit_collection` freezes the
@@ -43,6 +44,12 @@ def resume() -> None:
     global _paused
     if _paused:
         _paused = False
+        if gc.get_freeze_count() == 0:  # (a caller's frozen objects stay frozen)
+            # what start-up allocated is long-lived: straight into the oldest generation
+            # (freezing then unfreezing moves the objects without traversing them), so the
+            # next young collection does not traverse all of them
+            gc.freeze()
+            gc.unfreeze()
         gc.enable()
 
 
