@@ -62,18 +62,33 @@ HEAVY_MODULES = ("pandas", "matplotlib", "pint", "dask", "distributed", "tqdm")
 
 # launched as ``python -c``: reports (on stderr) the time and the heavy modules loaded when
 # the CLI first enters the integrator (the checking wrapper ``_dynamics_kernel.integrate``,
-# which passmd.dynamics looks up at call time), then finishes the command
+# which passmd.dynamics looks up at call time), then finishes the command. The wrapper is
+# put in when the command itself imports the kernel module (an import hook), so numba loads
+# inside ``cli.main`` at the same point as in a real launch.
 _FIRST_STEP = """
-import json, sys, time
-from passmd import _dynamics_kernel as kern, cli
-integrate = kern.integrate
-def announced(*args, **kwargs):
-    heavy = [m for m in json.loads(sys.argv[1]) if m in sys.modules]
-    sys.stderr.write(json.dumps({"ready": time.time(), "heavy": heavy}) + "\\n")
-    sys.stderr.flush()
-    kern.integrate = integrate
-    return integrate(*args, **kwargs)
-kern.integrate = announced
+import importlib.machinery, json, sys, time
+class Hook:
+    @staticmethod
+    def find_spec(name, path, target=None):
+        if name != "passmd._dynamics_kernel":
+            return None
+        sys.meta_path.remove(Hook)
+        spec = importlib.machinery.PathFinder.find_spec(name, path)
+        load = spec.loader.exec_module
+        def exec_module(kern):
+            load(kern)
+            integrate = kern.integrate
+            def announced(*args, **kwargs):
+                heavy = [m for m in json.loads(sys.argv[1]) if m in sys.modules]
+                sys.stderr.write(json.dumps({"ready": time.time(), "heavy": heavy}) + "\\n")
+                sys.stderr.flush()
+                kern.integrate = integrate
+                return integrate(*args, **kwargs)
+            kern.integrate = announced
+        spec.loader.exec_module = exec_module
+        return spec
+sys.meta_path.insert(0, Hook)
+from passmd import cli
 sys.exit(cli.main(sys.argv[2:]))
 """
 

@@ -42,8 +42,9 @@ _DIMENSION_WORDS = {
 
 
 # SI factors of the display units the package shows and reads bare numbers in, so that
-# formatting output and reading bare numbers need no unit registry (building pint's takes
-# ≈ 0.3–1 s of start-up); tests check each factor against pint's. Any other unit goes to pint.
+# formatting output, reading bare numbers and reading numbers given in a display unit
+# (``150nm``, ``40kHz``) need no unit registry (building pint's takes ≈ 0.3–1 s of start-up);
+# tests check each factor against pint's. Any other unit goes to pint.
 _DISPLAY_FACTORS = {
     "": 1.0,
     "m": 1.0,
@@ -64,6 +65,31 @@ _DISPLAY_FACTORS = {
     "GPa": 1e9,
     "V": 1.0,
     "V/us": 1e6,
+}
+
+
+# The SI unit each display unit measures in: two display units have the same dimension
+# exactly when they share it (tests check this against pint's dimensionalities).
+_DISPLAY_BASES = {
+    "": "",
+    "m": "m",
+    "mm": "m",
+    "um": "m",
+    "nm": "m",
+    "s": "s",
+    "us": "s",
+    "kg": "kg",
+    "g": "kg",
+    "Hz": "Hz",
+    "kHz": "Hz",
+    "N": "N",
+    "mN": "N",
+    "N/m": "N/m",
+    "kg/s": "kg/s",
+    "Pa": "Pa",
+    "GPa": "Pa",
+    "V": "V",
+    "V/us": "V/s",
 }
 
 
@@ -148,6 +174,10 @@ def parse_quantity(text, unit: str, *, name: str = "value") -> float:
     if not unit_text:
         # a bare number is in the display unit: no registry needed
         return float(Decimal(number_text) * Decimal(repr(float(_si_factor(unit)))))
+    base = _DISPLAY_BASES.get(unit_text)
+    if base is not None and base == _DISPLAY_BASES.get(unit):
+        # a display unit of the expected dimension: no registry needed either (same factor)
+        return float(Decimal(number_text) * Decimal(repr(_DISPLAY_FACTORS[unit_text])))
     display = _unit(unit)
     try:
         given = registry().parse_units(unit_text)

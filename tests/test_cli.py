@@ -11,6 +11,7 @@ multiplication, so "0.25mm" is exactly 0.25e-3), and JSON round-trips floats exa
 """
 
 import contextlib
+import gc
 import inspect
 import io
 import json
@@ -521,6 +522,80 @@ def test_failed_simulation_exits_1(monkeypatch, capsys):
     err = capsys.readouterr().err
     assert status == 1 and out == ""
     assert err == "passmd run: error: run failed: simulation diverged at integrator step 12\n"
+
+
+# --------------------------------------------------------------------------------------
+# garbage collection paused while a command starts (passmd.cli.startup)
+# --------------------------------------------------------------------------------------
+
+
+def test_run_pauses_the_collector_until_its_simulation_has_run(monkeypatch, tmp_path):
+    """Imports and kernel loading run without automatic collection; the outputs (pandas,
+    matplotlib) and whatever follows the command run with it."""
+    from passmd import dynamics
+    from passmd.cli.commands import run as run_command
+
+    enabled = {}
+    simulate, write_outputs = dynamics.simulate, run_command.write_outputs
+
+    def spy_simulate(*args, **kwargs):
+        enabled["simulation"] = gc.isenabled()
+        return simulate(*args, **kwargs)
+
+    def spy_write_outputs(*args, **kwargs):
+        enabled["outputs"] = gc.isenabled()
+        return write_outputs(*args, **kwargs)
+
+    monkeypatch.setattr(dynamics, "simulate", spy_simulate)
+    monkeypatch.setattr(run_command, "write_outputs", spy_write_outputs)
+    assert gc.isenabled()
+    status, _ = run_cli("run", "--contacts", "1", "--actuator", "rigid", "--periods", "1",
+                        "--csv", str(tmp_path / "series.csv"))
+    assert status == 0
+    assert enabled == {"simulation": False, "outputs": True}
+    assert gc.isenabled() and gc.get_freeze_count() == 0  # nothing left frozen for the caller
+
+
+def test_other_commands_run_with_the_collector_and_a_disabled_one_stays_off(monkeypatch):
+    from passmd import theory
+
+    enabled = []
+    drive_theory = theory.drive_theory
+
+    def spy(*args, **kwargs):
+        enabled.append(gc.isenabled())
+        return drive_theory(*args, **kwargs)
+
+    monkeypatch.setattr(theory, "drive_theory", spy)
+    assert run_cli("theory")[0] == 0
+    assert run_cli("run", "--periods", "0")[0] == 2  # a usage error: the collector is on again
+    assert enabled == [True] and gc.isenabled()
+    gc.disable()
+    try:
+        assert run_cli("theory")[0] == 0
+        assert enabled == [True, False] and not gc.isenabled()  # the caller's choice is kept
+    finally:
+        gc.enable()
+
+
+_EXIT_PROBE = """
+import atexit, contextlib, gc, io, sys
+# registered before the command: atexit runs it after the command's own exit callbacks
+atexit.register(lambda: sys.stderr.write(f"frozen at exit: {gc.get_freeze_count() > 0}\\n"))
+from passmd import cli
+with contextlib.redirect_stdout(io.StringIO()):
+    status = cli.main(["theory"])
+sys.stderr.write(f"frozen after main: {gc.get_freeze_count() > 0}\\n")
+sys.exit(status)
+"""
+
+
+def test_the_exit_collection_is_skipped():
+    """The interpreter's last collection, through all the command loaded, is skipped (the objects
+    are frozen at exit, not before: a caller that goes on keeps collecting them)."""
+    done = subprocess.run([sys.executable, "-c", _EXIT_PROBE], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.splitlines() == ["frozen after main: False", "frozen at exit: True"]
 
 
 def test_unwritable_output_exits_1(tmp_path, capsys):

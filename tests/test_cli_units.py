@@ -92,3 +92,15 @@ def test_display_factors_are_pints():
     for unit, factor in units._DISPLAY_FACTORS.items():
         expected = units.registry().Quantity(1.0, units._unit(unit)).to_base_units().magnitude
         assert factor == expected, unit
+
+
+def test_display_units_share_a_base_exactly_when_pint_gives_them_one_dimension():
+    """A number given in a display unit (``150nm``, ``40kHz``) is read without the registry when
+    the unit's base is the expected one; that must be pint's dimension check."""
+    from passmd import units
+
+    assert units._DISPLAY_BASES.keys() == units._DISPLAY_FACTORS.keys()
+    for a in units._DISPLAY_BASES:
+        for b in units._DISPLAY_BASES:
+            same = units._unit(a).dimensionality == units._unit(b).dimensionality
+            assert (units._DISPLAY_BASES[a] == units._DISPLAY_BASES[b]) == same, (a, b)

@@ -7,6 +7,11 @@ of a parallel sweep) and no module of a higher layer (protocols, experiments, fi
 plots, ledger, presentation, command line): the package is layered one way, core at the
 bottom. Each import runs in a fresh interpreter, so nothing another test imported counts.
 Imports inside functions count too: the sources are read for every import statement.
+
+The command line builds on the same rule: its parser and every command module load only
+what a command needs when it runs (README, "Architecture"), so ``passmd run`` reaches its
+first integrator step without pandas, matplotlib, pint, Dask or tqdm (the progress bar
+only on a terminal), and ``passmd --help`` without the simulator.
 """
 
 import ast
@@ -46,7 +51,9 @@ CORE = frozenset(
     )
 )
 
-HEAVY = ("pandas", "matplotlib")
+#: Modules the simulator and the ``run`` command do not need (other commands, the book, plots,
+#: unit parsing beyond the display units, sweeps, progress bars on a terminal).
+HEAVY = ("pandas", "matplotlib", "pint", "dask", "distributed", "tqdm")
 
 _PROBE = """
 import importlib, json, sys
@@ -57,7 +64,7 @@ print(json.dumps(sorted(m for m in json.loads(sys.argv[2]) if m in sys.modules))
 
 
 @pytest.mark.parametrize("module", KERNEL_PATH)
-def test_core_module_imports_no_pandas_matplotlib_or_higher_layer(module):
+def test_core_module_imports_no_heavy_module_or_higher_layer(module):
     done = subprocess.run(
         [sys.executable, "-c", _PROBE, module, json.dumps(HEAVY)],
         capture_output=True, text=True, check=True,
@@ -99,3 +106,59 @@ def test_waveform_constructors_never_reach_the_simulator(module):
         names = _imported_passmd_modules(ast.parse(source.read()))
     simulator = {"passmd.dynamics", "passmd._dynamics_kernel", "passmd.time_steps", "passmd.contact"}
     assert not names & simulator, f"{module} imports {sorted(names & simulator)}"
+
+
+# Builds the parser and parses a ``run`` command line, as ``passmd`` does before dispatching.
+_PARSER_PROBE = """
+import json, sys
+from passmd.cli import make_parser
+args = make_parser().parse_args(["run", "--periods", "1"])
+assert args.handler.__name__ == "run_run", args.handler
+print(json.dumps(sorted(m for m in json.loads(sys.argv[1]) if m in sys.modules)))
+"""
+
+
+def test_command_line_parser_loads_no_heavy_module_nor_the_simulator():
+    """Every command module is imported to build the parser: none may load a heavy module, and
+    ``passmd --help`` or a usage error needs no numba."""
+    done = subprocess.run(
+        [sys.executable, "-c", _PARSER_PROBE, json.dumps([*HEAVY, "numba", "scipy"])],
+        capture_output=True, text=True, check=True,
+    )
+    assert json.loads(done.stdout) == []
+
+
+# Runs ``passmd run`` in this fresh interpreter; prints the heavy modules loaded when the command
+# enters the integrator (the checking wrapper ``_dynamics_kernel.integrate``, which
+# passmd.dynamics looks up at call time) and when the command has printed its result.
+_RUN_PROBE = """
+import contextlib, io, json, sys
+from passmd import _dynamics_kernel as kern, cli
+heavy = json.loads(sys.argv[1])
+loaded = {}
+integrate = kern.integrate
+def first_step(*args, **kwargs):
+    loaded.setdefault("first_step", [m for m in heavy if m in sys.modules])
+    return integrate(*args, **kwargs)
+kern.integrate = first_step
+with contextlib.redirect_stdout(io.StringIO()):
+    status = cli.main(sys.argv[2:])
+loaded["end"] = [m for m in heavy if m in sys.modules]
+print(json.dumps({"status": status, **loaded}))
+"""
+
+
+def test_run_command_loads_no_heavy_module(tmp_path):
+    """``passmd run`` (one period of a one-contact rigid drive: a cheap run; a quantity with its
+    unit) loads no heavy module, neither before its first integrator step nor up to its printed
+    result."""
+    argv = ["run", "--periods", "1", "--contacts", "1", "--actuator", "rigid", "--frequency", "100Hz",
+            "--max-points", "2", "--json"]
+    done = subprocess.run(
+        [sys.executable, "-c", _RUN_PROBE, json.dumps(HEAVY), *argv],
+        capture_output=True, text=True, check=True, cwd=tmp_path,
+    )
+    report = json.loads(done.stdout.splitlines()[-1])
+    assert report["status"] == 0, done.stderr
+    assert report["first_step"] == [], f"passmd run loads {report['first_step']} before its first step"
+    assert report["end"] == [], f"passmd run loads {report['end']}"

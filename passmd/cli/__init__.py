@@ -32,8 +32,9 @@ the cache.
 Modules: ``passmd.cli.parser`` (the parser), ``passmd.cli.app`` (dispatch and exit
 status), ``passmd.cli.options`` and ``passmd.cli.drive`` (quantity options, the
 drive they describe), ``passmd.cli.output`` (human and JSON output),
-``passmd.cli.streams`` (standard streams), ``passmd.cli.configuration`` (the
-RunConfig of ``figure`` and ``ledger``), ``passmd.cli.commands`` (one module per command).
+``passmd.cli.streams`` (standard streams), ``passmd.cli.startup`` (garbage collection
+paused while a command starts), ``passmd.cli.configuration`` (the RunConfig of ``figure``
+and ``ledger``), ``passmd.cli.commands`` (one module per command).
 """
 
 from __future__ import annotations

@@ -11,6 +11,7 @@ import numpy as np
 
 from passmd._result_bounds import ResultError
 from passmd.cache import CacheWarning
+from passmd.cli import startup
 from passmd.cli.errors import OPTIONAL_EXTRAS, MissingDependencyError, OutputError, UsageError
 from passmd.cli.parser import PROG, make_parser
 from passmd.cli.streams import (
@@ -57,7 +58,18 @@ def main(argv=None, out=None) -> int:
     """Run the command line; return the exit status (0 ok, 2 usage error, 1 failed run).
 
     130 on Ctrl-C, 141 when standard output was closed by its reader (nothing printed).
+    Automatic garbage collection is paused while the command starts, and skipped at the
+    interpreter's exit (:mod:`passmd.cli.startup`).
     """
+    startup.skip_exit_collection()
+    startup.pause()
+    try:
+        return _main(argv, out)
+    finally:
+        startup.resume()
+
+
+def _main(argv, out) -> int:
     to_stdout = out is None
     for stream in (sys.stdout, sys.stderr):
         use_ascii_fallback(stream)
@@ -82,6 +94,8 @@ def _error(prog: str, text: str, status: int) -> int:
 
 def _dispatch(args, out: Out, prog: str, to_stdout: bool) -> int:  # noqa: C901 - one except per failure
     try:
+        if not getattr(args, "resumes_collector", False):
+            startup.resume()
         status = args.handler(args, out)
         out.flush()
         return status

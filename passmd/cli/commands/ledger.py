@@ -5,7 +5,6 @@ from __future__ import annotations
 import textwrap
 
 from passmd.cache import DEFAULT_CACHE_DIR
-from passmd.claims import STATUSES
 from passmd.cli.configuration import run_config
 from passmd.cli.errors import OutputError
 from passmd.cli.options import add_sweep_options
@@ -49,6 +48,7 @@ def _write_baseline(ledger, evaluated, args) -> None:
 def run_ledger(args, out) -> int:
     """Every claim of the paper with its computed category, values and evidence (Sections 4–6)."""
     from passmd import ledger, ledger_views
+    from passmd.claims import STATUSES
 
     evaluated = ledger.evaluate(config=run_config(args))
     if args.write_baseline:

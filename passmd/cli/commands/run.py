@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from passmd._result_bounds import check_run_bounds
+from passmd.cli import startup
 from passmd.cli.commands.contact import check_springs
 from passmd.cli.drive import build_drive
 from passmd.cli.errors import OutputError, UsageError
@@ -47,7 +48,8 @@ def add_parser(command) -> None:
     p.add_argument("--load-cell", action="store_true",
                    help="the runner pushes against the load cell (default: off, free runner)")
     add_output_options(p)
-    p.set_defaults(handler=run_run)
+    # collection stays paused through the imports and the kernels' loading (passmd.cli.startup)
+    p.set_defaults(handler=run_run, resumes_collector=True)
 
 
 def waveform_args(args, drive):
@@ -155,6 +157,7 @@ def run_run(args, out) -> int:
     check_memory(args)
     check_output_paths(args)
     result = simulate(args, drive)
+    startup.resume()
     summary = result.summary()
     summary["wall_time_s"] = float(result.wall_time)
     check_results(summary)
