@@ -24,8 +24,9 @@ from __future__ import annotations
 
 import atexit
 import gc
+import sys
 
-__all__ = ["pause", "resume", "skip_exit_collection"]
+__all__ = ["load_numba_without_blas_probe", "pause", "resume", "skip_exit_collection"]
 
 _paused = False
 _exit_registered = False
@@ -59,3 +60,29 @@ def skip_exit_collection() -> None:
     if not _exit_registered:
         _exit_registered = True
         atexit.register(gc.freeze)
+
+
+#: scipy's BLAS module, which numba imports (with scipy.linalg) to see whether it can compile
+#: linear algebra (``numba.np.arraymath``, at the first use of a compiled function).
+_BLAS_MODULE = "scipy.linalg.cython_blas"
+
+
+def load_numba_without_blas_probe() -> None:
+    """Load numba's array-math registry with scipy's BLAS module hidden from its probe.
+
+    At the first call of any compiled function, numba imports ``numba.np.arraymath``, which
+    imports ``scipy.linalg.cython_blas`` (and scipy.linalg with it: 0.1–0.15 s, a fifth of
+    ``passmd run``'s start-up) only to decide whether ``np.dot`` and the like can be compiled.
+    passmd's kernels call no BLAS routine, so a command that only runs them loads the registry
+    first with that module hidden (numba then records "no BLAS" for this process) and unhides
+    it at once: scipy, imported later by anything else, is untouched. A no-op if numba's
+    registry or scipy's BLAS module is already loaded.
+    """
+    if "numba.np.arraymath" in sys.modules or _BLAS_MODULE in sys.modules:
+        return
+    sys.modules[_BLAS_MODULE] = None  # (an import of a None entry raises ImportError)
+    try:
+        import numba.np.arraymath  # noqa: F401
+    finally:
+        if sys.modules.get(_BLAS_MODULE, 0) is None:
+            del sys.modules[_BLAS_MODULE]

@@ -104,6 +104,7 @@ def check_output_paths(args) -> None:
 
 def simulate(args, drive):
     """The run the options describe (the saw-tooth or the optimized waveform of Eq. 15)."""
+    startup.load_numba_without_blas_probe()
     from passmd import dynamics, optimized_waveform, waveforms
     from passmd.protocols import eq15
 
