@@ -71,6 +71,19 @@ def test_response_snapshot(quick, name, dataframe_regression):
                                tolerances=_tolerances(locked.columns))
 
 
+@pytest.mark.parametrize("name", ["fig8a", "fig8b"])
+def test_response_velocity_is_the_runs(quick, name):
+    """The series' runner velocity is the run's: it agrees with the slope of the runner position
+    (central differences of the zoom view) to 5 % of its range, so no constant column (such as the
+    Eq. 15 design's V_r) can stand in for it."""
+    zoom = quick[name][quick[name]["view"] == "zoom"]
+    t, x, v = (zoom[c].to_numpy() for c in ("time_s", "runner_position_m", "runner_velocity_m_per_s"))
+    slope = np.gradient(x, t)
+    span = np.ptp(v)
+    assert span > 0
+    assert np.abs(slope[1:-1] - v[1:-1]).max() < 0.05 * span
+
+
 def test_fig9a_snapshot(quick, dataframe_regression):
     frame = quick["fig9a"]
     periods = frame[frame["view"] == "period"]

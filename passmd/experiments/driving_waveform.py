@@ -389,7 +389,7 @@ def fig8b(config: RunConfig) -> pd.DataFrame:
     if within t_s; 4: end of t_s; 5: end of t_a). Constant columns: the design
     (``settling_time_s``, ``acceleration_time_s``, ``acceleration_amplitude_m``,
     ``acceleration_velocity_m_per_s``, ``micro_vibration_frequency_Hz``,
-    ``runner_velocity_m_per_s``, ``presliding_m``, ``linear_frequency_Hz``).
+    ``design_runner_velocity_m_per_s`` (V_r of Eq. 15), ``presliding_m``, ``linear_frequency_Hz``).
     """
     c = section5_fields()
     design = designs([c], config).iloc[0]
@@ -407,9 +407,11 @@ def fig8b(config: RunConfig) -> pd.DataFrame:
              "3": float(z1) if z1 < T + t_s else math.nan, "4": T + t_s, "5": T + t_s + t_a}
     frame = pd.concat([series, _points_frame(series, times)], ignore_index=True)
     for key in ("settling_time_s", "acceleration_time_s", "acceleration_amplitude_m",
-                "acceleration_velocity_m_per_s", "micro_vibration_frequency_Hz", "runner_velocity_m_per_s",
-                "presliding_m", "linear_frequency_Hz"):
+                "acceleration_velocity_m_per_s", "micro_vibration_frequency_Hz", "presliding_m",
+                "linear_frequency_Hz"):
         frame[key] = float(design[key])
+    # the design's V_r under its own name: the series' runner_velocity_m_per_s is the run's
+    frame["design_runner_velocity_m_per_s"] = float(design["runner_velocity_m_per_s"])
     return _display(frame)
 
 
