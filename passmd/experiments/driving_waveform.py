@@ -415,9 +415,11 @@ def fig8b(config: RunConfig) -> pd.DataFrame:
     return _display(frame)
 
 
-#: Integration refinement of the fly-back window run: the default rigid step (1/400 of the runner's
-#: linear vibration period, about 0.23 µs) is longer than t_a (about 0.2 µs); divided by this the
-#: acceleration spans ~20 (quick) or ~40 (paper) steps.
+#: Integration refinement of the fly-back window run (``simulate``'s ``resolution``: the
+#: error-controlled step's tolerance divided by its fourth power, so the step by about this):
+#: t_a (about 0.2 µs) spans at least ``time_steps.MIN_SEGMENT_STEPS`` steps like every piece,
+#: and the refinement keeps the steps around it (the fly-back's slip and the settling t_s)
+#: as fine as t_a's.
 WINDOW_RESOLUTION = {"quick": 20.0, "paper": 40.0}
 #: Record spacing of the fly-back window run: t_a / this (evenly spaced over the whole run).
 WINDOW_SAMPLES_PER_ACCELERATION = 10
@@ -436,7 +438,7 @@ def window_point(hemisphere_radius: float, preload: float, runner: str, actuator
     fly-back to :data:`WINDOW_AFTER` after the end of t_a is returned (time series ``time_s``,
     ``runner_velocity_m_per_s``, ``runner_position_m``, ``piezo_position_m``, ``slip_share_<g>``),
     with the fly-back start and end, the start and end of t_a (s) and the largest record
-    spacing inside t_a (``record_spacing_s``; records fall on integration steps).
+    spacing inside t_a (``record_spacing_s``).
     """
     drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
     amplitude = drive.actuator.full_stroke_amplitude
