@@ -151,6 +151,24 @@ def test_convergence_facts_on_a_second_order_table():
     assert facts["ctrl_saving_rigid"] == pytest.approx(20.0)
 
 
+def test_convergence_plot_names_configurations_and_step_controls():
+    """One legend entry per configuration (colour) and per step control (line style), the
+    default scheme named as such; one curve per configuration and control."""
+    import matplotlib.pyplot as plt
+
+    from passmd.plots.numerics import plot_convergence
+
+    conv = _synthetic_convergence(lambda r: 2e-10 * r**-3.0)
+    fig = plot_convergence(conv)
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert labels[:2] == ["six contacts, flexible", "six contacts, rigid"]
+    assert labels[2:6] == ["error-controlled (default)", "explicit adaptive", "quasi-static actuator",
+                           "fixed fine step"]
+    curves = len(conv.groupby(["configuration", "step_control"]))
+    assert len(fig.axes[0].get_lines()) == curves + 3  # and the slope guides and the converged-accuracy line
+    plt.close(fig)
+
+
 def test_controlled_order_is_fitted_above_its_floor():
     """The error-controlled scheme's order leaves out the runs at its floor (within
     FLOOR_FACTOR of its finest runs' error) and those coarser than CONTROLLED_FIT_COARSEST:
