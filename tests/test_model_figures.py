@@ -115,30 +115,106 @@ def test_mdr_facts_come_from_the_figure_data():
     assert contact["sliding_force_mN"] == pytest.approx(0.2 * contact["normal_force_N"] * 1e3, rel=1e-12)
 
 
-def test_convergence_facts_on_a_second_order_table():
-    """Synthetic errors falling exactly as h²: the fitted order is 2, the savings the step ratios."""
+def _synthetic_convergence(controlled_error):
+    """A convergence table whose explicit errors fall exactly as h², with the error-controlled
+    scheme's errors ``controlled_error(r)``; steps per control in fixed ratios."""
     rows = []
-    for label in ("six contacts, flexible", "one contact, rigid"):
-        controls = ("adaptive", "fixed", "quasi-static") if "flexible" in label else ("fixed",)
+    per_step = {"controlled": 50, "adaptive": 100, "fixed": 1000, "quasi-static": 20}
+    for label in ("six contacts, flexible", "six contacts, rigid"):
+        controls = numerics.STEP_CONTROLS if "flexible" in label else numerics.RIGID_STEP_CONTROLS
         for control in controls:
-            for r in (0.5, 1.0, 2.0, 4.0):
-                steps = {"adaptive": 100, "fixed": 1000, "quasi-static": 20}[control] * r
-                rows.append(
-                    {
-                        "configuration": label,
-                        "step_control": control,
-                        "resolution": r,
-                        "steps": steps,
-                        "final_position_m": 1e-6,
-                        "error_m": 1e-10 * r**-2.0,
-                    }
-                )
-    facts = numerics.convergence_facts(pd.DataFrame(rows))
+            for r in (0.25, 0.5, 1.0, 2.0, 4.0):
+                steps = per_step[control] * r
+                error = controlled_error(r) if control == "controlled" else 1e-10 * r**-2.0
+                rows.append({"configuration": label, "step_control": control, "resolution": r, "steps": steps,
+                             "rejected_steps": 0.1 * steps if control == "controlled" else 0,
+                             "final_position_m": 1e-6, "error_m": error})
+    return pd.DataFrame(rows)
+
+
+def test_convergence_facts_on_a_second_order_table():
+    """Synthetic errors falling exactly as h² (explicit) and h³ (error-controlled): the fitted
+    orders are 2 and 3, the savings the step ratios."""
+    facts = numerics.convergence_facts(_synthetic_convergence(lambda r: -2e-10 * r**-3.0))
     assert facts["conv_order"] == pytest.approx(2.0, rel=1e-9)
     assert facts["quasi_order"] == pytest.approx(2.0, rel=1e-9)
     assert facts["conv_max_err_nm"] == pytest.approx(0.1, rel=1e-9)
     assert facts["adaptive_saving"] == pytest.approx(10.0) and facts["quasi_saving"] == pytest.approx(5.0)
     assert facts["adaptive_vs_fixed_nm"] == 0.0
+    assert facts["ctrl_order"] == pytest.approx(3.0, rel=1e-9)
+    assert facts["ctrl_max_err_nm"] == pytest.approx(0.2, rel=1e-9)
+    assert facts["ctrl_floor_nm"] == pytest.approx(0.2 / 64, rel=1e-9)  # the finest runs' (r = 4) error
+    assert facts["ctrl_floor_rigid_nm"] == facts["ctrl_floor_flexible_nm"] == facts["ctrl_floor_nm"]
+    assert facts["ctrl_rejected_pct"] == pytest.approx(10.0)
+    assert facts["ctrl_saving_adaptive"] == pytest.approx(2.0)
+    assert facts["ctrl_saving_fixed"] == pytest.approx(20.0)
+    assert facts["ctrl_saving_rigid"] == pytest.approx(20.0)
+
+
+def test_convergence_plot_names_configurations_and_step_controls():
+    """One legend entry per configuration (colour) and per step control (line style), the
+    default scheme named as such; one curve per configuration and control."""
+    import matplotlib.pyplot as plt
+
+    from passmd.plots.numerics import plot_convergence
+
+    conv = _synthetic_convergence(lambda r: 2e-10 * r**-3.0)
+    fig = plot_convergence(conv)
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert labels[:2] == ["six contacts, flexible", "six contacts, rigid"]
+    assert labels[2:6] == ["error-controlled (default)", "explicit adaptive", "quasi-static actuator",
+                           "fixed fine step"]
+    curves = len(conv.groupby(["configuration", "step_control"]))
+    assert len(fig.axes[0].get_lines()) == curves + 3  # and the slope guides and the converged-accuracy line
+    plt.close(fig)
+
+
+def test_controlled_order_is_fitted_above_its_floor():
+    """The error-controlled scheme's order leaves out the runs at its floor (within
+    FLOOR_FACTOR of its finest runs' error) and those coarser than CONTROLLED_FIT_COARSEST:
+    a h³ error that levels off at 1e-11 m and is flat below resolution 0.5 still fits as 3."""
+
+    def error(r):
+        if r < numerics.CONTROLLED_FIT_COARSEST:
+            return 8e-10  # the longest step binds: no longer the tolerance's error
+        return max(1e-10 * r**-3.0, 1e-11)
+
+    conv = _synthetic_convergence(error)
+    facts = numerics.convergence_facts(conv)
+    assert facts["ctrl_order"] == pytest.approx(3.0, rel=1e-9)
+    assert facts["ctrl_floor_nm"] == pytest.approx(0.01, rel=1e-9)
+    # without those exclusions the same runs fit far from 3
+    controlled = conv[conv["step_control"] == "controlled"]
+    assert numerics.fitted_order_above_floor(controlled, factor=0.0, coarsest=0.0)[0] < 2.0
+    flat = controlled.assign(error_m=1e-11)
+    with pytest.raises(ValueError, match=r"only 0 resolution\(s\) with an error above 3 times the floor"):
+        numerics.fitted_order_above_floor(flat)
+
+
+def test_convergence_reference_is_the_reference_controls_finest_run():
+    """Each configuration runs the applicable step controls plus its reference control, and its
+    reference is that control's finest run, whatever order the controls are listed in."""
+    conv = numerics.convergence_study(periods=1, resolutions=(1.0, 2.0), step_controls=("controlled",))
+    for label, _, actuator_model in numerics.CONFIGURATIONS:
+        rows = conv[conv["configuration"] == label]
+        reference = numerics.REFERENCE_CONTROL[actuator_model]
+        assert set(rows["step_control"]) == {"controlled", reference}
+        zero = rows[rows["error_m"] == 0.0]
+        assert list(zero["step_control"]) == [reference] and list(zero["resolution"]) == [2.0]
+    assert (conv.loc[conv["step_control"] == "controlled", "rejected_steps"] > 0).all()
+    with pytest.raises(ValueError, match=r"^step_controls = 'implicit'"):
+        numerics.convergence_study(step_controls=("implicit",))
+
+
+def test_energy_facts_compare_the_same_runs():
+    energy = pd.DataFrame({"configuration": ["a", "b"], "contact_model": ["exact"] * 2,
+                           "relative_residual": [-4e-5, 1e-5]})
+    refined = energy.assign(relative_residual=[1e-5, 5e-6])
+    facts = numerics.energy_facts(energy, refined)
+    assert facts == pytest.approx({"energy_max_rel": 4e-5, "energy_shrink_min": 2.0,
+                                   "energy_shrink_max": 4.0})
+    with pytest.raises(ValueError, match="same runs"):
+        numerics.energy_facts(energy, refined.iloc[::-1])
 
 
 def test_settle_and_coulomb_texts():
@@ -164,6 +240,8 @@ def test_step_plan_and_benchmark_facts():
     plan = numerics.step_plan_table()
     assert list(plan["configuration"]) == [c[0] for c in numerics.CONFIGURATIONS]
     assert (plan["fine step (ns)"] < plan["stability limit 2/ω (ns)"]).all()
+    # the error-controlled step may grow far beyond the explicit steps (the runner mode is exact)
+    assert (plan["longest controlled step (ns)"] > plan["coarse step (ns)"]).all()
     facts = numerics.benchmark_facts(numerics.benchmark_table())
     assert facts["bench_six_flex_ms"] > 0 and facts["bench_fixed_ns"] > 0
     assert facts["target_ms_per_period"] == numerics.TARGET_MS_PER_PERIOD

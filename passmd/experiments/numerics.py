@@ -32,6 +32,24 @@ CONFIGURATIONS = (
 RESOLUTIONS = {"quick": (0.5, 1.0, 2.0, 4.0), "paper": (0.25, 0.5, 1.0, 2.0, 4.0, 8.0)}
 
 
+#: Step controls of :func:`convergence_study` by name: the keywords of
+#: :func:`passmd.dynamics.simulate` that select each scheme.
+STEP_CONTROLS = {
+    "controlled": {},  # the default: error-controlled steps (rigid; flexible once quasi-static)
+    "adaptive": {"error_control": False},  # explicit adaptive step (fine while ringing, coarse after)
+    "quasi-static": {"error_control": False, "quasi_static": True},  # m_a neglected, fixed runner step
+    "fixed": {"adaptive": False},  # the fine step throughout: the reference scheme
+}
+#: Step controls that differ for rigid actuators (they have no actuator mode to adapt to: their
+#: explicit adaptive and quasi-static steps are the fixed one).
+RIGID_STEP_CONTROLS = ("controlled", "fixed")
+#: The step control whose finest run is a configuration's reference, by actuator model: the fixed
+#: fine step (rigid) and the explicit adaptive step (flexible: there the fixed fine step runs only
+#: up to resolution 2; how closely the two agree is ``adaptive_vs_fixed_nm`` of
+#: :func:`convergence_facts`).
+REFERENCE_CONTROL = {"rigid": "fixed", "flexible": "adaptive"}
+
+
 def convergence_study(
     amplitude: float = 150e-9,
     frequency: float = PROTOCOL.drive_frequency,
@@ -39,35 +57,41 @@ def convergence_study(
     resolutions=RESOLUTIONS["quick"],
     preload: float = 0.4,
     hemisphere_radius: float = 1e-3,
-    step_controls=("adaptive", "fixed"),
+    step_controls=("controlled", "adaptive", "fixed"),
 ) -> pd.DataFrame:
     """Runner position after ``periods`` saw-tooth periods against the time-step refinement.
 
-    For each configuration the finest run is the reference; ``error_m`` is the difference
-    to it. Flexible actuators are run with the adaptive step (default) and with the fixed
-    fine step, so the table also shows what the adaptation costs in accuracy; with
-    ``"quasi-static"`` in ``step_controls`` also with the quasi-static actuator step
-    (``simulate(..., quasi_static=True)``).
+    Each configuration runs the ``step_controls`` that apply to it (:data:`STEP_CONTROLS`;
+    rigid actuators only :data:`RIGID_STEP_CONTROLS`) and always its reference control
+    (:data:`REFERENCE_CONTROL`), at every resolution (the fixed fine step of flexible actuators
+    only up to 2). ``resolution`` divides the explicit steps and, for ``"controlled"``, the
+    error tolerance by its fourth power (:func:`passmd.dynamics.simulate`), so that its steps
+    too are ≈ ``resolution`` times shorter. The reference is the finest run of the reference
+    control; ``error_m`` is the difference to it.
 
     Returns
     -------
     DataFrame
         Columns ``configuration, step_control, resolution, fine_step_s, coarse_step_s,
-        steps, final_position_m, error_m``.
+        steps, rejected_steps, final_position_m, error_m``.
     """
+    for control in step_controls:
+        check_choice("step_controls", control, tuple(STEP_CONTROLS))
     rows = []
     for label, contacts, model in CONFIGURATIONS:
         drive = Drive(
             hemisphere_radius=hemisphere_radius, preload=preload, contacts=contacts, actuator_model=model
         )
         wf = waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
-        controls = tuple(step_controls) if model == "flexible" else ("fixed",)
+        reference = REFERENCE_CONTROL[model]
+        applicable = tuple(STEP_CONTROLS) if model == "flexible" else RIGID_STEP_CONTROLS
+        controls = [c for c in step_controls if c in applicable]
+        controls += [] if reference in controls else [reference]
         for control in controls:
             for r in resolutions:
                 if control == "fixed" and model == "flexible" and r > 2.0:
                     continue  # the fixed fine step at r > 2 costs minutes and adds nothing
-                res = dynamics.simulate(drive, wf, resolution=r, adaptive=control != "fixed",
-                                        quasi_static=control == "quasi-static", max_points=2)
+                res = dynamics.simulate(drive, wf, resolution=r, max_points=2, **STEP_CONTROLS[control])
                 rows.append(
                     {
                         "configuration": label,
@@ -76,30 +100,37 @@ def convergence_study(
                         "fine_step_s": res.fine_step,
                         "coarse_step_s": res.coarse_step,
                         "steps": res.steps,
+                        "rejected_steps": res.rejected_steps,
                         "final_position_m": res.final_position,
+                        "reference": control == reference,
                     }
                 )
     df = pd.DataFrame(rows)
-    # reference: the finest run of each configuration (adaptive for flexible actuators)
-    finest = df.loc[df.groupby("configuration")["resolution"].idxmax()]
+    # reference: the finest run of each configuration's reference control
+    is_reference = df.pop("reference")
+    runs = df[is_reference]
+    finest = runs.loc[runs.groupby("configuration")["resolution"].idxmax()]
     ref = finest.set_index("configuration")["final_position_m"]
     df["error_m"] = df["final_position_m"] - df["configuration"].map(ref)
     return df
 
 
 def energy_balance_table(
-    amplitude: float = 150e-9, frequency: float = 1000.0, periods: int = 3
+    amplitude: float = 150e-9, frequency: float = 1000.0, periods: int = 3, resolution: float = 1.0
 ) -> pd.DataFrame:
     """Energy balance W_in = E_kin + E_el + W_contact + W_damp of each configuration.
 
-    Runs with the exact contact and with the discrete contact (N = 200 springs).
+    Runs the default (error-controlled) scheme of :func:`passmd.dynamics.simulate` at
+    ``resolution`` with the exact contact and with the discrete contact
+    (:data:`passmd.defaults.PROTOCOL` ``.springs`` springs).
     """
     rows = []
     for label, contacts, model in CONFIGURATIONS:
         drive = Drive(contacts=contacts, actuator_model=model)
         wf = waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
         for contact in ("exact", "discrete"):
-            res = dynamics.simulate(drive, wf, contact_model=contact, springs=PROTOCOL.springs, max_points=2)
+            res = dynamics.simulate(drive, wf, contact_model=contact, springs=PROTOCOL.springs,
+                                    max_points=2, resolution=resolution)
             bal = res.energy_balance()
             rows.append({"configuration": label, "contact_model": contact, **bal})
     return pd.DataFrame(rows)
@@ -307,8 +338,9 @@ def coulomb_limit_rates(table: pd.DataFrame) -> pd.DataFrame:
 # Figures of the numerics section (rows of passmd.figures)
 # --------------------------------------------------------------------------------------
 
-#: Step controls of the convergence figure (flexible actuators; rigid ones use the fixed step).
-CONVERGENCE_STEP_CONTROLS = ("adaptive", "fixed", "quasi-static")
+#: Step controls of the convergence figure (:data:`STEP_CONTROLS`; rigid actuators run those of
+#: :data:`RIGID_STEP_CONTROLS`).
+CONVERGENCE_STEP_CONTROLS = ("controlled", "adaptive", "quasi-static", "fixed")
 #: Saw-tooth of the rigid-Coulomb-limit figure: amplitude (m), frequency (Hz), periods (the last step counts).
 COULOMB_RUN = {"amplitude": 150e-9, "frequency": PROTOCOL.drive_frequency, "periods": 4}
 
@@ -336,7 +368,9 @@ def model_coulomb_limit(config: RunConfig) -> pd.DataFrame:
 def step_plan_table() -> pd.DataFrame:
     """The integrator's steps (:func:`passmd.time_steps.step_plan`) for each of :data:`CONFIGURATIONS`.
 
-    Columns: ``configuration``, stiffest mode (kHz), stability limit 2/ω, fine and coarse step (ns).
+    Columns: ``configuration``, stiffest mode (kHz), stability limit 2/ω, fine and coarse step and
+    the longest error-controlled step (ns; :data:`passmd.time_steps.LONGEST_OMEGA_DT` over the
+    runner mode's ω, whatever the local error allows).
     """
     rows = []
     for label, contacts, model in CONFIGURATIONS:
@@ -350,6 +384,7 @@ def step_plan_table() -> pd.DataFrame:
             "stability limit 2/ω (ns)": from_si(plan.stability_limit, "ns"),
             "fine step (ns)": from_si(plan.fine_step, "ns"),
             "coarse step (ns)": from_si(plan.coarse_step, "ns"),
+            "longest controlled step (ns)": from_si(plan.longest_step, "ns"),
         })
     return pd.DataFrame(rows)
 
@@ -360,19 +395,70 @@ def fitted_convergence_order(rows: pd.DataFrame) -> float:
     return float(-np.polyfit(np.log(fit["resolution"]), np.log(np.abs(fit["error_m"])), 1)[0])
 
 
+#: A run of the error-controlled scheme enters its fitted order only if its error exceeds this
+#: multiple of the scheme's floor (the largest error of its finest runs, where it no longer
+#: approaches the reference): within it, the floor and not the step sets the error. At 3 the floor
+#: is at most a third of any error that enters the fit.
+FLOOR_FACTOR = 3.0
+#: Coarsest resolution in the error-controlled scheme's fitted order. Coarser, the tolerance
+#: (resolution⁻⁴ times the default) lets many steps reach the longest step
+#: (:data:`passmd.time_steps.LONGEST_OMEGA_DT` over ω), which it then no longer sets: at 0.25 the
+#: runs change when that bound is raised, at 0.5 and finer they hardly do.
+CONTROLLED_FIT_COARSEST = 0.5
+
+
+def fitted_order_above_floor(rows: pd.DataFrame, factor: float = FLOOR_FACTOR,
+                             coarsest: float = CONTROLLED_FIT_COARSEST) -> tuple[float, float]:
+    """Order p of |error| ∝ h^p of one step control, fitted above its error floor.
+
+    The floor is the largest |error| of the control's finest runs (all configurations); the
+    least-squares slope is taken over the runs at ``coarsest`` resolution or finer whose |error|
+    exceeds ``factor`` times the floor. Returns (p, floor in m).
+
+    Raises
+    ------
+    ValueError
+        Fewer than two resolutions above the floor: coarser runs are needed to fit an order.
+    """
+    finest = rows[rows["resolution"] == rows["resolution"].max()]
+    floor = float(np.abs(finest["error_m"]).max())
+    fit = rows[(np.abs(rows["error_m"]) > factor * floor) & (rows["resolution"] >= coarsest)]
+    if fit["resolution"].nunique() < 2:
+        raise ValueError(f"only {fit['resolution'].nunique()} resolution(s) with an error above {factor:g} "
+                         f"times the floor of {floor:.3g} m: run coarser resolutions to fit an order")
+    order = -np.polyfit(np.log(fit["resolution"]), np.log(np.abs(fit["error_m"])), 1)[0]
+    return float(order), floor
+
+
 def convergence_facts(conv: pd.DataFrame) -> dict:
-    """Orders, largest errors at the default step (nm), adaptive-vs-fixed difference (nm) and the
-    step savings of the adaptive and quasi-static steps for six flexible contacts
-    (:func:`model_convergence`)."""
-    explicit = conv[conv["step_control"] != "quasi-static"]
+    """Numbers the convergence paragraphs quote (:func:`model_convergence`).
+
+    Explicit schemes (adaptive and fixed): ``conv_order`` and ``conv_max_err_nm``, their order
+    and largest error at the default step (nm); ``adaptive_vs_fixed_nm``, their largest
+    difference (flexible); ``adaptive_saving``, fixed over adaptive steps. Quasi-static step:
+    ``quasi_order``, ``quasi_max_err_nm`` and ``quasi_saving`` (adaptive over its steps).
+    Error-controlled scheme: ``ctrl_order`` and ``ctrl_floor_nm`` (:func:`fitted_order_above_floor`),
+    ``ctrl_floor_rigid_nm`` and ``ctrl_floor_flexible_nm`` (the largest error of its finest runs
+    with rigid and with flexible actuators), ``ctrl_max_err_nm`` (its largest error at the
+    default tolerance), ``ctrl_rejected_pct`` (the largest share of its steps rejected there,
+    %), ``ctrl_saving_adaptive`` and ``ctrl_saving_fixed`` (explicit adaptive and fixed steps
+    over its own, six contacts, flexible) and ``ctrl_saving_rigid`` (fixed over its own, six
+    contacts, rigid). Savings are at the default step, for six flexible contacts unless said.
+    """
+    explicit = conv[conv["step_control"].isin(("adaptive", "fixed"))]
     default = explicit[explicit["resolution"] == 1.0]
     quasi = conv[conv["step_control"] == "quasi-static"]
+    controlled = conv[conv["step_control"] == "controlled"]
+    ctrl_default = controlled[controlled["resolution"] == 1.0]
+    ctrl_order, ctrl_floor = fitted_order_above_floor(controlled)
+    ctrl_finest = controlled[controlled["resolution"] == controlled["resolution"].max()]
+    ctrl_flexible = ctrl_finest["configuration"].str.contains("flexible")
     adaptive = conv[conv["step_control"] == "adaptive"]
     adaptive = adaptive.set_index(["configuration", "resolution"])["final_position_m"]
     fixed = conv[(conv["step_control"] == "fixed") & conv["configuration"].str.contains("flexible")]
     fixed = fixed.set_index(["configuration", "resolution"])["final_position_m"]
     steps = conv[conv["resolution"] == 1.0].set_index(["configuration", "step_control"])["steps"]
-    six = "six contacts, flexible"
+    six, six_rigid = "six contacts, flexible", "six contacts, rigid"
     return {
         "conv_order": fitted_convergence_order(explicit),
         "quasi_order": fitted_convergence_order(quasi),
@@ -381,7 +467,28 @@ def convergence_facts(conv: pd.DataFrame) -> dict:
         "adaptive_vs_fixed_nm": float(np.abs(adaptive.reindex(fixed.index) - fixed).max() * 1e9),
         "adaptive_saving": float(steps[(six, "fixed")] / steps[(six, "adaptive")]),
         "quasi_saving": float(steps[(six, "adaptive")] / steps[(six, "quasi-static")]),
+        "ctrl_order": ctrl_order,
+        "ctrl_floor_nm": ctrl_floor * 1e9,
+        "ctrl_floor_rigid_nm": float(np.abs(ctrl_finest[~ctrl_flexible]["error_m"]).max() * 1e9),
+        "ctrl_floor_flexible_nm": float(np.abs(ctrl_finest[ctrl_flexible]["error_m"]).max() * 1e9),
+        "ctrl_max_err_nm": float(np.abs(ctrl_default["error_m"]).max() * 1e9),
+        "ctrl_rejected_pct": float((ctrl_default["rejected_steps"] / ctrl_default["steps"]).max() * 100),
+        "ctrl_saving_adaptive": float(steps[(six, "adaptive")] / steps[(six, "controlled")]),
+        "ctrl_saving_fixed": float(steps[(six, "fixed")] / steps[(six, "controlled")]),
+        "ctrl_saving_rigid": float(steps[(six_rigid, "fixed")] / steps[(six_rigid, "controlled")]),
     }
+
+
+def energy_facts(energy: pd.DataFrame, refined: pd.DataFrame) -> dict:
+    """Largest |relative residual| of :func:`energy_balance_table` (``energy_max_rel``) and the
+    smallest and largest factor by which each run's residual shrinks in ``refined``, the same
+    table at resolution 2 (``energy_shrink_min``, ``energy_shrink_max``; 4 for an O(h²) error)."""
+    keys = ["configuration", "contact_model"]
+    if not energy[keys].reset_index(drop=True).equals(refined[keys].reset_index(drop=True)):
+        raise ValueError("refined must list the same runs as energy, in the same order")
+    shrink = energy["relative_residual"].abs().to_numpy() / refined["relative_residual"].abs().to_numpy()
+    return {"energy_max_rel": float(energy["relative_residual"].abs().max()),
+            "energy_shrink_min": float(shrink.min()), "energy_shrink_max": float(shrink.max())}
 
 
 def settle_facts(sens: pd.DataFrame) -> dict:

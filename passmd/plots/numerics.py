@@ -5,27 +5,53 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
+from matplotlib.lines import Line2D
+from matplotlib.ticker import NullLocator
 
 from passmd.time_steps import CONVERGED_ACCURACY
 
-__all__ = ["CONVERGED_STEP_NM", "plot_convergence", "plot_coulomb_limit"]
+__all__ = ["CONVERGED_STEP_NM", "STEP_CONTROL_STYLES", "plot_convergence", "plot_coulomb_limit"]
 
 #: Position error drawn as the convergence target (:data:`passmd.time_steps.CONVERGED_ACCURACY`) (nm).
 CONVERGED_STEP_NM = CONVERGED_ACCURACY * 1e9
 
 
+#: Legend name of each step control of the convergence figure
+#: (:data:`passmd.experiments.numerics.STEP_CONTROLS`) and its line style and marker.
+STEP_CONTROL_STYLES = {
+    "controlled": ("error-controlled (default)", "-", "o"),
+    "adaptive": ("explicit adaptive", "--", "s"),
+    "quasi-static": ("quasi-static actuator", "-.", "^"),
+    "fixed": ("fixed fine step", ":", "x"),
+}
+
+
 def plot_convergence(df: pd.DataFrame):
-    """|position error| after the run against the step refinement, per configuration and step control."""
-    fig, ax = plt.subplots(figsize=(6.4, 4))
+    """|position error| after the run against the step refinement: one colour per configuration,
+    one line style and marker per step control (:data:`STEP_CONTROL_STYLES`)."""
+    fig, ax = plt.subplots(figsize=(6.4, 5.2))
+    colours = {label: f"C{i}" for i, label in enumerate(df["configuration"].unique())}
     for (label, control), g in df.groupby(["configuration", "step_control"], sort=False):
         g = g[g["error_m"] != 0]
-        ax.loglog(g["resolution"], np.abs(g["error_m"]) * 1e9, "o-", label=f"{label} ({control} step)")
+        _, style, marker = STEP_CONTROL_STYLES[control]
+        ax.loglog(g["resolution"], np.abs(g["error_m"]) * 1e9, ls=style, marker=marker, color=colours[label],
+                  lw=2.0 if control == "controlled" else 1.0, ms=5)
     r = np.array(sorted(df["resolution"].unique()))
-    ax.loglog(r, 0.02 * r**-2.0, "k:", label="slope −2")
+    ax.loglog(r, 0.02 * r**-2.0, color="grey", ls=(0, (1, 3)), lw=1)
+    ax.loglog(r, 0.02 * r**-3.0, color="grey", ls=(0, (5, 1, 1, 1)), lw=1)
     ax.axhline(CONVERGED_STEP_NM, color="grey", lw=0.8, ls="--")
-    ax.set_xlabel("step refinement (1 = default)")
+    ax.set_xticks(r, [f"{v:g}" for v in r])
+    ax.xaxis.set_minor_locator(NullLocator())
+    ax.set_xlabel("step refinement (1 = default; error-controlled: tolerance ÷ refinement⁴)")
     ax.set_ylabel("|position error| after 3 periods (nm)")
-    ax.legend(fontsize=7)
+    handles = [Line2D([], [], color=c, lw=2, label=label) for label, c in colours.items()]
+    handles += [Line2D([], [], color="k", ls=STEP_CONTROL_STYLES[c][1], marker=STEP_CONTROL_STYLES[c][2],
+                       lw=2.0 if c == "controlled" else 1.0, label=STEP_CONTROL_STYLES[c][0])
+                for c in STEP_CONTROL_STYLES if c in set(df["step_control"])]
+    handles += [Line2D([], [], color="grey", ls=(0, (1, 3)), label="slope −2"),
+                Line2D([], [], color="grey", ls=(0, (5, 1, 1, 1)), label="slope −3")]
+    ax.legend(handles=handles, fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.16))
+    fig.tight_layout()
     return fig
 
 
