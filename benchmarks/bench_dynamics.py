@@ -190,6 +190,7 @@ def main(argv=None) -> int:
         "machine": platform.processor() or platform.machine(),
         "python": platform.python_version(),
         "repeats": args.repeats,
+        "periods_per_run": PERIODS,
         "cpus": os.cpu_count(),
         "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()),
         # 1-, 5-, 15-minute load averages before and after: > 0.5 means the machine was not quiet

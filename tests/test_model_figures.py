@@ -244,4 +244,7 @@ def test_step_plan_and_benchmark_facts():
     assert (plan["longest controlled step (ns)"] > plan["coarse step (ns)"]).all()
     facts = numerics.benchmark_facts(numerics.benchmark_table())
     assert facts["bench_six_flex_ms"] > 0 and facts["bench_fixed_ns"] > 0
+    # the default (error-controlled) row, not the explicit adaptive one it replaced
+    assert facts["bench_six_flex_ms"] < facts["bench_six_flex_adaptive_ms"]
+    assert facts["bench_periods"] >= 1
     assert facts["target_ms_per_period"] == numerics.TARGET_MS_PER_PERIOD

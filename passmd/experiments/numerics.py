@@ -545,20 +545,24 @@ def coulomb_rising_gaps(coulomb: pd.DataFrame) -> list[str]:
     return rising
 
 
-#: Speed targets of the integrator: ms per 100 Hz period of the six-contact flexible drive
-#: (adaptive step, exact contact) and ns per fixed step (exact contact).
-TARGET_MS_PER_PERIOD, TARGET_NS_PER_STEP = 20.0, 25.0
+#: Speed targets of the integrator (README, "Performance"): ms per 100 Hz period of the
+#: six-contact flexible drive with the default (error-controlled) step and the exact contact,
+#: which a sweep of the assumption space needs, and ns per fixed step (exact contact).
+TARGET_MS_PER_PERIOD, TARGET_NS_PER_STEP = 1.0, 25.0
 
 
 def benchmark_facts(bench: pd.DataFrame) -> dict:
     """The speed numbers the performance paragraph quotes, from :func:`benchmark_table`:
-    ms per 100 Hz period (six flexible contacts, adaptive, exact), the largest ns per fixed
-    step (exact), the machine's load average, and the targets."""
+    ms per 100 Hz period (six flexible contacts, exact contact) with the default
+    error-controlled step and with the explicit adaptive one, the periods each timed run
+    lasted, the largest ns per fixed step (exact), the machine's load average, and the targets."""
     six_flex = bench[(bench["contacts"] == 6) & (bench["actuator"] == "flexible")
-                     & (bench["step"] == "adaptive") & (bench["contact_model"] == "exact")].iloc[0]
+                     & (bench["contact_model"] == "exact")].set_index("step")
     fixed_exact = bench[(bench["step"] == "fixed") & (bench["contact_model"] == "exact")]
     return {
-        "bench_six_flex_ms": float(six_flex["ms_per_100Hz_period"]),
+        "bench_six_flex_ms": float(six_flex.loc["controlled", "ms_per_100Hz_period"]),
+        "bench_six_flex_adaptive_ms": float(six_flex.loc["adaptive", "ms_per_100Hz_period"]),
+        "bench_periods": int(bench.attrs["meta"].get("periods_per_run", 1)),
         "bench_fixed_ns": float(fixed_exact["ns_per_step"].max()),
         "bench_load": float(bench.attrs["meta"].get("load_average_before", [float("nan")])[0]),
         "target_ms_per_period": TARGET_MS_PER_PERIOD,
