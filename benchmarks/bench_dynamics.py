@@ -152,6 +152,7 @@ def bench(contacts: int, model: str, contact: str, control: str, repeats: int, s
         "contact_model": contact if contact == "exact" else f"discrete N={springs}",
         "steps_per_period": res.steps / PERIODS,
         "rejected_per_period": res.rejected_steps / PERIODS,
+        "fine_per_period": res.fine_steps / PERIODS,
         "fine_step_ns": res.fine_step * 1e9,
         "coarse_step_ns": res.coarse_step * 1e9,
         "ns_per_step": wall / res.steps * 1e9,
