@@ -247,4 +247,5 @@ def test_step_plan_and_benchmark_facts():
     # the default (error-controlled) row, not the explicit adaptive one it replaced
     assert facts["bench_six_flex_ms"] < facts["bench_six_flex_adaptive_ms"]
     assert facts["bench_periods"] >= 1
+    assert facts["bench_processes"] >= 1 and facts["bench_six_flex_processes_ms"] > 0
     assert facts["target_ms_per_period"] == numerics.TARGET_MS_PER_PERIOD

@@ -175,11 +175,13 @@ def benchmark_table(path: str | Path | None = None) -> pd.DataFrame:
     """The speed benchmark's last results (``benchmarks/bench_dynamics.py``), as a table.
 
     Reads :func:`benchmark_results` ``("dynamics", path)``; ``df.attrs["meta"]`` holds the
-    machine and settings it was measured with.
+    machine and settings it was measured with, ``df.attrs["across_processes"]`` the headline
+    configuration timed in several fresh processes (empty if the file predates it).
     """
     data = benchmark_results("dynamics", path)
     df = pd.DataFrame(data["rows"])
     df.attrs["meta"] = data.get("meta", {})
+    df.attrs["across_processes"] = data.get("across_processes", {})
     return df
 
 
@@ -555,7 +557,10 @@ def benchmark_facts(bench: pd.DataFrame) -> dict:
     """The speed numbers the performance paragraph quotes, from :func:`benchmark_table`:
     ms per 100 Hz period (six flexible contacts, exact contact) with the default
     error-controlled step and with the explicit adaptive one, the periods each timed run
-    lasted, the largest ns per fixed step (exact), the machine's load average, and the targets."""
+    lasted, the same default-step configuration's median over fresh processes and their number
+    (``bench_six_flex_processes_ms``, ``bench_processes``; NaN and 0 if not measured), the
+    largest ns per fixed step (exact), the machine's load average, and the targets."""
+    spread = bench.attrs.get("across_processes", {})
     six_flex = bench[(bench["contacts"] == 6) & (bench["actuator"] == "flexible")
                      & (bench["contact_model"] == "exact")].set_index("step")
     fixed_exact = bench[(bench["step"] == "fixed") & (bench["contact_model"] == "exact")]
@@ -563,6 +568,8 @@ def benchmark_facts(bench: pd.DataFrame) -> dict:
         "bench_six_flex_ms": float(six_flex.loc["controlled", "ms_per_100Hz_period"]),
         "bench_six_flex_adaptive_ms": float(six_flex.loc["adaptive", "ms_per_100Hz_period"]),
         "bench_periods": int(bench.attrs["meta"].get("periods_per_run", 1)),
+        "bench_six_flex_processes_ms": float(spread.get("median_ms_per_100Hz_period", float("nan"))),
+        "bench_processes": len(spread.get("ms_per_100Hz_period_per_process", [])),
         "bench_fixed_ns": float(fixed_exact["ns_per_step"].max()),
         "bench_load": float(bench.attrs["meta"].get("load_average_before", [float("nan")])[0]),
         "target_ms_per_period": TARGET_MS_PER_PERIOD,
