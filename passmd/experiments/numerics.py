@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from passmd import dynamics, theory, time_steps, waveforms
+from passmd import dynamics, sweep, theory, time_steps, waveforms
 from passmd._validation import check_choice, check_count, check_range
 from passmd.config import RunConfig
 from passmd.defaults import PROTOCOL
@@ -50,6 +50,18 @@ RIGID_STEP_CONTROLS = ("controlled", "fixed")
 REFERENCE_CONTROL = {"rigid": "fixed", "flexible": "adaptive"}
 
 
+def convergence_point(contacts: int, actuator_model: str, step_control: str, resolution: float,
+                      amplitude: float, frequency: float, periods: int, preload: float,
+                      hemisphere_radius: float) -> dict:
+    """One run of :func:`convergence_study`: the saw-tooth run's steps and final position (SI)."""
+    drive = Drive(hemisphere_radius=hemisphere_radius, preload=preload, contacts=contacts,
+                  actuator_model=actuator_model)
+    wf = waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
+    res = dynamics.simulate(drive, wf, resolution=resolution, max_points=2, **STEP_CONTROLS[step_control])
+    return {"fine_step_s": res.fine_step, "coarse_step_s": res.coarse_step, "steps": res.steps,
+            "rejected_steps": res.rejected_steps, "final_position_m": res.final_position}
+
+
 def convergence_study(
     amplitude: float = 150e-9,
     frequency: float = PROTOCOL.drive_frequency,
@@ -58,6 +70,7 @@ def convergence_study(
     preload: float = 0.4,
     hemisphere_radius: float = 1e-3,
     step_controls=("controlled", "adaptive", "fixed"),
+    config: RunConfig | None = None,
 ) -> pd.DataFrame:
     """Runner position after ``periods`` saw-tooth periods against the time-step refinement.
 
@@ -67,7 +80,9 @@ def convergence_study(
     only up to 2). ``resolution`` divides the explicit steps and, for ``"controlled"``, the
     error tolerance by its fourth power (:func:`passmd.dynamics.simulate`), so that its steps
     too are ≈ ``resolution`` times shorter. The reference is the finest run of the reference
-    control; ``error_m`` is the difference to it.
+    control; ``error_m`` is the difference to it. With a ``config`` the runs
+    (:func:`convergence_point`) go through :func:`passmd.sweep.run`, in parallel and cached;
+    without one they run here, one after the other.
 
     Returns
     -------
@@ -77,12 +92,8 @@ def convergence_study(
     """
     for control in step_controls:
         check_choice("step_controls", control, tuple(STEP_CONTROLS))
-    rows = []
+    labels, points = [], []
     for label, contacts, model in CONFIGURATIONS:
-        drive = Drive(
-            hemisphere_radius=hemisphere_radius, preload=preload, contacts=contacts, actuator_model=model
-        )
-        wf = waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
         reference = REFERENCE_CONTROL[model]
         applicable = tuple(STEP_CONTROLS) if model == "flexible" else RIGID_STEP_CONTROLS
         controls = [c for c in step_controls if c in applicable]
@@ -91,25 +102,26 @@ def convergence_study(
             for r in resolutions:
                 if control == "fixed" and model == "flexible" and r > 2.0:
                     continue  # the fixed fine step at r > 2 costs minutes and adds nothing
-                res = dynamics.simulate(drive, wf, resolution=r, max_points=2, **STEP_CONTROLS[control])
-                rows.append(
-                    {
-                        "configuration": label,
-                        "step_control": control,
-                        "resolution": float(r),
-                        "fine_step_s": res.fine_step,
-                        "coarse_step_s": res.coarse_step,
-                        "steps": res.steps,
-                        "rejected_steps": res.rejected_steps,
-                        "final_position_m": res.final_position,
-                        "reference": control == reference,
-                    }
-                )
-    df = pd.DataFrame(rows)
+                labels.append((label, control == reference))
+                points.append({"contacts": contacts, "actuator_model": model, "step_control": control,
+                               "resolution": float(r), "amplitude": amplitude, "frequency": frequency,
+                               "periods": periods, "preload": preload,
+                               "hemisphere_radius": hemisphere_radius})
+    if config is None:
+        runs = pd.DataFrame([{**p, **convergence_point(**p)} for p in points])
+    else:
+        runs = sweep.run(convergence_point, points, description="time-step convergence", config=config)
+    df = pd.DataFrame({
+        "configuration": [label for label, _ in labels],
+        "step_control": runs["step_control"].to_numpy(),
+        "resolution": runs["resolution"].to_numpy(dtype=float),
+        **{c: runs[c].to_numpy() for c in ("fine_step_s", "coarse_step_s", "steps", "rejected_steps",
+                                           "final_position_m")},
+    })
     # reference: the finest run of each configuration's reference control
-    is_reference = df.pop("reference")
-    runs = df[is_reference]
-    finest = runs.loc[runs.groupby("configuration")["resolution"].idxmax()]
+    is_reference = np.array([ref for _, ref in labels])
+    reference_runs = df[is_reference]
+    finest = reference_runs.loc[reference_runs.groupby("configuration")["resolution"].idxmax()]
     ref = finest.set_index("configuration")["final_position_m"]
     df["error_m"] = df["final_position_m"] - df["configuration"].map(ref)
     return df
@@ -349,7 +361,8 @@ COULOMB_RUN = {"amplitude": 150e-9, "frequency": PROTOCOL.drive_frequency, "peri
 
 def model_convergence(config: RunConfig) -> pd.DataFrame:
     """:func:`convergence_study` over the profile's :data:`RESOLUTIONS` and every step control."""
-    return convergence_study(resolutions=RESOLUTIONS[config.profile], step_controls=CONVERGENCE_STEP_CONTROLS)
+    return convergence_study(resolutions=RESOLUTIONS[config.profile], step_controls=CONVERGENCE_STEP_CONTROLS,
+                             config=config)
 
 
 def model_coulomb_limit(config: RunConfig) -> pd.DataFrame:
