@@ -317,6 +317,15 @@ def _save_position(carry, segment, mid, t, x_p, a_r, F, next_rec, track, n_rec, 
     carry[C_STEP] = dt_ctrl
 
 
+@njit(inline="always", **KERNEL_OPTIONS)
+def _note_peak(peak, track, g, force, sliding_force):
+    """Keep the largest |T_g|/μF_N since the tracked period's slip mark (no period tracked: track < 0)."""
+    if track >= 0:
+        ratio = abs(force) / sliding_force
+        if ratio > peak[track, g]:
+            peak[track, g] = ratio
+
+
 @njit(**KERNEL_OPTIONS)
 def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     """Integrate over the segments; returns (status, steps done, rows recorded, fine steps).
@@ -374,7 +383,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     omega = np.sqrt(omega2)
     beta = linear_stiffness / (linear_stiffness + load_stiffness) if linear_stiffness > 0.0 else 0.0
     dt_trig = -1.0
-    cs = sn = one_minus_cos = 0.0
+    cs = sn = one_minus_cos = sine_excess = 0.0
     activity_threshold, quiet_steps, quasi_static, record_interval, error_tolerance = control
     control_on = error_tolerance > 0.0
     # error estimates below this need no root: the step grows by the largest factor
@@ -622,10 +631,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                         acc_contact += multiplicity[g] * 0.5 * (T[g] + T_ext) * (u_ext - u_old[g])
                         T[g] = T_ext
                         u_old[g] = u_ext
-                        if track >= 0:
-                            ratio = abs(T_ext) / sliding[g]
-                            if ratio > peak[track, g]:
-                                peak[track, g] = ratio
+                        _note_peak(peak, track, g, T_ext, sliding[g])
                 Tn = contact_update_row(params, state, g, u)
                 w = multiplicity[g] * 0.5 * (T[g] + Tn)
                 acc_contact += w * (u - u_old[g])
@@ -634,10 +640,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                 T[g] = Tn
                 u_old[g] = u
                 F += multiplicity[g] * Tn
-                if track >= 0:
-                    ratio = abs(Tn) / sliding[g]
-                    if ratio > peak[track, g]:
-                        peak[track, g] = ratio
+                _note_peak(peak, track, g, Tn, sliding[g])
             # kick
             a_r_new = (F - load_stiffness * x_r) * inv_mr
             if controlled and omega > 0.0:
