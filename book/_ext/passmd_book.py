@@ -7,7 +7,9 @@
   a file of that page in the build folder; :func:`passmd.sweep.run` appends every sweep's
   cached/computed counts to it from inside the chapter's kernel.
 * The ``passmd-sweep-table`` directive is replaced, once every page has been read, by a
-  table of those counts per page (so its own position in the reading order does not matter).
+  table of those counts per page (so its own position in the reading order does not matter),
+  after a first row for the ``passmd ledger`` run with which ``nox -s book`` computes every
+  figure before the chapters (``$PASSMD_BOOK_PREFETCH_LOG``).
   The logs are cleared when a build starts: the counts are complete because ``nox -s book``
   builds with ``--all`` (every page read and executed).
 * Docstrings write absolute values as ``|x|`` (plain text, as ``help()`` shows them); for
@@ -26,6 +28,16 @@ from docutils import nodes
 from sphinx.util.docutils import SphinxDirective
 
 SWEEP_LOG_ENV = "PASSMD_SWEEP_LOG"
+#: Set by ``nox -s book``: the sweep log of the ``passmd ledger`` run that computes every
+#: figure before the chapters are executed (its counts are the table's first row).
+PREFETCH_LOG_ENV = "PASSMD_BOOK_PREFETCH_LOG"
+#: Extensions that work on merged build state only but do not declare it: Sphinx would read
+#: (execute) the chapters one at a time because of them (``tools/build_book.py --jobs``).
+UNDECLARED_PARALLEL_SAFE = (
+    "sphinx-mathjax-offline",  # sets mathjax_path; copies its assets once the build finished
+    "sphinx_multitoc_numbering",  # numbers sections from the merged environment, after reading
+    "sphinx_jupyterbook_latex",  # transforms of the page being read (LaTeX structure) only
+)
 
 
 def _log_dir(app) -> Path:
@@ -83,22 +95,32 @@ def _table(rows: list[list[str]], header: list[str]) -> nodes.table:
     return table
 
 
+def _counts(path: Path) -> list[int]:
+    """Sweeps, points from the cache and points computed in one sweep log."""
+    records = [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines() if line]
+    return [len(records), sum(r["cached"] for r in records), sum(r["computed"] for r in records)]
+
+
 def _fill_tables(app, doctree, docname: str) -> None:
     placeholders = list(doctree.findall(sweep_table_placeholder))
     if not placeholders:
         return
-    rows, totals = [], [0, 0, 0]
+    logs = []
+    prefetch = os.environ.get(PREFETCH_LOG_ENV)
+    if prefetch and Path(prefetch).is_file():
+        logs.append(("before the chapters: passmd ledger (nox -s book)", Path(prefetch)))
     for docname_of_page in sorted(app.env.found_docs):
         path = _log_dir(app) / (docname_of_page.replace("/", "__") + ".jsonl")
-        if not path.is_file():
-            continue
-        records = [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines() if line]
-        counts = [len(records), sum(r["cached"] for r in records), sum(r["computed"] for r in records)]
+        if path.is_file():
+            title = app.env.titles.get(docname_of_page)
+            logs.append((title.astext() if title is not None else docname_of_page, path))
+    rows, totals = [], [0, 0, 0]
+    for label, path in logs:
+        counts = _counts(path)
         totals = [a + b for a, b in zip(totals, counts, strict=True)]
-        title = app.env.titles.get(docname_of_page)
-        rows.append([title.astext() if title is not None else docname_of_page, *map(str, counts)])
-    rows.append(["all pages", *map(str, totals)])
-    header = ["page", "sweeps", "points from the cache", "points computed"]
+        rows.append([label, *map(str, counts)])
+    rows.append(["all", *map(str, totals)])
+    header = ["run", "sweeps", "points from the cache", "points computed"]
     for placeholder in placeholders:
         placeholder.replace_self(_table(rows, header))
 
@@ -122,4 +144,10 @@ def setup(app):
     app.connect("doctree-resolved", _fill_tables)
     app.add_node(sweep_table_placeholder)
     app.add_directive("passmd-sweep-table", SweepTable)
-    return {"version": "1", "parallel_read_safe": False, "parallel_write_safe": True}
+    for name in UNDECLARED_PARALLEL_SAFE:
+        app.setup_extension(name)
+        app.extensions[name].parallel_read_safe = True
+        app.extensions[name].parallel_write_safe = True
+    # Parallel reading is safe here: each page's sweep log is chosen in the process that
+    # reads (executes) the page, and the tables are filled after every page was read.
+    return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
