@@ -196,7 +196,8 @@ def markdown(rows: list) -> str:
              "|---|---|---|---|---|---|---|---|"]
     for r in rows:
         lines.append(f"| {r['contacts']} | {r['actuator']} | {r['step']} | {r['contact_model']} "
-                     f"| {r['steps_per_period']:.0f} ({r['fine_per_period']:.0f}; {r['rejected_per_period']:.0f}) "
+                     f"| {r['steps_per_period']:.0f} "
+                     f"({r['fine_per_period']:.0f}; {r['rejected_per_period']:.0f}) "
                      f"| {r['ns_per_step']:.1f} | {r['ms_per_100Hz_period']:.2f} "
                      f"| {r['error_vs_fixed_fine_nm']:.4f} |")
     return "\n".join(lines)
