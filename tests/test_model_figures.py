@@ -210,11 +210,24 @@ def test_energy_facts_compare_the_same_runs():
     energy = pd.DataFrame({"configuration": ["a", "b"], "contact_model": ["exact"] * 2,
                            "relative_residual": [-4e-5, 1e-5]})
     refined = energy.assign(relative_residual=[1e-5, 5e-6])
-    facts = numerics.energy_facts(energy, refined)
+    explicit = energy.assign(relative_residual=[2e-6, -1e-6])
+    facts = numerics.energy_facts(energy, refined, explicit)
     assert facts == pytest.approx({"energy_max_rel": 4e-5, "energy_shrink_min": 2.0,
-                                   "energy_shrink_max": 4.0})
-    with pytest.raises(ValueError, match="same runs"):
-        numerics.energy_facts(energy, refined.iloc[::-1])
+                                   "energy_shrink_max": 4.0, "energy_explicit_max_rel": 2e-6,
+                                   "energy_explicit_ratio_min": 10.0})
+    with pytest.raises(ValueError, match="refined must list the same runs"):
+        numerics.energy_facts(energy, refined.iloc[::-1], explicit)
+    with pytest.raises(ValueError, match="explicit must list the same runs"):
+        numerics.energy_facts(energy, refined, explicit.iloc[::-1])
+
+
+def test_energy_balance_of_the_explicit_schemes_is_tighter():
+    """The error-controlled step trades energy accuracy for steps: the explicit schemes close
+    the balance several times tighter on the same runs (README, model-numerics chapter)."""
+    default = numerics.energy_balance_table(periods=2)
+    explicit = numerics.energy_balance_table(periods=2, error_control=False)
+    assert (default["relative_residual"].abs() < 1e-3).all()  # the test suite's bound
+    assert (explicit["relative_residual"].abs() < default["relative_residual"].abs()).all()
 
 
 def test_settle_and_coulomb_texts():
