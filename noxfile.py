@@ -189,6 +189,7 @@ def book(session: nox.Session) -> None:
     prefetch_log = os.path.abspath(os.path.join(build_dir, "passmd-prefetch.jsonl"))
     if os.path.exists(prefetch_log):
         os.remove(prefetch_log)
+    session.log(f"computing every figure of the {profile} profile first (passmd ledger; shown on failure)")
     session.run("python", "-m", "passmd", "ledger", "--profile", profile, "--json", silent=True,
                 env={**env, "PASSMD_SWEEP_LOG": prefetch_log})
     env["PASSMD_BOOK_PREFETCH_LOG"] = prefetch_log
