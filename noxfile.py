@@ -10,6 +10,7 @@ installed (``pip install nox uv``), plain virtualenv otherwise.
 from __future__ import annotations
 
 import glob
+import json
 import os
 import shutil
 import subprocess
@@ -187,12 +188,17 @@ def book(session: nox.Session) -> None:
     build_dir = os.path.join("book", "_build")
     os.makedirs(build_dir, exist_ok=True)
     prefetch_log = os.path.abspath(os.path.join(build_dir, "passmd-prefetch.jsonl"))
-    if os.path.exists(prefetch_log):
-        os.remove(prefetch_log)
+    prefetch_time = os.path.abspath(os.path.join(build_dir, "passmd-prefetch-time.json"))
+    for old in (prefetch_log, prefetch_time):
+        if os.path.exists(old):
+            os.remove(old)
     session.log(f"computing every figure of the {profile} profile first (passmd ledger; shown on failure)")
     session.run("python", "-m", "passmd", "ledger", "--profile", profile, "--json", silent=True,
                 env={**env, "PASSMD_SWEEP_LOG": prefetch_log})
+    with open(prefetch_time, "w", encoding="utf-8") as fh:
+        json.dump({"wall_seconds": time.monotonic() - start}, fh)
     env["PASSMD_BOOK_PREFETCH_LOG"] = prefetch_log
+    env["PASSMD_BOOK_PREFETCH_TIME"] = prefetch_time
     session.run("python", "tools/build_book.py", "--jobs", str(os.cpu_count() or 1),
                 "book", "--all", "-W", "-n", "--keep-going", *args, env=env)
     elapsed = time.monotonic() - start

@@ -29,8 +29,10 @@ from sphinx.util.docutils import SphinxDirective
 
 SWEEP_LOG_ENV = "PASSMD_SWEEP_LOG"
 #: Set by ``nox -s book``: the sweep log of the ``passmd ledger`` run that computes every
-#: figure before the chapters are executed (its counts are the table's first row).
+#: figure before the chapters are executed (its counts are the table's first row), and a
+#: JSON file with that run's wall time (``{"wall_seconds": ...}``).
 PREFETCH_LOG_ENV = "PASSMD_BOOK_PREFETCH_LOG"
+PREFETCH_TIME_ENV = "PASSMD_BOOK_PREFETCH_TIME"
 #: Extensions that work on merged build state only but do not declare it: Sphinx would read
 #: (execute) the chapters one at a time because of them (``tools/build_book.py --jobs``).
 UNDECLARED_PARALLEL_SAFE = (
@@ -101,6 +103,15 @@ def _counts(path: Path) -> list[int]:
     return [len(records), sum(r["cached"] for r in records), sum(r["computed"] for r in records)]
 
 
+def _prefetch_label() -> str:
+    label = "before the chapters: passmd ledger (nox -s book)"
+    timing = os.environ.get(PREFETCH_TIME_ENV)
+    if timing and Path(timing).is_file():
+        seconds = json.loads(Path(timing).read_text(encoding="utf-8"))["wall_seconds"]
+        label += f", {seconds:.0f} s wall time"
+    return label
+
+
 def _fill_tables(app, doctree, docname: str) -> None:
     placeholders = list(doctree.findall(sweep_table_placeholder))
     if not placeholders:
@@ -108,7 +119,7 @@ def _fill_tables(app, doctree, docname: str) -> None:
     logs = []
     prefetch = os.environ.get(PREFETCH_LOG_ENV)
     if prefetch and Path(prefetch).is_file():
-        logs.append(("before the chapters: passmd ledger (nox -s book)", Path(prefetch)))
+        logs.append((_prefetch_label(), Path(prefetch)))
     for docname_of_page in sorted(app.env.found_docs):
         path = _log_dir(app) / (docname_of_page.replace("/", "__") + ".jsonl")
         if path.is_file():
