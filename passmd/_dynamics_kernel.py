@@ -27,8 +27,11 @@ quasi-static phases of flexible ones): the runner's force splits into a linear s
 k_p for flexible actuators) to x_p, plus the load cell, and the rest g. The linear part is
 integrated exactly by the variation-of-constants formula (an exponential or
 "trigonometric" integrator; Hairer, Lubich & Wanner, Geometric Numerical Integration,
-Ch. XIII), g with its rate extrapolated from the last step in the position and linear over
-the step in the velocity. So the ≈ 11 kHz micro-vibration sets no step; what does is the
+Ch. XIII), g with its rate extrapolated from the last step in the position, and in the
+velocity quadratic in time through its values at the step's end, its start and the previous
+step's start. (With g linear over the step in the velocity, that update's local error was
+O(dt³) against the position's O(dt⁴), and the energy balance drifted by O(dt²): 3e-5 of the
+input work over three 1 kHz periods.) So the ≈ 11 kHz micro-vibration sets no step; what does is the
 local position error estimate dt²/6 |Δg − ġ dt|, checked against the tolerance with the
 forces at the drifted position (pure evaluations): a step above it is rejected and retried
 shorter, and the next step follows the usual controller (fourth root, safety factor,
@@ -40,6 +43,17 @@ inside such a step are interpolated (cubic Hermite in x_r).
 In every scheme the contact memory is updated exactly once per accepted step (twice when
 a reversal falls inside it), with the drifted positions, and the contact force is
 otherwise evaluated purely. Every corner of x_p(t) falls on a step boundary.
+
+Energy terms (``Buffers.energy``): the explicit steps sum the work of the drive, the
+damping and the contacts with the trapezoidal rule per step. An error-controlled step
+crosses the runner's ringing in a few steps, and across one T(t) and the path curve, so
+the trapezoidal rule would miss the dissipation of a micro-slip loop by a fraction of order
+(Ω dt)²; these steps use Simpson's rule in time instead. Its middle node is the drift
+formula at half the step (runner), the contact force there evaluated purely with the memory
+at the step's start, and for a quasi-static actuator its force balance over the first half
+step (one Newton step from the chord's midpoint); the actuator's velocity at the three nodes
+is that of the quadratic through its three positions. (A reversal inside the step is not
+split for this middle node: the error is of second order in the distance from the reversal.)
 """
 
 from __future__ import annotations
@@ -101,7 +115,8 @@ C_CONTROLLED = 23  # 1 while the error-controlled step is in use
 C_STEP = 24  # the error-controlled step (s)
 C_REJECTED = 25  # error-controlled steps rejected (counted in the steps too)
 C_GRATE = 26  # rate of g over the last error-controlled step (m/s³)
-CARRY_SIZE = 27
+C_HPREV = 27  # length of that step (s; 0: g's rate not known, no curvature estimate)
+CARRY_SIZE = 28
 
 
 #: numba options: the kernel allocates nothing (work arrays come from the caller), so it is
@@ -110,7 +125,7 @@ CARRY_SIZE = 27
 KERNEL_OPTIONS = {"cache": True, "error_model": "numpy", "_nrt": False}
 
 #: rows of the work array (shape (WORK_ROWS, groups)) the caller allocates
-WORK_ROWS = 10
+WORK_ROWS = 11
 #: quasi-static step: the actuator's force balance is solved to this fraction of S/K
 #: (≈ 6e-15 m; a force error ≤ 1e-6 μF_N)
 QUASI_TOLERANCE = 1e-6
@@ -384,6 +399,9 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     beta = linear_stiffness / (linear_stiffness + load_stiffness) if linear_stiffness > 0.0 else 0.0
     dt_trig = -1.0
     cs = sn = one_minus_cos = sine_excess = 0.0
+    sh = ch = half_one_minus_cos = half_sine_excess = 0.0  # the same at half the step
+    hh = xp_mid = xr_mid = vr_mid = F_mid = 0.0  # mid-step nodes of the energy quadrature
+    inv_dt = c_half = K_half = inv_K_half = 0.0
     activity_threshold, quiet_steps, quasi_static, record_interval, error_tolerance = control
     control_on = error_tolerance > 0.0
     # error estimates below this need no root: the step grows by the largest factor
@@ -403,7 +421,10 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     slope = work[7]  # last −h' of the quasi-static balance (0: none yet)
     T_old = work[8]  # T at the start of the step (samples inside an error-controlled step)
     share = work[9]  # slip share at the end of the step (samples inside an error-controlled step)
+    xa_mid = work[10]  # x_a at mid-step (energy quadrature of a quasi-static error-controlled step)
     gam = actuator_viscosity / actuator_mass
+    half_kp = 0.5 * actuator_stiffness
+    half_cp = 0.5 * actuator_viscosity
     inv_ma = 1.0 / actuator_mass
     inv_mr = 1.0 / runner_mass
     if carry[C_STARTED] == 0.0:
@@ -459,6 +480,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
             quasi = carry[C_QUASI] != 0.0
             controlled = carry[C_CONTROLLED] != 0.0
             g_rate = carry[C_GRATE]
+            h_prev = carry[C_HPREV]
             quiet = int(carry[C_QUIET])
             acc_xr = carry[C_ACC_XR]
             acc_f = carry[C_ACC_F]
@@ -482,6 +504,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
             quasi = False
             controlled = rigid and control_on
             g_rate = 0.0  # (x_p's rate changes at the corner: g's rate is not known)
+            h_prev = 0.0
             quiet = 0
             # segment-local accumulators (kept in registers, written back after the segment)
             acc_xr = 0.0
@@ -502,6 +525,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                 carry[C_QUASI] = 1.0 if quasi else 0.0
                 carry[C_CONTROLLED] = 1.0 if controlled else 0.0
                 carry[C_GRATE] = g_rate
+                carry[C_HPREV] = h_prev
                 carry[C_QUIET] = quiet
                 carry[C_ACC_XR] = acc_xr
                 carry[C_ACC_F] = acc_f
@@ -550,15 +574,30 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                     sn = 2.0 * sh * ch
                     one_minus_cos = 2.0 * sh * sh / omega2  # (1 − cos hΩ)/Ω², without cancellation
                     sine_excess = (dt * omega - sn) / (omega2 * omega)  # (hΩ − sin hΩ)/Ω³
+                    half_one_minus_cos = sh * sh / (omega2 * (1.0 + ch))  # 1 − cos x = sin²x/(1 + cos x)
+                    half_sine_excess = (0.5 * dt * omega - sh) / (omega2 * omega)
                 x_r = cs * y0 + sn / omega * w0 + one_minus_cos * ag0 + sine_excess * g_rate + beta * xp_new
+                # the same at mid-step: the nodes of the energy quadrature (module docstring)
+                hh = 0.5 * dt
+                xp_mid = x_p + vp * hh
+                xr_mid = (ch * y0 + sh / omega * w0 + half_one_minus_cos * ag0 + half_sine_excess * g_rate
+                          + beta * xp_mid)
+                vr_mid = (-omega * sh * y0 + ch * w0 + sh / omega * ag0 + half_one_minus_cos * g_rate
+                          + beta * vp)
             else:
                 x_r += dt * v_r + half_dt2 * a_r
+            simpson = controlled and omega > 0.0
+            quad_in = quad_damp = quad_contact = 0.0  # start and mid-step terms of that quadrature
             if rigid:
                 for g in range(G):
                     x_a[g] = xp_new
             elif quasi:
-                c_dt = actuator_viscosity / dt
+                inv_dt = 1.0 / dt
+                c_dt = actuator_viscosity * inv_dt
                 K = actuator_stiffness + c_dt
+                c_half = 2.0 * c_dt  # (the balance over half the step)
+                K_half = actuator_stiffness + c_half
+                inv_K_half = 1.0 / K_half
                 F_trial = 0.0  # Σ n_g T_g at the solved balance, T_g = K (center − x_a,g)
                 for g in range(G):
                     stretch_old[g] = x_p - x_a[g]
@@ -572,6 +611,22 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                         QUASI_TOLERANCE * sliding[g] / K,
                     )
                     F_trial += multiplicity[g] * K * (center - x_a[g])
+                    if simpson:
+                        # x_a at mid-step: the balance over the first half step, one Newton step
+                        # from the chord's midpoint (its error is of fourth order in dt)
+                        center_mid = (actuator_stiffness * xp_mid + c_half * xa_old[g]) * inv_K_half
+                        chord = 0.5 * (xa_old[g] + x_a[g])
+                        balance = (K_half * (center_mid - chord)
+                                   - contact_force_row(params, state, g, chord - xr_mid))
+                        xa_mid[g] = chord + balance / max(slope[g] - K + K_half, K_half)
+                        T_mid = K_half * (center_mid - xa_mid[g])
+                        # velocities of the quadratic through x_a at start, mid-step and end
+                        q0 = (4.0 * xa_mid[g] - 3.0 * xa_old[g] - x_a[g]) * inv_dt
+                        q_mid = (x_a[g] - xa_old[g]) * inv_dt
+                        n_g = multiplicity[g]
+                        quad_in += n_g * actuator_stiffness * (stretch_old[g] + 4.0 * (xp_mid - xa_mid[g]))
+                        quad_damp += n_g * actuator_viscosity * (q0 * q0 + 4.0 * q_mid * q_mid)
+                        quad_contact += n_g * (T[g] * (q0 - vr_old) + 4.0 * T_mid * (q_mid - vr_mid))
             else:
                 for g in range(G):
                     stretch_old[g] = x_p - x_a[g]
@@ -606,6 +661,10 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                     continue
                 if not done:
                     dt_ctrl = min(dt * factor, dt_longest)
+            if simpson and rigid:
+                F_mid = 0.0  # Σ n_g T_g at mid-step (pure)
+                for g in range(G):
+                    F_mid += multiplicity[g] * contact_force_row(params, state, g, xp_mid - xr_mid)
             # contact forces, memory committed once per step
             F = 0.0
             for g in range(G):
@@ -628,15 +687,16 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                     if du0 * (du0 + 2.0 * excess) < 0.0:  # the rate changes sign inside the step
                         u_ext = u_old[g] - du0 * du0 / (4.0 * excess)
                         T_ext = contact_update_row(params, state, g, u_ext)
-                        acc_contact += multiplicity[g] * 0.5 * (T[g] + T_ext) * (u_ext - u_old[g])
+                        if not simpson:
+                            acc_contact += multiplicity[g] * 0.5 * (T[g] + T_ext) * (u_ext - u_old[g])
                         T[g] = T_ext
                         u_old[g] = u_ext
                         _note_peak(peak, track, g, T_ext, sliding[g])
                 Tn = contact_update_row(params, state, g, u)
-                w = multiplicity[g] * 0.5 * (T[g] + Tn)
-                acc_contact += w * (u - u_old[g])
-                if rigid:
-                    acc_in += multiplicity[g] * 0.5 * (T_start + Tn) * (xp_new - x_p)
+                if not simpson:
+                    acc_contact += multiplicity[g] * 0.5 * (T[g] + Tn) * (u - u_old[g])
+                    if rigid:
+                        acc_in += multiplicity[g] * 0.5 * (T_start + Tn) * (xp_new - x_p)
                 T[g] = Tn
                 u_old[g] = u
                 F += multiplicity[g] * Tn
@@ -645,23 +705,45 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
             a_r_new = (F - load_stiffness * x_r) * inv_mr
             if controlled and omega > 0.0:
                 ag1 = a_r_new + omega2 * (x_r - beta * xp_new)
-                g_rate = (ag1 - ag0) / dt
-                v_r = -omega * sn * y0 + cs * w0 + sn / omega * ag0 + one_minus_cos * g_rate + beta * vp
+                rate = (ag1 - ag0) / dt
+                # g quadratic in time through its values at the end, the start and the start of
+                # the previous step (curvature 0 after a reset of its rate)
+                curvature = (rate - g_rate) / (dt + h_prev) if h_prev > 0.0 else 0.0
+                v_r = (-omega * sn * y0 + cs * w0 + sn / omega * ag0 + one_minus_cos * (rate - curvature * dt)
+                       + 2.0 * sine_excess * curvature + beta * vp)
+                g_rate = rate
+                h_prev = dt
             else:
                 v_r += 0.5 * dt * (a_r + a_r_new)
             a_r = a_r_new
+            if simpson and rigid:
+                acc_in += vp * dt / 6.0 * (F_old + 4.0 * F_mid + F)
+                acc_contact += dt / 6.0 * ((vp - vr_old) * F_old + 4.0 * (vp - vr_mid) * F_mid
+                                           + (vp - v_r) * F)
             if quasi:
                 activity = 0.0
                 for g in range(G):
                     v_old = v_a[g]
                     v_a[g] = (x_a[g] - xa_old[g]) / dt
                     a_nd[g] = (actuator_stiffness * (xp_new - x_a[g]) - T[g]) * inv_ma
-                    # backward Euler: c_p v_a (x_a − x_a,old) = c_p v_a² dt (halved below)
-                    acc_damp += multiplicity[g] * 2.0 * v_a[g] * v_a[g] * dt
-                    acc_in += multiplicity[g] * (stretch_old[g] + xp_new - x_a[g]) * (xp_new - x_p)
+                    if simpson:
+                        # end terms of the quadrature (start and mid-step ones: at the drift)
+                        q1 = (xa_old[g] - 4.0 * xa_mid[g] + 3.0 * x_a[g]) * inv_dt
+                        quad_in += multiplicity[g] * actuator_stiffness * (xp_new - x_a[g])
+                        quad_damp += multiplicity[g] * actuator_viscosity * q1 * q1
+                        quad_contact += multiplicity[g] * T[g] * (q1 - v_r)
+                    else:
+                        # backward Euler: c_p v_a (x_a − x_a,old) = c_p v_a² dt
+                        acc_damp += multiplicity[g] * actuator_viscosity * v_a[g] * v_a[g] * dt
+                        stretch_sum = stretch_old[g] + xp_new - x_a[g]
+                        acc_in += multiplicity[g] * half_kp * stretch_sum * (xp_new - x_p)
                     acc = abs(v_a[g] - v_old) / dt
                     if acc > activity:
                         activity = acc
+                if simpson:
+                    acc_in += vp * dt / 6.0 * quad_in
+                    acc_damp += dt / 6.0 * quad_damp
+                    acc_contact += dt / 6.0 * quad_contact
                 if activity >= activity_threshold:
                     fine = True
                     quasi = False
@@ -675,9 +757,9 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                     v_old = v_a[g]
                     v_a[g] = (v_old + 0.5 * dt * (a_nd[g] - gam * v_old + a_new)) * damp
                     a_nd[g] = a_new
-                    acc_damp += multiplicity[g] * (v_old * v_old + v_a[g] * v_a[g]) * dt
+                    acc_damp += multiplicity[g] * half_cp * (v_old * v_old + v_a[g] * v_a[g]) * dt
                     # work of the moving piezo base: k_p (x_p − x_a) dx_p, trapezoidal in (x_p − x_a)
-                    acc_in += multiplicity[g] * (stretch_old[g] + xp_new - x_a[g]) * (xp_new - x_p)
+                    acc_in += multiplicity[g] * half_kp * (stretch_old[g] + xp_new - x_a[g]) * (xp_new - x_p)
                     acc = abs(a_new - gam * v_a[g])
                     if acc > activity:
                         activity = acc
@@ -691,6 +773,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                                 controlled = quasi_static and control_on
                                 dt_ctrl = dt_quasi
                                 g_rate = 0.0
+                                h_prev = 0.0
                         else:
                             quiet = 0
                     elif activity >= activity_threshold:
@@ -763,11 +846,8 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
         if track >= 0:
             per[track, PER_MIN_XR] = min_xr
         energy[EN_CONTACT] += acc_contact
-        if rigid:
-            energy[EN_INPUT] += acc_in
-        else:
-            energy[EN_INPUT] += actuator_stiffness * 0.5 * acc_in
-            energy[EN_DAMPING] += actuator_viscosity * 0.5 * acc_damp
+        energy[EN_INPUT] += acc_in
+        energy[EN_DAMPING] += acc_damp
     # done: the loop state goes to carry as at a pause between two segments, so that a call
     # with these segments followed by more (the same arrays, longer) continues the run
     _save_position(carry, seg_t0.shape[0], 0.0, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps,
