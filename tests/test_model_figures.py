@@ -207,27 +207,27 @@ def test_convergence_reference_is_the_reference_controls_finest_run():
 
 
 def test_energy_facts_compare_the_same_runs():
-    energy = pd.DataFrame({"configuration": ["a", "b"], "contact_model": ["exact"] * 2,
-                           "relative_residual": [-4e-5, 1e-5]})
-    refined = energy.assign(relative_residual=[1e-5, 5e-6])
-    explicit = energy.assign(relative_residual=[2e-6, -1e-6])
-    facts = numerics.energy_facts(energy, refined, explicit)
-    assert facts == pytest.approx({"energy_max_rel": 4e-5, "energy_shrink_min": 2.0,
-                                   "energy_shrink_max": 4.0, "energy_explicit_max_rel": 2e-6,
-                                   "energy_explicit_ratio_min": 10.0})
-    with pytest.raises(ValueError, match="refined must list the same runs"):
-        numerics.energy_facts(energy, refined.iloc[::-1], explicit)
+    energy = pd.DataFrame({"configuration": ["a", "a", "b"], "contact_model": ["exact", "discrete", "exact"],
+                           "relative_residual": [-4e-7, 1e-6, 2e-7]})
+    explicit = energy.assign(relative_residual=[2e-6, -1e-7, 4e-6])
+    facts = numerics.energy_facts(energy, explicit)
+    assert facts == pytest.approx({"energy_max_rel": 1e-6, "energy_exact_max_rel": 4e-7,
+                                   "energy_discrete_max_rel": 1e-6, "energy_explicit_max_rel": 4e-6,
+                                   "energy_tighter": 4.0, "energy_ratio_min": 0.05, "energy_ratio_max": 10.0})
     with pytest.raises(ValueError, match="explicit must list the same runs"):
-        numerics.energy_facts(energy, refined, explicit.iloc[::-1])
+        numerics.energy_facts(energy, explicit.iloc[::-1])
 
 
-def test_energy_balance_of_the_explicit_schemes_is_tighter():
-    """The error-controlled step trades energy accuracy for steps: the explicit schemes close
-    the balance several times tighter on the same runs (README, model-numerics chapter)."""
-    default = numerics.energy_balance_table(periods=2)
-    explicit = numerics.energy_balance_table(periods=2, error_control=False)
-    assert (default["relative_residual"].abs() < 1e-3).all()  # the test suite's bound
-    assert (explicit["relative_residual"].abs() < default["relative_residual"].abs()).all()
+def test_energy_balance_of_the_default_scheme_is_as_tight_as_the_explicit_ones():
+    """The error-controlled step takes far longer steps than the explicit schemes but must
+    not close the energy balance worse: its largest residual on the model-numerics chapter's
+    runs is at most theirs (and both stay far inside the 1e-3 the integrator tests allow).
+    Simpson's rule for the work terms of a long step makes that possible; with the
+    trapezoidal rule the default's largest residual was several times theirs."""
+    default = numerics.energy_balance_table(periods=2)["relative_residual"].abs()
+    explicit = numerics.energy_balance_table(periods=2, error_control=False)["relative_residual"].abs()
+    assert default.max() <= explicit.max(), (default.max(), explicit.max())
+    assert explicit.max() < 1e-3
 
 
 def test_settle_and_coulomb_texts():
