@@ -50,10 +50,13 @@ crosses the runner's ringing in a few steps, and across one T(t) and the path cu
 the trapezoidal rule would miss the dissipation of a micro-slip loop by a fraction of order
 (Ω dt)²; these steps use Simpson's rule in time instead. Its middle node is the drift
 formula at half the step (runner), the contact force there evaluated purely with the memory
-at the step's start, and for a quasi-static actuator its force balance over the first half
-step (one Newton step from the chord's midpoint); the actuator's velocity at the three nodes
-is that of the quadratic through its three positions. (A reversal inside the step is not
-split for this middle node: the error is of second order in the distance from the reversal.)
+at the step's start (rigid actuators), or for a quasi-static actuator its force balance over
+the first half step, one Newton step from the chord's midpoint with the contact force there
+from the cubic Hermite in u through the step's ends (values, and tangents from the balance
+solves; evaluated instead when u turns inside the step or the start's tangent is not known);
+the actuator's velocity at the three nodes is that of the quadratic through its three
+positions. (A reversal inside a rigid step is not split for the middle node: the error is of
+second order in the distance from the reversal.) These terms never feed back into the motion.
 """
 
 from __future__ import annotations
@@ -125,7 +128,7 @@ CARRY_SIZE = 28
 KERNEL_OPTIONS = {"cache": True, "error_model": "numpy", "_nrt": False}
 
 #: rows of the work array (shape (WORK_ROWS, groups)) the caller allocates
-WORK_ROWS = 11
+WORK_ROWS = 12
 #: quasi-static step: the actuator's force balance is solved to this fraction of S/K
 #: (≈ 6e-15 m; a force error ≤ 1e-6 μF_N)
 QUASI_TOLERANCE = 1e-6
@@ -422,6 +425,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     T_old = work[8]  # T at the start of the step (samples inside an error-controlled step)
     share = work[9]  # slip share at the end of the step (samples inside an error-controlled step)
     xa_mid = work[10]  # x_a at mid-step (energy quadrature of a quasi-static error-controlled step)
+    tangent = work[11]  # dT/du at the start of a quasi-static step (< 0: not known)
     gam = actuator_viscosity / actuator_mass
     half_kp = 0.5 * actuator_stiffness
     half_cp = 0.5 * actuator_viscosity
@@ -616,9 +620,26 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                         # from the chord's midpoint (its error is of fourth order in dt)
                         center_mid = (actuator_stiffness * xp_mid + c_half * xa_old[g]) * inv_K_half
                         chord = 0.5 * (xa_old[g] + x_a[g])
-                        balance = (K_half * (center_mid - chord)
-                                   - contact_force_row(params, state, g, chord - xr_mid))
-                        xa_mid[g] = chord + balance / max(slope[g] - K + K_half, K_half)
+                        u_chord = chord - xr_mid
+                        # the contact force there: the cubic Hermite in u through both ends (values
+                        # and tangents: the start's from the last step, the end's from the balance
+                        # solve) when u is monotone over the step and the start's tangent is
+                        # known, else evaluated (a reversal turns the branch inside the step)
+                        k_end = slope[g] - K
+                        u_start = u_old[g]
+                        du = x_a[g] - x_r - u_start
+                        du0 = actuator_stiffness * (vp - vr_old) * dt / max(k_end + actuator_stiffness,
+                                                                             actuator_stiffness)
+                        if tangent[g] >= 0.0 and du != 0.0 and du0 * (du0 + 2.0 * (du - du0)) >= 0.0:
+                            sv = (u_chord - u_start) / du
+                            T_end = K * (center - x_a[g])
+                            rv = 1.0 - sv
+                            T_chord = ((1.0 + 2.0 * sv) * rv * rv * T[g] + sv * sv * (3.0 - 2.0 * sv) * T_end
+                                       + du * sv * rv * (rv * tangent[g] - sv * k_end))
+                        else:
+                            T_chord = contact_force_row(params, state, g, u_chord)
+                        balance = K_half * (center_mid - chord) - T_chord
+                        xa_mid[g] = chord + balance / max(k_end + K_half, K_half)
                         T_mid = K_half * (center_mid - xa_mid[g])
                         # velocities of the quadratic through x_a at start, mid-step and end
                         q0 = (4.0 * xa_mid[g] - 3.0 * xa_old[g] - x_a[g]) * inv_dt
@@ -726,6 +747,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                     v_old = v_a[g]
                     v_a[g] = (x_a[g] - xa_old[g]) / dt
                     a_nd[g] = (actuator_stiffness * (xp_new - x_a[g]) - T[g]) * inv_ma
+                    tangent[g] = slope[g] - K  # (the next step's start: this step's end)
                     if simpson:
                         # end terms of the quadrature (start and mid-step ones: at the drift)
                         q1 = (xa_old[g] - 4.0 * xa_mid[g] + 3.0 * x_a[g]) * inv_dt
@@ -774,6 +796,8 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                                 dt_ctrl = dt_quasi
                                 g_rate = 0.0
                                 h_prev = 0.0
+                                for g in range(G):
+                                    tangent[g] = -1.0
                         else:
                             quiet = 0
                     elif activity >= activity_threshold:
