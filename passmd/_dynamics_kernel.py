@@ -344,6 +344,23 @@ def _note_peak(peak, track, g, force, sliding_force):
             peak[track, g] = ratio
 
 
+@njit(inline="always", **KERNEL_OPTIONS)
+def _start_increment(rigid, rate, dt, actuator_stiffness, tangent_stiffness):
+    """Rate of u = x_a − x_r at the start of a step, times dt, from the rate v_p − v_r
+    (``rate``): as it is for rigid actuators; for a quasi-static one, from its balance
+    k_p (v_p − v_a) = k_t (v_a − v_r) with k_t the contact's tangent stiffness."""
+    if rigid:
+        return rate * dt
+    return actuator_stiffness * rate * dt / max(tangent_stiffness + actuator_stiffness, actuator_stiffness)
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _turns_inside(du0, du):
+    """Whether u turns inside the step: the quadratic through u's increment ``du`` over the
+    step and its rate at the start (times dt, ``du0``) has its extremum inside."""
+    return du0 * (2.0 * du - du0) < 0.0
+
+
 @njit(**KERNEL_OPTIONS)
 def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     """Integrate over the segments; returns (status, steps done, rows recorded, fine steps).
@@ -405,6 +422,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     sh = ch = half_one_minus_cos = half_sine_excess = 0.0  # the same at half the step
     hh = xp_mid = xr_mid = vr_mid = F_mid = 0.0  # mid-step nodes of the energy quadrature
     inv_dt = c_half = K_half = inv_K_half = 0.0
+    K = 0.0  # the quasi-static balance's stiffness k_p + c_p/dt (set in its steps)
     activity_threshold, quiet_steps, quasi_static, record_interval, error_tolerance = control
     control_on = error_tolerance > 0.0
     # error estimates below this need no root: the step grows by the largest factor
@@ -617,7 +635,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                     F_trial += multiplicity[g] * K * (center - x_a[g])
                     if simpson:
                         # x_a at mid-step: the balance over the first half step, one Newton step
-                        # from the chord's midpoint (its error is of fourth order in dt)
+                        # from the chord's midpoint (within O(dt²) of it)
                         center_mid = (actuator_stiffness * xp_mid + c_half * xa_old[g]) * inv_K_half
                         chord = 0.5 * (xa_old[g] + x_a[g])
                         u_chord = chord - xr_mid
@@ -628,9 +646,8 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                         k_end = slope[g] - K
                         u_start = u_old[g]
                         du = x_a[g] - x_r - u_start
-                        du0 = actuator_stiffness * (vp - vr_old) * dt / max(k_end + actuator_stiffness,
-                                                                             actuator_stiffness)
-                        if tangent[g] >= 0.0 and du != 0.0 and du0 * (du0 + 2.0 * (du - du0)) >= 0.0:
+                        du0 = _start_increment(False, vp - vr_old, dt, actuator_stiffness, k_end)
+                        if tangent[g] >= 0.0 and du != 0.0 and not _turns_inside(du0, du):
                             sv = (u_chord - u_start) / du
                             T_end = K * (center - x_a[g])
                             rv = 1.0 - sv
@@ -695,17 +712,11 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                 if controlled:
                     # a reversal of u inside the step is an event: the extremum of the quadratic
                     # through u at the start (value and rate) and at the end is committed first,
-                    # so the Masing branch turns at it, not at the last step boundary
-                    # rate of u at the start, times dt (quasi-static actuator: from its balance,
-                    # k_p (v_p − v_a) = k_t (v_a − v_r), k_t the contact's tangent stiffness
-                    # that the last balance solve found)
-                    if rigid:
-                        du0 = (vp - v_r) * dt
-                    else:
-                        du0 = actuator_stiffness * (vp - v_r) * dt / max(slope[g] - K + actuator_stiffness,
-                                                                          actuator_stiffness)
-                    excess = u - u_old[g] - du0  # curvature term of the quadratic, times dt²
-                    if du0 * (du0 + 2.0 * excess) < 0.0:  # the rate changes sign inside the step
+                    # so the Masing branch turns at it, not at the last step boundary (k_t:
+                    # the tangent stiffness that the last balance solve found)
+                    du0 = _start_increment(rigid, vp - v_r, dt, actuator_stiffness, slope[g] - K)
+                    if _turns_inside(du0, u - u_old[g]):
+                        excess = u - u_old[g] - du0  # curvature term of the quadratic, times dt²
                         u_ext = u_old[g] - du0 * du0 / (4.0 * excess)
                         T_ext = contact_update_row(params, state, g, u_ext)
                         if not simpson:
