@@ -4,7 +4,11 @@ Every panel is computed once per session (module fixture; the sweep cache makes 
 cheap). Snapshot tolerances: the rigid runs are deterministic; what can move between
 machines is floating-point reassociation (numba/numpy builds), which shifts results by
 orders of magnitude less than the tolerances below, while a change of the physics or of a
-protocol moves them by far more (a 0.01 nm change of a 200 nm step is 5e-5 relative).
+protocol moves them by far more (a 0.01 nm change of a 200 nm step is 5e-5 relative). So does
+a change of the integrator (halving the default step alone moves settled positions by
+picometres): the snapshots lock one scheme's results and are regenerated, with the reason in
+the changelog, when the scheme changes; its accuracy is checked on its own against the fixed
+fine step (``test_dynamics``, within ``time_steps.CONVERGED_ACCURACY``).
 """
 
 import numpy as np

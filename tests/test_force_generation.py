@@ -4,7 +4,11 @@ Snapshot tolerance: the simulations are deterministic and not chaotic — pertur
 frequency by a relative 1e-12 moves a 500-period stall force by about 1e-12 relative (checked
 while writing this module) — so floating-point differences between machines stay many orders
 of magnitude below RTOL = 1e-6, while any change of the physics, the stall criterion or a
-grid moves the locked numbers by far more.
+grid moves the locked numbers by far more. So does any change of the integrator: halving the
+default step alone moves settled positions by picometres, above RTOL. The snapshots therefore
+lock one scheme's results and are regenerated, with the reason in the changelog, when the
+scheme changes; the scheme's accuracy is checked on its own against the fixed fine step
+(``test_dynamics``, within ``time_steps.CONVERGED_ACCURACY``).
 """
 
 import math
