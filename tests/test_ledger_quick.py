@@ -1,4 +1,4 @@
-"""The whole ledger at the quick profile: every claim keeps its category; the profiles agree.
+"""The whole ledger on both profiles: every claim keeps its category; the profiles agree.
 
 ``tests/ledger_baseline_quick.csv`` and ``tests/ledger_baseline_paper.csv`` record each claim's
 category (claim, status) on the two profiles, with the command and date that produced them in
@@ -8,6 +8,10 @@ their ``#`` header. The quick test fails with a readable diff when any claim cha
 claims.csv. After reviewing a change, record it with
 
     PASSMD_UPDATE_LEDGER_BASELINE=1 pytest tests/test_ledger_quick.py
+
+The paper test evaluates the book's own profile (about 1.5 minutes on two cores with an empty
+cache) and fails with the same diff; its baseline is recorded with
+``passmd ledger --profile paper --write-baseline tests/ledger_baseline_paper.csv``.
 
 A claim's category must not depend on the profile: where the quick profile decides a claim,
 the paper profile must decide it the same way; the quick profile may only be inconclusive
@@ -43,6 +47,17 @@ def test_quick_ledger_keeps_every_category():
     assert ledger.orphan_extractors(claims) == [], "extractors tagged for ids not in claims.csv"
     # The claim computed from closed forms needs no figure: it must always be reproduced.
     assert baseline["fig10b-r1-stiffer-contact"] == "reproduced"
+
+
+@pytest.mark.slow
+def test_paper_ledger_keeps_every_category():
+    """The book's profile decides every claim as its baseline records: a change of the integrator,
+    a grid or a protocol that flips a verdict of the book fails here, not only in a rebuild."""
+    claims = load_claims()
+    evaluated = ledger.evaluate(claims, ledger.collect_results(RunConfig(profile="paper")), strict=True)
+    baseline = ledger.load_baseline(BASELINES["paper"])
+    assert set(baseline) == set(claims["id"]), "the paper baseline and claims.csv list different claims"
+    ledger.check_categories(evaluated, baseline)
 
 
 def profile_comparison() -> tuple[list[str], dict[str, str]]:
