@@ -8,7 +8,8 @@ protocol moves them by far more (a 0.01 nm change of a 200 nm step is 5e-5 relat
 a change of the integrator (halving the default step alone moves settled positions by
 picometres): the snapshots lock one scheme's results and are regenerated, with the reason in
 the changelog, when the scheme changes; its accuracy is checked on its own against the fixed
-fine step (``test_dynamics``, within ``time_steps.CONVERGED_ACCURACY``).
+fine step (``test_dynamics``, within ``time_steps.CONVERGED_ACCURACY``) and, at Fig. 10's
+fastest drive, where that step is too coarse, against a converged 1 ns step (below).
 """
 
 import functools

@@ -33,17 +33,27 @@ BASELINES = {profile: Path(__file__).with_name(f"ledger_baseline_{profile}.csv")
              for profile in PROFILES}
 
 
+def _evaluate(profile: str):
+    """Every claim evaluated on ``profile`` (strict: a computed figure's claim needs an extractor)."""
+    claims = load_claims()
+    return claims, ledger.evaluate(claims, ledger.collect_results(RunConfig(profile=profile)), strict=True)
+
+
+def _check_baseline(profile: str, claims, evaluated) -> dict[str, str]:
+    baseline = ledger.load_baseline(BASELINES[profile])
+    assert set(baseline) == set(claims["id"]), f"the {profile} baseline and claims.csv list different claims"
+    ledger.check_categories(evaluated, baseline)
+    return baseline
+
+
 @pytest.mark.slow
 def test_quick_ledger_keeps_every_category():
-    claims = load_claims()
-    evaluated = ledger.evaluate(claims, ledger.collect_results(RunConfig(profile="quick")), strict=True)
+    claims, evaluated = _evaluate("quick")
     if os.environ.get("PASSMD_UPDATE_LEDGER_BASELINE") == "1":
         header = (f"ledger categories, quick profile; produced {datetime.date.today().isoformat()} by\n"
                   "PASSMD_UPDATE_LEDGER_BASELINE=1 pytest tests/test_ledger_quick.py")
         ledger.write_baseline(evaluated, BASELINES["quick"], header=header)
-    baseline = ledger.load_baseline(BASELINES["quick"])
-    assert set(baseline) == set(claims["id"]), "the baseline and claims.csv list different claims"
-    ledger.check_categories(evaluated, baseline)
+    baseline = _check_baseline("quick", claims, evaluated)
     assert ledger.orphan_extractors(claims) == [], "extractors tagged for ids not in claims.csv"
     # The claim computed from closed forms needs no figure: it must always be reproduced.
     assert baseline["fig10b-r1-stiffer-contact"] == "reproduced"
@@ -53,11 +63,7 @@ def test_quick_ledger_keeps_every_category():
 def test_paper_ledger_keeps_every_category():
     """The book's profile decides every claim as its baseline records: a change of the integrator,
     a grid or a protocol that flips a verdict of the book fails here, not only in a rebuild."""
-    claims = load_claims()
-    evaluated = ledger.evaluate(claims, ledger.collect_results(RunConfig(profile="paper")), strict=True)
-    baseline = ledger.load_baseline(BASELINES["paper"])
-    assert set(baseline) == set(claims["id"]), "the paper baseline and claims.csv list different claims"
-    ledger.check_categories(evaluated, baseline)
+    _check_baseline("paper", *_evaluate("paper"))
 
 
 def profile_comparison() -> tuple[list[str], dict[str, str]]:
