@@ -9,7 +9,7 @@ claims.csv. After reviewing a change, record it with
 
     PASSMD_UPDATE_LEDGER_BASELINE=1 pytest tests/test_ledger_quick.py
 
-The paper test evaluates the book's own profile (about 1.5 minutes on two cores with an empty
+The paper test evaluates the book's own profile (about a minute on two cores with an empty
 cache) and fails with the same diff; its baseline is recorded with
 ``passmd ledger --profile paper --write-baseline tests/ledger_baseline_paper.csv``.
 
