@@ -12,7 +12,8 @@ A result is stored under a key that hashes
 
 Entry format (data, never code)
 -------------------------------
-Each entry is one file ``<directory>/<key[:2]>/<key>.pmc``::
+Each entry is one file ``<directory>/<key[:2]>/<key>.pmc`` (``key``: 64 lowercase hex
+digits, checked before it becomes a path)::
 
     PASSMD-CACHE 1\\n
     <sha256 hex of header+payload> <length of header in bytes>\\n
@@ -25,25 +26,52 @@ strings, floats (as ``float.hex()``, exact to the bit), lists, tuples, dicts wit
 string keys, and NumPy arrays or NumPy scalars (dtype, shape and a slice of the
 payload; numeric dtypes only). Reading parses JSON and copies bytes into arrays: no
 entry can run code when it is read (pickles could). A value of any other type (a
-DataFrame, an object array, an arbitrary class) is refused with a ``TypeError`` when
-it is stored; convert it where it is produced.
+DataFrame, an object array, an arbitrary class) or nested deeper than
+:data:`MAX_DEPTH` levels is refused with a ``TypeError`` when it is stored; convert it
+where it is produced. An entry larger than :data:`MAX_ENTRY_BYTES` or with a header
+larger than :data:`MAX_HEADER_BYTES` is not stored (one :class:`CacheWarning`; the
+caller keeps its result).
 
-An entry whose magic line, checksum, header, key or (when the caller names it, as
-:func:`passmd.sweep.run` does) function does not check out (corrupt, truncated, foreign
-or misplaced) is reported once with a :class:`CacheWarning`,
-removed, and treated as a miss, so the caller recomputes it. Entries are written
-atomically: to a temporary file in the same directory, flushed to disk, then moved into
-place with :func:`os.replace`; an interrupted write leaves either no entry or the
-complete one. A cache that cannot be written (read-only, not a directory, owned by
-another user, disk full) is reported once per directory with a :class:`CacheWarning`
-and the caller goes on without caching: the computed result is never lost.
+An entry whose magic line, checksum, header (also: above the size limit, nested too
+deeply), key or (when the caller names it, as :func:`passmd.sweep.run` does) function
+does not check out (corrupt, truncated, foreign or misplaced), or whose path holds a
+link or a special file instead of a regular file, is reported once with a
+:class:`CacheWarning`, removed (a link itself, never its target), and treated as a miss,
+so the caller recomputes it. Entries are written atomically: to a temporary file
+``.<key[:16]>-<random>.tmp`` in the same directory, flushed to disk, then moved into
+place with :func:`os.replace`; an interrupted write (any exception, also
+``KeyboardInterrupt`` or the exception a signal handler raises) removes its temporary
+file, and one killed outright leaves one that ``prune`` removes once it is stale
+(:data:`STALE_TEMP_SECONDS`). A cache that cannot be written (read-only, not a
+directory, owned by another user, disk full) is reported once per directory with a
+:class:`CacheWarning` and the caller goes on without caching: the computed result is
+never lost.
+
+Ownership: the cache deletes only its own files
+------------------------------------------------
+A cache directory carries the marker ``CACHEDIR.TAG`` (a cache directory tag, which
+backup tools skip, naming the format, ``PASSMD-CACHE 1``). :class:`Cache` writes it when
+it creates the directory, or on its first use of an existing directory that is empty or
+holds only files of the cache's own layout (two-hex-digit subfolders of entries that start
+with the magic line, and its own temporary files): a cache filled before markers existed
+is adopted. Any other directory without the marker (a mistyped path, a folder of the
+user's) is never read from, written into or pruned: a sweep reports it once and goes on
+without the cache, and :meth:`Cache.info`, :meth:`Cache.prune` and :meth:`Cache.clear`
+raise :class:`NotACache` (``passmd cache`` refuses it with one line); the same holds for
+a marker of another format version.
+
+Even inside a marked cache, deletion touches only files at an entry's path
+(``<key[:2]>/<key>.pmc``) that start with the magic line, or that are links or special
+files there (the link itself is removed), and the cache's own temporary files. Any
+other file (also a regular file at an entry's path that is not an entry: it is neither
+removed nor replaced, and its point is not cached) is reported as foreign and left alone.
 
 The directory is ``.passmd-cache/`` in the current working directory unless the caller
 names another (``Cache(directory)``; entry points take it from the run configuration,
 :class:`passmd.config.RunConfig`, whose ``cache_dir`` comes from ``$PASSMD_CACHE_DIR`` or
 ``--cache-dir``; this module reads no environment variable).
 ``passmd cache info|clear|prune`` shows, empties or prunes it (prune: entries of other
-code fingerprints, unreadable entries and leftovers of the former pickle format).
+code fingerprints, unreadable entries and stale temporary files).
 """
 
 from __future__ import annotations
@@ -53,6 +81,8 @@ import functools
 import hashlib
 import json
 import os
+import re
+import stat
 import tempfile
 import time
 import warnings
@@ -65,9 +95,16 @@ import numpy as np
 __all__ = [
     "DEFAULT_CACHE_DIR",
     "ENTRY_SUFFIX",
+    "FORMAT",
+    "MARKER_NAME",
+    "MAX_DEPTH",
+    "MAX_ENTRY_BYTES",
+    "MAX_HEADER_BYTES",
+    "STALE_TEMP_SECONDS",
     "Cache",
     "CacheWarning",
     "CorruptEntry",
+    "NotACache",
     "canonical",
     "code_fingerprint",
     "decode_entry",
@@ -80,14 +117,43 @@ __all__ = [
 DEFAULT_CACHE_DIR = ".passmd-cache"
 #: File suffix of an entry.
 ENTRY_SUFFIX = ".pmc"
-#: First line of every entry (format name and version).
-MAGIC = b"PASSMD-CACHE 1\n"
-#: Suffix of entries of the former pickle format: never read, removed by ``prune``/``clear``.
-LEGACY_SUFFIX = ".pkl"
+#: Format name and version: the first line of every entry and the marker's format line.
+FORMAT = "PASSMD-CACHE 1"
+#: First line of every entry.
+MAGIC = FORMAT.encode() + b"\n"
+#: The marker file of a cache directory (a cache directory tag, https://bford.info/cachedir/).
+MARKER_NAME = "CACHEDIR.TAG"
+_MARKER_SIGNATURE = "Signature: 8a477f597d28d172789f06886806bc55"
+_MARKER_FORMAT_LINE = "# passmd cache format: "
+_MARKER_TEXT = (
+    f"{_MARKER_SIGNATURE}\n"
+    "# This directory is a passmd simulation cache: passmd deletes only its own entries in it.\n"
+    f"{_MARKER_FORMAT_LINE}{FORMAT}\n"
+    "# For information about cache directory tags see https://bford.info/cachedir/\n"
+).encode()
+#: Largest marker file read (the tag is a few lines).
+_MARKER_MAX_BYTES = 4096
+#: Largest entry file read or written, in bytes (results are KiB to MiB; arrays live here).
+MAX_ENTRY_BYTES = 2**30
+#: Largest JSON header read or written, in bytes (the value tree without its array bytes).
+MAX_HEADER_BYTES = 16 * 2**20
+#: Deepest nesting of a stored value (a dict in a list in a dict ... counts one per level).
+MAX_DEPTH = 64
+#: Age after which ``prune`` removes one of the cache's temporary files (a write takes
+#: milliseconds; an older one was left by a process killed outright).
+STALE_TEMP_SECONDS = 600.0
+
+#: Names the cache owns: subfolders, entries and temporary files (groups: the key's first
+#: two digits, which must be the subfolder's name).
+_KEY = re.compile(r"[0-9a-f]{64}")
+_SUBDIR = re.compile(r"[0-9a-f]{2}")
+_ENTRY_NAME = re.compile(r"([0-9a-f]{2})[0-9a-f]{62}" + re.escape(ENTRY_SUFFIX))
+_TEMP_NAME = re.compile(r"\.([0-9a-f]{2})[0-9a-f]{14}-[a-z0-9_]{1,32}\.tmp")
+_MARKER_TEMP_NAME = re.compile(r"\.CACHEDIR\.TAG-[a-z0-9_]{1,32}\.tmp")
 
 _PACKAGE_DIR = Path(__file__).resolve().parent
 _MISS = object()
-#: Directories already reported as unwritable in this process (one warning each).
+#: Directories already reported as unusable in this process (one warning each).
 _REPORTED_UNWRITABLE: set[str] = set()
 
 
@@ -97,6 +163,21 @@ class CacheWarning(UserWarning):
 
 class CorruptEntry(ValueError):
     """An entry's bytes do not decode to a checked value (see :func:`decode_entry`)."""
+
+
+class NotACache(ValueError):
+    """A directory is not a passmd cache (no marker of this format): nothing in it is touched.
+
+    ``directory`` is the directory, ``reason`` says why (``str()`` joins both).
+    """
+
+    def __init__(self, directory: Path, reason: str):
+        super().__init__(f"{directory} {reason}")
+        self.directory, self.reason = directory, reason
+
+
+class _TooLarge(ValueError):
+    """An encoded entry above :data:`MAX_ENTRY_BYTES` or :data:`MAX_HEADER_BYTES`."""
 
 
 def default_cache_dir() -> Path:
@@ -201,8 +282,10 @@ def canonical(obj):
 # --------------------------------------------------------------------------------------
 
 
-def _encode_node(value, chunks: list[bytes], offset: list[int], where: str):
+def _encode_node(value, chunks: list[bytes], offset: list[int], where: str, depth: int = 1):
     """JSON node of one value; array bytes are appended to ``chunks``."""
+    if depth > MAX_DEPTH:
+        raise TypeError(f"cannot cache {where}: the value nests deeper than {MAX_DEPTH} levels")
     if value is None:
         return {"t": "none"}
     if isinstance(value, bool):
@@ -224,12 +307,12 @@ def _encode_node(value, chunks: list[bytes], offset: list[int], where: str):
     if isinstance(value, str):
         return {"t": "str", "v": value}
     if isinstance(value, (list, tuple)):
-        return {"t": type(value).__name__,
-                "v": [_encode_node(x, chunks, offset, f"{where}[{i}]") for i, x in enumerate(value)]}
+        items = [_encode_node(x, chunks, offset, f"{where}[{i}]", depth + 1) for i, x in enumerate(value)]
+        return {"t": type(value).__name__, "v": items}
     if isinstance(value, dict):
         if not all(isinstance(k, str) for k in value):
             raise TypeError(f"cannot cache {where}: a dict with non-string keys")
-        return {"t": "dict", "v": [[k, _encode_node(v, chunks, offset, f"{where}[{k!r}]")]
+        return {"t": "dict", "v": [[k, _encode_node(v, chunks, offset, f"{where}[{k!r}]", depth + 1)]
                                    for k, v in value.items()]}
     raise TypeError(
         f"cannot cache {where}: a {type(value).__name__} (the cache stores None, bool, int, float, "
@@ -237,7 +320,11 @@ def _encode_node(value, chunks: list[bytes], offset: list[int], where: str):
     )
 
 
-def _decode_node(node, payload: memoryview):
+def _decode_node(node, payload: memoryview, depth: int = 1):
+    if depth > MAX_DEPTH:
+        raise CorruptEntry(f"the value nests deeper than {MAX_DEPTH} levels")
+    if not isinstance(node, dict):
+        raise CorruptEntry("a value node that is not an object")
     kind = node["t"]
     if kind == "none":
         return None
@@ -254,10 +341,10 @@ def _decode_node(node, payload: memoryview):
             raise CorruptEntry("str node without a string")
         return node["v"]
     if kind in ("list", "tuple"):
-        items = [_decode_node(x, payload) for x in node["v"]]
+        items = [_decode_node(x, payload, depth + 1) for x in node["v"]]
         return items if kind == "list" else tuple(items)
     if kind == "dict":
-        return {str(k): _decode_node(v, payload) for k, v in node["v"]}
+        return {str(k): _decode_node(v, payload, depth + 1) for k, v in node["v"]}
     if kind == "array":
         dtype = np.dtype(node["dtype"])
         if dtype.hasobject or dtype.kind not in "biufc":
@@ -278,7 +365,11 @@ def encode_entry(key: str, value, *, function: str = "", fingerprint: str = "") 
     Raises
     ------
     TypeError
-        If ``value`` holds a type the format does not store.
+        If ``value`` holds a type the format does not store, or nests deeper than
+        :data:`MAX_DEPTH` levels.
+    ValueError
+        If the entry would exceed :data:`MAX_ENTRY_BYTES` or its header
+        :data:`MAX_HEADER_BYTES` (it could not be read back).
     """
     chunks: list[bytes] = []
     tree = _encode_node(value, chunks, [0], "the value")
@@ -287,16 +378,23 @@ def encode_entry(key: str, value, *, function: str = "", fingerprint: str = "") 
          "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "value": tree},
         separators=(",", ":"), allow_nan=False,
     ).encode()
+    if len(header) > MAX_HEADER_BYTES:
+        raise _TooLarge(f"its header of {len(header)} bytes is above the {MAX_HEADER_BYTES}-byte limit")
     payload = b"".join(chunks)
     digest = hashlib.sha256(header + payload).hexdigest()
-    return MAGIC + f"{digest} {len(header)}\n".encode() + header + payload
+    data = MAGIC + f"{digest} {len(header)}\n".encode() + header + payload
+    if len(data) > MAX_ENTRY_BYTES:
+        raise _TooLarge(f"its {len(data)} bytes are above the {MAX_ENTRY_BYTES}-byte limit")
+    return data
 
 
 def _split_entry(data: bytes) -> tuple[dict, memoryview]:
-    """Header (checked against the checksum) and payload of an entry's bytes."""
+    """Header (checked against the checksum and the limits) and payload of an entry's bytes."""
     if not data.startswith(MAGIC):
         raise CorruptEntry("not a passmd cache entry (bad first line)")
-    end = data.find(b"\n", len(MAGIC))
+    if len(data) > MAX_ENTRY_BYTES:
+        raise CorruptEntry(f"{len(data)} bytes, above the {MAX_ENTRY_BYTES}-byte limit")
+    end = data.find(b"\n", len(MAGIC), len(MAGIC) + 128)
     if end < 0:
         raise CorruptEntry("truncated (no checksum line)")
     try:
@@ -305,12 +403,16 @@ def _split_entry(data: bytes) -> tuple[dict, memoryview]:
     except (UnicodeDecodeError, ValueError) as exc:
         raise CorruptEntry("unreadable checksum line") from exc
     body = data[end + 1:]
+    if length > MAX_HEADER_BYTES:
+        raise CorruptEntry(f"a header of {length} bytes, above the {MAX_HEADER_BYTES}-byte limit")
     if length < 0 or length > len(body):
         raise CorruptEntry("truncated (header shorter than announced)")
     if hashlib.sha256(body).hexdigest() != digest:
         raise CorruptEntry("checksum mismatch (the bytes changed after they were written)")
     try:
         header = json.loads(body[:length].decode())
+    except RecursionError as exc:
+        raise CorruptEntry("a header nested too deeply to read") from exc
     except (UnicodeDecodeError, ValueError) as exc:
         raise CorruptEntry("unreadable header") from exc
     if not isinstance(header, dict) or header.get("format") != 1 or "value" not in header:
@@ -324,7 +426,8 @@ def decode_entry(data: bytes, key: str | None = None):
     Raises
     ------
     CorruptEntry
-        Bad magic line, checksum, header or node, or another key than ``key``.
+        Bad magic line, checksum, header or node, a header or value above the limits
+        (:data:`MAX_HEADER_BYTES`, :data:`MAX_DEPTH`), or another key than ``key``.
     """
     header, payload = _split_entry(data)
     if key is not None and header.get("key") != key:
@@ -333,9 +436,184 @@ def decode_entry(data: bytes, key: str | None = None):
         value = _decode_node(header["value"], payload)
     except CorruptEntry:
         raise
-    except (KeyError, TypeError, ValueError, OverflowError) as exc:
+    except (KeyError, TypeError, ValueError, OverflowError, IndexError, RecursionError) as exc:
         raise CorruptEntry(f"malformed value ({type(exc).__name__})") from exc
     return header, value
+
+
+# --------------------------------------------------------------------------------------
+# Files: what lies at a path, and which of the cache's files are its own
+# --------------------------------------------------------------------------------------
+
+
+def _check_key(key) -> str:
+    if not isinstance(key, str) or not _KEY.fullmatch(key):
+        shown = repr(key) if len(repr(key)) <= 80 else repr(key)[:76] + "...'"
+        raise ValueError(f"key = {shown} is not a cache key: must be 64 lowercase hexadecimal digits "
+                         "(as Cache.key returns)")
+    return key
+
+
+def _examine(path: Path, *, read: bool) -> tuple[str, object]:
+    """What lies at an entry's path, never following a link or blocking on a device.
+
+    ``("missing", None)``; ``("foreign", what)``: not the cache's (a directory, or a regular
+    file without the magic line): never removed or replaced; ``("bad", why)``: unreadable
+    as an entry and removable (a link, which is removed itself, a special file, an entry
+    above :data:`MAX_ENTRY_BYTES`); ``("entry", data)``: a regular file that starts with
+    the magic line, with its bytes when ``read``. Other ``OSError`` (permissions) propagate.
+    """
+    try:
+        info = os.lstat(path)
+    except FileNotFoundError:
+        return "missing", None
+    if stat.S_ISLNK(info.st_mode):
+        return "bad", "a symbolic link, not an entry"
+    if stat.S_ISDIR(info.st_mode):
+        return "foreign", "a directory"
+    if not stat.S_ISREG(info.st_mode):
+        return "bad", "not a regular file"
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except FileNotFoundError:
+        return "missing", None
+    except OSError as exc:
+        if os.path.islink(path):  # replaced by a link since the lstat
+            return "bad", "a symbolic link, not an entry"
+        raise exc
+    with os.fdopen(fd, "rb") as fh:
+        info = os.fstat(fh.fileno())
+        if not stat.S_ISREG(info.st_mode):
+            return "bad", "not a regular file"
+        head = fh.read(len(MAGIC))
+        if head != MAGIC:
+            return "foreign", "a file that is not a passmd cache entry (no PASSMD-CACHE first line)"
+        if info.st_size > MAX_ENTRY_BYTES:
+            return "bad", f"{info.st_size} bytes, above the {MAX_ENTRY_BYTES}-byte limit"
+        if not read:
+            return "entry", None
+        data = head + fh.read(MAX_ENTRY_BYTES + 1 - len(head))
+    if len(data) > MAX_ENTRY_BYTES:
+        return "bad", f"more than the {MAX_ENTRY_BYTES}-byte limit"
+    return "entry", data
+
+
+def _read_marker(directory: Path) -> str | None:
+    """The format a passmd marker in ``directory`` names, None if there is none."""
+    marker = directory / MARKER_NAME
+    try:
+        if not stat.S_ISREG(os.lstat(marker).st_mode):
+            return None
+        fd = os.open(marker, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+        with os.fdopen(fd, "rb") as fh:
+            if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
+                return None
+            text = fh.read(_MARKER_MAX_BYTES + 1)
+    except OSError:
+        return None
+    if len(text) > _MARKER_MAX_BYTES:
+        return None
+    lines = text.decode("utf-8", "replace").splitlines()
+    if not lines or lines[0].strip() != _MARKER_SIGNATURE:
+        return None
+    for line in lines[1:]:
+        if line.startswith(_MARKER_FORMAT_LINE) and line[len(_MARKER_FORMAT_LINE):].strip():
+            return line[len(_MARKER_FORMAT_LINE):].strip()
+    return None
+
+
+def _write_marker(directory: Path) -> None:
+    """Write the marker atomically without replacing a file already there."""
+    marker = directory / MARKER_NAME
+    fd, tmp = tempfile.mkstemp(prefix=f".{MARKER_NAME}-", suffix=".tmp", dir=directory)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(_MARKER_TEXT)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, 0o644)
+        try:
+            os.link(tmp, marker)  # atomic, and fails where a marker (or any file) is already
+        except FileExistsError:
+            pass
+        except OSError:  # a file system without hard links
+            if not os.path.lexists(marker):
+                os.replace(tmp, marker)
+    finally:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+
+
+def _unlink(path: Path) -> bool:
+    """Remove one file (a link itself); False if it was gone already."""
+    try:
+        os.unlink(path)
+    except FileNotFoundError:
+        return False
+    return True
+
+
+def _is_regular(path: Path) -> bool:
+    try:
+        return stat.S_ISREG(os.lstat(path).st_mode)
+    except OSError:
+        return False
+
+
+def _walk(directory: Path):
+    """``(kind, path)`` of every name in a cache directory (subfolders: their names).
+
+    ``kind``: ``"candidate"`` (at an entry's path: :func:`_examine` tells what it is),
+    ``"temp"`` (one of the cache's own temporary files), ``"foreign"`` (anything else: not
+    the cache's). The marker itself is not listed. Names that vanish meanwhile are skipped.
+    """
+    try:
+        top = sorted(os.listdir(directory))
+    except FileNotFoundError:
+        return
+    for name in top:
+        path = directory / name
+        if name == MARKER_NAME:
+            continue
+        if _MARKER_TEMP_NAME.fullmatch(name) and _is_regular(path):
+            yield "temp", path
+            continue
+        try:
+            is_subdir = _SUBDIR.fullmatch(name) is not None and stat.S_ISDIR(os.lstat(path).st_mode)
+        except FileNotFoundError:
+            continue
+        if not is_subdir:
+            yield "foreign", path
+            continue
+        try:
+            names = sorted(os.listdir(path))
+        except FileNotFoundError:
+            continue
+        for child in names:
+            file = path / child
+            entry = _ENTRY_NAME.fullmatch(child)
+            if entry and entry[1] == name:
+                yield "candidate", file
+                continue
+            temp = _TEMP_NAME.fullmatch(child)
+            if temp and temp[1] == name and _is_regular(file):
+                yield "temp", file
+                continue
+            yield "foreign", file
+
+
+def _first_stray(directory: Path) -> str | None:
+    """The first name in an unmarked directory that is not of the cache's own layout."""
+    for kind, path in _walk(directory):
+        if kind == "candidate" and _examine(path, read=False)[0] in ("entry", "missing"):
+            continue
+        if kind != "temp":
+            return path.relative_to(directory).as_posix()
+    if (directory / MARKER_NAME).exists() or os.path.islink(directory / MARKER_NAME):
+        return MARKER_NAME  # a tag of another program
+    return None
 
 
 class Cache:
@@ -344,7 +622,9 @@ class Cache:
     Parameters
     ----------
     directory : path, optional
-        Where entries live; default :func:`default_cache_dir`. Created on first write.
+        Where entries live; default :func:`default_cache_dir`. Created (with its marker)
+        on first write; an existing directory is used only under the rules of the module
+        docstring (marked, empty, or holding only the cache's own files).
     fingerprint : str, optional
         Code fingerprint mixed into every key; default :func:`code_fingerprint`.
 
@@ -353,6 +633,7 @@ class Cache:
     >>> cache = Cache("/tmp/passmd-doc-cache")
     >>> key = cache.key(divmod, {"a": 7, "b": 2})
     >>> cache.put(key, {"q": 3})
+    True
     >>> cache.get(key)
     {'q': 3}
     """
@@ -360,6 +641,8 @@ class Cache:
     def __init__(self, directory: str | os.PathLike | None = None, *, fingerprint: str | None = None):
         self.directory = Path(directory).expanduser().resolve() if directory else default_cache_dir()
         self.fingerprint = fingerprint if fingerprint is not None else code_fingerprint()
+        self._usable: bool | None = None  # decided on first use (see _ready)
+        self._reported: set = set()  # what _report_once reported
 
     def __repr__(self) -> str:
         return f"Cache({str(self.directory)!r}, fingerprint={self.fingerprint[:12]!r}...)"
@@ -375,13 +658,123 @@ class Cache:
         return hashlib.sha256(text.encode()).hexdigest()
 
     def path(self, key: str) -> Path:
-        """File of an entry: ``<directory>/<key[:2]>/<key>.pmc``."""
+        """File of an entry: ``<directory>/<key[:2]>/<key>.pmc``.
+
+        Raises
+        ------
+        ValueError
+            If ``key`` is not 64 lowercase hexadecimal digits (what :meth:`key` returns).
+        """
+        _check_key(key)
         return self.directory / key[:2] / f"{key}{ENTRY_SUFFIX}"
+
+    # ---- ownership of the directory ------------------------------------------------
+
+    def _inspect(self) -> tuple[str, str]:
+        """State of the directory and, for one that is not a usable cache, why.
+
+        ``missing``, ``empty``, ``marked`` (marker of this format), ``own-layout`` (no
+        marker, only the cache's own files), ``foreign``, ``other-format``,
+        ``not-a-directory``. ``OSError`` (permissions) propagates.
+        """
+        try:
+            info = os.stat(self.directory)
+        except FileNotFoundError:
+            return "missing", "does not exist"
+        if not stat.S_ISDIR(info.st_mode):
+            return "not-a-directory", "is not a directory"
+        found = _read_marker(self.directory)
+        if found == FORMAT:
+            return "marked", ""
+        if found is not None:
+            return "other-format", (f"is a passmd cache of format {found!r}; this passmd reads {FORMAT!r} "
+                                    "(use the passmd that wrote it, or remove the directory by hand)")
+        if not os.listdir(self.directory):
+            return "empty", ""
+        stray = _first_stray(self.directory)
+        if stray is None:
+            return "own-layout", (f"has no {MARKER_NAME} marker, though it holds only passmd cache entries "
+                                  "(a cache from before markers): the next run that caches results in it "
+                                  "marks it")
+        return "foreign", (f"is not a passmd cache: it has no {MARKER_NAME} marker written by passmd and "
+                           f"holds {stray!r}, which is not a passmd cache file")
+
+    def _ready(self, create: bool) -> bool:
+        """Whether entries may be read and written here; marks a new or adoptable directory.
+
+        ``create``: make a missing directory (a write); else a missing one is a miss. A
+        directory that is not usable is reported once (:class:`CacheWarning`).
+        """
+        if self._usable is not None:
+            return self._usable
+        try:
+            state, reason = self._inspect()
+            if state == "missing":
+                if not create:
+                    return False
+                try:
+                    self.directory.mkdir(parents=True)
+                    state = "empty"
+                except FileExistsError:  # made meanwhile, or a dangling link: look again
+                    state, reason = self._inspect()
+            if state in ("empty", "own-layout"):
+                _write_marker(self.directory)
+                state, reason = self._inspect()
+        except OSError as exc:
+            verb = "write" if create else "read"
+            self._report_unusable(f"cannot {verb} the cache {self.directory}: {exc.strerror or exc}")
+            self._usable = False
+            return False
+        self._usable = state == "marked"
+        if state == "not-a-directory":
+            self._report_unusable(f"cannot write the cache {self.directory}: it is not a directory")
+        elif not self._usable:
+            self._report_unusable(f"the cache directory {self.directory} {reason}")
+        return self._usable
+
+    def _owned(self) -> bool:
+        """For info/clear/prune: True for a marked cache, False for a missing or empty directory.
+
+        Raises
+        ------
+        NotACache
+            Any other directory (its files are never read or removed).
+        """
+        state, reason = self._inspect()
+        if state == "marked":
+            return True
+        if state in ("missing", "empty"):
+            return False
+        raise NotACache(self.directory, reason)
+
+    def _subfolder(self, folder: Path, *, create: bool) -> bool:
+        """Whether ``folder`` (``<directory>/<key[:2]>``) is a real directory; made on a write."""
+        try:
+            info = os.lstat(folder)
+        except FileNotFoundError:
+            if not create:
+                return False
+            try:
+                os.mkdir(folder)
+            except FileExistsError:
+                pass
+            info = os.lstat(folder)
+        if stat.S_ISDIR(info.st_mode):
+            return True
+        self._report_path(folder, "a link or a file where the cache keeps a subfolder")
+        return False
+
+    # ---- reading and writing entries -----------------------------------------------
 
     def get(self, key: str, default=None, *, function: str | None = None):
         """The stored value, or ``default`` on a miss (absent or unusable entry).
 
         ``function`` given: an entry written for another function is unusable too.
+
+        Raises
+        ------
+        ValueError
+            If ``key`` is not a cache key (see :meth:`path`).
         """
         value = self._load(key, function)
         return default if value is _MISS else value
@@ -391,15 +784,25 @@ class Cache:
 
     def _load(self, key: str, function: str | None = None):
         path = self.path(key)
-        try:
-            data = path.read_bytes()
-        except FileNotFoundError:
+        if not self._ready(create=False):
             return _MISS
-        except OSError as exc:  # unreadable (permissions, a directory in the way): a miss
+        try:
+            if not self._subfolder(path.parent, create=False):
+                return _MISS
+            kind, found = _examine(path, read=True)
+        except OSError as exc:  # unreadable (permissions): a miss
             self._report_unusable(f"cannot read the cache {self.directory}: {exc.strerror or exc}")
             return _MISS
+        if kind == "missing":
+            return _MISS
+        if kind == "foreign":
+            self._report_path(path, found)
+            return _MISS
+        if kind == "bad":
+            self._discard(path, found)
+            return _MISS
         try:
-            header, value = decode_entry(data, key)
+            header, value = decode_entry(found, key)
             if function is not None and header.get("function") not in (function, ""):
                 raise CorruptEntry(f"written by {header.get('function')!r}, not {function!r}")
         except CorruptEntry as exc:
@@ -408,13 +811,23 @@ class Cache:
         return value
 
     def _discard(self, path: Path, reason: str) -> None:
-        """Report an unusable entry once and remove it (the caller recomputes it)."""
+        """Report an unusable entry of the cache once and remove it (the caller recomputes it)."""
         try:
-            path.unlink()
+            _unlink(path)
             action = "removed; recomputing"
         except OSError:
             action = "could not remove it; recomputing"
         warnings.warn(f"cache entry {path} is unusable ({reason}); {action}", CacheWarning, stacklevel=4)
+
+    def _report_path(self, path: Path, what: str) -> None:
+        """Report once a path of the cache that holds something not the cache's (left alone)."""
+        self._report_once(path, f"cache path {path} holds {what}: left in place, and this result is not "
+                                "cached")
+
+    def _report_once(self, token, message: str) -> None:
+        if token not in self._reported:
+            self._reported.add(token)
+            warnings.warn(message, CacheWarning, stacklevel=5)
 
     def _report_unusable(self, message: str) -> None:
         marker = str(self.directory)
@@ -425,21 +838,37 @@ class Cache:
     def put(self, key: str, value, *, function: str = "") -> bool:
         """Store ``value`` atomically (temporary file in the same directory + ``os.replace``).
 
-        Returns whether the entry was written. A cache that cannot be written is reported
-        once per directory (:class:`CacheWarning`) and ``False`` is returned: the caller
-        keeps its result.
+        Returns whether the entry was written. A cache that cannot be written or is not a
+        passmd cache is reported once per directory (:class:`CacheWarning`), a file of
+        someone else's at the entry's path once (it is never replaced), an entry above the
+        size limits once; then ``False`` is returned: the caller keeps its result. The
+        temporary file is removed on any exception, ``KeyboardInterrupt`` included.
 
         Raises
         ------
+        ValueError
+            If ``key`` is not a cache key (see :meth:`path`), checked first.
         TypeError
             If ``value`` holds a type the entry format does not store (checked before
             anything is written).
         """
-        data = encode_entry(key, value, function=function, fingerprint=self.fingerprint)
         target = self.path(key)
+        try:
+            data = encode_entry(key, value, function=function, fingerprint=self.fingerprint)
+        except _TooLarge as exc:
+            self._report_once(("too large", function),
+                              f"a result of {function or 'this function'} is not cached: {exc}")
+            return False
+        if not self._ready(create=True):
+            return False
         tmp = None
         try:
-            target.parent.mkdir(parents=True, exist_ok=True)
+            if not self._subfolder(target.parent, create=True):
+                return False
+            kind, found = _examine(target, read=False)
+            if kind == "foreign":
+                self._report_path(target, found)
+                return False
             fd, tmp = tempfile.mkstemp(prefix=f".{key[:16]}-", suffix=".tmp", dir=target.parent)
             with os.fdopen(fd, "wb") as fh:
                 fh.write(data)
@@ -450,7 +879,7 @@ class Cache:
         except OSError as exc:
             self._report_unusable(f"cannot write the cache {self.directory}: {exc.strerror or exc}")
             return False
-        finally:
+        finally:  # also on KeyboardInterrupt and what a SIGTERM handler raises
             if tmp is not None:
                 try:
                     os.unlink(tmp)
@@ -458,29 +887,60 @@ class Cache:
                     pass
         return True
 
+    # ---- the whole directory -------------------------------------------------------
+
     def entries(self) -> list[Path]:
-        """Paths of all complete entries (temporary files excluded)."""
-        if not self.directory.is_dir():
-            return []
-        return sorted(p for p in self.directory.glob(f"??/*{ENTRY_SUFFIX}") if not p.name.startswith("."))
+        """Paths of all complete entries: regular files at entries' paths with the magic line."""
+        found = []
+        for kind, path in _walk(self.directory):
+            try:
+                if kind == "candidate" and _examine(path, read=False)[0] == "entry":
+                    found.append(path)
+            except OSError:
+                continue
+        return found
 
     def info(self) -> dict:
         """Summary of the directory: entries, bytes, entries per code fingerprint and function.
 
-        Unreadable entries and leftovers (temporary files, former pickle entries) are counted
-        apart; nothing is removed.
+        Unreadable entries, the cache's own temporary files (``leftovers``) and files that
+        are not the cache's (``foreign``, never touched) are counted apart; nothing is removed.
+
+        Raises
+        ------
+        NotACache
+            The directory exists, is not empty and has no marker of this format.
         """
         summary = {"directory": str(self.directory), "entries": 0, "bytes": 0, "current_code": 0,
-                   "other_code": 0, "unreadable": 0, "leftovers": 0, "functions": {}}
-        for path in self._files():
-            size = path.stat().st_size
+                   "other_code": 0, "unreadable": 0, "leftovers": 0, "foreign": 0, "functions": {}}
+        if not self._owned():
+            return summary
+        for kind, path in _walk(self.directory):
+            if kind == "foreign":
+                summary["foreign"] += 1
+                continue
+            try:
+                size = os.lstat(path).st_size
+                found = _examine(path, read=True) if kind == "candidate" else ("temp", None)
+            except FileNotFoundError:
+                continue
+            except OSError:
+                summary["unreadable"] += 1
+                continue
+            if found[0] == "missing":
+                continue
+            if found[0] == "foreign":
+                summary["foreign"] += 1
+                continue
             summary["bytes"] += size
-            if path.suffix != ENTRY_SUFFIX or path.name.startswith("."):
+            if found[0] == "temp":
                 summary["leftovers"] += 1
                 continue
             try:
-                header, _ = _split_entry(path.read_bytes())
-            except (CorruptEntry, OSError):
+                if found[0] == "bad":
+                    raise CorruptEntry(found[1])
+                header, _ = _split_entry(found[1])
+            except CorruptEntry:
                 summary["unreadable"] += 1
                 continue
             summary["entries"] += 1
@@ -490,36 +950,65 @@ class Cache:
             summary["functions"][name] = summary["functions"].get(name, 0) + 1
         return summary
 
-    def _files(self) -> list[Path]:
-        if not self.directory.is_dir():
-            return []
-        return sorted(p for p in self.directory.glob("??/*") if p.is_file())
-
     def prune(self) -> int:
-        """Remove entries of other code fingerprints, unreadable entries and leftovers.
+        """Remove entries of other code fingerprints, unreadable entries, stale temporary files.
 
-        Returns the number of files removed. Entries of the current code stay.
+        Returns the number of files removed. Entries of the current code, temporary files
+        younger than :data:`STALE_TEMP_SECONDS` (a write in progress) and files that are
+        not the cache's stay.
+
+        Raises
+        ------
+        NotACache
+            The directory exists, is not empty and has no marker of this format.
         """
+        if not self._owned():
+            return 0
         removed = 0
-        for path in self._files():
-            if path.suffix == ENTRY_SUFFIX and not path.name.startswith("."):
+        now = time.time()
+        for kind, path in _walk(self.directory):
+            try:
+                if kind == "temp":
+                    if now - os.lstat(path).st_mtime > STALE_TEMP_SECONDS:
+                        removed += _unlink(path)
+                    continue
+                if kind != "candidate":
+                    continue
+                found, data = _examine(path, read=True)
+            except FileNotFoundError:
+                continue
+            if found == "bad":
+                removed += _unlink(path)
+            elif found == "entry":
                 try:
-                    header, _ = _split_entry(path.read_bytes())
+                    header, _ = _split_entry(data)
                     if header.get("code") == self.fingerprint:
                         continue
-                except (CorruptEntry, OSError):
+                except CorruptEntry:
                     pass
-            elif path.suffix not in (".tmp", LEGACY_SUFFIX):
-                continue  # not ours
-            path.unlink(missing_ok=True)
-            removed += 1
+                removed += _unlink(path)
         return removed
 
     def clear(self) -> int:
-        """Delete every entry and leftover file; return the number of entries removed."""
+        """Remove every entry (readable or not) and temporary file of the cache.
+
+        Returns the number of files removed; files that are not the cache's stay. A write
+        in progress meanwhile loses its entry (reported by that writer, which keeps its
+        result).
+
+        Raises
+        ------
+        NotACache
+            The directory exists, is not empty and has no marker of this format.
+        """
+        if not self._owned():
+            return 0
         removed = 0
-        for path in self._files():
-            if path.suffix in (ENTRY_SUFFIX, ".tmp", LEGACY_SUFFIX):
-                removed += path.suffix == ENTRY_SUFFIX and not path.name.startswith(".")
-                path.unlink(missing_ok=True)
+        for kind, path in _walk(self.directory):
+            try:
+                if kind == "temp" or (kind == "candidate"
+                                      and _examine(path, read=False)[0] in ("entry", "bad")):
+                    removed += _unlink(path)
+            except FileNotFoundError:
+                continue
         return removed

@@ -28,6 +28,14 @@ def store(tmp_path):
     return Cache(tmp_path / "cache")
 
 
+@pytest.fixture
+def marked(store):
+    """An empty cache directory the cache created (and marked) itself."""
+    key = store.key(other_function, {"x": -1})
+    assert store.put(key, {"y": -1}) and store.clear() == 1
+    return store
+
+
 def test_key_depends_on_every_parameter_and_function(store):
     base = store.key(point_function, {"x": 0.1, "drive": Drive()})
     assert base == Cache(store.directory).key(point_function, {"drive": Drive(), "x": 0.1})  # order-free
@@ -96,8 +104,8 @@ def test_values_the_format_cannot_store_are_refused(store, value):
     assert not store.path(key).exists()
 
 
-def test_no_entry_can_run_code_when_read(store, tmp_path):
-    """A pickle that runs a command when unpickled is never unpickled."""
+def test_no_entry_can_run_code_when_read(marked, tmp_path):
+    """A pickle that runs a command when unpickled is never unpickled (nor removed: not ours)."""
     import pickle
 
     marker = tmp_path / "pwned"
@@ -106,14 +114,18 @@ def test_no_entry_can_run_code_when_read(store, tmp_path):
         def __reduce__(self):
             return (os.system, (f"touch {marker}",))
 
+    store = marked
     key = store.key(point_function, {"x": 9})
-    store.path(key).parent.mkdir(parents=True)
+    store.path(key).parent.mkdir(parents=True, exist_ok=True)
     store.path(key).write_bytes(pickle.dumps({"key": key, "value": Exploit()}))
-    with pytest.warns(cache_module.CacheWarning, match="not a passmd cache entry"):
+    with pytest.warns(cache_module.CacheWarning, match="not a passmd cache entry") as record:
         assert store.get(key, "miss") == "miss"
+        assert store.put(key, {"y": 9}) is False  # the same path: reported once, not replaced
+    assert len(record) == 1
     assert not marker.exists()
-    assert not store.path(key).exists()  # removed
+    assert store.path(key).read_bytes().startswith(b"\x80")  # left in place
     # the entry format itself is JSON + raw bytes: nothing in it is callable
+    store.path(key).unlink()
     store.put(key, {"y": np.arange(3.0)})
     data = store.path(key).read_bytes()
     assert data.startswith(cache_module.MAGIC) and b"pickle" not in data
@@ -198,14 +210,14 @@ def test_prune_and_info(store, tmp_path):
     old = Cache(store.directory, fingerprint="0" * 64)
     old.put(old.key(point_function, {"x": 1}), {"y": 1}, function="tests:point_function")
     store.put(store.key(point_function, {"x": 2}), {"y": 2}, function="tests:point_function")
-    legacy = store.directory / "ab" / ("ab" + "0" * 62 + ".pkl")
+    legacy = store.directory / "ab" / ("ab" + "0" * 62 + ".pkl")  # not an entry: never removed
     legacy.parent.mkdir(parents=True, exist_ok=True)
     legacy.write_bytes(b"\x80\x05old pickle")
     info = store.info()
-    assert (info["entries"], info["current_code"], info["other_code"], info["leftovers"]) == (2, 1, 1, 1)
+    assert (info["entries"], info["current_code"], info["other_code"], info["foreign"]) == (2, 1, 1, 1)
     assert info["functions"] == {"tests:point_function": 2}
-    assert store.prune() == 2  # the other fingerprint's entry and the pickle
-    assert store.info()["entries"] == 1 and not legacy.exists()
+    assert store.prune() == 1  # the other fingerprint's entry
+    assert store.info()["entries"] == 1 and legacy.exists()
     assert store.get(store.key(point_function, {"x": 2})) == {"y": 2}
 
 
@@ -239,16 +251,34 @@ def test_killed_write_leftover_is_ignored(store):
     assert store.get(key) == {"y": 3}
 
 
-@pytest.mark.parametrize("content", [b"", b"\x80\x05garbage", b"not a pickle at all",
-                                     b"PASSMD-CACHE 1\n", b"PASSMD-CACHE 1\nabc 5\n{}"])
-def test_corrupt_entry_is_a_miss(store, content):
+@pytest.mark.parametrize("content", [b"PASSMD-CACHE 1\n", b"PASSMD-CACHE 1\nabc 5\n{}",
+                                     b"PASSMD-CACHE 1\n" + b"\x00" * 100])
+def test_corrupt_entry_is_a_miss(marked, content):
+    store = marked
     key = store.key(point_function, {"x": 4})
-    store.path(key).parent.mkdir(parents=True)
+    store.path(key).parent.mkdir(parents=True, exist_ok=True)
     store.path(key).write_bytes(content)
-    with pytest.warns(cache_module.CacheWarning, match="unusable"):
+    with pytest.warns(cache_module.CacheWarning, match="unusable.*removed; recomputing"):
         assert store.get(key, "miss") == "miss"
-    store.put(key, {"y": 4})  # recomputed value overwrites it
+    assert not store.path(key).exists()
+    store.put(key, {"y": 4})  # the recomputed value takes its place
     assert store.get(key) == {"y": 4}
+
+
+@pytest.mark.parametrize("content", [b"", b"\x80\x05garbage", b"not a pickle at all", b"PASSMD-CACHE 2\n"])
+def test_a_file_at_an_entry_path_without_the_magic_line_is_left_alone(marked, content):
+    """Not the cache's (the magic line is missing): a miss, reported, neither removed nor replaced."""
+    store = marked
+    key = store.key(point_function, {"x": 4})
+    store.path(key).parent.mkdir(parents=True, exist_ok=True)
+    store.path(key).write_bytes(content)
+    with pytest.warns(cache_module.CacheWarning, match="not a passmd cache entry.*left in place"):
+        assert store.get(key, "miss") == "miss"
+    assert store.put(key, {"y": 4}) is False
+    assert store.path(key).read_bytes() == content
+    assert store.prune() == 0 and store.clear() == 0
+    assert store.path(key).read_bytes() == content
+    assert store.info()["foreign"] == 1
 
 
 def test_entry_under_wrong_key_is_a_miss(store):

@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+import os
 import textwrap
 
-from passmd.cache import DEFAULT_CACHE_DIR
-from passmd.cli.errors import OutputError
+from passmd.cache import DEFAULT_CACHE_DIR, MARKER_NAME
+from passmd.cli.errors import UsageError
 from passmd.cli.options import CACHE_DIR_HELP
 from passmd.cli.output import JSON_HELP, emit_json, emit_rows
 from passmd.config import ENVIRONMENT, RunConfig
@@ -16,11 +17,21 @@ _EPILOG = textwrap.dedent(f"""\
     info: entries (of the current code and of older code versions), size, entries per
     function. clear: remove every entry. prune: remove entries of other code versions
     (their code fingerprint differs, so they can never be served), unreadable entries
-    and leftovers. Entries are checksummed data (JSON header + raw array bytes), never
-    code; see passmd.cache for the format. Directory: ${ENVIRONMENT['cache_dir']} or ./{DEFAULT_CACHE_DIR}.
+    and stale temporary files. Entries are checksummed data (JSON header + raw array
+    bytes), never code; see passmd.cache for the format. Directory:
+    ${ENVIRONMENT['cache_dir']} or ./{DEFAULT_CACHE_DIR}.
 
-    --json keys: action, directory, and entries, bytes, current_code, other_code,
-    unreadable, leftovers, functions (info) or removed (clear, prune)""")
+    Only a cache's own files are ever removed: a cache directory carries the marker
+    {MARKER_NAME}, written when passmd creates the directory (or first caches into an
+    empty one, or into one holding only passmd cache entries: a cache from before
+    markers). A directory without it is refused with nothing read or removed; inside a
+    cache, only entries (files <key[:2]>/<key>.pmc that start with the PASSMD-CACHE line,
+    or links and special files in their place) and the cache's temporary files are
+    removed, and other files are counted as foreign and left alone.
+
+    --json keys: command, action, directory, and entries, bytes, current_code,
+    other_code, unreadable, leftovers, foreign, functions (info) or removed (clear,
+    prune: the number of files removed)""")
 
 
 def add_parser(command) -> None:
@@ -31,18 +42,30 @@ def add_parser(command) -> None:
     p.set_defaults(handler=run_cache)
 
 
+def _named(args) -> str:
+    """The cache directory as the user named it: option, environment variable or default."""
+    variable = ENVIRONMENT["cache_dir"]
+    if args.cache_dir:
+        return f"--cache-dir = {args.cache_dir!r}"
+    if (os.environ.get(variable) or "").strip():
+        return f"{variable} = {os.environ[variable].strip()!r}"
+    return f"the default cache directory ./{DEFAULT_CACHE_DIR}"
+
+
 def run_cache(args, out) -> int:
-    from passmd.cache import Cache
+    from passmd.cache import Cache, NotACache
 
     store = Cache(RunConfig.from_environment(cache_dir=args.cache_dir or None).cache_dir)
-    if store.directory.exists() and not store.directory.is_dir():
-        raise OutputError(f"the cache {store.directory} is not a directory")
-    if args.action == "info":
-        record = store.info()
-    elif args.action == "clear":
-        record = {"directory": str(store.directory), "removed": store.clear()}
-    else:
-        record = {"directory": str(store.directory), "removed": store.prune()}
+    try:
+        if args.action == "info":
+            record = store.info()
+        elif args.action == "clear":
+            record = {"directory": str(store.directory), "removed": store.clear()}
+        else:
+            record = {"directory": str(store.directory), "removed": store.prune()}
+    except NotACache as exc:
+        untouched = "nothing was read" if args.action == "info" else "nothing was removed"
+        raise UsageError(f"{_named(args)} ({exc.directory}) {exc.reason}; {untouched}") from exc
     if args.json:
         emit_json({"command": "cache", "action": args.action, **record}, out)
         return 0
@@ -53,7 +76,8 @@ def run_cache(args, out) -> int:
             ("entries", f"{record['entries']} ({record['current_code']} of the current code, "
                         f"{record['other_code']} of other code versions: 'passmd cache prune' removes them)"),
             ("size", f"{record['bytes'] / 2**20:.3g} MiB"),
-            ("unreadable / leftovers", f"{record['unreadable']} / {record['leftovers']}")]
+            ("unreadable / leftovers", f"{record['unreadable']} / {record['leftovers']}"),
+            ("foreign (left alone)", str(record["foreign"]))]
     rows += [(f"  {name}", str(n)) for name, n in sorted(record["functions"].items())]
     emit_rows("passmd cache", rows, out)
     return 0
