@@ -32,10 +32,11 @@ where it is produced. An entry larger than :data:`MAX_ENTRY_BYTES` or with a hea
 larger than :data:`MAX_HEADER_BYTES` is not stored (one :class:`CacheWarning`; the
 caller keeps its result).
 
-An entry whose magic line, checksum, header (also: above the size limit, nested too
-deeply), key or (when the caller names it, as :func:`passmd.sweep.run` does) function
-does not check out (corrupt, truncated, foreign or misplaced), or whose path holds a
-link or a special file instead of a regular file, is reported once with a
+An entry whose size (at most :data:`MAX_ENTRY_BYTES`), checksum, header (also: above
+its size limit, nested too deeply), key or (when the caller names it, as
+:func:`passmd.sweep.run` does) function does not check out (corrupt, truncated,
+foreign or misplaced), or whose path holds a link or a special file instead of a regular
+file, is reported once with a
 :class:`CacheWarning`, removed (a link itself, never its target), and treated as a miss,
 so the caller recomputes it. Entries are written atomically: to a temporary file
 ``.<key[:16]>-<random>.tmp`` in the same directory, flushed to disk, then moved into
