@@ -29,6 +29,10 @@ _EPILOG = textwrap.dedent("""\
     amplitude_m, frequency_Hz, drive{...}""")
 
 
+_SWING_NOTE = ("the load cell's period mean is still above μΣF_N: the runner swings on the load cell, "
+               "a transient, not a stall force; raise --max-periods")
+
+
 def add_parser(command) -> None:
     p = command("force", "generated force against the load cell at stall (Section 4.2)", _EPILOG)
     add_drive_options(p)
@@ -79,26 +83,32 @@ def run_force(args, out) -> int:
 
         wave = waveforms.sawtooth(amplitude, frequency, drive, periods=found["periods"], flyback=args.flyback)
         write_outputs(args, dynamics.simulate(drive, wave, max_points=args.max_points))
+    force, bound = found["generated_force_N"], found["coulomb_bound_N"]
+    # Only the runner's inertia carries a period mean past μΣF_N, in a run cut short while the
+    # runner swings on the load cell: that reading is no generated force, and no force above
+    # the Coulomb bound is reported.
+    swinging = not found["converged"] and abs(force) > bound
     record = {"command": "force", "waveform": "sawtooth", "flyback": args.flyback,
               "amplitude_m": amplitude, "frequency_Hz": frequency, "drive": drive_record(drive), **found}
+    if swinging:
+        record["generated_force_N"] = None
+        record["generated_force_note"] = _SWING_NOTE
     if args.json:
         emit_json(record, out)
         return 0
-    force, bound = found["generated_force_N"], found["coulomb_bound_N"]
     label, state = "generated force k·x̄_r", "stalled"
+    shown = fmt(force, "N")
     if not found["converged"]:
         state = f"NOT stalled after {found['periods_simulated']} periods"
-        if abs(force) > bound:  # only the runner's inertia carries a period mean past the bound
-            label = "load-cell force k·x̄_r"
-            state += (": above μΣF_N, the runner still swings on the load cell — a transient, not a stall "
-                      "force")
+        if swinging:
+            shown, state = "not determined", f"{state}: {_SWING_NOTE}"
     if found["remaining_force_N"] is None:
         to_come = f"still to come not estimated: {found['remaining_force_note']}"
     else:
         to_come = f"still to come ≈ {fmt(found['remaining_force_N'], 'N')}"
     rows = [
         ("waveform", f"sawtooth, A = {fmt(amplitude, 'nm')}, f = {fmt(frequency, 'kHz')}"),
-        (label, f"{fmt(force, 'N')}  ({state})"),
+        (label, f"{shown}  ({state})"),
         ("Coulomb bound μΣF_N", fmt(bound, "N")),
         ("run reported", f"{found['periods']} periods from rest; {to_come}"),
         ("last step", fmt(found["last_step_m"], "nm")),
