@@ -261,7 +261,7 @@ def _stall_frame(points: list[dict], description: str, config: RunConfig) -> pd.
             "converged": f["converged"].astype(bool),
             "periods": f["periods"].astype(int),
             "periods_simulated": f["periods_simulated"].astype(int),
-            "remaining_force_mN": f["remaining_force_N"] * 1e3,
+            "remaining_force_mN": f["remaining_force_N"].astype(float) * 1e3,  # None: not estimated
             "force_spread_mN": f["force_spread_N"] * 1e3,
             "mean_friction_mN": f["mean_friction_N"] * 1e3,
             "piezo_mean_force_mN": f["piezo_mean_force_N"] * 1e3,
