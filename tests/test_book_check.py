@@ -50,6 +50,14 @@ def _good_facts(**changes) -> dict:
     return facts
 
 
+def _overflow(**changes) -> dict:
+    """One item of the ``overflow`` fact: a display equation 922 px wide in a 688 px column."""
+    item = {"kind": "equation", "what": "u^*_{x,max,e} = ...", "width": 922, "column": 688,
+            "past_column": 234, "scroll_width": 0, "box_width": 0}
+    item.update(changes)
+    return item
+
+
 # ----------------------------------------------------------------------------- rules
 
 
@@ -78,7 +86,12 @@ def test_good_page_has_no_problems():
         ({"blank_images": ["a.png"]}, "blank image"),
         ({"broken_links": ["_downloads/x/fig.csv"]}, "missing file"),
         ({"ledger_tables": 0}, "ledger table"),
-        ({"ledger_overflow": [420]}, "420 px wider than the content column"),
+        ({"overflow": [_overflow(past_column=234, scroll_width=922, box_width=688)]},
+         "922 px wide, reaching 234 px past the 688 px column"),
+        ({"overflow": [_overflow(past_column=0, scroll_width=844, box_width=688)]},
+         "844 px of content in a 688 px box"),
+        ({"overflow": [_overflow(kind="table", what="configuration k")]}, "table 'configuration k'"),
+        ({"overflow": [_overflow(kind="figure", what="fig.png")]}, "figure 'fig.png'"),
         ({"error_outputs": ["ValueError: x"]}, "execution error"),
         ({"stderr_outputs": ["RuntimeWarning: y"]}, "stderr"),
         ({"traceback_in_text": True}, "traceback"),
@@ -96,6 +109,11 @@ def test_good_page_has_no_problems():
 def test_each_defect_is_a_problem(changes, fragment):
     problems = checker.page_problems(_good_facts(**changes))
     assert any(fragment in p for p in problems), problems
+
+
+def test_overflow_within_a_pixel_is_no_problem():
+    # sub-pixel layout: an item flush with the column's edge is measured up to 1 px past it
+    assert checker.page_problems(_good_facts(overflow=[_overflow(past_column=1)])) == []
 
 
 def test_expectations_come_from_the_page():
@@ -198,6 +216,36 @@ def test_check_fails_on_missing_figure_and_cell_error(broken_book_results):
 
 
 @pytest.mark.slow
+def test_check_fails_on_blocks_wider_than_the_column(broken_book_results):
+    # wide.md: a numbered equation MathJax widens past the column (its left part is cut off), an
+    # unnumbered one, a table and a figure that scroll sideways in their boxes. The page itself
+    # does not scroll, so the page-width rule alone passes it.
+    results, _, _ = broken_book_results
+    facts, problems = results["wide"]["facts"], results["wide"]["problems"]
+    assert not any("scrolls horizontally" in p for p in problems), problems
+    assert checker.page_problems({**facts, "overflow": []}) == []
+    by_kind = {}
+    for item in facts["overflow"]:
+        by_kind.setdefault(item["kind"], []).append(item)
+    assert len(by_kind["equation"]) == 2, by_kind
+    (cut,) = [item for item in by_kind["equation"] if "F = a_{1}" in item["what"]]
+    (scrolling,) = [item for item in by_kind["equation"] if "G &= b_{1}" in item["what"]]
+    for item in (cut, scrolling):
+        assert item["width"] > item["column"] + 100, item
+    assert cut["past_column"] > 100 and cut["box_width"] == cut["column"], cut
+    assert scrolling["scroll_width"] > scrolling["box_width"], scrolling
+    assert len(by_kind["table"]) == 1 and by_kind["table"][0]["scroll_width"] > 0, by_kind
+    assert len(by_kind["figure"]) == 1 and by_kind["figure"][0]["past_column"] > 100, by_kind
+    assert any("F = a_{1}" in p and "does not fit the content column" in p for p in problems), problems
+    assert any("G &= b_{1}" in p and "scrolls sideways" in p for p in problems), problems
+    assert any(p.startswith("table ") for p in problems), problems
+    assert any(p.startswith("figure 'data:image/png") for p in problems), problems
+    # the equation that fits, E = mc^2, and everything on the good page pass
+    assert not any("E = m c^2" in p for p in problems), problems
+    assert results["good"]["facts"]["overflow"] == []
+
+
+@pytest.mark.slow
 def test_screenshot_shows_what_a_reader_sees(broken_book_results, tmp_path):
     # The full-page screenshot, cut to the window's height, must be the window itself: same
     # width, and no sideways shift (the page once appeared shifted by about a fifth).
@@ -231,7 +279,7 @@ def test_command_line_exit_status(broken_book_results, capsys):
     status = checker.main([str(book / "_build" / "html"), "--toc", str(book / "_toc.yml")])
     out = capsys.readouterr().out
     assert status == 1
-    assert "[ok] good" in out and "[FAIL] broken" in out
+    assert "[ok] good" in out and "[FAIL] broken" in out and "[FAIL] wide" in out
 
 
 @pytest.mark.slow

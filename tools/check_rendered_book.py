@@ -14,7 +14,12 @@ all network requests blocked) with the system's Chromium driven by selenium, and
   ``$$``/``\\(``/``\\[`` in the text) or a web font that failed to load,
 * links to a local file that is not in the built book (e.g. a figure's CSV data),
 * tries to load anything from the network (the book must display offline),
-* scrolls horizontally in a window :data:`WINDOW_WIDTH` px wide (content wider than the window).
+* scrolls horizontally in a window :data:`WINDOW_WIDTH` px wide (content wider than the window),
+* shows a display equation (``mjx-container[display="true"]``), figure or table that does not
+  fit the content column (the article's content box) in that window: drawn past the column, cut
+  off by a box that hides overflow, or scrolling sideways in its box (``scrollWidth >
+  clientWidth``). The page-width rule misses these: a clipped or internally scrolling block
+  leaves the page's width intact.
 
 What a page must show comes from its ``passmd-expect`` meta tag, set in the chapter's front
 matter (``myst: html_meta: passmd-expect: "figures=2 ledger=1"``); pages without it must have
@@ -84,6 +89,69 @@ const ledgerSelector = arguments[0];
       if (t.includes(token)) { rawTex.push(t.trim().slice(0, 80)); break; }
     }
   }
+  // Display equations, figures and tables that do not fit the content column (the article's
+  // content box): reaching past it, scrolling sideways, or cut off by a box that hides overflow.
+  const overflowing = (root) => {
+    const style = getComputedStyle(root);
+    const box = root.getBoundingClientRect();
+    const colLeft = box.left + parseFloat(style.paddingLeft) + parseFloat(style.borderLeftWidth);
+    const colRight = box.right - parseFloat(style.paddingRight) - parseFloat(style.borderRightWidth);
+    const tex = new Map();  // mjx-container -> its TeX source, to name the equation
+    try {
+      for (const item of MathJax.startup.document.math) tex.set(item.typesetRoot, item.math);
+    } catch (e) {}
+    const named = (kind, el) => {
+      if (kind === 'equation') {
+        const src = tex.get(el) || el.textContent;
+        return src.replace(/\s+/g, ' ').trim().slice(0, 70);
+      }
+      if (kind === 'figure') {
+        const img = el.tagName === 'IMG' ? el : el.querySelector('img');
+        return ((img && img.getAttribute('src')) || el.textContent.trim()).slice(0, 70);
+      }
+      const caption = el.querySelector('caption, thead, tr');
+      return (caption ? caption.innerText : el.innerText).replace(/\s+/g, ' ').trim().slice(0, 70);
+    };
+    const items = [
+      ...Array.from(root.querySelectorAll('mjx-container[display="true"]')).map(e => ['equation', e]),
+      ...Array.from(root.querySelectorAll('figure, img:not(figure img)')).map(e => ['figure', e]),
+      ...Array.from(root.querySelectorAll('table')).map(e => ['table', e]),
+    ];
+    const found = [];
+    for (const [kind, el] of items) {
+      if (el.getClientRects().length === 0) continue;  // not displayed (e.g. a collapsed block)
+      // what is drawn: the element and its typeset math or images (they may overhang it)
+      const inner = {equation: ':scope > mjx-math', figure: 'img', table: null}[kind];
+      const drawn = [el, ...(inner ? el.querySelectorAll(inner) : [])];
+      const rects = drawn.map(e => e.getBoundingClientRect());
+      const left = Math.min(...rects.map(r => r.left));
+      let right = Math.max(...rects.map(r => r.right));
+      if (getComputedStyle(el).overflowX === 'visible') {  // content overflowing the element is drawn
+        right = Math.max(right, rects[0].left + el.clientLeft + el.scrollWidth);
+      }
+      const fact = {
+        kind, what: named(kind, el), width: Math.round(right - left),
+        column: Math.round(colRight - colLeft),
+        past_column: Math.round(Math.max(colLeft - left, right - colRight)),
+        scroll_width: 0, box_width: 0,
+      };
+      // the element scrolls itself, or a box around it (inside the article) scrolls or clips it
+      const boxes = [el];
+      for (let a = el.parentElement; a && a !== root.parentElement; a = a.parentElement) boxes.push(a);
+      for (const b of boxes) {
+        if (b.scrollWidth <= b.clientWidth + 1 || getComputedStyle(b).overflowX === 'visible') continue;
+        const r = b.getBoundingClientRect();
+        const visibleLeft = r.left + b.clientLeft;
+        if (b === el || left < visibleLeft - 1 || right > visibleLeft + b.clientWidth + 1) {
+          fact.scroll_width = b.scrollWidth;
+          fact.box_width = b.clientWidth;
+          break;
+        }
+      }
+      if (fact.past_column > 1 || fact.scroll_width) found.push(fact);
+    }
+    return found;
+  };
   const maths = Array.from(root.querySelectorAll('.math'));
   const text = root.innerText || '';
   done({
@@ -108,9 +176,7 @@ const ledgerSelector = arguments[0];
     raw_tex: rawTex.slice(0, 5),
     ledger_tables: Array.from(root.querySelectorAll(ledgerSelector))
       .filter(t => t.querySelectorAll('tbody tr').length > 0).length,
-    ledger_overflow: Array.from(root.querySelectorAll(ledgerSelector))
-      .map(t => Math.round(t.getBoundingClientRect().width - root.getBoundingClientRect().width))
-      .filter(excess => excess > 1),
+    overflow: overflowing(root),
     links: Array.from(root.querySelectorAll('a[href]')).map(a => a.getAttribute('href')),
     window_width: window.innerWidth,
     viewport_width: document.documentElement.clientWidth,
@@ -187,8 +253,18 @@ def page_problems(facts: dict) -> list[str]:
             f"{facts.get('ledger_tables', 0)} ledger table(s) ({LEDGER_SELECTOR} with rows), "
             f"expected at least {expect['ledger']}"
         )
-    for excess in facts.get("ledger_overflow", []):
-        problems.append(f"a ledger table is {excess} px wider than the content column")
+    for item in facts.get("overflow", []):
+        what = f"{item['kind']} {item['what']!r}"
+        if item["past_column"] > 1:
+            problems.append(
+                f"{what} does not fit the content column: {item['width']} px wide, reaching "
+                f"{item['past_column']} px past the {item['column']} px column"
+            )
+        if item["scroll_width"]:
+            problems.append(
+                f"{what} is cut off or scrolls sideways: {item['scroll_width']} px of content "
+                f"in a {item['box_width']} px box"
+            )
     for message in facts.get("error_outputs", []):
         problems.append(f"execution error shown: {message}")
     for message in facts.get("stderr_outputs", []):
