@@ -6,9 +6,12 @@ and without ``--json``.
 
 from __future__ import annotations
 
+import numpy as np
+
 from passmd.parameters import Drive
 
-__all__ = ["ResultError", "check_force_bound", "check_run_bounds", "friction_limit"]
+__all__ = ["EMPTY_BY_DESIGN", "ResultError", "check_force_bound", "check_run_bounds", "check_table",
+           "friction_limit"]
 
 
 class ResultError(RuntimeError):
@@ -72,3 +75,56 @@ def check_force_bound(found: dict, drive: Drive) -> None:
         raise ResultError(f"generated force {force:.4g} N exceeds what friction can hold (mu*sum(F_N) = "
                           f"{limit:.4g} N): the result is not trustworthy")
 
+
+
+# A critical-amplitude search that finds no step up to the full stroke has no critical amplitude
+# and no upper bracket (Section 4.1: "no step up to the full stroke" is a result).
+_NOT_FOUND = ("critical_amplitude_nm", "bracket_high_nm")
+_CRITICAL = dict.fromkeys(_NOT_FOUND, "no step up to the full stroke")
+_ONSET = dict.fromkeys(("onset_nm", "onset_high_nm"), "no force up to the full stroke")  # the same for Fig. 7
+# Fig. 9a is one tidy table of the time series (views full/zoom) and of the per-period rows.
+_SERIES = ("time_s", "time_ms", "time_us", "piezo_position_m", "runner_position_m", "runner_velocity_m_per_s",
+           "slip_share_1", "friction_force_1_N", "slip_share_2", "friction_force_2_N", "piezo_position_nm",
+           "runner_position_nm")
+_PERIODS = ("period", "settled_position_m", "back_step_m", "settled_position_nm", "back_step_nm")
+# Section 5's tables hold saw-tooth rows beside optimized-waveform rows; only the latter have a design.
+_DESIGN = dict.fromkeys(("flyback_time_s", "settling_time_s", "acceleration_time_s",
+                         "acceleration_amplitude_m", "ramp_time_s", "max_slip_share_acceleration"),
+                        "saw-tooth rows have no Eq. 15 design")
+
+#: Cells a figure leaves empty (NaN) by design, ``{figure: {column: why}}``: a quantity that does
+#: not exist for that row. Every other numeric cell of a result table must be finite.
+EMPTY_BY_DESIGN: dict[str, dict[str, str]] = {
+    **{name: _CRITICAL
+       for name in ("fig5b", "fig6a", "fig6b", "fig6c", "fig56_frequency", "fig56_viscosity")},
+    **{name: _ONSET for name in ("fig7a", "fig7b", "fig7grid")},
+    "fig7_difference": dict.fromkeys(("onset_low_nm", "onset_high_nm"), "no force up to the full stroke"),
+    "fig9a": {**dict.fromkeys(_SERIES, "per-period rows have no time series"),
+              **dict.fromkeys(_PERIODS, "time-series rows have no period")},
+    **{name: _DESIGN for name in ("fig9b", "fig10a", "fig10b", "fig10c")},
+    "mdr_convergence": {"fit_rel": "the power law is fitted on the larger spring counts only"},
+    "mdr_cost": dict.fromkeys(("springs", "reversals", "max_depth", "overflows"),
+                              "each contact model has its own cost parameters"),
+}
+
+
+def check_table(name: str, table) -> None:
+    """Every numeric cell of a result table finite, except :data:`EMPTY_BY_DESIGN`'s (never ±inf).
+
+    ``name`` is the figure (or result table) the message names. A NaN where the figure always
+    computes a number comes from outside the computation, e.g. a damaged cache entry.
+    """
+    allowed = EMPTY_BY_DESIGN.get(name, {})
+    for column in table.columns:
+        values = table[column]
+        if values.dtype.kind not in "iuf":  # numbers only: labels, flags and text are not results
+            continue
+        data = values.to_numpy(dtype=float, na_value=np.nan)
+        bad = np.isinf(data) if column in allowed else ~np.isfinite(data)
+        if bad.any():
+            row = int(np.flatnonzero(bad)[0])
+            raise ResultError(
+                f"{name}: column {column} is not finite ({float(data[row])!r} in row {row}, "
+                f"{int(bad.sum())} of {len(data)} rows): the result is not trustworthy (if it came from the "
+                "cache, clear the cache to recompute it)"
+            )

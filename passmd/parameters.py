@@ -16,7 +16,7 @@ from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
-from passmd._validation import check_choice, check_positive, check_range
+from passmd._validation import check_choice, check_positive, check_range, format_number
 from passmd.theory import contact_moduli
 
 __all__ = [
@@ -311,21 +311,21 @@ class PlausibleRange:
             why = self.hard_reason if kind == "hard limit" and self.hard_reason else self.reason
             if kind == "hard limit" and lo == 0.0 and limit.startswith(">"):
                 why = "a physical quantity of this kind is positive"
-            shown_value = f"{v / scale:.10g}{u}" if shown else repr(value)  # CLI: display unit
+            shown_value = f"{format_number(v, scale)}{u}" if shown else repr(value)  # CLI: display unit
             return ValueError(f"{label} = {shown_value} is out of range: must be {limit} "
                               f"({kind}: {why}){extra}")
 
         lo, hi = self.hard_low, self.hard_high
         if lo is not None and (v <= lo if self.hard_low_open else v < lo):
-            raise refuse(f"{'>' if self.hard_low_open else '>='} {lo / scale:g}{u}", "hard limit")
+            raise refuse(f"{'>' if self.hard_low_open else '>='} {format_number(lo, scale)}{u}", "hard limit")
         if hi is not None and v > hi:
-            raise refuse(f"<= {hi / scale:g}{u}", "hard limit")
+            raise refuse(f"<= {format_number(hi, scale)}{u}", "hard limit")
         if not allow_extrapolation:
             if self.soft_low is not None and v < self.soft_low:
-                raise refuse(f">= {self.soft_low / scale:g}{u}", "plausible range",
+                raise refuse(f">= {format_number(self.soft_low, scale)}{u}", "plausible range",
                              f"; {hint} goes beyond it")
             if self.soft_high is not None and v > self.soft_high:
-                raise refuse(f"<= {self.soft_high / scale:g}{u}", "plausible range",
+                raise refuse(f"<= {format_number(self.soft_high, scale)}{u}", "plausible range",
                              f"; {hint} goes beyond it")
         return v
 

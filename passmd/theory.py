@@ -11,62 +11,180 @@ Hertzian contact, 8aG in Mindlin's notation, is 2aG* here.
 References: H. Hertz (1882); R.D. Mindlin, H. Deresiewicz, J. Appl. Mech. 20 (1953)
 327; K.L. Johnson, *Contact Mechanics* (1985), §7.2; V.L. Popov, Friction 1 (2013) 41.
 
-Every function is vectorised (NumPy broadcasting) and uses SI units.
+Every function is vectorised (NumPy broadcasting) and uses SI units. The public functions
+check their arguments (``ValueError``/``TypeError`` naming the parameter, its value and the
+allowed range) and refuse a result that double precision cannot hold to its full relative
+precision (below the smallest normal double, 2.2e-308): a presliding displacement of
+1e-320 m has three significant digits, not sixteen. The drive's closed forms
+(:func:`drive_theory`) name the drive's parameters instead.
 """
 
 from __future__ import annotations
 
+import reprlib
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from passmd._validation import check_array
+from passmd._validation import check_array, format_number
 from passmd.defaults import PROTOCOL
 
 if TYPE_CHECKING:  # the closed forms read a drive's fields; parameters imports this module
     from passmd.parameters import Drive
 
 SIN45 = np.sin(np.pi / 4)
+#: Smallest normal double: below it a float keeps fewer than 53 significant bits.
+_TINY = float(np.finfo(float).tiny)
+#: Isotropic elasticity needs -1 < ν <= 1/2 (a positive bulk and shear modulus).
+_NU_LOW, _NU_HIGH = -1.0, 0.5
+#: The fields of a drive the closed forms read (a drive is checked for them, not for its class:
+#: passmd.parameters imports this module).
+_DRIVE_FIELDS = ("preload", "contacts", "hemisphere_radius", "friction_coefficient", "hemisphere_material",
+                 "runner_material", "actuator", "actuator_model", "runner_mass",
+                 "effective_load_cell_stiffness")
 
 
-def effective_youngs_modulus(E1, nu1, E2, nu2):
-    """Effective modulus E* with 1/E* = (1 − ν₁²)/E₁ + (1 − ν₂²)/E₂ (Eq. 4)."""
+def _check_drive(drive) -> None:
+    if not all(hasattr(drive, field) for field in _DRIVE_FIELDS):
+        raise TypeError(f"drive = {reprlib.repr(drive)} is not allowed: must be a passmd.parameters.Drive")
+
+
+def _positive(name: str, value, unit: str) -> np.ndarray:
+    return check_array(name, value, 0.0, lower_open=True, unit=unit)
+
+
+def _check_contacts(contacts) -> int:
+    if isinstance(contacts, (bool, np.bool_)) or not isinstance(contacts, (int, np.integer)):
+        raise TypeError(f"contacts = {contacts!r} is not allowed: must be the integer 1 or 6")
+    if contacts not in (1, 6):
+        raise ValueError(f"contacts = {contacts!r} is not allowed: must be one of 1, 6")
+    return int(contacts)
+
+
+def _require_normal(value, what: str, unit: str, inputs, where=None) -> None:
+    """Refuse ``value`` where it is below the smallest normal double (or not finite).
+
+    ``inputs``: ``(name, value, unit)`` of the parameters that made it, the one a user most
+    likely set first (the message leads with it); each is shown at the first refused element.
+    ``where``: the elements that must be normal (default all).
+    """
+    v = np.asarray(value, dtype=float)
+    bad = ~(np.isfinite(v) & (np.abs(v) >= _TINY))
+    if where is not None:
+        bad &= np.broadcast_to(np.asarray(where, dtype=bool), bad.shape)
+    if not bad.any():
+        return
+    i = int(np.flatnonzero(bad.ravel())[0])
+    shown = [f"{name} = {format_number(np.broadcast_to(np.asarray(x, dtype=float), v.shape).flat[i])}"
+             + (f" {u}" if u else "") for name, x, u in inputs]
+    context = f" (with {', '.join(shown[1:])})" if len(shown) > 1 else ""
+    raise ValueError(
+        f"{shown[0]}{context} is out of range: {what} = {format_number(v.flat[i])} {unit} is below the "
+        f"smallest normal double {_TINY:.4g} (hard limit: double precision; there a result keeps only "
+        "a few significant digits)"
+    )
+
+
+def _youngs(E1, nu1, E2, nu2):
     return 1.0 / ((1 - np.asarray(nu1) ** 2) / E1 + (1 - np.asarray(nu2) ** 2) / E2)
 
 
-def effective_shear_modulus(E1, nu1, E2, nu2):
-    """Effective shear modulus G* with 1/G* = Σ (2 − ν)/(4G), G = E/(2(1+ν)) (Eq. 4)."""
+def _shear(E1, nu1, E2, nu2):
     G1 = np.asarray(E1) / (2 * (1 + np.asarray(nu1)))
     G2 = np.asarray(E2) / (2 * (1 + np.asarray(nu2)))
     return 1.0 / ((2 - np.asarray(nu1)) / (4 * G1) + (2 - np.asarray(nu2)) / (4 * G2))
 
 
+def _materials(E1, nu1, E2, nu2):
+    """The four material constants, checked (E > 0, -1 < ν <= 1/2)."""
+    return (_positive("E1", E1, "Pa"), check_array("nu1", nu1, _NU_LOW, _NU_HIGH, lower_open=True),
+            _positive("E2", E2, "Pa"), check_array("nu2", nu2, _NU_LOW, _NU_HIGH, lower_open=True))
+
+
+def effective_youngs_modulus(E1, nu1, E2, nu2):
+    """Effective modulus E* with 1/E* = (1 − ν₁²)/E₁ + (1 − ν₂²)/E₂ (Eq. 4).
+
+    E₁, E₂ > 0 in Pa; -1 < ν₁, ν₂ <= 1/2.
+    """
+    args = _materials(E1, nu1, E2, nu2)
+    E_star = _youngs(*args)
+    _require_normal(E_star, "E*", "Pa", (("E1", args[0], "Pa"), ("E2", args[2], "Pa")))
+    return E_star
+
+
+def effective_shear_modulus(E1, nu1, E2, nu2):
+    """Effective shear modulus G* with 1/G* = Σ (2 − ν)/(4G), G = E/(2(1+ν)) (Eq. 4).
+
+    E₁, E₂ > 0 in Pa; -1 < ν₁, ν₂ <= 1/2.
+    """
+    args = _materials(E1, nu1, E2, nu2)
+    G_star = _shear(*args)
+    _require_normal(G_star, "G*", "Pa", (("E1", args[0], "Pa"), ("E2", args[2], "Pa")))
+    return G_star
+
+
 def contact_moduli(drive: Drive) -> tuple[float, float]:
     """(E*, G*) of the hemisphere/runner pair of a drive, in Pa."""
+    _check_drive(drive)
+    return _contact_moduli(drive)
+
+
+def _contact_moduli(drive: Drive) -> tuple[float, float]:
     h, r = drive.hemisphere_material, drive.runner_material
     args = (h.youngs_modulus, h.poissons_ratio, r.youngs_modulus, r.poissons_ratio)
-    return float(effective_youngs_modulus(*args)), float(effective_shear_modulus(*args))
+    E_star, G_star = float(_youngs(*args)), float(_shear(*args))
+    moduli = (("hemisphere_material.youngs_modulus", h.youngs_modulus, "Pa"),
+              ("runner_material.youngs_modulus", r.youngs_modulus, "Pa"))
+    _require_normal(E_star, "E*", "Pa", moduli)
+    _require_normal(G_star, "G*", "Pa", moduli)
+    return E_star, G_star
+
+
+def _hertz_cube(F, radius, E_star):
+    """a³ = 3 F_N R / (4 E*), the cube of the Hertz contact radius."""
+    return 3.0 * F * radius / (4.0 * E_star)
+
+
+def _contact_args(normal_force, radius, E_star):
+    """normal_force >= 0, radius > 0, E_star > 0, checked; a³ normal wherever F_N > 0."""
+    F = check_array("normal_force", normal_force, 0.0, unit="N")
+    R, E = _positive("radius", radius, "m"), _positive("E_star", E_star, "Pa")
+    cube = _hertz_cube(F, R, E)
+    _require_normal(cube, "the Hertz contact radius cubed, 3 F_N R / (4 E*),", "m^3",
+                    (("normal_force", F, "N"), ("radius", R, "m"), ("E_star", E, "Pa")), where=F > 0)
+    return F, R, E, cube
 
 
 def hertz_contact_radius(normal_force, radius, E_star):
-    """Hertz contact radius a = (3 F_N R / (4 E*))^(1/3)."""
-    F = check_array("normal_force", normal_force, 0.0)
-    return np.cbrt(3.0 * F * radius / (4.0 * E_star))
+    """Hertz contact radius a = (3 F_N R / (4 E*))^(1/3).
+
+    F_N >= 0 in N, R > 0 in m, E* > 0 in Pa.
+    """
+    return np.cbrt(_contact_args(normal_force, radius, E_star)[3])
 
 
 def hertz_indentation(normal_force, radius, E_star):
     """Hertz indentation depth d = a² / R."""
-    return hertz_contact_radius(normal_force, radius, E_star) ** 2 / radius
+    _, R, _, cube = _contact_args(normal_force, radius, E_star)
+    return np.cbrt(cube) ** 2 / R
 
 
 def hertz_normal_force(contact_radius, radius, E_star):
-    """Hertz normal force F_N = (4/3) E* a³ / R."""
-    return 4.0 / 3.0 * E_star * np.asarray(contact_radius) ** 3 / radius
+    """Hertz normal force F_N = (4/3) E* a³ / R (a >= 0 in m, R > 0 in m, E* > 0 in Pa)."""
+    a = check_array("contact_radius", contact_radius, 0.0, unit="m")
+    R, E = _positive("radius", radius, "m"), _positive("E_star", E_star, "Pa")
+    force = 4.0 / 3.0 * E * a ** 3 / R
+    _require_normal(force, "the Hertz normal force", "N", (("contact_radius", a, "m"),), where=a > 0)
+    return force
 
 
 def tangential_stiffness(normal_force, radius, E_star, G_star):
-    """Initial tangential stiffness 2 a G* of a sticking Hertzian contact (8aG in Mindlin)."""
-    return 2.0 * hertz_contact_radius(normal_force, radius, E_star) * G_star
+    """Initial tangential stiffness 2 a G* of a sticking Hertzian contact (8aG in Mindlin).
+
+    F_N >= 0 in N, R > 0 in m, E* > 0 and G* > 0 in Pa.
+    """
+    cube = _contact_args(normal_force, radius, E_star)[3]
+    return 2.0 * np.cbrt(cube) * _positive("G_star", G_star, "Pa")
 
 
 def normal_forces(preload, contacts: int = 6):
@@ -81,20 +199,18 @@ def normal_forces(preload, contacts: int = 6):
         ``(F_N1, F_N2)`` for six contacts, ``(F_p,)`` for one.
     """
     F = check_array("preload", preload, 0.0, lower_open=True, unit="N")
-    if contacts == 1:
+    if _check_contacts(contacts) == 1:
         return (F,)
-    if contacts == 6:
-        return (F / 2.0 / SIN45, F / 4.0 / SIN45)
-    raise ValueError(f"contacts = {contacts!r} is not allowed: must be one of 1, 6")
+    forces = _six_contact_forces(F)
+    _require_normal(forces[1], "the normal force per contact F_p / (4 sin 45°)", "N", (("preload", F, "N"),))
+    return forces
 
 
-def presliding_displacement(normal_force, radius, E_star, G_star, friction_coefficient):
-    """Presliding (full-slip) displacement u_x,max (Eq. 7, Eq. 10).
+def _six_contact_forces(F):
+    return (F / 2.0 / SIN45, F / 4.0 / SIN45)
 
-    u_x,max = 3μ/(4G*) · (4E*/3)^(1/3) · F_N^(2/3) / R^(1/3), which equals μ (E*/G*) d
-    with the Hertz indentation d.
-    """
-    F = check_array("normal_force", normal_force, 0.0)
+
+def _presliding(F, radius, E_star, G_star, friction_coefficient):
     return (
         3.0
         * friction_coefficient
@@ -105,29 +221,88 @@ def presliding_displacement(normal_force, radius, E_star, G_star, friction_coeff
     )
 
 
+def presliding_displacement(normal_force, radius, E_star, G_star, friction_coefficient):
+    """Presliding (full-slip) displacement u_x,max (Eq. 7, Eq. 10).
+
+    u_x,max = 3μ/(4G*) · (4E*/3)^(1/3) · F_N^(2/3) / R^(1/3), which equals μ (E*/G*) d
+    with the Hertz indentation d. F_N >= 0 in N, R > 0 in m, E* > 0 and G* > 0 in Pa,
+    μ > 0 (``friction_coefficient``).
+    """
+    F = check_array("normal_force", normal_force, 0.0, unit="N")
+    R, E = _positive("radius", radius, "m"), _positive("E_star", E_star, "Pa")
+    G, mu = _positive("G_star", G_star, "Pa"), _positive("friction_coefficient", friction_coefficient, "")
+    u = _presliding(F, R, E, G, mu)
+    _require_normal(u, "the presliding displacement u_x,max", "m",
+                    (("normal_force", F, "N"), ("friction_coefficient", mu, "")), where=F > 0)
+    return u
+
+
+def _actuator_deformation(friction_coefficient, F, actuator_stiffness, runner_mass, actuator_mass):
+    return friction_coefficient * F / actuator_stiffness * (runner_mass + actuator_mass) / runner_mass
+
+
 def actuator_deformation(friction_coefficient, normal_force, actuator_stiffness, runner_mass,
                          actuator_mass):
     """Tangential deformation of the actuator by the friction force (Eq. 9, Eq. 14).
 
-    u_x,a = μ F / k_p · (m_r + m_a) / m_r (van der Wulp 1997).
+    u_x,a = μ F / k_p · (m_r + m_a) / m_r (van der Wulp 1997). μ > 0, F_N >= 0 in N,
+    k_p > 0 in N/m, m_r > 0 and m_a >= 0 in kg.
     """
-    F = check_array("normal_force", normal_force, 0.0)
-    return friction_coefficient * F / actuator_stiffness * (runner_mass + actuator_mass) / runner_mass
+    mu = _positive("friction_coefficient", friction_coefficient, "")
+    F = check_array("normal_force", normal_force, 0.0, unit="N")
+    k = _positive("actuator_stiffness", actuator_stiffness, "N/m")
+    m_r = _positive("runner_mass", runner_mass, "kg")
+    m_a = check_array("actuator_mass", actuator_mass, 0.0, unit="kg")
+    u = _actuator_deformation(mu, F, k, m_r, m_a)
+    _require_normal(u, "the actuator deformation u_x,a", "m",
+                    (("normal_force", F, "N"), ("friction_coefficient", mu, ""),
+                     ("actuator_stiffness", k, "N/m")), where=F > 0)
+    return u
+
+
+def _harmonic(u1, u2):
+    """2 u₁ u₂ / (u₁ + u₂) without underflow or overflow, for positive finite u₁, u₂.
+
+    The paper's form wherever its product and sum are normal doubles (there it is accurate to
+    a few units in the last place, and it is what every result was computed with); else the
+    same value as m · 2 / (1 + m/M), m = min, M = max, whose factor lies in (1, 2]. The result
+    lies between min(u₁, u₂) and twice it at every magnitude.
+    """
+    u1, u2 = np.asarray(u1, dtype=float), np.asarray(u2, dtype=float)
+    with np.errstate(over="ignore", under="ignore", invalid="ignore", divide="ignore"):
+        product, total = 2.0 * u1 * u2, u1 + u2
+        direct = product / total
+        small, large = np.minimum(u1, u2), np.maximum(u1, u2)
+        scaled = small * (2.0 / (1.0 + small / large))
+    safe = np.isfinite(product) & (product >= _TINY) & np.isfinite(total)
+    # the exact value lies in [m, 2m]; rounding could leave it one unit in the last place outside
+    result = np.minimum(np.maximum(np.where(safe, direct, scaled), small), 2.0 * small)
+    return result if result.ndim else result[()]
 
 
 def harmonic_combination(u1, u2):
-    """Teidelt's combination 2 u₁ u₂ / (u₁ + u₂) (Eq. 11, Eq. 12)."""
-    u1, u2 = np.asarray(u1, dtype=float), np.asarray(u2, dtype=float)
-    return 2.0 * u1 * u2 / (u1 + u2)
+    """Teidelt's combination 2 u₁ u₂ / (u₁ + u₂) (Eq. 11, Eq. 12), u₁, u₂ > 0 in m.
+
+    Finite and between min(u₁, u₂) and twice it for every positive finite u₁, u₂: computed
+    where the product would underflow or overflow as m · 2 / (1 + m/M).
+    """
+    return _harmonic(_positive("u1", u1, "m"), _positive("u2", u2, "m"))
 
 
 def cattaneo_mindlin_force(u, normal_force, presliding, friction_coefficient):
     """Virgin tangential force of a Hertzian contact at constant normal force.
 
     F(u) = sign(u) μF_N [1 − (1 − |u|/u_max)^(3/2)] for |u| ≤ u_max, ±μF_N beyond
-    (Cattaneo 1938, Mindlin 1949). Initial slope (3/2) μF_N / u_max = 2aG*.
+    (Cattaneo 1938, Mindlin 1949). Initial slope (3/2) μF_N / u_max = 2aG*. u finite
+    in m, F_N >= 0 in N, u_max > 0 in m (``presliding``), μ > 0.
     """
-    u = np.asarray(u, dtype=float)
+    return _cattaneo_mindlin(check_array("u", u, unit="m"),
+                             check_array("normal_force", normal_force, 0.0, unit="N"),
+                             _positive("presliding", presliding, "m"),
+                             _positive("friction_coefficient", friction_coefficient, ""))
+
+
+def _cattaneo_mindlin(u, normal_force, presliding, friction_coefficient):
     s = np.clip(np.abs(u) / presliding, 0.0, 1.0)
     return np.sign(u) * friction_coefficient * normal_force * (1.0 - (1.0 - s) ** 1.5)
 
@@ -137,13 +312,21 @@ def masing_branch_force(u, reversal_displacement, reversal_force, direction, nor
     """Force on an unloading/reloading branch after a reversal (Mindlin–Deresiewicz, Masing).
 
     F = F_r + direction · 2 φ(|u − u_r| / 2), φ the virgin curve, limited to ±μF_N
-    (full sliding). ``direction`` is +1 for increasing u, −1 for decreasing u.
+    (full sliding). ``direction`` is +1 for increasing u, −1 for decreasing u; u and u_r
+    finite in m, F_r finite in N, the rest as in :func:`cattaneo_mindlin_force`.
     """
-    u = np.asarray(u, dtype=float)
-    half = np.abs(u - reversal_displacement) / 2.0
-    phi = cattaneo_mindlin_force(half, normal_force, presliding, friction_coefficient)
-    limit = friction_coefficient * normal_force
-    return np.clip(reversal_force + direction * 2.0 * phi, -limit, limit)
+    u = check_array("u", u, unit="m")
+    u_r = check_array("reversal_displacement", reversal_displacement, unit="m")
+    F_r = check_array("reversal_force", reversal_force, unit="N")
+    if isinstance(direction, (bool, np.bool_)) or direction not in (1, -1):
+        raise ValueError(f"direction = {direction!r} is not allowed: must be one of 1, -1")
+    F = check_array("normal_force", normal_force, 0.0, unit="N")
+    u_max = _positive("presliding", presliding, "m")
+    mu = _positive("friction_coefficient", friction_coefficient, "")
+    half = np.abs(u - u_r) / 2.0
+    phi = _cattaneo_mindlin(half, F, u_max, mu)
+    limit = mu * F
+    return np.clip(F_r + direction * 2.0 * phi, -limit, limit)
 
 
 def drive_theory(drive: Drive) -> dict:
@@ -156,24 +339,31 @@ def drive_theory(drive: Drive) -> dict:
     ``critical_amplitude_flexible_m`` (Eq. 8 / Eq. 12) and
     ``analytic_critical_amplitude_m`` (the one matching ``drive.actuator_model``).
     """
-    E_star, G_star = contact_moduli(drive)
+    _check_drive(drive)
+    E_star, G_star = _contact_moduli(drive)
     R, mu = drive.hemisphere_radius, drive.friction_coefficient
     act = drive.actuator
-    forces = np.array([float(f) for f in normal_forces(drive.preload, drive.contacts)])
-    u_max = presliding_displacement(forces, R, E_star, G_star, mu)
-    u_a = actuator_deformation(mu, forces, act.stiffness, drive.runner_mass, act.mass)
+    forces = np.array([float(f) for f in _drive_forces(drive)])
+    preload = ("preload", drive.preload, "N")
+    a = _drive_contact_radius(drive, forces, E_star)
+    u_max = _presliding(forces, R, E_star, G_star, mu)
+    _require_normal(u_max, "the presliding displacement u_x,max", "m",
+                    (preload, ("friction_coefficient", mu, "")))
+    u_a = _actuator_deformation(mu, forces, act.stiffness, drive.runner_mass, act.mass)
+    _require_normal(u_a, "the actuator deformation u_x,a", "m",
+                    (preload, ("friction_coefficient", mu, ""), ("actuator.stiffness", act.stiffness, "N/m")))
     if drive.contacts == 1:
         rigid, flexible = float(u_max[0]), float(u_max[0] + u_a[0])
     else:
-        rigid = float(harmonic_combination(u_max[0], u_max[1]))
-        flexible = float(harmonic_combination(u_max[0] + u_a[0], u_max[1] + u_a[1]))
+        rigid = float(_harmonic(u_max[0], u_max[1]))
+        flexible = float(_harmonic(u_max[0] + u_a[0], u_max[1] + u_a[1]))
     return {
         "E_star_Pa": E_star,
         "G_star_Pa": G_star,
         "normal_force_N": forces.tolist(),
-        "contact_radius_m": hertz_contact_radius(forces, R, E_star).tolist(),
-        "indentation_m": hertz_indentation(forces, R, E_star).tolist(),
-        "tangential_stiffness_N_per_m": tangential_stiffness(forces, R, E_star, G_star).tolist(),
+        "contact_radius_m": a.tolist(),
+        "indentation_m": (a ** 2 / R).tolist(),
+        "tangential_stiffness_N_per_m": (2.0 * a * G_star).tolist(),
         "presliding_m": u_max.tolist(),
         "actuator_deformation_m": u_a.tolist(),
         "critical_amplitude_rigid_m": rigid,
@@ -182,19 +372,35 @@ def drive_theory(drive: Drive) -> dict:
     }
 
 
+def _drive_contact_radius(drive: Drive, forces: np.ndarray, E_star: float) -> np.ndarray:
+    """Hertz contact radius per side of a (validated) drive; its cube a normal double (else refused)."""
+    cube = _hertz_cube(forces, drive.hemisphere_radius, E_star)
+    _require_normal(cube, "the Hertz contact radius cubed, 3 F_N R / (4 E*),", "m^3",
+                    (("preload", drive.preload, "N"), ("hemisphere_radius", drive.hemisphere_radius, "m"),
+                     ("E*", E_star, "Pa")))
+    return np.cbrt(cube)
+
+
+def _drive_forces(drive: Drive) -> tuple:
+    """Eq. 1 for a (validated) drive, each force a normal double (else refused naming the preload)."""
+    F = np.asarray(float(drive.preload))
+    forces = (F,) if drive.contacts == 1 else _six_contact_forces(F)
+    _require_normal(forces[-1], "the normal force per contact", "N", (("preload", drive.preload, "N"),))
+    return forces
+
+
 def runner_frequency(drive: Drive) -> float:
     """Runner-on-contacts natural frequency √(Σ 2aG* / m_r) / (2π) in Hz (rigid actuators).
 
     Σ runs over all contacts (2 × side 1 + 4 × side 2 for six contacts), plus the
     load cell when engaged. This is the micro-vibration frequency's linear estimate.
     """
-    E_star, G_star = contact_moduli(drive)
-    forces = normal_forces(drive.preload, drive.contacts)
+    _check_drive(drive)
+    E_star, G_star = _contact_moduli(drive)
+    forces = np.array([float(f) for f in _drive_forces(drive)])
+    stiffness = 2.0 * _drive_contact_radius(drive, forces, E_star) * G_star  # 2aG* per side
     multiplicity = (1,) if drive.contacts == 1 else PROTOCOL.contacts_per_side
-    k_total = sum(
-        m * float(tangential_stiffness(F, drive.hemisphere_radius, E_star, G_star))
-        for m, F in zip(multiplicity, forces, strict=True)
-    )
+    k_total = sum(m * float(k) for m, k in zip(multiplicity, stiffness, strict=True))
     k_total += drive.effective_load_cell_stiffness
     return float(np.sqrt(k_total / drive.runner_mass) / (2 * np.pi))
 
@@ -204,7 +410,8 @@ def friction_limit(drive: Drive) -> float:
 
     Six contacts: μ (2 F_N1 + 4 F_N2) = 2√2 μ F_p; one contact: μ F_p.
     """
-    forces = normal_forces(drive.preload, drive.contacts)
+    _check_drive(drive)
+    forces = _drive_forces(drive)
     multiplicity = (1,) if drive.contacts == 1 else PROTOCOL.contacts_per_side
     return float(drive.friction_coefficient * sum(m * float(F) for m, F in zip(multiplicity, forces,
                                                                                   strict=True)))

@@ -6,6 +6,14 @@ Inside the package everything is SI. Users type quantities with units —
 is read in the *display unit* the option documents (``--radius 0.25`` is 0.25 mm).
 A quantity of the wrong dimension (``--radius 3N``) raises :class:`QuantityError`,
 a :class:`ValueError` naming the option, the value and the expected unit.
+
+Angles are read by their physical meaning, not by pint's convention that a radian is a
+plain number and a revolution is 2π of them. A frequency counts cycles: ``Hz``, ``1/s``,
+``1/min`` and the full-cycle units (``turn``, ``cycle``, ``revolution``, ``rpm``, ``rps``)
+are accepted, one cycle per unit (``100 rpm`` is 1.667 Hz, not pint's 10.47/s). An
+angular rate (``rad/s``, ``deg/s``) is refused with the hint f = ω/2π, and an angle unit
+in any other quantity is refused: pint would silently turn ``0.2 rad`` into 0.2 and
+``1 turn`` into 6.28.
 """
 
 from __future__ import annotations
@@ -13,7 +21,7 @@ from __future__ import annotations
 import functools
 import math
 import re
-from decimal import Decimal
+from decimal import Decimal, localcontext
 
 __all__ = [
     "QuantityError",
@@ -22,6 +30,8 @@ __all__ = [
     "parse_quantities",
     "parse_quantity",
     "registry",
+    "si_factor",
+    "to_display",
 ]
 
 # A number (optionally signed, decimal or scientific) followed by an optional unit.
@@ -93,6 +103,12 @@ _DISPLAY_BASES = {
 }
 
 
+#: pint's canonical names of one full cycle (turn = revolution = cycle = circle) and of the
+#: rates it defines; every other unit whose root holds a radian is an angle (tests check
+#: this list against pint's registry).
+_CYCLE_UNITS = frozenset({"turn", "revolutions_per_minute", "revolutions_per_second"})
+
+
 class QuantityError(ValueError):
     """A quantity that cannot be read, or has the wrong dimension."""
 
@@ -111,6 +127,23 @@ def _si_factor(unit: str) -> float:
     if factor is None:
         factor = registry().Quantity(1.0, _unit(unit)).to_base_units().magnitude
     return factor
+
+
+def si_factor(unit: str) -> float:
+    """SI magnitude of one display ``unit`` (``si_factor("GPa")`` → 1e9, exactly the typed factor)."""
+    return float(_si_factor(unit))
+
+
+def to_display(value: float, unit: str) -> float:
+    """An SI value in the display ``unit``, divided in decimal (``to_display(2.5e-4, "mm")`` → 0.25).
+
+    The shortest decimal of ``value`` divided by the unit's decimal factor, rounded once: a
+    quantity parsed from ``"0.3nm"`` shows as 0.3 nm again (a binary division would give
+    0.30000000000000004), and for a plain number (``unit`` ``""``) it is ``value`` itself.
+    """
+    with localcontext() as ctx:
+        ctx.prec = 60
+        return float(Decimal(repr(float(value))) / Decimal(repr(si_factor(unit))))
 
 
 @functools.cache
@@ -180,21 +213,89 @@ def parse_quantity(text, unit: str, *, name: str = "value") -> float:
         return float(Decimal(number_text) * Decimal(repr(_DISPLAY_FACTORS[unit_text])))
     display = _unit(unit)
     try:
-        given = registry().parse_units(unit_text)
+        given = registry().parse_units("1" + unit_text if unit_text.startswith("/") else unit_text)  # 100/min
     except Exception as exc:  # pint's parser raises many kinds (even AssertionError for '0:')
         raise QuantityError(
             f"{name} = {text!r}: unknown unit {unit_text!r}; expected a {dimension_name(unit)}"
             f" unit such as {unit or 'a plain number'}"
         ) from exc
     if given.dimensionality != display.dimensionality:
-        expected = f"a {dimension_name(unit)} such as '1{unit}'" if unit else "a plain number"
         raise QuantityError(
             f"{name} = {text!r} has the wrong unit: {given:~P} is a "
-            f"{dimension_name(given)}, expected {expected}{shown}"
+            f"{dimension_name(given)}, expected {_expected(unit)}{shown}"
         )
+    factor, inverse = _physical_factor(given, unit, name=name, text=text, number=float(number_text))
     # Multiply in decimal so that "30nm" gives the float nearest 3e-8 (30 * 1e-9 would not).
-    factor = registry().Quantity(1.0, given).to_base_units().magnitude
-    return float(Decimal(number_text) * Decimal(repr(float(factor))))
+    return _times(number_text, factor, inverse)
+
+
+def _root_radians(name: str) -> int:
+    """Exponent of the radian in the root units of one pint unit name (``"rpm"`` → 1)."""
+    reg = registry()
+    _, root = reg.get_root_units(name)
+    return int(dict(reg.Quantity(1.0, root).unit_items()).get("radian", 0))
+
+
+def _physical_factor(given, unit: str, *, name: str, text, number: float) -> tuple[float, float]:
+    """SI factor of the pint unit ``given`` read by its physical meaning (see the module's docstring),
+    and the factor back (one SI unit in ``given``).
+
+    ``given`` already has the dimension of ``unit`` in pint's sense, where an angle is a plain
+    number. A full-cycle unit counts one cycle in a frequency; any other angle is refused.
+    """
+    reg = registry()
+    cycles, angles = 0, []
+    for unit_name, exponent in reg.Quantity(1.0, given).unit_items():
+        if _root_radians(unit_name) == 0:
+            continue
+        if reg.parse_unit_name(unit_name)[0][1] in _CYCLE_UNITS:
+            cycles += exponent
+        else:
+            angles.append(unit_name)
+    frequency = _is_frequency(unit)
+    if angles and frequency:
+        omega = number * reg.Quantity(1.0, given).to_base_units().magnitude  # in rad/s
+        raise QuantityError(
+            f"{name} = {text!r} is an angular rate ({given:~P}), not a frequency: a frequency counts "
+            f"cycles (Hz, kHz, rpm, turn/s); divide an angular frequency ω by 2π to get Hz "
+            f"(f = ω/2π ≈ {omega / (2.0 * math.pi):.6g} Hz here)"
+        )
+    if angles or (cycles and not frequency):
+        kind = "an angle" if angles else "a number of cycles"
+        raise QuantityError(
+            f"{name} = {text!r} has the wrong unit: {given:~P} holds {kind} (which the units library "
+            f"would read as a plain number, 1 turn = 6.28), expected {_expected(unit)}"
+        )
+    if cycles not in (0, 1):
+        raise QuantityError(f"{name} = {text!r} has the wrong unit: {given:~P} is not cycles per time, "
+                            f"expected {_expected(unit)}")
+    # one cycle per turn: to cycles per second (pint cancels the turn exactly: krpm -> 16.666...67)
+    si = reg.turn / reg.second if cycles else reg.Quantity(1.0, given).to_base_units().units
+    return (reg.Quantity(1.0, given).to(si).magnitude, reg.Quantity(1.0, si).to(given).magnitude)
+
+
+def _expected(unit: str) -> str:
+    """What a quantity of ``unit`` may be given in, for messages (``"a length such as '1mm'"``)."""
+    if not unit:
+        return "a plain number"
+    return f"a {dimension_name(unit)} such as '1{unit}'" + (" or '1 rpm'" if _is_frequency(unit) else "")
+
+
+def _is_frequency(unit: str) -> bool:
+    return _unit(unit).dimensionality == _unit("Hz").dimensionality
+
+
+def _times(number_text: str, factor: float, inverse: float) -> float:
+    """``number_text`` × ``factor`` in decimal, rounded once to a float.
+
+    When the unit's inverse factor is the shorter decimal (a minute is 60 s, but 1/60 Hz has 17
+    digits), divide by it instead: ``100 rpm`` is then the float nearest 5/3 Hz.
+    """
+    with localcontext() as ctx:
+        ctx.prec = 60
+        if len(repr(float(inverse))) < len(repr(float(factor))):
+            return float(Decimal(number_text) / Decimal(repr(float(inverse))))
+        return float(Decimal(number_text) * Decimal(repr(float(factor))))
 
 
 def parse_quantities(text: str, unit: str, *, name: str = "value") -> list[float]:

@@ -16,7 +16,7 @@ from passmd.cli.output import JSON_HELP, fmt
 from passmd.config import ENVIRONMENT
 from passmd.defaults import PROTOCOL
 from passmd.parameters import ACTUATOR_DAMPING_RATIO, PLAUSIBLE_RANGES, Drive
-from passmd.units import from_si, parse_quantity
+from passmd.units import parse_quantity, si_factor, to_display
 
 __all__ = ["ACTUATOR_DYNAMICS", "AMPLITUDE", "CACHE_DIR_HELP", "DEFAULT_DRIVE", "DRIVE_QUANTITIES",
            "FREQUENCY", "MATERIAL_FLAGS", "NORMAL_FORCE", "THRESHOLD", "TOLERANCE", "Quantity",
@@ -64,12 +64,12 @@ class Quantity:
             return None
         value = parse_quantity(raw, self.unit, name=self.flag)
         if self.plausible is not None:
-            scale = 1.0 / from_si(1.0, self.unit) if self.unit else 1.0
+            scale = si_factor(self.unit)
             PLAUSIBLE_RANGES[self.plausible].check(
                 self.flag, value, allow_extrapolation=bool(getattr(args, "allow_extrapolation", False)),
                 shown=self.flag, scale=scale, unit=self.unit, hint="--allow-extrapolation")
             return value
-        shown = float(f"{from_si(value, self.unit):.12g}")
+        shown = to_display(value, self.unit)  # the parsed value itself, in the unit shown
         check_range(self.flag, shown, self.lower, self.upper, lower_open=self.lower_open,
                     upper_open=self.upper_open, unit=self.unit or "–")
         return value

@@ -7,6 +7,7 @@ import sys
 import textwrap
 from pathlib import Path
 
+from passmd._result_bounds import check_table
 from passmd.cache import DEFAULT_CACHE_DIR
 from passmd.cli.configuration import run_config
 from passmd.cli.errors import NotAvailableError, OutputError, UsageError
@@ -105,6 +106,7 @@ def run_figure(args, out) -> int:
     config = run_config(args)
     _check_out(args)
     data = figures.figure_data(args.name, config)
+    check_table(args.name, data)  # finite before anything is written, as run and theory check theirs
     csv_path, png_path = _write(figures, provenance, args, data)
     record = {"command": "figure", "name": args.name, "profile": args.profile, "rows": len(data),
               "columns": list(map(str, data.columns)), "csv": str(csv_path), "png": str(png_path)}

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import textwrap
 
+from passmd._result_bounds import check_table
 from passmd.cache import DEFAULT_CACHE_DIR
 from passmd.cli.configuration import run_config
 from passmd.cli.errors import OutputError
@@ -50,7 +51,10 @@ def run_ledger(args, out) -> int:
     from passmd import ledger, ledger_views
     from passmd.claims import STATUSES
 
-    evaluated = ledger.evaluate(config=run_config(args))
+    results = ledger.collect_results(run_config(args))
+    for name, table in results.items():  # finite before anything is written, as run and theory check
+        check_table(name, table)
+    evaluated = ledger.evaluate(results=results)
     if args.write_baseline:
         _write_baseline(ledger, evaluated, args)
     counts = {s: int((evaluated["status"] == s).sum()) for s in STATUSES}
