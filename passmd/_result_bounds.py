@@ -82,6 +82,8 @@ def check_force_bound(found: dict, drive: Drive) -> None:
 _NOT_FOUND = ("critical_amplitude_nm", "bracket_high_nm")
 _CRITICAL = dict.fromkeys(_NOT_FOUND, "no step up to the full stroke")
 _ONSET = dict.fromkeys(("onset_nm", "onset_high_nm"), "no force up to the full stroke")  # the same for Fig. 7
+# A stall run's force still to come is withheld unless it approaches a limit below μΣF_N steadily.
+_TAIL = {"remaining_force_mN": "no credible extrapolation below μΣF_N (passmd.protocols.stall)"}
 # Fig. 9a is one tidy table of the time series (views full/zoom) and of the per-period rows.
 _SERIES = ("time_s", "time_ms", "time_us", "piezo_position_m", "runner_position_m", "runner_velocity_m_per_s",
            "slip_share_1", "friction_force_1_N", "slip_share_2", "friction_force_2_N", "piezo_position_nm",
@@ -97,7 +99,8 @@ _DESIGN = dict.fromkeys(("flyback_time_s", "settling_time_s", "acceleration_time
 EMPTY_BY_DESIGN: dict[str, dict[str, str]] = {
     **{name: _CRITICAL
        for name in ("fig5b", "fig6a", "fig6b", "fig6c", "fig56_frequency", "fig56_viscosity")},
-    **{name: _ONSET for name in ("fig7a", "fig7b", "fig7grid")},
+    **{name: {**_ONSET, **_TAIL} for name in ("fig7a", "fig7b", "fig7grid")},
+    "fig7freq": _TAIL,
     "fig7_difference": dict.fromkeys(("onset_low_nm", "onset_high_nm"), "no force up to the full stroke"),
     "fig9a": {**dict.fromkeys(_SERIES, "per-period rows have no time series"),
               **dict.fromkeys(_PERIODS, "time-series rows have no period")},
