@@ -17,11 +17,10 @@ import numpy as np
 
 from passmd._validation import InputError, check_choice, check_count, check_positive, check_range, shown
 from passmd.defaults import PROTOCOL
-from passmd.parameters import Assumption, Drive
+from passmd.parameters import Assumption, Drive, check_drive
 from passmd.waveforms import (
     SETTLE_FRACTION,
     Waveform,
-    check_drive,
     check_flyback_fits,
     flyback_time,
     piecewise_linear,

@@ -27,6 +27,7 @@ __all__ = [
     "PLAUSIBLE_RANGES",
     "PlausibleRange",
     "check_contact_plausible",
+    "check_drive",
     "check_plausible",
     "ASSUMPTIONS",
     "Actuator",
@@ -491,6 +492,13 @@ def check_contact_plausible(normal_force: float, radius: float, E_star: float, *
                      "outside the elastic regime the model describes)", soft=True)
 
 
+def check_drive(drive) -> Drive:
+    """``drive`` if it is a :class:`Drive`, else ``ValueError`` naming it (public functions' check)."""
+    if not isinstance(drive, Drive):
+        raise InputError(f"drive = {_plain(drive)} is not a Drive", name="drive", value=drive)
+    return drive
+
+
 def check_plausible(drive: Drive, *, allow_extrapolation: bool = False) -> None:
     """Check every parameter of a drive against :data:`PLAUSIBLE_RANGES` and the contact limits.
 
@@ -502,8 +510,7 @@ def check_plausible(drive: Drive, *, allow_extrapolation: bool = False) -> None:
         ratio ζ = c_p / (2√(k_p m_a)) is refused as a quantity computed from
         ``actuator.viscosity``.
     """
-    if not isinstance(drive, Drive):
-        raise InputError(f"drive = {_plain(drive)} is not a Drive", name="drive", value=drive)
+    check_drive(drive)
     r = PLAUSIBLE_RANGES
     kw = {"allow_extrapolation": allow_extrapolation}
     for name in ("hemisphere_radius", "preload", "friction_coefficient", "runner_mass",

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from passmd._validation import InputError, check_choice, check_count, check_positive, check_range, shown
-from passmd.parameters import PLAUSIBLE_RANGES, Assumption, Drive
+from passmd.parameters import PLAUSIBLE_RANGES, Assumption, Drive, check_drive
 
 #: Fraction of the stick phase (at its end) over which the settled position is averaged.
 SETTLE_FRACTION = 0.2
@@ -180,13 +180,6 @@ def flyback_time(amplitude: float, drive: Drive, flyback: str = "slew") -> float
     if flyback == "fixed":
         return full
     return amplitude / drive.actuator.full_stroke_amplitude * full
-
-
-def check_drive(drive) -> Drive:
-    """``drive`` if it is a :class:`~passmd.parameters.Drive`, else ``ValueError`` naming it."""
-    if not isinstance(drive, Drive):
-        raise InputError(f"drive = {shown(drive)} is not a Drive", name="drive", value=drive)
-    return drive
 
 
 #: Fewest spacings of double-precision time (at the run's end) a fly-back must last, so

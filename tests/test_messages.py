@@ -33,6 +33,7 @@ from passmd.cli.commands import run as run_command
 from passmd.cli.drive import _safe
 from passmd.cli.parser import make_parser
 from passmd.config import RunConfig
+from passmd.contact import MDRContact
 from passmd.parameters import (
     PLAUSIBLE_RANGES,
     Actuator,
@@ -283,6 +284,7 @@ API_CASES = [
      r"drive = 'x'"),
     ("optimized, periods text", lambda: optimized_waveform.optimized(1e-7, 100.0, D, "x", design=DESIGN),
      r"periods = 'x' is out of range"),
+    ("MDRContact.for_drive, not a drive", lambda: MDRContact.for_drive("x"), r"drive = 'x' is not a Drive"),
     ("optimized_design, not a drive", lambda: eq15.optimized_design(1e-7, "x"),
      r"drive = 'x' is not a Drive"),
     ("Drive, numpy contacts", lambda: Drive(contacts=np.int64(3)), r"contacts = 3 is not allowed"),

@@ -160,10 +160,7 @@ def _display_unit(si_unit: str, flag: str) -> str:
     unit = _quantity_unit(flag)
     if not unit or si_unit in ("", "–"):
         return ""
-    try:
-        return unit if dimension_name(unit) == dimension_name(si_unit) else ""
-    except Exception:  # a unit the registry does not know: keep SI
-        return ""
+    return unit if dimension_name(unit) == dimension_name(si_unit) else ""
 
 
 def _suffix(unit: str) -> str:

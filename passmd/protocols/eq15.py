@@ -15,8 +15,8 @@ import numpy as np
 from passmd import dynamics, theory
 from passmd._validation import InputError, check_positive, check_range, shown
 from passmd.optimized_waveform import RESPONSE_FREQUENCY, OptimizedDesign, max_piezo_velocity
-from passmd.parameters import Drive
-from passmd.waveforms import check_drive, sawtooth
+from passmd.parameters import Drive, check_drive
+from passmd.waveforms import sawtooth
 
 __all__ = ["MIN_SAMPLES", "SAMPLES_PER_VIBRATION", "micro_vibration_frequency", "optimized_design"]
 
