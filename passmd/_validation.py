@@ -1,9 +1,12 @@
 """Input checks shared by every public entry point.
 
-Each check raises :class:`ValueError` whose message names the parameter, the
-offending value and the allowed range, e.g.::
+Each check raises :class:`InputError` (a :class:`ValueError`) whose message names the
+parameter, the offending value (a plain number) and the allowed range, e.g.::
 
     runner_mass = -0.003 is out of range: must be a finite number > 0 (kg)
+
+and whose attributes carry the same parts, so that an entry point can say it again in
+the user's terms (the command line names the option the value came from).
 """
 
 from __future__ import annotations
@@ -31,13 +34,76 @@ def format_number(value, scale: float = 1.0) -> str:
     return short if not math.isfinite(x) or float(short) == x else repr(x)
 
 
-def _shown(value) -> str:
-    """``repr`` of a value, numpy scalars shown as the Python number they hold."""
-    if isinstance(value, np.floating):
-        return repr(float(value))
-    if isinstance(value, np.integer):
+class InputError(ValueError):
+    """A refused input: the message for the library's caller, the parts for an entry point.
+
+    Attributes
+    ----------
+    name : str
+        The checked quantity as the raising code names it: a parameter, or a record field,
+        dotted for a part of a drive (``"runner_mass"``, ``"actuator.damping_ratio"``).
+    value : object
+        The refused value (SI).
+    unit : str
+        SI unit of ``value`` and ``limits`` (``""`` or ``"–"``: dimensionless).
+    limits : tuple of (str, float)
+        What is allowed, e.g. ``((">", -1.0), ("<", 0.5))``; empty when no range applies.
+    why : str
+        Why the limit (``"plausible range: …"``, ``"hard limit: …"``); ``""`` if the range says it.
+    soft : bool
+        Whether ``allow_extrapolation`` lifts the limit.
+    quantity : str
+        For a quantity computed from an input: what it is (``"the damping ratio ζ = …"``);
+        ``""`` when ``name`` is itself an input.
+    source, source_value, source_limits
+        The input ``quantity`` was computed from (named like ``name``), its value, and the
+        limits on it that keep ``quantity`` allowed (SI).
+    sources : tuple of str
+        Several inputs a quantity comes from together (no single limit); ``detail`` says
+        what is wrong with them.
+    detail : str
+        The message without the inputs' names.
+    """
+
+    def __init__(self, message: str = "", *, name: str = "", value=None, unit: str = "", limits=(),
+                 why: str = "", soft: bool = False, quantity: str = "", source: str | None = None,
+                 source_value=None, source_limits=(), sources=(), detail: str = ""):
+        super().__init__(message)
+        self.name, self.value, self.unit, self.limits = name, value, unit, tuple(limits)
+        self.why, self.soft, self.quantity, self.detail = why, soft, quantity, detail
+        self.source, self.source_value, self.source_limits = source, source_value, tuple(source_limits)
+        self.sources = tuple(sources)
+
+    def derived_from(self, source: str, source_value, per: float, quantity: str) -> InputError:
+        """This error, for a quantity proportional to an input: ``quantity = source / per``.
+
+        ``per`` (> 0) is the input per unit of the quantity, so the limits carry over as
+        ``bound · per``.
+        """
+        self.quantity, self.source, self.source_value = quantity, source, source_value
+        self.source_limits = tuple((op, bound * per) for op, bound in self.limits)
+        return self
+
+
+def shown(value) -> str:
+    """``value`` as a message shows it: numbers plain (``1e+300``, never ``np.float64(…)``)."""
+    if isinstance(value, (bool, np.bool_)):
+        return repr(bool(value))
+    if isinstance(value, (int, np.integer)):
         return repr(int(value))
+    if isinstance(value, (Real, np.floating)):
+        return repr(float(value))
     return repr(value)
+
+
+def limits_of(lower, upper, lower_open, upper_open) -> tuple[tuple[str, float], ...]:
+    """``(("op", bound), …)`` of a range; ``None`` leaves a side open."""
+    parts = []
+    if lower is not None:
+        parts.append((">" if lower_open else ">=", float(lower)))
+    if upper is not None:
+        parts.append(("<" if upper_open else "<=", float(upper)))
+    return tuple(parts)
 
 
 def _describe(lower, upper, lower_open, upper_open) -> str:
@@ -78,10 +144,10 @@ def check_range(
     rng = _describe(lower, upper, lower_open, upper_open)
     rng = f" {rng}" if rng else ""
     suffix = f" ({unit})" if unit else ""
+    limits = limits_of(lower, upper, lower_open, upper_open)
     if isinstance(value, bool) or not isinstance(value, (Real, np.floating, np.integer)):
-        raise ValueError(
-            f"{name} = {_shown(value)} is not a number: must be a finite number{rng}{suffix}"
-        )
+        raise InputError(f"{name} = {shown(value)} is not a number: must be a finite number{rng}{suffix}",
+                         name=name, value=value, unit=unit, limits=limits)
     v = float(value)
     bad = not math.isfinite(v)
     if not bad and lower is not None:
@@ -89,7 +155,8 @@ def check_range(
     if not bad and upper is not None:
         bad = v >= upper if upper_open else v > upper
     if bad:
-        raise ValueError(f"{name} = {_shown(value)} is out of range: must be a finite number{rng}{suffix}")
+        raise InputError(f"{name} = {shown(value)} is out of range: must be a finite number{rng}{suffix}",
+                         name=name, value=v, unit=unit, limits=limits)
     return v
 
 
@@ -103,7 +170,8 @@ def check_count(name: str, value, minimum: int = 1) -> int:
     integral = isinstance(value, (int, np.integer)) or (
         isinstance(value, (float, np.floating)) and math.isfinite(value) and float(value).is_integer())
     if isinstance(value, (bool, np.bool_)) or not integral or value < minimum:
-        raise ValueError(f"{name} = {value!r} is out of range: must be an integer >= {minimum}")
+        raise InputError(f"{name} = {shown(value)} is out of range: must be an integer >= {minimum}",
+                         name=name, value=value, limits=((">=", minimum),))
     return int(value)
 
 
@@ -111,7 +179,8 @@ def check_choice(name: str, value, choices) -> str:
     """Return ``value`` if it is one of ``choices``."""
     if value not in choices:
         allowed = ", ".join(repr(c) for c in choices)
-        raise ValueError(f"{name} = {value!r} is not allowed: must be one of {allowed}")
+        raise InputError(f"{name} = {shown(value)} is not allowed: must be one of {allowed}", name=name,
+                         value=value)
     return value
 
 
@@ -136,8 +205,8 @@ def check_array(name: str, values, lower=None, upper=None, *, lower_open=False, 
         bad |= arr > upper
     if bad.any():
         first = float(arr.flat[int(np.flatnonzero(bad.ravel())[0])])
-        raise ValueError(
+        raise InputError(
             f"{name} contains {format_number(first)}, which is out of range: every element must be a "
-            f"finite number{rng}{suffix}"
-        )
+            f"finite number{rng}{suffix}", name=name, value=first, unit=unit,
+            limits=limits_of(lower, upper, lower_open, False))
     return arr

@@ -75,7 +75,7 @@ from passmd._contact_kernels import (
     sliding_force,
 )
 from passmd._validation import check_array, check_choice, check_positive, check_range
-from passmd.parameters import Assumption, Drive, check_contact_plausible
+from passmd.parameters import Assumption, Drive, check_contact_plausible, check_drive
 from passmd.theory import contact_moduli, hertz_contact_radius, hertz_indentation, normal_forces
 
 if TYPE_CHECKING:  # pandas is imported where a DataFrame is built (start-up time)
@@ -349,7 +349,7 @@ class MDRContact:
         ``side`` 0 is the two-contact side (F_N1), 1 the four-contact side (F_N2); a
         one-contact drive has side 0 only.
         """
-        forces = normal_forces(drive.preload, drive.contacts)
+        forces = normal_forces(check_drive(drive).preload, drive.contacts)
         if isinstance(side, bool) or side not in range(len(forces)):
             raise ValueError(
                 f"side = {side!r} is out of range: must be one of {list(range(len(forces)))} "

@@ -15,10 +15,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from passmd._validation import check_choice, check_positive, check_range
+from passmd._validation import InputError, check_choice, check_count, check_positive, check_range, shown
 from passmd.defaults import PROTOCOL
-from passmd.parameters import Assumption, Drive
-from passmd.waveforms import SETTLE_FRACTION, Waveform, flyback_time, piecewise_linear, sawtooth
+from passmd.parameters import Assumption, Drive, check_drive
+from passmd.waveforms import (
+    SETTLE_FRACTION,
+    Waveform,
+    check_flyback_fits,
+    flyback_time,
+    piecewise_linear,
+    sawtooth,
+)
 
 #: Saw-tooth frequency whose response the optimized waveform is designed from (Fig. 9a's 100 Hz,
 #: the protocol's driving frequency; :func:`passmd.protocols.eq15.optimized_design`).
@@ -95,7 +102,7 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
 
 def max_piezo_velocity(drive: Drive) -> float:
     """Fastest hemisphere velocity the amplifier allows, V_max = A_max · SR / V_pp (m/s), Section 2."""
-    return drive.actuator.full_stroke_amplitude / drive.amplifier.full_stroke_time
+    return check_drive(drive).actuator.full_stroke_amplitude / drive.amplifier.full_stroke_time
 
 
 @dataclass(frozen=True)
@@ -190,24 +197,24 @@ def optimized_timing(
         Bad input, or a fly-back longer than half a period (as :func:`~passmd.waveforms.sawtooth`).
     """
     if not isinstance(design, OptimizedDesign):
-        raise ValueError(f"design = {design!r} is not an OptimizedDesign")
+        raise InputError(f"design = {shown(design)} is not an OptimizedDesign", name="design", value=design)
     check_choice("short_period", short_period, ("cut", "skip"))
-    a_max = drive.actuator.full_stroke_amplitude
+    a_max = check_drive(drive).actuator.full_stroke_amplitude
     A = check_range("amplitude", amplitude, 0.0, a_max, lower_open=True, unit="m")
     f = check_positive("frequency", frequency, "Hz")
     frac = check_range("min_ramp_fraction", min_ramp_fraction, 0.0, 1.0, lower_open=True, upper_open=True)
     T = 1.0 / f
     t_fb = flyback_time(A, drive, flyback)
-    if t_fb >= 0.5 * T:
-        raise ValueError(
-            f"frequency = {f!r} is out of range: the fly-back of {t_fb * 1e6:.3g} µs must take less than "
-            f"half a period, so frequency must be < {0.5 / t_fb:.6g} Hz"
-        )
+    check_flyback_fits(t_fb, f)
     if design.acceleration_amplitude >= A:
-        raise ValueError(
-            f"acceleration_amplitude = {design.acceleration_amplitude!r} is out of range: must be < the "
-            f"actuation amplitude A = {A!r} m"
-        )
+        d_a = design.acceleration_amplitude
+        raise InputError(
+            f"acceleration_amplitude = {shown(d_a)} is out of range: must be < the actuation amplitude "
+            f"A = {shown(A)} m (Eq. 15: the fast segment Δ_a = V_a t_a ends below A)",
+            name="acceleration_amplitude", value=d_a, unit="m", limits=(("<", A),),
+            why="Eq. 15: the fast segment Δ_a = V_a t_a must end below the actuation amplitude A",
+            quantity="the Eq. 15 acceleration amplitude Δ_a = V_a t_a", source="amplitude", source_value=A,
+            source_limits=((">", d_a),))
     ramp_min = max(frac * (T - t_fb), A / max_piezo_velocity(drive))
     room = T - t_fb - ramp_min  # > 0: t_fb < T/2 and A/V_max <= t_fb (slew) or < 2 µs (fixed)
     t_s, t_a, d_a = design.settling_time, design.acceleration_time, design.acceleration_amplitude
@@ -296,9 +303,7 @@ def optimized(
         )
     check_choice("first_period", first_period, ("sawtooth", "optimized"))
     frac = check_range("settle_fraction", settle_fraction, 0.0, 1.0, lower_open=True, upper_open=True)
-    if int(periods) != periods or periods < 1:
-        raise ValueError(f"periods = {periods!r} is out of range: must be an integer >= 1")
-    periods = int(periods)
+    periods = check_count("periods", periods)
     timing = optimized_timing(
         design, amplitude, frequency, drive, flyback=flyback, min_ramp_fraction=min_ramp_fraction,
         short_period=short_period,

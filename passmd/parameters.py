@@ -16,7 +16,8 @@ from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
-from passmd._validation import check_choice, check_positive, check_range, format_number
+from passmd._validation import InputError, check_choice, check_positive, check_range, format_number
+from passmd._validation import shown as _plain
 from passmd.theory import contact_moduli
 
 __all__ = [
@@ -26,6 +27,7 @@ __all__ = [
     "PLAUSIBLE_RANGES",
     "PlausibleRange",
     "check_contact_plausible",
+    "check_drive",
     "check_plausible",
     "ASSUMPTIONS",
     "Actuator",
@@ -85,7 +87,8 @@ class Material:
 
     def __post_init__(self):
         if not isinstance(self.name, str):
-            raise ValueError(f"name = {self.name!r} is not allowed: must be a str")
+            raise InputError(f"name = {self.name!r} is not allowed: must be a str", name="name",
+                             value=self.name)
         check_positive("youngs_modulus", self.youngs_modulus, "Pa")
         check_range(
             "poissons_ratio", self.poissons_ratio, -1.0, 0.5, lower_open=True, upper_open=True
@@ -169,7 +172,9 @@ def actuator_for_radius(
 
 def actuator_viscosity(stiffness: float, mass: float, damping_ratio: float = ACTUATOR_DAMPING_RATIO) -> float:
     """Viscosity c_p = 2 ζ √(k_p m_a) of an actuator (Eq. 3) whose bare damping ratio is ζ."""
-    return 2.0 * damping_ratio * np.sqrt(stiffness * mass)
+    stiffness = check_positive("stiffness", stiffness, "N/m")
+    mass = check_positive("mass", mass, "kg")
+    return 2.0 * check_range("damping_ratio", damping_ratio, 0.0, unit="–") * np.sqrt(stiffness * mass)
 
 
 @dataclass(frozen=True)
@@ -230,28 +235,34 @@ class Drive:
 
     def __post_init__(self):
         if not isinstance(self.allow_extrapolation, bool):
-            raise ValueError(f"allow_extrapolation = {self.allow_extrapolation!r} is not allowed: "
-                             "must be True or False")
+            raise InputError(f"allow_extrapolation = {_plain(self.allow_extrapolation)} is not allowed: "
+                             "must be True or False", name="allow_extrapolation",
+                             value=self.allow_extrapolation)
         check_positive("hemisphere_radius", self.hemisphere_radius, "m")
         check_positive("preload", self.preload, "N")
         check_positive("friction_coefficient", self.friction_coefficient, "–")
         if not isinstance(self.contacts, (int, np.integer)) or isinstance(self.contacts, (bool, np.bool_)) \
                 or self.contacts not in (1, 6):
-            raise ValueError(f"contacts = {self.contacts!r} is not allowed: must be one of 1, 6")
+            raise InputError(f"contacts = {_plain(self.contacts)} is not allowed: must be one of 1, 6",
+                             name="contacts", value=self.contacts)
         check_choice("actuator_model", self.actuator_model, ("rigid", "flexible"))
         check_positive("runner_mass", self.runner_mass, "kg")
         check_positive("load_cell_stiffness", self.load_cell_stiffness, "N/m")
         if not isinstance(self.load_cell, bool):
-            raise ValueError(f"load_cell = {self.load_cell!r} is not allowed: must be True or False")
+            raise InputError(f"load_cell = {_plain(self.load_cell)} is not allowed: must be True or False",
+                             name="load_cell", value=self.load_cell)
         for name in ("hemisphere_material", "runner_material"):
             if not isinstance(getattr(self, name), Material):
-                raise ValueError(f"{name} = {getattr(self, name)!r} is not a Material")
+                raise InputError(f"{name} = {_plain(getattr(self, name))} is not a Material", name=name,
+                                 value=getattr(self, name))
         if self.actuator is None:
             object.__setattr__(self, "actuator", actuator_for_radius(self.hemisphere_radius))
         elif not isinstance(self.actuator, Actuator):
-            raise ValueError(f"actuator = {self.actuator!r} is not an Actuator")
+            raise InputError(f"actuator = {_plain(self.actuator)} is not an Actuator", name="actuator",
+                             value=self.actuator)
         if not isinstance(self.amplifier, Amplifier):
-            raise ValueError(f"amplifier = {self.amplifier!r} is not an Amplifier")
+            raise InputError(f"amplifier = {_plain(self.amplifier)} is not an Amplifier", name="amplifier",
+                             value=self.amplifier)
         if isinstance(self.contacts, np.integer):
             object.__setattr__(self, "contacts", int(self.contacts))
         check_plausible(self, allow_extrapolation=self.allow_extrapolation)
@@ -307,26 +318,28 @@ class PlausibleRange:
         label, unit = (shown or name), (self.unit if unit is None else unit)
         u = f" {unit}" if unit and unit != "–" else ""
 
-        def refuse(limit: str, kind: str, extra: str = "") -> ValueError:
+        def refuse(op: str, bound: float, kind: str) -> InputError:
             why = self.hard_reason if kind == "hard limit" and self.hard_reason else self.reason
-            if kind == "hard limit" and lo == 0.0 and limit.startswith(">"):
+            if kind == "hard limit" and lo == 0.0 and op.startswith(">"):
                 why = "a physical quantity of this kind is positive"
-            shown_value = f"{format_number(v, scale)}{u}" if shown else repr(value)  # CLI: display unit
-            return ValueError(f"{label} = {shown_value} is out of range: must be {limit} "
-                              f"({kind}: {why}){extra}")
+            soft = kind == "plausible range"
+            shown_value = f"{format_number(v, scale)}{u}" if shown else _plain(value)  # CLI: display unit
+            limit = f"{op} {format_number(bound, scale)}{u}"
+            return InputError(f"{label} = {shown_value} is out of range: must be {limit} "
+                              f"({kind}: {why}){f'; {hint} goes beyond it' if soft else ''}",
+                              name=label, value=v, unit=self.unit, limits=((op, bound),),
+                              why=f"{kind}: {why}", soft=soft)
 
         lo, hi = self.hard_low, self.hard_high
         if lo is not None and (v <= lo if self.hard_low_open else v < lo):
-            raise refuse(f"{'>' if self.hard_low_open else '>='} {format_number(lo, scale)}{u}", "hard limit")
+            raise refuse(">" if self.hard_low_open else ">=", lo, "hard limit")
         if hi is not None and v > hi:
-            raise refuse(f"<= {format_number(hi, scale)}{u}", "hard limit")
+            raise refuse("<=", hi, "hard limit")
         if not allow_extrapolation:
             if self.soft_low is not None and v < self.soft_low:
-                raise refuse(f">= {format_number(self.soft_low, scale)}{u}", "plausible range",
-                             f"; {hint} goes beyond it")
+                raise refuse(">=", self.soft_low, "plausible range")
             if self.soft_high is not None and v > self.soft_high:
-                raise refuse(f"<= {format_number(self.soft_high, scale)}{u}", "plausible range",
-                             f"; {hint} goes beyond it")
+                raise refuse("<=", self.soft_high, "plausible range")
         return v
 
 
@@ -450,35 +463,41 @@ def _hertz(normal_force: float, radius: float, E_star: float) -> tuple[float, fl
 
 def check_contact_plausible(normal_force: float, radius: float, E_star: float, *,
                             allow_extrapolation: bool = False, names: str = "normal_force, radius",
-                            hint: str = "allow_extrapolation=True") -> None:
+                            hint: str = "allow_extrapolation=True", sources: tuple[str, ...] = ()) -> None:
     """Refuse a contact outside Hertz's assumptions: a > R/10 (hard), p0 > 10 GPa (soft).
 
     Raises
     ------
-    ValueError
-        Naming the parameters (``names``), the contact radius or pressure and the limit.
+    InputError
+        A ``ValueError`` naming the parameters (``names``), the contact radius or pressure and
+        the limit; its ``sources`` are ``sources`` (the inputs, named like the drive's fields).
     """
+    def refuse(detail: str, soft: bool = False) -> InputError:
+        hinted = f"{detail}; {hint} goes beyond it" if soft else detail
+        return InputError(f"{names}: {hinted}", name=names, sources=sources, detail=detail, soft=soft)
+
     a = (3.0 * float(normal_force) * float(radius) / (4.0 * float(E_star))) ** (1.0 / 3.0)
     if not a > 0.0:  # the product underflows below the smallest double: no contact to model
-        raise ValueError(
-            f"{names}: the Hertz contact radius a = (3 F R / 4E*)^(1/3) = {a:.4g} m underflows; "
-            "must be > 0 (hard limit: double precision)"
-        )
+        raise refuse(f"the Hertz contact radius a = (3 F R / 4E*)^(1/3) = {a:.4g} m underflows; "
+                     "must be > 0 (hard limit: double precision)")
     with np.errstate(all="ignore"):
         a, p0 = _hertz(float(normal_force), float(radius), float(E_star))
     ratio = a / radius
     if not np.isfinite(ratio) or ratio > CONTACT_RADIUS_RATIO_LIMIT:
-        raise ValueError(
-            f"{names}: the Hertz contact radius a = {a:.4g} m is {ratio:.3g} R; must be <= "
-            f"{CONTACT_RADIUS_RATIO_LIMIT:g} R (hard limit: Hertz and the MDR need a contact small "
-            "against the sphere)"
-        )
+        raise refuse(f"the Hertz contact radius a = {a:.4g} m is {ratio:.3g} R; must be <= "
+                     f"{CONTACT_RADIUS_RATIO_LIMIT:g} R (hard limit: Hertz and the MDR need a contact small "
+                     "against the sphere)")
     if not allow_extrapolation and not p0 <= HERTZ_PRESSURE_LIMIT:
-        raise ValueError(
-            f"{names}: the peak Hertz pressure p0 = {p0 / 1e9:.4g} GPa is out of range: must be <= "
-            f"{HERTZ_PRESSURE_LIMIT / 1e9:g} GPa (plausible range: beyond it ruby and steel are far "
-            f"outside the elastic regime the model describes); {hint} goes beyond it"
-        )
+        raise refuse(f"the peak Hertz pressure p0 = {p0 / 1e9:.4g} GPa is out of range: must be <= "
+                     f"{HERTZ_PRESSURE_LIMIT / 1e9:g} GPa (plausible range: beyond it ruby and steel are far "
+                     "outside the elastic regime the model describes)", soft=True)
+
+
+def check_drive(drive) -> Drive:
+    """``drive`` if it is a :class:`Drive`, else ``ValueError`` naming it (public functions' check)."""
+    if not isinstance(drive, Drive):
+        raise InputError(f"drive = {_plain(drive)} is not a Drive", name="drive", value=drive)
+    return drive
 
 
 def check_plausible(drive: Drive, *, allow_extrapolation: bool = False) -> None:
@@ -486,9 +505,13 @@ def check_plausible(drive: Drive, *, allow_extrapolation: bool = False) -> None:
 
     Raises
     ------
-    ValueError
-        The first parameter outside its range, naming it, its value, the limit and why.
+    InputError
+        A ``ValueError``: the first parameter outside its range, naming it (the field,
+        dotted for a part: ``"actuator.mass"``), its value, the limit and why. The damping
+        ratio ζ = c_p / (2√(k_p m_a)) is refused as a quantity computed from
+        ``actuator.viscosity``.
     """
+    check_drive(drive)
     r = PLAUSIBLE_RANGES
     kw = {"allow_extrapolation": allow_extrapolation}
     for name in ("hemisphere_radius", "preload", "friction_coefficient", "runner_mass",
@@ -499,14 +522,27 @@ def check_plausible(drive: Drive, *, allow_extrapolation: bool = False) -> None:
         r["material.youngs_modulus"].check(f"{which}.youngs_modulus", material.youngs_modulus, **kw)
         r["material.poissons_ratio"].check(f"{which}.poissons_ratio", material.poissons_ratio, **kw)
     act, amp = drive.actuator, drive.amplifier
-    for name in ("stiffness", "mass", "damping_ratio", "full_stroke_amplitude"):
+    for name in ("stiffness", "mass"):
         r[f"actuator.{name}"].check(f"actuator.{name}", getattr(act, name), **kw)
+    try:
+        r["actuator.damping_ratio"].check("actuator.damping_ratio", act.damping_ratio, **kw)
+    except InputError as exc:
+        raise exc.derived_from("actuator.viscosity", act.viscosity, 2.0 * np.sqrt(act.stiffness * act.mass),
+                               "the damping ratio ζ = c_p / (2√(k_p m_a))") from None
+    r["actuator.full_stroke_amplitude"].check("actuator.full_stroke_amplitude", act.full_stroke_amplitude,
+                                              **kw)
     for name in ("peak_to_peak_voltage", "slew_rate"):
         r[f"amplifier.{name}"].check(f"amplifier.{name}", getattr(amp, name), **kw)
     E_star, _ = contact_moduli(drive)
     largest = drive.preload if drive.contacts == 1 else drive.preload / (2.0 * np.sin(np.pi / 4))  # Eq. 1
     check_contact_plausible(largest, drive.hemisphere_radius, E_star, names="preload, hemisphere_radius, "
-                            "materials", **kw)
+                            "materials", sources=_CONTACT_SOURCES, **kw)
+
+
+#: The drive's fields the Hertz contact of :func:`check_contact_plausible` depends on.
+_CONTACT_SOURCES = ("preload", "hemisphere_radius", "hemisphere_material.youngs_modulus",
+                    "hemisphere_material.poissons_ratio", "runner_material.youngs_modulus",
+                    "runner_material.poissons_ratio")
 
 
 #: Preload grids of the critical-amplitude figures (assumption ``preload_grids``).
@@ -525,7 +561,7 @@ def paper_drive(hemisphere_radius: float = 1.0e-3, preload: float = 0.4, **chang
     radius = check_positive("hemisphere_radius", hemisphere_radius, "m")
     if not any(np.isclose(radius, r, rtol=1e-9, atol=0) for r in TABLE2_RADII):
         raise ValueError(
-            f"hemisphere_radius = {hemisphere_radius!r} is not a paper radius: must be one of "
+            f"hemisphere_radius = {_plain(hemisphere_radius)} is not a paper radius: must be one of "
             + ", ".join(f"{r:g}" for r in sorted(TABLE2_RADII))
             + " (m)"
         )
@@ -538,6 +574,9 @@ def parameter_table(record) -> list[dict]:
     Nested records (materials, actuator, amplifier) are expanded with a dotted name.
     The book renders these rows instead of retyping Tables 1–2.
     """
+    if not hasattr(record, "__dataclass_fields__") or isinstance(record, type):
+        raise InputError(f"record = {_plain(record)} is not a parameter record (a Drive, Material, Actuator "
+                         "or Amplifier)", name="record", value=record)
     rows: list[dict] = []
     for f in fields(record):
         if not f.metadata:  # labels such as Material.name are not parameters

@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import itertools
-import json
 import logging
 import os
 import pickle
@@ -42,12 +41,9 @@ from tqdm.std import tqdm  # text bar on a terminal; tqdm.auto warns in notebook
 
 from passmd._validation import check_choice
 from passmd.cache import Cache, function_name
-from passmd.config import RunConfig
+from passmd.config import EXECUTORS, RunConfig
 
 __all__ = ["EXECUTORS", "grid", "progress_enabled", "run"]
-
-#: Names accepted by ``run(executor=...)``.
-EXECUTORS = ("process", "serial", "dask")
 
 
 def grid(**axes) -> list[dict]:
@@ -359,8 +355,7 @@ def run(
         "computed": len(collect.results),
         "function": label,
     }
-    if config.sweep_log is not None:
-        _log_sweep(frame.attrs["sweep"], config.sweep_log)
+    config.log_sweep(frame.attrs["sweep"])
     return frame
 
 
@@ -417,12 +412,3 @@ def _execution(executor, scheduler, workers, config: RunConfig):
     if workers is None:
         workers = config.workers
     return executor, scheduler, workers
-
-
-def _log_sweep(record: dict, path) -> None:
-    """Append ``record`` as one JSON line to the file ``path``.
-
-    One ``write`` of a short line in append mode: lines of concurrent writers do not mix.
-    """
-    with open(path, "a", encoding="utf-8") as fh:
-        fh.write(json.dumps(record) + "\n")

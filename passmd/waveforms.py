@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from passmd._validation import check_choice, check_count, check_positive, check_range
-from passmd.parameters import PLAUSIBLE_RANGES, Assumption, Drive
+from passmd._validation import InputError, check_choice, check_count, check_positive, check_range, shown
+from passmd.parameters import PLAUSIBLE_RANGES, Assumption, Drive, check_drive
 
 #: Fraction of the stick phase (at its end) over which the settled position is averaged.
 SETTLE_FRACTION = 0.2
@@ -97,14 +97,13 @@ class Waveform:
         if not (np.all(np.isfinite(t)) and np.all(np.isfinite(x))):
             raise ValueError("waveform times and positions must be finite numbers")
         if t[0] != 0.0:
-            raise ValueError(f"times[0] = {t[0]!r} is not allowed: a waveform starts at t = 0")
+            raise InputError(f"times[0] = {shown(t[0])} is not allowed: a waveform starts at t = 0",
+                             name="times", value=t[0])
         steps = np.diff(t)
         if np.any(steps <= 0):
             i = int(np.flatnonzero(steps <= 0)[0])
-            raise ValueError(
-                f"waveform times must increase strictly: times[{i + 1}] = {t[i + 1]!r} <= "
-                f"times[{i}] = {t[i]!r}"
-            )
+            raise InputError(f"waveform times must increase strictly: times[{i + 1}] = {shown(t[i + 1])} <= "
+                             f"times[{i}] = {shown(t[i])}", name="times", value=t[i + 1])
         check_positive("period", self.period, "s")
         check_count("periods", self.periods)
         w = np.asarray(self.settle_windows, dtype=float).reshape(-1, 2)
@@ -114,7 +113,12 @@ class Waveform:
         tset = set(t.tolist())
         for value in np.concatenate([w.ravel(), m]):
             if float(value) not in tset:
-                raise ValueError(f"phase mark t = {value!r} is not a breakpoint of the waveform")
+                raise InputError(f"phase mark t = {shown(value)} is not a breakpoint of the waveform",
+                                 name="settle_windows, slip_marks", value=value)
+        if not isinstance(self.kind, str):
+            raise InputError(f"kind = {shown(self.kind)} is not allowed: must be a str", name="kind",
+                             value=self.kind)
+        check_range("amplitude", self.amplitude, 0.0, unit="m")
         object.__setattr__(self, "times", t)
         object.__setattr__(self, "positions", x)
         object.__setattr__(self, "settle_windows", w)
@@ -170,10 +174,33 @@ def flyback_time(amplitude: float, drive: Drive, flyback: str = "slew") -> float
         ``"fixed"``: the full-stroke time V_pp / SR (2 µs) at every amplitude.
     """
     check_choice("flyback", flyback, ("slew", "fixed"))
+    check_drive(drive)
+    amplitude = check_range("amplitude", amplitude, 0.0, unit="m")
     full = drive.amplifier.full_stroke_time
     if flyback == "fixed":
         return full
     return amplitude / drive.actuator.full_stroke_amplitude * full
+
+
+#: Fewest spacings of double-precision time (at the run's end) a fly-back must last, so
+#: that its start and end are distinct breakpoints in every period (rounding of k·T + t).
+FLYBACK_SPACINGS = 4
+
+
+def _check_flyback_resolved(t_fb: float, amplitude: float, drive: Drive, period: float, periods: int) -> None:
+    """Refuse a slew-limited fly-back too short to be told from its period's end in double precision."""
+    duration = periods * period
+    t_min = FLYBACK_SPACINGS * float(np.spacing(duration))
+    if not t_fb >= t_min:
+        per = drive.actuator.full_stroke_amplitude / drive.amplifier.full_stroke_time  # amplitude per second
+        raise InputError(
+            f"amplitude = {shown(amplitude)} is out of range: its fly-back (A/A_max)·V_pp/SR = {t_fb:.4g} s "
+            f"is shorter than {t_min:.4g} s, which double-precision time cannot resolve over the "
+            f"{duration:.4g} s run; amplitude must be >= {t_min * per:.4g} m",
+            name="fly-back time", value=t_fb, unit="s", limits=((">=", t_min),),
+            why=f"hard limit: double-precision time cannot resolve a shorter fly-back over the "
+                f"{duration:.4g} s run",
+        ).derived_from("amplitude", amplitude, per, "the slew-limited fly-back time (A/A_max)·V_pp/SR")
 
 
 def sawtooth(
@@ -201,7 +228,7 @@ def sawtooth(
     settle_fraction : float
         Part of the ramp, at its end, used as the settle window.
     """
-    a_max = drive.actuator.full_stroke_amplitude
+    a_max = check_drive(drive).actuator.full_stroke_amplitude
     A = check_range("amplitude", amplitude, 0.0, a_max, unit="m")
     f = PLAUSIBLE_RANGES["frequency"].check("frequency", frequency,
                                             allow_extrapolation=drive.allow_extrapolation)
@@ -212,12 +239,9 @@ def sawtooth(
     t_fb = flyback_time(A, drive, flyback)
     if A == 0.0:
         t_fb = min(drive.amplifier.full_stroke_time, 0.5 * T)  # any edge: x_p stays 0
-    if t_fb >= 0.5 * T:
-        f_max = 0.5 / t_fb
-        raise ValueError(
-            f"frequency = {f!r} is out of range: the fly-back of {t_fb * 1e6:.3g} µs must take less than "
-            f"half a period, so frequency must be < {f_max:.6g} Hz"
-        )
+    check_flyback_fits(t_fb, f)
+    if A > 0.0 and flyback == "slew":
+        _check_flyback_resolved(t_fb, A, drive, T, periods)
     t_ramp = T - t_fb
     times, positions, windows, marks = [0.0], [0.0], [], []
     for k in range(periods):
@@ -238,6 +262,17 @@ def sawtooth(
         "sawtooth",
         A,
     )
+
+
+def check_flyback_fits(t_fb: float, frequency: float) -> None:
+    """Refuse a frequency whose half period is not longer than the fly-back ``t_fb`` (s)."""
+    if t_fb >= 0.5 * (1.0 / frequency):  # as the callers' period T = 1/f
+        f_max = 0.5 / t_fb
+        raise InputError(
+            f"frequency = {shown(frequency)} is out of range: the fly-back of {t_fb * 1e6:.3g} µs must take "
+            f"less than half a period, so frequency must be < {f_max:.6g} Hz",
+            name="frequency", value=frequency, unit="Hz", limits=(("<", f_max),),
+            why=f"the fly-back of {t_fb * 1e6:.3g} µs must take less than half a period")
 
 
 def piecewise_linear(
@@ -269,27 +304,40 @@ def piecewise_linear(
     """
     f = check_positive("frequency", frequency, "Hz")
     T = 1.0 / f
-    pt = np.asarray(period_times, dtype=float)
-    px = np.asarray(period_positions, dtype=float)
+    try:
+        pt = np.asarray(period_times, dtype=float)
+        px = np.asarray(period_positions, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"period_times = {shown(period_times)}, period_positions = "
+                         f"{shown(period_positions)}: must be arrays of numbers",
+                         name="period_times, period_positions") from None
     if pt.ndim != 1 or pt.shape != px.shape or pt.size < 2:
         raise ValueError("period_times and period_positions must be 1-D arrays of equal length >= 2")
     if not np.isclose(pt[0], 0.0, atol=0) or not np.isclose(pt[-1], T, rtol=1e-12):
         raise ValueError(
-            f"period_times must run from 0 to the period T = {T!r} s, got {pt[0]!r} … {pt[-1]!r}"
+            f"period_times must run from 0 to the period T = {shown(T)} s, got {shown(pt[0])} … "
+            f"{shown(pt[-1])}"
         )
     if np.any(np.diff(pt) <= 0):
         raise ValueError("period_times must increase strictly (a waveform must be monotone in time)")
     if px[0] != px[-1]:
         raise ValueError(
-            f"period_positions[0] = {px[0]!r} != period_positions[-1] = {px[-1]!r}: not periodic"
+            f"period_positions[0] = {shown(px[0])} != period_positions[-1] = {shown(px[-1])}: not periodic"
         )
     periods = check_count("periods", periods)
+    if not isinstance(kind, str):
+        raise InputError(f"kind = {shown(kind)} is not allowed: must be a str", name="kind", value=kind)
+    if np.ndim(settle_window) != 1 or np.size(settle_window) != 2:
+        raise InputError(f"settle_window = {shown(settle_window)} is not allowed: must be a (start, end) "
+                         "pair of times within the period", name="settle_window", value=settle_window)
     ws, we = (check_range("settle_window", v, 0.0, T, unit="s") for v in settle_window)
     if not ws < we:
-        raise ValueError(f"settle_window = {settle_window!r} is not allowed: start must be < end")
+        raise InputError(f"settle_window = {shown(settle_window)} is not allowed: start must be < end",
+                         name="settle_window", value=settle_window)
     check_range("slip_mark", slip_mark, 0.0, T, unit="s")
     if not np.any(pt == slip_mark):
-        raise ValueError(f"slip_mark = {slip_mark!r} is not a breakpoint of the period")
+        raise InputError(f"slip_mark = {shown(slip_mark)} is not a breakpoint of the period",
+                         name="slip_mark", value=slip_mark)
     extra = [v for v in (ws, we) if not np.any(np.isclose(pt, v, rtol=0, atol=1e-15 * T))]
     if extra:
         pt_full = np.sort(np.concatenate([pt, extra]))

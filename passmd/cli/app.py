@@ -12,6 +12,7 @@ import numpy as np
 from passmd._result_bounds import ResultError
 from passmd.cache import CacheWarning
 from passmd.cli import startup
+from passmd.cli.drive import explain
 from passmd.cli.errors import OPTIONAL_EXTRAS, MissingDependencyError, OutputError, UsageError
 from passmd.cli.parser import PROG, make_parser
 from passmd.cli.streams import (
@@ -107,8 +108,8 @@ def _dispatch(args, out: Out, prog: str, to_stdout: bool) -> int:  # noqa: C901 
         if to_stdout:
             silence_stdout()
         return _error(prog, f"cannot write the output: {exc.strerror or exc}", 1)
-    except (UsageError, QuantityError) as exc:
-        return _error(prog, str(exc), 2)
+    except (UsageError, QuantityError) as exc:  # a usage error raised from an input check: that check
+        return _error(prog, explain(exc, args), 2)
     except OutputError as exc:
         return _error(prog, str(exc), 1)
     except KeyboardInterrupt:
@@ -117,8 +118,8 @@ def _dispatch(args, out: Out, prog: str, to_stdout: bool) -> int:  # noqa: C901 
         # exit at once: the interpreter's exit-time collection of numba's object graph takes ≈ 1 s
         gc.freeze()
         return 130
-    except ValueError as exc:  # the package's input checks (passmd._validation)
-        return _error(prog, str(exc), 2)
+    except ValueError as exc:  # the package's input checks (passmd._validation), in the options' terms
+        return _error(prog, explain(exc, args), 2)
     except (ResultError, MissingDependencyError) as exc:
         return _error(prog, str(exc), 1)
     except RuntimeError as exc:  # passmd.dynamics.SimulationError and other failed runs

@@ -9,6 +9,8 @@ environment.
 from __future__ import annotations
 
 import importlib.util
+import os
+import stat
 
 from passmd.cli.errors import MissingDependencyError, UsageError
 from passmd.config import RunConfig
@@ -24,6 +26,38 @@ def _require_executor(config: RunConfig) -> None:
                                      "installed: pip install 'passmd[dask]'")
 
 
+def _check_sweep_log(config: RunConfig) -> None:
+    """Refuse, before any work, a sweep log that cannot be appended to (names the variable).
+
+    A missing file is fine (the first sweep creates it) if its directory exists and is
+    writable; a device is probed with a write of no bytes (``/dev/full`` refuses even that).
+    """
+    path = config.sweep_log
+    if path is None:
+        return
+    label = config.sweep_log_label
+    if path.is_dir():
+        raise UsageError(f"{label} is a directory: must name a file the sweeps append a line to")
+    parent = path.parent
+    if not path.exists():
+        if not parent.is_dir():
+            raise UsageError(f"{label}: the directory {str(parent)!r} does not exist")
+        if not os.access(parent, os.W_OK | os.X_OK):
+            raise UsageError(f"{label}: the directory {str(parent)!r} is not writable")
+        return
+    if not os.access(path, os.W_OK):
+        raise UsageError(f"{label} is not writable")
+    if stat.S_ISCHR(path.stat().st_mode):
+        try:
+            fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_NONBLOCK)
+            try:
+                os.write(fd, b"")
+            finally:
+                os.close(fd)
+        except OSError as exc:
+            raise UsageError(f"{label} cannot be written: {exc.strerror or exc}") from exc
+
+
 def run_config(args) -> RunConfig:
     """The environment's run configuration, replaced by the options ``figure``/``ledger`` were given."""
     if args.workers is not None and args.workers < 1:
@@ -34,4 +68,5 @@ def run_config(args) -> RunConfig:
                                         scheduler=args.scheduler, workers=args.workers,
                                         cache_dir=args.cache_dir)
     _require_executor(config)
+    _check_sweep_log(config)
     return config

@@ -19,8 +19,9 @@ from passmd.parameters import ACTUATOR_DAMPING_RATIO, PLAUSIBLE_RANGES, Drive
 from passmd.units import parse_quantity, si_factor, to_display
 
 __all__ = ["ACTUATOR_DYNAMICS", "AMPLITUDE", "CACHE_DIR_HELP", "DEFAULT_DRIVE", "DRIVE_QUANTITIES",
-           "FREQUENCY", "MATERIAL_FLAGS", "NORMAL_FORCE", "THRESHOLD", "TOLERANCE", "Quantity",
-           "add_drive_options", "add_output_options", "add_simulation_options", "add_sweep_options"]
+           "FREQUENCY", "MATERIAL_FLAGS", "NORMAL_FORCE", "OPTION_FOR", "QUANTITIES", "THRESHOLD",
+           "TOLERANCE", "Quantity", "add_drive_options", "add_output_options", "add_simulation_options",
+           "add_sweep_options"]
 
 #: The drive every option replaces a part of (Tables 1–2 at R = 1 mm, F_p = 0.4 N, μ = 0.2).
 DEFAULT_DRIVE = Drive()
@@ -139,6 +140,27 @@ THRESHOLD = Quantity("--threshold", "nm", "S", "steady protocol: a step counts w
                      "exceeds this", fmt(PROTOCOL.step_threshold, "nm"))
 TOLERANCE = Quantity("--tolerance", "nm", "W", "stop when the bracket is narrower than this",
                      fmt(PROTOCOL.search_tolerance, "nm"))
+
+#: Every option that takes a number with a unit, by flag.
+QUANTITIES = {q.flag: q for q in (*DRIVE_QUANTITIES, AMPLITUDE, FREQUENCY, NORMAL_FORCE, THRESHOLD,
+                                   TOLERANCE)}
+
+#: The option that sets each input the package's checks name (``passmd._validation.InputError.name``):
+#: the drive's fields (dotted for a part, as :class:`Quantity.field`), then the parameters of the
+#: waveforms, contacts and protocols the commands pass their options to.
+OPTION_FOR: dict[str, str] = {
+    **{q.field: q.flag for q in DRIVE_QUANTITIES},
+    "amplitude": AMPLITUDE.flag,
+    "frequency": FREQUENCY.flag,
+    "normal_force": NORMAL_FORCE.flag,
+    "threshold": THRESHOLD.flag,
+    "tolerance": TOLERANCE.flag,
+    "periods": "--periods",
+    "initial_periods": "--periods",
+    "max_periods": "--max-periods",
+    "springs": "--springs",
+    "max_points": "--max-points",
+}
 
 CACHE_DIR_HELP = f"cache directory (default: ${ENVIRONMENT['cache_dir']} or ./{DEFAULT_CACHE_DIR})"
 

@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 
 from passmd import dynamics, theory
-from passmd._validation import check_positive, check_range
+from passmd._validation import InputError, check_positive, check_range, shown
 from passmd.optimized_waveform import RESPONSE_FREQUENCY, OptimizedDesign, max_piezo_velocity
-from passmd.parameters import Drive
+from passmd.parameters import Drive, check_drive
 from passmd.waveforms import sawtooth
 
 __all__ = ["MIN_SAMPLES", "SAMPLES_PER_VIBRATION", "micro_vibration_frequency", "optimized_design"]
@@ -63,10 +63,10 @@ def micro_vibration_frequency(
     idx = np.flatnonzero((sign[:-1] != 0) & (sign[:-1] != sign[1:]))
     crossings = t[idx] - w[idx] * (t[idx + 1] - t[idx]) / (w[idx + 1] - w[idx])
     if crossings.size < 3:
-        raise ValueError(
-            f"no micro-vibration after t = {after!r} s: found {crossings.size} turning point(s) of the "
-            "runner, need 3 (is the amplitude above the critical amplitude, and the record long enough?)"
-        )
+        found = f"found {crossings.size} turning point(s) of the runner, need 3"
+        raise InputError(
+            f"no micro-vibration after t = {shown(after)} s: {found} (is the amplitude above the critical "
+            "amplitude, and the record long enough?)", name="after", value=after, detail=found)
     return float(1.0 / (crossings[2] - crossings[0])), crossings
 
 
@@ -113,7 +113,7 @@ def optimized_design(
     ValueError
         Bad input, V_a ≤ V_r, or no micro-vibration in the response.
     """
-    v_max = max_piezo_velocity(drive)
+    v_max = max_piezo_velocity(check_drive(drive))
     if acceleration_velocity is None:
         v_a = v_max
     else:
@@ -129,15 +129,21 @@ def optimized_design(
     samples = int(np.ceil(wave.duration * theory.runner_frequency(drive) * SAMPLES_PER_VIBRATION)) + 1
     result = dynamics.simulate(drive, wave, max_points=max(samples, MIN_SAMPLES))
     flyback_end = wave.period  # the first fly-back ends with the first period
-    f_s, _ = micro_vibration_frequency(
-        result.time, result.runner_velocity, wave.velocity(result.time), flyback_end
-    )
+    try:
+        f_s, _ = micro_vibration_frequency(
+            result.time, result.runner_velocity, wave.velocity(result.time), flyback_end
+        )
+    except InputError as exc:  # the response of this amplitude: name the amplitude
+        detail = (f"the saw-tooth response Eq. 15 is designed from shows no micro-vibration after the first "
+                  f"fly-back ({exc.detail}): the amplitude must be above the critical amplitude")
+        raise InputError(f"amplitude = {shown(amplitude)} m: {detail}", name="amplitude", value=amplitude,
+                         unit="m", sources=("amplitude",), detail=detail) from None
     t_s = 0.5 / f_s
     v_r = float(np.interp(flyback_end + t_s, result.time, result.runner_velocity))
     if not v_a > v_r:
-        raise ValueError(
-            f"acceleration_velocity = {v_a!r} is out of range: must exceed the runner velocity "
-            f"V_r = {v_r:.3g} m/s (Eq. 15)"
-        )
+        raise InputError(
+            f"acceleration_velocity = {shown(v_a)} is out of range: must exceed the runner velocity "
+            f"V_r = {v_r:.3g} m/s (Eq. 15)", name="acceleration_velocity", value=v_a, unit="m/s",
+            limits=((">", v_r),))
     t_a = u_max / (v_a - v_r)
     return OptimizedDesign(t_s, t_a, v_a * t_a, f_s, v_r, u_max, f_ref)

@@ -1,0 +1,321 @@
+"""Every refusal names what the user typed: the option, variable or parameter, its value, the limit.
+
+Contract (README, "Reliability"; standards: "Bad input gets ONE line naming the option …
+AS THE USER TYPED IT, its value and the allowed range"): a value refused deep in the
+package (a record, a waveform, the Eq. 15 design) reaches the user as the command-line
+option that set it, with the value as typed and the limit in the option's unit; a
+quantity computed from an option (the damping ratio from --actuator-viscosity, the
+fly-back from --amplitude, Δ_a of Eq. 15) says what it is and how to change the option;
+an environment variable is named as set. No message shows ``np.float64(…)`` or a field
+path such as ``actuator.damping_ratio``. The library raises ``ValueError`` naming its own
+parameter, with plain numbers.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import math
+import os
+import pickle
+import re
+import subprocess
+import sys
+from unittest import mock
+
+import numpy as np
+import pytest
+
+from passmd import cli, optimized_waveform, waveforms
+from passmd._validation import InputError
+from passmd.cli import options
+from passmd.cli.commands import run as run_command
+from passmd.cli.drive import _safe
+from passmd.cli.parser import make_parser
+from passmd.config import RunConfig
+from passmd.contact import MDRContact
+from passmd.parameters import (
+    PLAUSIBLE_RANGES,
+    Actuator,
+    Drive,
+    actuator_viscosity,
+    check_plausible,
+    parameter_table,
+)
+from passmd.protocols import eq15
+
+#: What a message must never show: numpy reprs, and the package's field paths and
+#: snake_case names (``actuator.damping_ratio``, ``acceleration_amplitude``).
+INTERNALS = (re.compile(r"np\.\w+\("), re.compile(r"\b[a-z_]{2,}\.[a-z_]{2,}\b"),
+             re.compile(r"\b[a-z]{2,}_[a-z]{2,}\b"))
+
+
+def assert_one_clean_line(err: str) -> str:
+    assert err.count("\n") == 1 and err.startswith("passmd"), err
+    assert "Traceback" not in err
+    for pattern in INTERNALS:
+        assert not pattern.search(err), (pattern.pattern, err)
+    return err
+
+
+def run_process(argv, env, cwd):
+    """``python -m passmd argv`` in a subprocess: (status, stdout, stderr)."""
+    full_env = {**os.environ, "MPLBACKEND": "Agg", "PASSMD_CACHE_DIR": str(cwd / "cache"), **env}
+    done = subprocess.run([sys.executable, "-m", "passmd", *argv], capture_output=True, text=True,
+                          env=full_env, cwd=cwd, timeout=300)
+    return done.returncode, done.stdout, done.stderr
+
+
+def run_main(argv):
+    """(status, stdout, stderr) of ``passmd argv`` in this process."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            status = cli.main(list(argv))
+        except SystemExit as exc:  # argparse
+            status = exc.code
+    return status, out.getvalue(), err.getvalue()
+
+
+# --------------------------------------------------------------------------------------
+# The inputs once answered in the package's own terms, each with what its line must say
+# (the option or variable as typed, the value, the limit), run as a user would.
+# --------------------------------------------------------------------------------------
+
+FIGURE = ["figure", "fig5a", "--profile", "quick", "--out", "out"]
+REPROS = {
+    "actuator viscosity 1e300": (
+        ["run", "--actuator-viscosity", "1e300"], {},
+        ("the damping ratio", "derived from --actuator-viscosity 1e300 kg/s", "is 1.322e+300",
+         "must be <= 10", "lower --actuator-viscosity to at most", "--allow-extrapolation")),
+    "hemisphere poisson -0.99": (
+        ["run", "--hemisphere-poisson", "-0.99"], {},
+        ("--hemisphere-poisson = -0.99 is out of range: must be >= 0",
+         "--allow-extrapolation goes beyond it")),
+    "amplitude 1e-300": (
+        ["run", "--amplitude", "1e-300"], {},
+        ("fly-back time", "derived from --amplitude 1e-300 nm", "must be >=",
+         "raise --amplitude to at least")),
+    "optimized waveform at 10 nm": (
+        ["run", "--waveform", "optimized", "--amplitude", "10nm"], {},
+        ("the Eq. 15 acceleration amplitude", "derived from --amplitude 10nm", "must be < 10 nm",
+         "raise --amplitude above")),
+    "PASSMD_WORKERS superscript two": (
+        FIGURE, {"PASSMD_WORKERS": "²"},
+        ("PASSMD_WORKERS = '²' is not allowed", "must be an integer >= 1")),
+    "PASSMD_EXECUTOR threads": (
+        FIGURE, {"PASSMD_EXECUTOR": "threads"},
+        ("PASSMD_EXECUTOR = 'threads' is not allowed", "must be one of process, serial, dask")),
+    "PASSMD_SWEEP_LOG on a full device": (
+        FIGURE, {"PASSMD_SWEEP_LOG": "/dev/full"},
+        ("PASSMD_SWEEP_LOG = '/dev/full' cannot be written", "No space left on device")),
+}
+
+
+@pytest.mark.parametrize("json_flag", [[], ["--json"]], ids=["human", "json"])
+@pytest.mark.parametrize("name", list(REPROS))
+def test_repro_names_what_was_typed(name, json_flag, tmp_path):
+    argv, env, fragments = REPROS[name]
+    if env.get("PASSMD_SWEEP_LOG") == "/dev/full" and not os.path.exists("/dev/full"):
+        pytest.skip("needs /dev/full")
+    status, out, err = run_process([*argv, *json_flag], env, tmp_path)
+    assert status == 2, err
+    assert out == ""
+    assert_one_clean_line(err)
+    for fragment in fragments:
+        assert fragment in err, (fragment, err)
+    assert not (tmp_path / "out").exists()  # refused before anything ran
+
+
+def test_viscosity_advice_holds():
+    """The viscosity bound the message gives is on its safe side; a hair above the exact one is refused."""
+    _, _, err = run_main(["theory", "--actuator-viscosity", "1e300"])
+    bound = float(re.search(r"to at most ([0-9.e+-]+) kg/s", err).group(1))
+    actuator = Drive().actuator
+    per_zeta = 2 * math.sqrt(actuator.stiffness * actuator.mass)  # c_p = 2ζ√(k_p m_a)
+    exact = PLAUSIBLE_RANGES["actuator.damping_ratio"].soft_high * per_zeta
+    assert exact * (1 - 1e-3) < bound <= exact
+    assert run_main(["theory", "--actuator-viscosity", f"{bound!r}"])[0] == 0
+    assert run_main(["theory", "--actuator-viscosity", f"{exact * (1 + 1e-9)!r}"])[0] == 2
+
+
+def test_eq15_advice_holds():
+    """Above the Δ_a the optimized-waveform message names, the design fits and the run succeeds."""
+    status, _, err = run_main(["run", "--waveform", "optimized", "--amplitude", "10nm", "--periods", "2"])
+    assert status == 2, err
+    bound = float(re.search(r"raise --amplitude above ([0-9.e+-]+) nm", err).group(1))
+    status, out, err = run_main(["run", "--waveform", "optimized", "--amplitude", f"{bound * 1.001:.6g}nm",
+                                 "--periods", "2", "--json"])
+    assert status == 0, err
+
+
+@pytest.mark.parametrize(("op", "bound", "shown"), [
+    (">", 19.7461, "19.75"), (">=", 1.40191e-9, "1.402e-09"), ("<", 250000.00000000003, "2.5e+05"),
+    ("<=", 7.5630681604756145, "7.563"), ("<=", 10.0, "10"), (">", -1.0, "-1"), ("<", 0.5, "0.5"),
+    (">", 0.0, "0"), ("<", 19.7469, "19.74"),
+])
+def test_limits_are_rounded_on_their_safe_side(op, bound, shown):
+    """A rounded lower limit is not below the exact one, a rounded upper one not above it."""
+    assert _safe(op, bound) == shown
+    assert (float(shown) >= bound) if op.startswith(">") else (float(shown) <= bound)
+
+
+# --------------------------------------------------------------------------------------
+# Every numeric option of ``run``, read from its parser (a new option is covered at once)
+# --------------------------------------------------------------------------------------
+
+
+def _numeric_run_options() -> list[str]:
+    run_parser = make_parser()._subparsers._group_actions[0].choices["run"]
+    return [action.option_strings[-1] for action in run_parser._actions
+            if action.option_strings and (action.type in (int, float)
+                                          or action.option_strings[-1] in options.QUANTITIES)]
+
+
+RUN_OPTIONS = _numeric_run_options()
+
+
+class _Reached(BaseException):
+    """The simulation was reached: every check passed."""
+
+
+def _reached(*args, **kwargs):
+    raise _Reached
+
+
+def test_the_option_list_is_read_from_the_parser():
+    assert {"--actuator-viscosity", "--hemisphere-poisson", "--amplitude", "--frequency", "--periods",
+            "--springs", "--max-points", "--contacts"} <= set(RUN_OPTIONS)
+    assert {q.flag for q in options.DRIVE_QUANTITIES} <= set(RUN_OPTIONS)
+
+
+@pytest.mark.parametrize("json_flag", [[], ["--json"]], ids=["human", "json"])
+@pytest.mark.parametrize("value", ["-1e300", "1e300"])
+@pytest.mark.parametrize("flag", RUN_OPTIONS)
+def test_every_numeric_run_option_is_named_when_refused(flag, value, json_flag):
+    argv = ["run", f"{flag}={value}", "--load-cell", *json_flag]  # --load-cell: its stiffness applies
+    with mock.patch.object(run_command, "simulate", _reached):
+        try:
+            status, out, err = run_main(argv)
+        except _Reached:
+            pytest.fail(f"{argv} was accepted")
+    assert status == 2, err
+    assert out == ""
+    assert_one_clean_line(err)
+    assert flag in err, err
+
+
+# --------------------------------------------------------------------------------------
+# Environment variables and the sweep log
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("variable", "value", "allowed"), [
+    ("PASSMD_WORKERS", "²", "an integer >= 1"),
+    ("PASSMD_WORKERS", "0", "an integer >= 1"),
+    ("PASSMD_WORKERS", "٣", "an integer >= 1"),
+    ("PASSMD_EXECUTOR", "threads", "one of process, serial, dask"),
+    ("PASSMD_PROFILE", "fast", "one of quick, paper"),
+])
+def test_environment_errors_name_the_variable(variable, value, allowed):
+    with pytest.raises(ValueError) as info:
+        RunConfig.from_environment({variable: value})
+    assert str(info.value).startswith(f"{variable} = {value!r} is not allowed: must be {allowed}"), info.value
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
+def test_sweep_log_write_failure_names_where_the_path_came_from():
+    with pytest.raises(OSError, match=r"sweep log PASSMD_SWEEP_LOG = '/dev/full': No space left"):
+        RunConfig.from_environment({"PASSMD_SWEEP_LOG": "/dev/full"}).log_sweep({"points": 1})
+    with pytest.raises(OSError, match=r"sweep log sweep_log = '/dev/full': No space left"):
+        RunConfig(sweep_log="/dev/full").log_sweep({"points": 1})
+
+
+@pytest.mark.parametrize(("log", "message"), [
+    ("missing-dir/sweeps", "PASSMD_SWEEP_LOG = 'missing-dir/sweeps': the directory 'missing-dir' does "
+                              "not exist"),
+    (".", "PASSMD_SWEEP_LOG = '.' is a directory"),
+])
+def test_unusable_sweep_log_is_refused_before_running(log, message, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("PASSMD_SWEEP_LOG", log)
+    status, out, err = run_main(["ledger", "--profile", "quick"])
+    assert status == 2 and out == ""
+    assert_one_clean_line(err)
+    assert message in err, err
+
+
+# --------------------------------------------------------------------------------------
+# The library: public functions check their arguments; messages show plain numbers
+# --------------------------------------------------------------------------------------
+
+DESIGN = optimized_waveform.OptimizedDesign(1e-6, 1e-6, 10e-9)
+D = Drive()
+#: (name, call, what the message must start with)
+API_CASES = [
+    ("flyback_time, not a drive", lambda: waveforms.flyback_time(1e-7, "x"), r"drive = 'x' is not a Drive"),
+    ("flyback_time, amplitude text", lambda: waveforms.flyback_time("a", D),
+     r"amplitude = 'a' is not a number"),
+    ("flyback_time, negative amplitude", lambda: waveforms.flyback_time(-1.0, D),
+     r"amplitude = -1.0 is out of range"),
+    ("sawtooth, not a drive", lambda: waveforms.sawtooth(1e-7, 100.0, "x"), r"drive = 'x' is not a Drive"),
+    ("piecewise_linear, settle window a number",
+     lambda: waveforms.piecewise_linear([0, 0.01], [0, 0], 100.0, 1, 3, 0.0), r"settle_window = 3 "),
+    ("piecewise_linear, kind a number",
+     lambda: waveforms.piecewise_linear([0, 0.01], [0, 0], 100.0, 1, (0, 0.005), 0.0, kind=3), r"kind = 3 "),
+    ("piecewise_linear, times text",
+     lambda: waveforms.piecewise_linear("ab", [0, 0], 100.0, 1, (0, 0.005), 0.0), r"period_times = 'ab'"),
+    ("Waveform, amplitude nan",
+     lambda: waveforms.Waveform([0.0, 1.0], [0.0, 0.0], 1.0, 1, [[0.0, 1.0]], [0.0], amplitude=math.nan),
+     r"amplitude = nan is out of range"),
+    ("Waveform, times not increasing",
+     lambda: waveforms.Waveform(np.array([0.0, 1.0, 1.0]), np.zeros(3), 1.0, 1, [[0.0, 1.0]], [0.0]),
+     r"waveform times must increase strictly: times\[2\] = 1.0 <= times\[1\] = 1.0$"),
+    ("actuator_viscosity, negative stiffness", lambda: actuator_viscosity(-1.0, 1.0),
+     r"stiffness = -1.0 is out"),
+    ("actuator_viscosity, text mass", lambda: actuator_viscosity(1.0, "a"), r"mass = 'a' is not a number"),
+    ("actuator_viscosity, negative damping", lambda: actuator_viscosity(1.0, 1.0, -0.1),
+     r"damping_ratio = -0.1 is out"),
+    ("parameter_table, not a record", lambda: parameter_table("x"),
+     r"record = 'x' is not a parameter record"),
+    ("check_plausible, not a drive", lambda: check_plausible("x"), r"drive = 'x' is not a Drive"),
+    ("max_piezo_velocity, not a drive", lambda: optimized_waveform.max_piezo_velocity("x"), r"drive = 'x'"),
+    ("optimized_timing, not a drive", lambda: optimized_waveform.optimized_timing(DESIGN, 1e-7, 100.0, "x"),
+     r"drive = 'x'"),
+    ("optimized, periods text", lambda: optimized_waveform.optimized(1e-7, 100.0, D, "x", design=DESIGN),
+     r"periods = 'x' is out of range"),
+    ("MDRContact.for_drive, not a drive", lambda: MDRContact.for_drive("x"), r"drive = 'x' is not a Drive"),
+    ("optimized_design, not a drive", lambda: eq15.optimized_design(1e-7, "x"),
+     r"drive = 'x' is not a Drive"),
+    ("Drive, numpy contacts", lambda: Drive(contacts=np.int64(3)), r"contacts = 3 is not allowed"),
+    ("Drive, numpy viscosity", lambda: Drive(actuator=Actuator(6.5e6, 2.2e-8, np.float64(1e300), 202e-9)),
+     r"actuator\.damping_ratio = 1\.32\d*e\+300 is out of range: must be <= 10"),
+]
+
+
+@pytest.mark.parametrize(("call", "start"),
+                         [pytest.param(call, start, id=name) for name, call, start in API_CASES])
+def test_public_functions_name_the_parameter(call, start):
+    with pytest.raises(ValueError, match="^" + start) as info:
+        call()
+    assert "np." not in str(info.value)
+
+
+def test_derived_quantity_carries_its_source():
+    """The damping ratio's error says which input it came from and the limit on that input."""
+    with pytest.raises(InputError) as info:
+        Drive(actuator=Actuator(6.5e6, 2.2e-8, 1e300, 202e-9))
+    exc = info.value
+    assert (exc.name, exc.source, exc.source_value, exc.soft) == ("actuator.damping_ratio",
+                                                                  "actuator.viscosity", 1e300, True)
+    (op, bound), = exc.source_limits
+    assert op == "<=" and bound == pytest.approx(10 * 2 * math.sqrt(6.5e6 * 2.2e-8), rel=1e-12)
+
+
+def test_input_error_survives_a_process_pool():
+    """Sweeps send a point's error back from a worker process: its parts must survive pickling."""
+    with pytest.raises(InputError) as info:
+        Drive(preload=1e30)
+    again = pickle.loads(pickle.dumps(info.value))
+    assert type(again) is InputError and str(again) == str(info.value)
+    assert (again.name, again.limits, again.soft) == (info.value.name, info.value.limits, info.value.soft)
