@@ -1,7 +1,8 @@
 """The run configuration of the commands that run figure sweeps (``figure``, ``ledger``).
 
 The environment is read once, here at the edge (:meth:`passmd.config.RunConfig.from_environment`),
-and the command's options replace what it says; the resulting :class:`~passmd.config.RunConfig`
+and the command's options replace what it says (a sweep's progress shows on any stderr unless
+``$CI`` is set); the resulting :class:`~passmd.config.RunConfig`
 is passed down to the figure table, the ledger and the cache. Nothing is written to the
 environment.
 """
@@ -9,6 +10,7 @@ environment.
 from __future__ import annotations
 
 import importlib.util
+from dataclasses import replace
 
 from passmd.cli.errors import MissingDependencyError, UsageError
 from passmd.config import RunConfig
@@ -34,4 +36,6 @@ def run_config(args) -> RunConfig:
                                         scheduler=args.scheduler, workers=args.workers,
                                         cache_dir=args.cache_dir)
     _require_executor(config)
+    if config.progress is None:  # a command shows a long sweep's progress off a terminal too ($CI: never)
+        config = replace(config, progress=True)
     return config
