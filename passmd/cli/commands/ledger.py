@@ -71,11 +71,11 @@ def _write_baseline(ledger, evaluated, args) -> None:
 
 def run_ledger(args, out) -> int:
     """Every claim of the paper with its computed category, values and evidence (Sections 4–6)."""
+    config = run_config(args)
+    _check_baseline(args, config)  # (before the ledger's modules load)
     from passmd import ledger, ledger_views
     from passmd.claims import STATUSES
 
-    config = run_config(args)
-    _check_baseline(args, config)
     evaluated = ledger.evaluate(config=config)
     if args.write_baseline:
         _write_baseline(ledger, evaluated, args)
