@@ -21,6 +21,7 @@ generous time limits that only detect a hang.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import re
@@ -168,8 +169,12 @@ def test_fifo_is_written_to_not_replaced(tmp_path):
     fifo = tmp_path / "pipe"
     os.mkfifo(fifo)
     reader = subprocess.Popen(["cat", str(fifo)], stdout=subprocess.PIPE)
-    write_atomically(fifo, lambda tmp: Path(tmp).write_text("time_s\n0.0\n"))
-    assert reader.communicate(timeout=HANG_S)[0] == b"time_s\n0.0\n"
+    try:
+        write_atomically(fifo, lambda tmp: Path(tmp).write_text("time_s\n0.0\n"))
+        assert reader.communicate(timeout=HANG_S)[0] == b"time_s\n0.0\n"
+    finally:
+        reader.kill()
+        reader.wait()
     assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["pipe"]
 
@@ -324,19 +329,22 @@ def _default_sigterm():  # runs in the child before exec: whatever the test runn
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
-def _start(argv, tmp_path, env=None) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, *argv], cwd=tmp_path, env=env or _env(tmp_path),
+@contextlib.contextmanager
+def _started(argv, tmp_path, env=None):
+    """``python argv`` running in ``tmp_path`` (binary pipes), killed if still running at the end."""
+    proc = subprocess.Popen([sys.executable, *argv], cwd=tmp_path, env=env or _env(tmp_path),
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=_default_sigterm)
+    try:
+        yield proc
+    finally:
+        proc.kill()
+        proc.communicate()
 
 
 def _terminate(proc, before: bytes) -> tuple[int, str, str]:
     """SIGTERM to ``proc``; (status, stdout, all of stderr)."""
-    try:
-        proc.send_signal(signal.SIGTERM)
-        out, rest = proc.communicate(timeout=HANG_S)
-    finally:
-        proc.kill()
-        proc.wait()
+    proc.send_signal(signal.SIGTERM)
+    out, rest = proc.communicate(timeout=HANG_S)
     return proc.returncode, out.decode(), (before + rest).decode()
 
 
@@ -355,9 +363,9 @@ def _check_interrupted(status, out, err, prog="passmd run", kept=""):
 def test_long_run_shows_progress_lines_off_a_terminal_and_sigterm_stops_it(tmp_path):
     """``run --periods 100000`` with stderr a pipe: a progress line after a few seconds (on
     stderr only); SIGTERM then ends it with one line, exit 143 and no CSV or temporary file."""
-    proc = _start(["-m", "passmd", "run", "--periods", "100000", "--csv", "series.csv"], tmp_path)
-    seen = _read_until(proc, b"simulation: ", HANG_S)
-    status, out, err = _terminate(proc, seen)
+    with _started(["-m", "passmd", "run", "--periods", "100000", "--csv", "series.csv"], tmp_path) as proc:
+        seen = _read_until(proc, b"simulation: ", HANG_S)
+        status, out, err = _terminate(proc, seen)
     _check_interrupted(status, out, err)
     first = err.splitlines()[0]
     assert first.startswith("simulation: ") and PROGRESS_LINE.match(first) and "\r" not in err, first
@@ -367,10 +375,10 @@ def test_long_run_shows_progress_lines_off_a_terminal_and_sigterm_stops_it(tmp_p
 def test_many_springs_count_in_the_work_estimate(tmp_path):
     """``run --contacts 1 --springs N``: a few thousand steps of N springs each is long work, so it
     shows progress; the kernel returns often enough for SIGTERM to stop it at once."""
-    proc = _start(["-m", "passmd", "run", "--contacts", "1", "--springs", "3000000", "--periods", "1",
-                   "--json"], tmp_path)
-    seen = _read_until(proc, b"simulation: ", HANG_S)
-    status, out, err = _terminate(proc, seen)
+    argv = ["-m", "passmd", "run", "--contacts", "1", "--springs", "3000000", "--periods", "1", "--json"]
+    with _started(argv, tmp_path) as proc:
+        seen = _read_until(proc, b"simulation: ", HANG_S)
+        status, out, err = _terminate(proc, seen)
     _check_interrupted(status, out, err)
 
 
@@ -507,22 +515,32 @@ def test_sigterm_stops_a_process_pool_sweep_and_its_workers(tmp_path):
     (code / "slow_points.py").write_text(_SLOW_POINTS)
     markers, out, cache = tmp_path / "markers", tmp_path / "out", tmp_path / "cache"
     markers.mkdir()
-    proc = _start(["-c", _SWEEP_RUNNER, str(code), "figure", "fig99z", "--out", str(out)], tmp_path,
-                  env=_env(tmp_path, MARKERS=str(markers)))
-    deadline = time.monotonic() + HANG_S
-    while len(list(markers.iterdir())) < 2:  # both workers are inside a point
-        assert time.monotonic() < deadline and proc.poll() is None, proc.stderr.read()
-        time.sleep(0.1)
-    status, stdout, err = _terminate(proc, b"")
-    _check_interrupted(status, stdout, err, prog="passmd figure",
-                       kept=" (finished points are kept in the cache)")
-    workers = {int(p.name.split("-")[1]) for p in markers.iterdir()}
-    deadline = time.monotonic() + HANG_S
-    while any(_alive(pid) for pid in workers):
-        assert time.monotonic() < deadline, f"worker processes {workers} still run"
-        time.sleep(0.1)
+    argv = ["-c", _SWEEP_RUNNER, str(code), "figure", "fig99z", "--out", str(out)]
+    try:
+        with _started(argv, tmp_path, env=_env(tmp_path, MARKERS=str(markers))) as proc:
+            deadline = time.monotonic() + HANG_S
+            while len(list(markers.iterdir())) < 2:  # both workers are inside a point
+                assert time.monotonic() < deadline and proc.poll() is None, "the workers did not start"
+                time.sleep(0.1)
+            status, stdout, err = _terminate(proc, b"")
+        _check_interrupted(status, stdout, err, prog="passmd figure",
+                           kept=" (finished points are kept in the cache)")
+        deadline = time.monotonic() + HANG_S
+        while any(_alive(pid) for pid in _workers(markers)):
+            assert time.monotonic() < deadline, f"worker processes {_workers(markers)} still run"
+            time.sleep(0.1)
+    except BaseException:  # a failed check must not leave the workers sleeping
+        for pid in filter(_alive, _workers(markers)):
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
+        raise
     assert not out.exists()
     assert [p for p in cache.rglob("*") if p.is_file() and p.suffix in (".tmp", ".part")] == []
+
+
+def _workers(markers: Path) -> set[int]:
+    """The worker processes that started a point (their marker files name them)."""
+    return {int(p.name.split("-")[1]) for p in markers.iterdir()}
 
 
 def _alive(pid: int) -> bool:
