@@ -331,13 +331,16 @@ def _default_sigterm():  # runs in the child before exec: whatever the test runn
 
 @contextlib.contextmanager
 def _started(argv, tmp_path, env=None):
-    """``python argv`` running in ``tmp_path`` (binary pipes), killed if still running at the end."""
+    """``python argv`` running in ``tmp_path`` (binary pipes) in a process group of its own, which
+    is killed at the end: worker processes a failed check left behind would hold the pipes open."""
     proc = subprocess.Popen([sys.executable, *argv], cwd=tmp_path, env=env or _env(tmp_path),
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=_default_sigterm)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=_default_sigterm,
+                            start_new_session=True)
     try:
         yield proc
     finally:
-        proc.kill()
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
         proc.communicate()
 
 
@@ -503,38 +506,39 @@ _SLOW_POINTS = textwrap.dedent("""
     from pathlib import Path
 
     def point(x):
-        Path(os.environ["MARKERS"], f"{x}-{os.getpid()}").write_text("")
-        time.sleep(600)
+        if x > 2:  # points 1 and 2 finish at once, 3 and 4 announce themselves and sleep
+            Path(os.environ["MARKERS"], f"{x}-{os.getpid()}").write_text("")
+            time.sleep(600)
         return {"y": x}
 """)
 
 
 def test_sigterm_stops_a_process_pool_sweep_and_its_workers(tmp_path):
+    """SIGTERM while both workers are inside a point: one line, exit 143, the workers gone, the
+    two finished points in the cache and no temporary file in it, no figure written."""
+    from passmd.cache import Cache
+
     code = tmp_path / "code"
     code.mkdir()
     (code / "slow_points.py").write_text(_SLOW_POINTS)
     markers, out, cache = tmp_path / "markers", tmp_path / "out", tmp_path / "cache"
     markers.mkdir()
     argv = ["-c", _SWEEP_RUNNER, str(code), "figure", "fig99z", "--out", str(out)]
-    try:
-        with _started(argv, tmp_path, env=_env(tmp_path, MARKERS=str(markers))) as proc:
-            deadline = time.monotonic() + HANG_S
-            while len(list(markers.iterdir())) < 2:  # both workers are inside a point
-                assert time.monotonic() < deadline and proc.poll() is None, "the workers did not start"
-                time.sleep(0.1)
-            status, stdout, err = _terminate(proc, b"")
+    with _started(argv, tmp_path, env=_env(tmp_path, MARKERS=str(markers))) as proc:
+        deadline = time.monotonic() + HANG_S
+        # both workers inside a slow point, the fast ones cached
+        while len(list(markers.iterdir())) < 2 or len(Cache(cache).entries()) < 2:
+            assert time.monotonic() < deadline and proc.poll() is None, "the sweep did not get going"
+            time.sleep(0.1)
+        status, stdout, err = _terminate(proc, b"")
         _check_interrupted(status, stdout, err, prog="passmd figure",
                            kept=" (finished points are kept in the cache)")
         deadline = time.monotonic() + HANG_S
         while any(_alive(pid) for pid in _workers(markers)):
             assert time.monotonic() < deadline, f"worker processes {_workers(markers)} still run"
             time.sleep(0.1)
-    except BaseException:  # a failed check must not leave the workers sleeping
-        for pid in filter(_alive, _workers(markers)):
-            with contextlib.suppress(ProcessLookupError):
-                os.kill(pid, signal.SIGKILL)
-        raise
     assert not out.exists()
+    assert len(Cache(cache).entries()) == 2
     assert [p for p in cache.rglob("*") if p.is_file() and p.suffix in (".tmp", ".part")] == []
 
 

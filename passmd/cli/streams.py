@@ -218,12 +218,12 @@ def check_outputs(outputs: dict[str, object], inputs: dict[str, object] | None =
 
 
 def _through_descriptor_link(path) -> bool:
-    """Whether ``path`` is in /proc or its links pass through it (``/dev/stdout`` →
+    """Whether ``path`` is in /proc or /dev/fd or its links pass through them (``/dev/stdout`` →
     ``/proc/self/fd/1``): it names an open descriptor's file, to be written to, never replaced."""
     current = os.path.abspath(path)
     for _ in range(40):  # the kernel's limit of links followed (ELOOP)
         parent = os.path.realpath(os.path.dirname(current))
-        if parent == "/proc" or parent.startswith("/proc/"):
+        if parent in ("/proc", "/dev/fd") or parent.startswith("/proc/"):
             return True
         current = os.path.join(parent, os.path.basename(current))
         if not os.path.islink(current):
