@@ -29,6 +29,7 @@ scheme of earlier versions (:mod:`passmd.time_steps`).
 
 from __future__ import annotations
 
+import sys
 import time as _time
 from dataclasses import dataclass, field
 
@@ -51,12 +52,17 @@ from passmd.waveforms import Waveform
 
 #: Verlet is stable for ω dt < 2; a user step must keep this margin below it.
 STABILITY_MARGIN = 0.9
-#: Steps per kernel call: the kernel returns to Python between calls, so Ctrl-C
-#: (KeyboardInterrupt) is honoured within one call (≈ 0.02–0.1 s at 45–200 ns per step)
-#: and the progress bar advances. Results do not depend on it (the kernel resumes exactly).
+#: Work per kernel call, in steps of the exact contact (:data:`SPRINGS_PER_STEP` springs of a
+#: discrete contact count as one more): the kernel returns to Python between calls, so Ctrl-C
+#: and SIGTERM are honoured within one call (≈ 0.02–0.4 s) and the progress bar advances.
+#: Results do not depend on it (the kernel resumes exactly).
 CHUNK_STEPS = 500_000
-#: Runs expected to take more steps than this show a progress bar (stderr, terminal only).
-PROGRESS_MIN_STEPS = 5e7
+#: Springs of a discrete MDR contact that cost about as much per step as the rest of a step
+#: (measured: ≈ 5 ns per spring and step against ≈ 0.4 µs per step of the exact contact).
+SPRINGS_PER_STEP = 100
+#: Runs expected to take more work than this (steps of the exact contact, ≈ 1 s) may show their
+#: progress on stderr (:mod:`passmd._progress`: nothing for runs ending within 2 s).
+PROGRESS_MIN_WORK = 2e6
 
 
 class SimulationError(RuntimeError):
@@ -225,23 +231,24 @@ class SimulationResult:
         return pd.DataFrame(data)
 
 
-def _progress_bar(steps: float, waveform: Waveform, progress: bool | None):
-    """A tqdm bar over simulated periods on stderr, for long runs on a terminal only."""
-    if progress is None:
-        import multiprocessing
-        import sys
+def _progress_bar(work: float, waveform: Waveform, progress: bool | str | None):
+    """Progress over simulated periods on stderr (:func:`passmd._progress.bar`), or None.
 
-        progress = (
-            steps >= PROGRESS_MIN_STEPS
-            and sys.stderr is not None
-            and sys.stderr.isatty()
-            and multiprocessing.parent_process() is None
-        )
-    if not progress:
+    ``work``: the run's expected work in steps of the exact contact. None: runs of more than
+    :data:`PROGRESS_MIN_WORK` when stderr is a terminal; ``"long"``: those runs whatever stderr
+    is (off a terminal, a line every few seconds); True: every run at once; False: none.
+    """
+    from passmd import _progress
+
+    if progress is False or sys.stderr is None:
         return None
-    from tqdm import tqdm
-
-    return tqdm(total=waveform.periods, unit="period", leave=False, dynamic_ncols=True)
+    if progress is not True:
+        if work < PROGRESS_MIN_WORK or _progress.in_worker():
+            return None
+        if progress is None and not _progress.is_terminal(sys.stderr):
+            return None
+    return _progress.bar(waveform.periods, unit="period", desc="simulation", fractional=True,
+                         delay=0.0 if progress is True else None)
 
 
 def simulate(
@@ -299,12 +306,15 @@ def simulate(
         retried shorter, and every reversal of a contact's displacement committed at its
         interpolated extremum (see :mod:`passmd._dynamics_kernel`). ``False``: the explicit
         adaptive step (or, with ``quasi_static``, the quasi-static step at a fixed runner step).
-    progress : bool, optional
-        Show a progress bar on stderr; default: for runs of more than
-        :data:`PROGRESS_MIN_STEPS` expected steps when stderr is a terminal.
+    progress : bool or "long", optional
+        Progress on stderr (:mod:`passmd._progress`). Default: for runs of more than
+        :data:`PROGRESS_MIN_WORK` (expected steps, a discrete contact's springs counted,
+        :data:`SPRINGS_PER_STEP`) when stderr is a terminal, shown once the run has lasted
+        2 s; ``"long"``: the same whatever stderr is (off a terminal, a line every few
+        seconds: the command line); True: at once, for any run; False: never.
 
-    The kernel runs in chunks of :data:`CHUNK_STEPS` steps and returns to Python between
-    them, so a KeyboardInterrupt stops the run within one chunk; results are identical to
+    The kernel runs in chunks of :data:`CHUNK_STEPS` steps (fewer with many springs) and returns
+    to Python between them, so a KeyboardInterrupt stops the run within one chunk; results are identical to
     an uninterrupted run. This is a :class:`Simulation` run through all periods at once.
 
     Raises
@@ -368,6 +378,9 @@ class Simulation:
         check_range("resolution", resolution, 0.0, lower_open=True)
         if int(max_points) != max_points or max_points < 2:
             raise ValueError(f"max_points = {max_points!r} is out of range: must be an integer >= 2")
+        if not (progress is None or isinstance(progress, bool) or (isinstance(progress, str)
+                                                                  and progress == "long")):
+            raise ValueError(f"progress = {progress!r} is not allowed: must be True, False, None or 'long'")
 
         params, state, multiplicity = _contact_rows(drive, contact_model, springs, share_side_state)
         k_contacts = np.array([contact_stiffness(params[g]) for g in range(multiplicity.size)])
@@ -382,6 +395,8 @@ class Simulation:
         self._multiplicity, self._params, self._state = multiplicity, params, state
         self._progress = progress
         G = multiplicity.size
+        # work of one step in steps of the exact contact: every spring of a discrete contact counts
+        self._step_work = 1.0 + (G * springs / SPRINGS_PER_STEP if contact_model == "discrete" else 0.0)
         self._buffers = kern.Buffers(
             y=np.zeros(2 + 2 * G),
             work=np.zeros((kern.WORK_ROWS, G)),
@@ -462,7 +477,7 @@ class Simulation:
         start = _time.perf_counter()
         try:
             status, steps, n_rec, fine_steps = _integrate_in_chunks(
-                arguments, leading, expected, self._progress
+                arguments, leading, expected, self._step_work, self._progress
             )
         finally:
             self.wall_time += _time.perf_counter() - start
@@ -557,22 +572,25 @@ def _steps(drive: Drive, plan: StepPlan, dt: float | None, adaptive: bool, quasi
     return fine_step, coarse_step, quasi, quasi_step
 
 
-def _integrate_in_chunks(arguments: tuple, waveform: Waveform, expected: float, progress: bool | None):
-    """Run the kernel :data:`CHUNK_STEPS` steps at a time (Ctrl-C is honoured between chunks).
+def _integrate_in_chunks(arguments: tuple, waveform: Waveform, expected: float, step_work: float,
+                         progress: bool | str | None):
+    """Run the kernel in chunks of :data:`CHUNK_STEPS` work (Ctrl-C is honoured between chunks).
 
-    Returns the kernel's (status, steps, rows recorded, fine steps) of the last call.
+    ``expected`` steps of ``step_work`` each (:data:`SPRINGS_PER_STEP`). Returns the kernel's
+    (status, steps, rows recorded, fine steps) of the last call.
     """
     carry = arguments[-1].carry
-    bar = _progress_bar(expected, waveform, progress)
+    bar = _progress_bar(expected * step_work, waveform, progress)
+    chunk = max(1, int(CHUNK_STEPS / step_work))
     try:
-        limit = CHUNK_STEPS
+        limit = chunk
         while True:
             status, steps, n_rec, fine_steps = kern.integrate(*arguments, limit)
             if status != kern.STATUS_PAUSED:
                 return status, steps, n_rec, fine_steps
-            limit = steps + CHUNK_STEPS
+            limit = steps + chunk
             if bar is not None:
-                bar.update(min(int(carry[kern.C_TIME] / waveform.period), waveform.periods) - bar.n)
+                bar.update(min(carry[kern.C_TIME] / waveform.period, waveform.periods) - bar.n)
     finally:
         if bar is not None:
             bar.close()

@@ -12,10 +12,11 @@ order the points finish in. Execution is
 * or any :class:`concurrent.futures.Executor` the caller owns (not shut down here).
 
 Every finished point is written to the on-disk cache (:mod:`passmd.cache`) as soon as
-it completes, so an interrupted sweep (Ctrl-C, a failing point, a killed job) keeps
-every finished point and a rerun recomputes only the rest. A progress bar (points
-done, rate, ETA) is shown on a terminal and kept quiet when stderr is not a TTY or the
-run configuration says so (``RunConfig.progress``, off on CI).
+it completes, so an interrupted sweep (Ctrl-C, SIGTERM, a failing point, a killed job) keeps
+every finished point and a rerun recomputes only the rest. Progress (points done, ETA;
+:mod:`passmd._progress`) shows once a sweep has run 2 s: by default on a terminal only;
+``progress=True`` (the command line) also off a terminal, as a line every few seconds;
+off when the run configuration says so (``RunConfig.progress``, off on CI).
 
 How a sweep runs comes from its arguments or the :class:`~passmd.config.RunConfig` an entry
 point passes down; this module reads no environment variable. Without either: a process pool
@@ -37,8 +38,8 @@ import sys
 from collections.abc import Callable, Mapping, Sequence
 
 import pandas as pd
-from tqdm.std import tqdm  # text bar on a terminal; tqdm.auto warns in notebook kernels without ipywidgets
 
+from passmd import _progress
 from passmd._validation import check_choice
 from passmd.cache import Cache, function_name
 from passmd.config import EXECUTORS, RunConfig
@@ -64,12 +65,10 @@ def grid(**axes) -> list[dict]:
 
 
 def progress_enabled(progress: bool | None = None, stream=None) -> bool:
-    """Whether to show a progress bar: ``progress`` if given, else whether ``stream`` is a TTY."""
+    """Whether to show progress: ``progress`` if given, else whether ``stream`` is a TTY."""
     if progress is not None:
         return bool(progress)
-    stream = sys.stderr if stream is None else stream
-    isatty = getattr(stream, "isatty", None)
-    return bool(isatty and isatty())
+    return _progress.is_terminal(sys.stderr if stream is None else stream)
 
 
 def _call(func, point):
@@ -78,8 +77,11 @@ def _call(func, point):
 
 
 def _ignore_sigint():  # pragma: no cover - runs in pool workers
-    """Pool worker initializer: Ctrl-C is handled by the parent, which stops the workers."""
+    """Pool worker initializer: Ctrl-C is handled by the parent, which stops the workers; SIGTERM
+    (the parent's stop, or a stop of the whole process group) ends a worker at once, whatever
+    handler the parent had installed before the fork."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def _check_points(points) -> list[dict]:
@@ -103,6 +105,16 @@ def _make_cache(cache) -> Cache | None:
     if isinstance(cache, (str, os.PathLike)):
         return Cache(cache)
     raise ValueError(f"cache = {cache!r} is not allowed: must be True, False, a Cache or a directory")
+
+
+class _NoBar:
+    """The progress bar of a sweep that shows none (tqdm is not even imported)."""
+
+    def update(self, n: int = 1) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
 
 
 class _Collector:
@@ -291,7 +303,8 @@ def run(
         ``./.passmd-cache``; ``False``: no caching; a :class:`~passmd.cache.Cache` or a
         directory to use that one.
     progress : bool, optional
-        Force the progress bar on or off; default: the configuration's ``progress``, else
+        Progress on stderr once the sweep has run 2 s: True on any stderr (off a terminal a
+        line every few seconds), False never; default: the configuration's ``progress``, else
         on a TTY.
     description : str, optional
         Label of the progress bar (default the function's name).
@@ -311,8 +324,8 @@ def run(
     Raises
     ------
     KeyboardInterrupt
-        On Ctrl-C, after cancelling pending points and stopping the workers; every
-        point finished so far is in the cache.
+        On Ctrl-C (or a subclass a SIGTERM handler raises), after cancelling pending points
+        and stopping the workers; every point finished so far is in the cache.
     Exception
         The first exception a point raised (with a note naming the point), after the
         points still running finished and were cached.
@@ -331,15 +344,8 @@ def run(
     todo = [i for i in range(len(points)) if i not in cached]
 
     label = description or getattr(func, "__name__", "sweep")
-    bar = tqdm(
-        total=len(points),
-        initial=len(cached),
-        desc=label,
-        unit="point",
-        disable=not progress_enabled(progress),
-        file=sys.stderr,
-        dynamic_ncols=True,
-    )
+    shown = bool(todo) and progress_enabled(progress) and not _progress.in_worker()
+    bar = _progress.bar(len(points), initial=len(cached), desc=label, unit="point") if shown else _NoBar()
     collect = _Collector(func, points, keys, store, bar)
     try:
         if todo:

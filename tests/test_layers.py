@@ -48,6 +48,7 @@ CORE = frozenset(
         "passmd.provenance",
         "passmd.readings",
         "passmd.reference",
+        "passmd._progress",
     )
 )
 

@@ -18,8 +18,10 @@ N, mm and kHz; ``--json`` prints one JSON object in SI units whose keys carry th
 Exit status: 0 success, 2 usage error (unknown option, wrong unit, out-of-range value,
 contradicting options), 1 failed run (the simulation diverged, a result failed its
 finiteness/plausibility check, an output could not be written, an optional dependency
-is missing, not enough memory), 130 interrupted (Ctrl-C), 141 standard output closed
-(a pipe reader such as ``head`` went away; nothing is printed, as Unix tools do).
+is missing, not enough memory), 130 interrupted (Ctrl-C), 143 terminated (SIGTERM, handled
+as Ctrl-C: no partial or temporary file is left), 141 standard output closed (a pipe reader
+such as ``head`` went away, or the command was started with it closed; nothing is printed,
+as Unix tools do).
 Errors print one line to stderr, never a traceback. Parameter ranges come from
 :data:`passmd.parameters.PLAUSIBLE_RANGES`; ``--allow-extrapolation`` lifts their soft
 limits. On a console that cannot encode the output's symbols (μ, ×, –, →), ASCII

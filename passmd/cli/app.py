@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import gc
 import os
+import signal
 import sys
 import warnings
 
@@ -20,12 +21,36 @@ from passmd.cli.streams import (
     PipeClosed,
     StdoutError,
     one_line_warnings,
+    reserve_closed_streams,
     silence_stdout,
     use_ascii_fallback,
 )
 from passmd.units import QuantityError
 
-__all__ = ["main"]
+__all__ = ["Terminated", "main"]
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the command is: it stops as on Ctrl-C (temporary files removed,
+    a sweep's workers stopped, finished points kept), with exit status 143."""
+
+
+def _terminate(signum, frame):
+    raise Terminated()
+
+
+def _stop_on_sigterm():
+    """Handle SIGTERM as Ctrl-C while the command runs; the previous handler, to restore.
+
+    Only where SIGTERM has its default action (a caller's own handler or an ignored SIGTERM
+    stays) and in the main thread (where Python runs signal handlers).
+    """
+    try:
+        if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
+            return signal.signal(signal.SIGTERM, _terminate)
+    except ValueError:  # not the main thread
+        pass
+    return None
 
 
 def _cannot_write(err: OSError) -> int:
@@ -58,20 +83,29 @@ def _parse(parser, argv, to_stdout: bool):
 def main(argv=None, out=None) -> int:
     """Run the command line; return the exit status (0 ok, 2 usage error, 1 failed run).
 
-    130 on Ctrl-C, 141 when standard output was closed by its reader (nothing printed).
+    130 on Ctrl-C, 143 on SIGTERM, which is handled as Ctrl-C (one line "interrupted", no
+    temporary or partial output file left, a sweep's worker processes stopped). 141 when
+    standard output was closed by its reader, and also when the command was started with it
+    closed (``>&-``): nothing is printed in either case, as for a pipe whose reader went away.
     Automatic garbage collection is paused while the command starts, and skipped at the
     interpreter's exit (:mod:`passmd.cli.startup`).
     """
     startup.skip_exit_collection()
     startup.pause()
+    previous = _stop_on_sigterm()
     try:
         return _main(argv, out)
+    except KeyboardInterrupt as exc:  # before the command started (parsing)
+        return _interrupted(PROG, exc, "")
     finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
         startup.resume()
 
 
 def _main(argv, out) -> int:
     to_stdout = out is None
+    reserve_closed_streams()
     for stream in (sys.stdout, sys.stderr):
         use_ascii_fallback(stream)
     out = Out(sys.stdout if out is None else out)
@@ -86,6 +120,13 @@ def _main(argv, out) -> int:
         warnings.simplefilter("ignore", RuntimeWarning)
         with np.errstate(all="ignore"):
             return _dispatch(args, out, prog, to_stdout)
+
+
+def _interrupted(prog: str, exc: KeyboardInterrupt, kept: str) -> int:
+    sys.stderr.write(f"{prog}: interrupted{kept}\n")
+    # exit at once: the interpreter's exit-time collection of numba's object graph takes ≈ 1 s
+    gc.freeze()
+    return 143 if isinstance(exc, Terminated) else 130
 
 
 def _error(prog: str, text: str, status: int) -> int:
@@ -112,12 +153,9 @@ def _dispatch(args, out: Out, prog: str, to_stdout: bool) -> int:  # noqa: C901 
         return _error(prog, explain(exc, args), 2)
     except OutputError as exc:
         return _error(prog, str(exc), 1)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (Terminated)
         kept = " (finished points are kept in the cache)" if args.command == "figure" else ""
-        sys.stderr.write(f"{prog}: interrupted{kept}\n")
-        # exit at once: the interpreter's exit-time collection of numba's object graph takes ≈ 1 s
-        gc.freeze()
-        return 130
+        return _interrupted(prog, exc, kept)
     except ValueError as exc:  # the package's input checks (passmd._validation), in the options' terms
         return _error(prog, explain(exc, args), 2)
     except (ResultError, MissingDependencyError) as exc:

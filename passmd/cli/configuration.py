@@ -1,7 +1,8 @@
 """The run configuration of the commands that run figure sweeps (``figure``, ``ledger``).
 
 The environment is read once, here at the edge (:meth:`passmd.config.RunConfig.from_environment`),
-and the command's options replace what it says; the resulting :class:`~passmd.config.RunConfig`
+and the command's options replace what it says (a sweep's progress shows on any stderr unless
+``$CI`` is set); the resulting :class:`~passmd.config.RunConfig`
 is passed down to the figure table, the ledger and the cache. Nothing is written to the
 environment.
 """
@@ -11,6 +12,7 @@ from __future__ import annotations
 import importlib.util
 import os
 import stat
+from dataclasses import replace
 
 from passmd.cli.errors import MissingDependencyError, UsageError
 from passmd.config import RunConfig
@@ -69,4 +71,6 @@ def run_config(args) -> RunConfig:
                                         cache_dir=args.cache_dir)
     _require_executor(config)
     _check_sweep_log(config)
+    if config.progress is None:  # a command shows a long sweep's progress off a terminal too ($CI: never)
+        config = replace(config, progress=True)
     return config

@@ -8,6 +8,7 @@ never retyped.
 
 from __future__ import annotations
 
+import argparse
 from dataclasses import dataclass
 
 from passmd._validation import check_range
@@ -20,8 +21,8 @@ from passmd.units import parse_quantity, si_factor, to_display
 
 __all__ = ["ACTUATOR_DYNAMICS", "AMPLITUDE", "CACHE_DIR_HELP", "DEFAULT_DRIVE", "DRIVE_QUANTITIES",
            "FREQUENCY", "MATERIAL_FLAGS", "NORMAL_FORCE", "OPTION_FOR", "QUANTITIES", "THRESHOLD",
-           "TOLERANCE", "Quantity", "add_drive_options", "add_output_options", "add_simulation_options",
-           "add_sweep_options"]
+           "TOLERANCE", "DirectoryPath", "FilePath", "Quantity", "add_drive_options", "add_output_options",
+           "add_simulation_options", "add_sweep_options"]
 
 #: The drive every option replaces a part of (Tables 1–2 at R = 1 mm, F_p = 0.4 N, μ = 0.2).
 DEFAULT_DRIVE = Drive()
@@ -162,6 +163,25 @@ OPTION_FOR: dict[str, str] = {
     "max_points": "--max-points",
 }
 
+
+class FilePath(argparse.Action):
+    """A path option (``action=FilePath``): an empty or blank name is refused while parsing,
+    before anything runs, naming the option as typed (``--csv = '' is not a file name``)."""
+
+    kind = "file"
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        if not values.strip():
+            parser.error(f"{option_string or self.dest} = {values!r} is not a {self.kind} name")
+        setattr(namespace, self.dest, values)
+
+
+class DirectoryPath(FilePath):
+    """A directory option: as :class:`FilePath` (``--out = '' is not a directory name``)."""
+
+    kind = "directory"
+
+
 CACHE_DIR_HELP = f"cache directory (default: ${ENVIRONMENT['cache_dir']} or ./{DEFAULT_CACHE_DIR})"
 
 
@@ -204,9 +224,9 @@ def add_output_options(parser) -> None:
     """--json, and the time series' --csv, --plot and --max-points."""
     group = parser.add_argument_group("output")
     group.add_argument("--json", action="store_true", help=JSON_HELP)
-    group.add_argument("--csv", metavar="FILE",
+    group.add_argument("--csv", metavar="FILE", action=FilePath,
                        help="write the time series to FILE (CSV, SI units) (default: none)")
-    group.add_argument("--plot", metavar="FILE",
+    group.add_argument("--plot", metavar="FILE", action=FilePath,
                        help="plot piezo and runner position to FILE (PNG) (default: none)")
     group.add_argument("--max-points", type=int, default=20000, metavar="N",
                        help="samples of the recorded time series (default: 20000)")
@@ -222,4 +242,4 @@ def add_sweep_options(parser) -> None:
                        help="Dask scheduler, e.g. tcp://10.0.0.5:8786 (default: none)")
     group.add_argument("--workers", type=int, default=None, metavar="N",
                        help="worker processes for process/local Dask (default: all cores)")
-    group.add_argument("--cache-dir", metavar="DIR", help=CACHE_DIR_HELP)
+    group.add_argument("--cache-dir", metavar="DIR", action=DirectoryPath, help=CACHE_DIR_HELP)

@@ -7,7 +7,7 @@ import textwrap
 
 from passmd.cache import DEFAULT_CACHE_DIR, MARKER_NAME
 from passmd.cli.errors import UsageError
-from passmd.cli.options import CACHE_DIR_HELP
+from passmd.cli.options import CACHE_DIR_HELP, DirectoryPath
 from passmd.cli.output import JSON_HELP, emit_json, emit_rows
 from passmd.config import ENVIRONMENT, RunConfig
 
@@ -37,7 +37,7 @@ _EPILOG = textwrap.dedent(f"""\
 def add_parser(command) -> None:
     p = command("cache", "the on-disk simulation cache: summary, empty it, or prune old entries", _EPILOG)
     p.add_argument("action", choices=("info", "clear", "prune"), help="what to do (default: none, required)")
-    p.add_argument("--cache-dir", metavar="DIR", help=CACHE_DIR_HELP)
+    p.add_argument("--cache-dir", metavar="DIR", action=DirectoryPath, help=CACHE_DIR_HELP)
     p.add_argument("--json", action="store_true", help=JSON_HELP)
     p.set_defaults(handler=run_cache)
 

@@ -11,9 +11,9 @@ from passmd._result_bounds import check_table
 from passmd.cache import DEFAULT_CACHE_DIR
 from passmd.cli.configuration import run_config
 from passmd.cli.errors import NotAvailableError, OutputError, UsageError
-from passmd.cli.options import add_sweep_options
+from passmd.cli.options import DirectoryPath, add_sweep_options
 from passmd.cli.output import JSON_HELP, emit_json
-from passmd.cli.streams import write_atomically
+from passmd.cli.streams import PipeClosed, check_outputs, write_atomically
 from passmd.config import ENVIRONMENT, PROFILES
 
 __all__ = ["NOT_AVAILABLE", "add_parser", "run_figure"]
@@ -37,7 +37,7 @@ def add_parser(command) -> None:
                    help="figure panel, e.g. fig5a, or 'list' (default: none, required)")
     p.add_argument("--profile", choices=PROFILES, default="paper",
                    help="resolution: quick (CI) or paper (the paper's grids) (default: paper)")
-    p.add_argument("--out", metavar="DIR", default=".",
+    p.add_argument("--out", metavar="DIR", default=".", action=DirectoryPath,
                    help="directory for NAME.csv and NAME.png (default: .)")
     add_sweep_options(p)
     p.add_argument("--json", action="store_true", help=JSON_HELP)
@@ -64,12 +64,15 @@ def _check_name(args, names) -> None:
         raise NotAvailableError(f"figure {args.name!r} is {NOT_AVAILABLE} (available: {known})")
 
 
-def _check_out(args) -> None:
-    if not args.out.strip():
-        raise UsageError(f"--out = {args.out!r} is not a directory name "
-                         "(use --out . for the working directory)")
+def _check_out(args, config) -> None:
+    """--out: a directory (or one to create); NAME.csv and NAME.png neither the sweep log nor
+    the file standard output goes to (blank names are refused by the parser)."""
     if Path(args.out).exists() and not Path(args.out).is_dir():
         raise OutputError(f"cannot write to --out {args.out}: it is not a directory")
+    target = Path(args.out)
+    check_outputs({f"{target / name} (--out {args.out})": target / name
+                   for name in (f"{args.name}.csv", f"{args.name}.png")}
+                  | {f"{ENVIRONMENT['sweep_log']} {config.sweep_log}": config.sweep_log})
 
 
 def _write(figures, provenance, args, data) -> tuple[Path, Path]:
@@ -88,6 +91,8 @@ def _write(figures, provenance, args, data) -> tuple[Path, Path]:
         fig = figures.figure_plot(args.name, data)
         write_atomically(png_path, lambda tmp: fig.savefig(
             tmp, dpi=150, format="png", metadata={"Description": provenance.summary(args.profile)}))
+    except BrokenPipeError as exc:  # (--out /dev/fd: a reader that went away)
+        raise PipeClosed() from exc
     except OSError as exc:
         raise OutputError(f"cannot write to --out {args.out}: {exc.strerror or exc}") from exc
     pyplot = sys.modules.get("matplotlib.pyplot")
@@ -104,7 +109,7 @@ def run_figure(args, out) -> int:
         return _list(figures, names, args, out)
     _check_name(args, names)
     config = run_config(args)
-    _check_out(args)
+    _check_out(args, config)
     data = figures.figure_data(args.name, config)
     check_table(args.name, data)  # finite before anything is written, as run and theory check theirs
     csv_path, png_path = _write(figures, provenance, args, data)

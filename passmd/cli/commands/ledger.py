@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import textwrap
+from pathlib import Path
 
 from passmd._result_bounds import check_table
 from passmd.cache import DEFAULT_CACHE_DIR
 from passmd.cli.configuration import run_config
-from passmd.cli.errors import OutputError
-from passmd.cli.options import add_sweep_options
+from passmd.cli.errors import OutputError, UsageError
+from passmd.cli.options import FilePath, add_sweep_options
 from passmd.cli.output import JSON_HELP, emit_json
+from passmd.cli.streams import PipeClosed, check_outputs, write_atomically
 from passmd.config import ENVIRONMENT, PROFILES
 
 __all__ = ["add_parser", "run_ledger"]
@@ -29,18 +31,40 @@ def add_parser(command) -> None:
     p = command("ledger", "the replication ledger: every claim's computed category and evidence", _EPILOG)
     p.add_argument("--profile", choices=PROFILES, default="quick",
                    help="resolution: quick (CI) or paper (the paper's grids) (default: quick)")
-    p.add_argument("--write-baseline", metavar="CSV", default=None,
+    p.add_argument("--write-baseline", metavar="CSV", default=None, action=FilePath,
                    help="also write the categories as a baseline CSV (default: none)")
     add_sweep_options(p)
     p.add_argument("--json", action="store_true", help=JSON_HELP)
     p.set_defaults(handler=run_ledger)
 
 
+def _check_baseline(args, config) -> None:
+    """--write-baseline, before the ledger is computed: a file in an existing directory, not the
+    claims table the ledger reads, the sweep log or the file standard output goes to."""
+    from passmd.claims import CLAIMS_PATH
+
+    name = args.write_baseline
+    if name is None:
+        return
+    target = Path(name)
+    if target.is_dir():
+        raise UsageError(f"--write-baseline = {name!r} is a directory: give a file name")
+    parent = target.parent if str(target.parent) else Path(".")
+    if not parent.is_dir():
+        raise OutputError(f"cannot write --write-baseline {name}: directory {str(parent)!r} does not exist")
+    check_outputs({f"--write-baseline {name}": name,
+                   f"{ENVIRONMENT['sweep_log']} {config.sweep_log}": config.sweep_log},
+                  inputs={f"the claims table {CLAIMS_PATH}": CLAIMS_PATH})
+
+
 def _write_baseline(ledger, evaluated, args) -> None:
     header = (f"ledger categories, {args.profile} profile; produced by\n"
               f"passmd ledger --profile {args.profile} --write-baseline {args.write_baseline}")
     try:
-        ledger.write_baseline(evaluated, args.write_baseline, header=header)
+        write_atomically(args.write_baseline,
+                         lambda tmp: ledger.write_baseline(evaluated, tmp, header=header))
+    except BrokenPipeError as exc:
+        raise PipeClosed() from exc
     except OSError as exc:
         raise OutputError(f"cannot write --write-baseline {args.write_baseline}: "
                           f"{exc.strerror or exc}") from exc
@@ -48,10 +72,12 @@ def _write_baseline(ledger, evaluated, args) -> None:
 
 def run_ledger(args, out) -> int:
     """Every claim of the paper with its computed category, values and evidence (Sections 4–6)."""
+    config = run_config(args)
+    _check_baseline(args, config)  # (before the ledger's modules load)
     from passmd import ledger, ledger_views
     from passmd.claims import STATUSES
 
-    results = ledger.collect_results(run_config(args))
+    results = ledger.collect_results(config)
     for name, table in results.items():  # finite before anything is written, as run and theory check
         check_table(name, table)
     evaluated = ledger.evaluate(results=results)

@@ -17,7 +17,7 @@ from passmd.cli.options import (
     add_simulation_options,
 )
 from passmd.cli.output import check_results, describe, drive_record, emit_json, emit_rows, fmt, nm
-from passmd.cli.streams import available_memory, write_atomically
+from passmd.cli.streams import PipeClosed, available_memory, check_outputs, write_atomically
 from passmd.defaults import PROTOCOL
 from passmd.units import from_si
 
@@ -83,12 +83,12 @@ def check_memory(args, periods_flag: str = "--periods") -> None:
 
 
 def check_output_paths(args) -> None:
-    """--csv/--plot: a file name in an existing directory, a known image format (before running)."""
+    """--csv/--plot: a file name in an existing directory, a known image format, two different
+    files neither of which is where standard output goes (before running; blank names are
+    refused by the parser)."""
     for flag, name in (("--csv", args.csv), ("--plot", args.plot)):
         if name is None:
             continue
-        if not name.strip():
-            raise UsageError(f"{flag} = {name!r} is not a file name")
         target = Path(name)
         if target.is_dir():
             raise UsageError(f"{flag} = {name!r} is a directory: give a file name")
@@ -100,6 +100,7 @@ def check_output_paths(args) -> None:
         if suffix not in _PLOT_FORMATS:
             raise UsageError(f"--plot = {args.plot!r} has {'no' if not suffix else 'an unknown'} image "
                              f"extension: must end in one of {', '.join('.' + f for f in _PLOT_FORMATS)}")
+    check_outputs({f"--csv {args.csv}": args.csv, f"--plot {args.plot}": args.plot})
 
 
 def simulate(args, drive):
@@ -121,15 +122,19 @@ def simulate(args, drive):
     return dynamics.simulate(
         drive, wave, contact_model="exact" if springs is None else "discrete",
         springs=PROTOCOL.springs if springs is None else springs, max_points=args.max_points,
+        progress="long",  # a long run's progress on stderr, also when it is not a terminal
     )
 
 
 def write_outputs(args, result) -> None:
-    """The time series to --csv and the positions' plot to --plot, each written atomically."""
+    """The time series to --csv and the positions' plot to --plot, each written atomically (a
+    device or pipe such as /dev/stdout is written to; a reader that went away is a closed pipe)."""
     if args.csv:
         try:
             frame = result.to_frame()
             write_atomically(args.csv, lambda tmp: frame.to_csv(tmp, index=False))
+        except BrokenPipeError as exc:
+            raise PipeClosed() from exc
         except OSError as exc:
             raise OutputError(f"cannot write --csv {args.csv}: {exc.strerror or exc}") from exc
     if args.plot:
@@ -147,6 +152,8 @@ def write_outputs(args, result) -> None:
         try:
             fmt_ = Path(args.plot).suffix.lstrip(".").lower()
             write_atomically(args.plot, lambda tmp: fig.savefig(tmp, dpi=150, format=fmt_))
+        except BrokenPipeError as exc:
+            raise PipeClosed() from exc
         except OSError as exc:
             raise OutputError(f"cannot write --plot {args.plot}: {exc.strerror or exc}") from exc
 
