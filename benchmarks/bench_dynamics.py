@@ -190,7 +190,7 @@ def across_processes(processes: int, repeats: int) -> dict:
 
 
 def markdown(rows: list) -> str:
-    """The rows as the README's Markdown table."""
+    """The rows as a Markdown table."""
     lines = ["| contacts | actuators | step control | contact model | steps per period (fine; rejected) "
              "| ns per step | ms per 100 Hz period | error vs fixed fine step (nm) |",
              "|---|---|---|---|---|---|---|---|"]

@@ -1,8 +1,8 @@
 """passmd: reproducible replication of Nguyen et al. (2018), Coatings 8, 62.
 
 "Improvements of Piezo-Actuated Stick–Slip Micro-Drives: Modeling and Driving
-Waveform". Its modules follow the paper's structure, in layers from the model up (README,
-"Architecture"):
+Waveform". Its modules follow the paper's structure, in layers from the model up (the
+``layers`` contract of ``pyproject.toml``, checked by import-linter):
 
 core
     ``parameters`` (Tables 1–2, drive records), ``defaults`` (protocol defaults), ``config``

@@ -437,7 +437,7 @@ def test_readme_counts_what_this_file_tries():
     """The README's reliability section states how many named cases and generated examples run."""
     text = README.read_text()
     section = text[text.index("## Reliability"):]
-    assert f"* {len(NAMED_CASES)} named command lines" in section
+    assert f"{len(NAMED_CASES)} named command lines" in section
     assert f"{os.environ.get('PASSMD_FUZZ_EXAMPLES', '250')} command lines per run over six" in section
     assert len({argv[0] for argv, _, _ in NAMED_CASES.values()}) >= 5
     assert len(COMMANDS) == 6

@@ -9,7 +9,7 @@ bottom. Each import runs in a fresh interpreter, so nothing another test importe
 Imports inside functions count too: the sources are read for every import statement.
 
 The command line builds on the same rule: its parser and every command module load only
-what a command needs when it runs (README, "Architecture"), so ``passmd run`` reaches its
+what a command needs when it runs (CONTRIBUTING, "Architecture"), so ``passmd run`` reaches its
 first integrator step without pandas, matplotlib, pint, Dask or tqdm (the progress bar
 only on a terminal), and ``passmd --help`` without the simulator.
 """

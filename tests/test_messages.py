@@ -1,7 +1,7 @@
 """Every refusal names what the user typed: the option, variable or parameter, its value, the limit.
 
-Contract (README, "Reliability"; standards: "Bad input gets ONE line naming the option …
-AS THE USER TYPED IT, its value and the allowed range"): a value refused deep in the
+Contract (README, "Reliability": one line naming the option or environment variable as
+typed, its value and the allowed range): a value refused deep in the
 package (a record, a waveform, the Eq. 15 design) reaches the user as the command-line
 option that set it, with the value as typed and the limit in the option's unit; a
 quantity computed from an option (the damping ratio from --actuator-viscosity, the

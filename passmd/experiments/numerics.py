@@ -579,7 +579,7 @@ def coulomb_rising_gaps(coulomb: pd.DataFrame) -> list[str]:
     return rising
 
 
-#: Speed targets of the integrator (README, "Performance"): ms per 100 Hz period of the
+#: Speed targets of the integrator: ms per 100 Hz period of the
 #: six-contact flexible drive with the default (error-controlled) step and the exact contact,
 #: which a sweep of the assumption space needs, and ns per fixed step (exact contact).
 TARGET_MS_PER_PERIOD, TARGET_NS_PER_STEP = 1.0, 25.0
