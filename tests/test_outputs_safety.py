@@ -354,8 +354,9 @@ def _terminate(proc, before: bytes, to_group: bool = False) -> tuple[int, str, s
     return proc.returncode, out.decode(), (before + rest).decode()
 
 
-#: A progress line off a terminal (passmd._progress), e.g. "simulation: 4.2% (4.2/100 periods) ...".
-PROGRESS_LINE = re.compile(r"^\w+: \d+\.\d% \([\d.]+/\d+ (periods|points)\) after [\d:]+, about \S+ left$")
+#: A progress line off a terminal (passmd._progress), e.g. "simulation: 4.2% (4.20/100 periods) ...".
+PROGRESS_LINE = re.compile(r"^\w+: \d+\.\d% \([\d.]+/\d+ (periods|points)\) after [\d:]+, "
+                           r"(about [\d:]+ left|time left known after the first (period|point))$")
 
 
 def _check_interrupted(status, out, err, prog="passmd run", kept=""):
@@ -468,7 +469,10 @@ def test_sweep_progress_lines_off_a_terminal(monkeypatch, capsys):
     captured = capsys.readouterr()
     lines = captured.err.splitlines()
     assert "slow_point: 50.0% (2/4 points)" in captured.err and "\r" not in captured.err
-    assert all(line.startswith("slow_point: ") for line in lines) and captured.out == ""
+    assert all(PROGRESS_LINE.match(line) and line.startswith("slow_point: ") for line in lines), lines
+    # the time left once a point is done (the average rate says nothing before)
+    assert lines[0].endswith("time left known after the first point") and lines[-1].endswith(" left")
+    assert "about" in lines[-1] and captured.out == ""
 
 
 def test_figure_and_ledger_ask_for_sweep_progress_unless_in_ci(monkeypatch):
