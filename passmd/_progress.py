@@ -3,10 +3,10 @@
 :func:`bar` is a :class:`tqdm.std.tqdm` that shows nothing for work ending within
 :data:`DELAY` seconds. On a terminal it redraws in place; anywhere else (a log file, a pipe,
 a CI console) it writes one whole line at most every :data:`LINE_INTERVAL` seconds: the
-fraction done, the elapsed time and the estimated time left. A closed standard error
-(``2>&-``) gets a disabled bar. Worker processes of a parallel sweep show nothing
-(:func:`in_worker`): their parent shows the sweep's progress. tqdm is imported only when a
-bar is made, so short runs never load it.
+fraction done, the elapsed time and, once a whole unit is done, the estimated time left.
+A closed standard error (``2>&-``) gets a disabled bar. Worker processes of a parallel sweep
+show nothing (:func:`in_worker`): their parent shows the sweep's progress. tqdm is imported
+only when a bar is made, so short runs never load it.
 """
 
 from __future__ import annotations
@@ -64,14 +64,28 @@ def bar(total: float, *, unit: str, desc: str, initial: float = 0, fractional: b
 
     stream = sys.stderr if stream is None else stream
     delay = DELAY if delay is None else delay
-    count = "{n:.1f}/{total:g}" if fractional else "{n_fmt}/{total_fmt}"
+    decimals = 2 if total < 10 else 1 if total < 1000 else 0
+    count = f"{{n:.{decimals}f}}/{{total:g}}" if fractional else "{n_fmt}/{total_fmt}"
     common = dict(total=total, initial=initial, unit=unit, desc=desc, leave=False, delay=delay,
                   disable=stream is None)
     if stream is None or is_terminal(stream):
         return tqdm(**common, file=stream, dynamic_ncols=True,
                     bar_format="{l_bar}{bar}| " + count + " {unit}s [{elapsed}<{remaining}]")
-    # miniters=0: every update may print, at most one line per LINE_INTERVAL; smoothing=0: the
-    # time left from the average rate so far (a log line stands for the whole interval)
-    return tqdm(**common, file=_Lines(stream), mininterval=LINE_INTERVAL, miniters=0, smoothing=0,
-                bar_format="{desc}: {percentage:.1f}% (" + count + " {unit}s) after {elapsed}, "
-                           "about {remaining} left")
+
+    class Lines(tqdm):
+        """Time left from the average rate once a whole unit is done: within one simulated period
+        the steps crowd where the waveform turns, so its first fraction says little."""
+
+        @property
+        def format_dict(self):
+            values = super().format_dict
+            n, total, done = values["n"], values["total"], values["n"] - values["initial"]
+            if done >= 1 and total:
+                values["left"] = f"about {self.format_interval(values['elapsed'] * (total - n) / done)} left"
+            else:
+                values["left"] = f"time left known after the first {unit}"
+            return values
+
+    # miniters=0: every update may print, at most one line per LINE_INTERVAL
+    return Lines(**common, file=_Lines(stream), mininterval=LINE_INTERVAL, miniters=0,
+                 bar_format="{desc}: {percentage:.1f}% (" + count + " {unit}s) after {elapsed}, {left}")

@@ -344,15 +344,19 @@ def _started(argv, tmp_path, env=None):
         proc.communicate()
 
 
-def _terminate(proc, before: bytes) -> tuple[int, str, str]:
-    """SIGTERM to ``proc``; (status, stdout, all of stderr)."""
-    proc.send_signal(signal.SIGTERM)
+def _terminate(proc, before: bytes, to_group: bool = False) -> tuple[int, str, str]:
+    """SIGTERM to ``proc`` (or its process group); (status, stdout, all of stderr)."""
+    if to_group:
+        os.killpg(proc.pid, signal.SIGTERM)
+    else:
+        proc.send_signal(signal.SIGTERM)
     out, rest = proc.communicate(timeout=HANG_S)
     return proc.returncode, out.decode(), (before + rest).decode()
 
 
-#: A progress line off a terminal (passmd._progress), e.g. "simulation: 4.2% (4.2/100 periods) ...".
-PROGRESS_LINE = re.compile(r"^\w+: \d+\.\d% \([\d.]+/\d+ (periods|points)\) after [\d:]+, about \S+ left$")
+#: A progress line off a terminal (passmd._progress), e.g. "simulation: 4.2% (4.20/100 periods) ...".
+PROGRESS_LINE = re.compile(r"^\w+: \d+\.\d% \([\d.]+/\d+ (periods|points)\) after [\d:]+, "
+                           r"(about [\d:]+ left|time left known after the first (period|point))$")
 
 
 def _check_interrupted(status, out, err, prog="passmd run", kept=""):
@@ -465,7 +469,10 @@ def test_sweep_progress_lines_off_a_terminal(monkeypatch, capsys):
     captured = capsys.readouterr()
     lines = captured.err.splitlines()
     assert "slow_point: 50.0% (2/4 points)" in captured.err and "\r" not in captured.err
-    assert all(line.startswith("slow_point: ") for line in lines) and captured.out == ""
+    assert all(PROGRESS_LINE.match(line) and line.startswith("slow_point: ") for line in lines), lines
+    # the time left once a point is done (the average rate says nothing before)
+    assert lines[0].endswith("time left known after the first point") and lines[-1].endswith(" left")
+    assert "about" in lines[-1] and captured.out == ""
 
 
 def test_figure_and_ledger_ask_for_sweep_progress_unless_in_ci(monkeypatch):
@@ -491,8 +498,8 @@ _SWEEP_RUNNER = textwrap.dedent("""
     from passmd import figures, sweep
     from passmd.cli import main
 
-    def figure_data(name, config):
-        return sweep.run(slow_points.point, sweep.grid(x=[1, 2, 3, 4]), executor="process", workers=2,
+    def figure_data(name, config):  # three workers: one is idle once the fast points are done
+        return sweep.run(slow_points.point, sweep.grid(x=[1, 2, 3, 4]), executor="process", workers=3,
                          config=config)
 
     figures.figure_names = lambda: ["fig99z"]
@@ -513,9 +520,12 @@ _SLOW_POINTS = textwrap.dedent("""
 """)
 
 
-def test_sigterm_stops_a_process_pool_sweep_and_its_workers(tmp_path):
-    """SIGTERM while both workers are inside a point: one line, exit 143, the workers gone, the
-    two finished points in the cache and no temporary file in it, no figure written."""
+@pytest.mark.parametrize("to_group", [False, True], ids=["to the command", "to its process group"])
+def test_sigterm_stops_a_process_pool_sweep_and_its_workers(tmp_path, to_group):
+    """SIGTERM while two workers are inside a point and one is idle, sent to the command (``kill
+    PID``) or to its whole process group (as a service manager or a closed terminal does): one
+    line, exit 143, the workers gone without a word, the two finished points in the cache and no
+    temporary file in it, no figure written."""
     from passmd.cache import Cache
 
     code = tmp_path / "code"
@@ -530,7 +540,7 @@ def test_sigterm_stops_a_process_pool_sweep_and_its_workers(tmp_path):
         while len(list(markers.iterdir())) < 2 or len(Cache(cache).entries()) < 2:
             assert time.monotonic() < deadline and proc.poll() is None, "the sweep did not get going"
             time.sleep(0.1)
-        status, stdout, err = _terminate(proc, b"")
+        status, stdout, err = _terminate(proc, b"", to_group=to_group)
         _check_interrupted(status, stdout, err, prog="passmd figure",
                            kept=" (finished points are kept in the cache)")
         deadline = time.monotonic() + HANG_S
@@ -540,6 +550,20 @@ def test_sigterm_stops_a_process_pool_sweep_and_its_workers(tmp_path):
     assert not out.exists()
     assert len(Cache(cache).entries()) == 2
     assert [p for p in cache.rglob("*") if p.is_file() and p.suffix in (".tmp", ".part")] == []
+
+
+def test_pool_workers_end_on_sigterm_whatever_the_parent_handles(monkeypatch):
+    """A worker forked while the command handles SIGTERM must not inherit the handler: it ends
+    at once on SIGTERM (and leaves Ctrl-C to its parent)."""
+    previous = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        signal.signal(signal.SIGTERM, lambda signum, frame: None)
+        sweep._ignore_sigint()  # the pool's worker initializer
+        assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
 
 
 def _workers(markers: Path) -> set[int]:
