@@ -9,17 +9,29 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 
 from passmd._result_bounds import ResultError
+from passmd.cli.errors import OutputError, UsageError
 from passmd.parameters import Drive
 from passmd.units import from_si
 
-__all__ = ["JSON_HELP", "check_results", "describe", "drive_record", "emit_json", "emit_rows", "fmt", "nm",
-           "plain", "sides"]
+__all__ = ["JSON_HELP", "check_output_file", "check_results", "describe", "drive_record", "emit_json",
+           "emit_rows", "fmt", "nm", "plain", "sides"]
 
 JSON_HELP = "print one JSON object (SI units) instead (default: off)"
+
+
+def check_output_file(flag: str, name: str) -> None:
+    """An output option names a file (not a directory) in an existing directory (before running)."""
+    target = Path(name)
+    if target.is_dir():
+        raise UsageError(f"{flag} = {name!r} is a directory: give a file name")
+    parent = target.parent if str(target.parent) else Path(".")
+    if not parent.is_dir():
+        raise OutputError(f"cannot write {flag} {name}: directory {str(parent)!r} does not exist")
 
 
 def fmt(value_si: float, unit: str) -> str:

@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import textwrap
-from pathlib import Path
 
 from passmd._result_bounds import check_table
 from passmd.cache import DEFAULT_CACHE_DIR
 from passmd.cli.configuration import run_config
-from passmd.cli.errors import OutputError, UsageError
+from passmd.cli.errors import OutputError
 from passmd.cli.options import FilePath, add_sweep_options
-from passmd.cli.output import JSON_HELP, emit_json
+from passmd.cli.output import JSON_HELP, check_output_file, emit_json
 from passmd.cli.streams import PipeClosed, check_outputs, write_atomically
 from passmd.config import ENVIRONMENT, PROFILES
 
@@ -46,12 +45,7 @@ def _check_baseline(args, config) -> None:
     name = args.write_baseline
     if name is None:
         return
-    target = Path(name)
-    if target.is_dir():
-        raise UsageError(f"--write-baseline = {name!r} is a directory: give a file name")
-    parent = target.parent if str(target.parent) else Path(".")
-    if not parent.is_dir():
-        raise OutputError(f"cannot write --write-baseline {name}: directory {str(parent)!r} does not exist")
+    check_output_file("--write-baseline", name)
     check_outputs({f"--write-baseline {name}": name,
                    f"{ENVIRONMENT['sweep_log']} {config.sweep_log}": config.sweep_log},
                   inputs={f"the claims table {CLAIMS_PATH}": CLAIMS_PATH})

@@ -16,7 +16,16 @@ from passmd.cli.options import (
     add_output_options,
     add_simulation_options,
 )
-from passmd.cli.output import check_results, describe, drive_record, emit_json, emit_rows, fmt, nm
+from passmd.cli.output import (
+    check_output_file,
+    check_results,
+    describe,
+    drive_record,
+    emit_json,
+    emit_rows,
+    fmt,
+    nm,
+)
 from passmd.cli.streams import PipeClosed, available_memory, check_outputs, write_atomically
 from passmd.defaults import PROTOCOL
 from passmd.units import from_si
@@ -87,14 +96,8 @@ def check_output_paths(args) -> None:
     files neither of which is where standard output goes (before running; blank names are
     refused by the parser)."""
     for flag, name in (("--csv", args.csv), ("--plot", args.plot)):
-        if name is None:
-            continue
-        target = Path(name)
-        if target.is_dir():
-            raise UsageError(f"{flag} = {name!r} is a directory: give a file name")
-        parent = target.parent if str(target.parent) else Path(".")
-        if not parent.is_dir():
-            raise OutputError(f"cannot write {flag} {name}: directory {str(parent)!r} does not exist")
+        if name is not None:
+            check_output_file(flag, name)
     if args.plot is not None:
         suffix = Path(args.plot).suffix.lower().lstrip(".")
         if suffix not in _PLOT_FORMATS:
