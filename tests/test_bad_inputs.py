@@ -81,7 +81,7 @@ def assert_one_line(err: str):
 NAMED_CASES = {
     "huge mu": (["theory", "--mu", "1e200"], 2, "--mu = 1e+200 is out of range: must be <= 1"),
     "huge mu, json": (["theory", "--mu", "1e200", "--json"], 2, "--mu = 1e+200"),
-    # finite: Eqs. 11-12 of u_x,max ~ 1e193 m no longer overflow (passmd.theory.harmonic_combination)
+    # finite: Eqs. 11-12 of u_x,max ~ 1e193 m do not overflow (passmd.theory.harmonic_combination)
     "huge mu, extrapolating": (["theory", "--mu", "1e200", "--allow-extrapolation"], 0, ""),
     "huge mu, extrapolating, json": (["theory", "--mu", "1e200", "--allow-extrapolation", "--json"], 0, ""),
     "huge stroke": (["run", "--actuator", "rigid", "--periods", "2", "--full-stroke-amplitude", "1e30",

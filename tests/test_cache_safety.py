@@ -71,7 +71,7 @@ def marked_cache(directory: Path) -> Cache:
 
 
 def user_files(root: Path) -> dict[Path, bytes]:
-    """The issue's victims: a user's *.pkl, *.tmp and *.pmc files in two-character subfolders."""
+    """A mistyped --cache-dir's files: a user's *.pkl, *.tmp and *.pmc files in two-character subfolders."""
     files = {root / "ab" / "results.pkl": b"\x80\x04 a user's pickle",
              root / "xy" / "draft.tmp": b"half a thesis",
              root / "00" / "scan.pmc": b"a user's .pmc file",

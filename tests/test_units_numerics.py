@@ -429,8 +429,8 @@ _NU, _E = RUBY.poissons_ratio, RUBY.youngs_modulus
      r"^u contains nan"),
 ])
 def test_public_closed_forms_refuse_bad_arguments(call, error, message):
-    """Negative moduli, ν outside (-1, 1/2], μ <= 0, ``contacts=True`` and a non-drive used to
-    return negative moduli and displacements or raise AttributeError."""
+    """Negative moduli, ν outside (-1, 1/2], μ <= 0, ``contacts=True`` and a non-drive are refused
+    naming the parameter, never turned into negative moduli or displacements or an AttributeError."""
     with pytest.raises(error, match=message):
         call()
 
