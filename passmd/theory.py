@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from passmd._validation import check_array, format_number
+from passmd._validation import InputError, check_array, format_number
 from passmd.defaults import PROTOCOL
 
 if TYPE_CHECKING:  # the closed forms read a drive's fields; parameters imports this module
@@ -78,11 +78,11 @@ def _require_normal(value, what: str, unit: str, inputs, where=None) -> None:
     shown = [f"{name} = {format_number(np.broadcast_to(np.asarray(x, dtype=float), v.shape).flat[i])}"
              + (f" {u}" if u else "") for name, x, u in inputs]
     context = f" (with {', '.join(shown[1:])})" if len(shown) > 1 else ""
-    raise ValueError(
-        f"{shown[0]}{context} is out of range: {what} = {format_number(v.flat[i])} {unit} is below the "
-        f"smallest normal double {_TINY:.4g} (hard limit: double precision; there a result keeps only "
-        "a few significant digits)"
-    )
+    detail = (f"{what} = {format_number(v.flat[i])} {unit} is below the smallest normal double {_TINY:.4g} "
+              "(hard limit: double precision; there a result keeps only a few significant digits)")
+    # the inputs' names let an entry point name its own options (passmd.cli.drive.explain)
+    raise InputError(f"{shown[0]}{context} is out of range: {detail}",
+                     sources=tuple(name for name, _, _ in inputs), detail=detail)
 
 
 def _youngs(E1, nu1, E2, nu2):

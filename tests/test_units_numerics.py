@@ -324,13 +324,13 @@ def test_harmonic_combination_keeps_the_papers_form_at_ordinary_magnitudes():
 
 @pytest.mark.parametrize("json_output", [True, False], ids=["json", "text"])
 def test_theory_at_a_preload_below_double_precision_is_refused_naming_the_preload(json_output):
-    """``passmd theory --preload 1e-300 --allow-extrapolation`` printed A_c = 0 nm: the Hertz
-    contact radius cubed is subnormal there, so it is refused, naming the preload."""
+    """``passmd theory --preload 1e-300 --allow-extrapolation``: the Hertz contact radius cubed is
+    subnormal there (A_c would print as 0 nm), so it is refused, naming the option as typed."""
     status, out, err = passmd("theory", "--preload", "1e-300", "--allow-extrapolation",
                               *(["--json"] if json_output else []))
     assert status == 2 and out == ""
     assert_one_line(err)
-    assert "preload = 1e-300 N" in err and "below the smallest normal double" in err
+    assert "--preload 1e-300" in err and "below the smallest normal double" in err
 
 
 @pytest.mark.parametrize("json_output", [True, False], ids=["json", "text"])
