@@ -23,6 +23,10 @@ presentation
     ``publish`` (the chapters' glue), ``ledger_views``
 entry points
     ``cli`` (the ``passmd`` command line), ``__main__``
+
+The names a drive designer needs are exported here, loaded on first use: ``Drive``,
+``paper_drive``, ``sawtooth``, ``simulate``, ``Simulation``, ``drive_theory``,
+``critical_amplitude``, ``generated_force``, ``optimized_design``, ``RunConfig``.
 """
 
 #: The version: its one source (pyproject.toml reads it, ``dynamic = ["version"]``; CITATION.cff
@@ -35,3 +39,35 @@ PAPER_CITATION = (
     "\"Improvements of Piezo-Actuated Stick–Slip Micro-Drives: Modeling and Driving "
     "Waveform\", Coatings 8(2), 62 (2018), doi:10.3390/coatings8020062"
 )
+
+#: The names a drive designer needs, re-exported from their modules. They load on first use
+#: (module ``__getattr__``, PEP 562), so ``import passmd`` and the command line's start-up do
+#: not import the simulator.
+_API = {
+    "Drive": "passmd.parameters",
+    "paper_drive": "passmd.parameters",
+    "sawtooth": "passmd.waveforms",
+    "simulate": "passmd.dynamics",
+    "Simulation": "passmd.dynamics",
+    "drive_theory": "passmd.theory",
+    "critical_amplitude": "passmd.protocols.critical_amplitude",
+    "generated_force": "passmd.protocols.stall",
+    "optimized_design": "passmd.protocols.eq15",
+    "RunConfig": "passmd.config",
+}
+
+__all__ = ["PAPER_CITATION", "__version__", *_API]
+
+
+def __getattr__(name: str):
+    if name in _API:
+        import importlib
+
+        value = getattr(importlib.import_module(_API[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'passmd' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_API))

@@ -1,0 +1,32 @@
+"""The package's public names (``passmd.__all__``): each is the object of the module it comes
+from, and ``import passmd`` loads none of them until used, so the command line's start-up and
+``passmd --version`` stay free of the simulator (numba), pandas and matplotlib."""
+
+from __future__ import annotations
+
+import importlib
+import subprocess
+import sys
+
+import pytest
+
+import passmd
+
+
+@pytest.mark.parametrize("name", sorted(passmd._API))
+def test_every_public_name_is_its_modules_object(name):
+    assert name in passmd.__all__
+    assert getattr(passmd, name) is getattr(importlib.import_module(passmd._API[name]), name)
+
+
+def test_import_passmd_loads_no_simulator():
+    code = ("import sys, passmd; heavy = [m for m in ('numba', 'pandas', 'matplotlib', 'passmd.dynamics') "
+            "if m in sys.modules]; print(','.join(heavy))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == ""
+
+
+def test_unknown_name_is_an_attribute_error():
+    with pytest.raises(AttributeError, match="no attribute 'simulat'"):
+        passmd.simulat  # noqa: B018
