@@ -259,6 +259,7 @@ def critical_amplitude(
     periods: int = STEADY_PERIODS,
     threshold: float = STEP_THRESHOLD,
     tolerance: float = PROTOCOL.search_tolerance,
+    progress: bool | str | None = None,
 ) -> dict:
     """Simulated critical amplitude A_c of a drive (protocols: see the module docstring).
 
@@ -279,6 +280,9 @@ def critical_amplitude(
         Measurable step δ (m) of the steady-state protocol.
     tolerance : float
         Largest width of the final bracket (m).
+    progress : bool or "long", optional
+        The bisection's runs on stderr (:mod:`passmd._progress`): None on a terminal only,
+        ``"long"`` also elsewhere, each once the search has taken a few seconds.
 
     Returns
     -------
@@ -295,17 +299,43 @@ def critical_amplitude(
     check_range("threshold", threshold, 0.0, lower_open=True, unit="m")
     if int(periods) != periods or periods < 2:
         raise ValueError(f"periods = {periods!r} is out of range: must be an integer >= 2")
+    if not (progress is None or isinstance(progress, bool) or progress == "long"):
+        raise ValueError(f"progress = {progress!r} is not allowed: must be True, False, None or 'long'")
     wall = [0.0]
+    upper = drive.actuator.full_stroke_amplitude
+    bar = _bisection_bar(upper, tolerance, progress)
 
     def moves(amplitude):
         if protocol == "steady":
             out = steady_step(drive, amplitude, frequency, periods=int(periods), flyback=flyback)
             wall[0] += out["wall_time_s"]
-            return out["last_step_m"] > threshold
-        out = first_flyback_slip(drive, amplitude, frequency, flyback=flyback)
-        wall[0] += out["wall_time_s"]
-        return out["full_sliding"]
+            moved = out["last_step_m"] > threshold
+        else:
+            out = first_flyback_slip(drive, amplitude, frequency, flyback=flyback)
+            wall[0] += out["wall_time_s"]
+            moved = out["full_sliding"]
+        if bar is not None:
+            bar.update(1)
+        return moved
 
-    found = bisect_amplitude(moves, drive.actuator.full_stroke_amplitude, tolerance)
+    try:
+        found = bisect_amplitude(moves, upper, tolerance)
+    finally:
+        if bar is not None:
+            bar.close()
     found["wall_time_s"] = wall[0]
     return found
+
+
+def _bisection_bar(upper: float, tolerance: float, progress: bool | str | None):
+    """A progress bar over the bisection's runs (1 + halvings of ``upper`` down to ``tolerance``)."""
+    import sys
+
+    from passmd import _progress
+
+    if progress is False or sys.stderr is None or _progress.in_worker():
+        return None
+    if progress is None and not _progress.is_terminal(sys.stderr):
+        return None
+    runs = 1 + max(0, math.ceil(math.log2(upper / tolerance)))
+    return _progress.bar(runs, unit="run", desc="critical amplitude")

@@ -280,6 +280,7 @@ def generated_force(
     abs_tolerance: float = STALL_ABS_TOLERANCE,
     rel_tolerance: float = STALL_REL_TOLERANCE,
     window: int = STALL_WINDOW,
+    progress: bool | str | None = None,
 ) -> dict:
     """Generated force at stall: saw-tooth runs from rest against the load cell (Section 4.2).
 
@@ -301,6 +302,8 @@ def generated_force(
         module docstring).
     window : int
         Periods examined by the stall criterion.
+    progress : bool or "long", optional
+        The run's progress on stderr (:class:`passmd.dynamics.Simulation`).
 
     Returns
     -------
@@ -349,7 +352,7 @@ def generated_force(
     # rest (the saw-tooth's breakpoints of period j do not depend on the number of periods),
     # so each check sees the forces a run of that length from rest would give.
     longest = waveforms.sawtooth(amplitude, frequency, drive, periods=int(max_periods), flyback=flyback)
-    run = dynamics.Simulation(drive, longest, max_points=2)
+    run = dynamics.Simulation(drive, longest, max_points=2, progress=progress)
     periods = int(initial_periods)
     while True:
         run.run_to(periods)

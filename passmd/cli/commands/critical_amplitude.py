@@ -63,6 +63,7 @@ def _search(args, drive) -> dict:
     found = ca.critical_amplitude(
         drive, protocol=args.protocol, frequency=frequency, flyback=args.flyback,
         periods=args.periods, threshold=threshold, tolerance=tolerance,
+        progress="long",  # a long search's progress on stderr, also when it is not a terminal
     )
     value = found["critical_amplitude_m"]
     return {

@@ -71,7 +71,8 @@ def run_force(args, out) -> int:
     # the force-generation chapter's stall protocol: runs from rest, lengthened until stalled
     try:
         found = stall.generated_force(drive, amplitude, frequency, flyback=args.flyback,
-                                      initial_periods=args.periods, max_periods=args.max_periods)
+                                      initial_periods=args.periods, max_periods=args.max_periods,
+                                      progress="long")  # on stderr, also off a terminal
     except ValueError as exc:  # name the command's options, not the library's parameters
         text = re.sub(r"\binitial_periods\b", "--periods", str(exc))
         raise UsageError(re.sub(r"\bmax_periods\b", "--max-periods", text)) from exc
