@@ -123,7 +123,7 @@ class RunConfig:
         return cls(**fields, **overrides, variables=variables)
 
     def log_sweep(self, record: Mapping) -> None:
-        """Append ``record`` as one JSON line to :attr:`sweep_log` (nothing without one).
+        """Append ``record`` as one JSON line to the ``sweep_log`` file (nothing without one).
 
         One ``write`` of a short line in append mode: lines of concurrent writers do not mix.
         ``OSError`` names the log as the user set it (the environment variable, if it came
