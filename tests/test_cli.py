@@ -660,3 +660,21 @@ def test_python_dash_m():
     assert len(json.loads(done.stdout)["force_N"]) == 4
     assert console("--version", module=True).stdout.startswith("passmd ")
     assert console(module=True).returncode == 2  # a subcommand is required
+
+
+def test_run_optimized_reports_its_eq15_design():
+    """`run --waveform optimized` gives the design it ran (t_s, t_a, Δ_a, V_a, f_s, V_r, u_x,max),
+    the one passmd.protocols.eq15 derives for this drive; a saw-tooth run has none."""
+    from passmd.parameters import Drive
+    from passmd.protocols import eq15
+
+    data = run_json("run", "--waveform", "optimized", "--frequency", "10kHz", "--periods", "3")
+    drive = Drive()
+    expected = eq15.optimized_design(drive.actuator.full_stroke_amplitude, drive).as_dict()
+    assert data["design"] == pytest.approx(expected, rel=1e-12)  # the same computation, run again
+    assert 0 < data["design"]["settling_time_s"] < 1 / 10e3
+    _, text = run_cli("run", "--waveform", "optimized", "--frequency", "10kHz", "--periods", "3")
+    row = next(line for line in text.splitlines() if line.strip().startswith("Eq. 15 design"))
+    symbols = ("t_s =", "t_a =", "Δ_a =", "V_a =", "f_s =", "V_r =", "u_x,max =")
+    assert all(symbol in row for symbol in symbols), row
+    assert "design" not in run_json("run", "--periods", "2")

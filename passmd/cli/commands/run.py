@@ -107,7 +107,7 @@ def check_output_paths(args) -> None:
 
 
 def simulate(args, drive):
-    """The run the options describe (the saw-tooth or the optimized waveform of Eq. 15)."""
+    """(result, Eq. 15 design or None) of the run the options describe (saw-tooth or Eq. 15)."""
     startup.load_numba_without_blas_probe()
     from passmd import dynamics, optimized_waveform, waveforms
     from passmd.protocols import eq15
@@ -121,12 +121,23 @@ def simulate(args, drive):
         wave = optimized_waveform.optimized(amplitude, frequency, drive, periods=args.periods,
                                             flyback=args.flyback, design=design)
     else:
+        design = None
         wave = waveforms.sawtooth(amplitude, frequency, drive, periods=args.periods, flyback=args.flyback)
-    return dynamics.simulate(
+    result = dynamics.simulate(
         drive, wave, contact_model="exact" if springs is None else "discrete",
         springs=PROTOCOL.springs if springs is None else springs, max_points=args.max_points,
         progress="long",  # a long run's progress on stderr, also when it is not a terminal
     )
+    return result, design
+
+
+def design_row(design) -> str:
+    """The Eq. 15 design in display units: t_s, t_a, Δ_a (V_a), f_s, V_r, u_x,max."""
+    return (f"t_s = {design.settling_time * 1e6:.4g} µs, t_a = {design.acceleration_time * 1e6:.4g} µs, "
+            f"Δ_a = {fmt(design.acceleration_amplitude, 'nm')} "
+            f"(V_a = {design.acceleration_velocity * 1e3:.4g} mm/s); from the saw-tooth response: "
+            f"f_s = {fmt(design.micro_vibration_frequency, 'kHz')}, "
+            f"V_r = {design.runner_velocity * 1e3:.4g} mm/s, u_x,max = {fmt(design.presliding, 'nm')}")
 
 
 def write_outputs(args, result) -> None:
@@ -167,10 +178,12 @@ def run_run(args, out) -> int:
     check_springs(args.springs)
     check_memory(args)
     check_output_paths(args)
-    result = simulate(args, drive)
+    result, design = simulate(args, drive)
     startup.resume()
     summary = result.summary()
     summary["wall_time_s"] = float(result.wall_time)
+    if design is not None:  # Eq. 15's parameters, derived from this drive's saw-tooth response
+        summary["design"] = design.as_dict()
     check_results(summary)
     check_run_bounds(summary, drive, float(summary["amplitude_m"]))
     write_outputs(args, result)
@@ -185,6 +198,8 @@ def run_run(args, out) -> int:
         ("step per period", nm(summary["step_sizes_m"]) if summary["step_sizes_m"] else "– (one period)"),
         ("back-step per period", nm(summary["back_steps_m"])),
     ]
+    if design is not None:
+        rows.insert(1, ("Eq. 15 design", design_row(design)))
     if "mean_velocity_m_per_s" in summary:
         rows.append(("mean velocity", f"{summary['mean_velocity_m_per_s'] * 1e3:.6g} mm/s"))
     if "generated_force_N" in summary:
