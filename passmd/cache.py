@@ -963,32 +963,22 @@ class Cache:
         NotACache
             The directory exists, is not empty and has no marker of this format.
         """
-        if not self._owned():
-            return 0
-        removed = 0
         now = time.time()
-        for kind, path in _walk(self.directory):
+
+        def doomed(kind: str, path: Path) -> bool:
+            if kind == "temp":
+                return now - os.lstat(path).st_mtime > STALE_TEMP_SECONDS
+            if kind != "candidate":
+                return False
+            found, data = _examine(path, read=True)
+            if found != "entry":
+                return found == "bad"
             try:
-                if kind == "temp":
-                    if now - os.lstat(path).st_mtime > STALE_TEMP_SECONDS:
-                        removed += _unlink(path)
-                    continue
-                if kind != "candidate":
-                    continue
-                found, data = _examine(path, read=True)
-            except FileNotFoundError:
-                continue
-            if found == "bad":
-                removed += _unlink(path)
-            elif found == "entry":
-                try:
-                    header, _ = _split_entry(data)
-                    if header.get("code") == self.fingerprint:
-                        continue
-                except CorruptEntry:
-                    pass
-                removed += _unlink(path)
-        return removed
+                return _split_entry(data)[0].get("code") != self.fingerprint
+            except CorruptEntry:
+                return True
+
+        return self._remove(doomed)
 
     def clear(self) -> int:
         """Remove every entry (readable or not) and temporary file of the cache.
@@ -1002,13 +992,20 @@ class Cache:
         NotACache
             The directory exists, is not empty and has no marker of this format.
         """
+        return self._remove(lambda kind, path: kind == "temp" or (
+            kind == "candidate" and _examine(path, read=False)[0] in ("entry", "bad")))
+
+    def _remove(self, doomed) -> int:
+        """Unlink each of the cache's own files for which ``doomed(kind, path)`` holds; the count.
+
+        Refuses a folder that is not a cache (:meth:`_owned`); a file gone meanwhile is skipped.
+        """
         if not self._owned():
             return 0
         removed = 0
         for kind, path in _walk(self.directory):
             try:
-                if kind == "temp" or (kind == "candidate"
-                                      and _examine(path, read=False)[0] in ("entry", "bad")):
+                if doomed(kind, path):
                     removed += _unlink(path)
             except FileNotFoundError:
                 continue
