@@ -10,8 +10,7 @@ import numpy as np
 
 from passmd.parameters import Drive
 
-__all__ = ["EMPTY_BY_DESIGN", "ResultError", "check_force_bound", "check_run_bounds", "check_table",
-           "friction_limit"]
+__all__ = ["EMPTY_BY_DESIGN", "ResultError", "check_run_bounds", "check_table"]
 
 
 class ResultError(RuntimeError):
@@ -31,7 +30,7 @@ def check_run_bounds(summary: dict, drive: Drive, amplitude: float) -> None:
     ``A + 2 (u_x,max + u_x,a)``. The check allows twice that (inertial over-travel after the
     fly-back), and the final position ``periods`` such steps.
     """
-    from passmd.theory import drive_theory
+    from passmd.theory import drive_theory, friction_limit
 
     duration = summary["periods"] / summary["frequency_Hz"]
     reach = friction_limit(drive) * duration**2 / (2.0 * drive.runner_mass)
@@ -52,29 +51,6 @@ def check_run_bounds(summary: dict, drive: Drive, amplitude: float) -> None:
     if final > summary["periods"] * step_limit:
         raise ResultError(f"final position {final:.4g} m exceeds {summary['periods']} periods of the largest "
                           f"possible step ({step_limit:.4g} m): the result is not trustworthy")
-
-
-def friction_limit(drive: Drive) -> float:
-    """μ Σ F_N: the largest friction force all contacts together can exert (Eq. 1)."""
-    from passmd.theory import normal_forces
-
-    forces = normal_forces(drive.preload, drive.contacts)
-    total = float(forces[0]) if drive.contacts == 1 else float(2 * forces[0] + 4 * forces[1])
-    return drive.friction_coefficient * total
-
-
-def check_force_bound(found: dict, drive: Drive) -> None:
-    """At stall the load cell's mean force is held by friction: |F| <= μ Σ F_N (Section 4.2).
-
-    Averaged over a period the runner's inertia contributes m_r Δv / T, negligible at stall;
-    5 % of margin covers it.
-    """
-    limit = friction_limit(drive)
-    force = abs(float(found["generated_force_N"]))
-    if force > 1.05 * limit:
-        raise ResultError(f"generated force {force:.4g} N exceeds what friction can hold (mu*sum(F_N) = "
-                          f"{limit:.4g} N): the result is not trustworthy")
-
 
 
 # A critical-amplitude search that finds no step up to the full stroke has no critical amplitude
