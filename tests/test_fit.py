@@ -89,6 +89,7 @@ def test_a_parameter_the_data_cannot_see_is_reported_not_identifiable(tmp_path):
     ("amplitude_nm,frequency_Hz,step_nm\n-60,100,1\n", "row 1 (line 2), column amplitude_nm: -60 is out of range"),
     ("amplitude_nm,frequency_Hz,step_nm\n", "no measurement rows"),
     ("", "empty file"),
+    ("amplitude_nm,frequency_Hz,step_nm,contacts\n60,100,1,3\n", "row 1 (line 2), column contacts: '3' is not allowed"),
 ])
 def test_malformed_files_get_one_line_naming_row_and_column(tmp_path, text, fragment):
     path = tmp_path / "data.csv"
@@ -163,3 +164,15 @@ def test_cli_fit_names_the_bad_row_and_option(tmp_path):
     assert status == 2 and "row 1 (line 2), column step_nm" in text and text.count("\n") == 1
     status, text = _run(["fit", str(path), "--free", "preload"])
     assert status == 2 and "--free = 'preload' is not allowed" in text
+
+
+def test_the_papers_numbers_read_as_measurements():
+    """The package's table of the paper's stated numbers is a valid measurement file, each row
+    with the drive model it was stated for (a row without it would be fitted with the wrong drive)."""
+    from passmd.reference import REFERENCE_DIR
+
+    data = F.read_measurements(REFERENCE_DIR / "paper_as_data.csv")
+    assert data.kind == ("critical_amplitude", "position")
+    assert data.model == ({"contacts": 1, "actuator_model": "flexible"}, {"contacts": 6, "actuator_model": "rigid"})
+    assert data.value == pytest.approx([50e-9, 552e-9], rel=1e-12)
+    assert data.known_sd

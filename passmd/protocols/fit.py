@@ -15,6 +15,12 @@ one measured quantity per row, each with an optional standard deviation ``<quant
     with the reading ``"steady"`` or ``"first"``; no A_c up to the full stroke reads as A_max).
 ``force_N``
     Generated force at stall against the load cell (Section 4.2, :mod:`passmd.protocols.stall`).
+``position_nm``
+    Runner position after three saw-tooth periods from rest (Fig. 9a's protocol).
+
+Optional columns ``contacts`` (1 or 6) and ``actuator_model`` (``rigid`` or ``flexible``) set a
+row's drive like ``preload_N`` and ``radius_mm``; the text columns ``id``, ``source_section``,
+``source_quote`` and ``notes`` (where a row comes from) are allowed and ignored.
 
 Estimator (:func:`fit`): weighted least squares, ``scipy.optimize.least_squares`` (trust-region
 reflective, bounded, optional robust loss) over the logarithms of the free parameters, so that
@@ -82,6 +88,9 @@ CORRELATION_LIMIT = 0.95
 JACOBIAN_STEP = 0.01
 #: Points of the global pass's Sobol design (a power of two; the start values are added).
 GLOBAL_STARTS = 16
+#: A profile's end is accepted where its cost rise is within this fraction of the threshold (a
+#: quadratic profile then puts the end within 5 % of the interval's half-width).
+PROFILE_TOLERANCE = 0.1
 #: Local least-squares searches started from the best points of the global pass.
 LOCAL_STARTS = 2
 #: Robust losses of ``scipy.optimize.least_squares`` (the intervals use the plain sum of squares).
@@ -95,7 +104,12 @@ MEASURED: dict[str, tuple[str, str, bool]] = {
     "velocity_mm_per_s": ("velocity", "mm/s", False),
     "critical_amplitude_nm": ("critical_amplitude", "nm", True),
     "force_N": ("force", "N", False),
+    "position_nm": ("position", "nm", False),
 }
+#: Columns that set a row's drive model, and the values each allows.
+MODELS: dict[str, tuple[str, ...]] = {"contacts": ("1", "6"), "actuator_model": ("rigid", "flexible")}
+#: Text columns that say where a row comes from; allowed and ignored.
+ANNOTATIONS = ("id", "source_section", "source_quote", "notes")
 #: Condition columns and their display units.
 CONDITIONS: dict[str, str] = {"amplitude_nm": "nm", "preload_N": "N", "frequency_Hz": "Hz", "radius_mm": "mm"}
 _SI = {"nm": 1e-9, "mm/s": 1e-3, "N": 1.0, "Hz": 1.0, "mm": 1e-3}
@@ -124,6 +138,7 @@ class Measurements:
     radius: np.ndarray  # m; NaN: the drive's
     line: tuple[int, ...]  # line of each row in the file (header = 1)
     name: str = "data"  # how the caller named the file
+    model: tuple[dict, ...] = ()  # per row: contacts / actuator_model given in the file (else empty)
 
     def __len__(self) -> int:
         return len(self.kind)
@@ -164,7 +179,7 @@ def measurements_from_rows(header: Sequence[str], rows: Sequence[Sequence[str]],
     """
     lines = list(range(2, len(rows) + 2)) if lines is None else list(lines)
     header = [h.strip() for h in header]
-    allowed = [*CONDITIONS, *MEASURED, *(f"{m}_sd" for m in MEASURED)]
+    allowed = [*CONDITIONS, *MEASURED, *(f"{m}_sd" for m in MEASURED), *MODELS, *ANNOTATIONS]
     for j, column in enumerate(header):
         if column not in allowed:
             raise MeasurementError(f"{name} header, column {j + 1} {column!r}: not a known column; allowed: "
@@ -181,7 +196,7 @@ def measurements_from_rows(header: Sequence[str], rows: Sequence[Sequence[str]],
     if not rows:
         raise MeasurementError(f"{name}: no measurement rows below the header", name="rows", value=0)
     out: dict[str, list] = {k: [] for k in ("kind", "column", "value", "sd", "amplitude", "frequency",
-                                            "preload", "radius", "line")}
+                                            "preload", "radius", "line", "model")}
     for k, row in enumerate(rows):
         line = lines[k]
         where = f"{name} row {k + 1} (line {line})"
@@ -222,6 +237,15 @@ def measurements_from_rows(header: Sequence[str], rows: Sequence[Sequence[str]],
             if math.isnan(cond[c]) and kind != "critical_amplitude":
                 raise MeasurementError(f"{where}, column {c}: missing; a {column} "
                                        f"measurement needs {' and '.join(need)}", name=c, value="")
+        model = {}
+        for c, choices in MODELS.items():
+            text = cells.get(c, "")
+            if text and text not in choices:
+                raise MeasurementError(f"{where}, column {c}: {text!r} is not allowed: must be one of "
+                                       + ", ".join(choices), name=c, value=text)
+            if text:
+                model[c] = int(text) if c == "contacts" else text
+        out["model"].append(model)
         if kind == "critical_amplitude" and math.isnan(cond["frequency_Hz"]):
             cond["frequency_Hz"] = PROTOCOL.drive_frequency
         out["kind"].append(kind)
@@ -239,9 +263,10 @@ def measurements_from_rows(header: Sequence[str], rows: Sequence[Sequence[str]],
         raise MeasurementError(f"{name} row {out['line'][k] - 1} (line {out['line'][k]}), column "
                                f"{out['column'][k]}_sd: missing; give a standard deviation for every row or "
                                "for none", name=out["column"][k] + "_sd", value="")
-    arrays = {k: np.array(v, dtype=float) for k, v in out.items() if k not in ("kind", "column", "line")}
+    text = ("kind", "column", "line", "model")
+    arrays = {k: np.array(v, dtype=float) for k, v in out.items() if k not in text}
     return Measurements(kind=tuple(out["kind"]), column=tuple(out["column"]), line=tuple(out["line"]),
-                        name=name, **arrays)
+                        name=name, model=tuple(out["model"]), **arrays)
 
 
 def read_measurements(path, *, name: str | None = None) -> Measurements:
@@ -408,6 +433,9 @@ def predict_point(drive: Drive, kind: str, amplitude: float, frequency: float, r
     """The model's value of one measurement (SI): ``{"prediction": value}`` (a sweep function)."""
     from passmd.protocols import velocity
 
+    if kind == "position":
+        run = velocity.step_run(drive, amplitude, frequency, "sawtooth")
+        return {"prediction": float(run["final_position_m"])}
     if kind in ("step", "velocity"):
         if frequency < velocity.STEP_PROTOCOL_BELOW:
             step = velocity.step_run(drive, amplitude, frequency, "sawtooth")["mean_step_m"]
@@ -427,10 +455,11 @@ def predict_point(drive: Drive, kind: str, amplitude: float, frequency: float, r
 
 
 def _row_drives(drive: Drive, data: Measurements) -> list[Drive]:
-    """Each row's drive: ``drive`` at the row's preload and radius (Table 2 actuator for another radius)."""
+    """Each row's drive: ``drive`` at the row's preload, radius (Table 2 actuator for another radius),
+    number of contacts and actuator model, where the row gives them."""
     out = []
     for i in range(len(data)):
-        changes = {}
+        changes = dict(data.model[i]) if data.model else {}
         if math.isfinite(data.preload[i]):
             changes["preload"] = float(data.preload[i])
         if math.isfinite(data.radius[i]) and not math.isclose(data.radius[i], drive.hemisphere_radius,
@@ -663,21 +692,22 @@ def _fit(model, drive, data, names, box, lo, hi, x_start, sigma, reading, loss, 
     def residual(pred):
         return (pred - data.value) / sigma
 
-    def perturbed(x):
+    def perturbed(x, cols):
         out = []
-        for j in range(p):
+        for j in cols:
             e = np.zeros(p)
             e[j] = h if x[j] + h <= hi[j] else -h
             out.append(x + e)
         return out
 
-    def fun_jac(x):
-        """Residual and Jacobian (d r / d log θ), base and perturbed points in one sweep."""
+    def fun_jac(x, cols=None):
+        """Residual and Jacobian (d r / d log θ; columns ``cols``), base and perturbed points in one sweep."""
         x = np.asarray(x, float)
-        steps = perturbed(x)
+        steps = perturbed(x, range(p) if cols is None else cols)
         base, *others = model.evaluate([x, *steps])
         r = residual(base)
-        jac = np.column_stack([(residual(o) - r) / (s - x).sum() for o, s in zip(others, steps, strict=True)])
+        jac = np.column_stack([(residual(o) - r) / (s - x).sum()
+                               for o, s in zip(others, steps, strict=True)]) if steps else np.zeros((n, 0))
         return r, jac
 
     # global pass: a Sobol design over the log box, one sweep
@@ -736,13 +766,13 @@ def _fit(model, drive, data, names, box, lo, hi, x_start, sigma, reading, loss, 
             return x
 
         if not others:
-            rr, _ = fun_jac(full([]))
+            rr, _ = fun_jac(full([]), [])
             return float(np.sum(rr ** 2)), []
-        sol = optimize.least_squares(lambda y: fun_jac(full(y))[0], start_others,
-                                     jac=lambda y: fun_jac(full(y))[1][:, others],
-                                     bounds=(lo[others], hi[others]), method="trf", xtol=1e-5, ftol=1e-6,
-                                     max_nfev=20)
-        return float(np.sum(fun_jac(full(sol.x))[0] ** 2)), sol.x
+        sol = optimize.least_squares(lambda y: fun_jac(full(y), others)[0], start_others,
+                                     jac=lambda y: fun_jac(full(y), others)[1],
+                                     bounds=(lo[others], hi[others]), method="trf", xtol=1e-4, ftol=1e-5,
+                                     max_nfev=10)
+        return float(np.sum(fun_jac(full(sol.x), others)[0] ** 2)), sol.x
 
     estimates: dict[str, dict] = {}
     flat: dict[str, bool] = {}
@@ -770,8 +800,13 @@ def _fit(model, drive, data, names, box, lo, hi, x_start, sigma, reading, loss, 
                 notes.append(f"{name} is at its {'lower' if sign < 0 else 'upper'} bound: widen --bounds")
                 continue
             d_in, v_in = 0.0, 0.0
-            delta = min(max(2.0 * se[j] if np.isfinite(se[j]) and se[j] > 0 else 0.1, 0.02), room)
+            # the quadratic approximation's end first: where a quadratic profile meets the threshold
+            guess = math.sqrt(threshold) * se[j] if np.isfinite(se[j]) and se[j] > 0 else 0.1
+            delta = min(max(guess, 0.02), room)
             v = D(delta)
+            if abs(v - threshold) < PROFILE_TOLERANCE * threshold:
+                ends.append(x_hat[j] + sign * delta)
+                continue
             while v < threshold and delta < room:
                 d_in, v_in = delta, v
                 delta = min(2.0 * delta, room)
@@ -786,7 +821,7 @@ def _fit(model, drive, data, names, box, lo, hi, x_start, sigma, reading, loss, 
                        else 0.5 * (d_in + delta))
                 mid = min(max(mid, d_in + 0.05 * (delta - d_in)), delta - 0.05 * (delta - d_in))
                 vm = D(mid)
-                if abs(vm - threshold) < 0.05 * threshold:
+                if abs(vm - threshold) < PROFILE_TOLERANCE * threshold:
                     delta = mid
                     break
                 if vm < threshold:
