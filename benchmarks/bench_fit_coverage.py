@@ -80,14 +80,16 @@ def main() -> int:
         futures = [pool.submit(_draw, seed, free, cache) for seed in range(args.draws)]
         for k, future in enumerate(cf.as_completed(futures)):
             draws.append(future.result())
-            print(f"draw {k + 1}/{args.draws} [{time.perf_counter() - start:.0f} s]", file=sys.stderr, flush=True)
+            print(f"draw {k + 1}/{args.draws} [{time.perf_counter() - start:.0f} s]", file=sys.stderr,
+                  flush=True)
     draws.sort(key=lambda d: d["seed"])
     coverage = {}
     n = len(draws)
     for name in free:
         for kind in ("profile", "wald"):
             share = sum(d[name][f"{kind}_holds"] for d in draws) / n
-            coverage[f"{name}.{kind}"] = {"coverage": share, "binomial_stderr": math.sqrt(share * (1 - share) / n)}
+            coverage[f"{name}.{kind}"] = {"coverage": share,
+                                          "binomial_stderr": math.sqrt(share * (1 - share) / n)}
     record = {"benchmark": "coverage of the fit's 95 % intervals", "model": "one contact, rigid actuators",
               "free": list(free), "truth": {k: TRUTH[k] for k in free}, "draws": n, "noise_nm": NOISE_NM,
               "preloads_N": PRELOADS, "amplitudes_nm": AMPLITUDES_NM, "nominal": 0.95, "coverage": coverage,

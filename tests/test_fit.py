@@ -78,18 +78,22 @@ def test_a_parameter_the_data_cannot_see_is_reported_not_identifiable(tmp_path):
 
 
 @pytest.mark.parametrize("text, fragment", [
-    ("amplitude_nm,frequency_Hz,step_nm\n60,100,abc\n", "row 1 (line 2), column step_nm: 'abc' is not a number"),
+    ("amplitude_nm,frequency_Hz,step_nm\n60,100,abc\n",
+     "row 1 (line 2), column step_nm: 'abc' is not a number"),
     ("amplitude_nm,frequency_Hz,step_nm\n60,100,1\n\n70,100,2,3\n", "row 2 (line 4): 4 fields"),
     ("amplitude_nm,frequency_Hz,step_um\n60,100,1\n", "column 3 'step_um': not a known column"),
     ("amplitude_nm,frequency_Hz\n60,100\n", "no measured column"),
     ("amplitude_nm,step_nm\n60,1\n", "row 1 (line 2), column frequency_Hz: missing"),
-    ("amplitude_nm,frequency_Hz,step_nm,force_N\n60,100,1,0.1\n", "row 1 (line 2), column force_N: more than one"),
+    ("amplitude_nm,frequency_Hz,step_nm,force_N\n60,100,1,0.1\n",
+     "row 1 (line 2), column force_N: more than one"),
     ("amplitude_nm,frequency_Hz,step_nm,step_nm_sd\n60,100,1,0.5\n70,100,2,\n",
      "row 2 (line 3), column step_nm_sd: missing"),
-    ("amplitude_nm,frequency_Hz,step_nm\n-60,100,1\n", "row 1 (line 2), column amplitude_nm: -60 is out of range"),
+    ("amplitude_nm,frequency_Hz,step_nm\n-60,100,1\n",
+     "row 1 (line 2), column amplitude_nm: -60 is out of range"),
     ("amplitude_nm,frequency_Hz,step_nm\n", "no measurement rows"),
     ("", "empty file"),
-    ("amplitude_nm,frequency_Hz,step_nm,contacts\n60,100,1,3\n", "row 1 (line 2), column contacts: '3' is not allowed"),
+    ("amplitude_nm,frequency_Hz,step_nm,contacts\n60,100,1,3\n",
+     "row 1 (line 2), column contacts: '3' is not allowed"),
 ])
 def test_malformed_files_get_one_line_naming_row_and_column(tmp_path, text, fragment):
     path = tmp_path / "data.csv"
@@ -112,7 +116,8 @@ def test_a_well_formed_file_reads_in_si(tmp_path):
 
 
 def test_free_names_and_bounds_are_checked():
-    data = F.measurements_from_rows(HEADER, [["60", "0.4", "100", "1", "0.5"], ["90", "0.4", "100", "2", "0.5"]])
+    data = F.measurements_from_rows(HEADER, [["60", "0.4", "100", "1", "0.5"],
+                                             ["90", "0.4", "100", "2", "0.5"]])
     with pytest.raises(ValueError, match="not a parameter the fit can free"):
         F.fit(RIGID, data, ["preload"], executor="serial", cache=False)
     with pytest.raises(ValueError, match="no effect on ideally rigid"):
@@ -173,6 +178,7 @@ def test_the_papers_numbers_read_as_measurements():
 
     data = F.read_measurements(REFERENCE_DIR / "paper_as_data.csv")
     assert data.kind == ("critical_amplitude", "position")
-    assert data.model == ({"contacts": 1, "actuator_model": "flexible"}, {"contacts": 6, "actuator_model": "rigid"})
+    assert data.model == ({"contacts": 1, "actuator_model": "flexible"},
+                          {"contacts": 6, "actuator_model": "rigid"})
     assert data.value == pytest.approx([50e-9, 552e-9], rel=1e-12)
     assert data.known_sd
