@@ -137,7 +137,10 @@ def _run(argv) -> tuple[int, str]:
 
     err = io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        status = cli.main(list(argv))
+        try:
+            status = cli.main(list(argv))
+        except SystemExit as exc:  # --help
+            status = exc.code
     return status, out.getvalue() + err.getvalue()
 
 
@@ -182,3 +185,21 @@ def test_the_papers_numbers_read_as_measurements():
                           {"contacts": 6, "actuator_model": "rigid"})
     assert data.value == pytest.approx([50e-9, 552e-9], rel=1e-12)
     assert data.known_sd
+
+
+def test_help_gives_every_option_a_default():
+    status, text = _run(["fit", "--help"])
+    assert status == 0
+    blocks, current = {}, None
+    for line in text.splitlines():
+        stripped = line.strip()
+        if line.startswith("  --"):  # an option's first line (continuations are indented further)
+            current = stripped.split()[0].rstrip(",")
+            blocks[current] = stripped
+        elif current and line.startswith(" " * 10) and stripped:
+            blocks[current] += " " + stripped
+        else:
+            current = None
+    assert {"--free", "--bounds", "--mu", "--json", "--out"} <= set(blocks)
+    for flag, help_text in blocks.items():
+        assert "default:" in help_text, (flag, help_text)

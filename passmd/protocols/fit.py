@@ -82,10 +82,13 @@ __all__ = [
 #: 0.95: their joint confidence region is then a ridge at least (1+0.95)/(1−0.95) ≈ 6 times
 #: longer than wide (eigenvalue ratio of the 2×2 correlation matrix; its axes √39 ≈ 6.2).
 CORRELATION_LIMIT = 0.95
-#: Relative step of the forward-difference Jacobian (in log-parameter space). 1 % stays well
-#: above the critical-amplitude bisection's resolution (0.1 nm of A_c ≈ 50 nm is 0.2 %) and below
-#: the curvature scale of the steady step as a function of μ, k_p, c_p (tens of %).
-JACOBIAN_STEP = 0.01
+#: Relative step of the forward-difference Jacobian (in log-parameter space). The simulated step
+#: of a six-contact flexible drive wiggles by a fraction of a nanometre on the 1 % scale of μ, k_p
+#: and ζ (Gauss–Newton steps from 1 % and 0.1 % differences disagree in direction), which traps a
+#: 1 % difference in local minima; a 5 % secant steps over them and stays well below the
+#: curvature scale of the step as a function of these parameters (tens of %). It is also far
+#: above the critical-amplitude bisection's resolution (0.1 nm of A_c ≈ 50 nm is 0.2 %).
+JACOBIAN_STEP = 0.05
 #: Points of the global pass's Sobol design (a power of two; the start values are added).
 GLOBAL_STARTS = 16
 #: A profile's end is accepted where its cost rise is within this fraction of the threshold (a

@@ -54,7 +54,7 @@ def add_parser(command) -> None:
     p.add_argument("data", metavar="DATA.csv", help="the measurements (see below)")
     group = p.add_argument_group("fit")
     group.add_argument("--free", required=True, metavar="NAME[,NAME...]",
-                       help="parameters to fit: " + ", ".join(FREE_NAMES))
+                       help="parameters to fit (default: none; required): " + ", ".join(FREE_NAMES))
     group.add_argument("--bounds", action="append", default=[], metavar="NAME=LOW..HIGH",
                        help="range of a free parameter in its option's unit (default: the plausible range)")
     group.add_argument("--reading", choices=("steady", "first"), default="steady",
@@ -69,7 +69,7 @@ def add_parser(command) -> None:
     out.add_argument("--json", action="store_true", help=JSON_HELP)
     out.add_argument("--out", metavar="DIR", action=DirectoryPath,
                      help="write " + ", ".join(_OUTPUTS) + " to DIR (created if missing; never replaces "
-                          "a file)")
+                          "a file) (default: none)")
     p.set_defaults(handler=run_fit)
 
 
