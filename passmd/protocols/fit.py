@@ -94,6 +94,10 @@ GLOBAL_STARTS = 16
 #: A profile's end is accepted where its cost rise is within this fraction of the threshold (a
 #: quadratic profile then puts the end within 5 % of the interval's half-width).
 PROFILE_TOLERANCE = 0.1
+#: Function evaluations of each inner minimisation of a profile over the other free parameters. It
+#: starts on the linearised conditional path (the covariance's regression of the others on the
+#: profiled one), a few Gauss–Newton steps from the conditional minimum.
+PROFILE_STEPS = 4
 #: Local least-squares searches started from the best points of the global pass.
 LOCAL_STARTS = 2
 #: Robust losses of ``scipy.optimize.least_squares`` (the intervals use the plain sum of squares).
@@ -743,6 +747,8 @@ def _fit(model, drive, data, names, box, lo, hi, x_start, sigma, reading, loss, 
         if best is None or cost < best[1]:
             best = (sol.x, cost)
     x_hat, cost = best
+    say("estimate " + ", ".join(f"{k} = {v:.5g}" for k, v in zip(names, np.exp(x_hat), strict=True))
+        + f", cost {cost:.5g}")
     r, J = fun_jac(x_hat)
     dof = n - p
     s2 = 1.0 if data.known_sd else cost / dof
@@ -774,7 +780,7 @@ def _fit(model, drive, data, names, box, lo, hi, x_start, sigma, reading, loss, 
         sol = optimize.least_squares(lambda y: fun_jac(full(y), others)[0], start_others,
                                      jac=lambda y: fun_jac(full(y), others)[1],
                                      bounds=(lo[others], hi[others]), method="trf", xtol=1e-4, ftol=1e-5,
-                                     max_nfev=10)
+                                     max_nfev=PROFILE_STEPS)
         return float(np.sum(fun_jac(full(sol.x), others)[0] ** 2)), sol.x
 
     estimates: dict[str, dict] = {}
