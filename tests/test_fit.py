@@ -203,3 +203,10 @@ def test_help_gives_every_option_a_default():
     assert {"--free", "--bounds", "--mu", "--json", "--out"} <= set(blocks)
     for flag, help_text in blocks.items():
         assert "default:" in help_text, (flag, help_text)
+
+
+def test_every_measured_quantity_has_a_plot_label():
+    """The figure labels each measured column; a new quantity without a label fails the --out figure."""
+    from passmd.plots import fit as plot
+
+    assert set(F.MEASURED) <= set(plot._LABELS)

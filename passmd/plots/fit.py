@@ -13,7 +13,7 @@ from matplotlib.figure import Figure
 __all__ = ["fit_figure"]
 
 _LABELS = {"step_nm": "step", "velocity_mm_per_s": "velocity", "critical_amplitude_nm": "critical amplitude",
-           "force_N": "generated force"}
+           "force_N": "generated force", "position_nm": "position after three periods"}
 
 
 def fit_figure(result) -> Figure:

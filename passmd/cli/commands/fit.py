@@ -148,11 +148,11 @@ def _write(target: Path, result, record: dict, text: str) -> None:
     from passmd.cli.streams import write_atomically
     from passmd.plots.fit import fit_figure
 
+    fig = fit_figure(result)  # before any file is written: a failing figure leaves none
     try:
         target.mkdir(exist_ok=True)
         write_atomically(target / "fit.json",
                          lambda tmp: Path(tmp).write_text(json.dumps(plain(record), indent=2) + "\n"))
-        fig = fit_figure(result)
         write_atomically(target / "fit.png", lambda tmp: fig.savefig(tmp, dpi=150, format="png"))
         write_atomically(target / "fitted-drive.txt", lambda tmp: Path(tmp).write_text(text))
     except OSError as exc:
