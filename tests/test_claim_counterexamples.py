@@ -18,10 +18,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd import ledger, readings, reference, theory
+from passmd import checks, ledger, readings, reference, theory
 from passmd.checks import NO_MEASURED_DATA, ClaimFails, NotEvaluable, check_claim
-from passmd.claims import load_claims
+from passmd.claims import SUBSTITUTE_PREFIX, load_claims, substitute_for
 from passmd.config import RunConfig
+from passmd.experiments import driving_waveform_claims as dw_claims
 from passmd.experiments.driving_waveform import section5_drive
 from passmd.experiments.force_generation import EARLIER, THIS
 
@@ -536,3 +537,61 @@ def test_check_fails_on_its_counter_example(claim_id, quick_results, claims):
         f"{claim_id} still holds on its counter-example ({description}): {outcome.detail}"
     )
     assert math.isnan(outcome.score) or outcome.score > 0
+
+
+# ======================================================================================
+# The pieces the counter-examples rely on
+# ======================================================================================
+
+
+def test_not_informative_must_be_a_reason():
+    with pytest.raises(ValueError, match="not_informative = 1 is not allowed"):
+        checks.extractor("fig8a-back-step", not_informative=1)
+    assert checks.extractor("fig8a-back-step")(lambda results: 0).not_informative == ""
+
+
+def test_a_substitute_row_needs_no_quote_but_a_real_claim(tmp_path):
+    claims = load_claims()
+    row = claims[claims["id"] == "fig7-rigid-mu03-flexible-mu02-onsets-agree"].iloc[0]
+    assert substitute_for(row) == "fig7-critical-amplitude-both-models" and row["source_quote"] == ""
+    bad = claims.drop(columns=["paper_value_num", "tolerance_num"])
+    at = bad["id"] == "fig7-rigid-mu03-flexible-mu02-onsets-agree"
+    bad.loc[at, "notes"] = SUBSTITUTE_PREFIX + "'no-such-claim': x"
+    path = tmp_path / "claims.csv"
+    bad.to_csv(path, index=False)
+    for name in (
+        "fig5b_closed_form.csv",
+        "fig6a_closed_form.csv",
+        "fig6b_closed_form.csv",
+        "fig6c_closed_form.csv",
+    ):
+        (tmp_path / name).write_bytes((reference.REFERENCE_DIR / name).read_bytes())
+    with pytest.raises(ValueError) as info:
+        load_claims(path)
+    assert "must name a claim id of this file" in str(info.value)
+
+
+def _velocities(frequencies, velocities, stick=None):
+    return pd.DataFrame(
+        {
+            "frequency_kHz": np.asarray(frequencies, float),
+            "velocity_mm_per_s": np.asarray(velocities, float),
+            "stick_during_acceleration": np.ones(len(frequencies), bool) if stick is None else stick,
+        }
+    )
+
+
+def test_a_fig10_maximum_away_from_the_papers_frequency_is_not_evaluable():
+    part = _velocities([1, 20, 60, 100, 110, 120, 130], [0.1, 5.0, 3.0, 2.0, 1.0, 0.5, 0.2])
+    with pytest.raises(NotEvaluable, match="not near the 110 kHz"):
+        dw_claims.reachable_maximum(part, dw_claims.NEAR_110)
+    assert dw_claims.reachable_maximum(part, dw_claims.AT_OR_BELOW_80)["frequency_kHz"] == 20.0
+
+
+def test_the_stick_edge_is_where_stick_is_lost_for_good():
+    f = [1, 20, 60, 100, 110, 120]
+    assert dw_claims.stick_edge(_velocities(f, f, stick=np.array([0, 1, 1, 1, 0, 0], bool))) == 100.0
+    with pytest.raises(ClaimFails, match="still sticks"):
+        dw_claims.stick_edge(_velocities(f, f, stick=np.array([0, 1, 1, 1, 1, 1], bool)))
+    with pytest.raises(ClaimFails, match="every grid frequency"):
+        dw_claims.stick_edge(_velocities(f, f, stick=np.zeros(6, bool)))

@@ -4,8 +4,11 @@ Decides the ledger's Section 4.1 rows (``passmd/data/reference/claims.csv``): no
 steady step below the critical amplitude in Fig. 5a (a threshold over the amplitude grid); the
 simulated A_c against the closed forms Eq. 7 and Eq. 8 (Fig. 5b, one contact), Eq. 11 (Fig. 6a)
 and Eq. 12 (Figs. 6b, 6c, six contacts), each a value check of the curve A_c(F_p); flexible
-above rigid (Fig. 5b) and A_c closer to Eq. 11's u_x,max,e than to either form of Eq. 10
-(Fig. 6a, deviations from :func:`passmd.checks.curve_deviation`) as orderings.
+above rigid (Fig. 5b), A_c closer to Eq. 11's u_x,max,e than to either form of Eq. 10 (Fig. 6a)
+and to Eq. 12 than to either form of Eq. 13 (Figs. 6b, 6c; deviations from
+:func:`passmd.checks.curve_deviation`), and the actuators' interaction changing A_c (six against
+one contact at the same preload) as orderings. Fig. 6b's agreement with the experiment is
+inconclusive: the measured data are not in the paper's text.
 
 Each extractor reads the figure tables of :mod:`passmd.experiments.critical_amplitude` at one
 ledger reading (:mod:`passmd.readings`: the A_c protocol, the fly-back rule, the drive

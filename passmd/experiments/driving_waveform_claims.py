@@ -2,15 +2,19 @@
 conclusion's claims drawn from them).
 
 Decides the ledger's Section 5 rows (``passmd/data/reference/claims.csv``). Section 5.1, from
-the time series of Fig. 8 and the resolved fly-back window (``fig8b_window``): the saw-tooth's
-back step, the optimized response's reversal after t_s, t_a starting at the runner's velocity
-maximum, stick during t_a, the contacts deformed to u_x,max after the fly-back and the runner
-fastest at the end of t_a. Section 5.2, from Fig. 9a's three periods (at the ledger's reading of
-μ) and the steady velocities of Figs. 9b and 10 (at its reading of the short-period rule of the
-optimized waveform): final positions and step increase, the velocity gain, the saw-tooth's
-step and velocity, the frequencies where the velocity turns and where t_s no longer fits, the
-reachable maxima of Fig. 10 and their orderings over preload, radius and runner material.
-Evidence functions add the numbers behind an ordering (Fig. 10: at the paper's 110 kHz).
+the time series of Figs. 8 and 9a and the resolved fly-back window (``fig8b_window``): the
+saw-tooth's back step and whether its micro-vibration dies within the next stick phase, the
+micro-vibration after the optimized waveform's acceleration against the saw-tooth's f_s, t_a
+starting at the runner's velocity maximum, stick during t_a, the contacts deformed to u_x,max
+after the fly-back, the runner fastest at the end of t_a and slipping forward further than the
+hemispheres move (Sub-phase II). Section 5.2, from Fig. 9a's three periods (at the ledger's
+reading of μ) and the steady velocities of Figs. 9b and 10 (at its reading of the short-period
+rule of the optimized waveform): final positions and step increase, the velocity gain, the
+saw-tooth's step and velocity, the frequencies where the velocity turns and where t_s no longer
+fits, the reachable maxima of Fig. 10 (interior and where the paper puts them, else
+inconclusive) and their orderings over preload, radius and runner material, the 0.1 N maximum
+at the loss of stick. Evidence functions add the numbers behind an ordering (Fig. 10: at the
+paper's 110 kHz).
 
 Each extractor reads the figure tables of :mod:`passmd.experiments.driving_waveform` and returns
 what :mod:`passmd.checks` compares with the paper; a grid that cannot locate what a claim names

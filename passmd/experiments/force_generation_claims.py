@@ -4,10 +4,12 @@ Decides the ledger's Section 4.2 rows (``passmd/data/reference/claims.csv``): th
 difference between the earlier model of [12] (rigid actuators, μ = 0.3) and this paper's
 (flexible actuators, μ = 0.2) at the full stroke and 0.8 N (a value, at the ledger's reading of
 the force-run frequency), the growth of that difference with the amplitude in Figs. 7a and 7b
-(trends), the earlier model above this paper's at every preload of both grids (an ordering),
-the onsets of force generation of both models (compared over the four preloads of Figs. 7a
-and 7b) and the split of the difference into its friction and actuator parts from one stall
-period (``fig7cycle``; with its evidence).
+(trends, above both models' onsets), the earlier model above this paper's at every preload of
+both grids (an ordering), the onsets of force generation of both models compared with each other
+over the four preloads of Figs. 7a and 7b (a model-against-model row), F_gen growing with the
+amplitude above its onset and with the preload (trends), and the split of the difference into
+its friction and actuator parts from one stall period (``fig7cycle``; with its evidence). The
+statements about the experiment of [12] are inconclusive: its data are not in the paper's text.
 
 Each extractor reads the figure tables of :mod:`passmd.experiments.force_generation` (stalled
 runs only, through :func:`~passmd.experiments.force_generation.force_difference` and
