@@ -21,7 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from passmd.checks import ClaimFails, NotEvaluable, evidence, extractor, no_measured_data
+from passmd.checks import ClaimFails, NotEvaluable, check_trend, evidence, extractor, no_measured_data
+from passmd.claims import load_claims
 from passmd.experiments.force_generation import (
     EARLIER,
     FORCE_FREQUENCY,
@@ -208,4 +209,13 @@ def _force_grows_with_preload(results) -> dict:
                                                        "y": rows["generated_force_mN"].to_numpy()}
     if not out:
         raise NotEvaluable("no full-stroke runs on the preload grids")
+    # 'grows with the preload' is over the whole grids: a pass needs all of them, a failure needs one
+    computed = {(round(r, 9), round(p, 9)) for r, p in zip(full["radius_mm"], full["preload_N"], strict=True)}
+    missing = [(r * 1e3, p) for r, grid_ in PRELOAD_GRIDS.items() for p in grid_
+               if (round(r * 1e3, 9), round(float(p), 9)) not in computed]
+    tolerance = float(load_claims().set_index("id").at["fig7-force-grows-with-preload", "tolerance_num"])
+    if missing and check_trend(out, "increasing", tolerance, "rel").passed:
+        raise NotEvaluable(f"grows over the {len(computed)} preloads computed on this profile; "
+                           f"{len(missing)} preloads of the grids are not computed, e.g. "
+                           f"{missing[0][1]:g} N at R = {missing[0][0]:g} mm")
     return out
