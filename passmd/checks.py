@@ -47,6 +47,7 @@ __all__ = [
     "ClaimFunctions",
     "ExtractorError",
     "Inconclusive",
+    "NO_MEASURED_DATA",
     "NotEvaluable",
     "Outcome",
     "check_claim",
@@ -59,6 +60,7 @@ __all__ = [
     "evidence",
     "extractor",
     "format_number",
+    "no_measured_data",
 ]
 
 
@@ -73,6 +75,16 @@ class NotEvaluable(Exception):
 
 #: The name the verdict taxonomy uses for :class:`NotEvaluable`.
 Inconclusive = NotEvaluable
+
+
+#: How the verdict of a claim about the experiment begins: the paper's text tabulates no measurement.
+NO_MEASURED_DATA = "no measured data in the paper's text"
+
+
+def no_measured_data(what: str):
+    """Raise :class:`NotEvaluable` for a claim about the experiment: the paper's text gives none of
+    its measurements (``what`` names them), so no computation can decide the claim."""
+    raise NotEvaluable(f"{NO_MEASURED_DATA}: {what}")
 
 
 class ClaimFails(Exception):
@@ -369,7 +381,7 @@ def _check_claim_id(claim_id) -> str:
     return claim_id
 
 
-def extractor(claim_id: str, depends_on=()) -> Callable[[Callable], Callable]:
+def extractor(claim_id: str, depends_on=(), *, not_informative: str = "") -> Callable[[Callable], Callable]:
     """Decorator: tag ``func(results[, reading]) -> ours`` as the extractor of a claim.
 
     ``ours`` must have the form the claim's check kind expects (module docstring) and be in
@@ -380,17 +392,26 @@ def extractor(claim_id: str, depends_on=()) -> Callable[[Callable], Callable]:
     on; the function then takes a second argument ``reading`` (``{axis: value}``) and is
     evaluated at every reading of :func:`passmd.readings.design`.
 
-    The decorator only sets ``func.claim_extractor`` (the id) and ``func.claim_depends_on``;
-    :func:`collect_claim_functions` finds the tagged functions of a module.
+    ``not_informative`` says why the claim's check cannot fail on any result the model can
+    produce (a closed-form identity, a statement every finite contact stiffness satisfies at the
+    claim's amplitude); empty (the default) for a check some counter-example makes fail. The
+    ledger counts the non-informative claims apart.
+
+    The decorator only sets ``func.claim_extractor`` (the id), ``func.claim_depends_on`` and
+    ``func.not_informative``; :func:`collect_claim_functions` finds the tagged functions of a module.
     """
     _check_claim_id(claim_id)
     depends = tuple(depends_on)
     for key in depends:
         readings.axis(key)  # ValueError naming the declared axes
+    if not isinstance(not_informative, str):
+        raise ValueError(f"not_informative = {not_informative!r} is not allowed: must be a reason (str), "
+                         "empty for an informative check")
 
     def tag(func: Callable) -> Callable:
         func.claim_extractor = claim_id
         func.claim_depends_on = depends
+        func.not_informative = not_informative.strip()
         return func
 
     return tag

@@ -28,9 +28,11 @@ __all__ = [
     "CONFIGURATION_COLUMNS",
     "RELATIONS",
     "STATUSES",
+    "SUBSTITUTE_PREFIX",
     "TOLERANCE_KINDS",
     "is_number",
     "load_claims",
+    "substitute_for",
     "tolerance_text",
 ]
 
@@ -93,6 +95,8 @@ def _row_errors(row: Mapping[str, str], reference_dir: Path) -> list[str]:
         bad("id", "a slug of lower-case letters, digits, '.', '_', '-'")
     for column in ("figure", "quantity", "ours_definition", "check", "source_section", "source_quote",
                    "tolerance_reason"):
+        if column == "source_quote" and substitute_for(row):
+            continue  # a model-against-model substitute states no claim of the paper
         if not row[column].strip():
             errors.append(f"{column} is empty: it is required")
     keys = [k for k in row["requires"].split(";") if k]
@@ -140,6 +144,18 @@ def _row_errors(row: Mapping[str, str], reference_dir: Path) -> list[str]:
     if kind in ("ordering", "trend") and row["paper_value"]:
         bad("paper_value", f"empty for a {kind} claim")
     return errors
+
+
+#: How a row's ``notes`` begin when the row is our model-against-model substitute for a claim about
+#: the experiment (``Model-against-model substitute for 'claim-id': ...``): it has no quote of its own.
+SUBSTITUTE_PREFIX = "Model-against-model substitute for "
+_SUBSTITUTE = re.compile(rf"^{SUBSTITUTE_PREFIX}'([a-z0-9][a-z0-9._-]*)'")
+
+
+def substitute_for(row: Mapping[str, str]) -> str:
+    """The claim id a model-against-model substitute row stands in for; empty for a claim of the paper."""
+    match = _SUBSTITUTE.match(row["notes"])
+    return match.group(1) if match else ""
 
 
 def _reference_errors(spec: str, reference_dir: Path) -> list[str]:
@@ -190,6 +206,10 @@ def load_claims(path=None) -> pd.DataFrame:
     errors.extend(f"id {claim!r} appears more than once" for claim in duplicated)
     for _, row in claims.iterrows():
         errors.extend(f"row {row['id']!r}: {message}" for message in _row_errors(row, path.parent))
+        target = substitute_for(row)
+        if target and (target not in set(claims["id"]) or row["source_quote"]):
+            errors.append(f"row {row['id']!r}: notes = {SUBSTITUTE_PREFIX}{target!r} is not allowed: must "
+                          "name a claim id of this file, and a substitute row has an empty source_quote")
     if errors:
         raise ValueError(f"{path.name} has {len(errors)} schema error(s):\n  " + "\n  ".join(errors))
     claims["paper_value_num"] = pd.to_numeric(claims["paper_value"].replace("", np.nan))

@@ -1,0 +1,597 @@
+"""Every claim check can fail: each informative extractor has a counter-example on which it fails.
+
+A counter-example is the quick profile's result tables with one quantity changed the way the
+claim forbids (a constructed result), or the default model run itself where that run already
+contradicts the paper (named "default model run"). The extractor reads it and
+:func:`passmd.checks.check_claim` must report a failure (or the extractor decides the claim
+against the paper with :class:`passmd.checks.ClaimFails`); an undecided counter-example
+(:class:`passmd.checks.NotEvaluable`) does not count.
+
+Claims whose check holds by construction are marked ``not_informative`` on their extractor with
+the reason, checked here by computation; claims about the experiment, whose data the paper's
+text does not give, are always inconclusive.
+"""
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from passmd import checks, ledger, readings, reference, theory
+from passmd.checks import NO_MEASURED_DATA, ClaimFails, NotEvaluable, check_claim
+from passmd.claims import SUBSTITUTE_PREFIX, load_claims, substitute_for
+from passmd.config import RunConfig
+from passmd.experiments import driving_waveform_claims as dw_claims
+from passmd.experiments.driving_waveform import section5_drive
+from passmd.experiments.force_generation import EARLIER, THIS
+
+#: Claims about the experiment of [12]: inconclusive whatever the model computes.
+EXPERIMENT_CLAIMS = (
+    "abstract-agreement-with-experiment",
+    "fig6b-experiment-agreement",
+    "fig7-critical-amplitude-both-models",
+    "fig7-flexible-covers-experiment",
+)
+
+
+# ======================================================================================
+# Building counter-examples from the quick tables
+# ======================================================================================
+
+
+def _edit(results: dict, key: str, change) -> dict:
+    """A shallow copy of ``results`` whose table ``key`` is ``change(copy of the table)``."""
+    out = dict(results)
+    out[key] = change(results[key].copy())
+    return out
+
+
+def _scale(key: str, column: str, factor: float, **where):
+    def change(t):
+        t.loc[_rows(t, **where), column] = t.loc[_rows(t, **where), column] * factor
+        return t
+
+    return lambda r: _edit(r, key, change)
+
+
+def _rows(t: pd.DataFrame, **where) -> pd.Series:
+    sel = pd.Series(True, index=t.index)
+    for column, value in where.items():
+        sel &= np.isclose(t[column], value) if isinstance(value, float) else (t[column] == value)
+    return sel
+
+
+def _model(t: pd.DataFrame, model: tuple) -> pd.Series:
+    return (t["actuator_model"] == model[0]) & np.isclose(t["friction_coefficient"], model[1])
+
+
+def _closed_form_as_ac(key: str, column: str):
+    """A_c replaced by one closed-form curve (e.g. a single side's presliding)."""
+    curve = reference.load_reference_curve(f"{key}_closed_form")
+
+    def change(t):
+        t["critical_amplitude_nm"] = np.interp(t["preload_N"], curve["preload_N"], curve[column])
+        return t
+
+    return lambda r: _edit(r, key, change)
+
+
+def _one_contact_ac_for_six(results):
+    """Six-contact A_c (Fig. 6b) set to the one-contact A_c (Fig. 5b) at the same preload."""
+    keys = ["actuator_model", "preload_N", "protocol", "flyback", "frequency_Hz", "damping_ratio"]
+    one = results["fig5b"][keys + ["critical_amplitude_nm"]].rename(columns={"critical_amplitude_nm": "one"})
+
+    def change(t):
+        merged = t.merge(one, on=keys, how="left")
+        t["critical_amplitude_nm"] = merged["one"].fillna(merged["critical_amplitude_nm"]).to_numpy()
+        return t
+
+    return _edit(results, "fig6b", change)
+
+
+def _flexible_force_for_rigid(key: str, offset_per_nm: float = 0.0):
+    """The earlier model's F_gen set to this paper's minus ``offset_per_nm`` · amplitude."""
+
+    def change(t):
+        for preload in t["preload_N"].unique():
+            this = t[_model(t, THIS) & np.isclose(t["preload_N"], preload)].set_index("amplitude_fraction")
+            earlier = _model(t, EARLIER) & np.isclose(t["preload_N"], preload)
+            fractions = t.loc[earlier, "amplitude_fraction"]
+            t.loc[earlier, "generated_force_mN"] = (
+                this.loc[fractions, "generated_force_mN"].to_numpy()
+                - offset_per_nm * t.loc[earlier, "amplitude_nm"].to_numpy()
+            )
+        return t
+
+    return lambda r: _edit(r, key, change)
+
+
+def _falling_force(key: str, x: str):
+    def change(t):
+        t["generated_force_mN"] = -t[x] * 1e3
+        return t
+
+    return lambda r: _edit(r, key, change)
+
+
+def _rigid_onset_doubled(results):
+    out = results
+    for key in ("fig7a", "fig7b"):
+
+        def change(t):
+            for preload in t["preload_N"].unique():
+                at = np.isclose(t["preload_N"], preload)
+                t.loc[at & _model(t, EARLIER), "onset_nm"] = 2 * float(
+                    t.loc[at & _model(t, THIS), "onset_nm"].iloc[0]
+                )
+            return t
+
+        out = _edit(out, key, change)
+    return out
+
+
+def _cycle_without_friction_part(results):
+    def change(t):
+        rigid_02 = float(t.loc[_model(t, ("rigid", 0.2)), "generated_force_mN"].iloc[0])
+        t.loc[_model(t, ("rigid", 0.3)), "generated_force_mN"] = rigid_02
+        return t
+
+    return _edit(results, "fig7cycle", change)
+
+
+def _earlier_below_at_full_stroke(results):
+    def change(t):
+        t.loc[_model(t, EARLIER) & np.isclose(t["amplitude_fraction"], 1.0), "generated_force_mN"] = 0.0
+        return t
+
+    return _edit(results, "fig7grid", change)
+
+
+def _fig9a(change_rows):
+    def change(t):
+        return change_rows(t)
+
+    return lambda r: _edit(r, "fig9a", change)
+
+
+def _optimized_as_sawtooth(t):
+    """Fig. 9a's optimized periods replaced by the saw-tooth's (no gain at all)."""
+    for mu in t["friction_coefficient"].unique():
+        at = np.isclose(t["friction_coefficient"], mu) & (t["view"] == "period")
+        saw = t[at & (t["waveform"] == "sawtooth")].sort_values("period")
+        opt = t[at & (t["waveform"] == "optimized")].sort_values("period")
+        t.loc[opt.index, "settled_position_m"] = saw["settled_position_m"].to_numpy()
+    return t
+
+
+def _series_values(key: str, column: str, values, variant: str = "optimized", **where):
+    """``column`` of one series set to ``values(frequency_kHz)``."""
+
+    def change(t):
+        sel = _rows(t, variant=variant, **where)
+        t.loc[sel, column] = values(t.loc[sel, "frequency_kHz"].to_numpy())
+        return t
+
+    return lambda r: _edit(r, key, change)
+
+
+def _peak(at_kHz: float, height: float):
+    """A velocity curve over the grid with its only maximum, ``height``, at ``at_kHz``."""
+    return lambda f: height - 0.01 * np.abs(f - at_kHz)
+
+
+def _chain(*steps):
+    def build(results):
+        for step in steps:
+            results = step(results)
+        return results
+
+    return build
+
+
+def _sawtooth_gain_zero(key: str):
+    """Fig. 9b's optimized velocities set to the saw-tooth's (gain 0 at every frequency)."""
+
+    def change(t):
+        saw = t[t["variant"] == "sawtooth"].set_index("frequency_kHz")["velocity_mm_per_s"]
+        opt = t["variant"] == "optimized"
+        t.loc[opt, "velocity_mm_per_s"] = saw.loc[t.loc[opt, "frequency_kHz"]].to_numpy()
+        return t
+
+    return lambda r: _edit(r, key, change)
+
+
+def _optimized_slower(results):
+    def change(t):
+        saw = t[t["variant"] == "sawtooth"].set_index("frequency_kHz")["velocity_mm_per_s"]
+        opt = t["variant"] == "optimized"
+        t.loc[opt, "velocity_mm_per_s"] = saw.loc[t.loc[opt, "frequency_kHz"]].to_numpy() - 1.0
+        return t
+
+    return _edit(results, "fig9b", change)
+
+
+def _frozen_runner_after_point4(results):
+    """Fig. 8b's runner held where it is at point 4 (it never slips forward)."""
+
+    def change(t):
+        point4 = t[(t["view"] == "point") & (t["point"].astype(str) == "4")].iloc[0]
+        later = (t["view"] == "zoom") & (t["time_us"] >= point4["time_us"])
+        t.loc[later, "runner_position_nm"] = point4["runner_position_nm"]
+        return t
+
+    return _edit(results, "fig8b", change)
+
+
+def _undamped_fig8a(results):
+    """A Fig. 8a record, finely sampled, whose 10 kHz micro-vibration never decays."""
+    period, f_s, flyback = 0.01, 10e3, 2e-6
+    rows = []
+    for view, (t0, t1, n) in {
+        "full": (0.0, 2 * period, 20001),
+        "zoom": (period - 10e-6, period + 250e-6, 2601),
+    }.items():
+        t = np.linspace(t0, t1, n)
+        ramp = 202e-9 * ((t % period) / period)
+        v = 202e-9 / period + np.where(t > period, 1e-3 * np.sin(2 * np.pi * f_s * (t - period)), 0.0)
+        rows.append(
+            pd.DataFrame({"view": view, "time_s": t, "piezo_position_m": ramp, "runner_velocity_m_per_s": v})
+        )
+    rows.append(pd.DataFrame({"view": ["point"], "point": ["1"], "time_s": [period - flyback]}))
+    table = pd.concat(rows, ignore_index=True)
+    table["micro_vibration_frequency_Hz"] = f_s
+    table["time_us"] = table["time_s"] * 1e6
+    return {**results, "fig8a": table}
+
+
+#: claim id -> (what the counter-example is, how it is built from the quick results).
+COUNTER_EXAMPLES = {
+    # Section 4.1
+    "fig5a-no-step-below-50nm": (
+        "a 1 µm step at every amplitude",
+        lambda r: _edit(r, "fig5a", lambda t: t.assign(steady_step_nm=1e3)),
+    ),
+    "fig5b-rigid-ac-matches-eq7": (
+        "rigid A_c 1.5 times larger",
+        _scale("fig5b", "critical_amplitude_nm", 1.5),
+    ),
+    "fig5b-flexible-ac-matches-eq8": (
+        "flexible A_c 1.5 times larger",
+        _scale("fig5b", "critical_amplitude_nm", 1.5),
+    ),
+    "fig5b-flexible-above-rigid": (
+        "flexible A_c a hundredth of its value",
+        _scale("fig5b", "critical_amplitude_nm", 0.01, actuator_model="flexible"),
+    ),
+    "fig6a-rigid-ac-matches-eq11": ("A_c 1.5 times larger", _scale("fig6a", "critical_amplitude_nm", 1.5)),
+    "fig6a-rigid-ac-not-eq10": (
+        "A_c equal to the side-1 presliding u_x,max,1",
+        _closed_form_as_ac("fig6a", "u_x_max_1_nm"),
+    ),
+    "fig6b-flexible-r1-ac-matches-eq12": (
+        "A_c 1.5 times larger",
+        _scale("fig6b", "critical_amplitude_nm", 1.5),
+    ),
+    "fig6c-flexible-r025-ac-matches-eq12": (
+        "A_c 1.5 times larger",
+        _scale("fig6c", "critical_amplitude_nm", 1.5),
+    ),
+    "fig6b-flexible-r1-ac-not-eq13": (
+        "A_c equal to u*_x,max,1 (Eq. 13)",
+        _closed_form_as_ac("fig6b", "u_x_max_1_star_nm"),
+    ),
+    "fig6c-flexible-r025-ac-not-eq13": (
+        "A_c equal to u*_x,max,2 (Eq. 13)",
+        _closed_form_as_ac("fig6c", "u_x_max_2_star_nm"),
+    ),
+    "sec4-1-interaction-changes-ac": (
+        "six-contact A_c equal to the one-contact A_c",
+        _one_contact_ac_for_six,
+    ),
+    # Section 4.2
+    "fig7a-force-difference-115mn": (
+        "the earlier model's F_gen equal to this paper's",
+        _flexible_force_for_rigid("fig7a"),
+    ),
+    "fig7a-discrepancy-grows-with-amplitude": (
+        "a difference falling with the amplitude",
+        _flexible_force_for_rigid("fig7a", offset_per_nm=1.0),
+    ),
+    "fig7b-discrepancy-grows-with-amplitude": (
+        "a difference falling with the amplitude",
+        _flexible_force_for_rigid("fig7b", offset_per_nm=1.0),
+    ),
+    "fig7-rigid-mu03-flexible-mu02-onsets-agree": (
+        "the rigid onsets twice the flexible ones",
+        _rigid_onset_doubled,
+    ),
+    "fig7-force-grows-with-amplitude-above-onset": (
+        "F_gen falling with the amplitude",
+        _falling_force("fig7a", "amplitude_nm"),
+    ),
+    "fig7-force-grows-with-preload": (
+        "F_gen falling with the preload",
+        _falling_force("fig7grid", "preload_N"),
+    ),
+    "sec4-2-friction-and-actuator-dynamics-cause-discrepancy": (
+        "μ 0.3 and μ 0.2 rigid forces equal",
+        _cycle_without_friction_part,
+    ),
+    "sec4-2-other-preloads-same-trend": (
+        "the earlier model's full-stroke force 0 at every preload",
+        _earlier_below_at_full_stroke,
+    ),
+    # Section 5.1
+    "sec5-response-to-optimized-similar": (
+        "the optimized run's f_s 1.5 times the saw-tooth's",
+        _scale("fig9a", "micro_vibration_frequency_Hz", 1.5, waveform="optimized"),
+    ),
+    "sec5-1-acceleration-starts-at-velocity-maximum": ("default model run", lambda r: r),
+    "sec5-1-stick-during-acceleration": ("default model run", lambda r: r),
+    "sec5-1-fastest-at-end-of-acceleration": ("default model run", lambda r: r),
+    "sec5-1-runner-overshoots-in-slip": ("the runner frozen from point 4 on", _frozen_runner_after_point4),
+    "fig8a-micro-vibration-damped-within-next-stick": ("an undamped 10 kHz micro-vibration", _undamped_fig8a),
+    # Section 5.2, Fig. 9
+    "fig9a-standard-position-552nm": (
+        "saw-tooth positions doubled",
+        _scale("fig9a", "settled_position_m", 2.0, waveform="sawtooth"),
+    ),
+    "fig9a-optimized-position-716nm": (
+        "optimized positions a tenth",
+        _scale("fig9a", "settled_position_m", 0.1, waveform="optimized"),
+    ),
+    "fig9a-step-increase-46.8pct": (
+        "optimized periods equal to the saw-tooth's",
+        _fig9a(_optimized_as_sawtooth),
+    ),
+    "fig9a-optimized-step-larger": (
+        "optimized periods equal to the saw-tooth's",
+        _fig9a(_optimized_as_sawtooth),
+    ),
+    "fig9b-optimized-faster-below-110khz": ("optimized 1 mm/s slower everywhere", _optimized_slower),
+    "fig9b-max-gain-2.5mm_s": ("optimized velocity equal to the saw-tooth's", _sawtooth_gain_zero("fig9b")),
+    "abstract-velocity-gain-15pct": (
+        "optimized velocity equal to the saw-tooth's",
+        _sawtooth_gain_zero("fig9b"),
+    ),
+    "fig9b-optimized-decreases-above-110khz": (
+        "optimized velocity rising to the grid's end",
+        _series_values("fig9b", "velocity_mm_per_s", lambda f: f),
+    ),
+    "fig9b-standard-increases-above-110khz": (
+        "saw-tooth velocity falling with frequency",
+        _series_values("fig9b", "velocity_mm_per_s", lambda f: -f, variant="sawtooth"),
+    ),
+    "fig9b-step-decreases-with-frequency": (
+        "saw-tooth step rising with frequency",
+        _series_values("fig9b", "step_nm", lambda f: f, variant="sawtooth"),
+    ),
+    "fig9b-sawtooth-velocity-16.5mm_s-at-110khz": (
+        "saw-tooth velocity 0",
+        _scale("fig9b", "velocity_mm_per_s", 0.0, variant="sawtooth"),
+    ),
+    "fig9b-no-time-to-settle-above-110khz": (
+        "t_s fitting at every frequency",
+        lambda r: _edit(r, "fig9b", lambda t: t.assign(settling_fits=True)),
+    ),
+    # Section 5.2, Fig. 10
+    "fig10a-max-velocity-19mm_s": (
+        "an interior maximum of 5 mm/s at 110 kHz",
+        _series_values("fig10a", "velocity_mm_per_s", _peak(110, 5.0), preload=0.4),
+    ),
+    "fig10a-max-velocity-at-110khz": (
+        "an interior maximum at 60 kHz",
+        _series_values("fig10a", "velocity_mm_per_s", _peak(60, 5.0), preload=0.4),
+    ),
+    "fig10a-1n-slower": (
+        "1 N peaking at 100 kHz above 0.4 N at 110 kHz",
+        _chain(
+            _series_values("fig10a", "velocity_mm_per_s", _peak(110, 5.0), preload=0.4),
+            _series_values("fig10a", "velocity_mm_per_s", _peak(100, 10.0), preload=1.0),
+        ),
+    ),
+    "fig10a-1n-larger-back-step": (
+        "1 N's back-step a tenth of 0.4 N's at interior maxima",
+        _chain(
+            _series_values("fig10a", "velocity_mm_per_s", _peak(110, 5.0), preload=0.4),
+            _series_values("fig10a", "velocity_mm_per_s", _peak(100, 10.0), preload=1.0),
+            _series_values("fig10a", "back_step_nm", lambda f: 10 + 0 * f, preload=0.4),
+            _series_values("fig10a", "back_step_nm", lambda f: 1 + 0 * f, preload=1.0),
+        ),
+    ),
+    "fig10a-0.1n-smaller-back-step": (
+        "0.1 N's back-step 10 nm larger than 0.4 N's",
+        _chain(
+            _series_values("fig10a", "back_step_nm", lambda f: 5 + 0 * f, preload=0.4),
+            _series_values("fig10a", "back_step_nm", lambda f: 15 + 0 * f, preload=0.1),
+        ),
+    ),
+    "fig10a-0.1n-stick-lost-above-80khz": (
+        "stick at every frequency at 0.1 N",
+        lambda r: _edit(r, "fig10a", lambda t: t.assign(stick_during_acceleration=True)),
+    ),
+    "fig10a-0.1n-slightly-slower": (
+        "0.1 N peaking at 60 kHz above 0.4 N at 110 kHz",
+        _chain(
+            _series_values("fig10a", "velocity_mm_per_s", _peak(110, 5.0), preload=0.4),
+            _series_values("fig10a", "velocity_mm_per_s", _peak(60, 10.0), preload=0.1),
+        ),
+    ),
+    "fig10a-0.1n-maximum-at-or-below-80khz": (
+        "0.1 N peaking at 20 kHz, stick lost only above 100 kHz",
+        _chain(
+            _series_values("fig10a", "velocity_mm_per_s", _peak(20, 5.0), preload=0.1),
+            _series_values("fig10a", "stick_during_acceleration", lambda f: f <= 100.0 + 1e-9, preload=0.1),
+        ),
+    ),
+    "fig10b-r1-faster": (
+        "R = 1 mm 1 mm/s slower at every frequency",
+        _chain(
+            _series_values("fig10b", "velocity_mm_per_s", lambda f: 5 + 0 * f, radius_mm=0.25),
+            _series_values("fig10b", "velocity_mm_per_s", lambda f: 4 + 0 * f, radius_mm=1.0),
+        ),
+    ),
+    "fig10b-r1-higher-max-frequency": (
+        "both radii peaking at 110 kHz",
+        _chain(
+            _series_values("fig10b", "velocity_mm_per_s", _peak(110, 5.0), radius_mm=0.25),
+            _series_values("fig10b", "velocity_mm_per_s", _peak(110, 6.0), radius_mm=1.0),
+        ),
+    ),
+    "fig10b-r1-smaller-back-step": (
+        "R = 1 mm's back-step ten times R = 0.25 mm's",
+        _chain(
+            _series_values("fig10b", "velocity_mm_per_s", _peak(110, 5.0), radius_mm=0.25),
+            _series_values("fig10b", "velocity_mm_per_s", _peak(110, 6.0), radius_mm=1.0),
+            _series_values("fig10b", "back_step_nm", lambda f: 1 + 0 * f, radius_mm=0.25),
+            _series_values("fig10b", "back_step_nm", lambda f: 10 + 0 * f, radius_mm=1.0),
+        ),
+    ),
+    "fig10c-youngs-modulus-negligible": (
+        "molybdenum half as fast as steel at 110 kHz",
+        _chain(
+            _series_values("fig10c", "velocity_mm_per_s", _peak(110, 10.0), runner="steel"),
+            _series_values("fig10c", "velocity_mm_per_s", _peak(110, 5.0), runner="molybdenum"),
+        ),
+    ),
+    "conclusion-youngs-modulus-weaker-than-preload-and-radius": (
+        "a runner effect of 15 mm/s, preload and radius effects of 0.1 mm/s",
+        _chain(
+            _series_values("fig10c", "velocity_mm_per_s", _peak(110, 20.0), runner="steel"),
+            _series_values("fig10c", "velocity_mm_per_s", _peak(110, 5.0), runner="molybdenum"),
+            _series_values("fig10a", "velocity_mm_per_s", _peak(110, 5.1), preload=0.4),
+            _series_values("fig10a", "velocity_mm_per_s", _peak(100, 5.0), preload=1.0),
+            _series_values("fig10b", "velocity_mm_per_s", _peak(110, 5.1), radius_mm=1.0),
+            _series_values("fig10b", "velocity_mm_per_s", _peak(100, 5.0), radius_mm=0.25),
+        ),
+    ),
+}
+
+
+# ======================================================================================
+# Tests
+# ======================================================================================
+
+
+def test_every_extractor_has_a_counter_example_or_is_marked_not_informative():
+    functions = ledger.extractors()
+    marked = {c for c, f in functions.items() if f.not_informative}
+    informative = set(functions) - marked - set(EXPERIMENT_CLAIMS)
+    assert sorted(informative - set(COUNTER_EXAMPLES)) == [], (
+        "informative extractors without a counter-example"
+    )
+    assert sorted(set(COUNTER_EXAMPLES) - informative) == [], "counter-examples for no informative extractor"
+    assert marked == {
+        "fig10b-r1-stiffer-contact",
+        "fig8a-back-step",
+        "sec5-1-spring-deformed-to-ux-max-after-flyback",
+    }
+    assert all(len(functions[c].not_informative) > 40 for c in marked), (
+        "a not-informative mark needs its reason"
+    )
+
+
+@pytest.mark.parametrize("claim_id", EXPERIMENT_CLAIMS)
+def test_experiment_claims_are_inconclusive_for_want_of_data(claim_id):
+    with pytest.raises(NotEvaluable, match=NO_MEASURED_DATA):
+        ledger.extractors()[claim_id]({})
+
+
+def test_not_informative_reasons_hold():
+    # closed-form identity: 2aG* ∝ R^(1/3) at every normal force, so the ratio is 4^(1/3) exactly
+    table = reference.tangential_stiffness_table()
+    k = {
+        r: g.sort_values(["preload_N", "side"])["tangential_stiffness_N_per_m"].to_numpy()
+        for r, g in table.groupby("radius_mm")
+    }
+    np.testing.assert_allclose(k[1.0] / k[0.25], 4 ** (1 / 3), rtol=1e-12)
+    # the 202 nm fly-back is at least six times either side's presliding u_x,max (Eq. 10) at 0.4 N
+    drive = section5_drive()
+    presliding = np.asarray(theory.drive_theory(drive)["presliding_m"])
+    assert drive.actuator.full_stroke_amplitude > 6 * presliding.max()
+
+
+@pytest.fixture(scope="module")
+def quick_results():
+    return ledger.collect_results(RunConfig(profile="quick"))
+
+
+@pytest.fixture(scope="module")
+def claims():
+    return load_claims().set_index("id", drop=False)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("claim_id", sorted(COUNTER_EXAMPLES))
+def test_check_fails_on_its_counter_example(claim_id, quick_results, claims):
+    description, build = COUNTER_EXAMPLES[claim_id]
+    func = ledger.extractors()[claim_id]
+    results = build(quick_results)
+    try:
+        ours = func(results, readings.default_reading()) if func.claim_depends_on else func(results)
+    except ClaimFails:
+        return  # decided against the paper outright
+    outcome = check_claim(claims.loc[claim_id], ours)
+    assert not outcome.passed, (
+        f"{claim_id} still holds on its counter-example ({description}): {outcome.detail}"
+    )
+    assert math.isnan(outcome.score) or outcome.score > 0
+
+
+# ======================================================================================
+# The pieces the counter-examples rely on
+# ======================================================================================
+
+
+def test_not_informative_must_be_a_reason():
+    with pytest.raises(ValueError, match="not_informative = 1 is not allowed"):
+        checks.extractor("fig8a-back-step", not_informative=1)
+    assert checks.extractor("fig8a-back-step")(lambda results: 0).not_informative == ""
+
+
+def test_a_substitute_row_needs_no_quote_but_a_real_claim(tmp_path):
+    claims = load_claims()
+    row = claims[claims["id"] == "fig7-rigid-mu03-flexible-mu02-onsets-agree"].iloc[0]
+    assert substitute_for(row) == "fig7-critical-amplitude-both-models" and row["source_quote"] == ""
+    bad = claims.drop(columns=["paper_value_num", "tolerance_num"])
+    at = bad["id"] == "fig7-rigid-mu03-flexible-mu02-onsets-agree"
+    bad.loc[at, "notes"] = SUBSTITUTE_PREFIX + "'no-such-claim': x"
+    path = tmp_path / "claims.csv"
+    bad.to_csv(path, index=False)
+    for name in (
+        "fig5b_closed_form.csv",
+        "fig6a_closed_form.csv",
+        "fig6b_closed_form.csv",
+        "fig6c_closed_form.csv",
+    ):
+        (tmp_path / name).write_bytes((reference.REFERENCE_DIR / name).read_bytes())
+    with pytest.raises(ValueError) as info:
+        load_claims(path)
+    assert "must name a claim id of this file" in str(info.value)
+
+
+def _velocities(frequencies, velocities, stick=None):
+    return pd.DataFrame(
+        {
+            "frequency_kHz": np.asarray(frequencies, float),
+            "velocity_mm_per_s": np.asarray(velocities, float),
+            "stick_during_acceleration": np.ones(len(frequencies), bool) if stick is None else stick,
+        }
+    )
+
+
+def test_a_fig10_maximum_away_from_the_papers_frequency_is_not_evaluable():
+    part = _velocities([1, 20, 60, 100, 110, 120, 130], [0.1, 5.0, 3.0, 2.0, 1.0, 0.5, 0.2])
+    with pytest.raises(NotEvaluable, match="not near the 110 kHz"):
+        dw_claims.reachable_maximum(part, dw_claims.NEAR_110)
+    assert dw_claims.reachable_maximum(part, dw_claims.AT_OR_BELOW_80)["frequency_kHz"] == 20.0
+
+
+def test_the_stick_edge_is_where_stick_is_lost_for_good():
+    f = [1, 20, 60, 100, 110, 120]
+    assert dw_claims.stick_edge(_velocities(f, f, stick=np.array([0, 1, 1, 1, 0, 0], bool))) == 100.0
+    with pytest.raises(ClaimFails, match="still sticks"):
+        dw_claims.stick_edge(_velocities(f, f, stick=np.array([0, 1, 1, 1, 1, 1], bool)))
+    with pytest.raises(ClaimFails, match="every grid frequency"):
+        dw_claims.stick_edge(_velocities(f, f, stick=np.zeros(6, bool)))
