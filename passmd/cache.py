@@ -72,10 +72,14 @@ files there (the link itself is removed), and the cache's own temporary files. A
 other file (also a regular file at an entry's path that is not an entry: it is neither
 removed nor replaced, and its point is not cached) is reported as foreign and left alone.
 
-The directory is ``.passmd-cache/`` in the current working directory unless the caller
-names another (``Cache(directory)``; entry points take it from the run configuration,
+The directory is the user's cache folder for passmd (:func:`default_cache_dir`, e.g.
+``~/.cache/passmd/results`` on Linux, via :mod:`platformdirs`) unless the caller names another
+(``Cache(directory)``; entry points take it from the run configuration,
 :class:`passmd.config.RunConfig`, whose ``cache_dir`` comes from ``$PASSMD_CACHE_DIR`` or
-``--cache-dir``; this module reads no environment variable).
+``--cache-dir``; this module reads no environment variable). A run of the command line or the
+API leaves nothing in the folder it runs in; the book and the tests (``noxfile.py``) set
+``PASSMD_CACHE_DIR`` to the project's own ``.passmd-cache/`` (:data:`DEFAULT_CACHE_DIR`), which
+they share.
 ``passmd cache info|clear|prune`` shows, empties or prunes it (prune: entries of other
 code fingerprints, unreadable entries and stale temporary files).
 """
@@ -101,6 +105,7 @@ from enum import Enum
 from pathlib import Path
 
 import numpy as np
+import platformdirs
 
 __all__ = [
     "DEFAULT_CACHE_DIR",
@@ -120,12 +125,14 @@ __all__ = [
     "code_fingerprint",
     "decode_entry",
     "default_cache_dir",
+    "describe_default_cache_dir",
     "encode_entry",
     "function_code",
     "function_name",
 ]
 
-#: Cache directory (relative to the current working directory) when nothing overrides it.
+#: Name of the project-local cache folder the book and the tests use (``noxfile.py`` sets
+#: ``PASSMD_CACHE_DIR`` to it at the repository's root); ignored by git.
 DEFAULT_CACHE_DIR = ".passmd-cache"
 #: File suffix of an entry.
 ENTRY_SUFFIX = ".pmc"
@@ -193,8 +200,16 @@ class _TooLarge(ValueError):
 
 
 def default_cache_dir() -> Path:
-    """``./.passmd-cache`` of the current working directory (absolute)."""
-    return Path(DEFAULT_CACHE_DIR).resolve()
+    """The user's cache folder for passmd's results (absolute): ``results`` in
+    :func:`platformdirs.user_cache_dir` of ``passmd`` (``$XDG_CACHE_HOME/passmd/results`` or
+    ``~/.cache/passmd/results`` on Linux, ``~/Library/Caches/passmd/results`` on macOS,
+    ``%LOCALAPPDATA%\\passmd\\Cache\\results`` on Windows)."""
+    return (Path(platformdirs.user_cache_dir("passmd", appauthor=False)) / "results").resolve()
+
+
+def describe_default_cache_dir() -> str:
+    """The default directory for messages and help: ``the user cache folder <path>``."""
+    return f"the user cache folder {default_cache_dir()}"
 
 
 def code_fingerprint(package_dir: str | os.PathLike | None = None) -> str:

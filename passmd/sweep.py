@@ -23,10 +23,10 @@ off when the run configuration says so (``RunConfig.progress``, off on CI).
 
 How a sweep runs comes from its arguments or the :class:`~passmd.config.RunConfig` an entry
 point passes down; this module reads no environment variable. Without either: a process pool
-over all cores and the cache in ``./.passmd-cache``. When the configuration names a
-``sweep_log`` file, every sweep appends one JSON line to it (the function, and how many
-points were taken from the cache and how many computed): the book's execution-statistics
-page sums them per chapter.
+over all cores and the cache in the user's cache folder (:func:`passmd.cache.default_cache_dir`).
+When the configuration names a ``sweep_log`` file, every sweep appends one JSON line to it
+(the function, and how many points were taken from the cache and how many computed): the
+book's execution-statistics page sums them per chapter.
 """
 
 from __future__ import annotations
@@ -304,8 +304,8 @@ def run(
         configuration's workers, else all cores.
     cache : bool, Cache or path
         ``True`` (default): the cache in the configuration's ``cache_dir``, else in
-        ``./.passmd-cache``; ``False``: no caching; a :class:`~passmd.cache.Cache` or a
-        directory to use that one.
+        the user's cache folder (:func:`passmd.cache.default_cache_dir`); ``False``: no
+        caching; a :class:`~passmd.cache.Cache` or a directory to use that one.
     progress : bool, optional
         Progress on stderr once the sweep has run 2 s: True on any stderr (off a terminal a
         line every few seconds), False never; default: the configuration's ``progress``, else

@@ -270,14 +270,15 @@ def test_run_configuration_fills_the_defaults(tmp_path):
 def test_the_environment_does_not_steer_a_sweep(tmp_path, monkeypatch):
     """Only entry points read PASSMD_*: a sweep without a configuration runs with the defaults."""
     monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
     monkeypatch.setenv("PASSMD_EXECUTOR", "threads")
     monkeypatch.setenv("PASSMD_WORKERS", "two")
     monkeypatch.setenv("PASSMD_CACHE_DIR", str(tmp_path / "elsewhere"))
     monkeypatch.setenv("PASSMD_SWEEP_LOG", str(tmp_path / "log.jsonl"))
     frame = sweep.run(drive_theory_point, THEORY_GRID[:2], executor="serial")
     assert frame.attrs["sweep"]["computed"] == 2
-    assert len(Cache(tmp_path / ".passmd-cache").entries()) == 2
-    assert not (tmp_path / "elsewhere").exists() and not (tmp_path / "log.jsonl").exists()
+    assert len(Cache(tmp_path / "xdg" / "passmd" / "results").entries()) == 2  # the user cache folder
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["xdg"]  # nothing in the working folder
 
 
 def test_lambda_runs_serially_without_cache():
