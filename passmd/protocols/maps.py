@@ -16,9 +16,9 @@ waveform's parameters, built from the protocols the book uses (nothing is re-der
   (:func:`passmd.protocols.stall.generated_force`, Section 4.2);
 * ``gain``: the steady velocity of the optimized waveform (Eq. 15, designed from this drive's
   own saw-tooth response at this amplitude, :func:`passmd.protocols.eq15.optimized_design`)
-  minus that of the saw-tooth, both by the steady-velocity protocol. Below the amplitude at
-  which the saw-tooth response has a micro-vibration, Eq. 15 has no design: the point's gain
-  is ``None`` and ``note`` says why.
+  minus that of the saw-tooth, both by the steady-velocity protocol. Where Eq. 15 gives no
+  waveform (no micro-vibration in the saw-tooth response, or Δ_a ≥ A at small amplitudes) the
+  point's gain is ``None`` and ``note`` says why.
 
 All values are SI, keys carrying the unit, and the cache stores them as they are.
 """
@@ -74,8 +74,9 @@ def stall_point(drive: Drive, amplitude: float, frequency: float) -> dict:
 def gain_point(drive: Drive, amplitude: float, frequency: float) -> dict:
     """Steady velocity of the Eq. 15 waveform minus that of the saw-tooth (m/s), both measured.
 
-    ``gain_m_per_s`` and ``design_*`` are ``None`` with a ``note`` where Eq. 15 has no design
-    (no micro-vibration in the saw-tooth response at this amplitude).
+    ``gain_m_per_s`` and the design's times are ``None`` with a ``note`` where Eq. 15 gives no
+    waveform: no micro-vibration in the saw-tooth response at this amplitude, or an
+    acceleration segment Δ_a not below the amplitude.
     """
     saw = velocity.steady_run(drive, amplitude, frequency, "sawtooth", "cut")
     out = {"sawtooth_velocity_m_per_s": saw["velocity_m_per_s"], "optimized_velocity_m_per_s": None,
@@ -83,10 +84,10 @@ def gain_point(drive: Drive, amplitude: float, frequency: float) -> dict:
            "acceleration_amplitude_m": None, "note": None}
     try:
         design = eq15.optimized_design(amplitude, drive)
-    except InputError as exc:
-        out["note"] = f"no Eq. 15 design: {exc.detail or exc}"
+        opt = velocity.steady_run(drive, amplitude, frequency, "optimized", "cut", design)
+    except InputError as exc:  # no micro-vibration to design from, or Δ_a ≥ A (Eq. 15)
+        out["note"] = f"no Eq. 15 waveform at this amplitude: {exc.detail or exc}"
         return out
-    opt = velocity.steady_run(drive, amplitude, frequency, "optimized", "cut", design)
     out.update(optimized_velocity_m_per_s=opt["velocity_m_per_s"],
                gain_m_per_s=opt["velocity_m_per_s"] - saw["velocity_m_per_s"],
                settling_time_s=design.settling_time, acceleration_time_s=design.acceleration_time,

@@ -7,14 +7,13 @@ import itertools
 import json
 import math
 import re
-import shlex
-import sys
 import textwrap
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from passmd._validation import InputError
 from passmd.cli.configuration import run_config
 from passmd.cli.drive import build_drive, explain
 from passmd.cli.errors import OutputError, UsageError
@@ -73,7 +72,7 @@ _EPILOG = textwrap.dedent(f"""\
     folder; see 'passmd cache --help'): Ctrl-C keeps every finished point, and a rerun, or a
     map sharing points with an earlier one, computes only the missing points.
 
-    --out PREFIX writes PREFIX.csv ('#' lines: passmd version, git commit, command; read
+    --out PREFIX writes PREFIX.csv ('#' lines: passmd version, git commit, options; read
     with pandas.read_csv(path, comment="#")), PREFIX.json (the --json object) and PREFIX.png
     (a curve for one axis, a heat map with contours for two).
 
@@ -277,8 +276,27 @@ def _points(args, axes: list[Axis], with_amplitude: bool) -> list[dict]:
             point["amplitude"] = min(amplitude, a_max)
             columns.setdefault("amplitude_m", point["amplitude"])
         columns.setdefault("frequency_Hz", point["frequency"])
+        _check_waveform(args, axes, at, drive, point.get("amplitude", drive.actuator.full_stroke_amplitude),
+                        point["frequency"])
         points.append({**point, **columns})
     return points
+
+
+def _check_waveform(args, axes, at, drive, amplitude, frequency) -> None:
+    """The saw-tooth of a point can be built (e.g. its fly-back fits in half a period), before
+    anything runs; a refused frequency axis is named as typed."""
+    from passmd import waveforms
+
+    try:
+        waveforms.sawtooth(amplitude, frequency, drive, periods=1)
+    except InputError as exc:
+        if exc.name == "frequency" and "frequency" in at and exc.limits:
+            axis = next(a for a in axes if a.name == "frequency")
+            limits = " and ".join(f"{op} {fmt(bound, 'kHz')}" for op, bound in exc.limits)
+            why = f" ({exc.why})" if exc.why else ""
+            raise _refuse(axis.typed, f"{_shown(axis, frequency)} is out of range: must be "
+                                      f"{limits}{why}") from None
+        raise UsageError(explain(exc, args)) from None
 
 
 # --------------------------------------------------------------------------------------
@@ -291,13 +309,19 @@ def _finite_or_none(value):
     return value
 
 
+def _arguments(args) -> str:
+    """The command's options as parsed (the record of what was asked), one JSON line."""
+    skip = ("handler", "resumes_collector", "json", "profile")
+    given = {k: v for k, v in sorted(vars(args).items()) if k not in skip and v not in (None, False)}
+    return json.dumps(given, separators=(",", ":"), ensure_ascii=False)
+
+
 def _record(args, axes, table, spec, drive) -> dict:
     from passmd import __version__
     from passmd.provenance import git_commit
 
     rows = [{k: _finite_or_none(v) for k, v in row.items()} for row in table.to_dict(orient="records")]
-    main = [row[spec.column] for row in rows]
-    missing = sum(v is None for v in main)
+    missing = sum(row[spec.column] is None for row in rows)
     return {
         "command": "sweep",
         "quantity": args.quantity,
@@ -308,7 +332,7 @@ def _record(args, axes, table, spec, drive) -> dict:
                   "spacing": a.spacing, "typed": a.typed} for a in axes],
         "drive": drive_record(drive),
         "provenance": {"passmd_version": __version__, "git_commit": git_commit(),
-                       "command_line": shlex.join(["passmd", *sys.argv[1:]])},
+                       "arguments": _arguments(args)},
         "sweep": {k: table.attrs["sweep"][k] for k in ("points", "cached", "computed")},
         "missing_values": missing,
         "columns": list(map(str, table.columns)),
@@ -322,6 +346,8 @@ def _write(args, record, axes, spec, table, title) -> dict:
 
     prefix = args.out
     files = {"csv": prefix + ".csv", "json": prefix + ".json"}
+    if len(axes) <= 2:
+        files["png"] = prefix + ".png"
     header = "".join(f"# {k}: {v}\n" for k, v in record["provenance"].items())
     header += f"# quantity: {args.quantity} ({spec.column})\n"
     try:
@@ -333,8 +359,7 @@ def _write(args, record, axes, spec, table, title) -> dict:
         write_atomically(files["csv"], write_csv)
         text = json.dumps(plain({**record, "files": files}), indent=2, allow_nan=False) + "\n"
         write_atomically(files["json"], lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
-        if len(axes) <= 2:
-            files["png"] = prefix + ".png"
+        if "png" in files:
             fig = _figure(axes, spec, table, title)
             facts = record["provenance"]
             summary = f"passmd {facts['passmd_version']}, commit {facts['git_commit']}"
@@ -367,6 +392,17 @@ def _extreme_rows(axes, spec, table) -> list[tuple[str, str]]:
     return rows
 
 
+def _check_values(quantity: str, column: str, table) -> None:
+    """The quantity is finite at every point; only a gain without an Eq. 15 waveform and a
+    critical amplitude above the full stroke may be missing (``None``, said in the output)."""
+    from passmd.cli.output import check_results
+
+    values = [v for v in table[column] if v is not None]
+    if quantity in ("gain", "critical-amplitude"):
+        values = [v for v in values if not (isinstance(v, float) and math.isnan(v))]
+    check_results({column: values})
+
+
 def run_sweep(args, out) -> int:
     from passmd.experiments.maps import compute_map
     from passmd.protocols.maps import MAP_QUANTITIES
@@ -379,10 +415,7 @@ def run_sweep(args, out) -> int:
     base = points[0]["drive"]
     table = compute_map(args.quantity, points, reading=args.reading or "steady",
                         waveform=args.waveform or "sawtooth", config=config)
-    check = [v for v in table[spec.column] if v is not None]
-    from passmd.cli.output import check_results
-
-    check_results({spec.column: check})  # the quantity itself is finite wherever it is defined
+    _check_values(args.quantity, spec.column, table)
     title = f"{spec.label} — {describe(base)}"
     record = _record(args, axes, table, spec, base)
     if args.out is not None:
@@ -397,7 +430,9 @@ def run_sweep(args, out) -> int:
                        f"{counts['computed']} computed)")]
     rows += _extreme_rows(axes, spec, table)
     if record["missing_values"]:
-        rows.append(("no value", f"{record['missing_values']} points (see the note column)"))
+        why = ("no Eq. 15 waveform there, see the note column" if args.quantity == "gain" else
+               "no onset up to the full stroke")
+        rows.append(("no value", f"{record['missing_values']} points ({why})"))
     if "files" in record:
         rows.append(("written", ", ".join(record["files"].values())))
     emit_rows(f"passmd sweep {args.quantity} — {describe(base)}", rows, out)
