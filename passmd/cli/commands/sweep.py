@@ -312,7 +312,8 @@ def _finite_or_none(value):
 def _arguments(args) -> str:
     """The command's options as parsed (the record of what was asked), one JSON line."""
     skip = ("handler", "resumes_collector", "json", "profile")
-    given = {k: v for k, v in sorted(vars(args).items()) if k not in skip and v not in (None, False)}
+    given = {k: v for k, v in sorted(vars(args).items())
+             if k not in skip and v is not None and v is not False}
     return json.dumps(given, separators=(",", ":"), ensure_ascii=False)
 
 
