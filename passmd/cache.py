@@ -276,8 +276,10 @@ def _origin(module_name: str | None) -> str:
     if module is None:
         return "library" if module_name in sys.builtin_module_names else "user"
     file = getattr(module, "__file__", None)
-    if file is None:
-        return "library"  # built into the interpreter
+    if file is None:  # built into the interpreter or frozen; else a notebook's or an exec'd namespace
+        origin = getattr(getattr(module, "__spec__", None), "origin", None)
+        builtin = module_name in sys.builtin_module_names or origin in ("built-in", "frozen")
+        return "library" if builtin else "user"
     path = Path(file).resolve()
     if path.is_relative_to(_PACKAGE_DIR) and (module_name == "passmd" or module_name.startswith("passmd.")):
         return "passmd"
@@ -360,6 +362,9 @@ def _code_node(obj, seen: set, where: str):
         methods = {k: _code_node(v, seen, f"{name}.{k}") for k, v in vars(obj).items()
                    if isinstance(v, types.FunctionType)}
         return {"class": name, "source": hashlib.sha256(source.encode()).hexdigest(), "methods": methods}
+    inner = getattr(obj, "__wrapped__", None) or getattr(obj, "py_func", None)  # lru_cache, numba
+    if inner is not None and inner is not obj:
+        return {"wrapper": type(obj).__qualname__, "wrapped": _code_node(inner, seen, where)}
     raise Unfingerprintable(f"{where} is a {type(obj).__name__} object ({name}), not a function")
 
 
@@ -416,7 +421,7 @@ def _value_node(value, seen: set, where: str):
             raise Unfingerprintable(f"{where} is the module {value.__name__}, whose source cannot be "
                                     "read") from exc
     if isinstance(value, (types.FunctionType, types.BuiltinFunctionType, types.MethodType, functools.partial,
-                          type)):
+                          type)) or hasattr(value, "__wrapped__") or hasattr(value, "py_func"):
         return _code_node(value, seen, where)
     if isinstance(value, tuple) and not hasattr(value, "_fields"):
         return {"__tuple__": [_value_node(x, seen, where) for x in value]}

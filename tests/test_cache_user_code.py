@@ -125,3 +125,31 @@ def test_passmd_and_library_functions_have_fixed_fingerprints():
     assert function_code(drive_theory) == function_code(drive_theory)
     assert function_code(np.sum) != function_code(np.mean)
     assert function_code(drive_theory_point) != function_code(drive_theory)  # test code is user code
+
+
+def test_a_notebook_function_is_recomputed_when_its_cell_changes(tmp_path, monkeypatch):
+    """A function defined in a namespace without a source file (a notebook's ``__main__``)."""
+    import types
+
+    store = Cache(tmp_path / "cache")
+    values = []
+    for preload in (0.6, 0.3):
+        namespace = types.ModuleType("notebook_session")  # no __file__, as a Jupyter kernel's __main__
+        monkeypatch.setitem(sys.modules, "notebook_session", namespace)
+        exec(f"PRELOAD = {preload}\ndef point(x):\n    return {{'y': PRELOAD * x}}\n", namespace.__dict__)
+        frame = _sweep(namespace.point, store)
+        values.append((frame["y"].tolist(), frame.attrs["sweep"]["cached"]))
+    assert values[0] == (pytest.approx([0.6, 1.2, 1.8], rel=1e-12), 0)
+    assert values[1] == (pytest.approx([0.3, 0.6, 0.9], rel=1e-12), 0)
+
+
+def test_decorated_helpers_are_fingerprinted_through_what_they_wrap(user_module, tmp_path):
+    """A helper behind functools.lru_cache is hashed by the function it wraps."""
+    store = Cache(tmp_path / "cache")
+    source = ("import functools\n@functools.lru_cache\ndef scale():\n    return {p}\n"
+              "def point(x):\n    return {{'y': scale() * x}}\n")
+    _sweep(user_module(source.format(p=0.6)).point, store)
+    assert _sweep(user_module(source.format(p=0.6)).point, store).attrs["sweep"]["cached"] == 3  # cached
+    edited = _sweep(user_module(source.format(p=0.3)).point, store)
+    assert edited.attrs["sweep"]["cached"] == 0
+    assert edited["y"].tolist() == pytest.approx([0.3, 0.6, 0.9], rel=1e-12)

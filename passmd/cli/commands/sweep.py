@@ -46,6 +46,8 @@ AXES: dict[str, Quantity] = {"amplitude": AMPLITUDE, "frequency": FREQUENCY,
 MAX_AXIS_POINTS = 1000
 MAX_POINTS = 100_000
 
+_NAMES = textwrap.fill("NAME: " + ", ".join(AXES) + ".", width=92, subsequent_indent=" " * 10,
+                       break_on_hyphens=False)
 _EPILOG = textwrap.dedent(f"""\
     QUANTITY:
       velocity, step, back-step  the steady-velocity protocol of the driving-waveform
@@ -63,13 +65,13 @@ _EPILOG = textwrap.dedent(f"""\
       NAME=LO..HI[:log][:N]   N values from LO to HI, linear (default) or log, N default 10
       NAME=V1,V2,...          a list;  NAME=V  a single value
       e.g. --vary frequency=100Hz..110kHz:log:24 --vary amplitude=50nm..130nm:24
-           --vary preload=0.1N,0.4N,1N --vary actuator-mass=1e-5kg..2e-5kg:5
+           --vary preload=0.1N,0.4N,1N --vary mu=0.1..0.3:5
     A bare number in --vary is in SI units (m, kg, N, Hz, Pa, N/m, kg/s, V, V/s).
-    NAME: {', '.join(AXES)}.
+    {_NAMES}
     Not varied: --amplitude (default the full stroke) and --frequency apply to every point.
 
-    Points run in parallel and are cached (${ENVIRONMENT['cache_dir']}, --cache-dir, else the user cache
-    folder; see 'passmd cache --help'): Ctrl-C keeps every finished point, and a rerun, or a
+    Points run in parallel and are cached (--cache-dir, else ${ENVIRONMENT['cache_dir']}, else the user
+    cache folder; see 'passmd cache --help'): Ctrl-C keeps every finished point, and a rerun, or a
     map sharing points with an earlier one, computes only the missing points.
 
     --out PREFIX writes PREFIX.csv ('#' lines: passmd version, git commit, options; read
