@@ -73,7 +73,7 @@ other file (also a regular file at an entry's path that is not an entry: it is n
 removed nor replaced, and its point is not cached) is reported as foreign and left alone.
 
 The directory is the user's cache folder for passmd (:func:`default_cache_dir`, e.g.
-``~/.cache/passmd/results`` on Linux, via :mod:`platformdirs`) unless the caller names another
+``~/.cache/passmd/results`` on Linux, via ``platformdirs``) unless the caller names another
 (``Cache(directory)``; entry points take it from the run configuration,
 :class:`passmd.config.RunConfig`, whose ``cache_dir`` comes from ``$PASSMD_CACHE_DIR`` or
 ``--cache-dir``; this module reads no environment variable). A run of the command line or the
@@ -201,7 +201,7 @@ class _TooLarge(ValueError):
 
 def default_cache_dir() -> Path:
     """The user's cache folder for passmd's results (absolute): ``results`` in
-    :func:`platformdirs.user_cache_dir` of ``passmd`` (``$XDG_CACHE_HOME/passmd/results`` or
+    ``platformdirs.user_cache_dir`` of ``passmd`` (``$XDG_CACHE_HOME/passmd/results`` or
     ``~/.cache/passmd/results`` on Linux, ``~/Library/Caches/passmd/results`` on macOS,
     ``%LOCALAPPDATA%\\passmd\\Cache\\results`` on Windows)."""
     return (Path(platformdirs.user_cache_dir("passmd", appauthor=False)) / "results").resolve()

@@ -110,6 +110,7 @@ class MapQuantity:
     also: tuple[str, ...] = ()
 
 
+#: The quantities of a map by name (``passmd sweep QUANTITY``).
 MAP_QUANTITIES = {q.name: q for q in (
     MapQuantity("velocity", steady_point, "velocity_m_per_s", "mm/s", "steady velocity"),
     MapQuantity("step", steady_point, "step_m", "nm", "steady step (velocity / f)"),
