@@ -16,15 +16,22 @@ __all__ = ["MapAxis", "map_figure"]
 
 @dataclass(frozen=True)
 class MapAxis:
-    """One axis of a map: its column (SI), its label, the unit it is shown in, log spacing."""
+    """One axis of a map: its column (SI), its label, the unit it is shown in, log spacing.
+
+    ``scale``: the SI value of one ``unit`` (e.g. 1e-3 for mm/s); None: the unit's own factor
+    (:func:`passmd.units.from_si`).
+    """
 
     column: str
     label: str
     unit: str
     log: bool = False
+    scale: float | None = None
 
     def shown(self, values) -> np.ndarray:
         values = np.asarray(values, dtype=float)
+        if self.scale is not None:
+            return values / self.scale
         return from_si(values, self.unit) if self.unit else values
 
     @property
@@ -32,10 +39,9 @@ class MapAxis:
         return f"{self.label} [{self.unit}]" if self.unit else self.label
 
 
-def _values(table, column: str, unit: str) -> np.ndarray:
-    """A result column as floats in ``unit``; missing values (None) are NaN, masked when drawn."""
-    raw = np.array([np.nan if v is None else float(v) for v in table[column]], dtype=float)
-    return from_si(raw, unit) if unit else raw
+def _values(table, axis: MapAxis) -> np.ndarray:
+    """A result column as floats in the axis' unit; missing values (None) are NaN, masked when drawn."""
+    return axis.shown([np.nan if v is None else float(v) for v in table[axis.column]])
 
 
 def _edges(centers: np.ndarray, log: bool) -> np.ndarray:
@@ -61,13 +67,13 @@ def map_figure(table, axes: Sequence[MapAxis], value: MapAxis, title: str,
         raise ValueError(f"axes = {len(axes)} axes: a map draws one or two")
     fig = Figure(figsize=(7, 4.8), layout="constrained")
     ax = fig.add_subplot()
-    z = _values(table, value.column, value.unit)
+    z = _values(table, value)
     if len(axes) == 1:
         (axis,) = axes
         x = axis.shown(table[axis.column])
         ax.plot(x, z, "o-", ms=3, label=value.label)
         for other in also:
-            ax.plot(x, _values(table, other.column, other.unit), "--", label=other.label)
+            ax.plot(x, _values(table, other), "--", label=other.label)
         if also:
             ax.legend(fontsize=8)
         ax.set_xlabel(axis.title)

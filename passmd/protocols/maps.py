@@ -103,6 +103,8 @@ class MapQuantity:
     function: object
     column: str
     unit: str
+    #: the SI value of one ``unit`` (the column is SI)
+    scale: float
     label: str
     #: whether the point takes an amplitude (the critical amplitude searches over it)
     amplitude: bool = True
@@ -112,11 +114,11 @@ class MapQuantity:
 
 #: The quantities of a map by name (``passmd sweep QUANTITY``).
 MAP_QUANTITIES = {q.name: q for q in (
-    MapQuantity("velocity", steady_point, "velocity_m_per_s", "mm/s", "steady velocity"),
-    MapQuantity("step", steady_point, "step_m", "nm", "steady step (velocity / f)"),
-    MapQuantity("back-step", steady_point, "back_step_m", "nm", "back-step"),
-    MapQuantity("critical-amplitude", critical_amplitude_point, "critical_amplitude_m", "nm",
+    MapQuantity("velocity", steady_point, "velocity_m_per_s", "mm/s", 1e-3, "steady velocity"),
+    MapQuantity("step", steady_point, "step_m", "nm", 1e-9, "steady step (velocity / f)"),
+    MapQuantity("back-step", steady_point, "back_step_m", "nm", 1e-9, "back-step"),
+    MapQuantity("critical-amplitude", critical_amplitude_point, "critical_amplitude_m", "nm", 1e-9,
                 "critical amplitude A_c", amplitude=False, also=("analytic_critical_amplitude_m",)),
-    MapQuantity("stall-force", stall_point, "generated_force_N", "N", "stall force"),
-    MapQuantity("gain", gain_point, "gain_m_per_s", "mm/s", "Eq. 15 velocity gain over the saw-tooth"),
+    MapQuantity("stall-force", stall_point, "generated_force_N", "N", 1.0, "stall force"),
+    MapQuantity("gain", gain_point, "gain_m_per_s", "mm/s", 1e-3, "Eq. 15 velocity gain over the saw-tooth"),
 )}

@@ -379,8 +379,9 @@ def _figure(axes, spec, table, title):
     from passmd.plots.sweep_map import MapAxis, map_figure
 
     shown = [MapAxis(a.column, a.name, a.quantity.unit, a.spacing == "log") for a in axes]
-    value = MapAxis(spec.column, spec.label, spec.unit)
-    also = [MapAxis(c, "closed form" if c.startswith("analytic") else c, spec.unit) for c in spec.also]
+    value = MapAxis(spec.column, spec.label, spec.unit, scale=spec.scale)
+    also = [MapAxis(c, "closed form" if c.startswith("analytic") else c, spec.unit, scale=spec.scale)
+            for c in spec.also]
     return map_figure(table, shown, value, title, also=also if len(axes) == 1 else ())
 
 
@@ -391,7 +392,7 @@ def _extreme_rows(axes, spec, table) -> list[tuple[str, str]]:
     rows = []
     for word, i in (("min", int(np.nanargmin(values))), ("max", int(np.nanargmax(values)))):
         where = ", ".join(f"{a.name} {_shown(a, table[a.column].iloc[i])}" for a in axes)
-        rows.append((f"{word} {spec.label}", f"{fmt(values[i], spec.unit)} at {where}"))
+        rows.append((f"{word} {spec.label}", f"{values[i] / spec.scale:.6g} {spec.unit} at {where}"))
     return rows
 
 
