@@ -122,6 +122,11 @@ def test_step_over_preload_is_the_protocols_value(tmp_path):
     assert data["rows"][0]["step_m"] != data["rows"][1]["step_m"]
     assert data["provenance"]["passmd_version"] and data["provenance"]["git_commit"]
     assert data["sweep"] == {"points": 2, "cached": 0, "computed": 2}
+    status, text = run_cli("sweep", "step", "--vary", "preload=0.2N,0.4N", "--frequency", "1kHz", *CHEAP,
+                           "--executor", "serial", "--cache-dir", str(tmp_path / "c"))
+    assert status == 0 and "2 (2 from the cache, 0 computed)" in text
+    for row in data["rows"]:  # a short curve is listed in full, in nm
+        assert f"preload {row['preload_N']:.6g} N  {row['step_m'] / 1e-9:.6g} nm" in text, text
 
 
 def test_a_map_writes_csv_json_png_in_grid_order_and_reruns_from_the_cache(tmp_path):

@@ -45,6 +45,8 @@ AXES: dict[str, Quantity] = {"amplitude": AMPLITUDE, "frequency": FREQUENCY,
 #: Most values of one axis and most points of a map.
 MAX_AXIS_POINTS = 1000
 MAX_POINTS = 100_000
+#: Longest curve the human output lists in full (longer ones and maps: the extremes).
+MAX_SHOWN = 40
 
 _NAMES = textwrap.fill("NAME: " + ", ".join(AXES) + ".", width=92, subsequent_indent=" " * 10,
                        break_on_hyphens=False)
@@ -385,6 +387,14 @@ def _figure(axes, spec, table, title):
     return map_figure(table, shown, value, title, also=also if len(axes) == 1 else ())
 
 
+def _curve_rows(axes, spec, table) -> list[tuple[str, str]]:
+    """A short curve in full: one row per value of its axis."""
+    (axis,) = axes
+    return [(f"{axis.name} {_shown(axis, x)}", "–" if v is None or (isinstance(v, float) and math.isnan(v))
+             else f"{v / spec.scale:.6g} {spec.unit}") for x, v in zip(table[axis.column], table[spec.column],
+                                                                    strict=True)]
+
+
 def _extreme_rows(axes, spec, table) -> list[tuple[str, str]]:
     values = np.array([np.nan if v is None else float(v) for v in table[spec.column]], dtype=float)
     if not np.isfinite(values).any():
@@ -432,11 +442,13 @@ def run_sweep(args, out) -> int:
                                 f"({len(a.values)}, {a.spacing})" for a in axes)),
             ("points", f"{counts['points']} ({counts['cached']} from the cache, "
                        f"{counts['computed']} computed)")]
-    rows += _extreme_rows(axes, spec, table)
+    rows += _curve_rows(axes, spec, table) if len(axes) == 1 and len(table) <= MAX_SHOWN else \
+        _extreme_rows(axes, spec, table)
     if record["missing_values"]:
         why = ("no Eq. 15 waveform there, see the note column" if args.quantity == "gain" else
                "no onset up to the full stroke")
-        rows.append(("no value", f"{record['missing_values']} points ({why})"))
+        count = record["missing_values"]
+        rows.append(("no value", f"{count} point{'s' * (count > 1)} ({why})"))
     if "files" in record:
         rows.append(("written", ", ".join(record["files"].values())))
     emit_rows(f"passmd sweep {args.quantity} — {describe(base)}", rows, out)
