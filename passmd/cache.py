@@ -8,7 +8,12 @@ A result is stored under a key that hashes
   and bytes, mappings in sorted order,
 * the *code fingerprint* (:func:`code_fingerprint`): a hash of every ``passmd/**/*.py``
   source file's path and bytes, so any edit of the package invalidates every entry and
-  a code change never serves a stale result (a version number alone would not).
+  a code change never serves a stale result (a version number alone would not),
+* the *function's own code* (:func:`function_code`): for a function outside passmd (a
+  user's own, in a script, notebook or module) its bytecode, defaults, closure values,
+  the plain-valued globals it reads and, recursively, the user code it calls; a function
+  whose code cannot be fingerprinted this way raises :class:`Unfingerprintable` and is
+  not cached (:func:`passmd.sweep.run` says so in one line).
 
 Entry format (data, never code)
 -------------------------------
@@ -67,10 +72,14 @@ files there (the link itself is removed), and the cache's own temporary files. A
 other file (also a regular file at an entry's path that is not an entry: it is neither
 removed nor replaced, and its point is not cached) is reported as foreign and left alone.
 
-The directory is ``.passmd-cache/`` in the current working directory unless the caller
-names another (``Cache(directory)``; entry points take it from the run configuration,
+The directory is the user's cache folder for passmd (:func:`default_cache_dir`, e.g.
+``~/.cache/passmd/results`` on Linux, via ``platformdirs``) unless the caller names another
+(``Cache(directory)``; entry points take it from the run configuration,
 :class:`passmd.config.RunConfig`, whose ``cache_dir`` comes from ``$PASSMD_CACHE_DIR`` or
-``--cache-dir``; this module reads no environment variable).
+``--cache-dir``; this module reads no environment variable). A run of the command line or the
+API leaves nothing in the folder it runs in; the book and the tests (``noxfile.py``) set
+``PASSMD_CACHE_DIR`` to the project's own ``.passmd-cache/`` (:data:`DEFAULT_CACHE_DIR`), which
+they share.
 ``passmd cache info|clear|prune`` shows, empties or prunes it (prune: entries of other
 code fingerprints, unreadable entries and stale temporary files).
 """
@@ -80,18 +89,23 @@ from __future__ import annotations
 import dataclasses
 import functools
 import hashlib
+import inspect
 import json
 import os
 import re
 import stat
+import sys
+import sysconfig
 import tempfile
 import time
+import types
 import warnings
 from collections.abc import Mapping
 from enum import Enum
 from pathlib import Path
 
 import numpy as np
+import platformdirs
 
 __all__ = [
     "DEFAULT_CACHE_DIR",
@@ -106,15 +120,19 @@ __all__ = [
     "CacheWarning",
     "CorruptEntry",
     "NotACache",
+    "Unfingerprintable",
     "canonical",
     "code_fingerprint",
     "decode_entry",
     "default_cache_dir",
+    "describe_default_cache_dir",
     "encode_entry",
+    "function_code",
     "function_name",
 ]
 
-#: Cache directory (relative to the current working directory) when nothing overrides it.
+#: Name of the project-local cache folder the book and the tests use (``noxfile.py`` sets
+#: ``PASSMD_CACHE_DIR`` to it at the repository's root); ignored by git.
 DEFAULT_CACHE_DIR = ".passmd-cache"
 #: File suffix of an entry.
 ENTRY_SUFFIX = ".pmc"
@@ -182,8 +200,16 @@ class _TooLarge(ValueError):
 
 
 def default_cache_dir() -> Path:
-    """``./.passmd-cache`` of the current working directory (absolute)."""
-    return Path(DEFAULT_CACHE_DIR).resolve()
+    """The user's cache folder for passmd's results (absolute): ``results`` in
+    ``platformdirs.user_cache_dir`` of ``passmd`` (``$XDG_CACHE_HOME/passmd/results`` or
+    ``~/.cache/passmd/results`` on Linux, ``~/Library/Caches/passmd/results`` on macOS,
+    ``%LOCALAPPDATA%\\passmd\\Cache\\results`` on Windows)."""
+    return (Path(platformdirs.user_cache_dir("passmd", appauthor=False)) / "results").resolve()
+
+
+def describe_default_cache_dir() -> str:
+    """The default directory for messages and help: ``the user cache folder <path>``."""
+    return f"the user cache folder {default_cache_dir()}"
 
 
 def code_fingerprint(package_dir: str | os.PathLike | None = None) -> str:
@@ -218,6 +244,200 @@ def _fingerprint(root: Path) -> str:
         digest.update(len(rel).to_bytes(8, "little") + rel)
         digest.update(len(data).to_bytes(8, "little") + data)
     return digest.hexdigest()
+
+
+# --------------------------------------------------------------------------------------
+# Fingerprint of the swept function's own code
+# --------------------------------------------------------------------------------------
+
+
+class Unfingerprintable(TypeError):
+    """A function whose code the cache cannot fingerprint (its results are not cached)."""
+
+
+#: Folders of the Python installation (standard library, site-packages): modules there are
+#: libraries, named by module and version in a fingerprint, not hashed.
+def _library_roots() -> tuple[Path, ...]:
+    roots = set()
+    for name in ("stdlib", "platstdlib", "purelib", "platlib"):
+        try:
+            roots.add(Path(sysconfig.get_path(name)).resolve())
+        except (KeyError, TypeError, OSError):
+            continue
+    return tuple(sorted(roots))
+
+
+_LIBRARY_ROOTS = _library_roots()
+
+
+def _origin(module_name: str | None) -> str:
+    """``"passmd"`` (covered by the package fingerprint), ``"library"`` or ``"user"``."""
+    module = sys.modules.get(module_name or "")
+    if module is None:
+        return "library" if module_name in sys.builtin_module_names else "user"
+    file = getattr(module, "__file__", None)
+    if file is None:  # built into the interpreter or frozen; else a notebook's or an exec'd namespace
+        origin = getattr(getattr(module, "__spec__", None), "origin", None)
+        builtin = module_name in sys.builtin_module_names or origin in ("built-in", "frozen")
+        return "library" if builtin else "user"
+    path = Path(file).resolve()
+    if path.is_relative_to(_PACKAGE_DIR) and (module_name == "passmd" or module_name.startswith("passmd.")):
+        return "passmd"
+    if any(path.is_relative_to(root) for root in _LIBRARY_ROOTS):
+        return "library"
+    return "user"
+
+
+def _library_version(module_name: str) -> str:
+    top = sys.modules.get(module_name.partition(".")[0])
+    return str(getattr(top, "__version__", "")) if top is not None else ""
+
+
+def function_code(func) -> str:
+    """Fingerprint of the code a swept function runs beyond passmd itself.
+
+    A function of the ``passmd`` package is covered by :func:`code_fingerprint` and gives
+    ``"passmd"``. Any other function (a user's, defined in a script, a notebook or a module
+    of their own) is hashed from what decides its results: its bytecode, constants and
+    names (not its line numbers), its defaults, the values of its closure, the globals it
+    names that are plain values (numbers, strings, arrays, dataclasses: as
+    :func:`canonical`), and, recursively, the functions and classes of user code it names
+    (a user module it names: the bytes of its source file). Library functions and modules
+    (the standard library, site-packages) count by name and version, ``functools.partial``
+    by its function and arguments.
+
+    Raises
+    ------
+    Unfingerprintable
+        The function names something whose state cannot be fingerprinted (an arbitrary
+        object, a class without source, a callable instance); the message says what.
+    """
+    digest = hashlib.sha256()
+    digest.update(json.dumps(_code_node(func, set(), "func"), sort_keys=True,
+                             separators=(",", ":")).encode())
+    return digest.hexdigest()
+
+
+def _code_node(obj, seen: set, where: str):
+    """A JSON-serialisable node standing for what ``obj`` contributes to a result."""
+    if isinstance(obj, functools.partial):
+        return {"partial": _code_node(obj.func, seen, where),
+                "args": [_value_node(a, seen, f"{where} argument") for a in obj.args],
+                "keywords": {k: _value_node(v, seen, f"{where} argument {k}")
+                             for k, v in obj.keywords.items()}}
+    if isinstance(obj, types.MethodType):
+        return {"method": _code_node(obj.__func__, seen, where),
+                "self": _value_node(obj.__self__, seen, f"{where}.__self__")}
+    module = getattr(obj, "__module__", None)
+    name = f"{module}:{getattr(obj, '__qualname__', getattr(obj, '__name__', '?'))}"
+    origin = _origin(module)
+    if origin == "passmd":
+        return {"passmd": name}
+    if origin == "library" or isinstance(obj, (types.BuiltinFunctionType, types.BuiltinMethodType)):
+        return {"library": name, "version": _library_version(module or "")}
+    if id(obj) in seen:
+        return {"seen": name}
+    seen.add(id(obj))
+    if isinstance(obj, types.FunctionType):
+        code = obj.__code__
+        closure = {}
+        for var, cell in zip(code.co_freevars, obj.__closure__ or (), strict=True):
+            try:
+                closure[var] = _value_node(cell.cell_contents, seen, f"{name} closure variable {var!r}")
+            except ValueError:  # an empty cell (a variable assigned later)
+                closure[var] = None
+        return {
+            "function": name,
+            "code": _bytecode(code),
+            "defaults": _value_node(obj.__defaults__, seen, f"{name} defaults"),
+            "kwdefaults": _value_node(obj.__kwdefaults__, seen, f"{name} defaults"),
+            "closure": closure,
+            "globals": _globals_node(code, obj.__globals__, seen, name),
+        }
+    if isinstance(obj, type):
+        try:
+            source = inspect.getsource(obj)
+        except (OSError, TypeError) as exc:
+            raise Unfingerprintable(f"{where} is the class {name}, whose source cannot be read") from exc
+        methods = {k: _code_node(v, seen, f"{name}.{k}") for k, v in vars(obj).items()
+                   if isinstance(v, types.FunctionType)}
+        return {"class": name, "source": hashlib.sha256(source.encode()).hexdigest(), "methods": methods}
+    inner = getattr(obj, "__wrapped__", None) or getattr(obj, "py_func", None)  # lru_cache, numba
+    if inner is not None and inner is not obj:
+        return {"wrapper": type(obj).__qualname__, "wrapped": _code_node(inner, seen, where)}
+    raise Unfingerprintable(f"{where} is a {type(obj).__name__} object ({name}), not a function")
+
+
+def _bytecode(code: types.CodeType):
+    """The parts of a code object that decide what it computes (no file name or line numbers)."""
+    consts = [_bytecode(c) if isinstance(c, types.CodeType) else _constant(c) for c in code.co_consts]
+    return {"bytes": code.co_code.hex(), "consts": consts, "names": list(code.co_names),
+            "varnames": list(code.co_varnames), "freevars": list(code.co_freevars),
+            "cellvars": list(code.co_cellvars), "args": [code.co_argcount, code.co_posonlyargcount,
+                                                         code.co_kwonlyargcount], "flags": code.co_flags}
+
+
+def _constant(value):
+    """A code constant's canonical form (constants are numbers, strings, bytes, tuples, frozensets)."""
+    if isinstance(value, bytes):
+        return {"__bytes__": value.hex()}
+    if isinstance(value, (tuple, frozenset)):
+        return {f"__{type(value).__name__}__": [_constant(x) for x in value]}
+    if value is Ellipsis:
+        return {"__ellipsis__": True}
+    if isinstance(value, complex):
+        return {"__complex__": [repr(value.real), repr(value.imag)]}
+    return canonical(value)
+
+
+def _names(code: types.CodeType):
+    """Every name the code (and the code nested in it) loads: globals and attributes alike."""
+    yield from code.co_names
+    for const in code.co_consts:
+        if isinstance(const, types.CodeType):
+            yield from _names(const)
+
+
+def _globals_node(code: types.CodeType, namespace: dict, seen: set, name: str) -> dict:
+    """The globals a function's code names, each by what it contributes (missing: a builtin)."""
+    found = {}
+    for var in sorted(set(_names(code))):
+        if var not in namespace:
+            continue  # a builtin or an attribute name: its name is in the bytecode already
+        found[var] = _value_node(namespace[var], seen, f"{name} global {var!r}")
+    return found
+
+
+def _value_node(value, seen: set, where: str):
+    """A value a function reads: plain values canonically, code recursively, modules by file."""
+    if isinstance(value, types.ModuleType):
+        origin = _origin(value.__name__)
+        if origin != "user":
+            return {"module": value.__name__, "origin": origin, "version": _library_version(value.__name__)}
+        file = getattr(value, "__file__", None)
+        try:
+            return {"module": value.__name__, "source": hashlib.sha256(Path(file).read_bytes()).hexdigest()}
+        except (OSError, TypeError) as exc:
+            raise Unfingerprintable(f"{where} is the module {value.__name__}, whose source cannot be "
+                                    "read") from exc
+    if isinstance(value, (types.FunctionType, types.BuiltinFunctionType, types.MethodType, functools.partial,
+                          type)) or hasattr(value, "__wrapped__") or hasattr(value, "py_func"):
+        return _code_node(value, seen, where)
+    if isinstance(value, tuple) and not hasattr(value, "_fields"):
+        return {"__tuple__": [_value_node(x, seen, where) for x in value]}
+    try:
+        node = canonical(value)
+    except TypeError:
+        pass
+    else:  # an instance of a class of user code: its methods may run too
+        cls = type(value)
+        if _origin(cls.__module__) == "user":
+            return {"value": node, "class": _code_node(cls, seen, where)}
+        return node
+    if callable(value) and _origin(getattr(value, "__module__", None)) in ("passmd", "library"):
+        return {"callable": f"{getattr(value, '__module__', '?')}:{type(value).__qualname__}",
+                "version": _library_version(getattr(value, "__module__", "") or "")}
+    raise Unfingerprintable(f"{where} is a {type(value).__name__}, whose state cannot be fingerprinted")
 
 
 def function_name(func) -> str:
@@ -648,12 +868,22 @@ class Cache:
     def __repr__(self) -> str:
         return f"Cache({str(self.directory)!r}, fingerprint={self.fingerprint[:12]!r}...)"
 
-    def key(self, func, params: Mapping) -> str:
-        """Hex key of ``func(**params)`` under this cache's code fingerprint."""
+    def key(self, func, params: Mapping, *, code: str | None = None) -> str:
+        """Hex key of ``func(**params)`` under this cache's code fingerprint and ``func``'s own code.
+
+        ``code``: :func:`function_code` of ``func``, computed here if not given (a sweep
+        computes it once for all its points).
+
+        Raises
+        ------
+        Unfingerprintable
+            ``func``'s code cannot be fingerprinted: its results must not be cached.
+        """
         payload = {
             "function": function_name(func),
             "params": canonical(dict(params)),
             "code": self.fingerprint,
+            "function_code": function_code(func) if code is None else code,
         }
         text = json.dumps(payload, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()

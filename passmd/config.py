@@ -52,7 +52,8 @@ class RunConfig:
     workers : int or None
         Parallel workers; None: one per CPU.
     cache_dir : Path or None
-        Directory of the result cache; None: ``./.passmd-cache``.
+        Directory of the result cache; None: the user's cache folder
+        (:func:`passmd.cache.default_cache_dir`).
     sweep_log : Path or None
         File every sweep appends one JSON line to (points cached and computed; the book's
         execution-statistics page sums them); None: no log.

@@ -13,17 +13,20 @@ order the points finish in. Execution is
 
 Every finished point is written to the on-disk cache (:mod:`passmd.cache`) as soon as
 it completes, so an interrupted sweep (Ctrl-C, SIGTERM, a failing point, a killed job) keeps
-every finished point and a rerun recomputes only the rest. Progress (points done, ETA;
+every finished point and a rerun recomputes only the rest. The cache key covers the swept
+function's own code too (:func:`passmd.cache.function_code`): a user's function that
+changed between two sweeps is recomputed, and one whose code cannot be fingerprinted is
+not cached (one :class:`~passmd.cache.CacheWarning` says why). Progress (points done, ETA;
 :mod:`passmd._progress`) shows once a sweep has run 2 s: by default on a terminal only;
 ``progress=True`` (the command line) also off a terminal, as a line every few seconds;
 off when the run configuration says so (``RunConfig.progress``, off on CI).
 
 How a sweep runs comes from its arguments or the :class:`~passmd.config.RunConfig` an entry
 point passes down; this module reads no environment variable. Without either: a process pool
-over all cores and the cache in ``./.passmd-cache``. When the configuration names a
-``sweep_log`` file, every sweep appends one JSON line to it (the function, and how many
-points were taken from the cache and how many computed): the book's execution-statistics
-page sums them per chapter.
+over all cores and the cache in the user's cache folder (:func:`passmd.cache.default_cache_dir`).
+When the configuration names a ``sweep_log`` file, every sweep appends one JSON line to it
+(the function, and how many points were taken from the cache and how many computed): the
+book's execution-statistics page sums them per chapter.
 """
 
 from __future__ import annotations
@@ -35,13 +38,14 @@ import os
 import pickle
 import signal
 import sys
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 
 import pandas as pd
 
 from passmd import _progress
 from passmd._validation import check_choice
-from passmd.cache import Cache, function_name
+from passmd.cache import Cache, CacheWarning, Unfingerprintable, function_code, function_name
 from passmd.config import EXECUTORS, RunConfig
 
 __all__ = ["EXECUTORS", "grid", "progress_enabled", "run"]
@@ -300,8 +304,8 @@ def run(
         configuration's workers, else all cores.
     cache : bool, Cache or path
         ``True`` (default): the cache in the configuration's ``cache_dir``, else in
-        ``./.passmd-cache``; ``False``: no caching; a :class:`~passmd.cache.Cache` or a
-        directory to use that one.
+        the user's cache folder (:func:`passmd.cache.default_cache_dir`); ``False``: no
+        caching; a :class:`~passmd.cache.Cache` or a directory to use that one.
     progress : bool, optional
         Progress on stderr once the sweep has run 2 s: True on any stderr (off a terminal a
         line every few seconds), False never; default: the configuration's ``progress``, else
@@ -339,11 +343,14 @@ def run(
     points = _check_points(points)
     store = _make_cache(cache)
     _check_picklable(func, executor)
-    keys = [store.key(func, p) for p in points] if store is not None else [None] * len(points)
+    label = description or getattr(func, "__name__", "sweep")
+    code = _function_code(store, func, label)
+    if code is None:
+        store = None
+    keys = [store.key(func, p, code=code) for p in points] if store is not None else [None] * len(points)
     cached = _cached(store, func, keys)
     todo = [i for i in range(len(points)) if i not in cached]
 
-    label = description or getattr(func, "__name__", "sweep")
     shown = bool(todo) and progress_enabled(progress) and not _progress.in_worker()
     bar = _progress.bar(len(points), initial=len(cached), desc=label, unit="point") if shown else _NoBar()
     collect = _Collector(func, points, keys, store, bar)
@@ -385,6 +392,17 @@ def _check_picklable(func, executor) -> None:
                 f"func = {func!r} cannot be sent to worker processes ({exc}); use a top-level "
                 "function or executor='serial'"
             ) from exc
+
+
+def _function_code(store: Cache | None, func, label: str) -> str | None:
+    """The fingerprint of ``func``'s own code, or None (with a one-line note) if it has none."""
+    if store is None:
+        return None
+    try:
+        return function_code(func)
+    except Unfingerprintable as exc:
+        warnings.warn(f"sweep {label!r} is not cached: {exc}", CacheWarning, stacklevel=3)
+        return None
 
 
 def _cached(store: Cache | None, func, keys) -> dict[int, dict]:

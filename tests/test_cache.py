@@ -311,10 +311,12 @@ def test_source_change_changes_fingerprint(tmp_path):
 
 
 def test_default_directory(tmp_path, monkeypatch):
+    """The user's cache folder (platformdirs; $XDG_CACHE_HOME on Linux), never the working folder."""
     monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("XDG_CACHE_HOME", os.fspath(tmp_path / "xdg"))
     monkeypatch.setenv("PASSMD_CACHE_DIR", os.fspath(tmp_path / "elsewhere"))  # read by entry points only
-    assert default_cache_dir() == tmp_path.resolve() / ".passmd-cache"
-    assert Cache().directory == tmp_path.resolve() / ".passmd-cache"
+    assert default_cache_dir() == (tmp_path / "xdg" / "passmd" / "results").resolve()
+    assert Cache().directory == default_cache_dir()
     # an entry point's run configuration names the directory; the cache takes it from there
     config = RunConfig.from_environment()
     assert Cache(config.cache_dir).directory == (tmp_path / "elsewhere").resolve()

@@ -118,10 +118,13 @@ def test_refusal_names_the_environment_variable_and_the_default(tmp_path):
     files = user_files(folder)
     status, _, err = cli("clear", env={"PASSMD_CACHE_DIR": str(folder)})
     assert status == 2 and f"PASSMD_CACHE_DIR = '{folder}' ({folder})" in one_line(err)
-    default = tmp_path / "project" / ".passmd-cache"
+    default = tmp_path / "xdg" / "passmd" / "results"  # the user cache folder (platformdirs, Linux)
     files |= user_files(default)
-    status, _, err = cli("prune", "--json", cwd=tmp_path / "project")
-    assert status == 2 and f"the default cache directory ./.passmd-cache ({default})" in one_line(err)
+    (tmp_path / "project").mkdir()
+    status, _, err = cli("prune", "--json", cwd=tmp_path / "project",
+                         env={"XDG_CACHE_HOME": str(tmp_path / "xdg"), "PASSMD_CACHE_DIR": ""})
+    assert status == 2 and f"the default cache directory ({default})" in one_line(err)
+    assert list((tmp_path / "project").iterdir()) == []
     status, _, err = cli("clear", "--cache-dir", ".", cwd=folder)  # a relative path, as typed
     assert status == 2 and f"--cache-dir = '.' ({folder})" in one_line(err)
     assert_intact(files)

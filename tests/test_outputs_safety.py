@@ -265,15 +265,15 @@ def test_empty_path_is_refused_before_anything_runs(tmp_path, case):
     """Refused while the command line is parsed: nothing computed (no cache, no sweep log), and
     ``cache clear --cache-dir ''`` does not fall back to clearing the default cache."""
     argv = EMPTY_PATHS[case]
-    default_cache = tmp_path / ".passmd-cache"
-    default_cache.mkdir()
+    default_cache = tmp_path / "xdg" / "passmd" / "results"  # the user cache folder (platformdirs, Linux)
+    default_cache.mkdir(parents=True)
     (default_cache / "keep.txt").write_text("mine\n")
-    env = {k: v for k, v in _env(tmp_path, PASSMD_SWEEP_LOG=str(tmp_path / "log")).items()
-           if k != "PASSMD_CACHE_DIR"}
+    env = {k: v for k, v in _env(tmp_path, PASSMD_SWEEP_LOG=str(tmp_path / "log"),
+                                 XDG_CACHE_HOME=str(tmp_path / "xdg")).items() if k != "PASSMD_CACHE_DIR"}
     done = passmd(argv, tmp_path, env=env)
     flag = argv[argv.index("") - 1]
     assert_refused(done, f"{flag} = '' is not a")
-    assert sorted(p.name for p in tmp_path.iterdir()) == [".passmd-cache"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["xdg"]
     assert [p.name for p in default_cache.iterdir()] == ["keep.txt"]
 
 

@@ -270,14 +270,15 @@ def test_run_configuration_fills_the_defaults(tmp_path):
 def test_the_environment_does_not_steer_a_sweep(tmp_path, monkeypatch):
     """Only entry points read PASSMD_*: a sweep without a configuration runs with the defaults."""
     monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
     monkeypatch.setenv("PASSMD_EXECUTOR", "threads")
     monkeypatch.setenv("PASSMD_WORKERS", "two")
     monkeypatch.setenv("PASSMD_CACHE_DIR", str(tmp_path / "elsewhere"))
     monkeypatch.setenv("PASSMD_SWEEP_LOG", str(tmp_path / "log.jsonl"))
     frame = sweep.run(drive_theory_point, THEORY_GRID[:2], executor="serial")
     assert frame.attrs["sweep"]["computed"] == 2
-    assert len(Cache(tmp_path / ".passmd-cache").entries()) == 2
-    assert not (tmp_path / "elsewhere").exists() and not (tmp_path / "log.jsonl").exists()
+    assert len(Cache(tmp_path / "xdg" / "passmd" / "results").entries()) == 2  # the user cache folder
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["xdg"]  # nothing in the working folder
 
 
 def test_lambda_runs_serially_without_cache():
@@ -359,3 +360,58 @@ def test_ctrl_c_stops_a_process_pool_sweep_and_rerun_resumes(tmp_path):
     assert int(done.stdout) == n - finished  # the rerun computed only the missing points
     assert len(evaluations(log)) == started + n - finished
     assert len(store.entries()) == n
+
+
+# --------------------------------------------------------------------------------------
+# Design maps (passmd.experiments.maps): the protocols' quantities through the sweep engine
+# --------------------------------------------------------------------------------------
+
+
+def test_compute_map_keeps_grid_order_and_the_caller_s_columns(store):
+    from passmd.experiments.maps import compute_map
+    from passmd.protocols.maps import critical_amplitude_point, steady_point
+
+    drive = Drive(contacts=1, actuator_model="rigid")
+    points = [{"drive": drive, "frequency": f, "amplitude": a, "f_kHz": f / 1e3, "a_nm": a * 1e9}
+              for f in (1e3, 2e3) for a in (100e-9, 150e-9)]
+    config = RunConfig(executor="serial", cache_dir=store.directory, progress=False)
+    table = compute_map("velocity", points, config=config)
+    assert list(table.columns[:2]) == ["f_kHz", "a_nm"] and "drive" not in table.columns
+    assert table["f_kHz"].tolist() == [1.0, 1.0, 2.0, 2.0] and table["a_nm"].tolist() == pytest.approx(
+        [100.0, 150.0, 100.0, 150.0])
+    for row, point in zip(table.itertuples(), points, strict=True):
+        expected = steady_point(drive, point["amplitude"], point["frequency"])
+        assert row.velocity_m_per_s == expected["velocity_m_per_s"]
+    # step and back-step are columns of the same runs: every point from the cache
+    assert compute_map("step", points, config=config).attrs["sweep"]["cached"] == 4
+    # the critical amplitude searches over the amplitude: a point without one is its input
+    ac = compute_map("critical-amplitude", [{"drive": drive, "frequency": 100.0}], reading="first",
+                     config=config)
+    expected = critical_amplitude_point(drive, 100.0, "first")
+    assert ac["critical_amplitude_m"].iloc[0] == expected["critical_amplitude_m"]
+    with pytest.raises(ValueError, match=r"points\[0\] has no 'amplitude': a velocity map needs"):
+        compute_map("velocity", [{"drive": drive, "frequency": 1e3}], config=config)
+    with pytest.raises(ValueError, match="quantity = 'speed' is not allowed"):
+        compute_map("speed", points, config=config)
+
+
+def test_map_figure_draws_a_heat_map_with_contours_and_a_curve():
+    from matplotlib.colors import TwoSlopeNorm
+
+    from passmd.plots.sweep_map import MapAxis, map_figure
+
+    f, a = np.meshgrid([1e3, 1e4, 1e5], [50e-9, 100e-9, 150e-9, 200e-9], indexing="ij")
+    v = (a * 1e9 - 60) * np.log10(f) * 1e-5  # changes sign: a diverging scale centred on zero
+    table = pd.DataFrame({"frequency_Hz": f.ravel(), "amplitude_m": a.ravel(), "velocity_m_per_s": v.ravel()})
+    axes = [MapAxis("frequency_Hz", "frequency", "kHz", log=True), MapAxis("amplitude_m", "amplitude", "nm")]
+    fig = map_figure(table, axes, MapAxis("velocity_m_per_s", "velocity", "mm/s"), "title")
+    ax = fig.axes[0]
+    mesh = ax.collections[0]
+    assert ax.get_xscale() == "log" and isinstance(mesh.norm, TwoSlopeNorm)
+    assert mesh.get_array().reshape(4, 3)[2, 1] == pytest.approx(v[1, 2] * 1e3)  # (amplitude, frequency) cell
+    assert len(ax.collections) > 1  # contour lines
+    curve = map_figure(table.iloc[:3].assign(frequency_Hz=[1e3, 1e4, 1e5]), axes[:1],
+                       MapAxis("velocity_m_per_s", "velocity", "mm/s"), "curve")
+    assert len(curve.axes[0].lines) == 1
+    with pytest.raises(ValueError, match="a map draws one or two"):
+        map_figure(table, axes * 2, MapAxis("velocity_m_per_s", "velocity", "mm/s"), "t")

@@ -12,7 +12,7 @@ import argparse
 from dataclasses import dataclass
 
 from passmd._validation import check_range
-from passmd.cache import DEFAULT_CACHE_DIR
+from passmd.cache import describe_default_cache_dir
 from passmd.cli.output import JSON_HELP, fmt
 from passmd.config import ENVIRONMENT
 from passmd.defaults import PROTOCOL
@@ -182,7 +182,8 @@ class DirectoryPath(FilePath):
     kind = "directory"
 
 
-CACHE_DIR_HELP = f"cache directory (default: ${ENVIRONMENT['cache_dir']} or ./{DEFAULT_CACHE_DIR})"
+CACHE_DIR_HELP = f"cache directory (default: ${ENVIRONMENT['cache_dir']}, else " \
+                 f"{describe_default_cache_dir()})"
 
 
 def add_drive_options(parser, *, contact_only: bool = False) -> None:

@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from passmd import __version__
-from passmd.cli.commands import cache, contact, critical_amplitude, figure, fit, force, ledger, run, theory
+from passmd.cli.commands import cache, contact, critical_amplitude, figure, fit, force, ledger, run, sweep, theory
 
 __all__ = ["DESCRIPTION", "PROG", "make_parser"]
 
@@ -20,7 +20,7 @@ read in the unit the option's help shows. Human output uses nm, N, mm and kHz; -
 prints one JSON object in SI units whose keys carry the unit (e.g. final_position_m)."""
 
 #: The subcommands in the order ``passmd --help`` lists them.
-COMMANDS = (theory, critical_amplitude, run, force, fit, contact, figure, cache, ledger)
+COMMANDS = (theory, critical_amplitude, run, force, sweep, fit, contact, figure, cache, ledger)
 
 
 class _Parser(argparse.ArgumentParser):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 import textwrap
 
-from passmd.cache import DEFAULT_CACHE_DIR, MARKER_NAME
+from passmd.cache import MARKER_NAME, describe_default_cache_dir
 from passmd.cli.errors import UsageError
 from passmd.cli.options import CACHE_DIR_HELP, DirectoryPath
 from passmd.cli.output import JSON_HELP, emit_json, emit_rows
@@ -19,7 +19,7 @@ _EPILOG = textwrap.dedent(f"""\
     (their code fingerprint differs, so they can never be served), unreadable entries
     and stale temporary files. Entries are checksummed data (JSON header + raw array
     bytes), never code; see passmd.cache for the format. Directory:
-    ${ENVIRONMENT['cache_dir']} or ./{DEFAULT_CACHE_DIR}.
+    ${ENVIRONMENT['cache_dir']}, else {describe_default_cache_dir()}.
 
     Only a cache's own files are ever removed: a cache directory carries the marker
     {MARKER_NAME}, written when passmd creates the directory (or first caches into an
@@ -49,7 +49,7 @@ def _named(args) -> str:
         return f"--cache-dir = {args.cache_dir!r}"
     if (os.environ.get(variable) or "").strip():
         return f"{variable} = {os.environ[variable].strip()!r}"
-    return f"the default cache directory ./{DEFAULT_CACHE_DIR}"
+    return "the default cache directory"
 
 
 def run_cache(args, out) -> int:

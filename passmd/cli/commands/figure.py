@@ -8,7 +8,7 @@ import textwrap
 from pathlib import Path
 
 from passmd._result_bounds import check_table
-from passmd.cache import DEFAULT_CACHE_DIR
+from passmd.cache import describe_default_cache_dir
 from passmd.cli.configuration import run_config
 from passmd.cli.errors import NotAvailableError, OutputError, UsageError
 from passmd.cli.options import DirectoryPath, add_sweep_options
@@ -22,7 +22,8 @@ NOT_AVAILABLE = "not available yet"
 
 _EPILOG = textwrap.dedent(f"""\
     'passmd figure list' lists the panels; any other name is refused. Sweeps are
-    cached in ./{DEFAULT_CACHE_DIR}/ (or ${ENVIRONMENT['cache_dir']}); see 'passmd cache --help'.
+    cached in ${ENVIRONMENT['cache_dir']}, else {describe_default_cache_dir()};
+    see 'passmd cache --help'.
 
     NAME.csv starts with '#' lines naming the passmd version, git commit and profile
     (read it with pandas.read_csv(path, comment="#")); NAME.png carries the same in

@@ -5,7 +5,7 @@ from __future__ import annotations
 import textwrap
 
 from passmd._result_bounds import check_table
-from passmd.cache import DEFAULT_CACHE_DIR
+from passmd.cache import DEFAULT_CACHE_DIR, describe_default_cache_dir
 from passmd.cli.configuration import run_config
 from passmd.cli.errors import OutputError
 from passmd.cli.options import FilePath, add_sweep_options
@@ -16,8 +16,9 @@ from passmd.config import ENVIRONMENT, PROFILES
 __all__ = ["add_parser", "run_ledger"]
 
 _EPILOG = textwrap.dedent(f"""\
-    Computes (or reads from the cache the book uses, ./{DEFAULT_CACHE_DIR}/ or ${ENVIRONMENT['cache_dir']})
-    every figure's results at --profile and evaluates every claim of
+    Computes (or reads from the cache: ${ENVIRONMENT['cache_dir']}, else
+    {describe_default_cache_dir()}; the book built with nox uses ./{DEFAULT_CACHE_DIR}/
+    of the repository) every figure's results at --profile and evaluates every claim of
     passmd/data/reference/claims.csv over the declared readings of passmd.readings.
 
     --json keys: profile, summary, counts{{category: n}}, claims[{{claim, category, basis,
