@@ -6,7 +6,18 @@ import argparse
 import sys
 
 from passmd import __version__
-from passmd.cli.commands import cache, contact, critical_amplitude, figure, fit, force, ledger, run, sweep, theory
+from passmd.cli.commands import (
+    cache,
+    contact,
+    critical_amplitude,
+    figure,
+    fit,
+    force,
+    ledger,
+    run,
+    sweep,
+    theory,
+)
 
 __all__ = ["DESCRIPTION", "PROG", "make_parser"]
 
