@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import textwrap
 
-from passmd.cli.drive import build_drive
+from passmd.cli.drive import build_drive, drive_rows
 from passmd.cli.errors import UsageError
 from passmd.cli.options import FREQUENCY, THRESHOLD, TOLERANCE, add_drive_options
 from passmd.cli.output import JSON_HELP, check_results, describe, drive_record, emit_json, emit_rows, fmt
@@ -101,7 +101,7 @@ def run_critical_amplitude(args, out) -> int:
     rows = [] if args.analytic_only else _search_rows(record, drive)
     eq = "Eq. 7/11" if drive.actuator_model == "rigid" else "Eq. 8/12"
     rows.append((f"analytic A_c ({eq})", fmt(record["analytic_critical_amplitude_m"], "nm")))
-    emit_rows(f"passmd critical-amplitude — {describe(drive)}", rows, out)
+    emit_rows(f"passmd critical-amplitude — {describe(drive)}", [*rows, *drive_rows(drive)], out)
     return 0
 
 

@@ -7,7 +7,7 @@ import textwrap
 
 from passmd._result_bounds import ResultError
 from passmd.cli.commands.run import check_memory, check_output_paths, waveform_args, write_outputs
-from passmd.cli.drive import build_drive
+from passmd.cli.drive import build_drive, drive_rows
 from passmd.cli.errors import UsageError
 from passmd.cli.options import add_drive_options, add_output_options, add_simulation_options
 from passmd.cli.output import check_results, describe, drive_record, emit_json, emit_rows, fmt
@@ -116,5 +116,5 @@ def run_force(args, out) -> int:
         ("integration", f"{found['periods_simulated']} periods, {found['wall_time_s']:.3g} s"),
     ]
     emit_rows(f"passmd force — {describe(drive)}, load cell k = "
-              f"{fmt(drive.load_cell_stiffness, 'N/m')}", rows, out)
+              f"{fmt(drive.load_cell_stiffness, 'N/m')}", [*rows, *drive_rows(drive)], out)
     return 0

@@ -7,7 +7,7 @@ from pathlib import Path
 from passmd._result_bounds import check_run_bounds
 from passmd.cli import startup
 from passmd.cli.commands.contact import check_springs
-from passmd.cli.drive import build_drive
+from passmd.cli.drive import build_drive, drive_rows
 from passmd.cli.errors import OutputError, UsageError
 from passmd.cli.options import (
     AMPLITUDE,
@@ -205,5 +205,5 @@ def run_run(args, out) -> int:
     if "generated_force_N" in summary:
         rows.append(("generated force", fmt(summary["generated_force_N"], "N")))
     rows.append(("integrator", f"{summary['integrator_steps']} steps, {summary['wall_time_s']:.3g} s"))
-    emit_rows(f"passmd run — {describe(drive)}", rows, out)
+    emit_rows(f"passmd run — {describe(drive)}", [*rows, *drive_rows(drive)], out)
     return 0

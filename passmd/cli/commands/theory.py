@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import textwrap
 
-from passmd.cli.drive import build_drive
+from passmd.cli.drive import build_drive, drive_rows
 from passmd.cli.options import add_drive_options
 from passmd.cli.output import (
     JSON_HELP,
@@ -57,5 +57,5 @@ def run_theory(args, out) -> int:
         ("runner-on-contacts frequency", fmt(result["runner_frequency_Hz"], "kHz")),
         ("bare actuator frequency", fmt(result["actuator_natural_frequency_Hz"], "kHz")),
     ]
-    emit_rows(f"passmd theory — {describe(drive)}", rows, out)
+    emit_rows(f"passmd theory — {describe(drive)}", [*rows, *drive_rows(drive)], out)
     return 0
