@@ -165,7 +165,8 @@ def test_force_does_not_name_internal_parameters():
 
 def test_runner_that_cannot_move_is_not_reported_as_moved():
     """m_r = 1e30 kg (only with --allow-extrapolation): friction cannot move it by 20 nm."""
-    status, out, err, _ = run_main(["run", "--runner-mass", "1e30g", "--allow-extrapolation", "--periods", "1",
+    status, out, err, _ = run_main(["run", "--runner-mass", "1e30g", "--allow-extrapolation",
+                                    "--periods", "1",
                                     "--json"])
     if status == 0:  # a correct result: the runner stays within the work bound
         data = json.loads(out)
@@ -232,7 +233,8 @@ full_disk = pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /d
 
 
 @full_disk
-@pytest.mark.parametrize("argv", [["theory"], ["theory", "--json"], ["contact", "--path", "0nm,30nm", "--json"],
+@pytest.mark.parametrize("argv", [["theory"], ["theory", "--json"],
+                                  ["contact", "--path", "0nm,30nm", "--json"],
                                   ["--help"], ["run", "--help"], ["--version"]])
 def test_full_disk_on_stdout_is_one_line_exit_1(argv):
     with open("/dev/full", "w") as full:
