@@ -33,7 +33,7 @@ DEFAULT_DRIVE = Drive()
 #: A number without a unit (as passmd.units reads one; "nan" and "inf" are not numbers there).
 _BARE = re.compile(r"^[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?$")
 #: The SI unit of each display unit that is not SI (for the bare-number message).
-_SI_UNIT = {"mm": "m", "nm": "m", "kHz": "Hz", "g": "kg", "GPa": "Pa", "V/us": "V/s"}
+_SI_UNIT = {"mm": "m", "nm": "m", "kHz": "Hz", "g": "kg", "GPa": "Pa", "V/us": "V/s", "us": "s"}
 
 
 def refuse_bare(flag: str, raw, unit: str) -> None:
