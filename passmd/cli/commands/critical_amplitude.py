@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import textwrap
 
+from passmd.cli import kernels
 from passmd.cli.drive import build_drive, drive_rows
 from passmd.cli.errors import UsageError
 from passmd.cli.options import FREQUENCY, THRESHOLD, TOLERANCE, add_drive_options
@@ -73,6 +74,7 @@ def _search(args, drive) -> dict:
     frequency = FREQUENCY.parse_or(args, PROTOCOL.drive_frequency)
     if args.analytic_only:
         return {}
+    kernels.notice_if_cold()
     # the book's search (critical-amplitude chapters): one protocol for users and book
     found = ca.critical_amplitude(
         drive, protocol=args.protocol, frequency=frequency, flyback=args.flyback,

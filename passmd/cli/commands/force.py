@@ -6,6 +6,7 @@ import re
 import textwrap
 
 from passmd._result_bounds import ResultError
+from passmd.cli import kernels
 from passmd.cli.commands.run import check_memory, check_output_paths, waveform_args, write_outputs
 from passmd.cli.drive import build_drive, drive_rows
 from passmd.cli.errors import UsageError
@@ -68,6 +69,7 @@ def run_force(args, out) -> int:
 
     drive = build_drive(args, load_cell=True)
     amplitude, frequency = _check_options(args, drive)
+    kernels.notice_if_cold()
     # the force-generation chapter's stall protocol: runs from rest, lengthened until stalled
     try:
         found = stall.generated_force(drive, amplitude, frequency, flyback=args.flyback,

@@ -6,7 +6,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from passmd._result_bounds import check_run_bounds
-from passmd.cli import startup
+from passmd.cli import kernels, startup
 from passmd.cli.commands.contact import check_springs
 from passmd.cli.drive import build_drive, drive_rows
 from passmd.cli.errors import OutputError, UsageError
@@ -153,6 +153,7 @@ def check_output_paths(args) -> None:
 def simulate(args, drive):
     """(result, Eq. 15 design or None) of the run the options describe (saw-tooth or Eq. 15)."""
     startup.load_numba_without_blas_probe()
+    kernels.notice_if_cold()
     from passmd import dynamics, optimized_waveform, waveforms
     from passmd.protocols import eq15
 
