@@ -149,3 +149,16 @@ def test_bare_number_of_an_option_shown_in_si_is_si(capsys):
     status, out, _ = run(["theory", "--actuator-stiffness", "5e6", "--preload", "0.6", "--json"], capsys)
     drive = json.loads(out)["drive"]
     assert status == 0 and drive["actuator_stiffness_N_per_m"] == 5e6 and drive["preload_N"] == 0.6
+
+
+def test_readme_drive_file_example_reads(tmp_path):
+    import re
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    section = readme[readme.index("## Your own drive"):]
+    example = re.search(r"```toml\n(.*?)```", section, re.S).group(1)
+    path = tmp_path / "mydrive.toml"
+    path.write_text(example, encoding="utf-8")
+    drive = load_drive(path)
+    assert (drive.hemisphere_radius, drive.preload, drive.actuator.mass) == (0.5e-3, 0.6, 1.5e-8)
