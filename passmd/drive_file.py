@@ -5,7 +5,11 @@ dotted for a part (``actuator.mass``); top-level keys may also sit in a ``[drive
 
     hemisphere_radius = "0.5 mm"     # a string with a unit, read by passmd.units
     preload = 0.6                    # a bare number: SI (N)
-    contacts = "paper-six"           # or "one"
+    contacts = "paper-six"           # or "one"; or any arrangement as [[contact_groups]] tables:
+    #   [[contact_groups]]
+    #   count = 1
+    #   load_share = 1.0              # F_N per contact / F_p (or normal_force = "0.3 N")
+    #   radius = "0.5 mm"             # optional: the drive's hemisphere_radius
 
     [actuator]
     stiffness = "5e6 N/m"
@@ -36,6 +40,7 @@ from passmd.parameters import (
     PLAUSIBLE_RANGES,
     TABLE2_RADII,
     Amplifier,
+    ContactGroup,
     Drive,
     actuator_for_radius,
     actuator_viscosity,
@@ -76,6 +81,9 @@ CONTACT_PRESETS = {"one": 1, "paper-six": 6}
 DRIVE_KEYS: dict[str, DriveKey] = {k.key: k for k in (
     DriveKey("contacts", "choice", "", "n", "contact arrangement: \"one\" (one contact) or \"paper-six\" "
              "(two contacts on one side, four on the other)", "Section 4.1", choices=tuple(CONTACT_PRESETS)),
+    DriveKey("contact_groups", "groups", "", "n_g, F_N, R", "any other arrangement: [[contact_groups]] "
+             "tables of count, load_share (F_N / F_p per contact) or normal_force, and radius (default: the "
+             "drive's)", "instead of contacts"),
     DriveKey("actuator_model", "choice", "", "–", "\"flexible\" (mass–spring–damper) or \"rigid\" actuators",
              "Section 3.1", choices=("flexible", "rigid")),
     DriveKey("hemisphere_radius", "m", "mm", "R", "radius of the hemispheres", "Table 1",
@@ -145,6 +153,8 @@ def _value(where: str, spec: DriveKey, raw, allow_extrapolation: bool):
         if not isinstance(raw, str):
             raise _refuse(label, f"= {raw!r}: must be a string", name=spec.key, value=raw)
         return raw
+    if spec.unit == "groups":
+        return _groups(where, raw, allow_extrapolation)
     if spec.unit == "choice":
         if isinstance(raw, str) and raw in spec.choices:
             return raw
@@ -173,6 +183,41 @@ def _value(where: str, spec: DriveKey, raw, allow_extrapolation: bool):
     return value
 
 
+_GROUP_KEYS = {"count": "", "load_share": "", "normal_force": "N", "radius": "m"}
+
+
+def _groups(where: str, raw, allow_extrapolation: bool) -> tuple:
+    """``[[contact_groups]]`` tables to :class:`~passmd.parameters.ContactGroup` s, each key checked."""
+    if not isinstance(raw, list) or not raw or not all(isinstance(t, dict) for t in raw):
+        raise _refuse(where, "must be one or more [[contact_groups]] tables (count, load_share or "
+                             "normal_force, radius)", name="contact_groups", value=raw)
+    groups = []
+    for i, table in enumerate(raw):
+        label = f"{where}[{i}]"
+        unknown = [k for k in table if k not in _GROUP_KEYS]
+        if unknown:
+            raise _refuse(f"{label}.{unknown[0]}", f"is not a key of a contact group: the known keys are "
+                          f"{', '.join(_GROUP_KEYS)}", name="contact_groups", value=table)
+        count = table.get("count")
+        if isinstance(count, bool) or not isinstance(count, int) or count < 1:
+            raise _refuse(f"{label}.count", f"= {count!r}: must be an integer >= 1", name="contact_groups",
+                          value=count)
+        values = {"count": count}
+        for key in ("load_share", "normal_force", "radius"):
+            if key in table:
+                spec = DriveKey(f"contact_groups.{key}", _GROUP_KEYS[key], "", "", key, "",
+                                {"normal_force": "preload", "radius": "hemisphere_radius"}.get(key))
+                values[key] = _value(f"{label}.{key}", spec, table[key], allow_extrapolation)
+                if key == "load_share" and not values[key] > 0:
+                    raise _refuse(f"{label}.{key}", f"= {table[key]!r} is out of range: must be > 0",
+                                  name="contact_groups", value=table[key])
+        if ("load_share" in values) == ("normal_force" in values):
+            raise _refuse(label, "gives both or neither of load_share and normal_force: give exactly one",
+                          name="contact_groups", value=table)
+        groups.append(ContactGroup(**values))
+    return tuple(groups)
+
+
 def read_drive_file(path, *, allow_extrapolation: bool | None = None) -> dict:
     """The values a drive file gives, by key (SI floats, strings, booleans), each checked.
 
@@ -196,6 +241,9 @@ def read_drive_file(path, *, allow_extrapolation: bool | None = None) -> dict:
                              f"{', '.join(DRIVE_KEYS)}", name=unknown[0], value=raw[unknown[0]])
     lift = raw.get("allow_extrapolation") is True or bool(allow_extrapolation)
     values = {key: _value(f"{name}: {key}", DRIVE_KEYS[key], value, lift) for key, value in raw.items()}
+    if "contacts" in values and "contact_groups" in values:
+        raise DriveFileError(f"{name}: contacts and contact_groups both given: give one (a preset, or the "
+                             "groups)", name="contacts", value=values["contacts"])
     if "actuator.viscosity" in values and "actuator.damping_ratio" in values:
         raise DriveFileError(f"{name}: actuator.viscosity and actuator.damping_ratio both given: give one "
                              "(c_p = 2ζ√(k_p m_a))", name="actuator.viscosity",
@@ -260,6 +308,11 @@ def resolve(values: dict, origins: dict | None = None, **fixed) -> tuple[Drive, 
     if "contacts" in values:
         contacts = values["contacts"]
         changes["contacts"] = CONTACT_PRESETS[contacts] if isinstance(contacts, str) else contacts
+        changes["contact_groups"] = ()
+        sources["contact_groups"] = "not used (contacts)"
+    elif "contact_groups" in values:
+        changes["contact_groups"] = values["contact_groups"]
+        sources["contacts"] = "derived: the groups' total count"
     changes.update(fixed)
     for key, value in fixed.items():
         if key in DRIVE_KEYS:
@@ -270,7 +323,10 @@ def resolve(values: dict, origins: dict | None = None, **fixed) -> tuple[Drive, 
 def _field(drive: Drive, key: str):
     """The value of a drive-file key in ``drive`` (``contacts`` by preset name)."""
     if key == "contacts":
-        return {1: "one", 6: "paper-six"}[drive.contacts]
+        return {1: "one", 6: "paper-six"}[drive.contacts] if not drive.contact_groups else drive.contacts
+    if key == "contact_groups":
+        return [{name: value for name, value in vars(g).items() if value is not None}
+                for g in drive.contact_groups]
     if key == "actuator.damping_ratio":
         return drive.actuator.damping_ratio
     value = drive
@@ -341,11 +397,13 @@ def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None =
     lines = [f"# {title or 'passmd drive file'}",
              "# Values: a string with a unit (\"0.5 mm\", \"1.5e-5 kg\") or a bare number in SI units.",
              "# Keys left out take the paper's value (Tables 1-2; the actuator of Table 2 for the radius;",
-             "# c_p = 2ζ√(k_p m_a) with ζ = 0.05).",
+             "# c_p = 2ζ√(k_p m_a) with ζ = 0.05). Another arrangement of contacts: instead of `contacts`,",
+             "# one [[contact_groups]] table per kind: count, load_share (F_N/F_p) or normal_force, radius.",
              "# `passmd drive show --drive FILE` lists what a file resolves to, with sources."]
     section = None
     for key, spec in DRIVE_KEYS.items():
-        if key == "actuator.damping_ratio":
+        if key in ("actuator.damping_ratio", "contact_groups") or (
+                key == "contacts" and drive.contact_groups):
             continue
         head, _, name = key.rpartition(".")
         if head != section:
@@ -355,4 +413,9 @@ def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None =
         unit = f" [{spec.unit}]" if spec.unit in _SI_UNITS and spec.unit else ""
         source = sources.get(key, spec.source)
         lines.append(f"{name or key} = {_shown(value, spec)}  # {spec.symbol}: {spec.text}{unit}; {source}")
+    for group in drive.contact_groups:  # arrays of tables come last in TOML
+        lines += ["", "[[contact_groups]]  # contacts of one kind: count, F_N per contact (or its share of "
+                      "F_p), radius R [m]"]
+        lines += [f"{name} = {value if name == 'count' else _number(value)}"
+                  for name, value in vars(group).items() if value is not None]
     return "\n".join(lines) + "\n"

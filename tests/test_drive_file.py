@@ -77,8 +77,9 @@ def test_template_is_the_papers_drive_with_units_and_sources(tmp_path, capsys):
     status, out, _ = run(["drive", "template"], capsys)
     assert status == 0
     for key in DRIVE_KEYS:
-        if key != "actuator.damping_ratio":  # the template gives c_p itself
+        if key not in ("actuator.damping_ratio", "contact_groups"):  # c_p itself; the preset "contacts"
             assert f"{key.rpartition('.')[2]} = " in out, key
+    assert "[[contact_groups]]" in out  # how to describe another arrangement
     assert '"1 mm"' in out and "Table 1" in out and "Table 2" in out and "[kg]" in out
     path = tmp_path / "t.toml"
     path.write_text(out, encoding="utf-8")
@@ -162,3 +163,53 @@ def test_readme_drive_file_example_reads(tmp_path):
     path.write_text(example, encoding="utf-8")
     drive = load_drive(path)
     assert (drive.hemisphere_radius, drive.preload, drive.actuator.mass) == (0.5e-3, 0.6, 1.5e-8)
+
+
+GROUPS = """\
+preload = "0.5 N"
+actuator_model = "rigid"
+[[contact_groups]]
+count = 1
+load_share = 1.0
+[[contact_groups]]
+count = 3
+normal_force = "0.15 N"
+radius = "0.5 mm"
+"""
+
+
+def test_contact_groups_from_a_file_run_and_read_back(tmp_path, capsys):
+    from passmd.parameters import ContactGroup
+
+    path = tmp_path / "groups.toml"
+    path.write_text(GROUPS, encoding="utf-8")
+    drive = load_drive(path)
+    assert drive.contact_groups == (ContactGroup(1, load_share=1.0),
+                                    ContactGroup(3, normal_force=0.15, radius=0.5e-3))
+    assert drive.contacts == 4
+    again = tmp_path / "again.toml"
+    again.write_text(drive_toml(drive), encoding="utf-8")
+    assert load_drive(again) == drive
+    status, out, _ = run(["run", "--drive", str(path), "--periods", "2", "--max-points", "10", "--json"],
+                         capsys)
+    data = json.loads(out)
+    assert status == 0 and data["drive"]["contacts"] == 4
+    assert data["drive"]["contact_groups"][1] == {"count": 3, "load_share": None, "normal_force_N": 0.15,
+                                                  "radius_m": 0.5e-3}
+    status, out, _ = run(["theory", "--drive", str(path), "--contacts", "6", "--json"], capsys)
+    assert json.loads(out)["drive"]["contacts"] == 6 and "contact_groups" not in json.loads(out)["drive"]
+
+
+@pytest.mark.parametrize(("text", "fragment"), [
+    ("[[contact_groups]]\ncount = 2\n", "contact_groups[0] gives both or neither"),
+    ("[[contact_groups]]\ncount = 0\nload_share = 1.0\n", "contact_groups[0].count = 0: must be an integer"),
+    ("[[contact_groups]]\ncount = 2\nshare = 1.0\n", "contact_groups[0].share is not a key of a contact"),
+    ("[[contact_groups]]\ncount = 2\nnormal_force = \"2 mm\"\n", "contact_groups[0].normal_force = '2 mm'"),
+    ("contacts = \"one\"\n[[contact_groups]]\ncount = 2\nload_share = 0.5\n", "contacts and contact_groups"),
+])
+def test_bad_contact_groups_are_one_line_naming_the_table(text, fragment, tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(ValueError) as caught:
+        load_drive(path)
+    assert fragment in str(caught.value) and "\n" not in str(caught.value)

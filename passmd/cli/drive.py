@@ -67,6 +67,7 @@ def resolve_drive(args, **fixed) -> tuple[Drive, dict[str, str]]:
     if getattr(args, "contacts", None) is not None:
         values["contacts"] = {1: "one", 6: "paper-six"}[args.contacts]
         origins["contacts"] = "option --contacts"
+        values.pop("contact_groups", None)  # the option's preset replaces the file's groups
     if getattr(args, "actuator", None) is not None:
         values["actuator_model"], origins["actuator_model"] = args.actuator, "option --actuator"
     if getattr(args, "allow_extrapolation", False):

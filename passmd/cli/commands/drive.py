@@ -47,6 +47,8 @@ def run_template(args, out) -> int:
 
 def _shown(row: dict) -> str:
     value, unit = row["value"], row["display_unit"]
+    if isinstance(value, list):  # contact groups
+        return "; ".join(", ".join(f"{k} = {v:g}" for k, v in group.items()) for group in value) or "–"
     if isinstance(value, bool) or isinstance(value, str):
         return str(value).lower() if isinstance(value, bool) else value
     if unit and unit not in ("kg", "N/m", "kg/s"):
