@@ -222,7 +222,9 @@ def add_drive_options(parser, *, contact_only: bool = False) -> None:
                             "replace its values (default: the paper's drive)")
     if not contact_only:
         group.add_argument("--contacts", type=int, choices=(1, 6), default=None,
-                           help=f"one-contact or six-contact model (default: {DEFAULT_DRIVE.contacts})")
+                           help="one-contact or the paper's six-contact model; any other arrangement: "
+                                "[[contact_groups]] in a --drive file (default: the file's, else "
+                                f"{DEFAULT_DRIVE.contacts})")
         group.add_argument("--actuator", choices=("rigid", "flexible"), default=None,
                            help="ideally rigid or mass–spring–damper actuators "
                                 f"(default: {DEFAULT_DRIVE.actuator_model})")
