@@ -9,7 +9,7 @@ core
     (run configuration), ``theory`` (Hertz, Cattaneo–Mindlin, Eqs. 1 and 7–14), ``contact``
     (MDR contact with memory, Eqs. 4–6), ``waveforms`` and ``optimized_waveform`` (saw-tooth,
     Eq. 15), ``dynamics`` and ``time_steps`` (runner and actuators, Eqs. 2–3), ``reference``,
-    ``readings``, ``cache``, ``units``, ``provenance``
+    ``readings``, ``cache``, ``units``, ``provenance``, ``drive_file`` (drive files, TOML)
 protocols
     ``protocols`` (critical-amplitude search, stall criterion, step and velocity, Eq. 15
     design), ``sweep`` (parallel, cached grids), ``claims`` and ``checks`` (the ledger's
@@ -26,7 +26,8 @@ entry points
 
 The names a drive designer needs are exported here, loaded on first use: ``Drive``,
 ``paper_drive``, ``sawtooth``, ``simulate``, ``Simulation``, ``drive_theory``,
-``critical_amplitude``, ``generated_force``, ``optimized_design``, ``RunConfig``.
+``critical_amplitude``, ``generated_force``, ``optimized_design``, ``RunConfig``, and
+``load_drive``/``drive_toml`` (read and write a drive file).
 """
 
 #: The version: its one source (pyproject.toml reads it, ``dynamic = ["version"]``; CITATION.cff
@@ -54,6 +55,8 @@ _API = {
     "generated_force": "passmd.protocols.stall",
     "optimized_design": "passmd.protocols.eq15",
     "RunConfig": "passmd.config",
+    "load_drive": "passmd.drive_file",
+    "drive_toml": "passmd.drive_file",
 }
 
 __all__ = ["PAPER_CITATION", "__version__", *_API]

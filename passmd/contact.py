@@ -76,7 +76,7 @@ from passmd._contact_kernels import (
 )
 from passmd._validation import check_array, check_choice, check_positive, check_range
 from passmd.parameters import Assumption, Drive, check_contact_plausible, check_drive
-from passmd.theory import contact_moduli, hertz_contact_radius, hertz_indentation, normal_forces
+from passmd.theory import contact_layout, contact_moduli, hertz_contact_radius, hertz_indentation
 
 if TYPE_CHECKING:  # pandas is imported where a DataFrame is built (start-up time)
     import pandas as pd
@@ -347,16 +347,17 @@ class MDRContact:
         """Contact of one side of a drive: F_N from Eq. 1, (E*, G*) from the materials.
 
         ``side`` 0 is the two-contact side (F_N1), 1 the four-contact side (F_N2); a
-        one-contact drive has side 0 only.
+        one-contact drive has side 0 only; a drive with ``contact_groups`` has one side per group
+        (its own F_N and radius).
         """
-        forces = normal_forces(check_drive(drive).preload, drive.contacts)
+        forces, _, radii = contact_layout(check_drive(drive))
         if isinstance(side, bool) or side not in range(len(forces)):
             raise ValueError(
                 f"side = {side!r} is out of range: must be one of {list(range(len(forces)))} "
                 f"for a drive with {drive.contacts} contact(s)"
             )
         E_star, G_star = contact_moduli(drive)
-        return cls(float(forces[side]), drive.hemisphere_radius, E_star, G_star,
+        return cls(float(forces[side]), float(radii[side]), E_star, G_star,
                    drive.friction_coefficient, springs, capacity)
 
     # -- constants -------------------------------------------------------------------

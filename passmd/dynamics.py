@@ -46,7 +46,7 @@ from passmd.contact import (
 )
 from passmd.defaults import PROTOCOL
 from passmd.parameters import Drive
-from passmd.theory import contact_moduli, normal_forces
+from passmd.theory import contact_layout, contact_moduli
 from passmd.time_steps import LOCAL_ERROR_TOLERANCE, StepPlan, check_work, segments, step_plan
 from passmd.waveforms import Waveform
 
@@ -70,18 +70,16 @@ class SimulationError(RuntimeError):
 
 
 def contact_groups(drive: Drive, share_side_state: bool = True):
-    """Normal force and multiplicity of each contact group (Eq. 1).
+    """Normal force and multiplicity of each contact group (Eq. 1; any arrangement,
+    :func:`passmd.theory.contact_layout`).
 
-    With ``share_side_state=False`` the six contacts are six groups of one, so that
-    results do not rely on the by-symmetry sharing of one state per side.
+    With ``share_side_state=False`` every contact is a group of one, so that results do not
+    rely on the by-symmetry sharing of one state per group.
     """
-    forces = [float(f) for f in normal_forces(drive.preload, drive.contacts)]
-    if drive.contacts == 1:
-        return np.array(forces), np.array([1.0])
-    per_side = PROTOCOL.contacts_per_side
+    forces, multiplicity, _ = contact_layout(drive)
     if share_side_state:
-        return np.array(forces), np.array(per_side, dtype=float)
-    return np.array([forces[0]] * per_side[0] + [forces[1]] * per_side[1]), np.ones(sum(per_side))
+        return forces, multiplicity
+    return np.repeat(forces, multiplicity.astype(int)), np.ones(int(multiplicity.sum()))
 
 
 @dataclass
@@ -525,17 +523,20 @@ def _contact_rows(drive: Drive, contact_model: str, springs: int, share_side_sta
     the groups' multiplicities (:func:`contact_groups`)."""
     E_star, G_star = contact_moduli(drive)
     forces, multiplicity = contact_groups(drive, share_side_state)
+    _, counts, radii = contact_layout(drive)
+    if not share_side_state:
+        radii = np.repeat(radii, counts.astype(int))
     rows = [
         contact_arrays(
             contact_model,
             F,
-            drive.hemisphere_radius,
+            float(R),
             E_star,
             G_star,
             drive.friction_coefficient,
             springs=springs if contact_model == "discrete" else None,
         )
-        for F in forces
+        for F, R in zip(forces, radii, strict=True)
     ]
     params, state = stack_contacts(rows)
     return params, state, multiplicity

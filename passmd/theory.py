@@ -341,22 +341,19 @@ def drive_theory(drive: Drive) -> dict:
     """
     _check_drive(drive)
     E_star, G_star = _contact_moduli(drive)
-    R, mu = drive.hemisphere_radius, drive.friction_coefficient
+    mu = drive.friction_coefficient
     act = drive.actuator
-    forces = np.array([float(f) for f in _drive_forces(drive)])
+    forces, _, R = contact_layout(drive)
+    R = R if getattr(drive, "contact_groups", ()) else drive.hemisphere_radius  # the paper's: one R
     preload = ("preload", drive.preload, "N")
-    a = _drive_contact_radius(drive, forces, E_star)
+    a = _drive_contact_radius(drive, forces, E_star, R)
     u_max = _presliding(forces, R, E_star, G_star, mu)
     _require_normal(u_max, "the presliding displacement u_x,max", "m",
                     (preload, ("friction_coefficient", mu, "")))
     u_a = _actuator_deformation(mu, forces, act.stiffness, drive.runner_mass, act.mass)
     _require_normal(u_a, "the actuator deformation u_x,a", "m",
                     (preload, ("friction_coefficient", mu, ""), ("actuator.stiffness", act.stiffness, "N/m")))
-    if drive.contacts == 1:
-        rigid, flexible = float(u_max[0]), float(u_max[0] + u_a[0])
-    else:
-        rigid = float(_harmonic(u_max[0], u_max[1]))
-        flexible = float(_harmonic(u_max[0] + u_a[0], u_max[1] + u_a[1]))
+    rigid, flexible = _combined(u_max), _combined(u_max + u_a)
     return {
         "E_star_Pa": E_star,
         "G_star_Pa": G_star,
@@ -372,9 +369,37 @@ def drive_theory(drive: Drive) -> dict:
     }
 
 
-def _drive_contact_radius(drive: Drive, forces: np.ndarray, E_star: float) -> np.ndarray:
-    """Hertz contact radius per side of a (validated) drive; its cube a normal double (else refused)."""
-    cube = _hertz_cube(forces, drive.hemisphere_radius, E_star)
+def _combined(u: np.ndarray) -> float:
+    """Eqs. 7/8 (one group), Teidelt's Eqs. 11/12 (two), their generalisation (k groups).
+
+    The paper's combination of two sides, 2u₁u₂/(u₁ + u₂), is the harmonic mean of the sides'
+    presliding displacements: the amplitude at which the runner, held by the sides in parallel,
+    is pulled loose. Any number k of groups generalises it as the harmonic mean
+    k / Σ 1/u_g, unweighted by the contacts per group as Eq. 11 is; one group gives Eq. 7.
+    For two groups of any counts, forces and radii it is Eq. 11 itself; for k >= 3 it is an
+    estimate (a three-group drive's simulated steady A_c lay 11 % above it), whereas the first
+    fly-back's onset generalises exactly (:func:`first_flyback_critical_amplitude`).
+    """
+    if u.size == 1:
+        return float(u[0])
+    if u.size == 2:
+        return float(_harmonic(u[0], u[1]))
+    return float(u.size / np.sum(1.0 / u))
+
+
+def first_flyback_critical_amplitude(drive: Drive) -> float:
+    """The first fly-back's onset of full sliding, rigid actuators: max_g u_x,max,g (m).
+
+    From virgin contacts every contact slides only when the one with the largest presliding
+    displacement does (Eq. 7 for one contact, Eq. 10's side 1 for the paper's six); for any
+    arrangement it is the largest u_x,max,g of its groups (each with its own F_N and R).
+    """
+    return float(np.max(drive_theory(drive)["presliding_m"]))
+
+
+def _drive_contact_radius(drive: Drive, forces: np.ndarray, E_star: float, radii=None) -> np.ndarray:
+    """Hertz contact radius per group of a (validated) drive; its cube a normal double (else refused)."""
+    cube = _hertz_cube(forces, drive.hemisphere_radius if radii is None else radii, E_star)
     _require_normal(cube, "the Hertz contact radius cubed, 3 F_N R / (4 E*),", "m^3",
                     (("preload", drive.preload, "N"), ("hemisphere_radius", drive.hemisphere_radius, "m"),
                      ("E*", E_star, "Pa")))
@@ -384,9 +409,40 @@ def _drive_contact_radius(drive: Drive, forces: np.ndarray, E_star: float) -> np
 def _drive_forces(drive: Drive) -> tuple:
     """Eq. 1 for a (validated) drive, each force a normal double (else refused naming the preload)."""
     F = np.asarray(float(drive.preload))
-    forces = (F,) if drive.contacts == 1 else _six_contact_forces(F)
-    _require_normal(forces[-1], "the normal force per contact", "N", (("preload", drive.preload, "N"),))
+    if getattr(drive, "contact_groups", ()):
+        forces = tuple(np.asarray(float(g.normal_force) if g.normal_force is not None else g.load_share * F)
+                       for g in drive.contact_groups)
+    else:
+        forces = (F,) if drive.contacts == 1 else _six_contact_forces(F)
+    for force in reversed(forces):  # the paper's six: the smaller F_N2 first
+        _require_normal(force, "the normal force per contact", "N", (("preload", drive.preload, "N"),))
     return forces
+
+
+def _multiplicity(drive: Drive) -> tuple:
+    groups = getattr(drive, "contact_groups", ())
+    if groups:
+        return tuple(g.count for g in groups)
+    return (1,) if drive.contacts == 1 else PROTOCOL.contacts_per_side
+
+
+def _radii(drive: Drive) -> np.ndarray:
+    groups = getattr(drive, "contact_groups", ())
+    R = float(drive.hemisphere_radius)
+    return np.array([R if not groups or g.radius is None else float(g.radius) for g in groups] if groups
+                    else [R] * len(_multiplicity(drive)))
+
+
+def contact_layout(drive: Drive) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The drive's contact groups: normal force per contact (N, Eq. 1), contacts per group, and
+    the hemispheres' radius of each group (m).
+
+    One contact: ``([F_p], [1], [R])``; the paper's six: ``([F_N1, F_N2], [2, 4], [R, R])``;
+    a drive with ``contact_groups``: one entry per :class:`~passmd.parameters.ContactGroup`.
+    """
+    _check_drive(drive)
+    forces = np.array([float(f) for f in _drive_forces(drive)])
+    return forces, np.array(_multiplicity(drive), dtype=float), _radii(drive)
 
 
 def runner_frequency(drive: Drive) -> float:
@@ -397,9 +453,10 @@ def runner_frequency(drive: Drive) -> float:
     """
     _check_drive(drive)
     E_star, G_star = _contact_moduli(drive)
-    forces = np.array([float(f) for f in _drive_forces(drive)])
-    stiffness = 2.0 * _drive_contact_radius(drive, forces, E_star) * G_star  # 2aG* per side
-    multiplicity = (1,) if drive.contacts == 1 else PROTOCOL.contacts_per_side
+    forces, _, radii = contact_layout(drive)
+    radii = radii if getattr(drive, "contact_groups", ()) else drive.hemisphere_radius
+    stiffness = 2.0 * _drive_contact_radius(drive, forces, E_star, radii) * G_star  # 2aG* per group
+    multiplicity = _multiplicity(drive)
     k_total = sum(m * float(k) for m, k in zip(multiplicity, stiffness, strict=True))
     k_total += drive.effective_load_cell_stiffness
     return float(np.sqrt(k_total / drive.runner_mass) / (2 * np.pi))
@@ -412,7 +469,7 @@ def friction_limit(drive: Drive) -> float:
     """
     _check_drive(drive)
     forces = _drive_forces(drive)
-    multiplicity = (1,) if drive.contacts == 1 else PROTOCOL.contacts_per_side
+    multiplicity = _multiplicity(drive)
     return float(drive.friction_coefficient * sum(m * float(F) for m, F in zip(multiplicity, forces,
                                                                                   strict=True)))
 

@@ -30,3 +30,10 @@ def test_import_passmd_loads_no_simulator():
 def test_unknown_name_is_an_attribute_error():
     with pytest.raises(AttributeError, match="no attribute 'simulat'"):
         passmd.simulat  # noqa: B018
+
+
+def test_drive_file_round_trip_through_the_public_names(tmp_path):
+    drive = passmd.Drive(hemisphere_radius=0.5e-3, preload=0.6, friction_coefficient=0.25, contacts=1)
+    path = tmp_path / "mine.toml"
+    path.write_text(passmd.drive_toml(drive), encoding="utf-8")
+    assert passmd.load_drive(path) == drive

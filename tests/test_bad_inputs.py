@@ -84,30 +84,30 @@ NAMED_CASES = {
     # finite: Eqs. 11-12 of u_x,max ~ 1e193 m do not overflow (passmd.theory.harmonic_combination)
     "huge mu, extrapolating": (["theory", "--mu", "1e200", "--allow-extrapolation"], 0, ""),
     "huge mu, extrapolating, json": (["theory", "--mu", "1e200", "--allow-extrapolation", "--json"], 0, ""),
-    "huge stroke": (["run", "--actuator", "rigid", "--periods", "2", "--full-stroke-amplitude", "1e30",
+    "huge stroke": (["run", "--actuator", "rigid", "--periods", "2", "--full-stroke-amplitude", "1e30nm",
                      "--json"], 2, "--full-stroke-amplitude = 1e+30 nm is out of range"),
-    "huge stroke, extrapolating": (["run", "--full-stroke-amplitude", "1e30", "--allow-extrapolation"], 2,
+    "huge stroke, extrapolating": (["run", "--full-stroke-amplitude", "1e30nm", "--allow-extrapolation"], 2,
                                    "hard limit"),
-    "huge runner mass": (["run", "--runner-mass", "1e30", "--json"], 2, "--runner-mass = 1e+30 g"),
+    "huge runner mass": (["run", "--runner-mass", "1e30g", "--json"], 2, "--runner-mass = 1e+30 g"),
     "tiny preload": (["run", "--preload", "1e-30"], 2, "--preload = 1e-30 N is out of range"),
-    "tiny radius": (["run", "--radius", "1e-30"], 2, "--radius = 1e-30 mm is out of range"),
-    "tiny radius, extrapolating": (["theory", "--radius", "1e-30", "--allow-extrapolation"], 2,
+    "tiny radius": (["run", "--radius", "1e-30mm"], 2, "--radius = 1e-30 mm is out of range"),
+    "tiny radius, extrapolating": (["theory", "--radius", "1e-30mm", "--allow-extrapolation"], 2,
                                    "contact radius"),
-    "tiny hemisphere modulus": (["run", "--hemisphere-modulus", "1e-30"], 2, "--hemisphere-modulus"),
-    "tiny modulus, extrapolating": (["theory", "--hemisphere-modulus", "1e-30", "--allow-extrapolation",
+    "tiny hemisphere modulus": (["run", "--hemisphere-modulus", "1e-30GPa"], 2, "--hemisphere-modulus"),
+    "tiny modulus, extrapolating": (["theory", "--hemisphere-modulus", "1e-30GPa", "--allow-extrapolation",
                                      "--json"], 2, "hard limit"),
-    "huge contact force": (["contact", "--normal-force", "1e30", "--path", "0,1"], 2, "--normal-force"),
-    "huge contact force, extrapolating": (["contact", "--normal-force", "1e30", "--path", "0,1",
+    "huge contact force": (["contact", "--normal-force", "1e30", "--path", "0nm,1nm"], 2, "--normal-force"),
+    "huge contact force, extrapolating": (["contact", "--normal-force", "1e30", "--path", "0nm,1nm",
                                            "--allow-extrapolation", "--json"], 2, "contact radius"),
     "a billion samples": (["run", "--max-points", "1000000000"], 2, "GiB"),
     "a hundred million periods": (["run", "--periods", "100000000", "--json"], 2, "GiB"),
     "analytic-only checks its options": (["critical-amplitude", "--analytic-only", "--periods", "-5",
-                                          "--tolerance", "-1", "--frequency", "nan"], 2, "--periods = -5"),
-    "analytic-only tolerance": (["critical-amplitude", "--analytic-only", "--tolerance", "-1"], 2,
+                                          "--tolerance=-1nm", "--frequency", "nan"], 2, "--periods = -5"),
+    "analytic-only tolerance": (["critical-amplitude", "--analytic-only", "--tolerance=-1nm"], 2,
                                 "--tolerance = -1.0 is out of range"),
     "analytic-only frequency": (["critical-amplitude", "--analytic-only", "--frequency", "nan"], 2,
                                 "--frequency = 'nan'"),
-    "threshold without steady": (["critical-amplitude", "--protocol", "first", "--threshold", "1"], 2,
+    "threshold without steady": (["critical-amplitude", "--protocol", "first", "--threshold", "1nm"], 2,
                                  "--threshold contradicts --protocol first"),
     "rigid with actuator stiffness": (["theory", "--actuator", "rigid", "--actuator-stiffness", "5e6"], 2,
                                       "--actuator-stiffness contradicts --actuator rigid"),
@@ -121,18 +121,18 @@ NAMED_CASES = {
     "empty figure directory": (["figure", "fig5a", "--out", ""], 2, "--out = '' is not a directory name"),
     "figure name is a path": (["figure", "../../etc/passwd"], 2, "is not a figure name"),
     "unknown figure": (["figure", "fig0x"], 2, "figure 'fig0x' is not available"),
-    "frequency 1e-30": (["run", "--frequency", "1e-30"], 2, "--frequency = 1e-30 kHz is out of range"),
-    "frequency 1e-30, extrapolating": (["run", "--frequency", "1e-30", "--allow-extrapolation"], 2,
+    "frequency 1e-30": (["run", "--frequency", "1e-30kHz"], 2, "--frequency = 1e-30 kHz is out of range"),
+    "frequency 1e-30, extrapolating": (["run", "--frequency", "1e-30kHz", "--allow-extrapolation"], 2,
                                        "hard limit"),
     "amplitude a hair above the stroke": (["run", "--amplitude", "202.0000001nm"], 2,
                                           "--amplitude = 202.0000001 nm is out of range: must be <= 202 nm"),
     "force periods name the option": (["force", "--periods", "1", "--max-periods", "2"], 2, "--periods"),
     "unit text that trips the unit parser": (["theory", "--preload", "0:"], 2, "unknown unit ':'"),
     "periods written 1e8": (["run", "--periods", "1e8"], 2, "invalid int value: '1e8'"),
-    "slew rate 3e13": (["run", "--slew-rate", "3e13"], 2, "--slew-rate"),
+    "slew rate 3e13": (["run", "--slew-rate", "3e13V/us"], 2, "--slew-rate"),
     "load cell stiffness 1e30": (["force", "--load-cell-stiffness", "1e30"], 2, "--load-cell-stiffness"),
-    "runner mass 1e-30": (["run", "--runner-mass", "1e-30"], 2, "--runner-mass"),
-    "tiny tolerance, analytic only": (["critical-amplitude", "--analytic-only", "--tolerance", "1e-30"], 0,
+    "runner mass 1e-30": (["run", "--runner-mass", "1e-30g"], 2, "--runner-mass"),
+    "tiny tolerance, analytic only": (["critical-amplitude", "--analytic-only", "--tolerance", "1e-30nm"], 0,
                                       ""),
 }
 
@@ -165,7 +165,8 @@ def test_force_does_not_name_internal_parameters():
 
 def test_runner_that_cannot_move_is_not_reported_as_moved():
     """m_r = 1e30 kg (only with --allow-extrapolation): friction cannot move it by 20 nm."""
-    status, out, err, _ = run_main(["run", "--runner-mass", "1e30", "--allow-extrapolation", "--periods", "1",
+    status, out, err, _ = run_main(["run", "--runner-mass", "1e30g", "--allow-extrapolation",
+                                    "--periods", "1",
                                     "--json"])
     if status == 0:  # a correct result: the runner stays within the work bound
         data = json.loads(out)
@@ -232,7 +233,8 @@ full_disk = pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /d
 
 
 @full_disk
-@pytest.mark.parametrize("argv", [["theory"], ["theory", "--json"], ["contact", "--path", "0,30nm", "--json"],
+@pytest.mark.parametrize("argv", [["theory"], ["theory", "--json"],
+                                  ["contact", "--path", "0nm,30nm", "--json"],
                                   ["--help"], ["run", "--help"], ["--version"]])
 def test_full_disk_on_stdout_is_one_line_exit_1(argv):
     with open("/dev/full", "w") as full:
@@ -251,7 +253,7 @@ def test_closed_pipe_exits_quietly(json_flag):
     assert done.stderr.strip() in ("status=141", "status=0"), done.stderr
 
 
-@pytest.mark.parametrize("argv", [["theory"], ["contact", "--path", "0,30nm"], ["theory", "--help"],
+@pytest.mark.parametrize("argv", [["theory"], ["contact", "--path", "0nm,30nm"], ["theory", "--help"],
                                   ["theory", "--json"]])
 def test_ascii_console_gets_ascii_symbols(argv):
     done = run_process(argv, env={"PYTHONIOENCODING": "ascii"})

@@ -23,15 +23,15 @@ PASSMD = str(Path(sys.executable).parent / "passmd")
     ("argv", "option"),
     [
         # fly-back of 1e-17 s: steps below the float spacing of t
-        (["run", "--actuator", "rigid", "--periods", "2", "--amplitude", "1e-9"], "--amplitude"),
-        (["run", "--actuator", "rigid", "--periods", "2", "--slew-rate", "3e13"], "--slew-rate"),
+        (["run", "--actuator", "rigid", "--periods", "2", "--amplitude", "1e-9nm"], "--amplitude"),
+        (["run", "--actuator", "rigid", "--periods", "2", "--slew-rate", "3e13V/us"], "--slew-rate"),
         # a bracket narrower than the float spacing of the amplitude
         (["critical-amplitude", "--contacts", "1", "--actuator", "rigid", "--periods", "2",
-          "--tolerance", "1e-30"], "--tolerance"),
+          "--tolerance", "1e-30nm"], "--tolerance"),
         # step ∝ 1/√k and 1/√m_r: far below the time resolution
         (["force", "--actuator", "rigid", "--periods", "17", "--max-periods", "34",
           "--load-cell-stiffness", "1e30"], "--load-cell-stiffness"),
-        (["run", "--actuator", "rigid", "--periods", "2", "--runner-mass", "1e-30"], "--runner-mass"),
+        (["run", "--actuator", "rigid", "--periods", "2", "--runner-mass", "1e-30g"], "--runner-mass"),
         # ≈ 4e10 steps: beyond the step budget
         (["run", "--actuator", "rigid", "--periods", "1000000"], "--periods"),
     ],

@@ -95,9 +95,12 @@ def test_help_names_every_option_with_default(command):
     assert blocks, text
     for flag, help_line in blocks.items():
         assert "default:" in help_line, f"{command} {flag}: {help_line}"
-    quantities = {"--preload": "[N]", "--radius": "[mm]", "--mu": "[-]", "--amplitude": "[nm]",
-                  "--frequency": "[kHz]", "--normal-force": "[N]", "--path": "[nm]",
-                  "--runner-modulus": "[GPa]", "--actuator-stiffness": "[N/m]", "--runner-mass": "[g]"}
+    # a unit other than SI takes no bare number, and its help says so
+    quantities = {"--preload": "[N]", "--radius": "[mm; unit required]", "--mu": "[-]",
+                  "--amplitude": "[nm; unit required]", "--frequency": "[kHz; unit required]",
+                  "--normal-force": "[N]", "--path": "[nm; unit required]",
+                  "--runner-modulus": "[GPa; unit required]", "--actuator-stiffness": "[N/m]",
+                  "--runner-mass": "[g; unit required]"}
     for flag, unit in quantities.items():
         if flag in blocks:
             assert unit in blocks[flag], f"{command} {flag}: {blocks[flag]}"
@@ -135,7 +138,7 @@ def test_theory_json_matches_api():
     assert data["drive"]["actuator_viscosity_kg_per_s"] == drive.actuator.viscosity
 
 
-@pytest.mark.parametrize("radius", ["0.25mm", "0.25 mm", "0.25", "250um", "2.5e-4m"])
+@pytest.mark.parametrize("radius", ["0.25mm", "0.25 mm", "250um", "2.5e-4m"])
 def test_unit_parsing_of_radius(radius):
     data = run_json("theory", "--radius", radius, "--preload", "200mN", "--contacts", "1",
                     "--actuator", "rigid")
@@ -147,8 +150,8 @@ def test_unit_parsing_of_radius(radius):
 
 def test_overrides_reach_the_drive():
     data = run_json(
-        "theory", "--runner-modulus", "310GPa", "--runner-poisson", "0.3", "--hemisphere-modulus", "400",
-        "--actuator-stiffness", "5e6", "--actuator-mass", "3e-5", "--runner-mass", "5g", "--mu", "0.3",
+        "theory", "--runner-modulus", "310GPa", "--runner-poisson", "0.3", "--hemisphere-modulus", "400GPa",
+        "--actuator-stiffness", "5e6", "--actuator-mass", "3e-5g", "--runner-mass", "5g", "--mu", "0.3",
     )
     table2 = actuator_for_radius(1e-3)
     k_p, m_a = 5e6, 3e-8
@@ -194,7 +197,7 @@ def test_contact_json_matches_mdr_contact(springs):
 
 
 def test_contact_human_output():
-    status, text = run_cli("contact", "--path", "0,30,-10")
+    status, text = run_cli("contact", "--path", "0nm,30nm,-10nm")
     assert status == 0
     assert "exact" in text and "μF_N = 0.08 N" in text
 
@@ -255,7 +258,7 @@ def test_run_default_is_paper_drive_at_full_stroke():
 
 def test_run_writes_csv_and_png(tmp_path):
     csv, png = tmp_path / "series.csv", tmp_path / "plot.png"
-    status, text = run_cli("run", "--contacts", "1", "--actuator", "rigid", "--amplitude", "80",
+    status, text = run_cli("run", "--contacts", "1", "--actuator", "rigid", "--amplitude", "80nm",
                            "--periods", "2", "--max-points", "500", "--csv", str(csv), "--plot", str(png))
     assert status == 0
     assert "final position" in text and " nm" in text
@@ -373,11 +376,11 @@ def test_critical_amplitude_none_up_to_full_stroke():
         (["theory", "--bogus", "1"], "unrecognized arguments: --bogus 1"),
         (["frobnicate"], "invalid choice: 'frobnicate'"),
         (["contact"], "--path is required"),
-        (["contact", "--path", "0,3N"], "--path = '3N' has the wrong unit"),
-        (["contact", "--path", "0,,3"], "not a comma-separated list"),
-        (["contact", "--path", "0,3", "--springs", "1"], "--springs = 1 is out of range"),
+        (["contact", "--path", "0nm,3N"], "--path = '3N' has the wrong unit"),
+        (["contact", "--path", "0nm,,3nm"], "not a comma-separated list"),
+        (["contact", "--path", "0nm,3nm", "--springs", "1"], "--springs = 1 is out of range"),
         (["run", "--amplitude", "300nm"], "--amplitude = 300 nm is out of range: must be <= 202 nm"),
-        (["run", "--amplitude", "-5"], "--amplitude = -5.0 is out of range"),
+        (["run", "--amplitude=-5nm"], "--amplitude = -5.0 is out of range"),
         (["run", "--frequency", "300kHz"], "--frequency = 300kHz is out of range: must be < 250 kHz"),
         (["run", "--periods", "0"], "--periods = 0 is out of range"),
         (["run", "--waveform", "optimized", "--amplitude", "5nm"],

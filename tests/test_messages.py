@@ -93,8 +93,8 @@ REPROS = {
         ("--hemisphere-poisson = -0.99 is out of range: must be >= 0",
          "--allow-extrapolation goes beyond it")),
     "amplitude 1e-300": (
-        ["run", "--amplitude", "1e-300"], {},
-        ("fly-back time", "derived from --amplitude 1e-300 nm", "must be >=",
+        ["run", "--amplitude", "1e-300nm"], {},
+        ("fly-back time", "derived from --amplitude 1e-300nm", "must be >=",
          "raise --amplitude to at least")),
     "optimized waveform at 10 nm": (
         ["run", "--waveform", "optimized", "--amplitude", "10nm"], {},

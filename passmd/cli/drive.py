@@ -1,6 +1,7 @@
 """The drive a command line describes, and refused inputs said again in the options' terms.
 
-:func:`build_drive`: the defaults, replaced by what the user gave. :func:`explain`: the one
+:func:`build_drive`: the defaults, replaced by a drive file's values (``--drive``), then by
+the options the user gave. :func:`explain`: the one
 place a refused input (:class:`passmd._validation.InputError`, raised by the records and
 functions the options reach) is said again with the option that set it, as typed.
 """
@@ -8,16 +9,17 @@ functions the options reach) is said again with the option that set it, as typed
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from decimal import ROUND_CEILING, ROUND_FLOOR, Decimal
 
 from passmd._validation import InputError
 from passmd.cli.errors import UsageError
-from passmd.cli.options import ACTUATOR_DYNAMICS, DEFAULT_DRIVE, DRIVE_QUANTITIES, OPTION_FOR, QUANTITIES
-from passmd.parameters import Drive, actuator_for_radius, actuator_viscosity
+from passmd.cli.options import ACTUATOR_DYNAMICS, DRIVE_QUANTITIES, OPTION_FOR, QUANTITIES
+from passmd.cli.output import fmt
+from passmd.drive_file import DriveFileError, read_drive_file, resolve
+from passmd.parameters import Drive
 from passmd.units import dimension_name, from_si
 
-__all__ = ["build_drive", "explain"]
+__all__ = ["build_drive", "drive_rows", "explain", "resolve_drive"]
 
 
 def _given(args) -> dict[str, float]:
@@ -26,8 +28,8 @@ def _given(args) -> dict[str, float]:
     return {flag: value for flag, value in values.items() if value is not None}
 
 
-def _check_combinations(given, args, load_cell: bool) -> None:
-    if getattr(args, "actuator", None) == "rigid":
+def _check_combinations(given, args, load_cell: bool, rigid: bool) -> None:
+    if rigid:
         dynamics = [flag for flag in ACTUATOR_DYNAMICS if flag in given]
         if dynamics:
             raise UsageError(f"{dynamics[0]} contradicts --actuator rigid: ideally rigid actuators have no "
@@ -37,36 +39,66 @@ def _check_combinations(given, args, load_cell: bool) -> None:
                          "use it with `passmd force` or `passmd run --load-cell`")
 
 
+def resolve_drive(args, **fixed) -> tuple[Drive, dict[str, str]]:
+    """The drive the options (and ``--drive FILE``) describe, and where each parameter came from.
+
+    The drive file's values (:func:`passmd.drive_file.read_drive_file`), then each option
+    given replacing its key, then ``fixed`` (e.g. ``load_cell=True``) replacing fields last;
+    what is left comes from the paper as :func:`passmd.drive_file.resolve` says (Table 2
+    actuator of the radius, viscosity 2ζ√(k_p m_a) of the final k_p and m_a). Returns the
+    drive and, by drive-file key, ``"file NAME"``, ``"option --flag"`` or the default's source.
+    """
+    values, origins = {}, {}
+    path = getattr(args, "drive", None)
+    if path is not None:
+        values = read_drive_file(path, allow_extrapolation=bool(getattr(args, "allow_extrapolation", False)))
+        origins = dict.fromkeys(values, f"given in {path}")
+        if values.get("allow_extrapolation") is True:
+            args.allow_extrapolation = True  # the file lifts the soft limits for the options too
+    given = _given(args)
+    rigid = (getattr(args, "actuator", None) or values.get("actuator_model")) == "rigid"
+    _check_combinations(given, args, bool(fixed.get("load_cell", values.get("load_cell", False))), rigid)
+    for q in DRIVE_QUANTITIES:
+        if q.flag in given:
+            values[q.field] = given[q.flag]
+            origins[q.field] = f"option {q.flag}"
+            if q.field == "actuator.viscosity":
+                values.pop("actuator.damping_ratio", None)
+    if getattr(args, "contacts", None) is not None:
+        values["contacts"] = {1: "one", 6: "paper-six"}[args.contacts]
+        origins["contacts"] = "option --contacts"
+        values.pop("contact_groups", None)  # the option's preset replaces the file's groups
+    if getattr(args, "actuator", None) is not None:
+        values["actuator_model"], origins["actuator_model"] = args.actuator, "option --actuator"
+    if getattr(args, "allow_extrapolation", False):
+        values["allow_extrapolation"] = True
+        origins.setdefault("allow_extrapolation", "option --allow-extrapolation")
+    return resolve(values, origins, **fixed)
+
+
 def build_drive(args, **fixed) -> Drive:
     """The :class:`~passmd.parameters.Drive` the parsed options describe (SI inside).
 
-    :data:`~passmd.cli.options.DEFAULT_DRIVE` with each given option replacing its field;
-    ``fixed`` (e.g. ``load_cell=True``) replaces fields last. Actuator: Table 2 for the
-    radius, each given option replacing its field; the viscosity, unless given, is
-    2ζ√(k_p m_a) of the final k_p and m_a (:func:`~passmd.parameters.actuator_viscosity`).
-    The dataclasses validate the result.
+    As :func:`resolve_drive`, without the sources; the dataclasses validate the result.
     """
-    given = _given(args)
-    _check_combinations(given, args, bool(fixed.get("load_cell", False)))
-    fields = {q.field: given[q.flag] for q in DRIVE_QUANTITIES if q.flag in given}
+    return resolve_drive(args, **fixed)[0]
 
-    def part(name: str) -> dict[str, float]:
-        return {key.split(".", 1)[1]: value for key, value in fields.items() if key.startswith(name + ".")}
 
-    changes = {key: value for key, value in fields.items() if "." not in key}
-    base = actuator_for_radius(changes.get("hemisphere_radius", DEFAULT_DRIVE.hemisphere_radius))
-    actuator = {"stiffness": base.stiffness, "mass": base.mass, **part("actuator")}
-    actuator.setdefault("viscosity", actuator_viscosity(actuator["stiffness"], actuator["mass"]))
-    changes["actuator"] = replace(base, **actuator)
-    changes["amplifier"] = replace(DEFAULT_DRIVE.amplifier, **part("amplifier"))
-    for name in ("hemisphere_material", "runner_material"):
-        material = getattr(DEFAULT_DRIVE, name)
-        if part(name):
-            changes[name] = replace(material, **part(name), name=f"{material.name} (modified)")
-    changes["allow_extrapolation"] = bool(getattr(args, "allow_extrapolation", False))
-    if hasattr(args, "contacts"):
-        changes.update(contacts=args.contacts, actuator_model=args.actuator)
-    return replace(DEFAULT_DRIVE, **{**changes, **fixed})
+def drive_rows(drive: Drive) -> list[tuple[str, str]]:
+    """Two compact rows of the drive a command used: contacts and runner, and the actuators."""
+    act, amp = drive.actuator, drive.amplifier
+    e1, e2 = drive.hemisphere_material, drive.runner_material
+    rows = [("drive", f"R = {fmt(drive.hemisphere_radius, 'mm')}, F_p = {fmt(drive.preload, 'N')}, "
+                      f"μ = {drive.friction_coefficient:g}, m_r = {fmt(drive.runner_mass, 'g')}, "
+                      f"E_1 = {fmt(e1.youngs_modulus, 'GPa')}, E_2 = {fmt(e2.youngs_modulus, 'GPa')}, "
+                      f"ν = {e1.poissons_ratio:g}/{e2.poissons_ratio:g}")]
+    stroke = f"A_max = {fmt(act.full_stroke_amplitude, 'nm')}, SR = {amp.slew_rate / 1e6:.4g} V/µs"
+    if drive.actuator_model == "flexible":
+        rows.append(("actuators", f"k_p = {act.stiffness:.4g} N/m, m_a = {act.mass:.4g} kg, "
+                                  f"c_p = {act.viscosity:.4g} kg/s (ζ = {act.damping_ratio:.3g}), {stroke}"))
+    else:
+        rows.append(("actuators", f"rigid, {stroke}"))
+    return rows
 
 
 # --------------------------------------------------------------------------------------
@@ -88,6 +120,8 @@ def explain(exc: ValueError, args) -> str:
     keeps its message.
     """
     cause = exc if isinstance(exc, InputError) else exc.__cause__
+    if isinstance(cause, DriveFileError):  # already names the drive file and its key as typed
+        return str(cause)
     text = _rephrase(cause, args) if isinstance(cause, InputError) else None
     return text or str(exc)
 
@@ -152,7 +186,7 @@ def _typed(flag: str, args, value_si=None) -> str:
         float(text)
     except ValueError:
         return text
-    return f"{text} {unit}" if unit else text
+    return f"{text} {unit}" if unit else text  # only options shown in SI take a bare number
 
 
 def _display_unit(si_unit: str, flag: str) -> str:

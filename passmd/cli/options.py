@@ -1,14 +1,17 @@
 """The commands' options: quantities with units, and the option groups the commands share.
 
 A :class:`Quantity` is one option that takes a number with a unit (``0.4N``, ``1mm``,
-``202nm``); a bare number is read in the unit its help shows. Its default text is computed
-from the defaults it stands for (:data:`DEFAULT_DRIVE`, :data:`passmd.defaults.PROTOCOL`),
-never retyped.
+``202nm``). A bare number is read in SI units, as in a drive file; an option whose help
+shows another unit (mm, nm, kHz, g, GPa, V/us) refuses a bare number and asks for the unit,
+so that no number is ever read in a unit the user did not write.
+Its default text is computed from the defaults it stands for (:data:`DEFAULT_DRIVE`,
+:data:`passmd.defaults.PROTOCOL`), never retyped.
 """
 
 from __future__ import annotations
 
 import argparse
+import re
 from dataclasses import dataclass
 
 from passmd._validation import check_range
@@ -17,15 +20,34 @@ from passmd.cli.output import JSON_HELP, fmt
 from passmd.config import ENVIRONMENT
 from passmd.defaults import PROTOCOL
 from passmd.parameters import ACTUATOR_DAMPING_RATIO, PLAUSIBLE_RANGES, Drive
-from passmd.units import parse_quantity, si_factor, to_display
+from passmd.units import QuantityError, parse_quantity, si_factor, to_display
 
 __all__ = ["ACTUATOR_DYNAMICS", "AMPLITUDE", "CACHE_DIR_HELP", "DEFAULT_DRIVE", "DRIVE_QUANTITIES",
            "FREQUENCY", "MATERIAL_FLAGS", "NORMAL_FORCE", "OPTION_FOR", "QUANTITIES", "THRESHOLD",
-           "TOLERANCE", "DirectoryPath", "FilePath", "Quantity", "add_drive_options", "add_output_options",
-           "add_simulation_options", "add_sweep_options"]
+           "TOLERANCE", "DirectoryPath", "FilePath", "Quantity", "add_drive_options",
+           "add_output_options", "add_simulation_options", "add_sweep_options", "refuse_bare"]
 
 #: The drive every option replaces a part of (Tables 1–2 at R = 1 mm, F_p = 0.4 N, μ = 0.2).
 DEFAULT_DRIVE = Drive()
+
+#: A number without a unit (as passmd.units reads one; "nan" and "inf" are not numbers there).
+_BARE = re.compile(r"^[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?$")
+#: The SI unit of each display unit that is not SI (for the bare-number message).
+_SI_UNIT = {"mm": "m", "nm": "m", "kHz": "Hz", "g": "kg", "GPa": "Pa", "V/us": "V/s", "us": "s"}
+
+
+def refuse_bare(flag: str, raw, unit: str) -> None:
+    """Refuse a bare number (``QuantityError``) for an option shown in a unit that is not SI.
+
+    A bare number is read in SI units; where the option's help shows another unit (mm, nm,
+    kHz, g, GPa, V/us) it is refused, naming both units, so that it is never read in a unit
+    the user did not write.
+    """
+    text = str(raw).strip()
+    if _BARE.match(text) and si_factor(unit) != 1.0:
+        raise QuantityError(f"{flag} = {text} has no unit: write one, e.g. {text}{_SI_UNIT.get(unit, '')} "
+                            f"or {text}{unit} (an option shown in {unit} takes no bare number; a bare number "
+                            "is SI only where the option is shown in SI)")
 
 
 @dataclass(frozen=True)
@@ -51,7 +73,8 @@ class Quantity:
         return self.flag.lstrip("-").replace("-", "_")
 
     def add(self, parser) -> None:
-        unit = f"[{self.unit}]" if self.unit else "[-]"
+        unit = f"[{self.unit}]" if si_factor(self.unit) == 1.0 else f"[{self.unit}; unit required]"
+        unit = unit if self.unit else "[-]"
         parser.add_argument(
             self.flag,
             metavar=self.symbol,
@@ -64,6 +87,7 @@ class Quantity:
         raw = getattr(args, self.dest)
         if raw is None:
             return None
+        refuse_bare(self.flag, raw, self.unit)
         value = parse_quantity(raw, self.unit, name=self.flag)
         if self.plausible is not None:
             scale = si_factor(self.unit)
@@ -187,12 +211,22 @@ CACHE_DIR_HELP = f"cache directory (default: ${ENVIRONMENT['cache_dir']}, else "
 
 
 def add_drive_options(parser, *, contact_only: bool = False) -> None:
-    """The drive's options (Tables 1–2); ``contact_only``: those of one contact."""
-    group = parser.add_argument_group("drive (Tables 1–2; a bare number is in the unit shown)")
+    """The drive's options (Tables 1–2, or a drive file); ``contact_only``: those of one contact.
+
+    ``--drive FILE`` reads a drive file (:mod:`passmd.drive_file`); each option given replaces
+    the file's value.
+    """
+    group = parser.add_argument_group("drive (Tables 1–2, or --drive FILE; a bare number is SI: options "
+                                      "shown in another unit need the unit written)")
+    group.add_argument("--drive", metavar="FILE", action=FilePath,
+                       help="drive file (TOML, `passmd drive template` writes one); the options below "
+                            "replace its values (default: the paper's drive)")
     if not contact_only:
-        group.add_argument("--contacts", type=int, choices=(1, 6), default=DEFAULT_DRIVE.contacts,
-                           help=f"one-contact or six-contact model (default: {DEFAULT_DRIVE.contacts})")
-        group.add_argument("--actuator", choices=("rigid", "flexible"), default=DEFAULT_DRIVE.actuator_model,
+        group.add_argument("--contacts", type=int, choices=(1, 6), default=None,
+                           help="one-contact or the paper's six-contact model; any other arrangement: "
+                                "[[contact_groups]] in a --drive file (default: the file's, else "
+                                f"{DEFAULT_DRIVE.contacts})")
+        group.add_argument("--actuator", choices=("rigid", "flexible"), default=None,
                            help="ideally rigid or mass–spring–damper actuators "
                                 f"(default: {DEFAULT_DRIVE.actuator_model})")
     for q in DRIVE_QUANTITIES:

@@ -83,10 +83,14 @@ def nm(values, shown: int = 8) -> str:
     return ", ".join(text) + " nm"
 
 
-def sides(values, unit: str, digits: int = 5) -> str:
-    """One value, or the two sides of the six-contact drive (two and four contacts)."""
+def sides(values, unit: str, digits: int = 5, counts=None) -> str:
+    """One value, or the two sides of the six-contact drive (two and four contacts), or one per
+    contact group of another arrangement (``counts``: contacts per group)."""
     arr = np.atleast_1d(np.asarray(values, dtype=float))
     text = [f"{x:.{digits}g}" for x in from_si(arr, unit)]
+    if counts is not None:
+        return " | ".join(f"{t} {unit} (group {g + 1}, ×{n})" for g, (t, n) in enumerate(zip(text, counts,
+                                                                                         strict=True)))
     if len(text) == 2:
         return f"{text[0]} {unit} (side 1, ×2) | {text[1]} {unit} (side 2, ×4)"
     return f"{text[0]} {unit}"
@@ -123,4 +127,8 @@ def drive_record(drive: Drive) -> dict:
         "full_stroke_amplitude_m": act.full_stroke_amplitude,
         "amplifier_voltage_V": amp.peak_to_peak_voltage,
         "slew_rate_V_per_s": amp.slew_rate,
+        **({"contact_groups": [{"count": g.count, "load_share": g.load_share,
+                                "normal_force_N": g.normal_force, "radius_m": g.radius}
+                               for g in drive.contact_groups]}
+           if drive.contact_groups else {}),
     }

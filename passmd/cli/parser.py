@@ -10,6 +10,7 @@ from passmd.cli.commands import (
     cache,
     contact,
     critical_amplitude,
+    drive,
     figure,
     fit,
     force,
@@ -26,12 +27,15 @@ PROG = "passmd"
 DESCRIPTION = """\
 passmd: the piezo-actuated stick-slip micro-drive of Nguyen et al., Coatings 8, 62 (2018).
 
-Quantities accept units (0.4N, 1mm, '0.25 mm', 202nm, 100kHz, 310GPa); a bare number is
-read in the unit the option's help shows. Human output uses nm, N, mm and kHz; --json
-prints one JSON object in SI units whose keys carry the unit (e.g. final_position_m)."""
+Quantities accept units (0.4N, 1mm, '0.25 mm', 202nm, 100kHz, 310GPa). A bare number is
+read in SI units, and only where the option's help shows the SI unit (N, N/m, kg/s, V); an
+option shown in mm, nm, kHz, g, GPa or V/us refuses a bare number and asks for the unit.
+A drive file (--drive FILE, `passmd drive template`) reads bare numbers in SI.
+Human output uses nm, N, mm and kHz; --json prints one JSON object in SI units whose
+keys carry the unit (e.g. final_position_m)."""
 
 #: The subcommands in the order ``passmd --help`` lists them.
-COMMANDS = (theory, critical_amplitude, run, force, sweep, fit, contact, figure, cache, ledger)
+COMMANDS = (theory, critical_amplitude, run, force, sweep, fit, contact, drive, figure, cache, ledger)
 
 
 class _Parser(argparse.ArgumentParser):

@@ -5,23 +5,38 @@ from __future__ import annotations
 import math
 import textwrap
 
-from passmd.cli.drive import build_drive
+from passmd.cli import kernels
+from passmd.cli.drive import build_drive, drive_rows
 from passmd.cli.errors import UsageError
 from passmd.cli.options import FREQUENCY, THRESHOLD, TOLERANCE, add_drive_options
 from passmd.cli.output import JSON_HELP, check_results, describe, drive_record, emit_json, emit_rows, fmt
 from passmd.defaults import PROTOCOL
 from passmd.units import from_si
 
-__all__ = ["add_parser", "run_critical_amplitude"]
+__all__ = ["READINGS", "add_parser", "run_critical_amplitude"]
+
+#: The three readings of A_c, and what each means for a designer.
+READINGS = {
+    "analytic": "analytic (Eq. 7/8, 11/12): the contacts' presliding plus the actuators' deformation, "
+                "no runner dynamics; a first sizing, to be checked by simulation",
+    "steady": "simulated steady: above it the drive keeps stepping once running; size the working "
+              "amplitude by this one",
+    "first": "simulated first fly-back: above it every contact slides fully in the first fly-back from "
+             "rest; what a start from rest needs",
+}
 
 _EPILOG = textwrap.dedent("""\
+    Three readings of A_c, each for a different question: analytic (closed form, no
+    dynamics: a first sizing), simulated steady (the drive keeps stepping once running: size
+    the working amplitude by it), simulated first fly-back (a start from rest slips at once).
+
     The simulated A_c comes from the critical-amplitude chapters' search
     (passmd.protocols.critical_amplitude): bisection on [0, A_max] with one of two
     protocols, reporting its final bracket. steady: the last step of a run of
     --periods saw-tooth periods from rest exceeds --threshold; first: every contact
     slides fully in the first fly-back from virgin contacts.
 
-    --json keys (SI units): critical_amplitude_m (null if none up to A_max),
+    --json keys (SI units): reading, critical_amplitude_m (null if none up to A_max),
     bracket_m, analytic_critical_amplitude_m, critical_amplitude_rigid_m,
     critical_amplitude_flexible_m, protocol, threshold_m, tolerance_m, frequency_Hz,
     periods, flyback, simulations, wall_time_s, drive{...}""")
@@ -59,6 +74,7 @@ def _search(args, drive) -> dict:
     frequency = FREQUENCY.parse_or(args, PROTOCOL.drive_frequency)
     if args.analytic_only:
         return {}
+    kernels.notice_if_cold()
     # the book's search (critical-amplitude chapters): one protocol for users and book
     found = ca.critical_amplitude(
         drive, protocol=args.protocol, frequency=frequency, flyback=args.flyback,
@@ -67,6 +83,7 @@ def _search(args, drive) -> dict:
     )
     value = found["critical_amplitude_m"]
     return {
+        "reading": f"simulated {args.protocol}",
         "critical_amplitude_m": None if math.isnan(value) else value,
         "bracket_m": [found["bracket_low_m"],
                       None if math.isnan(found["bracket_high_m"]) else found["bracket_high_m"]],
@@ -101,7 +118,9 @@ def run_critical_amplitude(args, out) -> int:
     rows = [] if args.analytic_only else _search_rows(record, drive)
     eq = "Eq. 7/11" if drive.actuator_model == "rigid" else "Eq. 8/12"
     rows.append((f"analytic A_c ({eq})", fmt(record["analytic_critical_amplitude_m"], "nm")))
-    emit_rows(f"passmd critical-amplitude — {describe(drive)}", rows, out)
+    rows += [(f"what the {name} reading means", text.split(": ", 1)[1])
+             for name, text in READINGS.items()]
+    emit_rows(f"passmd critical-amplitude — {describe(drive)}", [*rows, *drive_rows(drive)], out)
     return 0
 
 
@@ -114,8 +133,9 @@ def _search_rows(record: dict, drive) -> list[tuple[str, str]]:
     else:
         criterion = "full sliding of every contact in the first fly-back"
     return [
-        ("simulated A_c", f"{fmt(found, 'nm')}  (bracket {from_si(lo, 'nm'):.4g}–"
-                          f"{from_si(hi, 'nm'):.4g} nm)" if found is not None else
+        (f"simulated A_c, {record['protocol']} reading",
+         f"{fmt(found, 'nm')}  (bracket {from_si(lo, 'nm'):.4g}–{from_si(hi, 'nm'):.4g} nm)"
+         if found is not None else
          f"none up to the full stroke {fmt(a_max, 'nm')} ({criterion})"),
         ("search", f"{record['protocol']}: {criterion}, "
                    f"f = {fmt(record['frequency_Hz'], 'kHz')}, {record['flyback']} fly-back, "

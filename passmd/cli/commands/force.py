@@ -6,8 +6,9 @@ import re
 import textwrap
 
 from passmd._result_bounds import ResultError
+from passmd.cli import kernels
 from passmd.cli.commands.run import check_memory, check_output_paths, waveform_args, write_outputs
-from passmd.cli.drive import build_drive
+from passmd.cli.drive import build_drive, drive_rows
 from passmd.cli.errors import UsageError
 from passmd.cli.options import add_drive_options, add_output_options, add_simulation_options
 from passmd.cli.output import check_results, describe, drive_record, emit_json, emit_rows, fmt
@@ -68,6 +69,7 @@ def run_force(args, out) -> int:
 
     drive = build_drive(args, load_cell=True)
     amplitude, frequency = _check_options(args, drive)
+    kernels.notice_if_cold()
     # the force-generation chapter's stall protocol: runs from rest, lengthened until stalled
     try:
         found = stall.generated_force(drive, amplitude, frequency, flyback=args.flyback,
@@ -116,5 +118,5 @@ def run_force(args, out) -> int:
         ("integration", f"{found['periods_simulated']} periods, {found['wall_time_s']:.3g} s"),
     ]
     emit_rows(f"passmd force — {describe(drive)}, load cell k = "
-              f"{fmt(drive.load_cell_stiffness, 'N/m')}", rows, out)
+              f"{fmt(drive.load_cell_stiffness, 'N/m')}", [*rows, *drive_rows(drive)], out)
     return 0

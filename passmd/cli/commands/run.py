@@ -2,16 +2,18 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 from passmd._result_bounds import check_run_bounds
-from passmd.cli import startup
+from passmd.cli import kernels, startup
 from passmd.cli.commands.contact import check_springs
-from passmd.cli.drive import build_drive
+from passmd.cli.drive import build_drive, drive_rows
 from passmd.cli.errors import OutputError, UsageError
 from passmd.cli.options import (
     AMPLITUDE,
     FREQUENCY,
+    Quantity,
     add_drive_options,
     add_output_options,
     add_simulation_options,
@@ -34,10 +36,19 @@ __all__ = ["add_parser", "check_memory", "check_output_paths", "run_run", "simul
            "write_outputs"]
 
 _RUN_KEYS = """\
+By default one run of --periods periods from rest; its mean velocity averages from rest.
+--steady measures instead as the book does (passmd.protocols.velocity): max(20, f·5 ms)
+periods from rest, the velocity the slope of the period-mean position over the run's
+second half ('steady' in --json: velocity_m_per_s, velocity_drift, step_m). It is not
+the default: a few periods from rest are what the paper's Fig. 9a and the step measure.
+--waveform optimized designs t_s, t_a, Δ_a by Eq. 15 from the drive's own saw-tooth
+response; --settling-time, --acceleration-time, --acceleration-amplitude replace them.
+
 --json keys (SI units): final_position_m, settled_positions_m, step_sizes_m,
 back_steps_m, mean_velocity_m_per_s (>= 2 periods), periods, frequency_Hz, amplitude_m,
 integrator_steps and the integrator's step sizes (keys ending in _time_step_s), wall_time_s, waveform,
-flyback, drive{...}"""
+flyback, protocol, drive{...}, design{...} and design_given_by_options (optimized),
+steady{...} (--steady)"""
 
 #: Bytes per recorded sample (time, piezo/runner positions and velocities, per-group
 #: contact columns, with the DataFrame/plot copies) and per period (waveform breakpoints,
@@ -45,17 +56,40 @@ flyback, drive{...}"""
 _BYTES_PER_SAMPLE = 4 * 8 * (4 + 3 * 6)
 _BYTES_PER_PERIOD = 8 * 64
 
+#: Options that replace a part of the Eq. 15 design of --waveform optimized (OptimizedDesign fields).
+EQ15_OVERRIDES = (
+    Quantity("--settling-time", "us", "t_s", "Eq. 15 settling time (optimized waveform)",
+             "1/(2 f_s) of the saw-tooth response", 0.0, False, field="settling_time"),
+    Quantity("--acceleration-time", "us", "t_a", "Eq. 15 acceleration time (optimized waveform)",
+             "u_x,max/(V_a − V_r)", field="acceleration_time"),
+    Quantity("--acceleration-amplitude", "nm", "Δ_a", "Eq. 15 acceleration amplitude (optimized waveform)",
+             "V_a t_a, V_a the slew-rate limit", field="acceleration_amplitude"),
+)
+
 #: Image formats --plot can write (matplotlib's Agg/PDF/SVG/PS backends).
 _PLOT_FORMATS = ("png", "pdf", "svg", "ps", "eps", "jpg", "jpeg", "tif", "tiff", "webp")
+
+
+_DEFAULT_PERIODS = 3
+#: Fewest periods of a --steady run: its second half must hold two quarters of >= 1 period.
+_STEADY_MIN_PERIODS = 4
 
 
 def add_parser(command) -> None:
     p = command("run", "one simulation of a driving waveform from rest", _RUN_KEYS +
                 ", generated_force_N (with --load-cell)")
     add_drive_options(p)
-    add_simulation_options(p, default_periods=3)
+    add_simulation_options(p, default_periods=_DEFAULT_PERIODS)
+    p.set_defaults(periods=None)  # --steady's own length unless given
     p.add_argument("--load-cell", action="store_true",
                    help="the runner pushes against the load cell (default: off, free runner)")
+    group = p.add_argument_group("steady velocity and the Eq. 15 design")
+    group.add_argument("--steady", action="store_true",
+                       help="the book's steady-velocity protocol: max(20, f·5 ms) periods from rest (unless "
+                            "--periods), velocity from the second half's period means (default: off, the "
+                            "mean velocity of --periods periods from rest)")
+    for q in EQ15_OVERRIDES:
+        q.add(group)
     add_output_options(p)
     # collection stays paused through the imports and the kernels' loading (passmd.cli.startup)
     p.set_defaults(handler=run_run, resumes_collector=True)
@@ -71,6 +105,16 @@ def waveform_args(args, drive):
             f"{from_si(a_max, 'nm'):.10g} nm, the actuator's full stroke (--full-stroke-amplitude)"
         )
     frequency = FREQUENCY.parse_or(args, PROTOCOL.drive_frequency)
+    if getattr(args, "steady", False) and args.periods is None:
+        from passmd.protocols.velocity import steady_periods
+
+        args.periods = steady_periods(frequency)
+    elif args.periods is None:
+        args.periods = _DEFAULT_PERIODS
+    if getattr(args, "steady", False) and args.periods < _STEADY_MIN_PERIODS:
+        raise UsageError(f"--periods = {args.periods} is out of range with --steady: must be an integer >= "
+                         f"{_STEADY_MIN_PERIODS} (the velocity of the second half, and the drift between its "
+                         "quarters, need two periods each)")
     if args.periods < 1:
         raise UsageError(f"--periods = {args.periods} is out of range: must be an integer >= 1")
     return min(amplitude, a_max), frequency
@@ -109,6 +153,7 @@ def check_output_paths(args) -> None:
 def simulate(args, drive):
     """(result, Eq. 15 design or None) of the run the options describe (saw-tooth or Eq. 15)."""
     startup.load_numba_without_blas_probe()
+    kernels.notice_if_cold()
     from passmd import dynamics, optimized_waveform, waveforms
     from passmd.protocols import eq15
 
@@ -118,6 +163,10 @@ def simulate(args, drive):
         # Eq. 15, designed from this drive's own simulated saw-tooth response (first period a
         # saw-tooth, as in the paper); a ValueError (e.g. Δ_a ≥ A) is a usage error
         design = eq15.optimized_design(amplitude, drive, flyback=args.flyback)
+        given = {q.field: q.parse(args) for q in EQ15_OVERRIDES}
+        given = {name: value for name, value in given.items() if value is not None}
+        if given:  # the user's values replace the design's (its f_s, V_r, u_x,max stay as measured)
+            design = replace(design, **given)
         wave = optimized_waveform.optimized(amplitude, frequency, drive, periods=args.periods,
                                             flyback=args.flyback, design=design)
     else:
@@ -131,10 +180,15 @@ def simulate(args, drive):
     return result, design
 
 
-def design_row(design) -> str:
-    """The Eq. 15 design in display units: t_s, t_a, Δ_a (V_a), f_s, V_r, u_x,max."""
-    return (f"t_s = {design.settling_time * 1e6:.4g} µs, t_a = {design.acceleration_time * 1e6:.4g} µs, "
-            f"Δ_a = {fmt(design.acceleration_amplitude, 'nm')} "
+def design_row(design, given=()) -> str:
+    """The Eq. 15 design in display units: t_s, t_a, Δ_a (V_a), f_s, V_r, u_x,max; ``given``:
+    the fields an option set (marked "(given)")."""
+    def mark(name):
+        return " (given)" if name in given else ""
+
+    return (f"t_s = {design.settling_time * 1e6:.4g} µs{mark('settling_time')}, "
+            f"t_a = {design.acceleration_time * 1e6:.4g} µs{mark('acceleration_time')}, "
+            f"Δ_a = {fmt(design.acceleration_amplitude, 'nm')}{mark('acceleration_amplitude')} "
             f"(V_a = {design.acceleration_velocity * 1e3:.4g} mm/s); from the saw-tooth response: "
             f"f_s = {fmt(design.micro_vibration_frequency, 'kHz')}, "
             f"V_r = {design.runner_velocity * 1e3:.4g} mm/s, u_x,max = {fmt(design.presliding, 'nm')}")
@@ -175,6 +229,18 @@ def write_outputs(args, result) -> None:
 def run_run(args, out) -> int:
     drive = build_drive(args, load_cell=bool(args.load_cell))
     waveform_args(args, drive)  # every option checked before anything runs
+    overrides = [q.flag for q in EQ15_OVERRIDES if getattr(args, q.dest) is not None]
+    if overrides and args.waveform != "optimized":
+        raise UsageError(f"{overrides[0]} needs --waveform optimized: it replaces a part of the Eq. 15 "
+                         "design")
+    delta = EQ15_OVERRIDES[2].parse(args)
+    for q in EQ15_OVERRIDES[:2]:
+        q.parse(args)
+    amplitude = waveform_args(args, drive)[0]
+    if delta is not None and not delta < amplitude:
+        raise UsageError(f"--acceleration-amplitude = {args.acceleration_amplitude} is out of range: must "
+                         f"be < {fmt(amplitude, 'nm')}, the actuation amplitude A (Eq. 15: the fast segment "
+                         "ends below A)")
     check_springs(args.springs)
     check_memory(args)
     check_output_paths(args)
@@ -184,11 +250,19 @@ def run_run(args, out) -> int:
     summary["wall_time_s"] = float(result.wall_time)
     if design is not None:  # Eq. 15's parameters, derived from this drive's saw-tooth response
         summary["design"] = design.as_dict()
+        summary["design_given_by_options"] = [q.field for q in EQ15_OVERRIDES
+                                              if getattr(args, q.dest) is not None]
+    if args.steady:  # the book's steady-velocity protocol, on this same run
+        from passmd.protocols.velocity import steady_velocity
+
+        steady = steady_velocity(result)
+        summary["steady"] = {**steady, "step_m": steady["velocity_m_per_s"] / float(summary["frequency_Hz"])}
     check_results(summary)
     check_run_bounds(summary, drive, float(summary["amplitude_m"]))
     write_outputs(args, result)
     if args.json:
         emit_json({"command": "run", "waveform": args.waveform, "flyback": args.flyback,
+                   "protocol": "steady" if args.steady else "from rest",
                    "drive": drive_record(drive), **summary}, out)
         return 0
     rows = [
@@ -199,11 +273,16 @@ def run_run(args, out) -> int:
         ("back-step per period", nm(summary["back_steps_m"])),
     ]
     if design is not None:
-        rows.insert(1, ("Eq. 15 design", design_row(design)))
+        rows.insert(1, ("Eq. 15 design", design_row(design, summary["design_given_by_options"])))
+    if "steady" in summary:
+        steady = summary["steady"]
+        rows.append(("steady velocity", f"{steady['velocity_m_per_s'] * 1e3:.6g} mm/s (second half's period "
+                                        f"means; step {fmt(steady['step_m'], 'nm')}, drift "
+                                        f"{steady['velocity_drift']:.2g})"))
     if "mean_velocity_m_per_s" in summary:
-        rows.append(("mean velocity", f"{summary['mean_velocity_m_per_s'] * 1e3:.6g} mm/s"))
+        rows.append(("mean velocity from rest", f"{summary['mean_velocity_m_per_s'] * 1e3:.6g} mm/s"))
     if "generated_force_N" in summary:
         rows.append(("generated force", fmt(summary["generated_force_N"], "N")))
     rows.append(("integrator", f"{summary['integrator_steps']} steps, {summary['wall_time_s']:.3g} s"))
-    emit_rows(f"passmd run — {describe(drive)}", rows, out)
+    emit_rows(f"passmd run — {describe(drive)}", [*rows, *drive_rows(drive)], out)
     return 0

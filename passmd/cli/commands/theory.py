@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import textwrap
 
-from passmd.cli.drive import build_drive
+from passmd.cli.drive import build_drive, drive_rows
 from passmd.cli.options import add_drive_options
 from passmd.cli.output import (
     JSON_HELP,
@@ -43,19 +43,24 @@ def run_theory(args, out) -> int:
     if args.json:
         emit_json({"command": "theory", "drive": drive_record(drive), **result}, out)
         return 0
+    counts = [g.count for g in drive.contact_groups] or None  # another arrangement: one value per group
+
+    def per_group(values, unit):
+        return sides(values, unit, counts=counts)
+
     rows = [
         ("E* (Eq. 4)", fmt(result["E_star_Pa"], "GPa")),
         ("G* (Eq. 4)", fmt(result["G_star_Pa"], "GPa")),
-        ("normal force per contact F_N (Eq. 1)", sides(result["normal_force_N"], "N")),
-        ("Hertz contact radius a", sides(result["contact_radius_m"], "mm")),
-        ("indentation d", sides(result["indentation_m"], "nm")),
-        ("tangential stiffness 2aG*", sides(result["tangential_stiffness_N_per_m"], "N/m")),
-        ("presliding u_x,max (Eq. 7/10)", sides(result["presliding_m"], "nm")),
-        ("actuator deformation u_x,a (Eq. 9/14)", sides(result["actuator_deformation_m"], "nm")),
+        ("normal force per contact F_N (Eq. 1)", per_group(result["normal_force_N"], "N")),
+        ("Hertz contact radius a", per_group(result["contact_radius_m"], "mm")),
+        ("indentation d", per_group(result["indentation_m"], "nm")),
+        ("tangential stiffness 2aG*", per_group(result["tangential_stiffness_N_per_m"], "N/m")),
+        ("presliding u_x,max (Eq. 7/10)", per_group(result["presliding_m"], "nm")),
+        ("actuator deformation u_x,a (Eq. 9/14)", per_group(result["actuator_deformation_m"], "nm")),
         ("A_c, rigid actuators (Eq. 7/11)", fmt(result["critical_amplitude_rigid_m"], "nm")),
         ("A_c, flexible actuators (Eq. 8/12)", fmt(result["critical_amplitude_flexible_m"], "nm")),
         ("runner-on-contacts frequency", fmt(result["runner_frequency_Hz"], "kHz")),
         ("bare actuator frequency", fmt(result["actuator_natural_frequency_Hz"], "kHz")),
     ]
-    emit_rows(f"passmd theory — {describe(drive)}", rows, out)
+    emit_rows(f"passmd theory — {describe(drive)}", [*rows, *drive_rows(drive)], out)
     return 0

@@ -1,0 +1,59 @@
+"""The one-line stderr notice before the kernels compile (passmd.cli.kernels): said when numba's
+cache holds no index as new as a kernel module's source, never on stdout (--json stays JSON)."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import sys
+from pathlib import Path
+
+from passmd.cli import kernels, main
+
+PACKAGE = Path(kernels.__file__).resolve().parents[1]
+
+
+def _copy(tmp_path, monkeypatch) -> Path:
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))  # no user-wide numba cache
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    package = tmp_path / "pkg"
+    package.mkdir()
+    for module in kernels.KERNEL_MODULES:
+        shutil.copy(PACKAGE / f"{module}.py", package / f"{module}.py")
+    return package
+
+
+def _index(package: Path, module: str, mtime: float) -> None:
+    cache = package / "__pycache__"
+    cache.mkdir(exist_ok=True)
+    name = cache / f"{module}.kernel-10.py{sys.version_info.major}{sys.version_info.minor}.nbi"
+    name.write_bytes(b"")
+    os.utime(name, (mtime, mtime))
+
+
+def test_cold_without_index_warm_with_fresh_ones_cold_again_when_a_source_is_newer(tmp_path, monkeypatch):
+    package = _copy(tmp_path, monkeypatch)
+    assert kernels.kernels_cold(package)
+    stamp = max((package / f"{m}.py").stat().st_mtime for m in kernels.KERNEL_MODULES)
+    for module in kernels.KERNEL_MODULES[:-1]:
+        _index(package, module, stamp + 10)
+    assert kernels.kernels_cold(package)  # one module still without an index
+    _index(package, kernels.KERNEL_MODULES[-1], stamp + 10)
+    assert not kernels.kernels_cold(package)
+    source = package / f"{kernels.KERNEL_MODULES[0]}.py"
+    os.utime(source, (stamp + 20, stamp + 20))  # the source changed after it was compiled
+    assert kernels.kernels_cold(package)
+
+
+def test_notice_goes_to_stderr_and_json_stays_clean(monkeypatch, capsys):
+    monkeypatch.setattr(kernels, "kernels_cold", lambda package_dir=None: True)
+    status = main(["run", "--contacts", "1", "--actuator", "rigid", "--periods", "1", "--max-points", "10",
+                   "--json"])
+    captured = capsys.readouterr()
+    assert status == 0
+    json.loads(captured.out)
+    assert captured.err.count(kernels.NOTICE) == 1
+    monkeypatch.setattr(kernels, "kernels_cold", lambda package_dir=None: False)
+    assert main(["theory", "--json"]) == 0
+    assert kernels.NOTICE not in capsys.readouterr().err
