@@ -14,6 +14,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+import passmd
 from passmd import cli
 from passmd.parameters import Drive
 from passmd.protocols import fit as F
@@ -157,8 +158,11 @@ def test_cli_fit_writes_report_figure_and_drive(tmp_path, monkeypatch):
     low, high = report["estimates"]["friction_coefficient"]["interval"]
     assert low < 0.25 < high
     assert (tmp_path / "out" / "fit.png").stat().st_size > 0
-    options = (tmp_path / "out" / "fitted-drive.txt").read_text()
-    assert "--mu" in options and "--actuator rigid" in options
+    # the fitted drive file reads back (as --drive does) to the fitted μ and the drive it started from
+    fitted = passmd.load_drive(tmp_path / "out" / "fitted-drive.toml")
+    assert fitted.friction_coefficient == report["estimates"]["friction_coefficient"]["value"]
+    assert (fitted.contacts, fitted.actuator_model) == (1, "rigid")
+    assert "fitted to data.csv" in (tmp_path / "out" / "fitted-drive.toml").read_text()
     # the outputs are never replaced
     status, text = _run(["fit", str(tmp_path / "data.csv"), "--free", "mu", "--contacts", "1", "--actuator",
                          "rigid", "--out", str(tmp_path / "out")])

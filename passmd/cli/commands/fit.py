@@ -10,7 +10,13 @@ from pathlib import Path
 
 from passmd.cli.drive import build_drive
 from passmd.cli.errors import OutputError, UsageError
-from passmd.cli.options import DRIVE_QUANTITIES, DirectoryPath, add_drive_options, add_sweep_options
+from passmd.cli.options import (
+    DRIVE_QUANTITIES,
+    DirectoryPath,
+    add_drive_options,
+    add_sweep_options,
+    refuse_bare,
+)
 from passmd.cli.output import JSON_HELP, check_results, describe, drive_record, emit_json, emit_rows, plain
 from passmd.units import from_si, parse_quantity
 
@@ -30,11 +36,11 @@ _EPILOG = textwrap.dedent("""\
     interval and an identifiability verdict (flat profile, or |correlation| > 0.95).
 
     --out DIR writes fit.json (the --json report), fit.png (data against the fitted model,
-    with residuals) and fitted-drive.txt (the fitted drive as options of `passmd run`).
+    with residuals) and fitted-drive.toml (the fitted drive, for --drive).
 
     --json keys (SI units): estimates{name: value, stderr, interval[low, high], unit, ...},
     residuals[...], correlation{parameters, matrix, limit}, identifiable, verdict, cost,
-    residual_scale, degrees_of_freedom, drive_options, drive{...}, wall_time_s""")
+    residual_scale, degrees_of_freedom, drive{...}, wall_time_s""")
 
 #: Free parameters as --free names them: the drive option without its dashes, or a derived one;
 #: each with its library name and the unit its --bounds and human output use.
@@ -46,7 +52,7 @@ FREE_NAMES: dict[str, tuple[str, str]] = {
     "flyback-time": ("flyback_time", "us"),
     "contact-stiffness-scale": ("contact_stiffness_scale", ""),
 }
-_OUTPUTS = ("fit.json", "fit.png", "fitted-drive.txt")
+_OUTPUTS = ("fit.json", "fit.png", "fitted-drive.toml")
 
 
 def add_parser(command) -> None:
@@ -56,7 +62,8 @@ def add_parser(command) -> None:
     group.add_argument("--free", required=True, metavar="NAME[,NAME...]",
                        help="parameters to fit (default: none; required): " + ", ".join(FREE_NAMES))
     group.add_argument("--bounds", action="append", default=[], metavar="NAME=LOW..HIGH",
-                       help="range of a free parameter in its option's unit (default: the plausible range)")
+                       help="range of a free parameter, with a unit (a bare number is SI, refused where the "
+                            "parameter is shown in another unit) (default: the plausible range)")
     group.add_argument("--reading", choices=("steady", "first"), default="steady",
                        help="how the simulator reads a critical amplitude (default: steady)")
     group.add_argument("--loss", choices=("linear", "soft_l1", "huber", "cauchy", "arctan"), default="linear",
@@ -95,6 +102,8 @@ def _bounds(args, names) -> dict[str, tuple[float, float]]:
             raise UsageError(f"--bounds = {text!r} names {name!r}, which is not in --free "
                              f"({', '.join(names)})")
         unit = FREE_NAMES[name][1]
+        for v in (low, high):
+            refuse_bare(f"--bounds {name}", v, unit)
         lo, hi = (parse_quantity(v.strip(), unit, name=f"--bounds {name}") for v in (low, high))
         if not 0 < lo < hi:
             raise UsageError(f"--bounds = {text!r} is out of range: must be 0 < LOW < HIGH")
@@ -102,24 +111,21 @@ def _bounds(args, names) -> dict[str, tuple[float, float]]:
     return out
 
 
-def _value(field: str, drive) -> float:
-    obj = drive
-    for part in field.split("."):
-        obj = getattr(obj, part)
-    return float(obj)
+def drive_file_text(drive, data_name: str, free: list[str]) -> str:
+    """The fitted drive as a drive file (``passmd.drive_toml``) that ``--drive`` reads back; the
+    fitted keys name the data they were fitted to as their source."""
+    from passmd.drive_file import DRIVE_KEYS, drive_toml
 
-
-def drive_file_text(drive, base) -> str:
-    """The fitted drive as a file: the options of ``passmd run`` that set it (those differing from
-    the defaults the fit started from, plus the contact and actuator model)."""
-    options = [f"--contacts {drive.contacts}", f"--actuator {drive.actuator_model}"]
-    for q in DRIVE_QUANTITIES:
-        if q.field.startswith("actuator.") and drive.actuator_model == "rigid":
-            continue
-        value = _value(q.field, drive)
-        if value != _value(q.field, base) or q.field in ("preload", "hemisphere_radius"):
-            options.append(f"{q.flag} {from_si(value, q.unit):.6g}")  # a bare number: the option's unit
-    return " ".join(options) + "\n"
+    fitted = {"actuator.damping_ratio": "actuator.viscosity", "flyback_time": "amplifier.slew_rate",
+              "contact_stiffness_scale": "hemisphere_material.youngs_modulus"}
+    sources = {}
+    for name in free:
+        key = fitted.get(name, name)
+        if key in DRIVE_KEYS:
+            sources[key] = f"fitted to {data_name} by passmd fit"
+    if "contact_stiffness_scale" in free:
+        sources["runner_material.youngs_modulus"] = f"fitted to {data_name} by passmd fit (scale on E)"
+    return drive_toml(drive, sources, title=f"drive fitted by passmd fit to {data_name}")
 
 
 def _progress(config):
@@ -154,7 +160,7 @@ def _write(target: Path, result, record: dict, text: str) -> None:
         write_atomically(target / "fit.json",
                          lambda tmp: Path(tmp).write_text(json.dumps(plain(record), indent=2) + "\n"))
         write_atomically(target / "fit.png", lambda tmp: fig.savefig(tmp, dpi=150, format="png"))
-        write_atomically(target / "fitted-drive.txt", lambda tmp: Path(tmp).write_text(text))
+        write_atomically(target / "fitted-drive.toml", lambda tmp: Path(tmp).write_text(text))
     except OSError as exc:
         raise OutputError(f"cannot write --out {target}: {exc.strerror or exc}") from exc
 
@@ -187,9 +193,8 @@ def run_fit(args, out) -> int:
         if exc.name in ("free", "bounds", "data"):
             raise UsageError(str(exc).replace("free = ", "--free: ")) from None
         raise
-    text = drive_file_text(result.drive, drive)
-    record = {"command": "fit", **result.report(), "drive_options": text.strip(),
-              "drive": drive_record(result.drive)}
+    text = drive_file_text(result.drive, Path(args.data).name, list(library))
+    record = {"command": "fit", **result.report(), "drive": drive_record(result.drive)}
     check_results(record)
     if target is not None:
         _write(target, result, record, text)
@@ -206,7 +211,6 @@ def run_fit(args, out) -> int:
     rows.append(("fit", f"{len(data)} measurements, cost {result.cost:.4g}, {result.dof} degrees of freedom, "
                         f"{result.simulations} simulations, {result.wall_time_s:.1f} s"))
     rows.append(("verdict", result.verdict))
-    rows.append(("fitted drive", text.strip()))
     if target is not None:
         rows.append(("written", ", ".join(str(target / n) for n in _OUTPUTS)))
     emit_rows(f"passmd fit — {describe(result.drive)}", rows, out)
