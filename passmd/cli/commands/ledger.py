@@ -69,7 +69,6 @@ def run_ledger(args, out) -> int:
     config = run_config(args)
     _check_baseline(args, config)  # (before the ledger's modules load)
     from passmd import ledger, ledger_views
-    from passmd.claims import STATUSES
 
     results = ledger.collect_results(config)
     for name, table in results.items():  # finite before anything is written, as run and theory check
@@ -77,12 +76,20 @@ def run_ledger(args, out) -> int:
     evaluated = ledger.evaluate(results=results)
     if args.write_baseline:
         _write_baseline(ledger, evaluated, args)
-    counts = {s: int((evaluated["status"] == s).sum()) for s in STATUSES}
+    counts = ledger.headline(evaluated)
+    joint = evaluated.attrs["joint"]
     if args.json:
         emit_json({"command": "ledger", "profile": args.profile, "summary": ledger_views.summary(evaluated),
-                   "counts": counts, "claims": ledger.records(evaluated)}, out)
+                   "counts": counts, "joint_reading": ledger.joint_record(joint),
+                   "conflicting_pairs": evaluated.attrs["conflicts"],
+                   "claims": ledger.records(evaluated)}, out)
         return 0
     out.write(f"passmd ledger — profile {args.profile}: {ledger_views.summary(evaluated)}\n")
+    out.write(f"joint reading: {joint['described']} ({joint['holding']} of {joint['claims']} claims hold; "
+              f"{len(joint['ties'])} tied points)\n")
+    out.write("counts: " + ", ".join(f"{n} {s}" for s, n in counts.items()) + "\n")
+    for pair in evaluated.attrs["conflicts"]:
+        out.write(f"conflict: {pair['claims'][0]} / {pair['claims'][1]}\n")
     for row in evaluated.itertuples():
         basis = " (closed form)" if row.basis == "closed form" else ""
         out.write(f"\n{row.claim}: {row.status}{basis}\n  {row.verdict}\n")
