@@ -37,6 +37,7 @@ from passmd._verdicts import NO_EXTRACTOR, PointResult, claim_points, claim_row,
 from passmd.checks import ClaimFunctions, collect_claim_functions, extractor
 from passmd.claims import is_number, load_claims
 from passmd.config import RunConfig
+from passmd.experiments import force_generation
 
 __all__ = [
     "LEDGER_COLUMNS",
@@ -56,6 +57,7 @@ __all__ = [
     "extractors",
     "conflicting_pairs",
     "headline",
+    "joint_map",
     "joint_reading",
     "joint_record",
     "load_baseline",
@@ -115,10 +117,13 @@ def result_sources() -> dict[str, Callable[[RunConfig], pd.DataFrame]]:
     """Every available result table: ``{key: compute(config) -> DataFrame}``.
 
     The figures of ``passmd.figures`` (in the table's order) plus ``closed_forms``
-    (the closed-form tables some claims are checked against, :func:`closed_form_results`).
+    (the closed-form tables some claims are checked against, :func:`closed_form_results`) and
+    ``fig7flyback`` (Figs. 7a and 7b with the fixed fly-back, the force claims' ``flyback``
+    readings: :func:`passmd.experiments.force_generation.fig7flyback`).
     """
     sources = {name: _figure_source(name) for name in figures.figure_names()}
     sources["closed_forms"] = closed_form_results
+    sources["fig7flyback"] = force_generation.fig7flyback
     return sources
 
 
@@ -251,6 +256,44 @@ def evaluate(
     table.attrs["points"] = point_rows
     table.attrs["joint"] = {k: v for k, v in joint.items() if k != "states"}
     table.attrs["conflicts"] = conflicting_pairs(states)
+    table.attrs["joint_map"] = _map_columns(joint)
+    return table
+
+
+def _map_columns(joint: Mapping) -> list[dict]:
+    """The readings of the claims × readings map: the defaults, the joint reading, its ties and
+    runner-ups (each once), with every claim's state there."""
+    space, table = joint["states"]["space"], joint["states"]["table"]
+    wanted = [readings.default_reading(), joint["reading"],
+              *(e["reading"] for e in (*joint["ties"], *joint["runner_ups"]))]
+    columns, seen = [], set()
+    for reading in wanted:
+        i = space.index(reading)
+        key = tuple(table[i].values())
+        if key in seen:
+            continue
+        seen.add(key)
+        role = ("defaults" if reading == readings.default_reading() else "")
+        role = "joint reading" if reading == joint["reading"] else role
+        columns.append({"reading": readings.describe(reading), "role": role,
+                        "holding": sum(s == "holds" for s in table[i].values()), "states": dict(table[i])})
+    return columns
+
+
+def joint_map(evaluated: pd.DataFrame) -> pd.DataFrame:
+    """Claims × readings: every claim's state (``holds``, ``fails``, ``inconclusive``, ``—`` not
+    reached by its design) at the defaults, the joint reading, its ties and runner-ups.
+
+    Columns are the readings in words, prefixed with their role (``defaults``, ``joint reading``);
+    ``attrs["holding"]`` gives how many claims hold at each column.
+    """
+    columns = evaluated.attrs.get("joint_map", [])
+    names = [(f"{c['role']}: {c['reading']}" if c["role"] and c["reading"] != c["role"] else c["reading"])
+             for c in columns]
+    table = pd.DataFrame({n: c["states"] for n, c in zip(names, columns, strict=True)},
+                         index=list(evaluated["claim"]))
+    table.index.name = "claim"
+    table.attrs["holding"] = {n: c["holding"] for n, c in zip(names, columns, strict=True)}
     return table
 
 

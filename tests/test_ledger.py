@@ -765,3 +765,38 @@ def test_baseline_readings_of_a_claim_along_several_axes(tmp_path):
     path.write_text("# made before readings were recorded\nclaim,status\nval,reproduced\n", encoding="utf-8")
     assert ledger.load_baseline_readings(path) == {}
     assert ledger.load_baseline(path) == {"val": "reproduced"}
+
+
+def test_flexible_ac_tables_hold_the_product_of_protocol_flyback_and_damping():
+    """At the drive frequency the A_c searches of flexible actuators cover protocol × fly-back × ζ
+    (the points the joint reading needs, e.g. the first fly-back with the fixed fly-back at every ζ);
+    rigid actuators have no fly-back or ζ axis."""
+    from passmd import readings
+    from passmd.defaults import PROTOCOL
+    from passmd.experiments import critical_amplitude as ca
+
+    flexible = ca._protocols("flexible", (PROTOCOL.drive_frequency,))
+    at_drive = {(c["protocol"], c["flyback"], c.get("damping_ratio", readings.axis("damping_ratio").default))
+                for c in flexible if c["frequency"] == PROTOCOL.drive_frequency}
+    expected = {(p, f, z) for p in ("steady", "first") for f in readings.axis("flyback").values()
+                for z in readings.axis("damping_ratio").values()}
+    assert at_drive == expected and len(flexible) == len(expected)
+    assert {c["flyback"] for c in ca._protocols("rigid", (PROTOCOL.drive_frequency,))} == {"slew"}
+
+
+def test_force_panels_at_a_flyback_reading():
+    """The Fig. 7 panels at the fixed fly-back come from fig7flyback (flexible rows fixed, rigid rows
+    unchanged); without that table the reading is not covered."""
+    from passmd import readings
+    from passmd.experiments import force_generation as fg
+
+    panel = pd.DataFrame({"panel": ["fig7a"] * 2, "actuator_model": ["rigid", "flexible"]})
+    fixed = panel.assign(flyback=["slew", "fixed"])
+    fixed = pd.concat([fixed, fixed.assign(panel="fig7b")], ignore_index=True)
+    reading = {**readings.default_reading(), "flyback": "fixed"}
+    assert fg.panel_at({"fig7a": panel}, "fig7a") is panel
+    with pytest.raises(checks.NotEvaluable, match="needs results: fig7flyback"):
+        fg.panel_at({"fig7a": panel}, "fig7a", reading)
+    rows = fg.panel_at({"fig7a": panel, "fig7flyback": fixed}, "fig7a", reading)
+    assert rows["panel"].tolist() == ["fig7a"] * 2 and rows["flyback"].tolist() == ["slew", "fixed"]
+    assert "fig7flyback" in ledger.result_sources()
