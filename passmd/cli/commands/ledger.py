@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import datetime
 import textwrap
 
 from passmd._result_bounds import check_table
@@ -18,12 +19,18 @@ __all__ = ["add_parser", "run_ledger"]
 _EPILOG = textwrap.dedent(f"""\
     Computes (or reads from the cache the book uses, ./{DEFAULT_CACHE_DIR}/ or ${ENVIRONMENT['cache_dir']})
     every figure's results at --profile and evaluates every claim of
-    passmd/data/reference/claims.csv over the declared readings of passmd.readings.
+    passmd/data/reference/claims.csv on the product of the readings of passmd.readings it
+    depends on; each category comes from the defaults and the joint reading (the point of the
+    assumption space where the most claims hold together).
 
-    --json keys: profile, summary, counts{{category: n}}, claims[{{claim, category, basis,
-    verdict, evidence[], reason, depends_on[], readings{{reading: state}}, fraction_holds,
-    best_reading, tolerance, check, paper_<SI unit>, ours_<SI unit>, ours_text,
-    abs_deviation_<SI unit>, rel_deviation (fraction)}}]""")
+    --json keys: profile, summary, counts{{category: n, fragile, not informative}},
+    joint_reading{{reading, described, holding, equivalent_points, claims, ties[], runner_ups[],
+    points}}, conflicting_pairs[{{claims, first_holds_at, second_holds_at, example}}],
+    claims[{{claim, category, basis, verdict, evidence[], reason, depends_on[],
+    readings{{reading: state}}, points[{{reading, state, score, detail}}], default_state,
+    joint_state, margin, margin_text, fails_at, decided_at, fragile, informative,
+    not_informative, fraction_holds, best_reading, tolerance, check, paper_<SI unit>,
+    ours_<SI unit>, ours_text, abs_deviation_<SI unit>, rel_deviation (fraction)}}]""")
 
 
 def add_parser(command) -> None:
@@ -52,7 +59,7 @@ def _check_baseline(args, config) -> None:
 
 
 def _write_baseline(ledger, evaluated, args) -> None:
-    header = (f"ledger categories, {args.profile} profile; produced by\n"
+    header = (f"ledger categories, {args.profile} profile; produced {datetime.date.today().isoformat()} by\n"
               f"passmd ledger --profile {args.profile} --write-baseline {args.write_baseline}")
     try:
         write_atomically(args.write_baseline,
