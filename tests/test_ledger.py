@@ -453,6 +453,15 @@ def test_joint_reading_is_the_argmax_with_ties_runner_ups_and_conflicts(tmp_path
     assert ("holds at fly-back rule = fixed; how A_c is read = first, which breaks b"
             in by_id.at["a", "verdict"])
     assert by_id.at["a", "readings"] == 4 and by_id.at["a", "fails_at"] == 3  # the full product, 2 × 2
+    table = ledger.joint_map(evaluated)
+    assert list(table.columns) == ["joint reading: defaults", "fly-back rule = fixed; how A_c is read = first",
+                                   "how A_c is read = first"]
+    assert table["how A_c is read = first"].tolist() == ["fails", "fails", "holds"]
+    import matplotlib
+    matplotlib.use("Agg")
+    from passmd.plots.ledger_map import plot_joint_map
+    fig = plot_joint_map(table)
+    assert fig.axes[0].has_data() and "(2 hold)" in fig.axes[0].get_xticklabels()[0].get_text()
     # counter-example: once 'a' holds everywhere, the three hold together and nothing conflicts
     module._a = checks.extractor("a", depends_on=("flyback", "ac_protocol"))(
         lambda results, reading: {"lhs": 2.0, "rhs": 1.0})
