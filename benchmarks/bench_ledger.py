@@ -10,6 +10,10 @@ book's execution statistics show.
 Usage::
 
     python benchmarks/bench_ledger.py [--profile paper] [--out passmd/data/benchmarks/ledger.json]
+        [--cache-dir DIR]
+
+``--cache-dir`` names an empty directory to use as the cache and keep (e.g. to write a baseline
+from the same computation afterwards); by default a temporary one is used and removed.
 """
 
 from __future__ import annotations
@@ -28,9 +32,12 @@ from pathlib import Path
 from passmd import provenance
 
 
-def measure(profile: str) -> dict:
+def measure(profile: str, cache_dir: str | None = None) -> dict:
     load_before = os.getloadavg()
-    with tempfile.TemporaryDirectory(prefix="passmd-bench-ledger-") as cache:
+    if cache_dir is not None and Path(cache_dir).exists() and any(Path(cache_dir).iterdir()):
+        raise SystemExit(f"--cache-dir {cache_dir} is not empty: the measurement must start cold")
+    with tempfile.TemporaryDirectory(prefix="passmd-bench-ledger-") as temporary:
+        cache = temporary if cache_dir is None else cache_dir
         env = {**os.environ, "PASSMD_CACHE_DIR": cache}
         usage = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
@@ -56,10 +63,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--profile", default="paper", choices=("quick", "paper"))
     parser.add_argument("--out", default="passmd/data/benchmarks/ledger.json")
+    parser.add_argument("--cache-dir", default=None)
     args = parser.parse_args()
     out = Path(args.out)
     runs = json.loads(out.read_text(encoding="utf-8")) if out.exists() else []
-    runs.append(measure(args.profile))
+    runs.append(measure(args.profile, args.cache_dir))
     tmp = out.with_name(f".{out.name}.tmp")
     tmp.write_text(json.dumps(runs, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
     tmp.replace(out)

@@ -776,20 +776,21 @@ def test_baseline_readings_of_a_claim_along_several_axes(tmp_path):
     assert ledger.load_baseline(path) == {"val": "reproduced"}
 
 
-def test_flexible_ac_tables_hold_the_product_of_protocol_flyback_and_damping():
-    """At the drive frequency the A_c searches of flexible actuators cover protocol × fly-back × ζ
-    (the points the joint reading needs, e.g. the first fly-back with the fixed fly-back at every ζ);
-    rigid actuators have no fly-back or ζ axis."""
+def test_flexible_ac_tables_hold_protocol_times_flyback_at_the_default_damping():
+    """At the drive frequency and the default ζ the A_c searches of flexible actuators cover
+    protocol × fly-back (the points the joint reading needs, e.g. the first fly-back with the fixed
+    fly-back); ζ's alternatives only with the steady protocol and the slew-rate fly-back. Rigid
+    actuators have no fly-back or ζ axis."""
     from passmd import readings
     from passmd.defaults import PROTOCOL
     from passmd.experiments import critical_amplitude as ca
 
+    zeta = readings.axis("damping_ratio").default
     flexible = ca._protocols("flexible", (PROTOCOL.drive_frequency,))
-    at_drive = {(c["protocol"], c["flyback"], c.get("damping_ratio", readings.axis("damping_ratio").default))
-                for c in flexible if c["frequency"] == PROTOCOL.drive_frequency}
-    expected = {(p, f, z) for p in ("steady", "first") for f in readings.axis("flyback").values()
-                for z in readings.axis("damping_ratio").values()}
-    assert at_drive == expected and len(flexible) == len(expected)
+    points = {(c["protocol"], c["flyback"], c.get("damping_ratio", zeta)) for c in flexible}
+    expected = {(p, f, zeta) for p in ("steady", "first") for f in readings.axis("flyback").values()}
+    expected |= {("steady", "slew", z) for z in readings.axis("damping_ratio").alternatives}
+    assert points == expected and len(flexible) == len(expected)
     assert {c["flyback"] for c in ca._protocols("rigid", (PROTOCOL.drive_frequency,))} == {"slew"}
 
 

@@ -168,21 +168,19 @@ def _protocols(actuator_model: str, frequencies) -> list[dict]:
     """The (protocol, fly-back, frequency[, ζ]) combinations drawn for an actuator model.
 
     The ledger evaluates the A_c claims on the product of their axes (:mod:`passmd.readings`).
-    At ``PROTOCOL.drive_frequency`` the tables hold that whole product: both protocols and, for
-    flexible actuators, both fly-back rules × every evaluated ζ (Table 2's c_p is lost); the
-    other drive frequencies of the band are searched with the steady protocol, the slew-rate
-    fly-back and the default ζ only (their combinations with the other axes are not computed,
-    and the ledger counts them as not covered).
+    At ``PROTOCOL.drive_frequency`` and the default ζ the tables hold both protocols × (for
+    flexible actuators) both fly-back rules; the evaluated alternatives of ζ (Table 2's c_p is
+    lost) are searched with the steady protocol and the slew-rate fly-back, the other drive
+    frequencies of the band with the steady protocol, the slew-rate fly-back and the default ζ.
+    The other points of the product are not computed: the ledger counts them as not covered.
     """
     combos = [{"protocol": "steady", "flyback": "slew", "frequency": float(f)} for f in frequencies]
     combos.append({"protocol": "first", "flyback": "slew", "frequency": PROTOCOL.drive_frequency})
     if actuator_model == "flexible":  # the fly-back rule and ζ only matter for flexible actuators
         combos.append({"protocol": "steady", "flyback": "fixed", "frequency": PROTOCOL.drive_frequency})
         combos.append({"protocol": "first", "flyback": "fixed", "frequency": PROTOCOL.drive_frequency})
-        combos.extend({"protocol": protocol, "flyback": flyback, "frequency": PROTOCOL.drive_frequency,
-                       "damping_ratio": float(z)}
-                      for z in readings.axis("damping_ratio").alternatives
-                      for protocol in PROTOCOLS for flyback in readings.axis("flyback").values())
+        combos.extend({"protocol": "steady", "flyback": "slew", "frequency": PROTOCOL.drive_frequency,
+                       "damping_ratio": float(z)} for z in readings.axis("damping_ratio").alternatives)
     return combos
 
 
