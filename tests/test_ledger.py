@@ -454,7 +454,8 @@ def test_joint_reading_is_the_argmax_with_ties_runner_ups_and_conflicts(tmp_path
             in by_id.at["a", "verdict"])
     assert by_id.at["a", "readings"] == 4 and by_id.at["a", "fails_at"] == 3  # the full product, 2 × 2
     table = ledger.joint_map(evaluated)
-    assert list(table.columns) == ["joint reading: defaults", "fly-back rule = fixed; how A_c is read = first",
+    both = "fly-back rule = fixed; how A_c is read = first"
+    assert list(table.columns) == ["joint reading: defaults", both,
                                    "how A_c is read = first"]
     assert table["how A_c is read = first"].tolist() == ["fails", "fails", "holds"]
     import matplotlib
@@ -599,9 +600,10 @@ def test_collect_results_calls_every_figure_of_the_table(monkeypatch):
     table = {"fig5a": types.SimpleNamespace(compute=_fig5a)}
     monkeypatch.setattr(figures, "figure_names", lambda: list(table))
     monkeypatch.setattr(figures, "figure_spec", lambda name: table[name])
+    monkeypatch.setattr(ledger.force_generation, "fig7flyback", _fig5a)
     results = ledger.collect_results(QUICK)
-    assert list(results) == ["fig5a", "closed_forms"]
-    assert calls == [QUICK]
+    assert list(results) == ["fig5a", "closed_forms", "fig7flyback"]
+    assert calls == [QUICK, QUICK]
     pd.testing.assert_frame_equal(results["closed_forms"], reference.tangential_stiffness_table())
     with pytest.raises(TypeError, match="config = 'quick' is not allowed: must be a passmd.config.RunConfig"):
         ledger.collect_results("quick")
