@@ -66,7 +66,7 @@ RELATIONS = {
 #: A tolerance is relative (a fraction) or absolute (in the claim's unit).
 TOLERANCE_KINDS = ("rel", "abs")
 #: Verdict classes, in the order the summary lists them.
-STATUSES = ("reproduced", "reproduced under another reading", "not reproduced", "inconclusive")
+STATUSES = ("reproduced", "reproduced under the joint reading", "not reproduced", "inconclusive")
 #: A claim id: a slug of lower-case letters, digits, '.', '_' and '-'.
 CLAIM_ID = re.compile(r"^[a-z0-9][a-z0-9._-]*$")
 

@@ -14,8 +14,9 @@ Three pieces meet here:
 
 :func:`evaluate` runs the checks over the readings of the assumption space
 (:mod:`passmd.readings`) and computes every claim's category: ``reproduced``,
-``reproduced under another reading``, ``not reproduced`` or ``inconclusive``, with its
-evidence; no category is typed in. :mod:`passmd.ledger_views` presents them in the book;
+``reproduced under the joint reading``, ``not reproduced`` or ``inconclusive``, from the
+defaults and the joint reading of all claims, with its evidence; no category is typed in.
+:mod:`passmd.ledger_views` presents them in the book;
 :func:`check_categories` compares them with a committed baseline in the tests, and
 :func:`records` gives them to ``passmd ledger --json``.
 """
@@ -32,10 +33,11 @@ import numpy as np
 import pandas as pd
 
 from passmd import figures, readings, reference
-from passmd._verdicts import NO_EXTRACTOR, claim_row, shown
+from passmd._verdicts import NO_EXTRACTOR, PointResult, claim_points, claim_row, point_at, shown
 from passmd.checks import ClaimFunctions, collect_claim_functions, extractor
 from passmd.claims import is_number, load_claims
 from passmd.config import RunConfig
+from passmd.experiments import force_generation
 
 __all__ = [
     "LEDGER_COLUMNS",
@@ -53,6 +55,11 @@ __all__ = [
     "depends_on",
     "evaluate",
     "extractors",
+    "conflicting_pairs",
+    "headline",
+    "joint_map",
+    "joint_reading",
+    "joint_record",
     "load_baseline",
     "load_baseline_readings",
     "orphan_extractors",
@@ -64,7 +71,9 @@ __all__ = [
 #: Columns of :func:`evaluate`'s result.
 LEDGER_COLUMNS = ("claim", "figure", "quantity", "paper", "ours", "unit", "abs_deviation", "rel_deviation",
                   "tolerance", "status", "verdict", "evidence", "reason", "basis", "check", "depends_on",
-                  "readings", "holds_at", "fraction_holds", "best_reading", "note")
+                  "readings", "holds_at", "fails_at", "decided_at", "fraction_holds", "best_reading",
+                  "default_state", "joint_state", "margin", "margin_text", "fragile", "informative",
+                  "not_informative", "note")
 
 
 # ======================================================================================
@@ -108,10 +117,13 @@ def result_sources() -> dict[str, Callable[[RunConfig], pd.DataFrame]]:
     """Every available result table: ``{key: compute(config) -> DataFrame}``.
 
     The figures of ``passmd.figures`` (in the table's order) plus ``closed_forms``
-    (the closed-form tables some claims are checked against, :func:`closed_form_results`).
+    (the closed-form tables some claims are checked against, :func:`closed_form_results`) and
+    ``fig7flyback`` (Figs. 7a and 7b with the fixed fly-back, the force claims' ``flyback``
+    readings: :func:`passmd.experiments.force_generation.fig7flyback`).
     """
     sources = {name: _figure_source(name) for name in figures.figure_names()}
     sources["closed_forms"] = closed_form_results
+    sources["fig7flyback"] = force_generation.fig7flyback
     return sources
 
 
@@ -162,17 +174,22 @@ def evaluate(
 ) -> pd.DataFrame:
     """Evaluate every claim against the result tables, over its readings of the assumption space.
 
-    Each claim is checked at every reading of :func:`passmd.readings.design` for the axes its
-    extractor depends on (the defaults first). Its category is computed from those checks:
+    Each claim is checked at every reading of :func:`passmd.readings.design` (the full product of
+    the axes its extractor depends on, the defaults first). The joint reading
+    (:func:`joint_reading`) is the point of the whole space where the most claims hold together;
+    each claim's category is computed from two points only, the defaults and the joint reading:
 
     * ``reproduced``: the check holds at the defaults;
-    * ``reproduced under another reading``: it fails at the defaults and holds at a named
-      non-default reading;
-    * ``not reproduced``: it fails at every reading evaluated (a total failure, e.g. no step up
-      to the full stroke, is a failure);
-    * ``inconclusive``: the data cannot decide at the defaults (an extremum at the grid's edge,
-      non-finite values, missing results), or it fails there and some reading is not covered
-      while none holds.
+    * ``reproduced under the joint reading``: it does not hold at the defaults and holds at the
+      joint reading;
+    * ``not reproduced``: it fails at the defaults or at the joint reading and holds at neither (a
+      total failure, e.g. no step up to the full stroke, is a failure); the verdict names another
+      reading where it holds, if any, and the claims that reading breaks;
+    * ``inconclusive``: neither point decides it (an extremum at the grid's edge, non-finite
+      values, missing results, no run at that reading).
+
+    The table's ``attrs`` carry ``points`` (every claim at every evaluated reading), ``joint``
+    (:func:`joint_reading` without its state table) and ``conflicts`` (:func:`conflicting_pairs`).
 
     NaN never counts as holding (:class:`passmd.checks.NotEvaluable`). Claims whose ``requires``
     are only ``closed_forms`` have ``basis`` "closed form" and are not simulation results.
@@ -200,7 +217,12 @@ def evaluate(
         ``status`` (the category, one of :data:`passmd.claims.STATUSES`), ``verdict`` (one
         computed line), ``evidence`` (computed lines, ``" | "``-separated), ``reason``
         (claims.csv's human reason), ``basis``, ``readings`` (evaluated), ``holds_at`` (how
-        many hold), ``fraction_holds``, ``best_reading``, ``depends_on``.
+        many hold), ``fails_at`` and ``decided_at`` (how many fail, of the decided ones),
+        ``fraction_holds``, ``best_reading``, ``depends_on``, ``default_state`` and
+        ``joint_state``, ``margin`` (the check's score at the defaults: deviation over tolerance
+        for value and trend checks) with ``margin_text``, ``fragile`` (holds at the defaults but
+        fails at the joint reading or at most of its decided readings), ``informative`` and
+        ``not_informative`` (why its check cannot fail, from the extractor).
     """
     if results is None:
         if config is None:
@@ -208,19 +230,180 @@ def evaluate(
         results = collect_results(config)
     claims = load_claims() if claims is None else claims
     functions = claim_functions(modules)
-    problems, rows, point_rows = [], [], []
+    evaluated = {}
+    problems = []
     for _, claim in claims.iterrows():
-        row, points = claim_row(claim, results, functions)
-        if strict and row["verdict"] == NO_EXTRACTOR:
+        points, why = claim_points(claim, results, functions)
+        if strict and why == NO_EXTRACTOR:
             problems.append(f"claim {claim['id']!r} has its results but no registered extractor")
-        rows.append(row)
-        point_rows.extend({"claim": claim["id"], "reading": readings.describe(p.reading),
-                           "state": p.state, "detail": p.detail} for p in points)
+        evaluated[claim["id"]] = (points, functions.depends_on.get(claim["id"], ()))
     if problems:
         raise LookupError("ledger evaluation is incomplete:\n  " + "\n  ".join(problems))
+    joint = joint_reading(evaluated)
+    states = joint["states"]
+    rows, point_rows = [], []
+    for _, claim in claims.iterrows():
+        points, depends = evaluated[claim["id"]]
+        row, _ = claim_row(claim, results, functions, joint=joint["reading"], points=points or None,
+                           elsewhere=_elsewhere(claim["id"], states, joint))
+        rows.append(row)
+        point_rows.extend({"claim": claim["id"], "reading": readings.describe(p.reading),
+                           "point": {k: p.reading[k] for k in depends if k in p.reading},
+                           "state": p.state, "detail": p.detail,
+                           "score": (p.outcome.score if p.outcome is not None
+                                     and math.isfinite(p.outcome.score) else None)} for p in points)
     table = pd.DataFrame(rows, columns=list(LEDGER_COLUMNS))
     table.attrs["points"] = point_rows
+    table.attrs["joint"] = {k: v for k, v in joint.items() if k != "states"}
+    table.attrs["conflicts"] = conflicting_pairs(states)
+    table.attrs["joint_map"] = _map_columns(joint)
     return table
+
+
+def _map_columns(joint: Mapping) -> list[dict]:
+    """The readings of the claims × readings map: the defaults, the joint reading, its ties and
+    runner-ups (each once), with every claim's state there."""
+    space, table = joint["states"]["space"], joint["states"]["table"]
+    wanted = [readings.default_reading(), joint["reading"],
+              *(e["reading"] for e in (*joint["ties"], *joint["runner_ups"]))]
+    columns, seen = [], set()
+    for reading in wanted:
+        i = space.index(reading)
+        key = tuple(table[i].values())
+        if key in seen:
+            continue
+        seen.add(key)
+        role = ("defaults" if reading == readings.default_reading() else "")
+        role = "joint reading" if reading == joint["reading"] else role
+        columns.append({"reading": readings.describe(reading), "role": role,
+                        "holding": sum(s == "holds" for s in table[i].values()), "states": dict(table[i])})
+    return columns
+
+
+def joint_map(evaluated: pd.DataFrame) -> pd.DataFrame:
+    """Claims × readings: every claim's state (``holds``, ``fails``, ``inconclusive``, ``—`` not
+    reached by its design) at the defaults, the joint reading, its ties and runner-ups.
+
+    Columns are the readings in words, prefixed with their role (``defaults``, ``joint reading``);
+    ``attrs["holding"]`` gives how many claims hold at each column.
+    """
+    columns = evaluated.attrs.get("joint_map", [])
+    names = [(f"{c['role']}: {c['reading']}" if c["role"] and c["reading"] != c["role"] else c["reading"])
+             for c in columns]
+    table = pd.DataFrame({n: c["states"] for n, c in zip(names, columns, strict=True)},
+                         index=list(evaluated["claim"]))
+    table.index.name = "claim"
+    table.attrs["holding"] = {n: c["holding"] for n, c in zip(names, columns, strict=True)}
+    return table
+
+
+def joint_reading(evaluated: Mapping[str, tuple[list[PointResult], tuple]], runner_ups: int = 5) -> dict:
+    """The point of the whole declared assumption space where the most claims hold together.
+
+    ``evaluated`` is ``{claim id: (points, depends_on)}`` (:func:`passmd._verdicts.claim_points`).
+    A claim's state at a point of :func:`passmd.readings.space` is its state at the projection of
+    that point onto the axes it is evaluated along (it does not depend on the others); a point its
+    design does not reach counts as not holding. Ties are broken towards the defaults (fewest
+    changed axes, then the order of the space). Points at which every claim has the same state are
+    one reading for the ledger: each is represented by its member closest to the defaults.
+
+    Returns ``reading`` (the joint reading), ``described``, ``holding`` (how many claims hold
+    there), ``equivalent_points`` (how many points of the space it stands for), ``claims``
+    (total), ``ties`` (other distinct readings with as many), ``runner_ups`` (the next
+    ``runner_ups`` distinct readings with their counts), ``points`` (the space's size) and
+    ``states`` (``{point index: {claim: state}}`` with the space under ``"space"``).
+    """
+    space = readings.space()
+    table = {}
+    for i, point in enumerate(space):
+        column = {}
+        for claim, (points, depends) in evaluated.items():
+            found = point_at(points, depends, point) if points else None
+            column[claim] = "—" if found is None else found.state
+        table[i] = column
+    counts = [sum(state == "holds" for state in table[i].values()) for i in range(len(space))]
+    base = readings.default_reading()
+
+    def changed(i):
+        return sum(space[i][k] != base[k] for k in base)
+
+    # points where every claim has the same state are one reading for the ledger: keep the one
+    # closest to the defaults, and how many it stands for
+    classes: dict[tuple, list[int]] = {}
+    for i in sorted(range(len(space)), key=lambda i: (changed(i), i)):
+        classes.setdefault(tuple(table[i].values()), []).append(i)
+    members = {group[0]: len(group) for group in classes.values()}
+    order = sorted(members, key=lambda i: (-counts[i], changed(i), i))
+    best = order[0]
+
+    def entry(i):
+        return {"reading": space[i], "described": readings.describe(space[i]), "holding": counts[i],
+                "equivalent_points": members[i]}
+
+    return {
+        **entry(best), "claims": len(evaluated),
+        "ties": [entry(i) for i in order[1:] if counts[i] == counts[best]],
+        "runner_ups": [entry(i) for i in order if counts[i] < counts[best]][:runner_ups],
+        "points": len(space),
+        "states": {"space": space, "table": table, "best": best},
+    }
+
+
+def conflicting_pairs(states: Mapping) -> list[dict]:
+    """Pairs of claims that each hold somewhere in the space but never at the same point, one
+    failing wherever the other holds: no reading makes both hold.
+
+    Each pair: ``claims`` (the two ids), ``first_holds_at`` and ``second_holds_at`` (how many
+    points of the space each holds at), ``example`` (a point where the first holds and the
+    second fails, in words).
+    """
+    space, table = states["space"], states["table"]
+    claims = list(table[0]) if table else []
+    holds = {c: {i for i in table if table[i][c] == "holds"} for c in claims}
+    fails = {c: {i for i in table if table[i][c] == "fails"} for c in claims}
+    out = []
+    for a_index, a in enumerate(claims):
+        for b in claims[a_index + 1:]:
+            if not holds[a] or not holds[b] or holds[a] & holds[b]:
+                continue
+            if not (holds[a] <= fails[b] and holds[b] <= fails[a]):
+                continue
+            example = min(holds[a])
+            out.append({"claims": [a, b], "first_holds_at": len(holds[a]), "second_holds_at": len(holds[b]),
+                        "example": readings.describe(space[example])})
+    return out
+
+
+def _elsewhere(claim: str, states: Mapping, joint: Mapping) -> str:
+    """Where a claim that does not hold at the joint reading holds instead (the point of the space
+    with the most claims holding among those where it holds), and which claims holding at the joint
+    reading fail there."""
+    space, table, best = states["space"], states["table"], states["best"]
+    if table[best][claim] == "holds":
+        return ""
+    candidates = [i for i in table if table[i][claim] == "holds"]
+    if not candidates:
+        return ""
+    pick = max(candidates, key=lambda i: (sum(s == "holds" for s in table[i].values()), -i))
+    broken = [c for c in table[best] if table[best][c] == "holds" and table[pick][c] == "fails"]
+    return (f"holds at {readings.describe(space[pick])}, which breaks "
+            + (", ".join(broken) if broken else "no claim holding at the joint reading"))
+
+
+def joint_record(joint: Mapping) -> dict:
+    """The joint reading as plain data (``passmd ledger --json``): its point, how many claims hold
+    there of how many, the tied points and the runner-ups with their counts, the space's size."""
+    return {k: joint[k] for k in ("reading", "described", "holding", "equivalent_points", "claims", "ties",
+                                  "runner_ups", "points")}
+
+
+def headline(evaluated: pd.DataFrame) -> dict:
+    """Counts per category, plus the fragile rows and the rows whose check is not informative."""
+    from passmd.claims import STATUSES
+    counts = {s: int((evaluated["status"] == s).sum()) for s in STATUSES}
+    counts["fragile"] = int(evaluated["fragile"].astype(bool).sum())
+    counts["not informative"] = int((~evaluated["informative"].astype(bool)).sum())
+    return counts
 
 
 def assumption_map(evaluated: pd.DataFrame) -> pd.DataFrame:
@@ -232,7 +415,7 @@ def assumption_map(evaluated: pd.DataFrame) -> pd.DataFrame:
     (readings where it holds, of those evaluated) and ``best reading`` (where it holds best).
     """
     points = pd.DataFrame(evaluated.attrs.get("points", []),
-                          columns=["claim", "reading", "state", "detail"])
+                          columns=["claim", "reading", "point", "state", "detail", "score"])
     varied = points.groupby("claim")["reading"].transform("size") > 1
     points = points[varied]
     if points.empty:
@@ -278,12 +461,16 @@ def records(evaluated: pd.DataFrame) -> list[dict]:
     """The ledger as plain records with SI keys (``passmd ledger --json``).
 
     Per claim: ``claim``, ``category``, ``basis``, ``verdict``, ``evidence`` (list),
-    ``reason``, ``depends_on`` (list), ``readings`` (``{reading: state}``), ``fraction_holds``,
+    ``reason``, ``depends_on`` (list), ``readings`` (``{reading: state}``), ``points`` (every
+    evaluated reading as ``{axis: value}`` of its axes, with state, score and detail),
+    ``default_state``, ``joint_state``, ``margin`` and ``margin_text``, ``fails_at`` of
+    ``decided_at``, ``fragile``, ``informative`` and ``not_informative``, ``fraction_holds``,
     ``best_reading``, ``tolerance`` (as shown), and, where numeric, ``paper_<si>``,
     ``ours_<si>`` and ``abs_deviation_<si>`` in SI units (e.g. ``ours_m``, ``paper_m_per_s``),
     ``rel_deviation`` as a fraction. Non-numeric values are null, with ``ours_text`` as shown.
     """
-    points = pd.DataFrame(evaluated.attrs.get("points", []), columns=["claim", "reading", "state", "detail"])
+    points = pd.DataFrame(evaluated.attrs.get("points", []),
+                          columns=["claim", "reading", "point", "state", "detail", "score"])
     out = []
     for row in evaluated.itertuples():
         si, factor = SI_UNITS.get(row.unit, (re.sub(r"[^A-Za-z0-9]+", "_", row.unit), 1.0))
@@ -301,6 +488,15 @@ def records(evaluated: pd.DataFrame) -> list[dict]:
             "verdict": row.verdict, "evidence": [e for e in row.evidence.split(" | ") if e],
             "reason": row.reason, "depends_on": [d for d in row.depends_on.split(";") if d],
             "readings": dict(zip(mine["reading"], mine["state"], strict=True)),
+            "points": [{"reading": p, "state": st, "detail": d,
+                        "score": float(sc) if sc is not None and math.isfinite(sc) else None}
+                       for p, st, sc, d in zip(mine["point"], mine["state"], mine["score"], mine["detail"],
+                                               strict=True)],
+            "default_state": row.default_state, "joint_state": row.joint_state,
+            "margin": None if not math.isfinite(row.margin) else float(row.margin),
+            "margin_text": row.margin_text, "fails_at": int(row.fails_at), "decided_at": int(row.decided_at),
+            "fragile": bool(row.fragile), "informative": bool(row.informative),
+            "not_informative": row.not_informative,
             "fraction_holds": None if not math.isfinite(row.fraction_holds) else float(row.fraction_holds),
             "best_reading": row.best_reading, "tolerance": row.tolerance, "check": row.check,
             f"paper{suffix}": paper, f"ours{suffix}": number(row.ours), "ours_text": shown(row.ours),
@@ -327,7 +523,7 @@ READINGS_SEPARATOR = " | "
 
 def claim_readings(claim_id: str, modules=None) -> tuple[str, ...]:
     """The readings a claim is evaluated at now, in words (:func:`passmd.readings.describe`)."""
-    return tuple(readings.describe(r) for r in readings.design(depends_on(claim_id, modules)))
+    return tuple(readings.describe(r) for r in readings.design(depends_on(claim_id, modules), claim_id))
 
 
 def load_baseline_readings(path) -> dict[str, tuple[str, ...]]:

@@ -76,13 +76,18 @@ def headline_markdown(evaluated: pd.DataFrame, page: str = "replication_report",
         parts.append(label)
     closed = int(((evaluated["status"] == "reproduced") & (evaluated["basis"] == "closed form")).sum())
     note = f" ({closed} of the reproduced a closed-form identity, not a simulation)" if closed else ""
-    return f"{len(evaluated)} claims: " + ", ".join(parts) + note
+    flags = (f"; {int(evaluated['fragile'].astype(bool).sum())} fragile (hold at the defaults but fail at "
+             f"the joint reading or at most of their readings), "
+             f"{int((~evaluated['informative'].astype(bool)).sum())} not informative "
+             "(their check cannot fail)"
+             if "fragile" in evaluated else "")
+    return f"{len(evaluated)} claims: " + ", ".join(parts) + note + flags
 
 
 #: Background colours of the categories in :func:`styled`.
 STATUS_COLOURS = {
     "reproduced": "#d4edda",
-    "reproduced under another reading": "#d1ecf1",
+    "reproduced under the joint reading": "#d1ecf1",
     "not reproduced": "#f8d7da",
     "inconclusive": "#e9ecef",
 }
@@ -91,7 +96,8 @@ STATUS_COLOURS = {
 def styled(evaluated: pd.DataFrame, *, links: bool = False):
     """A pandas ``Styler`` of the ledger for the book: one short line per claim.
 
-    Columns: claim, figure, paper, ours, category (coloured badge). Details (quote, reason,
+    Columns: claim, figure, paper, ours, category (coloured badge), margin at the defaults,
+    failing readings (of the decided ones) and flags (fragile, not informative). Details (quote, reason,
     evidence, readings) are in :func:`details_markdown`; with ``links=True`` each claim links
     to its details on the same page. The table carries the HTML class ``passmd-ledger`` (the
     rendered-book check looks for it) and wraps inside the content column.
@@ -99,6 +105,12 @@ def styled(evaluated: pd.DataFrame, *, links: bool = False):
     shown = evaluated[["claim", "figure", "paper", "ours", "status"]].copy()
     shown["ours"] = [format_number(v) if isinstance(v, (float, np.floating)) else str(v)
                      for v in shown["ours"]]
+    if "margin_text" in evaluated:
+        shown["margin"] = evaluated["margin_text"].to_numpy()
+        shown["fails at"] = [f"{int(f)} of {int(d)}" if d else "—"
+                             for f, d in zip(evaluated["fails_at"], evaluated["decided_at"], strict=True)]
+        shown["flags"] = [", ".join(([("fragile")] if fr else []) + ([] if inf else ["not informative"]))
+                          for fr, inf in zip(evaluated["fragile"], evaluated["informative"], strict=True)]
     if links:
         shown["claim"] = [f'<a href="#{claim_anchor(c)}">{c}</a>' for c in evaluated["claim"]]
     shown["status"] = [s + (" (closed form)" if b == "closed form" else "")

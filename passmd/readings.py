@@ -7,12 +7,23 @@ Each is declared here once as an :class:`Axis`: its default (the value the rest 
 uses), the values of its plausible range that we evaluate, the whole range in words, and the
 source of that range.
 
-A *reading* is one point of that space: ``{axis key: value}``. The ledger evaluates every claim
-at the readings of its :func:`design` (one-at-a-time: the defaults, then each evaluated
-alternative of each axis the claim depends on, the others at their defaults). An extractor
-declares the axes it reads with ``passmd.checks.extractor(id, depends_on=(...))`` and receives the
-reading as its ``reading`` argument; when the result tables hold no run at that reading it
-raises :class:`passmd.checks.NotEvaluable`, and that point counts as not covered.
+A *reading* is one point of that space: ``{axis key: value}``. **A reading keeps the claim's
+object**: an axis may change only what the paper left unstated (the fly-back, the damping, the
+drive frequency, μ, how A_c is read off the runs, how t_s is fitted into a short period), never
+the thing a claim is about. A value that would change the object is not a reading: it is listed
+in ``Axis.not_readings`` with the reason and shown as a study in its chapter. Setting t_s = 0
+wherever the settling time does not fit (``skip``) removes Eq. 15's settling phase from every
+period from 10 kHz up, so that waveform is not Eq. 15 and ``skip`` is no reading of the Eq. 15
+claims; the driving-waveform chapter keeps it as the study "what if the settling is dropped".
+
+The ledger evaluates every claim on the full product of the axes it depends on
+(:func:`design`: the defaults first), minus the axes declared open for it. An extractor
+declares the axes it reads with ``passmd.checks.extractor(id, depends_on=(...))`` and receives
+the reading as its ``reading`` argument; when the result tables hold no run at that reading it
+raises :class:`passmd.checks.NotEvaluable`, and that point counts as not covered. A claim that
+does not depend on an axis has the same state at every value of it, so every point of the whole
+space (:func:`space`) has a state for every claim (:func:`project`): that is what the joint
+reading of :mod:`passmd.ledger` is chosen from.
 
 Axes declared with no evaluated alternative are listed in the report as open: the ledger cannot
 yet say whether a claim's verdict moves along them. An axis with alternatives can still be open for
@@ -22,6 +33,7 @@ the alternatives, so they are evaluated at the default only.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
@@ -29,7 +41,7 @@ import pandas as pd
 
 from passmd.defaults import PROTOCOL
 
-__all__ = ["AXES", "Axis", "axis", "default_reading", "design", "describe", "space_table"]
+__all__ = ["AXES", "Axis", "axis", "default_reading", "design", "describe", "project", "space", "space_table"]
 
 
 @dataclass(frozen=True)
@@ -46,6 +58,7 @@ class Axis:
     assumption_key: str = ""  # the key of the matching passmd.parameters assumption, if any
     open_for: tuple = ()  # claim ids the axis applies to but whose result tables lack its alternatives
     open_reason: str = ""  # why those claims are not evaluated along the axis
+    not_readings: tuple = ()  # (value, reason): values that would change a claim's object (studies only)
 
     def values(self) -> tuple:
         return (self.default, *self.alternatives)
@@ -70,6 +83,14 @@ AXES: dict[str, Axis] = {
             source="Section 2 states the amplifier's 150 V/µs and 300 V_pp but not the fly-back of the "
             "simulated saw-tooth; 'fixed' is the full-stroke 2 µs at every amplitude",
             assumption_key="flyback_duration",
+            open_for=("fig7a-force-difference-115mn", "fig7a-discrepancy-grows-with-amplitude",
+                      "fig7b-discrepancy-grows-with-amplitude", "fig7-critical-amplitude-both-models",
+                      "sec4-2-other-preloads-same-trend",
+                      "sec4-2-friction-and-actuator-dynamics-cause-discrepancy"),
+            open_reason="the flexible onsets of Section 4.2 move with the fly-back; Figs. 7a and 7b are "
+            "computed with the fixed fly-back too (result table fig7flyback, read per reading by "
+            "passmd.experiments.force_generation.panel_at), but these claims' extractors do not read the "
+            "axis yet; the preload grid and the stall cycle are computed with the slew-rate fly-back only",
         ),
         Axis(
             key="ac_protocol",
@@ -97,11 +118,15 @@ AXES: dict[str, Axis] = {
             key="short_period",
             label="Eq. 15 when t_s does not fit",
             default="cut",
-            alternatives=("skip",),
+            alternatives=(),
             unit="",
-            plausible_range="cut the settling time t_s to the time left in the period, or skip it (t_s = 0)",
+            plausible_range="cut the settling time t_s to the time left in the period (t_s > 0 keeps "
+            "Eq. 15's settling phase)",
             source="Section 5.2 says only that above 110 kHz there is 'not enough time for settling'",
             assumption_key="optimized_short_period",
+            not_readings=(("skip", "t_s = 0 wherever the settling time does not fit removes Eq. 15's "
+                           "settling phase from 10 kHz up: the waveform is no longer Eq. 15, so it is the "
+                           "driving-waveform chapter's study 'what if the settling is dropped'"),),
         ),
         Axis(
             key="damping_ratio",
@@ -184,19 +209,31 @@ def default_reading() -> dict:
     return {key: a.default for key, a in AXES.items()}
 
 
-def design(depends_on: Iterable[str]) -> list[dict]:
+def design(depends_on: Iterable[str], claim_id: str | None = None) -> list[dict]:
     """The readings a claim depending on ``depends_on`` is evaluated at.
 
-    One-at-a-time design: the defaults first, then every evaluated alternative of each axis in
-    ``depends_on`` with every other axis at its default. Each reading is a full
-    ``{axis key: value}`` dict.
+    The full product of the values (default and evaluated alternatives) of every axis in
+    ``depends_on``, except the axes declared open for ``claim_id`` (``Axis.open_for``), every
+    other axis at its default; the defaults first. Each reading is a full ``{axis key: value}``
+    dict.
     """
     base = default_reading()
-    points = [base]
-    for key in depends_on:
-        for value in axis(key).alternatives:
-            points.append({**base, key: value})
-    return points
+    keys = [k for k in dict.fromkeys(depends_on) if claim_id is None or claim_id not in axis(k).open_for]
+    return [{**base, **dict(zip(keys, values, strict=True))}
+            for values in itertools.product(*(axis(k).values() for k in keys))]
+
+
+def space() -> list[dict]:
+    """Every point of the declared assumption space (the product of all axes' values), defaults first."""
+    return design(AXES)
+
+
+def project(reading: Mapping, keys: Iterable[str]) -> dict:
+    """``reading`` with every axis not in ``keys`` at its default: the point of a claim's
+    :func:`design` that gives its state at ``reading`` (a claim has the same state at every value
+    of an axis it does not depend on)."""
+    keys = set(keys)
+    return {k: (reading[k] if k in keys else a.default) for k, a in AXES.items()}
 
 
 def describe(reading: Mapping, *, only_changed: bool = True) -> str:
@@ -214,6 +251,7 @@ def space_table() -> pd.DataFrame:
          "evaluated alternatives": ", ".join(a.show(v) for v in a.alternatives) or "none yet",
          "plausible range": a.plausible_range, "source": a.source,
          "open for": (f"{len(a.open_for)} claims ({', '.join(a.open_for)}): {a.open_reason}"
-                      if a.open_for else "")}
+                      if a.open_for else ""),
+         "not a reading": "; ".join(f"{a.show(v)}: {why}" for v, why in a.not_readings)}
         for a in AXES.values()
     ])

@@ -354,9 +354,10 @@ def test_evidence_functions_follow_the_checks(tmp_path):
         "evidence not available on these results: no runs at 100 Hz")
 
 
-def test_another_reading_and_uncovered_readings(tmp_path):
-    """A claim that fails at the defaults but holds at a declared alternative names that reading;
-    one whose alternatives are not in the tables is inconclusive, not 'not reproduced'."""
+def test_joint_reading_and_uncovered_readings(tmp_path):
+    """A claim that fails at the defaults but holds at the joint reading is 'reproduced under the
+    joint reading'; one that fails at the defaults while the joint reading is not covered is 'not
+    reproduced': a failure is never promoted to inconclusive by an undecided other point."""
     claims = load_claims(_write(tmp_path, SYNTHETIC[:2]))
     module = types.ModuleType("synthetic_claims")
 
@@ -371,13 +372,15 @@ def test_another_reading_and_uncovered_readings(tmp_path):
         return {"lhs": 0.5, "rhs": 1.0}
 
     module._val, module._ord = _val, _ord
-    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module]).set_index("claim")
-    assert evaluated.at["val", "status"] == "reproduced under another reading"
-    assert evaluated.at["val", "verdict"] == "holds at fly-back rule = fixed"
+    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
+    assert evaluated.attrs["joint"]["described"] == "fly-back rule = fixed"
+    evaluated = evaluated.set_index("claim")
+    assert evaluated.at["val", "status"] == "reproduced under the joint reading"
+    assert evaluated.at["val", "verdict"].endswith("holds at the joint reading")
     assert evaluated.at["val", "best_reading"] == "fly-back rule = fixed"
     assert evaluated.at["val", "fraction_holds"] == 0.5
-    assert evaluated.at["ord", "status"] == "inconclusive"
-    assert "not covered: fly-back rule = fixed (no fixed fly-back runs)" in evaluated.at["ord", "verdict"]
+    assert evaluated.at["ord", "status"] == "not reproduced"
+    assert "the joint reading does not decide it" in evaluated.at["ord", "verdict"]
     table = ledger.assumption_map(evaluated.reset_index())
     assert list(table.columns) == ["claim", "defaults", "fly-back rule = fixed", "holds at", "best reading"]
     row = table.set_index("claim").loc["val"].tolist()
@@ -386,6 +389,130 @@ def test_another_reading_and_uncovered_readings(tmp_path):
     assert "R1: fly-back rule = fixed" in html
     assert ledger.depends_on("val", modules=[module]) == ("flyback",)
     assert ledger.claim_readings("val", modules=[module]) == ("defaults", "fly-back rule = fixed")
+
+
+def _point(state, reading=None, score=math.nan):
+    from passmd._verdicts import PointResult
+    outcome = None if state == "inconclusive" else checks.Outcome(state == "holds", 1.0, score=score)
+    return PointResult(reading or {}, state, outcome, f"{state} here")
+
+
+def test_category_rule_is_symmetric():
+    """The category comes from the defaults and the joint reading only: a failure at either point
+    with the other undecided is 'not reproduced', never 'inconclusive'; only two undecided points
+    are inconclusive; a hold at the defaults is 'reproduced' whatever the joint reading shows."""
+    from passmd._verdicts import _categorise
+
+    holds, fails, undecided = _point("holds"), _point("fails"), _point("inconclusive")
+    assert _categorise(fails, undecided)[0] == "not reproduced"
+    assert _categorise(undecided, fails)[0] == "not reproduced"
+    assert _categorise(fails, fails)[0] == "not reproduced"
+    assert _categorise(undecided, undecided)[0] == "inconclusive"
+    assert _categorise(undecided, None)[0] == "inconclusive"
+    assert _categorise(fails, holds)[0] == "reproduced under the joint reading"
+    assert _categorise(undecided, holds)[0] == "reproduced under the joint reading"
+    assert _categorise(holds, fails) == ("reproduced", "holds at the defaults; fails at the joint reading "
+                                                       "(fails here)")
+    assert _categorise(fails, None, "holds at X, which breaks y")[1].endswith("holds at X, which breaks y")
+
+
+def test_joint_reading_is_the_argmax_with_ties_runner_ups_and_conflicts(tmp_path):
+    """Three claims over fly-back × A_c protocol: 'a' holds only at (fixed, first), 'b' only with the
+    steady protocol, 'c' (no axis) everywhere. Two claims hold at the steady points (b, c) and at
+    (fixed, first) (a, c): a tie, which the defaults win; one at (slew, first). 'a' and 'b' never
+    hold together and each fails where the other holds: a conflicting pair."""
+    rows = [_claim(id=i, check="ordering", relation=">", unit="") for i in ("a", "b", "c")]
+    claims = load_claims(_write(tmp_path, rows))
+    module = types.ModuleType("synthetic_claims")
+
+    @checks.extractor("a", depends_on=("flyback", "ac_protocol"))
+    def _a(results, reading):
+        good = reading["flyback"] == "fixed" and reading["ac_protocol"] == "first"
+        return {"lhs": 2.0 if good else 0.5, "rhs": 1.0}
+
+    @checks.extractor("b", depends_on=("ac_protocol",))
+    def _b(results, reading):
+        return {"lhs": 2.0 if reading["ac_protocol"] == "steady" else 0.5, "rhs": 1.0}
+
+    @checks.extractor("c")
+    def _c(results):
+        return {"lhs": 2.0, "rhs": 1.0}
+
+    module._a, module._b, module._c = _a, _b, _c
+    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
+    joint = evaluated.attrs["joint"]
+    assert joint["described"] == "defaults" and joint["holding"] == 2 and joint["claims"] == 3
+    # (slew, steady) and (fixed, steady) give every claim the same states: one reading, the defaults
+    assert joint["equivalent_points"] == joint["points"] // 2
+    assert [(r["described"], r["holding"]) for r in joint["ties"]] == [
+        ("fly-back rule = fixed; how A_c is read = first", 2)]
+    assert [(r["described"], r["holding"]) for r in joint["runner_ups"]] == [("how A_c is read = first", 1)]
+    assert [p["claims"] for p in evaluated.attrs["conflicts"]] == [["a", "b"]]
+    by_id = evaluated.set_index("claim")
+    assert by_id.at["a", "status"] == "not reproduced"
+    assert ("holds at fly-back rule = fixed; how A_c is read = first, which breaks b"
+            in by_id.at["a", "verdict"])
+    assert by_id.at["a", "readings"] == 4 and by_id.at["a", "fails_at"] == 3  # the full product, 2 × 2
+    table = ledger.joint_map(evaluated)
+    both = "fly-back rule = fixed; how A_c is read = first"
+    assert list(table.columns) == ["joint reading: defaults", both,
+                                   "how A_c is read = first"]
+    assert table["how A_c is read = first"].tolist() == ["fails", "fails", "holds"]
+    import matplotlib
+    matplotlib.use("Agg")
+    from passmd.plots.ledger_map import plot_joint_map
+    fig = plot_joint_map(table)
+    assert fig.axes[0].has_data() and "(2 hold)" in fig.axes[0].get_xticklabels()[0].get_text()
+    # counter-example: once 'a' holds everywhere, the three hold together and nothing conflicts
+    module._a = checks.extractor("a", depends_on=("flyback", "ac_protocol"))(
+        lambda results, reading: {"lhs": 2.0, "rhs": 1.0})
+    again = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
+    assert again.attrs["joint"]["holding"] == 3 and again.attrs["conflicts"] == []
+
+
+def test_fragile_margin_and_informative_flags(tmp_path):
+    """A claim holding at the defaults but failing at most of its readings is fragile; the margin is
+    the deviation against the tolerance; an extractor marked not informative says why."""
+    claims = load_claims(_write(tmp_path, SYNTHETIC[:2]))
+    module = types.ModuleType("synthetic_claims")
+
+    @checks.extractor("val", depends_on=("ac_protocol", "flyback"))
+    def _val(results, reading):
+        return 103.0 if reading["flyback"] == "slew" and reading["ac_protocol"] == "steady" else 150.0
+
+    def _ord(results):
+        return {"lhs": 2.0, "rhs": 1.0}
+
+    _ord = checks.extractor("ord")(_ord)
+    _ord.not_informative = "holds for any finite stiffness"
+    module._val, module._ord = _val, _ord
+    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module]).set_index("claim")
+    assert evaluated.at["val", "status"] == "reproduced"
+    assert evaluated.at["val", "fails_at"] == 3 and evaluated.at["val", "decided_at"] == 4
+    assert evaluated.at["val", "fragile"]
+    assert evaluated.at["val", "margin_text"] == "3.0% against 5 %"
+    assert evaluated.at["val", "margin"] == pytest.approx(0.6)
+    assert not evaluated.at["ord", "fragile"] and not evaluated.at["ord", "informative"]
+    assert evaluated.at["ord", "not_informative"] == "holds for any finite stiffness"
+    counts = ledger.headline(evaluated.reset_index())
+    assert counts["fragile"] == 1 and counts["not informative"] == 1 and counts["reproduced"] == 2
+
+
+def test_design_is_the_full_product_and_skip_is_no_reading_of_eq15():
+    """A claim is evaluated on the product of its axes (not one at a time), minus the axes open for
+    it; the short-period rule 'skip' (t_s = 0, no settling phase) is no reading of an Eq. 15 claim."""
+    from passmd import readings
+
+    points = readings.design(("flyback", "ac_protocol", "damping_ratio"))
+    assert len(points) == 2 * 2 * 3 and points[0] == readings.default_reading()
+    assert {"flyback": "fixed", "ac_protocol": "first"}.items() <= points[-1].items()
+    open_claim = readings.axis("damping_ratio").open_for[0]
+    assert len(readings.design(("flyback", "damping_ratio"), open_claim)) == 2
+    for claim in ("fig9b-max-gain-2.5mm_s", "abstract-velocity-gain-15pct", "fig10a-max-velocity-19mm_s"):
+        assert "short_period" in ledger.depends_on(claim)
+        assert {r["short_period"] for r in readings.design(ledger.depends_on(claim), claim)} == {"cut"}
+    assert "skip" in dict(readings.axis("short_period").not_readings)
+    assert all(p["short_period"] != "skip" for p in readings.space())
 
 
 def test_unknown_assumption_axis_is_refused():
@@ -432,7 +559,7 @@ def test_not_evaluable_from_extractor(tmp_path):
     module = _tag(types.ModuleType("synthetic_claims"), "val", _coarse)
     evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
     assert evaluated.at[0, "status"] == "inconclusive"
-    assert evaluated.at[0, "verdict"] == "at the defaults: quick grid has no point at 100 Hz"
+    assert evaluated.at[0, "verdict"] == "not decided at the defaults: quick grid has no point at 100 Hz"
 
 
 def test_any_category_change_fails_with_a_readable_diff(tmp_path):
@@ -473,9 +600,10 @@ def test_collect_results_calls_every_figure_of_the_table(monkeypatch):
     table = {"fig5a": types.SimpleNamespace(compute=_fig5a)}
     monkeypatch.setattr(figures, "figure_names", lambda: list(table))
     monkeypatch.setattr(figures, "figure_spec", lambda name: table[name])
+    monkeypatch.setattr(ledger.force_generation, "fig7flyback", _fig5a)
     results = ledger.collect_results(QUICK)
-    assert list(results) == ["fig5a", "closed_forms"]
-    assert calls == [QUICK]
+    assert list(results) == ["fig5a", "closed_forms", "fig7flyback"]
+    assert calls == [QUICK, QUICK]
     pd.testing.assert_frame_equal(results["closed_forms"], reference.tangential_stiffness_table())
     with pytest.raises(TypeError, match="config = 'quick' is not allowed: must be a passmd.config.RunConfig"):
         ledger.collect_results("quick")
@@ -564,7 +692,7 @@ def test_styled_one_line_per_claim_and_details(tmp_path):
     assert "deviation 50 % exceeds the tolerance 5 %" in details
     headline = ledger_views.headline_markdown(evaluated)
     assert "[1 not reproduced](replication_report.md#ledger-not-reproduced)" in headline
-    assert "0 reproduced under another reading" in headline
+    assert "0 reproduced under the joint reading" in headline
 
 
 def test_assumptions_table_lists_the_registered_assumptions():
@@ -648,3 +776,39 @@ def test_baseline_readings_of_a_claim_along_several_axes(tmp_path):
     path.write_text("# made before readings were recorded\nclaim,status\nval,reproduced\n", encoding="utf-8")
     assert ledger.load_baseline_readings(path) == {}
     assert ledger.load_baseline(path) == {"val": "reproduced"}
+
+
+def test_flexible_ac_tables_hold_protocol_times_flyback_at_the_default_damping():
+    """At the drive frequency and the default ζ the A_c searches of flexible actuators cover
+    protocol × fly-back (the points the joint reading needs, e.g. the first fly-back with the fixed
+    fly-back); ζ's alternatives only with the steady protocol and the slew-rate fly-back. Rigid
+    actuators have no fly-back or ζ axis."""
+    from passmd import readings
+    from passmd.defaults import PROTOCOL
+    from passmd.experiments import critical_amplitude as ca
+
+    zeta = readings.axis("damping_ratio").default
+    flexible = ca._protocols("flexible", (PROTOCOL.drive_frequency,))
+    points = {(c["protocol"], c["flyback"], c.get("damping_ratio", zeta)) for c in flexible}
+    expected = {(p, f, zeta) for p in ("steady", "first") for f in readings.axis("flyback").values()}
+    expected |= {("steady", "slew", z) for z in readings.axis("damping_ratio").alternatives}
+    assert points == expected and len(flexible) == len(expected)
+    assert {c["flyback"] for c in ca._protocols("rigid", (PROTOCOL.drive_frequency,))} == {"slew"}
+
+
+def test_force_panels_at_a_flyback_reading():
+    """The Fig. 7 panels at the fixed fly-back come from fig7flyback (flexible rows fixed, rigid rows
+    unchanged); without that table the reading is not covered."""
+    from passmd import readings
+    from passmd.experiments import force_generation as fg
+
+    panel = pd.DataFrame({"panel": ["fig7a"] * 2, "actuator_model": ["rigid", "flexible"]})
+    fixed = panel.assign(flyback=["slew", "fixed"])
+    fixed = pd.concat([fixed, fixed.assign(panel="fig7b")], ignore_index=True)
+    reading = {**readings.default_reading(), "flyback": "fixed"}
+    assert fg.panel_at({"fig7a": panel}, "fig7a") is panel
+    with pytest.raises(checks.NotEvaluable, match="needs results: fig7flyback"):
+        fg.panel_at({"fig7a": panel}, "fig7a", reading)
+    rows = fg.panel_at({"fig7a": panel, "fig7flyback": fixed}, "fig7a", reading)
+    assert rows["panel"].tolist() == ["fig7a"] * 2 and rows["flyback"].tolist() == ["slew", "fixed"]
+    assert "fig7flyback" in ledger.result_sources()

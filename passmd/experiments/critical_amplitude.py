@@ -167,10 +167,12 @@ def _settings(config: RunConfig) -> ProfileSettings:
 def _protocols(actuator_model: str, frequencies) -> list[dict]:
     """The (protocol, fly-back, frequency[, ζ]) combinations drawn for an actuator model.
 
-    Flexible actuators are also searched at the evaluated alternatives of the ledger's axis
-    ``damping_ratio`` (:mod:`passmd.readings`; Table 2's c_p is lost), steady state with the
-    slew-rate fly-back at ``PROTOCOL.drive_frequency``; every other row uses
-    :data:`~passmd.parameters.ACTUATOR_DAMPING_RATIO`.
+    The ledger evaluates the A_c claims on the product of their axes (:mod:`passmd.readings`).
+    At ``PROTOCOL.drive_frequency`` and the default ζ the tables hold both protocols × (for
+    flexible actuators) both fly-back rules; the evaluated alternatives of ζ (Table 2's c_p is
+    lost) are searched with the steady protocol and the slew-rate fly-back, the other drive
+    frequencies of the band with the steady protocol, the slew-rate fly-back and the default ζ.
+    The other points of the product are not computed: the ledger counts them as not covered.
     """
     combos = [{"protocol": "steady", "flyback": "slew", "frequency": float(f)} for f in frequencies]
     combos.append({"protocol": "first", "flyback": "slew", "frequency": PROTOCOL.drive_frequency})

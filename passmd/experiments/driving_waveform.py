@@ -61,7 +61,9 @@ FIG10B_RADII = (1e-3, 0.25e-3)
 SECTION5_FRICTION = float(readings.axis("friction_coefficient").default)
 #: μ of the Fig. 9a runs: the default and the ledger's evaluated alternatives (Section 4.2's 0.3).
 FIG9A_FRICTION = tuple(float(mu) for mu in readings.axis("friction_coefficient").values())
-#: Waveform variants of Figs. 9b and 10: (waveform, short_period rule).
+#: Waveform variants of Figs. 9b and 10: (waveform, short_period rule). ``skip`` (t_s = 0 where the
+#: settling time does not fit) is the chapter's study "what if the settling is dropped": it removes
+#: Eq. 15's settling phase, so it is no ledger reading of the Eq. 15 claims (passmd.readings).
 VARIANTS = (("sawtooth", ""), ("optimized", "cut"), ("optimized", "skip"))
 
 

@@ -26,10 +26,12 @@ import pandas as pd
 
 from passmd import sweep
 from passmd._validation import check_choice, check_range
+from passmd.checks import NotEvaluable
 from passmd.config import PROFILES, RunConfig
 from passmd.defaults import PROTOCOL
 from passmd.parameters import PRELOAD_GRIDS, Assumption, Drive, paper_drive
 from passmd.protocols import stall
+from passmd.protocols.critical_amplitude import critical_amplitude
 from passmd.protocols.stall import (
     MAX_PERIODS,
     STALL_ABS_TOLERANCE,
@@ -55,12 +57,14 @@ __all__ = [
     "fig7a",
     "fig7b",
     "fig7cycle",
+    "fig7flyback",
     "fig7freq",
     "fig7grid",
     "force_difference",
     "force_drive",
     "model_rows",
     "onset_point",
+    "panel_at",
     "stall_point",
 ]
 
@@ -187,13 +191,14 @@ def stall_point(
     friction_coefficient: float,
     amplitude_fraction: float,
     frequency: float,
+    flyback: str = "slew",
 ) -> dict:
     """:func:`~passmd.protocols.stall.generated_force`
-    of the Fig. 7 drive at ``amplitude_fraction`` × A_max."""
+    of the Fig. 7 drive at ``amplitude_fraction`` × A_max, with the ``flyback`` rule."""
     drive = force_drive(hemisphere_radius, preload, actuator_model, friction_coefficient)
     fraction = check_range("amplitude_fraction", amplitude_fraction, 0.0, 1.0)
     amplitude = fraction * drive.actuator.full_stroke_amplitude
-    out = generated_force(drive, amplitude, frequency)
+    out = generated_force(drive, amplitude, frequency, flyback=flyback)
     out["amplitude_m"] = amplitude
     return out
 
@@ -205,11 +210,14 @@ def onset_point(
     friction_coefficient: float,
     frequency: float,
     tolerance: float,
+    flyback: str = "slew",
 ) -> dict:
     """:func:`~passmd.protocols.stall.force_onset`
-    of the Fig. 7 drive, plus the closed form (Eq. 11 or 12) in m."""
+    of the Fig. 7 drive (the critical amplitude with the load cell engaged, with the ``flyback``
+    rule), plus the closed form (Eq. 11 or 12) in m."""
     drive = force_drive(hemisphere_radius, preload, actuator_model, friction_coefficient)
-    out = force_onset(drive, frequency, tolerance)
+    out = (force_onset(drive, frequency, tolerance) if flyback == "slew" else
+           critical_amplitude(drive, frequency=frequency, tolerance=tolerance, flyback=flyback))
     if out["critical_amplitude_m"] is None:
         out["critical_amplitude_m"] = math.nan
     out["analytic_critical_amplitude_m"] = float(drive_theory(drive)["analytic_critical_amplitude_m"])
@@ -275,8 +283,8 @@ def _stall_frame(points: list[dict], description: str, config: RunConfig) -> pd.
 def _onset_frame(curves: list[tuple], config: RunConfig) -> pd.DataFrame:
     points = [
         {"hemisphere_radius": r, "preload": float(p), "actuator_model": m, "friction_coefficient": mu,
-         "frequency": FORCE_FREQUENCY, "tolerance": ONSET_TOLERANCE[config.profile]}
-        for r, p, m, mu in curves
+         "frequency": FORCE_FREQUENCY, "tolerance": ONSET_TOLERANCE[config.profile], **_flyback(fb)}
+        for r, p, m, mu, fb in curves
     ]
     f = sweep.run(onset_point, points, description="fig7 onsets", config=config)
     return pd.DataFrame(
@@ -294,14 +302,23 @@ def _onset_frame(curves: list[tuple], config: RunConfig) -> pd.DataFrame:
     )
 
 
-def _curves_frame(radius_preloads: dict, fractions, config: RunConfig, panel: str) -> pd.DataFrame:
-    """F_gen against amplitude for every (radius, preload, model), with each curve's onset."""
-    curves = [(r, float(p), m, mu) for r, preloads in radius_preloads.items() for p in preloads
-              for m, mu, _ in MODELS]
+def _flyback(rule: str) -> dict:
+    """The fly-back parameter of a sweep point: none for the slew-rate default, so those points
+    are the same (and cached once) in every table."""
+    return {} if rule == "slew" else {"flyback": rule}
+
+
+def _curves_frame(radius_preloads: dict, fractions, config: RunConfig, panel: str,
+                  models=MODELS, flyback: str = "slew") -> pd.DataFrame:
+    """F_gen against amplitude for every (radius, preload, model), with each curve's onset; the
+    flexible actuators' saw-tooth has the ``flyback`` rule (rigid actuators follow any fly-back:
+    their runs use the slew-rate one)."""
+    curves = [(r, float(p), m, mu, flyback if m == "flexible" else "slew")
+              for r, preloads in radius_preloads.items() for p in preloads for m, mu, *_ in models]
     points = [
         {"hemisphere_radius": r, "preload": p, "actuator_model": m, "friction_coefficient": mu,
-         "amplitude_fraction": float(a), "frequency": FORCE_FREQUENCY}
-        for r, p, m, mu in curves for a in fractions
+         "amplitude_fraction": float(a), "frequency": FORCE_FREQUENCY, **_flyback(fb)}
+        for r, p, m, mu, fb in curves for a in fractions
     ]
     stalls = _stall_frame(points, panel, config)
     onsets = _onset_frame(curves, config)
@@ -324,6 +341,30 @@ def fig7a(config: RunConfig) -> pd.DataFrame:
 def fig7b(config: RunConfig) -> pd.DataFrame:
     """Fig. 7b: F_gen against A (0–96 nm), R = 0.25 mm, F_p = 0.2 and 0.4 N, both models (mN, nm)."""
     return _panel("fig7b", config)
+
+
+def fig7flyback(config: RunConfig) -> pd.DataFrame:
+    """Figs. 7a and 7b with the fixed 2 µs fly-back (ledger axis ``flyback``): both panels' curves,
+    this paper's model with the fixed fly-back and the earlier one (rigid actuators, unchanged),
+    in the panels' format with a ``panel`` column (``fig7a``, ``fig7b``)."""
+    fractions = _settings(config.profile).panel_fractions
+    table = pd.concat([_curves_frame({PANELS[name][0]: PANELS[name][1]}, fractions, config, name,
+                                     flyback="fixed") for name in PANELS], ignore_index=True)
+    table.insert(1, "flyback", np.where(table["actuator_model"] == "flexible", "fixed", "slew"))
+    return table
+
+
+def panel_at(results, name: str, reading=None) -> pd.DataFrame:
+    """The table of panel ``name`` (``fig7a`` or ``fig7b``) at a ledger reading: the panel itself
+    at the slew-rate fly-back, its rows of ``fig7flyback`` at the fixed one. Raises
+    :class:`passmd.checks.NotEvaluable` when the results hold no such table."""
+    rule = "slew" if reading is None else reading["flyback"]
+    if rule == "slew":
+        return results[name]
+    if "fig7flyback" not in results:
+        raise NotEvaluable(f"no Fig. 7 runs with the {rule} fly-back (needs results: fig7flyback)")
+    table = results["fig7flyback"]
+    return table[(table["panel"] == name) & (table["flyback"].isin([rule, "slew"]))].reset_index(drop=True)
 
 
 def fig7grid(config: RunConfig) -> pd.DataFrame:

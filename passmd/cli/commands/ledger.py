@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import datetime
 import textwrap
 
 from passmd._result_bounds import check_table
@@ -19,12 +20,18 @@ _EPILOG = textwrap.dedent(f"""\
     Computes (or reads from the cache: ${ENVIRONMENT['cache_dir']}, else
     {describe_default_cache_dir()}; the book built with nox uses ./{DEFAULT_CACHE_DIR}/
     of the repository) every figure's results at --profile and evaluates every claim of
-    passmd/data/reference/claims.csv over the declared readings of passmd.readings.
+    passmd/data/reference/claims.csv on the product of the readings of passmd.readings it
+    depends on; each category comes from the defaults and the joint reading (the point of the
+    assumption space where the most claims hold together).
 
-    --json keys: profile, summary, counts{{category: n}}, claims[{{claim, category, basis,
-    verdict, evidence[], reason, depends_on[], readings{{reading: state}}, fraction_holds,
-    best_reading, tolerance, check, paper_<SI unit>, ours_<SI unit>, ours_text,
-    abs_deviation_<SI unit>, rel_deviation (fraction)}}]""")
+    --json keys: profile, summary, counts{{category: n, fragile, not informative}},
+    joint_reading{{reading, described, holding, equivalent_points, claims, ties[], runner_ups[],
+    points}}, conflicting_pairs[{{claims, first_holds_at, second_holds_at, example}}],
+    claims[{{claim, category, basis, verdict, evidence[], reason, depends_on[],
+    readings{{reading: state}}, points[{{reading, state, score, detail}}], default_state,
+    joint_state, margin, margin_text, fails_at, decided_at, fragile, informative,
+    not_informative, fraction_holds, best_reading, tolerance, check, paper_<SI unit>,
+    ours_<SI unit>, ours_text, abs_deviation_<SI unit>, rel_deviation (fraction)}}]""")
 
 
 def add_parser(command) -> None:
@@ -53,7 +60,7 @@ def _check_baseline(args, config) -> None:
 
 
 def _write_baseline(ledger, evaluated, args) -> None:
-    header = (f"ledger categories, {args.profile} profile; produced by\n"
+    header = (f"ledger categories, {args.profile} profile; produced {datetime.date.today().isoformat()} by\n"
               f"passmd ledger --profile {args.profile} --write-baseline {args.write_baseline}")
     try:
         write_atomically(args.write_baseline,
@@ -70,7 +77,6 @@ def run_ledger(args, out) -> int:
     config = run_config(args)
     _check_baseline(args, config)  # (before the ledger's modules load)
     from passmd import ledger, ledger_views
-    from passmd.claims import STATUSES
 
     results = ledger.collect_results(config)
     for name, table in results.items():  # finite before anything is written, as run and theory check
@@ -78,12 +84,20 @@ def run_ledger(args, out) -> int:
     evaluated = ledger.evaluate(results=results)
     if args.write_baseline:
         _write_baseline(ledger, evaluated, args)
-    counts = {s: int((evaluated["status"] == s).sum()) for s in STATUSES}
+    counts = ledger.headline(evaluated)
+    joint = evaluated.attrs["joint"]
     if args.json:
         emit_json({"command": "ledger", "profile": args.profile, "summary": ledger_views.summary(evaluated),
-                   "counts": counts, "claims": ledger.records(evaluated)}, out)
+                   "counts": counts, "joint_reading": ledger.joint_record(joint),
+                   "conflicting_pairs": evaluated.attrs["conflicts"],
+                   "claims": ledger.records(evaluated)}, out)
         return 0
     out.write(f"passmd ledger — profile {args.profile}: {ledger_views.summary(evaluated)}\n")
+    out.write(f"joint reading: {joint['described']} ({joint['holding']} of {joint['claims']} claims hold; "
+              f"{len(joint['ties'])} tied points)\n")
+    out.write("counts: " + ", ".join(f"{n} {s}" for s, n in counts.items()) + "\n")
+    for pair in evaluated.attrs["conflicts"]:
+        out.write(f"conflict: {pair['claims'][0]} / {pair['claims'][1]}\n")
     for row in evaluated.itertuples():
         basis = " (closed form)" if row.basis == "closed form" else ""
         out.write(f"\n{row.claim}: {row.status}{basis}\n  {row.verdict}\n")
