@@ -45,6 +45,7 @@ __all__ = [
     "SI_UNITS",
     "assumption_map",
     "category_changes",
+    "chapter_rows",
     "check_categories",
     "claim_functions",
     "claim_modules",
@@ -440,6 +441,22 @@ def claims_for(claims: pd.DataFrame, figures) -> pd.DataFrame:
     keys = {figures} if isinstance(figures, str) else set(figures)
     needed = claims["requires"].str.split(";").map(lambda parts: {p for p in parts if p})
     return claims[needed.map(lambda parts: parts <= keys)].reset_index(drop=True)
+
+
+def chapter_rows(figures, config: RunConfig) -> pd.DataFrame:
+    """A chapter's ledger rows, judged in the whole ledger.
+
+    The category of a claim depends on the joint reading, which only the whole ledger can find:
+    every claim is evaluated on ``config``'s results (:func:`evaluate`) and the rows of the
+    claims that need only the result keys ``figures`` (:func:`claims_for`) are returned, so that
+    every chapter shows the categories of the replication report.
+    """
+    evaluated = evaluate(config=_check_config(config))
+    ids = set(claims_for(load_claims(), figures)["id"])
+    rows = evaluated[evaluated["claim"].isin(ids)].reset_index(drop=True)
+    rows.attrs = {**evaluated.attrs,
+                  "points": [p for p in evaluated.attrs.get("points", []) if p["claim"] in ids]}
+    return rows
 
 
 def orphan_extractors(claims: pd.DataFrame | None = None, modules=None) -> list[str]:

@@ -31,15 +31,19 @@ from passmd.experiments.force_generation import (
     THIS,
     force_difference,
     model_rows,
+    panel_at,
 )
 from passmd.parameters import PRELOAD_GRIDS
 
 
-@extractor("fig7a-force-difference-115mn", depends_on=("force_frequency",))
+@extractor("fig7a-force-difference-115mn", depends_on=("force_frequency", "flyback"))
 def _fig7a_difference(results, reading) -> float:
     frequency = float(reading["force_frequency"])
     if np.isclose(frequency, FORCE_FREQUENCY):
-        diff = force_difference(results["fig7a"], 0.8)
+        diff = force_difference(panel_at(results, "fig7a", reading), 0.8)
+    elif reading["flyback"] != "slew":
+        raise NotEvaluable(f"the frequency runs (fig7freq) use the slew-rate fly-back only, not at "
+                           f"{frequency:g} Hz with the {reading['flyback']} one")
     else:  # the frequency panel holds the full-stroke runs at the other frequencies
         if "fig7freq" not in results:
             raise NotEvaluable("needs results: fig7freq")
@@ -106,10 +110,10 @@ def _onset(table, model, preload: float, name: str) -> float:
     return float(rows["onset_nm"].iloc[0])
 
 
-def _trend(results, name: str) -> dict:
+def _trend(results, name: str, reading) -> dict:
     # The discrepancy in the *level* of generated force: only amplitudes at which both models
     # generate force (above both onsets); between the onsets only one model does.
-    table = results[name]
+    table = panel_at(results, name, reading)
     out = {}
     for preload in PANELS[name][1]:
         onsets = [_onset(table, model, preload, name) for model in (EARLIER, THIS)]
@@ -124,14 +128,14 @@ def _trend(results, name: str) -> dict:
     return out
 
 
-@extractor("fig7a-discrepancy-grows-with-amplitude")
-def _fig7a_trend(results) -> dict:
-    return _trend(results, "fig7a")
+@extractor("fig7a-discrepancy-grows-with-amplitude", depends_on=("flyback",))
+def _fig7a_trend(results, reading) -> dict:
+    return _trend(results, "fig7a", reading)
 
 
-@extractor("fig7b-discrepancy-grows-with-amplitude")
-def _fig7b_trend(results) -> dict:
-    return _trend(results, "fig7b")
+@extractor("fig7b-discrepancy-grows-with-amplitude", depends_on=("flyback",))
+def _fig7b_trend(results, reading) -> dict:
+    return _trend(results, "fig7b", reading)
 
 
 @extractor("fig7-critical-amplitude-both-models")
@@ -149,11 +153,11 @@ def _abstract_experiment(results):
     no_measured_data("the experimental data of [12] are shown only in the plots of Figs. 6b and 7")
 
 
-@extractor("fig7-rigid-mu03-flexible-mu02-onsets-agree")
-def _fig7_onsets(results) -> dict:
+@extractor("fig7-rigid-mu03-flexible-mu02-onsets-agree", depends_on=("flyback",))
+def _fig7_onsets(results, reading) -> dict:
     lhs, rhs = [], []
     for name in ("fig7a", "fig7b"):
-        table = results[name]
+        table = panel_at(results, name, reading)
         for preload in PANELS[name][1]:
             onset = {}
             for model in (EARLIER, THIS):
@@ -169,12 +173,12 @@ def _fig7_onsets(results) -> dict:
     return {"lhs": np.array(lhs), "rhs": np.array(rhs)}
 
 
-@extractor("fig7-force-grows-with-amplitude-above-onset")
-def _force_grows_with_amplitude(results) -> dict:
+@extractor("fig7-force-grows-with-amplitude-above-onset", depends_on=("flyback",))
+def _force_grows_with_amplitude(results, reading) -> dict:
     # each model's F_gen over the stalled amplitudes above its own onset, at each panel preload
     out = {}
     for name in ("fig7a", "fig7b"):
-        table = results[name]
+        table = panel_at(results, name, reading)
         for preload in PANELS[name][1]:
             for model in (EARLIER, THIS):
                 rows = model_rows(table, model, preload)
