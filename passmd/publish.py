@@ -45,6 +45,7 @@ __all__ = [
     "current_profile",
     "data_link",
     "drive_parameters",
+    "figure_png",
     "format_quantity",
     "implementations",
     "parameter_frame",
@@ -455,19 +456,25 @@ def put_all(facts: dict) -> None:
             put(name, value)
 
 
-def show_figure(fig) -> None:
-    """Display a matplotlib ``Figure`` made outside pyplot (e.g. ``passmd.plots.sweep_map.map_figure``)
-    as a PNG image, as the notebook's inline backend shows a pyplot figure (tight bounding box)."""
+def figure_png(fig) -> bytes:
+    """A matplotlib ``Figure`` as PNG bytes, with the tight bounding box the inline backend uses."""
     import io
 
-    from IPython.display import Image, display
     from matplotlib.figure import Figure
 
     if not isinstance(fig, Figure):
         raise ValueError(f"fig = {type(fig).__name__} is not allowed: must be a matplotlib Figure")
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", bbox_inches="tight")
-    display(Image(data=buffer.getvalue(), format="png"))
+    return buffer.getvalue()
+
+
+def show_figure(fig) -> None:
+    """Display a matplotlib ``Figure`` made outside pyplot (e.g. ``passmd.plots.sweep_map.map_figure``)
+    as a PNG image (:func:`figure_png`), as the notebook's inline backend shows a pyplot figure."""
+    from IPython.display import Image, display
+
+    display(Image(data=figure_png(fig), format="png"))
 
 
 def show_table(df, formats: dict | None = None) -> None:
