@@ -75,10 +75,12 @@ def _map_table(velocities, frequencies, amplitudes):
 
 
 def test_map_facts_find_the_fastest_point_and_the_top_row():
-    table = _map_table([1e-4, 2e-4, 5e-3, 4e-3], [100.0, 1e4], [50e-9, 100e-9])
+    # amplitudes 5 nm apart: only the largest is the top row (an absolute tolerance of 1e-8 m would
+    # take both)
+    table = _map_table([1e-4, 2e-4, 5e-3, 4e-3], [100.0, 1e4], [95e-9, 100e-9])
     facts = design.map_facts(table)
     assert facts["v_max_mm_s"] == pytest.approx(5.0) and facts["v_max_f_kHz"] == pytest.approx(10.0)
-    assert facts["v_max_A_nm"] == pytest.approx(50.0)
+    assert facts["v_max_A_nm"] == pytest.approx(95.0) and facts["A_top_nm"] == pytest.approx(100.0)
     assert facts["step_low_f_nm"] == pytest.approx(2e-4 / 100 * 1e9)  # largest amplitude, lowest f
     assert facts["step_high_f_nm"] == pytest.approx(4e-3 / 1e4 * 1e9)
     assert facts["map_points"] == 4

@@ -308,7 +308,8 @@ def map_facts(table: pd.DataFrame) -> dict:
     highest frequency at the largest amplitude (nm, mm/s, kHz)."""
     v = table["velocity_m_per_s"].to_numpy(float)
     best = int(np.nanargmax(v))
-    top = table[np.isclose(table["amplitude_m"], table["amplitude_m"].max())].sort_values("frequency_Hz")
+    a = table["amplitude_m"].to_numpy(float)
+    top = table[np.isclose(a, a.max(), rtol=1e-9, atol=0.0)].sort_values("frequency_Hz")  # the largest only
     return {"v_max_mm_s": v[best] * 1e3, "v_max_f_kHz": table["frequency_Hz"].iloc[best] / 1e3,
             "v_max_A_nm": table["amplitude_m"].iloc[best] * 1e9,
             "step_low_f_nm": top["step_m"].iloc[0] * 1e9, "step_high_f_nm": top["step_m"].iloc[-1] * 1e9,
