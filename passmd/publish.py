@@ -45,12 +45,15 @@ __all__ = [
     "current_profile",
     "data_link",
     "drive_parameters",
+    "figure_png",
     "format_quantity",
     "implementations",
     "parameter_frame",
     "put",
     "put_text",
+    "show_figure",
     "show_table",
+    "text_link",
     "to_unit",
 ]
 
@@ -144,6 +147,27 @@ def data_link(df, name: str, *, label: str | None = None, root=None) -> Markdown
     os.replace(tmp, target)  # atomic: a reader never sees a half-written file
     text = label if label is not None else target.name
     return Markdown(f"{{download}}`{text} </{_DATA_SUBDIR.as_posix()}/{target.name}>`")
+
+
+def text_link(text: str, filename: str, *, label: str | None = None, root=None) -> Markdown:
+    """Write ``text`` as ``<book>/_generated/data/<filename>`` and return a MyST download link.
+
+    For files a reader feeds back to ``passmd`` as they are (a drive file, a measurement CSV),
+    so no provenance lines are added. ``filename``: letters, digits, ``_``, ``-``, ``.``.
+    """
+    if not isinstance(filename, str) or not _NAME_PATTERN.match(filename):
+        raise ValueError(f"filename = {filename!r} is not allowed: must be a file name of letters, digits, "
+                         "'_', '-', '.'")
+    if not isinstance(text, str):
+        raise ValueError(f"text = {type(text).__name__} is not allowed: must be a str")
+    folder = book_root(root) / _DATA_SUBDIR
+    folder.mkdir(parents=True, exist_ok=True)
+    target = folder / filename
+    tmp = target.with_name(f".{target.name}.{os.getpid()}.tmp")
+    tmp.write_text(text, encoding="utf-8")
+    os.replace(tmp, target)  # atomic: a reader never sees a half-written file
+    shown = label if label is not None else filename
+    return Markdown(f"{{download}}`{shown} </{_DATA_SUBDIR.as_posix()}/{filename}>`")
 
 
 @lru_cache(maxsize=1)
@@ -430,6 +454,27 @@ def put_all(facts: dict) -> None:
             put_text(name, value)
         else:
             put(name, value)
+
+
+def figure_png(fig) -> bytes:
+    """A matplotlib ``Figure`` as PNG bytes, with the tight bounding box the inline backend uses."""
+    import io
+
+    from matplotlib.figure import Figure
+
+    if not isinstance(fig, Figure):
+        raise ValueError(f"fig = {type(fig).__name__} is not allowed: must be a matplotlib Figure")
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", bbox_inches="tight")
+    return buffer.getvalue()
+
+
+def show_figure(fig) -> None:
+    """Display a matplotlib ``Figure`` made outside pyplot (e.g. ``passmd.plots.sweep_map.map_figure``)
+    as a PNG image (:func:`figure_png`), as the notebook's inline backend shows a pyplot figure."""
+    from IPython.display import Image, display
+
+    display(Image(data=figure_png(fig), format="png"))
 
 
 def show_table(df, formats: dict | None = None) -> None:

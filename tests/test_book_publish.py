@@ -236,3 +236,30 @@ def test_put_all_glues_numbers_and_text(monkeypatch):
     monkeypatch.setattr(publish, "put_text", lambda name, text: glued.__setitem__(name, ("text", text)))
     publish.put_all({"a": 1.5, "b": "below"})
     assert glued == {"a": ("number", 1.5), "b": ("text", "below")}
+
+
+def test_text_link_writes_the_text_as_is(book):
+    text = "preload = 0.6\n# no provenance lines: passmd reads this file back\n"
+    link = publish.text_link(text, "fitted-drive.toml", root=book)
+    target = book / "_generated" / "data" / "fitted-drive.toml"
+    assert target.read_text(encoding="utf-8") == text
+    assert link == "{download}`fitted-drive.toml </_generated/data/fitted-drive.toml>`"
+    assert [p.name for p in target.parent.iterdir()] == ["fitted-drive.toml"]  # no temporary file left
+    for bad in ("../up.toml", "a/b.toml", ""):
+        with pytest.raises(ValueError, match="filename = "):
+            publish.text_link(text, bad, root=book)
+    with pytest.raises(ValueError, match="text = bytes"):
+        publish.text_link(b"x", "x.toml", root=book)
+
+
+def test_figure_png_is_a_png_of_the_figure():
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(2, 1), dpi=100)
+    fig.add_subplot().plot([0, 1], [1, 0])
+    png = publish.figure_png(fig)
+    assert png.startswith(b"\x89PNG\r\n\x1a\n")
+    width, height = int.from_bytes(png[16:20], "big"), int.from_bytes(png[20:24], "big")
+    assert 100 < width < 400 and 50 < height < 200  # 2 × 1 in at 100 dpi, box fitted to the content
+    with pytest.raises(ValueError, match="fig = list"):
+        publish.figure_png([1])

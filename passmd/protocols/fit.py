@@ -72,6 +72,7 @@ __all__ = [
     "MeasurementError",
     "default_bounds",
     "fit",
+    "fitted_drive_file",
     "measurements_from_rows",
     "predict",
     "predict_point",
@@ -956,3 +957,21 @@ def write_measurements(path, data: Measurements, values: np.ndarray | None = Non
                     data.column[i]: values[i] / scale, data.column[i] + "_sd": data.sd[i] / scale}
             out.writerow(["" if c not in cell or not math.isfinite(cell[c]) else repr(float(cell[c]))
                           for c in header])
+
+
+def fitted_drive_file(drive: Drive, data_name: str, free: Sequence[str]) -> str:
+    """The fitted drive as a drive file (:func:`passmd.drive_file.drive_toml`) that ``--drive`` and
+    :func:`passmd.drive_file.load_drive` read back; the fitted keys name the data (``data_name``)
+    as their source. ``free``: the fitted parameters' names (:data:`FREE_PARAMETERS`)."""
+    from passmd.drive_file import DRIVE_KEYS, drive_toml
+
+    fitted = {"actuator.damping_ratio": "actuator.viscosity", "flyback_time": "amplifier.slew_rate",
+              "contact_stiffness_scale": "hemisphere_material.youngs_modulus"}
+    sources = {}
+    for name in free:
+        key = fitted.get(name, name)
+        if key in DRIVE_KEYS:
+            sources[key] = f"fitted to {data_name} by passmd fit"
+    if "contact_stiffness_scale" in free:
+        sources["runner_material.youngs_modulus"] = f"fitted to {data_name} by passmd fit (scale on E)"
+    return drive_toml(drive, sources, title=f"drive fitted by passmd fit to {data_name}")

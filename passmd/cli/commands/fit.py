@@ -112,20 +112,11 @@ def _bounds(args, names) -> dict[str, tuple[float, float]]:
 
 
 def drive_file_text(drive, data_name: str, free: list[str]) -> str:
-    """The fitted drive as a drive file (``passmd.drive_toml``) that ``--drive`` reads back; the
-    fitted keys name the data they were fitted to as their source."""
-    from passmd.drive_file import DRIVE_KEYS, drive_toml
+    """The fitted drive as a drive file that ``--drive`` reads back
+    (:func:`passmd.protocols.fit.fitted_drive_file`)."""
+    from passmd.protocols.fit import fitted_drive_file
 
-    fitted = {"actuator.damping_ratio": "actuator.viscosity", "flyback_time": "amplifier.slew_rate",
-              "contact_stiffness_scale": "hemisphere_material.youngs_modulus"}
-    sources = {}
-    for name in free:
-        key = fitted.get(name, name)
-        if key in DRIVE_KEYS:
-            sources[key] = f"fitted to {data_name} by passmd fit"
-    if "contact_stiffness_scale" in free:
-        sources["runner_material.youngs_modulus"] = f"fitted to {data_name} by passmd fit (scale on E)"
-    return drive_toml(drive, sources, title=f"drive fitted by passmd fit to {data_name}")
+    return fitted_drive_file(drive, data_name, free)
 
 
 def _progress(config):

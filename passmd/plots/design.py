@@ -1,0 +1,78 @@
+"""Figures of the chapter "Design your own drive" (data from :mod:`passmd.experiments.design`).
+
+The maps are drawn by :func:`passmd.plots.sweep_map.map_figure`, as ``passmd sweep`` draws them;
+here are the three figures a map does not cover.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+__all__ = ["critical_amplitude_figure", "heldback_figure", "stall_force_figure"]
+
+_READINGS = (("closed_form_nm", "closed form (Eqs. 7–8, 11–12)", "--"),
+             ("first_nm", "simulated, first fly-back", "s-"),
+             ("steady_nm", "simulated, steady", "o-"))
+
+
+def critical_amplitude_figure(table, full_stroke_nm: float) -> Figure:
+    """The three readings of A_c against preload, with the full stroke as a ceiling."""
+    fig = Figure(figsize=(6.4, 4.4), layout="constrained")
+    ax = fig.add_subplot()
+    for column, label, style in _READINGS:
+        ax.plot(table["preload_N"], table[column], style, ms=4, label=label)
+    ax.axhline(full_stroke_nm, color="grey", lw=0.8, ls=":")
+    ax.annotate("full stroke", (float(table["preload_N"].min()), full_stroke_nm), textcoords="offset points",
+                xytext=(2, -11), fontsize=8, color="grey")
+    ax.set_xlabel("preload F_p [N]")
+    ax.set_ylabel("critical amplitude A_c [nm]")
+    ax.set_ylim(0, 1.08 * full_stroke_nm)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="upper left")
+    return fig
+
+
+def stall_force_figure(table) -> Figure:
+    """Stall force against amplitude, one curve per preload, with each preload's Coulomb bound
+    μ·ΣF_N (dotted); points that did not stall are red crosses."""
+    fig = Figure(figsize=(6.4, 4.4), layout="constrained")
+    ax = fig.add_subplot()
+    for k, (preload, rows) in enumerate(table.groupby("preload_N", sort=True)):
+        colour = f"C{k}"
+        done = rows[rows["converged"]]
+        ax.plot(done["amplitude_nm"], done["force_mN"], "o-", ms=4, color=colour,
+                label=f"F_p = {preload:g} N")
+        ax.axhline(float(rows["bound_mN"].iloc[0]), color=colour, lw=0.8, ls=":")
+        open_ = rows[~rows["converged"]]
+        if len(open_):
+            ax.plot(open_["amplitude_nm"], open_["force_mN"], "x", color="red", ms=7)
+    ax.set_xlabel("amplitude A [nm]")
+    ax.set_ylabel("stall force F_gen [mN]")
+    ax.set_ylim(bottom=0)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, title="dotted: μ·ΣF_N", title_fontsize=8)
+    return fig
+
+
+def heldback_figure(table, labels: dict[str, str]) -> Figure:
+    """Held-back measurements (with ±1 σ) against each drive's prediction, one slot per point.
+
+    ``labels``: prediction column stem (``<stem>_nm``) -> legend text.
+    """
+    fig = Figure(figsize=(7.2, 4.2), layout="constrained")
+    ax = fig.add_subplot()
+    x = np.arange(len(table))
+    ax.errorbar(x, table["measured_nm"], yerr=table["sd_nm"], fmt="o", color="black", ms=5,
+                label="measured (held back)")
+    for k, (stem, label) in enumerate(labels.items()):
+        ax.plot(x + 0.12 * (k + 1), table[f"{stem}_nm"], ["x", "D"][k % 2], ms=6, color=f"C{k + 1}",
+                label=label)
+    ax.set_xticks(x, [f"{f / 1e3:g} kHz\n{p:g} N\n{a:.0f} nm" for f, p, a in
+                      zip(table["frequency_Hz"], table["preload_N"], table["amplitude_nm"], strict=True)],
+                  fontsize=7)
+    ax.set_ylabel("step [nm]")
+    ax.set_xlabel("held-back point: frequency, preload, amplitude")
+    ax.grid(alpha=0.3, axis="y")
+    ax.legend(fontsize=8)
+    return fig

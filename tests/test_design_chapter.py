@@ -1,0 +1,146 @@
+"""The data functions of the chapter "Design your own drive" (passmd.experiments.design)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from passmd.config import RunConfig
+from passmd.drive_file import DRIVE_KEYS, DriveFileError, load_drive
+from passmd.experiments import design
+from passmd.protocols import fit as fitting
+
+
+def test_example_drive_is_the_chapter_drive_with_sources():
+    drive, sources = design.example_drive()
+    assert design.EXAMPLE_DRIVE_FILE.is_file()  # package data: an installed wheel has it too
+    assert (drive.hemisphere_radius, drive.preload, drive.friction_coefficient) == (0.5e-3, 0.6, 0.25)
+    assert (drive.actuator.stiffness, drive.actuator.mass, drive.runner_mass) == (5e6, 2e-6, 5e-3)
+    assert drive.contacts == 6 and drive.actuator_model == "flexible" and not drive.allow_extrapolation
+    assert sources["preload"] == "given in example_drive.toml"
+    assert sources["actuator.full_stroke_amplitude"].startswith("Table 2 interpolated")
+    assert sources["actuator.viscosity"].startswith("derived from ζ")
+
+
+def test_example_mass_is_inside_the_plausible_range_and_a_heavier_one_is_not(tmp_path):
+    """The example needs no allow_extrapolation; the benchmark's 1.5e-5 kg would."""
+    text = design.EXAMPLE_DRIVE_FILE.read_text(encoding="utf-8")
+    heavy = tmp_path / "heavy.toml"
+    heavy.write_text(text.replace('mass = "2e-6 kg"', 'mass = "1.5e-5 kg"'), encoding="utf-8")
+    with pytest.raises(DriveFileError, match="actuator.mass.*out of range"):
+        load_drive(heavy)
+
+
+def test_parameter_table_has_every_drive_show_row():
+    drive, sources = design.example_drive()
+    table = design.parameter_table(drive, sources).set_index("key")
+    assert list(table.index) == list(DRIVE_KEYS)
+    assert table.loc["hemisphere_radius", ["value", "unit"]].tolist() == ["0.5", "mm"]
+    assert table.loc["actuator.full_stroke_amplitude", "value"] == "131.3"  # Table 2 at 0.5 mm
+    assert table.loc["contacts", "value"] == "paper-six"
+
+
+@pytest.mark.parametrize("profile", ["quick", "paper"])
+def test_map_grid_runs_frequency_slow_amplitude_fast(profile):
+    drive, _ = design.example_drive()
+    s = design.PROFILE_SETTINGS[profile]
+    points = design.map_points(drive, profile)
+    assert len(points) == s.map_frequencies * s.map_amplitudes
+    f = np.array([p["frequency_Hz"] for p in points]).reshape(s.map_frequencies, s.map_amplitudes)
+    a = np.array([p["amplitude_m"] for p in points]).reshape(s.map_frequencies, s.map_amplitudes)
+    assert np.all(f == f[:, :1]) and np.all(np.diff(f[:, 0]) > 0)
+    assert np.all(a == a[:1, :]) and np.all(np.diff(a[0]) > 0)
+    np.testing.assert_allclose([f[0, 0], f[-1, 0]], design.MAP_FREQUENCY_RANGE, rtol=1e-12)  # round-off
+    np.testing.assert_allclose([a[0, 0], a[0, -1]], [design.MAP_AMPLITUDE_LOW,
+                                                     drive.actuator.full_stroke_amplitude], rtol=1e-12)
+
+
+def test_profile_executor_applies_only_where_none_was_chosen():
+    assert design._run_config(RunConfig(), "quick").executor == "serial"
+    assert design._run_config(RunConfig(executor="process"), "quick").executor == "process"
+    assert design._run_config(RunConfig(), "paper").executor is None
+    with pytest.raises(ValueError, match="profile = 'fast'"):
+        design._run_config(RunConfig(), "fast")
+
+
+def _map_table(velocities, frequencies, amplitudes):
+    grid = [(f, a) for f in frequencies for a in amplitudes]
+    f = [f for f, _ in grid]
+    return pd.DataFrame({"frequency_Hz": f, "amplitude_m": [a for _, a in grid],
+                         "velocity_m_per_s": velocities, "step_m": np.array(velocities) / f})
+
+
+def test_map_facts_find_the_fastest_point_and_the_top_row():
+    # amplitudes 5 nm apart: only the largest is the top row (an absolute tolerance of 1e-8 m would
+    # take both)
+    table = _map_table([1e-4, 2e-4, 5e-3, 4e-3], [100.0, 1e4], [95e-9, 100e-9])
+    facts = design.map_facts(table)
+    assert facts["v_max_mm_s"] == pytest.approx(5.0) and facts["v_max_f_kHz"] == pytest.approx(10.0)
+    assert facts["v_max_A_nm"] == pytest.approx(95.0) and facts["A_top_nm"] == pytest.approx(100.0)
+    assert facts["step_low_f_nm"] == pytest.approx(2e-4 / 100 * 1e9)  # largest amplitude, lowest f
+    assert facts["step_high_f_nm"] == pytest.approx(4e-3 / 1e4 * 1e9)
+    assert facts["map_points"] == 4
+
+
+def test_gain_facts_count_missing_waveforms_and_signs():
+    table = pd.DataFrame({"frequency_Hz": [1e3, 1e3, 1e4, 1e4], "amplitude_m": [5e-8, 1e-7, 5e-8, 1e-7],
+                          "gain_m_per_s": [None, -1e-3, 2e-3, 5e-4]})
+    facts = design.gain_facts(table)
+    counts = (facts["gain_points"], facts["gain_designed"], facts["gain_none"], facts["gain_faster"])
+    assert counts == (4, 3, 1, 2)
+    assert facts["gain_max_mm_s"] == pytest.approx(2.0) and facts["gain_max_f_kHz"] == pytest.approx(10.0)
+    assert facts["gain_min_mm_s"] == pytest.approx(-1.0)
+    none = design.gain_facts(table.assign(gain_m_per_s=[None] * 4))
+    assert none["gain_designed"] == 0 and "gain_max_mm_s" not in none
+
+
+def test_fit_facts_say_whether_the_interval_holds_the_truth():
+    truth, _ = design.example_drive()
+    start = design.start_drive(truth, "paper")
+    assert start.friction_coefficient == 0.2 and start.actuator.stiffness == pytest.approx(4.8333e6, rel=1e-4)
+    result = SimpleNamespace(names=["friction_coefficient", "actuator.stiffness"], estimates={
+        "friction_coefficient": {"value": 0.249, "stderr": 0.003, "interval": [0.243, 0.256]},
+        "actuator.stiffness": {"value": 4.0e6, "stderr": 1e5, "interval": [3.8e6, 4.2e6]}})
+    table = design.fit_facts(result, truth, start).set_index("parameter")
+    assert table.loc["friction_coefficient", "holds_truth"]
+    assert not table.loc["actuator.stiffness", "holds_truth"]  # 5e6 is outside 3.8–4.2e6
+    assert table.loc["actuator.stiffness", "start"] == pytest.approx(start.actuator.stiffness)
+
+
+def test_heldback_facts_rms():
+    table = pd.DataFrame({"measured_nm": [10.0, 20.0], "start_nm": [13.0, 16.0], "fitted_nm": [10.0, 21.0]})
+    facts = design.heldback_facts(table)
+    assert facts["rms_start_nm"] == pytest.approx(np.sqrt((9 + 16) / 2))
+    assert facts["rms_fitted_nm"] == pytest.approx(np.sqrt(0.5)) and facts["heldback_points"] == 2
+
+
+def test_fitted_drive_file_reads_back_to_the_fitted_drive():
+    truth, _ = design.example_drive()
+    fitted = replace(truth, friction_coefficient=0.2493217)
+    text = fitting.fitted_drive_file(fitted, "m.csv", ["friction_coefficient"])
+    assert design.load_fitted(text) == fitted
+    line = next(line for line in text.splitlines() if line.startswith("friction_coefficient"))
+    assert "fitted to m.csv by passmd fit" in line
+
+
+def test_synthetic_measurements_are_the_simulation_plus_the_stated_noise(tmp_path):
+    truth, _ = design.example_drive()
+    config = RunConfig(cache_dir=tmp_path)
+    data, held = design.synthetic_measurements(truth, "quick", config)
+    s = design.PROFILE_SETTINGS["quick"]
+    assert len(data) == len(s.fit_preloads) * len(s.fit_amplitudes_nm) and len(held) == len(s.heldback)
+    noise = np.random.default_rng(design.SEED).normal(0.0, design.NOISE_NM * 1e-9, len(data) + len(held))
+    exact = fitting.predict(truth, data, cache=False, executor="serial")
+    # the same simulation and the same draws: equal to round-off of the sum (values ~1e-7 m)
+    np.testing.assert_allclose(data.value, exact + noise[:len(data)], rtol=0, atol=1e-18)
+    assert np.all(data.sd == design.NOISE_NM * 1e-9) and data.known_sd
+    text = design.measurements_csv(data)
+    path = tmp_path / "m.csv"
+    path.write_text(text, encoding="utf-8")
+    back = fitting.read_measurements(path)
+    np.testing.assert_allclose(back.value, data.value, rtol=1e-15)  # repr() round trip
+    np.testing.assert_allclose(back.amplitude, data.amplitude, rtol=1e-15)
