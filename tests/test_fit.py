@@ -45,7 +45,7 @@ def test_round_trip_interval_contains_the_true_friction_coefficient(tmp_path):
     assert low < 0.25 < high
     assert abs(est["value"] - 0.25) < 3 * est["stderr"]
     assert low < est["value"] < high
-    assert result.identifiable
+    assert result.identifiable and result.converged
     assert result.drive.friction_coefficient == pytest.approx(est["value"], rel=1e-12)
     # noise of the stated size: the normalised residuals scatter like N(0, 1) (6 rows: a loose bound)
     assert np.sqrt(np.mean(result.residuals ** 2)) < 3.0
@@ -60,6 +60,24 @@ def test_a_biased_model_leaves_the_truth_outside(tmp_path):
     result = F.fit(RIGID, biased, ["friction_coefficient"], executor="serial", cache=tmp_path, starts=4)
     low, high = result.estimates["friction_coefficient"]["interval"]
     assert not low < 0.25 < high
+
+
+def test_a_fit_stopped_in_a_local_minimum_says_so_and_claims_no_intervals(tmp_path, monkeypatch):
+    """A local search cut to one evaluation stops at the start (μ = 0.2, the truth 0.25) and no
+    new search may follow: the profile of μ meets a lower cost than the estimate, so the result
+    says it has not converged and the verdict claims no identifiability (the round trip above,
+    with the full search, is the counter-example: converged and identifiable)."""
+    monkeypatch.setattr(F, "LOCAL_EVALUATIONS", 1)
+    monkeypatch.setattr(F, "REFITS", 0)
+    monkeypatch.setattr(F, "SCAN_ROUNDS", 0)
+    truth = RIGID.replace(friction_coefficient=0.25)
+    data = _synthetic(truth, (0.2, 0.4), (60, 100, 140), seed=3, cache=tmp_path)
+    result = F.fit(RIGID.replace(friction_coefficient=0.2), data, ["friction_coefficient"], executor="serial",
+                   cache=tmp_path, starts=0)
+    assert result.estimates["friction_coefficient"]["value"] == pytest.approx(0.2, rel=1e-9)
+    assert not result.converged and not result.identifiable
+    assert result.verdict.startswith("Not converged to the global minimum")
+    assert result.report()["converged"] is False
 
 
 def test_a_parameter_the_data_cannot_see_is_reported_not_identifiable(tmp_path):
