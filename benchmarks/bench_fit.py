@@ -8,8 +8,9 @@ process pool over all cores and an empty result cache (a fresh temporary directo
 time covers the global pass, the local searches, the scan of a parameter whose residuals
 oscillate (k_p here) and the three profiles, i.e. everything ``passmd fit`` computes. The record
 says whether the fit converged (no profile met a lower cost) and whether its intervals hold the
-truth; the cost at the truth shows a fit stopped in a local minimum. Progress lines go to stderr. The machine's load average before and after
-is recorded with the time (the 2-core machine may be shared).
+truth; the cost at the truth shows a fit stopped in a local minimum. Progress lines go to
+stderr. The machine's load average before and after is recorded with the time (the 2-core
+machine may be shared).
 
 Usage::
 
