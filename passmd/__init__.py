@@ -26,8 +26,9 @@ entry points
 
 The names a drive designer needs are exported here, loaded on first use: ``Drive``,
 ``paper_drive``, ``sawtooth``, ``simulate``, ``Simulation``, ``drive_theory``,
-``critical_amplitude``, ``generated_force``, ``optimized_design``, ``RunConfig``, and
-``load_drive``/``drive_toml`` (read and write a drive file).
+``critical_amplitude``, ``generated_force``, ``optimized_design``, ``RunConfig``,
+``load_drive``/``drive_toml`` (read and write a drive file), and ``fit``/``read_measurements``
+(calibrate free drive parameters to measurements).
 """
 
 #: The version: its one source (pyproject.toml reads it, ``dynamic = ["version"]``; CITATION.cff
@@ -57,6 +58,8 @@ _API = {
     "RunConfig": "passmd.config",
     "load_drive": "passmd.drive_file",
     "drive_toml": "passmd.drive_file",
+    "fit": "passmd.protocols.fit",
+    "read_measurements": "passmd.protocols.fit",
 }
 
 __all__ = ["PAPER_CITATION", "__version__", *_API]

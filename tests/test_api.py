@@ -37,3 +37,15 @@ def test_drive_file_round_trip_through_the_public_names(tmp_path):
     path = tmp_path / "mine.toml"
     path.write_text(passmd.drive_toml(drive), encoding="utf-8")
     assert passmd.load_drive(path) == drive
+
+
+def test_calibration_is_public():
+    """``passmd.fit`` and ``passmd.read_measurements`` calibrate a drive without reaching into
+    ``passmd.protocols``: the paper's own numbers read through the public name."""
+    from passmd.reference import REFERENCE_DIR
+
+    assert {"fit", "read_measurements"} <= set(passmd.__all__)
+    data = passmd.read_measurements(REFERENCE_DIR / "paper_as_data.csv")
+    assert data.kind == ("critical_amplitude", "position")
+    with pytest.raises(ValueError, match="not a parameter the fit can free"):
+        passmd.fit(passmd.Drive(), data, ["preload"], executor="serial", cache=False)

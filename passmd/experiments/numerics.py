@@ -154,7 +154,7 @@ def energy_balance_table(
 
 
 #: Benchmark results shipped with the package (``passmd/data/benchmarks/<name>.json``).
-BENCHMARKS = ("contact", "driving_waveform", "dynamics")
+BENCHMARKS = ("contact", "driving_waveform", "dynamics", "fit", "fit_coverage")
 
 
 def benchmark_results(name: str, path: str | Path | None = None) -> dict:
@@ -162,8 +162,8 @@ def benchmark_results(name: str, path: str | Path | None = None) -> dict:
 
     Parameters
     ----------
-    name : {"contact", "driving_waveform", "dynamics"}
-        The benchmark.
+    name : {"contact", "driving_waveform", "dynamics", "fit", "fit_coverage"}
+        The benchmark (``fit_coverage``: ``benchmarks/bench_fit_coverage.py``).
     path : path-like, optional
         A results file to read instead of the one installed with the package
         (``passmd/data/benchmarks/<name>.json``, package data, which the benchmark
@@ -172,7 +172,7 @@ def benchmark_results(name: str, path: str | Path | None = None) -> dict:
     Returns
     -------
     dict
-        ``{"meta": {...}, "rows": [...]}`` as the script wrote it.
+        As the script wrote it (``{"meta": {...}, "rows": [...]}`` for the speed benchmarks).
     """
     check_choice("name", name, BENCHMARKS)
     if path is None:

@@ -28,7 +28,11 @@ parameters spanning decades are scaled alike. Every model evaluation runs throug
 :func:`passmd.sweep.run` (parallel and cached); the residual Jacobian is a forward difference of
 relative step :data:`JACOBIAN_STEP`, evaluated in the same sweep as its base point. A coarse
 global pass (a scrambled Sobol design of :data:`GLOBAL_STARTS` points over the bounds, one sweep)
-picks the starts, so that a kink of the stick–slip response does not trap the local search.
+picks the starts, so that a kink of the stick–slip response does not trap the local search. A
+free parameter whose residuals oscillate on the Jacobian's scale (:data:`ROUGHNESS_LIMIT`; the
+step of a flexible drive against k_p) is then scanned around the estimate, the others re-minimised,
+and a lower point restarts the local search. When a profile still meets a lower cost than the
+estimate, the fit says it has not converged to the global minimum and claims no intervals.
 
 Uncertainty: standard errors from the Jacobian at the optimum (``s² (JᵀJ)⁻¹``, with ``s²`` the
 residual variance when no standard deviations are given, else 1), the correlation matrix, and a
@@ -87,7 +91,8 @@ CORRELATION_LIMIT = 0.95
 #: above the critical-amplitude bisection's resolution (0.1 nm of A_c ≈ 50 nm is 0.2 %) and below
 #: the curvature scale of the steady step as a function of μ, k_p, c_p (tens of %). The simulated
 #: step also wiggles by fractions of a nanometre on this scale, so a local search can stop in a
-#: shallow local minimum: the profiles look for lower costs and restart it (``REFITS``).
+#: shallow local minimum: a rough parameter is scanned (``ROUGHNESS_LIMIT``), and the profiles
+#: look for lower costs and restart it (``REFITS``).
 JACOBIAN_STEP = 0.01
 #: Points of the global pass's Sobol design (a power of two; the start values are added).
 GLOBAL_STARTS = 16
@@ -105,6 +110,23 @@ REFITS = 2
 REFIT_MARGIN = 0.5
 #: Local least-squares searches started from the best points of the global pass.
 LOCAL_STARTS = 2
+#: Function evaluations of one local least-squares search.
+LOCAL_EVALUATIONS = 60
+#: A free parameter is *rough* where the forward and backward differences of the residuals at the
+#: estimate (step JACOBIAN_STEP) differ by more than this fraction of their mean: the response
+#: oscillates on the Jacobian's scale. The step of the six-contact flexible drive does so in k_p
+#: (by ±1–2 nm with a period of about 5–9 % of k_p at 0.2–0.6 N, also in the steady state), and
+#: its least-squares cost is then a comb of minima a local search cannot cross. A smooth response
+#: (the step against μ or ζ) gives h·|f''/f'| ≈ 0.01–0.03.
+ROUGHNESS_LIMIT = 0.25
+#: Scan of a rough parameter: offsets from the estimate in log space (±SCAN_HALF_WIDTH in steps
+#: of SCAN_SPACING), each with one batched Gauss–Newton step of the other free parameters, whose
+#: conditional minima then spread the comb's basins to about ±2 % in k_p. The lowest point, if
+#: below the estimate by REFIT_MARGIN, starts a new local search (SCAN_ROUNDS times at most: the
+#: new estimate lies inside the range just scanned, and the profiles still look for lower costs).
+SCAN_SPACING = 0.015
+SCAN_HALF_WIDTH = 0.18
+SCAN_ROUNDS = 1
 #: Robust losses of ``scipy.optimize.least_squares`` (the intervals use the plain sum of squares).
 LOSSES = ("linear", "soft_l1", "huber", "cauchy", "arctan")
 #: Readings of the critical amplitude (:data:`passmd.protocols.critical_amplitude.PROTOCOLS`).
@@ -553,6 +575,7 @@ class FitResult:
     evaluations: int
     wall_time_s: float
     notes: list[str] = field(default_factory=list)
+    converged: bool = True  # False: a profile met a lower cost than the estimate (a local minimum)
 
     @property
     def residuals(self) -> np.ndarray:
@@ -573,6 +596,7 @@ class FitResult:
             "correlation": {"parameters": list(self.names), "matrix": self.correlation.tolist(),
                             "limit": CORRELATION_LIMIT},
             "identifiable": self.identifiable,
+            "converged": self.converged,
             "verdict": self.verdict,
             "cost": self.cost,
             "residual_scale": self.scale,
@@ -746,8 +770,53 @@ def _fit(model, drive, data, names, box, lo, hi, x_start, sigma, reading, loss, 
             return memo[key] if key in memo else fun_jac(x)[1]
 
         sol = optimize.least_squares(f, x0, jac=jf, bounds=(lo, hi), loss=loss, method="trf", x_scale=1.0,
-                                     xtol=1e-6, ftol=1e-8, gtol=1e-8, max_nfev=60)
+                                     xtol=1e-6, ftol=1e-8, gtol=1e-8, max_nfev=LOCAL_EVALUATIONS)
         return sol.x, float(np.sum(f(sol.x) ** 2))
+
+    def rough(x):
+        """Indices of the free parameters whose residuals oscillate on the Jacobian's scale at x."""
+        steps = [x + np.eye(p)[j] * (-h if x[j] - h >= lo[j] else h) for j in range(p)]
+        r, jac = fun_jac(x)
+        back = model.evaluate(steps)
+        out = []
+        for j in range(p):
+            other = (residual(back[j]) - r) / (steps[j] - x).sum()
+            mean = 0.5 * np.linalg.norm(jac[:, j] + other)
+            # only a response that matters across the scan: a change of more than one σ
+            if (np.linalg.norm(jac[:, j] - other) > ROUGHNESS_LIMIT * mean
+                    and max(np.linalg.norm(jac[:, j]), np.linalg.norm(other)) * SCAN_HALF_WIDTH > 1.0):
+                out.append(j)
+        return out
+
+    def scan(x, j):
+        """(x, cost) of the lowest point of a scan of parameter j, the others one Gauss–Newton step
+        from x's (all points in one sweep per stage)."""
+        others = [k for k in range(p) if k != j]
+        count = int(round(SCAN_HALF_WIDTH / SCAN_SPACING))
+        points = []
+        for k in range(-count, count + 1):
+            t = x[j] + k * SCAN_SPACING
+            if k and lo[j] <= t <= hi[j]:
+                y = np.array(x, float)
+                y[j] = t
+                points.append(y)
+        if others:
+            trials = [[y, *(y + np.eye(p)[m] * (h if y[m] + h <= hi[m] else -h) for m in others)]
+                      for y in points]
+            values = model.evaluate([v for group in trials for v in group])
+            moved = []
+            for i, group in enumerate(trials):
+                base = residual(values[i * (len(others) + 1)])
+                jac = np.column_stack([(residual(values[i * (len(others) + 1) + 1 + a]) - base)
+                                       / (group[1 + a] - group[0]).sum() for a in range(len(others))])
+                step = np.linalg.lstsq(jac, -base, rcond=None)[0]
+                y = np.array(group[0], float)
+                y[others] = np.clip(y[others] + step, lo[others], hi[others])
+                moved.append(y)
+            points = points + moved
+        costs = [float(np.sum(residual(v) ** 2)) for v in model.evaluate(points)]
+        k = int(np.argmin(costs))
+        return points[k], costs[k]
 
     best = None
     for k, x0 in enumerate(picks):
@@ -756,7 +825,22 @@ def _fit(model, drive, data, names, box, lo, hi, x_start, sigma, reading, loss, 
         if best is None or c < best[1]:
             best = (x, c)
     x_hat, cost = best
+    for _ in range(SCAN_ROUNDS):
+        found = None
+        margin = REFIT_MARGIN * (1.0 if data.known_sd else cost / (n - p))
+        for j in rough(x_hat):
+            say(f"{names[j]}: the residuals oscillate on the Jacobian's scale; scanning "
+                f"±{SCAN_HALF_WIDTH:.0%}")
+            x_scan, c_scan = scan(x_hat, j)
+            if c_scan < cost - margin and (found is None or c_scan < found[1]):
+                found = (x_scan, c_scan)
+        if found is None:
+            break
+        say(f"the scan met cost {found[1]:.5g} below the estimate's {cost:.5g}: searching again from there")
+        x_new, c_new = local(found[0])
+        x_hat, cost = (x_new, c_new) if c_new < found[1] else found
     notes: list[str] = []
+    converged = True
     for attempt in range(REFITS + 1):
         say("estimate " + ", ".join(f"{k} = {v:.5g}" for k, v in zip(names, np.exp(x_hat), strict=True))
             + f", cost {cost:.5g}")
@@ -865,6 +949,7 @@ def _fit(model, drive, data, names, box, lo, hi, x_start, sigma, reading, loss, 
         if lowest[0] >= cost - REFIT_MARGIN * s2:
             break
         if attempt == REFITS:
+            converged = False
             notes.append(f"a profile met cost {lowest[0]:.5g} below the estimate's {cost:.5g} after {REFITS} "
                          "new searches: the least-squares minimum may not be global (widen --starts)")
             break
@@ -872,6 +957,12 @@ def _fit(model, drive, data, names, box, lo, hi, x_start, sigma, reading, loss, 
         x_hat, cost = local(lowest[1])
     notes = list(dict.fromkeys(notes))
     identifiable, verdict = _verdict(names, corr, flat, rank, data)
+    if not converged:
+        identifiable = False
+        verdict = (f"Not converged to the global minimum: a profile met cost {lowest[0]:.5g} below the "
+                   f"estimate's {cost:.5g}, so the standard errors and intervals describe a local minimum "
+                   "and claim nothing about the parameters; rerun with more --starts or narrower --bounds. "
+                   + verdict)
     fitted = model.drive_at(x_hat, drive)
     fitted = replace(fitted, allow_extrapolation=drive.allow_extrapolation)
     pred = model.evaluate([x_hat])[0]
@@ -879,7 +970,7 @@ def _fit(model, drive, data, names, box, lo, hi, x_start, sigma, reading, loss, 
                      predicted=pred, weights=sigma, cost=cost, scale=math.sqrt(s2), dof=dof,
                      identifiable=identifiable, verdict=verdict, reading=reading, loss=loss,
                      simulations=model.simulations, evaluations=model.evaluations,
-                     wall_time_s=time.perf_counter() - t0, notes=notes)
+                     wall_time_s=time.perf_counter() - t0, notes=notes, converged=converged)
 
 
 def _advice(data: Measurements) -> str:

@@ -26,20 +26,22 @@ _EPILOG = textwrap.dedent("""\
     DATA.csv: one measurement a row; column names carry their units. Conditions:
     amplitude_nm, preload_N, frequency_Hz, radius_mm (preload and radius default to the
     drive's; a critical amplitude's frequency to 100 Hz). Measured, one per row: step_nm,
-    velocity_mm_per_s, critical_amplitude_nm, force_N, each with an optional <column>_sd
+    velocity_mm_per_s, critical_amplitude_nm, force_N, position_nm, each with an optional <column>_sd
     (given for every row or for none; without it each row weighs one unit of its column
     and the residual scale is estimated).
 
     The fit: a Sobol global pass over the bounds, then bounded weighted least squares in
     log-parameter space (passmd.protocols.fit), every model evaluation a cached parallel
-    sweep. Each estimate comes with its standard error (Jacobian), a 95 % profile-likelihood
-    interval and an identifiability verdict (flat profile, or |correlation| > 0.95).
+    sweep; a parameter whose response oscillates on the Jacobian's scale is scanned first. Each
+    estimate comes with its standard error (Jacobian), a 95 % profile-likelihood interval and an
+    identifiability verdict (flat profile, or |correlation| > 0.95); a fit whose profiles meet a
+    lower cost than its estimate is reported as not converged, with no intervals claimed.
 
     --out DIR writes fit.json (the --json report), fit.png (data against the fitted model,
     with residuals) and fitted-drive.toml (the fitted drive, for --drive).
 
     --json keys (SI units): estimates{name: value, stderr, interval[low, high], unit, ...},
-    residuals[...], correlation{parameters, matrix, limit}, identifiable, verdict, cost,
+    residuals[...], correlation{parameters, matrix, limit}, identifiable, converged, verdict, cost,
     residual_scale, degrees_of_freedom, drive{...}, wall_time_s""")
 
 #: Free parameters as --free names them: the drive option without its dashes, or a derived one;
