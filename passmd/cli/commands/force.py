@@ -56,6 +56,12 @@ def _check_options(args, drive):
     if args.springs is not None:
         raise UsageError("--springs is not supported by force: the stall runs use the exact contact")
     amplitude, frequency = waveform_args(args, drive)
+    from passmd.protocols.stall import STALL_WINDOW
+
+    shortest = STALL_WINDOW + 1  # the stall criterion compares the means of a window of periods
+    if args.periods < shortest:
+        raise UsageError(f"--periods = {args.periods} is out of range: must be >= {shortest} (the stall "
+                         "criterion's window of periods, plus one)")
     if args.max_periods < args.periods:
         raise UsageError(f"--max-periods = {args.max_periods} is out of range: must be >= --periods "
                          f"({args.periods})")

@@ -153,7 +153,6 @@ def check_output_paths(args) -> None:
 def simulate(args, drive):
     """(result, Eq. 15 design or None) of the run the options describe (saw-tooth or Eq. 15)."""
     startup.load_numba_without_blas_probe()
-    kernels.notice_if_cold()
     from passmd import dynamics, optimized_waveform, waveforms
     from passmd.protocols import eq15
 
@@ -162,6 +161,7 @@ def simulate(args, drive):
     if args.waveform == "optimized":
         # Eq. 15, designed from this drive's own simulated saw-tooth response (first period a
         # saw-tooth, as in the paper); a ValueError (e.g. Δ_a ≥ A) is a usage error
+        kernels.notice_if_cold()  # the design simulates: every option is checked by now
         design = eq15.optimized_design(amplitude, drive, flyback=args.flyback)
         given = {q.field: q.parse(args) for q in EQ15_OVERRIDES}
         given = {name: value for name, value in given.items() if value is not None}
@@ -172,6 +172,7 @@ def simulate(args, drive):
     else:
         design = None
         wave = waveforms.sawtooth(amplitude, frequency, drive, periods=args.periods, flyback=args.flyback)
+        kernels.notice_if_cold()  # after the last check of the options: a refusal stays one line
     result = dynamics.simulate(
         drive, wave, contact_model="exact" if springs is None else "discrete",
         springs=PROTOCOL.springs if springs is None else springs, max_points=args.max_points,
