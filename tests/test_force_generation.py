@@ -305,25 +305,31 @@ def test_panels_show_both_models_and_their_onsets(quick):
 
 
 def test_ledger_rows_of_fig7(quick):
-    keys = ["fig7a", "fig7b"]
+    keys = ["fig7a", "fig7b", "fig7flyback"]
     claims = ledger.claims_for(ledger.load_claims(), keys)
     assert set(claims["id"]) == {
         "fig7a-force-difference-115mn", "fig7a-discrepancy-grows-with-amplitude",
         "fig7b-discrepancy-grows-with-amplitude", "fig7-critical-amplitude-both-models",
+        "fig7-rigid-mu03-flexible-mu02-onsets-agree", "fig7-force-grows-with-amplitude-above-onset",
+        "fig7-flexible-covers-experiment",
     }
-    evaluated = ledger.evaluate(claims, {k: quick[k] for k in keys})
-    assert (evaluated["status"] != "inconclusive").all(), evaluated[["claim", "verdict"]]
+    results = {k: quick[k] for k in ("fig7a", "fig7b")}
+    results["fig7flyback"] = fg.fig7flyback(RunConfig(profile="quick"))
+    evaluated = ledger.evaluate(claims, results)
     status = dict(zip(evaluated["claim"], evaluated["status"], strict=True))
+    verdict = dict(zip(evaluated["claim"], evaluated["verdict"], strict=True))
+    # the experiment of [12] is only plotted: no verdict without its data
+    for claim in ("fig7-critical-amplitude-both-models", "fig7-flexible-covers-experiment"):
+        assert status[claim] == "inconclusive" and "no measured data" in verdict[claim]
     assert status["fig7a-force-difference-115mn"] == "reproduced"
-    # the quick grid (0, 0.2, 0.7, 1.0 × A_max) has an amplitude between the two onsets at 0.3 N (fig7a)
-    # and at 0.4 N (fig7b): the difference dips there, as on the paper grid (see the chapter)
-    assert status["fig7a-discrepancy-grows-with-amplitude"] == "not reproduced"
-    assert status["fig7b-discrepancy-grows-with-amplitude"] == "not reproduced"
-    assert status["fig7-critical-amplitude-both-models"] == "not reproduced"
-    # each of them shows the evaluated check beside it
+    # the discrepancy in the level of force is measured above both models' onsets, where it grows
+    assert status["fig7a-discrepancy-grows-with-amplitude"] == "reproduced"
+    assert status["fig7b-discrepancy-grows-with-amplitude"] == "reproduced"
+    assert status["fig7-force-grows-with-amplitude-above-onset"] == "reproduced"
+    # the model-against-model substitute: the rigid μ 0.3 onsets are not within 20 % of the flexible ones
+    assert status["fig7-rigid-mu03-flexible-mu02-onsets-agree"] == "not reproduced"
     assert evaluated.set_index("claim").loc[
-        ["fig7a-discrepancy-grows-with-amplitude", "fig7-critical-amplitude-both-models"], "evidence"
-    ].str.contains("fails").all()
+        "fig7-rigid-mu03-flexible-mu02-onsets-agree", "evidence"].count("fails") >= 1
 
 
 def test_force_difference_extractor_uses_only_stalled_pairs(quick):
