@@ -5,8 +5,6 @@ compared *exactly* with the point functions of passmd.protocols.maps called on t
 the options describe (same deterministic code, same SI inputs; JSON round-trips floats).
 """
 
-import contextlib
-import io
 import json
 import math
 import os
@@ -19,30 +17,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from test_cli import run_cli, run_json  # the command in this process, as the other CLI tests run it
 
-from passmd import cli
 from passmd.cli.commands.sweep import parse_vary
 from passmd.parameters import Drive
 from passmd.protocols import maps
 
 #: A cheap drive for the map tests: one contact, rigid actuators (Tables 1–2 otherwise).
 CHEAP = ("--contacts", "1", "--actuator", "rigid")
-
-
-def run_cli(*argv):
-    out = io.StringIO()
-    with contextlib.redirect_stdout(out):
-        try:
-            status = cli.main(list(argv))
-        except SystemExit as exc:
-            status = exc.code
-    return status, out.getvalue()
-
-
-def run_json(*argv):
-    status, text = run_cli(*argv, "--json")
-    assert status == 0, text
-    return json.loads(text)
 
 
 def test_vary_ranges_lists_and_bare_si_numbers():
