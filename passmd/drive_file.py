@@ -78,6 +78,7 @@ _DEFAULT = Drive()
 #: The paper's two contact arrangements, by name (Section 4.1).
 CONTACT_PRESETS = {"one": 1, "paper-six": 6}
 
+#: Every key a drive file may hold, by its dotted name (the Drive field path).
 DRIVE_KEYS: dict[str, DriveKey] = {k.key: k for k in (
     DriveKey("contacts", "choice", "", "n", "contact arrangement: \"one\" (one contact) or \"paper-six\" "
              "(two contacts on one side, four on the other)", "Section 4.1", choices=tuple(CONTACT_PRESETS)),

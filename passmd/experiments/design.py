@@ -99,6 +99,7 @@ class ProfileSettings:
 MAP_FREQUENCY_RANGE = (100.0, 110e3)
 MAP_AMPLITUDE_LOW = 40e-9
 
+#: The grids of each book profile (quick: coarse, for CI; paper: the full maps and fit).
 PROFILE_SETTINGS = {
     "quick": ProfileSettings(
         preloads=(0.2, 0.6, 1.0),

@@ -74,6 +74,7 @@ __all__ = [
     "FreeParameter",
     "Measurements",
     "MeasurementError",
+    "ROUGHNESS_LIMIT",
     "default_bounds",
     "fit",
     "fitted_drive_file",
@@ -81,9 +82,10 @@ __all__ = [
     "predict",
     "predict_point",
     "read_measurements",
+    "write_measurements",
 ]
 
-#: |correlation| above which two free parameters are reported as not separable by the data.
+#: The absolute correlation above which two free parameters are reported as not separable by the data.
 #: 0.95: their joint confidence region is then a ridge at least (1+0.95)/(1−0.95) ≈ 6 times
 #: longer than wide (eigenvalue ratio of the 2×2 correlation matrix; its axes √39 ≈ 6.2).
 CORRELATION_LIMIT = 0.95
@@ -445,7 +447,8 @@ def _check_free(drive: Drive, free: Sequence[str]) -> list[str]:
 
 def default_bounds(drive: Drive, name: str,
                    max_frequency: float = PROTOCOL.drive_frequency) -> tuple[float, float]:
-    """Default (low, high) of a free parameter: the plausible range of :data:`PLAUSIBLE_RANGES`.
+    """Default (low, high) of a free parameter: its plausible range
+    (:data:`~passmd.parameters.PLAUSIBLE_RANGES`).
 
     The damping ratio's range starts at 1e-3 (the logarithmic scale needs a positive lower end);
     the fly-back is limited to a quarter of the shortest driving period.

@@ -34,7 +34,7 @@ _EPILOG = textwrap.dedent("""\
     log-parameter space (passmd.protocols.fit), every model evaluation a cached parallel
     sweep; a parameter whose response oscillates on the Jacobian's scale is scanned first. Each
     estimate comes with its standard error (Jacobian), a 95 % profile-likelihood interval and an
-    identifiability verdict (flat profile, or |correlation| > 0.95); a fit whose profiles meet a
+    identifiability verdict (flat profile, or a correlation beyond ±0.95); a fit whose profiles meet a
     lower cost than its estimate is reported as not converged, with no intervals claimed.
 
     --out DIR writes fit.json (the --json report), fit.png (data against the fitted model,

@@ -48,28 +48,30 @@ MAX_POINTS = 100_000
 #: Longest curve the human output lists in full (longer ones and maps: the extremes).
 MAX_SHOWN = 40
 
-_NAMES = textwrap.fill("NAME: " + ", ".join(AXES) + ".", width=92, subsequent_indent=" " * 10,
-                       break_on_hyphens=False)
-_EPILOG = textwrap.dedent(f"""\
-    QUANTITY:
-      velocity, step, back-step  the steady-velocity protocol of the driving-waveform
-                                 chapter: max(20, f·5 ms) periods from rest, the slope of the
-                                 period-mean position over the second half; step = velocity/f
-      critical-amplitude         simulated A_c, --reading steady (last step of a saw-tooth
-                                 run exceeds 0.5 nm: what continuous operation needs) or first
-                                 (every contact slides in the first fly-back: what moves the
-                                 drive once); the closed form (Eqs. 7-8, 11-12) is reported too
-      stall-force                generated force at stall against the load cell (Section 4.2)
-      gain                       steady velocity of the Eq. 15 waveform (designed from this
-                                 drive's saw-tooth response) minus that of the saw-tooth
+_NAMES = "NAME: " + ", ".join(AXES) + "."
+_EPILOG = textwrap.dedent("""\
+    QUANTITY is one of:
 
-    --vary NAME=SPEC (repeat for a map; the first axis is the x axis, the last runs fastest):
-      NAME=LO..HI[:log][:N]   N values from LO to HI, linear (default) or log, N default 10
-      NAME=V1,V2,...          a list;  NAME=V  a single value
-      e.g. --vary frequency=100Hz..110kHz:log:24 --vary amplitude=50nm..130nm:24
-           --vary preload=0.1N,0.4N,1N --vary mu=0.1..0.3:5
+    - velocity, step, back-step: the steady-velocity protocol of the driving-waveform chapter:
+      max(20, f·5 ms) periods from rest, the slope of the period-mean position over the second
+      half; step = velocity/f
+    - critical-amplitude: simulated A_c, --reading steady (last step of a saw-tooth run exceeds
+      0.5 nm: what continuous operation needs) or first (every contact slides in the first
+      fly-back: what moves the drive once); the closed form (Eqs. 7-8, 11-12) is reported too
+    - stall-force: generated force at stall against the load cell (Section 4.2)
+    - gain: steady velocity of the Eq. 15 waveform (designed from this drive's saw-tooth
+      response) minus that of the saw-tooth
+
+    --vary NAME=SPEC, repeated for a map (the first axis is the x axis, the last runs fastest):
+
+    - NAME=LO..HI[:log][:N]: N values from LO to HI, linear (default) or log, N default 10
+    - NAME=V1,V2,...: a list; NAME=V: a single value
+    - e.g. --vary frequency=100Hz..110kHz:log:24 --vary amplitude=50nm..130nm:24, or
+      --vary preload=0.1N,0.4N,1N --vary mu=0.1..0.3:5
+
     A bare number in --vary is in SI units (m, kg, N, Hz, Pa, N/m, kg/s, V, V/s).
-    {_NAMES}
+    """) + textwrap.fill(_NAMES, width=92, break_on_hyphens=False) + textwrap.dedent(f"""
+
     Not varied: --amplitude (default the full stroke) and --frequency apply to every point.
 
     Points run in parallel and are cached (--cache-dir, else ${ENVIRONMENT['cache_dir']}, else the user
