@@ -20,7 +20,7 @@ from passmd.cli.options import (
 from passmd.cli.output import JSON_HELP, check_results, describe, drive_record, emit_json, emit_rows, plain
 from passmd.units import from_si, parse_quantity
 
-__all__ = ["FREE_NAMES", "add_parser", "drive_file_text", "run_fit"]
+__all__ = ["FREE_NAMES", "add_parser", "run_fit"]
 
 _EPILOG = textwrap.dedent("""\
     DATA.csv: one measurement a row; column names carry their units. Conditions:
@@ -113,14 +113,6 @@ def _bounds(args, names) -> dict[str, tuple[float, float]]:
     return out
 
 
-def drive_file_text(drive, data_name: str, free: list[str]) -> str:
-    """The fitted drive as a drive file that ``--drive`` reads back
-    (:func:`passmd.protocols.fit.fitted_drive_file`)."""
-    from passmd.protocols.fit import fitted_drive_file
-
-    return fitted_drive_file(drive, data_name, free)
-
-
 def _progress(config):
     if config.progress is False:
         return None
@@ -186,7 +178,7 @@ def run_fit(args, out) -> int:
         if exc.name in ("free", "bounds", "data"):
             raise UsageError(str(exc).replace("free = ", "--free: ")) from None
         raise
-    text = drive_file_text(result.drive, Path(args.data).name, list(library))
+    text = fitting.fitted_drive_file(result.drive, Path(args.data).name, list(library))
     record = {"command": "fit", **result.report(), "drive": drive_record(result.drive)}
     check_results(record)
     if target is not None:
