@@ -127,7 +127,7 @@ def _split_profile(args: list[str]) -> tuple[str, list[str]]:
     """Take ``--profile NAME`` (or ``--profile=NAME``) out of the session's arguments.
 
     Without it the profile is ``$PASSMD_PROFILE`` or ``paper``; the value is validated by
-    ``passmd.publish.current_profile`` inside the session's environment.
+    ``passmd.report.publish.current_profile`` inside the session's environment.
     """
     profile = os.environ.get("PASSMD_PROFILE", "") or "paper"
     rest: list[str] = []
@@ -168,7 +168,7 @@ def book(session: nox.Session) -> None:
     # inside the first chapter and fail the -W build.
     session.run(
         "python", "-c",
-        "import matplotlib.pyplot; from passmd.publish import current_profile; "
+        "import matplotlib.pyplot; from passmd.report.publish import current_profile; "
         "print('book profile:', current_profile())",
         env=env,
     )

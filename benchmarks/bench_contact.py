@@ -26,7 +26,7 @@ import numba
 import numpy as np
 from numba import njit
 
-from passmd.contact import (
+from passmd.model.contact import (
     MDRContact,
     contact_arrays,
     contact_force,
@@ -35,8 +35,8 @@ from passmd.contact import (
     contact_update_row,
     stack_contacts,
 )
-from passmd.parameters import Drive
-from passmd.theory import contact_moduli, normal_forces
+from passmd.model.parameters import Drive
+from passmd.model.theory import contact_moduli, normal_forces
 
 SPRINGS = (100, 200, 1000, 10000)
 PATH_POINTS = 1_000_000  # samples of the exact model's path

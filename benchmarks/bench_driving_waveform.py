@@ -6,11 +6,11 @@ Timed blocks (each repeated, median and fastest reported; numba compiles in an u
 * ``design``: :func:`passmd.protocols.eq15.optimized_design` of the Section 5 drive (two 100 Hz
   saw-tooth periods recorded densely, f_s and V_r measured, Eq. 15);
 * ``steady_sawtooth_<f>`` / ``steady_optimized_<f>``: one steady-velocity point
-  (:func:`passmd.experiments.driving_waveform.velocity_point`) at 1 kHz and 110 kHz;
+  (:func:`passmd.experiments.driving_waveform.figures.velocity_point`) at 1 kHz and 110 kHz;
 * ``step_100hz``: one Fig. 9a protocol run (three 100 Hz periods, rigid actuators).
 
 Then, once, with an empty temporary simulation cache: every panel (``figure_data``) and the
-studies beyond the paper (:mod:`passmd.experiments.waveform_studies`) at ``--profile``,
+studies beyond the paper (:mod:`passmd.experiments.driving_waveform.studies`) at ``--profile``,
 as wall time of this process plus its sweep workers.
 
 Usage::
@@ -30,10 +30,10 @@ import tempfile
 import time
 from pathlib import Path
 
-from passmd.config import RunConfig
-from passmd.defaults import PROTOCOL
-from passmd.experiments import waveform_studies as studies
-from passmd.figures import figure_data
+from passmd.experiments.driving_waveform import studies
+from passmd.experiments.figure_table import figure_data
+from passmd.model.defaults import PROTOCOL
+from passmd.runtime.config import RunConfig
 
 PANELS = ("fig8a", "fig8b", "fig9a", "fig9b", "fig10a", "fig10b", "fig10c")
 
@@ -49,9 +49,10 @@ def _timed(func, repeats: int) -> dict:
 
 
 def blocks(repeats: int) -> dict:
-    from passmd import dynamics, optimized_waveform
-    from passmd.experiments import driving_waveform as dw
+    from passmd.experiments.driving_waveform import figures as dw
+    from passmd.model import optimized_waveform
     from passmd.protocols import eq15
+    from passmd.solver import simulation as dynamics
 
     drive = dw.section5_drive()
     amplitude = drive.actuator.full_stroke_amplitude

@@ -33,9 +33,10 @@ import sys
 import time
 from pathlib import Path
 
-from passmd import dynamics, waveforms
-from passmd.defaults import PROTOCOL
-from passmd.parameters import Drive
+from passmd.model import waveforms
+from passmd.model.defaults import PROTOCOL
+from passmd.model.parameters import Drive
+from passmd.solver import simulation as dynamics
 
 CONFIGS = [
     (contacts, model, contact, control)
@@ -46,7 +47,7 @@ CONFIGS = [
     for control in (("fixed", "controlled", "adaptive", "quasi-static") if model == "flexible"
                     else ("fixed", "controlled"))
 ]
-#: Keyword arguments of :func:`passmd.dynamics.simulate` for each step control.
+#: Keyword arguments of :func:`passmd.solver.simulation.simulate` for each step control.
 CONTROLS = {
     "controlled": {},
     "adaptive": {"error_control": False},
@@ -62,7 +63,7 @@ HEAVY_MODULES = ("pandas", "matplotlib", "pint", "dask", "distributed", "tqdm")
 
 # launched as ``python -c``: reports (on stderr) the time and the heavy modules loaded when
 # the CLI first enters the integrator (the checking wrapper ``_dynamics_kernel.integrate``,
-# which passmd.dynamics looks up at call time), then finishes the command. The wrapper is
+# which passmd.solver.simulation looks up at call time), then finishes the command. The wrapper is
 # put in when the command itself imports the kernel module (an import hook), so numba loads
 # inside ``cli.main`` at the same point as in a real launch.
 _FIRST_STEP = """
@@ -70,7 +71,7 @@ import importlib.machinery, json, sys, time
 class Hook:
     @staticmethod
     def find_spec(name, path, target=None):
-        if name != "passmd._dynamics_kernel":
+        if name != "passmd.solver.kernels":
             return None
         sys.meta_path.remove(Hook)
         spec = importlib.machinery.PathFinder.find_spec(name, path)
@@ -111,13 +112,13 @@ def startup(repeats: int) -> dict:
             times.append(report["ready"] - start)
         heavy = report["heavy"]
     imp = subprocess.run(
-        [sys.executable, "-X", "importtime", "-c", "import passmd.cli, passmd.dynamics"],
+        [sys.executable, "-X", "importtime", "-c", "import passmd.cli, passmd.solver.simulation"],
         capture_output=True, text=True, env=_warm_env(), check=True,
     ).stderr
     cumulative = {}
     for line in imp.splitlines():
         parts = [p.strip() for p in line.split("|")]
-        if len(parts) == 3 and parts[2] in ("passmd.cli", "passmd.dynamics", "numpy", "numba"):
+        if len(parts) == 3 and parts[2] in ("passmd.cli", "passmd.solver.simulation", "numpy", "numba"):
             cumulative[parts[2]] = int(parts[1]) / 1e6
     return {
         "command": "passmd run --periods 1",
@@ -165,8 +166,9 @@ def bench(contacts: int, model: str, contact: str, control: str, repeats: int, s
 # contacts, flexible actuators, exact contact, in a process of its own
 _ONE_PROCESS = """
 import json, statistics, sys
-from passmd import dynamics, waveforms
-from passmd.parameters import Drive
+from passmd.solver import simulation as dynamics
+from passmd.model import waveforms
+from passmd.model.parameters import Drive
 d = Drive(contacts=6, actuator_model="flexible")
 wf = waveforms.sawtooth(150e-9, float(sys.argv[1]), d, periods=int(sys.argv[2]))
 dynamics.simulate(d, wf, max_points=2000)

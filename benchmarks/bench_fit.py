@@ -31,9 +31,9 @@ from pathlib import Path
 
 import numpy as np
 
-from passmd.config import RunConfig
-from passmd.parameters import Drive
+from passmd.model.parameters import Drive
 from passmd.protocols import fit as F
+from passmd.runtime.config import RunConfig
 
 TRUTH = {"friction_coefficient": 0.25, "actuator.stiffness": 5e6, "actuator.damping_ratio": 0.1}
 PRELOADS = (0.2, 0.4, 0.6)

@@ -29,7 +29,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from passmd.parameters import Drive
+from passmd.model.parameters import Drive
 from passmd.protocols import fit as F
 
 BASE = Drive(contacts=1, actuator_model="rigid")

@@ -29,7 +29,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from passmd import provenance
+from passmd.runtime import provenance
 
 
 def measure(profile: str, cache_dir: str | None = None) -> dict:

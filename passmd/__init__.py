@@ -1,28 +1,25 @@
 """passmd: reproducible replication of Nguyen et al. (2018), Coatings 8, 62.
 
 "Improvements of Piezo-Actuated Stick–Slip Micro-Drives: Modeling and Driving
-Waveform". Its modules follow the paper's structure, in layers from the model up (the
-``layers`` contract of ``pyproject.toml``, checked by import-linter):
+Waveform". One folder per domain, and one per book chapter under ``experiments``:
 
-core
-    ``parameters`` (Tables 1–2, drive records), ``defaults`` (protocol defaults), ``config``
-    (run configuration), ``theory`` (Hertz, Cattaneo–Mindlin, Eqs. 1 and 7–14), ``contact``
-    (MDR contact with memory, Eqs. 4–6), ``waveforms`` and ``optimized_waveform`` (saw-tooth,
-    Eq. 15), ``dynamics`` and ``time_steps`` (runner and actuators, Eqs. 2–3), ``reference``,
-    ``readings``, ``cache``, ``units``, ``provenance``, ``drive_file`` (drive files, TOML)
-protocols
-    ``protocols`` (critical-amplitude search, stall criterion, step and velocity, Eq. 15
-    design), ``sweep`` (parallel, cached grids), ``claims`` and ``checks`` (the ledger's
-    schema and checks), ``mdr_validation``
-plots
-    ``plots`` (a figure's data to a matplotlib figure)
-figures
-    ``figures`` (the figure table), ``experiments`` (compute functions, claim extractors,
-    chapter facts), ``ledger`` (claims against results), ``assumptions``
-presentation
-    ``publish`` (the chapters' glue), ``ledger_views``
-entry points
-    ``cli`` (the ``passmd`` command line), ``__main__``
+``model``
+    parameters (Tables 1–2), closed forms (Eqs. 1, 7–14), the MDR contact (Eqs. 4–6),
+    waveforms and the Eq. 15 design, drive files, protocol defaults
+``solver``
+    the hybrid simulation (Eqs. 2–3), its integration schemes and numba kernels
+``protocols``
+    the paper's measurements: critical amplitude, stall force, velocity, Eq. 15 design, fit
+``experiments``
+    each chapter's figure data, claim extractors and facts; the figure table
+``ledger``
+    the paper's claims, their checks, the assumption space and the verdicts
+``plots``, ``report``, ``cli``
+    drawing, the book's helpers, the ``passmd`` command line
+``runtime``
+    cache, sweeps, run configuration, units, provenance, input checks
+
+Which may import which is the ``layers`` contract of ``pyproject.toml`` (import-linter).
 
 The names a drive designer needs are exported here, loaded on first use: ``Drive``,
 ``paper_drive``, ``sawtooth``, ``simulate``, ``Simulation``, ``drive_theory``,
@@ -46,18 +43,18 @@ PAPER_CITATION = (
 #: (module ``__getattr__``, PEP 562), so ``import passmd`` and the command line's start-up do
 #: not import the simulator.
 _API = {
-    "Drive": "passmd.parameters",
-    "paper_drive": "passmd.parameters",
-    "sawtooth": "passmd.waveforms",
-    "simulate": "passmd.dynamics",
-    "Simulation": "passmd.dynamics",
-    "drive_theory": "passmd.theory",
+    "Drive": "passmd.model.parameters",
+    "paper_drive": "passmd.model.parameters",
+    "sawtooth": "passmd.model.waveforms",
+    "simulate": "passmd.solver.simulation",
+    "Simulation": "passmd.solver.simulation",
+    "drive_theory": "passmd.model.theory",
     "critical_amplitude": "passmd.protocols.critical_amplitude",
     "generated_force": "passmd.protocols.stall",
     "optimized_design": "passmd.protocols.eq15",
-    "RunConfig": "passmd.config",
-    "load_drive": "passmd.drive_file",
-    "drive_toml": "passmd.drive_file",
+    "RunConfig": "passmd.runtime.config",
+    "load_drive": "passmd.model.drive_file",
+    "drive_toml": "passmd.model.drive_file",
     "fit": "passmd.protocols.fit",
     "read_measurements": "passmd.protocols.fit",
 }

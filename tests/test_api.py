@@ -20,7 +20,8 @@ def test_every_public_name_is_its_modules_object(name):
 
 
 def test_import_passmd_loads_no_simulator():
-    code = ("import sys, passmd; heavy = [m for m in ('numba', 'pandas', 'matplotlib', 'passmd.dynamics') "
+    code = ("import sys, passmd; heavy = [m for m in ('numba', 'pandas', 'matplotlib', "
+            "'passmd.solver.simulation') "
             "if m in sys.modules]; print(','.join(heavy))")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
@@ -42,7 +43,7 @@ def test_drive_file_round_trip_through_the_public_names(tmp_path):
 def test_calibration_is_public():
     """``passmd.fit`` and ``passmd.read_measurements`` calibrate a drive without reaching into
     ``passmd.protocols``: the paper's own numbers read through the public name."""
-    from passmd.reference import REFERENCE_DIR
+    from passmd.ledger.reference import REFERENCE_DIR
 
     assert {"fit", "read_measurements"} <= set(passmd.__all__)
     data = passmd.read_measurements(REFERENCE_DIR / "paper_as_data.csv")

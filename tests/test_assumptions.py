@@ -8,8 +8,8 @@ import pkgutil
 import pytest
 
 import passmd
-from passmd import assumptions
-from passmd.parameters import Assumption
+from passmd.model.parameters import Assumption
+from passmd.report import assumptions
 
 
 def _modules_defining_assumptions() -> set[str]:

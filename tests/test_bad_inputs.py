@@ -33,8 +33,8 @@ from hypothesis import strategies as st
 from passmd import cli
 from passmd.cli import kernels, options
 from passmd.cli.commands import run as run_command
-from passmd.contact import MDRContact
-from passmd.parameters import Actuator, Amplifier, Drive, Material
+from passmd.model.contact import MDRContact
+from passmd.model.parameters import Actuator, Amplifier, Drive, Material
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 PATH_20000 = ",".join(f"{i % 40}nm" for i in range(20000))
@@ -81,7 +81,7 @@ def assert_one_line(err: str):
 NAMED_CASES = {
     "huge mu": (["theory", "--mu", "1e200"], 2, "--mu = 1e+200 is out of range: must be <= 1"),
     "huge mu, json": (["theory", "--mu", "1e200", "--json"], 2, "--mu = 1e+200"),
-    # finite: Eqs. 11-12 of u_x,max ~ 1e193 m do not overflow (passmd.theory.harmonic_combination)
+    # finite: Eqs. 11-12 of u_x,max ~ 1e193 m do not overflow (passmd.model.theory.harmonic_combination)
     "huge mu, extrapolating": (["theory", "--mu", "1e200", "--allow-extrapolation"], 0, ""),
     "huge mu, extrapolating, json": (["theory", "--mu", "1e200", "--allow-extrapolation", "--json"], 0, ""),
     "huge stroke": (["run", "--actuator", "rigid", "--periods", "2", "--full-stroke-amplitude", "1e30nm",
@@ -215,14 +215,14 @@ def test_named_library_cases(build, match):
 
 
 def test_sawtooth_periods_is_a_count():
-    from passmd import waveforms
+    from passmd.model import waveforms
 
     with pytest.raises(ValueError, match="periods = True"):
         waveforms.sawtooth(100e-9, 100.0, Drive(), periods=True)
 
 
 def test_validation_messages_read_well():
-    from passmd._validation import check_range
+    from passmd.runtime.validation import check_range
 
     with pytest.raises(ValueError) as info:
         check_range("x", float("nan"))
@@ -379,7 +379,7 @@ def scratch(tmp_path_factory):
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(argv=command_lines())
 def test_generated_command_lines_end_cleanly(scratch, argv):
-    from passmd import figures
+    from passmd.experiments import figure_table as figures
     from passmd.protocols import critical_amplitude, stall
 
     # the long computations are replaced by a marker: reaching them means every check passed

@@ -1,4 +1,4 @@
-"""passmd.publish: the helpers the book's chapters use (profile, CSV links, captions, units)."""
+"""passmd.report.publish: the helpers the book's chapters use (profile, CSV links, captions, units)."""
 
 from __future__ import annotations
 
@@ -9,8 +9,9 @@ import pandas as pd
 import pytest
 
 import passmd
-from passmd import provenance, publish
-from passmd.parameters import paper_drive
+from passmd.model.parameters import paper_drive
+from passmd.report import publish
+from passmd.runtime import provenance
 
 
 @pytest.fixture
@@ -184,7 +185,7 @@ def test_parameter_frame_rejects_bad_input():
 
 
 def test_assumptions_frame_holds_every_assumption_in_the_tables_order():
-    from passmd.assumptions import all_assumptions
+    from passmd.report.assumptions import all_assumptions
 
     df = publish.assumptions_frame()
     assert list(df.columns) == ["key", "symbol", "value", "unit", "rationale", "sensitivity"]
@@ -194,15 +195,16 @@ def test_assumptions_frame_holds_every_assumption_in_the_tables_order():
 
 def test_implementations_resolve_names_and_fail_on_stale_ones():
     df = publish.implementations({
-        "Eq. (1)": "passmd.theory.normal_forces",
-        "Eq. (6)": ["passmd.contact.MDRContact", "passmd.contact.MDRContact.path"],
+        "Eq. (1)": "passmd.model.theory.normal_forces",
+        "Eq. (6)": ["passmd.model.contact.MDRContact", "passmd.model.contact.MDRContact.path"],
     })
     assert list(df["implemented by"]) == [
-        "passmd.theory.normal_forces", "passmd.contact.MDRContact", "passmd.contact.MDRContact.path"
+        "passmd.model.theory.normal_forces", "passmd.model.contact.MDRContact",
+        "passmd.model.contact.MDRContact.path"
     ]
     assert "Eq. 1" in df["summary"].iloc[0]
     with pytest.raises(ValueError, match="'no_such_function' not found"):
-        publish.implementations({"Eq. (1)": "passmd.theory.no_such_function"})
+        publish.implementations({"Eq. (1)": "passmd.model.theory.no_such_function"})
     with pytest.raises(ValueError, match="no such module"):
         publish.implementations({"Eq. (1)": "nosuchpackage.f"})
 

@@ -46,7 +46,9 @@ def test_former_hangs_end_with_a_one_line_error(argv, option):
 # started in a subprocess: reports on stderr when the kernel is first entered, then runs the CLI
 _RUNNER = """
 import sys
-from passmd import _dynamics_kernel as kern, cli, dynamics
+from passmd import cli
+from passmd.solver import kernels as kern
+from passmd.solver import simulation as dynamics
 
 integrate = kern.integrate
 def announced(*args):

@@ -1,4 +1,4 @@
-"""On-disk cache (passmd.cache): keys, code fingerprint, atomic writes, corrupt entries."""
+"""On-disk cache (passmd.runtime.cache): keys, code fingerprint, atomic writes, corrupt entries."""
 
 import os
 import shutil
@@ -9,10 +9,10 @@ import pandas as pd
 import pytest
 
 import passmd
-from passmd import cache as cache_module
-from passmd.cache import Cache, canonical, code_fingerprint, default_cache_dir
-from passmd.config import RunConfig
-from passmd.parameters import Drive
+from passmd.model.parameters import Drive
+from passmd.runtime import cache as cache_module
+from passmd.runtime.cache import Cache, canonical, code_fingerprint, default_cache_dir
+from passmd.runtime.config import RunConfig
 
 
 def point_function(x):
@@ -154,7 +154,7 @@ def test_scalar_in_the_header_is_covered_by_the_checksum(store):
 
 
 def test_a_sweep_recomputes_a_corrupt_entry_with_one_warning(store):
-    from passmd import sweep
+    from passmd.runtime import sweep
 
     points = [{"x": 1.0}, {"x": 2.0}]
     first = sweep.run(point_function, points, executor="serial", cache=store, progress=False)
@@ -171,7 +171,7 @@ def test_a_sweep_recomputes_a_corrupt_entry_with_one_warning(store):
 
 @pytest.mark.parametrize("how", ["read-only", "a file", "disk full", "no permission"])
 def test_unwritable_cache_warns_once_and_keeps_the_result(tmp_path, monkeypatch, how):
-    from passmd import sweep
+    from passmd.runtime import sweep
 
     monkeypatch.setattr(cache_module, "_REPORTED_UNWRITABLE", set())
     directory = tmp_path / "cache"
@@ -328,7 +328,7 @@ def test_cached_rerun_is_bit_identical(store):
     """A sweep served from the cache returns exactly the computed values (floats by bits)."""
     from sweep_points import drive_theory_point
 
-    from passmd import sweep
+    from passmd.runtime import sweep
 
     points = sweep.grid(preload=[0.1, 0.37, 1.0], contacts=[1, 6])
     cold = sweep.run(drive_theory_point, points, executor="serial", cache=store, progress=False)
@@ -342,7 +342,7 @@ def test_cached_rerun_is_bit_identical(store):
 
 def test_entry_of_another_function_is_recomputed(store):
     """Right key, well-formed, but written by another function: foreign content is not served."""
-    from passmd import sweep
+    from passmd.runtime import sweep
 
     key = store.key(point_function, {"x": 1.0})
     store.put(key, {"full_time_s": 1.0}, function="somewhere:else")

@@ -1,6 +1,6 @@
-"""The cache deletes only its own files and survives any entry (passmd.cache, ``passmd cache``).
+"""The cache deletes only its own files and survives any entry (passmd.runtime.cache, ``passmd cache``).
 
-Contract (README, "Reliability"; rules in the :mod:`passmd.cache` docstring): a directory
+Contract (README, "Reliability"; rules in the :mod:`passmd.runtime.cache` docstring): a directory
 without the cache's marker is never read, written or pruned; inside a cache only files at
 an entry's path that start with the magic line (or links and special files there) and the
 cache's own temporary files are removed, and counts are true; keys are checked before
@@ -27,9 +27,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from passmd import cache as cache_module
-from passmd import sweep
-from passmd.cache import MAGIC, MARKER_NAME, Cache, CacheWarning, CorruptEntry, NotACache
+from passmd.runtime import cache as cache_module
+from passmd.runtime import sweep
+from passmd.runtime.cache import MAGIC, MARKER_NAME, Cache, CacheWarning, CorruptEntry, NotACache
 
 FUZZ = int(os.environ.get("PASSMD_CACHE_FUZZ_EXAMPLES", "40"))
 FUZZ_SETTINGS = settings(max_examples=FUZZ, deadline=None,
@@ -484,8 +484,8 @@ def test_put_removes_its_temporary_file_on_any_exception(tmp_path, monkeypatch, 
 
 SIGTERM_SCRIPT = """
 import os, signal, sys, time
-from passmd import sweep
-from passmd.cache import Cache
+from passmd.runtime import sweep
+from passmd.runtime.cache import Cache
 
 
 def point(x):

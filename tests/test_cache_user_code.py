@@ -1,7 +1,7 @@
 """The sweep cache and a user's own function: a changed function is never served from the cache.
 
 A user's point function lives outside passmd, so the package's code fingerprint does not
-cover it; the key holds the function's own code (passmd.cache.function_code). Each test
+cover it; the key holds the function's own code (passmd.runtime.cache.function_code). Each test
 writes a user module to a temporary folder, sweeps it, edits the module and sweeps again
 under the same module and function name: the values must be the edited code's.
 """
@@ -14,8 +14,8 @@ import warnings
 import numpy as np
 import pytest
 
-from passmd import sweep
-from passmd.cache import Cache, CacheWarning, Unfingerprintable, function_code
+from passmd.runtime import sweep
+from passmd.runtime.cache import Cache, CacheWarning, Unfingerprintable, function_code
 
 POINTS = [{"x": 1.0}, {"x": 2.0}, {"x": 3.0}]
 
@@ -120,7 +120,7 @@ def test_passmd_and_library_functions_have_fixed_fingerprints():
     """passmd's own functions are covered by the package fingerprint; libraries by name and version."""
     from sweep_points import drive_theory_point
 
-    from passmd.theory import drive_theory
+    from passmd.model.theory import drive_theory
 
     assert function_code(drive_theory) == function_code(drive_theory)
     assert function_code(np.sum) != function_code(np.mean)

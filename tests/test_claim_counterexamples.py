@@ -3,9 +3,9 @@
 A counter-example is the quick profile's result tables with one quantity changed the way the
 claim forbids (a constructed result), or the default model run itself where that run already
 contradicts the paper (named "default model run"). The extractor reads it and
-:func:`passmd.checks.check_claim` must report a failure (or the extractor decides the claim
-against the paper with :class:`passmd.checks.ClaimFails`); an undecided counter-example
-(:class:`passmd.checks.NotEvaluable`) does not count.
+:func:`passmd.ledger.checks.check_claim` must report a failure (or the extractor decides the claim
+against the paper with :class:`passmd.ledger.checks.ClaimFails`); an undecided counter-example
+(:class:`passmd.ledger.checks.NotEvaluable`) does not count.
 
 Claims whose check holds by construction are marked ``not_informative`` on their extractor with
 the reason, checked here by computation; claims about the experiment, whose data the paper's
@@ -18,13 +18,15 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd import checks, ledger, readings, reference, theory
-from passmd.checks import NO_MEASURED_DATA, ClaimFails, NotEvaluable, check_claim
-from passmd.claims import SUBSTITUTE_PREFIX, load_claims, substitute_for
-from passmd.config import RunConfig
-from passmd.experiments import driving_waveform_claims as dw_claims
-from passmd.experiments.driving_waveform import section5_drive
-from passmd.experiments.force_generation import EARLIER, THIS
+from passmd.experiments.driving_waveform import claims as dw_claims
+from passmd.experiments.driving_waveform.figures import section5_drive
+from passmd.experiments.force_generation.figures import EARLIER, THIS
+from passmd.ledger import checks, readings, reference
+from passmd.ledger import evaluation as ledger
+from passmd.ledger.checks import NO_MEASURED_DATA, ClaimFails, NotEvaluable, check_claim
+from passmd.ledger.claims import SUBSTITUTE_PREFIX, load_claims, substitute_for
+from passmd.model import theory
+from passmd.runtime.config import RunConfig
 
 #: Claims about the experiment of [12]: inconclusive whatever the model computes.
 EXPERIMENT_CLAIMS = (

@@ -27,12 +27,13 @@ import pytest
 from sweep_points import drive_theory_point
 
 import passmd
-from passmd import cli, provenance, sweep
-from passmd.cache import Cache
-from passmd.contact import MDRContact
-from passmd.defaults import PROTOCOL
-from passmd.parameters import ACTUATOR_DAMPING_RATIO, Drive, Material, actuator_for_radius
-from passmd.theory import contact_moduli, drive_theory, runner_frequency
+from passmd import cli
+from passmd.model.contact import MDRContact
+from passmd.model.defaults import PROTOCOL
+from passmd.model.parameters import ACTUATOR_DAMPING_RATIO, Drive, Material, actuator_for_radius
+from passmd.model.theory import contact_moduli, drive_theory, runner_frequency
+from passmd.runtime import provenance, sweep
+from passmd.runtime.cache import Cache
 
 SUBCOMMANDS = ["theory", "critical-amplitude", "run", "force", "contact", "figure"]
 
@@ -208,7 +209,8 @@ def test_contact_human_output():
 
 
 def simulate_summary(drive, amplitude, frequency, periods, flyback="slew", springs=None):
-    from passmd import dynamics, waveforms
+    from passmd.model import waveforms
+    from passmd.solver import simulation as dynamics
 
     wave = waveforms.sawtooth(amplitude, frequency, drive, periods=periods, flyback=flyback)
     result = dynamics.simulate(drive, wave, contact_model="exact" if springs is None else "discrete",
@@ -234,8 +236,9 @@ def test_run_json_matches_simulate():
 
 def test_run_optimized_waveform_matches_api():
     """`run --waveform optimized` drives the runner with the Eq. 15 waveform designed from the drive."""
-    from passmd import dynamics, optimized_waveform
+    from passmd.model import optimized_waveform
     from passmd.protocols import eq15
+    from passmd.solver import simulation as dynamics
 
     data = run_json("run", "--waveform", "optimized", "--actuator", "rigid", "--periods", "3")
     drive = Drive(actuator_model="rigid")
@@ -304,8 +307,9 @@ def test_critical_amplitude_analytic_only():
 
 
 def test_critical_amplitude_is_the_books_search():
-    """`critical-amplitude` reports what passmd.experiments.critical_amplitude finds, bracket included."""
-    from passmd.experiments import critical_amplitude as ca
+    """`critical-amplitude` reports what passmd.experiments.critical_amplitude.figures finds, bracket
+    included."""
+    from passmd.experiments.critical_amplitude import figures as ca
 
     data = run_json("critical-amplitude", "--contacts", "1", "--actuator", "rigid", "--tolerance", "2nm")
     drive = Drive(contacts=1, actuator_model="rigid")
@@ -423,7 +427,7 @@ def fake_figure(monkeypatch):
     """The figure table holds one stand-in panel, fig99z (computed at a RunConfig)."""
     from types import SimpleNamespace
 
-    from passmd import figures
+    from passmd.experiments import figure_table as figures
 
     spec = SimpleNamespace(name="fig99z", title="a stand-in panel")
     monkeypatch.setattr(figures, "figure_names", lambda: ["fig99z"])
@@ -475,7 +479,7 @@ def test_figure_reads_the_environment_once_and_its_options_win(fake_figure, tmp_
 @pytest.mark.parametrize("how", ["a file", "read-only"])
 def test_figure_with_an_unwritable_cache_keeps_its_result(fake_figure, tmp_path, monkeypatch, capsys, how):
     """The cache cannot be written: one warning line, the figure is still computed and written."""
-    from passmd import cache as cache_module
+    from passmd.runtime import cache as cache_module
 
     monkeypatch.setattr(cache_module, "_REPORTED_UNWRITABLE", set())
     cache_dir = tmp_path / "cache"
@@ -516,7 +520,7 @@ def test_cache_command_info_prune_clear(tmp_path):
 
 
 def test_failed_simulation_exits_1(monkeypatch, capsys):
-    from passmd import dynamics
+    from passmd.solver import simulation as dynamics
 
     def diverge(*args, **kwargs):
         raise dynamics.SimulationError("simulation diverged at integrator step 12")
@@ -536,8 +540,8 @@ def test_failed_simulation_exits_1(monkeypatch, capsys):
 def test_run_pauses_the_collector_until_its_simulation_has_run(monkeypatch, tmp_path):
     """Imports and kernel loading run without automatic collection; the outputs (pandas,
     matplotlib) and whatever follows the command run with it."""
-    from passmd import dynamics
     from passmd.cli.commands import run as run_command
+    from passmd.solver import simulation as dynamics
 
     enabled = {}
     simulate, write_outputs = dynamics.simulate, run_command.write_outputs
@@ -563,7 +567,7 @@ def test_run_pauses_the_collector_until_its_simulation_has_run(monkeypatch, tmp_
 
 
 def test_other_commands_run_with_the_collector_and_a_disabled_one_stays_off(monkeypatch):
-    from passmd import theory
+    from passmd.model import theory
 
     enabled = []
     drive_theory = theory.drive_theory
@@ -610,7 +614,7 @@ import numpy as np
 from passmd.cli import startup
 startup.load_numba_without_blas_probe()
 hidden = "scipy.linalg" not in sys.modules and "scipy.linalg.cython_blas" not in sys.modules
-from passmd.contact import contact_arrays, contact_force
+from passmd.model.contact import contact_arrays, contact_force
 params, state = contact_arrays("exact", 0.4, 1e-3, 1e11, 5e10, 0.2)
 force = contact_force(params, state, 1e-9)  # a compiled kernel runs without BLAS
 import scipy.linalg.cython_blas  # and scipy's BLAS module is importable afterwards
@@ -668,7 +672,7 @@ def test_python_dash_m():
 def test_run_optimized_reports_its_eq15_design():
     """`run --waveform optimized` gives the design it ran (t_s, t_a, Δ_a, V_a, f_s, V_r, u_x,max),
     the one passmd.protocols.eq15 derives for this drive; a saw-tooth run has none."""
-    from passmd.parameters import Drive
+    from passmd.model.parameters import Drive
     from passmd.protocols import eq15
 
     data = run_json("run", "--waveform", "optimized", "--frequency", "10kHz", "--periods", "3")

@@ -8,10 +8,10 @@ import json
 import pytest
 
 from passmd.cli import main
-from passmd.dynamics import simulate
-from passmd.parameters import Drive
+from passmd.model.parameters import Drive
+from passmd.model.waveforms import sawtooth
 from passmd.protocols import velocity
-from passmd.waveforms import sawtooth
+from passmd.solver.simulation import simulate
 
 RIGID_ONE = ["--contacts", "1", "--actuator", "rigid"]
 

@@ -20,7 +20,7 @@ import pytest
 from test_cli import run_cli, run_json  # the command in this process, as the other CLI tests run it
 
 from passmd.cli.commands.sweep import parse_vary
-from passmd.parameters import Drive
+from passmd.model.parameters import Drive
 from passmd.protocols import maps
 
 #: A cheap drive for the map tests: one contact, rigid actuators (Tables 1–2 otherwise).

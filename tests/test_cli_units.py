@@ -1,4 +1,4 @@
-"""Quantity parsing at the package's edges (passmd.units).
+"""Quantity parsing at the package's edges (passmd.runtime.units).
 
 Conversions are decimal (the typed number times the unit's SI factor, rounded once),
 so "0.25mm" must give exactly the float 0.25e-3: equality, not a tolerance.
@@ -7,7 +7,7 @@ so "0.25mm" must give exactly the float 0.25e-3: equality, not a tolerance.
 import numpy as np
 import pytest
 
-from passmd.units import QuantityError, dimension_name, from_si, parse_quantities, parse_quantity
+from passmd.runtime.units import QuantityError, dimension_name, from_si, parse_quantities, parse_quantity
 
 
 @pytest.mark.parametrize(
@@ -87,7 +87,7 @@ def test_from_si_inverts_parse():
 def test_display_factors_are_pints():
     """Bare numbers and output use a table of display-unit factors (no registry at start-up);
     each must be exactly the factor pint gives."""
-    from passmd import units
+    from passmd.runtime import units
 
     for unit, factor in units._DISPLAY_FACTORS.items():
         expected = units.registry().Quantity(1.0, units._unit(unit)).to_base_units().magnitude
@@ -97,7 +97,7 @@ def test_display_factors_are_pints():
 def test_display_units_share_a_base_exactly_when_pint_gives_them_one_dimension():
     """A number given in a display unit (``150nm``, ``40kHz``) is read without the registry when
     the unit's base is the expected one; that must be pint's dimension check."""
-    from passmd import units
+    from passmd.runtime import units
 
     assert units._DISPLAY_BASES.keys() == units._DISPLAY_FACTORS.keys()
     for a in units._DISPLAY_BASES:

@@ -1,8 +1,8 @@
-"""MDR contact with memory (passmd.contact): closed forms, memory rules, discrete vs exact.
+"""MDR contact with memory (passmd.model.contact): closed forms, memory rules, discrete vs exact.
 
 Tolerances (relative to the sliding force μF_N unless said):
 * ROUND = 1e-12: identities that hold to floating-point rounding (the exact model against
-  the closed forms of passmd.theory, mirror symmetry, sums of a few thousand springs).
+  the closed forms of passmd.model.theory, mirror symmetry, sums of a few thousand springs).
 * DISCRETE = 5e-3: the MDR validation chapter's acceptance bound for N ≥ 1000 springs against
   the exact model (0.5 % of μF_N).
 """
@@ -12,9 +12,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from passmd import contact, theory
-from passmd.contact import MDRContact, contact_arrays, stack_contacts
-from passmd.parameters import Drive
+from passmd.model import contact, theory
+from passmd.model.contact import MDRContact, contact_arrays, stack_contacts
+from passmd.model.parameters import Drive
 
 ROUND = 1e-12  # rounding only
 DISCRETE = 5e-3  # discrete within 0.5 % of μF_N for N >= 1000 (see the module docstring)

@@ -1,6 +1,6 @@
-"""Contact arrangements beyond the paper's one and six contacts (passmd.parameters.ContactGroup):
+"""Contact arrangements beyond the paper's one and six contacts (passmd.model.parameters.ContactGroup):
 the simulator takes any arrangement, and its simulated critical amplitude agrees with the
-generalised closed forms (passmd.theory: Eq. 10's first fly-back onset max_g u_x,max,g for any
+generalised closed forms (passmd.model.theory: Eq. 10's first fly-back onset max_g u_x,max,g for any
 number of groups, Eq. 11 for two groups of any counts, forces and radii)."""
 
 from __future__ import annotations
@@ -8,10 +8,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from passmd.defaults import PROTOCOL
-from passmd.parameters import PAPER_SIX, ContactGroup, Drive
+from passmd.model.defaults import PROTOCOL
+from passmd.model.parameters import PAPER_SIX, ContactGroup, Drive
+from passmd.model.theory import (
+    drive_theory,
+    first_flyback_critical_amplitude,
+    friction_limit,
+    runner_frequency,
+)
 from passmd.protocols import critical_amplitude as search
-from passmd.theory import drive_theory, first_flyback_critical_amplitude, friction_limit, runner_frequency
 
 #: The search's final bracket, as in tests/test_critical_amplitude.py.
 TOLERANCE = 0.5e-9

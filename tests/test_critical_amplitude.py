@@ -14,13 +14,15 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd import figures, ledger, waveforms
-from passmd.config import RunConfig
-from passmd.defaults import PROTOCOL
-from passmd.experiments import critical_amplitude as ca
-from passmd.experiments import critical_amplitude_facts as ca_facts
+from passmd.experiments import figure_table as figures
+from passmd.experiments.critical_amplitude import facts as ca_facts
+from passmd.experiments.critical_amplitude import figures as ca
+from passmd.ledger import evaluation as ledger
+from passmd.model import waveforms
+from passmd.model.defaults import PROTOCOL
+from passmd.model.theory import drive_theory, runner_frequency
 from passmd.protocols import critical_amplitude as search
-from passmd.theory import drive_theory, runner_frequency
+from passmd.runtime.config import RunConfig
 
 PANELS = ("fig5a", "fig5b", "fig6a", "fig6b", "fig6c", "fig56_viscosity", "fig56_frequency")
 NM = 1e9
@@ -244,7 +246,7 @@ def test_searches_report_brackets(quick):
 
 
 def test_closed_form_columns_are_the_committed_reference_curves(quick):
-    from passmd import reference
+    from passmd.ledger import reference
 
     for name, curve in (
         ("fig5b", "fig5b_closed_form"),

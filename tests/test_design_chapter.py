@@ -1,4 +1,4 @@
-"""The data functions of the chapter "Design your own drive" (passmd.experiments.design)."""
+"""The data functions of the chapter "Design your own drive" (passmd.experiments.design.figures)."""
 
 from __future__ import annotations
 
@@ -9,10 +9,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd.config import RunConfig
-from passmd.drive_file import DRIVE_KEYS, DriveFileError, load_drive
-from passmd.experiments import design
+from passmd.experiments.design import figures as design
+from passmd.model.drive_file import DRIVE_KEYS, DriveFileError, load_drive
 from passmd.protocols import fit as fitting
+from passmd.runtime.config import RunConfig
 
 
 def test_example_drive_is_the_chapter_drive_with_sources():

@@ -1,4 +1,4 @@
-"""Drive files (passmd.drive_file, ``--drive FILE``, ``passmd drive``): what a file says is the
+"""Drive files (passmd.model.drive_file, ``--drive FILE``, ``passmd drive``): what a file says is the
 drive that runs, bare numbers are SI, options replace the file's values, a refused key or value
 is one line naming the file and the key as typed, and ``drive_toml`` round-trips exactly."""
 
@@ -9,8 +9,8 @@ import json
 import pytest
 
 from passmd.cli import main
-from passmd.drive_file import DRIVE_KEYS, drive_toml, load_drive, read_drive_file, resolve
-from passmd.parameters import RUBY, Actuator, Drive, Material, actuator_for_radius, actuator_viscosity
+from passmd.model.drive_file import DRIVE_KEYS, drive_toml, load_drive, read_drive_file, resolve
+from passmd.model.parameters import RUBY, Actuator, Drive, Material, actuator_for_radius, actuator_viscosity
 
 #: The new user's drive of the README (R = 0.5 mm, between Table 2's rows).
 MINE = """\
@@ -179,7 +179,7 @@ radius = "0.5 mm"
 
 
 def test_contact_groups_from_a_file_run_and_read_back(tmp_path, capsys):
-    from passmd.parameters import ContactGroup
+    from passmd.model.parameters import ContactGroup
 
     path = tmp_path / "groups.toml"
     path.write_text(GROUPS, encoding="utf-8")

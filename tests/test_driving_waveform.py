@@ -1,4 +1,4 @@
-"""The optimized driving waveform of Section 5 (passmd.optimized_waveform) and its Eq. 15 design.
+"""The optimized driving waveform of Section 5 (passmd.model.optimized_waveform) and its Eq. 15 design.
 
 The paper's case: six contacts, rigid actuators, R = 1 mm, F_p = 0.4 N, μ = 0.2, A = 202 nm.
 Rigid runs are cheap (≈ 0.2 µs steps), so the design (two 100 Hz saw-tooth periods) is
@@ -8,17 +8,18 @@ computed once per module.
 import numpy as np
 import pytest
 
-from passmd import dynamics, theory, waveforms
-from passmd.defaults import PROTOCOL
-from passmd.optimized_waveform import (
+from passmd.model import theory, waveforms
+from passmd.model.defaults import PROTOCOL
+from passmd.model.optimized_waveform import (
     MIN_RAMP_FRACTION,
     OptimizedDesign,
     max_piezo_velocity,
     optimized,
     optimized_timing,
 )
-from passmd.parameters import paper_drive
+from passmd.model.parameters import paper_drive
 from passmd.protocols import eq15
+from passmd.solver import simulation as dynamics
 
 A = 202e-9  # m, the paper's full amplitude for R = 1 mm
 #: The saw-tooth frequency of the design and of Fig. 9a (Hz).

@@ -19,16 +19,18 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd import dynamics, theory, time_steps, waveforms
-from passmd.config import RunConfig
-from passmd.defaults import PROTOCOL
-from passmd.experiments import driving_waveform as dw
-from passmd.experiments import driving_waveform_claims as dw_claims
-from passmd.experiments import waveform_facts as wf
-from passmd.experiments import waveform_studies as studies
-from passmd.optimized_waveform import OptimizedDesign, max_piezo_velocity, optimized
+from passmd.experiments.driving_waveform import claims as dw_claims
+from passmd.experiments.driving_waveform import facts as wf
+from passmd.experiments.driving_waveform import figures as dw
+from passmd.experiments.driving_waveform import studies
+from passmd.model import theory, waveforms
+from passmd.model.defaults import PROTOCOL
+from passmd.model.optimized_waveform import OptimizedDesign, max_piezo_velocity, optimized
 from passmd.plots import driving_waveform as plots
 from passmd.protocols import eq15
+from passmd.runtime.config import RunConfig
+from passmd.solver import simulation as dynamics
+from passmd.solver import steps as time_steps
 
 PANELS = ("fig8a", "fig8b", "fig9a", "fig9b", "fig10a", "fig10b", "fig10c")
 #: The quick profile, as the tests run every panel.
@@ -256,7 +258,7 @@ def _velocity_series(f_kHz, v):
 
 
 def test_reachable_maximum_must_be_interior():
-    from passmd.checks import NotEvaluable
+    from passmd.ledger.checks import NotEvaluable
 
     inside = _velocity_series([1, 50, 110, 130], [0.1, 10.0, 19.0, 12.0])
     assert dw_claims.reachable_maximum(inside)["frequency_kHz"] == 110.0
@@ -267,7 +269,7 @@ def test_reachable_maximum_must_be_interior():
 
 
 def test_turning_point_needs_a_rise_then_a_fall_where_the_paper_puts_it():
-    from passmd.checks import ClaimFails
+    from passmd.ledger.checks import ClaimFails
 
     rise_fall = _velocity_series([1, 60, 105, 110, 115, 130], [0.1, 8.0, 18.0, 19.0, 18.5, 15.0])
     assert dw_claims.turning_point(rise_fall, 110.0)["frequency_kHz"].tolist() == [110.0, 115.0, 130.0]
@@ -334,7 +336,8 @@ def test_acceleration_slip_and_window_facts(quick):
 
 
 def test_fig9a_facts_agree_with_the_ledger(quick):
-    from passmd import ledger, readings
+    from passmd.ledger import evaluation as ledger
+    from passmd.ledger import readings
 
     facts = wf.fig9a_facts(quick["fig9a"])
     extract = ledger.extractors()

@@ -1,4 +1,4 @@
-"""Physics and numerics of the hybrid simulator (passmd.dynamics).
+"""Physics and numerics of the hybrid simulator (passmd.solver.simulation).
 
 Runs are kept short (1 kHz drive, few periods) so the whole file takes seconds; the
 physics checked does not depend on the drive frequency being the paper's.
@@ -7,9 +7,11 @@ physics checked does not depend on the drive frequency being the paper's.
 import numpy as np
 import pytest
 
-from passmd import dynamics, theory, time_steps, waveforms
-from passmd.contact import contact_arrays, contact_stiffness, stack_contacts
-from passmd.parameters import Drive
+from passmd.model import theory, waveforms
+from passmd.model.contact import contact_arrays, contact_stiffness, stack_contacts
+from passmd.model.parameters import Drive
+from passmd.solver import simulation as dynamics
+from passmd.solver import steps as time_steps
 
 F_TEST = 1000.0  # Hz: 1 ms periods keep tests fast; the runner mode (~5-11 kHz) settles within
 
@@ -151,7 +153,7 @@ def test_divergence_is_reported(monkeypatch):
 
 def test_kernel_wrapper_refuses_a_wrong_array_naming_it(monkeypatch):
     """The compiled loop does no bounds checks: its Python wrapper checks every array first."""
-    from passmd import _dynamics_kernel as kern
+    from passmd.solver import kernels as kern
 
     seen = []
     integrate = kern.integrate
@@ -206,7 +208,7 @@ def test_default_step_converged_to_005_nm():
     within it of the reference, the fixed (rigid) or explicit adaptive (flexible) step 4×
     finer: that run's O(dt²) error is 16× smaller than at the default step, so it stands in
     for dt → 0."""
-    from passmd.experiments.numerics import convergence_study
+    from passmd.experiments.numerics.figures import convergence_study
 
     df = convergence_study(resolutions=(1.0, 4.0), step_controls=("controlled", "adaptive"))
     default = df[df["resolution"] == 1.0]

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from passmd import figures
-from passmd.config import RunConfig
+from passmd.experiments import figure_table as figures
+from passmd.runtime.config import RunConfig
 
 BOOK = Path(__file__).resolve().parents[1] / "book"
 
@@ -45,16 +45,19 @@ def test_figure_data_takes_a_run_configuration():
 
 def test_claim_modules_are_the_experiment_modules_with_extractors():
     """Every experiment module that tags a claim extractor is listed, and only those."""
-    package = Path(figures.__file__).parent / "experiments"
-    tagged = {f"passmd.experiments.{path.stem}" for path in package.glob("*.py")
+    package = Path(figures.__file__).parent
+    tagged = {"passmd." + ".".join(path.relative_to(package.parent).with_suffix("").parts)
+              for path in package.rglob("*.py")
               if re.search(r"^@(register_)?extractor\(", path.read_text(), flags=re.M)}
     assert {module.__name__ for module in figures.CLAIM_MODULES} == tagged
 
 
-@pytest.mark.parametrize("module", ["passmd.experiments.critical_amplitude",
+@pytest.mark.parametrize("module", ["passmd.experiments.critical_amplitude.figures",
+                                    "passmd.experiments.figure_table", "passmd.ledger.evaluation",
                                     "passmd.protocols.critical_amplitude"])
 def test_computing_loads_no_plotting(module):
-    """Experiments and protocols never import passmd.plots (the figure table joins them)."""
+    """Figure data, the ledger and the protocols load no matplotlib: the figure table names each
+    plot function and imports it only to draw."""
     code = (f"import sys, {module}; "
             "print(any(m.startswith(('matplotlib', 'passmd.plots')) for m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)

@@ -16,7 +16,7 @@ import pytest
 
 import passmd
 from passmd import cli
-from passmd.parameters import Drive
+from passmd.model.parameters import Drive
 from passmd.protocols import fit as F
 
 RIGID = Drive(contacts=1, actuator_model="rigid")
@@ -223,7 +223,7 @@ def test_cli_fit_names_the_bad_row_and_option(tmp_path):
 def test_the_papers_numbers_read_as_measurements():
     """The package's table of the paper's stated numbers is a valid measurement file, each row
     with the drive model it was stated for (a row without it would be fitted with the wrong drive)."""
-    from passmd.reference import REFERENCE_DIR
+    from passmd.ledger.reference import REFERENCE_DIR
 
     data = F.read_measurements(REFERENCE_DIR / "paper_as_data.csv")
     assert data.kind == ("critical_amplitude", "position")

@@ -18,7 +18,7 @@ import sys
 import numpy as np
 import pytest
 
-from passmd.parameters import PRELOAD_GRIDS, paper_drive
+from passmd.model.parameters import PRELOAD_GRIDS, paper_drive
 from passmd.protocols import stall
 
 #: The sweep: one preload per decade over four decades, one stiffness per decade over three.

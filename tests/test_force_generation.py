@@ -17,13 +17,16 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd import checks, dynamics, ledger, readings, waveforms
-from passmd.config import RunConfig
-from passmd.defaults import PROTOCOL
-from passmd.experiments import force_facts as ff
-from passmd.experiments import force_generation as fg
+from passmd.experiments.force_generation import facts as ff
+from passmd.experiments.force_generation import figures as fg
+from passmd.ledger import checks, readings
+from passmd.ledger import evaluation as ledger
+from passmd.model import waveforms
+from passmd.model.defaults import PROTOCOL
 from passmd.plots import force_generation as fg_plots
 from passmd.protocols import stall
+from passmd.runtime.config import RunConfig
+from passmd.solver import simulation as dynamics
 
 RTOL = 1e-6
 #: Absolute floor for forces in mN and lengths in nm (1e-9 of the unit): below anything read.
@@ -444,7 +447,7 @@ def _cycle(force_mN: float, before_nm=(1.0, 2.0)) -> pd.DataFrame:
 
 
 def test_deflection_swing_adds_the_sliding_friction():
-    from passmd.theory import normal_forces
+    from passmd.model.theory import normal_forces
 
     cycle = _cycle(100.0)
     assert ff.deflection_swing(cycle, "rigid", 0.3, 1) == 0.0

@@ -24,33 +24,26 @@ import pytest
 
 #: The modules on the simulator's path (the kernels included).
 KERNEL_PATH = (
-    "passmd.parameters",
-    "passmd.theory",
-    "passmd.contact",
-    "passmd._contact_kernels",
-    "passmd.waveforms",
-    "passmd.optimized_waveform",
-    "passmd.time_steps",
-    "passmd.dynamics",
-    "passmd._dynamics_kernel",
+    "passmd.model.parameters",
+    "passmd.model.theory",
+    "passmd.model.contact",
+    "passmd.model.contact_kernels",
+    "passmd.model.waveforms",
+    "passmd.model.optimized_waveform",
+    "passmd.solver.steps",
+    "passmd.solver.simulation",
+    "passmd.solver.kernels",
 )
 
-#: The core layer: the only passmd modules a kernel-path import may load.
-CORE = frozenset(
-    KERNEL_PATH
-    + (
-        "passmd",
-        "passmd.units",
-        "passmd._validation",
-        "passmd.config",
-        "passmd.defaults",
-        "passmd.cache",
-        "passmd.provenance",
-        "passmd.readings",
-        "passmd.reference",
-        "passmd._progress",
-    )
-)
+#: The packages of the simulator's path: the model, the solver and the runtime beneath them.
+CORE_PACKAGES = ("passmd.model", "passmd.solver", "passmd.runtime")
+
+
+def _outside_core(modules) -> list[str]:
+    """The passmd modules of ``modules`` outside the simulator's packages (the root excepted)."""
+    return sorted(m for m in modules
+                  if m != "passmd" and not any(m == p or m.startswith(p + ".") for p in CORE_PACKAGES))
+
 
 #: Modules the simulator and the ``run`` command do not need (other commands, the book, plots,
 #: unit parsing beyond the display units, sweeps, progress bars on a terminal).
@@ -73,7 +66,7 @@ def test_core_module_imports_no_heavy_module_or_higher_layer(module):
     loaded, heavy = (json.loads(line) for line in done.stdout.splitlines())
     assert heavy == [], f"importing {module} loads {heavy}"
     assert module in loaded  # the probe imported what it should
-    assert set(loaded) <= CORE, f"importing {module} loads higher layers: {sorted(set(loaded) - CORE)}"
+    assert _outside_core(loaded) == [], f"importing {module} loads higher layers: {_outside_core(loaded)}"
 
 
 def _imported_passmd_modules(tree: ast.Module) -> set[str]:
@@ -95,17 +88,18 @@ def test_core_module_source_names_no_higher_layer(module):
     path = importlib.util.find_spec(module).origin
     with open(path, encoding="utf-8") as source:
         names = _imported_passmd_modules(ast.parse(source.read()))
-    assert names <= CORE, f"{module} imports higher layers: {sorted(names - CORE)}"
+    assert _outside_core(names) == [], f"{module} imports higher layers: {_outside_core(names)}"
 
 
-@pytest.mark.parametrize("module", ["passmd.waveforms", "passmd.optimized_waveform"])
+@pytest.mark.parametrize("module", ["passmd.model.waveforms", "passmd.model.optimized_waveform"])
 def test_waveform_constructors_never_reach_the_simulator(module):
     """Waveforms are pure constructors (Eq. 15's design from a simulated response lives in
     passmd.protocols.eq15): their modules import nothing of the simulator."""
     path = importlib.util.find_spec(module).origin
     with open(path, encoding="utf-8") as source:
         names = _imported_passmd_modules(ast.parse(source.read()))
-    simulator = {"passmd.dynamics", "passmd._dynamics_kernel", "passmd.time_steps", "passmd.contact"}
+    simulator = {"passmd.solver.simulation", "passmd.solver.kernels", "passmd.solver.steps",
+                 "passmd.model.contact"}
     assert not names & simulator, f"{module} imports {sorted(names & simulator)}"
 
 
@@ -130,11 +124,12 @@ def test_command_line_parser_loads_no_heavy_module_nor_the_simulator():
 
 
 # Runs ``passmd run`` in this fresh interpreter; prints the heavy modules loaded when the command
-# enters the integrator (the checking wrapper ``_dynamics_kernel.integrate``, which
-# passmd.dynamics looks up at call time) and when the command has printed its result.
+# enters the integrator (the checking wrapper ``kernels.integrate``, which
+# passmd.solver.simulation looks up at call time) and when the command has printed its result.
 _RUN_PROBE = """
 import contextlib, io, json, sys
-from passmd import _dynamics_kernel as kern, cli
+from passmd import cli
+from passmd.solver import kernels as kern
 heavy = json.loads(sys.argv[1])
 loaded = {}
 integrate = kern.integrate

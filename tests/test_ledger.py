@@ -17,9 +17,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd import checks, figures, ledger, ledger_views, reference
-from passmd.claims import CHECK_KINDS, CLAIM_COLUMNS, load_claims
-from passmd.config import RunConfig
+from passmd.experiments import figure_table as figures
+from passmd.ledger import checks, reference
+from passmd.ledger import evaluation as ledger
+from passmd.ledger.claims import CHECK_KINDS, CLAIM_COLUMNS, load_claims
+from passmd.report import ledger_views
+from passmd.runtime.config import RunConfig
 
 QUICK, PAPER_PROFILE = RunConfig(profile="quick"), RunConfig(profile="paper")
 PAPER = Path(os.environ.get("PASSMD_PAPER", "/work/shared/paper/nguyen2018-passmd.md"))
@@ -392,7 +395,7 @@ def test_joint_reading_and_uncovered_readings(tmp_path):
 
 
 def _point(state, reading=None, score=math.nan):
-    from passmd._verdicts import PointResult
+    from passmd.ledger.verdicts import PointResult
     outcome = None if state == "inconclusive" else checks.Outcome(state == "holds", 1.0, score=score)
     return PointResult(reading or {}, state, outcome, f"{state} here")
 
@@ -401,7 +404,7 @@ def test_category_rule_is_symmetric():
     """The category comes from the defaults and the joint reading only: a failure at either point
     with the other undecided is 'not reproduced', never 'inconclusive'; only two undecided points
     are inconclusive; a hold at the defaults is 'reproduced' whatever the joint reading shows."""
-    from passmd._verdicts import _categorise
+    from passmd.ledger.verdicts import _categorise
 
     holds, fails, undecided = _point("holds"), _point("fails"), _point("inconclusive")
     assert _categorise(fails, undecided)[0] == "not reproduced"
@@ -501,7 +504,7 @@ def test_fragile_margin_and_informative_flags(tmp_path):
 def test_design_is_the_full_product_and_skip_is_no_reading_of_eq15():
     """A claim is evaluated on the product of its axes (not one at a time), minus the axes open for
     it; the short-period rule 'skip' (t_s = 0, no settling phase) is no reading of an Eq. 15 claim."""
-    from passmd import readings
+    from passmd.ledger import readings
 
     points = readings.design(("flyback", "ac_protocol", "damping_ratio"))
     assert len(points) == 2 * 2 * 3 and points[0] == readings.default_reading()
@@ -605,7 +608,8 @@ def test_collect_results_calls_every_figure_of_the_table(monkeypatch):
     assert list(results) == ["fig5a", "closed_forms", "fig7flyback"]
     assert calls == [QUICK, QUICK]
     pd.testing.assert_frame_equal(results["closed_forms"], reference.tangential_stiffness_table())
-    with pytest.raises(TypeError, match="config = 'quick' is not allowed: must be a passmd.config.RunConfig"):
+    with pytest.raises(TypeError, match="config = 'quick' is not allowed: "
+                       "must be a passmd.runtime.config.RunConfig"):
         ledger.collect_results("quick")
     with pytest.raises(ValueError, match="are not available"):
         ledger.collect_results(QUICK, figures=["fig9z"])
@@ -651,17 +655,18 @@ def test_collect_claim_functions_finds_each_claim_once():
 
 
 def test_real_extractors_live_in_the_figures_claim_modules():
-    """Every extractor of the package is found in passmd.figures.CLAIM_MODULES (and the ledger's own
+    """Every extractor of the package is found in passmd.experiments.figure_table.CLAIM_MODULES (and the
+    ledger's own
     closed-form one), and the experiments do not import the ledger (the layers are one-way)."""
     found = ledger.claim_functions()
     homes = {f.__module__ for f in found.extractors.values()}
-    assert homes == {m.__name__ for m in figures.CLAIM_MODULES} | {"passmd.ledger"}
-    assert found.extractors["fig10b-r1-stiffer-contact"].__module__ == "passmd.ledger"
+    assert homes == {m.__name__ for m in figures.CLAIM_MODULES} | {"passmd.ledger.evaluation"}
+    assert found.extractors["fig10b-r1-stiffer-contact"].__module__ == "passmd.ledger.evaluation"
     assert found.depends_on["fig5a-no-step-below-50nm"] == ("flyback",)
     assert {"fig10a-1n-slower", "sec5-response-to-optimized-similar"} <= set(found.evidence)
     assert ledger.orphan_extractors() == []
     code = ("import sys; import " + ", ".join(m.__name__ for m in figures.CLAIM_MODULES)
-            + "; print(sorted(m for m in sys.modules if m.startswith('passmd.ledger')))")
+            + "; print(sorted(m for m in sys.modules if m.startswith('passmd.ledger.evaluation')))")
     imported = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert imported.stdout.strip() == "[]"
 
@@ -751,7 +756,7 @@ def test_open_claims_of_each_axis_are_exactly_those_not_evaluated_along_it():
     read it. μ applies to every claim that assumes it (claims.csv ``assumed``); the actuator damping
     ratio ζ to every claim with a flexible actuator. ``Axis.open_for`` must list exactly the rest, so
     the report never calls a claim covered along an axis it was not evaluated at."""
-    from passmd import readings
+    from passmd.ledger import readings
 
     claims = load_claims()
     applies = {
@@ -784,9 +789,9 @@ def test_flexible_ac_tables_hold_protocol_times_flyback_at_the_default_damping()
     protocol × fly-back (the points the joint reading needs, e.g. the first fly-back with the fixed
     fly-back); ζ's alternatives only with the steady protocol and the slew-rate fly-back. Rigid
     actuators have no fly-back or ζ axis."""
-    from passmd import readings
-    from passmd.defaults import PROTOCOL
-    from passmd.experiments import critical_amplitude as ca
+    from passmd.experiments.critical_amplitude import figures as ca
+    from passmd.ledger import readings
+    from passmd.model.defaults import PROTOCOL
 
     zeta = readings.axis("damping_ratio").default
     flexible = ca._protocols("flexible", (PROTOCOL.drive_frequency,))
@@ -800,8 +805,8 @@ def test_flexible_ac_tables_hold_protocol_times_flyback_at_the_default_damping()
 def test_force_panels_at_a_flyback_reading():
     """The Fig. 7 panels at the fixed fly-back come from fig7flyback (flexible rows fixed, rigid rows
     unchanged); without that table the reading is not covered."""
-    from passmd import readings
-    from passmd.experiments import force_generation as fg
+    from passmd.experiments.force_generation import figures as fg
+    from passmd.ledger import readings
 
     panel = pd.DataFrame({"panel": ["fig7a"] * 2, "actuator_model": ["rigid", "flexible"]})
     fixed = panel.assign(flyback=["slew", "fixed"])

@@ -25,9 +25,9 @@ from pathlib import Path
 
 import pytest
 
-from passmd import ledger
-from passmd.claims import load_claims
-from passmd.config import PROFILES, RunConfig
+from passmd.ledger import evaluation as ledger
+from passmd.ledger.claims import load_claims
+from passmd.runtime.config import PROFILES, RunConfig
 
 BASELINES = {profile: Path(__file__).with_name(f"ledger_baseline_{profile}.csv")
              for profile in PROFILES}

@@ -12,9 +12,9 @@ between machines:
 import numpy as np
 import pytest
 
-from passmd import mdr_validation as mv
-from passmd import theory
-from passmd.parameters import Drive
+from passmd.experiments.mdr_validation import closed_forms as mv
+from passmd.model import theory
+from passmd.model.parameters import Drive
 
 ROUND = 1e-12  # identities that hold to rounding (exact model vs closed forms)
 DISCRETE = 5e-3  # MDR chapter's acceptance bound: discrete within 0.5 % of μF_N for N >= 1000

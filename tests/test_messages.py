@@ -26,15 +26,14 @@ from unittest import mock
 import numpy as np
 import pytest
 
-from passmd import cli, optimized_waveform, waveforms
-from passmd._validation import InputError
+from passmd import cli
 from passmd.cli import options
 from passmd.cli.commands import run as run_command
 from passmd.cli.drive import _safe
 from passmd.cli.parser import make_parser
-from passmd.config import RunConfig
-from passmd.contact import MDRContact
-from passmd.parameters import (
+from passmd.model import optimized_waveform, waveforms
+from passmd.model.contact import MDRContact
+from passmd.model.parameters import (
     PLAUSIBLE_RANGES,
     Actuator,
     Drive,
@@ -43,6 +42,8 @@ from passmd.parameters import (
     parameter_table,
 )
 from passmd.protocols import eq15
+from passmd.runtime.config import RunConfig
+from passmd.runtime.validation import InputError
 
 #: What a message must never show: numpy reprs, and the package's field paths and
 #: snake_case names (``actuator.damping_ratio``, ``acceleration_amplitude``).

@@ -1,4 +1,5 @@
-"""Figures and facts of the model, numerics and MDR-validation chapters (rows of passmd.figures)."""
+"""Figures and facts of the model, numerics and MDR-validation chapters (rows of
+passmd.experiments.figure_table)."""
 
 from __future__ import annotations
 
@@ -6,10 +7,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd import figures, publish, theory
-from passmd.config import RunConfig
-from passmd.defaults import PROTOCOL
-from passmd.experiments import mdr, model, numerics
+from passmd.experiments import figure_table as figures
+from passmd.experiments.mdr_validation import figures as mdr
+from passmd.experiments.model import figures as model
+from passmd.experiments.numerics import figures as numerics
+from passmd.model import theory
+from passmd.model.defaults import PROTOCOL
+from passmd.report import publish
+from passmd.runtime.config import RunConfig
 
 QUICK = RunConfig(profile="quick")
 CHEAP = (

@@ -36,11 +36,14 @@ from pathlib import Path
 
 import pytest
 
-from passmd import _progress, dynamics, sweep, waveforms
-from passmd.claims import CLAIMS_PATH
 from passmd.cli import main
 from passmd.cli.streams import write_atomically
-from passmd.parameters import Drive
+from passmd.ledger.claims import CLAIMS_PATH
+from passmd.model import waveforms
+from passmd.model.parameters import Drive
+from passmd.runtime import progress as _progress
+from passmd.runtime import sweep
+from passmd.solver import simulation as dynamics
 
 #: Generous limits: a refusal or a one-period run takes seconds (start-up included).
 QUICK_S = 120
@@ -198,7 +201,7 @@ def test_replaced_file_keeps_its_permissions(tmp_path):
 
 def test_a_writers_own_temporary_files_are_removed_when_it_is_interrupted(tmp_path):
     """A writer that makes its own temporary beside the file it was given (as
-    ``passmd.ledger.write_baseline`` does) and is interrupted leaves nothing behind."""
+    ``passmd.ledger.evaluation.write_baseline`` does) and is interrupted leaves nothing behind."""
     (tmp_path / "kept.txt").write_text("mine\n")
 
     def interrupted(tmp):
@@ -354,7 +357,7 @@ def _terminate(proc, before: bytes, to_group: bool = False) -> tuple[int, str, s
     return proc.returncode, out.decode(), (before + rest).decode()
 
 
-#: A progress line off a terminal (passmd._progress), e.g. "simulation: 4.2% (4.20/100 periods) ...".
+#: A progress line off a terminal (passmd.runtime.progress), e.g. "simulation: 4.2% (4.20/100 periods) ...".
 PROGRESS_LINE = re.compile(r"^\w+: \d+\.\d% \([\d.]+/\d+ (periods|points)\) after [\d:]+, "
                            r"(about [\d:]+ left|time left known after the first (period|point))$")
 
@@ -495,7 +498,8 @@ _SWEEP_RUNNER = textwrap.dedent("""
     import sys, types
     sys.path.insert(0, sys.argv[1])
     import slow_points
-    from passmd import figures, sweep
+    from passmd.experiments import figure_table as figures
+    from passmd.runtime import sweep
     from passmd.cli import main
 
     def figure_data(name, config):  # three workers: one is idle once the fast points are done
@@ -526,7 +530,7 @@ def test_sigterm_stops_a_process_pool_sweep_and_its_workers(tmp_path, to_group):
     PID``) or to its whole process group (as a service manager or a closed terminal does): one
     line, exit 143, the workers gone without a word, the two finished points in the cache and no
     temporary file in it, no figure written."""
-    from passmd.cache import Cache
+    from passmd.runtime.cache import Cache
 
     code = tmp_path / "code"
     code.mkdir()

@@ -92,7 +92,7 @@ def _environment_uses(path: Path) -> tuple[list[str], list[str]]:
 
 
 def test_the_package_never_writes_the_environment_and_the_engine_never_reads_it():
-    """Entry points read the environment once into a RunConfig and pass it down (passmd.config)."""
+    """Entry points read the environment once into a RunConfig and pass it down (passmd.runtime.config)."""
     writes = []
     for path in sorted((ROOT / "passmd").rglob("*.py")):
         writes += _environment_uses(path)[0]

@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from passmd import theory
-from passmd.parameters import (
+from passmd.model import theory
+from passmd.model.parameters import (
     ASSUMPTIONS,
     MOLYBDENUM,
     PLAUSIBLE_RANGES,
@@ -173,7 +173,7 @@ def test_every_paper_configuration_is_inside_the_soft_limits():
 
 def test_contact_radius_underflow_is_refused_with_the_parameters_named():
     """A preload so small that (3 F R / 4E*)^(1/3) underflows to 0 has no contact to model."""
-    from passmd.parameters import check_contact_plausible
+    from passmd.model.parameters import check_contact_plausible
 
     with pytest.raises(ValueError, match=r"preload: the Hertz contact radius .* underflows"):
         check_contact_plausible(1e-320, 1e-3, 1e11, allow_extrapolation=True, names="preload")

@@ -1,4 +1,4 @@
-"""passmd.provenance: version, git commit and profile of a result, found robustly."""
+"""passmd.runtime.provenance: version, git commit and profile of a result, found robustly."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 import passmd
-from passmd import provenance
+from passmd.runtime import provenance
 
 GIT = shutil.which("git")
 needs_git = pytest.mark.skipif(GIT is None, reason="git is not installed")

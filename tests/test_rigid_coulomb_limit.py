@@ -2,15 +2,15 @@
 
 Scaling the contact moduli E*, G* by k shrinks the presliding u_x,max ∝ k^(−2/3) (Eq. 7 with the
 Hertz indentation d ∝ E*^(−2/3)); the rigid-actuator drive must then approach the closed-form
-step of :func:`passmd.theory.coulomb_sawtooth_step`, which no part of the simulator computes.
+step of :func:`passmd.model.theory.coulomb_sawtooth_step`, which no part of the simulator computes.
 """
 
 import numpy as np
 import pytest
 
-from passmd import theory
-from passmd.experiments import numerics
-from passmd.parameters import Drive
+from passmd.experiments.numerics import figures as numerics
+from passmd.model import theory
+from passmd.model.parameters import Drive
 
 
 @pytest.fixture(scope="module")

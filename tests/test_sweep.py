@@ -1,4 +1,4 @@
-"""Sweep engine (passmd.sweep): executors agree, grid order, caching, interruption and resume.
+"""Sweep engine (passmd.runtime.sweep): executors agree, grid order, caching, interruption and resume.
 
 The point functions live at module level so worker processes can unpickle them.
 Results of the same deterministic function must be *identical* across executors
@@ -16,11 +16,11 @@ import pandas as pd
 import pytest
 from sweep_points import drive_theory_point, sawtooth_point
 
-from passmd import sweep
-from passmd.cache import Cache
-from passmd.config import RunConfig
-from passmd.parameters import Drive
-from passmd.theory import contact_moduli, drive_theory
+from passmd.model.parameters import Drive
+from passmd.model.theory import contact_moduli, drive_theory
+from passmd.runtime import sweep
+from passmd.runtime.cache import Cache
+from passmd.runtime.config import RunConfig
 
 
 def logged_square(x, log):
@@ -135,7 +135,7 @@ def test_dask_scheduler_address(serial_theory):
 
 def contact_path_point(normal_force, springs):
     """Forces of one MDR contact along a fixed path (a small-array result)."""
-    from passmd.contact import MDRContact
+    from passmd.model.contact import MDRContact
 
     path = np.array([0.0, 30e-9, -10e-9, 45e-9, 5e-9])
     E_star, G_star = contact_moduli(Drive())
@@ -302,8 +302,8 @@ def test_progress_quiet_off_tty_and_in_ci():
 
 SIGINT_SCRIPT = """
 import sys, time
-from passmd import sweep
-from passmd.cache import Cache
+from passmd.runtime import sweep
+from passmd.runtime.cache import Cache
 
 
 def slow(x, log):
@@ -363,12 +363,12 @@ def test_ctrl_c_stops_a_process_pool_sweep_and_rerun_resumes(tmp_path):
 
 
 # --------------------------------------------------------------------------------------
-# Design maps (passmd.experiments.maps): the protocols' quantities through the sweep engine
+# Design maps (passmd.experiments.design.maps): the protocols' quantities through the sweep engine
 # --------------------------------------------------------------------------------------
 
 
 def test_compute_map_keeps_grid_order_and_the_caller_s_columns(store):
-    from passmd.experiments.maps import compute_map
+    from passmd.experiments.design.maps import compute_map
     from passmd.protocols.maps import critical_amplitude_point, steady_point
 
     drive = Drive(contacts=1, actuator_model="rigid")

@@ -1,4 +1,4 @@
-"""Closed forms of passmd.theory against hand arithmetic and against physics.
+"""Closed forms of passmd.model.theory against hand arithmetic and against physics.
 
 Tolerances: hand values are written with 6 significant digits, so they are compared
 with rtol = 1e-5; identities between closed forms hold to rounding (rtol = 1e-12).
@@ -7,8 +7,8 @@ with rtol = 1e-5; identities between closed forms hold to rounding (rtol = 1e-12
 import numpy as np
 import pytest
 
-from passmd import theory
-from passmd.parameters import RUBY, STEEL, Drive
+from passmd.model import theory
+from passmd.model.parameters import RUBY, STEEL, Drive
 
 HAND = 1e-5  # 6 significant digits typed from the hand calculation
 EXACT = 1e-12  # algebraic identities, floating-point rounding only

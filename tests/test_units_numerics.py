@@ -36,11 +36,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from passmd import cli, figures, ledger, theory
-from passmd._result_bounds import EMPTY_BY_DESIGN, ResultError, check_table
-from passmd._validation import check_array, check_range, format_number
-from passmd.parameters import RUBY, STEEL, Drive
-from passmd.units import _CYCLE_UNITS, QuantityError, parse_quantity, registry, to_display
+from passmd import cli
+from passmd.cli.result_bounds import EMPTY_BY_DESIGN, ResultError, check_table
+from passmd.experiments import figure_table as figures
+from passmd.ledger import evaluation as ledger
+from passmd.model import theory
+from passmd.model.parameters import RUBY, STEEL, Drive
+from passmd.runtime.units import _CYCLE_UNITS, QuantityError, parse_quantity, registry, to_display
+from passmd.runtime.validation import check_array, check_range, format_number
 
 TWO_ULP = 2.0**-51  # a unit factor and a decimal product, each rounded once
 FOUR_ROUNDINGS = 2.0**-50  # the harmonic combination's scaled form
@@ -411,7 +414,7 @@ _NU, _E = RUBY.poissons_ratio, RUBY.youngs_modulus
     (lambda: theory.normal_forces(0.4, contacts=6.0), TypeError, r"^contacts = 6.0 is not allowed"),
     (lambda: theory.normal_forces("0.4"), ValueError, r"^preload = '0.4' is not a number"),
     (lambda: theory.drive_theory("not a drive"), TypeError,
-     r"^drive = 'not a drive' is not allowed: must be a passmd.parameters.Drive$"),
+     r"^drive = 'not a drive' is not allowed: must be a passmd.model.parameters.Drive$"),
     (lambda: theory.contact_moduli(None), TypeError, r"^drive = None is not allowed"),
     (lambda: theory.runner_frequency(3), TypeError, r"^drive = 3 is not allowed"),
     (lambda: theory.friction_limit({}), TypeError, r"^drive = \{\} is not allowed"),

@@ -8,8 +8,8 @@ runs, each must exit with 0:
 
 * ``passmd --version`` (prints the metadata's version);
 * ``passmd theory --json`` (closed forms);
-* the claims loader: ``passmd.claims.load_claims()`` and every reference curve of
-  ``passmd.reference.CURVES``, plus the benchmark results the book reads;
+* the claims loader: ``passmd.ledger.claims.load_claims()`` and every reference curve of
+  ``passmd.ledger.reference.CURVES``, plus the benchmark results the book reads;
 * ``passmd ledger --profile quick --json`` (every claim's computed category; with
   ``--ledger-cache DIR`` it reads the simulation cache the test session filled, whose keys
   hold for the installed package too: they hash the same source files);
@@ -47,9 +47,10 @@ def main(argv: list[str] | None = None) -> int:
     repo = args.repo.resolve()
 
     import passmd
-    from passmd import provenance, reference
-    from passmd.claims import CLAIMS_PATH, load_claims
-    from passmd.experiments import numerics
+    from passmd.experiments.numerics import figures as numerics
+    from passmd.ledger import reference
+    from passmd.ledger.claims import CLAIMS_PATH, load_claims
+    from passmd.runtime import provenance
 
     location = Path(passmd.__file__).resolve()
     if repo in location.parents or Path.cwd().resolve() == repo or repo in Path.cwd().resolve().parents:

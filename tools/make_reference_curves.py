@@ -1,8 +1,8 @@
 """Write the paper's closed-form reference curves (Figs. 5b, 6a–c) into passmd/data/reference/.
 
 Usage: ``python tools/make_reference_curves.py [--out DIR]``. The tables are computed by
-:func:`passmd.reference.closed_form_curves` (Eqs. 1, 7–14 of Nguyen et al. 2018 via
-``passmd.theory``) on ``passmd.parameters.PRELOAD_GRIDS``; ``tests/test_reference.py``
+:func:`passmd.ledger.reference.closed_form_curves` (Eqs. 1, 7–14 of Nguyen et al. 2018 via
+``passmd.model.theory``) on ``passmd.model.parameters.PRELOAD_GRIDS``; ``tests/test_reference.py``
 fails if the committed files and a fresh computation disagree. The default target is the
 repository's reference data folder (package data of ``passmd``), found from this file's
 location, never the installed package.
@@ -11,7 +11,7 @@ location, never the installed package.
 import argparse
 from pathlib import Path
 
-from passmd.reference import write_reference_curves
+from passmd.ledger.reference import write_reference_curves
 
 REPOSITORY_REFERENCE_DIR = Path(__file__).resolve().parents[1] / "passmd" / "data" / "reference"
 

@@ -1,10 +1,10 @@
 """Sphinx extension of the passmd book: provenance footer and per-chapter sweep statistics.
 
 * The footer (``html_theme_options["extra_footer"]``) gets the ``passmd`` version, git
-  commit and profile of the build (:func:`passmd.provenance.summary`), the same line every
+  commit and profile of the build (:func:`passmd.runtime.provenance.summary`), the same line every
   figure caption carries.
 * Before each page is read (and its notebook executed), ``$PASSMD_SWEEP_LOG`` is pointed at
-  a file of that page in the build folder; :func:`passmd.sweep.run` appends every sweep's
+  a file of that page in the build folder; :func:`passmd.runtime.sweep.run` appends every sweep's
   cached/computed counts to it from inside the chapter's kernel.
 * The ``passmd-sweep-table`` directive is replaced, once every page has been read, by a
   table of those counts per page (so its own position in the reading order does not matter),
@@ -47,8 +47,8 @@ def _log_dir(app) -> Path:
 
 
 def _add_footer(app, config) -> None:
-    from passmd import provenance
-    from passmd.publish import current_profile
+    from passmd.report.publish import current_profile
+    from passmd.runtime import provenance
 
     options = dict(config.html_theme_options or {})
     footer = options.get("extra_footer", "")

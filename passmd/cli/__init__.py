@@ -23,11 +23,11 @@ as Ctrl-C: no partial or temporary file is left), 141 standard output closed (a 
 such as ``head`` went away, or the command was started with it closed; nothing is printed,
 as Unix tools do).
 Errors print one line to stderr, never a traceback. Parameter ranges come from
-:data:`passmd.parameters.PLAUSIBLE_RANGES`; ``--allow-extrapolation`` lifts their soft
+:data:`passmd.model.parameters.PLAUSIBLE_RANGES`; ``--allow-extrapolation`` lifts their soft
 limits. On a console that cannot encode the output's symbols (μ, ×, –, →), ASCII
 stand-ins are printed.
 
-``figure`` and ``ledger`` run with one :class:`~passmd.config.RunConfig`: the environment
+``figure`` and ``ledger`` run with one :class:`~passmd.runtime.config.RunConfig`: the environment
 (``PASSMD_*``, read once here) replaced by the options given, passed down to the sweeps and
 the cache.
 

@@ -10,12 +10,11 @@ import warnings
 
 import numpy as np
 
-from passmd._result_bounds import ResultError
-from passmd.cache import CacheWarning
 from passmd.cli import startup
 from passmd.cli.drive import explain
 from passmd.cli.errors import OPTIONAL_EXTRAS, MissingDependencyError, OutputError, UsageError
 from passmd.cli.parser import PROG, make_parser
+from passmd.cli.result_bounds import ResultError
 from passmd.cli.streams import (
     Out,
     PipeClosed,
@@ -25,7 +24,8 @@ from passmd.cli.streams import (
     silence_stdout,
     use_ascii_fallback,
 )
-from passmd.units import QuantityError
+from passmd.runtime.cache import CacheWarning
+from passmd.runtime.units import QuantityError
 
 __all__ = ["Terminated", "main"]
 
@@ -156,11 +156,11 @@ def _dispatch(args, out: Out, prog: str, to_stdout: bool) -> int:  # noqa: C901 
     except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (Terminated)
         kept = " (finished points are kept in the cache)" if args.command == "figure" else ""
         return _interrupted(prog, exc, kept)
-    except ValueError as exc:  # the package's input checks (passmd._validation), in the options' terms
+    except ValueError as exc:  # the package's input checks (passmd.runtime.validation), in the options' terms
         return _error(prog, explain(exc, args), 2)
     except (ResultError, MissingDependencyError) as exc:
         return _error(prog, str(exc), 1)
-    except RuntimeError as exc:  # passmd.dynamics.SimulationError and other failed runs
+    except RuntimeError as exc:  # passmd.solver.simulation.SimulationError and other failed runs
         return _error(prog, f"run failed: {exc}", 1)
     except ModuleNotFoundError as exc:
         extra = OPTIONAL_EXTRAS.get((exc.name or "").split(".")[0])

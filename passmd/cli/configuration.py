@@ -1,8 +1,8 @@
 """The run configuration of the commands that run figure sweeps (``figure``, ``ledger``).
 
-The environment is read once, here at the edge (:meth:`passmd.config.RunConfig.from_environment`),
+The environment is read once, here at the edge (:meth:`passmd.runtime.config.RunConfig.from_environment`),
 and the command's options replace what it says (a sweep's progress shows on any stderr unless
-``$CI`` is set); the resulting :class:`~passmd.config.RunConfig`
+``$CI`` is set); the resulting :class:`~passmd.runtime.config.RunConfig`
 is passed down to the figure table, the ledger and the cache. Nothing is written to the
 environment.
 """
@@ -15,7 +15,7 @@ import stat
 from dataclasses import replace
 
 from passmd.cli.errors import MissingDependencyError, UsageError
-from passmd.config import RunConfig
+from passmd.runtime.config import RunConfig
 
 __all__ = ["run_config"]
 

@@ -2,7 +2,7 @@
 
 :func:`build_drive`: the defaults, replaced by a drive file's values (``--drive``), then by
 the options the user gave. :func:`explain`: the one
-place a refused input (:class:`passmd._validation.InputError`, raised by the records and
+place a refused input (:class:`passmd.runtime.validation.InputError`, raised by the records and
 functions the options reach) is said again with the option that set it, as typed.
 """
 
@@ -11,13 +11,13 @@ from __future__ import annotations
 import math
 from decimal import ROUND_CEILING, ROUND_FLOOR, Decimal
 
-from passmd._validation import InputError
 from passmd.cli.errors import UsageError
 from passmd.cli.options import ACTUATOR_DYNAMICS, DRIVE_QUANTITIES, OPTION_FOR, QUANTITIES
 from passmd.cli.output import fmt
-from passmd.drive_file import DriveFileError, read_drive_file, resolve
-from passmd.parameters import Drive
-from passmd.units import dimension_name, from_si
+from passmd.model.drive_file import DriveFileError, read_drive_file, resolve
+from passmd.model.parameters import Drive
+from passmd.runtime.units import dimension_name, from_si
+from passmd.runtime.validation import InputError
 
 __all__ = ["build_drive", "drive_rows", "explain", "resolve_drive"]
 
@@ -42,9 +42,9 @@ def _check_combinations(given, args, load_cell: bool, rigid: bool) -> None:
 def resolve_drive(args, **fixed) -> tuple[Drive, dict[str, str]]:
     """The drive the options (and ``--drive FILE``) describe, and where each parameter came from.
 
-    The drive file's values (:func:`passmd.drive_file.read_drive_file`), then each option
+    The drive file's values (:func:`passmd.model.drive_file.read_drive_file`), then each option
     given replacing its key, then ``fixed`` (e.g. ``load_cell=True``) replacing fields last;
-    what is left comes from the paper as :func:`passmd.drive_file.resolve` says (Table 2
+    what is left comes from the paper as :func:`passmd.model.drive_file.resolve` says (Table 2
     actuator of the radius, viscosity 2ζ√(k_p m_a) of the final k_p and m_a). Returns the
     drive and, by drive-file key, ``"file NAME"``, ``"option --flag"`` or the default's source.
     """
@@ -77,7 +77,7 @@ def resolve_drive(args, **fixed) -> tuple[Drive, dict[str, str]]:
 
 
 def build_drive(args, **fixed) -> Drive:
-    """The :class:`~passmd.parameters.Drive` the parsed options describe (SI inside).
+    """The :class:`~passmd.model.parameters.Drive` the parsed options describe (SI inside).
 
     As :func:`resolve_drive`, without the sources; the dataclasses validate the result.
     """
@@ -113,7 +113,7 @@ _VERBS = {">": "raise {} above", ">=": "raise {} to at least", "<": "lower {} be
 def explain(exc: ValueError, args) -> str:
     """The one-line message of a refused input, naming the option the user typed.
 
-    An :class:`~passmd._validation.InputError` (or a usage error raised from one) whose input
+    An :class:`~passmd.runtime.validation.InputError` (or a usage error raised from one) whose input
     an option of this command sets (:data:`~passmd.cli.options.OPTION_FOR`) is said again
     with that option as typed, the limit in the option's unit and why; a quantity computed
     from an option says what it is, its value and how to change the option. Any other error

@@ -5,7 +5,7 @@ A :class:`Quantity` is one option that takes a number with a unit (``0.4N``, ``1
 shows another unit (mm, nm, kHz, g, GPa, V/us) refuses a bare number and asks for the unit,
 so that no number is ever read in a unit the user did not write.
 Its default text is computed from the defaults it stands for (:data:`DEFAULT_DRIVE`,
-:data:`passmd.defaults.PROTOCOL`), never retyped.
+:data:`passmd.model.defaults.PROTOCOL`), never retyped.
 """
 
 from __future__ import annotations
@@ -14,13 +14,13 @@ import argparse
 import re
 from dataclasses import dataclass
 
-from passmd._validation import check_range
-from passmd.cache import describe_default_cache_dir
 from passmd.cli.output import JSON_HELP, fmt
-from passmd.config import ENVIRONMENT
-from passmd.defaults import PROTOCOL
-from passmd.parameters import ACTUATOR_DAMPING_RATIO, PLAUSIBLE_RANGES, Drive
-from passmd.units import QuantityError, parse_quantity, si_factor, to_display
+from passmd.model.defaults import PROTOCOL
+from passmd.model.parameters import ACTUATOR_DAMPING_RATIO, PLAUSIBLE_RANGES, Drive
+from passmd.runtime.cache import describe_default_cache_dir
+from passmd.runtime.config import ENVIRONMENT
+from passmd.runtime.units import QuantityError, parse_quantity, si_factor, to_display
+from passmd.runtime.validation import check_range
 
 __all__ = ["ACTUATOR_DYNAMICS", "AMPLITUDE", "CACHE_DIR_HELP", "DEFAULT_DRIVE", "DRIVE_QUANTITIES",
            "FREQUENCY", "MATERIAL_FLAGS", "NORMAL_FORCE", "OPTION_FOR", "QUANTITIES", "THRESHOLD",
@@ -30,7 +30,7 @@ __all__ = ["ACTUATOR_DYNAMICS", "AMPLITUDE", "CACHE_DIR_HELP", "DEFAULT_DRIVE", 
 #: The drive every option replaces a part of (Tables 1–2 at R = 1 mm, F_p = 0.4 N, μ = 0.2).
 DEFAULT_DRIVE = Drive()
 
-#: A number without a unit (as passmd.units reads one; "nan" and "inf" are not numbers there).
+#: A number without a unit (as passmd.runtime.units reads one; "nan" and "inf" are not numbers there).
 _BARE = re.compile(r"^[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?$")
 #: The SI unit of each display unit that is not SI (for the bare-number message).
 _SI_UNIT = {"mm": "m", "nm": "m", "kHz": "Hz", "g": "kg", "GPa": "Pa", "V/us": "V/s", "us": "s"}
@@ -63,7 +63,7 @@ class Quantity:
     lower_open: bool = True
     upper: float | None = None
     upper_open: bool = False
-    #: key of passmd.parameters.PLAUSIBLE_RANGES checked instead of lower/upper
+    #: key of passmd.model.parameters.PLAUSIBLE_RANGES checked instead of lower/upper
     plausible: str | None = None
     #: the Drive field the option sets, dotted for a part (``"actuator.mass"``); None: not a drive field
     field: str | None = None
@@ -170,7 +170,7 @@ TOLERANCE = Quantity("--tolerance", "nm", "W", "stop when the bracket is narrowe
 QUANTITIES = {q.flag: q for q in (*DRIVE_QUANTITIES, AMPLITUDE, FREQUENCY, NORMAL_FORCE, THRESHOLD,
                                    TOLERANCE)}
 
-#: The option that sets each input the package's checks name (``passmd._validation.InputError.name``):
+#: The option that sets each input the package's checks name (``passmd.runtime.validation.InputError.name``):
 #: the drive's fields (dotted for a part, as :class:`Quantity.field`), then the parameters of the
 #: waveforms, contacts and protocols the commands pass their options to.
 OPTION_FOR: dict[str, str] = {
@@ -213,7 +213,7 @@ CACHE_DIR_HELP = f"cache directory (default: ${ENVIRONMENT['cache_dir']}, else "
 def add_drive_options(parser, *, contact_only: bool = False) -> None:
     """The drive's options (Tables 1–2, or a drive file); ``contact_only``: those of one contact.
 
-    ``--drive FILE`` reads a drive file (:mod:`passmd.drive_file`); each option given replaces
+    ``--drive FILE`` reads a drive file (:mod:`passmd.model.drive_file`); each option given replaces
     the file's value.
     """
     group = parser.add_argument_group("drive (Tables 1–2, or --drive FILE; a bare number is SI: options "
@@ -268,7 +268,7 @@ def add_output_options(parser) -> None:
 
 
 def add_sweep_options(parser) -> None:
-    """Options of the commands that run figure sweeps (``figure``, ``ledger``); see passmd.sweep."""
+    """Options of the commands that run figure sweeps (``figure``, ``ledger``); see passmd.runtime.sweep."""
     group = parser.add_argument_group("sweep execution")
     group.add_argument("--executor", choices=("process", "serial", "dask"), default=None,
                        help="process pool, in this process, or Dask (default: process, or dask with "

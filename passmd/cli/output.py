@@ -2,7 +2,7 @@
 
 Human output uses nm, N, mm and kHz; ``--json`` prints one JSON object in SI units whose
 keys carry the unit. Both go through :func:`plain`, so a non-finite number is the same
-:class:`~passmd._result_bounds.ResultError` with and without ``--json``.
+:class:`~passmd.cli.result_bounds.ResultError` with and without ``--json``.
 """
 
 from __future__ import annotations
@@ -13,10 +13,10 @@ from pathlib import Path
 
 import numpy as np
 
-from passmd._result_bounds import ResultError
 from passmd.cli.errors import OutputError, UsageError
-from passmd.parameters import Drive
-from passmd.units import from_si
+from passmd.cli.result_bounds import ResultError
+from passmd.model.parameters import Drive
+from passmd.runtime.units import from_si
 
 __all__ = ["JSON_HELP", "check_output_file", "check_results", "describe", "drive_record", "emit_json",
            "emit_rows", "fmt", "nm", "plain", "sides"]

@@ -1,6 +1,6 @@
 """Plots of the critical-amplitude figures (Figs. 5, 6 and the sensitivity panels).
 
-Each function takes the tidy DataFrame of a Section 4.1 figure (:mod:`passmd.figures`)
+Each function takes the tidy DataFrame of a Section 4.1 figure (:mod:`passmd.experiments.figure_table`)
 and returns a matplotlib Figure: lengths in nm, forces in N, frequencies in Hz, the
 paper's colours where it has them (Fig. 5b: rigid green, flexible black; Fig. 6:
 u_x,max,e red).
@@ -12,8 +12,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from passmd.defaults import PROTOCOL
-from passmd.parameters import ACTUATOR_DAMPING_RATIO
+from passmd.model.defaults import PROTOCOL
+from passmd.model.parameters import ACTUATOR_DAMPING_RATIO
 
 COLOURS = {"rigid": "tab:green", "flexible": "black"}
 SIDE_COLOURS = {1: "tab:blue", 2: "tab:orange", "e": "tab:red"}

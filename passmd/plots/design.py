@@ -1,4 +1,4 @@
-"""Figures of the chapter "Design your own drive" (data from :mod:`passmd.experiments.design`).
+"""Figures of the chapter "Design your own drive" (data from :mod:`passmd.experiments.design.figures`).
 
 The maps are drawn by :func:`passmd.plots.sweep_map.map_figure`, as ``passmd sweep`` draws them;
 here are the three figures a map does not cover.

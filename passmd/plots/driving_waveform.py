@@ -1,6 +1,6 @@
 """Plots of the driving-waveform chapter (Figs. 8–10 and the studies beyond the paper).
 
-Each function takes the tidy DataFrame of :mod:`passmd.experiments.driving_waveform` and
+Each function takes the tidy DataFrame of :mod:`passmd.experiments.driving_waveform.figures` and
 returns a matplotlib Figure; axes in nm, µs/ms, kHz and mm/s.
 """
 
@@ -9,7 +9,7 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
-from passmd.defaults import PROTOCOL
+from passmd.model.defaults import PROTOCOL
 
 #: The saw-tooth frequency of Figs. 8, 9a and the settling scan, as the titles show it.
 _STEP_HZ = f"{PROTOCOL.drive_frequency:g} Hz"
@@ -189,7 +189,7 @@ def plot_fig10c(df):
 
 
 # --------------------------------------------------------------------------------------
-# Beyond the paper (passmd.experiments.waveform_studies)
+# Beyond the paper (passmd.experiments.driving_waveform.studies)
 # --------------------------------------------------------------------------------------
 
 
@@ -225,7 +225,7 @@ def plot_settling_scan(scans: dict):
 
 def plot_settling_scans(df):
     """:func:`plot_settling_scan` of the tidy table of
-    :func:`passmd.experiments.waveform_facts.settling_scans` (one curve per ``series``)."""
+    :func:`passmd.experiments.driving_waveform.facts.settling_scans` (one curve per ``series``)."""
     return plot_settling_scan({label: part for label, part in df.groupby("series", sort=False)})
 
 

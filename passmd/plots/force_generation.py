@@ -1,6 +1,6 @@
 """Plots of the force-generation figures (Fig. 7 and the chapter's panels beyond it).
 
-Each function takes the tidy DataFrame of :mod:`passmd.experiments.force_generation` and
+Each function takes the tidy DataFrame of :mod:`passmd.experiments.force_generation.figures` and
 returns a matplotlib Figure: amplitudes in nm, forces in mN, preloads in N, time in µs/ms.
 Runs that did not stall (``converged`` False) are drawn as red crosses, never on a curve.
 """
@@ -200,7 +200,7 @@ def plot_cycle(df: pd.DataFrame, zoom_us: float = 400.0):
 def plot_fig7_difference(df: pd.DataFrame):
     """F_gen(rigid, μ = 0.3) − F_gen(flexible, μ = 0.2) against A, one axes per panel.
 
-    ``df`` is :func:`passmd.experiments.force_facts.fig7_difference`: one curve per preload,
+    ``df`` is :func:`passmd.experiments.force_generation.facts.fig7_difference`: one curve per preload,
     the amplitudes between the two models' onsets shaded.
     """
     names = list(dict.fromkeys(df["panel"]))

@@ -8,7 +8,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from passmd.units import from_si
+from passmd.runtime.units import from_si
 
 __all__ = [
     "TARGET_ERROR_REL",

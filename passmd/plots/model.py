@@ -1,5 +1,5 @@
 """Plots of the model chapter (Sections 2–3): the saw-tooth, the two schematics of Fig. 3 and
-one MDR contact (Fig. 4). Each takes the DataFrame of a row of :mod:`passmd.figures`."""
+one MDR contact (Fig. 4). Each takes the DataFrame of a row of :mod:`passmd.experiments.figure_table`."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 from matplotlib import patches
 
-from passmd.units import from_si
+from passmd.runtime.units import from_si
 
 __all__ = ["plot_cross_section", "plot_free_body", "plot_mdr_loop", "plot_sawtooth"]
 

@@ -8,16 +8,16 @@ import pandas as pd
 from matplotlib.lines import Line2D
 from matplotlib.ticker import NullLocator
 
-from passmd.time_steps import CONVERGED_ACCURACY
+from passmd.solver.steps import CONVERGED_ACCURACY
 
 __all__ = ["CONVERGED_STEP_NM", "STEP_CONTROL_STYLES", "plot_convergence", "plot_coulomb_limit"]
 
-#: Position error drawn as the convergence target (:data:`passmd.time_steps.CONVERGED_ACCURACY`) (nm).
+#: Position error drawn as the convergence target (:data:`passmd.solver.steps.CONVERGED_ACCURACY`) (nm).
 CONVERGED_STEP_NM = CONVERGED_ACCURACY * 1e9
 
 
 #: Legend name of each step control of the convergence figure
-#: (:data:`passmd.experiments.numerics.STEP_CONTROLS`) and its line style and marker.
+#: (:data:`passmd.experiments.numerics.figures.STEP_CONTROLS`) and its line style and marker.
 STEP_CONTROL_STYLES = {
     "controlled": ("error-controlled (default)", "-", "o"),
     "adaptive": ("explicit adaptive", "--", "s"),

@@ -9,7 +9,7 @@ import numpy as np
 from matplotlib import colors
 from matplotlib.figure import Figure
 
-from passmd.units import from_si
+from passmd.runtime.units import from_si
 
 __all__ = ["MapAxis", "map_figure"]
 
@@ -19,7 +19,7 @@ class MapAxis:
     """One axis of a map: its column (SI), its label, the unit it is shown in, log spacing.
 
     ``scale``: the SI value of one ``unit`` (e.g. 1e-3 for mm/s); None: the unit's own factor
-    (:func:`passmd.units.from_si`).
+    (:func:`passmd.runtime.units.from_si`).
     """
 
     column: str

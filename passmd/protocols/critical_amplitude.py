@@ -12,7 +12,7 @@ Two critical amplitudes, both found by bisection on the amplitude
     Saw-tooth runs from rest (virgin contacts) of :data:`STEADY_PERIODS` periods at the
     drive frequency f (default ``PROTOCOL.drive_frequency``); the step that counts is the
     *last* one (settled position of the last period minus that of the one before,
-    :attr:`passmd.dynamics.SimulationResult.step_sizes`), by when the transient of the first
+    :attr:`passmd.solver.simulation.SimulationResult.step_sizes`), by when the transient of the first
     fly-backs has died out. A_c is the smallest amplitude whose last step exceeds the
     "measurable step" :data:`STEP_THRESHOLD`. After a full slide the contact is left
     pre-strained and the runner keeps a residual micro-vibration, so this A_c depends on the
@@ -27,7 +27,7 @@ Search: bisection on the reproducible bracket [0, A_max] (A_max: the actuator's 
 stroke, Table 2). A = 0 makes no step and no slip, so only A_max is simulated to open the
 bracket; it halves until narrower than the tolerance, and reports the final bracket, its
 midpoint as A_c and the number of runs. Grids, figures and claims of Section 4.1 are in
-:mod:`passmd.experiments.critical_amplitude`.
+:mod:`passmd.experiments.critical_amplitude.figures`.
 """
 
 from __future__ import annotations
@@ -36,10 +36,11 @@ import math
 
 import numpy as np
 
-from passmd import dynamics, waveforms
-from passmd._validation import check_choice, check_positive, check_range
-from passmd.defaults import PROTOCOL
-from passmd.parameters import Assumption, Drive
+from passmd.model import waveforms
+from passmd.model.defaults import PROTOCOL
+from passmd.model.parameters import Assumption, Drive
+from passmd.runtime.validation import check_choice, check_positive, check_range
+from passmd.solver import simulation as dynamics
 
 __all__ = [
     "ASSUMPTIONS",
@@ -131,7 +132,7 @@ def steady_step(
         Periods of the run (>= 2); the steps are the changes of the settled position from
         one period to the next.
     flyback : {"slew", "fixed"}
-        Fly-back rule (:func:`passmd.waveforms.flyback_time`).
+        Fly-back rule (:func:`passmd.model.waveforms.flyback_time`).
 
     Returns
     -------
@@ -273,7 +274,7 @@ def critical_amplitude(
     frequency : float
         Drive frequency f of the saw-tooth (Hz).
     flyback : {"slew", "fixed"}
-        Fly-back rule (:func:`passmd.waveforms.flyback_time`).
+        Fly-back rule (:func:`passmd.model.waveforms.flyback_time`).
     periods : int
         Periods of a steady-state run (>= 2).
     threshold : float
@@ -281,7 +282,7 @@ def critical_amplitude(
     tolerance : float
         Largest width of the final bracket (m).
     progress : bool or "long", optional
-        The bisection's runs on stderr (:mod:`passmd._progress`): None on a terminal only,
+        The bisection's runs on stderr (:mod:`passmd.runtime.progress`): None on a terminal only,
         ``"long"`` also elsewhere, each once the search has taken a few seconds.
 
     Returns
@@ -331,7 +332,7 @@ def _bisection_bar(upper: float, tolerance: float, progress: bool | str | None):
     """A progress bar over the bisection's runs (1 + halvings of ``upper`` down to ``tolerance``)."""
     import sys
 
-    from passmd import _progress
+    from passmd.runtime import progress as _progress
 
     if progress is False or sys.stderr is None or _progress.in_worker():
         return None

@@ -3,25 +3,26 @@
 Section 5.1 measures the micro-vibration frequency f_s and the runner velocity V_r "by
 analyzing the movement of the runner" under the saw-tooth (Fig. 8a) and derives the
 optimized waveform's settling time, acceleration time and amplitude from them (Eq. 15).
-Here the response is simulated (:func:`passmd.dynamics.simulate`); the waveform itself is
-built from the resulting :class:`~passmd.optimized_waveform.OptimizedDesign` by
-:func:`passmd.optimized_waveform.optimized`, which never simulates.
+Here the response is simulated (:func:`passmd.solver.simulation.simulate`); the waveform itself is
+built from the resulting :class:`~passmd.model.optimized_waveform.OptimizedDesign` by
+:func:`passmd.model.optimized_waveform.optimized`, which never simulates.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from passmd import dynamics, theory
-from passmd._validation import InputError, check_positive, check_range, shown
-from passmd.optimized_waveform import RESPONSE_FREQUENCY, OptimizedDesign, max_piezo_velocity
-from passmd.parameters import Drive, check_drive
-from passmd.waveforms import sawtooth
+from passmd.model import theory
+from passmd.model.optimized_waveform import RESPONSE_FREQUENCY, OptimizedDesign, max_piezo_velocity
+from passmd.model.parameters import Drive, check_drive
+from passmd.model.waveforms import sawtooth
+from passmd.runtime.validation import InputError, check_positive, check_range, shown
+from passmd.solver import simulation as dynamics
 
 __all__ = ["MIN_SAMPLES", "SAMPLES_PER_VIBRATION", "micro_vibration_frequency", "optimized_design"]
 
 #: Recorded samples per period of the linear runner-on-contacts vibration
-#: (:func:`passmd.theory.runner_frequency`) in the design run: enough to place the zero
+#: (:func:`passmd.model.theory.runner_frequency`) in the design run: enough to place the zero
 #: crossings of ẋ_r − ẋ_p by linear interpolation.
 SAMPLES_PER_VIBRATION = 200
 #: Fewest recorded samples of the design run, whatever the vibration frequency.
@@ -40,7 +41,7 @@ def micro_vibration_frequency(
     Parameters
     ----------
     time, runner_velocity, piezo_velocity : array_like
-        Recorded samples (s, m/s, m/s), e.g. of a :class:`passmd.dynamics.SimulationResult`.
+        Recorded samples (s, m/s, m/s), e.g. of a :class:`passmd.solver.simulation.SimulationResult`.
     after : float
         Start of the free vibration (s), e.g. the end of a fly-back.
 
@@ -89,7 +90,7 @@ def optimized_design(
         t_s = 1 / (2 f_s),     (V_a − V_r) t_a = u_x,max,     Δ_a = V_a t_a.
 
     Eq. 15 leaves V_a free; it is ``acceleration_velocity``, by default the fastest the
-    amplifier allows (:func:`~passmd.optimized_waveform.max_piezo_velocity`, slew-rate limit).
+    amplifier allows (:func:`~passmd.model.optimized_waveform.max_piezo_velocity`, slew-rate limit).
 
     Parameters
     ----------
@@ -104,9 +105,9 @@ def optimized_design(
         (Eq. 7 / Eq. 10).
     response_frequency : float
         Saw-tooth frequency of the analysed response (Hz); default the protocol's driving
-        frequency (:data:`passmd.defaults.PROTOCOL`).
+        frequency (:data:`passmd.model.defaults.PROTOCOL`).
     flyback : {"slew", "fixed"}
-        Fly-back rule of that saw-tooth (:func:`~passmd.waveforms.flyback_time`).
+        Fly-back rule of that saw-tooth (:func:`~passmd.model.waveforms.flyback_time`).
 
     Raises
     ------

@@ -25,7 +25,7 @@ row's drive like ``preload_N`` and ``radius_mm``; the text columns ``id``, ``sou
 Estimator (:func:`fit`): weighted least squares, ``scipy.optimize.least_squares`` (trust-region
 reflective, bounded, optional robust loss) over the logarithms of the free parameters, so that
 parameters spanning decades are scaled alike. Every model evaluation runs through
-:func:`passmd.sweep.run` (parallel and cached); the residual Jacobian is a forward difference of
+:func:`passmd.runtime.sweep.run` (parallel and cached); the residual Jacobian is a forward difference of
 relative step :data:`JACOBIAN_STEP`, evaluated in the same sweep as its base point. A coarse
 global pass (a scrambled Sobol design of :data:`GLOBAL_STARTS` points over the bounds, one sweep)
 picks the starts, so that a kink of the stick–slip response does not trap the local search. A
@@ -56,11 +56,11 @@ from pathlib import Path
 
 import numpy as np
 
-from passmd import sweep
-from passmd._validation import InputError, check_choice
-from passmd.config import RunConfig
-from passmd.defaults import PROTOCOL
-from passmd.parameters import PLAUSIBLE_RANGES, Drive, actuator_for_radius, check_drive
+from passmd.model.defaults import PROTOCOL
+from passmd.model.parameters import PLAUSIBLE_RANGES, Drive, actuator_for_radius, check_drive
+from passmd.runtime import sweep
+from passmd.runtime.config import RunConfig
+from passmd.runtime.validation import InputError, check_choice
 
 __all__ = [
     "CONDITIONS",
@@ -448,7 +448,7 @@ def _check_free(drive: Drive, free: Sequence[str]) -> list[str]:
 def default_bounds(drive: Drive, name: str,
                    max_frequency: float = PROTOCOL.drive_frequency) -> tuple[float, float]:
     """Default (low, high) of a free parameter: its plausible range
-    (:data:`~passmd.parameters.PLAUSIBLE_RANGES`).
+    (:data:`~passmd.model.parameters.PLAUSIBLE_RANGES`).
 
     The damping ratio's range starts at 1e-3 (the logarithmic scale needs a positive lower end);
     the fly-back is limited to a quarter of the shortest driving period.
@@ -673,7 +673,7 @@ def fit(
     seed : int
         Seed of the scrambled Sobol design (the fit is deterministic for a seed).
     executor, cache, config
-        How the model evaluations run (:func:`passmd.sweep.run`); a process pool is kept for the
+        How the model evaluations run (:func:`passmd.runtime.sweep.run`); a process pool is kept for the
         whole fit.
     progress : callable, optional
         Receives one line per stage (global pass, each local search, each profile).
@@ -1054,10 +1054,10 @@ def write_measurements(path, data: Measurements, values: np.ndarray | None = Non
 
 
 def fitted_drive_file(drive: Drive, data_name: str, free: Sequence[str]) -> str:
-    """The fitted drive as a drive file (:func:`passmd.drive_file.drive_toml`) that ``--drive`` and
-    :func:`passmd.drive_file.load_drive` read back; the fitted keys name the data (``data_name``)
+    """The fitted drive as a drive file (:func:`passmd.model.drive_file.drive_toml`) that ``--drive`` and
+    :func:`passmd.model.drive_file.load_drive` read back; the fitted keys name the data (``data_name``)
     as their source. ``free``: the fitted parameters' names (:data:`FREE_PARAMETERS`)."""
-    from passmd.drive_file import DRIVE_KEYS, drive_toml
+    from passmd.model.drive_file import DRIVE_KEYS, drive_toml
 
     fitted = {"actuator.damping_ratio": "actuator.viscosity", "flyback_time": "amplifier.slew_rate",
               "contact_stiffness_scale": "hemisphere_material.youngs_modulus"}

@@ -1,6 +1,6 @@
 """The quantities a design map evaluates at one point: a drive, an amplitude, a frequency.
 
-Each quantity is a pure point function of a :class:`~passmd.parameters.Drive` and the
+Each quantity is a pure point function of a :class:`~passmd.model.parameters.Drive` and the
 waveform's parameters, built from the protocols the book uses (nothing is re-derived here):
 
 * ``velocity``, ``step``, ``back-step``: the steady-velocity protocol
@@ -11,7 +11,7 @@ waveform's parameters, built from the protocols the book uses (nothing is re-der
   with the reading ``steady`` (the last step of a run of saw-tooth periods exceeds the
   measurable step: the amplitude a drive in continuous operation needs) or ``first`` (full
   sliding of every contact in the first fly-back from rest: the amplitude that moves a
-  drive once), plus the closed form (Eqs. 7–8, 11–12, :func:`passmd.theory.drive_theory`);
+  drive once), plus the closed form (Eqs. 7–8, 11–12, :func:`passmd.model.theory.drive_theory`);
 * ``stall-force``: the generated force at stall against the load cell
   (:func:`passmd.protocols.stall.generated_force`, Section 4.2);
 * ``gain``: the steady velocity of the optimized waveform (Eq. 15, designed from this drive's
@@ -28,11 +28,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from passmd import theory
-from passmd._validation import InputError, check_choice
-from passmd.parameters import Drive
+from passmd.model import theory
+from passmd.model.parameters import Drive
 from passmd.protocols import critical_amplitude as ca
 from passmd.protocols import eq15, stall, velocity
+from passmd.runtime.validation import InputError, check_choice
 
 __all__ = ["MAP_QUANTITIES", "READINGS", "MapQuantity", "critical_amplitude_point", "gain_point",
            "stall_point", "steady_point"]

@@ -4,7 +4,7 @@ The runner starts at rest, touching the load cell (a linear spring k, Table 1) a
 length, with virgin contacts, and is driven by a saw-tooth until its steps stall: the load
 cell then pushes back, on average over a period, as hard as the contacts carry the runner
 forward. The force at stall is the *generated force* F_gen = k·x̄_r, x̄_r the runner's mean
-position over the last period (:attr:`passmd.dynamics.SimulationResult.generated_force`).
+position over the last period (:attr:`passmd.solver.simulation.SimulationResult.generated_force`).
 
 Coulomb bound
     Over one period m_r (v_end − v_start) = T (F̄_fric − k·x̄_r), and every contact's friction
@@ -46,7 +46,7 @@ Onset of force generation (assumption ``force_onset``)
     is the critical amplitude of the drive with the load cell engaged, found by the
     critical-amplitude search (steady-state protocol at the same frequency).
 
-Everything here takes a :class:`~passmd.parameters.Drive` and SI values; it knows nothing
+Everything here takes a :class:`~passmd.model.parameters.Drive` and SI values; it knows nothing
 of figures, grids or the ledger.
 """
 
@@ -57,13 +57,14 @@ import time
 
 import numpy as np
 
-from passmd import dynamics, waveforms
-from passmd._validation import check_choice, check_positive, check_range
-from passmd.defaults import PROTOCOL
-from passmd.parameters import Drive
+from passmd.model import waveforms
+from passmd.model.defaults import PROTOCOL
+from passmd.model.parameters import Drive
+from passmd.model.theory import friction_limit, normal_forces
 from passmd.protocols.critical_amplitude import critical_amplitude
-from passmd.theory import friction_limit, normal_forces
-from passmd.time_steps import CONVERGED_ACCURACY
+from passmd.runtime.validation import check_choice, check_positive, check_range
+from passmd.solver import simulation as dynamics
+from passmd.solver.steps import CONVERGED_ACCURACY
 
 __all__ = [
     "INITIAL_PERIODS",
@@ -157,7 +158,7 @@ def bound_margin(drive: Drive) -> float:
     """How far above μΣF_N a computed period-mean force may lie from integration error alone (N).
 
     The integrator's settled runner positions are accurate to
-    :data:`passmd.time_steps.CONVERGED_ACCURACY`, so k·x̄_r is accurate to k times that;
+    :data:`passmd.solver.steps.CONVERGED_ACCURACY`, so k·x̄_r is accurate to k times that;
     1e-12·μΣF_N covers the rounding of the force sums.
     """
     if not isinstance(drive, Drive):
@@ -293,7 +294,7 @@ def generated_force(
     frequency : float
         Driving frequency f (Hz).
     flyback : {"slew", "fixed"}
-        Fly-back rule of :func:`passmd.waveforms.sawtooth`.
+        Fly-back rule of :func:`passmd.model.waveforms.sawtooth`.
     initial_periods, max_periods : int
         Periods of the first run, lengthened until stall or until ``max_periods``.
     abs_tolerance, rel_tolerance : float
@@ -303,7 +304,7 @@ def generated_force(
     window : int
         Periods examined by the stall criterion.
     progress : bool or "long", optional
-        The run's progress on stderr (:class:`passmd.dynamics.Simulation`).
+        The run's progress on stderr (:class:`passmd.solver.simulation.Simulation`).
 
     Returns
     -------
@@ -326,7 +327,7 @@ def generated_force(
     ------
     ValueError
         Bad input (names the parameter, its value and the allowed range).
-    passmd.dynamics.SimulationError
+    passmd.solver.simulation.SimulationError
         A run diverged.
     ForceBoundError
         A result breaks the Coulomb bound (:func:`check_force_bounds`).

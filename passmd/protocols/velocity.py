@@ -1,6 +1,6 @@
 """How fast a waveform drives the runner (Section 5.2): step and steady velocity of a drive.
 
-Two measurements, as pure functions of a :class:`~passmd.parameters.Drive` and a waveform:
+Two measurements, as pure functions of a :class:`~passmd.model.parameters.Drive` and a waveform:
 
 * **Steps at low frequency** (Fig. 9a): a few periods from rest; the settled positions and
   the mean step from period 2 on (across the optimized slips), × f for a velocity.
@@ -9,7 +9,7 @@ Two measurements, as pure functions of a :class:`~passmd.parameters.Drive` and a
   stick phase to average over, and from rest the runner needs about a millisecond (hundreds
   of periods) to reach its steady velocity. A run lasts ``max(MIN_PERIODS, f·STEADY_TIME)``
   periods from rest; the velocity is the slope of the runner's period-mean position
-  (``period_mean_position`` of :class:`passmd.dynamics.SimulationResult`, no stick phase
+  (``period_mean_position`` of :class:`passmd.solver.simulation.SimulationResult`, no stick phase
   assumed) over the run's second half, and ``velocity_drift`` compares its third and fourth
   quarter. For the optimized waveform the run also reports whether the contacts stick while
   the hemispheres accelerate (assumption ``stick_during_acceleration``).
@@ -23,8 +23,9 @@ import math
 
 import numpy as np
 
-from passmd import dynamics, optimized_waveform, waveforms
-from passmd._validation import check_choice
+from passmd.model import optimized_waveform, waveforms
+from passmd.runtime.validation import check_choice
+from passmd.solver import simulation as dynamics
 
 __all__ = [
     "FULL_SLIDING_SHARE",
@@ -116,7 +117,7 @@ def steady_run(drive, amplitude: float, frequency: float, waveform: str, short_p
         ``velocity_m_per_s``, ``velocity_drift``, ``step_m`` (velocity / f),
         ``back_step_m`` (mean over the second half), ``periods``,
         ``simulator_mean_velocity_m_per_s``, ``wall_time_s`` and, for the optimized
-        waveform, the times actually used (:func:`passmd.optimized_waveform.optimized_timing`),
+        waveform, the times actually used (:func:`passmd.model.optimized_waveform.optimized_timing`),
         ``max_slip_share_acceleration`` and ``stick_during_acceleration``.
     """
     periods = steady_periods(frequency)

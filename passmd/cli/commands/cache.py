@@ -5,11 +5,11 @@ from __future__ import annotations
 import os
 import textwrap
 
-from passmd.cache import MARKER_NAME, describe_default_cache_dir
 from passmd.cli.errors import UsageError
 from passmd.cli.options import CACHE_DIR_HELP, DirectoryPath
 from passmd.cli.output import JSON_HELP, emit_json, emit_rows
-from passmd.config import ENVIRONMENT, RunConfig
+from passmd.runtime.cache import MARKER_NAME, describe_default_cache_dir
+from passmd.runtime.config import ENVIRONMENT, RunConfig
 
 __all__ = ["add_parser", "run_cache"]
 
@@ -18,7 +18,7 @@ _EPILOG = textwrap.dedent(f"""\
     function. clear: remove every entry. prune: remove entries of other code versions
     (their code fingerprint differs, so they can never be served), unreadable entries
     and stale temporary files. Entries are checksummed data (JSON header + raw array
-    bytes), never code; see passmd.cache for the format. Directory:
+    bytes), never code; see passmd.runtime.cache for the format. Directory:
     ${ENVIRONMENT['cache_dir']}, else {describe_default_cache_dir()}.
 
     Only a cache's own files are ever removed: a cache directory carries the marker
@@ -53,7 +53,7 @@ def _named(args) -> str:
 
 
 def run_cache(args, out) -> int:
-    from passmd.cache import Cache, NotACache
+    from passmd.runtime.cache import Cache, NotACache
 
     store = Cache(RunConfig.from_environment(cache_dir=args.cache_dir or None).cache_dir)
     try:

@@ -10,8 +10,8 @@ from passmd.cli.drive import build_drive
 from passmd.cli.errors import UsageError
 from passmd.cli.options import DEFAULT_DRIVE, NORMAL_FORCE, add_drive_options, refuse_bare
 from passmd.cli.output import JSON_HELP, check_results, emit_json, fmt
-from passmd.parameters import check_contact_plausible
-from passmd.units import from_si, parse_quantities
+from passmd.model.parameters import check_contact_plausible
+from passmd.runtime.units import from_si, parse_quantities
 
 __all__ = ["add_parser", "check_springs", "run_contact"]
 
@@ -51,8 +51,8 @@ def check_springs(springs):
 
 
 def run_contact(args, out) -> int:
-    from passmd.contact import MDRContact
-    from passmd.theory import contact_moduli
+    from passmd.model.contact import MDRContact
+    from passmd.model.theory import contact_moduli
 
     if args.path is None:
         raise UsageError("--path is required, e.g. --path 0nm,30nm,-10nm,45nm")

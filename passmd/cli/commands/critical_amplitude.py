@@ -10,8 +10,8 @@ from passmd.cli.drive import build_drive, drive_rows
 from passmd.cli.errors import UsageError
 from passmd.cli.options import FREQUENCY, THRESHOLD, TOLERANCE, add_drive_options
 from passmd.cli.output import JSON_HELP, check_results, describe, drive_record, emit_json, emit_rows, fmt
-from passmd.defaults import PROTOCOL
-from passmd.units import from_si
+from passmd.model.defaults import PROTOCOL
+from passmd.runtime.units import from_si
 
 __all__ = ["READINGS", "add_parser", "run_critical_amplitude"]
 
@@ -99,7 +99,7 @@ def _search(args, drive) -> dict:
 
 
 def run_critical_amplitude(args, out) -> int:
-    from passmd.theory import drive_theory
+    from passmd.model.theory import drive_theory
 
     drive = build_drive(args)
     theory = drive_theory(drive)

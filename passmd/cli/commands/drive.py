@@ -35,7 +35,7 @@ def add_parser(command) -> None:
 
 
 def run_template(args, out) -> int:
-    from passmd.drive_file import drive_toml, resolve
+    from passmd.model.drive_file import drive_toml, resolve
 
     drive, sources = resolve({})
     sources = {key: text[len("default ("):-1] if text.startswith("default (") else text
@@ -57,7 +57,7 @@ def _shown(row: dict) -> str:
 
 
 def run_show(args, out) -> int:
-    from passmd.drive_file import parameter_rows
+    from passmd.model.drive_file import parameter_rows
 
     drive, sources = resolve_drive(args)
     rows = parameter_rows(drive, sources)

@@ -7,14 +7,14 @@ import sys
 import textwrap
 from pathlib import Path
 
-from passmd._result_bounds import check_table
-from passmd.cache import describe_default_cache_dir
 from passmd.cli.configuration import run_config
 from passmd.cli.errors import NotAvailableError, OutputError, UsageError
 from passmd.cli.options import DirectoryPath, add_sweep_options
 from passmd.cli.output import JSON_HELP, emit_json
+from passmd.cli.result_bounds import check_table
 from passmd.cli.streams import PipeClosed, check_outputs, write_atomically
-from passmd.config import ENVIRONMENT, PROFILES
+from passmd.runtime.cache import describe_default_cache_dir
+from passmd.runtime.config import ENVIRONMENT, PROFILES
 
 __all__ = ["NOT_AVAILABLE", "add_parser", "run_figure"]
 
@@ -103,7 +103,8 @@ def _write(figures, provenance, args, data) -> tuple[Path, Path]:
 
 
 def run_figure(args, out) -> int:
-    from passmd import figures, provenance
+    from passmd.experiments import figure_table as figures
+    from passmd.runtime import provenance
 
     names = figures.figure_names()
     if args.name == "list":

@@ -18,7 +18,7 @@ from passmd.cli.options import (
     refuse_bare,
 )
 from passmd.cli.output import JSON_HELP, check_results, describe, drive_record, emit_json, emit_rows, plain
-from passmd.units import from_si, parse_quantity
+from passmd.runtime.units import from_si, parse_quantity
 
 __all__ = ["FREE_NAMES", "add_parser", "run_fit"]
 
@@ -151,8 +151,8 @@ def _write(target: Path, result, record: dict, text: str) -> None:
 
 
 def run_fit(args, out) -> int:
-    from passmd.config import RunConfig
     from passmd.protocols import fit as fitting
+    from passmd.runtime.config import RunConfig
 
     names = _free(args)
     bounds = _bounds(args, names)

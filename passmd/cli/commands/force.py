@@ -5,14 +5,14 @@ from __future__ import annotations
 import re
 import textwrap
 
-from passmd._result_bounds import ResultError
 from passmd.cli import kernels
 from passmd.cli.commands.run import check_memory, check_output_paths, waveform_args, write_outputs
 from passmd.cli.drive import build_drive, drive_rows
 from passmd.cli.errors import UsageError
 from passmd.cli.options import add_drive_options, add_output_options, add_simulation_options
 from passmd.cli.output import check_results, describe, drive_record, emit_json, emit_rows, fmt
-from passmd.defaults import PROTOCOL
+from passmd.cli.result_bounds import ResultError
+from passmd.model.defaults import PROTOCOL
 
 __all__ = ["add_parser", "run_force"]
 
@@ -88,7 +88,8 @@ def run_force(args, out) -> int:
         raise ResultError(str(exc)) from exc
     check_results(found)
     if args.csv or args.plot:  # the reported run again, for its time series
-        from passmd import dynamics, waveforms
+        from passmd.model import waveforms
+        from passmd.solver import simulation as dynamics
 
         wave = waveforms.sawtooth(amplitude, frequency, drive, periods=found["periods"], flyback=args.flyback)
         write_outputs(args, dynamics.simulate(drive, wave, max_points=args.max_points))

@@ -5,14 +5,14 @@ from __future__ import annotations
 import datetime
 import textwrap
 
-from passmd._result_bounds import check_table
-from passmd.cache import DEFAULT_CACHE_DIR, describe_default_cache_dir
 from passmd.cli.configuration import run_config
 from passmd.cli.errors import OutputError
 from passmd.cli.options import FilePath, add_sweep_options
 from passmd.cli.output import JSON_HELP, check_output_file, emit_json
+from passmd.cli.result_bounds import check_table
 from passmd.cli.streams import PipeClosed, check_outputs, write_atomically
-from passmd.config import ENVIRONMENT, PROFILES
+from passmd.runtime.cache import DEFAULT_CACHE_DIR, describe_default_cache_dir
+from passmd.runtime.config import ENVIRONMENT, PROFILES
 
 __all__ = ["add_parser", "run_ledger"]
 
@@ -20,7 +20,7 @@ _EPILOG = textwrap.dedent(f"""\
     Computes (or reads from the cache: ${ENVIRONMENT['cache_dir']}, else
     {describe_default_cache_dir()}; the book built with nox uses ./{DEFAULT_CACHE_DIR}/
     of the repository) every figure's results at --profile and evaluates every claim of
-    passmd/data/reference/claims.csv on the product of the readings of passmd.readings it
+    passmd/data/reference/claims.csv on the product of the readings of passmd.ledger.readings it
     depends on; each category comes from the defaults and the joint reading (the point of the
     assumption space where the most claims hold together).
 
@@ -48,7 +48,7 @@ def add_parser(command) -> None:
 def _check_baseline(args, config) -> None:
     """--write-baseline, before the ledger is computed: a file in an existing directory, not the
     claims table the ledger reads, the sweep log or the file standard output goes to."""
-    from passmd.claims import CLAIMS_PATH
+    from passmd.ledger.claims import CLAIMS_PATH
 
     name = args.write_baseline
     if name is None:
@@ -76,7 +76,8 @@ def run_ledger(args, out) -> int:
     """Every claim of the paper with its computed category, values and evidence (Sections 4–6)."""
     config = run_config(args)
     _check_baseline(args, config)  # (before the ledger's modules load)
-    from passmd import ledger, ledger_views
+    from passmd.ledger import evaluation as ledger
+    from passmd.report import ledger_views
 
     results = ledger.collect_results(config)
     for name, table in results.items():  # finite before anything is written, as run and theory check

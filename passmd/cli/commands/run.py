@@ -5,7 +5,6 @@ from __future__ import annotations
 from dataclasses import replace
 from pathlib import Path
 
-from passmd._result_bounds import check_run_bounds
 from passmd.cli import kernels, startup
 from passmd.cli.commands.contact import check_springs
 from passmd.cli.drive import build_drive, drive_rows
@@ -28,9 +27,10 @@ from passmd.cli.output import (
     fmt,
     nm,
 )
+from passmd.cli.result_bounds import check_run_bounds
 from passmd.cli.streams import PipeClosed, available_memory, check_outputs, write_atomically
-from passmd.defaults import PROTOCOL
-from passmd.units import from_si
+from passmd.model.defaults import PROTOCOL
+from passmd.runtime.units import from_si
 
 __all__ = ["add_parser", "check_memory", "check_output_paths", "run_run", "simulate", "waveform_args",
            "write_outputs"]
@@ -153,8 +153,9 @@ def check_output_paths(args) -> None:
 def simulate(args, drive):
     """(result, Eq. 15 design or None) of the run the options describe (saw-tooth or Eq. 15)."""
     startup.load_numba_without_blas_probe()
-    from passmd import dynamics, optimized_waveform, waveforms
+    from passmd.model import optimized_waveform, waveforms
     from passmd.protocols import eq15
+    from passmd.solver import simulation as dynamics
 
     amplitude, frequency = waveform_args(args, drive)
     springs = check_springs(args.springs)

@@ -13,7 +13,6 @@ from pathlib import Path
 
 import numpy as np
 
-from passmd._validation import InputError
 from passmd.cli.configuration import run_config
 from passmd.cli.drive import build_drive, explain
 from passmd.cli.errors import OutputError, UsageError
@@ -28,9 +27,10 @@ from passmd.cli.options import (
 )
 from passmd.cli.output import JSON_HELP, check_output_file, describe, drive_record, emit_json, emit_rows, fmt
 from passmd.cli.streams import PipeClosed, check_outputs, write_atomically
-from passmd.config import ENVIRONMENT
-from passmd.defaults import PROTOCOL
-from passmd.units import QuantityError, from_si, parse_quantity
+from passmd.model.defaults import PROTOCOL
+from passmd.runtime.config import ENVIRONMENT
+from passmd.runtime.units import QuantityError, from_si, parse_quantity
+from passmd.runtime.validation import InputError
 
 __all__ = ["AXES", "MAX_AXIS_POINTS", "MAX_POINTS", "Axis", "add_parser", "parse_vary", "run_sweep"]
 
@@ -291,7 +291,7 @@ def _points(args, axes: list[Axis], with_amplitude: bool) -> list[dict]:
 def _check_waveform(args, axes, at, drive, amplitude, frequency) -> None:
     """The saw-tooth of a point can be built (e.g. its fly-back fits in half a period), before
     anything runs; a refused frequency axis is named as typed."""
-    from passmd import waveforms
+    from passmd.model import waveforms
 
     try:
         waveforms.sawtooth(amplitude, frequency, drive, periods=1)
@@ -325,7 +325,7 @@ def _arguments(args) -> str:
 
 def _record(args, axes, table, spec, drive) -> dict:
     from passmd import __version__
-    from passmd.provenance import git_commit
+    from passmd.runtime.provenance import git_commit
 
     rows = [{k: _finite_or_none(v) for k, v in row.items()} for row in table.to_dict(orient="records")]
     missing = sum(row[spec.column] is None for row in rows)
@@ -420,7 +420,7 @@ def _check_values(quantity: str, column: str, table) -> None:
 
 
 def run_sweep(args, out) -> int:
-    from passmd.experiments.maps import compute_map
+    from passmd.experiments.design.maps import compute_map
     from passmd.protocols.maps import MAP_QUANTITIES
 
     spec = MAP_QUANTITIES[args.quantity]

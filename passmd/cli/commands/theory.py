@@ -33,7 +33,7 @@ def add_parser(command) -> None:
 
 
 def run_theory(args, out) -> int:
-    from passmd.theory import drive_theory, runner_frequency
+    from passmd.model.theory import drive_theory, runner_frequency
 
     drive = build_drive(args)
     result = drive_theory(drive)

@@ -1,0 +1,416 @@
+"""Critical actuation amplitude: grids, figures and claims of Figs. 5 and 6 (Section 4.1).
+
+The paper finds the critical amplitude A_c with its dynamic simulation and compares it with
+closed forms: Eq. 7 (one contact, rigid actuator), Eq. 8 (one contact, flexible), Eq. 11
+(six contacts, rigid) and Eq. 12 (six contacts, flexible). The search itself (both
+protocols, the bisection, the step threshold) is :mod:`passmd.protocols.critical_amplitude`;
+this module runs it over the preload grids of a resolution profile through
+:mod:`passmd.runtime.sweep`; the claim extractors of Section 4.1 are
+:mod:`passmd.experiments.critical_amplitude.claims`, the facts the chapters quote
+:mod:`passmd.experiments.critical_amplitude.facts`.
+
+Figures (rows of :mod:`passmd.experiments.figure_table`): ``fig5a`` (step vs amplitude), ``fig5b`` (one
+contact, A_c vs preload), ``fig6a``–``fig6c`` (six contacts), and two sensitivity panels
+beyond the paper, ``fig56_viscosity`` (A_c vs actuator viscosity c_p) and
+``fig56_frequency`` (A_c vs drive frequency). Each compute function takes a
+:class:`~passmd.runtime.config.RunConfig` and returns a tidy DataFrame (lengths in nm)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from passmd.ledger import readings, reference
+from passmd.ledger.checks import ClaimFails, NotEvaluable
+from passmd.model.defaults import PROTOCOL
+from passmd.model.parameters import ACTUATOR_DAMPING_RATIO, PRELOAD_GRIDS, Drive, actuator_for_radius
+from passmd.protocols.critical_amplitude import (
+    PROTOCOLS,
+    STEADY_PERIODS,
+    STEP_THRESHOLD,
+    critical_amplitude,
+    steady_step,
+)
+from passmd.runtime import sweep
+from passmd.runtime.config import RunConfig
+
+__all__ = [
+    "FIG5A_DRIVE",
+    "PROFILE_SETTINGS",
+    "critical_amplitude_point",
+    "fig56_frequency",
+    "fig56_viscosity",
+    "fig5a",
+    "fig5b",
+    "fig6a",
+    "fig6b",
+    "fig6c",
+    "paper_drive_for",
+    "primary",
+    "step_point",
+]
+
+def paper_drive_for(
+    contacts: int,
+    actuator_model: str,
+    hemisphere_radius: float,
+    preload: float,
+    damping_ratio: float = ACTUATOR_DAMPING_RATIO,
+) -> Drive:
+    """The Fig. 5/6 drive: Tables 1–2, free runner (no load cell), μ = 0.2, actuator damping ζ."""
+    return Drive(
+        hemisphere_radius=hemisphere_radius,
+        preload=preload,
+        contacts=contacts,
+        actuator_model=actuator_model,
+        actuator=actuator_for_radius(hemisphere_radius, damping_ratio=damping_ratio),
+    )
+
+
+# --------------------------------------------------------------------------------------
+# Sweep point functions (top level, scalar keyword arguments: picklable and cacheable)
+# --------------------------------------------------------------------------------------
+
+
+def critical_amplitude_point(
+    contacts: int,
+    actuator_model: str,
+    hemisphere_radius: float,
+    preload: float,
+    protocol: str,
+    frequency: float,
+    flyback: str,
+    tolerance: float,
+    damping_ratio: float = ACTUATOR_DAMPING_RATIO,
+    periods: int = STEADY_PERIODS,
+    threshold: float = STEP_THRESHOLD,
+) -> dict:
+    """The A_c search (:func:`~passmd.protocols.critical_amplitude.critical_amplitude`) of
+    :func:`paper_drive_for`: one sweep point, SI results."""
+    drive = paper_drive_for(contacts, actuator_model, hemisphere_radius, preload, damping_ratio)
+    return critical_amplitude(
+        drive,
+        protocol=protocol,
+        frequency=frequency,
+        flyback=flyback,
+        periods=periods,
+        threshold=threshold,
+        tolerance=tolerance,
+    )
+
+
+def step_point(
+    contacts: int,
+    actuator_model: str,
+    hemisphere_radius: float,
+    preload: float,
+    amplitude: float,
+    frequency: float,
+    flyback: str,
+    damping_ratio: float = ACTUATOR_DAMPING_RATIO,
+    periods: int = STEADY_PERIODS,
+) -> dict:
+    """First and last step (m) and integration time (s) of a saw-tooth run of :func:`paper_drive_for`."""
+    if amplitude == 0.0:  # x_p stays 0: nothing moves
+        return {"first_step_m": 0.0, "last_step_m": 0.0, "wall_time_s": 0.0}
+    drive = paper_drive_for(contacts, actuator_model, hemisphere_radius, preload, damping_ratio)
+    out = steady_step(drive, amplitude, frequency, periods=periods, flyback=flyback)
+    return {key: out[key] for key in ("first_step_m", "last_step_m", "wall_time_s")}
+
+
+# --------------------------------------------------------------------------------------
+# Profiles and figure data
+# --------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ProfileSettings:
+    """What a resolution profile means for the critical-amplitude figures."""
+
+    preloads: dict  # hemisphere radius (m) -> preloads (N) of Figs. 5b and 6
+    frequencies: tuple  # drive frequencies of the steady-state band (Hz)
+    tolerance: float  # width of the final bisection bracket (m)
+    amplitude_step: float  # amplitude grid step of Fig. 5a (m)
+    damping_ratios: tuple  # actuator damping ratios ζ of the viscosity panel
+    sensitivity_frequencies: tuple  # drive frequencies of the frequency panel (Hz)
+
+
+#: Hemisphere radius (m) and preload (N) of Fig. 5a (Section 4.1), also used by the
+#: damping and drive-frequency sensitivity figures.
+FIG5A_DRIVE = (1.0e-3, 0.4)
+
+PROFILE_SETTINGS = {
+    "quick": ProfileSettings(
+        preloads={1.0e-3: (0.2, 0.6, 1.0), 0.25e-3: (0.2, 0.4)},
+        frequencies=(PROTOCOL.drive_frequency,),
+        tolerance=0.5e-9,
+        amplitude_step=20e-9,
+        damping_ratios=(0.005, 0.05, 0.5),
+        sensitivity_frequencies=(PROTOCOL.drive_frequency, 1000.0),
+    ),
+    "paper": ProfileSettings(
+        preloads={r: tuple(float(p) for p in grid) for r, grid in PRELOAD_GRIDS.items()},
+        frequencies=PROTOCOL.critical_amplitude_band,
+        tolerance=PROTOCOL.search_tolerance,
+        amplitude_step=1e-9,
+        damping_ratios=tuple(float(z) for z in ACTUATOR_DAMPING_RATIO * np.logspace(-1, 1, 5)),
+        sensitivity_frequencies=(20.0, 50.0, PROTOCOL.drive_frequency, 200.0, 500.0, 1000.0),
+    ),
+}
+
+
+def _settings(config: RunConfig) -> ProfileSettings:
+    return PROFILE_SETTINGS[config.profile]
+
+
+def _protocols(actuator_model: str, frequencies) -> list[dict]:
+    """The (protocol, fly-back, frequency[, ζ]) combinations drawn for an actuator model.
+
+    The ledger evaluates the A_c claims on the product of their axes (:mod:`passmd.ledger.readings`).
+    At ``PROTOCOL.drive_frequency`` and the default ζ the tables hold both protocols × (for
+    flexible actuators) both fly-back rules; the evaluated alternatives of ζ (Table 2's c_p is
+    lost) are searched with the steady protocol and the slew-rate fly-back, the other drive
+    frequencies of the band with the steady protocol, the slew-rate fly-back and the default ζ.
+    The other points of the product are not computed: the ledger counts them as not covered.
+    """
+    combos = [{"protocol": "steady", "flyback": "slew", "frequency": float(f)} for f in frequencies]
+    combos.append({"protocol": "first", "flyback": "slew", "frequency": PROTOCOL.drive_frequency})
+    if actuator_model == "flexible":  # the fly-back rule and ζ only matter for flexible actuators
+        combos.append({"protocol": "steady", "flyback": "fixed", "frequency": PROTOCOL.drive_frequency})
+        combos.append({"protocol": "first", "flyback": "fixed", "frequency": PROTOCOL.drive_frequency})
+        combos.extend({"protocol": "steady", "flyback": "slew", "frequency": PROTOCOL.drive_frequency,
+                       "damping_ratio": float(z)} for z in readings.axis("damping_ratio").alternatives)
+    return combos
+
+
+def _run_searches(points: list[dict], description: str, config: RunConfig) -> pd.DataFrame:
+    """Run critical-amplitude searches through the sweep engine; tidy frame in nm."""
+    frame = sweep.run(critical_amplitude_point, points, description=description, config=config)
+    out = pd.DataFrame(
+        {
+            "contacts": frame["contacts"].astype(int),
+            "actuator_model": frame["actuator_model"],
+            "radius_mm": frame["hemisphere_radius"] * 1e3,
+            "preload_N": frame["preload"],
+            "protocol": frame["protocol"],
+            "flyback": frame["flyback"],
+            "frequency_Hz": frame["frequency"],
+            "damping_ratio": frame["damping_ratio"],
+            "critical_amplitude_nm": frame["critical_amplitude_m"] * 1e9,
+            "bracket_low_nm": frame["bracket_low_m"] * 1e9,
+            "bracket_high_nm": frame["bracket_high_m"] * 1e9,
+            "runs": frame["runs"].astype(int),
+            "wall_time_s": frame["wall_time_s"],
+        }
+    )
+    out.attrs["sweep"] = frame.attrs.get("sweep", {})  # points computed / taken from the cache
+    return out
+
+
+def _preload_figure(config: RunConfig, contacts: int, radius: float, models, curve: str) -> pd.DataFrame:
+    s = _settings(config)
+    points = [
+        {
+            "contacts": contacts,
+            "actuator_model": model,
+            "hemisphere_radius": radius,
+            "preload": float(p),
+            "tolerance": s.tolerance,
+            "damping_ratio": ACTUATOR_DAMPING_RATIO,
+            **combo,
+        }
+        for p in s.preloads[radius]
+        for model in models
+        for combo in _protocols(model, s.frequencies)
+    ]
+    table = _run_searches(points, curve.split("_")[0], config)
+    closed = reference.closed_form_curves(curve)
+    merged = table.merge(closed, on="preload_N", how="left", validate="many_to_one")
+    merged.attrs = table.attrs
+    return merged
+
+
+def fig5a(config: RunConfig) -> pd.DataFrame:
+    """Fig. 5a: first and steady-state step against the amplitude (one contact, F_p = 0.4 N, R = 1 mm).
+
+    Rigid and flexible actuators with the slew-rate fly-back, and flexible with the fixed
+    2 µs fly-back, at ``PROTOCOL.drive_frequency``; the amplitude grid runs from 0 to the full
+    stroke in the profile's step. Lengths in nm.
+    """
+    s = _settings(config)
+    radius, preload = FIG5A_DRIVE
+    a_max = actuator_for_radius(radius).full_stroke_amplitude
+    amplitudes = np.round(np.arange(0.0, a_max * (1 + 1e-9), s.amplitude_step), 15)
+    series = [("rigid", "slew"), ("flexible", "slew"), ("flexible", "fixed")]
+    points = [
+        {
+            "contacts": 1,
+            "actuator_model": model,
+            "hemisphere_radius": radius,
+            "preload": preload,
+            "amplitude": float(a),
+            "frequency": PROTOCOL.drive_frequency,
+            "flyback": flyback,
+        }
+        for model, flyback in series
+        for a in amplitudes
+    ]
+    frame = sweep.run(step_point, points, description="fig5a", config=config)
+    closed = reference.closed_form_curves("fig5b_closed_form").set_index("preload_N").loc[preload]
+    table = pd.DataFrame(
+        {
+            "actuator_model": frame["actuator_model"],
+            "flyback": frame["flyback"],
+            "frequency_Hz": frame["frequency"],
+            "preload_N": frame["preload"],
+            "amplitude_nm": frame["amplitude"] * 1e9,
+            "first_step_nm": frame["first_step_m"] * 1e9,
+            "steady_step_nm": frame["last_step_m"] * 1e9,
+            "threshold_nm": STEP_THRESHOLD * 1e9,
+            "u_x_max_nm": closed["u_x_max_nm"],
+            "u_x_max_plus_u_x_a_nm": closed["u_x_max_plus_u_x_a_nm"],
+            "wall_time_s": frame["wall_time_s"],
+        }
+    )
+    table.attrs["sweep"] = frame.attrs.get("sweep", {})
+    return table
+
+
+def fig5b(config: RunConfig) -> pd.DataFrame:
+    """Fig. 5b: A_c against preload, one contact, rigid and flexible, with Eqs. 7 and 8 (nm)."""
+    return _preload_figure(config, 1, 1.0e-3, ("rigid", "flexible"), "fig5b_closed_form")
+
+
+def fig6a(config: RunConfig) -> pd.DataFrame:
+    """Fig. 6a: A_c against preload, six contacts, rigid actuators, with Eqs. 10 and 11 (nm)."""
+    return _preload_figure(config, 6, 1.0e-3, ("rigid",), "fig6a_closed_form")
+
+
+def fig6b(config: RunConfig) -> pd.DataFrame:
+    """Fig. 6b: A_c against preload, six contacts, flexible actuators, R = 1 mm, with Eqs. 12–14 (nm)."""
+    return _preload_figure(config, 6, 1.0e-3, ("flexible",), "fig6b_closed_form")
+
+
+def fig6c(config: RunConfig) -> pd.DataFrame:
+    """Fig. 6c: A_c against preload, six contacts, flexible actuators, R = 0.25 mm, with Eqs. 12–14 (nm)."""
+    return _preload_figure(config, 6, 0.25e-3, ("flexible",), "fig6c_closed_form")
+
+
+def _closed_form_at(contacts: int, actuator_model: str, radius: float, preload: float) -> float:
+    """Eq. 7/8 (one contact) or Eq. 11/12 (six contacts) in nm, from passmd.model.theory."""
+    from passmd.model.theory import drive_theory
+
+    drive = paper_drive_for(contacts, actuator_model, radius, preload)
+    return drive_theory(drive)["analytic_critical_amplitude_m"] * 1e9
+
+
+def fig56_viscosity(config: RunConfig) -> pd.DataFrame:
+    """Beyond the paper: A_c of flexible actuators against c_p (a decade either side of the default).
+
+    One and six contacts, F_p = 0.4 N, R = 1 mm; both protocols and both fly-back rules.
+    ``actuator_viscosity_kg_per_s`` is c_p = 2ζ√(k_p m_a); ``closed_form_nm`` is Eq. 8
+    (one contact) or Eq. 12 (six), which do not depend on c_p.
+    """
+    s = _settings(config)
+    radius, preload = FIG5A_DRIVE
+    points = [
+        {
+            "contacts": n,
+            "actuator_model": "flexible",
+            "hemisphere_radius": radius,
+            "preload": preload,
+            "protocol": protocol,
+            "frequency": PROTOCOL.drive_frequency,
+            "flyback": flyback,
+            "tolerance": s.tolerance,
+            "damping_ratio": float(z),
+        }
+        for n in (1, 6)
+        for z in s.damping_ratios
+        for protocol in PROTOCOLS
+        for flyback in ("slew", "fixed")
+    ]
+    table = _run_searches(points, "fig56_viscosity", config)
+    table["actuator_viscosity_kg_per_s"] = [
+        actuator_for_radius(radius, damping_ratio=z).viscosity for z in table["damping_ratio"]
+    ]
+    table["closed_form_nm"] = [_closed_form_at(n, "flexible", radius, preload) for n in table["contacts"]]
+    return table
+
+
+def fig56_frequency(config: RunConfig) -> pd.DataFrame:
+    """Beyond the paper: A_c (both protocols) against the drive frequency of the runs.
+
+    One and six contacts, rigid and flexible (slew-rate fly-back), F_p = 0.4 N, R = 1 mm;
+    ``closed_form_nm`` is Eq. 7/8 (one contact) or Eq. 11/12 (six).
+    """
+    s = _settings(config)
+    radius, preload = FIG5A_DRIVE
+    points = [
+        {
+            "contacts": n,
+            "actuator_model": model,
+            "hemisphere_radius": radius,
+            "preload": preload,
+            "protocol": protocol,
+            "frequency": float(f),
+            "flyback": "slew",
+            "tolerance": s.tolerance,
+            "damping_ratio": ACTUATOR_DAMPING_RATIO,
+        }
+        for n in (1, 6)
+        for model in ("rigid", "flexible")
+        for protocol in PROTOCOLS
+        for f in s.sensitivity_frequencies
+    ]
+    table = _run_searches(points, "fig56_frequency", config)
+    table["closed_form_nm"] = [
+        _closed_form_at(n, m, radius, preload)
+        for n, m in zip(table["contacts"], table["actuator_model"], strict=True)
+    ]
+    return table
+
+
+# --------------------------------------------------------------------------------------
+# One reading of the A_c protocol (the chapters' facts and the ledger's claims)
+# --------------------------------------------------------------------------------------
+
+
+def primary(table: pd.DataFrame, actuator_model: str | None = None, reading=None) -> pd.DataFrame:
+    """The rows of one reading of the A_c protocol (default: steady state,
+    ``PROTOCOL.drive_frequency``, slew-rate fly-back, ζ =
+    :data:`~passmd.model.parameters.ACTUATOR_DAMPING_RATIO`).
+
+    ``reading`` is a ledger reading (:mod:`passmd.ledger.readings`): its ``ac_protocol``,
+    ``flyback``, ``drive_frequency_s4`` and ``damping_ratio`` select the rows. The fly-back
+    rule and ζ apply to flexible actuators only (the rigid runs use the slew-rate fly-back). Raises
+    :class:`passmd.ledger.checks.NotEvaluable` when the table holds no run at that reading and
+    :class:`passmd.ledger.checks.ClaimFails` when a preload makes no step up to the full stroke.
+    """
+    protocol, flyback, frequency = "steady", "slew", PROTOCOL.drive_frequency
+    zeta = ACTUATOR_DAMPING_RATIO
+    if reading is not None:
+        protocol, flyback = reading["ac_protocol"], reading["flyback"]
+        frequency = float(reading["drive_frequency_s4"])
+        zeta = float(reading.get("damping_ratio", zeta))
+    if actuator_model == "rigid":  # no actuator dynamics: neither the fly-back rule nor ζ applies
+        flyback, zeta = "slew", ACTUATOR_DAMPING_RATIO
+    rows = table[
+        (table["protocol"] == protocol)
+        & (table["flyback"] == flyback)
+        & np.isclose(table["frequency_Hz"], frequency)
+        & np.isclose(table["damping_ratio"], zeta, rtol=1e-9, atol=0)
+    ]
+    if actuator_model is not None:
+        rows = rows[rows["actuator_model"] == actuator_model]
+    rows = rows.sort_values("preload_N")
+    if rows.empty:
+        raise NotEvaluable(f"no {protocol} A_c runs with the {flyback} fly-back at {frequency:g} Hz "
+                           f"and ζ = {zeta:g} on this grid")
+    if rows["critical_amplitude_nm"].isna().any():
+        where = rows.loc[rows["critical_amplitude_nm"].isna(), "preload_N"].tolist()
+        raise ClaimFails(f"no step up to the full stroke at {', '.join(f'{p:g}' for p in where)} N "
+                         "(A_c above A_max)")
+    return rows

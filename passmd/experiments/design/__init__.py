@@ -1,0 +1,1 @@
+"""The chapter "Design your own drive": the worked example and design maps."""

@@ -1,0 +1,354 @@
+"""The worked example of the chapter "Design your own drive": a drive that is not the paper's.
+
+The drive is a drive file shipped with the package (:data:`EXAMPLE_DRIVE_FILE`), read as
+``passmd --drive FILE`` reads it. Every figure's data comes from the functions a designer
+calls: :func:`passmd.experiments.design.maps.compute_map` (what ``passmd sweep`` runs) for the
+critical amplitude, the step and velocity map, the Eq. 15 gain map and the stall force, and
+:func:`passmd.protocols.fit.fit` (what ``passmd fit`` runs) for the calibration. One function
+per figure; the grids of each profile are in :data:`PROFILE_SETTINGS`.
+
+The calibration is a round trip: measurements of the example drive are simulated
+(:func:`synthetic_measurements`, Gaussian noise of :data:`NOISE_NM` with seed :data:`SEED`),
+the unknown parameters are fitted from a designer's first guess (:data:`START`: the paper's
+Table 1 friction coefficient, Table 2's stiffness for the radius), and the fitted drive predicts
+measurements that were held back from the fit.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+from dataclasses import dataclass, replace
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from passmd.experiments.design.maps import compute_map
+from passmd.model.defaults import PROTOCOL
+from passmd.model.drive_file import load_drive, parameter_rows, read_drive_file, resolve
+from passmd.model.parameters import Drive, actuator_for_radius
+from passmd.protocols import fit as fitting
+from passmd.protocols import stall
+from passmd.runtime.config import PROFILES, RunConfig
+from passmd.runtime.units import from_si
+from passmd.runtime.validation import check_choice
+
+__all__ = [
+    "EXAMPLE_DRIVE_FILE",
+    "NOISE_NM",
+    "PROFILE_SETTINGS",
+    "SEED",
+    "START",
+    "ProfileSettings",
+    "calibrate",
+    "critical_amplitude_curve",
+    "example_drive",
+    "fit_facts",
+    "gain_facts",
+    "gain_map",
+    "heldback_facts",
+    "heldback_predictions",
+    "load_fitted",
+    "map_facts",
+    "map_points",
+    "measurements_csv",
+    "parameter_table",
+    "stall_force_curve",
+    "start_drive",
+    "step_velocity_map",
+    "synthetic_measurements",
+]
+
+#: The example drive file (package data, so an installed wheel has it too).
+EXAMPLE_DRIVE_FILE = Path(os.fspath(resources.files("passmd") / "data" / "drives" / "example_drive.toml"))
+#: Standard deviation of the synthetic measurements' noise (nm): a step read to about 1 nm, as
+#: a capacitive or interferometric sensor on a test stand reads it.
+NOISE_NM = 1.0
+#: Seed of the noise (numpy's default generator): the measurements are the same on every build.
+SEED = 0
+#: Frequency of the calibration's steps (Hz): Section 4.1's saw-tooth frequency.
+FIT_FREQUENCY = PROTOCOL.drive_frequency
+#: A designer's first guess of each free parameter: its source. The values are the paper's.
+START = {"friction_coefficient": "Table 1 (μ = 0.2)",
+         "actuator.stiffness": "Table 2 interpolated at the radius"}
+
+
+@dataclass(frozen=True)
+class ProfileSettings:
+    """What a profile computes for the chapter."""
+
+    preloads: tuple[float, ...]  # critical amplitude against preload (N)
+    map_frequencies: int  # log-spaced from MAP_FREQUENCY_RANGE
+    map_amplitudes: int  # linear over MAP_AMPLITUDE_RANGE
+    stall_fractions: tuple[float, ...]  # stall force amplitudes, fractions of the full stroke
+    stall_preloads: tuple[float, ...]  # N
+    free: tuple[str, ...]  # fitted parameters
+    fit_preloads: tuple[float, ...]  # N
+    fit_amplitudes_nm: tuple[float, ...]  # at each fit preload, FIT_FREQUENCY
+    #: held-back points: (frequency Hz, preload N, amplitude nm), steps never shown to the fit
+    heldback: tuple[tuple[float, float, float], ...]
+    #: executor of the sweeps when the configuration names none (None: the sweep engine's default)
+    executor: str | None = None
+
+
+#: Frequency and amplitude ranges of the maps: 100 Hz (Fig. 9a) to 110 kHz (Fig. 9b); amplitudes
+#: from 40 nm (above the example drive's steady critical amplitude) to its full stroke.
+MAP_FREQUENCY_RANGE = (100.0, 110e3)
+MAP_AMPLITUDE_LOW = 40e-9
+
+#: The grids of each book profile (quick: coarse, for CI; paper: the full maps and fit).
+PROFILE_SETTINGS = {
+    "quick": ProfileSettings(
+        preloads=(0.2, 0.6, 1.0),
+        map_frequencies=6, map_amplitudes=6,
+        stall_fractions=(0.6, 1.0), stall_preloads=(0.6,),
+        free=("friction_coefficient",),
+        fit_preloads=(0.6,), fit_amplitudes_nm=(70.0, 90.0, 110.0, 130.0),
+        heldback=((100.0, 0.9, 80.0), (100.0, 0.9, 125.0), (5e3, 0.6, 80.0), (5e3, 0.6, 125.0)),
+        # A few cheap points per sweep: starting a process pool (each worker imports numpy, numba
+        # and passmd, seconds on a loaded 2-core machine) costs more than the points themselves.
+        executor="serial",
+    ),
+    "paper": ProfileSettings(
+        preloads=tuple(np.round(np.linspace(0.1, 1.0, 10), 3)),
+        map_frequencies=24, map_amplitudes=24,
+        stall_fractions=tuple(np.round(np.linspace(0.4, 1.0, 7), 3)), stall_preloads=(0.3, 0.6, 0.9),
+        free=("friction_coefficient", "actuator.stiffness"),
+        fit_preloads=(0.3, 0.6), fit_amplitudes_nm=tuple(np.linspace(60.0, 130.0, 8)),
+        heldback=tuple((f, p, a) for f, p in ((100.0, 0.9), (5e3, 0.6), (20e3, 0.6))
+                       for a in (80.0, 105.0, 130.0)),
+    ),
+}
+
+
+def _settings(profile: str) -> ProfileSettings:
+    return PROFILE_SETTINGS[check_choice("profile", profile, PROFILES)]
+
+
+def _run_config(config: RunConfig | None, profile: str) -> RunConfig:
+    """``config`` with the profile's executor where it names none (an explicit choice wins)."""
+    config = RunConfig() if config is None else config
+    executor = _settings(profile).executor
+    if config.executor is None and config.scheduler is None and executor is not None:
+        return replace(config, executor=executor)
+    return config
+
+
+def example_drive(path=None) -> tuple[Drive, dict]:
+    """The drive a drive file describes and where each parameter came from, as ``passmd drive show``.
+
+    ``path``: default :data:`EXAMPLE_DRIVE_FILE`; the given keys' source is ``given in NAME``.
+    """
+    path = EXAMPLE_DRIVE_FILE if path is None else Path(path)
+    values = read_drive_file(path)
+    return resolve(values, dict.fromkeys(values, f"given in {path.name}"))
+
+
+def parameter_table(drive: Drive, sources: dict) -> pd.DataFrame:
+    """The rows of ``passmd drive show`` (:func:`passmd.model.drive_file.parameter_rows`), each value in
+    its display unit."""
+    rows = []
+    for row in parameter_rows(drive, sources):
+        value, unit = row["value"], row["display_unit"]
+        if isinstance(value, list):
+            shown = "; ".join(", ".join(f"{k} = {v:g}" for k, v in g.items()) for g in value) or "–"
+        elif isinstance(value, bool):
+            shown = str(value).lower()
+        elif isinstance(value, str):
+            shown = value
+        else:
+            shown = f"{float(from_si(value, unit)) if unit else value:.4g}"
+        rows.append({"key": row["key"], "symbol": row["symbol"], "value": shown, "unit": unit,
+                     "source": row["source"]})
+    return pd.DataFrame(rows)
+
+
+def critical_amplitude_curve(drive: Drive, profile: str, config: RunConfig | None = None) -> pd.DataFrame:
+    """A_c against preload at Section 4.1's frequency: the closed form (Eqs. 7–8, 11–12) and the
+    two simulated readings (``steady``, ``first``), as ``passmd sweep critical-amplitude``.
+
+    Columns (nm, N): ``preload_N``, ``closed_form_nm``, ``steady_nm``, ``first_nm``.
+    """
+    config = _run_config(config, profile)
+    points = [{"drive": replace(drive, preload=float(p)), "frequency": PROTOCOL.drive_frequency,
+               "preload_N": float(p)} for p in _settings(profile).preloads]
+    out = pd.DataFrame({"preload_N": [p["preload_N"] for p in points]})
+    for reading in ("steady", "first"):
+        table = compute_map("critical-amplitude", points, reading=reading, config=config,
+                            description=f"A_c ({reading}) against preload")
+        out[f"{reading}_nm"] = [math.nan if v is None else v * 1e9 for v in table["critical_amplitude_m"]]
+        out["closed_form_nm"] = table["analytic_critical_amplitude_m"].to_numpy(float) * 1e9
+    return out[["preload_N", "closed_form_nm", "steady_nm", "first_nm"]]
+
+
+def map_points(drive: Drive, profile: str) -> list[dict]:
+    """The frequency × amplitude grid of the maps (frequency the x axis, amplitude fastest), with
+    the columns ``passmd sweep --vary frequency=... --vary amplitude=...`` writes."""
+    s = _settings(profile)
+    frequencies = np.geomspace(*MAP_FREQUENCY_RANGE, s.map_frequencies)
+    amplitudes = np.linspace(MAP_AMPLITUDE_LOW, drive.actuator.full_stroke_amplitude, s.map_amplitudes)
+    return [{"drive": drive, "frequency": float(f), "amplitude": float(a), "frequency_Hz": float(f),
+             "amplitude_m": float(a)} for f in frequencies for a in amplitudes]
+
+
+def step_velocity_map(drive: Drive, profile: str, config: RunConfig | None = None) -> pd.DataFrame:
+    """Steady velocity, step and back-step of the saw-tooth over the map grid (``passmd sweep velocity``)."""
+    return compute_map("velocity", map_points(drive, profile), config=_run_config(config, profile),
+                       description="step/velocity map")
+
+
+def gain_map(drive: Drive, profile: str, config: RunConfig | None = None) -> pd.DataFrame:
+    """Eq. 15 waveform's steady velocity minus the saw-tooth's over the map grid (``passmd sweep gain``)."""
+    return compute_map("gain", map_points(drive, profile), config=_run_config(config, profile),
+                       description="Eq. 15 gain map")
+
+
+def stall_force_curve(drive: Drive, profile: str, config: RunConfig | None = None) -> pd.DataFrame:
+    """Generated force at stall against the amplitude at Section 4.2's frequency, per preload
+    (``passmd sweep stall-force``), with the Coulomb bound μ·ΣF_N of each preload.
+
+    Columns: ``preload_N``, ``amplitude_nm``, ``force_mN``, ``converged``, ``periods``, ``bound_mN``.
+    """
+    s = _settings(profile)
+    a_max = drive.actuator.full_stroke_amplitude
+    points = [{"drive": replace(drive, preload=float(p), load_cell=True),
+               "frequency": PROTOCOL.drive_frequency, "amplitude": float(x * a_max), "preload_N": float(p)}
+              for p in s.stall_preloads for x in s.stall_fractions]
+    table = compute_map("stall-force", points, config=_run_config(config, profile), description="stall force")
+    return pd.DataFrame({
+        "preload_N": table["preload_N"],
+        "amplitude_nm": [p["amplitude"] * 1e9 for p in points],
+        "force_mN": table["generated_force_N"].to_numpy(float) * 1e3,
+        "converged": table["converged"].astype(bool),
+        "periods": table["periods"],
+        "bound_mN": [stall.coulomb_bound(p["drive"]) * 1e3 for p in points],
+    })
+
+
+def start_drive(truth: Drive, profile: str) -> Drive:
+    """A designer's first guess: ``truth`` with each free parameter at the paper's value (:data:`START`)."""
+    drive = truth
+    for name in _settings(profile).free:
+        if name == "friction_coefficient":
+            drive = replace(drive, friction_coefficient=Drive().friction_coefficient)
+        elif name == "actuator.stiffness":
+            table2 = actuator_for_radius(truth.hemisphere_radius).stiffness
+            drive = fitting.FREE_PARAMETERS[name].set(drive, table2, truth)
+    return drive
+
+
+def _measurements(points, truth: Drive, rng, config) -> fitting.Measurements:
+    header = ["amplitude_nm", "preload_N", "frequency_Hz", "step_nm", "step_nm_sd"]
+    rows = [[repr(float(a)), repr(float(p)), repr(float(f)), "0", repr(NOISE_NM)] for f, p, a in points]
+    data = fitting.measurements_from_rows(header, rows, name="synthetic measurements")
+    exact = fitting.predict(truth, data, config=config)
+    return replace(data, value=exact + rng.normal(0.0, NOISE_NM * 1e-9, exact.size))
+
+
+def synthetic_measurements(truth: Drive, profile: str, config: RunConfig | None = None
+                           ) -> tuple[fitting.Measurements, fitting.Measurements]:
+    """Steps of ``truth`` simulated as ``passmd fit`` predicts them, plus Gaussian noise of
+    :data:`NOISE_NM` (seed :data:`SEED`): ``(fit data, held-back data)``."""
+    s = _settings(profile)
+    config = _run_config(config, profile)
+    rng = np.random.default_rng(SEED)
+    fit_points = [(FIT_FREQUENCY, p, a) for p in s.fit_preloads for a in s.fit_amplitudes_nm]
+    return _measurements(fit_points, truth, rng, config), _measurements(s.heldback, truth, rng, config)
+
+
+def measurements_csv(data: fitting.Measurements) -> str:
+    """The text of the measurement CSV that ``passmd fit`` reads
+    (:func:`passmd.protocols.fit.write_measurements`)."""
+    with tempfile.TemporaryDirectory(prefix="passmd-design-") as folder:
+        path = Path(folder) / "measurements.csv"
+        fitting.write_measurements(path, data)
+        return path.read_text(encoding="utf-8")
+
+
+def calibrate(start: Drive, data: fitting.Measurements, profile: str,
+              config: RunConfig | None = None) -> fitting.FitResult:
+    """The fit of the profile's free parameters to ``data`` from ``start`` (``passmd fit``'s defaults)."""
+    return fitting.fit(start, data, list(_settings(profile).free), config=_run_config(config, profile))
+
+
+def load_fitted(text: str) -> Drive:
+    """The drive a drive file's text describes, read as ``--drive`` reads a file
+    (:func:`passmd.model.drive_file.load_drive`)."""
+    with tempfile.TemporaryDirectory(prefix="passmd-design-") as folder:
+        path = Path(folder) / "fitted-drive.toml"
+        path.write_text(text, encoding="utf-8")
+        return load_drive(path)
+
+
+def heldback_predictions(heldback: fitting.Measurements, drives: dict[str, Drive], profile: str,
+                         config: RunConfig | None = None) -> pd.DataFrame:
+    """The held-back measurements and each drive's prediction of them (nm), one row per point.
+
+    ``drives``: label -> drive (e.g. the first guess and the fitted drive); a column
+    ``<label>_nm`` each.
+    """
+    out = pd.DataFrame({"frequency_Hz": heldback.frequency, "preload_N": heldback.preload,
+                        "amplitude_nm": heldback.amplitude * 1e9, "measured_nm": heldback.value * 1e9,
+                        "sd_nm": heldback.sd * 1e9})
+    config = _run_config(config, profile)
+    for label, drive in drives.items():
+        out[f"{label}_nm"] = fitting.predict(drive, heldback, config=config) * 1e9
+    return out
+
+
+# --------------------------------------------------------------------------------------
+# What the chapter quotes
+# --------------------------------------------------------------------------------------
+
+
+def map_facts(table: pd.DataFrame) -> dict:
+    """The step/velocity map's extremes: the fastest point, and the step at the grid's lowest and
+    highest frequency at the largest amplitude (nm, mm/s, kHz)."""
+    v = table["velocity_m_per_s"].to_numpy(float)
+    best = int(np.nanargmax(v))
+    a = table["amplitude_m"].to_numpy(float)
+    top = table[np.isclose(a, a.max(), rtol=1e-9, atol=0.0)].sort_values("frequency_Hz")  # the largest only
+    return {"v_max_mm_s": v[best] * 1e3, "v_max_f_kHz": table["frequency_Hz"].iloc[best] / 1e3,
+            "v_max_A_nm": table["amplitude_m"].iloc[best] * 1e9,
+            "step_low_f_nm": top["step_m"].iloc[0] * 1e9, "step_high_f_nm": top["step_m"].iloc[-1] * 1e9,
+            "f_low_kHz": top["frequency_Hz"].iloc[0] / 1e3, "f_high_kHz": top["frequency_Hz"].iloc[-1] / 1e3,
+            "A_top_nm": top["amplitude_m"].iloc[0] * 1e9, "map_points": len(table)}
+
+
+def gain_facts(table: pd.DataFrame) -> dict:
+    """How the Eq. 15 waveform compares with the saw-tooth over the map: points with a waveform,
+    how many of them are faster, the largest gain and loss (mm/s) and where the gain is largest."""
+    gain = np.array([np.nan if g is None else float(g) for g in table["gain_m_per_s"]])
+    valid = np.isfinite(gain)
+    out = {"gain_points": len(table), "gain_designed": int(valid.sum()), "gain_none": int((~valid).sum()),
+           "gain_faster": int((gain[valid] > 0).sum())}
+    if valid.any():
+        best, worst = int(np.nanargmax(gain)), int(np.nanargmin(gain))
+        out.update(gain_max_mm_s=gain[best] * 1e3, gain_max_f_kHz=table["frequency_Hz"].iloc[best] / 1e3,
+                   gain_max_A_nm=table["amplitude_m"].iloc[best] * 1e9, gain_min_mm_s=gain[worst] * 1e3)
+    return out
+
+
+def fit_facts(result: fitting.FitResult, truth: Drive, start: Drive) -> pd.DataFrame:
+    """One row per free parameter: the value simulated (truth), the first guess, the estimate,
+    its standard error and 95 % profile interval, and whether the interval holds the truth (SI)."""
+    rows = []
+    for name in result.names:
+        p = fitting.FREE_PARAMETERS[name]
+        est = result.estimates[name]
+        low, high = est["interval"]
+        rows.append({"parameter": name, "symbol": p.symbol, "unit": p.unit, "truth": p.get(truth),
+                     "start": p.get(start), "estimate": est["value"], "stderr": est["stderr"],
+                     "low": low, "high": high, "holds_truth": bool(low <= p.get(truth) <= high)})
+    return pd.DataFrame(rows)
+
+
+def heldback_facts(table: pd.DataFrame, labels=("start", "fitted")) -> dict:
+    """Root-mean-square deviation (nm) of each drive's predictions from the held-back measurements."""
+    out = {"heldback_points": len(table)}
+    for label in labels:
+        out[f"rms_{label}_nm"] = float(np.sqrt(np.mean((table[f"{label}_nm"] - table["measured_nm"]) ** 2)))
+    return out

@@ -1,0 +1,584 @@
+"""Driving waveform: Figs. 8–10 (Section 5) and two studies beyond the paper.
+
+Section 5 drives the six-contact drive with rigid actuators (R = 1 mm, F_p = 0.4 N,
+A = 202 nm, μ = 0.2 assumed) with the standard saw-tooth and with the optimized waveform
+of Eq. 15 (:func:`passmd.model.optimized_waveform.optimized`), designed once per drive from its own
+100 Hz saw-tooth response (:func:`passmd.protocols.eq15.optimized_design`).
+
+The velocities are measured by the protocol of :mod:`passmd.protocols.velocity` (the
+*steady* velocity at kHz frequencies, the steps at 100 Hz); ``SimulationResult.mean_velocity``
+(settled positions of the first and last period) includes the start-up and is kept as
+``simulator_mean_velocity_m_per_s`` for comparison.
+
+Figures (``compute(config: RunConfig) -> DataFrame``, in the figure table of
+:mod:`passmd.experiments.figure_table`):
+``fig8a`` saw-tooth response with contact status; ``fig8b`` the optimized waveform with
+t_s, t_a, Δ_a; ``fig9a`` runner position over three 100 Hz periods, both waveforms;
+``fig9b`` steady velocity against frequency, both waveforms; ``fig10a``–``fig10c`` the
+optimized waveform's velocity for three preloads, two radii, two runner materials.
+
+Beyond the paper (flexible actuators, the settling time, a numerical optimum of the
+waveform): :mod:`passmd.experiments.driving_waveform.studies`; the numbers the chapter reads from both:
+:mod:`passmd.experiments.driving_waveform.facts`; the ledger's claims on Figs. 8–10:
+:mod:`passmd.experiments.driving_waveform.claims`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from passmd.ledger import readings
+from passmd.ledger.checks import NotEvaluable
+from passmd.model import optimized_waveform, theory, waveforms
+from passmd.model.defaults import PROTOCOL
+from passmd.model.parameters import MOLYBDENUM, STEEL, Assumption, Drive, paper_drive
+from passmd.protocols import eq15
+from passmd.protocols.velocity import (
+    FULL_SLIDING_SHARE,
+    MIN_PERIODS,
+    STEADY_TIME,
+    STEP_PERIODS,
+    make_waveform,
+    steady_run,
+)
+from passmd.runtime import sweep
+from passmd.runtime.config import PROFILES, RunConfig
+from passmd.runtime.validation import check_choice
+from passmd.solver import simulation as dynamics
+
+#: Driving frequency of Figs. 8 and 9a (Hz).
+STEP_FREQUENCY = PROTOCOL.drive_frequency
+#: Fig. 9b/10 frequency grids (Hz): the paper's "1 to 130 kHz with a step of 5 kHz".
+FREQUENCIES = {
+    "paper": np.array([1e3] + [5e3 * k for k in range(1, 27)]),
+    "quick": np.array([1e3, 20e3, 60e3, 100e3, 110e3, 120e3, 130e3]),
+}
+#: Runner materials of Fig. 10c.
+RUNNERS = {"steel": STEEL, "molybdenum": MOLYBDENUM}
+#: Preloads of Fig. 10a (N) and radii of Fig. 10b (m).
+FIG10A_PRELOADS = (0.1, 0.4, 1.0)
+FIG10B_RADII = (1e-3, 0.25e-3)
+#: μ of Section 5 (not stated there): the default of the ledger's axis ``friction_coefficient``.
+SECTION5_FRICTION = float(readings.axis("friction_coefficient").default)
+#: μ of the Fig. 9a runs: the default and the ledger's evaluated alternatives (Section 4.2's 0.3).
+FIG9A_FRICTION = tuple(float(mu) for mu in readings.axis("friction_coefficient").values())
+#: Waveform variants of Figs. 9b and 10: (waveform, short_period rule). ``skip`` (t_s = 0 where the
+#: settling time does not fit) is the chapter's study "what if the settling is dropped": it removes
+#: Eq. 15's settling phase, so it is no ledger reading of the Eq. 15 claims (passmd.ledger.readings).
+VARIANTS = (("sawtooth", ""), ("optimized", "cut"), ("optimized", "skip"))
+
+
+def variant_name(waveform: str, short_period: str) -> str:
+    """Label of a (waveform, short-period rule) pair of :data:`VARIANTS` in tables and plots."""
+    if waveform == "sawtooth":
+        return "sawtooth"
+    return "optimized_skip" if short_period == "skip" else "optimized"
+
+ASSUMPTIONS: tuple[Assumption, ...] = (
+    Assumption(
+        key="frequency_grid",
+        symbol="f",
+        value="1, 5, 10, …, 130 kHz",
+        unit="kHz",
+        rationale=(
+            "'from 1 to 130 kHz with a step of 5 kHz' (Section 5.2) does not say whether the grid is "
+            "1, 6, 11, … or 1, 5, 10, …; the second contains the 80 and 110 kHz the text names."
+        ),
+        sensitivity="Only where a threshold falls between grid points (±5 kHz).",
+    ),
+    Assumption(
+        key="steady_velocity",
+        symbol="v̄",
+        value=(
+            f"slope of the period-mean runner position over the second half of a run of "
+            f"max({MIN_PERIODS}, f·{STEADY_TIME * 1e3:g} ms) periods from rest"
+        ),
+        unit="mm/s",
+        rationale=(
+            "The paper calls the velocity 'a multiple of the driving frequency and step size' without "
+            "saying over which periods. At 100 kHz there is no stick phase and the runner needs ~1 ms "
+            "from rest to its steady velocity; the steady velocity is what a user of the drive sees."
+        ),
+        sensitivity="Driving-waveform chapter: third against fourth quarter of each run (velocity_drift).",
+    ),
+    Assumption(
+        key="controllable_frequency",
+        symbol="f_max",
+        value="the frequency of the largest steady velocity on the grid",
+        unit="kHz",
+        rationale=(
+            "Section 5.2 reads the 'reachable maximal velocity' 'at maximal controllable frequencies' "
+            "(0.4 N: 19 mm/s at 110 kHz), beyond which the velocity drops; the model has no chaos "
+            "criterion of its own."
+        ),
+        sensitivity="Fig. 10b's ordering of maximal controllable frequencies only.",
+    ),
+    Assumption(
+        key="stick_during_acceleration",
+        symbol="–",
+        value="no contact group reaches full sliding (slip share 1) during t_a, second half of the run",
+        unit="–",
+        rationale=(
+            "Section 5.1's stick condition u ≤ u_x,max: the contacts must not slide fully while the "
+            "hemispheres accelerate the runner. Partial slip of the contact's rim is not a relative "
+            "slip of runner and hemisphere."
+        ),
+        sensitivity="Fig. 10a's 0.1 N stick threshold.",
+    ),
+)
+
+
+# ======================================================================================
+# Drives and point functions (top level: the sweep sends them to worker processes)
+# ======================================================================================
+
+
+def section5_drive(hemisphere_radius: float = 1e-3, preload: float = 0.4, runner: str = "steel",
+                   actuator_model: str = "rigid", friction_coefficient: float = SECTION5_FRICTION) -> Drive:
+    """The drive of Section 5: six contacts, Table 1–2 parameters, free runner, μ = 0.2.
+
+    ``runner`` names the runner material (``"steel"``, Table 1, or ``"molybdenum"``,
+    Fig. 10c); ``actuator_model`` is ``"rigid"`` in the paper. ``friction_coefficient`` is
+    Section 5's unstated μ (ledger axis ``friction_coefficient``, :mod:`passmd.ledger.readings`).
+    """
+    check_choice("runner", runner, tuple(RUNNERS))
+    return paper_drive(hemisphere_radius, preload, actuator_model=actuator_model,
+                       runner_material=RUNNERS[runner], friction_coefficient=friction_coefficient)
+
+
+def make_design(settling_time: float, acceleration_time: float,
+                acceleration_amplitude: float) -> optimized_waveform.OptimizedDesign:
+    """An :class:`~passmd.model.optimized_waveform.OptimizedDesign` from plain sweep parameters."""
+    return optimized_waveform.OptimizedDesign(settling_time, acceleration_time, acceleration_amplitude)
+
+
+def design_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
+                 friction_coefficient: float = SECTION5_FRICTION) -> dict:
+    """Eq. 15 design of a drive at its full amplitude (:func:`passmd.protocols.eq15.optimized_design`).
+
+    Returns the design's :meth:`~passmd.model.optimized_waveform.OptimizedDesign.as_dict` plus the amplitude
+    and the linear runner-on-contacts frequency (:func:`passmd.model.theory.runner_frequency`).
+    """
+    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model, friction_coefficient)
+    amplitude = drive.actuator.full_stroke_amplitude
+    out = eq15.optimized_design(amplitude, drive).as_dict()
+    out["amplitude_m"] = amplitude
+    out["linear_frequency_Hz"] = theory.runner_frequency(drive)
+    return out
+
+
+def velocity_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
+                   frequency: float, waveform: str, short_period: str, settling_time: float,
+                   acceleration_time: float, acceleration_amplitude: float) -> dict:
+    """Steady velocity of one Section 5 drive, waveform and frequency at the full amplitude.
+
+    :func:`passmd.protocols.velocity.steady_run`; the design fields are ignored for the saw-tooth.
+    """
+    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
+    design = None if waveform != "optimized" else make_design(settling_time, acceleration_time,
+                                                               acceleration_amplitude)
+    return steady_run(drive, drive.actuator.full_stroke_amplitude, frequency, waveform, short_period, design)
+
+
+def trace_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
+                frequency: float, periods: int, waveform: str, settling_time: float,
+                acceleration_time: float, acceleration_amplitude: float, zoom_start: float,
+                zoom_end: float, full_samples: int, zoom_samples: int,
+                friction_coefficient: float = SECTION5_FRICTION) -> dict:
+    """Time series of one run from rest, for the time-domain figures (Figs. 8, 9a).
+
+    The run is recorded at ≥ 200 samples per linear runner-vibration period and returned
+    resampled on two uniform grids: the whole run (``full_*``) and ``[zoom_start,
+    zoom_end]`` (``zoom_*``). Also returns the per-period measures, the micro-vibration
+    frequency f_s after the first fly-back (saw-tooth) or after the first acceleration
+    (optimized), measured as in the design (:func:`passmd.protocols.eq15.micro_vibration_frequency`),
+    and the first three turning points of the runner after the first fly-back.
+    """
+    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model, friction_coefficient)
+    amplitude = drive.actuator.full_stroke_amplitude
+    design = None if waveform == "sawtooth" else make_design(
+        settling_time, acceleration_time, acceleration_amplitude)
+    wave = make_waveform(drive, amplitude, frequency, periods, waveform, "cut", design)
+    samples = int(math.ceil(wave.duration * theory.runner_frequency(drive) * 200)) + 1
+    result = dynamics.simulate(drive, wave, max_points=max(samples, 2000))
+    t = result.time
+    period = 1.0 / frequency
+    v_p = wave.velocity(t)
+    if waveform == "sawtooth":
+        after = period
+    else:
+        timing = optimized_waveform.optimized_timing(design, amplitude, frequency, drive)
+        after = period + timing["settling_time_s"] + timing["acceleration_time_s"]
+    f_s, _ = eq15.micro_vibration_frequency(t, result.runner_velocity, v_p, after)
+    _, turning = eq15.micro_vibration_frequency(t, result.runner_velocity, v_p, period)
+    out = {
+        "settled_positions_m": result.settled_positions,
+        "back_steps_m": result.back_steps,
+        "micro_vibration_frequency_Hz": f_s,
+        "vibration_after_s": after,
+        "flyback_start_s": period - waveforms.flyback_time(amplitude, drive),
+        "turning_times_s": turning[:3],
+        "wall_time_s": result.wall_time,
+    }
+    channels = {
+        "piezo_position_m": result.piezo_position,
+        "runner_position_m": result.runner_position,
+        "runner_velocity_m_per_s": result.runner_velocity,
+    }
+    for g in range(result.multiplicity.size):
+        channels[f"slip_share_{g + 1}"] = result.slip_share[g]
+        channels[f"friction_force_{g + 1}_N"] = result.friction_force[g]
+    for view, (t0, t1, n) in {"full": (0.0, wave.duration, full_samples),
+                              "zoom": (zoom_start, zoom_end, zoom_samples)}.items():
+        grid = np.linspace(t0, t1, int(n))
+        out[f"{view}_time_s"] = grid
+        for name, values in channels.items():
+            out[f"{view}_{name}"] = np.interp(grid, t, values)
+        out[f"{view}_piezo_position_m"] = wave.position(grid)  # exact, not resampled
+    return out
+
+
+# ======================================================================================
+# Tables behind the figures
+# ======================================================================================
+
+def section5_fields(hemisphere_radius: float = 1e-3, preload: float = 0.4, runner: str = "steel",
+                    actuator_model: str = "rigid") -> dict:
+    """A drive configuration as plain sweep parameters (see :func:`section5_drive`)."""
+    return {"hemisphere_radius": float(hemisphere_radius), "preload": float(preload), "runner": runner,
+            "actuator_model": actuator_model}
+
+
+def designs(drives: list[dict], config: RunConfig) -> pd.DataFrame:
+    """Eq. 15 design of each drive (:func:`section5_fields`, :func:`design_point`), one row each, cached."""
+    return sweep.run(design_point, [dict(c) for c in drives], description="waveform design", config=config)
+
+
+def design_fields(row) -> dict:
+    """The design columns of a :func:`designs` row as the sweep parameters of the point functions."""
+    return {"settling_time": float(row["settling_time_s"]),
+            "acceleration_time": float(row["acceleration_time_s"]),
+            "acceleration_amplitude": float(row["acceleration_amplitude_m"])}
+
+
+def velocity_table(drives: list[dict], frequencies, config: RunConfig) -> pd.DataFrame:
+    """Steady velocity of every configuration × waveform variant (:data:`VARIANTS`) × frequency.
+
+    Each configuration's optimized waveform is its own Eq. 15 design. Adds display
+    columns (``frequency_kHz``, ``velocity_mm_per_s``, ``step_nm``, ``back_step_nm``,
+    ``radius_mm``) and ``variant`` (``sawtooth``, ``optimized``, ``optimized_skip``).
+    """
+    design_rows = designs(drives, config)
+    points = []
+    for c, (_, d) in zip(drives, design_rows.iterrows(), strict=True):
+        fields = design_fields(d)
+        for waveform, rule in VARIANTS:
+            for f in frequencies:
+                points.append({**c, "frequency": float(f), "waveform": waveform, "short_period": rule,
+                               **fields})
+    table = sweep.run(velocity_point, points, description="steady velocity", config=config)
+    table["variant"] = [variant_name(w, r)
+                        for w, r in zip(table["waveform"], table["short_period"], strict=True)]
+    table["frequency_kHz"] = table["frequency"] / 1e3
+    table["velocity_mm_per_s"] = table["velocity_m_per_s"] * 1e3
+    table["step_nm"] = table["step_m"] * 1e9
+    table["back_step_nm"] = table["back_step_m"] * 1e9
+    table["radius_mm"] = table["hemisphere_radius"] * 1e3
+    table["micro_vibration_frequency_Hz"] = np.repeat(design_rows["micro_vibration_frequency_Hz"].to_numpy(),
+                                                      len(VARIANTS) * len(frequencies))
+    return table
+
+
+def _frequencies(profile: str) -> np.ndarray:
+    check_choice("profile", profile, PROFILES)
+    return FREQUENCIES[profile]
+
+
+def _trace(c: dict, frequency: float, periods: int, waveform: str, fields: dict, zoom: tuple[float, float],
+           full_samples: int, zoom_samples: int, config: RunConfig) -> dict:
+    point = {**c, "frequency": float(frequency), "periods": int(periods), "waveform": waveform, **fields,
+             "zoom_start": float(zoom[0]), "zoom_end": float(zoom[1]), "full_samples": int(full_samples),
+             "zoom_samples": int(zoom_samples)}
+    return sweep.run(trace_point, [point], description="trace", config=config).iloc[0].to_dict()
+
+
+def _status(shares: np.ndarray) -> np.ndarray:
+    """Contact status per sample: full slip (a group slides fully), partial slip, stick."""
+    top = shares.max(axis=0)
+    return np.where(top >= FULL_SLIDING_SHARE, "full slip", np.where(top > 1e-3, "partial slip", "stick"))
+
+
+def _series_frame(trace: dict, view: str, groups: int) -> pd.DataFrame:
+    t = np.asarray(trace[f"{view}_time_s"])
+    frame = pd.DataFrame({"view": view, "time_s": t})
+    for name in ("piezo_position_m", "runner_position_m", "runner_velocity_m_per_s"):
+        frame[name] = np.asarray(trace[f"{view}_{name}"])
+    shares = []
+    for g in range(1, groups + 1):
+        frame[f"slip_share_{g}"] = np.asarray(trace[f"{view}_slip_share_{g}"])
+        frame[f"friction_force_{g}_N"] = np.asarray(trace[f"{view}_friction_force_{g}_N"])
+        shares.append(frame[f"slip_share_{g}"].to_numpy())
+    frame["contact_status"] = _status(np.array(shares))
+    return frame
+
+
+def _points_frame(series: pd.DataFrame, times: dict) -> pd.DataFrame:
+    """Rows marking the numbered points of Fig. 8 (interpolated from the zoom series)."""
+    zoom = series[series["view"] == "zoom"]
+    rows = []
+    for label, t in times.items():
+        if not np.isfinite(t):
+            continue
+        row = {"view": "point", "point": label, "time_s": t}
+        for col in zoom.columns:
+            if col not in ("view", "time_s", "contact_status"):
+                row[col] = float(np.interp(t, zoom["time_s"], zoom[col]))
+        nearest = int(np.argmin(np.abs(zoom["time_s"].to_numpy() - t)))
+        row["contact_status"] = zoom["contact_status"].iloc[nearest]
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def _display(frame: pd.DataFrame) -> pd.DataFrame:
+    for col in ("piezo_position_m", "runner_position_m", "settled_position_m", "back_step_m"):
+        if col in frame:
+            frame[col.replace("_m", "_nm")] = frame[col] * 1e9
+    frame["time_ms"] = frame["time_s"] * 1e3
+    frame["time_us"] = frame["time_s"] * 1e6
+    return frame
+
+
+# ======================================================================================
+# Figures 8–10
+# ======================================================================================
+
+
+def _samples(profile: str) -> tuple[int, int]:
+    check_choice("profile", profile, PROFILES)
+    return (400, 300) if profile == "quick" else (2000, 1500)
+
+
+def fig8a(config: RunConfig) -> pd.DataFrame:
+    """Saw-tooth response (100 Hz, two periods, Section 5 drive) with the contact status.
+
+    Views: ``full`` (both periods), ``zoom`` (the first fly-back and the micro-vibration
+    after it), ``point`` (points 1–4 of Section 5.1: end of stick, fastest backward motion,
+    reversal, fastest forward motion). Constant columns: ``first_back_step_m`` and the
+    measured ``micro_vibration_frequency_Hz``.
+    """
+    c = section5_fields()
+    T = 1.0 / STEP_FREQUENCY
+    trace = _trace(c, STEP_FREQUENCY, 2, "sawtooth", {"settling_time": 0.0, "acceleration_time": 0.0,
+                                                    "acceleration_amplitude": 0.0},
+                   (T - 10e-6, T + 250e-6), *_samples(config.profile), config)
+    series = pd.concat([_series_frame(trace, "full", 2), _series_frame(trace, "zoom", 2)], ignore_index=True)
+    z1, z2 = trace["turning_times_s"][0], trace["turning_times_s"][1]
+    zoom = series[series["view"] == "zoom"]
+    t, v = zoom["time_s"].to_numpy(), zoom["runner_velocity_m_per_s"].to_numpy()
+    first, second = (t >= T) & (t <= z1), (t >= z1) & (t <= z2)
+    times = {"1": trace["flyback_start_s"], "2": float(t[first][np.argmin(v[first])]), "3": float(z1),
+             "4": float(t[second][np.argmax(v[second])])}
+    frame = pd.concat([series, _points_frame(series, times)], ignore_index=True)
+    frame["first_back_step_m"] = float(trace["back_steps_m"][0])
+    frame["micro_vibration_frequency_Hz"] = float(trace["micro_vibration_frequency_Hz"])
+    return _display(frame)
+
+
+def fig8b(config: RunConfig) -> pd.DataFrame:
+    """The optimized waveform of the Section 5 drive and the runner's response (100 Hz).
+
+    Period 1 is a saw-tooth, period 2 optimized. Views ``full``, ``zoom`` (the fly-back,
+    t_s and t_a) and ``point`` (1: end of stick; 2: fastest backward motion; 3: reversal,
+    if within t_s; 4: end of t_s; 5: end of t_a). Constant columns: the design
+    (``settling_time_s``, ``acceleration_time_s``, ``acceleration_amplitude_m``,
+    ``acceleration_velocity_m_per_s``, ``micro_vibration_frequency_Hz``,
+    ``design_runner_velocity_m_per_s`` (V_r of Eq. 15), ``presliding_m``, ``linear_frequency_Hz``).
+    """
+    c = section5_fields()
+    design = designs([c], config).iloc[0]
+    fields = design_fields(design)
+    T = 1.0 / STEP_FREQUENCY
+    t_s, t_a = fields["settling_time"], fields["acceleration_time"]
+    trace = _trace(c, STEP_FREQUENCY, 2, "optimized", fields, (T - 5e-6, T + t_s + t_a + 60e-6),
+                   *_samples(config.profile), config)
+    series = pd.concat([_series_frame(trace, "full", 2), _series_frame(trace, "zoom", 2)], ignore_index=True)
+    z1 = trace["turning_times_s"][0]
+    zoom = series[series["view"] == "zoom"]
+    t, v = zoom["time_s"].to_numpy(), zoom["runner_velocity_m_per_s"].to_numpy()
+    hold = (t >= T) & (t <= min(z1, T + t_s))
+    times = {"1": trace["flyback_start_s"], "2": float(t[hold][np.argmin(v[hold])]),
+             "3": float(z1) if z1 < T + t_s else math.nan, "4": T + t_s, "5": T + t_s + t_a}
+    frame = pd.concat([series, _points_frame(series, times)], ignore_index=True)
+    for key in ("settling_time_s", "acceleration_time_s", "acceleration_amplitude_m",
+                "acceleration_velocity_m_per_s", "micro_vibration_frequency_Hz", "presliding_m",
+                "linear_frequency_Hz"):
+        frame[key] = float(design[key])
+    # the design's V_r under its own name: the series' runner_velocity_m_per_s is the run's
+    frame["design_runner_velocity_m_per_s"] = float(design["runner_velocity_m_per_s"])
+    return _display(frame)
+
+
+#: Integration refinement of the fly-back window run (``simulate``'s ``resolution``: the
+#: error-controlled step's tolerance divided by its fourth power, so the step by about this):
+#: t_a (about 0.2 µs) spans at least ``time_steps.MIN_SEGMENT_STEPS`` steps like every piece,
+#: and the refinement keeps the steps around it (the fly-back's slip and the settling t_s)
+#: as fine as t_a's.
+WINDOW_RESOLUTION = {"quick": 20.0, "paper": 40.0}
+#: Record spacing of the fly-back window run: t_a / this (evenly spaced over the whole run).
+WINDOW_SAMPLES_PER_ACCELERATION = 10
+#: The window kept: from this long before the fly-back to this long after the end of t_a (s);
+#: 30 µs after t_a covers more than a quarter of the runner's ~10 kHz micro-vibration.
+WINDOW_BEFORE, WINDOW_AFTER = 2e-6, 30e-6
+
+
+def window_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
+                 settling_time: float, acceleration_time: float, acceleration_amplitude: float,
+                 resolution: float, samples_per_acceleration: int) -> dict:
+    """Fig. 8b's run (100 Hz, period 1 saw-tooth, period 2 optimized) resolved inside t_a.
+
+    The run is integrated with the step divided by ``resolution`` and recorded every
+    t_a / ``samples_per_acceleration``; only the window from :data:`WINDOW_BEFORE` before the
+    fly-back to :data:`WINDOW_AFTER` after the end of t_a is returned (time series ``time_s``,
+    ``runner_velocity_m_per_s``, ``runner_position_m``, ``piezo_position_m``, ``slip_share_<g>``),
+    with the fly-back start and end, the start and end of t_a (s) and the largest record
+    spacing inside t_a (``record_spacing_s``).
+    """
+    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
+    amplitude = drive.actuator.full_stroke_amplitude
+    design = make_design(settling_time, acceleration_time, acceleration_amplitude)
+    wave = make_waveform(drive, amplitude, STEP_FREQUENCY, 2, "optimized", "cut", design)
+    timing = optimized_waveform.optimized_timing(design, amplitude, STEP_FREQUENCY, drive)
+    period = 1.0 / STEP_FREQUENCY
+    flyback = waveforms.flyback_time(amplitude, drive)
+    start_a = period + timing["settling_time_s"]
+    end_a = start_a + timing["acceleration_time_s"]
+    points = int(math.ceil(wave.duration * samples_per_acceleration / timing["acceleration_time_s"])) + 1
+    result = dynamics.simulate(drive, wave, resolution=resolution, max_points=points)
+    t = result.time
+    keep = (t >= period - flyback - WINDOW_BEFORE) & (t <= end_a + WINDOW_AFTER)
+    inside = t[(t >= start_a) & (t <= end_a)]
+    if inside.size < 2:
+        raise dynamics.SimulationError("fewer than two recorded samples inside the acceleration t_a")
+    out = {"time_s": t[keep], "runner_velocity_m_per_s": result.runner_velocity[keep],
+           "runner_position_m": result.runner_position[keep], "piezo_position_m": result.piezo_position[keep],
+           "flyback_start_s": period - flyback, "flyback_end_s": period, "acceleration_start_s": start_a,
+           "acceleration_end_s": end_a, "record_spacing_s": float(np.max(np.diff(inside))),
+           "wall_time_s": result.wall_time}
+    for g in range(result.multiplicity.size):
+        out[f"slip_share_{g + 1}"] = result.slip_share[g][keep]
+    return out
+
+
+def fig8b_window(config: RunConfig) -> pd.DataFrame:
+    """The fly-back and the acceleration t_a of Fig. 8b's optimized period, resolved inside t_a.
+
+    One run of the Section 5 drive (0.4 N, 100 Hz, its own Eq. 15 design) integrated with the
+    step divided by :data:`WINDOW_RESOLUTION` and recorded every t_a /
+    :data:`WINDOW_SAMPLES_PER_ACCELERATION` (:func:`window_point`). Columns: ``time_s``,
+    ``time_us``, runner and piezo positions (nm) and velocity, ``slip_share_1`` and
+    ``slip_share_2``, ``phase`` (``flyback``, ``settling``, ``acceleration``, ``after``) and
+    the constant phase times (s) and record spacing.
+    """
+    c = section5_fields()
+    fields = design_fields(designs([c], config).iloc[0])
+    point = {**c, **fields, "resolution": WINDOW_RESOLUTION[config.profile],
+             "samples_per_acceleration": WINDOW_SAMPLES_PER_ACCELERATION}
+    run = sweep.run(window_point, [point], description="fly-back window", config=config).iloc[0].to_dict()
+    t = np.asarray(run["time_s"])
+    frame = pd.DataFrame({"time_s": t, "time_us": t * 1e6})
+    for name in ("runner_velocity_m_per_s", "runner_position_m", "piezo_position_m", "slip_share_1",
+                 "slip_share_2"):
+        frame[name] = np.asarray(run[name])
+    frame["runner_position_nm"] = frame["runner_position_m"] * 1e9
+    frame["piezo_position_nm"] = frame["piezo_position_m"] * 1e9
+    marks = {k: float(run[k]) for k in ("flyback_start_s", "flyback_end_s", "acceleration_start_s",
+                                       "acceleration_end_s", "record_spacing_s")}
+    frame["phase"] = np.select(
+        [t < marks["flyback_start_s"], t <= marks["flyback_end_s"], t < marks["acceleration_start_s"],
+         t <= marks["acceleration_end_s"]], ["before", "flyback", "settling", "acceleration"], "after")
+    for key, value in marks.items():
+        frame[key] = value
+    frame["wall_time_s"] = float(run["wall_time_s"])
+    return frame
+
+
+def fig9a(config: RunConfig) -> pd.DataFrame:
+    """Three 100 Hz periods from rest with both waveforms (Section 5 drive, Fig. 9a).
+
+    Views per ``waveform``: ``full`` (time series), ``period`` (``period`` 1–3 with
+    ``settled_position_m`` and ``back_step_m``). Constant columns per waveform:
+    ``final_position_m`` (settled position after three periods) and
+    ``micro_vibration_frequency_Hz`` (after the first fly-back for the saw-tooth, after the
+    first acceleration for the optimized waveform).
+
+    ``friction_coefficient`` tags each run: μ = 0.2 (the figure) and the evaluated alternatives
+    of the ledger's axis ``friction_coefficient`` (:data:`FIG9A_FRICTION`), each with its own
+    Eq. 15 design.
+    """
+    full, _ = _samples(config.profile)
+    parts = []
+    for mu in FIG9A_FRICTION:
+        c = {**section5_fields(), "friction_coefficient": mu}
+        fields = design_fields(designs([c], config).iloc[0])
+        for waveform in ("sawtooth", "optimized"):
+            trace = _trace(c, STEP_FREQUENCY, STEP_PERIODS, waveform, fields, (0.0, 1e-3), full, 2, config)
+            series = _series_frame(trace, "full", 2)
+            settled = np.asarray(trace["settled_positions_m"])
+            per = pd.DataFrame({"view": "period", "period": np.arange(1, settled.size + 1),
+                                "time_s": np.arange(1, settled.size + 1) / STEP_FREQUENCY,
+                                "settled_position_m": settled,
+                                "back_step_m": np.asarray(trace["back_steps_m"])})
+            frame = pd.concat([series, per], ignore_index=True)
+            frame["waveform"] = waveform
+            frame["friction_coefficient"] = mu
+            frame["section5_friction"] = mu == SECTION5_FRICTION
+            frame["final_position_m"] = float(settled[-1])
+            frame["micro_vibration_frequency_Hz"] = float(trace["micro_vibration_frequency_Hz"])
+            parts.append(frame)
+    return _display(pd.concat(parts, ignore_index=True))
+
+
+def at_section5_friction(frame: pd.DataFrame, friction_coefficient: float = SECTION5_FRICTION
+                         ) -> pd.DataFrame:
+    """The rows of a table tagged with ``friction_coefficient`` at one μ (default: Section 5's 0.2)."""
+    return frame[np.isclose(frame["friction_coefficient"], friction_coefficient, rtol=1e-9, atol=0)]
+
+
+def fig9b(config: RunConfig) -> pd.DataFrame:
+    """Steady velocity of the Section 5 drive over the frequency grid, every waveform variant."""
+    return velocity_table([section5_fields()], _frequencies(config.profile), config)
+
+
+def fig10a(config: RunConfig) -> pd.DataFrame:
+    """Steady velocity against frequency for F_p = 0.1, 0.4, 1 N (R = 1 mm, steel)."""
+    return velocity_table([section5_fields(preload=p) for p in FIG10A_PRELOADS], _frequencies(config.profile),
+                          config)
+
+
+def fig10b(config: RunConfig) -> pd.DataFrame:
+    """Steady velocity against frequency for R = 1 mm (A = 202 nm) and 0.25 mm (A = 96 nm), 0.4 N."""
+    return velocity_table([section5_fields(hemisphere_radius=r) for r in FIG10B_RADII],
+                          _frequencies(config.profile), config)
+
+
+def fig10c(config: RunConfig) -> pd.DataFrame:
+    """Steady velocity against frequency for a steel (210 GPa) and a molybdenum (310 GPa) runner."""
+    return velocity_table([section5_fields(runner=r) for r in RUNNERS], _frequencies(config.profile), config)
+
+
+# ======================================================================================
+# Readings of the velocity tables (the chapter's facts and the ledger's claims)
+# ======================================================================================
+
+#: Frequency at which Section 5.2 reads the reachable maximal velocity at 0.4 N (kHz).
+PAPER_MAXIMUM_KHZ = 110.0
+
+
+def range_maximum(part: pd.DataFrame) -> pd.Series:
+    """The row of the largest steady velocity over the whole frequency grid (edges included)."""
+    if not np.all(np.isfinite(part["velocity_mm_per_s"].to_numpy(dtype=float))):
+        raise NotEvaluable("non-finite velocities on the frequency grid")
+    return part.loc[part["velocity_mm_per_s"].idxmax()]

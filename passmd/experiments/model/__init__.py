@@ -1,0 +1,1 @@
+"""The model chapter (Sections 2–3): figure data."""

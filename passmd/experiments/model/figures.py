@@ -1,0 +1,192 @@
+"""The model chapter's figures (Sections 2–3): the driving signal, the macroscopic model's
+normal forces (Eq. 1) and one MDR contact's force loop (Eqs. 4–6).
+
+Each compute function takes a :class:`~passmd.runtime.config.RunConfig` (the figures are cheap and
+the same on every profile) and returns a tidy DataFrame with SI columns and the display
+columns the plots of :mod:`passmd.plots.model` read. The drive is the paper's R = 1 mm drive
+at F_p = 0.4 N (:func:`model_drive`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from passmd.experiments.critical_amplitude.figures import FIG5A_DRIVE
+from passmd.model import theory
+from passmd.model.contact import MDRContact
+from passmd.model.defaults import PROTOCOL
+from passmd.model.parameters import Drive, paper_drive
+from passmd.model.waveforms import flyback_time, sawtooth
+from passmd.runtime.config import RunConfig
+from passmd.runtime.units import from_si
+
+__all__ = [
+    "MODEL_PRELOAD",
+    "MODEL_RADIUS",
+    "MDR_LOOP_SPRINGS",
+    "SAWTOOTH_PERIODS",
+    "actuator_row",
+    "closed_form_rows",
+    "model_cross_section",
+    "model_drive",
+    "model_free_body",
+    "model_mdr_loop",
+    "model_sawtooth",
+    "normal_force_balance",
+]
+
+#: Hemisphere radius R (m) and preload F_p (N) of the model chapter's drive (Table 2, Fig. 5a).
+MODEL_RADIUS, MODEL_PRELOAD = FIG5A_DRIVE
+#: Periods of the saw-tooth drawn for Figs. 1d and 3c.
+SAWTOOTH_PERIODS = 3
+#: Discrete springs of the force loop drawn against the exact contact (Fig. 4b).
+MDR_LOOP_SPRINGS = 50
+
+
+def model_drive(hemisphere_radius: float = MODEL_RADIUS) -> Drive:
+    """The paper's drive of radius ``hemisphere_radius`` at the model chapter's preload."""
+    return paper_drive(hemisphere_radius, MODEL_PRELOAD)
+
+
+def model_sawtooth(config: RunConfig) -> pd.DataFrame:
+    """Saw-tooth piezo position x_p(t) of Figs. 1d and 3c at full stroke and the drive frequency.
+
+    Returns
+    -------
+    DataFrame
+        One row per waveform corner: ``time_s, x_p_m, time_ms, x_p_nm``, and the scalars
+        ``amplitude_m``, ``frequency_Hz``, ``periods``, ``ramp_end_s`` (end of the first
+        ramp), ``flyback_time_s`` (:func:`passmd.model.waveforms.flyback_time`).
+    """
+    drive = model_drive()
+    amplitude = drive.actuator.full_stroke_amplitude
+    wave = sawtooth(amplitude, PROTOCOL.drive_frequency, drive, periods=SAWTOOTH_PERIODS)
+    t = np.asarray(wave.times)
+    x = np.asarray(wave.positions)
+    return pd.DataFrame(
+        {
+            "time_s": t,
+            "x_p_m": x,
+            "time_ms": from_si(t, "ms"),
+            "x_p_nm": from_si(x, "nm"),
+            "amplitude_m": amplitude,
+            "frequency_Hz": PROTOCOL.drive_frequency,
+            "periods": wave.periods,
+            "ramp_end_s": float(wave.slip_marks[0]),
+            "flyback_time_s": flyback_time(amplitude, drive),
+        }
+    )
+
+
+def normal_force_balance(drive: Drive) -> dict:
+    """Normal forces of Eq. 1 and the preload their horizontal components carry on each side.
+
+    Returns
+    -------
+    dict
+        ``preload_N``, ``normal_force_1_N`` (F_N1), ``normal_force_2_N`` (F_N2),
+        ``balance_right_N`` (2 F_N1 sin 45°) and ``balance_left_N`` (4 F_N2 sin 45°), both
+        equal to F_p.
+    """
+    f1, f2 = (float(f) for f in theory.normal_forces(drive.preload, 6))
+    return {
+        "preload_N": drive.preload,
+        "normal_force_1_N": f1,
+        "normal_force_2_N": f2,
+        "balance_right_N": 2 * f1 * np.sin(np.pi / 4),
+        "balance_left_N": 4 * f2 * np.sin(np.pi / 4),
+    }
+
+
+def model_free_body(config: RunConfig) -> pd.DataFrame:
+    """Data of the free-body diagram of the macroscopic model (Fig. 3a): Eq. 1's normal forces."""
+    return pd.DataFrame([normal_force_balance(model_drive())])
+
+
+def model_cross_section(config: RunConfig) -> pd.DataFrame:
+    """Data of the runner's cross-section (Fig. 3b): Eq. 1's normal forces and their balance."""
+    return pd.DataFrame([normal_force_balance(model_drive())])
+
+
+def model_mdr_loop(config: RunConfig) -> pd.DataFrame:
+    """One side-1 contact (Fig. 4): Hertz geometry and its friction force along a loading loop.
+
+    The path loads from rest to 0.8 u_x,max (Eq. 7), unloads to −0.8 u_x,max and reloads,
+    with the exact contact and with :data:`MDR_LOOP_SPRINGS` discrete springs (Eqs. 4–6).
+
+    Returns
+    -------
+    DataFrame
+        One row per path point: ``u_m, force_exact_N, force_discrete_N`` and the display
+        columns ``u_nm, force_exact_mN, force_<N>_springs_mN``; scalars ``normal_force_N``,
+        ``hemisphere_radius_m``, ``contact_radius_m`` (a), ``indentation_m`` (d),
+        ``presliding_m`` (u_x,max), ``sliding_force_N`` (μF_N), ``springs``.
+    """
+    drive = model_drive()
+    f1 = float(theory.normal_forces(drive.preload, 6)[0])
+    e_star, g_star = theory.contact_moduli(drive)
+    radius = drive.hemisphere_radius
+    mu = drive.friction_coefficient
+    u_max = float(theory.presliding_displacement(f1, radius, e_star, g_star, mu))
+    amp = 0.8 * u_max
+    path = np.concatenate(
+        [np.linspace(0, amp, 120), np.linspace(amp, -amp, 240), np.linspace(-amp, amp, 240)]
+    )
+    exact = MDRContact.for_drive(drive, side=0).path(path)
+    discrete = MDRContact.for_drive(drive, side=0, springs=MDR_LOOP_SPRINGS).path(path)
+    return pd.DataFrame(
+        {
+            "u_m": path,
+            "force_exact_N": exact,
+            "force_discrete_N": discrete,
+            "u_nm": from_si(path, "nm"),
+            "force_exact_mN": from_si(exact, "mN"),
+            f"force_{MDR_LOOP_SPRINGS}_springs_mN": from_si(discrete, "mN"),
+            "normal_force_N": f1,
+            "hemisphere_radius_m": radius,
+            "contact_radius_m": float(theory.hertz_contact_radius(f1, radius, e_star)),
+            "indentation_m": float(theory.hertz_indentation(f1, radius, e_star)),
+            "presliding_m": u_max,
+            "sliding_force_N": mu * f1,
+            "springs": MDR_LOOP_SPRINGS,
+        }
+    )
+
+
+def closed_form_rows(drive: Drive) -> dict[str, str]:
+    """The closed forms of Section 4 for a six-contact drive, formatted for the model chapter.
+
+    Values of :func:`passmd.model.theory.drive_theory` (Eqs. 1, 4, 7, 9–14) and the runner's
+    frequency on its contacts, in display units, 4 significant digits (2aG*: 3), two sides
+    joined by ", ".
+    """
+    th = theory.drive_theory(drive)
+
+    def join(values, unit, digits=4):
+        return ", ".join(f"{from_si(v, unit):.{digits}g}" for v in values)
+
+    return {
+        "E* (GPa)": f"{from_si(th['E_star_Pa'], 'GPa'):.4g}",
+        "G* (GPa)": f"{from_si(th['G_star_Pa'], 'GPa'):.4g}",
+        "F_N1, F_N2 (N)": join(th["normal_force_N"], "N"),
+        "a₁, a₂ (µm)": join(th["contact_radius_m"], "um"),
+        "2aG* per contact (N/m)": join(th["tangential_stiffness_N_per_m"], "N/m", 3),
+        "u_x,max,1, u_x,max,2 (nm), Eq. 10": join(th["presliding_m"], "nm"),
+        "u_x,a,1, u_x,a,2 (nm), Eq. 14": join(th["actuator_deformation_m"], "nm"),
+        "u_x,max,e rigid (nm), Eq. 11": f"{from_si(th['critical_amplitude_rigid_m'], 'nm'):.4g}",
+        "u*_x,max,e flexible (nm), Eq. 12": f"{from_si(th['critical_amplitude_flexible_m'], 'nm'):.4g}",
+        "runner on its contacts (kHz)": f"{from_si(theory.runner_frequency(drive), 'kHz'):.4g}",
+    }
+
+
+def actuator_row(drive: Drive) -> dict[str, str]:
+    """Table 2's actuator of a drive and its bare natural frequency √(k_p/m_a)/2π, formatted."""
+    actuator = drive.actuator
+    return {
+        "drive": f"R = {from_si(drive.hemisphere_radius, 'mm'):.3g} mm",
+        "k_p (N/m)": f"{actuator.stiffness:.3g}",
+        "m_a (g)": f"{from_si(actuator.mass, 'g'):.3g}",
+        "bare actuator √(k_p/m_a)/2π (MHz)": f"{actuator.natural_frequency / 1e6:.3g}",
+        "damping ratio ζ (assumed)": f"{actuator.damping_ratio:.3g}",
+    }

@@ -1,0 +1,1 @@
+"""The numerics chapter: trust in the integrator (convergence, energy, cost)."""

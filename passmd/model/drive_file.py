@@ -1,0 +1,422 @@
+"""Drive files: a drive described in TOML, read back to a :class:`~passmd.model.parameters.Drive`.
+
+A drive file names the drive's parameters by their :class:`~passmd.model.parameters.Drive` field,
+dotted for a part (``actuator.mass``); top-level keys may also sit in a ``[drive]`` table::
+
+    hemisphere_radius = "0.5 mm"     # a string with a unit, read by passmd.runtime.units
+    preload = 0.6                    # a bare number: SI (N)
+    contacts = "paper-six"           # or "one"; or any arrangement as [[contact_groups]] tables:
+    #   [[contact_groups]]
+    #   count = 1
+    #   load_share = 1.0              # F_N per contact / F_p (or normal_force = "0.3 N")
+    #   radius = "0.5 mm"             # optional: the drive's hemisphere_radius
+
+    [actuator]
+    stiffness = "5e6 N/m"
+    mass = "1.5e-5 kg"
+    damping_ratio = 0.05             # c_p = 2ζ√(k_p m_a); or viscosity = "..." (not both)
+
+A bare number is always in SI units (m, kg, s, N, N/m, kg/s, Pa, V, V/s): a file has no
+display unit. Every value is checked once, here, against the ranges the command line uses
+(:data:`~passmd.model.parameters.PLAUSIBLE_RANGES`); a refused value is one line naming the file,
+the key as typed, the value and the allowed range.
+
+What is not given comes from the paper: Table 1 (materials, masses, μ), Section 4 (preload),
+Table 2 for the actuator of the drive's radius (interpolated between its two rows), and the
+viscosity derived from the damping ratio ζ (assumption ``actuator_viscosity``).
+:func:`resolve` records where each value came from, for ``passmd drive show``.
+:func:`drive_toml` writes a file :func:`load_drive` reads back to an equal drive.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import dataclass, replace
+
+from passmd.model.parameters import (
+    ACTUATOR_DAMPING_RATIO,
+    PLAUSIBLE_RANGES,
+    TABLE2_RADII,
+    Amplifier,
+    ContactGroup,
+    Drive,
+    actuator_for_radius,
+    actuator_viscosity,
+)
+from passmd.runtime.units import QuantityError, parse_quantity
+from passmd.runtime.validation import InputError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+__all__ = ["CONTACT_PRESETS", "DRIVE_KEYS", "DriveFileError", "DriveKey", "drive_toml", "load_drive",
+           "parameter_rows", "read_drive_file", "resolve"]
+
+
+class DriveFileError(InputError):
+    """A drive file that cannot be read, or a key or value in it that is refused (one line)."""
+
+
+@dataclass(frozen=True)
+class DriveKey:
+    """One key of a drive file: its SI unit, display unit, symbol, meaning and default's source."""
+
+    key: str
+    unit: str  # SI unit of a bare number ("" for plain numbers, "str"/"bool"/"choice" for others)
+    display: str  # unit the template and ``drive show`` write the value in
+    symbol: str
+    text: str
+    source: str  # where the default comes from
+    plausible: str | None = None  # key of PLAUSIBLE_RANGES
+    choices: tuple = ()
+
+
+_DEFAULT = Drive()
+#: The paper's two contact arrangements, by name (Section 4.1).
+CONTACT_PRESETS = {"one": 1, "paper-six": 6}
+
+#: Every key a drive file may hold, by its dotted name (the Drive field path).
+DRIVE_KEYS: dict[str, DriveKey] = {k.key: k for k in (
+    DriveKey("contacts", "choice", "", "n", "contact arrangement: \"one\" (one contact) or \"paper-six\" "
+             "(two contacts on one side, four on the other)", "Section 4.1", choices=tuple(CONTACT_PRESETS)),
+    DriveKey("contact_groups", "groups", "", "n_g, F_N, R", "any other arrangement: [[contact_groups]] "
+             "tables of count, load_share (F_N / F_p per contact) or normal_force, and radius (default: the "
+             "drive's)", "instead of contacts"),
+    DriveKey("actuator_model", "choice", "", "–", "\"flexible\" (mass–spring–damper) or \"rigid\" actuators",
+             "Section 3.1", choices=("flexible", "rigid")),
+    DriveKey("hemisphere_radius", "m", "mm", "R", "radius of the hemispheres", "Table 1",
+             "hemisphere_radius"),
+    DriveKey("preload", "N", "N", "F_p", "preload", "Section 4", "preload"),
+    DriveKey("friction_coefficient", "", "", "μ", "friction coefficient", "Table 1; Section 4.2",
+             "friction_coefficient"),
+    DriveKey("runner_mass", "kg", "g", "m_r", "runner mass", "Table 1", "runner_mass"),
+    DriveKey("load_cell_stiffness", "N/m", "N/m", "k", "load cell stiffness", "Table 1",
+             "load_cell_stiffness"),
+    DriveKey("load_cell", "bool", "", "–", "the runner pushes against the load cell", "Section 4.2"),
+    DriveKey("allow_extrapolation", "bool", "", "–", "accept values outside the plausible ranges "
+             "(soft limits only)", "default"),
+    DriveKey("hemisphere_material.name", "str", "", "–", "name of the hemispheres' material", "Table 1"),
+    DriveKey("hemisphere_material.youngs_modulus", "Pa", "GPa", "E_1", "Young's modulus of the hemispheres",
+             "Table 1", "material.youngs_modulus"),
+    DriveKey("hemisphere_material.poissons_ratio", "", "", "ν_1", "Poisson's ratio of the hemispheres",
+             "Table 1", "material.poissons_ratio"),
+    DriveKey("runner_material.name", "str", "", "–", "name of the runner's material", "Table 1"),
+    DriveKey("runner_material.youngs_modulus", "Pa", "GPa", "E_2", "Young's modulus of the runner", "Table 1",
+             "material.youngs_modulus"),
+    DriveKey("runner_material.poissons_ratio", "", "", "ν_2", "Poisson's ratio of the runner", "Table 1",
+             "material.poissons_ratio"),
+    DriveKey("actuator.stiffness", "N/m", "N/m", "k_p", "actuator stiffness", "Table 2",
+             "actuator.stiffness"),
+    DriveKey("actuator.mass", "kg", "kg", "m_a", "actuator mass", "Table 2 (as printed)", "actuator.mass"),
+    DriveKey("actuator.viscosity", "kg/s", "kg/s", "c_p", "actuator viscosity (or give damping_ratio)",
+             f"derived from ζ = {ACTUATOR_DAMPING_RATIO:g}"),
+    DriveKey("actuator.damping_ratio", "", "", "ζ", "damping ratio of the bare actuator, "
+             "c_p = 2ζ√(k_p m_a) (or give viscosity)", "assumed (Table 2's column is lost)",
+             "actuator.damping_ratio"),
+    DriveKey("actuator.full_stroke_amplitude", "m", "nm", "A_max", "actuation amplitude at the full voltage",
+             "Table 2", "actuator.full_stroke_amplitude"),
+    DriveKey("amplifier.peak_to_peak_voltage", "V", "V", "V_pp", "amplifier peak-to-peak voltage",
+             "Section 2", "amplifier.peak_to_peak_voltage"),
+    DriveKey("amplifier.slew_rate", "V/s", "V/us", "SR", "amplifier slew rate", "Section 2",
+             "amplifier.slew_rate"),
+)}
+
+_SI_UNITS = {"m", "kg", "s", "N", "N/m", "kg/s", "Pa", "V", "V/s", "Hz", ""}
+
+
+def _flatten(table: dict, prefix: str = "") -> dict:
+    out = {}
+    for name, value in table.items():
+        key = f"{prefix}{name}"
+        if isinstance(value, dict):
+            out.update(_flatten(value, "" if key == "drive" and not prefix else key + "."))
+        else:
+            out[key] = value
+    return out
+
+
+def _refuse(where: str, text: str, **kw) -> DriveFileError:
+    """``"file: key = value …"``: ``where`` is ``"file: key"``, ``text`` starts with ``"= value"``."""
+    return DriveFileError(f"{where} {text}", **kw)
+
+
+def _value(where: str, spec: DriveKey, raw, allow_extrapolation: bool):
+    """The SI value (or string/bool) of one key, checked; ``where`` is ``"file: key"``."""
+    label = f"{where}"
+    if spec.unit == "bool":
+        if not isinstance(raw, bool):
+            raise _refuse(label, f"= {raw!r}: must be true or false", name=spec.key, value=raw)
+        return raw
+    if spec.unit == "str":
+        if not isinstance(raw, str):
+            raise _refuse(label, f"= {raw!r}: must be a string", name=spec.key, value=raw)
+        return raw
+    if spec.unit == "groups":
+        return _groups(where, raw, allow_extrapolation)
+    if spec.unit == "choice":
+        if isinstance(raw, str) and raw in spec.choices:
+            return raw
+        if spec.key == "contacts" and not isinstance(raw, bool) and raw in CONTACT_PRESETS.values():
+            return {1: "one", 6: "paper-six"}[raw]
+        raise _refuse(label, f"= {raw!r}: must be one of {', '.join(repr(c) for c in spec.choices)}",
+                      name=spec.key, value=raw)
+    if isinstance(raw, bool) or not isinstance(raw, (int, float, str)):
+        raise _refuse(label, f"= {raw!r}: must be a number (SI, {spec.unit or 'plain'}) or a string with "
+                             f"a unit, e.g. \"1 {spec.display or spec.unit}\"", name=spec.key, value=raw)
+    try:
+        value = parse_quantity(raw, spec.unit, name=label)
+    except QuantityError as exc:
+        raise DriveFileError(str(exc), name=spec.key, value=raw) from None
+    si = f" {spec.unit}" if spec.unit else ""
+    if spec.plausible is not None:
+        try:
+            PLAUSIBLE_RANGES[spec.plausible].check(spec.key, value, allow_extrapolation=allow_extrapolation)
+        except InputError as exc:
+            limits = " and ".join(f"{op} {bound:.4g}{si}" for op, bound in exc.limits)
+            hint = "; allow_extrapolation = true goes beyond it" if exc.soft else ""
+            raise _refuse(label, f"= {raw!r} is out of range: must be {limits} ({exc.why}){hint}",
+                          name=spec.key, value=raw, limits=exc.limits, soft=exc.soft) from None
+    elif spec.key == "actuator.viscosity" and not value >= 0.0:
+        raise _refuse(label, f"= {raw!r} is out of range: must be >= 0{si}", name=spec.key, value=raw)
+    return value
+
+
+_GROUP_KEYS = {"count": "", "load_share": "", "normal_force": "N", "radius": "m"}
+
+
+def _groups(where: str, raw, allow_extrapolation: bool) -> tuple:
+    """``[[contact_groups]]`` tables to :class:`~passmd.model.parameters.ContactGroup` s, each key checked."""
+    if not isinstance(raw, list) or not raw or not all(isinstance(t, dict) for t in raw):
+        raise _refuse(where, "must be one or more [[contact_groups]] tables (count, load_share or "
+                             "normal_force, radius)", name="contact_groups", value=raw)
+    groups = []
+    for i, table in enumerate(raw):
+        label = f"{where}[{i}]"
+        unknown = [k for k in table if k not in _GROUP_KEYS]
+        if unknown:
+            raise _refuse(f"{label}.{unknown[0]}", f"is not a key of a contact group: the known keys are "
+                          f"{', '.join(_GROUP_KEYS)}", name="contact_groups", value=table)
+        count = table.get("count")
+        if isinstance(count, bool) or not isinstance(count, int) or count < 1:
+            raise _refuse(f"{label}.count", f"= {count!r}: must be an integer >= 1", name="contact_groups",
+                          value=count)
+        values = {"count": count}
+        for key in ("load_share", "normal_force", "radius"):
+            if key in table:
+                spec = DriveKey(f"contact_groups.{key}", _GROUP_KEYS[key], "", "", key, "",
+                                {"normal_force": "preload", "radius": "hemisphere_radius"}.get(key))
+                values[key] = _value(f"{label}.{key}", spec, table[key], allow_extrapolation)
+                if key == "load_share" and not values[key] > 0:
+                    raise _refuse(f"{label}.{key}", f"= {table[key]!r} is out of range: must be > 0",
+                                  name="contact_groups", value=table[key])
+        if ("load_share" in values) == ("normal_force" in values):
+            raise _refuse(label, "gives both or neither of load_share and normal_force: give exactly one",
+                          name="contact_groups", value=table)
+        groups.append(ContactGroup(**values))
+    return tuple(groups)
+
+
+def read_drive_file(path, *, allow_extrapolation: bool | None = None) -> dict:
+    """The values a drive file gives, by key (SI floats, strings, booleans), each checked.
+
+    ``allow_extrapolation`` (the command line's option) lifts the soft limits as the file's own
+    ``allow_extrapolation = true`` does. Raises :class:`DriveFileError` (a ``ValueError``): the
+    file unreadable or not TOML, a key unknown (the known ones listed), or a value refused.
+    """
+    name = str(path)
+    try:
+        with open(path, "rb") as handle:
+            table = tomllib.load(handle)
+    except OSError as exc:
+        raise DriveFileError(f"cannot read the drive file {name}: {exc.strerror or exc}", name="drive",
+                             value=name) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise DriveFileError(f"{name}: not a TOML file: {exc}", name="drive", value=name) from None
+    raw = _flatten(table)
+    unknown = [key for key in raw if key not in DRIVE_KEYS]
+    if unknown:
+        raise DriveFileError(f"{name}: unknown key {unknown[0]!r}: the known keys are "
+                             f"{', '.join(DRIVE_KEYS)}", name=unknown[0], value=raw[unknown[0]])
+    lift = raw.get("allow_extrapolation") is True or bool(allow_extrapolation)
+    values = {key: _value(f"{name}: {key}", DRIVE_KEYS[key], value, lift) for key, value in raw.items()}
+    if "contacts" in values and "contact_groups" in values:
+        raise DriveFileError(f"{name}: contacts and contact_groups both given: give one (a preset, or the "
+                             "groups)", name="contacts", value=values["contacts"])
+    if "actuator.viscosity" in values and "actuator.damping_ratio" in values:
+        raise DriveFileError(f"{name}: actuator.viscosity and actuator.damping_ratio both given: give one "
+                             "(c_p = 2ζ√(k_p m_a))", name="actuator.viscosity",
+                             value=values["actuator.viscosity"])
+    return values
+
+
+def _table2_source(radius: float) -> str:
+    radii = sorted(TABLE2_RADII)
+    if any(math.isclose(radius, r, rel_tol=1e-9) for r in radii):
+        return f"Table 2 (R = {radius * 1e3:g} mm)"
+    if radii[0] < radius < radii[-1]:
+        return f"Table 2 interpolated at R = {radius * 1e3:.4g} mm"
+    return f"Table 2 clamped (R = {radius * 1e3:.4g} mm outside {radii[0] * 1e3:g}–{radii[-1] * 1e3:g} mm)"
+
+
+def resolve(values: dict, origins: dict | None = None, **fixed) -> tuple[Drive, dict]:
+    """The drive ``values`` describe, and where each of its parameters came from.
+
+    ``values``: SI values by drive-file key (:data:`DRIVE_KEYS`); ``origins``: how each was
+    given (``"file"``, ``"option"``; default ``"given"``). ``fixed`` replaces Drive fields last
+    (``load_cell=True`` for a stall run). What is not given: the paper's default (its source),
+    the Table 2 actuator of the radius (interpolated between its rows), the viscosity
+    2ζ√(k_p m_a) of the final k_p and m_a. Returns ``(drive, sources)``, ``sources`` by key.
+    """
+    origins = origins or {}
+    sources = {key: origins.get(key, "given") for key in values}
+    for key, spec in DRIVE_KEYS.items():
+        sources.setdefault(key, f"default ({spec.source})")
+
+    def get(key):
+        return values.get(key, _field(_DEFAULT, key))
+
+    radius = get("hemisphere_radius")
+    base = actuator_for_radius(radius)
+    table2 = _table2_source(radius)
+    act = {name: values.get(f"actuator.{name}", getattr(base, name))
+           for name in ("stiffness", "mass", "full_stroke_amplitude")}
+    for name in act:
+        if f"actuator.{name}" not in values:
+            sources[f"actuator.{name}"] = table2
+    zeta = values.get("actuator.damping_ratio", ACTUATOR_DAMPING_RATIO)
+    if "actuator.viscosity" in values:
+        viscosity = values["actuator.viscosity"]
+        sources["actuator.damping_ratio"] = "derived from c_p"
+    else:
+        viscosity = float(actuator_viscosity(act["stiffness"], act["mass"], zeta))
+        sources["actuator.viscosity"] = f"derived from ζ = {zeta:g}: 2ζ√(k_p m_a)"
+    changes = {"actuator": replace(base, viscosity=viscosity, **act)}
+    for which in ("hemisphere_material", "runner_material"):
+        material = getattr(_DEFAULT, which)
+        part = {key.split(".", 1)[1]: value for key, value in values.items() if key.startswith(which + ".")}
+        if part:
+            part.setdefault("name", f"{material.name} (modified)")
+            changes[which] = replace(material, **part)
+    amplifier = {key.split(".", 1)[1]: value for key, value in values.items() if key.startswith("amplifier.")}
+    changes["amplifier"] = replace(Amplifier(), **amplifier)
+    for key in ("hemisphere_radius", "preload", "friction_coefficient", "runner_mass", "load_cell_stiffness",
+                "load_cell", "allow_extrapolation", "actuator_model"):
+        if key in values:
+            changes[key] = values[key]
+    if "contacts" in values:
+        contacts = values["contacts"]
+        changes["contacts"] = CONTACT_PRESETS[contacts] if isinstance(contacts, str) else contacts
+        changes["contact_groups"] = ()
+        sources["contact_groups"] = "not used (contacts)"
+    elif "contact_groups" in values:
+        changes["contact_groups"] = values["contact_groups"]
+        sources["contacts"] = "derived: the groups' total count"
+    changes.update(fixed)
+    for key, value in fixed.items():
+        if key in DRIVE_KEYS:
+            sources[key] = f"set by the command ({value!r})"
+    return replace(_DEFAULT, **changes), sources
+
+
+def _field(drive: Drive, key: str):
+    """The value of a drive-file key in ``drive`` (``contacts`` by preset name)."""
+    if key == "contacts":
+        return {1: "one", 6: "paper-six"}[drive.contacts] if not drive.contact_groups else drive.contacts
+    if key == "contact_groups":
+        return [{name: value for name, value in vars(g).items() if value is not None}
+                for g in drive.contact_groups]
+    if key == "actuator.damping_ratio":
+        return drive.actuator.damping_ratio
+    value = drive
+    for part in key.split("."):
+        value = getattr(value, part)
+    return value
+
+
+def load_drive(path, **fixed) -> Drive:
+    """The :class:`~passmd.model.parameters.Drive` a drive file describes (module docstring).
+
+    What the file does not give comes from the paper (Tables 1–2, ζ for the viscosity), as
+    on the command line. ``fixed`` replaces Drive fields last. Raises ``ValueError`` naming
+    the file and the key for a refused value or an unknown key.
+    """
+    values = read_drive_file(path)
+    try:
+        return resolve(values, **fixed)[0]
+    except DriveFileError:
+        raise
+    except InputError as exc:
+        raise DriveFileError(f"{path}: {exc}", name=exc.name, value=exc.value) from None
+
+
+def parameter_rows(drive: Drive, sources: dict | None = None) -> list[dict]:
+    """Every drive-file key of ``drive``: value (SI), unit, symbol, meaning and source."""
+    sources = sources or {}
+    rows = []
+    for key, spec in DRIVE_KEYS.items():
+        unit = spec.unit if spec.unit in _SI_UNITS else ""
+        rows.append({"key": key, "value": _field(drive, key), "unit": unit,
+                     "display_unit": spec.display, "symbol": spec.symbol, "meaning": spec.text,
+                     "source": sources.get(key, spec.source)})
+    return rows
+
+
+def _number(value: float) -> str:
+    """A float as TOML that reads back to the same double (``repr``, integers with ``.0``)."""
+    text = repr(float(value))
+    return text if any(c in text for c in ".en") else text + ".0"
+
+
+def _shown(value, spec: DriveKey) -> str:
+    """A value as TOML: a string in the display unit when that reads back exactly, else SI."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if spec.display and spec.display != spec.unit:
+        from passmd.runtime.units import from_si
+
+        text = f"{float(from_si(value, spec.display)):.12g} {spec.display}"
+        if parse_quantity(text, spec.unit) == value:
+            return f'"{text}"'
+    return _number(value)  # a bare number: SI
+
+
+def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None = None) -> str:
+    """A commented drive file of ``drive``: :func:`load_drive` reads it back to an equal drive.
+
+    Every key is written, with its symbol, meaning, unit and source (``sources`` by key,
+    else the paper's source of the default). The viscosity is written as given (c_p), not
+    as ζ, so that it reads back exactly.
+    """
+    if not isinstance(drive, Drive):
+        raise InputError(f"drive = {drive!r} is not a Drive", name="drive", value=drive)
+    sources = sources or {}
+    lines = [f"# {title or 'passmd drive file'}",
+             "# Values: a string with a unit (\"0.5 mm\", \"1.5e-5 kg\") or a bare number in SI units.",
+             "# Keys left out take the paper's value (Tables 1-2; the actuator of Table 2 for the radius;",
+             "# c_p = 2ζ√(k_p m_a) with ζ = 0.05). Another arrangement of contacts: instead of `contacts`,",
+             "# one [[contact_groups]] table per kind: count, load_share (F_N/F_p) or normal_force, radius.",
+             "# `passmd drive show --drive FILE` lists what a file resolves to, with sources."]
+    section = None
+    for key, spec in DRIVE_KEYS.items():
+        if key in ("actuator.damping_ratio", "contact_groups") or (
+                key == "contacts" and drive.contact_groups):
+            continue
+        head, _, name = key.rpartition(".")
+        if head != section:
+            lines += ["", f"[{head}]"] if head else [""]
+            section = head
+        value = _field(drive, key)
+        unit = f" [{spec.unit}]" if spec.unit in _SI_UNITS and spec.unit else ""
+        source = sources.get(key, spec.source)
+        lines.append(f"{name or key} = {_shown(value, spec)}  # {spec.symbol}: {spec.text}{unit}; {source}")
+    for group in drive.contact_groups:  # arrays of tables come last in TOML
+        lines += ["", "[[contact_groups]]  # contacts of one kind: count, F_N per contact (or its share of "
+                      "F_p), radius R [m]"]
+        lines += [f"{name} = {value if name == 'count' else _number(value)}"
+                  for name, value in vars(group).items() if value is not None]
+    return "\n".join(lines) + "\n"

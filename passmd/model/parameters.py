@@ -1,0 +1,649 @@
+"""Parameter sets of the drive: materials, actuators, amplifier and the whole drive.
+
+Every value cites where it comes from in Nguyen et al. (2018) (Table 1, Table 2,
+Section 2). Where the paper is silent, the value is an *assumption*: it is defined
+once in this module, listed in ``ASSUMPTIONS``, and shown in the book's
+assumptions table.
+
+All quantities are SI (m, kg, s, N, Pa). Records are frozen dataclasses validated
+in ``__post_init__``; each field carries its paper symbol, unit and source in its
+metadata, which :func:`parameter_table` turns into the book's parameter tables.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields, replace
+
+import numpy as np
+
+from passmd.model.theory import contact_layout, contact_moduli
+from passmd.runtime.validation import InputError, check_choice, check_positive, check_range, format_number
+from passmd.runtime.validation import shown as _plain
+
+__all__ = [
+    "ACTUATOR_DAMPING_RATIO",
+    "CONTACT_RADIUS_RATIO_LIMIT",
+    "HERTZ_PRESSURE_LIMIT",
+    "PLAUSIBLE_RANGES",
+    "PlausibleRange",
+    "check_contact_plausible",
+    "check_drive",
+    "check_plausible",
+    "ASSUMPTIONS",
+    "Actuator",
+    "Amplifier",
+    "Assumption",
+    "ContactGroup",
+    "Drive",
+    "MOLYBDENUM",
+    "Material",
+    "PRELOAD_GRIDS",
+    "RUBY",
+    "STEEL",
+    "TABLE2_RADII",
+    "actuator_for_radius",
+    "actuator_viscosity",
+    "paper_drive",
+    "parameter_table",
+]
+
+
+def _meta(symbol: str, unit: str, source: str) -> dict:
+    return {"symbol": symbol, "unit": unit, "source": source}
+
+
+@dataclass(frozen=True)
+class Assumption:
+    """A value the paper does not give, with its default and why."""
+
+    key: str  # identifier used in code and in the book
+    symbol: str  # the paper's (or our) symbol
+    value: str  # default, formatted for display
+    unit: str  # display unit
+    rationale: str  # why this default
+    sensitivity: str  # where its effect is shown
+
+
+# --------------------------------------------------------------------------------------
+# Assumptions where the paper is silent (one place; the book renders ASSUMPTIONS).
+# --------------------------------------------------------------------------------------
+
+#: Damping ratio ζ of the bare actuator used to derive the viscosity
+#: c_p = 2 ζ sqrt(k_p m_a). Table 2's "Viscosity Factor" column was lost.
+ACTUATOR_DAMPING_RATIO = 0.05
+
+
+# --------------------------------------------------------------------------------------
+# Records
+# --------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Material:
+    """Isotropic elastic material."""
+
+    youngs_modulus: float = field(metadata=_meta("E", "Pa", "Table 1"))  # Young's modulus E
+    poissons_ratio: float = field(metadata=_meta("ν", "–", "Table 1"))  # Poisson's ratio ν
+    name: str = ""  # label for tables and plots
+
+    def __post_init__(self):
+        if not isinstance(self.name, str):
+            raise InputError(f"name = {self.name!r} is not allowed: must be a str", name="name",
+                             value=self.name)
+        check_positive("youngs_modulus", self.youngs_modulus, "Pa")
+        check_range(
+            "poissons_ratio", self.poissons_ratio, -1.0, 0.5, lower_open=True, upper_open=True
+        )
+
+    @property
+    def shear_modulus(self) -> float:
+        """Shear modulus G = E / (2 (1 + ν)) in Pa."""
+        return self.youngs_modulus / (2.0 * (1.0 + self.poissons_ratio))
+
+
+#: Ruby hemispheres, Table 1 (E_1 = 370 GPa, ν_1 = 0.33).
+RUBY = Material(370e9, 0.33, "ruby")
+#: Steel runner, Table 1 (E_2 = 210 GPa, ν_2 = 0.33).
+STEEL = Material(210e9, 0.33, "steel")
+#: Molybdenum runner, Section 5.2 / Fig. 10c (E_2 = 310 GPa; ν assumed, see ASSUMPTIONS).
+MOLYBDENUM = Material(310e9, 0.33, "molybdenum")
+
+
+@dataclass(frozen=True)
+class Actuator:
+    """One piezo actuator as a mass–spring–damper (Eq. 3)."""
+
+    stiffness: float = field(metadata=_meta("k_p", "N/m", "Table 2"))  # k_p
+    mass: float = field(metadata=_meta("m_a", "kg", "Table 2 (as printed)"))  # m_a
+    viscosity: float = field(metadata=_meta("c_p", "kg/s", "assumed (Table 2 lost)"))  # c_p
+    full_stroke_amplitude: float = field(
+        metadata=_meta("A_max", "m", "Table 2 amplitude range at 300 V_pp")
+    )  # actuation amplitude at the full 300 V_pp stroke
+
+    def __post_init__(self):
+        check_positive("actuator_stiffness", self.stiffness, "N/m")
+        check_positive("actuator_mass", self.mass, "kg")
+        check_range("actuator_viscosity", self.viscosity, 0.0, unit="kg/s")
+        check_positive("full_stroke_amplitude", self.full_stroke_amplitude, "m")
+
+    @property
+    def natural_frequency(self) -> float:
+        """Bare actuator natural frequency √(k_p/m_a)/(2π) in Hz."""
+        return float(np.sqrt(self.stiffness / self.mass) / (2 * np.pi))
+
+    @property
+    def damping_ratio(self) -> float:
+        """ζ = c_p / (2 √(k_p m_a))."""
+        return self.viscosity / (2.0 * np.sqrt(self.stiffness * self.mass))
+
+
+#: Hemisphere radii of Table 2 with (k_p [N/m], m_a [kg], A_max [m]).
+#: m_a is printed as 1.1e-5 g and 2.2e-5 g; used as printed (see the model chapter).
+TABLE2_RADII: dict[float, tuple[float, float, float]] = {
+    0.25e-3: (4.0e6, 1.1e-8, 96e-9),
+    1.0e-3: (6.5e6, 2.2e-8, 202e-9),
+}
+
+
+def actuator_for_radius(
+    hemisphere_radius: float, damping_ratio: float = ACTUATOR_DAMPING_RATIO
+) -> Actuator:
+    """Table 2 actuator for a hemisphere radius R.
+
+    Parameters
+    ----------
+    hemisphere_radius : float
+        R in m. Table 2 rows (0.25 mm, 1 mm) are exact; other radii interpolate
+        linearly and are clamped outside (an assumption, see ``ASSUMPTIONS``).
+    damping_ratio : float
+        ζ of the bare actuator; c_p = 2 ζ √(k_p m_a).
+    """
+    radius = check_positive("hemisphere_radius", hemisphere_radius, "m")
+    zeta = check_range("damping_ratio", damping_ratio, 0.0, unit="–")
+    radii = np.array(sorted(TABLE2_RADII))
+    rows = np.array([TABLE2_RADII[r] for r in radii])
+    k_p, m_a, a_max = (float(np.interp(radius, radii, rows[:, j])) for j in range(3))
+    return Actuator(
+        stiffness=k_p,
+        mass=m_a,
+        viscosity=actuator_viscosity(k_p, m_a, zeta),
+        full_stroke_amplitude=a_max,
+    )
+
+
+def actuator_viscosity(stiffness: float, mass: float, damping_ratio: float = ACTUATOR_DAMPING_RATIO) -> float:
+    """Viscosity c_p = 2 ζ √(k_p m_a) of an actuator (Eq. 3) whose bare damping ratio is ζ."""
+    stiffness = check_positive("stiffness", stiffness, "N/m")
+    mass = check_positive("mass", mass, "kg")
+    return 2.0 * check_range("damping_ratio", damping_ratio, 0.0, unit="–") * np.sqrt(stiffness * mass)
+
+
+@dataclass(frozen=True)
+class Amplifier:
+    """Driving electronics (Section 2)."""
+
+    peak_to_peak_voltage: float = field(
+        default=300.0, metadata=_meta("V_pp", "V", "Section 2")
+    )  # maximal amplitude 300 V_pp
+    slew_rate: float = field(
+        default=150e6, metadata=_meta("SR", "V/s", "Section 2 (150 V/µs)")
+    )  # typical slew rate
+
+    def __post_init__(self):
+        check_positive("peak_to_peak_voltage", self.peak_to_peak_voltage, "V")
+        check_positive("slew_rate", self.slew_rate, "V/s")
+
+    @property
+    def full_stroke_time(self) -> float:
+        """Shortest fly-back of a full 300 V stroke, V_pp / SR (2 µs)."""
+        return self.peak_to_peak_voltage / self.slew_rate
+
+
+@dataclass(frozen=True)
+class ContactGroup:
+    """Contacts of one kind in a drive's arrangement: how many, how loaded, how curved.
+
+    The normal force on each contact of the group is ``normal_force`` (N) if given, else
+    ``load_share`` × the drive's preload (the paper's six contacts: two at F_p/(2 sin 45°),
+    four at F_p/(4 sin 45°), Eq. 1). ``radius``: the hemispheres' radius R in m (default: the
+    drive's ``hemisphere_radius``). Contacts of a group share one state in the simulation
+    (they see the same actuator and runner motion).
+    """
+
+    count: int = field(metadata=_meta("n_g", "–", "arrangement"))
+    load_share: float | None = field(default=None, metadata=_meta("F_N/F_p", "–", "arrangement"))
+    normal_force: float | None = field(default=None, metadata=_meta("F_N", "N", "arrangement"))
+    radius: float | None = field(default=None, metadata=_meta("R_g", "m", "arrangement"))
+
+    def __post_init__(self):
+        if isinstance(self.count, (bool, np.bool_)) or not isinstance(self.count, (int, np.integer)) \
+                or self.count < 1:
+            raise InputError(f"count = {_plain(self.count)} is not allowed: must be an integer >= 1",
+                             name="count", value=self.count)
+        object.__setattr__(self, "count", int(self.count))
+        if (self.load_share is None) == (self.normal_force is None):
+            raise InputError("load_share and normal_force: give exactly one (the normal force per contact, "
+                             "or its share of the preload)", name="load_share", value=self.load_share)
+        if self.load_share is not None:
+            check_positive("load_share", self.load_share, "–")
+        if self.normal_force is not None:
+            check_positive("normal_force", self.normal_force, "N")
+        if self.radius is not None:
+            check_positive("radius", self.radius, "m")
+
+
+#: The paper's six-contact arrangement (Section 4.1, Eq. 1) as contact groups: side 1, two
+#: contacts at F_p/(2 sin 45°); side 2, four at F_p/(4 sin 45°).
+PAPER_SIX = (ContactGroup(2, load_share=1.0 / (2.0 * np.sin(np.pi / 4))),
+             ContactGroup(4, load_share=1.0 / (4.0 * np.sin(np.pi / 4))))
+
+
+@dataclass(frozen=True)
+class Drive:
+    """The whole drive: geometry, preload, materials, masses and model choices.
+
+    Defaults reproduce the paper's R = 1 mm drive at F_p = 0.4 N with μ = 0.2
+    (Table 1, Section 4.2) and flexible actuators, six contacts, no load cell.
+    """
+
+    hemisphere_radius: float = field(
+        default=1.0e-3, metadata=_meta("R", "m", "Table 1")
+    )  # radius of the ruby hemispheres
+    preload: float = field(default=0.4, metadata=_meta("F_p", "N", "Section 4"))  # preload
+    friction_coefficient: float = field(
+        default=0.2, metadata=_meta("μ", "–", "Table 1; Section 4.2")
+    )  # 0.2 (this paper) or 0.3 (earlier work)
+    contacts: int = field(default=6, metadata=_meta("n", "–", "Section 4.1"))  # 1 or 6
+    actuator_model: str = field(
+        default="flexible", metadata=_meta("–", "–", "Section 3.1")
+    )  # "rigid" or "flexible"
+    runner_mass: float = field(default=3e-3, metadata=_meta("m_r", "kg", "Table 1"))  # m_r
+    load_cell_stiffness: float = field(
+        default=2.5e4, metadata=_meta("k", "N/m", "Table 1")
+    )  # load cell spring k (used only when load_cell is True)
+    load_cell: bool = field(
+        default=False, metadata=_meta("–", "–", "Section 4.2")
+    )  # runner pushes against the load cell
+    hemisphere_material: Material = field(default=RUBY, metadata=_meta("E_1, ν_1", "", "Table 1"))
+    runner_material: Material = field(default=STEEL, metadata=_meta("E_2, ν_2", "", "Table 1"))
+    actuator: Actuator | None = field(
+        default=None, metadata=_meta("k_p, m_a, c_p", "", "Table 2")
+    )  # None: Table 2 actuator for hemisphere_radius
+    amplifier: Amplifier = field(default_factory=Amplifier, metadata=_meta("", "", "Section 2"))
+    #: Lift the soft limits of :data:`PLAUSIBLE_RANGES` (never the hard ones), for exploring.
+    allow_extrapolation: bool = False
+    #: Any other arrangement of contacts (:class:`ContactGroup` s); empty: the paper's arrangement
+    #: ``contacts`` names (1 or 6). When given, ``contacts`` is their total count.
+    contact_groups: tuple = ()
+
+    def __post_init__(self):
+        if not isinstance(self.allow_extrapolation, bool):
+            raise InputError(f"allow_extrapolation = {_plain(self.allow_extrapolation)} is not allowed: "
+                             "must be True or False", name="allow_extrapolation",
+                             value=self.allow_extrapolation)
+        check_positive("hemisphere_radius", self.hemisphere_radius, "m")
+        check_positive("preload", self.preload, "N")
+        check_positive("friction_coefficient", self.friction_coefficient, "–")
+        if not isinstance(self.contact_groups, tuple) or not all(
+                isinstance(g, ContactGroup) for g in self.contact_groups):
+            raise InputError(f"contact_groups = {_plain(self.contact_groups)} is not allowed: must be a "
+                             "tuple of ContactGroup", name="contact_groups", value=self.contact_groups)
+        if self.contact_groups:
+            object.__setattr__(self, "contacts", sum(g.count for g in self.contact_groups))
+        elif not isinstance(self.contacts, (int, np.integer)) or isinstance(self.contacts, (bool, np.bool_)) \
+                or self.contacts not in (1, 6):
+            raise InputError(f"contacts = {_plain(self.contacts)} is not allowed: must be one of 1, 6",
+                             name="contacts", value=self.contacts)
+        check_choice("actuator_model", self.actuator_model, ("rigid", "flexible"))
+        check_positive("runner_mass", self.runner_mass, "kg")
+        check_positive("load_cell_stiffness", self.load_cell_stiffness, "N/m")
+        if not isinstance(self.load_cell, bool):
+            raise InputError(f"load_cell = {_plain(self.load_cell)} is not allowed: must be True or False",
+                             name="load_cell", value=self.load_cell)
+        for name in ("hemisphere_material", "runner_material"):
+            if not isinstance(getattr(self, name), Material):
+                raise InputError(f"{name} = {_plain(getattr(self, name))} is not a Material", name=name,
+                                 value=getattr(self, name))
+        if self.actuator is None:
+            object.__setattr__(self, "actuator", actuator_for_radius(self.hemisphere_radius))
+        elif not isinstance(self.actuator, Actuator):
+            raise InputError(f"actuator = {_plain(self.actuator)} is not an Actuator", name="actuator",
+                             value=self.actuator)
+        if not isinstance(self.amplifier, Amplifier):
+            raise InputError(f"amplifier = {_plain(self.amplifier)} is not an Amplifier", name="amplifier",
+                             value=self.amplifier)
+        if isinstance(self.contacts, np.integer):
+            object.__setattr__(self, "contacts", int(self.contacts))
+        check_plausible(self, allow_extrapolation=self.allow_extrapolation)
+
+    def replace(self, **changes) -> Drive:
+        """A copy with some fields changed (validated again).
+
+        Changing ``hemisphere_radius`` without giving ``actuator`` picks the Table 2
+        actuator of the new radius.
+        """
+        if "hemisphere_radius" in changes and "actuator" not in changes:
+            changes["actuator"] = None
+        return replace(self, **changes)
+
+    @property
+    def effective_load_cell_stiffness(self) -> float:
+        """k if the load cell is engaged, else 0 (free runner)."""
+        return self.load_cell_stiffness if self.load_cell else 0.0
+
+
+# --------------------------------------------------------------------------------------
+# Plausible ranges (one place): hard limits where the model's physics breaks, soft limits
+# around Tables 1–2 where it was checked. Library and CLI both check against this table.
+# --------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class PlausibleRange:
+    """Where a parameter keeps the model valid.
+
+    ``hard_*``: outside, the model does not apply (never lifted). ``soft_*``: the decades
+    around Tables 1–2 the model was checked in; ``allow_extrapolation=True`` (CLI
+    ``--allow-extrapolation``) lifts them for exploration. ``None`` leaves a side open.
+    """
+
+    unit: str
+    hard_low: float | None
+    soft_low: float | None
+    soft_high: float | None
+    hard_high: float | None
+    reason: str  # why the soft limits (and, unless hard_reason says otherwise, the hard ones)
+    hard_low_open: bool = True  # a hard lower bound of 0 is excluded (positive quantities)
+    hard_reason: str = ""  # why the hard limits, when it differs from ``reason``
+
+    def check(self, name: str, value, *, allow_extrapolation: bool = False, shown: str | None = None,
+              scale: float = 1.0, unit: str | None = None, hint: str = "allow_extrapolation=True") -> float:
+        """``float(value)`` if plausible, else ``ValueError`` naming the value, limit and why.
+
+        ``shown``/``scale``/``unit`` let the CLI report an option in its display unit
+        (``value`` and the bounds are divided by ``scale``).
+        """
+        v = check_range(name, value, unit=self.unit)  # a finite real number
+        label, unit = (shown or name), (self.unit if unit is None else unit)
+        u = f" {unit}" if unit and unit != "–" else ""
+
+        def refuse(op: str, bound: float, kind: str) -> InputError:
+            why = self.hard_reason if kind == "hard limit" and self.hard_reason else self.reason
+            if kind == "hard limit" and lo == 0.0 and op.startswith(">"):
+                why = "a physical quantity of this kind is positive"
+            soft = kind == "plausible range"
+            shown_value = f"{format_number(v, scale)}{u}" if shown else _plain(value)  # CLI: display unit
+            limit = f"{op} {format_number(bound, scale)}{u}"
+            return InputError(f"{label} = {shown_value} is out of range: must be {limit} "
+                              f"({kind}: {why}){f'; {hint} goes beyond it' if soft else ''}",
+                              name=label, value=v, unit=self.unit, limits=((op, bound),),
+                              why=f"{kind}: {why}", soft=soft)
+
+        lo, hi = self.hard_low, self.hard_high
+        if lo is not None and (v <= lo if self.hard_low_open else v < lo):
+            raise refuse(">" if self.hard_low_open else ">=", lo, "hard limit")
+        if hi is not None and v > hi:
+            raise refuse("<=", hi, "hard limit")
+        if not allow_extrapolation:
+            if self.soft_low is not None and v < self.soft_low:
+                raise refuse(">=", self.soft_low, "plausible range")
+            if self.soft_high is not None and v > self.soft_high:
+                raise refuse("<=", self.soft_high, "plausible range")
+        return v
+
+
+_TWO_DECADES = "two decades either side of Tables 1–2, where the model was checked"
+#: Ranges of the drive's parameters (SI). Keys: Drive fields, ``actuator.*``,
+#: ``amplifier.*``, ``material.*`` (both materials), and the waveform's ``frequency``.
+PLAUSIBLE_RANGES: dict[str, PlausibleRange] = {
+    "hemisphere_radius": PlausibleRange("m", 0.0, 10e-6, 100e-3, None,
+                                        "Table 2's 0.25–1 mm, " + _TWO_DECADES),
+    "preload": PlausibleRange("N", 0.0, 1e-3, 100.0, None, "Section 4's 0.1–1 N, " + _TWO_DECADES),
+    "friction_coefficient": PlausibleRange(
+        "–", 0.0, 0.01, 1.0, None,
+        "dry friction of ruby on steel is 0.1–0.3 (Table 1: 0.2, earlier work 0.3); beyond 1 the "
+        "Cattaneo–Mindlin traction of a Hertz contact is no longer a small perturbation"),
+    "runner_mass": PlausibleRange("kg", 0.0, 3e-5, 0.3, None, "Table 1's 3 g, " + _TWO_DECADES),
+    "load_cell_stiffness": PlausibleRange("N/m", 0.0, 250.0, 2.5e6, None,
+                                          "Table 1's 2.5e4 N/m, " + _TWO_DECADES),
+    "material.youngs_modulus": PlausibleRange(
+        "Pa", 0.0, 1e9, 1.2e12, None,
+        "engineering solids from polymers (1 GPa) to diamond (1.2 TPa); Table 1: 210–370 GPa"),
+    "material.poissons_ratio": PlausibleRange(
+        "–", -1.0, 0.0, 0.5, 0.5, "isotropic elasticity needs -1 < ν < 0.5; Table 1: 0.33"),
+    "actuator.stiffness": PlausibleRange("N/m", 0.0, 4e4, 6.5e8, None,
+                                         "Table 2's 4–6.5e6 N/m, " + _TWO_DECADES),
+    "actuator.mass": PlausibleRange("kg", 0.0, 1.1e-10, 2.2e-6, None,
+                                    "Table 2's 1.1–2.2e-8 kg (as printed), " + _TWO_DECADES),
+    "actuator.damping_ratio": PlausibleRange(
+        "–", 0.0, None, 10.0, None,
+        "c_p up to ten times critical damping of the bare actuator (the default is ζ = 0.05)",
+        hard_low_open=False),
+    "actuator.full_stroke_amplitude": PlausibleRange(
+        "m", 0.0, 0.96e-9, 20.2e-6, 10.0, "Table 2's 96–202 nm, " + _TWO_DECADES,
+        hard_reason="beyond 10 m of travel, double-precision rounding of positions (2.2e-16 relative) "
+        "exceeds 1e-6 of the ~10 nm presliding displacement"),
+    "amplifier.peak_to_peak_voltage": PlausibleRange("V", 0.0, 3.0, 3e4, None,
+                                                     "Section 2's 300 V_pp, " + _TWO_DECADES),
+    "amplifier.slew_rate": PlausibleRange("V/s", 0.0, 1.5e6, 1.5e10, None,
+                                          "Section 2's 150 V/µs, " + _TWO_DECADES),
+    "frequency": PlausibleRange(
+        "Hz", 1e-3, 1.0, 1e6, None,
+        "the paper drives from 100 Hz (Fig. 9a) to 130 kHz (Fig. 9b); two decades below, one above",
+        hard_reason="below 1 mHz a period is too long for its µs fly-back to stay resolvable in "
+        "double-precision time"),
+}
+ASSUMPTIONS: tuple[Assumption, ...] = (
+    Assumption(
+        key="actuator_viscosity",
+        symbol="c_p",
+        value=f"2·ζ·√(k_p m_a), ζ = {ACTUATOR_DAMPING_RATIO:g}",
+        unit="kg/s",
+        rationale=(
+            "Table 2's 'Viscosity Factor' column is lost in the available text. A bare "
+            "piezo actuator is lightly damped; ζ = 0.05 (Q = 10) is a typical order."
+        ),
+        sensitivity="Critical-amplitude chapters: A_c over a decade of c_p either side.",
+    ),
+    Assumption(
+        key="preload_grids",
+        symbol="F_p",
+        value="R = 1 mm: 0.1–1.0 N; R = 0.25 mm: 0.1–0.5 N; step 0.1 N",
+        unit="N",
+        rationale=(
+            "Table 2's 'Preload Range' column is lost; its header gives the 0.1 N step. "
+            "The ranges are those the text uses (Figs. 7 and 10: 0.1, 0.3, 0.4, 0.8, 1 N "
+            "for R = 1 mm; 0.2, 0.4 N for R = 0.25 mm)."
+        ),
+        sensitivity="Only the extent of the Fig. 5b/6 grids; no result depends on it.",
+    ),
+    Assumption(
+        key="molybdenum_poisson",
+        symbol="ν_2 (Mo)",
+        value="0.33",
+        unit="–",
+        rationale=(
+            "Section 5.2 gives only E_2 = 310 (printed 'MPa', a typo for GPa given "
+            "Table 1) for molybdenum; ν is kept at Table 1's 0.33 so only E changes."
+        ),
+        sensitivity="Fig. 10c only.",
+    ),
+    Assumption(
+        key="actuator_other_radii",
+        symbol="k_p(R), m_a(R), A_max(R)",
+        value="linear in R between Table 2's rows, constant outside",
+        unit="–",
+        rationale=(
+            "Table 2 gives actuators for R = 0.25 mm and 1 mm only. Other radii (CLI "
+            "sizing) interpolate; the paper's figures use the tabulated radii only."
+        ),
+        sensitivity="None of the paper's figures; CLI results at other radii.",
+    ),
+    Assumption(
+        key="plausible_ranges",
+        symbol="–",
+        value="soft: two decades around Tables 1–2, μ ≤ 1, p0 ≤ 10 GPa; hard: a ≤ R/10, positive quantities",
+        unit="–",
+        rationale=(
+            "The paper gives the model's parameters, not where it stops applying. Hard limits follow "
+            "from its physics (Hertz/MDR need a ≤ R/10); soft limits keep inputs within two decades of "
+            "the tabulated values, where the model was checked (PLAUSIBLE_RANGES gives each reason)."
+        ),
+        sensitivity="None of the paper's figures (all inside the soft limits); other inputs are refused "
+                    "unless allow_extrapolation / --allow-extrapolation.",
+    ),
+)
+
+#: Hard limit on the Hertz contact radius: a <= R/10. Hertz's half-space solution and the
+#: MDR both assume a contact small against the sphere (K.L. Johnson, Contact Mechanics, §4.2).
+CONTACT_RADIUS_RATIO_LIMIT = 0.1
+#: Soft limit on the peak Hertz pressure p0 = 3 F_N / (2π a²): 10 GPa. Hardened bearing steel
+#: first yields at p0 ≈ 1.6 Y ≈ 3 GPa and ruby's compressive strength is 2–3 GPa; the paper's
+#: own grids reach 2.9 GPa (R = 0.25 mm, F_p = 0.5 N). Beyond 10 GPa the contact is far outside
+#: the elastic regime the Hertz/MDR model describes.
+HERTZ_PRESSURE_LIMIT = 10e9
+
+
+def _hertz(normal_force: float, radius: float, E_star: float) -> tuple[float, float]:
+    """(a, p0) of a Hertz contact (a = (3 F R / 4E*)^(1/3), p0 = 3F / (2π a²))."""
+    a = (3.0 * normal_force * radius / (4.0 * E_star)) ** (1.0 / 3.0)
+    return a, 3.0 * normal_force / (2.0 * np.pi * a * a)
+
+
+def check_contact_plausible(normal_force: float, radius: float, E_star: float, *,
+                            allow_extrapolation: bool = False, names: str = "normal_force, radius",
+                            hint: str = "allow_extrapolation=True", sources: tuple[str, ...] = ()) -> None:
+    """Refuse a contact outside Hertz's assumptions: a > R/10 (hard), p0 > 10 GPa (soft).
+
+    Raises
+    ------
+    InputError
+        A ``ValueError`` naming the parameters (``names``), the contact radius or pressure and
+        the limit; its ``sources`` are ``sources`` (the inputs, named like the drive's fields).
+    """
+    def refuse(detail: str, soft: bool = False) -> InputError:
+        hinted = f"{detail}; {hint} goes beyond it" if soft else detail
+        return InputError(f"{names}: {hinted}", name=names, sources=sources, detail=detail, soft=soft)
+
+    a = (3.0 * float(normal_force) * float(radius) / (4.0 * float(E_star))) ** (1.0 / 3.0)
+    if not a > 0.0:  # the product underflows below the smallest double: no contact to model
+        raise refuse(f"the Hertz contact radius a = (3 F R / 4E*)^(1/3) = {a:.4g} m underflows; "
+                     "must be > 0 (hard limit: double precision)")
+    with np.errstate(all="ignore"):
+        a, p0 = _hertz(float(normal_force), float(radius), float(E_star))
+    ratio = a / radius
+    if not np.isfinite(ratio) or ratio > CONTACT_RADIUS_RATIO_LIMIT:
+        raise refuse(f"the Hertz contact radius a = {a:.4g} m is {ratio:.3g} R; must be <= "
+                     f"{CONTACT_RADIUS_RATIO_LIMIT:g} R (hard limit: Hertz and the MDR need a contact small "
+                     "against the sphere)")
+    if not allow_extrapolation and not p0 <= HERTZ_PRESSURE_LIMIT:
+        raise refuse(f"the peak Hertz pressure p0 = {p0 / 1e9:.4g} GPa is out of range: must be <= "
+                     f"{HERTZ_PRESSURE_LIMIT / 1e9:g} GPa (plausible range: beyond it ruby and steel are far "
+                     "outside the elastic regime the model describes)", soft=True)
+
+
+def check_drive(drive) -> Drive:
+    """``drive`` if it is a :class:`Drive`, else ``ValueError`` naming it (public functions' check)."""
+    if not isinstance(drive, Drive):
+        raise InputError(f"drive = {_plain(drive)} is not a Drive", name="drive", value=drive)
+    return drive
+
+
+def check_plausible(drive: Drive, *, allow_extrapolation: bool = False) -> None:
+    """Check every parameter of a drive against :data:`PLAUSIBLE_RANGES` and the contact limits.
+
+    Raises
+    ------
+    InputError
+        A ``ValueError``: the first parameter outside its range, naming it (the field,
+        dotted for a part: ``"actuator.mass"``), its value, the limit and why. The damping
+        ratio ζ = c_p / (2√(k_p m_a)) is refused as a quantity computed from
+        ``actuator.viscosity``.
+    """
+    check_drive(drive)
+    r = PLAUSIBLE_RANGES
+    kw = {"allow_extrapolation": allow_extrapolation}
+    for name in ("hemisphere_radius", "preload", "friction_coefficient", "runner_mass",
+                 "load_cell_stiffness"):
+        r[name].check(name, getattr(drive, name), **kw)
+    for which in ("hemisphere_material", "runner_material"):
+        material = getattr(drive, which)
+        r["material.youngs_modulus"].check(f"{which}.youngs_modulus", material.youngs_modulus, **kw)
+        r["material.poissons_ratio"].check(f"{which}.poissons_ratio", material.poissons_ratio, **kw)
+    act, amp = drive.actuator, drive.amplifier
+    for name in ("stiffness", "mass"):
+        r[f"actuator.{name}"].check(f"actuator.{name}", getattr(act, name), **kw)
+    try:
+        r["actuator.damping_ratio"].check("actuator.damping_ratio", act.damping_ratio, **kw)
+    except InputError as exc:
+        raise exc.derived_from("actuator.viscosity", act.viscosity, 2.0 * np.sqrt(act.stiffness * act.mass),
+                               "the damping ratio ζ = c_p / (2√(k_p m_a))") from None
+    r["actuator.full_stroke_amplitude"].check("actuator.full_stroke_amplitude", act.full_stroke_amplitude,
+                                              **kw)
+    for name in ("peak_to_peak_voltage", "slew_rate"):
+        r[f"amplifier.{name}"].check(f"amplifier.{name}", getattr(amp, name), **kw)
+    E_star, _ = contact_moduli(drive)
+    forces, _, radii = contact_layout(drive)  # Eq. 1; the most loaded contact first (it fails first)
+    for g in np.argsort(-forces / radii ** 2, kind="stable"):  # a/R and p0 grow as (F/R²)^(1/3)
+        check_contact_plausible(forces[g], radii[g], E_star, names="preload, hemisphere_radius, "
+                                "materials", sources=_CONTACT_SOURCES, **kw)
+
+
+#: The drive's fields the Hertz contact of :func:`check_contact_plausible` depends on.
+_CONTACT_SOURCES = ("preload", "hemisphere_radius", "hemisphere_material.youngs_modulus",
+                    "hemisphere_material.poissons_ratio", "runner_material.youngs_modulus",
+                    "runner_material.poissons_ratio")
+
+
+#: Preload grids of the critical-amplitude figures (assumption ``preload_grids``).
+PRELOAD_GRIDS: dict[float, np.ndarray] = {
+    1.0e-3: np.round(np.arange(1, 11) * 0.1, 10),
+    0.25e-3: np.round(np.arange(1, 6) * 0.1, 10),
+}
+
+
+def paper_drive(hemisphere_radius: float = 1.0e-3, preload: float = 0.4, **changes) -> Drive:
+    """The paper's drive for one of Table 2's radii (1 mm or 0.25 mm).
+
+    Raises ``ValueError`` for radii Table 2 does not list; use :class:`Drive`
+    directly for other radii.
+    """
+    radius = check_positive("hemisphere_radius", hemisphere_radius, "m")
+    if not any(np.isclose(radius, r, rtol=1e-9, atol=0) for r in TABLE2_RADII):
+        raise ValueError(
+            f"hemisphere_radius = {_plain(hemisphere_radius)} is not a paper radius: must be one of "
+            + ", ".join(f"{r:g}" for r in sorted(TABLE2_RADII))
+            + " (m)"
+        )
+    return Drive(hemisphere_radius=radius, preload=preload, **changes)
+
+
+def parameter_table(record) -> list[dict]:
+    """Rows (name, symbol, value, unit, source) describing a parameter record.
+
+    Nested records (materials, actuator, amplifier) are expanded with a dotted name.
+    The book renders these rows instead of retyping Tables 1–2.
+    """
+    if not hasattr(record, "__dataclass_fields__") or isinstance(record, type):
+        raise InputError(f"record = {_plain(record)} is not a parameter record (a Drive, Material, Actuator "
+                         "or Amplifier)", name="record", value=record)
+    rows: list[dict] = []
+    for f in fields(record):
+        if not f.metadata:  # labels such as Material.name are not parameters
+            continue
+        value = getattr(record, f.name)
+        if hasattr(value, "__dataclass_fields__"):
+            for sub in parameter_table(value):
+                sub["name"] = f"{f.name}.{sub['name']}"
+                rows.append(sub)
+            continue
+        rows.append(
+            {
+                "name": f.name,
+                "symbol": f.metadata.get("symbol", ""),
+                "value": value,
+                "unit": f.metadata.get("unit", ""),
+                "source": f.metadata.get("source", ""),
+            }
+        )
+    return rows

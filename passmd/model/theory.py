@@ -1,0 +1,556 @@
+"""Closed-form results: Hertz, Cattaneo–Mindlin, and the paper's Eqs. 1 and 7–14.
+
+Conventions (MDR, Popov 2013; see the model chapter):
+
+* 1/E* = (1 − ν₁²)/E₁ + (1 − ν₂²)/E₂
+* 1/G* = (2 − ν₁)/(4 G₁) + (2 − ν₂)/(4 G₂),  G = E / (2 (1 + ν))
+
+This G* is four times Mindlin's "G", so the tangential stiffness of a sticking
+Hertzian contact, 8aG in Mindlin's notation, is 2aG* here.
+
+References: H. Hertz (1882); R.D. Mindlin, H. Deresiewicz, J. Appl. Mech. 20 (1953)
+327; K.L. Johnson, *Contact Mechanics* (1985), §7.2; V.L. Popov, Friction 1 (2013) 41.
+
+Every function is vectorised (NumPy broadcasting) and uses SI units. The public functions
+check their arguments (``ValueError``/``TypeError`` naming the parameter, its value and the
+allowed range) and refuse a result that double precision cannot hold to its full relative
+precision (below the smallest normal double, 2.2e-308): a presliding displacement of
+1e-320 m has three significant digits, not sixteen. The drive's closed forms
+(:func:`drive_theory`) name the drive's parameters instead.
+"""
+
+from __future__ import annotations
+
+import reprlib
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from passmd.model.defaults import PROTOCOL
+from passmd.runtime.validation import InputError, check_array, format_number
+
+if TYPE_CHECKING:  # the closed forms read a drive's fields; parameters imports this module
+    from passmd.model.parameters import Drive
+
+SIN45 = np.sin(np.pi / 4)
+#: Smallest normal double: below it a float keeps fewer than 53 significant bits.
+_TINY = float(np.finfo(float).tiny)
+#: Isotropic elasticity needs -1 < ν <= 1/2 (a positive bulk and shear modulus).
+_NU_LOW, _NU_HIGH = -1.0, 0.5
+#: The fields of a drive the closed forms read (a drive is checked for them, not for its class:
+#: passmd.model.parameters imports this module).
+_DRIVE_FIELDS = ("preload", "contacts", "hemisphere_radius", "friction_coefficient", "hemisphere_material",
+                 "runner_material", "actuator", "actuator_model", "runner_mass",
+                 "effective_load_cell_stiffness")
+
+
+def _check_drive(drive) -> None:
+    if not all(hasattr(drive, field) for field in _DRIVE_FIELDS):
+        raise TypeError(f"drive = {reprlib.repr(drive)} is not allowed: "
+                        "must be a passmd.model.parameters.Drive")
+
+
+def _positive(name: str, value, unit: str) -> np.ndarray:
+    return check_array(name, value, 0.0, lower_open=True, unit=unit)
+
+
+def _check_contacts(contacts) -> int:
+    if isinstance(contacts, (bool, np.bool_)) or not isinstance(contacts, (int, np.integer)):
+        raise TypeError(f"contacts = {contacts!r} is not allowed: must be the integer 1 or 6")
+    if contacts not in (1, 6):
+        raise ValueError(f"contacts = {contacts!r} is not allowed: must be one of 1, 6")
+    return int(contacts)
+
+
+def _require_normal(value, what: str, unit: str, inputs, where=None) -> None:
+    """Refuse ``value`` where it is below the smallest normal double (or not finite).
+
+    ``inputs``: ``(name, value, unit)`` of the parameters that made it, the one a user most
+    likely set first (the message leads with it); each is shown at the first refused element.
+    ``where``: the elements that must be normal (default all).
+    """
+    v = np.asarray(value, dtype=float)
+    bad = ~(np.isfinite(v) & (np.abs(v) >= _TINY))
+    if where is not None:
+        bad &= np.broadcast_to(np.asarray(where, dtype=bool), bad.shape)
+    if not bad.any():
+        return
+    i = int(np.flatnonzero(bad.ravel())[0])
+    shown = [f"{name} = {format_number(np.broadcast_to(np.asarray(x, dtype=float), v.shape).flat[i])}"
+             + (f" {u}" if u else "") for name, x, u in inputs]
+    context = f" (with {', '.join(shown[1:])})" if len(shown) > 1 else ""
+    detail = (f"{what} = {format_number(v.flat[i])} {unit} is below the smallest normal double {_TINY:.4g} "
+              "(hard limit: double precision; there a result keeps only a few significant digits)")
+    # the inputs' names let an entry point name its own options (passmd.cli.drive.explain)
+    raise InputError(f"{shown[0]}{context} is out of range: {detail}",
+                     sources=tuple(name for name, _, _ in inputs), detail=detail)
+
+
+def _youngs(E1, nu1, E2, nu2):
+    return 1.0 / ((1 - np.asarray(nu1) ** 2) / E1 + (1 - np.asarray(nu2) ** 2) / E2)
+
+
+def _shear(E1, nu1, E2, nu2):
+    G1 = np.asarray(E1) / (2 * (1 + np.asarray(nu1)))
+    G2 = np.asarray(E2) / (2 * (1 + np.asarray(nu2)))
+    return 1.0 / ((2 - np.asarray(nu1)) / (4 * G1) + (2 - np.asarray(nu2)) / (4 * G2))
+
+
+def _materials(E1, nu1, E2, nu2):
+    """The four material constants, checked (E > 0, -1 < ν <= 1/2)."""
+    return (_positive("E1", E1, "Pa"), check_array("nu1", nu1, _NU_LOW, _NU_HIGH, lower_open=True),
+            _positive("E2", E2, "Pa"), check_array("nu2", nu2, _NU_LOW, _NU_HIGH, lower_open=True))
+
+
+def effective_youngs_modulus(E1, nu1, E2, nu2):
+    """Effective modulus E* with 1/E* = (1 − ν₁²)/E₁ + (1 − ν₂²)/E₂ (Eq. 4).
+
+    E₁, E₂ > 0 in Pa; -1 < ν₁, ν₂ <= 1/2.
+    """
+    args = _materials(E1, nu1, E2, nu2)
+    E_star = _youngs(*args)
+    _require_normal(E_star, "E*", "Pa", (("E1", args[0], "Pa"), ("E2", args[2], "Pa")))
+    return E_star
+
+
+def effective_shear_modulus(E1, nu1, E2, nu2):
+    """Effective shear modulus G* with 1/G* = Σ (2 − ν)/(4G), G = E/(2(1+ν)) (Eq. 4).
+
+    E₁, E₂ > 0 in Pa; -1 < ν₁, ν₂ <= 1/2.
+    """
+    args = _materials(E1, nu1, E2, nu2)
+    G_star = _shear(*args)
+    _require_normal(G_star, "G*", "Pa", (("E1", args[0], "Pa"), ("E2", args[2], "Pa")))
+    return G_star
+
+
+def contact_moduli(drive: Drive) -> tuple[float, float]:
+    """(E*, G*) of the hemisphere/runner pair of a drive, in Pa."""
+    _check_drive(drive)
+    return _contact_moduli(drive)
+
+
+def _contact_moduli(drive: Drive) -> tuple[float, float]:
+    h, r = drive.hemisphere_material, drive.runner_material
+    args = (h.youngs_modulus, h.poissons_ratio, r.youngs_modulus, r.poissons_ratio)
+    E_star, G_star = float(_youngs(*args)), float(_shear(*args))
+    moduli = (("hemisphere_material.youngs_modulus", h.youngs_modulus, "Pa"),
+              ("runner_material.youngs_modulus", r.youngs_modulus, "Pa"))
+    _require_normal(E_star, "E*", "Pa", moduli)
+    _require_normal(G_star, "G*", "Pa", moduli)
+    return E_star, G_star
+
+
+def _hertz_cube(F, radius, E_star):
+    """a³ = 3 F_N R / (4 E*), the cube of the Hertz contact radius."""
+    return 3.0 * F * radius / (4.0 * E_star)
+
+
+def _contact_args(normal_force, radius, E_star):
+    """normal_force >= 0, radius > 0, E_star > 0, checked; a³ normal wherever F_N > 0."""
+    F = check_array("normal_force", normal_force, 0.0, unit="N")
+    R, E = _positive("radius", radius, "m"), _positive("E_star", E_star, "Pa")
+    cube = _hertz_cube(F, R, E)
+    _require_normal(cube, "the Hertz contact radius cubed, 3 F_N R / (4 E*),", "m^3",
+                    (("normal_force", F, "N"), ("radius", R, "m"), ("E_star", E, "Pa")), where=F > 0)
+    return F, R, E, cube
+
+
+def hertz_contact_radius(normal_force, radius, E_star):
+    """Hertz contact radius a = (3 F_N R / (4 E*))^(1/3).
+
+    F_N >= 0 in N, R > 0 in m, E* > 0 in Pa.
+    """
+    return np.cbrt(_contact_args(normal_force, radius, E_star)[3])
+
+
+def hertz_indentation(normal_force, radius, E_star):
+    """Hertz indentation depth d = a² / R."""
+    _, R, _, cube = _contact_args(normal_force, radius, E_star)
+    return np.cbrt(cube) ** 2 / R
+
+
+def hertz_normal_force(contact_radius, radius, E_star):
+    """Hertz normal force F_N = (4/3) E* a³ / R (a >= 0 in m, R > 0 in m, E* > 0 in Pa)."""
+    a = check_array("contact_radius", contact_radius, 0.0, unit="m")
+    R, E = _positive("radius", radius, "m"), _positive("E_star", E_star, "Pa")
+    force = 4.0 / 3.0 * E * a ** 3 / R
+    _require_normal(force, "the Hertz normal force", "N", (("contact_radius", a, "m"),), where=a > 0)
+    return force
+
+
+def tangential_stiffness(normal_force, radius, E_star, G_star):
+    """Initial tangential stiffness 2 a G* of a sticking Hertzian contact (8aG in Mindlin).
+
+    F_N >= 0 in N, R > 0 in m, E* > 0 and G* > 0 in Pa.
+    """
+    cube = _contact_args(normal_force, radius, E_star)[3]
+    return 2.0 * np.cbrt(cube) * _positive("G_star", G_star, "Pa")
+
+
+def normal_forces(preload, contacts: int = 6):
+    """Normal force per contact on each side of the runner (Eq. 1).
+
+    Six contacts: F_N1 = F_p / (2 sin 45°) on each of the two right-hand contacts,
+    F_N2 = F_p / (4 sin 45°) on each of the four left-hand ones. One contact: F_p.
+
+    Returns
+    -------
+    tuple of arrays
+        ``(F_N1, F_N2)`` for six contacts, ``(F_p,)`` for one.
+    """
+    F = check_array("preload", preload, 0.0, lower_open=True, unit="N")
+    if _check_contacts(contacts) == 1:
+        return (F,)
+    forces = _six_contact_forces(F)
+    _require_normal(forces[1], "the normal force per contact F_p / (4 sin 45°)", "N", (("preload", F, "N"),))
+    return forces
+
+
+def _six_contact_forces(F):
+    return (F / 2.0 / SIN45, F / 4.0 / SIN45)
+
+
+def _presliding(F, radius, E_star, G_star, friction_coefficient):
+    return (
+        3.0
+        * friction_coefficient
+        / (4.0 * G_star)
+        * np.cbrt(4.0 * E_star / 3.0)
+        * F ** (2.0 / 3.0)
+        / np.cbrt(radius)
+    )
+
+
+def presliding_displacement(normal_force, radius, E_star, G_star, friction_coefficient):
+    """Presliding (full-slip) displacement u_x,max (Eq. 7, Eq. 10).
+
+    u_x,max = 3μ/(4G*) · (4E*/3)^(1/3) · F_N^(2/3) / R^(1/3), which equals μ (E*/G*) d
+    with the Hertz indentation d. F_N >= 0 in N, R > 0 in m, E* > 0 and G* > 0 in Pa,
+    μ > 0 (``friction_coefficient``).
+    """
+    F = check_array("normal_force", normal_force, 0.0, unit="N")
+    R, E = _positive("radius", radius, "m"), _positive("E_star", E_star, "Pa")
+    G, mu = _positive("G_star", G_star, "Pa"), _positive("friction_coefficient", friction_coefficient, "")
+    u = _presliding(F, R, E, G, mu)
+    _require_normal(u, "the presliding displacement u_x,max", "m",
+                    (("normal_force", F, "N"), ("friction_coefficient", mu, "")), where=F > 0)
+    return u
+
+
+def _actuator_deformation(friction_coefficient, F, actuator_stiffness, runner_mass, actuator_mass):
+    return friction_coefficient * F / actuator_stiffness * (runner_mass + actuator_mass) / runner_mass
+
+
+def actuator_deformation(friction_coefficient, normal_force, actuator_stiffness, runner_mass,
+                         actuator_mass):
+    """Tangential deformation of the actuator by the friction force (Eq. 9, Eq. 14).
+
+    u_x,a = μ F / k_p · (m_r + m_a) / m_r (van der Wulp 1997). μ > 0, F_N >= 0 in N,
+    k_p > 0 in N/m, m_r > 0 and m_a >= 0 in kg.
+    """
+    mu = _positive("friction_coefficient", friction_coefficient, "")
+    F = check_array("normal_force", normal_force, 0.0, unit="N")
+    k = _positive("actuator_stiffness", actuator_stiffness, "N/m")
+    m_r = _positive("runner_mass", runner_mass, "kg")
+    m_a = check_array("actuator_mass", actuator_mass, 0.0, unit="kg")
+    u = _actuator_deformation(mu, F, k, m_r, m_a)
+    _require_normal(u, "the actuator deformation u_x,a", "m",
+                    (("normal_force", F, "N"), ("friction_coefficient", mu, ""),
+                     ("actuator_stiffness", k, "N/m")), where=F > 0)
+    return u
+
+
+def _harmonic(u1, u2):
+    """2 u₁ u₂ / (u₁ + u₂) without underflow or overflow, for positive finite u₁, u₂.
+
+    The paper's form wherever its product and sum are normal doubles (there it is accurate to
+    a few units in the last place, and it is what every result was computed with); else the
+    same value as m · 2 / (1 + m/M), m = min, M = max, whose factor lies in (1, 2]. The result
+    lies between min(u₁, u₂) and twice it at every magnitude.
+    """
+    u1, u2 = np.asarray(u1, dtype=float), np.asarray(u2, dtype=float)
+    with np.errstate(over="ignore", under="ignore", invalid="ignore", divide="ignore"):
+        product, total = 2.0 * u1 * u2, u1 + u2
+        direct = product / total
+        small, large = np.minimum(u1, u2), np.maximum(u1, u2)
+        scaled = small * (2.0 / (1.0 + small / large))
+    safe = np.isfinite(product) & (product >= _TINY) & np.isfinite(total)
+    # the exact value lies in [m, 2m]; rounding could leave it one unit in the last place outside
+    result = np.minimum(np.maximum(np.where(safe, direct, scaled), small), 2.0 * small)
+    return result if result.ndim else result[()]
+
+
+def harmonic_combination(u1, u2):
+    """Teidelt's combination 2 u₁ u₂ / (u₁ + u₂) (Eq. 11, Eq. 12), u₁, u₂ > 0 in m.
+
+    Finite and between min(u₁, u₂) and twice it for every positive finite u₁, u₂: computed
+    where the product would underflow or overflow as m · 2 / (1 + m/M).
+    """
+    return _harmonic(_positive("u1", u1, "m"), _positive("u2", u2, "m"))
+
+
+def cattaneo_mindlin_force(u, normal_force, presliding, friction_coefficient):
+    """Virgin tangential force of a Hertzian contact at constant normal force.
+
+    F(u) = sign(u) μF_N [1 − (1 − |u|/u_max)^(3/2)] for |u| ≤ u_max, ±μF_N beyond
+    (Cattaneo 1938, Mindlin 1949). Initial slope (3/2) μF_N / u_max = 2aG*. u finite
+    in m, F_N >= 0 in N, u_max > 0 in m (``presliding``), μ > 0.
+    """
+    return _cattaneo_mindlin(check_array("u", u, unit="m"),
+                             check_array("normal_force", normal_force, 0.0, unit="N"),
+                             _positive("presliding", presliding, "m"),
+                             _positive("friction_coefficient", friction_coefficient, ""))
+
+
+def _cattaneo_mindlin(u, normal_force, presliding, friction_coefficient):
+    s = np.clip(np.abs(u) / presliding, 0.0, 1.0)
+    return np.sign(u) * friction_coefficient * normal_force * (1.0 - (1.0 - s) ** 1.5)
+
+
+def masing_branch_force(u, reversal_displacement, reversal_force, direction, normal_force,
+                        presliding, friction_coefficient):
+    """Force on an unloading/reloading branch after a reversal (Mindlin–Deresiewicz, Masing).
+
+    F = F_r + direction · 2 φ(|u − u_r| / 2), φ the virgin curve, limited to ±μF_N
+    (full sliding). ``direction`` is +1 for increasing u, −1 for decreasing u; u and u_r
+    finite in m, F_r finite in N, the rest as in :func:`cattaneo_mindlin_force`.
+    """
+    u = check_array("u", u, unit="m")
+    u_r = check_array("reversal_displacement", reversal_displacement, unit="m")
+    F_r = check_array("reversal_force", reversal_force, unit="N")
+    if isinstance(direction, (bool, np.bool_)) or direction not in (1, -1):
+        raise ValueError(f"direction = {direction!r} is not allowed: must be one of 1, -1")
+    F = check_array("normal_force", normal_force, 0.0, unit="N")
+    u_max = _positive("presliding", presliding, "m")
+    mu = _positive("friction_coefficient", friction_coefficient, "")
+    half = np.abs(u - u_r) / 2.0
+    phi = _cattaneo_mindlin(half, F, u_max, mu)
+    limit = mu * F
+    return np.clip(F_r + direction * 2.0 * phi, -limit, limit)
+
+
+def drive_theory(drive: Drive) -> dict:
+    """The closed forms for one drive configuration, SI units.
+
+    Keys: ``E_star_Pa``, ``G_star_Pa``, ``normal_force_N`` (per side),
+    ``contact_radius_m``, ``indentation_m``, ``tangential_stiffness_N_per_m``,
+    ``presliding_m`` (u_x,max per side, Eq. 7/10), ``actuator_deformation_m``
+    (u_x,a per side, Eq. 9/14), ``critical_amplitude_rigid_m`` (Eq. 7 / Eq. 11),
+    ``critical_amplitude_flexible_m`` (Eq. 8 / Eq. 12) and
+    ``analytic_critical_amplitude_m`` (the one matching ``drive.actuator_model``).
+    """
+    _check_drive(drive)
+    E_star, G_star = _contact_moduli(drive)
+    mu = drive.friction_coefficient
+    act = drive.actuator
+    forces, _, R = contact_layout(drive)
+    R = R if getattr(drive, "contact_groups", ()) else drive.hemisphere_radius  # the paper's: one R
+    preload = ("preload", drive.preload, "N")
+    a = _drive_contact_radius(drive, forces, E_star, R)
+    u_max = _presliding(forces, R, E_star, G_star, mu)
+    _require_normal(u_max, "the presliding displacement u_x,max", "m",
+                    (preload, ("friction_coefficient", mu, "")))
+    u_a = _actuator_deformation(mu, forces, act.stiffness, drive.runner_mass, act.mass)
+    _require_normal(u_a, "the actuator deformation u_x,a", "m",
+                    (preload, ("friction_coefficient", mu, ""), ("actuator.stiffness", act.stiffness, "N/m")))
+    rigid, flexible = _combined(u_max), _combined(u_max + u_a)
+    return {
+        "E_star_Pa": E_star,
+        "G_star_Pa": G_star,
+        "normal_force_N": forces.tolist(),
+        "contact_radius_m": a.tolist(),
+        "indentation_m": (a ** 2 / R).tolist(),
+        "tangential_stiffness_N_per_m": (2.0 * a * G_star).tolist(),
+        "presliding_m": u_max.tolist(),
+        "actuator_deformation_m": u_a.tolist(),
+        "critical_amplitude_rigid_m": rigid,
+        "critical_amplitude_flexible_m": flexible,
+        "analytic_critical_amplitude_m": rigid if drive.actuator_model == "rigid" else flexible,
+    }
+
+
+def _combined(u: np.ndarray) -> float:
+    """Eqs. 7/8 (one group), Teidelt's Eqs. 11/12 (two), their generalisation (k groups).
+
+    The paper's combination of two sides, 2u₁u₂/(u₁ + u₂), is the harmonic mean of the sides'
+    presliding displacements: the amplitude at which the runner, held by the sides in parallel,
+    is pulled loose. Any number k of groups generalises it as the harmonic mean
+    k / Σ 1/u_g, unweighted by the contacts per group as Eq. 11 is; one group gives Eq. 7.
+    For two groups of any counts, forces and radii it is Eq. 11 itself; for k >= 3 it is an
+    estimate (a three-group drive's simulated steady A_c lay 11 % above it), whereas the first
+    fly-back's onset generalises exactly (:func:`first_flyback_critical_amplitude`).
+    """
+    if u.size == 1:
+        return float(u[0])
+    if u.size == 2:
+        return float(_harmonic(u[0], u[1]))
+    return float(u.size / np.sum(1.0 / u))
+
+
+def first_flyback_critical_amplitude(drive: Drive) -> float:
+    """The first fly-back's onset of full sliding, rigid actuators: max_g u_x,max,g (m).
+
+    From virgin contacts every contact slides only when the one with the largest presliding
+    displacement does (Eq. 7 for one contact, Eq. 10's side 1 for the paper's six); for any
+    arrangement it is the largest u_x,max,g of its groups (each with its own F_N and R).
+    """
+    return float(np.max(drive_theory(drive)["presliding_m"]))
+
+
+def _drive_contact_radius(drive: Drive, forces: np.ndarray, E_star: float, radii=None) -> np.ndarray:
+    """Hertz contact radius per group of a (validated) drive; its cube a normal double (else refused)."""
+    cube = _hertz_cube(forces, drive.hemisphere_radius if radii is None else radii, E_star)
+    _require_normal(cube, "the Hertz contact radius cubed, 3 F_N R / (4 E*),", "m^3",
+                    (("preload", drive.preload, "N"), ("hemisphere_radius", drive.hemisphere_radius, "m"),
+                     ("E*", E_star, "Pa")))
+    return np.cbrt(cube)
+
+
+def _drive_forces(drive: Drive) -> tuple:
+    """Eq. 1 for a (validated) drive, each force a normal double (else refused naming the preload)."""
+    F = np.asarray(float(drive.preload))
+    if getattr(drive, "contact_groups", ()):
+        forces = tuple(np.asarray(float(g.normal_force) if g.normal_force is not None else g.load_share * F)
+                       for g in drive.contact_groups)
+    else:
+        forces = (F,) if drive.contacts == 1 else _six_contact_forces(F)
+    for force in reversed(forces):  # the paper's six: the smaller F_N2 first
+        _require_normal(force, "the normal force per contact", "N", (("preload", drive.preload, "N"),))
+    return forces
+
+
+def _multiplicity(drive: Drive) -> tuple:
+    groups = getattr(drive, "contact_groups", ())
+    if groups:
+        return tuple(g.count for g in groups)
+    return (1,) if drive.contacts == 1 else PROTOCOL.contacts_per_side
+
+
+def _radii(drive: Drive) -> np.ndarray:
+    groups = getattr(drive, "contact_groups", ())
+    R = float(drive.hemisphere_radius)
+    return np.array([R if not groups or g.radius is None else float(g.radius) for g in groups] if groups
+                    else [R] * len(_multiplicity(drive)))
+
+
+def contact_layout(drive: Drive) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The drive's contact groups: normal force per contact (N, Eq. 1), contacts per group, and
+    the hemispheres' radius of each group (m).
+
+    One contact: ``([F_p], [1], [R])``; the paper's six: ``([F_N1, F_N2], [2, 4], [R, R])``;
+    a drive with ``contact_groups``: one entry per :class:`~passmd.model.parameters.ContactGroup`.
+    """
+    _check_drive(drive)
+    forces = np.array([float(f) for f in _drive_forces(drive)])
+    return forces, np.array(_multiplicity(drive), dtype=float), _radii(drive)
+
+
+def runner_frequency(drive: Drive) -> float:
+    """Runner-on-contacts natural frequency √(Σ 2aG* / m_r) / (2π) in Hz (rigid actuators).
+
+    Σ runs over all contacts (2 × side 1 + 4 × side 2 for six contacts), plus the
+    load cell when engaged. This is the micro-vibration frequency's linear estimate.
+    """
+    _check_drive(drive)
+    E_star, G_star = _contact_moduli(drive)
+    forces, _, radii = contact_layout(drive)
+    radii = radii if getattr(drive, "contact_groups", ()) else drive.hemisphere_radius
+    stiffness = 2.0 * _drive_contact_radius(drive, forces, E_star, radii) * G_star  # 2aG* per group
+    multiplicity = _multiplicity(drive)
+    k_total = sum(m * float(k) for m, k in zip(multiplicity, stiffness, strict=True))
+    k_total += drive.effective_load_cell_stiffness
+    return float(np.sqrt(k_total / drive.runner_mass) / (2 * np.pi))
+
+
+def friction_limit(drive: Drive) -> float:
+    """Total Coulomb friction limit μ Σ F_N of all contacts on the runner (N, Eq. 1).
+
+    Six contacts: μ (2 F_N1 + 4 F_N2) = 2√2 μ F_p; one contact: μ F_p.
+    """
+    _check_drive(drive)
+    forces = _drive_forces(drive)
+    multiplicity = _multiplicity(drive)
+    return float(drive.friction_coefficient * sum(m * float(F) for m, F in zip(multiplicity, forces,
+                                                                                  strict=True)))
+
+
+def coulomb_sawtooth_step(amplitude, frequency, flyback_time, friction_force, runner_mass):
+    """Step per period of a rigid-actuator saw-tooth drive with Coulomb friction.
+
+    The limit of the drive of Eqs. 2–6 when the contact stiffness goes to infinity: the
+    presliding (Eq. 7) vanishes and every contact becomes a rigid Coulomb contact, so the
+    drive is the idealised inertia (stick–slip) drive of M. Hunstig, "Piezoelectric
+    Inertia Motors—A Critical Review of History, Concepts, Design, Applications, and
+    Perspectives", Actuators 6 (2017) 7, Sections 2–3 (see also M. Hunstig, T. Hemsel,
+    W. Sextro, Sens. Actuators A 200 (2013) 90, the paper's ref. 21). The closed form
+    below is derived here for the saw-tooth of :func:`passmd.model.waveforms.sawtooth`.
+
+    Assumptions: rigid actuators (the hemispheres follow x_p exactly); one runner of mass
+    m_r, no load cell; Coulomb friction with one coefficient for sticking and sliding,
+    total limit F_c = μ Σ F_N, so the runner's friction acceleration is at most
+    a = F_c / m_r; no presliding, no elastic play; x_p(t) a saw-tooth of amplitude A,
+    period T = 1/f: a linear ramp 0 → A of duration t_r = T − t_f (velocity
+    v_r = A / t_r) and a linear fly-back A → 0 of duration t_f (velocity v_f = −A / t_f),
+    with t_f < t_r; periodic steady state.
+
+    Derivation. On a linear piece x_p has zero acceleration, so a runner moving with the
+    piezo needs no friction force and sticks. At each corner the piezo velocity jumps
+    while the runner's cannot: the runner slips and friction, of magnitude F_c against
+    the relative velocity, changes its velocity at the rate a until it matches the
+    piezo's, when it sticks again. Start a period at the corner ramp → fly-back with the
+    runner stuck (velocity v_r). Its relative velocity v − v_f = v_r − v_f − a t > 0
+    falls linearly; two cases:
+
+    1. a t_f < v_r − v_f, i.e. a t_f² < A + v_r t_f = A T / t_r: the runner slides
+       through the whole fly-back, relative slip (v_r − v_f) t_f − a t_f²/2, and leaves
+       it at v_r − a t_f < v_r. On the ramp it is accelerated at +a and re-sticks after
+       exactly t_f (< t_r), relative slip −a t_f²/2. Net step per period (x_p returns
+       to where it started, so the step is the total relative slip)::
+
+           s = (v_r − v_f) t_f − a t_f² = A T / t_r − a t_f²  (> 0 in this case).
+
+    2. a t_f ≥ v_r − v_f: the runner reaches v_f after t* = (v_r − v_f)/a ≤ t_f and
+       sticks for the rest of the fly-back (relative slip (v_r − v_f)²/(2a)). At the
+       corner back to the ramp the jump v_f → v_r is the same size, the slip lasts t*
+       again and is (v_r − v_f)²/(2a) backwards: s = 0, the runner only follows.
+
+    Both cases together: s = max(A T / t_r − a t_f², 0), continuous at the boundary.
+    The first, from rest, corner (0 → v_r) only offsets the runner by −v_r²/(2a) and
+    the runner sticks again after v_r/a; from the first fly-back on every period is the
+    steady state above. For t_f → 0 the step tends to A (the ideal saw-tooth).
+
+    Parameters
+    ----------
+    amplitude : array_like
+        Saw-tooth amplitude A in m, ≥ 0.
+    frequency : array_like
+        Driving frequency f = 1/T in Hz, > 0.
+    flyback_time : array_like
+        Fly-back duration t_f in s, 0 < t_f < T/2 (so that t_f < t_r).
+    friction_force : array_like
+        Total Coulomb friction limit F_c = μ Σ F_N in N, > 0 (:func:`friction_limit`).
+    runner_mass : array_like
+        Runner mass m_r in kg, > 0.
+
+    Returns
+    -------
+    ndarray
+        Net runner step per period s in m (forward, in the ramp's direction), ≥ 0.
+    """
+    A = check_array("amplitude", amplitude, 0.0, unit="m")
+    f = check_array("frequency", frequency, 0.0, lower_open=True, unit="Hz")
+    t_f = check_array("flyback_time", flyback_time, 0.0, lower_open=True, unit="s")
+    F_c = check_array("friction_force", friction_force, 0.0, lower_open=True, unit="N")
+    m_r = check_array("runner_mass", runner_mass, 0.0, lower_open=True, unit="kg")
+    T = 1.0 / f
+    if np.any(t_f >= 0.5 * T):
+        bad = np.broadcast_arrays(t_f, T)
+        i = int(np.flatnonzero((bad[0] >= 0.5 * bad[1]).ravel())[0])
+        raise ValueError(
+            f"flyback_time = {float(bad[0].ravel()[i])!r} is out of range: must be < half the period "
+            f"{float(0.5 * bad[1].ravel()[i])!r} s (the runner must re-stick on the ramp)"
+        )
+    t_r = T - t_f
+    a = F_c / m_r
+    return np.maximum(A * T / t_r - a * t_f**2, 0.0)

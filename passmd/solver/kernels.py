@@ -1,0 +1,895 @@
+"""numba kernel of the hybrid simulation (Eqs. 2–3 with the MDR contacts in the loop).
+
+Only :mod:`passmd.solver.simulation` calls this; it allocates and interprets. The compiled kernel
+takes five NamedTuples of scalars and arrays (numba compiles NamedTuples, not
+dataclasses): :class:`Segments` (the linear pieces of x_p(t) and their steps),
+:class:`Mechanics` (masses, stiffnesses, damping), :class:`StepControl` (step adaptation
+and recording), :class:`Contacts` (the contact rows of :mod:`passmd.model.contact`) and
+:class:`Buffers` (state and outputs, written in place). :func:`integrate`, a Python
+wrapper, checks their shapes and types before it enters the compiled loop.
+
+The array layouts (column and slot indices), the argument records and the compiled loop
+stay in this one module on purpose: numba compiles the indices into the loop as
+constants and its on-disk cache (``cache=True``) is invalidated only when this file
+changes, so a layout kept in another module could change without the cached loop
+noticing.
+
+Schemes. Fine and coarse steps: velocity Verlet (kick–drift–kick) on runner and
+actuators; the actuator's viscous term −c_p ẋ_a is treated with the trapezoidal rule in
+the velocity update (implicit in v, still explicit overall). With flexible actuators the
+step adapts: fine (resolving the ≈ 3 MHz actuator mode) while the actuators ring, coarse
+(a fraction of the explicit stability limit) or quasi-static (m_a neglected, the
+actuator's force balance solved per step) while they follow.
+
+Error-controlled steps (``StepControl.error_tolerance`` > 0; rigid actuators, and the
+quasi-static phases of flexible ones): the runner's force splits into a linear spring K
+(``Mechanics.linear_stiffness``: the contacts' initial tangent stiffness, in series with
+k_p for flexible actuators) to x_p, plus the load cell, and the rest g. The linear part is
+integrated exactly by the variation-of-constants formula (an exponential or
+"trigonometric" integrator; Hairer, Lubich & Wanner, Geometric Numerical Integration,
+Ch. XIII), g with its rate extrapolated from the last step in the position, and in the
+velocity quadratic in time through its values at the step's end, its start and the previous
+step's start. (With g linear over the step in the velocity, that update's local error was
+O(dt³) against the position's O(dt⁴), and the energy balance drifted by O(dt²): 3e-5 of the
+input work over three 1 kHz periods.) So the ≈ 11 kHz micro-vibration sets no step; what does is the
+local position error estimate dt²/6 |Δg − ġ dt|, checked against the tolerance with the
+forces at the drifted position (pure evaluations): a step above it is rejected and retried
+shorter, and the next step follows the usual controller (fourth root, safety factor,
+bounded growth). A reversal of a contact's displacement u inside a step is an event: the
+extremum of the quadratic through u's value and rate at the start and its value at the end
+is committed first, so the Masing branch turns there and not at a step boundary. Samples
+inside such a step are interpolated (cubic Hermite in x_r).
+
+In every scheme the contact memory is updated exactly once per accepted step (twice when
+a reversal falls inside it), with the drifted positions, and the contact force is
+otherwise evaluated purely. Every corner of x_p(t) falls on a step boundary.
+
+Energy terms (``Buffers.energy``): the explicit steps sum the work of the drive, the
+damping and the contacts with the trapezoidal rule per step. An error-controlled step
+crosses the runner's ringing in a few steps, and across one T(t) and the path curve, so
+the trapezoidal rule would miss the dissipation of a micro-slip loop by a fraction of order
+(Ω dt)²; these steps use Simpson's rule in time instead. Its middle node is the drift
+formula at half the step (runner), the contact force there evaluated purely with the memory
+at the step's start (rigid actuators), or for a quasi-static actuator its force balance over
+the first half step, one Newton step from the chord's midpoint with the contact force there
+from the cubic Hermite in u through the step's ends (values, and tangents from the balance
+solves; evaluated instead when u turns inside the step or the start's tangent is not known);
+the actuator's velocity at the three nodes is that of the quadratic through its three
+positions. (A reversal inside a rigid step is not split for the middle node: the error is of
+second order in the distance from the reversal.) These terms never feed back into the motion.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from passmd.model.contact import contact_force_row, contact_slip_share_row, contact_update_row
+
+# columns of the per-period accumulator array
+PER_WINDOW_INTEGRAL = 0  # ∫ (x_r − x_p) dt over the settle window
+PER_WINDOW_LENGTH = 1  # window length (s)
+PER_WINDOW_END_XP = 2  # x_p at the window's end
+PER_MARK_XR = 3  # x_r at the slip mark
+PER_MIN_XR = 4  # min x_r from the slip mark to the next window
+PER_XR_INTEGRAL = 5  # ∫ x_r dt over the period
+PER_FRICTION_INTEGRAL = 6  # ∫ Σ m_g T_g dt over the period (force on the runner)
+PER_DURATION = 7  # Σ dt over the period
+PER_COLUMNS = 8
+
+# energy accumulators
+EN_INPUT = 0  # work done by the piezo drive
+EN_DAMPING = 1  # dissipated by c_p
+EN_CONTACT = 2  # ∫ T du: stored in and dissipated by the contacts
+EN_COLUMNS = 3
+
+STATUS_OK = 0
+STATUS_DIVERGED = 1
+STATUS_PAUSED = 2  # the step limit was reached; call again with the same arrays to go on
+
+# slots of the carry array: everything the integration loop keeps between steps besides
+# ``y`` and ``work``, so that a paused integration resumes bit for bit where it stopped
+C_STARTED = 0  # 0 before the first call (forces and accelerations not yet evaluated)
+C_SEGMENT = 1  # segment in progress
+C_MID = 2  # 1 when paused inside that segment
+C_TIME = 3
+C_XP = 4
+C_AR = 5  # runner acceleration
+C_FORCE = 6  # Σ n_g T_g
+C_NEXT_RECORD = 7
+C_TRACK = 8
+C_RECORDED = 9
+C_STEPS = 10
+C_FINE_STEPS = 11
+C_FINE = 12  # 1 while the fine step is in use
+C_QUIET = 13
+C_ACC_XR = 14  # segment-local accumulators
+C_ACC_F = 15
+C_ACC_WIN = 16
+C_ACC_IN = 17
+C_ACC_DAMP = 18
+C_ACC_CONTACT = 19
+C_ACC_T = 20
+C_MIN_XR = 21
+C_QUASI = 22  # 1 while the quasi-static actuator step is in use
+C_CONTROLLED = 23  # 1 while the error-controlled step is in use
+C_STEP = 24  # the error-controlled step (s)
+C_REJECTED = 25  # error-controlled steps rejected (counted in the steps too)
+C_GRATE = 26  # rate of g over the last error-controlled step (m/s³)
+C_HPREV = 27  # length of that step (s; 0: g's rate not known, no curvature estimate)
+CARRY_SIZE = 28
+
+
+#: numba options: the kernel allocates nothing (work arrays come from the caller), so it is
+#: compiled without reference counting; with it, every call into the contact kernels paid
+#: atomic reference-count updates on the array arguments (≈ 30 ns per step).
+KERNEL_OPTIONS = {"cache": True, "error_model": "numpy", "_nrt": False}
+
+#: rows of the work array (shape (WORK_ROWS, groups)) the caller allocates
+WORK_ROWS = 12
+#: quasi-static step: the actuator's force balance is solved to this fraction of S/K
+#: (≈ 6e-15 m; a force error ≤ 1e-6 μF_N)
+QUASI_TOLERANCE = 1e-6
+#: quasi-static step: most secant/bisection iterations of one force balance (the bracket
+#: halves at least every other iteration, so 200 is far beyond the ≈ 50 that reach the
+#: float resolution of S/K)
+QUASI_MAX_ITERATIONS = 200
+#: A step that would leave less than this fraction of itself before the end of a linear
+#: piece of x_p(t) is stretched to end on the piece's corner (no sliver steps from rounding).
+LAST_STEP_STRETCH = 1.000001
+#: Divergence: the run stops (STATUS_DIVERGED) once |x_r| or an actuator's stretch
+#: |x_a − x_p| reaches this (m). The drive's travel is a few µm, so 1 m is a runaway.
+POSITION_LIMIT = 1.0
+#: Divergence: the run stops once |v_r| or |v_a| reaches this (m/s). The amplifier moves the
+#: hemispheres at most A_max·SR/V_pp ≈ 0.1 m/s, so 100 m/s is a runaway. (Comparisons with
+#: NaN are False, so a NaN state stops the run too.)
+VELOCITY_LIMIT = 100.0
+#: Error-controlled step: the next step is this fraction of the one the estimate allows
+#: (the safety factor of step-size controllers, Hairer, Nørsett & Wanner, Sect. II.4).
+#: With 0.8 and the growth below, one step in 15 is rejected on a 100 Hz saw-tooth (0.9 and
+#: 1.5: one in 5, and more steps in all).
+STEP_SAFETY = 0.8
+#: Error-controlled step: largest growth and shrink factors from one step to the next.
+STEP_GROWTH = 1.25
+STEP_SHRINK = 0.2
+
+
+class Segments(NamedTuple):
+    """The linear pieces of x_p(t), one entry per piece (built by :mod:`passmd.solver.simulation`)."""
+
+    t0: np.ndarray  # start time (s)
+    t1: np.ndarray  # end time (s)
+    x0: np.ndarray  # x_p at the start (m)
+    x1: np.ndarray  # x_p at the end (m)
+    fine: np.ndarray  # fine step (s)
+    coarse: np.ndarray  # coarse step while the actuators do not ring (s)
+    period: np.ndarray  # int64: period the piece belongs to
+    window: np.ndarray  # int64: 1 when the piece lies in its period's settle window
+    mark: np.ndarray  # int64: 1 when the piece starts at a slip mark
+    quasi: np.ndarray  # step of the quasi-static actuator; first error-controlled step (s)
+    longest: np.ndarray  # longest error-controlled step (s)
+
+
+class Mechanics(NamedTuple):
+    """Masses, stiffnesses and damping of Eqs. 2–3 (SI units)."""
+
+    runner_mass: float  # m_r
+    load_stiffness: float  # k of the load cell (0 without it)
+    multiplicity: np.ndarray  # float: contacts n_g per group
+    rigid: bool  # rigid actuators: x_a = x_p
+    actuator_mass: float  # m_a
+    actuator_stiffness: float  # k_p
+    actuator_viscosity: float  # c_p
+    linear_stiffness: float  # K: part of Σ n_g T_g the error-controlled step integrates exactly (N/m)
+
+
+class StepControl(NamedTuple):
+    """Step adaptation (flexible actuators) and recording."""
+
+    activity_threshold: float  # |ẍ_a| above which the actuators ring (m/s²)
+    quiet_steps: int  # fine steps below the threshold before the step grows
+    quasi_static: bool  # quiet phases use the quasi-static actuator step
+    record_interval: float  # time between recorded samples (s)
+    error_tolerance: float  # local position error per step of the runner (m); 0: uniform steps
+
+
+class Contacts(NamedTuple):
+    """The contact groups: rows of :func:`passmd.model.contact.stack_contacts` and μF_N per group."""
+
+    params: np.ndarray
+    state: np.ndarray  # contact memory, updated in place
+    sliding: np.ndarray  # μF_N of one contact of each group (N)
+
+
+class Buffers(NamedTuple):
+    """State and outputs, all written in place (see :func:`integrate` for the layouts)."""
+
+    y: np.ndarray  # (2 + 2G,): [x_r, v_r, x_a(0..G−1), v_a(0..G−1)]
+    work: np.ndarray  # (WORK_ROWS, G): scratch carried between calls
+    carry: np.ndarray  # (CARRY_SIZE,): loop state of a paused run, zeros before the first call
+    record: np.ndarray  # (samples, 4 + 3G): [t, x_p, x_r, v_r, (x_a, T, slip share) per group]
+    per: np.ndarray  # (periods, PER_COLUMNS): per-period accumulators
+    peak: np.ndarray  # (periods, G): largest |T_g|/μF_N after each slip mark
+    energy: np.ndarray  # (EN_COLUMNS,): energy accumulators
+
+
+@njit(**KERNEL_OPTIONS)
+def quasi_static_position(params, state, g, x_r, center, K, S, guess, slope, tolerance):
+    """Actuator position x of group g in force balance with its contact (m_a neglected).
+
+    Solves h(x) = K (center − x) − T_g(x − x_r) = 0 with the contact's memory as committed
+    (pure evaluations). T_g is non-decreasing in u on every Masing branch and |T_g| ≤ S
+    (μF_N), so h is strictly decreasing, −h' ∈ [K, K + 2aG*], and the root lies in
+    [center − S/K, center + S/K]. From ``guess``, a step with ``slope`` (the previous
+    step's −h', or K), then secant steps kept inside the shrinking bracket (bisection when
+    a step leaves it), until a step is below ``tolerance`` (m). Returns (x, −h' estimate).
+    """
+    lo = center - S / K
+    hi = center + S / K
+    x = min(max(guess, lo), hi)
+    h = K * (center - x) - contact_force_row(params, state, g, x - x_r)
+    x_prev = x
+    h_prev = h
+    for it in range(QUASI_MAX_ITERATIONS):
+        if h == 0.0:
+            return x, slope
+        if h > 0.0:
+            lo = x
+        else:
+            hi = x
+        if it > 0 and h != h_prev:
+            secant = (h_prev - h) / (x - x_prev)
+            if secant >= K:
+                slope = secant
+        x_new = x + h / slope
+        if not (lo <= x_new <= hi):  # (the root is at an end of the bracket in full sliding)
+            x_new = 0.5 * (lo + hi)
+        if abs(x_new - x) <= tolerance or hi - lo <= tolerance:
+            return x_new, slope
+        x_prev = x
+        h_prev = h
+        x = x_new
+        h = K * (center - x) - contact_force_row(params, state, g, x - x_r)
+    return x, slope
+
+
+def integrate(segments: Segments, mechanics: Mechanics, control: StepControl, contacts: Contacts,
+              buffers: Buffers, step_limit: int):
+    """Check the kernel's arguments, then run :func:`_integrate` (see there for what it does).
+
+    Returns (status, steps done, rows recorded, fine steps).
+
+    Raises
+    ------
+    ValueError
+        An argument of the wrong type, dtype or shape, naming it: the compiled loop does
+        no bounds checks, so a wrong shape would read or write outside an array.
+    """
+    _check_arguments(segments, mechanics, control, contacts, buffers, step_limit)
+    return _integrate(segments, mechanics, control, contacts, buffers, int(step_limit))
+
+
+def _check_array(name, value, shape, dtype=np.float64):
+    """ValueError unless ``value`` is a C-contiguous array of ``dtype`` and ``shape`` (None: any)."""
+    if not isinstance(value, np.ndarray) or value.dtype != dtype or not value.flags.c_contiguous:
+        raise ValueError(f"{name} must be a C-contiguous {np.dtype(dtype).name} array, got {value!r:.80}")
+    wanted = tuple("*" if n is None else n for n in shape)
+    if len(value.shape) != len(shape) or any(
+        n is not None and m != n for m, n in zip(value.shape, shape, strict=True)
+    ):
+        raise ValueError(f"{name} has shape {value.shape}, must be {wanted}")
+
+
+def _check_arguments(segments, mechanics, control, contacts, buffers, step_limit):
+    """Types and shapes of :func:`integrate`'s arguments (ValueError naming the first bad one)."""
+    for name, value, kind in (("segments", segments, Segments), ("mechanics", mechanics, Mechanics),
+                              ("control", control, StepControl), ("contacts", contacts, Contacts),
+                              ("buffers", buffers, Buffers)):
+        if not isinstance(value, kind):
+            raise ValueError(f"{name} = {value!r:.80} is not a {kind.__name__}")
+    n = segments.t0.shape[0] if isinstance(segments.t0, np.ndarray) else -1
+    if n < 1:
+        raise ValueError("segments.t0 must be a non-empty array")
+    for field in Segments._fields:
+        dtype = np.int64 if field in ("period", "window", "mark") else np.float64
+        _check_array(f"segments.{field}", getattr(segments, field), (n,), dtype)
+    G = mechanics.multiplicity.shape[0] if isinstance(mechanics.multiplicity, np.ndarray) else 0
+    if G < 1:
+        raise ValueError("mechanics.multiplicity must be a non-empty array")
+    _check_array("mechanics.multiplicity", mechanics.multiplicity, (G,))
+    _check_array("contacts.params", contacts.params, (G, None))
+    _check_array("contacts.state", contacts.state, (G, None))
+    _check_array("contacts.sliding", contacts.sliding, (G,))
+    periods = int(segments.period.max()) + 1
+    _check_array("buffers.y", buffers.y, (2 + 2 * G,))
+    _check_array("buffers.work", buffers.work, (WORK_ROWS, G))
+    _check_array("buffers.carry", buffers.carry, (CARRY_SIZE,))
+    _check_array("buffers.record", buffers.record, (None, 4 + 3 * G))
+    _check_array("buffers.per", buffers.per, (periods, PER_COLUMNS))
+    _check_array("buffers.peak", buffers.peak, (periods, G))
+    _check_array("buffers.energy", buffers.energy, (EN_COLUMNS,))
+    if buffers.record.shape[0] < 1:
+        raise ValueError("buffers.record must have at least one row")
+    if int(step_limit) != step_limit or step_limit < 0:
+        raise ValueError(f"step_limit = {step_limit!r} is out of range: must be an integer >= 0")
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _save_position(carry, segment, mid, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps, dt_ctrl):
+    """Where the loop stands (segment, time, piezo position, runner acceleration, force,
+    recording and step counters, error-controlled step) into ``carry``: at a pause and at the
+    end of a call alike, so that a later call resumes or extends the run bit for bit."""
+    carry[C_SEGMENT] = segment
+    carry[C_MID] = mid
+    carry[C_TIME] = t
+    carry[C_XP] = x_p
+    carry[C_AR] = a_r
+    carry[C_FORCE] = F
+    carry[C_NEXT_RECORD] = next_rec
+    carry[C_TRACK] = track
+    carry[C_RECORDED] = n_rec
+    carry[C_STEPS] = steps
+    carry[C_FINE_STEPS] = fine_steps
+    carry[C_STEP] = dt_ctrl
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _note_peak(peak, track, g, force, sliding_force):
+    """Keep the largest |T_g|/μF_N since the tracked period's slip mark (no period tracked: track < 0)."""
+    if track >= 0:
+        ratio = abs(force) / sliding_force
+        if ratio > peak[track, g]:
+            peak[track, g] = ratio
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _start_increment(rigid, rate, dt, actuator_stiffness, tangent_stiffness):
+    """Rate of u = x_a − x_r at the start of a step, times dt, from the rate v_p − v_r
+    (``rate``): as it is for rigid actuators; for a quasi-static one, from its balance
+    k_p (v_p − v_a) = k_t (v_a − v_r) with k_t the contact's tangent stiffness."""
+    if rigid:
+        return rate * dt
+    return actuator_stiffness * rate * dt / max(tangent_stiffness + actuator_stiffness, actuator_stiffness)
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _turns_inside(du0, du):
+    """Whether u turns inside the step: the quadratic through u's increment ``du`` over the
+    step and its rate at the start (times dt, ``du0``) has its extremum inside."""
+    return du0 * (2.0 * du - du0) < 0.0
+
+
+@njit(**KERNEL_OPTIONS)
+def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
+    """Integrate over the segments; returns (status, steps done, rows recorded, fine steps).
+
+    One function of ≈ 280 lines, not several small ones, on purpose: the step loop keeps
+    about twenty scalars (time, accelerations, step-control flags, the per-segment
+    accumulators) in registers across every step; helpers would pass them back and forth
+    on every one of the 10⁶–10⁹ steps of a run, or keep them in memory.
+
+    Work is bounded: once ``step_limit`` steps (counted from the start of the run) are
+    done, the kernel stores its loop state in ``buffers.carry`` (zeros before the first
+    call) and returns STATUS_PAUSED; calling it again with the same arrays continues
+    exactly where it stopped, with the same floating-point operations in the same order as
+    an uninterrupted run (the contact memory lives in ``contacts.state``). A run that has
+    integrated all its segments stores its loop state the same way (between two segments) and
+    returns STATUS_OK; calling it again with the segments extended by more pieces (and ``per``
+    and ``peak`` by their periods, the same arrays longer) continues the run with the new
+    pieces, as if they had been there from the start.
+
+    ``contacts.sliding`` holds μF_N of each group; ``peak[k, g]`` receives the largest
+    |T_g|/μF_N from period k's slip mark to the next settle window (1 exactly when the group
+    slid fully). ``y`` = [x_r, v_r, x_a(0..G−1), v_a(0..G−1)]: the actuator entries are read
+    on the first call and written when the run ends (in between they live in ``work``,
+    scratch of shape (WORK_ROWS, G)); x_r and v_r are written whenever the kernel returns.
+    ``record`` rows are [t, x_p, x_r, v_r, (x_a, T, slip share) per group].
+
+    Step control (flexible actuators): every segment starts with the fine step
+    ``seg_fine`` (a corner of x_p(t) excites the actuator mode). Once the largest
+    actuator acceleration |ẍ_a| has stayed below ``activity_threshold`` for
+    ``quiet_steps`` fine steps, the step grows to ``seg_coarse``; it falls back to fine
+    as soon as |ẍ_a| exceeds the threshold again. Rigid actuators: ``seg_fine`` only.
+
+    With ``quasi_static`` the quiet phases instead neglect m_a: each step of
+    ``seg_quasi`` (set by the runner's mode) solves the actuator's force balance
+    k_p (x_p − x_a) = c_p ẋ_a + T(x_a − x_r) implicitly (backward Euler in the damping
+    term, :func:`quasi_static_position`), then commits the contact memory once, as the
+    explicit step does. The implied actuator acceleration is checked against the same
+    threshold; above it, the fine explicit step takes over again.
+
+    With ``error_tolerance`` > 0 the quasi-static phases (flexible) and every step (rigid)
+    are error-controlled (module docstring): the first such step of a quasi-static phase is
+    ``seg_quasi``, then each step follows from the last one's error estimate, at most
+    ``seg_longest``; rigid actuators carry the step from piece to piece. Rejected steps count
+    in ``steps`` (and in ``carry[C_REJECTED]``).
+    """
+    (seg_t0, seg_t1, seg_x0, seg_x1, seg_fine, seg_coarse, seg_period, seg_window, seg_mark, seg_quasi,
+     seg_longest) = segments
+    runner_mass, load_stiffness, multiplicity, rigid = mechanics[:4]
+    actuator_mass, actuator_stiffness, actuator_viscosity, linear_stiffness = mechanics[4:]
+    # error-controlled step: the runner on the linear spring K to x_p (and the load cell)
+    # oscillates at Ω about z = β x_p; the variation-of-constants formula integrates that part
+    # exactly, with the rest of the force, g = a + Ω² (x_r − z), constant over the step in x_r
+    # and linear in v_r (both exact for a constant g)
+    omega2 = (linear_stiffness + load_stiffness) / runner_mass
+    omega = np.sqrt(omega2)
+    beta = linear_stiffness / (linear_stiffness + load_stiffness) if linear_stiffness > 0.0 else 0.0
+    dt_trig = -1.0
+    cs = sn = one_minus_cos = sine_excess = 0.0
+    sh = ch = half_one_minus_cos = half_sine_excess = 0.0  # the same at half the step
+    hh = xp_mid = xr_mid = vr_mid = F_mid = 0.0  # mid-step nodes of the energy quadrature
+    inv_dt = c_half = K_half = inv_K_half = 0.0
+    K = 0.0  # the quasi-static balance's stiffness k_p + c_p/dt (set in its steps)
+    activity_threshold, quiet_steps, quasi_static, record_interval, error_tolerance = control
+    control_on = error_tolerance > 0.0
+    # error estimates below this need no root: the step grows by the largest factor
+    small_error = error_tolerance * (STEP_SAFETY / STEP_GROWTH) ** 4
+    params, state, sliding = contacts
+    y, work, carry, record, per, peak, energy = buffers
+    G = multiplicity.shape[0]
+    x_r = y[0]
+    v_r = y[1]
+    x_a = work[0]
+    v_a = work[1]
+    T = work[2]
+    u_old = work[3]
+    a_nd = work[4]  # actuator acceleration without the damping term
+    stretch_old = work[5]  # x_p − x_a at the previous step
+    xa_old = work[6]  # x_a at the previous step (quasi-static step)
+    slope = work[7]  # last −h' of the quasi-static balance (0: none yet)
+    T_old = work[8]  # T at the start of the step (samples inside an error-controlled step)
+    share = work[9]  # slip share at the end of the step (samples inside an error-controlled step)
+    xa_mid = work[10]  # x_a at mid-step (energy quadrature of a quasi-static error-controlled step)
+    tangent = work[11]  # dT/du at the start of a quasi-static step (< 0: not known)
+    gam = actuator_viscosity / actuator_mass
+    half_kp = 0.5 * actuator_stiffness
+    half_cp = 0.5 * actuator_viscosity
+    inv_ma = 1.0 / actuator_mass
+    inv_mr = 1.0 / runner_mass
+    if carry[C_STARTED] == 0.0:
+        for g in range(G):
+            x_a[g] = y[2 + g]
+            v_a[g] = y[2 + G + g]
+        t = seg_t0[0]
+        x_p = seg_x0[0]
+        F = 0.0
+        for g in range(G):
+            u = x_a[g] - x_r
+            T[g] = contact_force_row(params, state, g, u)
+            u_old[g] = u
+            F += multiplicity[g] * T[g]
+            a_nd[g] = (actuator_stiffness * (x_p - x_a[g]) - T[g]) * inv_ma
+        a_r = (F - load_stiffness * x_r) * inv_mr
+        n_rec = 0
+        next_rec = t
+        track = -1
+        steps = 0
+        fine_steps = 0
+        first_segment = 0
+        resume = False
+        dt_ctrl = seg_fine[0]
+        carry[C_STARTED] = 1.0
+    else:
+        t = carry[C_TIME]
+        x_p = carry[C_XP]
+        a_r = carry[C_AR]
+        F = carry[C_FORCE]
+        n_rec = int(carry[C_RECORDED])
+        next_rec = carry[C_NEXT_RECORD]
+        track = int(carry[C_TRACK])
+        steps = int(carry[C_STEPS])
+        fine_steps = int(carry[C_FINE_STEPS])
+        first_segment = int(carry[C_SEGMENT])
+        resume = carry[C_MID] != 0.0
+        dt_ctrl = carry[C_STEP]
+    max_rec = record.shape[0]
+    for s in range(first_segment, seg_t0.shape[0]):
+        k = seg_period[s]
+        t_end = seg_t1[s]
+        vp = (seg_x1[s] - seg_x0[s]) / (t_end - seg_t0[s])
+        in_window = seg_window[s] != 0
+        dt_fine = seg_fine[s]
+        dt_coarse = seg_coarse[s]
+        dt_quasi = seg_quasi[s]
+        dt_longest = seg_longest[s]
+        adaptive = (not rigid) and dt_coarse > dt_fine
+        if resume:
+            resume = False
+            fine = carry[C_FINE] != 0.0
+            quasi = carry[C_QUASI] != 0.0
+            controlled = carry[C_CONTROLLED] != 0.0
+            g_rate = carry[C_GRATE]
+            h_prev = carry[C_HPREV]
+            quiet = int(carry[C_QUIET])
+            acc_xr = carry[C_ACC_XR]
+            acc_f = carry[C_ACC_F]
+            acc_win = carry[C_ACC_WIN]
+            acc_in = carry[C_ACC_IN]
+            acc_damp = carry[C_ACC_DAMP]
+            acc_contact = carry[C_ACC_CONTACT]
+            acc_t = carry[C_ACC_T]
+            min_xr = carry[C_MIN_XR]
+        else:
+            if seg_mark[s]:
+                track = k
+                per[k, PER_MARK_XR] = x_r
+                per[k, PER_MIN_XR] = x_r
+            if in_window and track >= 0 and k > track:
+                track = -1
+            # every piece starts with the fine step (its corner excites the actuator mode);
+            # rigid actuators under error control go on with the controlled step (a corner
+            # changes the rate of g, and the error estimate adapts to it)
+            fine = not (rigid and control_on)
+            quasi = False
+            controlled = rigid and control_on
+            g_rate = 0.0  # (x_p's rate changes at the corner: g's rate is not known)
+            h_prev = 0.0
+            quiet = 0
+            # segment-local accumulators (kept in registers, written back after the segment)
+            acc_xr = 0.0
+            acc_f = 0.0
+            acc_win = 0.0
+            acc_in = 0.0
+            acc_damp = 0.0
+            acc_contact = 0.0
+            acc_t = 0.0
+            min_xr = per[track, PER_MIN_XR] if track >= 0 else 0.0
+        done = False
+        while not done:
+            if steps >= step_limit:
+                # pause: everything the loop carries goes to carry, y and work
+                _save_position(carry, s, 1.0, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps,
+                               dt_ctrl)
+                carry[C_FINE] = 1.0 if fine else 0.0
+                carry[C_QUASI] = 1.0 if quasi else 0.0
+                carry[C_CONTROLLED] = 1.0 if controlled else 0.0
+                carry[C_GRATE] = g_rate
+                carry[C_HPREV] = h_prev
+                carry[C_QUIET] = quiet
+                carry[C_ACC_XR] = acc_xr
+                carry[C_ACC_F] = acc_f
+                carry[C_ACC_WIN] = acc_win
+                carry[C_ACC_IN] = acc_in
+                carry[C_ACC_DAMP] = acc_damp
+                carry[C_ACC_CONTACT] = acc_contact
+                carry[C_ACC_T] = acc_t
+                carry[C_MIN_XR] = min_xr
+                y[0] = x_r
+                y[1] = v_r
+                return STATUS_PAUSED, steps, n_rec, fine_steps
+            if fine:
+                dt = dt_fine
+            elif controlled:
+                dt = min(dt_ctrl, dt_longest)
+            elif quasi:
+                dt = dt_quasi
+            else:
+                dt = dt_coarse
+            remaining = t_end - t
+            if remaining <= dt * LAST_STEP_STRETCH:
+                dt = remaining
+                t_new = t_end
+                xp_new = seg_x1[s]
+                done = True
+            else:
+                t_new = t + dt
+                xp_new = seg_x0[s] + vp * (t_new - seg_t0[s])
+            if fine:
+                fine_steps += 1
+            half_dt2 = 0.5 * dt * dt
+            xr_old = x_r
+            vr_old = v_r
+            F_old = F
+            # drift
+            if controlled and omega > 0.0:
+                y0 = x_r - beta * x_p
+                w0 = v_r - beta * vp
+                ag0 = a_r + omega2 * y0
+                if dt != dt_trig:  # (steps repeat at the longest step: their sines are kept)
+                    dt_trig = dt
+                    sh = np.sin(0.5 * dt * omega)
+                    ch = np.cos(0.5 * dt * omega)
+                    cs = 1.0 - 2.0 * sh * sh
+                    sn = 2.0 * sh * ch
+                    one_minus_cos = 2.0 * sh * sh / omega2  # (1 − cos hΩ)/Ω², without cancellation
+                    sine_excess = (dt * omega - sn) / (omega2 * omega)  # (hΩ − sin hΩ)/Ω³
+                    half_one_minus_cos = sh * sh / (omega2 * (1.0 + ch))  # 1 − cos x = sin²x/(1 + cos x)
+                    half_sine_excess = (0.5 * dt * omega - sh) / (omega2 * omega)
+                x_r = cs * y0 + sn / omega * w0 + one_minus_cos * ag0 + sine_excess * g_rate + beta * xp_new
+                # the same at mid-step: the nodes of the energy quadrature (module docstring)
+                hh = 0.5 * dt
+                xp_mid = x_p + vp * hh
+                xr_mid = (ch * y0 + sh / omega * w0 + half_one_minus_cos * ag0 + half_sine_excess * g_rate
+                          + beta * xp_mid)
+                vr_mid = (-omega * sh * y0 + ch * w0 + sh / omega * ag0 + half_one_minus_cos * g_rate
+                          + beta * vp)
+            else:
+                x_r += dt * v_r + half_dt2 * a_r
+            simpson = controlled and omega > 0.0
+            quad_in = quad_damp = quad_contact = 0.0  # start and mid-step terms of that quadrature
+            if rigid:
+                for g in range(G):
+                    x_a[g] = xp_new
+            elif quasi:
+                inv_dt = 1.0 / dt
+                c_dt = actuator_viscosity * inv_dt
+                K = actuator_stiffness + c_dt
+                c_half = 2.0 * c_dt  # (the balance over half the step)
+                K_half = actuator_stiffness + c_half
+                inv_K_half = 1.0 / K_half
+                F_trial = 0.0  # Σ n_g T_g at the solved balance, T_g = K (center − x_a,g)
+                for g in range(G):
+                    stretch_old[g] = x_p - x_a[g]
+                    xa_old[g] = x_a[g]
+                    center = (actuator_stiffness * xp_new + c_dt * x_a[g]) / K
+                    # Newton predictor from the last solution: T moves by k_t Δu, k_t = slope − K
+                    sg = max(slope[g], K)
+                    guess = x_a[g] + (K * (center - x_a[g]) - T[g] - (sg - K) * (xr_old - x_r)) / sg
+                    x_a[g], slope[g] = quasi_static_position(
+                        params, state, g, x_r, center, K, sliding[g], guess, sg,
+                        QUASI_TOLERANCE * sliding[g] / K,
+                    )
+                    F_trial += multiplicity[g] * K * (center - x_a[g])
+                    if simpson:
+                        # x_a at mid-step: the balance over the first half step, one Newton step
+                        # from the chord's midpoint (within O(dt²) of it)
+                        center_mid = (actuator_stiffness * xp_mid + c_half * xa_old[g]) * inv_K_half
+                        chord = 0.5 * (xa_old[g] + x_a[g])
+                        u_chord = chord - xr_mid
+                        # the contact force there: the cubic Hermite in u through both ends (values
+                        # and tangents: the start's from the last step, the end's from the balance
+                        # solve) when u is monotone over the step and the start's tangent is
+                        # known, else evaluated (a reversal turns the branch inside the step)
+                        k_end = slope[g] - K
+                        u_start = u_old[g]
+                        du = x_a[g] - x_r - u_start
+                        du0 = _start_increment(False, vp - vr_old, dt, actuator_stiffness, k_end)
+                        if tangent[g] >= 0.0 and du != 0.0 and not _turns_inside(du0, du):
+                            sv = (u_chord - u_start) / du
+                            T_end = K * (center - x_a[g])
+                            rv = 1.0 - sv
+                            T_chord = ((1.0 + 2.0 * sv) * rv * rv * T[g] + sv * sv * (3.0 - 2.0 * sv) * T_end
+                                       + du * sv * rv * (rv * tangent[g] - sv * k_end))
+                        else:
+                            T_chord = contact_force_row(params, state, g, u_chord)
+                        balance = K_half * (center_mid - chord) - T_chord
+                        xa_mid[g] = chord + balance / max(k_end + K_half, K_half)
+                        T_mid = K_half * (center_mid - xa_mid[g])
+                        # velocities of the quadratic through x_a at start, mid-step and end
+                        q0 = (4.0 * xa_mid[g] - 3.0 * xa_old[g] - x_a[g]) * inv_dt
+                        q_mid = (x_a[g] - xa_old[g]) * inv_dt
+                        n_g = multiplicity[g]
+                        quad_in += n_g * actuator_stiffness * (stretch_old[g] + 4.0 * (xp_mid - xa_mid[g]))
+                        quad_damp += n_g * actuator_viscosity * (q0 * q0 + 4.0 * q_mid * q_mid)
+                        quad_contact += n_g * (T[g] * (q0 - vr_old) + 4.0 * T_mid * (q_mid - vr_mid))
+            else:
+                for g in range(G):
+                    stretch_old[g] = x_p - x_a[g]
+                    x_a[g] += dt * v_a[g] + half_dt2 * (a_nd[g] - gam * v_a[g])
+            if controlled:
+                # local position error of the drift, dt³ x'''/6 with x''' ≈ Δa/dt, from the
+                # forces at the drifted positions with the memory as committed (pure; the
+                # quasi-static balance has them already)
+                if rigid:
+                    F_trial = 0.0
+                    for g in range(G):
+                        F_trial += multiplicity[g] * contact_force_row(params, state, g, x_a[g] - x_r)
+                # (the trigonometric step: of g only, its linear part is exact)
+                da = (F_trial - load_stiffness * x_r) * inv_mr - a_r
+                if omega > 0.0:
+                    # g extrapolated at its last rate: the error is of its change of rate, O(dt⁴)
+                    da += omega2 * (x_r - beta * xp_new - y0) - g_rate * dt
+                err = abs(da) * dt * dt / 6.0
+                factor = STEP_GROWTH
+                if err > small_error:
+                    allowed = STEP_SAFETY * np.sqrt(np.sqrt(error_tolerance / err))  # local error ∝ dt⁴
+                    factor = min(STEP_GROWTH, max(STEP_SHRINK, allowed))
+                if err > error_tolerance and dt > dt_fine:
+                    # rejected: back to the start of the step, to retry with a shorter one
+                    x_r = xr_old
+                    for g in range(G):
+                        x_a[g] = x_p if rigid else xa_old[g]
+                    dt_ctrl = max(dt * factor, dt_fine)
+                    done = False
+                    steps += 1
+                    carry[C_REJECTED] += 1.0
+                    continue
+                if not done:
+                    dt_ctrl = min(dt * factor, dt_longest)
+            if simpson and rigid:
+                F_mid = 0.0  # Σ n_g T_g at mid-step (pure)
+                for g in range(G):
+                    F_mid += multiplicity[g] * contact_force_row(params, state, g, xp_mid - xr_mid)
+            # contact forces, memory committed once per step
+            F = 0.0
+            for g in range(G):
+                u = x_a[g] - x_r
+                T_start = T[g]
+                T_old[g] = T_start
+                if controlled:
+                    # a reversal of u inside the step is an event: the extremum of the quadratic
+                    # through u at the start (value and rate) and at the end is committed first,
+                    # so the Masing branch turns at it, not at the last step boundary (k_t:
+                    # the tangent stiffness that the last balance solve found)
+                    du0 = _start_increment(rigid, vp - v_r, dt, actuator_stiffness, slope[g] - K)
+                    if _turns_inside(du0, u - u_old[g]):
+                        excess = u - u_old[g] - du0  # curvature term of the quadratic, times dt²
+                        u_ext = u_old[g] - du0 * du0 / (4.0 * excess)
+                        T_ext = contact_update_row(params, state, g, u_ext)
+                        if not simpson:
+                            acc_contact += multiplicity[g] * 0.5 * (T[g] + T_ext) * (u_ext - u_old[g])
+                        T[g] = T_ext
+                        u_old[g] = u_ext
+                        _note_peak(peak, track, g, T_ext, sliding[g])
+                Tn = contact_update_row(params, state, g, u)
+                if not simpson:
+                    acc_contact += multiplicity[g] * 0.5 * (T[g] + Tn) * (u - u_old[g])
+                    if rigid:
+                        acc_in += multiplicity[g] * 0.5 * (T_start + Tn) * (xp_new - x_p)
+                T[g] = Tn
+                u_old[g] = u
+                F += multiplicity[g] * Tn
+                _note_peak(peak, track, g, Tn, sliding[g])
+            # kick
+            a_r_new = (F - load_stiffness * x_r) * inv_mr
+            if controlled and omega > 0.0:
+                ag1 = a_r_new + omega2 * (x_r - beta * xp_new)
+                rate = (ag1 - ag0) / dt
+                # g quadratic in time through its values at the end, the start and the start of
+                # the previous step (curvature 0 after a reset of its rate)
+                curvature = (rate - g_rate) / (dt + h_prev) if h_prev > 0.0 else 0.0
+                v_r = (-omega * sn * y0 + cs * w0 + sn / omega * ag0 + one_minus_cos * (rate - curvature * dt)
+                       + 2.0 * sine_excess * curvature + beta * vp)
+                g_rate = rate
+                h_prev = dt
+            else:
+                v_r += 0.5 * dt * (a_r + a_r_new)
+            a_r = a_r_new
+            if simpson and rigid:
+                acc_in += vp * dt / 6.0 * (F_old + 4.0 * F_mid + F)
+                acc_contact += dt / 6.0 * ((vp - vr_old) * F_old + 4.0 * (vp - vr_mid) * F_mid
+                                           + (vp - v_r) * F)
+            if quasi:
+                activity = 0.0
+                for g in range(G):
+                    v_old = v_a[g]
+                    v_a[g] = (x_a[g] - xa_old[g]) / dt
+                    a_nd[g] = (actuator_stiffness * (xp_new - x_a[g]) - T[g]) * inv_ma
+                    tangent[g] = slope[g] - K  # (the next step's start: this step's end)
+                    if simpson:
+                        # end terms of the quadrature (start and mid-step ones: at the drift)
+                        q1 = (xa_old[g] - 4.0 * xa_mid[g] + 3.0 * x_a[g]) * inv_dt
+                        quad_in += multiplicity[g] * actuator_stiffness * (xp_new - x_a[g])
+                        quad_damp += multiplicity[g] * actuator_viscosity * q1 * q1
+                        quad_contact += multiplicity[g] * T[g] * (q1 - v_r)
+                    else:
+                        # backward Euler: c_p v_a (x_a − x_a,old) = c_p v_a² dt
+                        acc_damp += multiplicity[g] * actuator_viscosity * v_a[g] * v_a[g] * dt
+                        stretch_sum = stretch_old[g] + xp_new - x_a[g]
+                        acc_in += multiplicity[g] * half_kp * stretch_sum * (xp_new - x_p)
+                    acc = abs(v_a[g] - v_old) / dt
+                    if acc > activity:
+                        activity = acc
+                if simpson:
+                    acc_in += vp * dt / 6.0 * quad_in
+                    acc_damp += dt / 6.0 * quad_damp
+                    acc_contact += dt / 6.0 * quad_contact
+                if activity >= activity_threshold:
+                    fine = True
+                    quasi = False
+                    controlled = False
+                    quiet = 0
+            elif not rigid:
+                damp = 1.0 / (1.0 + 0.5 * dt * gam)
+                activity = 0.0
+                for g in range(G):
+                    a_new = (actuator_stiffness * (xp_new - x_a[g]) - T[g]) * inv_ma
+                    v_old = v_a[g]
+                    v_a[g] = (v_old + 0.5 * dt * (a_nd[g] - gam * v_old + a_new)) * damp
+                    a_nd[g] = a_new
+                    acc_damp += multiplicity[g] * half_cp * (v_old * v_old + v_a[g] * v_a[g]) * dt
+                    # work of the moving piezo base: k_p (x_p − x_a) dx_p, trapezoidal in (x_p − x_a)
+                    acc_in += multiplicity[g] * half_kp * (stretch_old[g] + xp_new - x_a[g]) * (xp_new - x_p)
+                    acc = abs(a_new - gam * v_a[g])
+                    if acc > activity:
+                        activity = acc
+                if adaptive:
+                    if fine:
+                        if activity < activity_threshold:
+                            quiet += 1
+                            if quiet >= quiet_steps:
+                                fine = False
+                                quasi = quasi_static
+                                controlled = quasi_static and control_on
+                                dt_ctrl = dt_quasi
+                                g_rate = 0.0
+                                h_prev = 0.0
+                                for g in range(G):
+                                    tangent[g] = -1.0
+                        else:
+                            quiet = 0
+                    elif activity >= activity_threshold:
+                        fine = True
+                        quiet = 0
+            # per-period measures
+            acc_xr += (xr_old + x_r) * dt
+            acc_f += (F_old + F) * dt
+            acc_t += dt
+            if in_window:
+                acc_win += ((xr_old - x_p) + (x_r - xp_new)) * dt
+            if x_r < min_xr:
+                min_xr = x_r
+            t_old = t
+            xp_old = x_p
+            t = t_new
+            x_p = xp_new
+            steps += 1
+            # divergence (also catches NaN: comparisons with NaN are False)
+            ok = abs(x_r) < POSITION_LIMIT and abs(v_r) < VELOCITY_LIMIT
+            if not rigid:
+                for g in range(G):
+                    ok = ok and abs(x_a[g] - x_p) < POSITION_LIMIT and abs(v_a[g]) < VELOCITY_LIMIT
+            if not ok:
+                y[0] = x_r
+                y[1] = v_r
+                return STATUS_DIVERGED, steps, n_rec, fine_steps
+            if controlled and next_rec <= t and n_rec < max_rec:
+                # samples at their own times inside a long step: cubic Hermite in x_r (from
+                # the positions and velocities at both ends), linear in x_p, x_a and T; the
+                # slip share of the step's end
+                for g in range(G):
+                    share[g] = contact_slip_share_row(params, state, g, x_a[g] - x_r)
+                while next_rec <= t and n_rec < max_rec:
+                    th = (next_rec - t_old) / dt
+                    th2 = th * th
+                    th3 = th2 * th
+                    record[n_rec, 0] = next_rec
+                    record[n_rec, 1] = xp_old + th * (x_p - xp_old)
+                    record[n_rec, 2] = ((2.0 * th3 - 3.0 * th2 + 1.0) * xr_old + (3.0 * th2 - 2.0 * th3) * x_r
+                                        + ((th3 - 2.0 * th2 + th) * vr_old + (th3 - th2) * v_r) * dt)
+                    record[n_rec, 3] = (6.0 * (th2 - th) * (xr_old - x_r) / dt + (3.0 * th2 - 4.0 * th + 1.0)
+                                        * vr_old + (3.0 * th2 - 2.0 * th) * v_r)
+                    for g in range(G):
+                        xa0 = xp_old if rigid else xa_old[g]
+                        record[n_rec, 4 + 3 * g] = xa0 + th * (x_a[g] - xa0)
+                        record[n_rec, 5 + 3 * g] = T_old[g] + th * (T[g] - T_old[g])
+                        record[n_rec, 6 + 3 * g] = share[g]
+                    n_rec += 1
+                    next_rec += record_interval
+            elif t >= next_rec and n_rec < max_rec:
+                record[n_rec, 0] = t
+                record[n_rec, 1] = x_p
+                record[n_rec, 2] = x_r
+                record[n_rec, 3] = v_r
+                for g in range(G):
+                    record[n_rec, 4 + 3 * g] = x_a[g]
+                    record[n_rec, 5 + 3 * g] = T[g]
+                    record[n_rec, 6 + 3 * g] = contact_slip_share_row(params, state, g, x_a[g] - x_r)
+                n_rec += 1
+                while next_rec <= t:
+                    next_rec += record_interval
+        per[k, PER_XR_INTEGRAL] += 0.5 * acc_xr
+        per[k, PER_FRICTION_INTEGRAL] += 0.5 * acc_f
+        per[k, PER_DURATION] += acc_t
+        if in_window:
+            per[k, PER_WINDOW_INTEGRAL] += 0.5 * acc_win
+            per[k, PER_WINDOW_LENGTH] += acc_t
+            per[k, PER_WINDOW_END_XP] = seg_x1[s]
+        if track >= 0:
+            per[track, PER_MIN_XR] = min_xr
+        energy[EN_CONTACT] += acc_contact
+        energy[EN_INPUT] += acc_in
+        energy[EN_DAMPING] += acc_damp
+    # done: the loop state goes to carry as at a pause between two segments, so that a call
+    # with these segments followed by more (the same arrays, longer) continues the run
+    _save_position(carry, seg_t0.shape[0], 0.0, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps,
+                   dt_ctrl)
+    y[0] = x_r
+    y[1] = v_r
+    for g in range(G):
+        y[2 + g] = x_a[g]
+        y[2 + G + g] = v_a[g]
+    return STATUS_OK, steps, n_rec, fine_steps
