@@ -20,14 +20,21 @@ def _copy(tmp_path, monkeypatch) -> Path:
     package = tmp_path / "pkg"
     package.mkdir()
     for module in kernels.KERNEL_MODULES:
+        (package / module).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy(PACKAGE / f"{module}.py", package / f"{module}.py")
     return package
 
 
+def test_every_kernel_module_exists():
+    """The notice checks the modules that hold the kernels: each is a source file of the package."""
+    for module in kernels.KERNEL_MODULES:
+        assert (PACKAGE / f"{module}.py").is_file(), module
+
+
 def _index(package: Path, module: str, mtime: float) -> None:
-    cache = package / "__pycache__"
+    cache = (package / module).parent / "__pycache__"
     cache.mkdir(exist_ok=True)
-    name = cache / f"{module}.kernel-10.py{sys.version_info.major}{sys.version_info.minor}.nbi"
+    name = cache / f"{Path(module).name}.kernel-10.py{sys.version_info.major}{sys.version_info.minor}.nbi"
     name.write_bytes(b"")
     os.utime(name, (mtime, mtime))
 

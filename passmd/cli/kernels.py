@@ -16,8 +16,9 @@ from pathlib import Path
 
 __all__ = ["KERNEL_MODULES", "kernels_cold", "notice_if_cold"]
 
-#: The modules whose ``@njit(cache=True)`` functions a simulation compiles.
-KERNEL_MODULES = ("_dynamics_kernel", "_contact_kernels", "contact")
+#: The modules whose ``@njit(cache=True)`` functions a simulation compiles, relative to the
+#: package folder.
+KERNEL_MODULES = ("solver/kernels", "model/contact_kernels", "model/contact")
 
 NOTICE = "compiling the simulation kernels (≈ 20 s, once) …"
 
@@ -35,15 +36,16 @@ def kernels_cold(package_dir: Path | None = None) -> bool:
     """Whether some kernel module has no index file in numba's cache as new as its source."""
     package_dir = package_dir or Path(__file__).resolve().parents[1]
     tag = f".py{sys.version_info.major}{sys.version_info.minor}.nbi"
-    dirs = [d for d in _cache_dirs(package_dir) if d.is_dir()]
-    names = {d: os.listdir(d) for d in dirs}
     for module in KERNEL_MODULES:
         source = package_dir / f"{module}.py"
         try:
             stamp = source.stat().st_mtime
         except OSError:
             continue
-        fresh = any(name.startswith(module + ".") and name.endswith(tag)
+        dirs = [d for d in _cache_dirs(source.parent) if d.is_dir()]
+        names = {d: os.listdir(d) for d in dirs}
+        stem = source.stem
+        fresh = any(name.startswith(stem + ".") and name.endswith(tag)
                     and (d / name).stat().st_mtime >= stamp for d in dirs for name in names[d])
         if not fresh:
             return True
