@@ -298,7 +298,7 @@ def test_source_change_changes_fingerprint(tmp_path):
     before = code_fingerprint(package)
     assert before == code_fingerprint(package)  # deterministic
     assert code_fingerprint() == code_fingerprint(Path(passmd.__file__).parent)
-    theory = package / "theory.py"
+    theory = package / "model" / "theory.py"
     theory.write_bytes(theory.read_bytes() + b"\n# an edit\n")
     edited = code_fingerprint(package)
     assert edited != before

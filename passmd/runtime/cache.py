@@ -170,7 +170,8 @@ _ENTRY_NAME = re.compile(r"([0-9a-f]{2})[0-9a-f]{62}" + re.escape(ENTRY_SUFFIX))
 _TEMP_NAME = re.compile(r"\.([0-9a-f]{2})[0-9a-f]{14}-[a-z0-9_]{1,32}\.tmp")
 _MARKER_TEMP_NAME = re.compile(r"\.CACHEDIR\.TAG-[a-z0-9_]{1,32}\.tmp")
 
-_PACKAGE_DIR = Path(__file__).resolve().parent
+#: The ``passmd`` package folder (this module is ``passmd/runtime/cache.py``).
+_PACKAGE_DIR = Path(__file__).resolve().parents[1]
 _MISS = object()
 #: Directories already reported as unusable in this process (one warning each).
 _REPORTED_UNWRITABLE: set[str] = set()
