@@ -12,6 +12,7 @@ import passmd
 from passmd.model.parameters import Drive
 from passmd.runtime import cache as cache_module
 from passmd.runtime.cache import Cache, canonical, code_fingerprint, default_cache_dir
+from passmd.runtime.cache import store as cache_store
 from passmd.runtime.config import RunConfig
 
 
@@ -173,7 +174,7 @@ def test_a_sweep_recomputes_a_corrupt_entry_with_one_warning(store):
 def test_unwritable_cache_warns_once_and_keeps_the_result(tmp_path, monkeypatch, how):
     from passmd.runtime import sweep
 
-    monkeypatch.setattr(cache_module, "_REPORTED_UNWRITABLE", set())
+    monkeypatch.setattr(cache_store, "_REPORTED_UNWRITABLE", set())
     directory = tmp_path / "cache"
     if how == "read-only":
         if os.geteuid() == 0:
@@ -186,12 +187,12 @@ def test_unwritable_cache_warns_once_and_keeps_the_result(tmp_path, monkeypatch,
         def full(*args, **kwargs):
             raise OSError(28, "No space left on device")
 
-        monkeypatch.setattr(cache_module.os, "fsync", full)
+        monkeypatch.setattr(cache_store.os, "fsync", full)
     else:  # another user's directory, also when the tests run as root
         def denied(*args, **kwargs):
             raise PermissionError(13, "Permission denied")
 
-        monkeypatch.setattr(cache_module.tempfile, "mkstemp", denied)
+        monkeypatch.setattr(cache_store.tempfile, "mkstemp", denied)
     store = Cache(directory)
     points = [{"x": float(x)} for x in range(4)]
     try:
@@ -228,7 +229,7 @@ def test_interrupted_write_leaves_no_entry(store, monkeypatch):
     def crash(src, dst):
         raise KeyboardInterrupt  # the process dies exactly here
 
-    monkeypatch.setattr(cache_module.os, "replace", crash)
+    monkeypatch.setattr(cache_store.os, "replace", crash)
     with pytest.raises(KeyboardInterrupt):
         store.put(key, {"y": 2})
     monkeypatch.undo()

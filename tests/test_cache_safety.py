@@ -30,6 +30,8 @@ from hypothesis import strategies as st
 from passmd.runtime import cache as cache_module
 from passmd.runtime import sweep
 from passmd.runtime.cache import MAGIC, MARKER_NAME, Cache, CacheWarning, CorruptEntry, NotACache
+from passmd.runtime.cache import entry as cache_entry
+from passmd.runtime.cache import store as cache_store
 
 FUZZ = int(os.environ.get("PASSMD_CACHE_FUZZ_EXAMPLES", "40"))
 FUZZ_SETTINGS = settings(max_examples=FUZZ, deadline=None,
@@ -385,13 +387,13 @@ def test_a_header_above_the_size_limit_is_removed_unparsed(tmp_path):
 
 def test_a_result_above_the_size_limits_is_kept_not_cached(tmp_path, monkeypatch):
     store = marked_cache(tmp_path / "cache")
-    monkeypatch.setattr(cache_module, "MAX_ENTRY_BYTES", 10_000)
+    monkeypatch.setattr(cache_entry, "MAX_ENTRY_BYTES", 10_000)
     too_large = "is not cached: its .* bytes are above the 10000-byte limit"
     with pytest.warns(CacheWarning, match=too_large) as record:
         frame = sweep.run(point_function, [{"x": np.zeros(2000)}, {"x": np.ones(2000)}], executor="serial",
                           cache=store, progress=False)
     assert len(record) == 1 and len(frame) == 2 and store.entries() == []
-    monkeypatch.setattr(cache_module, "MAX_HEADER_BYTES", 100)
+    monkeypatch.setattr(cache_entry, "MAX_HEADER_BYTES", 100)
     with pytest.warns(CacheWarning, match="header of .* bytes is above the 100-byte limit"):
         assert store.put(KEY_A, {"y": list(range(50))}, function="other") is False
 
@@ -475,7 +477,7 @@ def test_put_removes_its_temporary_file_on_any_exception(tmp_path, monkeypatch, 
     def interrupted(*args, **kwargs):
         raise exception
 
-    monkeypatch.setattr(cache_module.os, where, interrupted)
+    monkeypatch.setattr(cache_store.os, where, interrupted)
     with pytest.raises(exception):
         store.put(KEY_A, {"y": 1.0})
     monkeypatch.undo()

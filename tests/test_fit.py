@@ -79,7 +79,7 @@ def test_a_rough_parameter_is_scanned_out_of_a_local_minimum(tmp_path, monkeypat
     result = F.fit(start, data, ["actuator.stiffness"], starts=0, executor="serial", cache=tmp_path)
     low, high = result.estimates["actuator.stiffness"]["interval"]
     assert low < 5e6 < high and result.converged
-    monkeypatch.setattr(F, "SCAN_ROUNDS", 0)
+    monkeypatch.setattr(F.estimator, "SCAN_ROUNDS", 0)
     stuck = F.fit(start, data, ["actuator.stiffness"], starts=0, executor="serial", cache=tmp_path)
     low, high = stuck.estimates["actuator.stiffness"]["interval"]
     assert not low < 5e6 < high
@@ -91,9 +91,9 @@ def test_a_fit_stopped_in_a_local_minimum_says_so_and_claims_no_intervals(tmp_pa
     new search may follow: the profile of μ meets a lower cost than the estimate, so the result
     says it has not converged and the verdict claims no identifiability (the round trip above,
     with the full search, is the counter-example: converged and identifiable)."""
-    monkeypatch.setattr(F, "LOCAL_EVALUATIONS", 1)
-    monkeypatch.setattr(F, "REFITS", 0)
-    monkeypatch.setattr(F, "SCAN_ROUNDS", 0)
+    monkeypatch.setattr(F.estimator, "LOCAL_EVALUATIONS", 1)
+    monkeypatch.setattr(F.estimator, "REFITS", 0)
+    monkeypatch.setattr(F.estimator, "SCAN_ROUNDS", 0)
     truth = RIGID.replace(friction_coefficient=0.25)
     data = _synthetic(truth, (0.2, 0.4), (60, 100, 140), seed=3, cache=tmp_path)
     result = F.fit(RIGID.replace(friction_coefficient=0.2), data, ["friction_coefficient"], executor="serial",

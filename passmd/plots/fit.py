@@ -1,4 +1,4 @@
-"""Plot of a calibration (:func:`passmd.protocols.fit.fit`): measurements against the fitted model.
+"""Plot of a calibration (:func:`passmd.protocols.fit.estimator.fit`): measurements against the fitted model.
 
 One column per measured quantity: above, the measurements (with their standard deviations
 where given) and the fitted model's value at each, against the amplitude (the preload for

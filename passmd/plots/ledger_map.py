@@ -1,5 +1,5 @@
 """The replication report's map: every claim's state at the defaults, the joint reading and the
-runner-up readings of the assumption space (:func:`passmd.ledger.evaluation.joint_map`)."""
+runner-up readings of the assumption space (:func:`passmd.ledger.joint.joint_map`)."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ STATE_COLOURS = {"holds": "#5cb85c", "fails": "#d9534f", "inconclusive": "#bbbbb
 
 def plot_joint_map(table: pd.DataFrame):
     """Claims (rows) × readings (columns) coloured by state; column labels carry how many claims
-    hold there. ``table`` is :func:`passmd.ledger.evaluation.joint_map`'s result."""
+    hold there. ``table`` is :func:`passmd.ledger.joint.joint_map`'s result."""
     states = list(STATE_COLOURS)
     codes = np.vectorize(lambda s: states.index(s) if s in states else states.index("—"))(
         table.to_numpy(dtype=object)) if table.size else np.zeros((0, 0))

@@ -53,7 +53,7 @@ class RunConfig:
         Parallel workers; None: one per CPU.
     cache_dir : Path or None
         Directory of the result cache; None: the user's cache folder
-        (:func:`passmd.runtime.cache.default_cache_dir`).
+        (:func:`passmd.runtime.cache.store.default_cache_dir`).
     sweep_log : Path or None
         File every sweep appends one JSON line to (points cached and computed; the book's
         execution-statistics page sums them); None: no log.

@@ -14,16 +14,17 @@ order the points finish in. Execution is
 Every finished point is written to the on-disk cache (:mod:`passmd.runtime.cache`) as soon as
 it completes, so an interrupted sweep (Ctrl-C, SIGTERM, a failing point, a killed job) keeps
 every finished point and a rerun recomputes only the rest. The cache key covers the swept
-function's own code too (:func:`passmd.runtime.cache.function_code`): a user's function that
+function's own code too (:func:`passmd.runtime.cache.keys.function_code`): a user's function that
 changed between two sweeps is recomputed, and one whose code cannot be fingerprinted is
-not cached (one :class:`~passmd.runtime.cache.CacheWarning` says why). Progress (points done, ETA;
+not cached (one :class:`~passmd.runtime.cache.store.CacheWarning` says why). Progress (points done, ETA;
 :mod:`passmd.runtime.progress`) shows once a sweep has run 2 s: by default on a terminal only;
 ``progress=True`` (the command line) also off a terminal, as a line every few seconds;
 off when the run configuration says so (``RunConfig.progress``, off on CI).
 
 How a sweep runs comes from its arguments or the :class:`~passmd.runtime.config.RunConfig` an entry
 point passes down; this module reads no environment variable. Without either: a process pool
-over all cores and the cache in the user's cache folder (:func:`passmd.runtime.cache.default_cache_dir`).
+over all cores and the cache in the user's cache folder
+(:func:`passmd.runtime.cache.store.default_cache_dir`).
 When the configuration names a ``sweep_log`` file, every sweep appends one JSON line to it
 (the function, and how many points were taken from the cache and how many computed): the
 book's execution-statistics page sums them per chapter.
@@ -304,8 +305,8 @@ def run(
         configuration's workers, else all cores.
     cache : bool, Cache or path
         ``True`` (default): the cache in the configuration's ``cache_dir``, else in
-        the user's cache folder (:func:`passmd.runtime.cache.default_cache_dir`); ``False``: no
-        caching; a :class:`~passmd.runtime.cache.Cache` or a directory to use that one.
+        the user's cache folder (:func:`passmd.runtime.cache.store.default_cache_dir`); ``False``: no
+        caching; a :class:`~passmd.runtime.cache.store.Cache` or a directory to use that one.
     progress : bool, optional
         Progress on stderr once the sweep has run 2 s: True on any stderr (off a terminal a
         line every few seconds), False never; default: the configuration's ``progress``, else

@@ -4,7 +4,7 @@ The drive is a drive file shipped with the package (:data:`EXAMPLE_DRIVE_FILE`),
 ``passmd --drive FILE`` reads it. Every figure's data comes from the functions a designer
 calls: :func:`passmd.experiments.design.maps.compute_map` (what ``passmd sweep`` runs) for the
 critical amplitude, the step and velocity map, the Eq. 15 gain map and the stall force, and
-:func:`passmd.protocols.fit.fit` (what ``passmd fit`` runs) for the calibration. One function
+:func:`passmd.protocols.fit.estimator.fit` (what ``passmd fit`` runs) for the calibration. One function
 per figure; the grids of each profile are in :data:`PROFILE_SETTINGS`.
 
 The calibration is a round trip: measurements of the example drive are simulated
@@ -262,7 +262,7 @@ def synthetic_measurements(truth: Drive, profile: str, config: RunConfig | None 
 
 def measurements_csv(data: fitting.Measurements) -> str:
     """The text of the measurement CSV that ``passmd fit`` reads
-    (:func:`passmd.protocols.fit.write_measurements`)."""
+    (:func:`passmd.protocols.fit.measurements.write_measurements`)."""
     with tempfile.TemporaryDirectory(prefix="passmd-design-") as folder:
         path = Path(folder) / "measurements.csv"
         fitting.write_measurements(path, data)
