@@ -1,14 +1,11 @@
 """Force generation (Fig. 7): stall criterion, physics at stall, quick-profile snapshots, ledger rows.
 
-Snapshot tolerance: the simulations are deterministic and not chaotic — perturbing the drive
-frequency by a relative 1e-12 moves a 500-period stall force by about 1e-12 relative (checked
-while writing this module) — so floating-point differences between machines stay many orders
-of magnitude below RTOL = 1e-6, while any change of the physics, the stall criterion or a
-grid moves the locked numbers by far more. So does any change of the integrator: halving the
-default step alone moves settled positions by picometres, above RTOL. The snapshots therefore
-lock one scheme's results and are regenerated, with the reason in the changelog, when the
-scheme changes; the scheme's accuracy is checked on its own against the fixed fine step
-(``test_dynamics``, within ``time_steps.CONVERGED_ACCURACY``).
+The snapshots lock the stall forces, steps and onsets of Fig. 7 and the measures of its stall
+cycles to the accuracies :mod:`passmd.experiments.numerics` states for the default integrator
+(``snapshot_accuracy.tolerances``: forces to the stall criterion's tolerance, onsets to one
+bracket width); ``test_finer_run_passes_the_snapshots`` shows a run with the step halved
+passes them too. Not locked: how the protocol got there (periods integrated, brackets,
+timings), the label strings and the sampled cycle series.
 """
 
 import math
@@ -16,6 +13,7 @@ import math
 import numpy as np
 import pandas as pd
 import pytest
+import snapshot_accuracy as snap
 
 from passmd import checks, dynamics, ledger, readings, waveforms
 from passmd.config import RunConfig
@@ -25,9 +23,6 @@ from passmd.experiments import force_generation as fg
 from passmd.plots import force_generation as fg_plots
 from passmd.protocols import stall
 
-RTOL = 1e-6
-#: Absolute floor for forces in mN and lengths in nm (1e-9 of the unit): below anything read.
-ATOL = 1e-9
 FIGURES = ("fig7a", "fig7b", "fig7grid", "fig7freq", "fig7cycle")
 #: The plot of each figure (the figure table pairs them the same way).
 PLOTS = {"fig7a": fg_plots.plot_panel, "fig7b": fg_plots.plot_panel, "fig7grid": fg_plots.plot_grid,
@@ -223,34 +218,51 @@ def test_stall_cycle_is_the_stalled_state():
 # --------------------------------------------------------------------------------------
 
 
-def _locked(frame: pd.DataFrame) -> pd.DataFrame:
-    out = frame.drop(columns=[c for c in TIMINGS if c in frame]).reset_index(drop=True)
-    for col in out.columns:
-        if out[col].dtype == bool:
-            out[col] = out[col].astype(int)
-    return out
+#: Columns that record how the protocols got their result, not the result: the periods integrated,
+#: the onset search's bracket and the cycle's record spacing.
+PROTOCOL_COLUMNS = ("periods", "onset_low_nm", "onset_high_nm", "sample_spacing_us")
+#: Snapshot file of each locked table.
+SNAPSHOTS = {**{f"test_quick_snapshot_{n}_": n for n in ("fig7a", "fig7b", "fig7grid", "fig7freq")},
+             "test_quick_cycle_measures": "fig7cycle"}
 
 
-@pytest.mark.parametrize("name", ["fig7a", "fig7b", "fig7grid", "fig7freq"])
-def test_quick_snapshot(quick, name, dataframe_regression):
-    frame = quick[name]
-    assert frame["converged"].all(), frame.loc[~frame["converged"]]
-    dataframe_regression.check(_locked(frame), default_tolerance={"rtol": RTOL, "atol": ATOL})
+def locked(name, frame: pd.DataFrame) -> pd.DataFrame:
+    """The snapshot table of ``name``: for the stall cycles, one row of measures per run."""
+    if name == "fig7cycle":
+        series_columns = ("time_us", "piezo_nm", "runner_nm", "load_cell_mN", "friction_mN")
+        per_side = ("friction_side", "deflection_side", "slip_share_side")
+        measures = [c for c in frame.columns if c not in series_columns and not c.startswith(per_side)]
+        frame = frame[measures].drop_duplicates(["actuator_model", "friction_coefficient"])
+    frame = frame.drop(columns=[c for c in TIMINGS + PROTOCOL_COLUMNS if c in frame])
+    return snap.numeric(frame)
 
 
-def test_quick_cycle_snapshot(quick, dataframe_regression):
-    frame = quick["fig7cycle"]
-    series_columns = ("time_us", "piezo_nm", "runner_nm", "load_cell_mN", "friction_mN")
-    per_side = ("friction_side", "deflection_side", "slip_share_side")
-    measures = [c for c in frame.columns if c not in series_columns and not c.startswith(per_side)]
-    runs = frame[measures].drop_duplicates(["actuator_model", "friction_coefficient"])
-    assert len(runs) == 4
-    series = frame.iloc[::25][["time_us", "runner_nm", "friction_mN", "deflection_side1_nm",
-                               "slip_share_side2"]]
-    dataframe_regression.check(_locked(runs), basename="test_quick_cycle_measures",
-                               default_tolerance={"rtol": RTOL, "atol": ATOL})
-    dataframe_regression.check(_locked(series), basename="test_quick_cycle_series",
-                               default_tolerance={"rtol": RTOL, "atol": 1e-6})
+def check(dataframe_regression, basename, table):
+    tolerances = snap.tolerances(table.columns, amplitudes=("onset_nm",),
+                                 bracket_width=fg.ONSET_TOLERANCE["quick"],
+                                 forces_in_length=("net_displacement_nm",))
+    dataframe_regression.check(table, basename=basename, default_tolerance=snap.EXACT, tolerances=tolerances)
+
+
+@pytest.mark.parametrize("basename", SNAPSHOTS)
+def test_quick_snapshot(quick, basename, dataframe_regression):
+    frame = quick[SNAPSHOTS[basename]]
+    if "converged" in frame:
+        assert frame["converged"].all(), frame.loc[~frame["converged"]]
+    else:
+        assert len(frame.drop_duplicates(["actuator_model", "friction_coefficient"])) == 4
+    check(dataframe_regression, basename, locked(SNAPSHOTS[basename], frame))
+
+
+@pytest.mark.slow
+def test_finer_run_passes_the_snapshots(tmp_path_factory, dataframe_regression):
+    """Every Fig. 7 table run with the step halved (``snapshot_accuracy.finer_run``) passes every
+    snapshot check: the snapshots lock the physics to the stated accuracy, not one scheme."""
+    config = snap.finer_config(tmp_path_factory.mktemp("finer-cache"))
+    with snap.finer_run():
+        finer = {name: getattr(fg, name)(config) for name in set(SNAPSHOTS.values())}
+    for basename, name in SNAPSHOTS.items():
+        check(dataframe_regression, basename, locked(name, finer[name]))
 
 
 @pytest.mark.parametrize("name", FIGURES)
