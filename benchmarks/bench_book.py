@@ -36,7 +36,8 @@ BUDGET_S = {"paper": 360.0, "quick": 300.0}
 def measure(profile: str) -> dict:
     load_before = os.getloadavg()
     start = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "nox", "-R", "-s", "book", "--", "--cold", "--profile", profile],
+    command = [sys.executable, "-m", "nox", "-R", "-s", "book", "--", "--cold", "--profile", profile]
+    done = subprocess.run(command,
                           capture_output=True, text=True)
     wall = time.perf_counter() - start
     if done.returncode != 0:

@@ -36,7 +36,6 @@ from passmd.cli.commands import run as run_command
 from passmd.model.contact import MDRContact
 from passmd.model.parameters import Actuator, Amplifier, Drive, Material
 
-README = Path(__file__).resolve().parents[1] / "README.md"
 PATH_20000 = ",".join(f"{i % 40}nm" for i in range(20000))
 
 
@@ -75,7 +74,7 @@ def assert_one_line(err: str):
 
 # --------------------------------------------------------------------------------------
 # Named cases: inputs once found to misbehave, each with the outcome it must have now
-# (status, a piece of the one stderr line). Counted in the README's reliability section.
+# (status, a piece of the one stderr line).
 # --------------------------------------------------------------------------------------
 
 NAMED_CASES = {
@@ -439,12 +438,8 @@ def test_generated_records_are_valid_or_a_value_error(record, args):
         assert "argument" in str(exc), exc
 
 
-def test_readme_counts_what_this_file_tries():
-    """The README's reliability section states how many named cases and generated examples run."""
-    text = README.read_text()
-    section = text[text.index("## Reliability"):]
-    assert f"{len(NAMED_CASES)} named command lines" in section
-    assert f"{os.environ.get('PASSMD_FUZZ_EXAMPLES', '250')} command lines per run over six" in section
+def test_named_cases_cover_every_command():
+    """The named command lines reach at least five commands, and the generated ones all six."""
     assert len({argv[0] for argv, _, _ in NAMED_CASES.values()}) >= 5
     assert len(COMMANDS) == 6
 

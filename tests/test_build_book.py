@@ -91,77 +91,58 @@ def test_jobs_must_be_positive():
     assert "--jobs = 0 is out of range" in result.stderr
 
 
-_OVERLAP_PROBE = r"""
-import asyncio, importlib.util, multiprocessing, sys, time
-import nbformat
-from nbclient import NotebookClient
+def _lock_is_held(lock_path: Path) -> bool:
+    """Whether some open file holds the exclusive lock on ``lock_path`` (flock locks belong to
+    an open file, so a second open of the file in the same process contends for it too)."""
+    import fcntl
 
-spec = importlib.util.spec_from_file_location("build_book", sys.argv[1])
-build_book = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(build_book)
-lock_path, log_path, serialize = sys.argv[2], sys.argv[3], sys.argv[4] == "1"
-
-
-async def fake_start_kernel(self, **kwargs):  # stands for picking the ports and launching
-    self.started = time.monotonic()
-    await asyncio.sleep(0.3)
+    with open(lock_path, "a") as probe:
+        try:
+            fcntl.flock(probe, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            return True
+        fcntl.flock(probe, fcntl.LOCK_UN)
+        return False
 
 
-async def fake_start_client(self):  # stands for binding the ports and answering kernel_info
-    await asyncio.sleep(0.3)
-    with open(log_path, "a") as log:
-        log.write(f"{self.started} {time.monotonic()}\n")
-
-
-NotebookClient.async_start_new_kernel = fake_start_kernel
-NotebookClient.async_start_new_kernel_client = fake_start_client
-if serialize:
-    build_book.serialize_kernel_starts(lock_path)
-
-
-async def start():
-    client = NotebookClient(nbformat.v4.new_notebook())
-    await client.async_start_new_kernel()
-    await client.async_start_new_kernel_client()
-
-
-def reader():
-    asyncio.run(start())
-
-
-if __name__ == "__main__":
-    context = multiprocessing.get_context("fork")  # as Sphinx forks its parallel readers
-    readers = [context.Process(target=reader) for _ in range(3)]
-    for p in readers:
-        p.start()
-    for p in readers:
-        p.join()
-    sys.exit(max(p.exitcode for p in readers))
-"""
-
-
-def _kernel_start_intervals(tmp_path: Path, serialize: bool) -> list[tuple[float, float]]:
-    probe = tmp_path / "probe.py"
-    probe.write_text(_OVERLAP_PROBE, encoding="utf-8")
-    log = tmp_path / f"starts-{serialize}.log"
-    result = subprocess.run(
-        [sys.executable, str(probe), str(ROOT / "tools" / "build_book.py"), str(tmp_path / "start.lock"),
-         str(log), "1" if serialize else "0"],
-        capture_output=True, text=True, timeout=60,
-    )
-    assert result.returncode == 0, result.stderr[-3000:]
-    intervals = sorted(tuple(map(float, line.split())) for line in log.read_text().splitlines())
-    assert len(intervals) == 3
-    return intervals
-
-
-def test_kernel_starts_of_parallel_readers_do_not_overlap(tmp_path):
-    """Three forked readers start a (stand-in) kernel at once: with the build wrapper's lock,
-    each start runs from its choice of ports until its answer before the next begins, so two
-    kernels never hold the same picked-but-unbound port; without the lock the starts overlap
-    (the probe can tell)."""
+def test_kernel_start_holds_the_lock_from_the_choice_of_ports_until_the_answer(tmp_path, monkeypatch):
+    """The build wrapper's lock (what keeps two forked readers from picking the same
+    picked-but-unbound port) is held while a kernel picks its ports and while its client starts,
+    is released once the client has answered, and is released too when the start fails."""
     _require_jupyter_book()
-    locked = _kernel_start_intervals(tmp_path, serialize=True)
-    assert all(end <= next_start for (_, end), (next_start, _) in zip(locked, locked[1:], strict=False))
-    free = _kernel_start_intervals(tmp_path, serialize=False)
-    assert any(end > next_start for (_, end), (next_start, _) in zip(free, free[1:], strict=False))
+    import asyncio
+    import importlib.util
+
+    import nbformat
+    from nbclient import NotebookClient
+
+    spec = importlib.util.spec_from_file_location("build_book", ROOT / "tools" / "build_book.py")
+    build_book = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(build_book)
+    lock_path = tmp_path / "start.lock"
+    seen = []
+
+    async def start_kernel(self, **kwargs):  # stands for picking the ports and launching
+        seen.append(("kernel", _lock_is_held(lock_path)))
+        if kwargs.get("fail"):
+            raise RuntimeError("kernel died")
+
+    async def start_client(self):  # stands for binding the ports and answering kernel_info
+        seen.append(("client", _lock_is_held(lock_path)))
+
+    monkeypatch.setattr(NotebookClient, "async_start_new_kernel", start_kernel)
+    monkeypatch.setattr(NotebookClient, "async_start_new_kernel_client", start_client)
+    build_book.serialize_kernel_starts(str(lock_path))
+
+    async def start(fail=False):
+        client = NotebookClient(nbformat.v4.new_notebook())
+        await client.async_start_new_kernel(fail=fail)
+        await client.async_start_new_kernel_client()
+
+    asyncio.run(start())
+    assert seen == [("kernel", True), ("client", True)]
+    assert not _lock_is_held(lock_path)
+    with pytest.raises(RuntimeError, match="kernel died"):
+        asyncio.run(start(fail=True))
+    assert seen[-1] == ("kernel", True)
+    assert not _lock_is_held(lock_path)

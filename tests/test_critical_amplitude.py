@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+import snapshot_accuracy as snap
 
 from passmd.experiments import figure_table as figures
 from passmd.experiments.critical_amplitude import facts as ca_facts
@@ -26,7 +27,6 @@ from passmd.runtime.config import RunConfig
 
 PANELS = ("fig5a", "fig5b", "fig6a", "fig6b", "fig6c", "fig56_viscosity", "fig56_frequency")
 NM = 1e9
-LABELS = ("actuator_model", "protocol", "flyback")  # the text columns of the figure data
 
 
 @pytest.fixture(scope="module")
@@ -272,25 +272,42 @@ def test_plots_draw_every_panel(quick, name):
     plt.close(fig)
 
 
+#: Columns that record how the search got its result (its bracket and number of runs), not the result.
+SEARCH_COLUMNS = ("bracket_low_nm", "bracket_high_nm", "runs", "wall_time_s")
+
+
+def locked(frame: pd.DataFrame) -> pd.DataFrame:
+    """The snapshot table of a panel: its numbers, without the search's bookkeeping and labels."""
+    return snap.numeric(frame.drop(columns=[c for c in SEARCH_COLUMNS if c in frame]))
+
+
+def check(dataframe_regression, name, table):
+    """Critical amplitudes to one quick bracket width (plus the position accuracy), steps to the
+    position accuracy, closed forms and inputs exactly (``snapshot_accuracy``)."""
+    tolerances = snap.tolerances(table.columns, amplitudes=("critical_amplitude_nm",),
+                                 bracket_width=ca.PROFILE_SETTINGS["quick"].tolerance)
+    for col in table.columns:
+        closed_form = col.startswith("u_x_") or col.endswith(("closed_form_nm", "threshold_nm"))
+        if closed_form or col == "amplitude_nm":
+            tolerances[col] = snap.EXACT  # closed forms (Eqs. 7–12) and the amplitude grid
+    dataframe_regression.check(table, basename=f"test_quick_data_snapshot_{name}_",
+                               default_tolerance=snap.EXACT, tolerances=tolerances)
+
+
 @pytest.mark.parametrize("name", PANELS)
 def test_quick_data_snapshot(quick, name, dataframe_regression):
-    """Lock the quick data. Tolerances: A_c and brackets 0.5 nm — a bisection decision flipped by
-    floating-point noise on another machine moves the bracket by at most its quick width; step
-    sizes 0.05 nm — the simulator's convergence level of a step (model chapter)."""
-    table = quick[name].drop(columns=["wall_time_s"], errors="ignore")
-    table = table.drop(columns=[c for c in LABELS if c in table]).reset_index(drop=True)
-    tolerances = {
-        c: {"atol": 0.5} for c in table.columns if c.endswith(("amplitude_nm", "_low_nm", "_high_nm"))
-    }
-    tolerances.update({c: {"atol": 0.05} for c in ("first_step_nm", "steady_step_nm")})
-    tolerances["runs"] = {"atol": 1}
-    dataframe_regression.check(table, default_tolerance={"rtol": 1e-9, "atol": 1e-12}, tolerances=tolerances)
+    check(dataframe_regression, name, locked(quick[name]))
 
 
-def test_labels_of_quick_rows_do_not_change(quick, data_regression):
-    """The text columns (which model, protocol, fly-back each row is) in grid order."""
-    labels = {name: quick[name][[c for c in LABELS if c in quick[name]]].to_dict("list") for name in PANELS}
-    data_regression.check(labels)
+@pytest.mark.slow
+def test_finer_run_passes_the_snapshots(tmp_path_factory, dataframe_regression):
+    """Every panel run with the step halved (``snapshot_accuracy.finer_run``) passes every
+    snapshot check: the snapshots lock the physics to the stated accuracy, not one scheme."""
+    config = snap.finer_config(tmp_path_factory.mktemp("finer-cache"))
+    with snap.finer_run():
+        finer = {name: figures.figure_data(name, config) for name in PANELS}
+    for name in PANELS:
+        check(dataframe_regression, name, locked(finer[name]))
 
 
 # --------------------------------------------------------------------------------------

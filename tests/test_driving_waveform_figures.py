@@ -1,15 +1,11 @@
 """Figs. 8–10 at the quick profile: regression snapshots and the physics the chapter relies on.
 
 Every panel is computed once per session (module fixture; the sweep cache makes reruns
-cheap). Snapshot tolerances: the rigid runs are deterministic; what can move between
-machines is floating-point reassociation (numba/numpy builds), which shifts results by
-orders of magnitude less than the tolerances below, while a change of the physics or of a
-protocol moves them by far more (a 0.01 nm change of a 200 nm step is 5e-5 relative). So does
-a change of the integrator (halving the default step alone moves settled positions by
-picometres): the snapshots lock one scheme's results and are regenerated, with the reason in
-the changelog, when the scheme changes; its accuracy is checked on its own against the fixed
-fine step (``test_dynamics``, within ``time_steps.CONVERGED_ACCURACY``) and, at Fig. 10's
-fastest drive, where that step is too coarse, against a converged 1 ns step (below).
+cheap). The snapshots lock what the chapter reads — the points of Fig. 8, the settled
+positions of Fig. 9a, the steady velocities and steps of Figs. 9b–10, each drive's row once —
+to the accuracies :mod:`passmd.experiments.numerics.figures` states for the default integrator
+(``snapshot_accuracy.tolerances``); ``test_finer_run_passes_the_snapshots`` shows a run with
+the step halved passes them too.
 """
 
 import functools
@@ -18,6 +14,7 @@ import inspect
 import numpy as np
 import pandas as pd
 import pytest
+import snapshot_accuracy as snap
 
 from passmd.experiments.driving_waveform import claims as dw_claims
 from passmd.experiments.driving_waveform import facts as wf
@@ -35,11 +32,10 @@ from passmd.solver import steps as time_steps
 PANELS = ("fig8a", "fig8b", "fig9a", "fig9b", "fig10a", "fig10b", "fig10c")
 #: The quick profile, as the tests run every panel.
 QUICK = RunConfig(profile="quick")
-#: Relative tolerance of positions, velocities and times in the snapshots (see module docstring).
-RTOL = 1e-6
-#: Absolute floors: 1e-12 m (1 pm) for positions, 1e-9 m/s for velocities, 1e-6 for slip shares,
-#: 1e-3 Hz for frequencies — all far below anything the chapter reads.
-ATOL = {"m": 1e-12, "m_per_s": 1e-9, "share": 1e-6, "Hz": 1e-3, "N": 1e-9}
+#: Panels locked in the snapshots (their functions are the tables' own).
+SNAPSHOTS = {**{f"test_response_snapshot_{n}_": n for n in ("fig8a", "fig8b")},
+             "test_fig9a_snapshot": "fig9a",
+             **{f"test_velocity_snapshot_{n}_": n for n in ("fig9b", "fig10a", "fig10b", "fig10c")}}
 
 
 @pytest.fixture(scope="module")
@@ -47,38 +43,82 @@ def quick():
     return {name: getattr(dw, name)(QUICK) for name in PANELS}
 
 
-def _tolerances(columns):
-    out = {}
-    for col in columns:
-        for suffix, atol in (("_m_per_s", ATOL["m_per_s"]), ("_m", ATOL["m"]), ("_Hz", ATOL["Hz"]),
-                             ("_N", ATOL["N"]), ("slip_share", ATOL["share"])):
-            if col.endswith(suffix) or suffix in col:
-                out[col] = {"rtol": RTOL, "atol": atol}
-                break
-    return out
+POINT_COLUMNS = ("time_s", "piezo_position_m", "runner_position_m", "runner_velocity_m_per_s", "slip_share_1",
+                 "slip_share_2")
+VELOCITY_COLUMNS = ("frequency", "preload", "hemisphere_radius", "velocity_m_per_s", "back_step_m", "step_m",
+                    "settling_time_s", "acceleration_time_s", "settling_fits", "stick_during_acceleration",
+                    "max_slip_share_acceleration", "micro_vibration_frequency_Hz")
+#: The Section 5 drive (Fig. 9b's): the other velocity panels lock only their other drives.
+SECTION5 = dw.section5_fields()
 
 
-def _numeric(frame: pd.DataFrame, columns) -> pd.DataFrame:
-    out = frame[list(columns)].copy().reset_index(drop=True)
-    for col in out.columns:
-        if out[col].dtype == bool or out[col].dtype == object:
-            out[col] = out[col].map({True: 1.0, False: 0.0, None: np.nan}).astype(float)
-    return out
-
-
-TIME_SERIES = ("time_s", "piezo_position_m", "runner_position_m", "runner_velocity_m_per_s", "slip_share_1",
-               "slip_share_2")
-
-
-@pytest.mark.parametrize("name", ["fig8a", "fig8b"])
-def test_response_snapshot(quick, name, dataframe_regression):
-    frame = quick[name]
+def _response(frame):
     points = frame[frame["view"] == "point"]
-    series = frame[frame["view"] != "point"].iloc[::10]
-    locked = _numeric(pd.concat([points, series]), TIME_SERIES)
+    locked = snap.numeric(points[list(POINT_COLUMNS)])
     locked["micro_vibration_frequency_Hz"] = frame["micro_vibration_frequency_Hz"].iloc[0]
-    dataframe_regression.check(locked, default_tolerance={"rtol": RTOL, "atol": ATOL["m"]},
-                               tolerances=_tolerances(locked.columns))
+    return locked
+
+
+def _fig9a(frame):
+    periods = frame[frame["view"] == "period"]
+    columns = ["period", "settled_position_m", "back_step_m", "micro_vibration_frequency_Hz"]
+    locked = snap.numeric(periods[columns])
+    locked["optimized"] = (periods["waveform"] == "optimized").to_numpy().astype(float)
+    locked["friction_coefficient"] = periods["friction_coefficient"].to_numpy(dtype=float)
+    return locked
+
+
+def _velocity(frame, name):
+    if name != "fig9b":  # Fig. 9b's rows (the Section 5 drive) are locked there, once
+        section5 = np.logical_and.reduce([frame[k] == v for k, v in SECTION5.items()])
+        frame = frame[~section5]
+    locked = snap.numeric(frame[list(VELOCITY_COLUMNS)])
+    variants = {"sawtooth": 0.0, "optimized": 1.0, "optimized_skip": 2.0}
+    locked["variant"] = frame["variant"].map(variants).to_numpy()
+    locked["molybdenum"] = (frame["runner"] == "molybdenum").astype(float).to_numpy()
+    return locked
+
+
+def locked(name, frame):
+    """The snapshot table of panel ``name``."""
+    if name in ("fig8a", "fig8b"):
+        return _response(frame)
+    return _fig9a(frame) if name == "fig9a" else _velocity(frame, name)
+
+
+def check(dataframe_regression, basename, table):
+    dataframe_regression.check(table, basename=basename, default_tolerance=snap.EXACT,
+                               tolerances=snap.tolerances(table.columns))
+
+
+@pytest.mark.parametrize("basename", SNAPSHOTS)
+def test_snapshot(quick, basename, dataframe_regression):
+    name = SNAPSHOTS[basename]
+    check(dataframe_regression, basename, locked(name, quick[name]))
+
+
+def test_section5_rows_are_fig9bs_in_every_velocity_panel(quick):
+    """The rows the Fig. 10 snapshots leave out are Fig. 9b's (locked there), value for value."""
+    key = ["frequency", "variant"]
+    columns = [c for c in VELOCITY_COLUMNS if c not in key]
+    reference = quick["fig9b"].set_index(key)[columns]
+    for name in ("fig10a", "fig10b", "fig10c"):
+        frame = quick[name]
+        rows = frame[np.logical_and.reduce([frame[k] == v for k, v in SECTION5.items()])]
+        assert len(rows) == len(reference), name
+        rows = rows.set_index(key)[columns]
+        pd.testing.assert_frame_equal(rows, reference.loc[rows.index])
+
+
+@pytest.mark.slow
+def test_finer_run_passes_the_snapshots(tmp_path_factory, dataframe_regression):
+    """Every panel run with the step halved (``snapshot_accuracy.finer_run``) passes every
+    snapshot check: the snapshots lock the physics to the stated accuracy, not one scheme."""
+    config = snap.finer_config(tmp_path_factory.mktemp("finer-cache"))
+    with snap.finer_run():
+        finer = {name: getattr(dw, name)(config) for name in set(SNAPSHOTS.values())}
+    for basename, name in SNAPSHOTS.items():
+        check(dataframe_regression, basename, locked(name, finer[name]))
 
 
 @pytest.mark.parametrize("name", ["fig8a", "fig8b"])
@@ -92,32 +132,6 @@ def test_response_velocity_is_the_runs(quick, name):
     span = np.ptp(v)
     assert span > 0
     assert np.abs(slope[1:-1] - v[1:-1]).max() < 0.05 * span
-
-
-def test_fig9a_snapshot(quick, dataframe_regression):
-    frame = quick["fig9a"]
-    periods = frame[frame["view"] == "period"]
-    locked = _numeric(periods, ("period", "settled_position_m", "back_step_m",
-                                "micro_vibration_frequency_Hz"))
-    locked["optimized"] = (periods["waveform"] == "optimized").to_numpy().astype(float)
-    locked["friction_coefficient"] = periods["friction_coefficient"].to_numpy(dtype=float)
-    dataframe_regression.check(locked, default_tolerance={"rtol": RTOL, "atol": ATOL["m"]},
-                               tolerances=_tolerances(locked.columns))
-
-
-VELOCITY_COLUMNS = ("frequency", "preload", "hemisphere_radius", "velocity_m_per_s", "back_step_m", "step_m",
-                    "settling_time_s", "acceleration_time_s", "settling_fits", "stick_during_acceleration",
-                    "max_slip_share_acceleration", "micro_vibration_frequency_Hz")
-
-
-@pytest.mark.parametrize("name", ["fig9b", "fig10a", "fig10b", "fig10c"])
-def test_velocity_snapshot(quick, name, dataframe_regression):
-    frame = quick[name]
-    locked = _numeric(frame, VELOCITY_COLUMNS)
-    locked["variant"] = frame["variant"].map({"sawtooth": 0.0, "optimized": 1.0, "optimized_skip": 2.0})
-    locked["molybdenum"] = (frame["runner"] == "molybdenum").astype(float)
-    dataframe_regression.check(locked, default_tolerance={"rtol": RTOL, "atol": ATOL["m"]},
-                               tolerances=_tolerances(locked.columns))
 
 
 #: A fixed step of 1 ns resolves Fig. 10's fastest drive: halving it (and halving again)

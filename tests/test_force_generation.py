@@ -1,14 +1,11 @@
 """Force generation (Fig. 7): stall criterion, physics at stall, quick-profile snapshots, ledger rows.
 
-Snapshot tolerance: the simulations are deterministic and not chaotic — perturbing the drive
-frequency by a relative 1e-12 moves a 500-period stall force by about 1e-12 relative (checked
-while writing this module) — so floating-point differences between machines stay many orders
-of magnitude below RTOL = 1e-6, while any change of the physics, the stall criterion or a
-grid moves the locked numbers by far more. So does any change of the integrator: halving the
-default step alone moves settled positions by picometres, above RTOL. The snapshots therefore
-lock one scheme's results and are regenerated, with the reason in the changelog, when the
-scheme changes; the scheme's accuracy is checked on its own against the fixed fine step
-(``test_dynamics``, within ``time_steps.CONVERGED_ACCURACY``).
+The snapshots lock the stall forces, steps and onsets of Fig. 7 and the measures of its stall
+cycles to the accuracies :mod:`passmd.experiments.numerics.figures` states for the default integrator
+(``snapshot_accuracy.tolerances``: forces to the stall criterion's tolerance, onsets to one
+bracket width); ``test_finer_run_passes_the_snapshots`` shows a run with the step halved
+passes them too. Not locked: how the protocol got there (periods integrated, brackets,
+timings), the label strings and the sampled cycle series.
 """
 
 import math
@@ -16,6 +13,7 @@ import math
 import numpy as np
 import pandas as pd
 import pytest
+import snapshot_accuracy as snap
 
 from passmd.experiments.force_generation import facts as ff
 from passmd.experiments.force_generation import figures as fg
@@ -28,9 +26,6 @@ from passmd.protocols import stall
 from passmd.runtime.config import RunConfig
 from passmd.solver import simulation as dynamics
 
-RTOL = 1e-6
-#: Absolute floor for forces in mN and lengths in nm (1e-9 of the unit): below anything read.
-ATOL = 1e-9
 FIGURES = ("fig7a", "fig7b", "fig7grid", "fig7freq", "fig7cycle")
 #: The plot of each figure (the figure table pairs them the same way).
 PLOTS = {"fig7a": fg_plots.plot_panel, "fig7b": fg_plots.plot_panel, "fig7grid": fg_plots.plot_grid,
@@ -117,75 +112,50 @@ def test_a_run_that_has_not_stalled_is_flagged():
 # --------------------------------------------------------------------------------------
 
 
-def _restarted_generated_force(drive, amplitude, frequency, initial_periods=stall.INITIAL_PERIODS,
-                               max_periods=stall.MAX_PERIODS):
-    """Reference: the protocol as it was first written, each longer run repeated from rest.
-
-    Returns its dict (without the timings) and the period counts of its runs."""
-    drive = drive if drive.load_cell else drive.replace(load_cell=True)
-    k = drive.load_cell_stiffness
-    window, abs_tol, rel_tol = stall.STALL_WINDOW, stall.STALL_ABS_TOLERANCE, stall.STALL_REL_TOLERANCE
-    limit, margin = stall.coulomb_bound(drive), stall.bound_margin(drive)
-    periods, simulated, runs = int(initial_periods), 0, []
-    while True:
-        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
-        result = dynamics.simulate(drive, wave, max_points=2)
-        simulated += periods
-        runs.append(periods)
-        forces = k * result.period_mean_position
-        estimate = stall.stall_estimate(forces, window)
-        converged = stall._stalled(estimate, float(forces[-1]), abs_tol, rel_tol)
-        if converged or periods >= max_periods:
-            break
-        periods = stall._next_periods(periods, estimate, float(forces[-1]), window, abs_tol, rel_tol,
-                                      int(max_periods))
-    T = wave.period
-    piezo_mean = float(np.mean(wave.position(np.linspace((periods - 1) * T, periods * T, 4001))))
-    remaining, note = stall.credible_tail(forces, estimate, converged, limit, margin, window)
-    return {
-        "generated_force_N": float(forces[-1]),
-        "converged": bool(converged),
-        "coulomb_bound_N": limit,
-        "periods": int(periods),
-        "periods_simulated": int(simulated),
-        "remaining_force_N": remaining,
-        "remaining_force_note": note,
-        "force_spread_N": estimate["spread_N"],
-        "mean_friction_N": float(result.period_mean_friction[-1]),
-        "piezo_mean_force_N": k * piezo_mean,
-        "last_step_m": float(result.step_sizes[-1]),
-        "net_displacement_m": float(result.period_mean_position[-1] - piezo_mean),
-    }, runs
+def _stall_tolerance(drive, force):
+    """The stall criterion's tolerance (module docstring of :mod:`passmd.protocols.stall`)."""
+    return max(min(stall.STALL_ABS_TOLERANCE, stall.STALL_BOUND_FRACTION * stall.coulomb_bound(drive)),
+               stall.STALL_REL_TOLERANCE * abs(force))
 
 
 @pytest.mark.parametrize(
-    "model, mu, preload, fraction, limits, runs",
+    "model, mu, preload, fraction, limits",
     [
-        ("flexible", 0.2, 0.8, 0.2, {}, 1),  # stalls at the first check (64 periods)
-        ("flexible", 0.2, 0.3, 1.0, {}, 2),  # one extension (64 → 96)
-        ("rigid", 0.3, 0.3, 0.2, {}, 3),  # two extensions (64 → 256 → 912)
-        ("rigid", 0.3, 0.3, 1.0, {"initial_periods": 17, "max_periods": 50}, 2),  # stopped at max_periods
+        ("flexible", 0.2, 0.8, 0.2, {}),  # stalls at the first check
+        ("flexible", 0.2, 0.3, 1.0, {}),  # one extension
+        ("rigid", 0.3, 0.3, 0.2, {}),  # two extensions
+        ("rigid", 0.3, 0.3, 1.0, {"initial_periods": 17, "max_periods": 50}),  # stopped at max_periods
     ],
 )
-def test_continued_run_equals_the_runs_from_rest(monkeypatch, model, mu, preload, fraction, limits, runs):
-    """Every returned value is the restarted protocol's to the last bit (deterministic floating
-    point, same operations), except the periods integrated (each once now) and the timings;
-    the stall criterion is evaluated after the same numbers of periods."""
+def test_stall_result_is_the_run_from_rest_of_its_length(model, mu, preload, fraction, limits):
+    """What ``generated_force`` reports is what a run from rest of the reported number of periods
+    gives, bit for bit (a continued run is the same floating-point computation), each period is
+    integrated once, and a result reported as stalled meets the stall criterion on that run's
+    forces while the forces of the shortest run it may stop at do not (else it would have)."""
     drive = fg.force_drive(1e-3, preload, model, mu)
     amplitude = fraction * drive.actuator.full_stroke_amplitude
-    old, old_runs = _restarted_generated_force(drive, amplitude, fg.FORCE_FREQUENCY, **limits)
-    checked = []
-    estimate = stall.stall_estimate
-    monkeypatch.setattr(stall, "stall_estimate", lambda f, w: checked.append(len(f)) or estimate(f, w))
-    new = stall.generated_force(drive, amplitude, fg.FORCE_FREQUENCY, **limits)
-    assert len(old_runs) == runs and checked == old_runs
-    assert set(new) == set(old) | {"wall_time_s", "cpu_time_s"}
-    for key, value in old.items():
-        if key != "periods_simulated":
-            assert new[key] == value, key  # exact: bit-for-bit identical floats
-    assert old["periods_simulated"] == sum(old_runs)
-    assert new["periods_simulated"] == new["periods"] == old_runs[-1]
-    assert new["converged"] == ("max_periods" not in limits)
+    out = stall.generated_force(drive, amplitude, fg.FORCE_FREQUENCY, **limits)
+    periods = out["periods"]
+    assert out["periods_simulated"] == periods
+    assert out["converged"] == ("max_periods" not in limits)
+    if not out["converged"]:
+        assert periods == limits["max_periods"]
+    wave = waveforms.sawtooth(amplitude, fg.FORCE_FREQUENCY, drive, periods=periods)
+    run = dynamics.simulate(drive, wave, max_points=2)
+    forces = drive.load_cell_stiffness * run.period_mean_position
+    assert out["generated_force_N"] == forces[-1]
+    assert out["mean_friction_N"] == run.period_mean_friction[-1]
+    assert out["last_step_m"] == run.step_sizes[-1]
+    tolerance = _stall_tolerance(drive, forces[-1])
+    estimate = stall.stall_estimate(forces)
+    assert out["force_spread_N"] == estimate["spread_N"]
+    stalled = estimate["remaining_N"] <= tolerance and estimate["spread_N"] <= tolerance
+    assert stalled == out["converged"]
+    initial = limits.get("initial_periods", stall.INITIAL_PERIODS)
+    if periods > initial:  # extended: the first check did not pass
+        first = stall.stall_estimate(forces[:initial])
+        first_tolerance = _stall_tolerance(drive, forces[initial - 1])
+        assert first["remaining_N"] > first_tolerance or first["spread_N"] > first_tolerance
 
 
 # --------------------------------------------------------------------------------------
@@ -251,34 +221,51 @@ def test_stall_cycle_is_the_stalled_state():
 # --------------------------------------------------------------------------------------
 
 
-def _locked(frame: pd.DataFrame) -> pd.DataFrame:
-    out = frame.drop(columns=[c for c in TIMINGS if c in frame]).reset_index(drop=True)
-    for col in out.columns:
-        if out[col].dtype == bool:
-            out[col] = out[col].astype(int)
-    return out
+#: Columns that record how the protocols got their result, not the result: the periods integrated,
+#: the onset search's bracket and the cycle's record spacing.
+PROTOCOL_COLUMNS = ("periods", "onset_low_nm", "onset_high_nm", "sample_spacing_us")
+#: Snapshot file of each locked table.
+SNAPSHOTS = {**{f"test_quick_snapshot_{n}_": n for n in ("fig7a", "fig7b", "fig7grid", "fig7freq")},
+             "test_quick_cycle_measures": "fig7cycle"}
 
 
-@pytest.mark.parametrize("name", ["fig7a", "fig7b", "fig7grid", "fig7freq"])
-def test_quick_snapshot(quick, name, dataframe_regression):
-    frame = quick[name]
-    assert frame["converged"].all(), frame.loc[~frame["converged"]]
-    dataframe_regression.check(_locked(frame), default_tolerance={"rtol": RTOL, "atol": ATOL})
+def locked(name, frame: pd.DataFrame) -> pd.DataFrame:
+    """The snapshot table of ``name``: for the stall cycles, one row of measures per run."""
+    if name == "fig7cycle":
+        series_columns = ("time_us", "piezo_nm", "runner_nm", "load_cell_mN", "friction_mN")
+        per_side = ("friction_side", "deflection_side", "slip_share_side")
+        measures = [c for c in frame.columns if c not in series_columns and not c.startswith(per_side)]
+        frame = frame[measures].drop_duplicates(["actuator_model", "friction_coefficient"])
+    frame = frame.drop(columns=[c for c in TIMINGS + PROTOCOL_COLUMNS if c in frame])
+    return snap.numeric(frame)
 
 
-def test_quick_cycle_snapshot(quick, dataframe_regression):
-    frame = quick["fig7cycle"]
-    series_columns = ("time_us", "piezo_nm", "runner_nm", "load_cell_mN", "friction_mN")
-    per_side = ("friction_side", "deflection_side", "slip_share_side")
-    measures = [c for c in frame.columns if c not in series_columns and not c.startswith(per_side)]
-    runs = frame[measures].drop_duplicates(["actuator_model", "friction_coefficient"])
-    assert len(runs) == 4
-    series = frame.iloc[::25][["time_us", "runner_nm", "friction_mN", "deflection_side1_nm",
-                               "slip_share_side2"]]
-    dataframe_regression.check(_locked(runs), basename="test_quick_cycle_measures",
-                               default_tolerance={"rtol": RTOL, "atol": ATOL})
-    dataframe_regression.check(_locked(series), basename="test_quick_cycle_series",
-                               default_tolerance={"rtol": RTOL, "atol": 1e-6})
+def check(dataframe_regression, basename, table):
+    tolerances = snap.tolerances(table.columns, amplitudes=("onset_nm",),
+                                 bracket_width=fg.ONSET_TOLERANCE["quick"],
+                                 forces_in_length=("net_displacement_nm",))
+    dataframe_regression.check(table, basename=basename, default_tolerance=snap.EXACT, tolerances=tolerances)
+
+
+@pytest.mark.parametrize("basename", SNAPSHOTS)
+def test_quick_snapshot(quick, basename, dataframe_regression):
+    frame = quick[SNAPSHOTS[basename]]
+    if "converged" in frame:
+        assert frame["converged"].all(), frame.loc[~frame["converged"]]
+    else:
+        assert len(frame.drop_duplicates(["actuator_model", "friction_coefficient"])) == 4
+    check(dataframe_regression, basename, locked(SNAPSHOTS[basename], frame))
+
+
+@pytest.mark.slow
+def test_finer_run_passes_the_snapshots(tmp_path_factory, dataframe_regression):
+    """Every Fig. 7 table run with the step halved (``snapshot_accuracy.finer_run``) passes every
+    snapshot check: the snapshots lock the physics to the stated accuracy, not one scheme."""
+    config = snap.finer_config(tmp_path_factory.mktemp("finer-cache"))
+    with snap.finer_run():
+        finer = {name: getattr(fg, name)(config) for name in set(SNAPSHOTS.values())}
+    for basename, name in SNAPSHOTS.items():
+        check(dataframe_regression, basename, locked(name, finer[name]))
 
 
 @pytest.mark.parametrize("name", FIGURES)
