@@ -284,7 +284,8 @@ class Drive:
         # each number once, against its range (a hard limit > 0 and the plausible range)
         for name in ("hemisphere_radius", "preload", "friction_coefficient", "runner_mass",
                      "load_cell_stiffness"):
-            PLAUSIBLE_RANGES[name].check(name, getattr(self, name), allow_extrapolation=self.allow_extrapolation)
+            PLAUSIBLE_RANGES[name].check(name, getattr(self, name),
+                                         allow_extrapolation=self.allow_extrapolation)
         if not isinstance(self.contact_groups, tuple) or not all(
                 isinstance(g, ContactGroup) for g in self.contact_groups):
             raise InputError(f"contact_groups = {_plain(self.contact_groups)} is not allowed: must be a "
@@ -304,7 +305,8 @@ class Drive:
                 raise InputError(f"{name} = {_plain(getattr(self, name))} is not a Material", name=name,
                                  value=getattr(self, name))
         if self.actuator is None:
-            object.__setattr__(self, "actuator", _table2_actuator(self.hemisphere_radius, ACTUATOR_DAMPING_RATIO))
+            actuator = _table2_actuator(self.hemisphere_radius, ACTUATOR_DAMPING_RATIO)
+            object.__setattr__(self, "actuator", actuator)
         elif not isinstance(self.actuator, Actuator):
             raise InputError(f"actuator = {_plain(self.actuator)} is not an Actuator", name="actuator",
                              value=self.actuator)
