@@ -75,7 +75,7 @@ from passmd.model.contact_kernels import (
     sliding_force,
 )
 from passmd.model.parameters import Assumption, Drive, check_contact_plausible, check_drive
-from passmd.model.theory import contact_layout, contact_moduli, hertz_contact_radius, hertz_indentation
+from passmd.model.theory import _hertz_contact_radius, contact_layout, contact_moduli
 from passmd.runtime.validation import check_array, check_choice, check_positive, check_range
 
 if TYPE_CHECKING:  # pandas is imported where a DataFrame is built (start-up time)
@@ -212,10 +212,20 @@ def contact_arrays(model, normal_force, radius, E_star, G_star, mu, springs=None
     E = check_positive("E_star", E_star, "Pa")
     G = check_positive("G_star", G_star, "Pa")
     mu = check_positive("mu", mu, "–")
-    a = float(hertz_contact_radius(F, R, E))
     if model == "exact":
-        cap = _check_capacity(capacity)
-        d = float(hertz_indentation(F, R, E))
+        return _contact_arrays(model, F, R, E, G, mu, None, _check_capacity(capacity))
+    return _contact_arrays(model, F, R, E, G, mu, _check_springs(springs), capacity)
+
+
+def _contact_arrays(model: str, F: float, R: float, E: float, G: float, mu: float, springs: int | None,
+                    capacity: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`contact_arrays` of arguments its caller has checked (the public function, or a
+    :class:`~passmd.model.parameters.Drive`'s contact: the drive checked its force, radius and moduli)."""
+    a_array = _hertz_contact_radius(F, R, E)
+    a = float(a_array)
+    if model == "exact":
+        cap = capacity
+        d = float(a_array ** 2 / R)  # the Hertz indentation a²/R
         params = np.zeros(PARAMS_HEADER)
         params[P_MODEL] = EXACT
         params[P_UMAX] = mu * E / G * d  # Eq. 7
@@ -225,7 +235,7 @@ def contact_arrays(model, normal_force, radius, E_star, G_star, mu, springs=None
         params[P_SPACING] = 0.0
         state = np.zeros(STATE_HEADER + 2 * cap)
     else:
-        n = _check_springs(springs)
+        n = springs
         dx = 2.0 * a / n
         x = -a + (np.arange(n) + 0.5) * dx
         g = x**2 / R
@@ -330,13 +340,16 @@ class MDRContact:
 
     def __init__(self, normal_force, radius, E_star, G_star, mu, springs=None,
                  capacity=DEFAULT_CAPACITY):
-        self.model = "exact" if springs is None else "discrete"
-        self.params, self.state = contact_arrays(
-            self.model, normal_force, radius, E_star, G_star, mu, springs, capacity
-        )
+        model = "exact" if springs is None else "discrete"
+        arrays = contact_arrays(model, normal_force, radius, E_star, G_star, mu, springs, capacity)
         # Hertz and the MDR need a contact small against the sphere (hard limit a <= R/10)
         check_contact_plausible(normal_force, radius, E_star, names="normal_force, radius, E_star",
                                 allow_extrapolation=True)
+        self._set(model, arrays, springs, mu, radius, E_star, G_star)
+
+    def _set(self, model, arrays, springs, mu, radius, E_star, G_star) -> None:
+        self.model = model
+        self.params, self.state = arrays
         self.springs = None if springs is None else int(springs)
         self.friction_coefficient = float(mu)
         self.hemisphere_radius = float(radius)
@@ -356,9 +369,18 @@ class MDRContact:
                 f"side = {side!r} is out of range: must be one of {list(range(len(forces)))} "
                 f"for a drive with {drive.contacts} contact(s)"
             )
+        model = "exact" if springs is None else "discrete"
+        if springs is None:
+            capacity = _check_capacity(capacity)
+        else:
+            springs = _check_springs(springs)
         E_star, G_star = contact_moduli(drive)
-        return cls(float(forces[side]), float(radii[side]), E_star, G_star,
-                   drive.friction_coefficient, springs, capacity)
+        F, R, mu = float(forces[side]), float(radii[side]), drive.friction_coefficient
+        # the drive checked its contacts' force, radius and moduli (and a <= R/10): built unchecked
+        contact = cls.__new__(cls)
+        contact._set(model, _contact_arrays(model, F, R, E_star, G_star, mu, springs, capacity), springs, mu,
+                     R, E_star, G_star)
+        return contact
 
     # -- constants -------------------------------------------------------------------
     @property

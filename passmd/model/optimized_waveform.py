@@ -20,8 +20,8 @@ from passmd.model.parameters import Assumption, Drive, check_drive
 from passmd.model.waveforms import (
     SETTLE_FRACTION,
     Waveform,
+    _flyback_time,
     check_flyback_fits,
-    flyback_time,
     piecewise_linear,
     sawtooth,
 )
@@ -210,8 +210,9 @@ def optimized_timing(
     A = check_range("amplitude", amplitude, 0.0, a_max, lower_open=True, unit="m")
     f = check_positive("frequency", frequency, "Hz")
     frac = check_range("min_ramp_fraction", min_ramp_fraction, 0.0, 1.0, lower_open=True, upper_open=True)
+    check_choice("flyback", flyback, ("slew", "fixed"))
     T = 1.0 / f
-    t_fb = flyback_time(A, drive, flyback)
+    t_fb = _flyback_time(A, drive, flyback)
     check_flyback_fits(t_fb, f)
     if design.acceleration_amplitude >= A:
         d_a = design.acceleration_amplitude

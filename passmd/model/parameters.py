@@ -159,16 +159,16 @@ def actuator_for_radius(
         ζ of the bare actuator; c_p = 2 ζ √(k_p m_a).
     """
     radius = check_positive("hemisphere_radius", hemisphere_radius, "m")
-    zeta = check_range("damping_ratio", damping_ratio, 0.0, unit="–")
+    return _table2_actuator(radius, check_range("damping_ratio", damping_ratio, 0.0, unit="–"))
+
+
+def _table2_actuator(radius: float, zeta: float) -> Actuator:
+    """:func:`actuator_for_radius` of a radius > 0 and a ζ >= 0 the caller has checked."""
     radii = np.array(sorted(TABLE2_RADII))
     rows = np.array([TABLE2_RADII[r] for r in radii])
     k_p, m_a, a_max = (float(np.interp(radius, radii, rows[:, j])) for j in range(3))
-    return Actuator(
-        stiffness=k_p,
-        mass=m_a,
-        viscosity=actuator_viscosity(k_p, m_a, zeta),
-        full_stroke_amplitude=a_max,
-    )
+    return Actuator(stiffness=k_p, mass=m_a, viscosity=2.0 * zeta * np.sqrt(k_p * m_a),
+                    full_stroke_amplitude=a_max)
 
 
 def actuator_viscosity(stiffness: float, mass: float, damping_ratio: float = ACTUATOR_DAMPING_RATIO) -> float:
@@ -281,9 +281,11 @@ class Drive:
             raise InputError(f"allow_extrapolation = {_plain(self.allow_extrapolation)} is not allowed: "
                              "must be True or False", name="allow_extrapolation",
                              value=self.allow_extrapolation)
-        check_positive("hemisphere_radius", self.hemisphere_radius, "m")
-        check_positive("preload", self.preload, "N")
-        check_positive("friction_coefficient", self.friction_coefficient, "–")
+        # each number once, against its range (a hard limit > 0 and the plausible range)
+        for name in ("hemisphere_radius", "preload", "friction_coefficient", "runner_mass",
+                     "load_cell_stiffness"):
+            PLAUSIBLE_RANGES[name].check(name, getattr(self, name),
+                                         allow_extrapolation=self.allow_extrapolation)
         if not isinstance(self.contact_groups, tuple) or not all(
                 isinstance(g, ContactGroup) for g in self.contact_groups):
             raise InputError(f"contact_groups = {_plain(self.contact_groups)} is not allowed: must be a "
@@ -295,8 +297,6 @@ class Drive:
             raise InputError(f"contacts = {_plain(self.contacts)} is not allowed: must be one of 1, 6",
                              name="contacts", value=self.contacts)
         check_choice("actuator_model", self.actuator_model, ("rigid", "flexible"))
-        check_positive("runner_mass", self.runner_mass, "kg")
-        check_positive("load_cell_stiffness", self.load_cell_stiffness, "N/m")
         if not isinstance(self.load_cell, bool):
             raise InputError(f"load_cell = {_plain(self.load_cell)} is not allowed: must be True or False",
                              name="load_cell", value=self.load_cell)
@@ -305,7 +305,8 @@ class Drive:
                 raise InputError(f"{name} = {_plain(getattr(self, name))} is not a Material", name=name,
                                  value=getattr(self, name))
         if self.actuator is None:
-            object.__setattr__(self, "actuator", actuator_for_radius(self.hemisphere_radius))
+            actuator = _table2_actuator(self.hemisphere_radius, ACTUATOR_DAMPING_RATIO)
+            object.__setattr__(self, "actuator", actuator)
         elif not isinstance(self.actuator, Actuator):
             raise InputError(f"actuator = {_plain(self.actuator)} is not an Actuator", name="actuator",
                              value=self.actuator)
@@ -314,7 +315,7 @@ class Drive:
                              value=self.amplifier)
         if isinstance(self.contacts, np.integer):
             object.__setattr__(self, "contacts", int(self.contacts))
-        check_plausible(self, allow_extrapolation=self.allow_extrapolation)
+        _check_parts_plausible(self, allow_extrapolation=self.allow_extrapolation)
 
     def replace(self, **changes) -> Drive:
         """A copy with some fields changed (validated again).
@@ -561,11 +562,16 @@ def check_plausible(drive: Drive, *, allow_extrapolation: bool = False) -> None:
         ``actuator.viscosity``.
     """
     check_drive(drive)
-    r = PLAUSIBLE_RANGES
-    kw = {"allow_extrapolation": allow_extrapolation}
     for name in ("hemisphere_radius", "preload", "friction_coefficient", "runner_mass",
                  "load_cell_stiffness"):
-        r[name].check(name, getattr(drive, name), **kw)
+        PLAUSIBLE_RANGES[name].check(name, getattr(drive, name), allow_extrapolation=allow_extrapolation)
+    _check_parts_plausible(drive, allow_extrapolation=allow_extrapolation)
+
+
+def _check_parts_plausible(drive: Drive, *, allow_extrapolation: bool) -> None:
+    """:func:`check_plausible` but for the drive's own numbers (``Drive`` checks them first)."""
+    r = PLAUSIBLE_RANGES
+    kw = {"allow_extrapolation": allow_extrapolation}
     for which in ("hemisphere_material", "runner_material"):
         material = getattr(drive, which)
         r["material.youngs_modulus"].check(f"{which}.youngs_modulus", material.youngs_modulus, **kw)

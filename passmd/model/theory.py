@@ -147,13 +147,19 @@ def _hertz_cube(F, radius, E_star):
 
 
 def _contact_args(normal_force, radius, E_star):
-    """normal_force >= 0, radius > 0, E_star > 0, checked; a³ normal wherever F_N > 0."""
+    """normal_force >= 0, radius > 0, E_star > 0, checked (as arrays)."""
     F = check_array("normal_force", normal_force, 0.0, unit="N")
-    R, E = _positive("radius", radius, "m"), _positive("E_star", E_star, "Pa")
+    return F, _positive("radius", radius, "m"), _positive("E_star", E_star, "Pa")
+
+
+def _hertz_contact_radius(F, R, E):
+    """a = (3 F_N R / (4 E*))^(1/3) of F_N >= 0, R > 0, E* > 0 its caller has checked (the public
+    :func:`hertz_contact_radius`, or a drive's contact, which :class:`~passmd.model.parameters.Drive`
+    checked); a³ is refused where F_N > 0 and it is below the smallest normal double."""
     cube = _hertz_cube(F, R, E)
     _require_normal(cube, "the Hertz contact radius cubed, 3 F_N R / (4 E*),", "m^3",
                     (("normal_force", F, "N"), ("radius", R, "m"), ("E_star", E, "Pa")), where=F > 0)
-    return F, R, E, cube
+    return np.cbrt(cube)
 
 
 def hertz_contact_radius(normal_force, radius, E_star):
@@ -161,13 +167,13 @@ def hertz_contact_radius(normal_force, radius, E_star):
 
     F_N >= 0 in N, R > 0 in m, E* > 0 in Pa.
     """
-    return np.cbrt(_contact_args(normal_force, radius, E_star)[3])
+    return _hertz_contact_radius(*_contact_args(normal_force, radius, E_star))
 
 
 def hertz_indentation(normal_force, radius, E_star):
     """Hertz indentation depth d = a² / R."""
-    _, R, _, cube = _contact_args(normal_force, radius, E_star)
-    return np.cbrt(cube) ** 2 / R
+    F, R, E = _contact_args(normal_force, radius, E_star)
+    return _hertz_contact_radius(F, R, E) ** 2 / R
 
 
 def hertz_normal_force(contact_radius, radius, E_star):
@@ -184,8 +190,8 @@ def tangential_stiffness(normal_force, radius, E_star, G_star):
 
     F_N >= 0 in N, R > 0 in m, E* > 0 and G* > 0 in Pa.
     """
-    cube = _contact_args(normal_force, radius, E_star)[3]
-    return 2.0 * np.cbrt(cube) * _positive("G_star", G_star, "Pa")
+    a = _hertz_contact_radius(*_contact_args(normal_force, radius, E_star))
+    return 2.0 * a * _positive("G_star", G_star, "Pa")
 
 
 def normal_forces(preload, contacts: int = 6):

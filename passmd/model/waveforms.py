@@ -182,7 +182,11 @@ def flyback_time(amplitude: float, drive: Drive, flyback: str = "slew") -> float
     """
     check_choice("flyback", flyback, ("slew", "fixed"))
     check_drive(drive)
-    amplitude = check_range("amplitude", amplitude, 0.0, unit="m")
+    return _flyback_time(check_range("amplitude", amplitude, 0.0, unit="m"), drive, flyback)
+
+
+def _flyback_time(amplitude: float, drive: Drive, flyback: str) -> float:
+    """:func:`flyback_time` of arguments its caller has checked (A >= 0 in m, a Drive, a rule)."""
     full = drive.amplifier.full_stroke_time
     if flyback == "fixed":
         return full
@@ -241,9 +245,9 @@ def sawtooth(
                                             allow_extrapolation=drive.allow_extrapolation)
     frac = check_range("settle_fraction", settle_fraction, 0.0, 1.0, lower_open=True, upper_open=True)
     periods = check_count("periods", periods)
-    periods = int(periods)
+    check_choice("flyback", flyback, ("slew", "fixed"))
     T = 1.0 / f
-    t_fb = flyback_time(A, drive, flyback)
+    t_fb = _flyback_time(A, drive, flyback)
     if A == 0.0:
         t_fb = min(drive.amplifier.full_stroke_time, 0.5 * T)  # any edge: x_p stays 0
     check_flyback_fits(t_fb, f)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
+from typing import NamedTuple
 
 from passmd.cli import kernels, startup
 from passmd.cli.commands.contact import check_springs
@@ -32,8 +33,8 @@ from passmd.cli.streams import PipeClosed, available_memory, check_outputs, writ
 from passmd.model.defaults import PROTOCOL
 from passmd.runtime.units import from_si
 
-__all__ = ["add_parser", "check_memory", "check_output_paths", "run_run", "simulate", "waveform_args",
-           "write_outputs"]
+__all__ = ["RunOptions", "add_parser", "check_memory", "check_output_paths", "check_run_options", "run_run",
+           "simulate", "waveform_args", "write_outputs"]
 
 _RUN_KEYS = """\
 By default one run of --periods periods from rest; its mean velocity averages from rest.
@@ -150,22 +151,49 @@ def check_output_paths(args) -> None:
     check_outputs({f"--csv {args.csv}": args.csv, f"--plot {args.plot}": args.plot})
 
 
-def simulate(args, drive):
-    """(result, Eq. 15 design or None) of the run the options describe (saw-tooth or Eq. 15)."""
+class RunOptions(NamedTuple):
+    """The options of a run, checked once (:func:`check_run_options`), in SI."""
+
+    amplitude: float
+    frequency: float
+    #: None: the exact contact; else the discrete contact's springs (>= 2)
+    springs: int | None
+    #: the Eq. 15 design's fields the options replace (--settling-time, ...), by field
+    design_overrides: dict
+
+
+def check_run_options(args, drive) -> RunOptions:
+    """Every option of ``run`` that is not the drive's, checked before anything runs."""
+    amplitude, frequency = waveform_args(args, drive)
+    overrides = [q.flag for q in EQ15_OVERRIDES if getattr(args, q.dest) is not None]
+    if overrides and args.waveform != "optimized":
+        raise UsageError(f"{overrides[0]} needs --waveform optimized: it replaces a part of the Eq. 15 "
+                         "design")
+    # Δ_a first: of several refused values the one the amplitude bounds is reported
+    given = {q.field: q.parse(args) for q in (EQ15_OVERRIDES[2], *EQ15_OVERRIDES[:2])}
+    given = {name: value for name, value in given.items() if value is not None}
+    delta = given.get("acceleration_amplitude")
+    if delta is not None and not delta < amplitude:
+        raise UsageError(f"--acceleration-amplitude = {args.acceleration_amplitude} is out of range: must "
+                         f"be < {fmt(amplitude, 'nm')}, the actuation amplitude A (Eq. 15: the fast segment "
+                         "ends below A)")
+    return RunOptions(amplitude, frequency, check_springs(args.springs), given)
+
+
+def simulate(args, drive, options: RunOptions):
+    """(result, Eq. 15 design or None) of the run the options describe (saw-tooth or Eq. 15);
+    ``options`` from :func:`check_run_options`."""
     startup.load_numba_without_blas_probe()
     from passmd.model import optimized_waveform, waveforms
     from passmd.protocols import eq15
     from passmd.solver import simulation as dynamics
 
-    amplitude, frequency = waveform_args(args, drive)
-    springs = check_springs(args.springs)
+    amplitude, frequency, springs, given = options
     if args.waveform == "optimized":
         # Eq. 15, designed from this drive's own simulated saw-tooth response (first period a
         # saw-tooth, as in the paper); a ValueError (e.g. Δ_a ≥ A) is a usage error
         kernels.notice_if_cold()  # the design simulates: every option is checked by now
         design = eq15.optimized_design(amplitude, drive, flyback=args.flyback)
-        given = {q.field: q.parse(args) for q in EQ15_OVERRIDES}
-        given = {name: value for name, value in given.items() if value is not None}
         if given:  # the user's values replace the design's (its f_s, V_r, u_x,max stay as measured)
             design = replace(design, **given)
         wave = optimized_waveform.optimized(amplitude, frequency, drive, periods=args.periods,
@@ -230,23 +258,10 @@ def write_outputs(args, result) -> None:
 
 def run_run(args, out) -> int:
     drive = build_drive(args, load_cell=bool(args.load_cell))
-    waveform_args(args, drive)  # every option checked before anything runs
-    overrides = [q.flag for q in EQ15_OVERRIDES if getattr(args, q.dest) is not None]
-    if overrides and args.waveform != "optimized":
-        raise UsageError(f"{overrides[0]} needs --waveform optimized: it replaces a part of the Eq. 15 "
-                         "design")
-    delta = EQ15_OVERRIDES[2].parse(args)
-    for q in EQ15_OVERRIDES[:2]:
-        q.parse(args)
-    amplitude = waveform_args(args, drive)[0]
-    if delta is not None and not delta < amplitude:
-        raise UsageError(f"--acceleration-amplitude = {args.acceleration_amplitude} is out of range: must "
-                         f"be < {fmt(amplitude, 'nm')}, the actuation amplitude A (Eq. 15: the fast segment "
-                         "ends below A)")
-    check_springs(args.springs)
+    options = check_run_options(args, drive)
     check_memory(args)
     check_output_paths(args)
-    result, design = simulate(args, drive)
+    result, design = simulate(args, drive, options)
     startup.resume()
     summary = result.summary()
     summary["wall_time_s"] = float(result.wall_time)
