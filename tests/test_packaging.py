@@ -42,16 +42,6 @@ def test_citation_and_changelog_name_this_version():
     assert f"## [{passmd.__version__}]" in changelog and "## [Unreleased]" in changelog
 
 
-def test_package_data_is_declared_for_every_data_file(pyproject):
-    patterns = pyproject["tool"]["setuptools"]["package-data"]["passmd"]
-    package = ROOT / "passmd"
-    data_files = [p for p in (package / "data").rglob("*") if p.is_file() and "__pycache__" not in p.parts]
-    assert data_files
-    for path in data_files:
-        relative = path.relative_to(package)
-        assert any(relative.match(pattern) for pattern in patterns), f"{relative} is not package data"
-
-
 def _environment_uses(path: Path) -> tuple[list[str], list[str]]:
     """(writes, reads) of the process environment in one source file, as ``file:line``."""
     import ast
