@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from passmd.model import theory
+from passmd.model import hertz, theory
 from passmd.model.parameters import PRELOAD_GRIDS, Assumption, paper_drive
 from passmd.runtime.validation import check_choice
 
@@ -283,7 +283,7 @@ def tangential_stiffness_table(radii=(1.0e-3, 0.25e-3), preloads=None) -> pd.Dat
     for radius in radii:
         E_star, G_star = theory.contact_moduli(paper_drive(radius, float(grid[0])))
         for side, forces in enumerate(theory.normal_forces(grid, contacts=6), start=1):
-            stiffness = theory.tangential_stiffness(forces, radius, E_star, G_star)
+            stiffness = hertz.tangential_stiffness(forces, radius, E_star, G_star)
             rows.extend(
                 {"radius_mm": radius * 1e3, "preload_N": p, "side": side, "normal_force_N": f,
                  "tangential_stiffness_N_per_m": k}
