@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from passmd.model import hertz, theory
-from passmd.model.parameters import RUBY, STEEL, Drive
+from passmd.model.parameters import Drive
+from passmd.model.tables import RUBY, STEEL
 
 HAND = 1e-5  # 6 significant digits typed from the hand calculation
 EXACT = 1e-12  # algebraic identities, floating-point rounding only

@@ -75,7 +75,8 @@ from passmd.model.contact_kernels import (
     sliding_force,
 )
 from passmd.model.hertz import _hertz_contact_radius
-from passmd.model.parameters import Assumption, Drive, check_contact_plausible, check_drive
+from passmd.model.parameters import Drive, check_contact_plausible, check_drive
+from passmd.model.tables import Assumption
 from passmd.model.theory import contact_layout, contact_moduli
 from passmd.runtime.validation import check_array, check_choice, check_positive, check_range
 
