@@ -45,7 +45,8 @@ from pathlib import Path
 import numpy as np
 
 from passmd.experiments.design.maps import compute_map
-from passmd.model.parameters import Drive, actuator_for_radius, actuator_viscosity
+from passmd.model.parameters import Drive
+from passmd.model.tables import actuator_for_radius, actuator_viscosity
 from passmd.protocols.maps import steady_point
 from passmd.runtime.config import RunConfig
 

@@ -8,7 +8,7 @@ import pkgutil
 import pytest
 
 import passmd
-from passmd.model.parameters import Assumption
+from passmd.model.tables import Assumption
 from passmd.report import assumptions
 
 

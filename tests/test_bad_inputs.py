@@ -34,7 +34,8 @@ from passmd import cli
 from passmd.cli import kernels, options
 from passmd.cli.commands import run as run_command
 from passmd.model.contact import MDRContact
-from passmd.model.parameters import Actuator, Amplifier, Drive, Material
+from passmd.model.parameters import Drive
+from passmd.model.tables import Actuator, Amplifier, Material
 
 PATH_20000 = ",".join(f"{i % 40}nm" for i in range(20000))
 

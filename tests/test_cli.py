@@ -30,7 +30,8 @@ import passmd
 from passmd import cli
 from passmd.model.contact import MDRContact
 from passmd.model.defaults import PROTOCOL
-from passmd.model.parameters import ACTUATOR_DAMPING_RATIO, Drive, Material, actuator_for_radius
+from passmd.model.parameters import Drive
+from passmd.model.tables import ACTUATOR_DAMPING_RATIO, Material, actuator_for_radius
 from passmd.model.theory import contact_moduli, drive_theory, runner_frequency
 from passmd.runtime import provenance, sweep
 from passmd.runtime.cache import Cache

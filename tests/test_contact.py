@@ -12,7 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from passmd.model import contact, theory
+from passmd.model import contact, hertz, theory
 from passmd.model.contact import MDRContact, contact_arrays, stack_contacts
 from passmd.model.parameters import Drive
 
@@ -51,7 +51,7 @@ def legs(points, per_leg=25):
 def test_virgin_loading_is_cattaneo_mindlin(model):
     c = exact() if model == "exact" else discrete(2000)
     u = np.linspace(0.0, 1.3 * U_MAX, 400)
-    expected = theory.cattaneo_mindlin_force(u, F_N, U_MAX, MU)
+    expected = hertz.cattaneo_mindlin_force(u, F_N, U_MAX, MU)
     tol = ROUND if model == "exact" else DISCRETE
     np.testing.assert_allclose(c.path(u), expected, rtol=0, atol=tol * F_S)
 
@@ -62,12 +62,12 @@ def test_first_unloading_branch_is_masing(model, turn):
     c = exact() if model == "exact" else discrete(2000)
     up = np.linspace(0.0, turn * U_MAX, 200)
     c.path(up)
-    u_r, f_r = up[-1], float(theory.cattaneo_mindlin_force(up[-1], F_N, U_MAX, MU))
+    u_r, f_r = up[-1], float(hertz.cattaneo_mindlin_force(up[-1], F_N, U_MAX, MU))
     down = np.linspace(u_r, u_r - 3.0 * U_MAX, 600)[1:]
-    expected = theory.masing_branch_force(down, u_r, f_r, -1, F_N, U_MAX, MU)
+    expected = hertz.masing_branch_force(down, u_r, f_r, -1, F_N, U_MAX, MU)
     if turn < 1:  # the branch reaches the virgin curve's mirror point and follows it
         beyond = down <= -u_r
-        expected[beyond] = theory.cattaneo_mindlin_force(down[beyond], F_N, U_MAX, MU)
+        expected[beyond] = hertz.cattaneo_mindlin_force(down[beyond], F_N, U_MAX, MU)
     tol = ROUND if model == "exact" else DISCRETE
     np.testing.assert_allclose(c.path(down), expected, rtol=0, atol=tol * F_S)
 
@@ -76,7 +76,7 @@ def test_initial_stiffness_is_2aG():
     c = exact()
     h = 1e-6 * U_MAX
     slope = c.force(h) / h
-    k = float(theory.tangential_stiffness(F_N, R, E_STAR, G_STAR))
+    k = float(hertz.tangential_stiffness(F_N, R, E_STAR, G_STAR))
     assert slope == pytest.approx(k, rel=1e-5)  # one-sided difference, error ~ h/u_max
     assert c.stiffness == pytest.approx(k, rel=ROUND)
     assert discrete(1000).stiffness == pytest.approx(k, rel=1e-3)  # Σ G*Δx = 2aG* up to Δx
@@ -100,7 +100,7 @@ def test_discrete_indentation_balances_normal_force():
         springs = c.spring_states()
         assert springs["normal_force_N"].sum() == pytest.approx(F_N, rel=ROUND)
         assert params[0] == contact.DISCRETE
-    d_hertz = float(theory.hertz_indentation(F_N, R, E_STAR))
+    d_hertz = float(hertz.hertz_indentation(F_N, R, E_STAR))
     assert discrete(1000).indentation == pytest.approx(d_hertz, rel=1e-5)  # midpoint rule, O(N^-2)
 
 

@@ -10,7 +10,8 @@ import pytest
 
 from passmd.cli import main
 from passmd.model.drive_file import DRIVE_KEYS, drive_toml, load_drive, read_drive_file, resolve
-from passmd.model.parameters import RUBY, Actuator, Drive, Material, actuator_for_radius, actuator_viscosity
+from passmd.model.parameters import Drive
+from passmd.model.tables import RUBY, Actuator, Material, actuator_for_radius, actuator_viscosity
 
 #: The new user's drive of the README (R = 0.5 mm, between Table 2's rows).
 MINE = """\

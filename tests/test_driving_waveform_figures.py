@@ -16,7 +16,7 @@ import pandas as pd
 import pytest
 import snapshot_accuracy as snap
 
-from passmd.experiments.driving_waveform import claims as dw_claims
+from passmd.experiments.driving_waveform import claims_velocity as dw_claims
 from passmd.experiments.driving_waveform import facts as wf
 from passmd.experiments.driving_waveform import figures as dw
 from passmd.experiments.driving_waveform import studies

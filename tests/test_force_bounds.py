@@ -18,7 +18,8 @@ import sys
 import numpy as np
 import pytest
 
-from passmd.model.parameters import PRELOAD_GRIDS, paper_drive
+from passmd.model.parameters import paper_drive
+from passmd.model.tables import PRELOAD_GRIDS
 from passmd.protocols import stall
 
 #: The sweep: one preload per decade over four decades, one stiffness per decade over three.

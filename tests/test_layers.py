@@ -26,6 +26,7 @@ import pytest
 KERNEL_PATH = (
     "passmd.model.parameters",
     "passmd.model.theory",
+    "passmd.model.hertz",
     "passmd.model.contact",
     "passmd.model.contact_kernels",
     "passmd.model.waveforms",

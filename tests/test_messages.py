@@ -33,14 +33,8 @@ from passmd.cli.drive import _safe
 from passmd.cli.parser import make_parser
 from passmd.model import optimized_waveform, waveforms
 from passmd.model.contact import MDRContact
-from passmd.model.parameters import (
-    PLAUSIBLE_RANGES,
-    Actuator,
-    Drive,
-    actuator_viscosity,
-    check_plausible,
-    parameter_table,
-)
+from passmd.model.parameters import PLAUSIBLE_RANGES, Drive, check_plausible
+from passmd.model.tables import Actuator, actuator_viscosity, parameter_table
 from passmd.protocols import eq15
 from passmd.runtime.config import RunConfig
 from passmd.runtime.validation import InputError

@@ -13,7 +13,7 @@ import pandas as pd
 import pytest
 
 from passmd.ledger import reference
-from passmd.model.parameters import PRELOAD_GRIDS
+from passmd.model.tables import PRELOAD_GRIDS
 
 WRITTEN = 1e-8  # 10 significant digits in the CSV files
 HAND = 1e-5  # 6 significant digits typed from the hand calculation

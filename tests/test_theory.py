@@ -7,8 +7,9 @@ with rtol = 1e-5; identities between closed forms hold to rounding (rtol = 1e-12
 import numpy as np
 import pytest
 
-from passmd.model import theory
-from passmd.model.parameters import RUBY, STEEL, Drive
+from passmd.model import hertz, theory
+from passmd.model.parameters import Drive
+from passmd.model.tables import RUBY, STEEL
 
 HAND = 1e-5  # 6 significant digits typed from the hand calculation
 EXACT = 1e-12  # algebraic identities, floating-point rounding only
@@ -24,8 +25,8 @@ def test_effective_moduli_by_hand():
     = 8.28981e-12 /Pa  →  G* = 120.630 GPa.
     """
     args = (RUBY.youngs_modulus, RUBY.poissons_ratio, STEEL.youngs_modulus, STEEL.poissons_ratio)
-    assert theory.effective_youngs_modulus(*args) == pytest.approx(150.337e9, rel=HAND)
-    assert theory.effective_shear_modulus(*args) == pytest.approx(120.630e9, rel=HAND)
+    assert hertz.effective_youngs_modulus(*args) == pytest.approx(150.337e9, rel=HAND)
+    assert hertz.effective_shear_modulus(*args) == pytest.approx(120.630e9, rel=HAND)
 
 
 def test_hertz_by_hand():
@@ -35,15 +36,15 @@ def test_hertz_by_hand():
     d = a²/R = 1.58503e-7 m.
     """
     E = 150.337243e9
-    assert theory.hertz_contact_radius(0.4, 1e-3, E) == pytest.approx(12.5898e-6, rel=HAND)
-    assert theory.hertz_indentation(0.4, 1e-3, E) == pytest.approx(1.58503e-7, rel=HAND)
+    assert hertz.hertz_contact_radius(0.4, 1e-3, E) == pytest.approx(12.5898e-6, rel=HAND)
+    assert hertz.hertz_indentation(0.4, 1e-3, E) == pytest.approx(1.58503e-7, rel=HAND)
 
 
 def test_hertz_force_recovered_from_radius():
     E, R = 150e9, 0.25e-3
     F = np.linspace(0.05, 1.0, 20)
-    a = theory.hertz_contact_radius(F, R, E)
-    np.testing.assert_allclose(theory.hertz_normal_force(a, R, E), F, rtol=EXACT)
+    a = hertz.hertz_contact_radius(F, R, E)
+    np.testing.assert_allclose(hertz.hertz_normal_force(a, R, E), F, rtol=EXACT)
 
 
 def test_normal_forces_eq1_by_hand():
@@ -72,7 +73,7 @@ def test_presliding_equals_mu_ratio_times_indentation():
     F = np.linspace(0.1, 1.0, 10)
     np.testing.assert_allclose(
         theory.presliding_displacement(F, R, E, G, mu),
-        mu * E / G * theory.hertz_indentation(F, R, E),
+        mu * E / G * hertz.hertz_indentation(F, R, E),
         rtol=EXACT,
     )
 
@@ -117,11 +118,11 @@ def test_cattaneo_mindlin_virgin_curve():
     d = Drive(preload=0.4, contacts=1)
     out = theory.drive_theory(d)
     F, mu, u_max = 0.4, d.friction_coefficient, out["presliding_m"][0]
-    assert theory.cattaneo_mindlin_force(u_max, F, u_max, mu) == pytest.approx(mu * F, rel=EXACT)
-    assert theory.cattaneo_mindlin_force(3 * u_max, F, u_max, mu) == pytest.approx(mu * F, rel=EXACT)
-    assert theory.cattaneo_mindlin_force(-u_max, F, u_max, mu) == pytest.approx(-mu * F, rel=EXACT)
+    assert hertz.cattaneo_mindlin_force(u_max, F, u_max, mu) == pytest.approx(mu * F, rel=EXACT)
+    assert hertz.cattaneo_mindlin_force(3 * u_max, F, u_max, mu) == pytest.approx(mu * F, rel=EXACT)
+    assert hertz.cattaneo_mindlin_force(-u_max, F, u_max, mu) == pytest.approx(-mu * F, rel=EXACT)
     h = 1e-6 * u_max  # forward difference; slope error ~ h/u_max relative
-    slope = theory.cattaneo_mindlin_force(h, F, u_max, mu) / h
+    slope = hertz.cattaneo_mindlin_force(h, F, u_max, mu) / h
     assert slope == pytest.approx(out["tangential_stiffness_N_per_m"][0], rel=1e-5)
 
 
@@ -130,10 +131,10 @@ def test_masing_branch_closes_on_virgin_curve():
     the mirrored point (−u_r, −F_r) (Masing's rule) and reaches −μF_N at u_r − 2u_max."""
     F, mu, u_max = 0.4, 0.2, 40e-9
     u_r = 0.6 * u_max
-    F_r = theory.cattaneo_mindlin_force(u_r, F, u_max, mu)
-    back = theory.masing_branch_force(-u_r, u_r, F_r, -1, F, u_max, mu)
+    F_r = hertz.cattaneo_mindlin_force(u_r, F, u_max, mu)
+    back = hertz.masing_branch_force(-u_r, u_r, F_r, -1, F, u_max, mu)
     assert back == pytest.approx(-F_r, rel=EXACT)
-    full = theory.masing_branch_force(u_r - 2 * u_max, u_r, F_r, -1, F, u_max, mu)
+    full = hertz.masing_branch_force(u_r - 2 * u_max, u_r, F_r, -1, F, u_max, mu)
     assert full == pytest.approx(-mu * F, rel=EXACT)
 
 

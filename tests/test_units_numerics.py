@@ -40,8 +40,9 @@ from passmd import cli
 from passmd.cli.result_bounds import EMPTY_BY_DESIGN, ResultError, check_table
 from passmd.experiments import figure_table as figures
 from passmd.ledger import evaluation as ledger
-from passmd.model import theory
-from passmd.model.parameters import RUBY, STEEL, Drive
+from passmd.model import hertz, theory
+from passmd.model.parameters import Drive
+from passmd.model.tables import RUBY, STEEL
 from passmd.runtime.units import _CYCLE_UNITS, QuantityError, parse_quantity, registry, to_display
 from passmd.runtime.validation import check_array, check_range, format_number
 
@@ -355,7 +356,7 @@ def test_theory_at_a_tiny_representable_preload_is_finite_and_positive(json_outp
 
 
 @pytest.mark.parametrize(("call", "message"), [
-    (lambda: theory.hertz_contact_radius(1e-300, 1e-3, E_STAR),
+    (lambda: hertz.hertz_contact_radius(1e-300, 1e-3, E_STAR),
      r"^normal_force = 1e-300 N \(with radius = 0.001 m, E_star = 150337243000.0 Pa\) is out of range: the "
      r"Hertz "
      r"contact radius cubed"),
@@ -365,7 +366,7 @@ def test_theory_at_a_tiny_representable_preload_is_finite_and_positive(json_outp
      r"^normal_force = 1e-303 N .* the actuator deformation u_x,a = .* m is below the smallest normal"),
     (lambda: theory.normal_forces(1e-308),
      r"^preload = 1e-308 N is out of range: the normal force per contact"),
-    (lambda: theory.hertz_normal_force(1e-110, 1e-3, E_STAR), r"^contact_radius = 1e-110 m is out of range"),
+    (lambda: hertz.hertz_normal_force(1e-110, 1e-3, E_STAR), r"^contact_radius = 1e-110 m is out of range"),
     (lambda: theory.drive_theory(Drive(preload=1e-300, allow_extrapolation=True)),
      r"^preload = 1e-300 N \(with hemisphere_radius = 0.001 m, E\* = .* Pa\) is out of range"),
     (lambda: theory.drive_theory(Drive(friction_coefficient=1e-305, allow_extrapolation=True)),
@@ -381,7 +382,7 @@ def test_closed_forms_refuse_results_below_double_precision(call, message):
 
 def test_closed_forms_keep_zero_force_at_zero():
     """F_N = 0 is no contact, not an underflow: a = 0, u_x,max = 0."""
-    np.testing.assert_array_equal(theory.hertz_contact_radius([0.0, 0.4], 1e-3, E_STAR)[:1], [0.0])
+    np.testing.assert_array_equal(hertz.hertz_contact_radius([0.0, 0.4], 1e-3, E_STAR)[:1], [0.0])
     assert float(theory.presliding_displacement(0.0, 1e-3, E_STAR, G_STAR, 0.2)) == 0.0
     assert float(theory.actuator_deformation(0.2, 0.0, 6.5e6, 3e-3, 2.2e-8)) == 0.0
 
@@ -394,11 +395,11 @@ _NU, _E = RUBY.poissons_ratio, RUBY.youngs_modulus
 
 
 @pytest.mark.parametrize(("call", "error", "message"), [
-    (lambda: theory.effective_youngs_modulus(-1, _NU, STEEL.youngs_modulus, _NU), ValueError,
+    (lambda: hertz.effective_youngs_modulus(-1, _NU, STEEL.youngs_modulus, _NU), ValueError,
      r"^E1 contains -1, which is out of range: every element must be a finite number > 0 \(Pa\)$"),
-    (lambda: theory.effective_shear_modulus(_E, -1.0, STEEL.youngs_modulus, _NU), ValueError,
+    (lambda: hertz.effective_shear_modulus(_E, -1.0, STEEL.youngs_modulus, _NU), ValueError,
      r"^nu1 contains -1, which is out of range: every element must be a finite number > -1 and <= 0.5$"),
-    (lambda: theory.effective_youngs_modulus(_E, _NU, STEEL.youngs_modulus, 0.6), ValueError,
+    (lambda: hertz.effective_youngs_modulus(_E, _NU, STEEL.youngs_modulus, 0.6), ValueError,
      r"^nu2 contains 0.6"),
     (lambda: theory.presliding_displacement(0.4, 1e-3, E_STAR, G_STAR, friction_coefficient=-0.2), ValueError,
      r"^friction_coefficient contains -0.2, which is out of range: every element must be a finite .* > 0$"),
@@ -418,17 +419,17 @@ _NU, _E = RUBY.poissons_ratio, RUBY.youngs_modulus
     (lambda: theory.contact_moduli(None), TypeError, r"^drive = None is not allowed"),
     (lambda: theory.runner_frequency(3), TypeError, r"^drive = 3 is not allowed"),
     (lambda: theory.friction_limit({}), TypeError, r"^drive = \{\} is not allowed"),
-    (lambda: theory.hertz_contact_radius(0.4, 1e-3, -E_STAR), ValueError,
+    (lambda: hertz.hertz_contact_radius(0.4, 1e-3, -E_STAR), ValueError,
      r"^E_star contains -150337243000.0, "),
-    (lambda: theory.tangential_stiffness(0.4, 1e-3, E_STAR, 0.0), ValueError, r"^G_star contains 0, "),
+    (lambda: hertz.tangential_stiffness(0.4, 1e-3, E_STAR, 0.0), ValueError, r"^G_star contains 0, "),
     (lambda: theory.actuator_deformation(0.2, 0.4, 6.5e6, 0.0, 2.2e-8), ValueError,
      r"^runner_mass contains 0, "),
     (lambda: theory.harmonic_combination(-1e-9, 2e-9), ValueError, r"^u1 contains -1e-09, .* > 0 \(m\)$"),
     (lambda: theory.harmonic_combination(1e-9, np.inf), ValueError, r"^u2 contains inf, "),
-    (lambda: theory.cattaneo_mindlin_force(1e-9, 0.4, 0.0, 0.2), ValueError, r"^presliding contains 0, "),
-    (lambda: theory.masing_branch_force(0.0, 1e-9, 0.01, 0, 0.4, 4e-8, 0.2), ValueError,
+    (lambda: hertz.cattaneo_mindlin_force(1e-9, 0.4, 0.0, 0.2), ValueError, r"^presliding contains 0, "),
+    (lambda: hertz.masing_branch_force(0.0, 1e-9, 0.01, 0, 0.4, 4e-8, 0.2), ValueError,
      r"^direction = 0 is not allowed: must be one of 1, -1$"),
-    (lambda: theory.masing_branch_force(np.nan, 1e-9, 0.01, 1, 0.4, 4e-8, 0.2), ValueError,
+    (lambda: hertz.masing_branch_force(np.nan, 1e-9, 0.01, 1, 0.4, 4e-8, 0.2), ValueError,
      r"^u contains nan"),
 ])
 def test_public_closed_forms_refuse_bad_arguments(call, error, message):

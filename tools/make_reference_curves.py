@@ -2,7 +2,7 @@
 
 Usage: ``python tools/make_reference_curves.py [--out DIR]``. The tables are computed by
 :func:`passmd.ledger.reference.closed_form_curves` (Eqs. 1, 7–14 of Nguyen et al. 2018 via
-``passmd.model.theory``) on ``passmd.model.parameters.PRELOAD_GRIDS``; ``tests/test_reference.py``
+``passmd.model.theory``) on ``passmd.model.tables.PRELOAD_GRIDS``; ``tests/test_reference.py``
 fails if the committed files and a fresh computation disagree. The default target is the
 repository's reference data folder (package data of ``passmd``), found from this file's
 location, never the installed package.

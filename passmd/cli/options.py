@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 from passmd.cli.output import JSON_HELP, fmt
 from passmd.model.defaults import PROTOCOL
-from passmd.model.parameters import ACTUATOR_DAMPING_RATIO, PLAUSIBLE_RANGES, Drive
+from passmd.model.parameters import PLAUSIBLE_RANGES, Drive
+from passmd.model.tables import ACTUATOR_DAMPING_RATIO
 from passmd.runtime.cache import describe_default_cache_dir
 from passmd.runtime.config import ENVIRONMENT
 from passmd.runtime.units import QuantityError, parse_quantity, si_factor, to_display

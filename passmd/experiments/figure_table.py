@@ -22,6 +22,7 @@ from passmd.experiments.critical_amplitude import claims as critical_amplitude_c
 from passmd.experiments.critical_amplitude import facts as critical_amplitude_facts
 from passmd.experiments.critical_amplitude import figures as critical_amplitude
 from passmd.experiments.driving_waveform import claims as driving_waveform_claims
+from passmd.experiments.driving_waveform import claims_velocity as driving_waveform_velocity_claims
 from passmd.experiments.driving_waveform import facts as waveform_facts
 from passmd.experiments.driving_waveform import figures as driving_waveform
 from passmd.experiments.driving_waveform import studies as waveform_studies
@@ -151,7 +152,7 @@ FIGURES: tuple[FigureSpec, ...] = (
 
 #: The experiment modules whose functions carry claim extractors (Sections 4.1, 4.2, 5).
 CLAIM_MODULES: tuple[ModuleType, ...] = (critical_amplitude_claims, force_generation_claims,
-                                         driving_waveform_claims)
+                                         driving_waveform_claims, driving_waveform_velocity_claims)
 
 _BY_NAME = {spec.name: spec for spec in FIGURES}
 

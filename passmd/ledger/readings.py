@@ -55,7 +55,7 @@ class Axis:
     unit: str  # display unit of the values ('' for words)
     plausible_range: str  # the whole plausible range, in words
     source: str  # where that range comes from
-    assumption_key: str = ""  # the key of the matching passmd.model.parameters assumption, if any
+    assumption_key: str = ""  # the key of the matching passmd.model.tables assumption, if any
     open_for: tuple = ()  # claim ids the axis applies to but whose result tables lack its alternatives
     open_reason: str = ""  # why those claims are not evaluated along the axis
     not_readings: tuple = ()  # (value, reason): values that would change a claim's object (studies only)

@@ -25,8 +25,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from passmd.model import theory
-from passmd.model.parameters import PRELOAD_GRIDS, Assumption, paper_drive
+from passmd.model import hertz, theory
+from passmd.model.parameters import paper_drive
+from passmd.model.tables import PRELOAD_GRIDS, Assumption
 from passmd.runtime.validation import check_choice
 
 __all__ = [
@@ -149,7 +150,7 @@ def closed_form_curves(
     Returns
     -------
     pandas.DataFrame
-        ``preload_N`` on :data:`passmd.model.parameters.PRELOAD_GRIDS` for the figure's radius,
+        ``preload_N`` on :data:`passmd.model.tables.PRELOAD_GRIDS` for the figure's radius,
         then the columns of ``CURVES[name].columns`` in nm.
     """
     spec = _spec(name)
@@ -198,7 +199,7 @@ def curve_header(name: str, friction_coefficient: float = REFERENCE_FRICTION_COE
         f"Fig. {spec.figure} closed-form reference curves, Nguyen et al. (2018), Coatings 8, 62.",
         f"{spec.contacts} contact(s), R = {spec.hemisphere_radius * 1e3:g} mm, "
         f"mu = {drive.friction_coefficient:g} (assumption friction_coefficient_sections_4_1_and_5), "
-        "preload grid of passmd.model.parameters.PRELOAD_GRIDS.",
+        "preload grid of passmd.model.tables.PRELOAD_GRIDS.",
         f"E* = {E_star / 1e9:.6g} GPa, G* = {G_star / 1e9:.6g} GPa (Table 1, MDR convention); "
         f"k_p = {act.stiffness:.6g} N/m, m_a = {act.mass:.6g} kg (Table 2), m_r = {drive.runner_mass:g} kg.",
         *(f"{column}: {meaning}" for column, meaning in spec.columns.items()),
@@ -283,7 +284,7 @@ def tangential_stiffness_table(radii=(1.0e-3, 0.25e-3), preloads=None) -> pd.Dat
     for radius in radii:
         E_star, G_star = theory.contact_moduli(paper_drive(radius, float(grid[0])))
         for side, forces in enumerate(theory.normal_forces(grid, contacts=6), start=1):
-            stiffness = theory.tangential_stiffness(forces, radius, E_star, G_star)
+            stiffness = hertz.tangential_stiffness(forces, radius, E_star, G_star)
             rows.extend(
                 {"radius_mm": radius * 1e3, "preload_N": p, "side": side, "normal_force_N": f,
                  "tangential_stiffness_N_per_m": k}

@@ -74,8 +74,10 @@ from passmd.model.contact_kernels import (
     contact_update_row,
     sliding_force,
 )
-from passmd.model.parameters import Assumption, Drive, check_contact_plausible, check_drive
-from passmd.model.theory import _hertz_contact_radius, contact_layout, contact_moduli
+from passmd.model.hertz import _hertz_contact_radius
+from passmd.model.parameters import Drive, check_contact_plausible, check_drive
+from passmd.model.tables import Assumption
+from passmd.model.theory import contact_layout, contact_moduli
 from passmd.runtime.validation import check_array, check_choice, check_positive, check_range
 
 if TYPE_CHECKING:  # pandas is imported where a DataFrame is built (start-up time)
@@ -192,7 +194,7 @@ def contact_arrays(model, normal_force, radius, E_star, G_star, mu, springs=None
     radius : float
         Hemisphere radius R, m (> 0); the MDR profile is g(x) = x²/R (R₁ = R/2, Eq. 5).
     E_star, G_star : float
-        Effective moduli E*, G* in Pa (MDR convention, see :mod:`passmd.model.theory`).
+        Effective moduli E*, G* in Pa (MDR convention, see :mod:`passmd.model.hertz`).
     mu : float
         Friction coefficient μ (> 0).
     springs : int or None

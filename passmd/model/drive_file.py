@@ -34,13 +34,11 @@ import math
 import sys
 from dataclasses import dataclass, replace
 
-from passmd.model.parameters import (
+from passmd.model.parameters import PLAUSIBLE_RANGES, ContactGroup, Drive
+from passmd.model.tables import (
     ACTUATOR_DAMPING_RATIO,
-    PLAUSIBLE_RANGES,
     TABLE2_RADII,
     Amplifier,
-    ContactGroup,
-    Drive,
     actuator_for_radius,
     actuator_viscosity,
 )

@@ -16,7 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from passmd.model.defaults import PROTOCOL
-from passmd.model.parameters import Assumption, Drive, check_drive
+from passmd.model.parameters import Drive, check_drive
+from passmd.model.tables import Assumption
 from passmd.model.waveforms import (
     SETTLE_FRACTION,
     Waveform,

@@ -21,7 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from passmd.model.parameters import PLAUSIBLE_RANGES, Assumption, Drive, check_drive
+from passmd.model.parameters import PLAUSIBLE_RANGES, Drive, check_drive
+from passmd.model.tables import Assumption
 from passmd.runtime.validation import (
     InputError,
     check_choice,

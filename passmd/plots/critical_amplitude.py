@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from passmd.model.defaults import PROTOCOL
-from passmd.model.parameters import ACTUATOR_DAMPING_RATIO
+from passmd.model.tables import ACTUATOR_DAMPING_RATIO
 
 COLOURS = {"rigid": "tab:green", "flexible": "black"}
 SIDE_COLOURS = {1: "tab:blue", 2: "tab:orange", "e": "tab:red"}

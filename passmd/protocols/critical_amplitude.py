@@ -38,7 +38,8 @@ import numpy as np
 
 from passmd.model import waveforms
 from passmd.model.defaults import PROTOCOL
-from passmd.model.parameters import Assumption, Drive
+from passmd.model.parameters import Drive
+from passmd.model.tables import Assumption
 from passmd.runtime.validation import check_choice, check_positive, check_range
 from passmd.solver import simulation as dynamics
 

@@ -1,7 +1,7 @@
 """The table of every assumption: values the paper does not give, where each is defined.
 
 Each module that makes an assumption defines it next to the code that uses it, as a
-module-level tuple ``ASSUMPTIONS`` of :class:`~passmd.model.parameters.Assumption` records;
+module-level tuple ``ASSUMPTIONS`` of :class:`~passmd.model.tables.Assumption` records;
 :func:`all_assumptions` concatenates those tuples from the explicit list
 :data:`ASSUMPTION_MODULES`, in the order the book's assumptions tables show them.
 """
@@ -14,8 +14,8 @@ from passmd.experiments.driving_waveform import figures as driving_waveform
 from passmd.experiments.driving_waveform import studies as waveform_studies
 from passmd.experiments.force_generation import figures as force_generation
 from passmd.ledger import reference
-from passmd.model import contact, optimized_waveform, parameters, waveforms
-from passmd.model.parameters import Assumption
+from passmd.model import contact, optimized_waveform, parameters, tables, waveforms
+from passmd.model.tables import Assumption
 from passmd.protocols import critical_amplitude
 
 __all__ = ["ASSUMPTION_MODULES", "all_assumptions"]
@@ -23,6 +23,7 @@ __all__ = ["ASSUMPTION_MODULES", "all_assumptions"]
 #: Every module that defines ``ASSUMPTIONS``: the model, then the protocols and experiments
 #: in the paper's order (Sections 2–5).
 ASSUMPTION_MODULES: tuple[ModuleType, ...] = (
+    tables,
     parameters,
     contact,
     waveforms,

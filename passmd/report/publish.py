@@ -288,7 +288,7 @@ def parameter_frame(*records, labels=None, units=None):
     ----------
     *records
         Parameter dataclasses (e.g. two :class:`passmd.model.parameters.Drive`), read with
-        :func:`passmd.model.parameters.parameter_table`.
+        :func:`passmd.model.tables.parameter_table`.
     labels : list of str, optional
         Column titles of the records' values; default ``value`` (one record) or
         ``value 1``, ``value 2``, ...
@@ -302,7 +302,7 @@ def parameter_frame(*records, labels=None, units=None):
     """
     import pandas as pd
 
-    from passmd.model.parameters import parameter_table
+    from passmd.model.tables import parameter_table
 
     if not records:
         raise ValueError("records is empty: give at least one parameter record")

@@ -18,7 +18,7 @@ from passmd.experiments.critical_amplitude.figures import (
     primary,
 )
 from passmd.model.defaults import PROTOCOL
-from passmd.model.parameters import ACTUATOR_DAMPING_RATIO, actuator_for_radius
+from passmd.model.tables import ACTUATOR_DAMPING_RATIO, actuator_for_radius
 from passmd.protocols.critical_amplitude import (
     STEADY_PERIODS,
     STEP_THRESHOLD,

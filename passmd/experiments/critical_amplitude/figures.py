@@ -25,7 +25,8 @@ import pandas as pd
 from passmd.ledger import readings, reference
 from passmd.ledger.checks import ClaimFails, NotEvaluable
 from passmd.model.defaults import PROTOCOL
-from passmd.model.parameters import ACTUATOR_DAMPING_RATIO, PRELOAD_GRIDS, Drive, actuator_for_radius
+from passmd.model.parameters import Drive
+from passmd.model.tables import ACTUATOR_DAMPING_RATIO, PRELOAD_GRIDS, actuator_for_radius
 from passmd.protocols.critical_amplitude import (
     PROTOCOLS,
     STEADY_PERIODS,
@@ -381,7 +382,7 @@ def fig56_frequency(config: RunConfig) -> pd.DataFrame:
 def primary(table: pd.DataFrame, actuator_model: str | None = None, reading=None) -> pd.DataFrame:
     """The rows of one reading of the A_c protocol (default: steady state,
     ``PROTOCOL.drive_frequency``, slew-rate fly-back, ζ =
-    :data:`~passmd.model.parameters.ACTUATOR_DAMPING_RATIO`).
+    :data:`~passmd.model.tables.ACTUATOR_DAMPING_RATIO`).
 
     ``reading`` is a ledger reading (:mod:`passmd.ledger.readings`): its ``ac_protocol``,
     ``flyback``, ``drive_frequency_s4`` and ``damping_ratio`` select the rows. The fly-back

@@ -29,7 +29,8 @@ import pandas as pd
 from passmd.experiments.design.maps import compute_map
 from passmd.model.defaults import PROTOCOL
 from passmd.model.drive_file import load_drive, parameter_rows, read_drive_file, resolve
-from passmd.model.parameters import Drive, actuator_for_radius
+from passmd.model.parameters import Drive
+from passmd.model.tables import actuator_for_radius
 from passmd.protocols import fit as fitting
 from passmd.protocols import stall
 from passmd.runtime.config import PROFILES, RunConfig

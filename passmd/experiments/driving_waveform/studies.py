@@ -27,7 +27,7 @@ from passmd.experiments.driving_waveform.figures import (
     variant_name,
 )
 from passmd.model import optimized_waveform
-from passmd.model.parameters import Assumption
+from passmd.model.tables import Assumption
 from passmd.protocols.velocity import (
     STEP_PERIODS,
     STEP_PROTOCOL_BELOW,

@@ -33,7 +33,7 @@ from passmd.experiments.force_generation.figures import (
 )
 from passmd.ledger.checks import ClaimFails, NotEvaluable, check_trend, evidence, extractor, no_measured_data
 from passmd.ledger.claims import load_claims
-from passmd.model.parameters import PRELOAD_GRIDS
+from passmd.model.tables import PRELOAD_GRIDS
 
 
 @extractor("fig7a-force-difference-115mn", depends_on=("force_frequency", "flyback"))

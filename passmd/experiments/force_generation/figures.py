@@ -26,7 +26,8 @@ import pandas as pd
 
 from passmd.ledger.checks import NotEvaluable
 from passmd.model.defaults import PROTOCOL
-from passmd.model.parameters import PRELOAD_GRIDS, Assumption, Drive, paper_drive
+from passmd.model.parameters import Drive, paper_drive
+from passmd.model.tables import PRELOAD_GRIDS, Assumption
 from passmd.model.theory import drive_theory
 from passmd.protocols import stall
 from passmd.protocols.critical_amplitude import critical_amplitude

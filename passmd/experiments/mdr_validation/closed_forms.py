@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from passmd.model import theory
+from passmd.model import hertz, theory
 from passmd.model.contact import MDRContact
 from passmd.model.parameters import Drive
 from passmd.runtime.validation import check_range
@@ -69,7 +69,7 @@ def normal_validation(drive: Drive | None = None, springs=(20, 100, 1000), point
     E_star, _ = theory.contact_moduli(drive)
     R = drive.hemisphere_radius
     F_max = 2.0 * float(theory.normal_forces(drive.preload, drive.contacts)[0])
-    a_max = float(theory.hertz_contact_radius(F_max, R, E_star))
+    a_max = float(hertz.hertz_contact_radius(F_max, R, E_star))
     d = np.linspace(1.0, points, points) / points * a_max**2 / R
     out = {"indentation_m": d, "hertz_N": 4.0 / 3.0 * E_star * np.sqrt(R) * d**1.5}
     for n in springs:
@@ -88,14 +88,14 @@ def virgin_validation(drive: Drive | None = None, springs=(20, 100, 1000), point
     Returns
     -------
     pandas.DataFrame
-        ``u_m``, ``cattaneo_mindlin_N`` (:func:`passmd.model.theory.cattaneo_mindlin_force`),
+        ``u_m``, ``cattaneo_mindlin_N`` (:func:`passmd.model.hertz.cattaneo_mindlin_force`),
         ``exact_N``, ``discrete_<N>_N``, ``slip_share_exact``.
     """
     exact = _contact(drive)
     u = np.linspace(0.0, 1.2 * exact.presliding, points)
     out = {
         "u_m": u,
-        "cattaneo_mindlin_N": theory.cattaneo_mindlin_force(
+        "cattaneo_mindlin_N": hertz.cattaneo_mindlin_force(
             u, exact.normal_force, exact.presliding, exact.friction_coefficient
         ),
         "slip_share_exact": exact.slip_share(u),
@@ -150,9 +150,9 @@ def masing_reference(u, segment, turns, normal_force, presliding, friction_coeff
     def branch(k, x):
         origin = HYSTERESIS_BRANCH_ORIGIN[k]
         if origin is None:
-            return theory.cattaneo_mindlin_force(x, *args)
+            return hertz.cattaneo_mindlin_force(x, *args)
         direction = np.sign(turns[k + 1] - turns[k])
-        return theory.masing_branch_force(x, turns[origin], f_turn[origin], direction, *args)
+        return hertz.masing_branch_force(x, turns[origin], f_turn[origin], direction, *args)
 
     f_turn = [0.0]
     for k in range(len(turns) - 1):  # force at each turning point, from the branch arriving there

@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from passmd.experiments.critical_amplitude.figures import FIG5A_DRIVE
-from passmd.model import theory
+from passmd.model import hertz, theory
 from passmd.model.contact import MDRContact
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive, paper_drive
@@ -145,8 +145,8 @@ def model_mdr_loop(config: RunConfig) -> pd.DataFrame:
             f"force_{MDR_LOOP_SPRINGS}_springs_mN": from_si(discrete, "mN"),
             "normal_force_N": f1,
             "hemisphere_radius_m": radius,
-            "contact_radius_m": float(theory.hertz_contact_radius(f1, radius, e_star)),
-            "indentation_m": float(theory.hertz_indentation(f1, radius, e_star)),
+            "contact_radius_m": float(hertz.hertz_contact_radius(f1, radius, e_star)),
+            "indentation_m": float(hertz.hertz_indentation(f1, radius, e_star)),
             "presliding_m": u_max,
             "sliding_force_N": mu * f1,
             "springs": MDR_LOOP_SPRINGS,

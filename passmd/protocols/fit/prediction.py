@@ -15,7 +15,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from passmd.model.parameters import Drive, actuator_for_radius, check_drive
+from passmd.model.parameters import Drive, check_drive
+from passmd.model.tables import actuator_for_radius
 from passmd.protocols.fit.free_parameters import FREE_PARAMETERS
 from passmd.protocols.fit.measurements import (
     READINGS,
