@@ -1,10 +1,10 @@
 """Speed of the hybrid simulator: ns per integrator step and wall time per 100 Hz period.
 
 Runs each configuration (one/six contacts × rigid/flexible × exact/discrete N = 200) with
-each step control: the default error-controlled step ("controlled"), the fixed fine step
-(the reference scheme) and, for flexible actuators, the explicit adaptive step and the
-quasi-static actuator step at a fixed runner step (the schemes before the error control,
-``simulate(..., error_control=False)``). Each run is three 100 Hz saw-tooth periods (150 nm,
+each integration scheme (:data:`passmd.time_steps.SCHEMES`): the default error-controlled
+step ("controlled"), the fixed fine step ("fixed", the reference) and, for flexible
+actuators, the explicit adaptive step ("adaptive") and the quasi-static actuator at a fixed
+runner step ("quasi-static"). Each run is three 100 Hz saw-tooth periods (150 nm,
 0.4 N, R = 1 mm: the first from rest, two after a slip), repeated; the medians of the wall
 time give ms per period (wall / 3) and ns per integrator step (rejected error-controlled
 steps included). numba compilation happens in an untimed warm-up run. Each row also gives
@@ -46,13 +46,6 @@ CONFIGS = [
     for control in (("fixed", "controlled", "adaptive", "quasi-static") if model == "flexible"
                     else ("fixed", "controlled"))
 ]
-#: Keyword arguments of :func:`passmd.dynamics.simulate` for each step control.
-CONTROLS = {
-    "controlled": {},
-    "adaptive": {"error_control": False},
-    "quasi-static": {"error_control": False, "quasi_static": True},
-    "fixed": {"adaptive": False},
-}
 #: 100 Hz periods of each timed run (the first from rest, the others after a slip).
 PERIODS = 3
 
@@ -133,7 +126,7 @@ _REFERENCE: dict = {}
 
 def bench(contacts: int, model: str, contact: str, control: str, repeats: int, springs: int = 200) -> dict:
     drive = Drive(contacts=contacts, actuator_model=model)
-    kw = dict(contact_model=contact, springs=springs, **CONTROLS[control])
+    kw = dict(contact_model=contact, springs=springs, scheme=control)
     warm = waveforms.sawtooth(150e-9, 10e3, drive, periods=1)
     dynamics.simulate(drive, warm, **kw)  # compile
     wf = waveforms.sawtooth(150e-9, PROTOCOL.drive_frequency, drive, periods=PERIODS)

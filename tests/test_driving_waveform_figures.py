@@ -136,7 +136,8 @@ def test_fig10_steady_step_at_130_khz_is_converged(quick, monkeypatch, preload, 
     row = row.iloc[0]
     point = {name: row[name] for name in inspect.signature(dw.velocity_point).parameters}
     default_simulate = dynamics.simulate
-    monkeypatch.setattr(dynamics, "simulate", functools.partial(default_simulate, dt=CONVERGED_DT))
+    monkeypatch.setattr(dynamics, "simulate", functools.partial(default_simulate,
+                                                       scheme=time_steps.SCHEMES["fixed"].replace(dt=CONVERGED_DT)))
     converged = dw.velocity_point(**point)
     assert converged["periods"] == row["periods"]
     assert abs(row["step_m"] - converged["step_m"]) < time_steps.CONVERGED_ACCURACY

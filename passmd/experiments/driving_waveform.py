@@ -29,7 +29,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from passmd import dynamics, optimized_waveform, readings, sweep, theory, waveforms
+from passmd import dynamics, optimized_waveform, readings, sweep, theory, time_steps, waveforms
 from passmd._validation import check_choice
 from passmd.checks import NotEvaluable
 from passmd.config import PROFILES, RunConfig
@@ -452,7 +452,8 @@ def window_point(hemisphere_radius: float, preload: float, runner: str, actuator
     start_a = period + timing["settling_time_s"]
     end_a = start_a + timing["acceleration_time_s"]
     points = int(math.ceil(wave.duration * samples_per_acceleration / timing["acceleration_time_s"])) + 1
-    result = dynamics.simulate(drive, wave, resolution=resolution, max_points=points)
+    refined = time_steps.SCHEMES["controlled"].replace(refine=resolution)
+    result = dynamics.simulate(drive, wave, scheme=refined, max_points=points)
     t = result.time
     keep = (t >= period - flyback - WINDOW_BEFORE) & (t <= end_a + WINDOW_AFTER)
     inside = t[(t >= start_a) & (t <= end_a)]
