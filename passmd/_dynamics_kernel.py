@@ -29,9 +29,9 @@ integrated exactly by the variation-of-constants formula (an exponential or
 "trigonometric" integrator; Hairer, Lubich & Wanner, Geometric Numerical Integration,
 Ch. XIII), g with its rate extrapolated from the last step in the position, and in the
 velocity quadratic in time through its values at the step's end, its start and the previous
-step's start. (With g linear over the step in the velocity, that update's local error was
-O(dt³) against the position's O(dt⁴), and the energy balance drifted by O(dt²): 3e-5 of the
-input work over three 1 kHz periods.) So the ≈ 11 kHz micro-vibration sets no step; what does is the
+step's start (g linear over the step would leave the velocity an O(dt³) local error against
+the position's O(dt⁴), and the energy balance an O(dt²) drift). So the ≈ 11 kHz
+micro-vibration sets no step; what does is the
 local position error estimate dt²/6 |Δg − ġ dt|, checked against the tolerance with the
 forces at the drifted position (pure evaluations): a step above it is rejected and retried
 shorter, and the next step follows the usual controller (fourth root, safety factor,
@@ -123,8 +123,8 @@ CARRY_SIZE = 28
 
 
 #: numba options: the kernel allocates nothing (work arrays come from the caller), so it is
-#: compiled without reference counting; with it, every call into the contact kernels paid
-#: atomic reference-count updates on the array arguments (≈ 30 ns per step).
+#: compiled without reference counting, which would add atomic reference-count updates on
+#: the array arguments of every call into the contact kernels.
 KERNEL_OPTIONS = {"cache": True, "error_model": "numpy", "_nrt": False}
 
 #: rows of the work array (shape (WORK_ROWS, groups)) the caller allocates
@@ -149,7 +149,7 @@ VELOCITY_LIMIT = 100.0
 #: Error-controlled step: the next step is this fraction of the one the estimate allows
 #: (the safety factor of step-size controllers, Hairer, Nørsett & Wanner, Sect. II.4).
 #: With 0.8 and the growth below, one step in 15 is rejected on a 100 Hz saw-tooth (0.9 and
-#: 1.5: one in 5, and more steps in all).
+#: 1.5 reject one in 5, and take more steps in all).
 STEP_SAFETY = 0.8
 #: Error-controlled step: largest growth and shrink factors from one step to the next.
 STEP_GROWTH = 1.25
@@ -279,22 +279,22 @@ def integrate(segments: Segments, mechanics: Mechanics, control: StepControl, co
     ``record`` rows are [t, x_p, x_r, v_r, (x_a, T, slip share) per group].
 
     Step control (flexible actuators): every segment starts with the fine step
-    ``seg_fine`` (a corner of x_p(t) excites the actuator mode). Once the largest
-    actuator acceleration |ẍ_a| has stayed below ``activity_threshold`` for
-    ``quiet_steps`` fine steps, the step grows to ``seg_coarse``; it falls back to fine
-    as soon as |ẍ_a| exceeds the threshold again. Rigid actuators: ``seg_fine`` only.
+    ``segments.fine`` (a corner of x_p(t) excites the actuator mode). Once the largest
+    actuator acceleration |ẍ_a| has stayed below ``control.activity_threshold`` for
+    ``control.quiet_steps`` fine steps, the step grows to ``segments.coarse``; it falls back to fine
+    as soon as |ẍ_a| exceeds the threshold again. Rigid actuators: ``segments.fine`` only.
 
-    With ``quasi_static`` the quiet phases instead neglect m_a: each step of
-    ``seg_quasi`` (set by the runner's mode) solves the actuator's force balance
+    With ``control.quasi_static`` the quiet phases instead neglect m_a: each step of
+    ``segments.quasi`` (set by the runner's mode) solves the actuator's force balance
     k_p (x_p − x_a) = c_p ẋ_a + T(x_a − x_r) implicitly (backward Euler in the damping
     term, :func:`quasi_static_position`), then commits the contact memory once, as the
     explicit step does. The implied actuator acceleration is checked against the same
     threshold; above it, the fine explicit step takes over again.
 
-    With ``error_tolerance`` > 0 the quasi-static phases (flexible) and every step (rigid)
+    With ``control.error_tolerance`` > 0 the quasi-static phases (flexible) and every step (rigid)
     are error-controlled (module docstring): the first such step of a quasi-static phase is
-    ``seg_quasi``, then each step follows from the last one's error estimate, at most
-    ``seg_longest``; rigid actuators carry the step from piece to piece. Rejected steps count
+    ``segments.quasi``, then each step follows from the last one's error estimate, at most
+    ``segments.longest``; rigid actuators carry the step from piece to piece. Rejected steps count
     in ``steps`` (and in ``carry[C_REJECTED]``).
 
     Raises
@@ -398,9 +398,12 @@ def _turns_inside(du0, du):
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
-def _save_segment(carry, fine, quasi, controlled, g_rate, h_prev, quiet, acc):
-    """Step control and segment-local accumulators ``acc`` = (∫x_r, ∫F, ∫window, W_in, W_damp,
-    W_contact, Σdt, min x_r) into ``carry`` at a pause inside a segment (:func:`_restore_segment`)."""
+def _save_segment(carry, y, x_r, v_r, fine, quasi, controlled, g_rate, h_prev, quiet, acc):
+    """Runner state into ``y``, step control and segment-local accumulators ``acc`` = (∫x_r,
+    ∫F, ∫window, W_in, W_damp, W_contact, Σdt, min x_r) into ``carry`` at a pause inside a
+    segment (:func:`_restore_segment`)."""
+    y[0] = x_r
+    y[1] = v_r
     carry[C_FINE] = 1.0 if fine else 0.0
     carry[C_QUASI] = 1.0 if quasi else 0.0
     carry[C_CONTROLLED] = 1.0 if controlled else 0.0
@@ -426,7 +429,7 @@ def _restore_segment(carry):
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
-def _begin_run(mechanics, contacts, y, work, carry, seg_t0, seg_x0, seg_fine, inv_ma, inv_mr):
+def _begin_run(mechanics, contacts, y, rows, carry, seg_t0, seg_x0, seg_fine, inv_ma, inv_mr):
     """Loop state at the start of a call: from rest (first call: actuators from ``y``, forces
     evaluated) or from ``carry``. Returns (t, x_p, a_r, F, n_rec, next_rec, track, steps,
     fine_steps, first segment, resume inside it, error-controlled step)."""
@@ -436,7 +439,7 @@ def _begin_run(mechanics, contacts, y, work, carry, seg_t0, seg_x0, seg_fine, in
                 int(carry[C_SEGMENT]), carry[C_MID] != 0.0, carry[C_STEP])
     multiplicity = mechanics.multiplicity
     params, state, _ = contacts
-    x_a, v_a, T, u_old, a_nd = work[0], work[1], work[2], work[3], work[4]
+    x_a, v_a, T, u_old, a_nd = rows[0], rows[1], rows[2], rows[3], rows[4]
     G = multiplicity.shape[0]
     x_r = y[0]
     for g in range(G):
@@ -505,16 +508,16 @@ def _trig_kick(trig, omega, omega2, beta, a_r_new, x_r, xp_new, vp, y0, w0, ag0,
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
-def _quasi_midpoint(mechanics, contacts, work, g, balance_terms, x_r, nodes, quad):
+def _quasi_midpoint(mechanics, contacts, rows, g, balance_terms, x_r, nodes, quad):
     """Simpson middle node of group g in a quasi-static error-controlled step: x_a at mid-step
     from the balance over the first half step, one Newton step from the chord's midpoint
-    (within O(dt²) of it), into ``work[10]``; adds the group's start and mid-step terms to
-    ``quad`` = (input, damping, contact) and returns it."""
+    (within O(dt²) of it), into ``rows[10]`` (``rows``: the rows of ``Buffers.work``); adds
+    the group's start and mid-step terms to ``quad`` = (input, damping, contact), returned."""
     actuator_stiffness = mechanics.actuator_stiffness
     actuator_viscosity = mechanics.actuator_viscosity
     params, state, _ = contacts
-    x_a, T, u_old, stretch_old, xa_old, slope = work[0], work[2], work[3], work[5], work[6], work[7]
-    xa_mid, tangent = work[10], work[11]
+    x_a, T, u_old, stretch_old, xa_old, slope = rows[0], rows[2], rows[3], rows[5], rows[6], rows[7]
+    xa_mid, tangent = rows[10], rows[11]
     K, K_half, c_half, inv_K_half, inv_dt, center, dt = balance_terms
     xp_mid, xr_mid, vr_mid, vp, vr_old = nodes
     quad_in, quad_damp, quad_contact = quad
@@ -551,7 +554,7 @@ def _quasi_midpoint(mechanics, contacts, work, g, balance_terms, x_r, nodes, qua
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
-def _quasi_balance(mechanics, contacts, work, x_p, xp_new, x_r, xr_old, dt, simpson, nodes):
+def _quasi_balance(mechanics, contacts, rows, x_p, xp_new, x_r, xr_old, dt, simpson, nodes):
     """Drift of quasi-static actuators: each group's force balance solved at the step's end
     (:func:`quasi_static_position`, backward Euler in the damping term), and with ``simpson``
     its mid-step node (:func:`_quasi_midpoint`). Returns (K = k_p + c_p/dt, 1/dt, Σ n_g T_g at
@@ -559,7 +562,7 @@ def _quasi_balance(mechanics, contacts, work, x_p, xp_new, x_r, xr_old, dt, simp
     multiplicity = mechanics.multiplicity
     actuator_stiffness = mechanics.actuator_stiffness
     params, state, sliding = contacts
-    x_a, T, stretch_old, xa_old, slope = work[0], work[2], work[5], work[6], work[7]
+    x_a, T, stretch_old, xa_old, slope = rows[0], rows[2], rows[5], rows[6], rows[7]
     inv_dt = 1.0 / dt
     c_dt = mechanics.actuator_viscosity * inv_dt
     K = actuator_stiffness + c_dt
@@ -581,12 +584,12 @@ def _quasi_balance(mechanics, contacts, work, x_p, xp_new, x_r, xr_old, dt, simp
         F_trial += multiplicity[g] * K * (center - x_a[g])
         if simpson:
             terms = (K, K_half, c_half, inv_K_half, inv_dt, center, dt)
-            quad = _quasi_midpoint(mechanics, contacts, work, g, terms, x_r, nodes, quad)
+            quad = _quasi_midpoint(mechanics, contacts, rows, g, terms, x_r, nodes, quad)
     return K, inv_dt, F_trial, quad[0], quad[1], quad[2]
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
-def _step_factor(mechanics, contacts, work, rigid, F_trial, x_r, a_r, xp_new, y0, dt, g_rate, omega, omega2,
+def _step_factor(mechanics, contacts, rows, rigid, F_trial, x_r, a_r, xp_new, y0, dt, g_rate, omega, omega2,
                  beta, inv_mr, error_tolerance, small_error):
     """Local position error of the drift, dt³ x'''/6 with x''' ≈ Δa/dt, from the forces at the
     drifted positions with the memory as committed (pure; the quasi-static balance has them
@@ -594,7 +597,7 @@ def _step_factor(mechanics, contacts, work, rigid, F_trial, x_r, a_r, xp_new, y0
     if rigid:
         multiplicity = mechanics.multiplicity
         params, state, _ = contacts
-        x_a = work[0]
+        x_a = rows[0]
         F_trial = 0.0
         for g in range(multiplicity.shape[0]):
             F_trial += multiplicity[g] * contact_force_row(params, state, g, x_a[g] - x_r)
@@ -623,14 +626,14 @@ def _rigid_mid_force(mechanics, contacts, xp_mid, xr_mid):
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
-def _commit_contacts(mechanics, contacts, work, peak, track, x_r, v_r, vp, dt, K, controlled, simpson, x_p,
+def _commit_contacts(mechanics, contacts, rows, peak, track, x_r, v_r, vp, dt, K, controlled, simpson, x_p,
                      xp_new, acc_contact, acc_in):
     """Contact forces at the step's end, the memory committed once (twice when u turns inside an
     error-controlled step: first at the extremum). Returns (Σ n_g T_g, acc_contact, acc_in)."""
     multiplicity = mechanics.multiplicity
     rigid = mechanics.rigid
     params, state, sliding = contacts
-    x_a, T, u_old, slope, T_old = work[0], work[2], work[3], work[7], work[8]
+    x_a, T, u_old, slope, T_old = rows[0], rows[2], rows[3], rows[7], rows[8]
     F = 0.0
     for g in range(multiplicity.shape[0]):
         u = x_a[g] - x_r
@@ -664,7 +667,7 @@ def _commit_contacts(mechanics, contacts, work, peak, track, x_r, v_r, vp, dt, K
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
-def _quasi_kick(mechanics, work, x_p, xp_new, v_r, vp, dt, K, inv_dt, inv_ma, simpson, quad, acc_in, acc_damp,
+def _quasi_kick(mechanics, rows, x_p, xp_new, v_r, vp, dt, K, inv_dt, inv_ma, simpson, quad, acc_in, acc_damp,
                 acc_contact):
     """Actuator velocities and accelerations after a quasi-static step and its energy terms
     (Simpson's rule when ``simpson``, else backward Euler in the damping and trapezoidal input
@@ -673,8 +676,8 @@ def _quasi_kick(mechanics, work, x_p, xp_new, v_r, vp, dt, K, inv_dt, inv_ma, si
     actuator_stiffness = mechanics.actuator_stiffness
     actuator_viscosity = mechanics.actuator_viscosity
     half_kp = 0.5 * actuator_stiffness
-    x_a, v_a, T, a_nd, stretch_old, xa_old = work[0], work[1], work[2], work[4], work[5], work[6]
-    slope, xa_mid, tangent = work[7], work[10], work[11]
+    x_a, v_a, T, a_nd, stretch_old, xa_old = rows[0], rows[1], rows[2], rows[4], rows[5], rows[6]
+    slope, xa_mid, tangent = rows[7], rows[10], rows[11]
     quad_in, quad_damp, quad_contact = quad
     activity = 0.0
     for g in range(multiplicity.shape[0]):
@@ -704,14 +707,14 @@ def _quasi_kick(mechanics, work, x_p, xp_new, v_r, vp, dt, K, inv_dt, inv_ma, si
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
-def _actuator_kick(mechanics, work, x_p, xp_new, dt, gam, inv_ma, acc_damp, acc_in):
+def _actuator_kick(mechanics, rows, x_p, xp_new, dt, gam, inv_ma, acc_damp, acc_in):
     """Velocity Verlet kick of flexible actuators (damping trapezoidal, implicit in v) and its
     damping and input work. Returns (largest |ẍ_a|, acc_damp, acc_in)."""
     multiplicity = mechanics.multiplicity
     actuator_stiffness = mechanics.actuator_stiffness
     half_kp = 0.5 * actuator_stiffness
     half_cp = 0.5 * mechanics.actuator_viscosity
-    x_a, v_a, T, a_nd, stretch_old = work[0], work[1], work[2], work[4], work[5]
+    x_a, v_a, T, a_nd, stretch_old = rows[0], rows[1], rows[2], rows[4], rows[5]
     damp = 1.0 / (1.0 + 0.5 * dt * gam)
     activity = 0.0
     for g in range(multiplicity.shape[0]):
@@ -767,13 +770,13 @@ def _runaway(rigid, x_r, v_r, x_a, v_a, x_p):
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
-def _record_inside(contacts, work, record, rigid, n_rec, next_rec, record_interval, t_old, t, dt, xp_old, x_p,
+def _record_inside(contacts, rows, record, rigid, n_rec, next_rec, record_interval, t_old, t, dt, xp_old, x_p,
                    xr_old, x_r, vr_old, v_r):
     """Samples at their own times inside a long step: cubic Hermite in x_r (from the positions
     and velocities at both ends), linear in x_p, x_a and T; the slip share of the step's end.
     Returns (rows recorded, next sample time)."""
     params, state, _ = contacts
-    x_a, T, xa_old, T_old, share = work[0], work[2], work[6], work[8], work[9]
+    x_a, T, xa_old, T_old, share = rows[0], rows[2], rows[6], rows[8], rows[9]
     G = x_a.shape[0]
     max_rec = record.shape[0]
     for g in range(G):
@@ -799,11 +802,11 @@ def _record_inside(contacts, work, record, rigid, n_rec, next_rec, record_interv
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
-def _record_step_end(contacts, work, record, n_rec, next_rec, record_interval, t, x_p, x_r, v_r):
+def _record_step_end(contacts, rows, record, n_rec, next_rec, record_interval, t, x_p, x_r, v_r):
     """One sample at the step's end (the next sample time is at or before it). Returns (rows
     recorded, next sample time)."""
     params, state, _ = contacts
-    x_a, T = work[0], work[2]
+    x_a, T = rows[0], rows[2]
     record[n_rec, 0] = t
     record[n_rec, 1] = x_p
     record[n_rec, 2] = x_r
@@ -816,6 +819,88 @@ def _record_step_end(contacts, work, record, n_rec, next_rec, record_interval, t
     while next_rec <= t:
         next_rec += record_interval
     return n_rec, next_rec
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _open_segment(per, mark, in_window, k, track, x_r, rigid, control_on):
+    """Start of a segment: slip-mark tracking and the initial step control. Every piece starts
+    with the fine step (its corner excites the actuator mode); rigid actuators under error
+    control go on with the controlled step (a corner changes the rate of g, and the error
+    estimate adapts to it). Returns (track, fine, quasi, controlled, g_rate, h_prev, quiet,
+    acc) with the segment-local accumulators ``acc`` zero (see :func:`_save_segment`)."""
+    if mark:
+        track = k
+        per[k, PER_MARK_XR] = x_r
+        per[k, PER_MIN_XR] = x_r
+    if in_window and track >= 0 and k > track:
+        track = -1
+    min_xr = per[track, PER_MIN_XR] if track >= 0 else 0.0
+    # (g's rate is not known after the corner: x_p's rate changes there)
+    return (track, not (rigid and control_on), False, rigid and control_on, 0.0, 0.0, 0,
+            (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, min_xr))
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _step_length(fine, controlled, quasi, dt_ctrl, segments, s, t, vp):
+    """The next step: its length, end time, x_p there, and whether it ends the segment (a step
+    that would leave a sliver of the piece is stretched to its corner)."""
+    if fine:
+        dt = segments.fine[s]
+    elif controlled:
+        dt = min(dt_ctrl, segments.longest[s])
+    elif quasi:
+        dt = segments.quasi[s]
+    else:
+        dt = segments.coarse[s]
+    t_end = segments.t1[s]
+    if t_end - t <= dt * LAST_STEP_STRETCH:
+        return t_end - t, t_end, segments.x1[s], True
+    t_new = t + dt
+    return dt, t_new, segments.x0[s] + vp * (t_new - segments.t0[s]), False
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _linear_mode(linear_stiffness, load_stiffness, runner_mass):
+    """(Ω², Ω, β) of the error-controlled step: the runner on the linear spring K to x_p (and the
+    load cell) oscillates at Ω about z = β x_p; that part is integrated exactly."""
+    omega2 = (linear_stiffness + load_stiffness) / runner_mass
+    beta = linear_stiffness / (linear_stiffness + load_stiffness) if linear_stiffness > 0.0 else 0.0
+    return omega2, np.sqrt(omega2), beta
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _reject(carry, x_a, xa_old, rigid, x_p, xr_old, shorter, dt_fine):
+    """A rejected error-controlled step: positions back to the step's start, counted in
+    ``carry``. Returns (x_r, the step to retry with, not done)."""
+    for g in range(x_a.shape[0]):
+        x_a[g] = x_p if rigid else xa_old[g]
+    carry[C_REJECTED] += 1.0
+    return xr_old, max(shorter, dt_fine), False
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _measure(acc_xr, acc_f, acc_t, acc_win, min_xr, in_window, xr_old, x_r, F_old, F, x_p, xp_new, dt):
+    """The step's share of the per-period measures (trapezoidal; the window integral of
+    x_r − x_p only inside the settle window) and the lowest x_r."""
+    acc_xr += (xr_old + x_r) * dt
+    acc_f += (F_old + F) * dt
+    acc_t += dt
+    if in_window:
+        acc_win += ((xr_old - x_p) + (x_r - xp_new)) * dt
+    if x_r < min_xr:
+        min_xr = x_r
+    return acc_xr, acc_f, acc_t, acc_win, min_xr
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _save_state(y, x_r, v_r, x_a, v_a):
+    """The state into ``y`` = [x_r, v_r, x_a(0..G−1), v_a(0..G−1)] at the end of a run."""
+    G = x_a.shape[0]
+    y[0] = x_r
+    y[1] = v_r
+    for g in range(G):
+        y[2 + g] = x_a[g]
+        y[2 + G + g] = v_a[g]
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
@@ -847,11 +932,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
      seg_longest) = segments
     runner_mass, load_stiffness, multiplicity, rigid = mechanics[:4]
     actuator_mass, actuator_viscosity, linear_stiffness = mechanics[4], mechanics[6], mechanics[7]
-    # error-controlled step: the runner on the linear spring K to x_p (and the load cell)
-    # oscillates at Ω about z = β x_p; that part is integrated exactly (module docstring)
-    omega2 = (linear_stiffness + load_stiffness) / runner_mass
-    omega = np.sqrt(omega2)
-    beta = linear_stiffness / (linear_stiffness + load_stiffness) if linear_stiffness > 0.0 else 0.0
+    omega2, omega, beta = _linear_mode(linear_stiffness, load_stiffness, runner_mass)
     dt_trig = -1.0
     trig = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     y0 = w0 = ag0 = xp_mid = xr_mid = vr_mid = F_mid = 0.0  # drift terms and mid-step nodes
@@ -861,14 +942,17 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     # error estimates below this need no root: the step grows by the largest factor
     small_error = error_tolerance * (STEP_SAFETY / STEP_GROWTH) ** 4
     y, work, carry, record, per, peak, energy = buffers
+    # the rows of ``work`` as a tuple of views, made once: the helpers index it with constants
+    rows = (work[0], work[1], work[2], work[3], work[4], work[5], work[6], work[7], work[8], work[9],
+            work[10], work[11])
     x_r = y[0]
     v_r = y[1]
-    x_a, v_a, a_nd, stretch_old, xa_old, tangent = work[0], work[1], work[4], work[5], work[6], work[11]
+    x_a, v_a, a_nd, stretch_old, xa_old, tangent = rows[0], rows[1], rows[4], rows[5], rows[6], rows[11]
     gam = actuator_viscosity / actuator_mass
     inv_ma = 1.0 / actuator_mass
     inv_mr = 1.0 / runner_mass
     (t, x_p, a_r, F, n_rec, next_rec, track, steps, fine_steps, first_segment, resume,
-     dt_ctrl) = _begin_run(mechanics, contacts, y, work, carry, seg_t0, seg_x0, seg_fine, inv_ma, inv_mr)
+     dt_ctrl) = _begin_run(mechanics, contacts, y, rows, carry, seg_t0, seg_x0, seg_fine, inv_ma, inv_mr)
     for s in range(first_segment, seg_t0.shape[0]):
         k = seg_period[s]
         t_end = seg_t1[s]
@@ -881,50 +965,18 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
             (fine, quasi, controlled, g_rate, h_prev, quiet, acc_xr, acc_f, acc_win, acc_in, acc_damp,
              acc_contact, acc_t, min_xr) = _restore_segment(carry)
         else:
-            if seg_mark[s]:
-                track = k
-                per[k, PER_MARK_XR] = x_r
-                per[k, PER_MIN_XR] = x_r
-            if in_window and track >= 0 and k > track:
-                track = -1
-            # every piece starts with the fine step (its corner excites the actuator mode);
-            # rigid actuators under error control go on with the controlled step (a corner
-            # changes the rate of g, and the error estimate adapts to it)
-            fine = not (rigid and control_on)
-            quasi = False
-            controlled = rigid and control_on
-            g_rate = 0.0  # (x_p's rate changes at the corner: g's rate is not known)
-            h_prev = 0.0
-            quiet = 0
-            # segment-local accumulators (kept in registers, written back after the segment)
-            acc_xr = acc_f = acc_win = acc_in = acc_damp = acc_contact = acc_t = 0.0
-            min_xr = per[track, PER_MIN_XR] if track >= 0 else 0.0
+            track, fine, quasi, controlled, g_rate, h_prev, quiet, acc = _open_segment(
+                per, seg_mark[s], in_window, k, track, x_r, rigid, control_on)
+            acc_xr, acc_f, acc_win, acc_in, acc_damp, acc_contact, acc_t, min_xr = acc
         done = False
         while not done:
             if steps >= step_limit:  # pause: everything the loop carries goes to carry, y and work
                 _save_position(carry, s, 1.0, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps,
                                dt_ctrl)
-                _save_segment(carry, fine, quasi, controlled, g_rate, h_prev, quiet,
+                _save_segment(carry, y, x_r, v_r, fine, quasi, controlled, g_rate, h_prev, quiet,
                               (acc_xr, acc_f, acc_win, acc_in, acc_damp, acc_contact, acc_t, min_xr))
-                y[0] = x_r
-                y[1] = v_r
                 return STATUS_PAUSED, steps, n_rec, fine_steps
-            if fine:
-                dt = dt_fine
-            elif controlled:
-                dt = min(dt_ctrl, seg_longest[s])
-            elif quasi:
-                dt = seg_quasi[s]
-            else:
-                dt = seg_coarse[s]
-            if t_end - t <= dt * LAST_STEP_STRETCH:
-                dt = t_end - t
-                t_new = t_end
-                xp_new = seg_x1[s]
-                done = True
-            else:
-                t_new = t + dt
-                xp_new = seg_x0[s] + vp * (t_new - seg_t0[s])
+            dt, t_new, xp_new, done = _step_length(fine, controlled, quasi, dt_ctrl, segments, s, t, vp)
             if fine:
                 fine_steps += 1
             xr_old = x_r
@@ -946,31 +998,26 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                     x_a[g] = xp_new
             elif quasi:
                 K, inv_dt, F_trial, quad_in, quad_damp, quad_contact = _quasi_balance(
-                    mechanics, contacts, work, x_p, xp_new, x_r, xr_old, dt, simpson,
+                    mechanics, contacts, rows, x_p, xp_new, x_r, xr_old, dt, simpson,
                     (xp_mid, xr_mid, vr_mid, vp, vr_old))
             else:
                 for g in range(x_a.shape[0]):
                     stretch_old[g] = x_p - x_a[g]
                     x_a[g] += dt * v_a[g] + 0.5 * dt * dt * (a_nd[g] - gam * v_a[g])
             if controlled:
-                err, factor = _step_factor(mechanics, contacts, work, rigid, F_trial, x_r, a_r, xp_new, y0,
+                err, factor = _step_factor(mechanics, contacts, rows, rigid, F_trial, x_r, a_r, xp_new, y0,
                                            dt, g_rate, omega, omega2, beta, inv_mr, error_tolerance,
                                            small_error)
                 if err > error_tolerance and dt > dt_fine:
                     # rejected: back to the start of the step, to retry with a shorter one
-                    x_r = xr_old
-                    for g in range(x_a.shape[0]):
-                        x_a[g] = x_p if rigid else xa_old[g]
-                    dt_ctrl = max(dt * factor, dt_fine)
-                    done = False
+                    x_r, dt_ctrl, done = _reject(carry, x_a, xa_old, rigid, x_p, xr_old, dt * factor, dt_fine)
                     steps += 1
-                    carry[C_REJECTED] += 1.0
                     continue
                 if not done:
                     dt_ctrl = min(dt * factor, seg_longest[s])
             if simpson and rigid:
                 F_mid = _rigid_mid_force(mechanics, contacts, xp_mid, xr_mid)
-            F, acc_contact, acc_in = _commit_contacts(mechanics, contacts, work, peak, track, x_r, v_r, vp,
+            F, acc_contact, acc_in = _commit_contacts(mechanics, contacts, rows, peak, track, x_r, v_r, vp,
                                                       dt, K, controlled, simpson, x_p, xp_new, acc_contact,
                                                       acc_in)
             a_r_new = (F - load_stiffness * x_r) * inv_mr  # kick
@@ -986,7 +1033,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                                            + (vp - v_r) * F)
             if quasi:
                 activity, acc_in, acc_damp, acc_contact = _quasi_kick(
-                    mechanics, work, x_p, xp_new, v_r, vp, dt, K, inv_dt, inv_ma, simpson,
+                    mechanics, rows, x_p, xp_new, v_r, vp, dt, K, inv_dt, inv_ma, simpson,
                     (quad_in, quad_damp, quad_contact), acc_in, acc_damp, acc_contact)
                 if activity >= activity_threshold:
                     fine = True
@@ -994,20 +1041,14 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                     controlled = False
                     quiet = 0
             elif not rigid:
-                activity, acc_damp, acc_in = _actuator_kick(mechanics, work, x_p, xp_new, dt, gam, inv_ma,
+                activity, acc_damp, acc_in = _actuator_kick(mechanics, rows, x_p, xp_new, dt, gam, inv_ma,
                                                             acc_damp, acc_in)
                 if adaptive:
                     fine, quasi, controlled, quiet, dt_ctrl, g_rate, h_prev = _adapt(
                         activity, activity_threshold, quiet_steps, quasi_static, control_on, fine, quasi,
                         controlled, quiet, dt_ctrl, seg_quasi[s], g_rate, h_prev, tangent)
-            # per-period measures
-            acc_xr += (xr_old + x_r) * dt
-            acc_f += (F_old + F) * dt
-            acc_t += dt
-            if in_window:
-                acc_win += ((xr_old - x_p) + (x_r - xp_new)) * dt
-            if x_r < min_xr:
-                min_xr = x_r
+            acc_xr, acc_f, acc_t, acc_win, min_xr = _measure(acc_xr, acc_f, acc_t, acc_win, min_xr, in_window,
+                                                             xr_old, x_r, F_old, F, x_p, xp_new, dt)
             t_old = t
             xp_old = x_p
             t = t_new
@@ -1018,11 +1059,11 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                 y[1] = v_r
                 return STATUS_DIVERGED, steps, n_rec, fine_steps
             if controlled and next_rec <= t and n_rec < record.shape[0]:
-                n_rec, next_rec = _record_inside(contacts, work, record, rigid, n_rec, next_rec,
+                n_rec, next_rec = _record_inside(contacts, rows, record, rigid, n_rec, next_rec,
                                                  record_interval, t_old, t, dt, xp_old, x_p, xr_old, x_r,
                                                  vr_old, v_r)
             elif t >= next_rec and n_rec < record.shape[0]:
-                n_rec, next_rec = _record_step_end(contacts, work, record, n_rec, next_rec, record_interval,
+                n_rec, next_rec = _record_step_end(contacts, rows, record, n_rec, next_rec, record_interval,
                                                    t, x_p, x_r, v_r)
         _close_segment(per, energy, k, track, in_window, seg_x1[s],
                        (acc_xr, acc_f, acc_win, acc_in, acc_damp, acc_contact, acc_t, min_xr))
@@ -1030,9 +1071,5 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     # with these segments followed by more (the same arrays, longer) continues the run
     _save_position(carry, seg_t0.shape[0], 0.0, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps,
                    dt_ctrl)
-    y[0] = x_r
-    y[1] = v_r
-    for g in range(x_a.shape[0]):
-        y[2 + g] = x_a[g]
-        y[2 + x_a.shape[0] + g] = v_a[g]
+    _save_state(y, x_r, v_r, x_a, v_a)
     return STATUS_OK, steps, n_rec, fine_steps
