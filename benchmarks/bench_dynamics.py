@@ -13,8 +13,9 @@ step's.
 
 Kernel comparison: the kernel of :data:`OLD_KERNEL_COMMIT` (one numba function before its
 split into inline helpers, loaded from ``git show`` into a module of its own) and the current
-one run the same configurations in alternation in this one process; the medians of their
-wall times, their ratio (current / old), and whether the two runs agree to the last bit.
+one run the same configurations in alternation in this one process, each first in every other
+pair; the medians of their wall times, their ratio (current / old), and whether the two runs
+agree to the last bit.
 
 Start-up: the median time from launching ``passmd run --periods 1`` to its first
 integrator step (warm: bytecode and numba caches written by an untimed first launch),
@@ -105,9 +106,10 @@ def _outcome(res) -> tuple:
             res.final_state.tobytes(), res.runner_position.tobytes(), tuple(sorted(res.energy.items())))
 
 
-def compare_kernels(commit: str, repeats: int, springs: int = 200) -> list:
-    """Old and current kernel on :data:`KERNEL_CONFIGS`, timed in alternation: medians (ms per
-    100 Hz period), their ratio, and whether the results are identical to the last bit."""
+def compare_kernels(commit: str, pairs: int, springs: int = 200) -> list:
+    """Old and current kernel on :data:`KERNEL_CONFIGS`, timed in ``pairs`` alternating pairs
+    (each kernel first in every other one): medians (ms per 100 Hz period), their ratio, and
+    whether the results are identical to the last bit."""
     old = old_kernel(commit)
     rows = []
     for contacts, model, contact, scheme in KERNEL_CONFIGS:
@@ -116,8 +118,11 @@ def compare_kernels(commit: str, repeats: int, springs: int = 200) -> list:
         wf = waveforms.sawtooth(150e-9, PROTOCOL.drive_frequency, drive, periods=PERIODS)
         walls = {"old": [], "new": []}
         outcome = {}
-        for i in range(repeats + 1):
-            for name, module in (("old", old), ("new", None)):
+        for i in range(pairs + 1):
+            # the order alternates: the second run of a pair is slowed by the first (measured:
+            # ≈ 20 % in either order), a fixed order would charge that to one kernel
+            pair = (("old", old), ("new", None)) if i % 2 else (("new", None), ("old", old))
+            for name, module in pair:
                 with running(module):
                     res = dynamics.simulate(drive, wf, **kw)
                 if i:  # the first round compiles
@@ -282,12 +287,17 @@ def main(argv=None) -> int:
     ap.add_argument("--repeats", type=int, default=5, help="timed repeats per configuration (median)")
     ap.add_argument("--old-kernel", default=OLD_KERNEL_COMMIT,
                     help="commit whose kernel the current one is timed against")
+    ap.add_argument("--kernel-pairs", type=int, default=40,
+                    help="timed old/new pairs per configuration of the kernel comparison (even: each "
+                         "kernel first in half of them)")
     ap.add_argument("--kernel-only", action="store_true", help="only the kernel comparison (not written)")
     ap.add_argument("--out", type=Path,
                     default=Path(__file__).resolve().parents[1] / "passmd/data/benchmarks/dynamics.json")
     args = ap.parse_args(argv)
+    if args.kernel_pairs < 2 or args.kernel_pairs % 2:
+        ap.error(f"--kernel-pairs {args.kernel_pairs} is out of range: must be an even number >= 2")
     load_before = os.getloadavg()
-    kernels = compare_kernels(args.old_kernel, args.repeats)
+    kernels = compare_kernels(args.old_kernel, args.kernel_pairs)
     for r in kernels:
         print(f"kernel {r['contacts']} {r['actuator']} {r['contact_model']} {r['step']}: old "
               f"{r['old_ms_per_100Hz_period']:.3f} ms, new {r['new_ms_per_100Hz_period']:.3f} ms per period, "
@@ -305,6 +315,7 @@ def main(argv=None) -> int:
         "machine": platform.processor() or platform.machine(),
         "python": platform.python_version(),
         "repeats": args.repeats,
+        "kernel_pairs": args.kernel_pairs,
         "periods_per_run": PERIODS,
         "cpus": os.cpu_count(),
         "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()),
