@@ -16,8 +16,10 @@ from pathlib import Path
 
 __all__ = ["KERNEL_MODULES", "kernels_cold", "notice_if_cold"]
 
-#: The modules whose ``@njit(cache=True)`` functions a simulation compiles.
-KERNEL_MODULES = ("_dynamics_kernel", "_contact_kernels", "contact")
+#: The modules whose ``@njit(cache=True)`` functions every simulation compiles (the step loop
+#: and the contact kernels it calls). Not :mod:`passmd.contact`: its array kernels serve
+#: MDRContact's methods, which no simulation calls, so a simulation never writes their index.
+KERNEL_MODULES = ("_dynamics_kernel", "_contact_kernels")
 
 NOTICE = "compiling the simulation kernels (≈ 20 s, once) …"
 
