@@ -1,15 +1,21 @@
 """Speed of the hybrid simulator: ns per integrator step and wall time per 100 Hz period.
 
 Runs each configuration (one/six contacts × rigid/flexible × exact/discrete N = 200) with
-each step control: the default error-controlled step ("controlled"), the fixed fine step
-(the reference scheme) and, for flexible actuators, the explicit adaptive step and the
-quasi-static actuator step at a fixed runner step (the schemes before the error control,
-``simulate(..., error_control=False)``). Each run is three 100 Hz saw-tooth periods (150 nm,
+each integration scheme (:data:`passmd.solver.steps.SCHEMES`): the default error-controlled
+step ("controlled"), the fixed fine step ("fixed", the reference) and, for flexible
+actuators, the explicit adaptive step ("adaptive") and the quasi-static actuator at a fixed
+runner step ("quasi-static"). Each run is three 100 Hz saw-tooth periods (150 nm,
 0.4 N, R = 1 mm: the first from rest, two after a slip), repeated; the medians of the wall
 time give ms per period (wall / 3) and ns per integrator step (rejected error-controlled
 steps included). numba compilation happens in an untimed warm-up run. Each row also gives
 the largest difference of the settled positions of the three periods from the fixed fine
 step's.
+
+Kernel comparison: the kernel of :data:`OLD_KERNEL_COMMIT` (one numba function before its
+split into inline helpers, loaded from ``git show`` into a module of its own) and the current
+one run the same configurations in alternation in this one process, each first in every other
+pair; the medians of their wall times, their ratio (current / old), and whether the two runs
+agree to the last bit.
 
 Start-up: the median time from launching ``passmd run --periods 1`` to its first
 integrator step (warm: bytecode and numba caches written by an untimed first launch),
@@ -24,14 +30,19 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import os
 import platform
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
+from contextlib import contextmanager
 from pathlib import Path
+
+import numpy as np
 
 from passmd.model import waveforms
 from passmd.model.defaults import PROTOCOL
@@ -47,15 +58,83 @@ CONFIGS = [
     for control in (("fixed", "controlled", "adaptive", "quasi-static") if model == "flexible"
                     else ("fixed", "controlled"))
 ]
-#: Keyword arguments of :func:`passmd.solver.simulation.simulate` for each step control.
-CONTROLS = {
-    "controlled": {},
-    "adaptive": {"error_control": False},
-    "quasi-static": {"error_control": False, "quasi_static": True},
-    "fixed": {"adaptive": False},
-}
 #: 100 Hz periods of each timed run (the first from rest, the others after a slip).
 PERIODS = 3
+
+
+#: The commit whose kernel the current one is timed against (the last with ``_integrate`` as
+#: one function).
+OLD_KERNEL_COMMIT = "37f6f0a9a427d3fbfea40a9de15b88372af24c65"
+#: Configurations of the kernel comparison: (contacts, actuators, contact model, scheme).
+KERNEL_CONFIGS = [(6, "flexible", "exact", "controlled"), (6, "rigid", "exact", "controlled"),
+                  (6, "flexible", "exact", "adaptive"), (6, "flexible", "discrete", "controlled"),
+                  (1, "flexible", "exact", "quasi-static")]
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def old_kernel(commit: str):
+    """``passmd/solver/kernels.py`` of ``commit`` as a module of its own (in a temporary
+    directory, so that its numba cache does not touch the package's)."""
+    source = subprocess.run(["git", "-C", str(ROOT), "show", f"{commit}:passmd/solver/kernels.py"],
+                            capture_output=True, text=True, check=True).stdout
+    path = Path(tempfile.mkdtemp(prefix="passmd-old-kernel-")) / "passmd_old_kernel.py"
+    path.write_text(source)
+    spec = importlib.util.spec_from_file_location("passmd_old_kernel", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@contextmanager
+def running(module):
+    """:mod:`passmd.solver.simulation` integrates with ``module``'s kernel (None: the current one); the
+    argument records are rebuilt as that module's NamedTuples."""
+    current = dynamics.kern.integrate
+    if module is not None:
+        def integrate(segments, mechanics, control, contacts, buffers, limit):
+            return module.integrate(module.Segments(*segments), module.Mechanics(*mechanics),
+                                    module.StepControl(*control), module.Contacts(*contacts),
+                                    module.Buffers(*buffers), limit)
+        dynamics.kern.integrate = integrate
+    try:
+        yield
+    finally:
+        dynamics.kern.integrate = current
+
+
+def _outcome(res) -> tuple:
+    return (res.steps, res.fine_steps, res.rejected_steps, res.settled_positions.tobytes(),
+            res.final_state.tobytes(), res.runner_position.tobytes(), tuple(sorted(res.energy.items())))
+
+
+def compare_kernels(commit: str, pairs: int, springs: int = 200) -> list:
+    """Old and current kernel on :data:`KERNEL_CONFIGS`, timed in ``pairs`` alternating pairs
+    (each kernel first in every other one): medians (ms per 100 Hz period), their ratio, and
+    whether the results are identical to the last bit."""
+    old = old_kernel(commit)
+    rows = []
+    for contacts, model, contact, scheme in KERNEL_CONFIGS:
+        drive = Drive(contacts=contacts, actuator_model=model)
+        kw = dict(contact_model=contact, springs=springs, scheme=scheme, max_points=2000)
+        wf = waveforms.sawtooth(150e-9, PROTOCOL.drive_frequency, drive, periods=PERIODS)
+        walls = {"old": [], "new": []}
+        outcome = {}
+        for i in range(pairs + 1):
+            # the order alternates: the second run of a pair is slowed by the first (measured:
+            # ≈ 20 % in either order), a fixed order would charge that to one kernel
+            pair = (("old", old), ("new", None)) if i % 2 else (("new", None), ("old", old))
+            for name, module in pair:
+                with running(module):
+                    res = dynamics.simulate(drive, wf, **kw)
+                if i:  # the first round compiles
+                    walls[name].append(res.wall_time)
+                outcome[name] = _outcome(res)
+        old_ms, new_ms = (float(np.median(walls[n])) / PERIODS * 1e3 for n in ("old", "new"))
+        rows.append({"contacts": contacts, "actuator": model, "contact_model": contact, "step": scheme,
+                     "old_ms_per_100Hz_period": old_ms, "new_ms_per_100Hz_period": new_ms,
+                     "new_over_old": new_ms / old_ms, "identical": outcome["old"] == outcome["new"],
+                     "old_all_s": walls["old"], "new_all_s": walls["new"]})
+    return rows
 
 
 #: modules the ``run`` command should not need (imported only by other commands)
@@ -134,7 +213,7 @@ _REFERENCE: dict = {}
 
 def bench(contacts: int, model: str, contact: str, control: str, repeats: int, springs: int = 200) -> dict:
     drive = Drive(contacts=contacts, actuator_model=model)
-    kw = dict(contact_model=contact, springs=springs, **CONTROLS[control])
+    kw = dict(contact_model=contact, springs=springs, scheme=control)
     warm = waveforms.sawtooth(150e-9, 10e3, drive, periods=1)
     dynamics.simulate(drive, warm, **kw)  # compile
     wf = waveforms.sawtooth(150e-9, PROTOCOL.drive_frequency, drive, periods=PERIODS)
@@ -208,10 +287,25 @@ def markdown(rows: list) -> str:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5, help="timed repeats per configuration (median)")
+    ap.add_argument("--old-kernel", default=OLD_KERNEL_COMMIT,
+                    help="commit whose kernel the current one is timed against")
+    ap.add_argument("--kernel-pairs", type=int, default=40,
+                    help="timed old/new pairs per configuration of the kernel comparison (even: each "
+                         "kernel first in half of them)")
+    ap.add_argument("--kernel-only", action="store_true", help="only the kernel comparison (not written)")
     ap.add_argument("--out", type=Path,
                     default=Path(__file__).resolve().parents[1] / "passmd/data/benchmarks/dynamics.json")
     args = ap.parse_args(argv)
+    if args.kernel_pairs < 2 or args.kernel_pairs % 2:
+        ap.error(f"--kernel-pairs {args.kernel_pairs} is out of range: must be an even number >= 2")
     load_before = os.getloadavg()
+    kernels = compare_kernels(args.old_kernel, args.kernel_pairs)
+    for r in kernels:
+        print(f"kernel {r['contacts']} {r['actuator']} {r['contact_model']} {r['step']}: old "
+              f"{r['old_ms_per_100Hz_period']:.3f} ms, new {r['new_ms_per_100Hz_period']:.3f} ms per period, "
+              f"new/old {r['new_over_old']:.3f}, identical: {r['identical']}")
+    if args.kernel_only:
+        return 0
     rows = [bench(c, m, k, control, args.repeats) for c, m, k, control in CONFIGS]
     start = startup(args.repeats)
     spread = across_processes(args.repeats, args.repeats)
@@ -223,6 +317,7 @@ def main(argv=None) -> int:
         "machine": platform.processor() or platform.machine(),
         "python": platform.python_version(),
         "repeats": args.repeats,
+        "kernel_pairs": args.kernel_pairs,
         "periods_per_run": PERIODS,
         "cpus": os.cpu_count(),
         "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()),
@@ -235,7 +330,9 @@ def main(argv=None) -> int:
           f"{len(spread['ms_per_100Hz_period_per_process'])} processes "
           f"({', '.join(f'{v:.2f}' for v in spread['ms_per_100Hz_period_per_process'])})")
     args.out.write_text(json.dumps({"meta": meta, "rows": rows, "startup": start,
-                                    "across_processes": spread}, indent=2))
+                                    "across_processes": spread,
+                                    "kernel_comparison": {"old_commit": args.old_kernel, "rows": kernels}},
+                                   indent=2))
     print(f"written {args.out}")
     return 0
 

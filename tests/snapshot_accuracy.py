@@ -20,6 +20,7 @@ from passmd.experiments.numerics import figures as acc
 from passmd.model.parameters import Drive
 from passmd.runtime.config import RunConfig
 from passmd.solver import simulation as dynamics
+from passmd.solver.steps import DEFAULT_SCHEME, resolve_scheme
 
 #: Columns computed without the integrator (inputs, closed forms, booleans): rounding only.
 EXACT = {"rtol": 1e-9, "atol": 1e-12}
@@ -88,16 +89,21 @@ def finer_run(factor: float = FINER):
     """Within the block every simulation runs ``factor`` times finer.
 
     Patches ``dynamics.Simulation``, which ``dynamics.simulate`` and the stall protocol
-    construct: the explicit steps are divided by ``factor`` and the error-controlled step's
-    local tolerance by ``factor``⁴ (its step then shrinks about ``factor`` times); runs already
-    asking for a finer setting get it ``factor`` times finer again. Sweeps inside must run
-    serially with a cache of their own (:func:`finer_config`).
+    construct: each run's scheme is refined by ``factor`` (:class:`passmd.solver.steps.Scheme`
+    ``refine``: explicit steps divided by it, the error-controlled step's local tolerance by its
+    fourth power, so that step shrinks about ``factor`` times); a fixed ``dt`` is divided by it.
+    Sweeps inside must run serially with a cache of their own (:func:`finer_config`).
     """
     default = dynamics.Simulation
 
     class Finer(default):
-        def __init__(self, *args, resolution: float = 1.0, **kwargs):
-            super().__init__(*args, resolution=resolution * factor, **kwargs)
+        def __init__(self, *args, scheme=DEFAULT_SCHEME, **kwargs):
+            scheme = resolve_scheme(scheme)
+            if scheme.dt:
+                finer = scheme.replace(dt=scheme.dt / factor)
+            else:
+                finer = scheme.replace(refine=scheme.refine * factor)
+            super().__init__(*args, scheme=finer, **kwargs)
 
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(dynamics, "Simulation", Finer)

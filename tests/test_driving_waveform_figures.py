@@ -16,10 +16,10 @@ import pandas as pd
 import pytest
 import snapshot_accuracy as snap
 
-from passmd.experiments.driving_waveform import claims_velocity as dw_claims
 from passmd.experiments.driving_waveform import facts as wf
 from passmd.experiments.driving_waveform import figures as dw
 from passmd.experiments.driving_waveform import studies
+from passmd.experiments.driving_waveform.figures import claims_velocity as dw_claims
 from passmd.model import theory, waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.optimized_waveform import OptimizedDesign, max_piezo_velocity, optimized
@@ -152,7 +152,8 @@ def test_fig10_steady_step_at_130_khz_is_converged(quick, monkeypatch, preload, 
     row = row.iloc[0]
     point = {name: row[name] for name in inspect.signature(dw.velocity_point).parameters}
     default_simulate = dynamics.simulate
-    monkeypatch.setattr(dynamics, "simulate", functools.partial(default_simulate, dt=CONVERGED_DT))
+    monkeypatch.setattr(dynamics, "simulate", functools.partial(default_simulate,
+                                                       scheme=time_steps.SCHEMES["fixed"].replace(dt=CONVERGED_DT)))
     converged = dw.velocity_point(**point)
     assert converged["periods"] == row["periods"]
     assert abs(row["step_m"] - converged["step_m"]) < time_steps.CONVERGED_ACCURACY

@@ -12,6 +12,7 @@ from passmd.model.contact import contact_arrays, contact_stiffness, stack_contac
 from passmd.model.parameters import Drive
 from passmd.solver import simulation as dynamics
 from passmd.solver import steps as time_steps
+from passmd.solver.steps import SCHEMES
 
 F_TEST = 1000.0  # Hz: 1 ms periods keep tests fast; the runner mode (~5-11 kHz) settles within
 
@@ -107,7 +108,7 @@ def test_time_step_convergence(model):
     d = Drive(contacts=1, actuator_model=model)
     wf = waveforms.sawtooth(120e-9, F_TEST, d, periods=3)
     coarse = dynamics.simulate(d, wf).final_position
-    fine = dynamics.simulate(d, wf, resolution=2.0).final_position
+    fine = dynamics.simulate(d, wf, scheme=SCHEMES["controlled"].replace(refine=2.0)).final_position
     assert abs(fine - coarse) < 0.005 * abs(fine)
 
 
@@ -135,7 +136,7 @@ def test_error_controlled_energy_balance_at_100_hz(contacts, model):
     d = Drive(contacts=contacts, actuator_model=model)
     for amplitude in (20e-9, 202e-9):
         default = run(d, amplitude, periods=3, frequency=100.0, max_points=2)
-        explicit = run(d, amplitude, periods=3, frequency=100.0, max_points=2, error_control=False)
+        explicit = run(d, amplitude, periods=3, frequency=100.0, max_points=2, scheme="adaptive")
         residual = abs(default.energy_balance()["relative_residual"])
         reference = abs(explicit.energy_balance()["relative_residual"])
         assert residual < 1e-5, (amplitude, residual)
@@ -148,7 +149,7 @@ def test_divergence_is_reported(monkeypatch):
     plan_dt = time_steps.step_plan(d, 3e6, 3e6).stability_limit
     monkeypatch.setattr(dynamics, "STABILITY_MARGIN", 100.0)  # let an unstable step through
     with pytest.raises(dynamics.SimulationError, match=r"diverged at integrator step \d+.*time step"):
-        dynamics.simulate(d, wf, dt=5 * plan_dt)
+        dynamics.simulate(d, wf, scheme=SCHEMES["fixed"].replace(dt=5 * plan_dt))
 
 
 def test_kernel_wrapper_refuses_a_wrong_array_naming_it(monkeypatch):
@@ -185,11 +186,44 @@ def test_bad_inputs():
         waveforms.piecewise_linear([0, 6e-4, 4e-4, 1e-3], [0, 1e-8, 2e-8, 0], F_TEST, 1, (1e-4, 2e-4), 6e-4)
     wf = waveforms.sawtooth(10e-9, F_TEST, d)
     with pytest.raises(ValueError, match=r"^dt = 1e-05 is out of range: .*stable"):
-        dynamics.simulate(one_contact("flexible"), wf, dt=1e-5)
+        dynamics.simulate(one_contact("flexible"), wf, scheme=SCHEMES["fixed"].replace(dt=1e-5))
     with pytest.raises(ValueError, match=r"^contact_model = 'soft'"):
         dynamics.simulate(d, wf, contact_model="soft")
     with pytest.raises(ValueError, match=r"^frequency = 400000.0 is out of range"):
         waveforms.sawtooth(202e-9, 4e5, Drive())
+
+
+@pytest.mark.parametrize("model", ["rigid", "flexible"])
+@pytest.mark.parametrize("name", list(SCHEMES))
+def test_every_scheme_runs_and_agrees(model, name):
+    """Each named scheme integrates a 2-period run to within the converged accuracy
+    (time_steps.CONVERGED_ACCURACY) of the fixed fine step; error control rejects steps only
+    where it is on."""
+    d = one_contact(model)
+    wf = waveforms.sawtooth(150e-9, F_TEST, d, periods=2)
+    ref = dynamics.simulate(d, wf, scheme="fixed", max_points=2)
+    res = dynamics.simulate(d, wf, scheme=name, max_points=2)
+    np.testing.assert_allclose(res.settled_positions, ref.settled_positions, rtol=0,
+                               atol=time_steps.CONVERGED_ACCURACY)
+    if name != "controlled":
+        assert res.rejected_steps == 0
+    assert res.fine_step == ref.fine_step
+    if name != "fixed" and model == "flexible":
+        assert res.steps < ref.steps / 2  # the quiet phases take longer steps
+
+
+def test_bad_scheme_is_one_line_naming_it():
+    d = one_contact()
+    wf = waveforms.sawtooth(50e-9, F_TEST, d, periods=1)
+    with pytest.raises(ValueError) as err:
+        dynamics.simulate(d, wf, scheme="verlet")
+    message = str(err.value)
+    assert message == ("scheme = 'verlet' is not allowed: must be one of 'controlled', 'adaptive', "
+                       "'quasi-static', 'fixed' or a passmd.solver.steps.Scheme")
+    with pytest.raises(ValueError, match=r"^dt = 1e-09 is not allowed with scheme 'adaptive'"):
+        SCHEMES["adaptive"].replace(dt=1e-9)
+    with pytest.raises(ValueError, match=r"^refine = -2.0 is out of range"):
+        SCHEMES["controlled"].replace(refine=-2.0)
 
 
 def test_summary_keys_and_units():
@@ -237,15 +271,15 @@ FIELDS = ("time", "runner_position", "runner_velocity", "actuator_position", "fr
 
 @pytest.mark.parametrize("model", ["rigid", "flexible"])
 @pytest.mark.parametrize("contacts", [1, 6])
-@pytest.mark.parametrize("error_control", [True, False])
-def test_chunked_run_is_bit_identical(monkeypatch, model, contacts, error_control):
+@pytest.mark.parametrize("scheme", ["controlled", "adaptive"])
+def test_chunked_run_is_bit_identical(monkeypatch, model, contacts, scheme):
     """The kernel pauses every CHUNK_STEPS steps (also inside a waveform piece) and resumes
     from its carried state: the run must be the uninterrupted run to the last bit."""
     d = Drive(actuator_model=model, contacts=contacts)
     wf = waveforms.sawtooth(150e-9, F_TEST, d, periods=3)
-    whole = dynamics.simulate(d, wf, max_points=3000, error_control=error_control)
+    whole = dynamics.simulate(d, wf, max_points=3000, scheme=scheme)
     monkeypatch.setattr(dynamics, "CHUNK_STEPS", 997)  # prime: pauses land everywhere
-    chunked = dynamics.simulate(d, wf, max_points=3000, error_control=error_control)
+    chunked = dynamics.simulate(d, wf, max_points=3000, scheme=scheme)
     assert chunked.steps == whole.steps and chunked.fine_steps == whole.fine_steps
     assert chunked.rejected_steps == whole.rejected_steps
     for name in FIELDS:
@@ -260,21 +294,21 @@ PERIOD_FIELDS = ("settled_positions", "back_steps", "peak_force_ratio", "period_
                  "period_mean_friction", "final_state")
 
 
-@pytest.mark.parametrize("model, contacts, quasi", [("rigid", 1, False), ("rigid", 6, False),
-                                                    ("flexible", 1, False), ("flexible", 6, False),
-                                                    ("flexible", 6, True)])
-def test_continued_simulation_is_the_shorter_run(monkeypatch, model, contacts, quasi):
+@pytest.mark.parametrize("model, contacts, scheme", [
+    ("rigid", 1, "controlled"), ("rigid", 6, "controlled"), ("flexible", 1, "controlled"),
+    ("flexible", 6, "controlled"), ("flexible", 6, "quasi-static")])
+def test_continued_simulation_is_the_shorter_run(monkeypatch, model, contacts, scheme):
     """A saw-tooth run stopped after n periods is the n-period run to the last bit, and running
     on (in several calls, with pauses anywhere) gives the run of the whole waveform."""
     monkeypatch.setattr(dynamics, "CHUNK_STEPS", 997)  # pauses also inside pieces
     d = Drive(actuator_model=model, contacts=contacts)
     wave = waveforms.sawtooth(150e-9, F_TEST, d, periods=5)
-    sim = dynamics.Simulation(d, wave, max_points=3000, quasi_static=quasi)
+    sim = dynamics.Simulation(d, wave, max_points=3000, scheme=scheme)
     sim.run_to(2)
     early = sim.result()
     kept = {name: getattr(early, name).copy() for name in PERIOD_FIELDS}
     short = dynamics.simulate(d, waveforms.sawtooth(150e-9, F_TEST, d, periods=2), max_points=3000,
-                              quasi_static=quasi)
+                              scheme=scheme)
     np.testing.assert_array_equal(early.waveform.times, short.waveform.times)
     np.testing.assert_array_equal(early.waveform.positions, short.waveform.positions)
     np.testing.assert_array_equal(early.waveform.settle_windows, short.waveform.settle_windows)
@@ -286,7 +320,7 @@ def test_continued_simulation_is_the_shorter_run(monkeypatch, model, contacts, q
     sim.run_to(3)
     sim.run_to(3)  # already there: nothing to do
     sim.run_to(5)
-    whole = dynamics.simulate(d, wave, max_points=3000, quasi_static=quasi)
+    whole = dynamics.simulate(d, wave, max_points=3000, scheme=scheme)
     continued = sim.result()
     assert continued.waveform is wave and continued.steps == whole.steps
     for name in FIELDS:
@@ -318,14 +352,14 @@ def test_continued_simulation_is_refused_as_the_shorter_run(monkeypatch):
     assert sim.periods_done == 2
 
 
-@pytest.mark.parametrize("error_control", [False, True])
-def test_expected_steps_match_the_run(error_control):
+@pytest.mark.parametrize("scheme", ["adaptive", "controlled"])
+def test_expected_steps_match_the_run(scheme):
     """The pre-run estimate is exact for fixed steps and a close lower bound when adaptive;
     error-controlled runs take fewer steps than it (it counts their uncontrolled steps)."""
     for model in ("rigid", "flexible"):
         d = Drive(actuator_model=model)
         wf = waveforms.sawtooth(202e-9, 100.0, d, periods=1)
-        res = dynamics.simulate(d, wf, error_control=error_control)
+        res = dynamics.simulate(d, wf, scheme=scheme)
         E, G = theory.contact_moduli(d)
         forces, mult = dynamics.contact_groups(d)
         rows = [contact_arrays("exact", F, d.hemisphere_radius, E, G, d.friction_coefficient) for F in forces]
@@ -333,7 +367,7 @@ def test_expected_steps_match_the_run(error_control):
         ks = np.array([contact_stiffness(params[g]) for g in range(len(rows))])
         plan = time_steps.step_plan(d, ks.max(), float(np.sum(mult * ks)))
         est = time_steps.expected_steps(wf, plan, res.fine_step, res.coarse_step).sum()
-        if error_control:
+        if scheme == "controlled":
             assert res.steps < est
             continue
         # rigid: every step is planned; flexible: ringing after the slip adds fine steps (< 2 %)
@@ -364,7 +398,8 @@ def test_step_below_the_time_resolution_is_refused():
         dynamics.simulate(light, waveforms.sawtooth(20e-9, F_TEST, light, periods=2))
     flexible = one_contact("flexible")
     with pytest.raises(time_steps.WorkLimitError, match=r"dt = 1e-22 s"):
-        dynamics.simulate(flexible, waveforms.sawtooth(20e-9, F_TEST, flexible, periods=2), dt=1e-22)
+        dynamics.simulate(flexible, waveforms.sawtooth(20e-9, F_TEST, flexible, periods=2),
+                          scheme=SCHEMES["fixed"].replace(dt=1e-22))
 
 
 def test_progress_bar_on_request(monkeypatch, capsys):
@@ -389,9 +424,8 @@ def test_quasi_static_step_matches_the_fixed_fine_step(contacts, contact):
     (the reference scheme), at the full stroke where the slips are largest."""
     d = Drive(contacts=contacts, actuator_model="flexible")
     wf = waveforms.sawtooth(202e-9, 100.0, d, periods=3)
-    ref = dynamics.simulate(d, wf, adaptive=False, contact_model=contact, max_points=2)
-    quasi = dynamics.simulate(d, wf, contact_model=contact, max_points=2, quasi_static=True,
-                              error_control=False)
+    ref = dynamics.simulate(d, wf, scheme="fixed", contact_model=contact, max_points=2)
+    quasi = dynamics.simulate(d, wf, contact_model=contact, max_points=2, scheme="quasi-static")
     assert quasi.steps < ref.steps / 50
     np.testing.assert_allclose(quasi.settled_positions, ref.settled_positions, rtol=0, atol=0.05e-9)
     assert abs(quasi.energy_balance()["relative_residual"]) < 1e-4
@@ -400,9 +434,9 @@ def test_quasi_static_step_matches_the_fixed_fine_step(contacts, contact):
 def test_quasi_static_step_chunked_is_bit_identical(monkeypatch):
     d = Drive(actuator_model="flexible")
     wf = waveforms.sawtooth(150e-9, F_TEST, d, periods=3)
-    whole = dynamics.simulate(d, wf, max_points=3000, quasi_static=True, error_control=False)
+    whole = dynamics.simulate(d, wf, max_points=3000, scheme="quasi-static")
     monkeypatch.setattr(dynamics, "CHUNK_STEPS", 997)
-    chunked = dynamics.simulate(d, wf, max_points=3000, quasi_static=True, error_control=False)
+    chunked = dynamics.simulate(d, wf, max_points=3000, scheme="quasi-static")
     for name in FIELDS:
         np.testing.assert_array_equal(getattr(chunked, name), getattr(whole, name), err_msg=name)
     assert chunked.energy == whole.energy
@@ -413,7 +447,7 @@ def test_quasi_static_step_converges():
     (second order), measured against resolution 8."""
     d = Drive(contacts=1, actuator_model="flexible")
     wf = waveforms.sawtooth(150e-9, 100.0, d, periods=3)
-    pos = {r: dynamics.simulate(d, wf, resolution=r, quasi_static=True, error_control=False,
+    pos = {r: dynamics.simulate(d, wf, scheme=SCHEMES["quasi-static"].replace(refine=r),
                                 max_points=2).final_position
            for r in (1.0, 2.0, 8.0)}
     e1, e2 = abs(pos[1.0] - pos[8.0]), abs(pos[2.0] - pos[8.0])
@@ -437,7 +471,7 @@ def test_error_controlled_step_matches_the_fixed_fine_step(contacts, model, cont
     the reference scheme, with far fewer steps, and an energy balance closed to 1e-4."""
     d = Drive(contacts=contacts, actuator_model=model)
     wf = waveforms.sawtooth(202e-9, 100.0, d, periods=3)
-    ref = dynamics.simulate(d, wf, adaptive=False, contact_model=contact, max_points=2)
+    ref = dynamics.simulate(d, wf, scheme="fixed", contact_model=contact, max_points=2)
     ctrl = dynamics.simulate(d, wf, contact_model=contact, max_points=2)
     assert ctrl.steps < ref.steps / 5
     np.testing.assert_allclose(ctrl.settled_positions, ref.settled_positions, rtol=0,
@@ -452,8 +486,9 @@ def test_error_controlled_step_converges():
     CONVERGED_ACCURACY."""
     d = Drive(contacts=6, actuator_model="rigid")
     wf = waveforms.sawtooth(150e-9, 100.0, d, periods=3)
-    ref = dynamics.simulate(d, wf, adaptive=False, resolution=4.0, max_points=2).final_position
-    runs = {r: dynamics.simulate(d, wf, resolution=r, max_points=2) for r in (0.5, 1.0, 2.0)}
+    ref = dynamics.simulate(d, wf, scheme=SCHEMES["fixed"].replace(refine=4.0), max_points=2).final_position
+    runs = {r: dynamics.simulate(d, wf, scheme=SCHEMES["controlled"].replace(refine=r), max_points=2)
+            for r in (0.5, 1.0, 2.0)}
     err = {r: abs(run.final_position - ref) for r, run in runs.items()}
     assert err[1.0] < time_steps.CONVERGED_ACCURACY
     assert err[2.0] < err[1.0] < err[0.5]
@@ -467,7 +502,7 @@ def test_error_controlled_step_rejects_and_counts():
     res = dynamics.simulate(d, waveforms.sawtooth(150e-9, 100.0, d, periods=2), max_points=2)
     assert 0 < res.rejected_steps < res.steps / 2
     fixed = dynamics.simulate(d, waveforms.sawtooth(150e-9, 100.0, d, periods=2), max_points=2,
-                              error_control=False)
+                              scheme="adaptive")
     assert fixed.rejected_steps == 0
 
 
@@ -479,7 +514,7 @@ def test_error_controlled_samples_at_their_own_times(model):
     samples, 1 µs apart, is itself accurate to a few pm at the ≈ 11 kHz ringing)."""
     d = Drive(contacts=6, actuator_model=model)
     wf = waveforms.sawtooth(150e-9, 100.0, d, periods=2)
-    ref = dynamics.simulate(d, wf, adaptive=False, max_points=20001)
+    ref = dynamics.simulate(d, wf, scheme="fixed", max_points=20001)
     ctrl = dynamics.simulate(d, wf, max_points=20001)
     if model == "rigid":  # (flexible: samples in the fine steps after a corner are at step ends)
         np.testing.assert_allclose(np.diff(ctrl.time), wf.duration / 20000, rtol=1e-6)
@@ -495,7 +530,7 @@ def test_error_controlled_reversals_keep_the_contact_dissipation():
     (the Masing loops' dissipation grows with the cube of their amplitude)."""
     d = Drive(contacts=6, actuator_model="rigid")
     wf = waveforms.sawtooth(150e-9, 100.0, d, periods=3)
-    ref = dynamics.simulate(d, wf, adaptive=False, max_points=2)
+    ref = dynamics.simulate(d, wf, scheme="fixed", max_points=2)
     ctrl = dynamics.simulate(d, wf, max_points=2)
     assert ctrl.energy["contact"] == pytest.approx(ref.energy["contact"], rel=1e-3)
     assert sum(m["reversals"] for m in ctrl.contact_memory) > 0

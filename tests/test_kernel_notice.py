@@ -6,8 +6,11 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import subprocess
 import sys
 from pathlib import Path
+
+import pytest
 
 from passmd.cli import kernels, main
 
@@ -64,3 +67,30 @@ def test_notice_goes_to_stderr_and_json_stays_clean(monkeypatch, capsys):
     monkeypatch.setattr(kernels, "kernels_cold", lambda package_dir=None: False)
     assert main(["theory", "--json"]) == 0
     assert kernels.NOTICE not in capsys.readouterr().err
+
+
+# in a fresh copy of the package: cold before, then one short simulation, then warm
+_COLD_START = """
+from passmd.solver import simulation as dynamics
+from passmd.model import waveforms
+from passmd.cli import kernels
+from passmd.model.parameters import Drive
+cold_before = kernels.kernels_cold()
+drive = Drive(contacts=1, actuator_model="rigid")
+dynamics.simulate(drive, waveforms.sawtooth(150e-9, 100.0, drive, periods=1), max_points=10)
+print(cold_before, kernels.kernels_cold())
+"""
+
+
+@pytest.mark.slow
+def test_one_simulation_warms_every_kernel_module(tmp_path):
+    """The notice stops after the first simulation: every module the check waits for gets an
+    index from a simulation (a module whose kernels no simulation compiles would keep the
+    notice up on every later run)."""
+    shutil.copytree(PACKAGE, tmp_path / "passmd", ignore=shutil.ignore_patterns("__pycache__"))
+    env = {**os.environ, "PYTHONPATH": str(tmp_path), "HOME": str(tmp_path / "home"),
+           "PYTHONDONTWRITEBYTECODE": "1"}
+    env.pop("NUMBA_CACHE_DIR", None)
+    done = subprocess.run([sys.executable, "-c", _COLD_START], capture_output=True, text=True, env=env,
+                          cwd=tmp_path, check=True)
+    assert done.stdout.split() == ["True", "False"], done.stderr

@@ -29,9 +29,9 @@ integrated exactly by the variation-of-constants formula (an exponential or
 "trigonometric" integrator; Hairer, Lubich & Wanner, Geometric Numerical Integration,
 Ch. XIII), g with its rate extrapolated from the last step in the position, and in the
 velocity quadratic in time through its values at the step's end, its start and the previous
-step's start. (With g linear over the step in the velocity, that update's local error was
-O(dt³) against the position's O(dt⁴), and the energy balance drifted by O(dt²): 3e-5 of the
-input work over three 1 kHz periods.) So the ≈ 11 kHz micro-vibration sets no step; what does is the
+step's start (g linear over the step would leave the velocity an O(dt³) local error against
+the position's O(dt⁴), and the energy balance an O(dt²) drift). So the ≈ 11 kHz
+micro-vibration sets no step; what does is the
 local position error estimate dt²/6 |Δg − ġ dt|, checked against the tolerance with the
 forces at the drifted position (pure evaluations): a step above it is rejected and retried
 shorter, and the next step follows the usual controller (fourth root, safety factor,
@@ -123,8 +123,8 @@ CARRY_SIZE = 28
 
 
 #: numba options: the kernel allocates nothing (work arrays come from the caller), so it is
-#: compiled without reference counting; with it, every call into the contact kernels paid
-#: atomic reference-count updates on the array arguments (≈ 30 ns per step).
+#: compiled without reference counting, which would add atomic reference-count updates on
+#: the array arguments of every call into the contact kernels.
 KERNEL_OPTIONS = {"cache": True, "error_model": "numpy", "_nrt": False}
 
 #: rows of the work array (shape (WORK_ROWS, groups)) the caller allocates
@@ -149,7 +149,7 @@ VELOCITY_LIMIT = 100.0
 #: Error-controlled step: the next step is this fraction of the one the estimate allows
 #: (the safety factor of step-size controllers, Hairer, Nørsett & Wanner, Sect. II.4).
 #: With 0.8 and the growth below, one step in 15 is rejected on a 100 Hz saw-tooth (0.9 and
-#: 1.5: one in 5, and more steps in all).
+#: 1.5 reject one in 5, and take more steps in all).
 STEP_SAFETY = 0.8
 #: Error-controlled step: largest growth and shrink factors from one step to the next.
 STEP_GROWTH = 1.25
@@ -257,9 +257,45 @@ def quasi_static_position(params, state, g, x_r, center, K, S, guess, slope, tol
 
 def integrate(segments: Segments, mechanics: Mechanics, control: StepControl, contacts: Contacts,
               buffers: Buffers, step_limit: int):
-    """Check the kernel's arguments, then run :func:`_integrate` (see there for what it does).
+    """Check the kernel's arguments, then integrate over the segments (:func:`_integrate`).
 
     Returns (status, steps done, rows recorded, fine steps).
+
+    Work is bounded: once ``step_limit`` steps (counted from the start of the run) are
+    done, the kernel stores its loop state in ``buffers.carry`` (zeros before the first
+    call) and returns STATUS_PAUSED; calling it again with the same arrays continues
+    exactly where it stopped, with the same floating-point operations in the same order as
+    an uninterrupted run (the contact memory lives in ``contacts.state``). A run that has
+    integrated all its segments stores its loop state the same way (between two segments) and
+    returns STATUS_OK; calling it again with the segments extended by more pieces (and ``per``
+    and ``peak`` by their periods, the same arrays longer) continues the run with the new
+    pieces, as if they had been there from the start.
+
+    ``contacts.sliding`` holds μF_N of each group; ``peak[k, g]`` receives the largest
+    |T_g|/μF_N from period k's slip mark to the next settle window (1 exactly when the group
+    slid fully). ``y`` = [x_r, v_r, x_a(0..G−1), v_a(0..G−1)]: the actuator entries are read
+    on the first call and written when the run ends (in between they live in ``work``,
+    scratch of shape (WORK_ROWS, G)); x_r and v_r are written whenever the kernel returns.
+    ``record`` rows are [t, x_p, x_r, v_r, (x_a, T, slip share) per group].
+
+    Step control (flexible actuators): every segment starts with the fine step
+    ``segments.fine`` (a corner of x_p(t) excites the actuator mode). Once the largest
+    actuator acceleration |ẍ_a| has stayed below ``control.activity_threshold`` for
+    ``control.quiet_steps`` fine steps, the step grows to ``segments.coarse``; it falls back to fine
+    as soon as |ẍ_a| exceeds the threshold again. Rigid actuators: ``segments.fine`` only.
+
+    With ``control.quasi_static`` the quiet phases instead neglect m_a: each step of
+    ``segments.quasi`` (set by the runner's mode) solves the actuator's force balance
+    k_p (x_p − x_a) = c_p ẋ_a + T(x_a − x_r) implicitly (backward Euler in the damping
+    term, :func:`quasi_static_position`), then commits the contact memory once, as the
+    explicit step does. The implied actuator acceleration is checked against the same
+    threshold; above it, the fine explicit step takes over again.
+
+    With ``control.error_tolerance`` > 0 the quasi-static phases (flexible) and every step (rigid)
+    are error-controlled (module docstring): the first such step of a quasi-static phase is
+    ``segments.quasi``, then each step follows from the last one's error estimate, at most
+    ``segments.longest``; rigid actuators carry the step from piece to piece. Rejected steps count
+    in ``steps`` (and in ``carry[C_REJECTED]``).
 
     Raises
     ------
@@ -361,390 +397,633 @@ def _turns_inside(du0, du):
     return du0 * (2.0 * du - du0) < 0.0
 
 
+@njit(inline="always", **KERNEL_OPTIONS)
+def _save_segment(carry, y, x_r, v_r, fine, quasi, controlled, g_rate, h_prev, quiet, acc):
+    """Runner state into ``y``, step control and segment-local accumulators ``acc`` = (∫x_r,
+    ∫F, ∫window, W_in, W_damp, W_contact, Σdt, min x_r) into ``carry`` at a pause inside a
+    segment (:func:`_restore_segment`)."""
+    y[0] = x_r
+    y[1] = v_r
+    carry[C_FINE] = 1.0 if fine else 0.0
+    carry[C_QUASI] = 1.0 if quasi else 0.0
+    carry[C_CONTROLLED] = 1.0 if controlled else 0.0
+    carry[C_GRATE] = g_rate
+    carry[C_HPREV] = h_prev
+    carry[C_QUIET] = quiet
+    carry[C_ACC_XR] = acc[0]
+    carry[C_ACC_F] = acc[1]
+    carry[C_ACC_WIN] = acc[2]
+    carry[C_ACC_IN] = acc[3]
+    carry[C_ACC_DAMP] = acc[4]
+    carry[C_ACC_CONTACT] = acc[5]
+    carry[C_ACC_T] = acc[6]
+    carry[C_MIN_XR] = acc[7]
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _restore_segment(carry):
+    """What :func:`_save_segment` stored: (fine, quasi, controlled, g_rate, h_prev, quiet, acc...)."""
+    return (carry[C_FINE] != 0.0, carry[C_QUASI] != 0.0, carry[C_CONTROLLED] != 0.0, carry[C_GRATE],
+            carry[C_HPREV], int(carry[C_QUIET]), carry[C_ACC_XR], carry[C_ACC_F], carry[C_ACC_WIN],
+            carry[C_ACC_IN], carry[C_ACC_DAMP], carry[C_ACC_CONTACT], carry[C_ACC_T], carry[C_MIN_XR])
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _begin_run(mechanics, contacts, y, rows, carry, seg_t0, seg_x0, seg_fine, inv_ma, inv_mr):
+    """Loop state at the start of a call: from rest (first call: actuators from ``y``, forces
+    evaluated) or from ``carry``. Returns (t, x_p, a_r, F, n_rec, next_rec, track, steps,
+    fine_steps, first segment, resume inside it, error-controlled step)."""
+    if carry[C_STARTED] != 0.0:
+        return (carry[C_TIME], carry[C_XP], carry[C_AR], carry[C_FORCE], int(carry[C_RECORDED]),
+                carry[C_NEXT_RECORD], int(carry[C_TRACK]), int(carry[C_STEPS]), int(carry[C_FINE_STEPS]),
+                int(carry[C_SEGMENT]), carry[C_MID] != 0.0, carry[C_STEP])
+    multiplicity = mechanics.multiplicity
+    params, state, _ = contacts
+    x_a, v_a, T, u_old, a_nd = rows[0], rows[1], rows[2], rows[3], rows[4]
+    G = multiplicity.shape[0]
+    x_r = y[0]
+    for g in range(G):
+        x_a[g] = y[2 + g]
+        v_a[g] = y[2 + G + g]
+    t = seg_t0[0]
+    x_p = seg_x0[0]
+    F = 0.0
+    for g in range(G):
+        u = x_a[g] - x_r
+        T[g] = contact_force_row(params, state, g, u)
+        u_old[g] = u
+        F += multiplicity[g] * T[g]
+        a_nd[g] = (mechanics.actuator_stiffness * (x_p - x_a[g]) - T[g]) * inv_ma
+    a_r = (F - mechanics.load_stiffness * x_r) * inv_mr
+    carry[C_STARTED] = 1.0
+    return t, x_p, a_r, F, 0, t, -1, 0, 0, 0, False, seg_fine[0]
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _trig_coefficients(dt, omega, omega2):
+    """Coefficients of the variation-of-constants step of length dt (and of half of it):
+    (sin, cos at half the step; cos, sin at the step; (1 − cos hΩ)/Ω², (hΩ − sin hΩ)/Ω³;
+    the last two at half the step), without cancellation."""
+    sh = np.sin(0.5 * dt * omega)
+    ch = np.cos(0.5 * dt * omega)
+    cs = 1.0 - 2.0 * sh * sh
+    sn = 2.0 * sh * ch
+    one_minus_cos = 2.0 * sh * sh / omega2
+    sine_excess = (dt * omega - sn) / (omega2 * omega)
+    half_one_minus_cos = sh * sh / (omega2 * (1.0 + ch))  # 1 − cos x = sin²x/(1 + cos x)
+    half_sine_excess = (0.5 * dt * omega - sh) / (omega2 * omega)
+    return sh, ch, cs, sn, one_minus_cos, sine_excess, half_one_minus_cos, half_sine_excess
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _trig_drift(trig, omega, omega2, beta, x_r, v_r, a_r, x_p, xp_new, vp, dt, g_rate):
+    """Drift of the error-controlled step (module docstring): x_r at the step's end and the
+    mid-step nodes of the energy quadrature. Returns (x_r, y0, w0, ag0, x_p, x_r, v_r at mid-step)."""
+    sh, ch, cs, sn, one_minus_cos, sine_excess, half_one_minus_cos, half_sine_excess = trig
+    y0 = x_r - beta * x_p
+    w0 = v_r - beta * vp
+    ag0 = a_r + omega2 * y0
+    x_end = cs * y0 + sn / omega * w0 + one_minus_cos * ag0 + sine_excess * g_rate + beta * xp_new
+    hh = 0.5 * dt
+    xp_mid = x_p + vp * hh
+    xr_mid = (ch * y0 + sh / omega * w0 + half_one_minus_cos * ag0 + half_sine_excess * g_rate
+              + beta * xp_mid)
+    vr_mid = (-omega * sh * y0 + ch * w0 + sh / omega * ag0 + half_one_minus_cos * g_rate
+              + beta * vp)
+    return x_end, y0, w0, ag0, xp_mid, xr_mid, vr_mid
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _trig_kick(trig, omega, omega2, beta, a_r_new, x_r, xp_new, vp, y0, w0, ag0, dt, g_rate, h_prev):
+    """Velocity of the error-controlled step, with the rest force g quadratic in time through
+    its values at the end, the start and the start of the previous step (curvature 0 after a
+    reset of its rate). Returns (v_r, g's rate over this step, this step's length)."""
+    cs, sn, one_minus_cos, sine_excess = trig[2], trig[3], trig[4], trig[5]
+    ag1 = a_r_new + omega2 * (x_r - beta * xp_new)
+    rate = (ag1 - ag0) / dt
+    curvature = (rate - g_rate) / (dt + h_prev) if h_prev > 0.0 else 0.0
+    v_r = (-omega * sn * y0 + cs * w0 + sn / omega * ag0 + one_minus_cos * (rate - curvature * dt)
+           + 2.0 * sine_excess * curvature + beta * vp)
+    return v_r, rate, dt
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _quasi_midpoint(mechanics, contacts, rows, g, balance_terms, x_r, nodes, quad):
+    """Simpson middle node of group g in a quasi-static error-controlled step: x_a at mid-step
+    from the balance over the first half step, one Newton step from the chord's midpoint
+    (within O(dt²) of it), into ``rows[10]`` (``rows``: the rows of ``Buffers.work``); adds
+    the group's start and mid-step terms to ``quad`` = (input, damping, contact), returned."""
+    actuator_stiffness = mechanics.actuator_stiffness
+    actuator_viscosity = mechanics.actuator_viscosity
+    params, state, _ = contacts
+    x_a, T, u_old, stretch_old, xa_old, slope = rows[0], rows[2], rows[3], rows[5], rows[6], rows[7]
+    xa_mid, tangent = rows[10], rows[11]
+    K, K_half, c_half, inv_K_half, inv_dt, center, dt = balance_terms
+    xp_mid, xr_mid, vr_mid, vp, vr_old = nodes
+    quad_in, quad_damp, quad_contact = quad
+    center_mid = (actuator_stiffness * xp_mid + c_half * xa_old[g]) * inv_K_half
+    chord = 0.5 * (xa_old[g] + x_a[g])
+    u_chord = chord - xr_mid
+    # the contact force there: the cubic Hermite in u through both ends (values and tangents:
+    # the start's from the last step, the end's from the balance solve) when u is monotone over
+    # the step and the start's tangent is known, else evaluated (a reversal turns the branch
+    # inside the step)
+    k_end = slope[g] - K
+    u_start = u_old[g]
+    du = x_a[g] - x_r - u_start
+    du0 = _start_increment(False, vp - vr_old, dt, actuator_stiffness, k_end)
+    if tangent[g] >= 0.0 and du != 0.0 and not _turns_inside(du0, du):
+        sv = (u_chord - u_start) / du
+        T_end = K * (center - x_a[g])
+        rv = 1.0 - sv
+        T_chord = ((1.0 + 2.0 * sv) * rv * rv * T[g] + sv * sv * (3.0 - 2.0 * sv) * T_end
+                   + du * sv * rv * (rv * tangent[g] - sv * k_end))
+    else:
+        T_chord = contact_force_row(params, state, g, u_chord)
+    balance = K_half * (center_mid - chord) - T_chord
+    xa_mid[g] = chord + balance / max(k_end + K_half, K_half)
+    T_mid = K_half * (center_mid - xa_mid[g])
+    # velocities of the quadratic through x_a at start, mid-step and end
+    q0 = (4.0 * xa_mid[g] - 3.0 * xa_old[g] - x_a[g]) * inv_dt
+    q_mid = (x_a[g] - xa_old[g]) * inv_dt
+    n_g = mechanics.multiplicity[g]
+    quad_in += n_g * actuator_stiffness * (stretch_old[g] + 4.0 * (xp_mid - xa_mid[g]))
+    quad_damp += n_g * actuator_viscosity * (q0 * q0 + 4.0 * q_mid * q_mid)
+    quad_contact += n_g * (T[g] * (q0 - vr_old) + 4.0 * T_mid * (q_mid - vr_mid))
+    return quad_in, quad_damp, quad_contact
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _quasi_balance(mechanics, contacts, rows, x_p, xp_new, x_r, xr_old, dt, simpson, nodes):
+    """Drift of quasi-static actuators: each group's force balance solved at the step's end
+    (:func:`quasi_static_position`, backward Euler in the damping term), and with ``simpson``
+    its mid-step node (:func:`_quasi_midpoint`). Returns (K = k_p + c_p/dt, 1/dt, Σ n_g T_g at
+    the balance, and the start and mid-step quadrature terms of input, damping and contact)."""
+    multiplicity = mechanics.multiplicity
+    actuator_stiffness = mechanics.actuator_stiffness
+    params, state, sliding = contacts
+    x_a, T, stretch_old, xa_old, slope = rows[0], rows[2], rows[5], rows[6], rows[7]
+    inv_dt = 1.0 / dt
+    c_dt = mechanics.actuator_viscosity * inv_dt
+    K = actuator_stiffness + c_dt
+    c_half = 2.0 * c_dt  # (the balance over half the step)
+    K_half = actuator_stiffness + c_half
+    inv_K_half = 1.0 / K_half
+    F_trial = 0.0  # Σ n_g T_g at the solved balance, T_g = K (center − x_a,g)
+    quad = (0.0, 0.0, 0.0)
+    for g in range(multiplicity.shape[0]):
+        stretch_old[g] = x_p - x_a[g]
+        xa_old[g] = x_a[g]
+        center = (actuator_stiffness * xp_new + c_dt * x_a[g]) / K
+        # Newton predictor from the last solution: T moves by k_t Δu, k_t = slope − K
+        sg = max(slope[g], K)
+        guess = x_a[g] + (K * (center - x_a[g]) - T[g] - (sg - K) * (xr_old - x_r)) / sg
+        x_a[g], slope[g] = quasi_static_position(
+            params, state, g, x_r, center, K, sliding[g], guess, sg, QUASI_TOLERANCE * sliding[g] / K,
+        )
+        F_trial += multiplicity[g] * K * (center - x_a[g])
+        if simpson:
+            terms = (K, K_half, c_half, inv_K_half, inv_dt, center, dt)
+            quad = _quasi_midpoint(mechanics, contacts, rows, g, terms, x_r, nodes, quad)
+    return K, inv_dt, F_trial, quad[0], quad[1], quad[2]
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _step_factor(mechanics, contacts, rows, rigid, F_trial, x_r, a_r, xp_new, y0, dt, g_rate, omega, omega2,
+                 beta, inv_mr, error_tolerance, small_error):
+    """Local position error of the drift, dt³ x'''/6 with x''' ≈ Δa/dt, from the forces at the
+    drifted positions with the memory as committed (pure; the quasi-static balance has them
+    already in ``F_trial``), and the factor for the next step. Returns (error, factor)."""
+    if rigid:
+        multiplicity = mechanics.multiplicity
+        params, state, _ = contacts
+        x_a = rows[0]
+        F_trial = 0.0
+        for g in range(multiplicity.shape[0]):
+            F_trial += multiplicity[g] * contact_force_row(params, state, g, x_a[g] - x_r)
+    # (the trigonometric step: of g only, its linear part is exact)
+    da = (F_trial - mechanics.load_stiffness * x_r) * inv_mr - a_r
+    if omega > 0.0:
+        # g extrapolated at its last rate: the error is of its change of rate, O(dt⁴)
+        da += omega2 * (x_r - beta * xp_new - y0) - g_rate * dt
+    err = abs(da) * dt * dt / 6.0
+    factor = STEP_GROWTH
+    if err > small_error:
+        allowed = STEP_SAFETY * np.sqrt(np.sqrt(error_tolerance / err))  # local error ∝ dt⁴
+        factor = min(STEP_GROWTH, max(STEP_SHRINK, allowed))
+    return err, factor
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _rigid_mid_force(mechanics, contacts, xp_mid, xr_mid):
+    """Σ n_g T_g at mid-step of a rigid error-controlled step (pure), the Simpson middle node."""
+    multiplicity = mechanics.multiplicity
+    params, state, _ = contacts
+    F_mid = 0.0
+    for g in range(multiplicity.shape[0]):
+        F_mid += multiplicity[g] * contact_force_row(params, state, g, xp_mid - xr_mid)
+    return F_mid
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _commit_contacts(mechanics, contacts, rows, peak, track, x_r, v_r, vp, dt, K, controlled, simpson, x_p,
+                     xp_new, acc_contact, acc_in):
+    """Contact forces at the step's end, the memory committed once (twice when u turns inside an
+    error-controlled step: first at the extremum). Returns (Σ n_g T_g, acc_contact, acc_in)."""
+    multiplicity = mechanics.multiplicity
+    rigid = mechanics.rigid
+    params, state, sliding = contacts
+    x_a, T, u_old, slope, T_old = rows[0], rows[2], rows[3], rows[7], rows[8]
+    F = 0.0
+    for g in range(multiplicity.shape[0]):
+        u = x_a[g] - x_r
+        T_start = T[g]
+        T_old[g] = T_start
+        if controlled:
+            # a reversal of u inside the step is an event: the extremum of the quadratic through
+            # u at the start (value and rate) and at the end is committed first, so the Masing
+            # branch turns at it, not at the last step boundary (k_t: the tangent stiffness
+            # that the last balance solve found)
+            du0 = _start_increment(rigid, vp - v_r, dt, mechanics.actuator_stiffness, slope[g] - K)
+            if _turns_inside(du0, u - u_old[g]):
+                excess = u - u_old[g] - du0  # curvature term of the quadratic, times dt²
+                u_ext = u_old[g] - du0 * du0 / (4.0 * excess)
+                T_ext = contact_update_row(params, state, g, u_ext)
+                if not simpson:
+                    acc_contact += multiplicity[g] * 0.5 * (T[g] + T_ext) * (u_ext - u_old[g])
+                T[g] = T_ext
+                u_old[g] = u_ext
+                _note_peak(peak, track, g, T_ext, sliding[g])
+        Tn = contact_update_row(params, state, g, u)
+        if not simpson:
+            acc_contact += multiplicity[g] * 0.5 * (T[g] + Tn) * (u - u_old[g])
+            if rigid:
+                acc_in += multiplicity[g] * 0.5 * (T_start + Tn) * (xp_new - x_p)
+        T[g] = Tn
+        u_old[g] = u
+        F += multiplicity[g] * Tn
+        _note_peak(peak, track, g, Tn, sliding[g])
+    return F, acc_contact, acc_in
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _quasi_kick(mechanics, rows, x_p, xp_new, v_r, vp, dt, K, inv_dt, inv_ma, simpson, quad, acc_in, acc_damp,
+                acc_contact):
+    """Actuator velocities and accelerations after a quasi-static step and its energy terms
+    (Simpson's rule when ``simpson``, else backward Euler in the damping and trapezoidal input
+    work). Returns (largest implied |ẍ_a|, acc_in, acc_damp, acc_contact)."""
+    multiplicity = mechanics.multiplicity
+    actuator_stiffness = mechanics.actuator_stiffness
+    actuator_viscosity = mechanics.actuator_viscosity
+    half_kp = 0.5 * actuator_stiffness
+    x_a, v_a, T, a_nd, stretch_old, xa_old = rows[0], rows[1], rows[2], rows[4], rows[5], rows[6]
+    slope, xa_mid, tangent = rows[7], rows[10], rows[11]
+    quad_in, quad_damp, quad_contact = quad
+    activity = 0.0
+    for g in range(multiplicity.shape[0]):
+        v_old = v_a[g]
+        v_a[g] = (x_a[g] - xa_old[g]) / dt
+        a_nd[g] = (actuator_stiffness * (xp_new - x_a[g]) - T[g]) * inv_ma
+        tangent[g] = slope[g] - K  # (the next step's start: this step's end)
+        if simpson:
+            # end terms of the quadrature (start and mid-step ones: at the drift)
+            q1 = (xa_old[g] - 4.0 * xa_mid[g] + 3.0 * x_a[g]) * inv_dt
+            quad_in += multiplicity[g] * actuator_stiffness * (xp_new - x_a[g])
+            quad_damp += multiplicity[g] * actuator_viscosity * q1 * q1
+            quad_contact += multiplicity[g] * T[g] * (q1 - v_r)
+        else:
+            # backward Euler: c_p v_a (x_a − x_a,old) = c_p v_a² dt
+            acc_damp += multiplicity[g] * actuator_viscosity * v_a[g] * v_a[g] * dt
+            stretch_sum = stretch_old[g] + xp_new - x_a[g]
+            acc_in += multiplicity[g] * half_kp * stretch_sum * (xp_new - x_p)
+        acc = abs(v_a[g] - v_old) / dt
+        if acc > activity:
+            activity = acc
+    if simpson:
+        acc_in += vp * dt / 6.0 * quad_in
+        acc_damp += dt / 6.0 * quad_damp
+        acc_contact += dt / 6.0 * quad_contact
+    return activity, acc_in, acc_damp, acc_contact
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _actuator_kick(mechanics, rows, x_p, xp_new, dt, gam, inv_ma, acc_damp, acc_in):
+    """Velocity Verlet kick of flexible actuators (damping trapezoidal, implicit in v) and its
+    damping and input work. Returns (largest |ẍ_a|, acc_damp, acc_in)."""
+    multiplicity = mechanics.multiplicity
+    actuator_stiffness = mechanics.actuator_stiffness
+    half_kp = 0.5 * actuator_stiffness
+    half_cp = 0.5 * mechanics.actuator_viscosity
+    x_a, v_a, T, a_nd, stretch_old = rows[0], rows[1], rows[2], rows[4], rows[5]
+    damp = 1.0 / (1.0 + 0.5 * dt * gam)
+    activity = 0.0
+    for g in range(multiplicity.shape[0]):
+        a_new = (actuator_stiffness * (xp_new - x_a[g]) - T[g]) * inv_ma
+        v_old = v_a[g]
+        v_a[g] = (v_old + 0.5 * dt * (a_nd[g] - gam * v_old + a_new)) * damp
+        a_nd[g] = a_new
+        acc_damp += multiplicity[g] * half_cp * (v_old * v_old + v_a[g] * v_a[g]) * dt
+        # work of the moving piezo base: k_p (x_p − x_a) dx_p, trapezoidal in (x_p − x_a)
+        acc_in += multiplicity[g] * half_kp * (stretch_old[g] + xp_new - x_a[g]) * (xp_new - x_p)
+        acc = abs(a_new - gam * v_a[g])
+        if acc > activity:
+            activity = acc
+    return activity, acc_damp, acc_in
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _adapt(activity, activity_threshold, quiet_steps, quasi_static, control_on, fine, quasi, controlled,
+           quiet, dt_ctrl, dt_quasi, g_rate, h_prev, tangent):
+    """Step control of flexible actuators after an explicit step: back to the fine step when
+    |ẍ_a| reaches the threshold; after ``quiet_steps`` fine steps below it, the quiet phase
+    (coarse, or quasi-static and error-controlled from ``dt_quasi``). Returns the new (fine,
+    quasi, controlled, quiet, dt_ctrl, g_rate, h_prev)."""
+    if fine:
+        if activity < activity_threshold:
+            quiet += 1
+            if quiet >= quiet_steps:
+                fine = False
+                quasi = quasi_static
+                controlled = quasi_static and control_on
+                dt_ctrl = dt_quasi
+                g_rate = 0.0
+                h_prev = 0.0
+                for g in range(tangent.shape[0]):
+                    tangent[g] = -1.0
+        else:
+            quiet = 0
+    elif activity >= activity_threshold:
+        fine = True
+        quiet = 0
+    return fine, quasi, controlled, quiet, dt_ctrl, g_rate, h_prev
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _runaway(rigid, x_r, v_r, x_a, v_a, x_p):
+    """Whether the state has diverged: |x_r|, |x_a − x_p| or a velocity beyond its limit (NaN
+    too: comparisons with NaN are False)."""
+    ok = abs(x_r) < POSITION_LIMIT and abs(v_r) < VELOCITY_LIMIT
+    if not rigid:
+        for g in range(x_a.shape[0]):
+            ok = ok and abs(x_a[g] - x_p) < POSITION_LIMIT and abs(v_a[g]) < VELOCITY_LIMIT
+    return not ok
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _record_inside(contacts, rows, record, rigid, n_rec, next_rec, record_interval, t_old, t, dt, xp_old, x_p,
+                   xr_old, x_r, vr_old, v_r):
+    """Samples at their own times inside a long step: cubic Hermite in x_r (from the positions
+    and velocities at both ends), linear in x_p, x_a and T; the slip share of the step's end.
+    Returns (rows recorded, next sample time)."""
+    params, state, _ = contacts
+    x_a, T, xa_old, T_old, share = rows[0], rows[2], rows[6], rows[8], rows[9]
+    G = x_a.shape[0]
+    max_rec = record.shape[0]
+    for g in range(G):
+        share[g] = contact_slip_share_row(params, state, g, x_a[g] - x_r)
+    while next_rec <= t and n_rec < max_rec:
+        th = (next_rec - t_old) / dt
+        th2 = th * th
+        th3 = th2 * th
+        record[n_rec, 0] = next_rec
+        record[n_rec, 1] = xp_old + th * (x_p - xp_old)
+        record[n_rec, 2] = ((2.0 * th3 - 3.0 * th2 + 1.0) * xr_old + (3.0 * th2 - 2.0 * th3) * x_r
+                            + ((th3 - 2.0 * th2 + th) * vr_old + (th3 - th2) * v_r) * dt)
+        record[n_rec, 3] = (6.0 * (th2 - th) * (xr_old - x_r) / dt + (3.0 * th2 - 4.0 * th + 1.0)
+                            * vr_old + (3.0 * th2 - 2.0 * th) * v_r)
+        for g in range(G):
+            xa0 = xp_old if rigid else xa_old[g]
+            record[n_rec, 4 + 3 * g] = xa0 + th * (x_a[g] - xa0)
+            record[n_rec, 5 + 3 * g] = T_old[g] + th * (T[g] - T_old[g])
+            record[n_rec, 6 + 3 * g] = share[g]
+        n_rec += 1
+        next_rec += record_interval
+    return n_rec, next_rec
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _record_step_end(contacts, rows, record, n_rec, next_rec, record_interval, t, x_p, x_r, v_r):
+    """One sample at the step's end (the next sample time is at or before it). Returns (rows
+    recorded, next sample time)."""
+    params, state, _ = contacts
+    x_a, T = rows[0], rows[2]
+    record[n_rec, 0] = t
+    record[n_rec, 1] = x_p
+    record[n_rec, 2] = x_r
+    record[n_rec, 3] = v_r
+    for g in range(x_a.shape[0]):
+        record[n_rec, 4 + 3 * g] = x_a[g]
+        record[n_rec, 5 + 3 * g] = T[g]
+        record[n_rec, 6 + 3 * g] = contact_slip_share_row(params, state, g, x_a[g] - x_r)
+    n_rec += 1
+    while next_rec <= t:
+        next_rec += record_interval
+    return n_rec, next_rec
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _open_segment(per, mark, in_window, k, track, x_r, rigid, control_on):
+    """Start of a segment: slip-mark tracking and the initial step control. Every piece starts
+    with the fine step (its corner excites the actuator mode); rigid actuators under error
+    control go on with the controlled step (a corner changes the rate of g, and the error
+    estimate adapts to it). Returns (track, fine, quasi, controlled, g_rate, h_prev, quiet,
+    acc) with the segment-local accumulators ``acc`` zero (see :func:`_save_segment`)."""
+    if mark:
+        track = k
+        per[k, PER_MARK_XR] = x_r
+        per[k, PER_MIN_XR] = x_r
+    if in_window and track >= 0 and k > track:
+        track = -1
+    min_xr = per[track, PER_MIN_XR] if track >= 0 else 0.0
+    # (g's rate is not known after the corner: x_p's rate changes there)
+    return (track, not (rigid and control_on), False, rigid and control_on, 0.0, 0.0, 0,
+            (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, min_xr))
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _step_length(fine, controlled, quasi, dt_ctrl, segments, s, t, vp):
+    """The next step: its length, end time, x_p there, and whether it ends the segment (a step
+    that would leave a sliver of the piece is stretched to its corner)."""
+    if fine:
+        dt = segments.fine[s]
+    elif controlled:
+        dt = min(dt_ctrl, segments.longest[s])
+    elif quasi:
+        dt = segments.quasi[s]
+    else:
+        dt = segments.coarse[s]
+    t_end = segments.t1[s]
+    if t_end - t <= dt * LAST_STEP_STRETCH:
+        return t_end - t, t_end, segments.x1[s], True
+    t_new = t + dt
+    return dt, t_new, segments.x0[s] + vp * (t_new - segments.t0[s]), False
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _linear_mode(linear_stiffness, load_stiffness, runner_mass):
+    """(Ω², Ω, β) of the error-controlled step: the runner on the linear spring K to x_p (and the
+    load cell) oscillates at Ω about z = β x_p; that part is integrated exactly."""
+    omega2 = (linear_stiffness + load_stiffness) / runner_mass
+    beta = linear_stiffness / (linear_stiffness + load_stiffness) if linear_stiffness > 0.0 else 0.0
+    return omega2, np.sqrt(omega2), beta
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _reject(carry, x_a, xa_old, rigid, x_p, xr_old, shorter, dt_fine):
+    """A rejected error-controlled step: positions back to the step's start, counted in
+    ``carry``. Returns (x_r, the step to retry with, not done)."""
+    for g in range(x_a.shape[0]):
+        x_a[g] = x_p if rigid else xa_old[g]
+    carry[C_REJECTED] += 1.0
+    return xr_old, max(shorter, dt_fine), False
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _measure(acc_xr, acc_f, acc_t, acc_win, min_xr, in_window, xr_old, x_r, F_old, F, x_p, xp_new, dt):
+    """The step's share of the per-period measures (trapezoidal; the window integral of
+    x_r − x_p only inside the settle window) and the lowest x_r."""
+    acc_xr += (xr_old + x_r) * dt
+    acc_f += (F_old + F) * dt
+    acc_t += dt
+    if in_window:
+        acc_win += ((xr_old - x_p) + (x_r - xp_new)) * dt
+    if x_r < min_xr:
+        min_xr = x_r
+    return acc_xr, acc_f, acc_t, acc_win, min_xr
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _save_state(y, x_r, v_r, x_a, v_a):
+    """The state into ``y`` = [x_r, v_r, x_a(0..G−1), v_a(0..G−1)] at the end of a run."""
+    G = x_a.shape[0]
+    y[0] = x_r
+    y[1] = v_r
+    for g in range(G):
+        y[2 + g] = x_a[g]
+        y[2 + G + g] = v_a[g]
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _close_segment(per, energy, k, track, in_window, x1, acc):
+    """Segment-local accumulators ``acc`` (see :func:`_save_segment`) into the per-period and
+    energy accumulators."""
+    acc_xr, acc_f, acc_win, acc_in, acc_damp, acc_contact, acc_t, min_xr = acc
+    per[k, PER_XR_INTEGRAL] += 0.5 * acc_xr
+    per[k, PER_FRICTION_INTEGRAL] += 0.5 * acc_f
+    per[k, PER_DURATION] += acc_t
+    if in_window:
+        per[k, PER_WINDOW_INTEGRAL] += 0.5 * acc_win
+        per[k, PER_WINDOW_LENGTH] += acc_t
+        per[k, PER_WINDOW_END_XP] = x1
+    if track >= 0:
+        per[track, PER_MIN_XR] = min_xr
+    energy[EN_CONTACT] += acc_contact
+    energy[EN_INPUT] += acc_in
+    energy[EN_DAMPING] += acc_damp
+
+
 @njit(**KERNEL_OPTIONS)
 def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
-    """Integrate over the segments; returns (status, steps done, rows recorded, fine steps).
-
-    One function of ≈ 280 lines, not several small ones, on purpose: the step loop keeps
-    about twenty scalars (time, accelerations, step-control flags, the per-segment
-    accumulators) in registers across every step; helpers would pass them back and forth
-    on every one of the 10⁶–10⁹ steps of a run, or keep them in memory.
-
-    Work is bounded: once ``step_limit`` steps (counted from the start of the run) are
-    done, the kernel stores its loop state in ``buffers.carry`` (zeros before the first
-    call) and returns STATUS_PAUSED; calling it again with the same arrays continues
-    exactly where it stopped, with the same floating-point operations in the same order as
-    an uninterrupted run (the contact memory lives in ``contacts.state``). A run that has
-    integrated all its segments stores its loop state the same way (between two segments) and
-    returns STATUS_OK; calling it again with the segments extended by more pieces (and ``per``
-    and ``peak`` by their periods, the same arrays longer) continues the run with the new
-    pieces, as if they had been there from the start.
-
-    ``contacts.sliding`` holds μF_N of each group; ``peak[k, g]`` receives the largest
-    |T_g|/μF_N from period k's slip mark to the next settle window (1 exactly when the group
-    slid fully). ``y`` = [x_r, v_r, x_a(0..G−1), v_a(0..G−1)]: the actuator entries are read
-    on the first call and written when the run ends (in between they live in ``work``,
-    scratch of shape (WORK_ROWS, G)); x_r and v_r are written whenever the kernel returns.
-    ``record`` rows are [t, x_p, x_r, v_r, (x_a, T, slip share) per group].
-
-    Step control (flexible actuators): every segment starts with the fine step
-    ``seg_fine`` (a corner of x_p(t) excites the actuator mode). Once the largest
-    actuator acceleration |ẍ_a| has stayed below ``activity_threshold`` for
-    ``quiet_steps`` fine steps, the step grows to ``seg_coarse``; it falls back to fine
-    as soon as |ẍ_a| exceeds the threshold again. Rigid actuators: ``seg_fine`` only.
-
-    With ``quasi_static`` the quiet phases instead neglect m_a: each step of
-    ``seg_quasi`` (set by the runner's mode) solves the actuator's force balance
-    k_p (x_p − x_a) = c_p ẋ_a + T(x_a − x_r) implicitly (backward Euler in the damping
-    term, :func:`quasi_static_position`), then commits the contact memory once, as the
-    explicit step does. The implied actuator acceleration is checked against the same
-    threshold; above it, the fine explicit step takes over again.
-
-    With ``error_tolerance`` > 0 the quasi-static phases (flexible) and every step (rigid)
-    are error-controlled (module docstring): the first such step of a quasi-static phase is
-    ``seg_quasi``, then each step follows from the last one's error estimate, at most
-    ``seg_longest``; rigid actuators carry the step from piece to piece. Rejected steps count
-    in ``steps`` (and in ``carry[C_REJECTED]``).
-    """
+    """Integrate over the segments (see :func:`integrate`); returns (status, steps done, rows
+    recorded, fine steps). Each step: choose its length, drift (runner, actuators), estimate
+    its error (error control; a rejected step starts over shorter), commit the contacts, kick,
+    adapt the step, accumulate the period's measures, check for divergence, record."""
     (seg_t0, seg_t1, seg_x0, seg_x1, seg_fine, seg_coarse, seg_period, seg_window, seg_mark, seg_quasi,
      seg_longest) = segments
     runner_mass, load_stiffness, multiplicity, rigid = mechanics[:4]
-    actuator_mass, actuator_stiffness, actuator_viscosity, linear_stiffness = mechanics[4:]
-    # error-controlled step: the runner on the linear spring K to x_p (and the load cell)
-    # oscillates at Ω about z = β x_p; the variation-of-constants formula integrates that part
-    # exactly, with the rest of the force, g = a + Ω² (x_r − z), constant over the step in x_r
-    # and linear in v_r (both exact for a constant g)
-    omega2 = (linear_stiffness + load_stiffness) / runner_mass
-    omega = np.sqrt(omega2)
-    beta = linear_stiffness / (linear_stiffness + load_stiffness) if linear_stiffness > 0.0 else 0.0
+    actuator_mass, actuator_viscosity, linear_stiffness = mechanics[4], mechanics[6], mechanics[7]
+    omega2, omega, beta = _linear_mode(linear_stiffness, load_stiffness, runner_mass)
     dt_trig = -1.0
-    cs = sn = one_minus_cos = sine_excess = 0.0
-    sh = ch = half_one_minus_cos = half_sine_excess = 0.0  # the same at half the step
-    hh = xp_mid = xr_mid = vr_mid = F_mid = 0.0  # mid-step nodes of the energy quadrature
-    inv_dt = c_half = K_half = inv_K_half = 0.0
-    K = 0.0  # the quasi-static balance's stiffness k_p + c_p/dt (set in its steps)
+    trig = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    y0 = w0 = ag0 = xp_mid = xr_mid = vr_mid = F_mid = 0.0  # drift terms and mid-step nodes
+    K = inv_dt = 0.0  # the quasi-static balance's stiffness k_p + c_p/dt and 1/dt (its steps)
     activity_threshold, quiet_steps, quasi_static, record_interval, error_tolerance = control
     control_on = error_tolerance > 0.0
     # error estimates below this need no root: the step grows by the largest factor
     small_error = error_tolerance * (STEP_SAFETY / STEP_GROWTH) ** 4
-    params, state, sliding = contacts
     y, work, carry, record, per, peak, energy = buffers
-    G = multiplicity.shape[0]
+    # the rows of ``work`` as a tuple of views, made once: the helpers index it with constants
+    rows = (work[0], work[1], work[2], work[3], work[4], work[5], work[6], work[7], work[8], work[9],
+            work[10], work[11])
     x_r = y[0]
     v_r = y[1]
-    x_a = work[0]
-    v_a = work[1]
-    T = work[2]
-    u_old = work[3]
-    a_nd = work[4]  # actuator acceleration without the damping term
-    stretch_old = work[5]  # x_p − x_a at the previous step
-    xa_old = work[6]  # x_a at the previous step (quasi-static step)
-    slope = work[7]  # last −h' of the quasi-static balance (0: none yet)
-    T_old = work[8]  # T at the start of the step (samples inside an error-controlled step)
-    share = work[9]  # slip share at the end of the step (samples inside an error-controlled step)
-    xa_mid = work[10]  # x_a at mid-step (energy quadrature of a quasi-static error-controlled step)
-    tangent = work[11]  # dT/du at the start of a quasi-static step (< 0: not known)
+    x_a, v_a, a_nd, stretch_old, xa_old, tangent = rows[0], rows[1], rows[4], rows[5], rows[6], rows[11]
     gam = actuator_viscosity / actuator_mass
-    half_kp = 0.5 * actuator_stiffness
-    half_cp = 0.5 * actuator_viscosity
     inv_ma = 1.0 / actuator_mass
     inv_mr = 1.0 / runner_mass
-    if carry[C_STARTED] == 0.0:
-        for g in range(G):
-            x_a[g] = y[2 + g]
-            v_a[g] = y[2 + G + g]
-        t = seg_t0[0]
-        x_p = seg_x0[0]
-        F = 0.0
-        for g in range(G):
-            u = x_a[g] - x_r
-            T[g] = contact_force_row(params, state, g, u)
-            u_old[g] = u
-            F += multiplicity[g] * T[g]
-            a_nd[g] = (actuator_stiffness * (x_p - x_a[g]) - T[g]) * inv_ma
-        a_r = (F - load_stiffness * x_r) * inv_mr
-        n_rec = 0
-        next_rec = t
-        track = -1
-        steps = 0
-        fine_steps = 0
-        first_segment = 0
-        resume = False
-        dt_ctrl = seg_fine[0]
-        carry[C_STARTED] = 1.0
-    else:
-        t = carry[C_TIME]
-        x_p = carry[C_XP]
-        a_r = carry[C_AR]
-        F = carry[C_FORCE]
-        n_rec = int(carry[C_RECORDED])
-        next_rec = carry[C_NEXT_RECORD]
-        track = int(carry[C_TRACK])
-        steps = int(carry[C_STEPS])
-        fine_steps = int(carry[C_FINE_STEPS])
-        first_segment = int(carry[C_SEGMENT])
-        resume = carry[C_MID] != 0.0
-        dt_ctrl = carry[C_STEP]
-    max_rec = record.shape[0]
+    (t, x_p, a_r, F, n_rec, next_rec, track, steps, fine_steps, first_segment, resume,
+     dt_ctrl) = _begin_run(mechanics, contacts, y, rows, carry, seg_t0, seg_x0, seg_fine, inv_ma, inv_mr)
     for s in range(first_segment, seg_t0.shape[0]):
         k = seg_period[s]
         t_end = seg_t1[s]
         vp = (seg_x1[s] - seg_x0[s]) / (t_end - seg_t0[s])
         in_window = seg_window[s] != 0
         dt_fine = seg_fine[s]
-        dt_coarse = seg_coarse[s]
-        dt_quasi = seg_quasi[s]
-        dt_longest = seg_longest[s]
-        adaptive = (not rigid) and dt_coarse > dt_fine
+        adaptive = (not rigid) and seg_coarse[s] > dt_fine
         if resume:
             resume = False
-            fine = carry[C_FINE] != 0.0
-            quasi = carry[C_QUASI] != 0.0
-            controlled = carry[C_CONTROLLED] != 0.0
-            g_rate = carry[C_GRATE]
-            h_prev = carry[C_HPREV]
-            quiet = int(carry[C_QUIET])
-            acc_xr = carry[C_ACC_XR]
-            acc_f = carry[C_ACC_F]
-            acc_win = carry[C_ACC_WIN]
-            acc_in = carry[C_ACC_IN]
-            acc_damp = carry[C_ACC_DAMP]
-            acc_contact = carry[C_ACC_CONTACT]
-            acc_t = carry[C_ACC_T]
-            min_xr = carry[C_MIN_XR]
+            (fine, quasi, controlled, g_rate, h_prev, quiet, acc_xr, acc_f, acc_win, acc_in, acc_damp,
+             acc_contact, acc_t, min_xr) = _restore_segment(carry)
         else:
-            if seg_mark[s]:
-                track = k
-                per[k, PER_MARK_XR] = x_r
-                per[k, PER_MIN_XR] = x_r
-            if in_window and track >= 0 and k > track:
-                track = -1
-            # every piece starts with the fine step (its corner excites the actuator mode);
-            # rigid actuators under error control go on with the controlled step (a corner
-            # changes the rate of g, and the error estimate adapts to it)
-            fine = not (rigid and control_on)
-            quasi = False
-            controlled = rigid and control_on
-            g_rate = 0.0  # (x_p's rate changes at the corner: g's rate is not known)
-            h_prev = 0.0
-            quiet = 0
-            # segment-local accumulators (kept in registers, written back after the segment)
-            acc_xr = 0.0
-            acc_f = 0.0
-            acc_win = 0.0
-            acc_in = 0.0
-            acc_damp = 0.0
-            acc_contact = 0.0
-            acc_t = 0.0
-            min_xr = per[track, PER_MIN_XR] if track >= 0 else 0.0
+            track, fine, quasi, controlled, g_rate, h_prev, quiet, acc = _open_segment(
+                per, seg_mark[s], in_window, k, track, x_r, rigid, control_on)
+            acc_xr, acc_f, acc_win, acc_in, acc_damp, acc_contact, acc_t, min_xr = acc
         done = False
         while not done:
-            if steps >= step_limit:
-                # pause: everything the loop carries goes to carry, y and work
+            if steps >= step_limit:  # pause: everything the loop carries goes to carry, y and work
                 _save_position(carry, s, 1.0, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps,
                                dt_ctrl)
-                carry[C_FINE] = 1.0 if fine else 0.0
-                carry[C_QUASI] = 1.0 if quasi else 0.0
-                carry[C_CONTROLLED] = 1.0 if controlled else 0.0
-                carry[C_GRATE] = g_rate
-                carry[C_HPREV] = h_prev
-                carry[C_QUIET] = quiet
-                carry[C_ACC_XR] = acc_xr
-                carry[C_ACC_F] = acc_f
-                carry[C_ACC_WIN] = acc_win
-                carry[C_ACC_IN] = acc_in
-                carry[C_ACC_DAMP] = acc_damp
-                carry[C_ACC_CONTACT] = acc_contact
-                carry[C_ACC_T] = acc_t
-                carry[C_MIN_XR] = min_xr
-                y[0] = x_r
-                y[1] = v_r
+                _save_segment(carry, y, x_r, v_r, fine, quasi, controlled, g_rate, h_prev, quiet,
+                              (acc_xr, acc_f, acc_win, acc_in, acc_damp, acc_contact, acc_t, min_xr))
                 return STATUS_PAUSED, steps, n_rec, fine_steps
-            if fine:
-                dt = dt_fine
-            elif controlled:
-                dt = min(dt_ctrl, dt_longest)
-            elif quasi:
-                dt = dt_quasi
-            else:
-                dt = dt_coarse
-            remaining = t_end - t
-            if remaining <= dt * LAST_STEP_STRETCH:
-                dt = remaining
-                t_new = t_end
-                xp_new = seg_x1[s]
-                done = True
-            else:
-                t_new = t + dt
-                xp_new = seg_x0[s] + vp * (t_new - seg_t0[s])
+            dt, t_new, xp_new, done = _step_length(fine, controlled, quasi, dt_ctrl, segments, s, t, vp)
             if fine:
                 fine_steps += 1
-            half_dt2 = 0.5 * dt * dt
             xr_old = x_r
             vr_old = v_r
             F_old = F
-            # drift
-            if controlled and omega > 0.0:
-                y0 = x_r - beta * x_p
-                w0 = v_r - beta * vp
-                ag0 = a_r + omega2 * y0
+            simpson = controlled and omega > 0.0
+            if simpson:  # drift
                 if dt != dt_trig:  # (steps repeat at the longest step: their sines are kept)
                     dt_trig = dt
-                    sh = np.sin(0.5 * dt * omega)
-                    ch = np.cos(0.5 * dt * omega)
-                    cs = 1.0 - 2.0 * sh * sh
-                    sn = 2.0 * sh * ch
-                    one_minus_cos = 2.0 * sh * sh / omega2  # (1 − cos hΩ)/Ω², without cancellation
-                    sine_excess = (dt * omega - sn) / (omega2 * omega)  # (hΩ − sin hΩ)/Ω³
-                    half_one_minus_cos = sh * sh / (omega2 * (1.0 + ch))  # 1 − cos x = sin²x/(1 + cos x)
-                    half_sine_excess = (0.5 * dt * omega - sh) / (omega2 * omega)
-                x_r = cs * y0 + sn / omega * w0 + one_minus_cos * ag0 + sine_excess * g_rate + beta * xp_new
-                # the same at mid-step: the nodes of the energy quadrature (module docstring)
-                hh = 0.5 * dt
-                xp_mid = x_p + vp * hh
-                xr_mid = (ch * y0 + sh / omega * w0 + half_one_minus_cos * ag0 + half_sine_excess * g_rate
-                          + beta * xp_mid)
-                vr_mid = (-omega * sh * y0 + ch * w0 + sh / omega * ag0 + half_one_minus_cos * g_rate
-                          + beta * vp)
+                    trig = _trig_coefficients(dt, omega, omega2)
+                x_r, y0, w0, ag0, xp_mid, xr_mid, vr_mid = _trig_drift(
+                    trig, omega, omega2, beta, x_r, v_r, a_r, x_p, xp_new, vp, dt, g_rate)
             else:
-                x_r += dt * v_r + half_dt2 * a_r
-            simpson = controlled and omega > 0.0
-            quad_in = quad_damp = quad_contact = 0.0  # start and mid-step terms of that quadrature
+                x_r += dt * v_r + 0.5 * dt * dt * a_r
+            quad_in = quad_damp = quad_contact = 0.0  # start and mid-step terms of the quadrature
+            F_trial = 0.0
             if rigid:
-                for g in range(G):
+                for g in range(x_a.shape[0]):
                     x_a[g] = xp_new
             elif quasi:
-                inv_dt = 1.0 / dt
-                c_dt = actuator_viscosity * inv_dt
-                K = actuator_stiffness + c_dt
-                c_half = 2.0 * c_dt  # (the balance over half the step)
-                K_half = actuator_stiffness + c_half
-                inv_K_half = 1.0 / K_half
-                F_trial = 0.0  # Σ n_g T_g at the solved balance, T_g = K (center − x_a,g)
-                for g in range(G):
-                    stretch_old[g] = x_p - x_a[g]
-                    xa_old[g] = x_a[g]
-                    center = (actuator_stiffness * xp_new + c_dt * x_a[g]) / K
-                    # Newton predictor from the last solution: T moves by k_t Δu, k_t = slope − K
-                    sg = max(slope[g], K)
-                    guess = x_a[g] + (K * (center - x_a[g]) - T[g] - (sg - K) * (xr_old - x_r)) / sg
-                    x_a[g], slope[g] = quasi_static_position(
-                        params, state, g, x_r, center, K, sliding[g], guess, sg,
-                        QUASI_TOLERANCE * sliding[g] / K,
-                    )
-                    F_trial += multiplicity[g] * K * (center - x_a[g])
-                    if simpson:
-                        # x_a at mid-step: the balance over the first half step, one Newton step
-                        # from the chord's midpoint (within O(dt²) of it)
-                        center_mid = (actuator_stiffness * xp_mid + c_half * xa_old[g]) * inv_K_half
-                        chord = 0.5 * (xa_old[g] + x_a[g])
-                        u_chord = chord - xr_mid
-                        # the contact force there: the cubic Hermite in u through both ends (values
-                        # and tangents: the start's from the last step, the end's from the balance
-                        # solve) when u is monotone over the step and the start's tangent is
-                        # known, else evaluated (a reversal turns the branch inside the step)
-                        k_end = slope[g] - K
-                        u_start = u_old[g]
-                        du = x_a[g] - x_r - u_start
-                        du0 = _start_increment(False, vp - vr_old, dt, actuator_stiffness, k_end)
-                        if tangent[g] >= 0.0 and du != 0.0 and not _turns_inside(du0, du):
-                            sv = (u_chord - u_start) / du
-                            T_end = K * (center - x_a[g])
-                            rv = 1.0 - sv
-                            T_chord = ((1.0 + 2.0 * sv) * rv * rv * T[g] + sv * sv * (3.0 - 2.0 * sv) * T_end
-                                       + du * sv * rv * (rv * tangent[g] - sv * k_end))
-                        else:
-                            T_chord = contact_force_row(params, state, g, u_chord)
-                        balance = K_half * (center_mid - chord) - T_chord
-                        xa_mid[g] = chord + balance / max(k_end + K_half, K_half)
-                        T_mid = K_half * (center_mid - xa_mid[g])
-                        # velocities of the quadratic through x_a at start, mid-step and end
-                        q0 = (4.0 * xa_mid[g] - 3.0 * xa_old[g] - x_a[g]) * inv_dt
-                        q_mid = (x_a[g] - xa_old[g]) * inv_dt
-                        n_g = multiplicity[g]
-                        quad_in += n_g * actuator_stiffness * (stretch_old[g] + 4.0 * (xp_mid - xa_mid[g]))
-                        quad_damp += n_g * actuator_viscosity * (q0 * q0 + 4.0 * q_mid * q_mid)
-                        quad_contact += n_g * (T[g] * (q0 - vr_old) + 4.0 * T_mid * (q_mid - vr_mid))
+                K, inv_dt, F_trial, quad_in, quad_damp, quad_contact = _quasi_balance(
+                    mechanics, contacts, rows, x_p, xp_new, x_r, xr_old, dt, simpson,
+                    (xp_mid, xr_mid, vr_mid, vp, vr_old))
             else:
-                for g in range(G):
+                for g in range(x_a.shape[0]):
                     stretch_old[g] = x_p - x_a[g]
-                    x_a[g] += dt * v_a[g] + half_dt2 * (a_nd[g] - gam * v_a[g])
+                    x_a[g] += dt * v_a[g] + 0.5 * dt * dt * (a_nd[g] - gam * v_a[g])
             if controlled:
-                # local position error of the drift, dt³ x'''/6 with x''' ≈ Δa/dt, from the
-                # forces at the drifted positions with the memory as committed (pure; the
-                # quasi-static balance has them already)
-                if rigid:
-                    F_trial = 0.0
-                    for g in range(G):
-                        F_trial += multiplicity[g] * contact_force_row(params, state, g, x_a[g] - x_r)
-                # (the trigonometric step: of g only, its linear part is exact)
-                da = (F_trial - load_stiffness * x_r) * inv_mr - a_r
-                if omega > 0.0:
-                    # g extrapolated at its last rate: the error is of its change of rate, O(dt⁴)
-                    da += omega2 * (x_r - beta * xp_new - y0) - g_rate * dt
-                err = abs(da) * dt * dt / 6.0
-                factor = STEP_GROWTH
-                if err > small_error:
-                    allowed = STEP_SAFETY * np.sqrt(np.sqrt(error_tolerance / err))  # local error ∝ dt⁴
-                    factor = min(STEP_GROWTH, max(STEP_SHRINK, allowed))
+                err, factor = _step_factor(mechanics, contacts, rows, rigid, F_trial, x_r, a_r, xp_new, y0,
+                                           dt, g_rate, omega, omega2, beta, inv_mr, error_tolerance,
+                                           small_error)
                 if err > error_tolerance and dt > dt_fine:
                     # rejected: back to the start of the step, to retry with a shorter one
-                    x_r = xr_old
-                    for g in range(G):
-                        x_a[g] = x_p if rigid else xa_old[g]
-                    dt_ctrl = max(dt * factor, dt_fine)
-                    done = False
+                    x_r, dt_ctrl, done = _reject(carry, x_a, xa_old, rigid, x_p, xr_old, dt * factor, dt_fine)
                     steps += 1
-                    carry[C_REJECTED] += 1.0
                     continue
                 if not done:
-                    dt_ctrl = min(dt * factor, dt_longest)
+                    dt_ctrl = min(dt * factor, seg_longest[s])
             if simpson and rigid:
-                F_mid = 0.0  # Σ n_g T_g at mid-step (pure)
-                for g in range(G):
-                    F_mid += multiplicity[g] * contact_force_row(params, state, g, xp_mid - xr_mid)
-            # contact forces, memory committed once per step
-            F = 0.0
-            for g in range(G):
-                u = x_a[g] - x_r
-                T_start = T[g]
-                T_old[g] = T_start
-                if controlled:
-                    # a reversal of u inside the step is an event: the extremum of the quadratic
-                    # through u at the start (value and rate) and at the end is committed first,
-                    # so the Masing branch turns at it, not at the last step boundary (k_t:
-                    # the tangent stiffness that the last balance solve found)
-                    du0 = _start_increment(rigid, vp - v_r, dt, actuator_stiffness, slope[g] - K)
-                    if _turns_inside(du0, u - u_old[g]):
-                        excess = u - u_old[g] - du0  # curvature term of the quadratic, times dt²
-                        u_ext = u_old[g] - du0 * du0 / (4.0 * excess)
-                        T_ext = contact_update_row(params, state, g, u_ext)
-                        if not simpson:
-                            acc_contact += multiplicity[g] * 0.5 * (T[g] + T_ext) * (u_ext - u_old[g])
-                        T[g] = T_ext
-                        u_old[g] = u_ext
-                        _note_peak(peak, track, g, T_ext, sliding[g])
-                Tn = contact_update_row(params, state, g, u)
-                if not simpson:
-                    acc_contact += multiplicity[g] * 0.5 * (T[g] + Tn) * (u - u_old[g])
-                    if rigid:
-                        acc_in += multiplicity[g] * 0.5 * (T_start + Tn) * (xp_new - x_p)
-                T[g] = Tn
-                u_old[g] = u
-                F += multiplicity[g] * Tn
-                _note_peak(peak, track, g, Tn, sliding[g])
-            # kick
-            a_r_new = (F - load_stiffness * x_r) * inv_mr
-            if controlled and omega > 0.0:
-                ag1 = a_r_new + omega2 * (x_r - beta * xp_new)
-                rate = (ag1 - ag0) / dt
-                # g quadratic in time through its values at the end, the start and the start of
-                # the previous step (curvature 0 after a reset of its rate)
-                curvature = (rate - g_rate) / (dt + h_prev) if h_prev > 0.0 else 0.0
-                v_r = (-omega * sn * y0 + cs * w0 + sn / omega * ag0 + one_minus_cos * (rate - curvature * dt)
-                       + 2.0 * sine_excess * curvature + beta * vp)
-                g_rate = rate
-                h_prev = dt
+                F_mid = _rigid_mid_force(mechanics, contacts, xp_mid, xr_mid)
+            F, acc_contact, acc_in = _commit_contacts(mechanics, contacts, rows, peak, track, x_r, v_r, vp,
+                                                      dt, K, controlled, simpson, x_p, xp_new, acc_contact,
+                                                      acc_in)
+            a_r_new = (F - load_stiffness * x_r) * inv_mr  # kick
+            if simpson:
+                v_r, g_rate, h_prev = _trig_kick(trig, omega, omega2, beta, a_r_new, x_r, xp_new, vp, y0, w0,
+                                                 ag0, dt, g_rate, h_prev)
             else:
                 v_r += 0.5 * dt * (a_r + a_r_new)
             a_r = a_r_new
@@ -753,143 +1032,44 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                 acc_contact += dt / 6.0 * ((vp - vr_old) * F_old + 4.0 * (vp - vr_mid) * F_mid
                                            + (vp - v_r) * F)
             if quasi:
-                activity = 0.0
-                for g in range(G):
-                    v_old = v_a[g]
-                    v_a[g] = (x_a[g] - xa_old[g]) / dt
-                    a_nd[g] = (actuator_stiffness * (xp_new - x_a[g]) - T[g]) * inv_ma
-                    tangent[g] = slope[g] - K  # (the next step's start: this step's end)
-                    if simpson:
-                        # end terms of the quadrature (start and mid-step ones: at the drift)
-                        q1 = (xa_old[g] - 4.0 * xa_mid[g] + 3.0 * x_a[g]) * inv_dt
-                        quad_in += multiplicity[g] * actuator_stiffness * (xp_new - x_a[g])
-                        quad_damp += multiplicity[g] * actuator_viscosity * q1 * q1
-                        quad_contact += multiplicity[g] * T[g] * (q1 - v_r)
-                    else:
-                        # backward Euler: c_p v_a (x_a − x_a,old) = c_p v_a² dt
-                        acc_damp += multiplicity[g] * actuator_viscosity * v_a[g] * v_a[g] * dt
-                        stretch_sum = stretch_old[g] + xp_new - x_a[g]
-                        acc_in += multiplicity[g] * half_kp * stretch_sum * (xp_new - x_p)
-                    acc = abs(v_a[g] - v_old) / dt
-                    if acc > activity:
-                        activity = acc
-                if simpson:
-                    acc_in += vp * dt / 6.0 * quad_in
-                    acc_damp += dt / 6.0 * quad_damp
-                    acc_contact += dt / 6.0 * quad_contact
+                activity, acc_in, acc_damp, acc_contact = _quasi_kick(
+                    mechanics, rows, x_p, xp_new, v_r, vp, dt, K, inv_dt, inv_ma, simpson,
+                    (quad_in, quad_damp, quad_contact), acc_in, acc_damp, acc_contact)
                 if activity >= activity_threshold:
                     fine = True
                     quasi = False
                     controlled = False
                     quiet = 0
             elif not rigid:
-                damp = 1.0 / (1.0 + 0.5 * dt * gam)
-                activity = 0.0
-                for g in range(G):
-                    a_new = (actuator_stiffness * (xp_new - x_a[g]) - T[g]) * inv_ma
-                    v_old = v_a[g]
-                    v_a[g] = (v_old + 0.5 * dt * (a_nd[g] - gam * v_old + a_new)) * damp
-                    a_nd[g] = a_new
-                    acc_damp += multiplicity[g] * half_cp * (v_old * v_old + v_a[g] * v_a[g]) * dt
-                    # work of the moving piezo base: k_p (x_p − x_a) dx_p, trapezoidal in (x_p − x_a)
-                    acc_in += multiplicity[g] * half_kp * (stretch_old[g] + xp_new - x_a[g]) * (xp_new - x_p)
-                    acc = abs(a_new - gam * v_a[g])
-                    if acc > activity:
-                        activity = acc
+                activity, acc_damp, acc_in = _actuator_kick(mechanics, rows, x_p, xp_new, dt, gam, inv_ma,
+                                                            acc_damp, acc_in)
                 if adaptive:
-                    if fine:
-                        if activity < activity_threshold:
-                            quiet += 1
-                            if quiet >= quiet_steps:
-                                fine = False
-                                quasi = quasi_static
-                                controlled = quasi_static and control_on
-                                dt_ctrl = dt_quasi
-                                g_rate = 0.0
-                                h_prev = 0.0
-                                for g in range(G):
-                                    tangent[g] = -1.0
-                        else:
-                            quiet = 0
-                    elif activity >= activity_threshold:
-                        fine = True
-                        quiet = 0
-            # per-period measures
-            acc_xr += (xr_old + x_r) * dt
-            acc_f += (F_old + F) * dt
-            acc_t += dt
-            if in_window:
-                acc_win += ((xr_old - x_p) + (x_r - xp_new)) * dt
-            if x_r < min_xr:
-                min_xr = x_r
+                    fine, quasi, controlled, quiet, dt_ctrl, g_rate, h_prev = _adapt(
+                        activity, activity_threshold, quiet_steps, quasi_static, control_on, fine, quasi,
+                        controlled, quiet, dt_ctrl, seg_quasi[s], g_rate, h_prev, tangent)
+            acc_xr, acc_f, acc_t, acc_win, min_xr = _measure(acc_xr, acc_f, acc_t, acc_win, min_xr, in_window,
+                                                             xr_old, x_r, F_old, F, x_p, xp_new, dt)
             t_old = t
             xp_old = x_p
             t = t_new
             x_p = xp_new
             steps += 1
-            # divergence (also catches NaN: comparisons with NaN are False)
-            ok = abs(x_r) < POSITION_LIMIT and abs(v_r) < VELOCITY_LIMIT
-            if not rigid:
-                for g in range(G):
-                    ok = ok and abs(x_a[g] - x_p) < POSITION_LIMIT and abs(v_a[g]) < VELOCITY_LIMIT
-            if not ok:
+            if _runaway(rigid, x_r, v_r, x_a, v_a, x_p):
                 y[0] = x_r
                 y[1] = v_r
                 return STATUS_DIVERGED, steps, n_rec, fine_steps
-            if controlled and next_rec <= t and n_rec < max_rec:
-                # samples at their own times inside a long step: cubic Hermite in x_r (from
-                # the positions and velocities at both ends), linear in x_p, x_a and T; the
-                # slip share of the step's end
-                for g in range(G):
-                    share[g] = contact_slip_share_row(params, state, g, x_a[g] - x_r)
-                while next_rec <= t and n_rec < max_rec:
-                    th = (next_rec - t_old) / dt
-                    th2 = th * th
-                    th3 = th2 * th
-                    record[n_rec, 0] = next_rec
-                    record[n_rec, 1] = xp_old + th * (x_p - xp_old)
-                    record[n_rec, 2] = ((2.0 * th3 - 3.0 * th2 + 1.0) * xr_old + (3.0 * th2 - 2.0 * th3) * x_r
-                                        + ((th3 - 2.0 * th2 + th) * vr_old + (th3 - th2) * v_r) * dt)
-                    record[n_rec, 3] = (6.0 * (th2 - th) * (xr_old - x_r) / dt + (3.0 * th2 - 4.0 * th + 1.0)
-                                        * vr_old + (3.0 * th2 - 2.0 * th) * v_r)
-                    for g in range(G):
-                        xa0 = xp_old if rigid else xa_old[g]
-                        record[n_rec, 4 + 3 * g] = xa0 + th * (x_a[g] - xa0)
-                        record[n_rec, 5 + 3 * g] = T_old[g] + th * (T[g] - T_old[g])
-                        record[n_rec, 6 + 3 * g] = share[g]
-                    n_rec += 1
-                    next_rec += record_interval
-            elif t >= next_rec and n_rec < max_rec:
-                record[n_rec, 0] = t
-                record[n_rec, 1] = x_p
-                record[n_rec, 2] = x_r
-                record[n_rec, 3] = v_r
-                for g in range(G):
-                    record[n_rec, 4 + 3 * g] = x_a[g]
-                    record[n_rec, 5 + 3 * g] = T[g]
-                    record[n_rec, 6 + 3 * g] = contact_slip_share_row(params, state, g, x_a[g] - x_r)
-                n_rec += 1
-                while next_rec <= t:
-                    next_rec += record_interval
-        per[k, PER_XR_INTEGRAL] += 0.5 * acc_xr
-        per[k, PER_FRICTION_INTEGRAL] += 0.5 * acc_f
-        per[k, PER_DURATION] += acc_t
-        if in_window:
-            per[k, PER_WINDOW_INTEGRAL] += 0.5 * acc_win
-            per[k, PER_WINDOW_LENGTH] += acc_t
-            per[k, PER_WINDOW_END_XP] = seg_x1[s]
-        if track >= 0:
-            per[track, PER_MIN_XR] = min_xr
-        energy[EN_CONTACT] += acc_contact
-        energy[EN_INPUT] += acc_in
-        energy[EN_DAMPING] += acc_damp
+            if controlled and next_rec <= t and n_rec < record.shape[0]:
+                n_rec, next_rec = _record_inside(contacts, rows, record, rigid, n_rec, next_rec,
+                                                 record_interval, t_old, t, dt, xp_old, x_p, xr_old, x_r,
+                                                 vr_old, v_r)
+            elif t >= next_rec and n_rec < record.shape[0]:
+                n_rec, next_rec = _record_step_end(contacts, rows, record, n_rec, next_rec, record_interval,
+                                                   t, x_p, x_r, v_r)
+        _close_segment(per, energy, k, track, in_window, seg_x1[s],
+                       (acc_xr, acc_f, acc_win, acc_in, acc_damp, acc_contact, acc_t, min_xr))
     # done: the loop state goes to carry as at a pause between two segments, so that a call
     # with these segments followed by more (the same arrays, longer) continues the run
     _save_position(carry, seg_t0.shape[0], 0.0, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps,
                    dt_ctrl)
-    y[0] = x_r
-    y[1] = v_r
-    for g in range(G):
-        y[2 + g] = x_a[g]
-        y[2 + G + g] = v_a[g]
+    _save_state(y, x_r, v_r, x_a, v_a)
     return STATUS_OK, steps, n_rec, fine_steps

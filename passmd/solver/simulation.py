@@ -12,19 +12,21 @@ T_g is the MDR friction force of one contact of group g (Eqs. 4–6, :mod:`passm
 with memory. Sign convention: u = x_a − x_r; +T acts on the runner, −T on the actuator
 (the paper's Eq. 2 writes the same with F_f = T).
 
-Integrator (see :mod:`passmd.solver.kernels`). While flexible actuators ring (after each
-corner of x_p(t)): velocity Verlet with a trapezoidal damping term at a fixed number of steps
-per period of the stiff mode (actuator on k_p plus the contact's 2aG*, ≈ 3 MHz), which an
-explicit symplectic scheme neither damps artificially nor lets drift in energy. Everywhere
-else (rigid actuators throughout; flexible ones once the ringing has decayed, with m_a
-neglected and the actuator's force balance solved per step) the step is error-controlled:
+Integrator (see :mod:`passmd.solver.kernels`; the schemes are
+:data:`passmd.solver.steps.SCHEMES`). While flexible actuators ring (after each corner of
+x_p(t)): velocity Verlet with a trapezoidal damping term at a fixed number of steps per
+period of the stiff mode (actuator on k_p plus the contact's 2aG*, ≈ 3 MHz), which an
+explicit symplectic scheme neither damps artificially nor lets drift in energy. In the
+default scheme ("controlled") everywhere else (rigid actuators throughout; flexible ones
+once the ringing has decayed, with m_a neglected and the actuator's force balance solved
+per step) the step is error-controlled:
 the runner's linear oscillation on its contacts (≈ 11 kHz) is integrated exactly, only the
 rest of the force limits the step, a step whose local error estimate exceeds
 :data:`passmd.solver.steps.LOCAL_ERROR_TOLERANCE` is rejected and retried shorter, and a
 reversal of a contact's displacement inside a step is committed at its interpolated
 extremum. Every corner of x_p(t) falls on a step boundary, and the contact memory is
-committed once per accepted step. ``error_control=False`` selects the explicit adaptive
-scheme of earlier versions (:mod:`passmd.solver.steps`).
+committed once per accepted step. The other schemes ("adaptive", "quasi-static", "fixed")
+step explicitly; the convergence studies compare them.
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ from __future__ import annotations
 import sys
 import time as _time
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
@@ -46,11 +49,21 @@ from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
 from passmd.model.theory import contact_layout, contact_moduli
 from passmd.model.waveforms import Waveform
-from passmd.runtime.validation import check_choice, check_count, check_positive, check_range
+from passmd.runtime.validation import check_choice, check_count
 from passmd.solver import kernels as kern
-from passmd.solver.steps import LOCAL_ERROR_TOLERANCE, StepPlan, check_work, segments, step_plan
+from passmd.solver.steps import (
+    DEFAULT_SCHEME,
+    LOCAL_ERROR_TOLERANCE,
+    Scheme,
+    StepPlan,
+    check_work,
+    resolve_scheme,
+    segments,
+    step_plan,
+)
 
-#: Verlet is stable for ω dt < 2; a user step must keep this margin below it.
+#: Verlet is stable for ω dt < 2; a given step (:attr:`passmd.solver.steps.Scheme.dt`) must keep
+#: this margin below it.
 STABILITY_MARGIN = 0.9
 #: Work per kernel call, in steps of the exact contact (:data:`SPRINGS_PER_STEP` springs of a
 #: discrete contact count as one more): the kernel returns to Python between calls, so Ctrl-C
@@ -249,87 +262,25 @@ def _progress_bar(work: float, waveform: Waveform, progress: bool | str | None):
                          delay=0.0 if progress is True else None)
 
 
-def simulate(
-    drive: Drive,
-    waveform: Waveform,
-    *,
-    contact_model: str = "exact",
-    springs: int = PROTOCOL.springs,
-    dt: float | None = None,
-    resolution: float = 1.0,
-    max_points: int = 20000,
-    share_side_state: bool = True,
-    adaptive: bool = True,
-    progress: bool | None = None,
-    quasi_static: bool = False,
-    error_control: bool = True,
-) -> SimulationResult:
+def simulate(drive: Drive, waveform: Waveform, **options) -> SimulationResult:
     """Simulate the drive under a piezo waveform from rest with virgin contacts.
 
-    Parameters
-    ----------
-    drive : Drive
-        Drive configuration (contacts, rigid/flexible actuators, load cell, materials).
-    waveform : Waveform
-        Desired piezo position x_p(t) (:mod:`passmd.model.waveforms`).
-    contact_model : {"exact", "discrete"}
-        Exact continuum MDR contact (default) or ``springs`` discrete MDR springs.
-    springs : int
-        Number of MDR springs for the discrete model.
-    dt : float, optional
-        Fixed time step in s (no adaptation); default: the steps of
-        :func:`passmd.solver.steps.step_plan`.
-        Must stay below the Verlet stability limit of the stiffest mode.
-    resolution : float
-        Divides the default step (convergence studies); with ``error_control`` it divides the
-        error tolerance by ``resolution``⁴ instead (the controlled step scales as its fourth
-        root); ignored when ``dt`` is given.
-    max_points : int
-        Number of recorded samples (evenly spaced in time).
-    share_side_state : bool
-        Six contacts: one state per side (default) or six independent contacts.
-    adaptive : bool
-        Adapt the step (default); ``False`` integrates with the fine step throughout (the
-        reference scheme of the convergence studies).
-    quasi_static : bool
-        Flexible actuators, adaptive step: in the quiet phases neglect the actuator mass and
-        solve its force balance implicitly (:func:`passmd.solver.kernels.quasi_static_position`)
-        instead of explicit coarse steps. Implied by ``error_control``; without it the runner's
-        step is the fixed :data:`passmd.solver.steps.STEPS_PER_QUASI_RUNNER_PERIOD` per period.
-    error_control : bool
-        The default scheme: rigid actuators, and flexible ones once their ringing after a corner
-        of x_p(t) has decayed (quasi-static actuator), take steps chosen by a local error
-        estimate of the runner's position (:data:`passmd.solver.steps.LOCAL_ERROR_TOLERANCE`),
-        with the runner's linear oscillation on its contacts integrated exactly, rejected steps
-        retried shorter, and every reversal of a contact's displacement committed at its
-        interpolated extremum (see :mod:`passmd.solver.kernels`). ``False``: the explicit
-        adaptive step (or, with ``quasi_static``, the quasi-static step at a fixed runner step).
-    progress : bool or "long", optional
-        Progress on stderr (:mod:`passmd.runtime.progress`). Default: for runs of more than
-        :data:`PROGRESS_MIN_WORK` (expected steps, a discrete contact's springs counted,
-        :data:`SPRINGS_PER_STEP`) when stderr is a terminal, shown once the run has lasted
-        2 s; ``"long"``: the same whatever stderr is (off a terminal, a line every few
-        seconds: the command line); True: at once, for any run; False: never.
-
-    The kernel runs in chunks of :data:`CHUNK_STEPS` steps (fewer with many springs) and returns
-    to Python between them, so a KeyboardInterrupt stops the run within one chunk; results are identical to
-    an uninterrupted run. This is a :class:`Simulation` run through all periods at once.
+    A :class:`Simulation` run through all periods at once: ``options`` are its keyword
+    arguments (``contact_model``, ``springs``, ``scheme``, ``max_points``,
+    ``share_side_state``, ``progress``; documented there), e.g.
+    ``simulate(drive, waveform, scheme="fixed")``.
 
     Raises
     ------
     ValueError
-        Bad input, or a ``dt`` the integrator cannot resolve.
+        Bad input, or a scheme's ``dt`` the integrator cannot resolve.
     passmd.solver.steps.WorkLimitError
         (a ValueError) The step falls below the float resolution of the simulated time, or
         the run would need more than :data:`passmd.solver.steps.MAX_STEPS` steps.
     SimulationError
         The integration diverged (non-finite or runaway state).
     """
-    run = Simulation(
-        drive, waveform, contact_model=contact_model, springs=springs, dt=dt, resolution=resolution,
-        max_points=max_points, share_side_state=share_side_state, adaptive=adaptive, progress=progress,
-        quasi_static=quasi_static, error_control=error_control,
-    )
+    run = Simulation(drive, waveform, **options)
     run.run_to(waveform.periods)
     return run.result()
 
@@ -347,7 +298,40 @@ class Simulation:
     ``waveform``. So a protocol that decides after n periods whether it needs more continues
     the run instead of repeating it from rest.
 
-    Parameters are those of :func:`simulate`; the run is refused
+    Parameters
+    ----------
+    drive : Drive
+        Drive configuration (contacts, rigid/flexible actuators, load cell, materials).
+    waveform : Waveform
+        Desired piezo position x_p(t) (:mod:`passmd.model.waveforms`).
+    contact_model : {"exact", "discrete"}
+        Exact continuum MDR contact (default) or ``springs`` discrete MDR springs.
+    springs : int
+        Number of MDR springs for the discrete model.
+    scheme : {"controlled", "adaptive", "quasi-static", "fixed"} or Scheme
+        Integration scheme (:data:`passmd.solver.steps.SCHEMES`). "controlled" (default):
+        error-controlled steps for rigid actuators, and for flexible ones once their ringing
+        after a corner of x_p(t) has decayed (quasi-static actuator); "adaptive": explicit
+        Verlet, fine while flexible actuators ring and coarse after; "quasi-static": the
+        quasi-static actuator at a fixed runner step after the ringing; "fixed": the fine step
+        throughout. A :class:`passmd.solver.steps.Scheme` refines one
+        (``SCHEMES["fixed"].replace(refine=2.0)``) or fixes the step
+        (``SCHEMES["fixed"].replace(dt=1e-9)``, below the Verlet stability limit of the
+        stiffest mode).
+    max_points : int
+        Number of recorded samples (evenly spaced in time).
+    share_side_state : bool
+        Six contacts: one state per side (default) or six independent contacts.
+    progress : bool or "long", optional
+        Progress on stderr (:mod:`passmd.runtime.progress`). Default: for runs of more than
+        :data:`PROGRESS_MIN_WORK` (expected steps, a discrete contact's springs counted,
+        :data:`SPRINGS_PER_STEP`) when stderr is a terminal, shown once the run has lasted
+        2 s; ``"long"``: the same whatever stderr is (off a terminal, a line every few
+        seconds: the command line); True: at once, for any run; False: never.
+
+    The kernel runs in chunks of :data:`CHUNK_STEPS` steps (fewer with many springs) and
+    returns to Python between them, so a KeyboardInterrupt stops the run within one chunk;
+    results are identical to an uninterrupted run. The run is refused
     (:func:`passmd.solver.steps.check_work`) period count by period count, as :func:`simulate`
     would refuse the shorter waveform.
     """
@@ -359,21 +343,17 @@ class Simulation:
         *,
         contact_model: str = "exact",
         springs: int = PROTOCOL.springs,
-        dt: float | None = None,
-        resolution: float = 1.0,
+        scheme: str | Scheme = DEFAULT_SCHEME,
         max_points: int = 20000,
         share_side_state: bool = True,
-        adaptive: bool = True,
         progress: bool | None = None,
-        quasi_static: bool = False,
-        error_control: bool = True,
     ):
         if not isinstance(drive, Drive):
             raise ValueError(f"drive = {drive!r} is not a Drive")
         if not isinstance(waveform, Waveform):
             raise ValueError(f"waveform = {waveform!r} is not a Waveform")
         check_choice("contact_model", contact_model, ("exact", "discrete"))
-        check_range("resolution", resolution, 0.0, lower_open=True)
+        scheme = resolve_scheme(scheme)
         if int(max_points) != max_points or max_points < 2:
             raise ValueError(f"max_points = {max_points!r} is out of range: must be an integer >= 2")
         if not (progress is None or isinstance(progress, bool) or (isinstance(progress, str)
@@ -383,12 +363,10 @@ class Simulation:
         params, state, multiplicity = _contact_rows(drive, contact_model, springs, share_side_state)
         k_contacts = np.array([contact_stiffness(params[g]) for g in range(multiplicity.size)])
         self._total_stiffness = float(np.sum(multiplicity * k_contacts))
-        self._plan = plan = step_plan(drive, float(k_contacts.max()), self._total_stiffness, resolution)
-        # (the error-controlled step of flexible actuators is the quasi-static one)
-        quasi_static = quasi_static or error_control
-        self._fine_step, coarse_step, quasi, quasi_step = _steps(drive, plan, dt, adaptive, quasi_static)
-        self._coarse_step = quasi_step if quasi else coarse_step
-        self._user_step = dt is not None
+        self._plan = plan = step_plan(drive, float(k_contacts.max()), self._total_stiffness, scheme.refine)
+        steps = _steps(drive, plan, scheme)
+        self._fine_step, self._coarse_step = steps.fine, steps.quiet
+        self._user_step = scheme.dt is not None
         self.drive, self.waveform, self.contact_model = drive, waveform, contact_model
         self._multiplicity, self._params, self._state = multiplicity, params, state
         self._progress = progress
@@ -404,9 +382,7 @@ class Simulation:
             peak=np.zeros((waveform.periods, G)),
             energy=np.zeros(kern.EN_COLUMNS),
         )
-        controlled = error_control and adaptive and dt is None and (quasi or drive.actuator_model == "rigid")
-        self._segments = segments(waveform, self._fine_step, coarse_step, quasi_step,
-                                  plan.longest_step if controlled else None)
+        self._segments = segments(waveform, steps.fine, steps.coarse, steps.quiet, steps.longest)
         # pieces of the first n periods: the first _ends[n − 1] (a piece's period never decreases)
         self._ends = np.searchsorted(self._segments.period, np.arange(1, waveform.periods + 1), side="left")
         self._mechanics = kern.Mechanics(
@@ -417,11 +393,12 @@ class Simulation:
             drive.actuator.mass,
             drive.actuator.stiffness,
             drive.actuator.viscosity,
-            _linear_stiffness(drive, multiplicity, k_contacts) if controlled else 0.0,
+            _linear_stiffness(drive, multiplicity, k_contacts) if steps.controlled else 0.0,
         )
         self._control = kern.StepControl(
-            plan.activity_threshold, plan.quiet_steps, quasi, waveform.duration / (max_points - 1),
-            LOCAL_ERROR_TOLERANCE / resolution**4 if controlled else 0.0,
+            plan.activity_threshold, plan.quiet_steps, steps.quasi_static,
+            waveform.duration / (max_points - 1),
+            LOCAL_ERROR_TOLERANCE / scheme.refine**4 if steps.controlled else 0.0,
         )
         self._contacts = kern.Contacts(params, state, np.array([sliding_force(params[g]) for g in range(G)]))
         self.periods_done = 0
@@ -551,26 +528,39 @@ def _linear_stiffness(drive: Drive, multiplicity: np.ndarray, k_contacts: np.nda
     return float(np.sum(multiplicity * k_contacts))
 
 
-def _steps(drive: Drive, plan: StepPlan, dt: float | None, adaptive: bool, quasi_static: bool):
-    """(fine step, coarse step, quasi-static flag, quasi-static step) of a run (s).
+class Steps(NamedTuple):
+    """The steps a scheme takes on one drive (s), from :func:`_steps`."""
 
-    A user ``dt`` replaces both steps and must keep :data:`STABILITY_MARGIN` below the
+    fine: float  # while flexible actuators ring; rigid actuators without error control throughout
+    coarse: float  # explicit step once flexible actuators stop ringing (= fine when it does not grow)
+    quasi_static: bool  # flexible actuators turn quasi-static once their ringing has decayed
+    quiet: float  # step once the ringing has decayed: the quasi-static (first controlled) or coarse one
+    controlled: bool  # error-controlled steps (rigid actuators; flexible ones while quasi-static)
+    longest: float | None  # longest error-controlled step (None without error control)
+
+
+def _steps(drive: Drive, plan: StepPlan, scheme: Scheme) -> Steps:
+    """The steps of ``scheme`` on ``drive`` under ``plan``.
+
+    A scheme's ``dt`` replaces the fine step and must keep :data:`STABILITY_MARGIN` below the
     Verlet stability limit of the stiffest mode.
     """
-    fine_step = plan.fine_step
-    coarse_step = plan.coarse_step if adaptive else plan.fine_step
-    if dt is not None:
-        check_positive("dt", dt, "s")
+    fine = coarse = plan.fine_step
+    if scheme.dt is not None:
         limit = STABILITY_MARGIN * plan.stability_limit
-        if dt > limit:
+        if scheme.dt > limit:
             raise ValueError(
-                f"dt = {dt!r} is out of range: the stiffest mode ({plan.stiffest_frequency / 1e6:.3g} MHz) "
-                f"needs dt < {limit:.3g} s for the explicit integrator to stay stable"
+                f"dt = {scheme.dt!r} is out of range: the stiffest mode "
+                f"({plan.stiffest_frequency / 1e6:.3g} MHz) needs dt < {limit:.3g} s for the explicit "
+                "integrator to stay stable"
             )
-        fine_step = coarse_step = float(dt)
-    quasi = quasi_static and adaptive and dt is None and drive.actuator_model == "flexible"
-    quasi_step = plan.quasi_step if quasi else coarse_step
-    return fine_step, coarse_step, quasi, quasi_step
+        fine = coarse = scheme.dt
+    elif scheme.quiet_step != "fine":
+        coarse = plan.coarse_step
+    quasi_static = scheme.quiet_step == "quasi-static" and drive.actuator_model == "flexible"
+    quiet = plan.quasi_step if quasi_static else coarse
+    controlled = scheme.error_control
+    return Steps(fine, coarse, quasi_static, quiet, controlled, plan.longest_step if controlled else None)
 
 
 def _integrate_in_chunks(arguments: tuple, waveform: Waveform, expected: float, step_work: float,

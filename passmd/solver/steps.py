@@ -1,22 +1,24 @@
-"""Time steps of the integrator, derived from the drive's parameters, and the work a run needs.
+"""Integration schemes and time steps of the hybrid simulation, and the work a run needs.
 
-The hybrid simulation (:mod:`passmd.solver.simulation`) integrates with uniform steps inside each
-linear piece of x_p(t): a fixed number of steps per period of the stiffest mode (flexible
-actuators: the actuator on k_p plus the contact's 2aG*, ≈ 3 MHz) or of the
-runner-on-contacts mode (rigid actuators), a coarser step while flexible actuators follow
-quasi-statically, and a minimum number of steps on every waveform edge. Before a run
-starts, :func:`check_work` refuses one whose step is below the float resolution of the
-simulated time or that would take more than :data:`MAX_STEPS` steps.
+A :class:`Scheme` says how :mod:`passmd.solver.simulation` steps through each linear piece of x_p(t);
+:data:`SCHEMES` names the four (see there). All of them take a fixed number of steps per
+period of the stiffest mode while flexible actuators ring (the actuator on k_p plus the
+contact's 2aG*, ≈ 3 MHz; the runner-on-contacts mode for rigid actuators) and a minimum
+number of steps on every waveform edge. :func:`step_plan` derives the steps from the
+drive's parameters. Before a run starts, :func:`check_work` refuses one whose step is below
+the float resolution of the simulated time or that would take more than :data:`MAX_STEPS`
+steps.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from passmd.model.parameters import Drive
 from passmd.model.waveforms import Waveform
+from passmd.runtime.validation import check_choice, check_positive
 from passmd.solver.kernels import Segments
 
 #: Accuracy the default steps are chosen for: the settled runner position after three 100 Hz
@@ -37,8 +39,9 @@ RINGING_TOLERANCE = 1e-11
 QUIET_PERIODS = 2
 #: Steps per period of the runner-on-contacts mode (rigid actuators).
 STEPS_PER_RUNNER_PERIOD = 400
-#: Quasi-static actuator step (``quasi_static=True``): steps per period of the
-#: runner-on-contacts mode, as for rigid actuators (the actuator in series only softens it).
+#: Quasi-static actuator step (schemes "quasi-static" and "controlled"): steps per period of
+#: the runner-on-contacts mode, as for rigid actuators (the actuator in series only softens it).
+#: The error-controlled step starts each quiet phase with it.
 STEPS_PER_QUASI_RUNNER_PERIOD = 400
 #: Error-controlled step (rigid actuators, or the quasi-static actuator step): local position
 #: error of the runner allowed per step (m).
@@ -48,8 +51,8 @@ LOCAL_ERROR_TOLERANCE = 3e-14
 LONGEST_OMEGA_DT = 1.5
 #: Minimum number of steps on every linear piece of x_p(t) (resolves the fly-back).
 MIN_SEGMENT_STEPS = 40
-#: Work budget of one simulation in integrator steps (≈ 15–30 min at the 45–90 ns per step
-#: that ``benchmarks/bench_dynamics.py`` measures). A run whose step plan needs more is
+#: Work budget of one simulation in integrator steps (a quarter to half an hour at the ns per
+#: step that ``benchmarks/bench_dynamics.py`` measures). A run whose step plan needs more is
 #: refused before it starts, with the option responsible named.
 MAX_STEPS = 2e10
 #: Smallest step, in units of the float spacing of the simulated time t: below it t + dt
@@ -64,6 +67,92 @@ class WorkLimitError(ValueError):
     responsible."""
 
 
+#: What flexible actuators step with once their ringing has decayed (:attr:`Scheme.quiet_step`).
+QUIET_STEPS = ("fine", "coarse", "quasi-static")
+
+
+@dataclass(frozen=True)
+class Scheme:
+    """How the integrator steps: one of :data:`SCHEMES`, possibly refined or with a fixed ``dt``.
+
+    Every scheme takes the fine step of :func:`step_plan` while flexible actuators ring (after
+    each corner of x_p(t)). The fields say what happens elsewhere.
+
+    Attributes
+    ----------
+    name : str
+        The key of :data:`SCHEMES` the scheme derives from.
+    quiet_step : {"fine", "coarse", "quasi-static"}
+        Flexible actuators once their ringing has decayed: the fine step throughout, the
+        coarse explicit step (velocity Verlet at :data:`COARSE_OMEGA_DT`), or the quasi-static
+        actuator (m_a neglected, its force balance solved per step,
+        :func:`passmd.solver.kernels.quasi_static_position`) at the runner-mode step
+        :data:`STEPS_PER_QUASI_RUNNER_PERIOD`.
+    error_control : bool
+        The quasi-static phases (flexible actuators) and every step (rigid ones) are chosen by
+        a local error estimate of the runner's position (:data:`LOCAL_ERROR_TOLERANCE`), with
+        the runner's linear oscillation on its contacts integrated exactly (see
+        :mod:`passmd.solver.kernels`). Without it rigid actuators take the fine step.
+    refine : float
+        Divides every step (convergence studies); under error control it divides the
+        tolerance by ``refine``⁴ instead (the controlled step scales as its fourth root).
+    dt : float or None
+        Scheme "fixed" only: this step (s) throughout instead of the fine step; it must stay
+        below the Verlet stability limit of the stiffest mode (``refine`` must then be 1).
+    """
+
+    name: str
+    quiet_step: str
+    error_control: bool
+    refine: float = 1.0
+    dt: float | None = None
+
+    def __post_init__(self):
+        check_choice("quiet_step", self.quiet_step, QUIET_STEPS)
+        object.__setattr__(self, "refine", check_positive("refine", self.refine))
+        if self.error_control and self.quiet_step != "quasi-static":
+            raise ValueError(f"error_control = True is not allowed with quiet_step = {self.quiet_step!r}: "
+                             "it needs 'quasi-static'")
+        if self.dt is not None:
+            object.__setattr__(self, "dt", check_positive("dt", self.dt, "s"))
+            if self.quiet_step != "fine" or self.error_control:
+                raise ValueError(f"dt = {self.dt!r} is not allowed with scheme {self.name!r}: only scheme "
+                                 "'fixed' takes a given step")
+            if self.refine != 1.0:
+                raise ValueError(f"refine = {self.refine!r} is not allowed with dt = {self.dt!r}: the "
+                                 "step is given; refine it by dividing dt")
+
+    def replace(self, **changes) -> Scheme:
+        """A copy with some fields changed (validated again), e.g. ``refine=2.0`` or ``dt=1e-9``."""
+        return replace(self, **changes)
+
+
+#: The schemes by name (``simulate(..., scheme=name)``); "controlled" is the default.
+SCHEMES = {
+    # error-controlled steps: rigid actuators throughout, flexible ones once quasi-static
+    "controlled": Scheme("controlled", "quasi-static", True),
+    # explicit adaptive Verlet: fine while flexible actuators ring, coarse after; rigid: fine
+    "adaptive": Scheme("adaptive", "coarse", False),
+    # fine while flexible actuators ring, then the quasi-static actuator at a fixed runner step
+    "quasi-static": Scheme("quasi-static", "quasi-static", False),
+    # the fine step (or a given dt) throughout: the reference of the convergence studies
+    "fixed": Scheme("fixed", "fine", False),
+}
+#: The scheme of :func:`passmd.solver.simulation.simulate` unless one is given.
+DEFAULT_SCHEME = "controlled"
+
+
+def resolve_scheme(scheme: str | Scheme) -> Scheme:
+    """The :class:`Scheme` a ``scheme`` argument names (a key of :data:`SCHEMES`, or a Scheme)."""
+    if isinstance(scheme, Scheme):
+        return scheme
+    if isinstance(scheme, str) and scheme in SCHEMES:
+        return SCHEMES[scheme]
+    allowed = ", ".join(repr(name) for name in SCHEMES)
+    raise ValueError(f"scheme = {scheme!r} is not allowed: must be one of {allowed} or a "
+                     "passmd.solver.steps.Scheme")
+
+
 @dataclass(frozen=True)
 class StepPlan:
     """How the integrator discretises time for one drive."""
@@ -74,12 +163,12 @@ class StepPlan:
     stability_limit: float  # Verlet stability limit 2/ω of that mode (s)
     activity_threshold: float  # actuator acceleration that counts as ringing (m/s²)
     quiet_steps: int  # fine steps below the threshold before the step grows
-    quasi_step: float = 0.0  # step of the quasi-static actuator (flexible, quasi_static=True) (s)
+    quasi_step: float = 0.0  # step of the quasi-static actuator (flexible actuators) (s)
     longest_step: float = 0.0  # longest error-controlled step (s)
 
 
 def step_plan(
-    drive: Drive, contact_stiffness_max: float, total_contact_stiffness: float, resolution: float = 1.0
+    drive: Drive, contact_stiffness_max: float, total_contact_stiffness: float, refine: float = 1.0
 ) -> StepPlan:
     """Time steps from the parameters (flexible: actuator mode; rigid: runner mode).
 
@@ -91,24 +180,24 @@ def step_plan(
         Largest tangential stiffness 2aG* of one contact (N/m).
     total_contact_stiffness : float
         Σ n_g 2aG*_g over all contacts (N/m).
-    resolution : float
-        Refinement factor: the step is divided by it (convergence studies).
+    refine : float
+        Refinement factor: the steps are divided by it (:attr:`Scheme.refine`).
     """
     act = drive.actuator
     runner_stiffness = total_contact_stiffness + drive.effective_load_cell_stiffness
     omega_runner = np.sqrt(runner_stiffness / drive.runner_mass)
     if drive.actuator_model == "flexible":
         omega = np.sqrt((act.stiffness + contact_stiffness_max) / act.mass)
-        dt = 2 * np.pi / omega / STEPS_PER_STIFF_PERIOD / resolution
-        # never beyond COARSE_OMEGA_DT/ω: a resolution < 1 coarsens the fine step only
-        coarse = COARSE_OMEGA_DT / omega / max(resolution, 1.0)
+        dt = 2 * np.pi / omega / STEPS_PER_STIFF_PERIOD / refine
+        # never beyond COARSE_OMEGA_DT/ω: a refine < 1 coarsens the fine step only
+        coarse = COARSE_OMEGA_DT / omega / max(refine, 1.0)
         threshold = omega**2 * RINGING_TOLERANCE
-        quiet = int(np.ceil(QUIET_PERIODS * STEPS_PER_STIFF_PERIOD * resolution))
+        quiet = int(np.ceil(QUIET_PERIODS * STEPS_PER_STIFF_PERIOD * refine))
     else:
         omega = omega_runner
-        dt = 2 * np.pi / omega / STEPS_PER_RUNNER_PERIOD / resolution
+        dt = 2 * np.pi / omega / STEPS_PER_RUNNER_PERIOD / refine
         coarse, threshold, quiet = dt, 0.0, 0
-    quasi = 2 * np.pi / omega_runner / STEPS_PER_QUASI_RUNNER_PERIOD / resolution
+    quasi = 2 * np.pi / omega_runner / STEPS_PER_QUASI_RUNNER_PERIOD / refine
     return StepPlan(
         float(dt),
         float(max(coarse, dt)),

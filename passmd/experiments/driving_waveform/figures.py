@@ -48,6 +48,7 @@ from passmd.runtime import sweep
 from passmd.runtime.config import PROFILES, RunConfig
 from passmd.runtime.validation import check_choice
 from passmd.solver import simulation as dynamics
+from passmd.solver import steps as time_steps
 
 #: Driving frequency of Figs. 8 and 9a (Hz).
 STEP_FREQUENCY = PROTOCOL.drive_frequency
@@ -456,7 +457,8 @@ def window_point(hemisphere_radius: float, preload: float, runner: str, actuator
     start_a = period + timing["settling_time_s"]
     end_a = start_a + timing["acceleration_time_s"]
     points = int(math.ceil(wave.duration * samples_per_acceleration / timing["acceleration_time_s"])) + 1
-    result = dynamics.simulate(drive, wave, resolution=resolution, max_points=points)
+    refined = time_steps.SCHEMES["controlled"].replace(refine=resolution)
+    result = dynamics.simulate(drive, wave, scheme=refined, max_points=points)
     t = result.time
     keep = (t >= period - flyback - WINDOW_BEFORE) & (t <= end_a + WINDOW_AFTER)
     inside = t[(t >= start_a) & (t <= end_a)]

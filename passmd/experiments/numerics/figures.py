@@ -73,13 +73,13 @@ CRITICAL_AMPLITUDE_BRACKETS = 1.0
 RESOLUTIONS = {"quick": (0.5, 1.0, 2.0, 4.0), "paper": (0.25, 0.5, 1.0, 2.0, 4.0, 8.0)}
 
 
-#: Step controls of :func:`convergence_study` by name: the keywords of
-#: :func:`passmd.solver.simulation.simulate` that select each scheme.
+#: Step controls of :func:`convergence_study` by name: the integration schemes
+#: (:data:`passmd.solver.steps.SCHEMES`) it compares.
 STEP_CONTROLS = {
-    "controlled": {},  # the default: error-controlled steps (rigid; flexible once quasi-static)
-    "adaptive": {"error_control": False},  # explicit adaptive step (fine while ringing, coarse after)
-    "quasi-static": {"error_control": False, "quasi_static": True},  # m_a neglected, fixed runner step
-    "fixed": {"adaptive": False},  # the fine step throughout: the reference scheme
+    "controlled": time_steps.SCHEMES["controlled"],  # the default: error-controlled steps
+    "adaptive": time_steps.SCHEMES["adaptive"],  # explicit adaptive step (fine while ringing, coarse after)
+    "quasi-static": time_steps.SCHEMES["quasi-static"],  # m_a neglected, fixed runner step
+    "fixed": time_steps.SCHEMES["fixed"],  # the fine step throughout: the reference scheme
 }
 #: Step controls that differ for rigid actuators (they have no actuator mode to adapt to: their
 #: explicit adaptive and quasi-static steps are the fixed one).
@@ -98,7 +98,8 @@ def convergence_point(contacts: int, actuator_model: str, step_control: str, res
     drive = Drive(hemisphere_radius=hemisphere_radius, preload=preload, contacts=contacts,
                   actuator_model=actuator_model)
     wf = waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
-    res = dynamics.simulate(drive, wf, resolution=resolution, max_points=2, **STEP_CONTROLS[step_control])
+    scheme = STEP_CONTROLS[step_control].replace(refine=resolution)
+    res = dynamics.simulate(drive, wf, scheme=scheme, max_points=2)
     return {"fine_step_s": res.fine_step, "coarse_step_s": res.coarse_step, "steps": res.steps,
             "rejected_steps": res.rejected_steps, "final_position_m": res.final_position}
 
@@ -179,16 +180,18 @@ def energy_balance_table(
 
     Runs :func:`passmd.solver.simulation.simulate` at ``resolution`` with the exact contact and with
     the discrete contact (:data:`passmd.model.defaults.PROTOCOL` ``.springs`` springs): the
-    default, error-controlled scheme, or with ``error_control=False`` the explicit schemes
-    (fixed fine step for rigid actuators, adaptive for flexible ones).
+    default, error-controlled scheme, or with ``error_control=False`` the explicit scheme
+    "adaptive" (:data:`passmd.solver.steps.SCHEMES`: the fixed fine step for rigid actuators,
+    adaptive for flexible ones).
     """
+    scheme = time_steps.SCHEMES["controlled" if error_control else "adaptive"].replace(refine=resolution)
     rows = []
     for label, contacts, model in CONFIGURATIONS:
         drive = Drive(contacts=contacts, actuator_model=model)
         wf = waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
         for contact in ("exact", "discrete"):
             res = dynamics.simulate(drive, wf, contact_model=contact, springs=PROTOCOL.springs,
-                                    max_points=2, resolution=resolution, error_control=error_control)
+                                    max_points=2, scheme=scheme)
             bal = res.energy_balance()
             rows.append({"configuration": label, "contact_model": contact, **bal})
     return pd.DataFrame(rows)
@@ -321,7 +324,7 @@ def rigid_coulomb_limit(
     Coulomb loss a t_f² is a fraction of a nanometre and the limit is ≈ A; and a slow fly-back
     whose slew rate is chosen so that a t_f² = ``slow_flyback_loss`` · A, where the limit is
     far below A and the formula's fly-back term is tested. The runs use the fixed step of the
-    runner mode (``error_control=False``), which shrinks with the stiffened contacts;
+    runner mode (scheme "fixed"), which shrinks with the stiffened contacts;
     ``resolution`` divides it, to show that the gap is the model's and not the time step's.
 
     Returns
@@ -355,7 +358,8 @@ def rigid_coulomb_limit(
                 # the fixed step of the stiffened runner mode: its error shrinks with the
                 # stiffness, as the gap it measures does (the error-controlled step's absolute
                 # tolerance would not, and would set a floor under the fitted rate)
-                res = dynamics.simulate(drive, wf, max_points=2, resolution=resolution, error_control=False)
+                res = dynamics.simulate(drive, wf, max_points=2,
+                                        scheme=time_steps.SCHEMES["fixed"].replace(refine=resolution))
                 step = float(res.step_sizes[-1])
                 rows.append({
                     "configuration": f"{'six contacts' if n == 6 else 'one contact'}, {label} fly-back",
