@@ -76,6 +76,11 @@ def test_the_preload_is_range_checked_at_the_option_and_in_the_drive_only(run_wa
     preload = [(helper, caller) for helper, name, caller in run_walk if "preload" in name]
     assert preload == [("PlausibleRange.check", "Quantity.parse"),  # --preload, in N, as typed
                        ("PlausibleRange.check", "Drive.__post_init__")], preload
+    # what the simulation derives from the checked drive (each contact's force, radius, moduli)
+    # is not checked again on its way to the kernel
+    derived = [(name, caller) for _, name, caller in run_walk
+               if name in ("normal_force", "radius", "E_star", "G_star", "mu")]
+    assert derived == [], derived
 
 
 def test_frequency_and_amplitude_are_checked_at_the_option_and_by_the_waveform_only(run_walk):

@@ -98,6 +98,7 @@ __all__ = [
     "contact_update",
     "contact_update_row",
     "discrete_indentation",
+    "drive_contact_arrays",
     "memory_diagnostics",
     "sliding_force",
     "stack_contacts",
@@ -217,6 +218,20 @@ def contact_arrays(model, normal_force, radius, E_star, G_star, mu, springs=None
     if model == "exact":
         return _contact_arrays(model, F, R, E, G, mu, None, _check_capacity(capacity))
     return _contact_arrays(model, F, R, E, G, mu, _check_springs(springs), capacity)
+
+
+def drive_contact_arrays(drive: Drive, normal_force: float, radius: float, springs: int | None = None
+                         ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`contact_arrays` of one contact of ``drive`` (exact model without ``springs``).
+
+    The :class:`~passmd.model.parameters.Drive` checked its contacts' force, radius, moduli and
+    friction coefficient on construction, so only ``springs`` is checked here.
+    """
+    E_star, G_star = contact_moduli(drive)
+    model = "exact" if springs is None else "discrete"
+    springs = None if springs is None else _check_springs(springs)
+    return _contact_arrays(model, float(normal_force), float(radius), E_star, G_star,
+                           drive.friction_coefficient, springs, DEFAULT_CAPACITY)
 
 
 def _contact_arrays(model: str, F: float, R: float, E: float, G: float, mu: float, springs: int | None,

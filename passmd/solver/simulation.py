@@ -39,15 +39,15 @@ from typing import NamedTuple
 import numpy as np
 
 from passmd.model.contact import (
-    contact_arrays,
     contact_stiffness,
+    drive_contact_arrays,
     memory_diagnostics,
     sliding_force,
     stack_contacts,
 )
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
-from passmd.model.theory import contact_layout, contact_moduli
+from passmd.model.theory import contact_layout
 from passmd.model.waveforms import Waveform
 from passmd.runtime.validation import check_choice, check_count
 from passmd.solver import kernels as kern
@@ -498,23 +498,12 @@ class Simulation:
 def _contact_rows(drive: Drive, contact_model: str, springs: int, share_side_state: bool):
     """Contact parameters and state of every group (:func:`passmd.model.contact.stack_contacts`) and
     the groups' multiplicities (:func:`contact_groups`)."""
-    E_star, G_star = contact_moduli(drive)
     forces, multiplicity = contact_groups(drive, share_side_state)
     _, counts, radii = contact_layout(drive)
     if not share_side_state:
         radii = np.repeat(radii, counts.astype(int))
-    rows = [
-        contact_arrays(
-            contact_model,
-            F,
-            float(R),
-            E_star,
-            G_star,
-            drive.friction_coefficient,
-            springs=springs if contact_model == "discrete" else None,
-        )
-        for F, R in zip(forces, radii, strict=True)
-    ]
+    discrete = springs if contact_model == "discrete" else None
+    rows = [drive_contact_arrays(drive, F, R, discrete) for F, R in zip(forces, radii, strict=True)]
     params, state = stack_contacts(rows)
     return params, state, multiplicity
 
