@@ -146,9 +146,6 @@ def fit(
     InputError
         Bad arguments; also when there are no more measurements than free parameters.
     """
-    from scipy import optimize, stats
-    from scipy.stats import qmc
-
     t0 = time.perf_counter()
     check_drive(drive)
     if not isinstance(data, Measurements):
@@ -179,74 +176,82 @@ def fit(
         chosen = pool
     model = _Model(drive, data, names, reading, executor=chosen, cache=cache, config=config)
     try:
-        return _fit(model, drive, data, names, box, lo, hi, x_start, sigma, reading, loss, starts, seed,
-                    say, t0, optimize, stats, qmc)
+        problem = _Problem(model, data, sigma, lo, hi, loss)
+        return _fit(problem, drive, names, box, x_start, reading, starts, seed, say, t0)
     finally:
         if pool is not None:
             pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _fit(model, drive, data, names, box, lo, hi, x_start, sigma, reading, loss, starts, seed, say, t0,
-         optimize, stats, qmc) -> FitResult:
-    n, p = len(data), len(names)
-    h = JACOBIAN_STEP
+class _Problem:
+    """The weighted least-squares problem in log-parameter space, evaluated through the model's sweeps.
 
-    def residual(pred):
-        return (pred - data.value) / sigma
+    Every method evaluates its points in as few ``model.evaluate`` calls as it can (one sweep
+    each), and the model caches them, so a point met twice costs nothing the second time.
+    """
 
-    def perturbed(x, cols):
+    def __init__(self, model: _Model, data: Measurements, sigma: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                 loss: str):
+        self.model, self.data, self.sigma, self.lo, self.hi, self.loss = model, data, sigma, lo, hi, loss
+        self.n, self.p = len(data), len(lo)
+        self.h = JACOBIAN_STEP
+
+    def residual(self, pred: np.ndarray) -> np.ndarray:
+        return (pred - self.data.value) / self.sigma
+
+    def costs(self, points: Sequence[np.ndarray]) -> list[float]:
+        """Sum of squared residuals at each point (one sweep)."""
+        return [float(np.sum(self.residual(v) ** 2)) for v in self.model.evaluate(points)]
+
+    def perturbed(self, x: np.ndarray, cols) -> list[np.ndarray]:
+        """x stepped by +h in each column of ``cols`` (by -h where +h leaves the box)."""
         out = []
         for j in cols:
-            e = np.zeros(p)
-            e[j] = h if x[j] + h <= hi[j] else -h
+            e = np.zeros(self.p)
+            e[j] = self.h if x[j] + self.h <= self.hi[j] else -self.h
             out.append(x + e)
         return out
 
-    def fun_jac(x, cols=None):
+    def fun_jac(self, x, cols=None) -> tuple[np.ndarray, np.ndarray]:
         """Residual and Jacobian (d r / d log θ; columns ``cols``), base and perturbed points in one sweep."""
         x = np.asarray(x, float)
-        steps = perturbed(x, range(p) if cols is None else cols)
-        base, *others = model.evaluate([x, *steps])
-        r = residual(base)
-        jac = np.column_stack([(residual(o) - r) / (s - x).sum()
-                               for o, s in zip(others, steps, strict=True)]) if steps else np.zeros((n, 0))
-        return r, jac
+        steps = self.perturbed(x, range(self.p) if cols is None else cols)
+        base, *others = self.model.evaluate([x, *steps])
+        r = self.residual(base)
+        if not steps:
+            return r, np.zeros((self.n, 0))
+        return r, np.column_stack([(self.residual(o) - r) / (s - x).sum()
+                                   for o, s in zip(others, steps, strict=True)])
 
-    # global pass: a Sobol design over the log box, one sweep
-    candidates = [x_start]
-    if starts:
-        design = qmc.Sobol(d=p, scramble=True, seed=seed).random(starts)
-        candidates += [lo + u * (hi - lo) for u in design]
-    say(f"global pass: {len(candidates)} parameter sets × {n} measurements")
-    costs = [float(np.sum(residual(v) ** 2)) for v in model.evaluate(candidates)]
-    order = np.argsort(costs)
-    picks = [candidates[k] for k in order[:LOCAL_STARTS]]
+    def local(self, x0: np.ndarray) -> tuple[np.ndarray, float]:
+        """A bounded least-squares search from x0 (:data:`LOCAL_EVALUATIONS`): (x, cost)."""
+        from scipy import optimize
 
-    def local(x0):
-        """A bounded least-squares search from x0: (x, cost)."""
-        memo = {}
+        memo = {}  # the Jacobian of each residual evaluation, so jac(x) needs no second sweep
 
         def f(x):
-            r, jac = fun_jac(x)
+            r, jac = self.fun_jac(x)
             memo[np.asarray(x, float).tobytes()] = jac
             return r
 
         def jf(x):
             key = np.asarray(x, float).tobytes()
-            return memo[key] if key in memo else fun_jac(x)[1]
+            return memo[key] if key in memo else self.fun_jac(x)[1]
 
-        sol = optimize.least_squares(f, x0, jac=jf, bounds=(lo, hi), loss=loss, method="trf", x_scale=1.0,
-                                     xtol=1e-6, ftol=1e-8, gtol=1e-8, max_nfev=LOCAL_EVALUATIONS)
+        sol = optimize.least_squares(f, x0, jac=jf, bounds=(self.lo, self.hi), loss=self.loss, method="trf",
+                                     x_scale=1.0, xtol=1e-6, ftol=1e-8, gtol=1e-8, max_nfev=LOCAL_EVALUATIONS)
         return sol.x, float(np.sum(f(sol.x) ** 2))
 
-    def rough(x):
-        """Indices of the free parameters whose residuals oscillate on the Jacobian's scale at x."""
+    def rough(self, x: np.ndarray) -> list[int]:
+        """Indices of the free parameters whose residuals oscillate on the Jacobian's scale at x
+        (forward and backward differences disagree by more than :data:`ROUGHNESS_LIMIT`)."""
+        p, h, lo = self.p, self.h, self.lo
         steps = [x + np.eye(p)[j] * (-h if x[j] - h >= lo[j] else h) for j in range(p)]
-        r, jac = fun_jac(x)
-        back = model.evaluate(steps)
+        r, jac = self.fun_jac(x)
+        back = self.model.evaluate(steps)
         out = []
         for j in range(p):
-            other = (residual(back[j]) - r) / (steps[j] - x).sum()
+            other = (self.residual(back[j]) - r) / (steps[j] - x).sum()
             mean = 0.5 * np.linalg.norm(jac[:, j] + other)
             # only a response that matters across the scan: a change of more than one σ
             if (np.linalg.norm(jac[:, j] - other) > ROUGHNESS_LIMIT * mean
@@ -254,9 +259,10 @@ def _fit(model, drive, data, names, box, lo, hi, x_start, sigma, reading, loss, 
                 out.append(j)
         return out
 
-    def scan(x, j):
+    def scan(self, x: np.ndarray, j: int) -> tuple[np.ndarray, float]:
         """(x, cost) of the lowest point of a scan of parameter j, the others one Gauss–Newton step
         from x's (all points in one sweep per stage)."""
+        p, h, lo, hi = self.p, self.h, self.lo, self.hi
         others = [k for k in range(p) if k != j]
         count = int(round(SCAN_HALF_WIDTH / SCAN_SPACING))
         points = []
@@ -269,149 +275,210 @@ def _fit(model, drive, data, names, box, lo, hi, x_start, sigma, reading, loss, 
         if others:
             trials = [[y, *(y + np.eye(p)[m] * (h if y[m] + h <= hi[m] else -h) for m in others)]
                       for y in points]
-            values = model.evaluate([v for group in trials for v in group])
+            values = self.model.evaluate([v for group in trials for v in group])
             moved = []
             for i, group in enumerate(trials):
-                base = residual(values[i * (len(others) + 1)])
-                jac = np.column_stack([(residual(values[i * (len(others) + 1) + 1 + a]) - base)
+                base = self.residual(values[i * (len(others) + 1)])
+                jac = np.column_stack([(self.residual(values[i * (len(others) + 1) + 1 + a]) - base)
                                        / (group[1 + a] - group[0]).sum() for a in range(len(others))])
                 step = np.linalg.lstsq(jac, -base, rcond=None)[0]
                 y = np.array(group[0], float)
                 y[others] = np.clip(y[others] + step, lo[others], hi[others])
                 moved.append(y)
             points = points + moved
-        costs = [float(np.sum(residual(v) ** 2)) for v in model.evaluate(points)]
+        costs = self.costs(points)
         k = int(np.argmin(costs))
         return points[k], costs[k]
 
+    def profile_cost(self, j: int, t: float, start_others, x_hat: np.ndarray, lowest: list) -> float:
+        """Least-squares cost with parameter j fixed at t (log), minimised over the others from
+        ``start_others`` (:data:`PROFILE_STEPS`); ``lowest`` = [cost, x] keeps the lowest cost met."""
+        from scipy import optimize
+
+        others = [k for k in range(self.p) if k != j]
+
+        def full(y):
+            x = np.array(x_hat, float)
+            x[j] = t
+            x[others] = y
+            return x
+
+        if not others:
+            c = float(np.sum(self.fun_jac(full([]), [])[0] ** 2))
+            if c < lowest[0]:
+                lowest[:] = [c, full([])]
+            return c
+        sol = optimize.least_squares(lambda y: self.fun_jac(full(y), others)[0], start_others,
+                                     jac=lambda y: self.fun_jac(full(y), others)[1],
+                                     bounds=(self.lo[others], self.hi[others]), method="trf", xtol=1e-4,
+                                     ftol=1e-5, max_nfev=PROFILE_STEPS)
+        c = float(np.sum(self.fun_jac(full(sol.x), others)[0] ** 2))
+        if c < lowest[0]:
+            lowest[:] = [c, full(sol.x)]
+        return c
+
+
+def _global_pass(problem: _Problem, x_start: np.ndarray, starts: int, seed: int, say) -> list[tuple]:
+    """The best :data:`LOCAL_STARTS` of the start values and a scrambled Sobol design over the log box
+    (one sweep), as (x, cost) pairs, lowest cost first."""
+    from scipy.stats import qmc
+
+    lo, hi = problem.lo, problem.hi
+    candidates = [x_start]
+    if starts:
+        design = qmc.Sobol(d=problem.p, scramble=True, seed=seed).random(starts)
+        candidates += [lo + u * (hi - lo) for u in design]
+    say(f"global pass: {len(candidates)} parameter sets × {problem.n} measurements")
+    costs = problem.costs(candidates)
+    order = np.argsort(costs)
+    return [(candidates[k], costs[k]) for k in order[:LOCAL_STARTS]]
+
+
+def _search(problem: _Problem, picks: list[tuple], names: list[str], say) -> tuple[np.ndarray, float]:
+    """The estimate (x, cost): local searches from the picks, then at most :data:`SCAN_ROUNDS`
+    scans of the rough parameters, each restarting the local search from a lower cost it meets."""
     best = None
-    for k, x0 in enumerate(picks):
-        say(f"local search {k + 1}/{len(picks)} from cost {costs[order[k]]:.4g}")
-        x, c = local(x0)
+    for k, (x0, c0) in enumerate(picks):
+        say(f"local search {k + 1}/{len(picks)} from cost {c0:.4g}")
+        x, c = problem.local(x0)
         if best is None or c < best[1]:
             best = (x, c)
     x_hat, cost = best
+    n, p = problem.n, problem.p
     for _ in range(SCAN_ROUNDS):
         found = None
-        margin = REFIT_MARGIN * (1.0 if data.known_sd else cost / (n - p))
-        for j in rough(x_hat):
+        margin = REFIT_MARGIN * (1.0 if problem.data.known_sd else cost / (n - p))
+        for j in problem.rough(x_hat):
             say(f"{names[j]}: the residuals oscillate on the Jacobian's scale; scanning "
                 f"±{SCAN_HALF_WIDTH:.0%}")
-            x_scan, c_scan = scan(x_hat, j)
+            x_scan, c_scan = problem.scan(x_hat, j)
             if c_scan < cost - margin and (found is None or c_scan < found[1]):
                 found = (x_scan, c_scan)
         if found is None:
             break
         say(f"the scan met cost {found[1]:.5g} below the estimate's {cost:.5g}: searching again from there")
-        x_new, c_new = local(found[0])
+        x_new, c_new = problem.local(found[0])
         x_hat, cost = (x_new, c_new) if c_new < found[1] else found
+    return x_hat, cost
+
+
+def _covariance(problem: _Problem, x_hat: np.ndarray, cost: float):
+    """(s², Jacobian rank, covariance, standard errors, correlation) of the log parameters at x_hat."""
+    _, J = problem.fun_jac(x_hat)
+    s2 = 1.0 if problem.data.known_sd else cost / (problem.n - problem.p)
+    jtj = J.T @ J
+    rank = int(np.linalg.matrix_rank(J, tol=1e-10 * max(1.0, float(np.abs(J).max()))))
+    cov = s2 * np.linalg.pinv(jtj)
+    se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(se, se)
+    corr = np.where(np.isfinite(corr), corr, 0.0)
+    np.fill_diagonal(corr, 1.0)
+    return s2, rank, cov, se, corr
+
+
+class _Profile:
+    """Parameter j's profile around the estimate: the cost rise (in units of s²) at a log distance
+    ``delta`` on side ``sign``, the others starting on the covariance's linearised conditional path."""
+
+    def __init__(self, problem: _Problem, j: int, x_hat, cost: float, s2: float, cov, lowest: list):
+        self.problem, self.j, self.x_hat, self.lowest = problem, j, x_hat, lowest
+        self.cost, self.s2 = cost, s2
+        self.others = [k for k in range(problem.p) if k != j]
+        self.slope = np.zeros(len(self.others))
+        if self.others and cov[j, j] > 0:
+            self.slope = cov[self.others, j] / cov[j, j]
+
+    def rise(self, sign: float, delta: float) -> float:
+        lo, hi, others, x_hat = self.problem.lo, self.problem.hi, self.others, self.x_hat
+        t = x_hat[self.j] + sign * delta
+        y0 = (np.clip(x_hat[others] + self.slope * sign * delta, lo[others], hi[others]) if others
+              else [])
+        c = self.problem.profile_cost(self.j, t, y0, x_hat, self.lowest)
+        return (c - self.cost) / self.s2
+
+
+def _profile_end(profile: _Profile, sign: float, se: float, threshold: float) -> tuple[float, bool]:
+    """One end of a 95 % profile interval (log): (end, flat), flat when the rise stays below the
+    threshold up to the bound. The quadratic approximation's end first, then doubling the distance
+    until the rise crosses the threshold, then a root search on the signed root of the rise."""
+    j, x_hat = profile.j, profile.x_hat
+    limit = (profile.problem.lo if sign < 0 else profile.problem.hi)[j]
+    room = abs(limit - x_hat[j])
+    d_in, v_in = 0.0, 0.0
+    guess = math.sqrt(threshold) * se if np.isfinite(se) and se > 0 else 0.1
+    delta = min(max(guess, 0.02), room)
+    v = profile.rise(sign, delta)
+    if abs(v - threshold) < PROFILE_TOLERANCE * threshold:
+        return x_hat[j] + sign * delta, False
+    while v < threshold and delta < room:
+        d_in, v_in = delta, v
+        delta = min(2.0 * delta, room)
+        v = profile.rise(sign, delta)
+    if v < threshold:  # flat up to the bound
+        return limit, True
+    for _ in range(4):  # the signed root of the profile is about linear in delta
+        a, b = math.sqrt(max(v_in, 0.0)), math.sqrt(max(v, 0.0))
+        mid = (d_in + (delta - d_in) * (math.sqrt(threshold) - a) / (b - a) if b > a
+               else 0.5 * (d_in + delta))
+        mid = min(max(mid, d_in + 0.05 * (delta - d_in)), delta - 0.05 * (delta - d_in))
+        vm = profile.rise(sign, mid)
+        if abs(vm - threshold) < PROFILE_TOLERANCE * threshold:
+            delta = mid
+            break
+        if vm < threshold:
+            d_in, v_in = mid, vm
+        else:
+            delta, v = mid, vm
+    return x_hat[j] + sign * delta, False
+
+
+def _estimates(problem: _Problem, names, box, x_hat, cost, s2, cov, se, threshold, lowest, notes, say):
+    """Each free parameter's estimate, standard error and profile interval ({name: record}, {name:
+    flat profile}); a bound the estimate sits on adds a note to ``notes``."""
+    estimates: dict[str, dict] = {}
+    flat: dict[str, bool] = {}
+    for j, name in enumerate(names):
+        say(f"profile of {name} ({j + 1}/{problem.p})")
+        profile = _Profile(problem, j, x_hat, cost, s2, cov, lowest)
+        ends = []
+        reached = False
+        for sign in (-1.0, 1.0):
+            limit = (problem.lo if sign < 0 else problem.hi)[j]
+            if abs(limit - x_hat[j]) <= 0.0:  # the estimate is at this bound: the interval ends there
+                ends.append(limit)
+                notes.append(f"{name} is at its {'lower' if sign < 0 else 'upper'} bound: widen --bounds")
+                continue
+            end, at_bound = _profile_end(profile, sign, se[j], threshold)
+            ends.append(end)
+            reached = reached or at_bound
+        value = float(np.exp(x_hat[j]))
+        flat[name] = reached
+        estimates[name] = {"value": value, "stderr": float(value * se[j]),
+                           "interval": [float(np.exp(ends[0])), float(np.exp(ends[1]))],
+                           "unit": FREE_PARAMETERS[name].unit, "symbol": FREE_PARAMETERS[name].symbol,
+                           "bounds": list(box[name]), "flat_profile": reached}
+    return estimates, flat
+
+
+def _fit(problem: _Problem, drive, names, box, x_start, reading, starts, seed, say, t0) -> FitResult:
+    """Global pass, local searches and scans, then errors and profiles; a profile that meets a lower
+    cost restarts the local search from there (:data:`REFITS` times at most)."""
+    from scipy import stats
+
+    data, model, n, p = problem.data, problem.model, problem.n, problem.p
+    x_hat, cost = _search(problem, _global_pass(problem, x_start, starts, seed, say), names, say)
+    dof = n - p
+    threshold = float(stats.chi2.ppf(0.95, 1) if data.known_sd else stats.f.ppf(0.95, 1, dof))
     notes: list[str] = []
     converged = True
     for attempt in range(REFITS + 1):
         say("estimate " + ", ".join(f"{k} = {v:.5g}" for k, v in zip(names, np.exp(x_hat), strict=True))
             + f", cost {cost:.5g}")
-        r, J = fun_jac(x_hat)
-        dof = n - p
-        s2 = 1.0 if data.known_sd else cost / dof
-        jtj = J.T @ J
-        rank = int(np.linalg.matrix_rank(J, tol=1e-10 * max(1.0, float(np.abs(J).max()))))
-        cov = s2 * np.linalg.pinv(jtj)
-        se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-        with np.errstate(invalid="ignore", divide="ignore"):
-            corr = cov / np.outer(se, se)
-        corr = np.where(np.isfinite(corr), corr, 0.0)
-        np.fill_diagonal(corr, 1.0)
-
+        s2, rank, cov, se, corr = _covariance(problem, x_hat, cost)
         lowest = [cost, x_hat]  # the lowest cost a profile meets, and where
-        threshold = float(stats.chi2.ppf(0.95, 1) if data.known_sd else stats.f.ppf(0.95, 1, dof))
-
-        def profile_cost(j, t, start_others, x_hat=x_hat, lowest=lowest):
-            """Least-squares cost with parameter j fixed at t (log), minimised over the others."""
-            others = [k for k in range(p) if k != j]
-
-            def full(y):
-                x = np.array(x_hat, float)
-                x[j] = t
-                x[others] = y
-                return x
-
-            if not others:
-                c = float(np.sum(fun_jac(full([]), [])[0] ** 2))
-                if c < lowest[0]:
-                    lowest[:] = [c, full([])]
-                return c, []
-            sol = optimize.least_squares(lambda y: fun_jac(full(y), others)[0], start_others,
-                                         jac=lambda y: fun_jac(full(y), others)[1],
-                                         bounds=(lo[others], hi[others]), method="trf", xtol=1e-4, ftol=1e-5,
-                                         max_nfev=PROFILE_STEPS)
-            c = float(np.sum(fun_jac(full(sol.x), others)[0] ** 2))
-            if c < lowest[0]:
-                lowest[:] = [c, full(sol.x)]
-            return c, sol.x
-
-        estimates: dict[str, dict] = {}
-        flat: dict[str, bool] = {}
-        for j, name in enumerate(names):
-            say(f"profile of {name} ({j + 1}/{p})")
-            others = [k for k in range(p) if k != j]
-            ends = []
-            reached = False
-            for sign in (-1.0, 1.0):
-                limit = (lo if sign < 0 else hi)[j]
-                room = abs(limit - x_hat[j])
-                # the linearised conditional path of the others gives each inner search its start
-                slope = np.zeros(len(others))
-                if others and cov[j, j] > 0:
-                    slope = cov[others, j] / cov[j, j]
-
-                def D(delta, slope=slope, sign=sign, j=j, others=others, x_hat=x_hat, cost=cost, s2=s2):
-                    t = x_hat[j] + sign * delta
-                    y0 = (np.clip(x_hat[others] + slope * sign * delta, lo[others], hi[others]) if others
-                          else [])
-                    c, _ = profile_cost(j, t, y0)
-                    return (c - cost) / s2
-
-                if room <= 0.0:  # the estimate is at this bound: the interval ends there
-                    ends.append(limit)
-                    notes.append(f"{name} is at its {'lower' if sign < 0 else 'upper'} bound: widen --bounds")
-                    continue
-                d_in, v_in = 0.0, 0.0
-                # the quadratic approximation's end first: where a quadratic profile meets the threshold
-                guess = math.sqrt(threshold) * se[j] if np.isfinite(se[j]) and se[j] > 0 else 0.1
-                delta = min(max(guess, 0.02), room)
-                v = D(delta)
-                if abs(v - threshold) < PROFILE_TOLERANCE * threshold:
-                    ends.append(x_hat[j] + sign * delta)
-                    continue
-                while v < threshold and delta < room:
-                    d_in, v_in = delta, v
-                    delta = min(2.0 * delta, room)
-                    v = D(delta)
-                if v < threshold:  # flat up to the bound
-                    reached = True
-                    ends.append(limit)
-                    continue
-                for _ in range(4):  # the signed root of the profile is about linear in delta
-                    a, b = math.sqrt(max(v_in, 0.0)), math.sqrt(max(v, 0.0))
-                    mid = (d_in + (delta - d_in) * (math.sqrt(threshold) - a) / (b - a) if b > a
-                           else 0.5 * (d_in + delta))
-                    mid = min(max(mid, d_in + 0.05 * (delta - d_in)), delta - 0.05 * (delta - d_in))
-                    vm = D(mid)
-                    if abs(vm - threshold) < PROFILE_TOLERANCE * threshold:
-                        delta = mid
-                        break
-                    if vm < threshold:
-                        d_in, v_in = mid, vm
-                    else:
-                        delta, v = mid, vm
-                ends.append(x_hat[j] + sign * delta)
-            value = float(np.exp(x_hat[j]))
-            flat[name] = reached
-            estimates[name] = {"value": value, "stderr": float(value * se[j]),
-                               "interval": [float(np.exp(ends[0])), float(np.exp(ends[1]))],
-                               "unit": FREE_PARAMETERS[name].unit, "symbol": FREE_PARAMETERS[name].symbol,
-                               "bounds": list(box[name]), "flat_profile": reached}
-
+        estimates, flat = _estimates(problem, names, box, x_hat, cost, s2, cov, se, threshold, lowest, notes,
+                                     say)
         if lowest[0] >= cost - REFIT_MARGIN * s2:
             break
         if attempt == REFITS:
@@ -420,7 +487,7 @@ def _fit(model, drive, data, names, box, lo, hi, x_start, sigma, reading, loss, 
                          "new searches: the least-squares minimum may not be global (widen --starts)")
             break
         say(f"a profile met cost {lowest[0]:.5g} below the estimate's {cost:.5g}: searching again from there")
-        x_hat, cost = local(lowest[1])
+        x_hat, cost = problem.local(lowest[1])
     notes = list(dict.fromkeys(notes))
     identifiable, verdict = _verdict(names, corr, flat, rank, data)
     if not converged:
@@ -429,11 +496,10 @@ def _fit(model, drive, data, names, box, lo, hi, x_start, sigma, reading, loss, 
                    f"estimate's {cost:.5g}, so the standard errors and intervals describe a local minimum "
                    "and claim nothing about the parameters; rerun with more --starts or narrower --bounds. "
                    + verdict)
-    fitted = model.drive_at(x_hat, drive)
-    fitted = replace(fitted, allow_extrapolation=drive.allow_extrapolation)
+    fitted = replace(model.drive_at(x_hat, drive), allow_extrapolation=drive.allow_extrapolation)
     pred = model.evaluate([x_hat])[0]
     return FitResult(drive=fitted, base=drive, names=names, estimates=estimates, correlation=corr, data=data,
-                     predicted=pred, weights=sigma, cost=cost, scale=math.sqrt(s2), dof=dof,
-                     identifiable=identifiable, verdict=verdict, reading=reading, loss=loss,
+                     predicted=pred, weights=problem.sigma, cost=cost, scale=math.sqrt(s2), dof=dof,
+                     identifiable=identifiable, verdict=verdict, reading=reading, loss=problem.loss,
                      simulations=model.simulations, evaluations=model.evaluations,
                      wall_time_s=time.perf_counter() - t0, notes=notes, converged=converged)
