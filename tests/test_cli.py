@@ -522,9 +522,10 @@ def test_cache_command_info_prune_clear(tmp_path):
 
 def test_failed_simulation_exits_1(monkeypatch, capsys):
     from passmd.solver import simulation as dynamics
+    from passmd.solver.results import SimulationError
 
     def diverge(*args, **kwargs):
-        raise dynamics.SimulationError("simulation diverged at integrator step 12")
+        raise SimulationError("simulation diverged at integrator step 12")
 
     monkeypatch.setattr(dynamics, "simulate", diverge)
     status, out = run_cli("run", "--periods", "1")

@@ -33,6 +33,8 @@ KERNEL_PATH = (
     "passmd.model.optimized_waveform",
     "passmd.solver.steps",
     "passmd.solver.simulation",
+    "passmd.solver.setup",
+    "passmd.solver.results",
     "passmd.solver.kernels",
 )
 

@@ -49,6 +49,7 @@ from passmd.runtime.config import PROFILES, RunConfig
 from passmd.runtime.validation import check_choice
 from passmd.solver import simulation as dynamics
 from passmd.solver import steps as time_steps
+from passmd.solver.results import SimulationError
 
 #: Driving frequency of Figs. 8 and 9a (Hz).
 STEP_FREQUENCY = PROTOCOL.drive_frequency
@@ -463,7 +464,7 @@ def window_point(hemisphere_radius: float, preload: float, runner: str, actuator
     keep = (t >= period - flyback - WINDOW_BEFORE) & (t <= end_a + WINDOW_AFTER)
     inside = t[(t >= start_a) & (t <= end_a)]
     if inside.size < 2:
-        raise dynamics.SimulationError("fewer than two recorded samples inside the acceleration t_a")
+        raise SimulationError("fewer than two recorded samples inside the acceleration t_a")
     out = {"time_s": t[keep], "runner_velocity_m_per_s": result.runner_velocity[keep],
            "runner_position_m": result.runner_position[keep], "piezo_position_m": result.piezo_position[keep],
            "flyback_start_s": period - flyback, "flyback_end_s": period, "acceleration_start_s": start_a,

@@ -23,6 +23,7 @@ from passmd.runtime.units import from_si
 from passmd.runtime.validation import check_choice, check_count, check_range
 from passmd.solver import simulation as dynamics
 from passmd.solver import steps as time_steps
+from passmd.solver.setup import contact_groups
 
 #: Configurations the numerics are shown for: (label, contacts, actuator model).
 CONFIGURATIONS = (
@@ -441,7 +442,7 @@ def step_plan_table() -> pd.DataFrame:
     for label, contacts, model in CONFIGURATIONS:
         drive = Drive(contacts=contacts, actuator_model=model)
         k_max = theory.drive_theory(drive)["tangential_stiffness_N_per_m"]
-        _, mult = dynamics.contact_groups(drive)
+        _, mult = contact_groups(drive)
         plan = time_steps.step_plan(drive, max(k_max), float(np.dot(mult, k_max)))
         rows.append({
             "configuration": label,
