@@ -3,7 +3,7 @@
 Every panel is computed once per session (module fixture; the sweep cache makes reruns
 cheap). The snapshots lock what the chapter reads — the points of Fig. 8, the settled
 positions of Fig. 9a, the steady velocities and steps of Figs. 9b–10, each drive's row once —
-to the accuracies :mod:`passmd.experiments.numerics.figures` states for the default integrator
+to the accuracies :mod:`passmd.experiments.numerics.accuracy` states for the default integrator
 (``snapshot_accuracy.tolerances``); ``test_finer_run_passes_the_snapshots`` shows a run with
 the step halved passes them too.
 """

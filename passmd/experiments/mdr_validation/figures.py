@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 
 from passmd.experiments.mdr_validation import closed_forms as mv
-from passmd.experiments.numerics.figures import benchmark_results
+from passmd.experiments.numerics.benchmarks import benchmark_results
 from passmd.model.contact import MDRContact
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
