@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd.experiments.driving_waveform.figures import claims_velocity as dw_claims
+from passmd.experiments.driving_waveform import claims_velocity as dw_claims
 from passmd.experiments.driving_waveform.figures import section5_drive
 from passmd.experiments.force_generation.figures import EARLIER, THIS
 from passmd.ledger import checks, readings, reference

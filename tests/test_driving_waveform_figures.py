@@ -16,10 +16,10 @@ import pandas as pd
 import pytest
 import snapshot_accuracy as snap
 
+from passmd.experiments.driving_waveform import claims_velocity as dw_claims
 from passmd.experiments.driving_waveform import facts as wf
 from passmd.experiments.driving_waveform import figures as dw
 from passmd.experiments.driving_waveform import studies
-from passmd.experiments.driving_waveform.figures import claims_velocity as dw_claims
 from passmd.model import theory, waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.optimized_waveform import OptimizedDesign, max_piezo_velocity, optimized

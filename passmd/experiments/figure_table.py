@@ -22,10 +22,10 @@ from passmd.experiments.critical_amplitude import claims as critical_amplitude_c
 from passmd.experiments.critical_amplitude import facts as critical_amplitude_facts
 from passmd.experiments.critical_amplitude import figures as critical_amplitude
 from passmd.experiments.driving_waveform import claims as driving_waveform_claims
+from passmd.experiments.driving_waveform import claims_velocity as driving_waveform_velocity_claims
 from passmd.experiments.driving_waveform import facts as waveform_facts
 from passmd.experiments.driving_waveform import figures as driving_waveform
 from passmd.experiments.driving_waveform import studies as waveform_studies
-from passmd.experiments.driving_waveform.figures import claims_velocity as driving_waveform_velocity_claims
 from passmd.experiments.force_generation import claims as force_generation_claims
 from passmd.experiments.force_generation import facts as force_facts
 from passmd.experiments.force_generation import figures as force_generation

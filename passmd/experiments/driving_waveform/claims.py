@@ -7,7 +7,7 @@ optimized waveform's acceleration against the saw-tooth's f_s, t_a starting at t
 velocity maximum, stick during t_a, the contacts deformed to u_x,max after the fly-back, the
 runner fastest at the end of t_a and slipping forward further than the hemispheres move
 (Sub-phase II). Section 5.2's positions and velocities are in
-:mod:`passmd.experiments.driving_waveform.figures.claims_velocity`. Each extractor reads the figure tables
+:mod:`passmd.experiments.driving_waveform.claims_velocity`. Each extractor reads the figure tables
 of :mod:`passmd.experiments.driving_waveform.figures` and returns what :mod:`passmd.ledger.checks`
 compares with the paper; too few samples in a phase make the claim inconclusive.
 """
