@@ -28,8 +28,8 @@ from sweep_points import drive_theory_point
 
 import passmd
 from passmd import cli
-from passmd.model.contact import MDRContact
 from passmd.model.defaults import PROTOCOL
+from passmd.model.mdr_contact import MDRContact
 from passmd.model.parameters import Drive
 from passmd.model.tables import ACTUATOR_DAMPING_RATIO, Material, actuator_for_radius
 from passmd.model.theory import contact_moduli, drive_theory, runner_frequency
