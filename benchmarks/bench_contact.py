@@ -27,7 +27,6 @@ import numpy as np
 from numba import njit
 
 from passmd.model.contact import (
-    MDRContact,
     contact_arrays,
     contact_force,
     contact_reset,
@@ -35,6 +34,7 @@ from passmd.model.contact import (
     contact_update_row,
     stack_contacts,
 )
+from passmd.model.mdr_contact import MDRContact
 from passmd.model.parameters import Drive
 from passmd.model.theory import contact_moduli, normal_forces
 

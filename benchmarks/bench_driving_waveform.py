@@ -6,7 +6,7 @@ Timed blocks (each repeated, median and fastest reported; numba compiles in an u
 * ``design``: :func:`passmd.protocols.eq15.optimized_design` of the Section 5 drive (two 100 Hz
   saw-tooth periods recorded densely, f_s and V_r measured, Eq. 15);
 * ``steady_sawtooth_<f>`` / ``steady_optimized_<f>``: one steady-velocity point
-  (:func:`passmd.experiments.driving_waveform.figures.velocity_point`) at 1 kHz and 110 kHz;
+  (:func:`passmd.experiments.driving_waveform.runs.velocity_point`) at 1 kHz and 110 kHz;
 * ``step_100hz``: one Fig. 9a protocol run (three 100 Hz periods, rigid actuators).
 
 Then, once, with an empty temporary simulation cache: every panel (``figure_data``) and the
@@ -49,12 +49,12 @@ def _timed(func, repeats: int) -> dict:
 
 
 def blocks(repeats: int) -> dict:
-    from passmd.experiments.driving_waveform import figures as dw
+    from passmd.experiments.driving_waveform import runs as dw_runs
     from passmd.model import optimized_waveform
     from passmd.protocols import eq15
     from passmd.solver import simulation as dynamics
 
-    drive = dw.section5_drive()
+    drive = dw_runs.section5_drive()
     amplitude = drive.actuator.full_stroke_amplitude
     design = eq15.optimized_design(amplitude, drive)
     fields = {"settling_time": design.settling_time, "acceleration_time": design.acceleration_time,
@@ -63,8 +63,8 @@ def blocks(repeats: int) -> dict:
     for f in (1e3, 110e3):
         for waveform, rule in (("sawtooth", ""), ("optimized", "cut")):
             out[f"steady_{waveform}_{f / 1e3:g}kHz"] = _timed(
-                lambda f=f, w=waveform, r=rule: dw.velocity_point(**dw.section5_fields(), frequency=f,
-                                                                  waveform=w, short_period=r, **fields),
+                lambda f=f, w=waveform, r=rule: dw_runs.velocity_point(
+                    **dw_runs.section5_fields(), frequency=f, waveform=w, short_period=r, **fields),
                 repeats)
     wave = optimized_waveform.optimized(amplitude, PROTOCOL.drive_frequency, drive, periods=3, design=design)
     out["step_100hz"] = _timed(lambda: dynamics.simulate(drive, wave, max_points=2), repeats)

@@ -1,7 +1,7 @@
 """What the regression snapshots compare with: the stated accuracies, and the one finer run.
 
 Every snapshot check takes its tolerances from :func:`tolerances`, which maps a column to the
-accuracy :mod:`passmd.experiments.numerics.figures` states for its quantity (positions, forces,
+accuracy :mod:`passmd.experiments.numerics.accuracy` states for its quantity (positions, forces,
 velocities, frequencies and times, slip shares, critical amplitudes). A column the integrator
 does not compute (inputs, closed forms, flags) is compared to :data:`EXACT`: only
 floating-point rounding may differ. So a snapshot locks the physics to the integrator's
@@ -16,7 +16,7 @@ import contextlib
 
 import pytest
 
-from passmd.experiments.numerics import figures as acc
+from passmd.experiments.numerics import accuracy as acc
 from passmd.model.parameters import Drive
 from passmd.runtime.config import RunConfig
 from passmd.solver import simulation as dynamics

@@ -26,7 +26,7 @@ def sawtooth_point(drive: Drive, amplitude: float, frequency: float, periods: in
                    flyback: str = "slew", springs: int | None = None) -> dict:
     """Measures of one saw-tooth run from rest (:func:`passmd.solver.simulation.simulate`).
 
-    Returns the run's :meth:`~passmd.solver.simulation.SimulationResult.summary` (SI, keys
+    Returns the run's :meth:`~passmd.solver.results.SimulationResult.summary` (SI, keys
     carrying the unit; without ``periods``, which is a parameter) plus ``mean_step_m``,
     the mean of the per-period step sizes (needs ``periods >= 2``). ``springs`` None:
     exact MDR contacts, else N discrete springs.

@@ -33,7 +33,7 @@ from hypothesis import strategies as st
 from passmd import cli
 from passmd.cli import kernels, options
 from passmd.cli.commands import run as run_command
-from passmd.model.contact import MDRContact
+from passmd.model.mdr_contact import MDRContact
 from passmd.model.parameters import Drive
 from passmd.model.tables import Actuator, Amplifier, Material
 

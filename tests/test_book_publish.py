@@ -196,11 +196,11 @@ def test_assumptions_frame_holds_every_assumption_in_the_tables_order():
 def test_implementations_resolve_names_and_fail_on_stale_ones():
     df = publish.implementations({
         "Eq. (1)": "passmd.model.theory.normal_forces",
-        "Eq. (6)": ["passmd.model.contact.MDRContact", "passmd.model.contact.MDRContact.path"],
+        "Eq. (6)": ["passmd.model.mdr_contact.MDRContact", "passmd.model.mdr_contact.MDRContact.path"],
     })
     assert list(df["implemented by"]) == [
-        "passmd.model.theory.normal_forces", "passmd.model.contact.MDRContact",
-        "passmd.model.contact.MDRContact.path"
+        "passmd.model.theory.normal_forces", "passmd.model.mdr_contact.MDRContact",
+        "passmd.model.mdr_contact.MDRContact.path"
     ]
     assert "Eq. 1" in df["summary"].iloc[0]
     with pytest.raises(ValueError, match="'no_such_function' not found"):

@@ -19,7 +19,7 @@ import pandas as pd
 import pytest
 
 from passmd.experiments.driving_waveform import claims_velocity as dw_claims
-from passmd.experiments.driving_waveform.figures import section5_drive
+from passmd.experiments.driving_waveform.runs import section5_drive
 from passmd.experiments.force_generation.figures import EARLIER, THIS
 from passmd.ledger import checks, readings, reference
 from passmd.ledger import evaluation as ledger

@@ -28,8 +28,8 @@ from sweep_points import drive_theory_point
 
 import passmd
 from passmd import cli
-from passmd.model.contact import MDRContact
 from passmd.model.defaults import PROTOCOL
+from passmd.model.mdr_contact import MDRContact
 from passmd.model.parameters import Drive
 from passmd.model.tables import ACTUATOR_DAMPING_RATIO, Material, actuator_for_radius
 from passmd.model.theory import contact_moduli, drive_theory, runner_frequency
@@ -522,9 +522,10 @@ def test_cache_command_info_prune_clear(tmp_path):
 
 def test_failed_simulation_exits_1(monkeypatch, capsys):
     from passmd.solver import simulation as dynamics
+    from passmd.solver.results import SimulationError
 
     def diverge(*args, **kwargs):
-        raise dynamics.SimulationError("simulation diverged at integrator step 12")
+        raise SimulationError("simulation diverged at integrator step 12")
 
     monkeypatch.setattr(dynamics, "simulate", diverge)
     status, out = run_cli("run", "--periods", "1")

@@ -13,7 +13,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from passmd.model import contact, hertz, theory
-from passmd.model.contact import MDRContact, contact_arrays, stack_contacts
+from passmd.model.contact import contact_arrays, stack_contacts
+from passmd.model.mdr_contact import MDRContact
 from passmd.model.parameters import Drive
 
 ROUND = 1e-12  # rounding only

@@ -3,7 +3,7 @@
 Every panel is computed once per session (module fixture; the sweep cache makes reruns
 cheap). The snapshots lock what the chapter reads — the points of Fig. 8, the settled
 positions of Fig. 9a, the steady velocities and steps of Figs. 9b–10, each drive's row once —
-to the accuracies :mod:`passmd.experiments.numerics.figures` states for the default integrator
+to the accuracies :mod:`passmd.experiments.numerics.accuracy` states for the default integrator
 (``snapshot_accuracy.tolerances``); ``test_finer_run_passes_the_snapshots`` shows a run with
 the step halved passes them too.
 """
@@ -19,6 +19,7 @@ import snapshot_accuracy as snap
 from passmd.experiments.driving_waveform import claims_velocity as dw_claims
 from passmd.experiments.driving_waveform import facts as wf
 from passmd.experiments.driving_waveform import figures as dw
+from passmd.experiments.driving_waveform import runs as dw_runs
 from passmd.experiments.driving_waveform import studies
 from passmd.model import theory, waveforms
 from passmd.model.defaults import PROTOCOL
@@ -49,7 +50,7 @@ VELOCITY_COLUMNS = ("frequency", "preload", "hemisphere_radius", "velocity_m_per
                     "settling_time_s", "acceleration_time_s", "settling_fits", "stick_during_acceleration",
                     "max_slip_share_acceleration", "micro_vibration_frequency_Hz")
 #: The Section 5 drive (Fig. 9b's): the other velocity panels lock only their other drives.
-SECTION5 = dw.section5_fields()
+SECTION5 = dw_runs.section5_fields()
 
 
 def _response(frame):
@@ -150,11 +151,11 @@ def test_fig10_steady_step_at_130_khz_is_converged(quick, monkeypatch, preload, 
     row = table[(table["frequency"] == 130e3) & (table["preload"] == preload) & (table["variant"] == variant)]
     assert len(row) == 1
     row = row.iloc[0]
-    point = {name: row[name] for name in inspect.signature(dw.velocity_point).parameters}
+    point = {name: row[name] for name in inspect.signature(dw_runs.velocity_point).parameters}
     default_simulate = dynamics.simulate
     monkeypatch.setattr(dynamics, "simulate", functools.partial(default_simulate,
                                                        scheme=time_steps.SCHEMES["fixed"].replace(dt=CONVERGED_DT)))
-    converged = dw.velocity_point(**point)
+    converged = dw_runs.velocity_point(**point)
     assert converged["periods"] == row["periods"]
     assert abs(row["step_m"] - converged["step_m"]) < time_steps.CONVERGED_ACCURACY
     assert abs(row["back_step_m"] - converged["back_step_m"]) < time_steps.CONVERGED_ACCURACY
@@ -168,7 +169,7 @@ def test_every_panel_plots(quick):
 
 def test_fig9a_plot_shows_section5_friction_only(quick):
     frame = quick["fig9a"]
-    assert set(frame.loc[frame["section5_friction"], "friction_coefficient"]) == {dw.SECTION5_FRICTION}
+    assert set(frame.loc[frame["section5_friction"], "friction_coefficient"]) == {dw_runs.SECTION5_FRICTION}
     assert len(dw.FIG9A_FRICTION) > 1 and not frame["section5_friction"].all()
     fig = plots.plot_fig9a(frame)
     # one runner trace and one set of settled positions per waveform, plus the piezo: μ = 0.2 runs only
@@ -201,13 +202,14 @@ def test_carrying_the_runner_then_stopping_beats_the_sawtooth():
     vibration (fastest forward motion, point 4), carry the runner at a velocity friction can
     give it (μΣF_N/m_r ≈ 75 m/s² over a few nm), stop: the runner slides on. +20 % is a
     conservative floor for hand-picked numbers (the optimiser finds ≈ +50 %)."""
-    drive = dw.section5_drive()
+    drive = dw_runs.section5_drive()
     amplitude = drive.actuator.full_stroke_amplitude
     design = eq15.optimized_design(amplitude, drive)
     carry = OptimizedDesign(0.75 / design.micro_vibration_frequency, 0.9 * amplitude / 3e-3,
                             0.9 * amplitude)
-    saw = dynamics.simulate(drive, waveforms.sawtooth(amplitude, dw.STEP_FREQUENCY, drive, periods=3))
-    opt = dynamics.simulate(drive, optimized(amplitude, dw.STEP_FREQUENCY, drive, periods=3, design=carry))
+    saw = dynamics.simulate(drive, waveforms.sawtooth(amplitude, dw_runs.STEP_FREQUENCY, drive, periods=3))
+    opt = dynamics.simulate(drive, optimized(amplitude, dw_runs.STEP_FREQUENCY, drive, periods=3,
+                                             design=carry))
     assert np.mean(opt.step_sizes) > 1.2 * np.mean(saw.step_sizes)
 
 
@@ -215,8 +217,8 @@ def test_micro_vibration_to_linear_frequency_ratio_is_universal_for_rigid_drives
     """After a full slide the swing back is a Masing branch from full sliding; with the
     amplitude well above u_x,max its shape scales with u_x,max and μF_N, so f_s / f_lin is the
     same for every preload and radius (the start velocity, a_f·t_fb, is ~1 % of the swing's)."""
-    table = dw.designs([dw.section5_fields(preload=p) for p in (0.1, 1.0)]
-                       + [dw.section5_fields(hemisphere_radius=0.25e-3)], QUICK)
+    table = dw_runs.designs([dw_runs.section5_fields(preload=p) for p in (0.1, 1.0)]
+                       + [dw_runs.section5_fields(hemisphere_radius=0.25e-3)], QUICK)
     ratio = table["micro_vibration_frequency_Hz"] / table["linear_frequency_Hz"]
     assert ratio.max() - ratio.min() < 2e-3  # 0.2 %: the residual start-velocity effect
     assert np.sqrt(2 / 3) < ratio.min() and ratio.max() < 1.0
@@ -239,7 +241,7 @@ def test_settling_fits_only_at_low_frequency(quick):
     # what the paper's 110 kHz would need: t_fb + 1/(2 f_s) within 1/(110 kHz)
     f_s = float(opt["micro_vibration_frequency_Hz"].iloc[0])
     assert 2e-6 + 0.5 / f_s > 1 / 110e3
-    assert f_s == pytest.approx(theory.runner_frequency(dw.section5_drive()), rel=0.2)
+    assert f_s == pytest.approx(theory.runner_frequency(dw_runs.section5_drive()), rel=0.2)
 
 
 def test_numerical_optimum_beats_heuristic_and_sawtooth():
@@ -248,7 +250,7 @@ def test_numerical_optimum_beats_heuristic_and_sawtooth():
     assert low["velocity_optimum_m_per_s"] > 1.2 * low["velocity_sawtooth_m_per_s"]
     assert np.all(table["velocity_optimum_m_per_s"] > table["velocity_eq15_m_per_s"])
     # every optimum respects the amplifier
-    v_max = max_piezo_velocity(dw.section5_drive())
+    v_max = max_piezo_velocity(dw_runs.section5_drive())
     assert np.all(table["optimum_acceleration_velocity_m_per_s"] <= v_max * (1 + 1e-12))
 
 
@@ -303,9 +305,9 @@ def test_flyback_window_resolves_the_acceleration():
     row = frame.iloc[0]
     t_a = row["acceleration_end_s"] - row["acceleration_start_s"]
     # records fall on integration steps: at most one step (t_a / 20) off the nominal t_a / 10
-    assert row["record_spacing_s"] <= 1.5 * t_a / dw.WINDOW_SAMPLES_PER_ACCELERATION
+    assert row["record_spacing_s"] <= 1.5 * t_a / dw_runs.WINDOW_SAMPLES_PER_ACCELERATION
     counts = frame["phase"].value_counts()
-    assert counts["acceleration"] >= dw.WINDOW_SAMPLES_PER_ACCELERATION - 1
+    assert counts["acceleration"] >= dw_runs.WINDOW_SAMPLES_PER_ACCELERATION - 1
     assert {"before", "flyback", "settling", "after"} <= set(counts.index)
     assert plots.plot_fig8b_window(frame).axes
 
@@ -316,8 +318,8 @@ def test_flyback_window_resolves_the_acceleration():
 
 
 def test_design_facts_and_table(quick):
-    drive = dw.section5_drive()
-    design = dw.designs([dw.section5_fields()], QUICK).iloc[0]
+    drive = dw_runs.section5_drive()
+    design = dw_runs.designs([dw_runs.section5_fields()], QUICK).iloc[0]
     facts = wf.design_facts(design, drive)
     assert facts["f_ratio"] == pytest.approx(facts["f_s_kHz"] / facts["f_lin_kHz"], rel=1e-12)
     assert facts["A_nm"] == pytest.approx(drive.actuator.full_stroke_amplitude * 1e9, rel=1e-12)
@@ -329,7 +331,7 @@ def test_design_facts_and_table(quick):
 
 
 def test_fig8a_facts_follow_the_points(quick):
-    facts = wf.fig8a_facts(quick["fig8a"], dw.section5_drive())
+    facts = wf.fig8a_facts(quick["fig8a"], dw_runs.section5_drive())
     # the runner reverses before it moves forward fastest, both within the micro-vibration's first cycle
     assert 0 < facts["t3_after_us"] < facts["t4_after_us"] < 1e3 / 5.0
     assert facts["back_step_nm"] > 0
@@ -369,7 +371,8 @@ def test_startup_and_fig9b_facts(quick):
     table = quick["fig9b"]
     start = wf.startup_facts(table)
     assert start["max_drift_pct"] < 0.5  # as test_velocity_runs_are_steady_and_consistent
-    facts = wf.fig9b_facts(table, dw.designs([dw.section5_fields()], QUICK).iloc[0], dw.section5_drive())
+    design = dw_runs.designs([dw_runs.section5_fields()], QUICK).iloc[0]
+    facts = wf.fig9b_facts(table, design, dw_runs.section5_drive())
     # t_s would fit at 110 kHz only with f_s ≥ 1 / (2 t_s,max): above the measured f_s by the factor's root
     assert facts["f_s_needed_kHz"] == pytest.approx(0.5e-3 / (facts["t_s_room_us"] * 1e-6), rel=1e-12)
     assert facts["stiffness_factor"] > 1
@@ -392,11 +395,11 @@ def test_reachable_table_and_stick_lost(quick):
 
 def test_optimum_and_flexible_facts():
     optimum = studies.numerical_optimum(QUICK)
-    design = dw.designs([dw.section5_fields()], QUICK).iloc[0]
-    a_f = wf.friction_acceleration(dw.section5_drive())
+    design = dw_runs.designs([dw_runs.section5_fields()], QUICK).iloc[0]
+    a_f = wf.friction_acceleration(dw_runs.section5_drive())
     facts = wf.optimum_facts(optimum, design, a_f)
     low = wf.optimum_at(optimum)
-    assert low["frequency"] == dw.STEP_FREQUENCY and low["actuator_model"] == "rigid"
+    assert low["frequency"] == dw_runs.STEP_FREQUENCY and low["actuator_model"] == "rigid"
     assert facts["opt_gain_100"] > 20  # the optimum beats the saw-tooth (test above: by > 20 %)
     t_a = design["acceleration_time_s"]
     assert facts["ta_ratio"] == pytest.approx(facts["opt_ta_us"] * 1e-6 / t_a, rel=1e-12)
@@ -406,7 +409,7 @@ def test_optimum_and_flexible_facts():
     carried = wf.carried_steps(optimum)
     assert carried["actuators"].tolist() == ["rigid", "flexible"]
     assert carried.iloc[0]["gain (%)"] > 20
-    flexible = dw.designs([dw.section5_fields(actuator_model="flexible")], QUICK).iloc[0]
-    flex = wf.flexible_facts(optimum, flexible, carried, dw.section5_drive())
+    flexible = dw_runs.designs([dw_runs.section5_fields(actuator_model="flexible")], QUICK).iloc[0]
+    flex = wf.flexible_facts(optimum, flexible, carried, dw_runs.section5_drive())
     assert np.isnan(flex["flex_opt_gain"])  # the quick profile does not optimise flexible actuators
-    assert flex["f_s_flex_kHz"] < wf.design_facts(design, dw.section5_drive())["f_s_kHz"]
+    assert flex["f_s_flex_kHz"] < wf.design_facts(design, dw_runs.section5_drive())["f_s_kHz"]

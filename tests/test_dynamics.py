@@ -10,8 +10,10 @@ import pytest
 from passmd.model import theory, waveforms
 from passmd.model.contact import contact_arrays, contact_stiffness, stack_contacts
 from passmd.model.parameters import Drive
+from passmd.solver import setup as run_setup
 from passmd.solver import simulation as dynamics
 from passmd.solver import steps as time_steps
+from passmd.solver.results import SimulationError
 from passmd.solver.steps import SCHEMES
 
 F_TEST = 1000.0  # Hz: 1 ms periods keep tests fast; the runner mode (~5-11 kHz) settles within
@@ -147,8 +149,8 @@ def test_divergence_is_reported(monkeypatch):
     d = one_contact("flexible")
     wf = waveforms.sawtooth(100e-9, F_TEST, d, periods=1)
     plan_dt = time_steps.step_plan(d, 3e6, 3e6).stability_limit
-    monkeypatch.setattr(dynamics, "STABILITY_MARGIN", 100.0)  # let an unstable step through
-    with pytest.raises(dynamics.SimulationError, match=r"diverged at integrator step \d+.*time step"):
+    monkeypatch.setattr(run_setup, "STABILITY_MARGIN", 100.0)  # let an unstable step through
+    with pytest.raises(SimulationError, match=r"diverged at integrator step \d+.*time step"):
         dynamics.simulate(d, wf, scheme=SCHEMES["fixed"].replace(dt=5 * plan_dt))
 
 
@@ -361,7 +363,7 @@ def test_expected_steps_match_the_run(scheme):
         wf = waveforms.sawtooth(202e-9, 100.0, d, periods=1)
         res = dynamics.simulate(d, wf, scheme=scheme)
         E, G = theory.contact_moduli(d)
-        forces, mult = dynamics.contact_groups(d)
+        forces, mult = run_setup.contact_groups(d)
         rows = [contact_arrays("exact", F, d.hemisphere_radius, E, G, d.friction_coefficient) for F in forces]
         params, _ = stack_contacts(rows)
         ks = np.array([contact_stiffness(params[g]) for g in range(len(rows))])

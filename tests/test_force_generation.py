@@ -1,7 +1,7 @@
 """Force generation (Fig. 7): stall criterion, physics at stall, quick-profile snapshots, ledger rows.
 
 The snapshots lock the stall forces, steps and onsets of Fig. 7 and the measures of its stall
-cycles to the accuracies :mod:`passmd.experiments.numerics.figures` states for the default integrator
+cycles to the accuracies :mod:`passmd.experiments.numerics.accuracy` states for the default integrator
 (``snapshot_accuracy.tolerances``: forces to the stall criterion's tolerance, onsets to one
 bracket width); ``test_finer_run_passes_the_snapshots`` shows a run with the step halved
 passes them too. Not locked: how the protocol got there (periods integrated, brackets,

@@ -32,7 +32,7 @@ from passmd.cli.commands import run as run_command
 from passmd.cli.drive import _safe
 from passmd.cli.parser import make_parser
 from passmd.model import optimized_waveform, waveforms
-from passmd.model.contact import MDRContact
+from passmd.model.mdr_contact import MDRContact
 from passmd.model.parameters import PLAUSIBLE_RANGES, Drive, check_plausible
 from passmd.model.tables import Actuator, actuator_viscosity, parameter_table
 from passmd.protocols import eq15

@@ -10,6 +10,8 @@ import pytest
 from passmd.experiments import figure_table as figures
 from passmd.experiments.mdr_validation import figures as mdr
 from passmd.experiments.model import figures as model
+from passmd.experiments.numerics import benchmarks as numerics_benchmarks
+from passmd.experiments.numerics import facts as numerics_facts
 from passmd.experiments.numerics import figures as numerics
 from passmd.model import theory
 from passmd.model.defaults import PROTOCOL
@@ -140,7 +142,7 @@ def _synthetic_convergence(controlled_error):
 def test_convergence_facts_on_a_second_order_table():
     """Synthetic errors falling exactly as h² (explicit) and h³ (error-controlled): the fitted
     orders are 2 and 3, the savings the step ratios."""
-    facts = numerics.convergence_facts(_synthetic_convergence(lambda r: -2e-10 * r**-3.0))
+    facts = numerics_facts.convergence_facts(_synthetic_convergence(lambda r: -2e-10 * r**-3.0))
     assert facts["conv_order"] == pytest.approx(2.0, rel=1e-9)
     assert facts["quasi_order"] == pytest.approx(2.0, rel=1e-9)
     assert facts["conv_max_err_nm"] == pytest.approx(0.1, rel=1e-9)
@@ -180,20 +182,20 @@ def test_controlled_order_is_fitted_above_its_floor():
     a h³ error that levels off at 1e-11 m and is flat below resolution 0.5 still fits as 3."""
 
     def error(r):
-        if r < numerics.CONTROLLED_FIT_COARSEST:
+        if r < numerics_facts.CONTROLLED_FIT_COARSEST:
             return 8e-10  # the longest step binds: no longer the tolerance's error
         return max(1e-10 * r**-3.0, 1e-11)
 
     conv = _synthetic_convergence(error)
-    facts = numerics.convergence_facts(conv)
+    facts = numerics_facts.convergence_facts(conv)
     assert facts["ctrl_order"] == pytest.approx(3.0, rel=1e-9)
     assert facts["ctrl_floor_nm"] == pytest.approx(0.01, rel=1e-9)
     # without those exclusions the same runs fit far from 3
     controlled = conv[conv["step_control"] == "controlled"]
-    assert numerics.fitted_order_above_floor(controlled, factor=0.0, coarsest=0.0)[0] < 2.0
+    assert numerics_facts.fitted_order_above_floor(controlled, factor=0.0, coarsest=0.0)[0] < 2.0
     flat = controlled.assign(error_m=1e-11)
     with pytest.raises(ValueError, match=r"only 0 resolution\(s\) with an error above 3 times the floor"):
-        numerics.fitted_order_above_floor(flat)
+        numerics_facts.fitted_order_above_floor(flat)
 
 
 def test_convergence_reference_is_the_reference_controls_finest_run():
@@ -215,12 +217,12 @@ def test_energy_facts_compare_the_same_runs():
     energy = pd.DataFrame({"configuration": ["a", "a", "b"], "contact_model": ["exact", "discrete", "exact"],
                            "relative_residual": [-4e-7, 1e-6, 2e-7]})
     explicit = energy.assign(relative_residual=[2e-6, -1e-7, 4e-6])
-    facts = numerics.energy_facts(energy, explicit)
+    facts = numerics_facts.energy_facts(energy, explicit)
     assert facts == pytest.approx({"energy_max_rel": 1e-6, "energy_exact_max_rel": 4e-7,
                                    "energy_discrete_max_rel": 1e-6, "energy_explicit_max_rel": 4e-6,
                                    "energy_tighter": 4.0, "energy_ratio_min": 0.05, "energy_ratio_max": 10.0})
     with pytest.raises(ValueError, match="explicit must list the same runs"):
-        numerics.energy_facts(energy, explicit.iloc[::-1])
+        numerics_facts.energy_facts(energy, explicit.iloc[::-1])
 
 
 def test_energy_balance_of_the_default_scheme_is_as_tight_as_the_explicit_ones():
@@ -243,27 +245,27 @@ def test_settle_and_coulomb_texts():
             "mean_step_m": [100e-9, 101e-9, 50e-9, 50e-9],
         }
     )
-    facts = numerics.settle_facts(sens)
+    facts = numerics_facts.settle_facts(sens)
     assert facts["settle_spread_nm"] == pytest.approx(1.0) and facts["settle_spread_rel"] == pytest.approx(
         100 / 100.5
     )
     gaps = pd.DataFrame(
         {"configuration": ["c"] * 3, "scale": [1.0, 4.0, 16.0], "difference_m": [-3e-9, -1e-9, -2e-9]}
     )
-    assert numerics.coulomb_side(gaps) == "below"
-    assert numerics.coulomb_rising_gaps(gaps) == ["c: 1.000 nm at k = 4 → 2.000 nm at k = 16"]
+    assert numerics_facts.coulomb_side(gaps) == "below"
+    assert numerics_facts.coulomb_rising_gaps(gaps) == ["c: 1.000 nm at k = 4 → 2.000 nm at k = 16"]
 
 
 def test_step_plan_and_benchmark_facts():
-    plan = numerics.step_plan_table()
+    plan = numerics_facts.step_plan_table()
     assert list(plan["configuration"]) == [c[0] for c in numerics.CONFIGURATIONS]
     assert (plan["fine step (ns)"] < plan["stability limit 2/ω (ns)"]).all()
     # the error-controlled step may grow far beyond the explicit steps (the runner mode is exact)
     assert (plan["longest controlled step (ns)"] > plan["coarse step (ns)"]).all()
-    facts = numerics.benchmark_facts(numerics.benchmark_table())
+    facts = numerics_facts.benchmark_facts(numerics_benchmarks.benchmark_table())
     assert facts["bench_six_flex_ms"] > 0 and facts["bench_fixed_ns"] > 0
     # the default (error-controlled) row, not the explicit adaptive one it replaced
     assert facts["bench_six_flex_ms"] < facts["bench_six_flex_adaptive_ms"]
     assert facts["bench_periods"] >= 1
     assert facts["bench_processes"] >= 1 and facts["bench_six_flex_processes_ms"] > 0
-    assert facts["target_ms_per_period"] == numerics.TARGET_MS_PER_PERIOD
+    assert facts["target_ms_per_period"] == numerics_facts.TARGET_MS_PER_PERIOD

@@ -135,7 +135,7 @@ def test_dask_scheduler_address(serial_theory):
 
 def contact_path_point(normal_force, springs):
     """Forces of one MDR contact along a fixed path (a small-array result)."""
-    from passmd.model.contact import MDRContact
+    from passmd.model.mdr_contact import MDRContact
 
     path = np.array([0.0, 30e-9, -10e-9, 45e-9, 5e-9])
     E_star, G_star = contact_moduli(Drive())

@@ -21,7 +21,7 @@ import pytest
 
 import passmd.runtime.validation as validation
 from passmd import cli
-from passmd.model.contact import MDRContact
+from passmd.model.mdr_contact import MDRContact
 from passmd.model.parameters import Drive, PlausibleRange
 from passmd.solver import simulation as dynamics
 

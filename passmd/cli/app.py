@@ -160,7 +160,7 @@ def _dispatch(args, out: Out, prog: str, to_stdout: bool) -> int:  # noqa: C901 
         return _error(prog, explain(exc, args), 2)
     except (ResultError, MissingDependencyError) as exc:
         return _error(prog, str(exc), 1)
-    except RuntimeError as exc:  # passmd.solver.simulation.SimulationError and other failed runs
+    except RuntimeError as exc:  # passmd.solver.results.SimulationError and other failed runs
         return _error(prog, f"run failed: {exc}", 1)
     except ModuleNotFoundError as exc:
         extra = OPTIONAL_EXTRAS.get((exc.name or "").split(".")[0])

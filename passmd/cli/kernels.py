@@ -18,7 +18,7 @@ __all__ = ["KERNEL_MODULES", "kernels_cold", "notice_if_cold"]
 
 #: The modules whose ``@njit(cache=True)`` functions every simulation compiles (the step loop
 #: and the contact kernels it calls), relative to the package folder. Not
-#: :mod:`passmd.model.contact`: its array kernels serve MDRContact's methods, which no
+#: :mod:`passmd.model.mdr_contact`: its array kernels serve MDRContact's methods, which no
 #: simulation calls, so a simulation never writes their index.
 KERNEL_MODULES = ("solver/kernels", "model/contact_kernels")
 

@@ -12,7 +12,7 @@ Two critical amplitudes, both found by bisection on the amplitude
     Saw-tooth runs from rest (virgin contacts) of :data:`STEADY_PERIODS` periods at the
     drive frequency f (default ``PROTOCOL.drive_frequency``); the step that counts is the
     *last* one (settled position of the last period minus that of the one before,
-    :attr:`passmd.solver.simulation.SimulationResult.step_sizes`), by when the transient of the first
+    :attr:`passmd.solver.results.SimulationResult.step_sizes`), by when the transient of the first
     fly-backs has died out. A_c is the smallest amplitude whose last step exceeds the
     "measurable step" :data:`STEP_THRESHOLD`. After a full slide the contact is left
     pre-strained and the runner keeps a residual micro-vibration, so this A_c depends on the

@@ -41,7 +41,7 @@ def micro_vibration_frequency(
     Parameters
     ----------
     time, runner_velocity, piezo_velocity : array_like
-        Recorded samples (s, m/s, m/s), e.g. of a :class:`passmd.solver.simulation.SimulationResult`.
+        Recorded samples (s, m/s, m/s), e.g. of a :class:`passmd.solver.results.SimulationResult`.
     after : float
         Start of the free vibration (s), e.g. the end of a fly-back.
 

@@ -4,7 +4,7 @@ The runner starts at rest, touching the load cell (a linear spring k, Table 1) a
 length, with virgin contacts, and is driven by a saw-tooth until its steps stall: the load
 cell then pushes back, on average over a period, as hard as the contacts carry the runner
 forward. The force at stall is the *generated force* F_gen = k·x̄_r, x̄_r the runner's mean
-position over the last period (:attr:`passmd.solver.simulation.SimulationResult.generated_force`).
+position over the last period (:attr:`passmd.solver.results.SimulationResult.generated_force`).
 
 Coulomb bound
     Over one period m_r (v_end − v_start) = T (F̄_fric − k·x̄_r), and every contact's friction
@@ -327,7 +327,7 @@ def generated_force(
     ------
     ValueError
         Bad input (names the parameter, its value and the allowed range).
-    passmd.solver.simulation.SimulationError
+    passmd.solver.results.SimulationError
         A run diverged.
     ForceBoundError
         A result breaks the Coulomb bound (:func:`check_force_bounds`).

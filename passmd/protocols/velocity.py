@@ -9,7 +9,7 @@ Two measurements, as pure functions of a :class:`~passmd.model.parameters.Drive`
   stick phase to average over, and from rest the runner needs about a millisecond (hundreds
   of periods) to reach its steady velocity. A run lasts ``max(MIN_PERIODS, f·STEADY_TIME)``
   periods from rest; the velocity is the slope of the runner's period-mean position
-  (``period_mean_position`` of :class:`passmd.solver.simulation.SimulationResult`, no stick phase
+  (``period_mean_position`` of :class:`passmd.solver.results.SimulationResult`, no stick phase
   assumed) over the run's second half, and ``velocity_drift`` compares its third and fourth
   quarter. For the optimized waveform the run also reports whether the contacts stick while
   the hemispheres accelerate (assumption ``stick_during_acceleration``).
@@ -26,6 +26,7 @@ import numpy as np
 from passmd.model import optimized_waveform, waveforms
 from passmd.runtime.validation import check_choice
 from passmd.solver import simulation as dynamics
+from passmd.solver.results import SimulationError
 
 __all__ = [
     "FULL_SLIDING_SHARE",
@@ -147,7 +148,7 @@ def steady_run(drive, amplitude: float, frequency: float, waveform: str, short_p
         k = np.searchsorted(start, t, side="right") - 1
         inside = (k >= 0) & (t <= start[np.clip(k, 0, None)] + timing["acceleration_time_s"])
         if not np.any(inside):
-            raise dynamics.SimulationError("no recorded sample falls inside an acceleration segment")
+            raise SimulationError("no recorded sample falls inside an acceleration segment")
         share = float(result.slip_share[:, inside].max())
         out["max_slip_share_acceleration"] = share
         out["stick_during_acceleration"] = bool(share < FULL_SLIDING_SHARE)

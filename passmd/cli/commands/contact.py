@@ -51,7 +51,7 @@ def check_springs(springs):
 
 
 def run_contact(args, out) -> int:
-    from passmd.model.contact import MDRContact
+    from passmd.model.mdr_contact import MDRContact
     from passmd.model.theory import contact_moduli
 
     if args.path is None:

@@ -18,9 +18,11 @@ import numpy as np
 import pandas as pd
 
 from passmd.experiments.driving_waveform.figures import (
+    at_section5_friction,
+)
+from passmd.experiments.driving_waveform.runs import (
     SECTION5_FRICTION,
     WINDOW_SAMPLES_PER_ACCELERATION,
-    at_section5_friction,
 )
 from passmd.ledger.checks import NotEvaluable, evidence, extractor
 from passmd.protocols.velocity import FULL_SLIDING_SHARE

@@ -24,6 +24,8 @@ from passmd.experiments.driving_waveform.figures import (
     FREQUENCIES,
     PAPER_MAXIMUM_KHZ,
     range_maximum,
+)
+from passmd.experiments.driving_waveform.runs import (
     variant_name,
 )
 from passmd.ledger.checks import ClaimFails, NotEvaluable, evidence, extractor

@@ -17,9 +17,11 @@ from passmd.experiments.driving_waveform.figures import (
     FIG10A_PRELOADS,
     FULL_SLIDING_SHARE,
     PAPER_MAXIMUM_KHZ,
-    STEP_FREQUENCY,
     at_section5_friction,
     range_maximum,
+)
+from passmd.experiments.driving_waveform.runs import (
+    STEP_FREQUENCY,
     section5_fields,
 )
 from passmd.experiments.driving_waveform.studies import numerical_optimum, settling_scan, step_point
@@ -35,7 +37,7 @@ def friction_acceleration(drive: Drive) -> float:
 
 
 def design_facts(design: pd.Series, drive: Drive) -> dict:
-    """The Eq. 15 design of a drive (a :func:`~passmd.experiments.driving_waveform.figures.designs` row)
+    """The Eq. 15 design of a drive (a :func:`~passmd.experiments.driving_waveform.runs.designs` row)
     and the
     drive's numbers behind it."""
     presliding = theory.drive_theory(drive)["presliding_m"]
@@ -207,7 +209,7 @@ def optimum_table(optimum: pd.DataFrame) -> pd.DataFrame:
 
 def optimum_facts(optimum: pd.DataFrame, design: pd.Series, a_f: float) -> dict:
     """The rigid optimum at 100 Hz against the saw-tooth and the Eq. 15 ``design`` (a
-    :func:`~passmd.experiments.driving_waveform.figures.designs` row): its gain (%), t_s (cycles), V_a
+    :func:`~passmd.experiments.driving_waveform.runs.designs` row): its gain (%), t_s (cycles), V_a
     (mm/s), Δ_a (nm), t_a (µs and × Eq. 15's), the slide V_a²/2a_f (nm, ``a_f`` the friction
     acceleration), Eq. 15's V_a over the optimum's, the gain per period (nm); and the gain (%) at
     the highest frequency optimised (kHz)."""

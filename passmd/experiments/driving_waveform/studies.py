@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from passmd.experiments.driving_waveform.figures import (
+from passmd.experiments.driving_waveform.runs import (
     STEP_FREQUENCY,
     VARIANTS,
     design_fields,

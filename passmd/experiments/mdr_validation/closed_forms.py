@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from passmd.model import hertz, theory
-from passmd.model.contact import MDRContact
+from passmd.model.mdr_contact import MDRContact
 from passmd.model.parameters import Drive
 from passmd.runtime.validation import check_range
 
@@ -37,8 +37,8 @@ def spring_picture(drive: Drive | None = None, springs: int = 41, turn: float = 
     Returns
     -------
     pandas.DataFrame
-        :meth:`passmd.model.contact.MDRContact.spring_states` columns plus ``displacement_m`` (the u shown)
-        and ``turn_m`` (where the loading turned).
+        :meth:`passmd.model.mdr_contact.MDRContact.spring_states` columns plus ``displacement_m``
+        (the u shown) and ``turn_m`` (where the loading turned).
     """
     check_range("turn", turn, 0.0, 1.0, lower_open=True)
     check_range("back", back, 0.0, 2.0 * turn, lower_open=True)

@@ -15,9 +15,9 @@ import numpy as np
 import pandas as pd
 
 from passmd.experiments.mdr_validation import closed_forms as mv
-from passmd.experiments.numerics.figures import benchmark_results
-from passmd.model.contact import MDRContact
+from passmd.experiments.numerics.benchmarks import benchmark_results
 from passmd.model.defaults import PROTOCOL
+from passmd.model.mdr_contact import MDRContact
 from passmd.model.parameters import Drive
 from passmd.runtime.config import RunConfig
 from passmd.runtime.units import from_si

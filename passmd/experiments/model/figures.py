@@ -14,8 +14,8 @@ import pandas as pd
 
 from passmd.experiments.critical_amplitude.figures import FIG5A_DRIVE
 from passmd.model import hertz, theory
-from passmd.model.contact import MDRContact
 from passmd.model.defaults import PROTOCOL
+from passmd.model.mdr_contact import MDRContact
 from passmd.model.parameters import Drive, paper_drive
 from passmd.model.waveforms import flyback_time, sawtooth
 from passmd.runtime.config import RunConfig

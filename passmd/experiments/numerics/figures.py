@@ -1,14 +1,13 @@
-"""Trust in the integrator: time-step convergence, energy balance, the rigid Coulomb limit, cost.
+"""Trust in the integrator: time-step convergence, energy balance, settle windows, the rigid Coulomb limit.
 
 These are not paper figures; they back every figure's numbers. Each function returns a
-tidy DataFrame in SI units.
+tidy DataFrame in SI units. The accuracies the integrator states for the figures are in
+:mod:`passmd.experiments.numerics.accuracy`, the numbers the chapter quotes from these tables in
+:mod:`passmd.experiments.numerics.facts`, the stored speed benchmarks in
+:mod:`passmd.experiments.numerics.benchmarks`.
 """
 
 from __future__ import annotations
-
-import json
-from importlib import resources
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -16,10 +15,8 @@ import pandas as pd
 from passmd.model import theory, waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Amplifier, Drive, Material
-from passmd.protocols import stall
 from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
-from passmd.runtime.units import from_si
 from passmd.runtime.validation import check_choice, check_count, check_range
 from passmd.solver import simulation as dynamics
 from passmd.solver import steps as time_steps
@@ -31,43 +28,6 @@ CONFIGURATIONS = (
     ("six contacts, rigid", 6, "rigid"),
     ("six contacts, flexible", 6, "flexible"),
 )
-
-# Accuracy the default integrator guarantees for what the figures report. Each is checked by
-# running the quick figure data again with the step halved (error-controlled tolerance ÷ 16):
-# every reported value moves by well under its stated accuracy, so any integrator at least as
-# accurate reproduces the figures within them (the regression snapshots compare with them).
-
-#: Positions, steps and back-steps (m): :data:`passmd.solver.steps.CONVERGED_ACCURACY`, the
-#: settled position's distance from a much finer run. Halving the step moved no quick step,
-#: back-step or settled position (Figs. 5a, 7–10) by more than 0.012 nm.
-POSITION_ACCURACY = time_steps.CONVERGED_ACCURACY
-#: Stall forces (N): the stall criterion's absolute tolerance
-#: (:data:`passmd.protocols.stall.STALL_ABS_TOLERANCE`) — a finer run may stop a few periods
-#: earlier or later, anywhere within it — plus :data:`STALL_FORCE_RTOL` of the force. The
-#: integrator's own share, k_l·POSITION_ACCURACY ≈ 1 µN, is far below; halving the step moved
-#: no quick force of Fig. 7 by more than 0.018 mN.
-FORCE_ACCURACY = stall.STALL_ABS_TOLERANCE
-#: Relative part of the stall-force accuracy (:data:`passmd.protocols.stall.STALL_REL_TOLERANCE`).
-STALL_FORCE_RTOL = stall.STALL_REL_TOLERANCE
-#: Steady velocities (m/s): a step per period accurate to POSITION_ACCURACY at the fastest
-#: step frequency of Figs. 9b–10 (130 kHz), 6.5 µm/s. Halving the step moved none by more
-#: than 1.4 µm/s.
-VELOCITY_ACCURACY = POSITION_ACCURACY * 130e3
-#: Micro-vibration frequencies and times (Eq. 15's t_s, t_a; turning points; the stall cycle's
-#: full-slip time), relative: read off the recorded samples, so quantised to the record
-#: spacing, which follows the step. Halving the step moved f_s and Eq. 15's times by at most
-#: 3.2e-6 and the full-slip time by one record spacing, 1.5e-4; 1e-3 leaves a factor 6.
-FREQUENCY_RTOL = 1e-3
-#: Slip shares (fraction of a contact's radius sliding): they change fastest at the turning
-#: points where Fig. 8 reads them, by up to 0.006 when the step was halved (their means and
-#: maxima over a phase by 0.0004); 0.02 leaves a factor 3.
-SLIP_SHARE_ACCURACY = 0.02
-#: Critical amplitudes and force onsets, in final bracket widths of their search (its
-#: ``tolerance``) plus POSITION_ACCURACY: the integrator's error can flip a bisection decision
-#: only at an amplitude within that error of the switch, which moves the reported midpoint by
-#: one width. Halving the step changed no quick critical amplitude or onset (Figs. 5–7).
-CRITICAL_AMPLITUDE_BRACKETS = 1.0
-
 
 #: Refinement factors of the default step (1 = the default).
 RESOLUTIONS = {"quick": (0.5, 1.0, 2.0, 4.0), "paper": (0.25, 0.5, 1.0, 2.0, 4.0, 8.0)}
@@ -87,7 +47,7 @@ RIGID_STEP_CONTROLS = ("controlled", "fixed")
 #: The step control whose finest run is a configuration's reference, by actuator model: the fixed
 #: fine step (rigid) and the explicit adaptive step (flexible: there the fixed fine step runs only
 #: up to resolution 2; how closely the two agree is ``adaptive_vs_fixed_nm`` of
-#: :func:`convergence_facts`).
+#: :func:`~passmd.experiments.numerics.facts.convergence_facts`).
 REFERENCE_CONTROL = {"rigid": "fixed", "flexible": "adaptive"}
 
 
@@ -195,55 +155,6 @@ def energy_balance_table(
             bal = res.energy_balance()
             rows.append({"configuration": label, "contact_model": contact, **bal})
     return pd.DataFrame(rows)
-
-
-#: Benchmark results shipped with the package (``passmd/data/benchmarks/<name>.json``).
-BENCHMARKS = ("contact", "driving_waveform", "dynamics", "fit", "fit_coverage")
-
-
-def benchmark_results(name: str, path: str | Path | None = None) -> dict:
-    """One benchmark script's last results (``benchmarks/bench_<name>.py``), as stored.
-
-    Parameters
-    ----------
-    name : {"contact", "driving_waveform", "dynamics", "fit", "fit_coverage"}
-        The benchmark (``fit_coverage``: ``benchmarks/bench_fit_coverage.py``).
-    path : path-like, optional
-        A results file to read instead of the one installed with the package
-        (``passmd/data/benchmarks/<name>.json``, package data, which the benchmark
-        scripts write by default when run from the repository).
-
-    Returns
-    -------
-    dict
-        As the script wrote it (``{"meta": {...}, "rows": [...]}`` for the speed benchmarks).
-    """
-    check_choice("name", name, BENCHMARKS)
-    if path is None:
-        resource = resources.files("passmd") / "data" / "benchmarks" / f"{name}.json"
-        if not resource.is_file():
-            raise FileNotFoundError(
-                f"{resource} is missing: run `python benchmarks/bench_{name}.py` in the repository"
-            )
-        return json.loads(resource.read_text(encoding="utf-8"))
-    path = Path(path)
-    if not path.exists():
-        raise FileNotFoundError(f"{path} is missing: run `python benchmarks/bench_{name}.py --out {path}`")
-    return json.loads(path.read_text(encoding="utf-8"))
-
-
-def benchmark_table(path: str | Path | None = None) -> pd.DataFrame:
-    """The speed benchmark's last results (``benchmarks/bench_dynamics.py``), as a table.
-
-    Reads :func:`benchmark_results` ``("dynamics", path)``; ``df.attrs["meta"]`` holds the
-    machine and settings it was measured with, ``df.attrs["across_processes"]`` the headline
-    configuration timed in several fresh processes (empty if the file predates it).
-    """
-    data = benchmark_results("dynamics", path)
-    df = pd.DataFrame(data["rows"])
-    df.attrs["meta"] = data.get("meta", {})
-    df.attrs["across_processes"] = data.get("across_processes", {})
-    return df
 
 
 def settle_fraction_sensitivity(
@@ -423,232 +334,3 @@ def model_coulomb_limit(config: RunConfig) -> pd.DataFrame:
     table["rate"] = table["configuration"].map(rates["rate"])
     table["expected_rate"] = EXPECTED_COULOMB_RATE
     return table
-
-
-# --------------------------------------------------------------------------------------
-# Facts the numerics section quotes (glue names -> numbers), each from its table
-# --------------------------------------------------------------------------------------
-
-
-def step_plan_table() -> pd.DataFrame:
-    """The integrator's steps (:func:`passmd.solver.steps.step_plan`) for each of :data:`CONFIGURATIONS`.
-
-    Columns: ``configuration``, stiffest mode (kHz), stability limit 2/ω, fine and coarse step and
-    the longest error-controlled step (ns; :data:`passmd.solver.steps.LONGEST_OMEGA_DT` over the
-    runner mode's ω, whatever the local error allows).
-    """
-    rows = []
-    for label, contacts, model in CONFIGURATIONS:
-        drive = Drive(contacts=contacts, actuator_model=model)
-        k_max = theory.drive_theory(drive)["tangential_stiffness_N_per_m"]
-        _, mult = dynamics.contact_groups(drive)
-        plan = time_steps.step_plan(drive, max(k_max), float(np.dot(mult, k_max)))
-        rows.append({
-            "configuration": label,
-            "stiffest mode (kHz)": from_si(plan.stiffest_frequency, "kHz"),
-            "stability limit 2/ω (ns)": from_si(plan.stability_limit, "ns"),
-            "fine step (ns)": from_si(plan.fine_step, "ns"),
-            "coarse step (ns)": from_si(plan.coarse_step, "ns"),
-            "longest controlled step (ns)": from_si(plan.longest_step, "ns"),
-        })
-    return pd.DataFrame(rows)
-
-
-def fitted_convergence_order(rows: pd.DataFrame) -> float:
-    """Order p of |error| ∝ h^p: least-squares slope over the runs at the default step or finer."""
-    fit = rows[(rows["error_m"] != 0) & (rows["resolution"] >= 1.0)]
-    return float(-np.polyfit(np.log(fit["resolution"]), np.log(np.abs(fit["error_m"])), 1)[0])
-
-
-#: A run of the error-controlled scheme enters its fitted order only if its error exceeds this
-#: multiple of the scheme's floor (the largest error of its finest runs, where it no longer
-#: approaches the reference): within it, the floor and not the step sets the error. At 3 the floor
-#: is at most a third of any error that enters the fit.
-FLOOR_FACTOR = 3.0
-#: Coarsest resolution in the error-controlled scheme's fitted order. Coarser, the tolerance
-#: (resolution⁻⁴ times the default) lets many steps reach the longest step
-#: (:data:`passmd.solver.steps.LONGEST_OMEGA_DT` over ω), which it then no longer sets: at 0.25 the
-#: runs change when that bound is raised, at 0.5 and finer they hardly do.
-CONTROLLED_FIT_COARSEST = 0.5
-
-
-def fitted_order_above_floor(rows: pd.DataFrame, factor: float = FLOOR_FACTOR,
-                             coarsest: float = CONTROLLED_FIT_COARSEST) -> tuple[float, float]:
-    """Order p of |error| ∝ h^p of one step control, fitted above its error floor.
-
-    The floor is the largest |error| of the control's finest runs (all configurations); the
-    least-squares slope is taken over the runs at ``coarsest`` resolution or finer whose |error|
-    exceeds ``factor`` times the floor. Returns (p, floor in m).
-
-    Raises
-    ------
-    ValueError
-        Fewer than two resolutions above the floor: coarser runs are needed to fit an order.
-    """
-    finest = rows[rows["resolution"] == rows["resolution"].max()]
-    floor = float(np.abs(finest["error_m"]).max())
-    fit = rows[(np.abs(rows["error_m"]) > factor * floor) & (rows["resolution"] >= coarsest)]
-    if fit["resolution"].nunique() < 2:
-        raise ValueError(f"only {fit['resolution'].nunique()} resolution(s) with an error above {factor:g} "
-                         f"times the floor of {floor:.3g} m: run coarser resolutions to fit an order")
-    order = -np.polyfit(np.log(fit["resolution"]), np.log(np.abs(fit["error_m"])), 1)[0]
-    return float(order), floor
-
-
-def convergence_facts(conv: pd.DataFrame) -> dict:
-    """Numbers the convergence paragraphs quote (:func:`model_convergence`).
-
-    Explicit schemes (adaptive and fixed): ``conv_order`` and ``conv_max_err_nm``, their order
-    and largest error at the default step (nm); ``adaptive_vs_fixed_nm``, their largest
-    difference (flexible); ``adaptive_saving``, fixed over adaptive steps. Quasi-static step:
-    ``quasi_order``, ``quasi_max_err_nm`` and ``quasi_saving`` (adaptive over its steps).
-    Error-controlled scheme: ``ctrl_order`` and ``ctrl_floor_nm`` (:func:`fitted_order_above_floor`),
-    ``ctrl_floor_rigid_nm`` and ``ctrl_floor_flexible_nm`` (the largest error of its finest runs
-    with rigid and with flexible actuators), ``ctrl_max_err_nm`` (its largest error at the
-    default tolerance), ``ctrl_rejected_pct`` (the largest share of its steps rejected there,
-    %), ``ctrl_saving_adaptive`` and ``ctrl_saving_fixed`` (explicit adaptive and fixed steps
-    over its own, six contacts, flexible) and ``ctrl_saving_rigid`` (fixed over its own, six
-    contacts, rigid). Savings are at the default step, for six flexible contacts unless said.
-    """
-    explicit = conv[conv["step_control"].isin(("adaptive", "fixed"))]
-    default = explicit[explicit["resolution"] == 1.0]
-    quasi = conv[conv["step_control"] == "quasi-static"]
-    controlled = conv[conv["step_control"] == "controlled"]
-    ctrl_default = controlled[controlled["resolution"] == 1.0]
-    ctrl_order, ctrl_floor = fitted_order_above_floor(controlled)
-    ctrl_finest = controlled[controlled["resolution"] == controlled["resolution"].max()]
-    ctrl_flexible = ctrl_finest["configuration"].str.contains("flexible")
-    adaptive = conv[conv["step_control"] == "adaptive"]
-    adaptive = adaptive.set_index(["configuration", "resolution"])["final_position_m"]
-    fixed = conv[(conv["step_control"] == "fixed") & conv["configuration"].str.contains("flexible")]
-    fixed = fixed.set_index(["configuration", "resolution"])["final_position_m"]
-    steps = conv[conv["resolution"] == 1.0].set_index(["configuration", "step_control"])["steps"]
-    six, six_rigid = "six contacts, flexible", "six contacts, rigid"
-    return {
-        "conv_order": fitted_convergence_order(explicit),
-        "quasi_order": fitted_convergence_order(quasi),
-        "quasi_max_err_nm": float(np.abs(quasi[quasi["resolution"] == 1.0]["error_m"]).max() * 1e9),
-        "conv_max_err_nm": float(np.abs(default["error_m"]).max() * 1e9),
-        "adaptive_vs_fixed_nm": float(np.abs(adaptive.reindex(fixed.index) - fixed).max() * 1e9),
-        "adaptive_saving": float(steps[(six, "fixed")] / steps[(six, "adaptive")]),
-        "quasi_saving": float(steps[(six, "adaptive")] / steps[(six, "quasi-static")]),
-        "ctrl_order": ctrl_order,
-        "ctrl_floor_nm": ctrl_floor * 1e9,
-        "ctrl_floor_rigid_nm": float(np.abs(ctrl_finest[~ctrl_flexible]["error_m"]).max() * 1e9),
-        "ctrl_floor_flexible_nm": float(np.abs(ctrl_finest[ctrl_flexible]["error_m"]).max() * 1e9),
-        "ctrl_max_err_nm": float(np.abs(ctrl_default["error_m"]).max() * 1e9),
-        "ctrl_rejected_pct": float((ctrl_default["rejected_steps"] / ctrl_default["steps"]).max() * 100),
-        "ctrl_saving_adaptive": float(steps[(six, "adaptive")] / steps[(six, "controlled")]),
-        "ctrl_saving_fixed": float(steps[(six, "fixed")] / steps[(six, "controlled")]),
-        "ctrl_saving_rigid": float(steps[(six_rigid, "fixed")] / steps[(six_rigid, "controlled")]),
-    }
-
-
-def energy_facts(energy: pd.DataFrame, explicit: pd.DataFrame) -> dict:
-    """Numbers of the energy-balance paragraph, from two :func:`energy_balance_table` runs.
-
-    ``energy`` is the default (error-controlled) scheme, ``explicit`` the same runs with
-    ``error_control=False``. Returns the largest |relative residual| of ``energy``
-    (``energy_max_rel``; ``energy_exact_max_rel`` and ``energy_discrete_max_rel`` per contact
-    model) and of ``explicit`` (``energy_explicit_max_rel``), their ratio
-    (``energy_tighter``: explicit over default), and the smallest and largest factor by which
-    a default run's residual exceeds the explicit scheme's on the same run
-    (``energy_ratio_min``, ``energy_ratio_max``).
-    """
-    keys = ["configuration", "contact_model"]
-    if not energy[keys].reset_index(drop=True).equals(explicit[keys].reset_index(drop=True)):
-        raise ValueError("explicit must list the same runs as energy, in the same order")
-    default = energy["relative_residual"].abs().to_numpy()
-    other = explicit["relative_residual"].abs().to_numpy()
-    ratio = default / other
-    exact = (energy["contact_model"] == "exact").to_numpy()
-    return {"energy_max_rel": float(default.max()),
-            "energy_exact_max_rel": float(default[exact].max()),
-            "energy_discrete_max_rel": float(default[~exact].max()),
-            "energy_explicit_max_rel": float(other.max()),
-            "energy_tighter": float(other.max() / default.max()),
-            "energy_ratio_min": float(ratio.min()), "energy_ratio_max": float(ratio.max())}
-
-
-def settle_facts(sens: pd.DataFrame) -> dict:
-    """Largest spread of the mean step over the settle windows: nm and % of the mean
-    (:func:`settle_fraction_sensitivity`)."""
-    spread = sens.groupby("configuration")["mean_step_m"].agg(lambda v: v.max() - v.min())
-    mean = sens.groupby("configuration")["mean_step_m"].mean()
-    return {"settle_spread_nm": float(spread.max() * 1e9),
-            "settle_spread_rel": float((spread / mean).max() * 100)}
-
-
-def coulomb_facts(coulomb: pd.DataFrame, refined: pd.DataFrame) -> dict:
-    """Numbers the Coulomb-limit paragraph quotes, from :func:`model_coulomb_limit` and the same
-    run at half the time step (``refined``): gaps (nm, % of A_c), fly-back times (µs), rates."""
-    k = np.array(sorted(coulomb["scale"].unique()))
-    by = coulomb.set_index(["configuration", "scale"])
-    paper, slow = "six contacts, paper slew rate fly-back", "six contacts, slow fly-back"
-    change = np.abs(refined["difference_m"] - coulomb["difference_m"])
-    slow_tf = coulomb[coulomb["flyback"] == "slow"]["flyback_time_s"]
-    return {
-        "cl_scale_max": float(k[-1]),
-        "cl_refined_nm": float(change.max() * 1e9),
-        "cl_refined_rel": float((change / np.abs(coulomb["difference_m"])).max() * 100),
-        "cl_tf_paper_us": float(by.loc[(paper, k[0]), "flyback_time_s"] * 1e6),
-        "cl_tf_slow_min_us": float(slow_tf.min() * 1e6),
-        "cl_tf_slow_max_us": float(slow_tf.max() * 1e6),
-        "cl_six_paper_limit_nm": float(by.loc[(paper, k[0]), "coulomb_step_m"] * 1e9),
-        "cl_six_paper_gap0_nm": float(-by.loc[(paper, k[0]), "difference_m"] * 1e9),
-        "cl_six_paper_gap0_ratio": float(-by.loc[(paper, k[0]), "difference_m"]
-                                         / by.loc[(paper, k[0]), "presliding_m"] * 100),
-        "cl_six_paper_gap_last_nm": float(-by.loc[(paper, k[-1]), "difference_m"] * 1e9),
-        "cl_six_slow_limit_nm": float(by.loc[(slow, k[0]), "coulomb_step_m"] * 1e9),
-        "cl_six_slow_gap_last_nm": float(abs(by.loc[(slow, k[-1]), "difference_m"]) * 1e9),
-        "cl_rate_min": float(coulomb["rate"].min()),
-        "cl_rate_max": float(coulomb["rate"].max()),
-        "cl_expected": float(EXPECTED_COULOMB_RATE),
-    }
-
-
-def coulomb_side(coulomb: pd.DataFrame) -> str:
-    """Where the simulated steps lie against the Coulomb limit: "below" or "on both sides of"."""
-    return "below" if (coulomb["difference_m"] < 0).all() else "on both sides of"
-
-
-def coulomb_rising_gaps(coulomb: pd.DataFrame) -> list[str]:
-    """Each place where the gap to the Coulomb limit grows from one stiffness factor to the next."""
-    rising = []
-    for label, g in coulomb.groupby("configuration", sort=False):
-        ordered = g.sort_values("scale")
-        gap = np.abs(ordered["difference_m"].to_numpy())
-        scales = ordered["scale"].to_numpy()
-        rising += [f"{label}: {gap[i] * 1e9:.3f} nm at k = {scales[i]:g} → {gap[i + 1] * 1e9:.3f} nm at "
-                   f"k = {scales[i + 1]:g}" for i in np.flatnonzero(np.diff(gap) >= 0)]
-    return rising
-
-
-#: Speed targets of the integrator: ms per 100 Hz period of the
-#: six-contact flexible drive with the default (error-controlled) step and the exact contact,
-#: which a sweep of the assumption space needs, and ns per fixed step (exact contact).
-TARGET_MS_PER_PERIOD, TARGET_NS_PER_STEP = 1.0, 25.0
-
-
-def benchmark_facts(bench: pd.DataFrame) -> dict:
-    """The speed numbers the performance paragraph quotes, from :func:`benchmark_table`:
-    ms per 100 Hz period (six flexible contacts, exact contact) with the default
-    error-controlled step and with the explicit adaptive one, the periods each timed run
-    lasted, the same default-step configuration's median over fresh processes and their number
-    (``bench_six_flex_processes_ms``, ``bench_processes``; NaN and 0 if not measured), the
-    largest ns per fixed step (exact), the machine's load average, and the targets."""
-    spread = bench.attrs.get("across_processes", {})
-    six_flex = bench[(bench["contacts"] == 6) & (bench["actuator"] == "flexible")
-                     & (bench["contact_model"] == "exact")].set_index("step")
-    fixed_exact = bench[(bench["step"] == "fixed") & (bench["contact_model"] == "exact")]
-    return {
-        "bench_six_flex_ms": float(six_flex.loc["controlled", "ms_per_100Hz_period"]),
-        "bench_six_flex_adaptive_ms": float(six_flex.loc["adaptive", "ms_per_100Hz_period"]),
-        "bench_periods": int(bench.attrs["meta"].get("periods_per_run", 1)),
-        "bench_six_flex_processes_ms": float(spread.get("median_ms_per_100Hz_period", float("nan"))),
-        "bench_processes": len(spread.get("ms_per_100Hz_period_per_process", [])),
-        "bench_fixed_ns": float(fixed_exact["ns_per_step"].max()),
-        "bench_load": float(bench.attrs["meta"].get("load_average_before", [float("nan")])[0]),
-        "target_ms_per_period": TARGET_MS_PER_PERIOD,
-        "target_ns_per_step": TARGET_NS_PER_STEP,
-    }
