@@ -11,7 +11,8 @@ Usage::
 
     python benchmarks/bench_book.py [--profile paper] [--out passmd/data/benchmarks/book.json]
 
-Needs the book session's environment (run ``nox -s book`` once first: ``-R`` reuses it).
+Needs ``nox`` on PATH and the book session's environment (run ``nox -s book`` once first:
+``-R`` reuses it); run it with a Python that imports passmd (e.g. the book session's).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ import datetime
 import json
 import os
 import re
+import shutil
 import subprocess
 import sys
 import time
@@ -36,7 +38,10 @@ BUDGET_S = {"paper": 360.0, "quick": 300.0}
 def measure(profile: str) -> dict:
     load_before = os.getloadavg()
     start = time.perf_counter()
-    command = [sys.executable, "-m", "nox", "-R", "-s", "book", "--", "--cold", "--profile", profile]
+    nox = shutil.which("nox")
+    if nox is None:
+        raise SystemExit("nox is not on PATH: install it (python3 -m pip install nox uv)")
+    command = [nox, "-R", "-s", "book", "--", "--cold", "--profile", profile]
     done = subprocess.run(command,
                           capture_output=True, text=True)
     wall = time.perf_counter() - start
