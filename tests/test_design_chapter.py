@@ -59,6 +59,13 @@ def test_map_grid_runs_frequency_slow_amplitude_fast(profile):
                                                      drive.actuator.full_stroke_amplitude], rtol=1e-12)
 
 
+@pytest.mark.parametrize("profile", ["quick", "paper"])
+def test_stall_curve_holds_the_drives_own_preload(profile):
+    """The chapter quotes the stall force at the example drive's preload: every profile computes it."""
+    drive, _ = design.example_drive()
+    assert drive.preload in design.PROFILE_SETTINGS[profile].stall_preloads
+
+
 def test_profile_executor_applies_only_where_none_was_chosen():
     assert design._run_config(RunConfig(), "quick").executor == "serial"
     assert design._run_config(RunConfig(executor="process"), "quick").executor == "process"

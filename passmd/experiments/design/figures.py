@@ -118,7 +118,7 @@ PROFILE_SETTINGS = {
     "paper": ProfileSettings(
         preloads=tuple(np.round(np.linspace(0.1, 1.0, 10), 3)),
         map_frequencies=12, map_amplitudes=12,
-        stall_fractions=(0.4, 0.7, 1.0), stall_preloads=(0.3, 0.9),
+        stall_fractions=(0.4, 0.7, 1.0), stall_preloads=(0.3, 0.6),
         free=("friction_coefficient", "actuator.stiffness"),
         fit_preloads=(0.3, 0.6), fit_amplitudes_nm=tuple(np.linspace(60.0, 130.0, 5)),
         heldback=tuple((f, p, a) for f, p in ((100.0, 0.9), (20e3, 0.6)) for a in (80.0, 105.0, 130.0)),
