@@ -46,7 +46,7 @@ class FigureSpec(NamedTuple):
     title: str  #: one line: what the panel shows
     chapter: str  #: book chapter file stem that shows it
     compute: Callable[[RunConfig], pd.DataFrame]  #: run configuration -> tidy data
-    #: ``"module:function"`` of :mod:`passmd.plots` drawing the data (a matplotlib Figure); named,
+    #: ``"module:function"`` of ``passmd.plots`` drawing the data (a matplotlib Figure); named,
     #: not imported, so that computing a figure's data (the ledger, the sweeps) loads no matplotlib
     plot: str
 

@@ -176,10 +176,10 @@ def evaluate(
 ) -> pd.DataFrame:
     """Evaluate every claim against the result tables, over its readings of the assumption space.
 
-    Each claim is checked at every reading of :func:`passmd.ledger.readings.design` (the full product of
-    the axes its extractor depends on, the defaults first). The joint reading
-    (:func:`joint_reading`) is the point of the whole space where the most claims hold together;
-    each claim's category is computed from two points only, the defaults and the joint reading:
+    Each claim is checked at every reading of :func:`passmd.ledger.readings.design` (the full product of the
+    axes its extractor depends on, the defaults first). The joint reading
+    (:func:`~passmd.ledger.joint.joint_reading`) is the point of the whole space where the most claims hold
+    together; each claim's category is computed from two points only, the defaults and the joint reading:
 
     * ``reproduced``: the check holds at the defaults;
     * ``reproduced under the joint reading``: it does not hold at the defaults and holds at the
@@ -191,7 +191,8 @@ def evaluate(
       values, missing results, no run at that reading).
 
     The table's ``attrs`` carry ``points`` (every claim at every evaluated reading), ``joint``
-    (:func:`joint_reading` without its state table) and ``conflicts`` (:func:`conflicting_pairs`).
+    (:func:`~passmd.ledger.joint.joint_reading` without its state table) and ``conflicts``
+    (:func:`~passmd.ledger.joint.conflicting_pairs`).
 
     NaN never counts as holding (:class:`passmd.ledger.checks.NotEvaluable`). Claims whose ``requires``
     are only ``closed_forms`` have ``basis`` "closed form" and are not simulation results.

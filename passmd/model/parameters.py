@@ -1,4 +1,5 @@
-"""The whole drive: the :class:`Drive` record, its contact arrangement and its plausible ranges.
+"""The whole drive: the :class:`~passmd.model.parameters.Drive` record, its contact arrangement and its
+plausible ranges.
 
 A :class:`Drive` gathers the geometry, preload, friction, masses, model choices and the parts of
 :mod:`passmd.model.tables` (materials, Table 2 actuator, amplifier); its contacts are the paper's

@@ -1,8 +1,8 @@
-"""Records of a simulation: :class:`SimulationResult` (the recorded series and per-period
-measures of one run, in SI units) and :class:`SimulationError` (a run that diverged), and
-:func:`measures`, which turns the integrator's buffers (``passmd.solver.kernels.Buffers``) into
-a result's fields. :class:`passmd.solver.simulation.Simulation` makes the results; everything
-that reads a run (protocols, experiments, the command line) reads these records.
+"""Records of a simulation: :class:`~passmd.solver.results.SimulationResult` (the recorded series and
+per-period measures of one run, in SI units) and :class:`~passmd.solver.results.SimulationError` (a run that
+diverged), and :func:`~passmd.solver.results.measures`, which turns the integrator's buffers
+(``passmd.solver.kernels.Buffers``) into a result's fields. :class:`passmd.solver.simulation.Simulation` makes
+the results; everything that reads a run (protocols, experiments, the command line) reads these records.
 """
 
 from __future__ import annotations

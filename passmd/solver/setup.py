@@ -1,9 +1,9 @@
 """What a simulation sets up before it integrates: the contact groups of a drive (Eq. 1) and
-their parameter and state rows for the kernels (:func:`contact_rows`), the contacts' linear
-stiffness the error-controlled step integrates exactly (:func:`linear_stiffness`), and the
-steps a :class:`passmd.solver.steps.Scheme` takes on a drive (:func:`scheme_steps`, which
-refuses a given step above the Verlet stability limit). :class:`passmd.solver.simulation.Simulation`
-calls these once per run.
+their parameter and state rows for the kernels (:func:`~passmd.solver.setup.contact_rows`), the contacts'
+linear stiffness the error-controlled step integrates exactly (:func:`~passmd.solver.setup.linear_stiffness`),
+and the steps a :class:`passmd.solver.steps.Scheme` takes on a drive
+(:func:`~passmd.solver.setup.scheme_steps`, which refuses a given step above the Verlet stability limit).
+:class:`passmd.solver.simulation.Simulation` calls these once per run.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from passmd.model.parameters import Drive
 from passmd.model.theory import contact_layout
 from passmd.solver.steps import Scheme, StepPlan
 
-#: Verlet is stable for ω dt < 2; a given step (:attr:`passmd.solver.steps.Scheme.dt`) must keep
+#: Verlet is stable for ω dt < 2; a given step (``Scheme.dt``) must keep
 #: this margin below it.
 STABILITY_MARGIN = 0.9
 

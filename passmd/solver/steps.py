@@ -67,7 +67,7 @@ class WorkLimitError(ValueError):
     responsible."""
 
 
-#: What flexible actuators step with once their ringing has decayed (:attr:`Scheme.quiet_step`).
+#: What flexible actuators step with once their ringing has decayed (``Scheme.quiet_step``).
 QUIET_STEPS = ("fine", "coarse", "quasi-static")
 
 
@@ -95,7 +95,7 @@ class Scheme:
         :mod:`passmd.solver.kernels`). Without it rigid actuators take the fine step.
     refine : float
         Divides every step (convergence studies); under error control it divides the
-        tolerance by ``refine``⁴ instead (the controlled step scales as its fourth root).
+        tolerance by the fourth power of ``refine`` instead (the controlled step scales as its fourth root).
     dt : float or None
         Scheme "fixed" only: this step (s) throughout instead of the fine step; it must stay
         below the Verlet stability limit of the stiffest mode (``refine`` must then be 1).
@@ -181,7 +181,7 @@ def step_plan(
     total_contact_stiffness : float
         Σ n_g 2aG*_g over all contacts (N/m).
     refine : float
-        Refinement factor: the steps are divided by it (:attr:`Scheme.refine`).
+        Refinement factor: the steps are divided by it (``Scheme.refine``).
     """
     act = drive.actuator
     runner_stiffness = total_contact_stiffness + drive.effective_load_cell_stiffness

@@ -1,7 +1,8 @@
 """The benchmark scripts' stored results (``benchmarks/bench_<name>.py``, written to the package
-data ``passmd/data/benchmarks/<name>.json``): :func:`benchmark_results` reads one script's file as
-stored, :func:`benchmark_table` the integrator's speed benchmark as a table. Speed is measured by
-those scripts, never by the tests; the chapters read it from here.
+data ``passmd/data/benchmarks/<name>.json``):
+:func:`~passmd.experiments.numerics.benchmarks.benchmark_results` reads one script's file as stored,
+:func:`~passmd.experiments.numerics.benchmarks.benchmark_table` the integrator's speed benchmark as a table.
+Speed is measured by those scripts, never by the tests; the chapters read it from here.
 """
 
 from __future__ import annotations

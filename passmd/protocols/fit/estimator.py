@@ -1,10 +1,11 @@
-"""The estimator of :func:`fit`: global pass, local least squares, scans of rough parameters, profiles.
+"""The estimator of :func:`~passmd.protocols.fit.estimator.fit`: global pass, local least squares, scans of
+rough parameters, profiles.
 
 A scrambled Sobol design over the bounds picks the starts, ``scipy.optimize.least_squares``
 refines the best of them in log-parameter space, a parameter whose residuals oscillate on the
 Jacobian's scale (:data:`ROUGHNESS_LIMIT`) is scanned, and each parameter's profile likelihood
 gives its 95 % interval; a profile that meets a lower cost restarts the search
-(:data:`REFITS`). The tuning constants below are the ones the method description in
+(``REFITS``). The tuning constants below are the ones the method description in
 :mod:`passmd.protocols.fit` refers to.
 """
 

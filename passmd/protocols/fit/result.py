@@ -1,4 +1,5 @@
-"""What a calibration returns: :class:`FitResult`, the identifiability verdict and the fitted drive file.
+"""What a calibration returns: :class:`~passmd.protocols.fit.result.FitResult`, the identifiability verdict
+and the fitted drive file.
 
 :class:`FitResult` holds the fitted drive, each estimate with its standard error and 95 %
 profile interval, the correlation matrix and the residuals; its verdict says which parameters

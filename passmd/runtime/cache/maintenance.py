@@ -1,8 +1,8 @@
 """Maintenance of a whole cache directory: listing, summarising, pruning and clearing it.
 
-What ``passmd cache info|prune|clear`` and :class:`~passmd.runtime.cache.Cache`'s methods of
+What ``passmd cache info|prune|clear`` and :class:`~passmd.runtime.cache.store.Cache`'s methods of
 the same names run. Each refuses a directory that is not a passmd cache
-(:class:`~passmd.runtime.cache.NotACache`) and removes only the cache's own files: entries,
+(:class:`~passmd.runtime.cache.layout.NotACache`) and removes only the cache's own files: entries,
 unreadable entries at an entry's path, and its temporary files once they are older than
 :data:`STALE_TEMP_SECONDS`.
 """

@@ -1,4 +1,5 @@
-"""The cache itself: :class:`Cache` reads and writes checked entries in a directory it owns.
+"""The cache itself: :class:`~passmd.runtime.cache.store.Cache` reads and writes checked entries in a
+directory it owns.
 
 A :class:`Cache` makes the key of a call (function, parameters, code fingerprints), finds an
 entry's file, marks or adopts its directory on first use, reads an entry back (an unusable
