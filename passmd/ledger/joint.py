@@ -61,7 +61,7 @@ def joint_map(evaluated: pd.DataFrame) -> pd.DataFrame:
 def joint_reading(evaluated: Mapping[str, tuple[list[PointResult], tuple]], runner_ups: int = 5) -> dict:
     """The point of the whole declared assumption space where the most claims hold together.
 
-    ``evaluated`` is ``{claim id: (points, depends_on)}`` (:func:`passmd.ledger.verdicts.claim_points`).
+    ``evaluated`` is ``{claim id: (points, depends_on)}`` (``passmd.ledger.verdicts.claim_points``).
     A claim's state at a point of :func:`passmd.ledger.readings.space` is its state at the projection of
     that point onto the axes it is evaluated along (it does not depend on the others); a point its
     design does not reach counts as not holding. Ties are broken towards the defaults (fewest
