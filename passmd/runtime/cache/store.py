@@ -306,42 +306,13 @@ class Cache:
         return maintenance.entries(self.directory)
 
     def info(self) -> dict:
-        """Summary of the directory: entries, bytes, entries per code fingerprint and function.
-
-        Unreadable entries, the cache's own temporary files (``leftovers``) and files that
-        are not the cache's (``foreign``, never touched) are counted apart; nothing is removed.
-
-        Raises
-        ------
-        NotACache
-            The directory exists, is not empty and has no marker of this format.
-        """
+        """Summary of the directory (:func:`~passmd.runtime.cache.maintenance.info`)."""
         return maintenance.info(self.directory, self.fingerprint)
 
     def prune(self) -> int:
-        """Remove entries of other code fingerprints, unreadable entries, stale temporary files.
-
-        Returns the number of files removed. Entries of the current code, temporary files
-        younger than :data:`~passmd.runtime.cache.maintenance.STALE_TEMP_SECONDS` (a write in
-        progress) and files that are not the cache's stay.
-
-        Raises
-        ------
-        NotACache
-            The directory exists, is not empty and has no marker of this format.
-        """
+        """Remove what the current code cannot read (:func:`~passmd.runtime.cache.maintenance.prune`)."""
         return maintenance.prune(self.directory, self.fingerprint)
 
     def clear(self) -> int:
-        """Remove every entry (readable or not) and temporary file of the cache.
-
-        Returns the number of files removed; files that are not the cache's stay. A write
-        in progress meanwhile loses its entry (reported by that writer, which keeps its
-        result).
-
-        Raises
-        ------
-        NotACache
-            The directory exists, is not empty and has no marker of this format.
-        """
+        """Remove every entry and temporary file (:func:`~passmd.runtime.cache.maintenance.clear`)."""
         return maintenance.clear(self.directory)
