@@ -141,7 +141,7 @@ def energy_facts(energy: pd.DataFrame, explicit: pd.DataFrame) -> dict:
     :func:`~passmd.experiments.numerics.figures.energy_balance_table` runs.
 
     ``energy`` is the default (error-controlled) scheme, ``explicit`` the same runs with
-    ``error_control=False``. Returns the largest |relative residual| of ``energy``
+    ``scheme="adaptive"``. Returns the largest |relative residual| of ``energy``
     (``energy_max_rel``; ``energy_exact_max_rel`` and ``energy_discrete_max_rel`` per contact
     model) and of ``explicit`` (``energy_explicit_max_rel``), their ratio
     (``energy_tighter``: explicit over default), and the smallest and largest factor by which

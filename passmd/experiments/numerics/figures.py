@@ -134,17 +134,17 @@ def energy_balance_table(
     frequency: float = 1000.0,
     periods: int = 3,
     resolution: float = 1.0,
-    error_control: bool = True,
+    scheme: str = "controlled",
 ) -> pd.DataFrame:
     """Energy balance W_in = E_kin + E_el + W_contact + W_damp of each configuration.
 
     Runs :func:`passmd.solver.simulation.simulate` at ``resolution`` with the exact contact and with
-    the discrete contact (:data:`passmd.model.defaults.PROTOCOL` ``.springs`` springs): the
-    default, error-controlled scheme, or with ``error_control=False`` the explicit scheme
-    "adaptive" (:data:`passmd.solver.steps.SCHEMES`: the fixed fine step for rigid actuators,
-    adaptive for flexible ones).
+    the discrete contact (:data:`passmd.model.defaults.PROTOCOL` ``.springs`` springs), with
+    ``scheme`` (:data:`passmd.solver.steps.SCHEMES`; the chapter compares the default,
+    error-controlled one with the explicit "adaptive" one: the fixed fine step for rigid
+    actuators, adaptive for flexible ones).
     """
-    scheme = time_steps.SCHEMES["controlled" if error_control else "adaptive"].replace(refine=resolution)
+    scheme = time_steps.resolve_scheme(scheme).replace(refine=resolution)
     rows = []
     for label, contacts, model in CONFIGURATIONS:
         drive = Drive(contacts=contacts, actuator_model=model)
