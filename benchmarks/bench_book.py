@@ -28,6 +28,8 @@ import sys
 import time
 from pathlib import Path
 
+from bench_ledger import append_run  # a sibling script: the benchmarks folder is on the path
+
 from passmd.runtime import provenance
 
 #: The wall time a cold build of each profile should stay within (s): the paper profile is the
@@ -66,13 +68,7 @@ def main() -> None:
     parser.add_argument("--profile", default="paper", choices=("quick", "paper"))
     parser.add_argument("--out", default="passmd/data/benchmarks/book.json")
     args = parser.parse_args()
-    out = Path(args.out)
-    runs = json.loads(out.read_text(encoding="utf-8")) if out.exists() else []
-    runs.append(measure(args.profile))
-    tmp = out.with_name(f".{out.name}.tmp")
-    tmp.write_text(json.dumps(runs, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
-    tmp.replace(out)
-    print(json.dumps(runs[-1], indent=1, ensure_ascii=False))
+    append_run(Path(args.out), measure(args.profile))
 
 
 if __name__ == "__main__":

@@ -59,19 +59,24 @@ def measure(profile: str, cache_dir: str | None = None) -> dict:
     }
 
 
+def append_run(out: Path, run: dict) -> None:
+    """Append ``run`` to the JSON list in ``out`` (created if absent), replacing the file atomically,
+    and print the run."""
+    runs = json.loads(out.read_text(encoding="utf-8")) if out.exists() else []
+    runs.append(run)
+    tmp = out.with_name(f".{out.name}.tmp")
+    tmp.write_text(json.dumps(runs, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
+    tmp.replace(out)
+    print(json.dumps(run, indent=1, ensure_ascii=False))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--profile", default="paper", choices=("quick", "paper"))
     parser.add_argument("--out", default="passmd/data/benchmarks/ledger.json")
     parser.add_argument("--cache-dir", default=None)
     args = parser.parse_args()
-    out = Path(args.out)
-    runs = json.loads(out.read_text(encoding="utf-8")) if out.exists() else []
-    runs.append(measure(args.profile, args.cache_dir))
-    tmp = out.with_name(f".{out.name}.tmp")
-    tmp.write_text(json.dumps(runs, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
-    tmp.replace(out)
-    print(json.dumps(runs[-1], indent=1, ensure_ascii=False))
+    append_run(Path(args.out), measure(args.profile, args.cache_dir))
 
 
 if __name__ == "__main__":
