@@ -15,6 +15,8 @@ import time
 
 import numpy as np
 
+from passmd.runtime.inputs import LIMITS
+
 __all__ = ["FORMAT", "MAGIC", "MAX_DEPTH", "MAX_ENTRY_BYTES", "MAX_HEADER_BYTES", "CorruptEntry",
            "decode_entry", "encode_entry"]
 
@@ -22,8 +24,9 @@ __all__ = ["FORMAT", "MAGIC", "MAX_DEPTH", "MAX_ENTRY_BYTES", "MAX_HEADER_BYTES"
 FORMAT = "PASSMD-CACHE 1"
 #: First line of every entry.
 MAGIC = FORMAT.encode() + b"\n"
-#: Largest entry file read or written, in bytes (results are KiB to MiB; arrays live here).
-MAX_ENTRY_BYTES = 2**30
+#: Largest entry file read or written, in bytes (results are KiB to MiB; arrays live here):
+#: the cache entry's limit of :data:`passmd.runtime.inputs.LIMITS`.
+MAX_ENTRY_BYTES = LIMITS["cache entry"]
 #: Largest JSON header read or written, in bytes (the value tree without its array bytes).
 MAX_HEADER_BYTES = 16 * 2**20
 #: Deepest nesting of a stored value (a dict in a list in a dict ... counts one per level).

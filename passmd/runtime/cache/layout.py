@@ -18,6 +18,7 @@ import tempfile
 from pathlib import Path
 
 from passmd.runtime.cache.entry import FORMAT, MAGIC, MAX_ENTRY_BYTES
+from passmd.runtime.inputs import RefusedFile, read_bounded
 
 __all__ = ["ENTRY_SUFFIX", "MARKER_NAME", "NotACache", "inspect_directory", "owned"]
 
@@ -33,8 +34,6 @@ _MARKER_TEXT = (
     f"{_MARKER_FORMAT_LINE}{FORMAT}\n"
     "# For information about cache directory tags see https://bford.info/cachedir/\n"
 ).encode()
-#: Largest marker file read (the tag is a few lines).
-_MARKER_MAX_BYTES = 4096
 
 #: Names the cache owns: subfolders, entries and temporary files (groups: the key's first
 #: two digits, which must be the subfolder's name).
@@ -72,57 +71,30 @@ def _examine(path: Path, *, read: bool) -> tuple[str, object]:
     as an entry and removable (a link, which is removed itself, a special file, an entry
     above :data:`~passmd.runtime.cache.entry.MAX_ENTRY_BYTES`); ``("entry", data)``: a
     regular file that starts with the magic line, with its bytes when ``read``. Other
-    ``OSError`` (permissions) propagate.
+    ``OSError`` (permissions) propagate. Read by :func:`passmd.runtime.inputs.read_bounded`.
     """
     try:
-        info = os.lstat(path)
+        data = read_bounded(path, "cache entry", follow_links=False, starts_with=MAGIC, read=read)
     except FileNotFoundError:
         return "missing", None
-    if stat.S_ISLNK(info.st_mode):
-        return "bad", "a symbolic link, not an entry"
-    if stat.S_ISDIR(info.st_mode):
+    except IsADirectoryError:
         return "foreign", "a directory"
-    if not stat.S_ISREG(info.st_mode):
-        return "bad", "not a regular file"
-    try:
-        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
-    except FileNotFoundError:
-        return "missing", None
-    except OSError as exc:
-        if os.path.islink(path):  # replaced by a link since the lstat
-            return "bad", "a symbolic link, not an entry"
-        raise exc
-    with os.fdopen(fd, "rb") as fh:
-        info = os.fstat(fh.fileno())
-        if not stat.S_ISREG(info.st_mode):
-            return "bad", "not a regular file"
-        head = fh.read(len(MAGIC))
-        if head != MAGIC:
+    except RefusedFile as exc:
+        if exc.reason == "start":
             return "foreign", "a file that is not a passmd cache entry (no PASSMD-CACHE first line)"
-        if info.st_size > MAX_ENTRY_BYTES:
-            return "bad", f"{info.st_size} bytes, above the {MAX_ENTRY_BYTES}-byte limit"
-        if not read:
-            return "entry", None
-        data = head + fh.read(MAX_ENTRY_BYTES + 1 - len(head))
-    if len(data) > MAX_ENTRY_BYTES:
-        return "bad", f"more than the {MAX_ENTRY_BYTES}-byte limit"
-    return "entry", data
+        if exc.reason == "size":
+            return "bad", f"{exc.size} bytes, above the {MAX_ENTRY_BYTES}-byte limit"
+        if exc.found == "a symbolic link":
+            return "bad", "a symbolic link, not an entry"
+        return "bad", "not a regular file"
+    return "entry", data if read else None
 
 
 def _read_marker(directory: Path) -> str | None:
     """The format a passmd marker in ``directory`` names, None if there is none."""
-    marker = directory / MARKER_NAME
     try:
-        if not stat.S_ISREG(os.lstat(marker).st_mode):
-            return None
-        fd = os.open(marker, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
-        with os.fdopen(fd, "rb") as fh:
-            if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
-                return None
-            text = fh.read(_MARKER_MAX_BYTES + 1)
-    except OSError:
-        return None
-    if len(text) > _MARKER_MAX_BYTES:
+        text = read_bounded(directory / MARKER_NAME, "cache marker", follow_links=False)
+    except (OSError, RefusedFile):
         return None
     lines = text.decode("utf-8", "replace").splitlines()
     if not lines or lines[0].strip() != _MARKER_SIGNATURE:
