@@ -42,6 +42,7 @@ from passmd.model.tables import (
     actuator_for_radius,
     actuator_viscosity,
 )
+from passmd.runtime.inputs import RefusedFile, decode_text, read_bounded
 from passmd.runtime.units import QuantityError, parse_quantity
 from passmd.runtime.validation import InputError
 
@@ -221,16 +222,21 @@ def read_drive_file(path, *, allow_extrapolation: bool | None = None) -> dict:
     """The values a drive file gives, by key (SI floats, strings, booleans), each checked.
 
     ``allow_extrapolation`` (the command line's option) lifts the soft limits as the file's own
-    ``allow_extrapolation = true`` does. Raises :class:`DriveFileError` (a ``ValueError``): the
-    file unreadable or not TOML, a key unknown (the known ones listed), or a value refused.
+    ``allow_extrapolation = true`` does. The file is read as UTF-8 (a byte-order mark is
+    dropped) from a regular file of at most ``LIMITS["drive file"]`` bytes
+    (:func:`passmd.runtime.inputs.read_bounded`). Raises :class:`DriveFileError` (a
+    ``ValueError``): the file unreadable, not a regular file, too large or not TOML, a key
+    unknown (the known ones listed), or a value refused.
     """
     name = str(path)
     try:
-        with open(path, "rb") as handle:
-            table = tomllib.load(handle)
+        text = decode_text(read_bounded(path, "drive file"), name, "drive file")
+        table = tomllib.loads(text)
     except OSError as exc:
         raise DriveFileError(f"cannot read the drive file {name}: {exc.strerror or exc}", name="drive",
                              value=name) from None
+    except RefusedFile as exc:
+        raise DriveFileError(str(exc), name="drive", value=name) from None
     except tomllib.TOMLDecodeError as exc:
         raise DriveFileError(f"{name}: not a TOML file: {exc}", name="drive", value=name) from None
     raw = _flatten(table)
