@@ -11,7 +11,9 @@ cell once and return :class:`Measurements` in SI units; a malformed file raises
 from __future__ import annotations
 
 import csv
+import io
 import math
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from passmd.model.defaults import PROTOCOL
+from passmd.runtime.inputs import RefusedFile, decode_text, read_bounded
 from passmd.runtime.validation import InputError
 
 __all__ = ["ANNOTATIONS", "CONDITIONS", "MEASURED", "MODELS", "READINGS", "MeasurementError", "Measurements",
@@ -106,8 +109,7 @@ def measurements_from_rows(header: Sequence[str], rows: Sequence[Sequence[str]],
     allowed = [*CONDITIONS, *MEASURED, *(f"{m}_sd" for m in MEASURED), *MODELS, *ANNOTATIONS]
     for j, column in enumerate(header):
         if column not in allowed:
-            raise MeasurementError(f"{name} header, column {j + 1} {column!r}: not a known column; allowed: "
-                                   + ", ".join(allowed), name=column, value=column)
+            raise _unknown_column(name, j, column, allowed)
         if column in header[:j]:
             raise MeasurementError(f"{name} header, column {column}: given twice", name=column, value=column)
         if column.endswith("_sd") and column[:-3] not in header:
@@ -193,15 +195,69 @@ def measurements_from_rows(header: Sequence[str], rows: Sequence[Sequence[str]],
                         name=name, model=tuple(out["model"]), **arrays)
 
 
+def _unknown_column(name: str, j: int, column: str, allowed: Sequence[str]) -> MeasurementError:
+    """An unknown header cell refused, with the known column it most likely means: the same name
+    in another case or punctuation (``Amplitude (nm)``), or the same quantity in another unit
+    (``amplitude_m``: ``amplitude_nm``); else the allowed columns are listed."""
+    where = f"{name} header, column {j + 1} {column!r}: not a known column"
+
+    def norm(text: str) -> str:
+        return re.sub(r"[^0-9a-zµ]+", "_", text.lower()).strip("_")
+
+    target = norm(column)
+    same = [known for known in allowed if norm(known) == target]
+    if same:
+        return MeasurementError(f"{where}; did you mean {same[0]}? (column names are written exactly so)",
+                                name=column, value=column)
+    sd = target.endswith("_sd")
+    base = target[:-3] if sd else target
+    units = {**CONDITIONS, **{c: unit for c, (_, unit, _) in MEASURED.items()}}
+    stems = {norm(c)[:-len(u.replace("/", "_per_")) - 1]: (c, u) for c, u in units.items()
+             if norm(c).endswith("_" + norm(u.replace("/", "_per_")))}
+    matches = [stem for stem in stems if base == stem or base.startswith(stem + "_")]
+    if matches:
+        known, unit = stems[max(matches, key=len)]
+        known = known + "_sd" if sd and known + "_sd" in allowed else known
+        return MeasurementError(f"{where}; the column of this quantity is {known}, in {unit} (a column name "
+                                "carries its unit: convert the values)", name=column, value=column)
+    return MeasurementError(f"{where}; allowed: " + ", ".join(allowed), name=column, value=column)
+
+
+#: Field separators a measurement file may use, recognised from its header line: the comma, and
+#: the semicolon or tab that spreadsheets write where the comma is the decimal separator.
+DELIMITERS = {",": "comma", ";": "semicolon", "\t": "tab"}
+_NAME = re.compile(r"\s*\"?\s*[A-Za-z_][\w ()\[\]/.µ-]*\"?\s*")
+_DECIMAL_COMMA = re.compile(r"\s*[+-]?\d*,\d+(?:[eE][+-]?\d+)?\s*")
+
+
+def _delimiter(header: str) -> str:
+    """The separator of a file whose first line is ``header``: the one that splits it into the
+    most column names (the comma when none splits it)."""
+    def names(delimiter: str) -> int:
+        cells = next(csv.reader([header], delimiter=delimiter), [])
+        return sum(1 for cell in cells if _NAME.fullmatch(cell)) if len(cells) > 1 else 0
+
+    return max(DELIMITERS, key=names)  # (max keeps the first of equals: the comma)
+
+
 def read_measurements(path, *, name: str | None = None) -> Measurements:
-    """Measurements from a CSV file (see the module docstring); ``name``: how to call it in errors."""
+    """Measurements from a CSV file (see the module docstring); ``name``: how to call it in errors.
+
+    The file is read as UTF-8 (a byte-order mark is dropped) from a regular file of at most
+    ``LIMITS["measurement file"]`` bytes (:func:`passmd.runtime.inputs.read_bounded`); its
+    separator, a comma, semicolon or tab (:data:`DELIMITERS`), is recognised from the header.
+    A number written with a decimal comma is refused (its row and column named), never read
+    as another number.
+    """
     label = str(path) if name is None else name
     try:
-        with open(path, newline="", encoding="utf-8") as handle:
-            lines = [row for row in csv.reader(handle)]
-    except UnicodeDecodeError as exc:
-        raise MeasurementError(f"{label}: not a UTF-8 text file ({exc.reason})", name="file",
-                               value=label) from None
+        text = decode_text(read_bounded(path, "measurement file", label=label), label, "measurement file")
+    except RefusedFile as exc:
+        raise MeasurementError(str(exc), name="file", value=label) from None
+    first = next((line for line in text.splitlines() if line.strip()), "")
+    delimiter = _delimiter(first)
+    try:
+        lines = list(csv.reader(io.StringIO(text, newline=""), delimiter=delimiter))
     except csv.Error as exc:
         raise MeasurementError(f"{label}: not a CSV file ({exc})", name="file", value=label) from None
     numbered = [(k + 1, row) for k, row in enumerate(lines) if any(cell.strip() for cell in row)]
@@ -209,7 +265,21 @@ def read_measurements(path, *, name: str | None = None) -> Measurements:
         raise MeasurementError(f"{label}: empty file; the first line must name the columns", name="file",
                                value=label)
     (_, header), body = numbered[0], numbered[1:]
+    if delimiter != ",":
+        _refuse_decimal_commas(label, header, body, DELIMITERS[delimiter])
     return measurements_from_rows(header, [row for _, row in body], name=label, lines=[k for k, _ in body])
+
+
+def _refuse_decimal_commas(label: str, header, body, separator: str) -> None:
+    """A cell such as ``5,2`` in a file separated by semicolons or tabs: refused, not misread."""
+    for k, (line, row) in enumerate(body):
+        for column, cell in zip(header, row, strict=False):
+            if _DECIMAL_COMMA.fullmatch(cell):
+                point = cell.strip().replace(",", ".")
+                raise MeasurementError(f"{label} row {k + 1} (line {line}), column {column.strip()}: {cell!r} "
+                                       f"has a decimal comma: write {point} (the file is separated by "
+                                       f"{separator}s; passmd reads a point as the decimal separator)",
+                                       name=column.strip(), value=cell)
 
 
 def write_measurements(path, data: Measurements, values: np.ndarray | None = None) -> None:
