@@ -17,6 +17,7 @@ Lengths are in nm, forces in N (the units of the CSV files and of the figures).
 
 from __future__ import annotations
 
+import io
 import os
 from dataclasses import dataclass
 from importlib import resources
@@ -28,6 +29,7 @@ import pandas as pd
 from passmd.model import hertz, theory
 from passmd.model.parameters import paper_drive
 from passmd.model.tables import PRELOAD_GRIDS, Assumption
+from passmd.runtime.inputs import decode_text, read_bounded
 from passmd.runtime.validation import check_choice
 
 __all__ = [
@@ -253,6 +255,9 @@ def load_reference_curve(name: str, directory: str | os.PathLike | None = None) 
         File stem or file name of a table in :data:`CURVES`.
     directory : path-like, optional
         Folder holding it; default :data:`REFERENCE_DIR`.
+
+    Read from a regular file of at most ``LIMITS["reference table"]`` bytes
+    (:func:`passmd.runtime.inputs.read_bounded`).
     """
     spec = _spec(name)
     path = (Path(directory) if directory is not None else REFERENCE_DIR) / spec.filename
@@ -260,7 +265,8 @@ def load_reference_curve(name: str, directory: str | os.PathLike | None = None) 
         raise FileNotFoundError(
             f"reference curve {path} is missing: run tools/make_reference_curves.py"
         )
-    return pd.read_csv(path, comment="#")
+    text = decode_text(read_bounded(path, "reference table"), str(path), "reference table")
+    return pd.read_csv(io.StringIO(text), comment="#")
 
 
 def tangential_stiffness_table(radii=(1.0e-3, 0.25e-3), preloads=None) -> pd.DataFrame:
