@@ -562,7 +562,7 @@ def test_pool_workers_end_on_sigterm_whatever_the_parent_handles(monkeypatch):
     previous = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         signal.signal(signal.SIGTERM, lambda signum, frame: None)
-        sweep._ignore_sigint()  # the pool's worker initializer
+        sweep._worker_signals()  # the pool's worker initializer
         assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL
         assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
     finally:

@@ -10,19 +10,55 @@ from __future__ import annotations
 import json
 import os
 import re
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from passmd.runtime.validation import InputError
 
-__all__ = ["ENVIRONMENT", "EXECUTORS", "PROFILES", "RunConfig"]
+__all__ = ["ENVIRONMENT", "EXECUTORS", "MAX_WORKERS", "PROFILES", "WORKERS_PER_CORE", "RunConfig", "WorkersCapped",
+           "usable_cores", "useful_workers"]
 
 #: Resolution profiles: ``quick`` (CI regression tests, minutes for everything) and
 #: ``paper`` (the paper's grids, the book's default).
 PROFILES = ("quick", "paper")
 #: Executors of the sweeps: a process pool, this process, or Dask.
 EXECUTORS = ("process", "serial", "dask")
+
+#: Worker counts above this are refused (a typo, not a machine): each worker is a process.
+MAX_WORKERS = 1024
+#: Workers worth running per usable core: sweep points are CPU-bound, more workers only compete
+#: for the cores (and each holds a copy of the simulator in memory).
+WORKERS_PER_CORE = 2
+_WORKERS_ALLOWED = f"must be an integer from 1 to {MAX_WORKERS}"
+
+
+class WorkersCapped(UserWarning):
+    """More workers were asked for than the machine's cores can use: fewer run (one line)."""
+
+
+def usable_cores() -> int:
+    """The cores this process may run on (its CPU affinity where the system tells it)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
+def useful_workers(requested: int | None, pending: int) -> int:
+    """Worker processes worth starting for ``pending`` points: ``requested`` (default one per
+    usable core), at most one per point and :data:`WORKERS_PER_CORE` per core. Capping at the
+    cores warns (:class:`WorkersCapped`); capping at the points is silent (nothing is lost)."""
+    cores = usable_cores()
+    cap = WORKERS_PER_CORE * cores
+    count = cores if requested is None else requested
+    if count > cap:
+        warnings.warn(f"workers = {count} is more than the {cores} usable cores can run: {cap} worker "
+                      f"processes run ({WORKERS_PER_CORE} per core)", WorkersCapped, stacklevel=3)
+        count = cap
+    return max(1, min(count, pending))
+
 
 #: The environment variables an entry point may read, by field of :class:`RunConfig`.
 ENVIRONMENT = {
@@ -50,7 +86,8 @@ class RunConfig:
     scheduler : str or None
         Address of a running dask scheduler (``executor="dask"`` only).
     workers : int or None
-        Parallel workers; None: one per CPU.
+        Parallel workers, 1 to :data:`MAX_WORKERS`; None: one per usable core. A sweep runs at
+        most one per point and :data:`WORKERS_PER_CORE` per core (:func:`useful_workers`).
     cache_dir : Path or None
         Directory of the result cache; None: the user's cache folder
         (:func:`passmd.runtime.cache.store.default_cache_dir`).
@@ -81,8 +118,8 @@ class RunConfig:
             raise InputError(f"executor = {self.executor!r} is not allowed: must be one of "
                              f"{', '.join(map(repr, EXECUTORS))}", name="executor", value=self.executor)
         if self.workers is not None and (isinstance(self.workers, bool) or not isinstance(self.workers, int)
-                                         or self.workers < 1):
-            raise InputError(f"workers = {self.workers!r} is not allowed: must be an integer >= 1",
+                                         or not 1 <= self.workers <= MAX_WORKERS):
+            raise InputError(f"workers = {self.workers!r} is not allowed: {_WORKERS_ALLOWED}",
                              name="workers", value=self.workers)
         if self.cache_dir is not None:
             object.__setattr__(self, "cache_dir", Path(self.cache_dir).expanduser().resolve())
@@ -110,8 +147,8 @@ class RunConfig:
                 continue
             variables[key] = name
             if key == "workers":
-                if not re.fullmatch(r"[0-9]+", text) or int(text) < 1:
-                    raise _refused(name, environ.get(name), "must be an integer >= 1 (decimal digits)")
+                if not re.fullmatch(r"[0-9]{1,9}", text) or not 1 <= int(text) <= MAX_WORKERS:
+                    raise _refused(name, environ.get(name), f"{_WORKERS_ALLOWED} (decimal digits)")
                 fields[key] = int(text)
             elif key == "progress":
                 fields[key] = False  # continuous integration: no progress bars in the logs

@@ -33,6 +33,7 @@ book's execution-statistics page sums them per chapter.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import itertools
 import logging
 import os
@@ -46,10 +47,10 @@ import pandas as pd
 
 from passmd.runtime import progress as _progress
 from passmd.runtime.cache import Cache, CacheWarning, Unfingerprintable, function_code, function_name
-from passmd.runtime.config import EXECUTORS, RunConfig
+from passmd.runtime.config import EXECUTORS, MAX_WORKERS, RunConfig, useful_workers
 from passmd.runtime.validation import check_choice
 
-__all__ = ["EXECUTORS", "grid", "progress_enabled", "run"]
+__all__ = ["EXECUTORS", "grid", "process_pool", "progress_enabled", "run"]
 
 
 def grid(**axes) -> list[dict]:
@@ -81,12 +82,40 @@ def _call(func, point):
     return func(**point)
 
 
-def _ignore_sigint():  # pragma: no cover - runs in pool workers
+#: The signals a process pool's start and shut-down hold back: delivered right after, in the sweep.
+_HELD_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+@contextlib.contextmanager
+def _signals_held():
+    """Hold SIGINT and SIGTERM back in this thread while worker processes are forked or stopped.
+
+    A worker forked meanwhile starts with both blocked, so that neither reaches it before its
+    initializer (:func:`_worker_signals`) has set its own handlers: a Ctrl-C or a SIGTERM to
+    the process group while the pool starts never raises inside a worker (a traceback). This
+    process receives a signal that came meanwhile as soon as the block ends, where the sweep
+    handles it (stopping the workers), never inside the executor's start or shut-down.
+    """
+    if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - Windows
+        yield
+        return
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD_SIGNALS)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+def _worker_signals():  # pragma: no cover - runs in pool workers
     """Pool worker initializer: Ctrl-C is handled by the parent, which stops the workers; SIGTERM
     (the parent's stop, or a stop of the whole process group) ends a worker at once, whatever
-    handler the parent had installed before the fork."""
+    handler the parent had installed before the fork. Then the signals the parent held back
+    while forking (:func:`_signals_held`) are let through: a SIGTERM that came meanwhile ends
+    the worker silently, a Ctrl-C is dropped."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, _HELD_SIGNALS)
 
 
 def _check_points(points) -> list[dict]:
@@ -196,43 +225,87 @@ def _collect_completed(futures: dict, completed, points, collect: _Collector) ->
         collect.done(i, result)
 
 
-def _run_futures(pool: cf.Executor, func, todo, points, collect: _Collector, *, own: bool) -> None:
+def _run_futures(pool: cf.Executor, func, todo, points, collect: _Collector) -> None:
+    """Evaluate the points on an executor the caller owns (not shut down here)."""
     futures = {pool.submit(_call, func, points[i]): i for i in todo}
     try:
         _collect_completed(futures, cf.as_completed, points, collect)
     except KeyboardInterrupt:
         _harvest(futures, collect)
-        if own and isinstance(pool, cf.ProcessPoolExecutor):
-            # Terminating the workers makes the pool fail its pending futures itself.
-            # Cancelling them first races with that: Python 3.11's executor thread then
-            # calls set_exception on a cancelled future and prints an InvalidStateError.
-            _stop_workers(pool)
-        else:
-            for future in futures:
-                future.cancel()
+        for future in futures:
+            future.cancel()
         raise
     except BaseException:
         for future in futures:
             future.cancel()
-        if own:  # let running points finish so that they are cached too
-            pool.shutdown(wait=True, cancel_futures=True)
-        else:
-            cf.wait(futures)
+        cf.wait(futures)  # a failed point: the running ones finish and are cached too
         _harvest(futures, collect)
         raise
 
 
 def _run_process(func, todo, points, collect: _Collector, workers) -> None:
-    pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint)
-    interrupted = False
+    """Evaluate the points in a process pool of ``workers`` processes, started and stopped here.
+
+    The pool starts (its workers are forked in ``submit``) and shuts down with SIGINT and
+    SIGTERM held back (:func:`_signals_held`); on Ctrl-C or SIGTERM the finished points are
+    kept and the workers terminated at once (running points are not waited for); when a point
+    fails, the points still running finish and are cached before its exception is raised.
+    """
+    pool, futures, interrupted = None, {}, False
     try:
-        _run_futures(pool, func, todo, points, collect, own=True)
+        with _signals_held():
+            pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_worker_signals)
+            futures = {pool.submit(_call, func, points[i]): i for i in todo}
+        try:
+            _collect_completed(futures, cf.as_completed, points, collect)
+        except KeyboardInterrupt:
+            raise
+        except BaseException:
+            for future in futures:
+                future.cancel()
+            pool.shutdown(wait=True, cancel_futures=True)  # let running points finish: cached too
+            _harvest(futures, collect)
+            raise
     except KeyboardInterrupt:
         interrupted = True
         raise
     finally:
-        # after an interrupt the workers are gone and the pool fails what is left (see above)
-        pool.shutdown(wait=False, cancel_futures=not interrupted)
+        if pool is not None:
+            with _signals_held():
+                if interrupted:
+                    _harvest(futures, collect)
+                    # Terminating the workers makes the pool fail its pending futures itself.
+                    # Cancelling them first races with that: Python 3.11's executor thread then
+                    # calls set_exception on a cancelled future and prints an InvalidStateError.
+                    _stop_workers(pool)
+                pool.shutdown(wait=True, cancel_futures=not interrupted)
+
+
+@contextlib.contextmanager
+def process_pool(workers: int | None = None):
+    """A process pool for several :func:`run` calls in a row (its workers start once), stopped
+    on leaving the block.
+
+    ``workers``: as for :func:`run` (capped at :data:`~passmd.runtime.config.WORKERS_PER_CORE`
+    per core). The workers are forked at once, with SIGINT and SIGTERM held back (as in
+    :func:`run`'s own pool); on leaving the block on Ctrl-C or SIGTERM they are terminated
+    without waiting for their running points, else shut down when idle.
+    """
+    workers = useful_workers(workers, MAX_WORKERS)
+    with _signals_held():
+        pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_worker_signals)
+        pool.submit(int)  # forks the workers now (the fork start method starts them all at once)
+    interrupted = False
+    try:
+        yield pool
+    except KeyboardInterrupt:
+        interrupted = True
+        raise
+    finally:
+        with _signals_held():
+            if interrupted:
+                _stop_workers(pool)
+            pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> None:
@@ -245,7 +318,7 @@ def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> No
         client = Client(scheduler)
     else:
         cluster = LocalCluster(
-            n_workers=workers or os.cpu_count() or 1,
+            n_workers=workers,
             threads_per_worker=1,
             dashboard_address=None,
             silence_logs=logging.ERROR,
@@ -301,8 +374,11 @@ def run(
         Dask scheduler address, e.g. ``"tcp://10.0.0.5:8786"`` (implies ``"dask"``).
         Default: the configuration's scheduler unless another executor was asked for.
     workers : int, optional
-        Worker processes for ``"process"`` and a local Dask cluster; default the
-        configuration's workers, else all cores.
+        Worker processes for ``"process"`` and a local Dask cluster (1 to
+        :data:`~passmd.runtime.config.MAX_WORKERS`); default the configuration's workers, else
+        one per usable core. At most one per point to compute and
+        :data:`~passmd.runtime.config.WORKERS_PER_CORE` per core run
+        (:func:`~passmd.runtime.config.useful_workers`; a warning says when the cores cap them).
     cache : bool, Cache or path
         ``True`` (default): the cache in the configuration's ``cache_dir``, else in
         the user's cache folder (:func:`passmd.runtime.cache.store.default_cache_dir`); ``False``: no
@@ -378,8 +454,9 @@ def _check_arguments(func, executor, scheduler, workers) -> None:
         check_choice("executor", executor, EXECUTORS)
     if not callable(func):
         raise ValueError(f"func = {func!r} is not callable")
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
-        raise ValueError(f"workers = {workers!r} is out of range: must be an integer >= 1")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                or not 1 <= workers <= MAX_WORKERS):
+        raise ValueError(f"workers = {workers!r} is out of range: must be an integer from 1 to {MAX_WORKERS}")
     if scheduler is not None and executor != "dask":
         raise ValueError(f"scheduler = {scheduler!r} needs executor='dask', not {executor!r}")
 
@@ -419,13 +496,14 @@ def _cached(store: Cache | None, func, keys) -> dict[int, dict]:
 
 def _execute(executor, func, todo, points, collect: _Collector, workers, scheduler) -> None:
     if isinstance(executor, cf.Executor):
-        _run_futures(executor, func, todo, points, collect, own=False)
+        _run_futures(executor, func, todo, points, collect)
     elif executor == "serial" or (len(todo) == 1 and scheduler is None and executor == "process"):
         _run_serial(func, todo, points, collect)
     elif executor == "process":
-        _run_process(func, todo, points, collect, workers)
+        _run_process(func, todo, points, collect, useful_workers(workers, len(todo)))
     else:
-        _run_dask(func, todo, points, collect, workers, scheduler)
+        local = None if scheduler else useful_workers(workers, len(todo))
+        _run_dask(func, todo, points, collect, local, scheduler)
 
 
 def _execution(executor, scheduler, workers, config: RunConfig):

@@ -151,8 +151,8 @@ def _write(target: Path, result, record: dict, text: str) -> None:
 
 
 def run_fit(args, out) -> int:
+    from passmd.cli.configuration import execution_config
     from passmd.protocols import fit as fitting
-    from passmd.runtime.config import RunConfig
 
     names = _free(args)
     bounds = _bounds(args, names)
@@ -168,8 +168,7 @@ def run_fit(args, out) -> int:
         raise UsageError(str(exc)) from None
     except IsADirectoryError:
         raise UsageError(f"DATA.csv = {args.data!r} is a directory") from None
-    config = RunConfig.from_environment(executor=args.executor, scheduler=args.scheduler,
-                                        workers=args.workers, cache_dir=args.cache_dir)
+    config = execution_config(args)
     library = {FREE_NAMES[n][0]: n for n in names}
     try:
         result = fitting.fit(drive, data, list(library), bounds=bounds, reading=args.reading, loss=args.loss,

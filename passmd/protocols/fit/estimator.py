@@ -12,6 +12,7 @@ gives its 95 % interval; a profile that meets a lower cost restarts the search
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -170,18 +171,13 @@ def fit(
     x_start = np.clip(np.log([max(FREE_PARAMETERS[k].get(drive), 1e-300) for k in names]), lo, hi)
     sigma = _weights(data)
     config = RunConfig() if config is None else config
-    pool = None
     chosen = executor if executor is not None else config.executor or "process"
-    if chosen == "process":
-        pool = cf.ProcessPoolExecutor(max_workers=config.workers, initializer=sweep._ignore_sigint)
-        chosen = pool
-    model = _Model(drive, data, names, reading, executor=chosen, cache=cache, config=config)
-    try:
+    with contextlib.ExitStack() as stack:
+        if chosen == "process":  # one pool for the whole fit (sweep.process_pool: signals, worker cap)
+            chosen = stack.enter_context(sweep.process_pool(config.workers))
+        model = _Model(drive, data, names, reading, executor=chosen, cache=cache, config=config)
         problem = _Problem(model, data, sigma, lo, hi, loss)
         return _fit(problem, drive, names, box, x_start, reading, starts, seed, say, t0)
-    finally:
-        if pool is not None:
-            pool.shutdown(wait=True, cancel_futures=True)
 
 
 class _Problem:
