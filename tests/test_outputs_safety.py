@@ -15,8 +15,9 @@ Contract (README, "Reliability"):
   temporary file left, a sweep's worker processes stopped.
 
 Command lines run in real subprocesses (``python -m passmd``). The signal tests wait for a
-marker (a progress line on stderr, files the sweep's workers create) before signalling, with
-generous time limits that only detect a hang.
+marker (a progress line on stderr, files the sweep's workers create, a gate of
+``tests/gates.py`` the command waits at) before signalling, with generous time limits that
+only detect a hang.
 """
 
 from __future__ import annotations
@@ -328,7 +329,11 @@ def _read_until(proc, marker: bytes, timeout: float) -> bytes:
     return seen
 
 
-def _default_sigterm():  # runs in the child before exec: whatever the test runner inherited
+def _default_signals():
+    """Runs in the child before exec: SIGINT and SIGTERM at their default action, whatever the test
+    runner inherited (a background job of a non-interactive shell starts with SIGINT ignored,
+    and an ignored signal stays ignored across exec)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
@@ -337,7 +342,7 @@ def _started(argv, tmp_path, env=None):
     """``python argv`` running in ``tmp_path`` (binary pipes) in a process group of its own, which
     is killed at the end: worker processes a failed check left behind would hold the pipes open."""
     proc = subprocess.Popen([sys.executable, *argv], cwd=tmp_path, env=env or _env(tmp_path),
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=_default_sigterm,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=_default_signals,
                             start_new_session=True)
     try:
         yield proc
@@ -617,3 +622,87 @@ def test_critical_amplitude_search_shows_progress_off_a_terminal(monkeypatch, ca
     lines = captured.err.splitlines()
     assert lines and all(line.startswith("critical amplitude: ") for line in lines), lines
     assert f"({found['runs']}/" in captured.err and "\r" not in captured.err and captured.out == ""
+
+
+# --------------------------------------------------------------------------------------
+# A signal at any moment of a process pool's life: starting, running, shutting down
+# --------------------------------------------------------------------------------------
+
+GATES_PY = Path(__file__).with_name("gates.py")
+#: A cheap map in a pool of two workers (one rigid contact: a point takes a fraction of a second).
+POOL_SWEEP = ["sweep", "velocity", "--vary", "frequency=100Hz..400Hz:4", "--contacts", "1", "--actuator", "rigid",
+              "--workers", "2"]
+#: A fit of one parameter to three steps, on the same drive, in a pool of two workers.
+POOL_FIT = ["fit", "data.csv", "--free", "mu", "--contacts", "1", "--actuator", "rigid", "--starts", "0",
+            "--executor", "process", "--workers", "2"]
+FIT_DATA = "amplitude_nm,frequency_Hz,step_nm\n100,1000,64.25\n150,1000,116.9\n200,1000,169.6\n"
+#: moment: (the gates the command stops at, the markers to see before the signal: tests/gates.py)
+MOMENTS = {
+    "pool starting": ("spawn,worker", ("spawn", "worker")),  # one worker forked, not yet initialized
+    "points running": ("point", ("point", "point")),  # both workers inside a point
+    "pool shutting down": ("shutdown", ("shutdown",)),  # every point done, the pool stopping
+}
+FIT_MOMENTS = {**MOMENTS, "between two sweeps": ("evaluate", ("evaluate",))}  # the pool idle
+
+
+def _descendants(pid: int) -> set[int]:
+    """The processes ``pid`` started, and theirs (from /proc)."""
+    parents = {}
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            with contextlib.suppress(OSError, IndexError, ValueError):
+                parents[int(entry.name)] = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
+    found, todo = set(), [pid]
+    while todo:
+        pid = todo.pop()
+        children = {child for child, parent in parents.items() if parent == pid}
+        todo += list(children - found)
+        found |= children
+    return found
+
+
+def _signal_at(tmp_path, argv, prog, moment, sig, moments=MOMENTS):
+    """Run ``argv`` stopped at ``moment``, send ``sig`` to its process group (as a terminal's Ctrl-C or
+    a service manager does), open the gates; (status, stdout, stderr), every process of it gone."""
+    gates, wanted = moments[moment]
+    directory = tmp_path / "gates"
+    directory.mkdir()
+    env = _env(tmp_path, CI="true")  # (no progress lines)
+    with _started([str(GATES_PY), str(directory), gates, *argv], tmp_path, env=env) as proc:
+        deadline = time.monotonic() + HANG_S
+        while sorted(p.name.rsplit("-", 1)[0] for p in directory.iterdir()) != sorted(wanted):
+            assert time.monotonic() < deadline and proc.poll() is None, \
+                f"{moment}: markers {sorted(p.name for p in directory.iterdir())}, not {wanted}"
+            time.sleep(0.05)
+        started = _descendants(proc.pid)
+        os.killpg(proc.pid, sig)
+        (directory / "open").write_text("")
+        out, err = proc.communicate(timeout=HANG_S)
+        deadline = time.monotonic() + HANG_S
+        while any(_alive(pid) for pid in started):
+            assert time.monotonic() < deadline, f"processes {started} of the command still run"
+            time.sleep(0.1)
+    return proc.returncode, out.decode(), err.decode()
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("moment", list(MOMENTS))
+def test_a_signal_at_any_moment_of_a_pool_sweep_is_one_line(tmp_path, moment, sig):
+    """Ctrl-C or SIGTERM to the command and its workers while the pool starts (a worker forked,
+    its handlers not yet set: it inherited the command's), runs or shuts down: exit 130 or 143,
+    the one line "interrupted", no traceback from a worker, no process left, no temporary file."""
+    status, out, err = _signal_at(tmp_path, [*POOL_SWEEP, "--out", "map"], "passmd sweep", moment, sig)
+    assert (status, out, err) == (128 + sig, "", "passmd sweep: interrupted\n")
+    assert {p.name for p in tmp_path.iterdir()} <= {"cache", "gates"}  # no map written
+    assert [p for p in tmp_path.rglob("*.tmp")] == []
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("moment", list(FIT_MOMENTS))
+def test_a_signal_at_any_moment_of_a_fit_is_one_line(tmp_path, moment, sig):
+    """The same for ``passmd fit``, whose one pool serves all its sweeps, and between two sweeps."""
+    (tmp_path / "data.csv").write_text(FIT_DATA)
+    status, out, err = _signal_at(tmp_path, [*POOL_FIT, "--out", "fit"], "passmd fit", moment, sig,
+                                  moments=FIT_MOMENTS)
+    assert (status, out, err) == (128 + sig, "", "passmd fit: interrupted\n")
+    assert {p.name for p in tmp_path.iterdir()} <= {"cache", "data.csv", "gates"}  # no fit written
