@@ -201,25 +201,42 @@ def test_a_drive_axis_rederives_the_actuator_as_the_options_do(tmp_path):
     assert amplitudes[0] != amplitudes[1]
 
 
+def _default_signals():  # in the child before exec: an inherited SIG_IGN would survive exec
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
 def test_ctrl_c_keeps_finished_points_and_the_rerun_computes_only_the_rest(tmp_path):
-    """A map interrupted by Ctrl-C (exit 130) resumes from the cache: nothing finished is recomputed."""
-    cache = tmp_path / "c"
-    argv = [sys.executable, "-m", "passmd", "sweep", "velocity", "--vary", "frequency=100Hz..400Hz:16",
-            "--contacts", "6", "--actuator", "flexible", "--workers", "2", "--cache-dir", str(cache)]
-    env = {**os.environ, "MPLBACKEND": "Agg"}
-    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
-    deadline = time.monotonic() + 240
-    while time.monotonic() < deadline and proc.poll() is None and len(list(cache.rglob("*.pmc"))) < 2:
-        time.sleep(0.05)
-    if proc.poll() is not None:
-        pytest.fail(f"the map ended before it could be interrupted: {proc.communicate()}")
-    proc.send_signal(signal.SIGINT)
-    _, err = proc.communicate(timeout=120)
-    assert proc.returncode == 130, err
-    kept = len(list(cache.rglob("*.pmc")))
-    assert 2 <= kept < 16
-    done = subprocess.run([*argv, "--json"], capture_output=True, text=True, env=env, timeout=600)
+    """A map interrupted by Ctrl-C (exit 130) resumes from the cache: nothing finished is recomputed.
+
+    The two lowest frequencies are computed; every other point waits at a gate
+    (``tests/gates.py``) until the test has seen both of them cached and both workers at the
+    gate, and Ctrl-C goes to the process group (as a terminal sends it) at that state.
+    """
+    cache, gates = tmp_path / "c", tmp_path / "gates"
+    gates.mkdir()
+    argv = ["sweep", "velocity", "--vary", "frequency=100Hz..400Hz:8", *CHEAP, "--workers", "2",
+            "--cache-dir", str(cache)]
+    env = {**os.environ, "MPLBACKEND": "Agg", "CI": "true", "GATE_ABOVE_HZ": "150"}  # 100 and 142.9 Hz pass
+    gated = [sys.executable, str(Path(__file__).with_name("gates.py")), str(gates), "point", *argv]
+    proc = subprocess.Popen(gated, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+                            preexec_fn=_default_signals, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 240  # (only detects a hang)
+        while len(list(gates.glob("point-*"))) < 2 or len(list(cache.rglob("*.pmc"))) < 2:
+            assert time.monotonic() < deadline and proc.poll() is None, proc.communicate()
+            time.sleep(0.05)
+        os.killpg(proc.pid, signal.SIGINT)
+        out, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.communicate()
+    assert (proc.returncode, out, err) == (130, "", "passmd sweep: interrupted\n")
+    assert len(list(cache.rglob("*.pmc"))) == 2
+    done = subprocess.run([sys.executable, "-m", "passmd", *argv, "--json"], capture_output=True, text=True,
+                          env=env, timeout=600)
     assert done.returncode == 0, done.stderr
     counts = json.loads(done.stdout)["sweep"]
-    assert counts == {"points": 16, "cached": kept, "computed": 16 - kept}
+    assert counts == {"points": 8, "cached": 2, "computed": 6}
     assert all(math.isfinite(row["velocity_m_per_s"]) for row in json.loads(done.stdout)["rows"])
