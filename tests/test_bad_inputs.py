@@ -134,6 +134,20 @@ NAMED_CASES = {
     "runner mass 1e-30": (["run", "--runner-mass", "1e-30g"], 2, "--runner-mass"),
     "tiny tolerance, analytic only": (["critical-amplitude", "--analytic-only", "--tolerance", "1e-30nm"], 0,
                                       ""),
+    # unbounded inputs: a device is never read (it would be read until killed)
+    "drive file /dev/zero": (["drive", "show", "--drive", "/dev/zero"], 2,
+                             "/dev/zero: a character device, not a regular file: a drive file is read from a "
+                             "regular file of at most 1 MiB"),
+    "measurements /dev/zero": (["fit", "/dev/zero", "--free", "mu"], 2,
+                               "/dev/zero: a character device, not a regular file: a measurement file is read "
+                               "from a regular file of at most 100 MiB"),
+    "drive file is a directory": (["theory", "--drive", "/"], 2, "cannot read the drive file /: Is a directory"),
+    # runaway worker counts: refused above the hard bound, before anything starts
+    "a hundred thousand workers": (["sweep", "velocity", "--vary", "frequency=100Hz..5kHz:log:3", "--workers",
+                                    "100000"], 2, "--workers = 100000 is out of range: must be an integer from "
+                                                  "1 to 1024"),
+    "a hundred thousand workers, figure": (["figure", "fig5a", "--workers", "100000"], 2,
+                                           "--workers = 100000 is out of range"),
 }
 
 
@@ -227,6 +241,147 @@ def test_validation_messages_read_well():
     with pytest.raises(ValueError) as info:
         check_range("x", float("nan"))
     assert str(info.value) == "x = nan is out of range: must be a finite number"
+
+
+# --------------------------------------------------------------------------------------
+# Input files as people (and accidents) make them: named cases that need a file
+# --------------------------------------------------------------------------------------
+
+
+def _refused(argv, *fragments, env=None):
+    status, out, err, caught = run_main(argv, env=env)
+    assert status == 2 and out == "", (argv, err)
+    assert_one_line(err)
+    for fragment in fragments:
+        assert fragment in err, (fragment, err)
+    return err
+
+
+@pytest.mark.parametrize("command", [["drive", "show", "--drive", "{}"], ["fit", "{}", "--free", "mu"]],
+                         ids=["drive file", "measurements"])
+def test_a_named_pipe_without_a_writer_is_refused_at_once(tmp_path, command):
+    """``mkfifo x; passmd fit x``: one line (it waited forever for a writer)."""
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    _refused([arg.format(fifo) for arg in command], f"{fifo}: a named pipe, not a regular file")
+
+
+def test_oversized_inputs_are_refused_by_their_size(tmp_path):
+    """A 2 MiB drive file and a 101 MiB measurement file (sparse: nothing is written or read)."""
+    drive, data = tmp_path / "big.toml", tmp_path / "big.csv"
+    with open(drive, "wb") as fh:
+        fh.truncate(2 * 2**20)
+    with open(data, "wb") as fh:
+        fh.truncate(101 * 2**20)
+    _refused(["theory", "--drive", str(drive)], f"{drive}: 2 MiB, above the 1 MiB limit of a drive file")
+    _refused(["fit", str(data), "--free", "mu"], f"{data}: 101 MiB, above the 100 MiB limit of a measurement file")
+
+
+def test_a_drive_file_with_a_byte_order_mark_reads_as_without(tmp_path):
+    """Windows editors save UTF-8 with a byte-order mark: read as UTF-8; UTF-16 is named."""
+    plain, marked, utf16 = (tmp_path / name for name in ("plain.toml", "bom.toml", "utf16.toml"))
+    text = 'preload = "0.5 N"\n[actuator]\ndamping_ratio = 0.1\n'
+    plain.write_bytes(text.encode())
+    marked.write_bytes(b"\xef\xbb\xbf" + text.replace("\n", "\r\n").encode())
+    utf16.write_bytes(text.encode("utf-16"))
+    shown = [run_main(["drive", "show", "--drive", str(p), "--json"]) for p in (plain, marked)]
+    assert [s[0] for s in shown] == [0, 0], shown
+    assert json.loads(shown[0][1])["drive"] == json.loads(shown[1][1])["drive"]
+    _refused(["drive", "show", "--drive", str(utf16)], f"{utf16}: saved as UTF-16", "must be UTF-8")
+
+
+MEASURED = "amplitude_nm{d}frequency_Hz{d}step_nm\n100{d}1000{d}64.25\n150{d}1000{d}116.9\n200{d}1000{d}169.6\n"
+
+
+@pytest.mark.parametrize("delimiter", [",", ";", "\t"], ids=["comma", "semicolon", "tab"])
+def test_measurements_separated_by_semicolons_or_tabs_read_as_with_commas(tmp_path, delimiter):
+    """Spreadsheets write semicolons (where the comma is the decimal separator) or tabs; the
+    separator is recognised from the header, and the file reads to the same measurements; a byte-
+    order mark (Excel's "CSV UTF-8") is dropped."""
+    from passmd.protocols.fit import read_measurements
+
+    path = tmp_path / "data.csv"
+    path.write_bytes(b"\xef\xbb\xbf" + MEASURED.format(d=delimiter).encode())
+    comma = tmp_path / "comma.csv"
+    comma.write_text(MEASURED.format(d=","))
+    got, expected = read_measurements(path), read_measurements(comma)
+    assert got.kind == expected.kind and np.array_equal(got.value, expected.value)
+    assert np.array_equal(got.amplitude, expected.amplitude)
+
+
+def test_a_decimal_comma_is_refused_not_misread(tmp_path):
+    path = tmp_path / "data.csv"
+    path.write_text(MEASURED.format(d=";").replace("64.25", "64,25"))
+    _refused(["fit", str(path), "--free", "mu"], f"{path} row 1 (line 2), column step_nm: '64,25' has a decimal "
+                                                 "comma: write 64.25", "separated by semicolons")
+
+
+@pytest.mark.parametrize(("column", "known"), [
+    ("amplitude_m", "amplitude_nm, in nm"), ("velocity_m_per_s", "velocity_mm_per_s, in mm/s"),
+    ("critical_amplitude_um", "critical_amplitude_nm, in nm"), ("step_um_sd", "step_nm_sd, in nm"),
+    ("frequency_kHz", "frequency_Hz, in Hz"), ("preload", "preload_N, in N"),
+])
+def test_an_unknown_column_in_another_unit_names_the_known_one(tmp_path, column, known):
+    path = tmp_path / "data.csv"
+    header = "amplitude_nm,frequency_Hz,step_nm,step_nm_sd".split(",")
+    header[{"amplitude": 0, "velocity": 2, "critical": 2, "step": 3, "frequency": 1, "preload": 0}[
+        column.split("_")[0]]] = column
+    path.write_text(",".join(header) + "\n100,1000,64,1\n")
+    err = _refused(["fit", str(path), "--free", "mu"], f"'{column}': not a known column; the column of this "
+                                                       f"quantity is {known}")
+    assert "allowed:" not in err
+
+
+def test_too_many_workers_are_capped_with_one_line(monkeypatch):
+    """Above two per usable core, one line names the option or the variable as typed and the count
+    run; the command then goes on (here: up to its computation, which gets the capped count)."""
+    from passmd.experiments.design import maps as design_maps
+
+    monkeypatch.setattr("passmd.cli.configuration.usable_cores", lambda: 2)
+    seen = []
+
+    def compute_map(*args, config, **kwargs):
+        seen.append(config.workers)
+        raise _Reached
+
+    monkeypatch.setattr(design_maps, "compute_map", compute_map)
+    argv = ["sweep", "velocity", "--vary", "frequency=100Hz..5kHz:log:3"]
+    for extra, env, typed in ((["--workers", "64"], {}, "--workers 64"),
+                              ([], {"PASSMD_WORKERS": "9"}, "PASSMD_WORKERS = 9")):
+        err = io.StringIO()
+        with mock.patch.dict(os.environ, env), contextlib.redirect_stderr(err), pytest.raises(_Reached):
+            cli.main([*argv, *extra])
+        assert err.getvalue() == (f"passmd sweep: warning: {typed} is more than the 2 usable cores can run: "
+                                  "4 worker processes run (2 per core)\n")
+    assert seen == [4, 4]
+
+
+def test_a_pool_never_starts_more_workers_than_points(monkeypatch):
+    """``sweep.run(workers=1000)`` over three points forks three processes (two per core at most)."""
+    import concurrent.futures as cf
+
+    from passmd.runtime import config, sweep
+
+    monkeypatch.setattr(config, "usable_cores", lambda: 2)
+    sizes = []
+
+    class Pool(cf.ThreadPoolExecutor):
+        def __init__(self, max_workers, initializer=None):
+            sizes.append(max_workers)
+            super().__init__(max_workers)
+
+    monkeypatch.setattr(cf, "ProcessPoolExecutor", Pool)
+    monkeypatch.setattr(sweep, "_worker_signals", lambda: None)
+    with pytest.warns(config.WorkersCapped, match="workers = 1000 is more than the 2 usable cores"):
+        sweep.run(_double, sweep.grid(x=[1, 2, 3]), executor="process", workers=1000, cache=False)
+    sweep.run(_double, sweep.grid(x=[1, 2, 3]), executor="process", workers=4, cache=False)
+    assert sizes == [3, 3]
+    with pytest.raises(ValueError, match="workers = 1025 is out of range: must be an integer from 1 to 1024"):
+        sweep.run(_double, sweep.grid(x=[1, 2]), workers=1025, cache=False)
+
+
+def _double(x):
+    return {"y": 2 * x}
 
 
 # --------------------------------------------------------------------------------------
@@ -440,7 +595,8 @@ def test_generated_records_are_valid_or_a_value_error(record, args):
 
 
 def test_named_cases_cover_every_command():
-    """The named command lines reach at least five commands, and the generated ones all six."""
+    """The named command lines reach at least five commands, and the generated ones all six (the
+    generated drive files, measurement files and --vary specifications: test_generated_inputs.py)."""
     assert len({argv[0] for argv, _, _ in NAMED_CASES.values()}) >= 5
     assert len(COMMANDS) == 6
 
