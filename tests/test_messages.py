@@ -97,7 +97,21 @@ REPROS = {
          "raise --amplitude above")),
     "PASSMD_WORKERS superscript two": (
         FIGURE, {"PASSMD_WORKERS": "²"},
-        ("PASSMD_WORKERS = '²' is not allowed", "must be an integer >= 1")),
+        ("PASSMD_WORKERS = '²' is not allowed", "must be an integer from 1 to 1024")),
+    "PASSMD_WORKERS a hundred thousand": (
+        FIGURE, {"PASSMD_WORKERS": "100000"},
+        ("PASSMD_WORKERS = '100000' is not allowed", "must be an integer from 1 to 1024")),
+    "fit with a hundred thousand workers": (
+        ["fit", "data.csv", "--free", "mu", "--workers", "100000"], {},
+        ("--workers = 100000 is out of range: must be an integer from 1 to 1024",)),
+    "drive file /dev/zero": (
+        ["theory", "--drive", "/dev/zero"], {},
+        ("/dev/zero: a character device, not a regular file: a drive file is read from a regular file of "
+         "at most 1 MiB",)),
+    "measurement file /dev/zero": (
+        ["fit", "/dev/zero", "--free", "mu"], {},
+        ("/dev/zero: a character device, not a regular file: a measurement file is read from a regular "
+         "file of at most 100 MiB",)),
     "PASSMD_EXECUTOR threads": (
         FIGURE, {"PASSMD_EXECUTOR": "threads"},
         ("PASSMD_EXECUTOR = 'threads' is not allowed", "must be one of process, serial, dask")),
@@ -113,6 +127,7 @@ def test_repro_names_what_was_typed(name, json_flag, tmp_path):
     argv, env, fragments = REPROS[name]
     if env.get("PASSMD_SWEEP_LOG") == "/dev/full" and not os.path.exists("/dev/full"):
         pytest.skip("needs /dev/full")
+    (tmp_path / "data.csv").write_text("amplitude_nm,frequency_Hz,step_nm\n100,1000,64\n150,1000,117\n")
     status, out, err = run_process([*argv, *json_flag], env, tmp_path)
     assert status == 2, err
     assert out == ""
@@ -206,16 +221,19 @@ def test_every_numeric_run_option_is_named_when_refused(flag, value, json_flag):
 
 
 @pytest.mark.parametrize(("variable", "value", "allowed"), [
-    ("PASSMD_WORKERS", "²", "an integer >= 1"),
-    ("PASSMD_WORKERS", "0", "an integer >= 1"),
-    ("PASSMD_WORKERS", "٣", "an integer >= 1"),
+    ("PASSMD_WORKERS", "²", "an integer from 1 to 1024"),
+    ("PASSMD_WORKERS", "0", "an integer from 1 to 1024"),
+    ("PASSMD_WORKERS", "٣", "an integer from 1 to 1024"),
+    ("PASSMD_WORKERS", "100000", "an integer from 1 to 1024"),
+    ("PASSMD_WORKERS", "9" * 5000, "an integer from 1 to 1024"),  # (beyond int()'s digit limit)
     ("PASSMD_EXECUTOR", "threads", "one of process, serial, dask"),
     ("PASSMD_PROFILE", "fast", "one of quick, paper"),
 ])
 def test_environment_errors_name_the_variable(variable, value, allowed):
     with pytest.raises(ValueError) as info:
         RunConfig.from_environment({variable: value})
-    assert str(info.value).startswith(f"{variable} = {value!r} is not allowed: must be {allowed}"), info.value
+    assert str(info.value).startswith(f"{variable} = {value!r} is not allowed: must be {allowed}"), \
+        str(info.value)[:200]
 
 
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
@@ -314,3 +332,66 @@ def test_input_error_survives_a_process_pool():
     again = pickle.loads(pickle.dumps(info.value))
     assert type(again) is InputError and str(again) == str(info.value)
     assert (again.name, again.limits, again.soft) == (info.value.name, info.value.limits, info.value.soft)
+
+
+# --------------------------------------------------------------------------------------
+# Input files: the file, what it is, the limit; the column the user meant
+# --------------------------------------------------------------------------------------
+
+
+def _files(tmp_path) -> dict:
+    """Inputs that are not what a reader reads, by what they are."""
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    big = tmp_path / "big"
+    with open(big, "wb") as fh:
+        fh.truncate(200 * 2**20)
+    utf16, latin1 = tmp_path / "utf16", tmp_path / "latin1"
+    utf16.write_bytes("preload = 0.4\n".encode("utf-16"))
+    latin1.write_bytes("preload = 0.4 # réglé\n".encode("latin-1"))
+    return {"a device": ("/dev/zero", "a character device, not a regular file: a {kind} is read from a regular "
+                                      "file of at most {limit}"),
+            "a named pipe": (str(fifo), "a named pipe, not a regular file: a {kind} is read from a regular file "
+                                        "of at most {limit}"),
+            "too large": (str(big), "200 MiB, above the {limit} limit of a {kind}"),
+            "UTF-16": (str(utf16), "saved as UTF-16: a {kind} must be UTF-8 text (save it as UTF-8)"),
+            "Latin-1": (str(latin1), "not UTF-8 text: byte 0xe9 on line 1 (a {kind} must be UTF-8 text)")}
+
+
+@pytest.mark.parametrize("what", ["a device", "a named pipe", "too large", "UTF-16", "Latin-1"])
+@pytest.mark.parametrize(("kind", "limit"), [("drive file", "1 MiB"), ("measurement file", "100 MiB")])
+def test_an_unread_input_file_is_named_with_what_it_is_and_the_limit(tmp_path, what, kind, limit):
+    """``file: what it is, the limit`` — from the library (a ValueError) and the command line alike."""
+    from passmd.model.drive_file import read_drive_file
+    from passmd.protocols.fit import read_measurements
+
+    path, text = _files(tmp_path)[what]
+    expected = f"{path}: " + text.format(kind=kind, limit=limit)
+    if what == "too large" and kind == "drive file":
+        expected = f"{path}: 200 MiB, above the 1 MiB limit of a drive file"
+    reader = read_drive_file if kind == "drive file" else read_measurements
+    with pytest.raises(ValueError) as info:
+        reader(path)
+    assert str(info.value) == expected
+    argv = ["theory", "--drive", path] if kind == "drive file" else ["fit", path, "--free", "mu"]
+    status, out, err = run_main(argv)
+    assert (status, out) == (2, "") and err == f"passmd {argv[0]}: error: {expected}\n"
+
+
+@pytest.mark.parametrize(("column", "message"), [
+    ("amplitude_m", "'amplitude_m': not a known column; the column of this quantity is amplitude_nm, in nm "
+                    "(a column name carries its unit: convert the values)"),
+    ("Amplitude (nm)", "'Amplitude (nm)': not a known column; did you mean amplitude_nm? (column names are "
+                       "written exactly so)"),
+    ("FORCE_N", "'FORCE_N': not a known column; did you mean force_N?"),
+    ("force_mN_sd", "'force_mN_sd': not a known column; the column of this quantity is force_N_sd, in N"),
+    ("temperature_K", "'temperature_K': not a known column; allowed: amplitude_nm, preload_N, frequency_Hz"),
+])
+def test_an_unknown_column_names_the_column_meant(tmp_path, column, message):
+    from passmd.protocols.fit import MeasurementError, read_measurements
+
+    path = tmp_path / "data.csv"
+    path.write_text(f"frequency_Hz,step_nm,{column}\n100,1,1\n")
+    with pytest.raises(MeasurementError) as info:
+        read_measurements(path)
+    assert str(info.value).startswith(f"{path} header, column 3 {message}"), str(info.value)
