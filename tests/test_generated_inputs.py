@@ -206,7 +206,7 @@ NAMES = st.sampled_from([*AXES, "foo", "", "Frequency", "mu ", "amplitude "])
 #: Specifications a user writes on purpose (so that many generated ones pass every check).
 PLAUSIBLE_SPECS = ["frequency=100Hz..1kHz:log:3", "amplitude=60nm..180nm:4", "preload=0.1N,0.4N,1N",
                    "mu=0.1..0.3:5", "radius=0.25mm,1mm", "frequency=2kHz", "amplitude=1e-7,2e-7",
-                   "actuator-mass=15mg..30mg:2", "preload=0.2..0.6:log:3"]
+                   "actuator-mass=1e-8..4e-8:2", "preload=0.2..0.6:log:3"]
 
 
 @st.composite
