@@ -53,3 +53,32 @@ def test_readme_python_quickstart_runs(tmp_path):
     assert done.returncode == 0, done.stderr
     printed = done.stdout.split("\n")
     assert len([line for line in printed if line.strip()]) == 2, done.stdout
+
+
+def test_reliability_counts_are_the_suites_own():
+    """The Reliability section's counts are those of the suites it lists: "`tests/X.py` (N named
+    tests)" their module-level test functions, the named command lines of the bad-input suite and
+    the generated examples per run; and the input-file limits it states are the readers' own."""
+    import ast
+
+    from passmd.runtime.inputs import LIMITS, format_size
+
+    text = README.read_text(encoding="utf-8")
+    start = text.index("## Reliability")
+    section = text[start:text.index("\n## ", start + 3)]
+    stated = re.findall(r"`(tests/test_\w+\.py)` \((\d+) named tests\)", section)
+    assert len(stated) >= 7, section
+    for path, count in stated:
+        tree = ast.parse((README.parent / path).read_text(encoding="utf-8"))
+        tests = [node for node in tree.body if isinstance(node, ast.FunctionDef) and node.name.startswith("test_")]
+        assert len(tests) == int(count), f"{path}: the README says {count}, the file has {len(tests)}"
+    sys.path.insert(0, str(README.parent / "tests"))
+    import test_bad_inputs
+
+    assert f"{len(test_bad_inputs.NAMED_CASES)} named command lines" in section
+    examples = os.environ.get("PASSMD_FUZZ_EXAMPLES", "250")
+    assert f"hypothesis suites: {examples} command lines per run" in section
+    assert f"hypothesis suites of {examples} generated drive" in section
+    flat = " ".join(section.split())
+    for kind in ("drive file", "measurement file", "reference table", "cache entry"):
+        assert f"a {kind} up to {format_size(LIMITS[kind])}" in flat, kind
