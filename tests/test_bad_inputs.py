@@ -139,13 +139,14 @@ NAMED_CASES = {
                              "/dev/zero: a character device, not a regular file: a drive file is read from a "
                              "regular file of at most 1 MiB"),
     "measurements /dev/zero": (["fit", "/dev/zero", "--free", "mu"], 2,
-                               "/dev/zero: a character device, not a regular file: a measurement file is read "
-                               "from a regular file of at most 100 MiB"),
-    "drive file is a directory": (["theory", "--drive", "/"], 2, "cannot read the drive file /: Is a directory"),
+                               "/dev/zero: a character device, not a regular file: a measurement file is "
+                               "read from a regular file of at most 100 MiB"),
+    "drive file is a directory": (["theory", "--drive", "/"], 2,
+                                  "cannot read the drive file /: Is a directory"),
     # runaway worker counts: refused above the hard bound, before anything starts
-    "a hundred thousand workers": (["sweep", "velocity", "--vary", "frequency=100Hz..5kHz:log:3", "--workers",
-                                    "100000"], 2, "--workers = 100000 is out of range: must be an integer from "
-                                                  "1 to 1024"),
+    "a hundred thousand workers": (["sweep", "velocity", "--vary", "frequency=100Hz..5kHz:log:3",
+                                    "--workers", "100000"], 2,
+                                   "--workers = 100000 is out of range: must be an integer from 1 to 1024"),
     "a hundred thousand workers, figure": (["figure", "fig5a", "--workers", "100000"], 2,
                                            "--workers = 100000 is out of range"),
 }
@@ -274,7 +275,8 @@ def test_oversized_inputs_are_refused_by_their_size(tmp_path):
     with open(data, "wb") as fh:
         fh.truncate(101 * 2**20)
     _refused(["theory", "--drive", str(drive)], f"{drive}: 2 MiB, above the 1 MiB limit of a drive file")
-    _refused(["fit", str(data), "--free", "mu"], f"{data}: 101 MiB, above the 100 MiB limit of a measurement file")
+    _refused(["fit", str(data), "--free", "mu"],
+             f"{data}: 101 MiB, above the 100 MiB limit of a measurement file")
 
 
 def test_a_drive_file_with_a_byte_order_mark_reads_as_without(tmp_path):
@@ -290,7 +292,8 @@ def test_a_drive_file_with_a_byte_order_mark_reads_as_without(tmp_path):
     _refused(["drive", "show", "--drive", str(utf16)], f"{utf16}: saved as UTF-16", "must be UTF-8")
 
 
-MEASURED = "amplitude_nm{d}frequency_Hz{d}step_nm\n100{d}1000{d}64.25\n150{d}1000{d}116.9\n200{d}1000{d}169.6\n"
+MEASURED = ("amplitude_nm{d}frequency_Hz{d}step_nm\n"
+            "100{d}1000{d}64.25\n150{d}1000{d}116.9\n200{d}1000{d}169.6\n")
 
 
 @pytest.mark.parametrize("delimiter", [",", ";", "\t"], ids=["comma", "semicolon", "tab"])
@@ -312,8 +315,9 @@ def test_measurements_separated_by_semicolons_or_tabs_read_as_with_commas(tmp_pa
 def test_a_decimal_comma_is_refused_not_misread(tmp_path):
     path = tmp_path / "data.csv"
     path.write_text(MEASURED.format(d=";").replace("64.25", "64,25"))
-    _refused(["fit", str(path), "--free", "mu"], f"{path} row 1 (line 2), column step_nm: '64,25' has a decimal "
-                                                 "comma: write 64.25", "separated by semicolons")
+    _refused(["fit", str(path), "--free", "mu"],
+             f"{path} row 1 (line 2), column step_nm: '64,25' has a decimal comma: write 64.25",
+             "separated by semicolons")
 
 
 @pytest.mark.parametrize(("column", "known"), [

@@ -97,7 +97,9 @@ def _toml_value(value) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, float):
-        return "nan" if math.isnan(value) else ("inf" if value > 0 else "-inf") if math.isinf(value) else repr(value)
+        if math.isnan(value):
+            return "nan"
+        return ("inf" if value > 0 else "-inf") if math.isinf(value) else repr(value)
     if isinstance(value, (int, str)):
         return str(value) if isinstance(value, int) else json.dumps(value)
     if isinstance(value, list):
@@ -198,8 +200,8 @@ def test_generated_measurement_files_end_cleanly(folder, data):
 # --------------------------------------------------------------------------------------
 
 QUANTITY_WITH_UNIT = st.builds(lambda x, u: f"{x!r}{u}", NUMBERS, st.sampled_from(UNITS))
-VALUE_TEXT = st.one_of(QUANTITY_WITH_UNIT, st.sampled_from(["100Hz", "1kHz", "0.4N", "60nm", "0.2", "1mm", "0",
-                                                            "-1", "nan", "", " ", "1e-300", "3e8kHz"]))
+VALUE_TEXT = st.one_of(QUANTITY_WITH_UNIT, st.sampled_from(
+    ["100Hz", "1kHz", "0.4N", "60nm", "0.2", "1mm", "0", "-1", "nan", "", " ", "1e-300", "3e8kHz"]))
 NAMES = st.sampled_from([*AXES, "foo", "", "Frequency", "mu ", "amplitude "])
 
 
@@ -224,17 +226,20 @@ def vary_specs(draw) -> str:
         if draw(st.booleans()):
             spec += ":log"
         if draw(st.booleans()):
-            spec += ":" + draw(st.one_of(st.integers(-2, 60).map(str), st.sampled_from(["1000", "1001", "x", ""])))
+            count = st.one_of(st.integers(-2, 60).map(str), st.sampled_from(["1000", "1001", "x", ""]))
+            spec += ":" + draw(count)
     return f"{name}={spec}" if draw(st.integers(0, 9)) else f"{name}{spec}"
 
 
 @FUZZ
-@given(quantity=st.sampled_from(list(MAP_QUANTITIES)), specs=st.one_of(st.lists(vary_specs(), min_size=1, max_size=1), st.lists(vary_specs(), min_size=2, max_size=2)),
+@given(quantity=st.sampled_from(list(MAP_QUANTITIES)),
+       specs=st.one_of(*(st.lists(vary_specs(), min_size=n, max_size=n) for n in (1, 2))),
        as_json=st.booleans())
 def test_generated_vary_specifications_end_cleanly(quantity, specs, as_json):
     from passmd.experiments.design import maps as design_maps
 
-    argv = ["sweep", quantity, *(a for spec in specs for a in ("--vary", spec)), *(["--json"] if as_json else [])]
+    argv = ["sweep", quantity, *(a for spec in specs for a in ("--vary", spec))]
+    argv += ["--json"] if as_json else []
     with mock.patch.object(design_maps, "compute_map", _reached):  # reaching the map: every check passed
         try:
             status, out, err, caught = run_main(argv)

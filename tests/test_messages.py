@@ -349,10 +349,9 @@ def _files(tmp_path) -> dict:
     utf16, latin1 = tmp_path / "utf16", tmp_path / "latin1"
     utf16.write_bytes("preload = 0.4\n".encode("utf-16"))
     latin1.write_bytes("preload = 0.4 # réglé\n".encode("latin-1"))
-    return {"a device": ("/dev/zero", "a character device, not a regular file: a {kind} is read from a regular "
-                                      "file of at most {limit}"),
-            "a named pipe": (str(fifo), "a named pipe, not a regular file: a {kind} is read from a regular file "
-                                        "of at most {limit}"),
+    kept = "not a regular file: a {kind} is read from a regular file of at most {limit}"
+    return {"a device": ("/dev/zero", "a character device, " + kept),
+            "a named pipe": (str(fifo), "a named pipe, " + kept),
             "too large": (str(big), "200 MiB, above the {limit} limit of a {kind}"),
             "UTF-16": (str(utf16), "saved as UTF-16: a {kind} must be UTF-8 text (save it as UTF-8)"),
             "Latin-1": (str(latin1), "not UTF-8 text: byte 0xe9 on line 1 (a {kind} must be UTF-8 text)")}

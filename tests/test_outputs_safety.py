@@ -630,8 +630,8 @@ def test_critical_amplitude_search_shows_progress_off_a_terminal(monkeypatch, ca
 
 GATES_PY = Path(__file__).with_name("gates.py")
 #: A cheap map in a pool of two workers (one rigid contact: a point takes a fraction of a second).
-POOL_SWEEP = ["sweep", "velocity", "--vary", "frequency=100Hz..400Hz:4", "--contacts", "1", "--actuator", "rigid",
-              "--workers", "2"]
+POOL_SWEEP = ["sweep", "velocity", "--vary", "frequency=100Hz..400Hz:4", "--contacts", "1", "--actuator",
+              "rigid", "--workers", "2"]
 #: A fit of one parameter to three steps, on the same drive, in a pool of two workers.
 POOL_FIT = ["fit", "data.csv", "--free", "mu", "--contacts", "1", "--actuator", "rigid", "--starts", "0",
             "--executor", "process", "--workers", "2"]

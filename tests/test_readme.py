@@ -70,7 +70,8 @@ def test_reliability_counts_are_the_suites_own():
     assert len(stated) >= 7, section
     for path, count in stated:
         tree = ast.parse((README.parent / path).read_text(encoding="utf-8"))
-        tests = [node for node in tree.body if isinstance(node, ast.FunctionDef) and node.name.startswith("test_")]
+        tests = [node for node in tree.body
+                 if isinstance(node, ast.FunctionDef) and node.name.startswith("test_")]
         assert len(tests) == int(count), f"{path}: the README says {count}, the file has {len(tests)}"
     sys.path.insert(0, str(README.parent / "tests"))
     import test_bad_inputs

@@ -17,8 +17,8 @@ from pathlib import Path
 
 from passmd.runtime.validation import InputError
 
-__all__ = ["ENVIRONMENT", "EXECUTORS", "MAX_WORKERS", "PROFILES", "WORKERS_PER_CORE", "RunConfig", "WorkersCapped",
-           "usable_cores", "useful_workers"]
+__all__ = ["ENVIRONMENT", "EXECUTORS", "MAX_WORKERS", "PROFILES", "WORKERS_PER_CORE", "RunConfig",
+           "WorkersCapped", "usable_cores", "useful_workers"]
 
 #: Resolution profiles: ``quick`` (CI regression tests, minutes for everything) and
 #: ``paper`` (the paper's grids, the book's default).

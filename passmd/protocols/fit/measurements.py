@@ -276,10 +276,10 @@ def _refuse_decimal_commas(label: str, header, body, separator: str) -> None:
         for column, cell in zip(header, row, strict=False):
             if _DECIMAL_COMMA.fullmatch(cell):
                 point = cell.strip().replace(",", ".")
-                raise MeasurementError(f"{label} row {k + 1} (line {line}), column {column.strip()}: {cell!r} "
-                                       f"has a decimal comma: write {point} (the file is separated by "
-                                       f"{separator}s; passmd reads a point as the decimal separator)",
-                                       name=column.strip(), value=cell)
+                where = f"{label} row {k + 1} (line {line}), column {column.strip()}"
+                raise MeasurementError(f"{where}: {cell!r} has a decimal comma: write {point} (the file is "
+                                       f"separated by {separator}s; passmd reads a point as the decimal "
+                                       "separator)", name=column.strip(), value=cell)
 
 
 def write_measurements(path, data: Measurements, values: np.ndarray | None = None) -> None:
