@@ -19,7 +19,7 @@ from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import PLAUSIBLE_RANGES, Drive
 from passmd.model.tables import ACTUATOR_DAMPING_RATIO
 from passmd.runtime.cache import describe_default_cache_dir
-from passmd.runtime.config import ENVIRONMENT
+from passmd.runtime.config import ENVIRONMENT, MAX_WORKERS, WORKERS_PER_CORE
 from passmd.runtime.units import QuantityError, parse_quantity, si_factor, to_display
 from passmd.runtime.validation import check_range
 
@@ -277,5 +277,7 @@ def add_sweep_options(parser) -> None:
     group.add_argument("--scheduler", metavar="ADDRESS", default=None,
                        help="Dask scheduler, e.g. tcp://10.0.0.5:8786 (default: none)")
     group.add_argument("--workers", type=int, default=None, metavar="N",
-                       help="worker processes for process/local Dask (default: all cores)")
+                       help=f"worker processes for process/local Dask, 1 to {MAX_WORKERS}; at most "
+                            f"{WORKERS_PER_CORE} per usable core and one per point run (default: one per "
+                            "usable core)")
     group.add_argument("--cache-dir", metavar="DIR", action=DirectoryPath, help=CACHE_DIR_HELP)

@@ -5,7 +5,7 @@
 order the points finish in. Execution is
 
 * ``"process"`` (default): a local :class:`concurrent.futures.ProcessPoolExecutor`
-  over all cores;
+  over the usable cores (never more workers than points to compute);
 * ``"dask"``: a Dask ``distributed`` cluster — the one at ``scheduler``
   (``"tcp://host:8786"``) if given, else a ``LocalCluster`` on this machine;
 * ``"serial"``: in this process, one point after the other;
