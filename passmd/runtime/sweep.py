@@ -292,20 +292,21 @@ def process_pool(workers: int | None = None):
     without waiting for their running points, else shut down when idle.
     """
     workers = useful_workers(workers, MAX_WORKERS)
-    with _signals_held():
-        pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_worker_signals)
-        pool.submit(int)  # forks the workers now (the fork start method starts them all at once)
-    interrupted = False
+    pool, interrupted = None, False
     try:
+        with _signals_held():
+            pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_worker_signals)
+            pool.submit(int)  # forks the workers now (the fork start method starts them all at once)
         yield pool
     except KeyboardInterrupt:
         interrupted = True
         raise
     finally:
-        with _signals_held():
-            if interrupted:
-                _stop_workers(pool)
-            pool.shutdown(wait=True, cancel_futures=True)
+        if pool is not None:
+            with _signals_held():
+                if interrupted:
+                    _stop_workers(pool)
+                pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> None:
