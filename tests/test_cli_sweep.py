@@ -60,6 +60,8 @@ def test_vary_ranges_lists_and_bare_si_numbers():
      "--vary = 'amplitude=50nm..300nm:3': 300 nm is out of range: must be <= 202 nm, the actuator's full "
      "stroke"),
     ("amplitude=0nm,100nm", "--vary = 'amplitude=0nm,100nm': 0 nm is out of range: must be > 0 nm"),
+    ("amplitude=1e-291nm,5nm",  # the fly-back it needs is shorter than a time step can resolve
+     "--vary = 'amplitude=1e-291nm,5nm': 1e-291 nm is out of range: must be >= "),
     ("radius=0.5mm,0.2", "--vary = 'radius=0.5mm,0.2': 200 mm is out of range: must be <= 100 mm"),  # SI
     ("preload=1m", "--vary = 'preload=1m': '1m' has the wrong unit"),
     ("mu=0.1,x", "--vary = 'mu=0.1,x': 'x' is not a quantity"),

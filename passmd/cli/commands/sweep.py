@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from passmd.cli.configuration import run_config
-from passmd.cli.drive import build_drive, explain
+from passmd.cli.drive import _bound, build_drive, explain
 from passmd.cli.errors import OutputError, UsageError
 from passmd.cli.options import (
     AMPLITUDE,
@@ -302,6 +302,11 @@ def _check_waveform(args, axes, at, drive, amplitude, frequency) -> None:
             why = f" ({exc.why})" if exc.why else ""
             raise _refuse(axis.typed, f"{_shown(axis, frequency)} is out of range: must be "
                                       f"{limits}{why}") from None
+        if exc.source == "amplitude" and "amplitude" in at and exc.source_limits:  # e.g. the fly-back time
+            axis = next(a for a in axes if a.name == "amplitude")
+            limits = " and ".join(f"{op} {_bound(op, bound, 'nm', 'm')}" for op, bound in exc.source_limits)
+            raise _refuse(axis.typed, f"{_shown(axis, amplitude)} is out of range: must be {limits} "
+                                      f"({exc.quantity} derived from it is out of range)") from None
         raise UsageError(explain(exc, args)) from None
 
 
