@@ -140,9 +140,9 @@ def read_bounded(path, kind: str, *, label: str | None = None, follow_links: boo
         Not a regular file, not starting with ``starts_with``, or above the limit: one line
         naming the file, what it is and the limit.
     IsADirectoryError
-        A directory (as :func:`open` raises it).
+        A directory (as ``open()`` raises it).
     OSError
-        Missing, unreadable (as :func:`open` raises it).
+        Missing, unreadable (as ``open()`` raises it).
     """
     label = str(path) if label is None else label
     limit = LIMITS[kind]

@@ -245,7 +245,7 @@ def read_measurements(path, *, name: str | None = None) -> Measurements:
 
     The file is read as UTF-8 (a byte-order mark is dropped) from a regular file of at most
     ``LIMITS["measurement file"]`` bytes (:func:`passmd.runtime.inputs.read_bounded`); its
-    separator, a comma, semicolon or tab (:data:`DELIMITERS`), is recognised from the header.
+    separator, a comma, semicolon or tab (``DELIMITERS``), is recognised from the header.
     A number written with a decimal comma is refused (its row and column named), never read
     as another number.
     """
