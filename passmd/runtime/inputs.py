@@ -40,8 +40,9 @@ class RefusedFile(InputError):
     """A file that is not read: not a regular file, not of its kind, or above its kind's limit.
 
     ``reason`` is ``"type"`` (``found`` says what lies there: ``"a named pipe"``), ``"start"``
-    (the file does not begin with the bytes its kind begins with) or ``"size"`` (``size``:
-    its size in bytes, or a lower bound when it grew while read). ``name`` is ``"file"`` and
+    (the file does not begin with the bytes its kind begins with), ``"size"`` (``size``: its
+    size in bytes, or a lower bound when it grew while read) or ``"encoding"`` (not UTF-8 text:
+    :func:`decode_text`). ``name`` is ``"file"`` and
     ``value`` the path as given.
     """
 
