@@ -41,7 +41,8 @@ def test_parameter_table_has_every_drive_show_row():
     assert list(table.index) == list(DRIVE_KEYS)
     assert table.loc["hemisphere_radius", ["value", "unit"]].tolist() == ["0.5", "mm"]
     assert table.loc["actuator.full_stroke_amplitude", "value"] == "131.3"  # Table 2 at 0.5 mm
-    assert table.loc["contacts", "value"] == "paper-six"
+    assert table.loc["contacts", "value"] == "6"  # derived from the groups
+    assert table.loc["contact_groups", "value"] == "2 at 45° (side 1); 4 at 45° (side 2)"
 
 
 @pytest.mark.parametrize("profile", ["quick", "paper"])

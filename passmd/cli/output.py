@@ -128,7 +128,8 @@ def drive_record(drive: Drive) -> dict:
         "amplifier_voltage_V": amp.peak_to_peak_voltage,
         "slew_rate_V_per_s": amp.slew_rate,
         **({"contact_groups": [{"count": g.count, "load_share": g.load_share,
-                                "normal_force_N": g.normal_force, "radius_m": g.radius}
+                                "normal_force_N": g.normal_force, "radius_m": g.radius,
+                                "contact_angle_rad": g.contact_angle, "side": g.side}
                                for g in drive.contact_groups]}
            if drive.contact_groups else {}),
     }

@@ -17,16 +17,15 @@ measurements that were held back from the fit.
 from __future__ import annotations
 
 import math
-import os
 import tempfile
 from dataclasses import dataclass, replace
-from importlib import resources
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from passmd.experiments.design.maps import compute_map
+from passmd.model import drive_file
 from passmd.model.defaults import PROTOCOL
 from passmd.model.drive_file import load_drive, parameter_rows, read_drive_file, resolve
 from passmd.model.parameters import Drive
@@ -63,8 +62,9 @@ __all__ = [
     "synthetic_measurements",
 ]
 
-#: The example drive file (package data, so an installed wheel has it too).
-EXAMPLE_DRIVE_FILE = Path(os.fspath(resources.files("passmd") / "data" / "drives" / "example_drive.toml"))
+#: The example drive file (package data, so an installed wheel has it too; ``passmd drive template
+#: --example`` prints it).
+EXAMPLE_DRIVE_FILE = drive_file.EXAMPLE_DRIVE_FILE
 #: Standard deviation of the synthetic measurements' noise (nm): a step read to about 1 nm, as
 #: a capacitive or interferometric sensor on a test stand reads it.
 NOISE_NM = 1.0
@@ -155,8 +155,8 @@ def parameter_table(drive: Drive, sources: dict) -> pd.DataFrame:
     rows = []
     for row in parameter_rows(drive, sources):
         value, unit = row["value"], row["display_unit"]
-        if isinstance(value, list):
-            shown = "; ".join(", ".join(f"{k} = {v:g}" for k, v in g.items()) for g in value) or "–"
+        if isinstance(value, list):  # contact groups
+            shown = "; ".join(_group_text(g) for g in value) or "–"
         elif isinstance(value, bool):
             shown = str(value).lower()
         elif isinstance(value, str):
@@ -166,6 +166,15 @@ def parameter_table(drive: Drive, sources: dict) -> pd.DataFrame:
         rows.append({"key": row["key"], "symbol": row["symbol"], "value": shown, "unit": unit,
                      "source": row["source"]})
     return pd.DataFrame(rows)
+
+
+def _group_text(group: dict) -> str:
+    """A drive file's contact group in words: ``2 at 45° (side 1), R = 0.5 mm, F_N/F_p = 0.5``."""
+    text = f"{group['count']} at {math.degrees(group['contact_angle']):.4g}°"
+    text += f" (side {group['side']})" if "side" in group else ""
+    text += f", R = {group['radius'] * 1e3:.4g} mm" if "radius" in group else ""
+    text += f", F_N/F_p = {group['load_share']:.4g}" if "load_share" in group else ""
+    return text + (f", F_N = {group['normal_force']:.4g} N" if "normal_force" in group else "")
 
 
 def critical_amplitude_curve(drive: Drive, profile: str, config: RunConfig | None = None) -> pd.DataFrame:
