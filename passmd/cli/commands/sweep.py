@@ -16,6 +16,7 @@ import numpy as np
 from passmd.cli.configuration import run_config
 from passmd.cli.drive import build_drive, explain
 from passmd.cli.errors import OutputError, UsageError
+from passmd.cli.notes import eq15_rows, missing_rows, resolution, ringing_rows, uses_eq15
 from passmd.cli.options import (
     AMPLITUDE,
     DRIVE_QUANTITIES,
@@ -60,7 +61,10 @@ _EPILOG = textwrap.dedent("""\
       fly-back: what moves the drive once); the closed form (Eqs. 7-8, 11-12) is reported too
     - stall-force: generated force at stall against the load cell (Section 4.2)
     - gain: steady velocity of the Eq. 15 waveform (designed from this drive's saw-tooth
-      response) minus that of the saw-tooth
+      response, --design-response) minus that of the saw-tooth. Eq. 15's period needs t_s + t_a,
+      the fly-back and a slow ramp: above the highest frequency at which it fits (the column
+      eq15_highest_frequency_Hz) a cell has no value and its note says so, as where Eq. 15 gives
+      no waveform at all; so does velocity --waveform optimized
 
     --vary NAME=SPEC, repeated for a map (the first axis is the x axis, the last runs fastest):
 
@@ -125,6 +129,10 @@ def add_parser(command) -> None:
                        help="waveform of velocity, step and back-step (default: sawtooth)")
     group.add_argument("--reading", choices=("steady", "first"), default=None,
                        help="reading of critical-amplitude (default: steady)")
+    group.add_argument("--design-response", choices=("paper", "driving"), default=None,
+                       help="saw-tooth response the Eq. 15 waveform is designed from: paper, the 100 Hz "
+                            "response of Section 5.2 (one design per drive and amplitude); driving, the "
+                            "response at each point's frequency (default: paper)")
     add_sweep_options(p)
     out = p.add_argument_group("output")
     out.add_argument("--out", metavar="PREFIX", action=FilePath,
@@ -236,6 +244,10 @@ def _check_options(args) -> None:
     if args.waveform is not None and args.quantity not in ("velocity", "step", "back-step"):
         raise UsageError(f"--waveform {args.waveform} has no effect on {args.quantity}: it chooses the "
                          "waveform of velocity, step and back-step")
+    if args.design_response is not None and not uses_eq15(args):
+        raise UsageError(f"--design-response {args.design_response} has no effect on {args.quantity}"
+                         f"{' --waveform sawtooth' if args.waveform else ''}: it chooses the response the "
+                         "Eq. 15 waveform is designed from (gain, or --waveform optimized)")
     if args.amplitude is not None and args.quantity == "critical-amplitude":
         raise UsageError("--amplitude has no effect on critical-amplitude: it searches over the amplitude")
     if args.out is not None:
@@ -335,6 +347,7 @@ def _record(args, axes, table, spec, drive) -> dict:
         "column": spec.column,
         "reading": (args.reading or "steady") if args.quantity == "critical-amplitude" else None,
         "waveform": (args.waveform or "sawtooth") if spec.function.__name__ == "steady_point" else None,
+        "design_response": (args.design_response or "paper") if uses_eq15(args) else None,
         "axes": [{"name": a.name, "column": a.column, "values": list(a.values), "unit": a.si_unit,
                   "spacing": a.spacing, "typed": a.typed} for a in axes],
         "drive": drive_record(drive),
@@ -408,13 +421,13 @@ def _extreme_rows(axes, spec, table) -> list[tuple[str, str]]:
     return rows
 
 
-def _check_values(quantity: str, column: str, table) -> None:
-    """The quantity is finite at every point; only a gain without an Eq. 15 waveform and a
-    critical amplitude above the full stroke may be missing (``None``, said in the output)."""
+def _check_values(args, column: str, table) -> None:
+    """The quantity is finite at every point; only an Eq. 15 quantity without an Eq. 15 waveform
+    and a critical amplitude above the full stroke may be missing (``None``, said in the output)."""
     from passmd.cli.output import check_results
 
     values = [v for v in table[column] if v is not None]
-    if quantity in ("gain", "critical-amplitude"):
+    if args.quantity == "critical-amplitude" or uses_eq15(args):
         values = [v for v in values if not (isinstance(v, float) and math.isnan(v))]
     check_results({column: values})
 
@@ -430,8 +443,9 @@ def run_sweep(args, out) -> int:
     points = _points(args, axes, spec.amplitude)
     base = points[0]["drive"]
     table = compute_map(args.quantity, points, reading=args.reading or "steady",
-                        waveform=args.waveform or "sawtooth", config=config)
-    _check_values(args.quantity, spec.column, table)
+                        waveform=args.waveform or "sawtooth", design_response=args.design_response or "paper",
+                        config=config)
+    _check_values(args, spec.column, table)
     title = f"{spec.label} — {describe(base)}"
     record = _record(args, axes, table, spec, base)
     if args.out is not None:
@@ -446,11 +460,10 @@ def run_sweep(args, out) -> int:
                        f"{counts['computed']} computed)")]
     rows += _curve_rows(axes, spec, table) if len(axes) == 1 and len(table) <= MAX_SHOWN else \
         _extreme_rows(axes, spec, table)
+    rows += eq15_rows(args, table)
+    rows += ringing_rows(axes, spec, table, resolution(spec, table["frequency_Hz"]), _shown)
     if record["missing_values"]:
-        why = ("no Eq. 15 waveform there, see the note column" if args.quantity == "gain" else
-               "no onset up to the full stroke")
-        count = record["missing_values"]
-        rows.append(("no value", f"{count} point{'s' * (count > 1)} ({why})"))
+        rows += missing_rows(args, table, record["missing_values"])
     if "files" in record:
         rows.append(("written", ", ".join(record["files"].values())))
     emit_rows(f"passmd sweep {args.quantity} — {describe(base)}", rows, out)
