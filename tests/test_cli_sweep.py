@@ -245,3 +245,25 @@ def test_ctrl_c_keeps_finished_points_and_the_rerun_computes_only_the_rest(tmp_p
     counts = json.loads(done.stdout)["sweep"]
     assert counts == {"points": 16, "cached": kept, "computed": 16 - kept}
     assert all(math.isfinite(row["velocity_m_per_s"]) for row in json.loads(done.stdout)["rows"])
+
+
+def test_help_explains_the_drift_and_its_limit():
+    from passmd.cli.commands.sweep import STEADY_DRIFT_PERCENT
+    from passmd.protocols.velocity import STEADY_DRIFT_LIMIT
+
+    assert STEADY_DRIFT_PERCENT / 100 == STEADY_DRIFT_LIMIT
+    _, text = run_cli("sweep", "--help")
+    assert "velocity_drift" in text and f"beyond {STEADY_DRIFT_PERCENT} %" in text
+
+
+@pytest.mark.parametrize(("typed", "values"), [
+    ("preload=0.1N..1N:10", (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0)),
+    ("amplitude=40nm..250nm:8", (4e-08, 7e-08, 1e-07, 1.3e-07, 1.6e-07, 1.9e-07, 2.2e-07, 2.5e-07)),
+    ("mu=0.1..0.3:5", (0.1, 0.15, 0.2, 0.25, 0.3)),
+])
+def test_grid_values_are_written_as_typed(typed, values):
+    """A linear grid in decimal: the CSV holds 0.4 for 0.1..1:10, not 0.39999999999999997."""
+    assert parse_vary(typed).values == values
+    log = parse_vary("frequency=100Hz..110kHz:log:6").values
+    assert log[0] == 100.0 and log[-1] == 110e3 and all(len(repr(v)) <= 14 for v in log)
+    np.testing.assert_allclose(log, np.geomspace(100.0, 110e3, 6), rtol=1e-11)

@@ -1,12 +1,12 @@
-"""What the commands say beside their values: the Eq. 15 design's source and where it fits, why a
-sweep's cells have no value, and the runner's ringing where it explains a non-monotone answer."""
+"""What the commands say and draw beside their values: the Eq. 15 design's source and where it fits,
+why a sweep's cells have no value, and the runner's ringing where it explains a non-monotone answer."""
 
 from __future__ import annotations
 
 import math
 
-__all__ = ["eq15_rows", "hz", "missing_rows", "resolution", "reversals", "ringing_rows", "ringing_text",
-           "uses_eq15"]
+__all__ = ["eq15_rows", "hz", "missing_rows", "resolution", "reversals", "ringing_notes", "ringing_rows",
+           "ringing_text", "sweep_figure", "sweep_title", "uses_eq15"]
 
 
 def hz(frequency: float) -> str:
@@ -127,10 +127,10 @@ def ringing_text(ring: dict, what: str) -> str:
     ``what``: the answer it affects (e.g. ``"the step"``)."""
     from passmd.protocols.ringing import MEASURABLE
 
-    if not math.isfinite(ring["ringing_frequency_Hz"]):
+    if ring["ringing_frequency_Hz"] is None or not math.isfinite(ring["ringing_frequency_Hz"]):
         return "none: the runner makes no swing after the fly-back"
     decay = ring["ringing_decay_time_s"]
-    decays = f"decaying to 1/e in {decay * 1e3:.3g} ms" if math.isfinite(decay) else \
+    decays = f"decaying to 1/e in {decay * 1e3:.3g} ms" if decay is not None and math.isfinite(decay) else \
         "decaying by less than 1/e while recorded"
     text = (f"after a fly-back the runner rings at {ring['ringing_frequency_Hz'] / 1e3:.3g} kHz, "
             f"±{ring['ringing_amplitude_m'] * 1e9:.3g} nm, {decays}; "
@@ -141,3 +141,45 @@ def ringing_text(ring: dict, what: str) -> str:
                 "its swing the runner is then, so it is not monotone in frequency, amplitude or preload (the "
                 "model's physics, not numerical noise)")
     return f"{text}, below the {MEASURABLE * 1e9:g} nm measurable step: {what} does not depend on it"
+
+
+def ringing_notes(table) -> list[str]:
+    """The legend line of a map whose values the runner's ringing affects (else none)."""
+    if "ringing_affects_steps" not in table or not any(bool(v) for v in table["ringing_affects_steps"]):
+        return []
+    left = max(_finite(table["ringing_at_next_flyback_m"]))
+    f = _span(_finite(table["ringing_frequency_Hz"]), 1e-3)
+    return [f"values depend on the runner's ringing ({f} kHz): up to ±{left * 1e9:.3g} nm of it is left\n"
+            "at the next fly-back, so turns of the curve are the model's physics, not noise"]
+
+
+def sweep_figure(args, axes, spec, table, title):
+    """The curve or heat map of the sweep: values apart from the points with no value, not steady or
+    below the resolution (:func:`passmd.plots.sweep_map.cell_marks`), named in the legend."""
+    from passmd.plots.sweep_map import MapAxis, cell_marks, map_figure
+
+    shown = [MapAxis(a.column, a.name, a.quantity.unit, a.spacing == "log") for a in axes]
+    reading = f", {args.reading or 'steady'} reading" if args.quantity == "critical-amplitude" else ""
+    value = MapAxis(spec.column, f"{spec.label}{reading}", spec.unit, scale=spec.scale)
+    also = [MapAxis(c, "closed form (Eqs. 7–8, 11–12)" if c.startswith("analytic") else c, spec.unit,
+                    scale=spec.scale) for c in spec.also]
+    from passmd.model.defaults import PROTOCOL
+
+    step = f"{PROTOCOL.step_threshold * 1e9:g} nm" + ("" if spec.unit == "nm" else " × f")
+    missing = {"gain": "no value: Eq. 15 gives no waveform or does not fit the period (note column)",
+               "critical-amplitude": "no onset up to the full stroke"}.get(
+        args.quantity, "no value (note column)" if uses_eq15(args) else "no value")
+    marks = cell_marks(table, value, resolution(spec, table["frequency_Hz"]) if spec.unit != "N" else None,
+                       missing_label=missing,
+                       resolution_label=f"|value| below the measurable step ({step}): no measurable "
+                       + ("difference" if args.quantity == "gain" else "motion"))
+    return map_figure(table, shown, value, title, also=also if len(axes) == 1 else (), marks=marks,
+                      notes=ringing_notes(table))
+
+
+def sweep_title(spec, axes, drive) -> str:
+    """A sweep's title: the quantity, what varies, and the base drive without the varied values."""
+    from passmd.cli.output import describe
+
+    varied = [a.name for a in axes]
+    return f"{spec.label} over {' × '.join(varied)}\n{describe(drive, omit=varied)}"

@@ -113,7 +113,8 @@ def _ringing(drive, found: float, frequency: float, args) -> dict:
     at = drive.actuator.full_stroke_amplitude if math.isnan(found) else found
     ring = ringing.at_frequency(ringing.stick_ringing(drive, at, frequency, flyback=args.flyback), frequency)
     ring["ringing_affects_steps"] = ring["ringing_affects_steps"] and args.protocol == "steady"
-    return {**ring, "amplitude_m": at}
+    return {**{k: None if isinstance(v, float) and math.isnan(v) else v for k, v in ring.items()},
+            "amplitude_m": at}
 
 
 def run_critical_amplitude(args, out) -> int:

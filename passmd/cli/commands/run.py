@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from pathlib import Path
 from typing import NamedTuple
@@ -251,7 +252,8 @@ def runner_ringing(drive, amplitude: float, frequency: float, flyback: str) -> d
     from passmd.protocols import ringing
 
     probe = ringing.stick_ringing(drive, amplitude, frequency, flyback=flyback)
-    return ringing.at_frequency(probe, frequency)
+    return {k: None if isinstance(v, float) and math.isnan(v) else v  # no swing: no frequency, no decay
+            for k, v in ringing.at_frequency(probe, frequency).items()}
 
 
 def design_row(design, given=()) -> str:
@@ -281,17 +283,12 @@ def write_outputs(args, result) -> None:
         except OSError as exc:
             raise OutputError(f"cannot write --csv {args.csv}: {exc.strerror or exc}") from exc
     if args.plot:
-        from matplotlib.figure import Figure
+        from passmd.plots.trace import positions_figure
 
-        fig = Figure(figsize=(7, 4), layout="constrained")
-        ax = fig.add_subplot()
-        t_ms = result.time * 1e3
-        ax.plot(t_ms, from_si(result.piezo_position, "nm"), label="piezo x_p", lw=0.8)
-        ax.plot(t_ms, from_si(result.runner_position, "nm"), label="runner x_r", lw=0.8)
-        ax.set_xlabel("time [ms]")
-        ax.set_ylabel("position [nm]")
-        ax.legend()
-        ax.set_title(describe(result.drive), fontsize=9)
+        wave = result.waveform
+        title = (f"{wave.kind}, A = {fmt(wave.amplitude, 'nm')}, f = {hz(wave.frequency)}, "
+                 f"{wave.periods} periods\n{describe(result.drive)}")
+        fig = positions_figure(result, title)
         try:
             fmt_ = Path(args.plot).suffix.lstrip(".").lower()
             write_atomically(args.plot, lambda tmp: fig.savefig(tmp, dpi=150, format=fmt_))
@@ -307,6 +304,7 @@ def run_run(args, out) -> int:
     check_memory(args)
     check_output_paths(args)
     result, design = simulate(args, drive, options)
+    ring = runner_ringing(drive, options.amplitude, options.frequency, args.flyback)  # a simulation too
     startup.resume()
     summary = result.summary()
     summary["wall_time_s"] = float(result.wall_time)
@@ -323,7 +321,6 @@ def run_run(args, out) -> int:
 
         steady = steady_velocity(result)
         summary["steady"] = {**steady, "step_m": steady["velocity_m_per_s"] / float(summary["frequency_Hz"])}
-    ring = runner_ringing(drive, float(summary["amplitude_m"]), float(summary["frequency_Hz"]), args.flyback)
     summary["ringing"] = ring
     check_results(summary)
     check_run_bounds(summary, drive, float(summary["amplitude_m"]))

@@ -9,6 +9,7 @@ import math
 import re
 import textwrap
 from dataclasses import dataclass
+from decimal import Decimal, localcontext
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +17,15 @@ import numpy as np
 from passmd.cli.configuration import run_config
 from passmd.cli.drive import build_drive, explain
 from passmd.cli.errors import OutputError, UsageError
-from passmd.cli.notes import eq15_rows, missing_rows, resolution, ringing_rows, uses_eq15
+from passmd.cli.notes import (
+    eq15_rows,
+    missing_rows,
+    resolution,
+    ringing_rows,
+    sweep_figure,
+    sweep_title,
+    uses_eq15,
+)
 from passmd.cli.options import (
     AMPLITUDE,
     DRIVE_QUANTITIES,
@@ -33,7 +42,8 @@ from passmd.runtime.config import ENVIRONMENT
 from passmd.runtime.units import QuantityError, from_si, parse_quantity
 from passmd.runtime.validation import InputError
 
-__all__ = ["AXES", "MAX_AXIS_POINTS", "MAX_POINTS", "Axis", "add_parser", "parse_vary", "run_sweep"]
+__all__ = ["AXES", "MAX_AXIS_POINTS", "MAX_POINTS", "Axis", "add_parser", "grid_values", "parse_vary",
+           "run_sweep"]
 
 #: The quantities (passmd.protocols.maps.MAP_QUANTITIES; listed here so --help does not import it).
 QUANTITY_NAMES = ("velocity", "step", "back-step", "critical-amplitude", "stall-force", "gain")
@@ -48,6 +58,9 @@ MAX_AXIS_POINTS = 1000
 MAX_POINTS = 100_000
 #: Longest curve the human output lists in full (longer ones and maps: the extremes).
 MAX_SHOWN = 40
+#: passmd.protocols.velocity.STEADY_DRIFT_LIMIT in percent (said here so --help does not import it;
+#: tests/test_cli_sweep.py checks they agree).
+STEADY_DRIFT_PERCENT = 5
 
 _NAMES = "NAME: " + ", ".join(AXES) + "."
 _EPILOG = textwrap.dedent("""\
@@ -86,9 +99,16 @@ _EPILOG = textwrap.dedent("""\
     with pandas.read_csv(path, comment="#")), PREFIX.json (the --json object) and PREFIX.png
     (a curve for one axis, a heat map with contours for two).
 
-    --json keys: command, quantity, column, reading, waveform, axes[{{name, values, unit,
-    spacing, typed}}], drive{{...}}, provenance{{...}}, sweep{{points, cached, computed}}, columns,
-    rows[{{...}}] (SI units, keys carrying the unit), files""")
+    --json keys: command, quantity, column, reading, waveform, design_response, axes[{{name,
+    values, unit, spacing, typed}}], drive{{...}}, provenance{{...}}, sweep{{points, cached,
+    computed}}, columns, rows[{{...}}] (SI units, keys carrying the unit), files. Among a row's
+    columns: velocity_drift (velocity, step, back-step), the velocity of the run's fourth quarter
+    minus that of its third, over the velocity: beyond {STEADY_DRIFT_PERCENT} % the point is not
+    steady (hatched in the PNG, as are points with no value and points whose |value| is below the
+    measurable step); ringing_* (every quantity but the stall force): the runner's swing after a
+    fly-back and what is left of it when the next starts (ringing_at_next_flyback_m): where that
+    exceeds the measurable step the value depends on the swing's phase, and a curve turns
+    (the output says so; the model's physics, not noise).""")
 
 
 @dataclass(frozen=True)
@@ -185,14 +205,24 @@ def parse_vary(text: str) -> Axis:
     lo, hi = value(low), value(high)
     if not lo < hi:
         raise _refuse(text, f"the range {low.strip()}..{high.strip()} is empty: LO must be below HI")
+    if spacing == "log" and lo <= 0:
+        raise _refuse(text, f"a log range must start above 0, not at {low.strip()}")
+    return Axis(name, grid_values(lo, hi, count, spacing), spacing, text)
+
+
+def grid_values(lo: float, hi: float, count: int, spacing: str) -> tuple[float, ...]:
+    """``count`` values from ``lo`` to ``hi`` (SI) as a reader writes them: a linear grid in decimal
+    (0.1..1:10 gives 0.4, not 0.39999999999999997), a log grid to 12 significant digits; the ends
+    exactly as typed. The points are computed at these values, so the CSV holds what ran."""
     if spacing == "log":
-        if lo <= 0:
-            raise _refuse(text, f"a log range must start above 0, not at {low.strip()}")
-        values = np.geomspace(lo, hi, count)
+        values = [float(f"{v:.12g}") for v in np.geomspace(lo, hi, count)]
     else:
-        values = np.linspace(lo, hi, count)
-    values[0], values[-1] = lo, hi  # the ends exactly as typed
-    return Axis(name, tuple(float(v) for v in values), spacing, text)
+        with localcontext() as ctx:
+            ctx.prec = 28
+            start, stop = Decimal(repr(lo)), Decimal(repr(hi))
+            values = [float(start + (stop - start) * k / (count - 1)) for k in range(count)]
+    values[0], values[-1] = lo, hi
+    return tuple(values)
 
 
 def _shown(axis: Axis, value: float) -> str:
@@ -380,7 +410,7 @@ def _write(args, record, axes, spec, table, title) -> dict:
         text = json.dumps(plain({**record, "files": files}), indent=2, allow_nan=False) + "\n"
         write_atomically(files["json"], lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
         if "png" in files:
-            fig = _figure(axes, spec, table, title)
+            fig = sweep_figure(args, axes, spec, table, title)
             facts = record["provenance"]
             summary = f"passmd {facts['passmd_version']}, commit {facts['git_commit']}"
             write_atomically(files["png"], lambda tmp: fig.savefig(
@@ -390,16 +420,6 @@ def _write(args, record, axes, spec, table, title) -> dict:
     except OSError as exc:
         raise OutputError(f"cannot write --out {prefix}: {exc.strerror or exc}") from exc
     return files
-
-
-def _figure(axes, spec, table, title):
-    from passmd.plots.sweep_map import MapAxis, map_figure
-
-    shown = [MapAxis(a.column, a.name, a.quantity.unit, a.spacing == "log") for a in axes]
-    value = MapAxis(spec.column, spec.label, spec.unit, scale=spec.scale)
-    also = [MapAxis(c, "closed form" if c.startswith("analytic") else c, spec.unit, scale=spec.scale)
-            for c in spec.also]
-    return map_figure(table, shown, value, title, also=also if len(axes) == 1 else ())
 
 
 def _curve_rows(axes, spec, table) -> list[tuple[str, str]]:
@@ -414,10 +434,15 @@ def _extreme_rows(axes, spec, table) -> list[tuple[str, str]]:
     values = np.array([np.nan if v is None else float(v) for v in table[spec.column]], dtype=float)
     if not np.isfinite(values).any():
         return [(spec.label, "no value (see the note column)")]
+    from passmd.protocols.velocity import STEADY_DRIFT_LIMIT
+
     rows = []
+    drift = table["velocity_drift"] if "velocity_drift" in table else None
     for word, i in (("min", int(np.nanargmin(values))), ("max", int(np.nanargmax(values)))):
         where = ", ".join(f"{a.name} {_shown(a, table[a.column].iloc[i])}" for a in axes)
-        rows.append((f"{word} {spec.label}", f"{values[i] / spec.scale:.6g} {spec.unit} at {where}"))
+        unsteady = drift is not None and abs(float(drift.iloc[i])) > STEADY_DRIFT_LIMIT
+        rows.append((f"{word} {spec.label}", f"{values[i] / spec.scale:.6g} {spec.unit} at {where}"
+                     + (f" (not steady: velocity_drift {float(drift.iloc[i]):.2g})" if unsteady else "")))
     return rows
 
 
@@ -446,7 +471,8 @@ def run_sweep(args, out) -> int:
                         waveform=args.waveform or "sawtooth", design_response=args.design_response or "paper",
                         config=config)
     _check_values(args, spec.column, table)
-    title = f"{spec.label} — {describe(base)}"
+    varied = [a.name for a in axes]
+    title = sweep_title(spec, axes, base)
     record = _record(args, axes, table, spec, base)
     if args.out is not None:
         record["files"] = _write(args, record, axes, spec, table, title)
@@ -466,5 +492,5 @@ def run_sweep(args, out) -> int:
         rows += missing_rows(args, table, record["missing_values"])
     if "files" in record:
         rows.append(("written", ", ".join(record["files"].values())))
-    emit_rows(f"passmd sweep {args.quantity} — {describe(base)}", rows, out)
+    emit_rows(f"passmd sweep {args.quantity} — {describe(base, omit=varied)}", rows, out)
     return 0
