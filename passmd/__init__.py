@@ -23,7 +23,8 @@ Which may import which is the ``layers`` contract of ``pyproject.toml`` (import-
 
 The names a drive designer needs are exported here, loaded on first use: ``Drive``,
 ``paper_drive``, ``sawtooth``, ``simulate``, ``Simulation``, ``drive_theory``,
-``critical_amplitude``, ``generated_force``, ``optimized_design``, ``RunConfig``,
+``critical_amplitude``, ``generated_force``, ``optimized_design``, ``optimized`` and
+``highest_fitting_frequency`` (Eq. 15's design, waveform and where it fits), ``RunConfig``,
 ``load_drive``/``drive_toml`` (read and write a drive file), and ``fit``/``read_measurements``
 (calibrate free drive parameters to measurements).
 """
@@ -52,6 +53,8 @@ _API = {
     "critical_amplitude": "passmd.protocols.critical_amplitude",
     "generated_force": "passmd.protocols.stall",
     "optimized_design": "passmd.protocols.eq15",
+    "optimized": "passmd.model.optimized_waveform",
+    "highest_fitting_frequency": "passmd.model.optimized_waveform",
     "RunConfig": "passmd.runtime.config",
     "load_drive": "passmd.model.drive_file",
     "drive_toml": "passmd.model.drive_file",

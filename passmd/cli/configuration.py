@@ -16,6 +16,7 @@ from dataclasses import replace
 
 from passmd.cli.errors import MissingDependencyError, UsageError
 from passmd.runtime.config import RunConfig
+from passmd.runtime.extras import install_hint
 
 __all__ = ["run_config"]
 
@@ -25,7 +26,7 @@ def _require_executor(config: RunConfig) -> None:
     if (config.executor == "dask" or (config.executor is None and config.scheduler)) \
             and importlib.util.find_spec("distributed") is None:
         raise MissingDependencyError("the Dask executor needs the 'distributed' package, which is not "
-                                     "installed: pip install 'passmd[dask]'")
+                                     f"installed: {install_hint('dask')}")
 
 
 def _check_sweep_log(config: RunConfig) -> None:

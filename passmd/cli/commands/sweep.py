@@ -367,7 +367,7 @@ def _arguments(args) -> str:
 
 def _record(args, axes, table, spec, drive) -> dict:
     from passmd import __version__
-    from passmd.runtime.provenance import git_commit
+    from passmd.runtime.provenance import commit_or_version
 
     rows = [{k: _finite_or_none(v) for k, v in row.items()} for row in table.to_dict(orient="records")]
     missing = sum(row[spec.column] is None for row in rows)
@@ -381,7 +381,7 @@ def _record(args, axes, table, spec, drive) -> dict:
         "axes": [{"name": a.name, "column": a.column, "values": list(a.values), "unit": a.si_unit,
                   "spacing": a.spacing, "typed": a.typed} for a in axes],
         "drive": drive_record(drive),
-        "provenance": {"passmd_version": __version__, "git_commit": git_commit(),
+        "provenance": {"passmd_version": __version__, "git_commit": commit_or_version(),
                        "arguments": _arguments(args)},
         "sweep": {k: table.attrs["sweep"][k] for k in ("points", "cached", "computed")},
         "missing_values": missing,
