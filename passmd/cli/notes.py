@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["eq15_rows", "hz", "missing_rows", "resolution", "reversals", "ringing_notes", "ringing_rows",
+__all__ = ["eq15_rows", "hz", "missing_rows", "resolution", "ringing_notes", "ringing_rows",
            "ringing_text", "sweep_figure", "sweep_title", "uses_eq15"]
 
 
@@ -48,24 +48,6 @@ def eq15_rows(args, table) -> list[tuple[str, str]]:
     return [("Eq. 15 design", f"from the saw-tooth response at {source}; {fits}")]
 
 
-def reversals(values, resolution) -> list[int]:
-    """Indices i where a curve turns: the change into point i and the change out of it have opposite
-    signs, each larger than the resolution (the larger of its two points'); NaN points are skipped."""
-    y = [float("nan") if v is None else float(v) for v in values]
-    res = [float(r) for r in resolution]
-    keep = [i for i, v in enumerate(y) if math.isfinite(v)]
-    turns, last = [], None  # last: (index, sign) of the last change larger than the resolution
-    for a, b in zip(keep, keep[1:], strict=False):
-        change = y[b] - y[a]
-        if abs(change) <= max(res[a], res[b]):
-            continue
-        sign = 1 if change > 0 else -1
-        if last is not None and sign != last[1]:
-            turns.append(a)
-        last = (b, sign)
-    return turns
-
-
 def ringing_rows(axes, spec, table, resolution, shown) -> list[tuple[str, str]]:
     """The runner's ringing where it affects a sweep's values (``ringing_*`` columns of
     :func:`passmd.experiments.design.maps.compute_map`), and the turns of a curve it explains.
@@ -90,8 +72,10 @@ def ringing_rows(axes, spec, table, resolution, shown) -> list[tuple[str, str]]:
              f"when the next fly-back starts (more than the {MEASURABLE * 1e9:g} nm measurable step), so the "
              f"{spec.label} there depends on where in its swing the runner is")]
     if len(axes) == 1:
+        from passmd.protocols.ringing import turns as find_turns
+
         values = table[spec.column]
-        turns = reversals(values, resolution)
+        turns = find_turns(values, resolution)
         if turns:
             near = [k for k in (turns[0] - 1, turns[0], turns[0] + 1) if 0 <= k < len(values)]
             where = ", ".join(f"{float(values.iloc[k]) / spec.scale:.4g} {spec.unit} at "

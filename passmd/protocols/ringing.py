@@ -28,7 +28,7 @@ from passmd.runtime.validation import check_choice, check_positive, check_range
 from passmd.solver import simulation as dynamics
 
 __all__ = ["HOLD", "MEASURABLE", "SAMPLES_PER_CYCLE", "at_frequency", "left_after", "ringing_point",
-           "stick_ringing"]
+           "stick_ringing", "turns"]
 
 #: Least time (s) the hemispheres are held after the fly-back while the ringing is recorded: two
 #: 100 Hz periods (Section 4.1's and Fig. 9a's saw-tooth).
@@ -152,3 +152,21 @@ def ringing_point(drive: Drive, amplitude: float, frequency: float = PROTOCOL.dr
     out = stick_ringing(drive, amplitude, frequency)
     return {**out, "swing_times_s": np.asarray(out["swing_times_s"]),
             "swing_amplitudes_m": np.asarray(out["swing_amplitudes_m"])}
+
+
+def turns(values, resolution) -> list[int]:
+    """Indices i where a curve turns: the change into point i and the change out of it have opposite
+    signs, each larger than the resolution (the larger of its two points'); NaN points are skipped."""
+    y = [float("nan") if v is None else float(v) for v in values]
+    res = [float(r) for r in resolution]
+    keep = [i for i, v in enumerate(y) if math.isfinite(v)]
+    found, last = [], None  # last: (index, sign) of the last change larger than the resolution
+    for a, b in zip(keep, keep[1:], strict=False):
+        change = y[b] - y[a]
+        if abs(change) <= max(res[a], res[b]):
+            continue
+        sign = 1 if change > 0 else -1
+        if last is not None and sign != last[1]:
+            found.append(last[0])  # where the last change ended: the extremum
+        last = (b, sign)
+    return found

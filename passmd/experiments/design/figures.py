@@ -30,6 +30,7 @@ from passmd.model.defaults import PROTOCOL
 from passmd.model.drive_file import load_drive, parameter_rows, read_drive_file, resolve
 from passmd.model.parameters import Drive
 from passmd.model.tables import actuator_for_radius
+from passmd.model.theory import contact_arrangement
 from passmd.protocols import fit as fitting
 from passmd.protocols import stall
 from passmd.runtime.config import PROFILES, RunConfig
@@ -177,30 +178,76 @@ def _group_text(group: dict) -> str:
     return text + (f", F_N = {group['normal_force']:.4g} N" if "normal_force" in group else "")
 
 
+def run_config(config: RunConfig | None, profile: str) -> RunConfig:
+    """The run configuration of the chapter's sweeps on ``profile`` (:data:`PROFILE_SETTINGS`)."""
+    return _run_config(config, profile)
+
+
+def contact_table(drive: Drive) -> pd.DataFrame:
+    """Each contact group of ``drive`` as ``passmd drive show`` lists it: side, count, contact angle,
+    radius, normal force per contact and where it comes from (given, or Eq. 1's balance)."""
+    rows = contact_arrangement(drive)
+    return pd.DataFrame({
+        "side": [r["side"] for r in rows], "contacts": [r["count"] for r in rows],
+        "contact angle α [°]": [math.degrees(r["contact_angle_rad"]) for r in rows],
+        "R [mm]": [r["radius_m"] * 1e3 for r in rows],
+        "F_N per contact [N]": [r["normal_force_N"] for r in rows],
+        "n F_N sin α [N]": [r["preload_share_N"] for r in rows],
+        "F_N from": [{"Eq. 1": "F_p / (n sin α), Eq. 1", "load_share": "given share of F_p",
+                      "normal_force": "given"}[r["force_from"]] for r in rows]})
+
+
+def preload_points(drive: Drive, profile: str) -> list[dict]:
+    """The points of A_c against preload at Section 4.1's frequency (``passmd sweep
+    critical-amplitude --vary preload=...``)."""
+    return [{"drive": replace(drive, preload=float(p)), "frequency": PROTOCOL.drive_frequency,
+             "preload_N": float(p)} for p in _settings(profile).preloads]
+
+
+def curve_from_maps(steady: pd.DataFrame, first: pd.DataFrame) -> pd.DataFrame:
+    """A_c against preload from the two ``critical-amplitude`` maps (readings ``steady``, ``first``).
+
+    Columns (nm, N, Hz): ``preload_N``, ``closed_form_nm``, ``steady_nm``, ``first_nm``, and the
+    runner's ringing at the steady A_c (:func:`passmd.protocols.ringing.at_frequency`):
+    ``ringing_frequency_Hz``, ``ringing_amplitude_nm``, ``ringing_left_nm`` (at the next fly-back),
+    ``ringing_affects``.
+    """
+    def nm(values):
+        return [math.nan if v is None else float(v) * 1e9 for v in values]
+
+    return pd.DataFrame({
+        "preload_N": steady["preload_N"].to_numpy(float),
+        "closed_form_nm": steady["analytic_critical_amplitude_m"].to_numpy(float) * 1e9,
+        "steady_nm": nm(steady["critical_amplitude_m"]), "first_nm": nm(first["critical_amplitude_m"]),
+        "ringing_frequency_Hz": steady["ringing_frequency_Hz"].to_numpy(float),
+        "ringing_amplitude_nm": nm(steady["ringing_amplitude_m"]),
+        "ringing_left_nm": nm(steady["ringing_at_next_flyback_m"]),
+        "ringing_affects": steady["ringing_affects_steps"].astype(bool).to_numpy()})
+
+
 def critical_amplitude_curve(drive: Drive, profile: str, config: RunConfig | None = None) -> pd.DataFrame:
     """A_c against preload at Section 4.1's frequency: the closed form (Eqs. 7–8, 11–12) and the
-    two simulated readings (``steady``, ``first``), as ``passmd sweep critical-amplitude``.
-
-    Columns (nm, N): ``preload_N``, ``closed_form_nm``, ``steady_nm``, ``first_nm``.
-    """
+    two simulated readings (``steady``, ``first``), as ``passmd sweep critical-amplitude``
+    (:func:`curve_from_maps`)."""
     config = _run_config(config, profile)
-    points = [{"drive": replace(drive, preload=float(p)), "frequency": PROTOCOL.drive_frequency,
-               "preload_N": float(p)} for p in _settings(profile).preloads]
-    out = pd.DataFrame({"preload_N": [p["preload_N"] for p in points]})
-    for reading in ("steady", "first"):
-        table = compute_map("critical-amplitude", points, reading=reading, config=config,
-                            description=f"A_c ({reading}) against preload")
-        out[f"{reading}_nm"] = [math.nan if v is None else v * 1e9 for v in table["critical_amplitude_m"]]
-        out["closed_form_nm"] = table["analytic_critical_amplitude_m"].to_numpy(float) * 1e9
-    return out[["preload_N", "closed_form_nm", "steady_nm", "first_nm"]]
+    points = preload_points(drive, profile)
+    steady, first = (compute_map("critical-amplitude", points, reading=reading, config=config,
+                                 description=f"A_c ({reading}) against preload")
+                     for reading in ("steady", "first"))
+    return curve_from_maps(steady, first)
+
+
+def map_axes(drive: Drive, profile: str) -> tuple[np.ndarray, np.ndarray]:
+    """The maps' frequencies (log-spaced, Hz) and amplitudes (linear up to the full stroke, m)."""
+    s = _settings(profile)
+    return (np.geomspace(*MAP_FREQUENCY_RANGE, s.map_frequencies),
+            np.linspace(MAP_AMPLITUDE_LOW, drive.actuator.full_stroke_amplitude, s.map_amplitudes))
 
 
 def map_points(drive: Drive, profile: str) -> list[dict]:
     """The frequency × amplitude grid of the maps (frequency the x axis, amplitude fastest), with
     the columns ``passmd sweep --vary frequency=... --vary amplitude=...`` writes."""
-    s = _settings(profile)
-    frequencies = np.geomspace(*MAP_FREQUENCY_RANGE, s.map_frequencies)
-    amplitudes = np.linspace(MAP_AMPLITUDE_LOW, drive.actuator.full_stroke_amplitude, s.map_amplitudes)
+    frequencies, amplitudes = map_axes(drive, profile)
     return [{"drive": drive, "frequency": float(f), "amplitude": float(a), "frequency_Hz": float(f),
              "amplitude_m": float(a)} for f in frequencies for a in amplitudes]
 
@@ -217,18 +264,29 @@ def gain_map(drive: Drive, profile: str, config: RunConfig | None = None) -> pd.
                        description="Eq. 15 gain map")
 
 
+def stall_points(drive: Drive, profile: str) -> list[dict]:
+    """The stall-force points at Section 4.2's frequency: the profile's preloads × amplitudes
+    (fractions of the full stroke), the runner against the load cell."""
+    s = _settings(profile)
+    a_max = drive.actuator.full_stroke_amplitude
+    return [{"drive": replace(drive, preload=float(p), load_cell=True), "frequency": PROTOCOL.drive_frequency,
+             "amplitude": float(x * a_max), "preload_N": float(p)}
+            for p in s.stall_preloads for x in s.stall_fractions]
+
+
 def stall_force_curve(drive: Drive, profile: str, config: RunConfig | None = None) -> pd.DataFrame:
     """Generated force at stall against the amplitude at Section 4.2's frequency, per preload
-    (``passmd sweep stall-force``), with the Coulomb bound μ·ΣF_N of each preload.
+    (``passmd sweep stall-force``), with the Coulomb bound μ·ΣF_N of each preload (:func:`stall_frame`)."""
+    points = stall_points(drive, profile)
+    table = compute_map("stall-force", points, config=_run_config(config, profile), description="stall force")
+    return stall_frame(points, table)
+
+
+def stall_frame(points: list[dict], table: pd.DataFrame) -> pd.DataFrame:
+    """The stall-force map of :func:`stall_points` as the chapter draws it.
 
     Columns: ``preload_N``, ``amplitude_nm``, ``force_mN``, ``converged``, ``periods``, ``bound_mN``.
     """
-    s = _settings(profile)
-    a_max = drive.actuator.full_stroke_amplitude
-    points = [{"drive": replace(drive, preload=float(p), load_cell=True),
-               "frequency": PROTOCOL.drive_frequency, "amplitude": float(x * a_max), "preload_N": float(p)}
-              for p in s.stall_preloads for x in s.stall_fractions]
-    table = compute_map("stall-force", points, config=_run_config(config, profile), description="stall force")
     return pd.DataFrame({
         "preload_N": table["preload_N"],
         "amplitude_nm": [p["amplitude"] * 1e9 for p in points],
