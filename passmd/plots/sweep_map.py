@@ -3,8 +3,9 @@
 A map shows a value only where it is one: cells with no value (Eq. 15 gives no waveform, no onset
 up to the full stroke), cells whose run is not steady and cells below the value's resolution are
 drawn apart (hatched or masked) and named in the legend, never coloured as if they were values. A
-quantity that changes sign is drawn on a symmetric diverging scale centred on zero (a tiny negative
-value stays near white), and contours are drawn only through resolved, steady cells.
+quantity with negative values is drawn on a scale symmetric about zero (diverging: blue below,
+red above, a tiny value of either sign near white), and contours are drawn only through resolved,
+steady cells.
 """
 
 from __future__ import annotations
@@ -180,7 +181,7 @@ def _heat_map(fig, ax, table, axes, value: MapAxis, z, marks: CellMarks) -> list
     plain = grid(marks.plain)
     shown = np.ma.masked_array(grid(z), mask=~plain)
     norm, cmap = None, "viridis"
-    if shown.count() and shown.min() < 0 < shown.max():  # diverging, symmetric: zero is white
+    if shown.count() and shown.min() < 0:  # a signed value: diverging, symmetric, zero white
         top = float(np.abs(shown).max())
         norm, cmap = colors.Normalize(vmin=-top, vmax=top), "RdBu_r"
     x_edges, y_edges = _edges(x, first.log), _edges(y, second.log)

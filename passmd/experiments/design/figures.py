@@ -32,7 +32,7 @@ from passmd.model.parameters import Drive
 from passmd.model.tables import actuator_for_radius
 from passmd.model.theory import contact_arrangement
 from passmd.protocols import fit as fitting
-from passmd.protocols import stall
+from passmd.protocols import ringing, stall
 from passmd.runtime.config import PROFILES, RunConfig
 from passmd.runtime.units import from_si
 from passmd.runtime.validation import check_choice
@@ -45,7 +45,10 @@ __all__ = [
     "START",
     "ProfileSettings",
     "calibrate",
+    "contact_table",
     "critical_amplitude_curve",
+    "curve_facts",
+    "curve_from_maps",
     "example_drive",
     "fit_facts",
     "gain_facts",
@@ -53,11 +56,17 @@ __all__ = [
     "heldback_facts",
     "heldback_predictions",
     "load_fitted",
+    "map_axes",
     "map_facts",
     "map_points",
     "measurements_csv",
     "parameter_table",
+    "preload_points",
+    "ringing_facts",
+    "run_config",
     "stall_force_curve",
+    "stall_frame",
+    "stall_points",
     "start_drive",
     "step_velocity_map",
     "synthetic_measurements",
@@ -421,3 +430,35 @@ def heldback_facts(table: pd.DataFrame, labels=("start", "fitted")) -> dict:
     for label in labels:
         out[f"rms_{label}_nm"] = float(np.sqrt(np.mean((table[f"{label}_nm"] - table["measured_nm"]) ** 2)))
     return out
+
+
+def curve_facts(curve: pd.DataFrame) -> dict:
+    """What the chapter says of A_c against preload, all read off ``curve`` (:func:`curve_from_maps`):
+    at how many preloads the closed form lies at or above both simulated readings, where the steady
+    reading exceeds it most (nm, N), how often the steady curve turns (changes beyond the
+    measurable step) and at how many preloads the runner still rings at the next fly-back."""
+    closed, steady, first = (curve[c].to_numpy(float) for c in ("closed_form_nm", "steady_nm", "first_nm"))
+    above = (closed >= steady) & (closed >= first)
+    excess = steady - closed
+    worst = int(np.nanargmax(excess))
+    turns = ringing.turns(steady, [PROTOCOL.step_threshold * 1e9] * len(steady))
+    return {"ca_points": len(curve), "ca_closed_above": int(above.sum()),
+            "ca_excess_nm": float(excess[worst]), "ca_excess_at_N": float(curve["preload_N"].iloc[worst]),
+            "ca_turns": len(turns), "ca_ringing_points": int(curve["ringing_affects"].sum()),
+            "ca_ringing_left_nm": float(np.nanmax(curve["ringing_left_nm"]))}
+
+
+def ringing_facts(probe: dict, frequency: float) -> dict:
+    """The ringing after a fly-back (:func:`passmd.protocols.ringing.stick_ringing`) as the chapter
+    quotes it: frequency (kHz), first swing (nm), 1/e time (ms), swing left at the next fly-back at
+    ``frequency`` (nm) and the longest period at which that is below the measurable step (ms; NaN
+    if the swing stays above it while recorded)."""
+    at = ringing.at_frequency(probe, frequency)
+    swings, times = np.asarray(probe["swing_amplitudes_m"]), np.asarray(probe["swing_times_s"])
+    below = np.flatnonzero(swings < ringing.MEASURABLE)
+    return {"ring_f_kHz": probe["ringing_frequency_Hz"] / 1e3,
+            "ring_amp_nm": probe["ringing_amplitude_m"] * 1e9,
+            "ring_decay_ms": probe["ringing_decay_time_s"] * 1e3,
+            "ring_left_nm": at["ringing_at_next_flyback_m"] * 1e9,
+            "ring_hold_ms": probe["ringing_hold_s"] * 1e3, "ring_next_ms": at["next_flyback_after_s"] * 1e3,
+            "ring_quiet_ms": float(times[below[0]] * 1e3) if below.size else math.nan}
