@@ -60,10 +60,10 @@ def ringing_rows(axes, spec, table, resolution, shown) -> list[tuple[str, str]]:
     if "ringing_affects_steps" not in table:
         return []
     affected = [bool(v) for v in table["ringing_affects_steps"]]
-    if not any(affected):
-        return []
     f, a = _finite(table["ringing_frequency_Hz"]), _finite(table["ringing_amplitude_m"])
     decay, left = _finite(table["ringing_decay_time_s"]), _finite(table["ringing_at_next_flyback_m"])
+    if not (any(affected) and f and a and left):
+        return []
     decays = f"decaying to 1/e in {_span(decay, 1e3)} ms" if decay else \
         "decaying by less than 1/e while recorded"
     rows = [("runner ringing",
@@ -81,10 +81,11 @@ def ringing_rows(axes, spec, table, resolution, shown) -> list[tuple[str, str]]:
             where = ", ".join(f"{float(values.iloc[k]) / spec.scale:.4g} {spec.unit} at "
                               f"{shown(axes[0], table[axes[0].column].iloc[k])}" for k in near)
             times = f"{len(turns)} time{'s' * (len(turns) > 1)}"
-            rows.append(("not monotone", f"the {spec.label} turns {times} over {axes[0].name} ({where}): "
-                                         "that is the ringing above, the model's physics, not numerical "
-                                         "noise "
-                                         "(a finer grid shows more turns, not a smoother curve)"))
+            rows.append(("not monotone",
+                         f"the {spec.label} turns {times} over {axes[0].name} ({where}); the runner still "
+                         "rings there when the next fly-back starts (above), which makes the value depend on "
+                         "its phase: the model's physics, not numerical noise (a finer grid shows more "
+                         "turns, not a smoother curve)"))
     return rows
 
 

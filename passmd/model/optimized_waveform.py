@@ -66,7 +66,10 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
             "the free micro-vibration after the slip is the one the waveform exploits; V_r is the "
             "runner's velocity where the acceleration starts (point 4). The design is made once "
             "per drive and used at every driving frequency ('when these influencing parameters "
-            "were varied, the input parameters for the optimized waveform were respectively changed')."
+            "were varied, the input parameters for the optimized waveform were respectively changed'). "
+            "The command line designs the same way by default and says so; --design-response driving "
+            "reads the response at the driving frequency instead, whose vibration cycle the next "
+            "fly-back cuts short as f approaches f_s."
         ),
         sensitivity="Driving-waveform chapter: step at 100 Hz against t_s over two vibration periods.",
     ),
@@ -102,8 +105,10 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         key="optimized_short_period",
         symbol="t_s, t_a",
         value=(
-            f"the slow ramp keeps ≥ {MIN_RAMP_FRACTION:g}·(T − t_fb) and ≥ A/V_max; short_period='cut': "
-            "t_s is cut to the time left, then t_a (at constant V_a); 'skip': t_s = 0"
+            f"the slow ramp keeps ≥ {MIN_RAMP_FRACTION:g}·(T − t_fb) and ≥ A/V_max; above the highest "
+            "frequency at which t_s + t_a then fit, a designer's waveform is refused; the study of "
+            "Fig. 9b, short_period='cut': t_s is cut to the time left, then t_a (at constant V_a); "
+            "'skip': t_s = 0"
         ),
         unit="s",
         rationale=(

@@ -82,7 +82,7 @@ def cell_marks(table, value: MapAxis, resolution=None, *, missing_label: str = "
     """The :class:`CellMarks` of ``table``'s ``value`` column.
 
     ``resolution``: each point's resolution (SI, as the column), e.g. the measurable step δ for a
-    step and δ·f for a velocity; a value with |value| below it is unresolved. A table with a
+    step and δ·f for a velocity; a value whose magnitude is below it is unresolved. A table with a
     ``velocity_drift`` column (the steady-velocity protocol) marks points whose |drift| exceeds
     :data:`passmd.protocols.velocity.STEADY_DRIFT_LIMIT` as not steady.
     """

@@ -24,6 +24,7 @@ import re
 from decimal import Decimal, localcontext
 
 __all__ = [
+    "ANGLE_UNITS",
     "QuantityError",
     "dimension_name",
     "from_si",
@@ -308,13 +309,13 @@ def parse_angle(text, *, name: str = "angle") -> float:
     """Read an angle (``"45 deg"``, ``"45°"``, ``"0.785 rad"``, a bare number in rad) in radians.
 
     Angles are kept out of :func:`parse_quantity` (pint reads a radian as a plain number); this
-    is the one place an angle is read. Degrees convert by :func:`math.radians`, so ``"45 deg"``
+    is the one place an angle is read. Degrees convert by ``math.radians``, so ``"45 deg"``
     is exactly ``math.pi / 4``.
 
     Raises
     ------
     QuantityError
-        Not a finite number with one of the units :data:`ANGLE_UNITS`.
+        Not a finite number with one of the units :data:`passmd.runtime.units.ANGLE_UNITS`.
     """
     if isinstance(text, bool):
         raise QuantityError(f"{name} = {text!r} is not an angle: give e.g. \"45 deg\"")

@@ -20,16 +20,17 @@ __all__ = ["READINGS", "add_parser", "run_critical_amplitude"]
 READINGS = {
     "analytic": "analytic (Eq. 7/8, 11/12): the contacts' presliding plus the actuators' deformation, "
                 "no runner dynamics; a first sizing, to be checked by simulation",
-    "steady": "simulated steady: above it the drive keeps stepping once running; size the working "
-              "amplitude by this one",
+    "steady": "simulated steady: where the last step of a run first exceeds the measurable step, what "
+              "continuous operation needs at this preload and frequency; read it at the drive's own (the "
+              "runner's ringing makes it turn with both)",
     "first": "simulated first fly-back: above it every contact slides fully in the first fly-back from "
              "rest; what a start from rest needs",
 }
 
 _EPILOG = textwrap.dedent("""\
     Three readings of A_c, each for a different question: analytic (closed form, no
-    dynamics: a first sizing), simulated steady (the drive keeps stepping once running: size
-    the working amplitude by it), simulated first fly-back (a start from rest slips at once).
+    dynamics: a first sizing), simulated steady (what continuous operation needs, read at the
+    drive's own preload and frequency), simulated first fly-back (a start from rest slips at once).
 
     The simulated A_c comes from the critical-amplitude chapters' search
     (passmd.protocols.critical_amplitude): bisection on [0, A_max] with one of two
