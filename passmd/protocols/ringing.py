@@ -65,8 +65,8 @@ def stick_ringing(drive: Drive, amplitude: float, frequency: float = PROTOCOL.dr
     Returns
     -------
     dict
-        ``ringing_frequency_Hz`` (from the first :data:`_MIN_TURNS` turning points, as Eq. 15's
-        f_s), ``ringing_amplitude_m`` (the first swing), ``ringing_decay_time_s`` (time after the
+        ``ringing_frequency_Hz`` (from the first three turning points, as Eq. 15's f_s),
+        ``ringing_amplitude_m`` (the first swing), ``ringing_decay_time_s`` (time after the
         fly-back's end until the swing falls to 1/e of the first; NaN if not within the hold),
         ``ringing_hold_s``, ``flyback_time_s``, and the envelope: ``swing_times_s`` (after the
         fly-back's end) and ``swing_amplitudes_m``. Without turning points (no ringing) the

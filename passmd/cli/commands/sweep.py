@@ -104,7 +104,7 @@ _EPILOG = textwrap.dedent("""\
     computed}}, columns, rows[{{...}}] (SI units, keys carrying the unit), files. Among a row's
     columns: velocity_drift (velocity, step, back-step), the velocity of the run's fourth quarter
     minus that of its third, over the velocity: beyond {STEADY_DRIFT_PERCENT} % the point is not
-    steady (hatched in the PNG, as are points with no value and points whose |value| is below the
+    steady (hatched in the PNG, as are points with no value and points whose magnitude is below the
     measurable step); ringing_* (every quantity but the stall force): the runner's swing after a
     fly-back and what is left of it when the next starts (ringing_at_next_flyback_m): where that
     exceeds the measurable step the value depends on the swing's phase, and a curve turns
