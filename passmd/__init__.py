@@ -23,9 +23,12 @@ Which may import which is the ``layers`` contract of ``pyproject.toml`` (import-
 
 The names a drive designer needs are exported here, loaded on first use: ``Drive``,
 ``paper_drive``, ``sawtooth``, ``simulate``, ``Simulation``, ``drive_theory``,
-``critical_amplitude``, ``generated_force``, ``optimized_design``, ``RunConfig``,
-``load_drive``/``drive_toml`` (read and write a drive file), and ``fit``/``read_measurements``
-(calibrate free drive parameters to measurements).
+``critical_amplitude``, ``generated_force``, ``optimized_design``, ``optimized`` and
+``highest_fitting_frequency`` (Eq. 15's design, waveform and where it fits), ``RunConfig``,
+``load_drive``/``drive_toml`` (read and write a drive file; ``EXAMPLE_DRIVE_FILE``, the book's
+worked example), ``contact_arrangement`` (each contact group's side, angle and normal force),
+``compute_map`` (what ``passmd sweep`` computes), ``stick_ringing`` (the runner's swing after a
+fly-back), and ``fit``/``read_measurements`` (calibrate free drive parameters to measurements).
 """
 
 #: The version: its one source (pyproject.toml reads it, ``dynamic = ["version"]``; CITATION.cff
@@ -52,9 +55,15 @@ _API = {
     "critical_amplitude": "passmd.protocols.critical_amplitude",
     "generated_force": "passmd.protocols.stall",
     "optimized_design": "passmd.protocols.eq15",
+    "optimized": "passmd.model.optimized_waveform",
+    "highest_fitting_frequency": "passmd.model.optimized_waveform",
     "RunConfig": "passmd.runtime.config",
     "load_drive": "passmd.model.drive_file",
     "drive_toml": "passmd.model.drive_file",
+    "EXAMPLE_DRIVE_FILE": "passmd.model.drive_file",
+    "contact_arrangement": "passmd.model.theory",
+    "compute_map": "passmd.experiments.design.maps",
+    "stick_ringing": "passmd.protocols.ringing",
     "fit": "passmd.protocols.fit",
     "read_measurements": "passmd.protocols.fit",
 }

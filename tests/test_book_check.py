@@ -104,11 +104,23 @@ def test_good_page_has_no_problems():
         ({"network_errors": ["net::ERR_BLOCKED_BY_CLIENT"]}, "network access"),
         ({"expect": "figures=many"}, "passmd-expect"),
         ({"page_width": 1650, "window_width": 1280}, "scrolls horizontally"),
+        ({"raw_myst": ["The measurements ({download}"]}, "raw MyST left in the page"),
+        ({"raw_myst": ["```bash passmd drive show"]}, "raw MyST left in the page"),
+        ({"inline_blocks": ["bash passmd drive show --drive x.toml passmd sweep step"]},
+         "a code block shown as inline text"),
+        ({"audience": "designer", "internal_imports": ["from passmd.report import publish"]},
+         "imports an internal module"),
     ],
 )
 def test_each_defect_is_a_problem(changes, fragment):
     problems = checker.page_problems(_good_facts(**changes))
     assert any(fragment in p for p in problems), problems
+
+
+def test_internal_imports_matter_on_a_designers_page_only():
+    # the replication chapters show the package's own modules; a designer's page shows the public API
+    assert checker.page_problems(_good_facts(internal_imports=["from passmd.ledger import readings"])) == []
+    assert checker.page_problems(_good_facts(audience="designer", internal_imports=[])) == []
 
 
 def test_overflow_within_a_pixel_is_no_problem():
@@ -246,6 +258,27 @@ def test_check_fails_on_blocks_wider_than_the_column(broken_book_results):
 
 
 @pytest.mark.slow
+def test_check_fails_on_a_designers_page_that_does_not_render(broken_book_results):
+    # designer.md: a download and a glue role glued as CommonMark (left raw), a command block glued
+    # into a paragraph (inline code), a visible cell importing passmd.runtime. Without the three new
+    # rules the page passes: the checks before them did not see any of it. good.md has the same
+    # three rendered (glue:md with :myst, the glue:md directive, `import passmd`) and passes.
+    results, _, book = broken_book_results
+    facts, problems = results["designer"]["facts"], results["designer"]["problems"]
+    assert checker.page_problems({**facts, "raw_myst": [], "inline_blocks": [], "internal_imports": []}) == []
+    assert any("raw MyST" in p and "{download}" in p for p in problems), problems
+    assert any("raw MyST" in p and "{glue:text}" in p for p in problems), problems
+    assert any("shown as inline text" in p and "bash passmd drive show" in p for p in problems), problems
+    assert any("internal module" in p and "from passmd.runtime import units" in p for p in problems), problems
+    assert not any("import passmd'" in p for p in problems), problems
+    good = results["good"]["facts"]
+    assert good["audience"] == "designer" and good["internal_imports"] == [] and good["raw_myst"] == []
+    html = (book / "_build" / "html" / "good.html").read_text(encoding="utf-8")
+    assert 'class="reference download internal"' in html and "drive.toml" in html  # the link works
+    assert "highlight-bash" in html and good["broken_links"] == []  # the block is a block
+
+
+@pytest.mark.slow
 def test_screenshot_shows_what_a_reader_sees(broken_book_results, tmp_path):
     # The full-page screenshot, cut to the window's height, must be the window itself: same
     # width, and no sideways shift (the page once appeared shifted by about a fifth).
@@ -279,7 +312,7 @@ def test_command_line_exit_status(broken_book_results, capsys):
     status = checker.main([str(book / "_build" / "html"), "--toc", str(book / "_toc.yml")])
     out = capsys.readouterr().out
     assert status == 1
-    assert "[ok] good" in out and "[FAIL] broken" in out and "[FAIL] wide" in out
+    assert "[ok] good" in out and "[FAIL] broken" in out and "[FAIL] wide" in out and "[FAIL] designer" in out
 
 
 @pytest.mark.slow

@@ -674,16 +674,33 @@ def test_python_dash_m():
 def test_run_optimized_reports_its_eq15_design():
     """`run --waveform optimized` gives the design it ran (t_s, t_a, Δ_a, V_a, f_s, V_r, u_x,max),
     the one passmd.protocols.eq15 derives for this drive; a saw-tooth run has none."""
+    from passmd.model.optimized_waveform import highest_fitting_frequency
     from passmd.model.parameters import Drive
     from passmd.protocols import eq15
 
-    data = run_json("run", "--waveform", "optimized", "--frequency", "10kHz", "--periods", "3")
+    data = run_json("run", "--waveform", "optimized", "--frequency", "5kHz", "--periods", "3")
     drive = Drive()
-    expected = eq15.optimized_design(drive.actuator.full_stroke_amplitude, drive).as_dict()
-    assert data["design"] == pytest.approx(expected, rel=1e-12)  # the same computation, run again
-    assert 0 < data["design"]["settling_time_s"] < 1 / 10e3
-    _, text = run_cli("run", "--waveform", "optimized", "--frequency", "10kHz", "--periods", "3")
+    amplitude = drive.actuator.full_stroke_amplitude
+    design = eq15.optimized_design(amplitude, drive)
+    assert data["design"] == pytest.approx(design.as_dict(), rel=1e-12)  # the same computation, run again
+    assert data["design"]["response_frequency_Hz"] == 100.0  # the paper's 100 Hz response (Section 5.2)
+    f_max = highest_fitting_frequency(design, amplitude, drive)
+    assert data["eq15_highest_frequency_Hz"] == pytest.approx(f_max, rel=1e-12)
+    assert 5e3 < f_max < 10e3  # so Eq. 15 fits at 5 kHz and not at 10 kHz
+    _, text = run_cli("run", "--waveform", "optimized", "--frequency", "5kHz", "--periods", "3")
     row = next(line for line in text.splitlines() if line.strip().startswith("Eq. 15 design"))
-    symbols = ("t_s =", "t_a =", "Δ_a =", "V_a =", "f_s =", "V_r =", "u_x,max =")
+    symbols = ("t_s =", "t_a =", "Δ_a =", "V_a =", "f_s =", "V_r =", "u_x,max =", "100 Hz saw-tooth response")
     assert all(symbol in row for symbol in symbols), row
+    assert re.search(rf"Eq. 15 fits +up to {f_max / 1e3:.4g} kHz", text), text
+    # above it the run is refused in one line naming the highest frequency at which Eq. 15 fits
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        status, _ = run_cli("run", "--waveform", "optimized", "--frequency", "10kHz", "--periods", "3")
+    text = err.getvalue()
+    assert status == 2 and text.count("\n") <= 1, text
+    assert ("--frequency 10kHz is out of range for --waveform optimized: must be <= "
+            f"{f_max / 1e3:.4g} kHz") in text
+    data = run_json("run", "--waveform", "optimized", "--frequency", "2kHz", "--periods", "3",
+                    "--design-response", "driving")
+    assert data["design"]["response_frequency_Hz"] == 2e3
     assert "design" not in run_json("run", "--periods", "2")

@@ -8,6 +8,7 @@ the options describe (same deterministic code, same SI inputs; JSON round-trips 
 import json
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -110,7 +111,7 @@ def test_step_over_preload_is_the_protocols_value(tmp_path):
                            "--executor", "serial", "--cache-dir", str(tmp_path / "c"))
     assert status == 0 and "2 (2 from the cache, 0 computed)" in text
     for row in data["rows"]:  # a short curve is listed in full, in nm
-        assert f"preload {row['preload_N']:.6g} N  {row['step_m'] / 1e-9:.6g} nm" in text, text
+        assert re.search(rf"preload {row['preload_N']:.6g} N +{row['step_m'] / 1e-9:.6g} nm", text), text
 
 
 def test_a_map_writes_csv_json_png_in_grid_order_and_reruns_from_the_cache(tmp_path):
@@ -169,15 +170,36 @@ def test_critical_amplitude_names_its_reading_and_carries_the_closed_form(tmp_pa
 
 
 def test_gain_is_missing_where_eq15_gives_no_waveform(tmp_path):
-    data = run_json("sweep", "gain", "--vary", "amplitude=20nm,202nm", "--frequency", "5kHz", *CHEAP,
-                    "--executor", "serial", "--cache-dir", str(tmp_path / "c"), "--out", str(tmp_path / "g"))
-    low, high = data["rows"]
-    assert low["gain_m_per_s"] is None and "no Eq. 15 waveform at this amplitude" in low["note"]
+    """A cell has no value, and its note says why, where Eq. 15 gives no waveform at the amplitude or
+    its period does not fit: above the highest fitting frequency, a column of every designed cell."""
+    from passmd.model.optimized_waveform import highest_fitting_frequency
+    from passmd.protocols import eq15
+
     drive = Drive(contacts=1, actuator_model="rigid")
-    expected = maps.gain_point(drive, 202e-9, 5e3)
-    assert high["gain_m_per_s"] == expected["gain_m_per_s"]
-    assert high["gain_m_per_s"] == high["optimized_velocity_m_per_s"] - high["sawtooth_velocity_m_per_s"]
-    assert data["missing_values"] == 1
+    f_max = highest_fitting_frequency(eq15.optimized_design(202e-9, drive), 202e-9, drive)
+    low_f, high_f = f_max / 2, 2 * f_max
+    axes = ("--vary", "amplitude=20nm,202nm", "--vary", f"frequency={low_f!r},{high_f!r}")
+    data = run_json("sweep", "gain", *axes, *CHEAP, "--executor", "serial", "--cache-dir",
+                    str(tmp_path / "c"), "--out", str(tmp_path / "g"))
+    by = {(round(r["amplitude_m"] * 1e9), r["frequency_Hz"]): r for r in data["rows"]}
+    for f in (low_f, high_f):
+        assert by[20, f]["gain_m_per_s"] is None
+        assert "no Eq. 15 waveform at this amplitude" in by[20, f]["note"]
+    fits, too_fast = by[202, low_f], by[202, high_f]
+    expected = maps.gain_point(drive, 202e-9, low_f)
+    assert fits["gain_m_per_s"] == expected["gain_m_per_s"] and fits["note"] is None
+    assert fits["gain_m_per_s"] == fits["optimized_velocity_m_per_s"] - fits["sawtooth_velocity_m_per_s"]
+    assert fits["eq15_highest_frequency_Hz"] == pytest.approx(f_max, rel=1e-12)
+    assert fits["response_frequency_Hz"] == 100.0 and data["design_response"] == "paper"
+    assert too_fast["gain_m_per_s"] is None and too_fast["sawtooth_velocity_m_per_s"] is not None
+    assert too_fast["note"].startswith("Eq. 15 does not fit the period") and f"{f_max / 1e3:.4g} kHz" in \
+        too_fast["note"]
+    assert data["missing_values"] == 3
+    status, text = run_cli("sweep", "gain", *axes, *CHEAP, "--executor", "serial", "--cache-dir",
+                           str(tmp_path / "c"))
+    assert status == 0 and "3 points: 1 where Eq. 15 does not fit the period, 2 where Eq. 15 gives no " \
+        "waveform at the amplitude (see the note column)" in text, text
+    assert f"from the saw-tooth response at 100 Hz; fits up to {f_max / 1e3:.4g} kHz" in text, text
 
 
 def test_stall_force_over_preload(tmp_path):
@@ -242,3 +264,25 @@ def test_ctrl_c_keeps_finished_points_and_the_rerun_computes_only_the_rest(tmp_p
     counts = json.loads(done.stdout)["sweep"]
     assert counts == {"points": 8, "cached": 2, "computed": 6}
     assert all(math.isfinite(row["velocity_m_per_s"]) for row in json.loads(done.stdout)["rows"])
+
+
+def test_help_explains_the_drift_and_its_limit():
+    from passmd.cli.commands.sweep import STEADY_DRIFT_PERCENT
+    from passmd.protocols.velocity import STEADY_DRIFT_LIMIT
+
+    assert STEADY_DRIFT_PERCENT / 100 == STEADY_DRIFT_LIMIT
+    _, text = run_cli("sweep", "--help")
+    assert "velocity_drift" in text and f"beyond {STEADY_DRIFT_PERCENT} %" in text
+
+
+@pytest.mark.parametrize(("typed", "values"), [
+    ("preload=0.1N..1N:10", (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0)),
+    ("amplitude=40nm..250nm:8", (4e-08, 7e-08, 1e-07, 1.3e-07, 1.6e-07, 1.9e-07, 2.2e-07, 2.5e-07)),
+    ("mu=0.1..0.3:5", (0.1, 0.15, 0.2, 0.25, 0.3)),
+])
+def test_grid_values_are_written_as_typed(typed, values):
+    """A linear grid in decimal: the CSV holds 0.4 for 0.1..1:10, not 0.39999999999999997."""
+    assert parse_vary(typed).values == values
+    log = parse_vary("frequency=100Hz..110kHz:log:6").values
+    assert log[0] == 100.0 and log[-1] == 110e3 and all(len(repr(v)) <= 14 for v in log)
+    np.testing.assert_allclose(log, np.geomspace(100.0, 110e3, 6), rtol=1e-11)

@@ -41,7 +41,8 @@ def test_parameter_table_has_every_drive_show_row():
     assert list(table.index) == list(DRIVE_KEYS)
     assert table.loc["hemisphere_radius", ["value", "unit"]].tolist() == ["0.5", "mm"]
     assert table.loc["actuator.full_stroke_amplitude", "value"] == "131.3"  # Table 2 at 0.5 mm
-    assert table.loc["contacts", "value"] == "paper-six"
+    assert table.loc["contacts", "value"] == "6"  # derived from the groups
+    assert table.loc["contact_groups", "value"] == "2 at 45° (side 1); 4 at 45° (side 2)"
 
 
 @pytest.mark.parametrize("profile", ["quick", "paper"])
@@ -103,6 +104,47 @@ def test_gain_facts_count_missing_waveforms_and_signs():
     assert facts["gain_min_mm_s"] == pytest.approx(-1.0)
     none = design.gain_facts(table.assign(gain_m_per_s=[None] * 4))
     assert none["gain_designed"] == 0 and "gain_max_mm_s" not in none
+
+
+def test_contact_table_is_eq1_for_the_example_guide():
+    """The example writes the paper's guide as groups: F_p/(2 sin 45°) and F_p/(4 sin 45°) per contact."""
+    drive, _ = design.example_drive()
+    table = design.contact_table(drive)
+    assert table["side"].tolist() == [1, 2] and table["contacts"].tolist() == [2, 4]
+    assert table["contact angle α [°]"].tolist() == pytest.approx([45.0, 45.0])
+    sin45 = np.sin(np.pi / 4)
+    assert table["F_N per contact [N]"].tolist() == [drive.preload / 2 / sin45, drive.preload / 4 / sin45]
+    assert table["n F_N sin α [N]"].tolist() == pytest.approx([drive.preload] * 2, rel=1e-15)
+
+
+def _curve(steady, closed=(30.0, 50.0, 70.0, 90.0), left=(2.0, 0.1, 3.0, 4.0)):
+    return pd.DataFrame({"preload_N": [0.2, 0.4, 0.6, 0.8], "closed_form_nm": closed, "steady_nm": steady,
+                         "first_nm": [25.0, 45.0, 65.0, 85.0], "ringing_left_nm": left,
+                         "ringing_affects": [v > 0.5 for v in left]})
+
+
+def test_curve_facts_say_where_the_closed_form_is_exceeded_and_how_often_the_curve_turns():
+    below = design.curve_facts(_curve([20.0, 40.0, 60.0, 80.0]))
+    assert below["ca_closed_above"] == 4 and below["ca_turns"] == 0 and below["ca_ringing_points"] == 3
+    # the issue's kind of drive: steady A_c above the closed form at one preload, turning twice
+    jagged = design.curve_facts(_curve([20.0, 55.0, 52.0, 80.0]))
+    assert jagged["ca_closed_above"] == 3 and jagged["ca_excess_nm"] == pytest.approx(5.0)
+    assert jagged["ca_excess_at_N"] == 0.4 and jagged["ca_turns"] == 2
+    assert jagged["ca_ringing_left_nm"] == 4.0
+    # a dip within the measurable step is no turn
+    assert design.curve_facts(_curve([20.0, 40.0, 39.8, 80.0]))["ca_turns"] == 0
+
+
+def test_ringing_facts_read_the_probe():
+    probe = {"ringing_frequency_Hz": 5e3, "ringing_amplitude_m": 40e-9, "ringing_decay_time_s": 3e-3,
+             "ringing_hold_s": 20e-3, "flyback_time_s": 1e-6,
+             "swing_times_s": np.array([1e-4, 5e-3, 9.999e-3, 15e-3]),
+             "swing_amplitudes_m": np.array([40e-9, 10e-9, 5e-9, 0.4e-9])}
+    facts = design.ringing_facts(probe, 100.0)
+    assert facts["ring_f_kHz"] == 5.0 and facts["ring_amp_nm"] == pytest.approx(40.0)
+    assert facts["ring_left_nm"] == pytest.approx(5.0, rel=1e-3)
+    assert facts["ring_quiet_ms"] == pytest.approx(15.0)
+    assert facts["ring_next_ms"] == pytest.approx(9.999)
 
 
 def test_fit_facts_say_whether_the_interval_holds_the_truth():

@@ -5,6 +5,7 @@ is one line naming the file and the key as typed, and ``drive_toml`` round-trips
 from __future__ import annotations
 
 import json
+import math
 
 import pytest
 
@@ -174,7 +175,7 @@ count = 1
 load_share = 1.0
 [[contact_groups]]
 count = 3
-normal_force = "0.15 N"
+normal_force = "0.1667 N"
 radius = "0.5 mm"
 """
 
@@ -186,7 +187,7 @@ def test_contact_groups_from_a_file_run_and_read_back(tmp_path, capsys):
     path.write_text(GROUPS, encoding="utf-8")
     drive = load_drive(path)
     assert drive.contact_groups == (ContactGroup(1, load_share=1.0),
-                                    ContactGroup(3, normal_force=0.15, radius=0.5e-3))
+                                    ContactGroup(3, normal_force=0.1667, radius=0.5e-3))
     assert drive.contacts == 4
     again = tmp_path / "again.toml"
     again.write_text(drive_toml(drive), encoding="utf-8")
@@ -195,14 +196,24 @@ def test_contact_groups_from_a_file_run_and_read_back(tmp_path, capsys):
                          capsys)
     data = json.loads(out)
     assert status == 0 and data["drive"]["contacts"] == 4
-    assert data["drive"]["contact_groups"][1] == {"count": 3, "load_share": None, "normal_force_N": 0.15,
-                                                  "radius_m": 0.5e-3}
+    assert data["drive"]["contact_groups"][1] == {"count": 3, "load_share": None, "normal_force_N": 0.1667,
+                                                  "radius_m": 0.5e-3, "contact_angle_rad": math.pi / 2,
+                                                  "side": None}
     status, out, _ = run(["theory", "--drive", str(path), "--contacts", "6", "--json"], capsys)
     assert json.loads(out)["drive"]["contacts"] == 6 and "contact_groups" not in json.loads(out)["drive"]
 
 
 @pytest.mark.parametrize(("text", "fragment"), [
-    ("[[contact_groups]]\ncount = 2\n", "contact_groups[0] gives both or neither"),
+    ("[[contact_groups]]\ncount = 2\nload_share = 0.5\nnormal_force = 0.2\n",
+     "contact_groups[0] gives both load_share and normal_force"),
+    ("[[contact_groups]]\ncount = 2\ncontact_angle = 45\n",
+     "contact_groups[0].contact_angle = 45 is out of range: must be > 0 and <= 90 deg"),
+    ("[[contact_groups]]\ncount = 2\ncontact_angle = \"45 N\"\n",
+     "contact_groups[0].contact_angle = '45 N' is not an angle"),
+    ("[[contact_groups]]\ncount = 2\nside = 3\n", "contact_groups[0].side = 3: must be 1 or 2"),
+    ("preload = 0.9\n[[contact_groups]]\ncount = 2\nload_share = 0.9\n[[contact_groups]]\ncount = 4\n"
+     "load_share = 0.9\n",
+     "bad.toml: contact_groups[0]: the normal forces on side 1 do not balance the preload"),
     ("[[contact_groups]]\ncount = 0\nload_share = 1.0\n", "contact_groups[0].count = 0: must be an integer"),
     ("[[contact_groups]]\ncount = 2\nshare = 1.0\n", "contact_groups[0].share is not a key of a contact"),
     ("[[contact_groups]]\ncount = 2\nnormal_force = \"2 mm\"\n", "contact_groups[0].normal_force = '2 mm'"),

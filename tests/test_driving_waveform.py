@@ -13,6 +13,8 @@ from passmd.model.defaults import PROTOCOL
 from passmd.model.optimized_waveform import (
     MIN_RAMP_FRACTION,
     OptimizedDesign,
+    check_fits,
+    highest_fitting_frequency,
     max_piezo_velocity,
     optimized,
     optimized_timing,
@@ -82,9 +84,10 @@ def test_measured_micro_vibration_frequency_against_linear_estimate(design, driv
 
 @pytest.mark.parametrize("frequency", [F_STEP, 1e3, 10e3, 50e3, 110e3, 130e3])
 def test_optimized_waveform_honours_slew_rate_and_period(design, drive, frequency):
-    wave = optimized(A, frequency, drive, periods=4, design=design)
+    fits = frequency <= highest_fitting_frequency(design, A, drive)
+    wave = optimized(A, frequency, drive, periods=4, design=design, short_period="refuse" if fits else "cut")
     T = 1.0 / frequency
-    assert wave.kind == "optimized"
+    assert wave.kind == ("optimized" if fits else "optimized, t_s cut")  # a truncated one says so
     assert wave.period == pytest.approx(T, rel=1e-15)
     assert wave.duration == pytest.approx(4 * T, rel=1e-12)
     # relative 1e-9: the fly-back and acceleration sit exactly at the limit, up to rounding
@@ -133,8 +136,41 @@ def test_long_acceleration_is_cut_not_failed(drive):
     # V_a is kept, so the amplitude shrinks with the time
     v_a = timing["acceleration_amplitude_m"] / timing["acceleration_time_s"]
     assert v_a == pytest.approx(2e-3, rel=1e-12)
-    wave = optimized(A, 50e3, drive, periods=2, design=slow)
+    wave = optimized(A, 50e3, drive, periods=2, design=slow, short_period="cut")
     assert np.max(np.abs(_slopes(wave))) <= max_piezo_velocity(drive) * (1 + 1e-9)
+
+
+def test_highest_fitting_frequency_is_where_settling_stops_fitting(design, drive):
+    """At or below it one Eq. 15 period fits whole (optimized_timing's settling_fits), above it not;
+    it follows the closed form T = t_fb + (t_s + t_a) / (1 − MIN_RAMP_FRACTION) here (the ramp's
+    share, not A/V_max, binds for the paper's drive)."""
+    f_max = highest_fitting_frequency(design, A, drive)
+    t_fb = waveforms.flyback_time(A, drive)
+    expected = 1.0 / (t_fb + (design.settling_time + design.acceleration_time) / (1 - MIN_RAMP_FRACTION))
+    assert f_max == pytest.approx(expected, rel=1e-12)
+    assert optimized_timing(design, A, f_max * (1 - 1e-9), drive)["settling_fits"]
+    assert not optimized_timing(design, A, f_max * (1 + 1e-9), drive)["settling_fits"]
+    # a short settling time: the slow ramp's A/V_max binds instead, and the rule still marks the edge
+    quick = OptimizedDesign(settling_time=1e-7, acceleration_time=1e-7, acceleration_amplitude=5e-9)
+    f_quick = highest_fitting_frequency(quick, A, drive)
+    assert f_quick == pytest.approx(1.0 / max(t_fb + 2e-7 + A / max_piezo_velocity(drive), 2 * t_fb,
+                                              t_fb + 4e-7), rel=1e-12)
+
+
+def test_eq15_refuses_a_period_it_does_not_fit(design, drive):
+    """By default the waveform is Eq. 15's or refused in one line naming the highest fitting frequency;
+    the truncated study waveforms are asked for by name."""
+    f_max = highest_fitting_frequency(design, A, drive)
+    assert check_fits(design, A, f_max * 0.99, drive) == f_max * 0.99
+    with pytest.raises(ValueError) as caught:
+        optimized(A, 2 * f_max, drive, periods=3, design=design)
+    message = str(caught.value)
+    assert "\n" not in message and f"must be <= {f_max:.4g} Hz" in message and "t_s = " in message
+    assert caught.value.name == "frequency" and caught.value.limits == (("<=", f_max),)
+    with pytest.raises(ValueError, match="out of range for the Eq. 15 waveform"):
+        optimized_timing(design, A, 2 * f_max, drive, short_period="refuse")
+    assert optimized(A, 2 * f_max, drive, periods=3, design=design, short_period="skip").kind == \
+        "optimized, t_s skipped"
 
 
 def test_bad_inputs(design, drive):

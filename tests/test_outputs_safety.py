@@ -364,7 +364,7 @@ def _terminate(proc, before: bytes, to_group: bool = False) -> tuple[int, str, s
 
 #: A progress line off a terminal (passmd.runtime.progress), e.g. "simulation: 4.2% (4.20/100 periods) ...".
 PROGRESS_LINE = re.compile(r"^\w+: \d+\.\d% \([\d.]+/\d+ (periods|points)\) after [\d:]+, "
-                           r"(about [\d:]+ left|time left known after the first (period|point))$")
+                           r"(about [\d:]+ left|time left known after 3 (periods|points))$")
 
 
 def _check_interrupted(status, out, err, prog="passmd run", kept=""):
@@ -478,8 +478,9 @@ def test_sweep_progress_lines_off_a_terminal(monkeypatch, capsys):
     lines = captured.err.splitlines()
     assert "slow_point: 50.0% (2/4 points)" in captured.err and "\r" not in captured.err
     assert all(PROGRESS_LINE.match(line) and line.startswith("slow_point: ") for line in lines), lines
-    # the time left once a point is done (the average rate says nothing before)
-    assert lines[0].endswith("time left known after the first point") and lines[-1].endswith(" left")
+    # the time left once three points are done (the first ones carry the start-up)
+    assert lines[0].endswith("time left known after 3 points") and lines[-1].endswith(" left")
+    assert not any("about" in line for line in lines if "(2/4 points)" in line or "(1/4 points)" in line)
     assert "about" in lines[-1] and captured.out == ""
 
 
@@ -706,3 +707,31 @@ def test_a_signal_at_any_moment_of_a_fit_is_one_line(tmp_path, moment, sig):
                                   moments=FIT_MOMENTS)
     assert (status, out, err) == (128 + sig, "", "passmd fit: interrupted\n")
     assert {p.name for p in tmp_path.iterdir()} <= {"cache", "data.csv", "gates"}  # no fit written
+
+
+def test_time_left_waits_for_a_few_units():
+    """No estimate from the first units (they carry the start-up); the average rate after them."""
+    assert _progress.time_left(12.0, 1, 12, "run") == f"time left known after {_progress.MIN_DONE} runs"
+    assert _progress.time_left(9.0, 3, 6, "point", lambda s: f"{s:.0f} s") == "about 18 s left"
+    assert _progress.time_left(9.0, 3, None, "point") == "time left unknown"
+    class Terminal:
+        text = ""
+
+        def isatty(self):
+            return True
+
+        def write(self, text):
+            self.text += text
+
+        def flush(self):
+            pass
+
+        def getvalue(self):
+            return self.text
+
+    terminal = Terminal()
+    bar = _progress.bar(13, unit="run", desc="critical amplitude", delay=0.0, stream=terminal)
+    bar.update(1)
+    bar.refresh()
+    assert "time left known after 3 runs" in terminal.getvalue() and "about" not in terminal.getvalue()
+    bar.close()

@@ -83,3 +83,12 @@ def test_stamp_summary_and_csv_header():
         "# profile: quick"]
     with pytest.raises(ValueError, match="profile = 'fast'"):
         provenance.stamp("fast")
+
+
+def test_an_installed_package_names_its_version_for_the_commit(monkeypatch):
+    """A wheel has no git checkout: its results say which release made them."""
+    monkeypatch.setattr(provenance, "git_commit", lambda: provenance.UNKNOWN)
+    expected = f"none: installed package, version {passmd.__version__}"
+    assert provenance.commit_or_version() == expected
+    assert provenance.stamp("quick")["git_commit"] == expected
+    assert f"commit {expected}" in provenance.summary("quick")

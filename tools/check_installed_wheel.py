@@ -83,8 +83,9 @@ def main(argv: list[str] | None = None) -> int:
 
     figure = json.loads(_run(exe, "figure", "fig9a", "--profile", "quick", "--json"))
     header = Path(figure["csv"]).read_text(encoding="utf-8").splitlines()[:3]
-    expected = [f"# passmd_version: {passmd.__version__}", f"# git_commit: {provenance.UNKNOWN}",
-                "# profile: quick"]
+    installed = f"none: installed package, version {passmd.__version__}"  # no checkout: the release
+    assert provenance.commit_or_version() == installed, provenance.commit_or_version()
+    expected = [f"# passmd_version: {passmd.__version__}", f"# git_commit: {installed}", "# profile: quick"]
     if header != expected:
         raise SystemExit(f"FAILED: provenance header of {figure['csv']} is {header}, expected {expected}")
     if not Path(figure["png"]).is_file():

@@ -12,6 +12,14 @@ all network requests blocked) with the system's Chromium driven by selenium, and
   blocks, or a Python traceback anywhere in the text),
 * leaves math unrendered (a ``.math`` element without MathJax output, a MathJax error, raw
   ``$$``/``\\(``/``\\[`` in the text) or a web font that failed to load,
+* leaves MyST unrendered: a role or directive name in braces (``{download}``, ``{glue:md}``, …)
+  or a code fence (`````) in the text,
+* shows a code block glued as inline text (an inline ``code`` element that starts with a
+  language name and whose lines' first word repeats, ``bash passmd … passmd …``, or that holds
+  a shell line continuation),
+* is written for a designer (``passmd-audience: designer`` meta tag) and shows a code cell that
+  imports an internal module: its visible code uses only the public API (``import passmd``,
+  ``from passmd import …``) and the command line,
 * links to a local file that is not in the built book (e.g. a figure's CSV data),
 * tries to load anything from the network (the book must display offline),
 * scrolls horizontally in a window :data:`WINDOW_WIDTH` px wide (content wider than the window),
@@ -152,12 +160,45 @@ const ledgerSelector = arguments[0];
     }
     return found;
   };
+  // MyST the build left unrendered, and code blocks glued as inline text (a glued fence)
+  const rawMyst = [];
+  const names = ['download', 'glue(:\\w+)?', 'doc', 'ref', 'numref', 'eq', 'math', 'term', 'code-cell',
+                 'literalinclude', 'figure', 'image', 'note', 'warning', 'admonition', 'list-table',
+                 'dropdown', 'tab-set'];
+  const roles = new RegExp('\\{(' + names.join('|') + ')\\}|```');
+  const textWalker = document.createTreeWalker(root, NodeFilter.SHOW_TEXT);
+  for (let node = textWalker.nextNode(); node; node = textWalker.nextNode()) {
+    const skipped = 'pre, code, script, style, textarea, .highlight';
+    if (node.parentElement && node.parentElement.closest(skipped)) continue;
+    const m = node.textContent.match(roles);
+    if (m) rawMyst.push(node.textContent.trim().slice(0, 80));
+  }
+  // a fence glued inline: its language name, then lines whose first word repeats (passmd … passmd …),
+  // or a shell line continuation; a one-line command in code font (python bench.py --x) is neither
+  const lexers = /^(bash|sh|shell|console|python|ipython3?|toml|yaml|json|text)\s+(\S+)\s+(.*)$/;
+  const glued = (t) => {
+    const m = t.match(lexers);
+    return / \\ /.test(t) || (m !== null && t.length > 40 && m[3].split(' ').includes(m[2]));
+  };
+  const inlineBlocks = Array.from(root.querySelectorAll('code'))
+    .filter(c => !c.closest('pre, .highlight'))
+    .map(c => c.textContent.replace(/\s+/g, ' ').trim())
+    .filter(glued)
+    .map(t => t.slice(0, 80));
+  const cellImports = Array.from(root.querySelectorAll('.cell_input pre, .cell_input .highlight'))
+    .flatMap(c => c.textContent.split('\n'))
+    .filter(line => /^\s*(from\s+passmd\.[\w.]+\s+import\b|import\s+passmd\.)/.test(line))
+    .map(line => line.trim().slice(0, 80));
   const maths = Array.from(root.querySelectorAll('.math'));
   const text = root.innerText || '';
   done({
     title: document.title,
     has_article: !!article,
     expect: (document.querySelector('meta[name="passmd-expect"]') || {}).content || null,
+    audience: (document.querySelector('meta[name="passmd-audience"]') || {}).content || null,
+    raw_myst: Array.from(new Set(rawMyst)).slice(0, 5),
+    inline_blocks: inlineBlocks.slice(0, 5),
+    internal_imports: Array.from(new Set(cellImports)).slice(0, 5),
     images: imgs.map(img => ({
       src: img.getAttribute('src'),
       ok: img.complete && img.naturalWidth > 0 && img.naturalHeight > 0,
@@ -281,6 +322,14 @@ def page_problems(facts: dict) -> list[str]:
         problems.append(f"MathJax error: {message}")
     for snippet in facts.get("raw_tex", []):
         problems.append(f"raw TeX left in the page: {snippet!r}")
+    for snippet in facts.get("raw_myst", []):
+        problems.append(f"raw MyST left in the page (a role, directive or fence not rendered): {snippet!r}")
+    for snippet in facts.get("inline_blocks", []):
+        problems.append(f"a code block shown as inline text: {snippet!r}")
+    if facts.get("audience") == "designer":
+        for line in facts.get("internal_imports", []):
+            problems.append(f"a visible code cell of a designer's page imports an internal module (only "
+                            f"`import passmd`, `from passmd import ...` and the command line): {line!r}")
     for href in facts.get("broken_links", []):
         problems.append(f"link to a missing file: {href}")
     visible = facts.get("viewport_width") or facts.get("window_width")

@@ -25,6 +25,7 @@ from passmd.cli.streams import (
     use_ascii_fallback,
 )
 from passmd.runtime.cache import CacheWarning
+from passmd.runtime.extras import install_hint
 from passmd.runtime.units import QuantityError
 
 __all__ = ["Terminated", "main"]
@@ -164,7 +165,7 @@ def _dispatch(args, out: Out, prog: str, to_stdout: bool) -> int:  # noqa: C901 
         return _error(prog, f"run failed: {exc}", 1)
     except ModuleNotFoundError as exc:
         extra = OPTIONAL_EXTRAS.get((exc.name or "").split(".")[0])
-        hint = f"pip install 'passmd[{extra}]'" if extra else "reinstall passmd with its dependencies"
+        hint = install_hint(extra) if extra else "reinstall passmd with its dependencies"
         return _error(prog, f"the package {exc.name!r} is not installed: {hint}", 1)
     except MemoryError:
         return _error(prog, "not enough memory for this run (lower --max-points or the number of periods)", 1)

@@ -17,6 +17,7 @@ from dataclasses import replace
 
 from passmd.cli.errors import MissingDependencyError, UsageError
 from passmd.runtime.config import MAX_WORKERS, WORKERS_PER_CORE, RunConfig, WorkersCapped, usable_cores
+from passmd.runtime.extras import install_hint
 
 __all__ = ["execution_config", "run_config"]
 
@@ -26,7 +27,7 @@ def _require_executor(config: RunConfig) -> None:
     if (config.executor == "dask" or (config.executor is None and config.scheduler)) \
             and importlib.util.find_spec("distributed") is None:
         raise MissingDependencyError("the Dask executor needs the 'distributed' package, which is not "
-                                     "installed: pip install 'passmd[dask]'")
+                                     f"installed: {install_hint('dask')}")
 
 
 def _check_sweep_log(config: RunConfig) -> None:

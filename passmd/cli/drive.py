@@ -73,7 +73,13 @@ def resolve_drive(args, **fixed) -> tuple[Drive, dict[str, str]]:
     if getattr(args, "allow_extrapolation", False):
         values["allow_extrapolation"] = True
         origins.setdefault("allow_extrapolation", "option --allow-extrapolation")
-    return resolve(values, origins, **fixed)
+    try:
+        return resolve(values, origins, **fixed)
+    except InputError as exc:
+        if exc.name == "contact_groups" and "contact_groups" in values and path is not None:
+            # the file's groups: name the file
+            raise DriveFileError(f"{path}: {exc}", name=exc.name, value=exc.value) from None
+        raise
 
 
 def build_drive(args, **fixed) -> Drive:

@@ -96,13 +96,14 @@ def sides(values, unit: str, digits: int = 5, counts=None) -> str:
     return f"{text[0]} {unit}"
 
 
-def describe(drive: Drive) -> str:
-    """One line naming the drive: radius, preload, friction, contacts, actuators."""
-    return (
-        f"R = {fmt(drive.hemisphere_radius, 'mm')}, F_p = {fmt(drive.preload, 'N')}, "
-        f"μ = {drive.friction_coefficient:g}, {drive.contacts} contact{'s' * (drive.contacts > 1)}, "
-        f"{drive.actuator_model} actuators"
-    )
+def describe(drive: Drive, omit=()) -> str:
+    """One line naming the drive: radius, preload, friction, contacts, actuators; ``omit``: the
+    parameters a sweep varies (``"radius"``, ``"preload"``, ``"mu"``), left out."""
+    parts = {"radius": f"R = {fmt(drive.hemisphere_radius, 'mm')}",
+             "preload": f"F_p = {fmt(drive.preload, 'N')}", "mu": f"μ = {drive.friction_coefficient:g}"}
+    return ", ".join([text for name, text in parts.items() if name not in omit]
+                     + [f"{drive.contacts} contact{'s' * (drive.contacts > 1)}",
+                        f"{drive.actuator_model} actuators"])
 
 
 def drive_record(drive: Drive) -> dict:
@@ -128,7 +129,8 @@ def drive_record(drive: Drive) -> dict:
         "amplifier_voltage_V": amp.peak_to_peak_voltage,
         "slew_rate_V_per_s": amp.slew_rate,
         **({"contact_groups": [{"count": g.count, "load_share": g.load_share,
-                                "normal_force_N": g.normal_force, "radius_m": g.radius}
+                                "normal_force_N": g.normal_force, "radius_m": g.radius,
+                                "contact_angle_rad": g.contact_angle, "side": g.side}
                                for g in drive.contact_groups]}
            if drive.contact_groups else {}),
     }

@@ -7,9 +7,12 @@ dotted for a part (``actuator.mass``); top-level keys may also sit in a ``[drive
     preload = 0.6                    # a bare number: SI (N)
     contacts = "paper-six"           # or "one"; or any arrangement as [[contact_groups]] tables:
     #   [[contact_groups]]
-    #   count = 1
-    #   load_share = 1.0              # F_N per contact / F_p (or normal_force = "0.3 N")
+    #   count = 2
+    #   side = 1                      # the side of the runner (1 or 2)
+    #   contact_angle = "45 deg"      # preload's line to the contact's plane (90 deg: flat)
     #   radius = "0.5 mm"             # optional: the drive's hemisphere_radius
+    #   load_share = 0.7              # optional: F_N / F_p (or normal_force = "0.3 N");
+    #                                 # left out: F_N = F_p / (n sin α) on the side (Eq. 1)
 
     [actuator]
     stiffness = "5e6 N/m"
@@ -31,10 +34,14 @@ viscosity derived from the damping ratio ζ (assumption ``actuator_viscosity``).
 from __future__ import annotations
 
 import math
+import os
 import sys
 from dataclasses import dataclass, replace
+from importlib import resources
+from pathlib import Path
 
-from passmd.model.parameters import PLAUSIBLE_RANGES, ContactGroup, Drive
+from passmd.model.arrangement import FLAT, ContactGroup, preset_groups
+from passmd.model.parameters import PLAUSIBLE_RANGES, Drive
 from passmd.model.tables import (
     ACTUATOR_DAMPING_RATIO,
     TABLE2_RADII,
@@ -43,7 +50,7 @@ from passmd.model.tables import (
     actuator_viscosity,
 )
 from passmd.runtime.inputs import RefusedFile, decode_text, read_bounded
-from passmd.runtime.units import QuantityError, parse_quantity
+from passmd.runtime.units import QuantityError, parse_angle, parse_quantity
 from passmd.runtime.validation import InputError
 
 if sys.version_info >= (3, 11):
@@ -51,8 +58,8 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-__all__ = ["CONTACT_PRESETS", "DRIVE_KEYS", "DriveFileError", "DriveKey", "drive_toml", "load_drive",
-           "parameter_rows", "read_drive_file", "resolve"]
+__all__ = ["CONTACT_PRESETS", "DRIVE_KEYS", "EXAMPLE_DRIVE_FILE", "DriveFileError", "DriveKey", "drive_toml",
+           "load_drive", "parameter_rows", "read_drive_file", "resolve"]
 
 
 class DriveFileError(InputError):
@@ -74,6 +81,10 @@ class DriveKey:
 
 
 _DEFAULT = Drive()
+#: The worked example of the book's chapter "Design your own drive" (package data: an installed wheel
+#: has it; ``passmd drive template --example`` prints it).
+EXAMPLE_DRIVE_FILE = Path(os.fspath(resources.files("passmd") / "data" / "drives"
+                                    / "example_drive.toml"))
 #: The paper's two contact arrangements, by name (Section 4.1).
 CONTACT_PRESETS = {"one": 1, "paper-six": 6}
 
@@ -81,9 +92,10 @@ CONTACT_PRESETS = {"one": 1, "paper-six": 6}
 DRIVE_KEYS: dict[str, DriveKey] = {k.key: k for k in (
     DriveKey("contacts", "choice", "", "n", "contact arrangement: \"one\" (one contact) or \"paper-six\" "
              "(two contacts on one side, four on the other)", "Section 4.1", choices=tuple(CONTACT_PRESETS)),
-    DriveKey("contact_groups", "groups", "", "n_g, F_N, R", "any other arrangement: [[contact_groups]] "
-             "tables of count, load_share (F_N / F_p per contact) or normal_force, and radius (default: the "
-             "drive's)", "instead of contacts"),
+    DriveKey("contact_groups", "groups", "", "n_g, side, α, F_N, R", "any other arrangement: "
+             "[[contact_groups]] tables of count, side (1 or 2), contact_angle (default 90 deg, flat), "
+             "radius (default: the drive's) and, optionally, load_share (F_N / F_p) or normal_force; each "
+             "side's Σ n F_N sin α must balance the preload (Eq. 1)", "instead of contacts"),
     DriveKey("actuator_model", "choice", "", "–", "\"flexible\" (mass–spring–damper) or \"rigid\" actuators",
              "Section 3.1", choices=("flexible", "rigid")),
     DriveKey("hemisphere_radius", "m", "mm", "R", "radius of the hemispheres", "Table 1",
@@ -183,14 +195,16 @@ def _value(where: str, spec: DriveKey, raw, allow_extrapolation: bool):
     return value
 
 
-_GROUP_KEYS = {"count": "", "load_share": "", "normal_force": "N", "radius": "m"}
+_GROUP_KEYS = {"count": "", "side": "", "contact_angle": "angle", "load_share": "", "normal_force": "N",
+               "radius": "m"}
 
 
 def _groups(where: str, raw, allow_extrapolation: bool) -> tuple:
-    """``[[contact_groups]]`` tables to :class:`~passmd.model.parameters.ContactGroup` s, each key checked."""
+    """``[[contact_groups]]`` tables to :class:`~passmd.model.arrangement.ContactGroup` s, each key
+    checked."""
     if not isinstance(raw, list) or not raw or not all(isinstance(t, dict) for t in raw):
-        raise _refuse(where, "must be one or more [[contact_groups]] tables (count, load_share or "
-                             "normal_force, radius)", name="contact_groups", value=raw)
+        raise _refuse(where, "must be one or more [[contact_groups]] tables (count, side, contact_angle, "
+                             "load_share or normal_force, radius)", name="contact_groups", value=raw)
     groups = []
     for i, table in enumerate(raw):
         label = f"{where}[{i}]"
@@ -198,11 +212,20 @@ def _groups(where: str, raw, allow_extrapolation: bool) -> tuple:
         if unknown:
             raise _refuse(f"{label}.{unknown[0]}", f"is not a key of a contact group: the known keys are "
                           f"{', '.join(_GROUP_KEYS)}", name="contact_groups", value=table)
-        count = table.get("count")
-        if isinstance(count, bool) or not isinstance(count, int) or count < 1:
-            raise _refuse(f"{label}.count", f"= {count!r}: must be an integer >= 1", name="contact_groups",
-                          value=count)
-        values = {"count": count}
+        values = {}
+        for key in ("count", "side"):
+            value = table.get(key)
+            if key in table or key == "count":
+                allowed = (1, 2) if key == "side" else None
+                if isinstance(value, bool) or not isinstance(value, int) or value < 1 or (
+                        allowed and value not in allowed):
+                    rule = "must be 1 or 2 (the side of the runner the group presses on)" if allowed else \
+                        "must be an integer >= 1"
+                    raise _refuse(f"{label}.{key}", f"= {value!r}: {rule}", name="contact_groups",
+                                  value=value)
+                values[key] = value
+        if "contact_angle" in table:
+            values["contact_angle"] = _angle(f"{label}.contact_angle", table["contact_angle"])
         for key in ("load_share", "normal_force", "radius"):
             if key in table:
                 spec = DriveKey(f"contact_groups.{key}", _GROUP_KEYS[key], "", "", key, "",
@@ -211,11 +234,26 @@ def _groups(where: str, raw, allow_extrapolation: bool) -> tuple:
                 if key == "load_share" and not values[key] > 0:
                     raise _refuse(f"{label}.{key}", f"= {table[key]!r} is out of range: must be > 0",
                                   name="contact_groups", value=table[key])
-        if ("load_share" in values) == ("normal_force" in values):
-            raise _refuse(label, "gives both or neither of load_share and normal_force: give exactly one",
+        if "load_share" in values and "normal_force" in values:
+            raise _refuse(label, "gives both load_share and normal_force: give at most one (neither: the "
+                                 "normal force follows from the preload and the contact angles, Eq. 1)",
                           name="contact_groups", value=table)
         groups.append(ContactGroup(**values))
     return tuple(groups)
+
+
+def _angle(where: str, raw) -> float:
+    """A contact angle in rad, 0 < α <= 90°; ``where`` is ``"file: contact_groups[i].contact_angle"``."""
+    try:
+        value = parse_angle(raw, name=where)
+    except QuantityError as exc:
+        raise DriveFileError(str(exc), name="contact_groups", value=raw) from None
+    if not 0.0 < value <= FLAT:
+        bare = " (a bare number is in rad: write \"45 deg\")" if not isinstance(raw, str) else ""
+        raise _refuse(where, f"= {raw!r} is out of range: must be > 0 and <= 90 deg (the angle between the "
+                             f"preload's line and the contact's tangent plane; 90 deg: a flat guide){bare}",
+                      name="contact_groups", value=raw)
+    return value
 
 
 def read_drive_file(path, *, allow_extrapolation: bool | None = None) -> dict:
@@ -403,7 +441,7 @@ def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None =
              "# Values: a string with a unit (\"0.5 mm\", \"1.5e-5 kg\") or a bare number in SI units.",
              "# Keys left out take the paper's value (Tables 1-2; the actuator of Table 2 for the radius;",
              "# c_p = 2ζ√(k_p m_a) with ζ = 0.05). Another arrangement of contacts: instead of `contacts`,",
-             "# one [[contact_groups]] table per kind: count, load_share (F_N/F_p) or normal_force, radius.",
+             "# one [[contact_groups]] table per kind of contact (see the end of this file).",
              "# `passmd drive show --drive FILE` lists what a file resolves to, with sources."]
     section = None
     for key, spec in DRIVE_KEYS.items():
@@ -419,8 +457,31 @@ def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None =
         source = sources.get(key, spec.source)
         lines.append(f"{name or key} = {_shown(value, spec)}  # {spec.symbol}: {spec.text}{unit}; {source}")
     for group in drive.contact_groups:  # arrays of tables come last in TOML
-        lines += ["", "[[contact_groups]]  # contacts of one kind: count, F_N per contact (or its share of "
-                      "F_p), radius R [m]"]
-        lines += [f"{name} = {value if name == 'count' else _number(value)}"
-                  for name, value in vars(group).items() if value is not None]
+        lines += ["", "[[contact_groups]]  # contacts of one kind: count, side, contact angle α, F_N per "
+                      "contact (or its share of F_p; else Eq. 1), radius R [m]"]
+        lines += [f"{name} = {_group_value(name, value)}" for name, value in _group_items(group)]
+    if not drive.contact_groups:  # the preset, written out as groups (commented: a file gives one of the two)
+        lines += ["", f"# `contacts = \"{_field(drive, 'contacts')}\"` written as contact groups (Eq. 1: "
+                      "each side carries F_p, a",
+                  "# contact at angle α carries F_N sin α of it); replace `contacts` by tables like these "
+                  "for another guide:"]
+        for group in preset_groups(drive.contacts):
+            lines += ["# [[contact_groups]]"] + [f"# {name} = {_group_value(name, value)}"
+                                                 for name, value in _group_items(group)]
     return "\n".join(lines) + "\n"
+
+
+def _group_items(group: ContactGroup) -> list[tuple[str, object]]:
+    """The given fields of a group, in the order a drive file lists them (as :data:`_GROUP_KEYS`)."""
+    return [(name, getattr(group, name)) for name in _GROUP_KEYS if getattr(group, name) is not None]
+
+
+def _group_value(name: str, value) -> str:
+    """A contact group's value as TOML: counts and sides as integers, the angle in degrees when that
+    reads back exactly (else rad, SI), the rest as SI numbers."""
+    if name in ("count", "side"):
+        return str(value)
+    if name == "contact_angle":
+        text = f"{math.degrees(value):.12g} deg"
+        return f'"{text}"' if parse_angle(text) == value else _number(value)
+    return _number(value)

@@ -7,6 +7,12 @@ micro-vibration to turn forward, then accelerate it within the stick limit,
 This module builds the waveform from a given design (:class:`OptimizedDesign`) and never
 simulates. The design from a simulated saw-tooth response of the drive (f_s and V_r
 measured, Eq. 15 applied) is :func:`passmd.protocols.eq15.optimized_design`.
+
+Eq. 15's period needs t_s + t_a, the fly-back and a slow ramp: above
+:func:`highest_fitting_frequency` it does not fit. :func:`optimized` then refuses (one line
+naming that frequency) unless a truncated waveform is asked for by name (``short_period="cut"``
+or ``"skip"``, the driving-waveform chapter's study of Fig. 9b above 110 kHz), whose ``kind``
+says it is truncated.
 """
 
 from __future__ import annotations
@@ -41,6 +47,9 @@ RESPONSE_FREQUENCY = PROTOCOL.drive_frequency
 #: Shortest share of T − t_fb that the slow ramp of an optimized period keeps when the settling
 #: time has to be cut (high frequencies).
 MIN_RAMP_FRACTION = 0.5
+#: What :func:`optimized` does when Eq. 15's period does not fit: refuse (the default), or build
+#: a truncated study waveform with t_s cut or skipped (assumption ``optimized_short_period``).
+SHORT_PERIOD_RULES = ("refuse", "cut", "skip")
 
 ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
@@ -57,7 +66,10 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
             "the free micro-vibration after the slip is the one the waveform exploits; V_r is the "
             "runner's velocity where the acceleration starts (point 4). The design is made once "
             "per drive and used at every driving frequency ('when these influencing parameters "
-            "were varied, the input parameters for the optimized waveform were respectively changed')."
+            "were varied, the input parameters for the optimized waveform were respectively changed'). "
+            "The command line designs the same way by default and says so; --design-response driving "
+            "reads the response at the driving frequency instead, whose vibration cycle the next "
+            "fly-back cuts short as f approaches f_s."
         ),
         sensitivity="Driving-waveform chapter: step at 100 Hz against t_s over two vibration periods.",
     ),
@@ -93,8 +105,10 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         key="optimized_short_period",
         symbol="t_s, t_a",
         value=(
-            f"the slow ramp keeps ≥ {MIN_RAMP_FRACTION:g}·(T − t_fb) and ≥ A/V_max; short_period='cut': "
-            "t_s is cut to the time left, then t_a (at constant V_a); 'skip': t_s = 0"
+            f"the slow ramp keeps ≥ {MIN_RAMP_FRACTION:g}·(T − t_fb) and ≥ A/V_max; above the highest "
+            "frequency at which t_s + t_a then fit, a designer's waveform is refused; the study of "
+            "Fig. 9b, short_period='cut': t_s is cut to the time left, then t_a (at constant V_a); "
+            "'skip': t_s = 0"
         ),
         unit="s",
         rationale=(
@@ -167,6 +181,71 @@ class OptimizedDesign:
         }
 
 
+def highest_fitting_frequency(design: OptimizedDesign, amplitude: float, drive: Drive, *,
+                              flyback: str = "slew", min_ramp_fraction: float = MIN_RAMP_FRACTION) -> float:
+    """Highest driving frequency (Hz) at which one Eq. 15 period fits whole (Fig. 8b).
+
+    A period holds t_s, t_a, the slow ramp and the fly-back t_fb; the slow ramp keeps at least
+    ``min_ramp_fraction``·(T − t_fb) and A/V_max (:func:`optimized_timing`). So Eq. 15 fits when
+
+        T − t_fb >= max((t_s + t_a) / (1 − min_ramp_fraction), t_s + t_a + A/V_max),  T >= 2 t_fb,
+
+    and this is 1/T at equality. At or below it :func:`optimized_timing` reports
+    ``settling_fits``; above it the settling time would have to be cut.
+
+    Parameters
+    ----------
+    design : OptimizedDesign
+        The Eq. 15 design (t_s, t_a).
+    amplitude : float
+        Actuation amplitude A in m (sets the fly-back's duration).
+    drive : Drive
+        The drive (its amplifier's slew-rate limit).
+    flyback : {"slew", "fixed"}
+        Fly-back rule (:func:`passmd.model.waveforms.flyback_time`).
+    min_ramp_fraction : float
+        Least share of T − t_fb the slow ramp keeps (assumption ``optimized_short_period``).
+    """
+    if not isinstance(design, OptimizedDesign):
+        raise InputError(f"design = {shown(design)} is not an OptimizedDesign", name="design", value=design)
+    a_max = check_drive(drive).actuator.full_stroke_amplitude
+    A = check_range("amplitude", amplitude, 0.0, a_max, lower_open=True, unit="m")
+    frac = check_range("min_ramp_fraction", min_ramp_fraction, 0.0, 1.0, lower_open=True, upper_open=True)
+    check_choice("flyback", flyback, ("slew", "fixed"))
+    t_fb = _flyback_time(A, drive, flyback)
+    need = design.settling_time + design.acceleration_time
+    period = t_fb + max(need / (1.0 - frac), need + A / max_piezo_velocity(drive))
+    return 1.0 / max(period, 2.0 * t_fb)
+
+
+def check_fits(design: OptimizedDesign, amplitude: float, frequency: float, drive: Drive, *,
+               flyback: str = "slew", min_ramp_fraction: float = MIN_RAMP_FRACTION) -> float:
+    """``frequency`` if one Eq. 15 period fits whole at it, else a one-line refusal naming the
+    highest frequency that fits (:func:`highest_fitting_frequency`).
+
+    Raises
+    ------
+    InputError
+        A ``ValueError`` named ``frequency``, its limit the highest fitting frequency.
+    """
+    f = check_positive("frequency", frequency, "Hz")
+    f_max = highest_fitting_frequency(design, amplitude, drive, flyback=flyback,
+                                      min_ramp_fraction=min_ramp_fraction)
+    timing = optimized_timing(design, amplitude, f, drive, flyback=flyback,
+                              min_ramp_fraction=min_ramp_fraction)
+    if timing["settling_fits"]:
+        return f
+    why = (f"Eq. 15: the settling time t_s = {design.settling_time * 1e6:.4g} µs and the acceleration "
+           f"t_a = {design.acceleration_time * 1e6:.4g} µs, with the fly-back "
+           f"({timing['flyback_time_s'] * 1e6:.3g} µs) and the slow ramp (at least {min_ramp_fraction:.0%} "
+           f"of the rest of the period), need a period of {1e6 / f_max:.4g} µs")
+    raise InputError(
+        f"frequency = {shown(f)} is out of range for the Eq. 15 waveform: must be <= {f_max:.4g} Hz, the "
+        f"highest frequency at which it fits this drive at A = {amplitude * 1e9:.4g} nm ({why}); a truncated "
+        "waveform is short_period='cut' or 'skip'", name="frequency", value=f, unit="Hz",
+        limits=(("<=", f_max),), why=why)
+
+
 def optimized_timing(
     design: OptimizedDesign,
     amplitude: float,
@@ -188,6 +267,7 @@ def optimized_timing(
     * ``short_period="cut"`` (default): t_s is cut to what is left (down to 0);
     * ``short_period="skip"``: t_s = 0 (waiting part of a vibration cycle lands at a
       phase the design did not choose);
+    * ``short_period="refuse"``: :func:`check_fits` refuses the frequency;
 
     then, if t_a alone does not fit, t_a is cut keeping V_a (so Δ_a shrinks). At high
     frequencies the waveform turns into a saw-tooth with a fast first segment.
@@ -206,7 +286,7 @@ def optimized_timing(
     """
     if not isinstance(design, OptimizedDesign):
         raise InputError(f"design = {shown(design)} is not an OptimizedDesign", name="design", value=design)
-    check_choice("short_period", short_period, ("cut", "skip"))
+    check_choice("short_period", short_period, SHORT_PERIOD_RULES)
     a_max = check_drive(drive).actuator.full_stroke_amplitude
     A = check_range("amplitude", amplitude, 0.0, a_max, lower_open=True, unit="m")
     f = check_positive("frequency", frequency, "Hz")
@@ -229,6 +309,8 @@ def optimized_timing(
     t_s, t_a, d_a = design.settling_time, design.acceleration_time, design.acceleration_amplitude
     settling_fits = t_s + t_a <= room
     acceleration_fits = t_a <= room
+    if short_period == "refuse" and not settling_fits:
+        check_fits(design, A, f, drive, flyback=flyback, min_ramp_fraction=frac)
     if not acceleration_fits:
         t_a = room
         d_a = design.acceleration_velocity * t_a
@@ -256,7 +338,7 @@ def optimized(
     flyback: str = "slew",
     settle_fraction: float = SETTLE_FRACTION,
     min_ramp_fraction: float = MIN_RAMP_FRACTION,
-    short_period: str = "cut",
+    short_period: str = "refuse",
 ) -> Waveform:
     """The optimized driving waveform of Section 5.1 (Fig. 8b, Eq. 15).
 
@@ -290,20 +372,24 @@ def optimized(
     min_ramp_fraction : float
         Share of T − t_fb the slow ramp keeps when t_s + t_a must be cut
         (:func:`optimized_timing`).
-    short_period : {"cut", "skip"}
-        What to do with t_s when t_s + t_a does not fit in a period (:func:`optimized_timing`).
+    short_period : {"refuse", "cut", "skip"}
+        What to do when t_s + t_a does not fit in a period: refuse the frequency, naming the
+        highest that fits (:func:`check_fits`), or build a truncated study waveform with t_s
+        cut or skipped (:func:`optimized_timing`).
 
     Returns
     -------
     Waveform
-        ``kind="optimized"``; slip marks at the start of each fly-back; settle windows at the
+        ``kind="optimized"`` (``"optimized, t_s cut"`` / ``"optimized, t_s skipped"`` when
+        truncated: not Eq. 15's waveform); slip marks at the start of each fly-back; settle windows at the
         end of each (slow) ramp, as for :func:`~passmd.model.waveforms.sawtooth`, so positions compare
         directly.
 
     Raises
     ------
     ValueError
-        No ``design`` (this function never simulates), or bad input.
+        No ``design`` (this function never simulates), bad input, or (``short_period="refuse"``)
+        a period Eq. 15 does not fit.
     """
     if design is None:
         raise ValueError(
@@ -322,6 +408,8 @@ def optimized(
     t_s, t_a = timing["settling_time_s"], timing["acceleration_time_s"]
     d_a = timing["acceleration_amplitude_m"]
     ramp_end = T - timing["flyback_time_s"]
+    kind = "optimized" if timing["settling_fits"] else \
+        f"optimized, t_s {dict(cut='cut', skip='skipped')[short_period]}"  # truncated: not Eq. 15's
     pt = ([0.0, t_s] if t_s > 0 else [0.0]) + [t_s + t_a, ramp_end, T]
     px = ([0.0, 0.0] if t_s > 0 else [0.0]) + [d_a, A, 0.0]
     window = (ramp_end - frac * timing["ramp_time_s"], ramp_end)
@@ -337,7 +425,7 @@ def optimized(
         offset = T
     if n_opt > 0:
         rest = piecewise_linear(
-            pt, px, 1.0 / T, n_opt, settle_window=window, slip_mark=ramp_end, kind="optimized"
+            pt, px, 1.0 / T, n_opt, settle_window=window, slip_mark=ramp_end, kind=kind
         )
         parts_t.append(offset + rest.times[1:])
         parts_x.append(rest.positions[1:])
@@ -350,6 +438,6 @@ def optimized(
         periods,
         np.concatenate(windows),
         np.concatenate(marks),
-        "optimized",
+        kind,
         A,
     )

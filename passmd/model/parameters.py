@@ -17,6 +17,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from passmd.model import arrangement
+from passmd.model.arrangement import PAPER_SIX as PAPER_SIX
+from passmd.model.arrangement import ContactGroup
 from passmd.model.tables import (
     ACTUATOR_DAMPING_RATIO,
     RUBY,
@@ -53,47 +56,6 @@ __all__ = [
 ]
 
 
-
-
-@dataclass(frozen=True)
-class ContactGroup:
-    """Contacts of one kind in a drive's arrangement: how many, how loaded, how curved.
-
-    The normal force on each contact of the group is ``normal_force`` (N) if given, else
-    ``load_share`` × the drive's preload (the paper's six contacts: two at F_p/(2 sin 45°),
-    four at F_p/(4 sin 45°), Eq. 1). ``radius``: the hemispheres' radius R in m (default: the
-    drive's ``hemisphere_radius``). Contacts of a group share one state in the simulation
-    (they see the same actuator and runner motion).
-    """
-
-    count: int = field(metadata=_meta("n_g", "–", "arrangement"))
-    load_share: float | None = field(default=None, metadata=_meta("F_N/F_p", "–", "arrangement"))
-    normal_force: float | None = field(default=None, metadata=_meta("F_N", "N", "arrangement"))
-    radius: float | None = field(default=None, metadata=_meta("R_g", "m", "arrangement"))
-
-    def __post_init__(self):
-        if isinstance(self.count, (bool, np.bool_)) or not isinstance(self.count, (int, np.integer)) \
-                or self.count < 1:
-            raise InputError(f"count = {_plain(self.count)} is not allowed: must be an integer >= 1",
-                             name="count", value=self.count)
-        object.__setattr__(self, "count", int(self.count))
-        if (self.load_share is None) == (self.normal_force is None):
-            raise InputError("load_share and normal_force: give exactly one (the normal force per contact, "
-                             "or its share of the preload)", name="load_share", value=self.load_share)
-        if self.load_share is not None:
-            check_positive("load_share", self.load_share, "–")
-        if self.normal_force is not None:
-            check_positive("normal_force", self.normal_force, "N")
-        if self.radius is not None:
-            check_positive("radius", self.radius, "m")
-
-
-#: The paper's six-contact arrangement (Section 4.1, Eq. 1) as contact groups: side 1, two
-#: contacts at F_p/(2 sin 45°); side 2, four at F_p/(4 sin 45°).
-PAPER_SIX = (ContactGroup(2, load_share=1.0 / (2.0 * np.sin(np.pi / 4))),
-             ContactGroup(4, load_share=1.0 / (4.0 * np.sin(np.pi / 4))))
-
-
 @dataclass(frozen=True)
 class Drive:
     """The whole drive: geometry, preload, materials, masses and model choices.
@@ -128,8 +90,10 @@ class Drive:
     amplifier: Amplifier = field(default_factory=Amplifier, metadata=_meta("", "", "Section 2"))
     #: Lift the soft limits of :data:`PLAUSIBLE_RANGES` (never the hard ones), for exploring.
     allow_extrapolation: bool = False
-    #: Any other arrangement of contacts (:class:`ContactGroup` s); empty: the paper's arrangement
-    #: ``contacts`` names (1 or 6). When given, ``contacts`` is their total count.
+    #: Any other arrangement of contacts (:class:`~passmd.model.arrangement.ContactGroup` s: count,
+    #: side, contact angle, radius, normal force); empty: the paper's arrangement ``contacts`` names
+    #: (1 or 6). When given, ``contacts`` is their total count and each side's groups must balance
+    #: the preload (Eq. 1, :func:`passmd.model.arrangement.check_balance`).
     contact_groups: tuple = ()
 
     def __post_init__(self):
@@ -148,6 +112,7 @@ class Drive:
                              "tuple of ContactGroup", name="contact_groups", value=self.contact_groups)
         if self.contact_groups:
             object.__setattr__(self, "contacts", sum(g.count for g in self.contact_groups))
+            arrangement.check_balance(self.preload, self.contact_groups)
         elif not isinstance(self.contacts, (int, np.integer)) or isinstance(self.contacts, (bool, np.bool_)) \
                 or self.contacts not in (1, 6):
             raise InputError(f"contacts = {_plain(self.contacts)} is not allowed: must be one of 1, 6",

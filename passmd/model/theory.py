@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from passmd.model.arrangement import group_normal_forces, group_sides, preset_groups
 from passmd.model.defaults import PROTOCOL
 from passmd.model.hertz import _TINY, _hertz_cube, _positive, _require_normal, _shear, _youngs
 from passmd.runtime.validation import check_array
@@ -247,11 +248,8 @@ def _drive_contact_radius(drive: Drive, forces: np.ndarray, E_star: float, radii
 def _drive_forces(drive: Drive) -> tuple:
     """Eq. 1 for a (validated) drive, each force a normal double (else refused naming the preload)."""
     F = np.asarray(float(drive.preload))
-    if getattr(drive, "contact_groups", ()):
-        forces = tuple(np.asarray(float(g.normal_force) if g.normal_force is not None else g.load_share * F)
-                       for g in drive.contact_groups)
-    else:
-        forces = (F,) if drive.contacts == 1 else _six_contact_forces(F)
+    groups = getattr(drive, "contact_groups", ()) or preset_groups(drive.contacts)
+    forces = group_normal_forces(F, groups)  # the paper's six: F_p/(2 sin 45°), F_p/(4 sin 45°) exactly
     for force in reversed(forces):  # the paper's six: the smaller F_N2 first
         _require_normal(force, "the normal force per contact", "N", (("preload", drive.preload, "N"),))
     return forces
@@ -281,6 +279,28 @@ def contact_layout(drive: Drive) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     _check_drive(drive)
     forces = np.array([float(f) for f in _drive_forces(drive)])
     return forces, np.array(_multiplicity(drive), dtype=float), _radii(drive)
+
+
+def contact_arrangement(drive: Drive) -> list[dict]:
+    """Each contact group of a drive with its side, contact angle and normal force (Eq. 1).
+
+    The paper's arrangements are written as their groups
+    (:func:`passmd.model.arrangement.preset_groups`). One dict per group: ``side``, ``count``,
+    ``contact_angle_rad``, ``radius_m``, ``normal_force_N`` (per contact), ``force_from``
+    (``"normal_force"``, ``"load_share"`` or ``"Eq. 1"``: the side's balance) and
+    ``preload_share_N`` (n F_N sin α, what the group carries of its side's F_p).
+    """
+    _check_drive(drive)
+    groups = getattr(drive, "contact_groups", ()) or preset_groups(drive.contacts)
+    forces, counts, radii = contact_layout(drive)
+    rows = []
+    for g, side, F, n, R in zip(groups, group_sides(groups), forces, counts, radii, strict=True):
+        source = ("normal_force" if g.normal_force is not None else
+                  "load_share" if g.load_share is not None else "Eq. 1")
+        rows.append({"side": side, "count": int(n), "contact_angle_rad": g.contact_angle,
+                     "radius_m": float(R), "normal_force_N": float(F), "force_from": source,
+                     "preload_share_N": float(n * F * np.sin(g.contact_angle))})
+    return rows
 
 
 def runner_frequency(drive: Drive) -> float:

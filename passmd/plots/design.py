@@ -1,7 +1,7 @@
 """Figures of the chapter "Design your own drive" (data from :mod:`passmd.experiments.design.figures`).
 
-The maps are drawn by :func:`passmd.plots.sweep_map.map_figure`, as ``passmd sweep`` draws them;
-here are the three figures a map does not cover.
+The maps are drawn by :func:`passmd.plots.sweep_map.map_figure`, as ``passmd sweep`` draws them
+(:func:`design_map`); here also are the figures a map does not cover.
 """
 
 from __future__ import annotations
@@ -9,7 +9,52 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-__all__ = ["critical_amplitude_figure", "heldback_figure", "stall_force_figure"]
+from passmd.model.defaults import PROTOCOL
+from passmd.plots.sweep_map import MapAxis, cell_marks, map_figure
+from passmd.protocols.maps import MAP_QUANTITIES
+
+__all__ = ["critical_amplitude_figure", "design_map", "heldback_figure", "ringing_figure",
+           "stall_force_figure"]
+
+#: The maps' axes: frequency (log) and amplitude, as ``passmd sweep --vary frequency=...:log --vary
+#: amplitude=...`` draws them.
+MAP_AXES = (MapAxis("frequency_Hz", "frequency", "kHz", log=True), MapAxis("amplitude_m", "amplitude", "nm"))
+
+
+def design_map(table, quantity: str, title: str) -> Figure:
+    """A frequency × amplitude map of ``quantity`` (a ``passmd sweep`` quantity) with the cells that
+    are no value, not steady or below the measurable step marked
+    (:func:`passmd.plots.sweep_map.cell_marks`)."""
+    spec = MAP_QUANTITIES[quantity]
+    value = MapAxis(spec.column, spec.label, spec.unit, scale=spec.scale)
+    delta = PROTOCOL.step_threshold
+    resolution = [delta * (1.0 if spec.unit == "nm" else float(f)) for f in table["frequency_Hz"]]
+    what = "difference" if quantity == "gain" else "motion"
+    marks = cell_marks(table, value, resolution,
+                       missing_label="no value: Eq. 15 gives no waveform or does not fit the period",
+                       resolution_label=f"|value| below the measurable step ({delta * 1e9:g} nm"
+                                        f"{'' if spec.unit == 'nm' else ' × f'}): no measurable {what}")
+    return map_figure(table, list(MAP_AXES), value, title, marks=marks)
+
+
+def ringing_figure(probe: dict, frequencies, measurable: float) -> Figure:
+    """The runner's swing after a fly-back against the time since (log axes), the measurable step,
+    and where the next fly-back comes at each of ``frequencies`` (Hz)."""
+    fig = Figure(figsize=(6.4, 4.0), layout="constrained")
+    ax = fig.add_subplot()
+    t_ms = np.asarray(probe["swing_times_s"]) * 1e3
+    ax.loglog(t_ms, np.asarray(probe["swing_amplitudes_m"]) * 1e9, "-", lw=1.2,
+              label=f"runner swing after the fly-back ({probe['ringing_frequency_Hz'] / 1e3:.3g} kHz)")
+    ax.axhline(measurable * 1e9, color="grey", ls="--", lw=0.8,
+               label=f"measurable step ({measurable * 1e9:g} nm)")
+    for k, f in enumerate(frequencies):
+        delay = (1.0 / f - probe["flyback_time_s"]) * 1e3
+        ax.axvline(delay, color=f"C{k + 1}", ls=":", lw=1.0, label=f"next fly-back at {f:g} Hz")
+    ax.set_xlabel("time after the fly-back [ms]")
+    ax.set_ylabel("swing of the runner [nm]")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    return fig
 
 _READINGS = (("closed_form_nm", "closed form (Eqs. 7–8, 11–12)", "--"),
              ("first_nm", "simulated, first fly-back", "s-"),
@@ -17,11 +62,16 @@ _READINGS = (("closed_form_nm", "closed form (Eqs. 7–8, 11–12)", "--"),
 
 
 def critical_amplitude_figure(table, full_stroke_nm: float) -> Figure:
-    """The three readings of A_c against preload, with the full stroke as a ceiling."""
+    """The three readings of A_c against preload, with the full stroke as a ceiling; steady points
+    that the runner's ringing affects (a measurable swing left at the next fly-back) ringed."""
     fig = Figure(figsize=(6.4, 4.4), layout="constrained")
     ax = fig.add_subplot()
     for column, label, style in _READINGS:
         ax.plot(table["preload_N"], table[column], style, ms=4, label=label)
+    if "ringing_affects" in table and table["ringing_affects"].any():
+        hit = table[table["ringing_affects"]]
+        ax.plot(hit["preload_N"], hit["steady_nm"], "o", ms=10, mfc="none", color="C3",
+                label="steady, runner still ringing at the next fly-back")
     ax.axhline(full_stroke_nm, color="grey", lw=0.8, ls=":")
     ax.annotate("full stroke", (float(table["preload_N"].min()), full_stroke_nm), textcoords="offset points",
                 xytext=(2, -11), fontsize=8, color="grey")

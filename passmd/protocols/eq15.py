@@ -13,13 +13,19 @@ from __future__ import annotations
 import numpy as np
 
 from passmd.model import theory
-from passmd.model.optimized_waveform import RESPONSE_FREQUENCY, OptimizedDesign, max_piezo_velocity
+from passmd.model.optimized_waveform import (
+    RESPONSE_FREQUENCY,
+    OptimizedDesign,
+    highest_fitting_frequency,
+    max_piezo_velocity,
+)
 from passmd.model.parameters import Drive, check_drive
 from passmd.model.waveforms import sawtooth
-from passmd.runtime.validation import InputError, check_positive, check_range, shown
+from passmd.runtime.validation import InputError, check_choice, check_positive, check_range, shown
 from passmd.solver import simulation as dynamics
 
-__all__ = ["MIN_SAMPLES", "SAMPLES_PER_VIBRATION", "micro_vibration_frequency", "optimized_design"]
+__all__ = ["DESIGN_RESPONSES", "MIN_SAMPLES", "SAMPLES_PER_VIBRATION", "design_at",
+           "micro_vibration_frequency", "optimized_design", "response_frequency"]
 
 #: Recorded samples per period of the linear runner-on-contacts vibration
 #: (:func:`passmd.model.theory.runner_frequency`) in the design run: enough to place the zero
@@ -27,6 +33,36 @@ __all__ = ["MIN_SAMPLES", "SAMPLES_PER_VIBRATION", "micro_vibration_frequency", 
 SAMPLES_PER_VIBRATION = 200
 #: Fewest recorded samples of the design run, whatever the vibration frequency.
 MIN_SAMPLES = 1000
+#: Which saw-tooth response a design for a driving frequency f is made from: ``"paper"``, the
+#: 100 Hz response of Section 5.2 (one design per drive, used at every f: the default, and the
+#: ledger's), or ``"driving"``, the response at f itself.
+DESIGN_RESPONSES = ("paper", "driving")
+
+
+def response_frequency(frequency: float, response: str = "paper") -> float:
+    """Frequency of the saw-tooth response a design for driving at ``frequency`` is made from (Hz).
+
+    ``"paper"``: :data:`~passmd.model.optimized_waveform.RESPONSE_FREQUENCY` (100 Hz, Section 5.2),
+    whose free micro-vibration after the first fly-back is not cut short by the next one;
+    ``"driving"``: ``frequency`` itself (the runner before the fly-back then moves at the ramp's
+    A·f, which enters V_r; near f_s the next fly-back cuts into the vibration cycle Eq. 15 reads).
+    """
+    check_choice("response", response, DESIGN_RESPONSES)
+    return RESPONSE_FREQUENCY if response == "paper" else check_positive("frequency", frequency, "Hz")
+
+
+def design_at(amplitude: float, frequency: float, drive: Drive, *, response: str = "paper",
+              flyback: str = "slew") -> tuple[OptimizedDesign, float]:
+    """The Eq. 15 design for driving ``drive`` at ``amplitude`` and ``frequency``, and the highest
+    frequency at which its period fits (:func:`~passmd.model.optimized_waveform.highest_fitting_frequency`).
+
+    The design is :func:`optimized_design` of the saw-tooth response :func:`response_frequency`
+    names. Whether ``frequency`` is at most the returned one is the caller's to check
+    (:func:`~passmd.model.optimized_waveform.check_fits` refuses it in one line).
+    """
+    design = optimized_design(amplitude, drive, response_frequency=response_frequency(frequency, response),
+                              flyback=flyback)
+    return design, highest_fitting_frequency(design, amplitude, drive, flyback=flyback)
 
 
 def micro_vibration_frequency(

@@ -15,10 +15,12 @@ waveform's parameters, built from the protocols the book uses (nothing is re-der
 * ``stall-force``: the generated force at stall against the load cell
   (:func:`passmd.protocols.stall.generated_force`, Section 4.2);
 * ``gain``: the steady velocity of the optimized waveform (Eq. 15, designed from this drive's
-  own saw-tooth response at this amplitude, :func:`passmd.protocols.eq15.optimized_design`)
-  minus that of the saw-tooth, both by the steady-velocity protocol. Where Eq. 15 gives no
-  waveform (no micro-vibration in the saw-tooth response, or Δ_a ≥ A at small amplitudes) the
-  point's gain is ``None`` and ``note`` says why.
+  own saw-tooth response at this amplitude, :func:`passmd.protocols.eq15.design_at`: by default
+  the 100 Hz response of Section 5.2) minus that of the saw-tooth, both by the steady-velocity
+  protocol. Where Eq. 15 gives no waveform (no micro-vibration in the saw-tooth response, Δ_a ≥ A
+  at small amplitudes, or a period too short for t_s + t_a, the fly-back and the slow ramp) the
+  point's gain is ``None`` and ``note`` says why; the highest frequency at which Eq. 15 fits is
+  a column of every point.
 
 All values are SI, keys carrying the unit, and the cache stores them as they are.
 """
@@ -31,31 +33,70 @@ from dataclasses import dataclass
 from passmd.model import theory
 from passmd.model.parameters import Drive
 from passmd.protocols import critical_amplitude as ca
-from passmd.protocols import eq15, stall, velocity
+from passmd.protocols import eq15, ringing, stall, velocity
 from passmd.runtime.validation import InputError, check_choice
 
 __all__ = ["MAP_QUANTITIES", "READINGS", "MapQuantity", "critical_amplitude_point", "gain_point",
-           "stall_point", "steady_point"]
+           "stall_point", "steady_point", "with_ringing"]
 
 #: Readings of the simulated critical amplitude (:data:`passmd.protocols.critical_amplitude.PROTOCOLS`).
 READINGS = ca.PROTOCOLS
 
 
-def steady_point(drive: Drive, amplitude: float, frequency: float, waveform: str = "sawtooth") -> dict:
+def steady_point(drive: Drive, amplitude: float, frequency: float, waveform: str = "sawtooth",
+                 design_response: str = "paper") -> dict:
     """Steady velocity, step and back-step of one waveform (:func:`~passmd.protocols.velocity.steady_run`).
 
-    ``waveform="optimized"``: the Eq. 15 waveform designed from this drive's saw-tooth
-    response at this amplitude.
+    ``waveform="optimized"``: the Eq. 15 waveform designed from this drive's saw-tooth response
+    (``design_response``, :func:`passmd.protocols.eq15.design_at`); where it does not fit the
+    period, or Eq. 15 gives none, the values are ``None`` and ``note`` says why.
     """
     check_choice("waveform", waveform, ("sawtooth", "optimized"))
-    design = eq15.optimized_design(amplitude, drive) if waveform == "optimized" else None
-    return velocity.steady_run(drive, amplitude, frequency, waveform, "cut", design)
+    if waveform == "sawtooth":
+        return velocity.steady_run(drive, amplitude, frequency, waveform, "cut", None)
+    design, f_max, note = _eq15_design(drive, amplitude, frequency, design_response)
+    if note is not None:
+        return {"velocity_m_per_s": None, "step_m": None, "back_step_m": None, "velocity_drift": None,
+                **_design_columns(design, f_max), "note": note}
+    out = velocity.steady_run(drive, amplitude, frequency, waveform, "refuse", design)
+    return {**out, **_design_columns(design, f_max), "note": None}
+
+
+def _eq15_design(drive, amplitude, frequency, response):
+    """(design, highest fitting frequency, note): the Eq. 15 design at this point (None where there is
+    none) and why it gives no waveform here (None where it does)."""
+    try:
+        design, f_max = eq15.design_at(amplitude, frequency, drive, response=response)
+    except InputError as exc:  # no micro-vibration to design from, or V_a ≤ V_r (Eq. 15)
+        return None, None, f"no Eq. 15 waveform at this amplitude: {exc.detail or exc}"
+    if not design.acceleration_amplitude < amplitude:
+        return design, f_max, (f"no Eq. 15 waveform at this amplitude: Δ_a = "
+                               f"{design.acceleration_amplitude * 1e9:.4g} nm is not below A")
+    if frequency > f_max:
+        busy = (design.settling_time + design.acceleration_time) * 1e6
+        return design, f_max, (f"Eq. 15 does not fit the period: t_s + t_a = {busy:.4g} µs, the fly-back "
+                               f"and the slow ramp need f <= {f_max / 1e3:.4g} kHz")
+    return design, f_max, None
+
+
+def _design_columns(design, f_max) -> dict:
+    """The Eq. 15 design's times, amplitude, source response and highest fitting frequency."""
+    if design is None:
+        return {"settling_time_s": None, "acceleration_time_s": None, "acceleration_amplitude_m": None,
+                "response_frequency_Hz": None, "eq15_highest_frequency_Hz": None}
+    return {"settling_time_s": design.settling_time, "acceleration_time_s": design.acceleration_time,
+            "acceleration_amplitude_m": design.acceleration_amplitude,
+            "response_frequency_Hz": design.response_frequency, "eq15_highest_frequency_Hz": f_max}
 
 
 def critical_amplitude_point(drive: Drive, frequency: float, reading: str = "steady") -> dict:
     """Simulated A_c (``reading``: ``steady`` or ``first``) and the closed form of the drive.
 
     ``critical_amplitude_m`` is ``None`` when no amplitude up to the full stroke moves the runner.
+    The runner's ringing after a fly-back at A_c (at the full stroke if none) is measured too
+    (:func:`passmd.protocols.ringing.at_frequency`): ``ringing_*`` columns; for the steady reading
+    ``ringing_affects_steps`` says whether a measurable swing is left at the next fly-back (the
+    first reading has no earlier fly-back, so it never does).
     """
     found = ca.critical_amplitude(drive, protocol=reading, frequency=frequency)
     for key in ("critical_amplitude_m", "bracket_high_m"):  # NaN: no onset up to the full stroke
@@ -63,7 +104,10 @@ def critical_amplitude_point(drive: Drive, frequency: float, reading: str = "ste
             found[key] = None
     closed_form = theory.drive_theory(drive)["analytic_critical_amplitude_m"]
     found["analytic_critical_amplitude_m"] = float(closed_form)
-    return found
+    at = found["critical_amplitude_m"] or drive.actuator.full_stroke_amplitude
+    rings = ringing.at_frequency(ringing.stick_ringing(drive, at, frequency), frequency)
+    rings["ringing_affects_steps"] = rings["ringing_affects_steps"] and reading == "steady"
+    return {**found, **rings}
 
 
 def stall_point(drive: Drive, amplitude: float, frequency: float) -> dict:
@@ -71,28 +115,33 @@ def stall_point(drive: Drive, amplitude: float, frequency: float) -> dict:
     return stall.generated_force(drive, amplitude, frequency)
 
 
-def gain_point(drive: Drive, amplitude: float, frequency: float) -> dict:
+def gain_point(drive: Drive, amplitude: float, frequency: float, design_response: str = "paper") -> dict:
     """Steady velocity of the Eq. 15 waveform minus that of the saw-tooth (m/s), both measured.
 
-    ``gain_m_per_s`` and the design's times are ``None`` with a ``note`` where Eq. 15 gives no
-    waveform: no micro-vibration in the saw-tooth response at this amplitude, or an
-    acceleration segment Δ_a not below the amplitude.
+    ``gain_m_per_s`` is ``None`` with a ``note`` where Eq. 15 gives no waveform: no
+    micro-vibration in the saw-tooth response at this amplitude, an acceleration segment Δ_a not
+    below the amplitude, or a period too short for it (above ``eq15_highest_frequency_Hz``).
     """
     saw = velocity.steady_run(drive, amplitude, frequency, "sawtooth", "cut")
     out = {"sawtooth_velocity_m_per_s": saw["velocity_m_per_s"], "optimized_velocity_m_per_s": None,
-           "gain_m_per_s": None, "settling_time_s": None, "acceleration_time_s": None,
-           "acceleration_amplitude_m": None, "note": None}
-    try:
-        design = eq15.optimized_design(amplitude, drive)
-        opt = velocity.steady_run(drive, amplitude, frequency, "optimized", "cut", design)
-    except InputError as exc:  # no micro-vibration to design from, or Δ_a ≥ A (Eq. 15)
-        out["note"] = f"no Eq. 15 waveform at this amplitude: {exc.detail or exc}"
-        return out
+           "gain_m_per_s": None}
+    design, f_max, note = _eq15_design(drive, amplitude, frequency, design_response)
+    out.update(_design_columns(design, f_max))
+    if note is not None:
+        return {**out, "note": note}
+    opt = velocity.steady_run(drive, amplitude, frequency, "optimized", "refuse", design)
     out.update(optimized_velocity_m_per_s=opt["velocity_m_per_s"],
-               gain_m_per_s=opt["velocity_m_per_s"] - saw["velocity_m_per_s"],
-               settling_time_s=design.settling_time, acceleration_time_s=design.acceleration_time,
-               acceleration_amplitude_m=design.acceleration_amplitude)
+               gain_m_per_s=opt["velocity_m_per_s"] - saw["velocity_m_per_s"], note=None)
     return out
+
+
+def with_ringing(table, ringing_rows, frequencies) -> None:
+    """Add to each row of ``table`` what the runner's ringing (its record, as
+    :func:`passmd.protocols.ringing.ringing_point` gives it) leaves at the row's next fly-back at its
+    frequency (:func:`passmd.protocols.ringing.at_frequency`): the ``ringing_*`` columns, in place."""
+    rows = [ringing.at_frequency(r, f) for r, f in zip(ringing_rows, frequencies, strict=True)]
+    for key in rows[0] if rows else ():
+        table[key] = [r[key] for r in rows]
 
 
 @dataclass(frozen=True)

@@ -33,6 +33,7 @@ __all__ = [
     "MAX_RECORD",
     "MIN_PERIODS",
     "SAMPLES_PER_ACCELERATION",
+    "STEADY_DRIFT_LIMIT",
     "STEADY_TIME",
     "STEP_PERIODS",
     "STEP_PROTOCOL_BELOW",
@@ -47,6 +48,10 @@ __all__ = [
 #: Simulated time of a steady-velocity run (s) and its least number of periods.
 STEADY_TIME = 5e-3
 MIN_PERIODS = 20
+#: Largest |velocity_drift| (fourth quarter's velocity minus the third's, over the velocity) of a
+#: run counted as steady; beyond it the velocity still changes (or is so small that noise of the
+#: period means dominates it) and a map marks the point as not steady.
+STEADY_DRIFT_LIMIT = 0.05
 #: Record spacing inside the acceleration segment: a slip share sample every t_a / this.
 SAMPLES_PER_ACCELERATION = 8
 #: Largest record of a steady run (rows); bounds memory at low frequencies.

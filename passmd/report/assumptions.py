@@ -14,7 +14,7 @@ from passmd.experiments.driving_waveform import figures as driving_waveform
 from passmd.experiments.driving_waveform import studies as waveform_studies
 from passmd.experiments.force_generation import figures as force_generation
 from passmd.ledger import reference
-from passmd.model import contact, optimized_waveform, parameters, tables, waveforms
+from passmd.model import arrangement, contact, optimized_waveform, parameters, tables, waveforms
 from passmd.model.tables import Assumption
 from passmd.protocols import critical_amplitude
 
@@ -25,6 +25,7 @@ __all__ = ["ASSUMPTION_MODULES", "all_assumptions"]
 ASSUMPTION_MODULES: tuple[ModuleType, ...] = (
     tables,
     parameters,
+    arrangement,
     contact,
     waveforms,
     reference,

@@ -6,8 +6,10 @@ or a data file found on its own says what produced it:
 
 * the version, :data:`passmd.__version__` (its one source);
 * the git commit of the source tree the package was imported from, ``"<hash> (uncommitted
-  changes)"`` when tracked or new files differ from that commit, and ``"unknown"`` when the
-  package is not imported from a git checkout (an installed wheel) or git is unavailable;
+  changes)"`` when tracked or new files differ from that commit, and, when the package is not
+  imported from a git checkout (an installed wheel) or git is unavailable, ``"none: installed
+  package, version X"`` (:func:`commit_or_version`), so a result found on its own still says
+  which release made it;
 * the build profile (``quick`` or ``paper``).
 
 The commit is looked up once per process (:func:`git_commit` is cached): a running
@@ -24,7 +26,7 @@ import passmd
 from passmd.runtime.config import PROFILES
 from passmd.runtime.validation import check_choice
 
-__all__ = ["UNKNOWN", "UNCOMMITTED", "csv_header", "git_commit", "stamp", "summary"]
+__all__ = ["UNKNOWN", "UNCOMMITTED", "commit_or_version", "csv_header", "git_commit", "stamp", "summary"]
 
 #: The commit when it cannot be known (no git, or not imported from a git checkout).
 UNKNOWN = "unknown"
@@ -74,11 +76,17 @@ def git_commit(package_dir: str | None = None) -> str:
     return f"{commit} ({UNCOMMITTED})" if status else commit
 
 
+def commit_or_version() -> str:
+    """:func:`git_commit`, or ``"none: installed package, version X"`` where it is unknown."""
+    commit = git_commit()
+    return commit if commit != UNKNOWN else f"none: installed package, version {passmd.__version__}"
+
+
 def stamp(profile: str) -> dict[str, str]:
     """``{"passmd_version", "git_commit", "profile"}`` of a result made on ``profile``."""
     return {
         "passmd_version": passmd.__version__,
-        "git_commit": git_commit(),
+        "git_commit": commit_or_version(),
         "profile": check_choice("profile", profile, PROFILES),
     }
 

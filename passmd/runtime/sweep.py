@@ -48,6 +48,7 @@ import pandas as pd
 from passmd.runtime import progress as _progress
 from passmd.runtime.cache import Cache, CacheWarning, Unfingerprintable, function_code, function_name
 from passmd.runtime.config import EXECUTORS, MAX_WORKERS, RunConfig, useful_workers
+from passmd.runtime.extras import install_hint
 from passmd.runtime.validation import check_choice
 
 __all__ = ["EXECUTORS", "grid", "process_pool", "progress_enabled", "run"]
@@ -313,7 +314,7 @@ def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> No
     try:
         from distributed import Client, LocalCluster, as_completed
     except ImportError as exc:  # pragma: no cover - dask is a declared extra
-        raise ImportError("executor='dask' needs dask.distributed: pip install 'passmd[dask]'") from exc
+        raise ImportError(f"executor='dask' needs dask.distributed: {install_hint('dask')}") from exc
     cluster = None
     if scheduler:
         client = Client(scheduler)

@@ -24,9 +24,11 @@ import re
 from decimal import Decimal, localcontext
 
 __all__ = [
+    "ANGLE_UNITS",
     "QuantityError",
     "dimension_name",
     "from_si",
+    "parse_angle",
     "parse_quantities",
     "parse_quantity",
     "registry",
@@ -296,6 +298,39 @@ def _times(number_text: str, factor: float, inverse: float) -> float:
         if len(repr(float(inverse))) < len(repr(float(factor))):
             return float(Decimal(number_text) / Decimal(repr(float(inverse))))
         return float(Decimal(number_text) * Decimal(repr(float(factor))))
+
+
+#: Angle units :func:`parse_angle` reads, and the radians in one of each (a bare number is rad, SI).
+ANGLE_UNITS = {"rad": 1.0, "radian": 1.0, "radians": 1.0, "deg": None, "degree": None, "degrees": None,
+               "°": None}
+
+
+def parse_angle(text, *, name: str = "angle") -> float:
+    """Read an angle (``"45 deg"``, ``"45°"``, ``"0.785 rad"``, a bare number in rad) in radians.
+
+    Angles are kept out of :func:`parse_quantity` (pint reads a radian as a plain number); this
+    is the one place an angle is read. Degrees convert by ``math.radians``, so ``"45 deg"``
+    is exactly ``math.pi / 4``.
+
+    Raises
+    ------
+    QuantityError
+        Not a finite number with one of the units :data:`passmd.runtime.units.ANGLE_UNITS`.
+    """
+    if isinstance(text, bool):
+        raise QuantityError(f"{name} = {text!r} is not an angle: give e.g. \"45 deg\"")
+    if isinstance(text, (int, float)):
+        number_text, unit_text = repr(float(text)), ""
+    else:
+        match = _QUANTITY.match(str(text).replace("°", " °"))
+        if match is None or match.group(2) not in ("", *ANGLE_UNITS):
+            raise QuantityError(f"{name} = {text!r} is not an angle: give a number with deg or rad, e.g. "
+                                "\"45 deg\" (a bare number is in rad)")
+        number_text, unit_text = match.group(1), match.group(2)
+    value = float(number_text)
+    if not math.isfinite(value):
+        raise QuantityError(f"{name} = {text!r} is not a finite number")
+    return value if ANGLE_UNITS.get(unit_text, 1.0) is not None else math.radians(value)
 
 
 def parse_quantities(text: str, unit: str, *, name: str = "value") -> list[float]:

@@ -8,6 +8,7 @@ import textwrap
 from passmd.cli import kernels
 from passmd.cli.drive import build_drive, drive_rows
 from passmd.cli.errors import UsageError
+from passmd.cli.notes import ringing_text
 from passmd.cli.options import FREQUENCY, THRESHOLD, TOLERANCE, add_drive_options
 from passmd.cli.output import JSON_HELP, check_results, describe, drive_record, emit_json, emit_rows, fmt
 from passmd.model.defaults import PROTOCOL
@@ -19,16 +20,17 @@ __all__ = ["READINGS", "add_parser", "run_critical_amplitude"]
 READINGS = {
     "analytic": "analytic (Eq. 7/8, 11/12): the contacts' presliding plus the actuators' deformation, "
                 "no runner dynamics; a first sizing, to be checked by simulation",
-    "steady": "simulated steady: above it the drive keeps stepping once running; size the working "
-              "amplitude by this one",
+    "steady": "simulated steady: where the last step of a run first exceeds the measurable step, what "
+              "continuous operation needs at this preload and frequency; read it at the drive's own (the "
+              "runner's ringing makes it turn with both)",
     "first": "simulated first fly-back: above it every contact slides fully in the first fly-back from "
              "rest; what a start from rest needs",
 }
 
 _EPILOG = textwrap.dedent("""\
     Three readings of A_c, each for a different question: analytic (closed form, no
-    dynamics: a first sizing), simulated steady (the drive keeps stepping once running: size
-    the working amplitude by it), simulated first fly-back (a start from rest slips at once).
+    dynamics: a first sizing), simulated steady (what continuous operation needs, read at the
+    drive's own preload and frequency), simulated first fly-back (a start from rest slips at once).
 
     The simulated A_c comes from the critical-amplitude chapters' search
     (passmd.protocols.critical_amplitude): bisection on [0, A_max] with one of two
@@ -39,7 +41,12 @@ _EPILOG = textwrap.dedent("""\
     --json keys (SI units): reading, critical_amplitude_m (null if none up to A_max),
     bracket_m, analytic_critical_amplitude_m, critical_amplitude_rigid_m,
     critical_amplitude_flexible_m, protocol, threshold_m, tolerance_m, frequency_Hz,
-    periods, flyback, simulations, wall_time_s, drive{...}""")
+    periods, flyback, simulations, wall_time_s, ringing{...} (the runner's swing after a
+    fly-back at A_c and what is left of it at the next: as passmd run), drive{...}
+
+    The steady A_c can jump up and down with preload, frequency or radius: the runner still
+    rings from the previous fly-back when the next one starts, and whether that one slips
+    depends on where in its swing the runner is (the "runner ringing" row says when).""")
 
 
 def add_parser(command) -> None:
@@ -95,7 +102,20 @@ def _search(args, drive) -> dict:
         "flyback": args.flyback,
         "simulations": found["runs"],
         "wall_time_s": found["wall_time_s"],
+        "ringing": _ringing(drive, value, frequency, args),
     }
+
+
+def _ringing(drive, found: float, frequency: float, args) -> dict:
+    """The runner's ringing after a fly-back at A_c (at the full stroke if none): whether the steady
+    reading depends on it (the first reading has no earlier fly-back)."""
+    from passmd.protocols import ringing
+
+    at = drive.actuator.full_stroke_amplitude if math.isnan(found) else found
+    ring = ringing.at_frequency(ringing.stick_ringing(drive, at, frequency, flyback=args.flyback), frequency)
+    ring["ringing_affects_steps"] = ring["ringing_affects_steps"] and args.protocol == "steady"
+    return {**{k: None if isinstance(v, float) and math.isnan(v) else v for k, v in ring.items()},
+            "amplitude_m": at}
 
 
 def run_critical_amplitude(args, out) -> int:
@@ -140,4 +160,7 @@ def _search_rows(record: dict, drive) -> list[tuple[str, str]]:
         ("search", f"{record['protocol']}: {criterion}, "
                    f"f = {fmt(record['frequency_Hz'], 'kHz')}, {record['flyback']} fly-back, "
                    f"{record['simulations']} simulations"),
+        ("runner ringing", f"at A = {fmt(record['ringing']['amplitude_m'], 'nm')}: "
+                           + ringing_text(record["ringing"], f"the {record['protocol']} A_c"
+                                          if record["protocol"] == "steady" else "the first reading")),
     ]

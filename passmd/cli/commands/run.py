@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from pathlib import Path
 from typing import NamedTuple
@@ -10,6 +11,7 @@ from passmd.cli import kernels, startup
 from passmd.cli.commands.contact import check_springs
 from passmd.cli.drive import build_drive, drive_rows
 from passmd.cli.errors import OutputError, UsageError
+from passmd.cli.notes import hz, ringing_text
 from passmd.cli.options import (
     AMPLITUDE,
     FREQUENCY,
@@ -43,13 +45,21 @@ periods from rest, the velocity the slope of the period-mean position over the r
 second half ('steady' in --json: velocity_m_per_s, velocity_drift, step_m). It is not
 the default: a few periods from rest are what the paper's Fig. 9a and the step measure.
 --waveform optimized designs t_s, t_a, Δ_a by Eq. 15 from the drive's own saw-tooth
-response; --settling-time, --acceleration-time, --acceleration-amplitude replace them.
+response (--design-response: the 100 Hz response of Section 5.2, or the one at --frequency);
+--settling-time, --acceleration-time, --acceleration-amplitude replace them. Eq. 15's period
+needs t_s + t_a, the fly-back and a slow ramp: above the highest frequency at which it fits
+(said in the output, eq15_highest_frequency_Hz in --json) the run is refused.
 
 --json keys (SI units): final_position_m, settled_positions_m, step_sizes_m,
 back_steps_m, mean_velocity_m_per_s (>= 2 periods), periods, frequency_Hz, amplitude_m,
 integrator_steps and the integrator's step sizes (keys ending in _time_step_s), wall_time_s, waveform,
-flyback, protocol, drive{...}, design{...} and design_given_by_options (optimized),
-steady{...} (--steady)"""
+flyback, protocol, drive{...}, design{...}, eq15_highest_frequency_Hz and
+design_given_by_options (optimized),
+steady{...} (--steady), ringing{ringing_frequency_Hz, ringing_amplitude_m, ringing_decay_time_s,
+next_flyback_after_s, ringing_at_next_flyback_m, ringing_affects_steps}: the runner's swing
+after a saw-tooth fly-back of this amplitude (passmd.protocols.ringing) and what is left of it
+when the next fly-back starts; velocity_drift (--steady) is the velocity of the run's fourth
+quarter minus that of its third, over the velocity: near 0 when the run is steady"""
 
 #: Bytes per recorded sample (time, piezo/runner positions and velocities, per-group
 #: contact columns, with the DataFrame/plot copies) and per period (waveform breakpoints,
@@ -89,6 +99,11 @@ def add_parser(command) -> None:
                        help="the book's steady-velocity protocol: max(20, f·5 ms) periods from rest (unless "
                             "--periods), velocity from the second half's period means (default: off, the "
                             "mean velocity of --periods periods from rest)")
+    group.add_argument("--design-response", choices=("paper", "driving"), default="paper",
+                       help="saw-tooth response the Eq. 15 design is made from: paper, the 100 Hz response "
+                            "of Section 5.2 (one design per drive and amplitude, whose micro-vibration no "
+                            "later fly-back cuts short); driving, the response at --frequency "
+                            "(default: paper)")
     for q in EQ15_OVERRIDES:
         q.add(group)
     add_output_options(p)
@@ -166,6 +181,8 @@ def check_run_options(args, drive) -> RunOptions:
     """Every option of ``run`` that is not the drive's, checked before anything runs."""
     amplitude, frequency = waveform_args(args, drive)
     overrides = [q.flag for q in EQ15_OVERRIDES if getattr(args, q.dest) is not None]
+    if args.design_response != "paper" and args.waveform != "optimized":
+        overrides.insert(0, f"--design-response {args.design_response}")
     if overrides and args.waveform != "optimized":
         raise UsageError(f"{overrides[0]} needs --waveform optimized: it replaces a part of the Eq. 15 "
                          "design")
@@ -193,9 +210,11 @@ def simulate(args, drive, options: RunOptions):
         # Eq. 15, designed from this drive's own simulated saw-tooth response (first period a
         # saw-tooth, as in the paper); a ValueError (e.g. Δ_a ≥ A) is a usage error
         kernels.notice_if_cold()  # the design simulates: every option is checked by now
-        design = eq15.optimized_design(amplitude, drive, flyback=args.flyback)
+        design = eq15.optimized_design(amplitude, drive, flyback=args.flyback, response_frequency=eq15.
+                                       response_frequency(frequency, args.design_response))
         if given:  # the user's values replace the design's (its f_s, V_r, u_x,max stay as measured)
             design = replace(design, **given)
+        _check_eq15_fits(args, design, amplitude, frequency, drive)
         wave = optimized_waveform.optimized(amplitude, frequency, drive, periods=args.periods,
                                             flyback=args.flyback, design=design)
     else:
@@ -210,6 +229,33 @@ def simulate(args, drive, options: RunOptions):
     return result, design
 
 
+def _check_eq15_fits(args, design, amplitude, frequency, drive) -> None:
+    """Refuse a --frequency at which Eq. 15's period does not fit, naming the highest that does."""
+    from passmd.model import optimized_waveform
+
+    f_max = optimized_waveform.highest_fitting_frequency(design, amplitude, drive, flyback=args.flyback)
+    if optimized_waveform.optimized_timing(design, amplitude, frequency, drive, flyback=args.flyback)[
+            "settling_fits"]:
+        return
+    source = "the options' t_s, t_a" if args.settling_time or args.acceleration_time else \
+        f"the {hz(design.response_frequency)} saw-tooth response"
+    raise UsageError(
+        f"--frequency {args.frequency} is out of range for --waveform optimized: must be <= {hz(f_max)}, the "
+        f"highest frequency at which Eq. 15 fits this drive at A = {fmt(amplitude, 'nm')}: t_s + t_a = "
+        f"{(design.settling_time + design.acceleration_time) * 1e6:.4g} µs (from {source}), the fly-back and "
+        f"the slow ramp (at least half of the rest) need a period of {1e6 / f_max:.4g} µs")
+
+
+def runner_ringing(drive, amplitude: float, frequency: float, flyback: str) -> dict:
+    """The runner's ringing after a saw-tooth fly-back of this run's amplitude and frequency and what
+    of it is left at the next fly-back (:func:`passmd.protocols.ringing.at_frequency`)."""
+    from passmd.protocols import ringing
+
+    probe = ringing.stick_ringing(drive, amplitude, frequency, flyback=flyback)
+    return {k: None if isinstance(v, float) and math.isnan(v) else v  # no swing: no frequency, no decay
+            for k, v in ringing.at_frequency(probe, frequency).items()}
+
+
 def design_row(design, given=()) -> str:
     """The Eq. 15 design in display units: t_s, t_a, Δ_a (V_a), f_s, V_r, u_x,max; ``given``:
     the fields an option set (marked "(given)")."""
@@ -219,7 +265,8 @@ def design_row(design, given=()) -> str:
     return (f"t_s = {design.settling_time * 1e6:.4g} µs{mark('settling_time')}, "
             f"t_a = {design.acceleration_time * 1e6:.4g} µs{mark('acceleration_time')}, "
             f"Δ_a = {fmt(design.acceleration_amplitude, 'nm')}{mark('acceleration_amplitude')} "
-            f"(V_a = {design.acceleration_velocity * 1e3:.4g} mm/s); from the saw-tooth response: "
+            f"(V_a = {design.acceleration_velocity * 1e3:.4g} mm/s); from the "
+            f"{hz(design.response_frequency)} saw-tooth response: "
             f"f_s = {fmt(design.micro_vibration_frequency, 'kHz')}, "
             f"V_r = {design.runner_velocity * 1e3:.4g} mm/s, u_x,max = {fmt(design.presliding, 'nm')}")
 
@@ -236,17 +283,12 @@ def write_outputs(args, result) -> None:
         except OSError as exc:
             raise OutputError(f"cannot write --csv {args.csv}: {exc.strerror or exc}") from exc
     if args.plot:
-        from matplotlib.figure import Figure
+        from passmd.plots.trace import positions_figure
 
-        fig = Figure(figsize=(7, 4), layout="constrained")
-        ax = fig.add_subplot()
-        t_ms = result.time * 1e3
-        ax.plot(t_ms, from_si(result.piezo_position, "nm"), label="piezo x_p", lw=0.8)
-        ax.plot(t_ms, from_si(result.runner_position, "nm"), label="runner x_r", lw=0.8)
-        ax.set_xlabel("time [ms]")
-        ax.set_ylabel("position [nm]")
-        ax.legend()
-        ax.set_title(describe(result.drive), fontsize=9)
+        wave = result.waveform
+        title = (f"{wave.kind}, A = {fmt(wave.amplitude, 'nm')}, f = {hz(wave.frequency)}, "
+                 f"{wave.periods} periods\n{describe(result.drive)}")
+        fig = positions_figure(result, title)
         try:
             fmt_ = Path(args.plot).suffix.lstrip(".").lower()
             write_atomically(args.plot, lambda tmp: fig.savefig(tmp, dpi=150, format=fmt_))
@@ -262,11 +304,16 @@ def run_run(args, out) -> int:
     check_memory(args)
     check_output_paths(args)
     result, design = simulate(args, drive, options)
+    ring = runner_ringing(drive, options.amplitude, options.frequency, args.flyback)  # a simulation too
     startup.resume()
     summary = result.summary()
     summary["wall_time_s"] = float(result.wall_time)
     if design is not None:  # Eq. 15's parameters, derived from this drive's saw-tooth response
+        from passmd.model.optimized_waveform import highest_fitting_frequency
+
         summary["design"] = design.as_dict()
+        summary["eq15_highest_frequency_Hz"] = highest_fitting_frequency(
+            design, float(summary["amplitude_m"]), drive, flyback=args.flyback)
         summary["design_given_by_options"] = [q.field for q in EQ15_OVERRIDES
                                               if getattr(args, q.dest) is not None]
     if args.steady:  # the book's steady-velocity protocol, on this same run
@@ -274,6 +321,7 @@ def run_run(args, out) -> int:
 
         steady = steady_velocity(result)
         summary["steady"] = {**steady, "step_m": steady["velocity_m_per_s"] / float(summary["frequency_Hz"])}
+    summary["ringing"] = ring
     check_results(summary)
     check_run_bounds(summary, drive, float(summary["amplitude_m"]))
     write_outputs(args, result)
@@ -291,6 +339,8 @@ def run_run(args, out) -> int:
     ]
     if design is not None:
         rows.insert(1, ("Eq. 15 design", design_row(design, summary["design_given_by_options"])))
+        rows.insert(2, ("Eq. 15 fits", f"up to {hz(summary['eq15_highest_frequency_Hz'])} for this drive at "
+                                       f"A = {fmt(summary['amplitude_m'], 'nm')}"))
     if "steady" in summary:
         steady = summary["steady"]
         rows.append(("steady velocity", f"{steady['velocity_m_per_s'] * 1e3:.6g} mm/s (second half's period "
@@ -300,6 +350,12 @@ def run_run(args, out) -> int:
         rows.append(("mean velocity from rest", f"{summary['mean_velocity_m_per_s'] * 1e3:.6g} mm/s"))
     if "generated_force_N" in summary:
         rows.append(("generated force", fmt(summary["generated_force_N"], "N")))
+    rows.append(("runner ringing", ringing_text(ring, "the step")))
+    over = [b for b in summary["back_steps_m"] if b > float(summary["amplitude_m"])]
+    if over and ring["ringing_affects_steps"]:
+        rows.append(("back-step > A", f"{len(over)} back-step{'s' * (len(over) > 1)} exceed the amplitude "
+                                      f"(up to {fmt(max(over), 'nm')}): the runner's swing at the fly-back "
+                                      "adds to it"))
     rows.append(("integrator", f"{summary['integrator_steps']} steps, {summary['wall_time_s']:.3g} s"))
     emit_rows(f"passmd run — {describe(drive)}", [*rows, *drive_rows(drive)], out)
     return 0

@@ -9,6 +9,7 @@ import math
 import re
 import textwrap
 from dataclasses import dataclass
+from decimal import Decimal, localcontext
 from pathlib import Path
 
 import numpy as np
@@ -16,6 +17,15 @@ import numpy as np
 from passmd.cli.configuration import run_config
 from passmd.cli.drive import _bound, build_drive, explain
 from passmd.cli.errors import OutputError, UsageError
+from passmd.cli.notes import (
+    eq15_rows,
+    missing_rows,
+    resolution,
+    ringing_rows,
+    sweep_figure,
+    sweep_title,
+    uses_eq15,
+)
 from passmd.cli.options import (
     AMPLITUDE,
     DRIVE_QUANTITIES,
@@ -32,7 +42,8 @@ from passmd.runtime.config import ENVIRONMENT
 from passmd.runtime.units import QuantityError, from_si, parse_quantity
 from passmd.runtime.validation import InputError
 
-__all__ = ["AXES", "MAX_AXIS_POINTS", "MAX_POINTS", "Axis", "add_parser", "parse_vary", "run_sweep"]
+__all__ = ["AXES", "MAX_AXIS_POINTS", "MAX_POINTS", "Axis", "add_parser", "grid_values", "parse_vary",
+           "run_sweep"]
 
 #: The quantities (passmd.protocols.maps.MAP_QUANTITIES; listed here so --help does not import it).
 QUANTITY_NAMES = ("velocity", "step", "back-step", "critical-amplitude", "stall-force", "gain")
@@ -47,6 +58,9 @@ MAX_AXIS_POINTS = 1000
 MAX_POINTS = 100_000
 #: Longest curve the human output lists in full (longer ones and maps: the extremes).
 MAX_SHOWN = 40
+#: passmd.protocols.velocity.STEADY_DRIFT_LIMIT in percent (said here so --help does not import it;
+#: tests/test_cli_sweep.py checks they agree).
+STEADY_DRIFT_PERCENT = 5
 
 _NAMES = "NAME: " + ", ".join(AXES) + "."
 _EPILOG = textwrap.dedent("""\
@@ -60,7 +74,10 @@ _EPILOG = textwrap.dedent("""\
       fly-back: what moves the drive once); the closed form (Eqs. 7-8, 11-12) is reported too
     - stall-force: generated force at stall against the load cell (Section 4.2)
     - gain: steady velocity of the Eq. 15 waveform (designed from this drive's saw-tooth
-      response) minus that of the saw-tooth
+      response, --design-response) minus that of the saw-tooth. Eq. 15's period needs t_s + t_a,
+      the fly-back and a slow ramp: above the highest frequency at which it fits (the column
+      eq15_highest_frequency_Hz) a cell has no value and its note says so, as where Eq. 15 gives
+      no waveform at all; so does velocity --waveform optimized
 
     --vary NAME=SPEC, repeated for a map (the first axis is the x axis, the last runs fastest):
 
@@ -82,9 +99,16 @@ _EPILOG = textwrap.dedent("""\
     with pandas.read_csv(path, comment="#")), PREFIX.json (the --json object) and PREFIX.png
     (a curve for one axis, a heat map with contours for two).
 
-    --json keys: command, quantity, column, reading, waveform, axes[{{name, values, unit,
-    spacing, typed}}], drive{{...}}, provenance{{...}}, sweep{{points, cached, computed}}, columns,
-    rows[{{...}}] (SI units, keys carrying the unit), files""")
+    --json keys: command, quantity, column, reading, waveform, design_response, axes[{{name,
+    values, unit, spacing, typed}}], drive{{...}}, provenance{{...}}, sweep{{points, cached,
+    computed}}, columns, rows[{{...}}] (SI units, keys carrying the unit), files. Among a row's
+    columns: velocity_drift (velocity, step, back-step), the velocity of the run's fourth quarter
+    minus that of its third, over the velocity: beyond {STEADY_DRIFT_PERCENT} % the point is not
+    steady (hatched in the PNG, as are points with no value and points whose magnitude is below the
+    measurable step); ringing_* (every quantity but the stall force): the runner's swing after a
+    fly-back and what is left of it when the next starts (ringing_at_next_flyback_m): where that
+    exceeds the measurable step the value depends on the swing's phase, and a curve turns
+    (the output says so; the model's physics, not noise).""")
 
 
 @dataclass(frozen=True)
@@ -125,6 +149,10 @@ def add_parser(command) -> None:
                        help="waveform of velocity, step and back-step (default: sawtooth)")
     group.add_argument("--reading", choices=("steady", "first"), default=None,
                        help="reading of critical-amplitude (default: steady)")
+    group.add_argument("--design-response", choices=("paper", "driving"), default=None,
+                       help="saw-tooth response the Eq. 15 waveform is designed from: paper, the 100 Hz "
+                            "response of Section 5.2 (one design per drive and amplitude); driving, the "
+                            "response at each point's frequency (default: paper)")
     add_sweep_options(p)
     out = p.add_argument_group("output")
     out.add_argument("--out", metavar="PREFIX", action=FilePath,
@@ -177,14 +205,24 @@ def parse_vary(text: str) -> Axis:
     lo, hi = value(low), value(high)
     if not lo < hi:
         raise _refuse(text, f"the range {low.strip()}..{high.strip()} is empty: LO must be below HI")
+    if spacing == "log" and lo <= 0:
+        raise _refuse(text, f"a log range must start above 0, not at {low.strip()}")
+    return Axis(name, grid_values(lo, hi, count, spacing), spacing, text)
+
+
+def grid_values(lo: float, hi: float, count: int, spacing: str) -> tuple[float, ...]:
+    """``count`` values from ``lo`` to ``hi`` (SI) as a reader writes them: a linear grid in decimal
+    (0.1..1:10 gives 0.4, not 0.39999999999999997), a log grid to 12 significant digits; the ends
+    exactly as typed. The points are computed at these values, so the CSV holds what ran."""
     if spacing == "log":
-        if lo <= 0:
-            raise _refuse(text, f"a log range must start above 0, not at {low.strip()}")
-        values = np.geomspace(lo, hi, count)
+        values = [float(f"{v:.12g}") for v in np.geomspace(lo, hi, count)]
     else:
-        values = np.linspace(lo, hi, count)
-    values[0], values[-1] = lo, hi  # the ends exactly as typed
-    return Axis(name, tuple(float(v) for v in values), spacing, text)
+        with localcontext() as ctx:
+            ctx.prec = 28
+            start, stop = Decimal(repr(lo)), Decimal(repr(hi))
+            values = [float(start + (stop - start) * k / (count - 1)) for k in range(count)]
+    values[0], values[-1] = lo, hi
+    return tuple(values)
 
 
 def _shown(axis: Axis, value: float) -> str:
@@ -236,6 +274,10 @@ def _check_options(args) -> None:
     if args.waveform is not None and args.quantity not in ("velocity", "step", "back-step"):
         raise UsageError(f"--waveform {args.waveform} has no effect on {args.quantity}: it chooses the "
                          "waveform of velocity, step and back-step")
+    if args.design_response is not None and not uses_eq15(args):
+        raise UsageError(f"--design-response {args.design_response} has no effect on {args.quantity}"
+                         f"{' --waveform sawtooth' if args.waveform else ''}: it chooses the response the "
+                         "Eq. 15 waveform is designed from (gain, or --waveform optimized)")
     if args.amplitude is not None and args.quantity == "critical-amplitude":
         raise UsageError("--amplitude has no effect on critical-amplitude: it searches over the amplitude")
     if args.out is not None:
@@ -330,7 +372,7 @@ def _arguments(args) -> str:
 
 def _record(args, axes, table, spec, drive) -> dict:
     from passmd import __version__
-    from passmd.runtime.provenance import git_commit
+    from passmd.runtime.provenance import commit_or_version
 
     rows = [{k: _finite_or_none(v) for k, v in row.items()} for row in table.to_dict(orient="records")]
     missing = sum(row[spec.column] is None for row in rows)
@@ -340,10 +382,11 @@ def _record(args, axes, table, spec, drive) -> dict:
         "column": spec.column,
         "reading": (args.reading or "steady") if args.quantity == "critical-amplitude" else None,
         "waveform": (args.waveform or "sawtooth") if spec.function.__name__ == "steady_point" else None,
+        "design_response": (args.design_response or "paper") if uses_eq15(args) else None,
         "axes": [{"name": a.name, "column": a.column, "values": list(a.values), "unit": a.si_unit,
                   "spacing": a.spacing, "typed": a.typed} for a in axes],
         "drive": drive_record(drive),
-        "provenance": {"passmd_version": __version__, "git_commit": git_commit(),
+        "provenance": {"passmd_version": __version__, "git_commit": commit_or_version(),
                        "arguments": _arguments(args)},
         "sweep": {k: table.attrs["sweep"][k] for k in ("points", "cached", "computed")},
         "missing_values": missing,
@@ -372,7 +415,7 @@ def _write(args, record, axes, spec, table, title) -> dict:
         text = json.dumps(plain({**record, "files": files}), indent=2, allow_nan=False) + "\n"
         write_atomically(files["json"], lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
         if "png" in files:
-            fig = _figure(axes, spec, table, title)
+            fig = sweep_figure(args, axes, spec, table, title)
             facts = record["provenance"]
             summary = f"passmd {facts['passmd_version']}, commit {facts['git_commit']}"
             write_atomically(files["png"], lambda tmp: fig.savefig(
@@ -382,16 +425,6 @@ def _write(args, record, axes, spec, table, title) -> dict:
     except OSError as exc:
         raise OutputError(f"cannot write --out {prefix}: {exc.strerror or exc}") from exc
     return files
-
-
-def _figure(axes, spec, table, title):
-    from passmd.plots.sweep_map import MapAxis, map_figure
-
-    shown = [MapAxis(a.column, a.name, a.quantity.unit, a.spacing == "log") for a in axes]
-    value = MapAxis(spec.column, spec.label, spec.unit, scale=spec.scale)
-    also = [MapAxis(c, "closed form" if c.startswith("analytic") else c, spec.unit, scale=spec.scale)
-            for c in spec.also]
-    return map_figure(table, shown, value, title, also=also if len(axes) == 1 else ())
 
 
 def _curve_rows(axes, spec, table) -> list[tuple[str, str]]:
@@ -406,20 +439,25 @@ def _extreme_rows(axes, spec, table) -> list[tuple[str, str]]:
     values = np.array([np.nan if v is None else float(v) for v in table[spec.column]], dtype=float)
     if not np.isfinite(values).any():
         return [(spec.label, "no value (see the note column)")]
+    from passmd.protocols.velocity import STEADY_DRIFT_LIMIT
+
     rows = []
+    drift = table["velocity_drift"] if "velocity_drift" in table else None
     for word, i in (("min", int(np.nanargmin(values))), ("max", int(np.nanargmax(values)))):
         where = ", ".join(f"{a.name} {_shown(a, table[a.column].iloc[i])}" for a in axes)
-        rows.append((f"{word} {spec.label}", f"{values[i] / spec.scale:.6g} {spec.unit} at {where}"))
+        unsteady = drift is not None and abs(float(drift.iloc[i])) > STEADY_DRIFT_LIMIT
+        rows.append((f"{word} {spec.label}", f"{values[i] / spec.scale:.6g} {spec.unit} at {where}"
+                     + (f" (not steady: velocity_drift {float(drift.iloc[i]):.2g})" if unsteady else "")))
     return rows
 
 
-def _check_values(quantity: str, column: str, table) -> None:
-    """The quantity is finite at every point; only a gain without an Eq. 15 waveform and a
-    critical amplitude above the full stroke may be missing (``None``, said in the output)."""
+def _check_values(args, column: str, table) -> None:
+    """The quantity is finite at every point; only an Eq. 15 quantity without an Eq. 15 waveform
+    and a critical amplitude above the full stroke may be missing (``None``, said in the output)."""
     from passmd.cli.output import check_results
 
     values = [v for v in table[column] if v is not None]
-    if quantity in ("gain", "critical-amplitude"):
+    if args.quantity == "critical-amplitude" or uses_eq15(args):
         values = [v for v in values if not (isinstance(v, float) and math.isnan(v))]
     check_results({column: values})
 
@@ -435,9 +473,11 @@ def run_sweep(args, out) -> int:
     points = _points(args, axes, spec.amplitude)
     base = points[0]["drive"]
     table = compute_map(args.quantity, points, reading=args.reading or "steady",
-                        waveform=args.waveform or "sawtooth", config=config)
-    _check_values(args.quantity, spec.column, table)
-    title = f"{spec.label} — {describe(base)}"
+                        waveform=args.waveform or "sawtooth", design_response=args.design_response or "paper",
+                        config=config)
+    _check_values(args, spec.column, table)
+    varied = [a.name for a in axes]
+    title = sweep_title(spec, axes, base)
     record = _record(args, axes, table, spec, base)
     if args.out is not None:
         record["files"] = _write(args, record, axes, spec, table, title)
@@ -451,12 +491,11 @@ def run_sweep(args, out) -> int:
                        f"{counts['computed']} computed)")]
     rows += _curve_rows(axes, spec, table) if len(axes) == 1 and len(table) <= MAX_SHOWN else \
         _extreme_rows(axes, spec, table)
+    rows += eq15_rows(args, table)
+    rows += ringing_rows(axes, spec, table, resolution(spec, table["frequency_Hz"]), _shown)
     if record["missing_values"]:
-        why = ("no Eq. 15 waveform there, see the note column" if args.quantity == "gain" else
-               "no onset up to the full stroke")
-        count = record["missing_values"]
-        rows.append(("no value", f"{count} point{'s' * (count > 1)} ({why})"))
+        rows += missing_rows(args, table, record["missing_values"])
     if "files" in record:
         rows.append(("written", ", ".join(record["files"].values())))
-    emit_rows(f"passmd sweep {args.quantity} — {describe(base)}", rows, out)
+    emit_rows(f"passmd sweep {args.quantity} — {describe(base, omit=varied)}", rows, out)
     return 0

@@ -17,22 +17,22 @@ measurements that were held back from the fit.
 from __future__ import annotations
 
 import math
-import os
 import tempfile
 from dataclasses import dataclass, replace
-from importlib import resources
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from passmd.experiments.design.maps import compute_map
+from passmd.model import drive_file
 from passmd.model.defaults import PROTOCOL
 from passmd.model.drive_file import load_drive, parameter_rows, read_drive_file, resolve
 from passmd.model.parameters import Drive
 from passmd.model.tables import actuator_for_radius
+from passmd.model.theory import contact_arrangement
 from passmd.protocols import fit as fitting
-from passmd.protocols import stall
+from passmd.protocols import ringing, stall
 from passmd.runtime.config import PROFILES, RunConfig
 from passmd.runtime.units import from_si
 from passmd.runtime.validation import check_choice
@@ -45,7 +45,10 @@ __all__ = [
     "START",
     "ProfileSettings",
     "calibrate",
+    "contact_table",
     "critical_amplitude_curve",
+    "curve_facts",
+    "curve_from_maps",
     "example_drive",
     "fit_facts",
     "gain_facts",
@@ -53,18 +56,25 @@ __all__ = [
     "heldback_facts",
     "heldback_predictions",
     "load_fitted",
+    "map_axes",
     "map_facts",
     "map_points",
     "measurements_csv",
     "parameter_table",
+    "preload_points",
+    "ringing_facts",
+    "run_config",
     "stall_force_curve",
+    "stall_frame",
+    "stall_points",
     "start_drive",
     "step_velocity_map",
     "synthetic_measurements",
 ]
 
-#: The example drive file (package data, so an installed wheel has it too).
-EXAMPLE_DRIVE_FILE = Path(os.fspath(resources.files("passmd") / "data" / "drives" / "example_drive.toml"))
+#: The example drive file (package data, so an installed wheel has it too; ``passmd drive template
+#: --example`` prints it).
+EXAMPLE_DRIVE_FILE = drive_file.EXAMPLE_DRIVE_FILE
 #: Standard deviation of the synthetic measurements' noise (nm): a step read to about 1 nm, as
 #: a capacitive or interferometric sensor on a test stand reads it.
 NOISE_NM = 1.0
@@ -155,8 +165,8 @@ def parameter_table(drive: Drive, sources: dict) -> pd.DataFrame:
     rows = []
     for row in parameter_rows(drive, sources):
         value, unit = row["value"], row["display_unit"]
-        if isinstance(value, list):
-            shown = "; ".join(", ".join(f"{k} = {v:g}" for k, v in g.items()) for g in value) or "–"
+        if isinstance(value, list):  # contact groups
+            shown = "; ".join(_group_text(g) for g in value) or "–"
         elif isinstance(value, bool):
             shown = str(value).lower()
         elif isinstance(value, str):
@@ -168,30 +178,85 @@ def parameter_table(drive: Drive, sources: dict) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def _group_text(group: dict) -> str:
+    """A drive file's contact group in words: ``2 at 45° (side 1), R = 0.5 mm, F_N/F_p = 0.5``."""
+    text = f"{group['count']} at {math.degrees(group['contact_angle']):.4g}°"
+    text += f" (side {group['side']})" if "side" in group else ""
+    text += f", R = {group['radius'] * 1e3:.4g} mm" if "radius" in group else ""
+    text += f", F_N/F_p = {group['load_share']:.4g}" if "load_share" in group else ""
+    return text + (f", F_N = {group['normal_force']:.4g} N" if "normal_force" in group else "")
+
+
+def run_config(config: RunConfig | None, profile: str) -> RunConfig:
+    """The run configuration of the chapter's sweeps on ``profile`` (:data:`PROFILE_SETTINGS`)."""
+    return _run_config(config, profile)
+
+
+def contact_table(drive: Drive) -> pd.DataFrame:
+    """Each contact group of ``drive`` as ``passmd drive show`` lists it: side, count, contact angle,
+    radius, normal force per contact and where it comes from (given, or Eq. 1's balance)."""
+    rows = contact_arrangement(drive)
+    return pd.DataFrame({
+        "side": [r["side"] for r in rows], "contacts": [r["count"] for r in rows],
+        "contact angle α [°]": [math.degrees(r["contact_angle_rad"]) for r in rows],
+        "R [mm]": [r["radius_m"] * 1e3 for r in rows],
+        "F_N per contact [N]": [r["normal_force_N"] for r in rows],
+        "n F_N sin α [N]": [r["preload_share_N"] for r in rows],
+        "F_N from": [{"Eq. 1": "F_p / (n sin α), Eq. 1", "load_share": "given share of F_p",
+                      "normal_force": "given"}[r["force_from"]] for r in rows]})
+
+
+def preload_points(drive: Drive, profile: str) -> list[dict]:
+    """The points of A_c against preload at Section 4.1's frequency (``passmd sweep
+    critical-amplitude --vary preload=...``)."""
+    return [{"drive": replace(drive, preload=float(p)), "frequency": PROTOCOL.drive_frequency,
+             "preload_N": float(p)} for p in _settings(profile).preloads]
+
+
+def curve_from_maps(steady: pd.DataFrame, first: pd.DataFrame) -> pd.DataFrame:
+    """A_c against preload from the two ``critical-amplitude`` maps (readings ``steady``, ``first``).
+
+    Columns (nm, N, Hz): ``preload_N``, ``closed_form_nm``, ``steady_nm``, ``first_nm``, and the
+    runner's ringing at the steady A_c (:func:`passmd.protocols.ringing.at_frequency`):
+    ``ringing_frequency_Hz``, ``ringing_amplitude_nm``, ``ringing_left_nm`` (at the next fly-back),
+    ``ringing_affects``.
+    """
+    def nm(values):
+        return [math.nan if v is None else float(v) * 1e9 for v in values]
+
+    return pd.DataFrame({
+        "preload_N": steady["preload_N"].to_numpy(float),
+        "closed_form_nm": steady["analytic_critical_amplitude_m"].to_numpy(float) * 1e9,
+        "steady_nm": nm(steady["critical_amplitude_m"]), "first_nm": nm(first["critical_amplitude_m"]),
+        "ringing_frequency_Hz": steady["ringing_frequency_Hz"].to_numpy(float),
+        "ringing_amplitude_nm": nm(steady["ringing_amplitude_m"]),
+        "ringing_left_nm": nm(steady["ringing_at_next_flyback_m"]),
+        "ringing_affects": steady["ringing_affects_steps"].astype(bool).to_numpy()})
+
+
 def critical_amplitude_curve(drive: Drive, profile: str, config: RunConfig | None = None) -> pd.DataFrame:
     """A_c against preload at Section 4.1's frequency: the closed form (Eqs. 7–8, 11–12) and the
-    two simulated readings (``steady``, ``first``), as ``passmd sweep critical-amplitude``.
-
-    Columns (nm, N): ``preload_N``, ``closed_form_nm``, ``steady_nm``, ``first_nm``.
-    """
+    two simulated readings (``steady``, ``first``), as ``passmd sweep critical-amplitude``
+    (:func:`curve_from_maps`)."""
     config = _run_config(config, profile)
-    points = [{"drive": replace(drive, preload=float(p)), "frequency": PROTOCOL.drive_frequency,
-               "preload_N": float(p)} for p in _settings(profile).preloads]
-    out = pd.DataFrame({"preload_N": [p["preload_N"] for p in points]})
-    for reading in ("steady", "first"):
-        table = compute_map("critical-amplitude", points, reading=reading, config=config,
-                            description=f"A_c ({reading}) against preload")
-        out[f"{reading}_nm"] = [math.nan if v is None else v * 1e9 for v in table["critical_amplitude_m"]]
-        out["closed_form_nm"] = table["analytic_critical_amplitude_m"].to_numpy(float) * 1e9
-    return out[["preload_N", "closed_form_nm", "steady_nm", "first_nm"]]
+    points = preload_points(drive, profile)
+    steady, first = (compute_map("critical-amplitude", points, reading=reading, config=config,
+                                 description=f"A_c ({reading}) against preload")
+                     for reading in ("steady", "first"))
+    return curve_from_maps(steady, first)
+
+
+def map_axes(drive: Drive, profile: str) -> tuple[np.ndarray, np.ndarray]:
+    """The maps' frequencies (log-spaced, Hz) and amplitudes (linear up to the full stroke, m)."""
+    s = _settings(profile)
+    return (np.geomspace(*MAP_FREQUENCY_RANGE, s.map_frequencies),
+            np.linspace(MAP_AMPLITUDE_LOW, drive.actuator.full_stroke_amplitude, s.map_amplitudes))
 
 
 def map_points(drive: Drive, profile: str) -> list[dict]:
     """The frequency × amplitude grid of the maps (frequency the x axis, amplitude fastest), with
     the columns ``passmd sweep --vary frequency=... --vary amplitude=...`` writes."""
-    s = _settings(profile)
-    frequencies = np.geomspace(*MAP_FREQUENCY_RANGE, s.map_frequencies)
-    amplitudes = np.linspace(MAP_AMPLITUDE_LOW, drive.actuator.full_stroke_amplitude, s.map_amplitudes)
+    frequencies, amplitudes = map_axes(drive, profile)
     return [{"drive": drive, "frequency": float(f), "amplitude": float(a), "frequency_Hz": float(f),
              "amplitude_m": float(a)} for f in frequencies for a in amplitudes]
 
@@ -208,18 +273,29 @@ def gain_map(drive: Drive, profile: str, config: RunConfig | None = None) -> pd.
                        description="Eq. 15 gain map")
 
 
+def stall_points(drive: Drive, profile: str) -> list[dict]:
+    """The stall-force points at Section 4.2's frequency: the profile's preloads × amplitudes
+    (fractions of the full stroke), the runner against the load cell."""
+    s = _settings(profile)
+    a_max = drive.actuator.full_stroke_amplitude
+    return [{"drive": replace(drive, preload=float(p), load_cell=True), "frequency": PROTOCOL.drive_frequency,
+             "amplitude": float(x * a_max), "preload_N": float(p)}
+            for p in s.stall_preloads for x in s.stall_fractions]
+
+
 def stall_force_curve(drive: Drive, profile: str, config: RunConfig | None = None) -> pd.DataFrame:
     """Generated force at stall against the amplitude at Section 4.2's frequency, per preload
-    (``passmd sweep stall-force``), with the Coulomb bound μ·ΣF_N of each preload.
+    (``passmd sweep stall-force``), with the Coulomb bound μ·ΣF_N of each preload (:func:`stall_frame`)."""
+    points = stall_points(drive, profile)
+    table = compute_map("stall-force", points, config=_run_config(config, profile), description="stall force")
+    return stall_frame(points, table)
+
+
+def stall_frame(points: list[dict], table: pd.DataFrame) -> pd.DataFrame:
+    """The stall-force map of :func:`stall_points` as the chapter draws it.
 
     Columns: ``preload_N``, ``amplitude_nm``, ``force_mN``, ``converged``, ``periods``, ``bound_mN``.
     """
-    s = _settings(profile)
-    a_max = drive.actuator.full_stroke_amplitude
-    points = [{"drive": replace(drive, preload=float(p), load_cell=True),
-               "frequency": PROTOCOL.drive_frequency, "amplitude": float(x * a_max), "preload_N": float(p)}
-              for p in s.stall_preloads for x in s.stall_fractions]
-    table = compute_map("stall-force", points, config=_run_config(config, profile), description="stall force")
     return pd.DataFrame({
         "preload_N": table["preload_N"],
         "amplitude_nm": [p["amplitude"] * 1e9 for p in points],
@@ -354,3 +430,35 @@ def heldback_facts(table: pd.DataFrame, labels=("start", "fitted")) -> dict:
     for label in labels:
         out[f"rms_{label}_nm"] = float(np.sqrt(np.mean((table[f"{label}_nm"] - table["measured_nm"]) ** 2)))
     return out
+
+
+def curve_facts(curve: pd.DataFrame) -> dict:
+    """What the chapter says of A_c against preload, all read off ``curve`` (:func:`curve_from_maps`):
+    at how many preloads the closed form lies at or above both simulated readings, where the steady
+    reading exceeds it most (nm, N), how often the steady curve turns (changes beyond the
+    measurable step) and at how many preloads the runner still rings at the next fly-back."""
+    closed, steady, first = (curve[c].to_numpy(float) for c in ("closed_form_nm", "steady_nm", "first_nm"))
+    above = (closed >= steady) & (closed >= first)
+    excess = steady - closed
+    worst = int(np.nanargmax(excess))
+    turns = ringing.turns(steady, [PROTOCOL.step_threshold * 1e9] * len(steady))
+    return {"ca_points": len(curve), "ca_closed_above": int(above.sum()),
+            "ca_excess_nm": float(excess[worst]), "ca_excess_at_N": float(curve["preload_N"].iloc[worst]),
+            "ca_turns": len(turns), "ca_ringing_points": int(curve["ringing_affects"].sum()),
+            "ca_ringing_left_nm": float(np.nanmax(curve["ringing_left_nm"]))}
+
+
+def ringing_facts(probe: dict, frequency: float) -> dict:
+    """The ringing after a fly-back (:func:`passmd.protocols.ringing.stick_ringing`) as the chapter
+    quotes it: frequency (kHz), first swing (nm), 1/e time (ms), swing left at the next fly-back at
+    ``frequency`` (nm) and the longest period at which that is below the measurable step (ms; NaN
+    if the swing stays above it while recorded)."""
+    at = ringing.at_frequency(probe, frequency)
+    swings, times = np.asarray(probe["swing_amplitudes_m"]), np.asarray(probe["swing_times_s"])
+    below = np.flatnonzero(swings < ringing.MEASURABLE)
+    return {"ring_f_kHz": probe["ringing_frequency_Hz"] / 1e3,
+            "ring_amp_nm": probe["ringing_amplitude_m"] * 1e9,
+            "ring_decay_ms": probe["ringing_decay_time_s"] * 1e3,
+            "ring_left_nm": at["ringing_at_next_flyback_m"] * 1e9,
+            "ring_hold_ms": probe["ringing_hold_s"] * 1e3, "ring_next_ms": at["next_flyback_after_s"] * 1e3,
+            "ring_quiet_ms": float(times[below[0]] * 1e3) if below.size else math.nan}
