@@ -57,6 +57,38 @@ def test_bisection_brackets_the_switch_and_counts_runs():
     assert 0.0 not in calls  # A = 0 is "no motion" by definition, never simulated
 
 
+def test_guided_search_returns_bisections_bracket_with_fewer_runs():
+    """Wherever the drive starts moving once on [0, A_max], the guided search's bracket is
+    bisection's to the last bit, whatever the slope of the measure and however noisy it is; with
+    several switches it still brackets one of them."""
+    rng = np.random.default_rng(7)
+    runs = []
+    for _ in range(400):
+        upper = float(rng.choice([202e-9, 96e-9, rng.uniform(10e-9, 160e-9)]))
+        tolerance = float(rng.choice([0.1e-9, 0.2e-9, 0.5e-9, 2e-9]))
+        switch, slope = rng.uniform(0.0, upper), rng.uniform(0.5, 2.0)
+
+        def probe(a, switch=switch, slope=slope):
+            moved = a >= switch
+            return moved, slope * (a - switch) + rng.uniform(-1e-11, 1e-11) if moved else None
+
+        found = search.search_amplitude(probe, upper, tolerance, slope=1.0)
+        plain = search.bisect_amplitude(lambda a, switch=switch: a >= switch, upper, tolerance)
+        assert found == {**plain, "runs": found["runs"]}
+        runs.append(found["runs"] / plain["runs"])
+    assert np.median(runs) < 0.6
+    switches = (30e-9, 45e-9, 120e-9)
+
+    def several(a):
+        moved = switches[0] <= a < switches[1] or a >= switches[2]
+        return moved, a - switches[2] if moved else None
+
+    found = search.search_amplitude(several, 202e-9, 0.1e-9, slope=1.0)
+    assert not several(found["bracket_low_m"])[0] and several(found["bracket_high_m"])[0]
+    assert found["bracket_high_m"] - found["bracket_low_m"] <= 0.1e-9
+    assert math.isnan(search.search_amplitude(lambda a: (False, None), 96e-9, 0.5e-9)["critical_amplitude_m"])
+
+
 def test_bisection_without_motion_at_full_stroke_reports_nan():
     out = search.bisect_amplitude(lambda a: False, 96e-9, 0.5e-9)
     assert math.isnan(out["critical_amplitude_m"]) and math.isnan(out["bracket_high_m"])
