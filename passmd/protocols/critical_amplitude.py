@@ -29,8 +29,8 @@ bracket; it halves until narrower than the tolerance, and reports the final brac
 midpoint as A_c and the number of runs. The steady-state search finds bisection's final
 bracket with fewer runs (:func:`search_amplitude`): above A_c the last step grows about 1 nm
 per nm of amplitude, so its linear extrapolation tells which of bisection's decisions need a
-run; whenever the step switches once on [0, A_max] the bracket is bisection's to the last bit. Grids, figures and claims of Section 4.1 are in
-:mod:`passmd.experiments.critical_amplitude.figures`.
+run; whenever the step switches once on [0, A_max] the bracket is bisection's to the last bit.
+Grids, figures and claims of Section 4.1 are in :mod:`passmd.experiments.critical_amplitude.figures`.
 """
 
 from __future__ import annotations
@@ -328,7 +328,8 @@ def search_amplitude(probe, upper: float, tolerance: float, *, slope: float | No
 
     evaluate(upper)
     if not known[upper]:
-        return {"critical_amplitude_m": math.nan, "bracket_low_m": upper, "bracket_high_m": math.nan, "runs": 1}
+        return {"critical_amplitude_m": math.nan, "bracket_low_m": upper, "bracket_high_m": math.nan,
+                "runs": 1}
     known[0.0], measured[0.0] = False, None  # A = 0: no drive, no motion (never simulated)
     widths = []
     while True:
