@@ -3,8 +3,8 @@
 :func:`state_table` tabulates every counted claim's state (``holds``, ``fails``,
 ``inconclusive``, or ``—`` where its design does not reach) at every point of
 :func:`passmd.ledger.readings.space`. :func:`joint_reading` picks, among the *covered* points
-(every claim that rests on computed evidence decided there), the one with the most claims
-holding (ties broken towards the defaults), with the number of points it was chosen from, its
+(every claim that rests on computed evidence evaluated there from its runs), the one with the
+most claims holding (ties broken towards the defaults), with the number of points it was chosen from, its
 ties and its runner-ups with their margins; points where all claims agree are one reading.
 :func:`conflicting_pairs` lists every pair of claims that each hold somewhere but never together,
 :func:`tensions` groups them by the readings that separate them, with near-duplicate rows (the
@@ -71,13 +71,14 @@ def state_table(evaluated: Mapping[str, tuple[list[PointResult], tuple]]) -> dic
 
     ``evaluated`` is ``{claim id: (points, depends_on)}`` (``passmd.ledger.verdicts.claim_points``); a
     claim's state at a point is its state at the projection of that point onto its axes, ``—``
-    where its design does not reach.
+    where its design does not reach or its tables hold no run.
     """
     space = readings.space()
     index = {}
     for claim, (points, depends) in evaluated.items():
         keys = [k for k in depends if len({p.reading[k] for p in points}) > 1] if points else []
-        index[claim] = (keys, {tuple(p.reading[k] for k in keys): p.state for p in points})
+        index[claim] = (keys, {tuple(p.reading[k] for k in keys): "—" if p.no_run else p.state
+                               for p in points})
     table = {}
     for i, point in enumerate(space):
         table[i] = {claim: (states.get(tuple(point[k] for k in keys), "—") if states else "—")
@@ -96,24 +97,28 @@ def joint_reading(evaluated: Mapping[str, tuple[list[PointResult], tuple]],
     """The point of the declared assumption space where the most claims hold together.
 
     ``evaluated`` is ``{claim id: (points, depends_on)}`` of the counted claims; ``computed`` the
-    ones that rest on computed evidence (default: all), which must be decided (hold or fail) at a
-    point for it to be *covered*. The joint reading is chosen among the covered points (among all
-    points if none is covered); ties are broken towards the defaults (fewest changed axes, then the
-    order of the space). Points at which every claim has the same state are one reading for the
-    ledger: each is represented by its member closest to the defaults.
+    ones that rest on computed evidence (default: all). A point is *covered* when every one of them
+    was evaluated there from its runs (a state, never a missing run: the strict ledger stops on one,
+    so every point is), *decided* when every one of them holds or fails there (an undecided state is
+    the data's own answer, e.g. two back-steps that are both zero cannot be ordered). The joint
+    reading is chosen among the covered points (among all if none is), an undecided claim counting
+    as not holding; ties are broken towards the defaults (fewest changed axes, then the order of the
+    space). Points at which every claim has the same state are one reading for the ledger: each is
+    represented by its member closest to the defaults.
 
     Returns ``reading``, ``described``, ``holding`` (claims holding there), ``equivalent_points``
     (points of the space it stands for), ``claims`` (total), ``points`` (the space's size),
-    ``covered_points``, ``chosen_from`` (points it was chosen among), ``ties`` (other distinct
-    readings with as many), ``runner_ups`` (the next ``runner_ups`` distinct readings, each with
-    ``holding`` and ``margin``: how many fewer claims hold there) and ``states``
+    ``covered_points``, ``decided_points``, ``chosen_from`` (points it was chosen among), ``ties``
+    (other distinct readings with as many), ``runner_ups`` (the next ``runner_ups`` distinct
+    readings, each with ``holding`` and ``margin``: how many fewer claims hold there) and ``states``
     (:func:`state_table`, with the index of the joint reading under ``"best"``).
     """
     states = state_table(evaluated) if states is None else states
     space, table = states["space"], states["table"]
     computed = set(evaluated) if computed is None else set(computed) & set(evaluated)
     counts = {i: sum(state == "holds" for state in table[i].values()) for i in table}
-    covered = [i for i in table if all(table[i][c] in DECIDED for c in computed)]
+    covered = [i for i in table if all(table[i][c] != "—" for c in computed)]
+    decided = [i for i in covered if all(table[i][c] in DECIDED for c in computed)]
     pool = covered or list(table)
     # points where every claim has the same state are one reading for the ledger: keep the one
     # closest to the defaults, and how many it stands for
@@ -130,7 +135,7 @@ def joint_reading(evaluated: Mapping[str, tuple[list[PointResult], tuple]],
 
     return {
         **entry(best), "claims": len(evaluated), "points": len(space), "covered_points": len(covered),
-        "chosen_from": len(pool),
+        "decided_points": len(decided), "chosen_from": len(pool),
         "ties": [entry(i) for i in order[1:] if counts[i] == counts[best]],
         "runner_ups": [{**entry(i), "margin": counts[best] - counts[i]}
                        for i in order if counts[i] < counts[best]][:runner_ups],
@@ -241,5 +246,5 @@ def joint_record(joint: Mapping) -> dict:
     it was chosen from, the tied points and the runner-ups with their counts and margins, and how it
     changes when rows are left out or studies counted (``variants``)."""
     keys = ("reading", "described", "holding", "equivalent_points", "claims", "points", "covered_points",
-            "chosen_from", "ties", "runner_ups", "variants")
+            "decided_points", "chosen_from", "ties", "runner_ups", "variants")
     return {k: joint[k] for k in keys if k in joint}

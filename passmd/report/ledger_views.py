@@ -65,9 +65,9 @@ def joint_sentences(joint: Mapping) -> list[str]:
         f"Joint reading: {joint['described']}, where {joint['holding']} of {joint['claims']} claims hold "
         "together.",
         f"It was chosen from {joint['chosen_from']} of the {joint['points']} points of the declared "
-        "assumption "
-        f"space ({joint['covered_points']} covered: every claim resting on computed evidence decided there); "
-        f"{joint['equivalent_points']} of them give every claim the same state as it does.",
+        f"assumption space ({joint['covered_points']} covered: every claim resting on computed evidence "
+        f"evaluated there from its runs; {joint['decided_points']} decided: every such claim holds or fails "
+        f"there); {joint['equivalent_points']} of them give every claim the same state as it does.",
         ("Tied with it: " + "; ".join(f"{t['described']} ({t['holding']})" for t in joint["ties"]) + "."
          if joint["ties"] else "No other reading ties with it."),
         ("Runner-ups: " + "; ".join(f"{r['described']} ({r['holding']} hold, {r['margin']} fewer)"

@@ -27,7 +27,7 @@ _EPILOG = textwrap.dedent(f"""\
 
     --json keys: profile, summary, counts{{category: n, fragile, not informative, about the
     experiment, studies}}, joint_reading{{reading, described, holding, equivalent_points, claims,
-    points, covered_points, chosen_from, ties[], runner_ups[{{reading, described, holding,
+    points, covered_points, decided_points, chosen_from, ties[], runner_ups[{{reading, described, holding,
     equivalent_points, margin}}], variants[{{left_out, claims_left_out[], reading, described,
     holding, claims}}]}}, conflicting_pairs[{{claims, first_holds_at, second_holds_at, example}}],
     tensions[{{separated_by[], sides[{{holds_only_at, claims[], linked[]}}], pairs}}],

@@ -186,18 +186,17 @@ def _settings(config: RunConfig) -> ProfileSettings:
 
 
 def _protocols(actuator_model: str, frequencies) -> list[dict]:
-    """The (protocol, fly-back, frequency[, ζ]) combinations drawn for an actuator model.
+    """The (protocol, fly-back, frequency[, ζ]) combinations the figures draw for an actuator model.
 
-    The ledger evaluates the A_c claims on the product of their axes (:mod:`passmd.ledger.readings`).
-    At ``PROTOCOL.drive_frequency`` and the default ζ the tables hold both protocols × (for
-    flexible actuators) both fly-back rules; the evaluated alternatives of ζ (Table 2's c_p is
-    lost) are searched with the steady protocol and the slew-rate fly-back, the other drive
-    frequencies of the band with the steady protocol, the slew-rate fly-back and the default ζ.
-    The other points of the product are not computed: the ledger counts them as not covered.
+    At ``PROTOCOL.drive_frequency`` and the default ζ both protocols × (for flexible actuators) both
+    fly-back rules; ζ's alternatives with the steady protocol and the slew-rate fly-back; the other
+    drive frequencies of the band with the steady protocol and the slew-rate fly-back. The ledger
+    evaluates the A_c claims on the full product of their axes, from :func:`ac_readings`, whose
+    default-reading runs are these.
     """
     combos = [{"protocol": "steady", "flyback": "slew", "frequency": float(f)} for f in frequencies]
     combos.append({"protocol": "first", "flyback": "slew", "frequency": PROTOCOL.drive_frequency})
-    if actuator_model == "flexible":  # the fly-back rule and ζ only matter for flexible actuators
+    if actuator_model == "flexible":  # the figures draw both rules and ζ's sensitivity for flexible ones
         combos.append({"protocol": "steady", "flyback": "fixed", "frequency": PROTOCOL.drive_frequency})
         combos.append({"protocol": "first", "flyback": "fixed", "frequency": PROTOCOL.drive_frequency})
         combos.extend({"protocol": "steady", "flyback": "slew", "frequency": PROTOCOL.drive_frequency,
