@@ -11,8 +11,8 @@ book's execution statistics show.
 
 Usage (one command, from the repository root)::
 
-    python3 benchmarks/bench_ledger.py            # paper profile: appended to passmd/data/benchmarks/ledger.json
-    python3 benchmarks/bench_ledger.py --quick    # the quick profile, written to a temporary file
+    python3 benchmarks/bench_ledger.py          # paper: appended to passmd/data/benchmarks/ledger.json
+    python3 benchmarks/bench_ledger.py --quick  # quick profile, written to a temporary file
 
 ``--python`` names the interpreter that runs ``passmd`` (default: this one if it imports passmd,
 else the ``tests`` or ``book`` nox environment of the repository); ``--cache-dir`` an empty
