@@ -204,10 +204,18 @@ def _design_problems(claim: Mapping, functions: ClaimFunctions, points) -> list[
     return problems
 
 
-def _variants(evaluated: Mapping, computed: set, rows: list[dict], states: Mapping) -> list[dict]:
-    """How the joint reading changes when rows are left out: the not-informative ones, and those
-    decided only where a method they rest on is undefined (e.g. Eq. 15)."""
+def _variants(evaluated: Mapping, computed: set, rows: list[dict], states: Mapping,
+              studies: Mapping) -> list[dict]:
+    """How the joint reading changes when rows are left out (the not-informative ones, and those
+    decided only where a method they rest on is undefined, e.g. Eq. 15) or when the studies (the
+    substitute and derived rows, never counted) are counted as claims."""
     out = []
+    if studies:
+        with_studies = {**evaluated, **studies}
+        joint = joint_reading(with_studies, computed | set(studies), states=state_table(with_studies))
+        out.append({"left_out": "studies counted as claims", "claims_left_out": [],
+                    "claims_added": sorted(studies), "reading": joint["reading"],
+                    "described": joint["described"], "holding": joint["holding"], "claims": joint["claims"]})
     for label, leave in (
         ("not-informative rows left out", {r["claim"] for r in rows if not r["informative"]}),
         ("rows decided only where a method they rest on is undefined left out",
@@ -220,8 +228,9 @@ def _variants(evaluated: Mapping, computed: set, rows: list[dict], states: Mappi
                  "table": {i: {c: s for c, s in column.items() if c not in leave}
                            for i, column in states["table"].items()}}
         joint = joint_reading(kept, computed - leave, states=table)
-        out.append({"left_out": label, "claims_left_out": sorted(leave), "reading": joint["reading"],
-                    "described": joint["described"], "holding": joint["holding"], "claims": joint["claims"]})
+        out.append({"left_out": label, "claims_left_out": sorted(leave), "claims_added": [],
+                    "reading": joint["reading"], "described": joint["described"], "holding": joint["holding"],
+                    "claims": joint["claims"]})
     return out
 
 
@@ -332,7 +341,8 @@ def evaluate(
     conflicts = conflicting_pairs(joint["states"], computed)
     table.attrs["joint"] = {**{k: v for k, v in joint.items() if k != "states"},
                             "variants": _variants(claims_of_paper, computed,
-                                                  [r for r in rows if r["claim"] not in studies], states)}
+                                                  [r for r in rows if r["claim"] not in studies], states,
+                                                  {c: evaluated[c] for c in studies})}
     table.attrs["conflicts"] = conflicts
     table.attrs["tensions"] = tensions(joint["states"], conflicts)
     table.attrs["joint_map"] = _map_columns(joint)

@@ -2,7 +2,7 @@
 
 The replication report quotes :data:`RULES` verbatim; the functions that apply them
 (:mod:`passmd.ledger.claims` for studies, :mod:`passmd.ledger.checks` for experiment claims,
-:mod:`passmd.ledger.verdicts` for fragility) take their constants from here.
+``passmd.ledger.verdicts`` for fragility) take their constants from here.
 
 Claims about the experiment
     A claim whose object is a measurement of [12] (an agreement with it, a discrepancy from it, or

@@ -76,7 +76,8 @@ def joint_sentences(joint: Mapping) -> list[str]:
     ]
     for variant in joint.get("variants", []):
         same = variant["reading"] == joint["reading"]
-        lines.append(f"With the {variant['left_out']} ({len(variant['claims_left_out'])}): "
+        changed = len(variant["claims_left_out"]) or len(variant.get("claims_added", []))
+        lines.append(f"With the {variant['left_out']} ({changed}): "
                      + ("the same reading" if same else variant["described"])
                      + f", {variant['holding']} of {variant['claims']} holding.")
     return lines

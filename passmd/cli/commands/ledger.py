@@ -28,8 +28,8 @@ _EPILOG = textwrap.dedent(f"""\
     --json keys: profile, summary, counts{{category: n, fragile, not informative, about the
     experiment, studies}}, joint_reading{{reading, described, holding, equivalent_points, claims,
     points, covered_points, decided_points, chosen_from, ties[], runner_ups[{{reading, described, holding,
-    equivalent_points, margin}}], variants[{{left_out, claims_left_out[], reading, described,
-    holding, claims}}]}}, conflicting_pairs[{{claims, first_holds_at, second_holds_at, example}}],
+    equivalent_points, margin}}], variants[{{left_out, claims_left_out[], claims_added[], reading,
+    described, holding, claims}}]}}, conflicting_pairs[{{claims, first_holds_at, second_holds_at, example}}],
     tensions[{{separated_by[], sides[{{holds_only_at, claims[], linked[]}}], pairs}}],
     claims[{{claim, figure, category, basis, study_of, verdict, evidence[], reason, depends_on[],
     readings{{reading: state}}, points[{{reading, state, score, detail, outside}}], default_state,
