@@ -342,9 +342,10 @@ COUNTER_EXAMPLES = {
     ),
     # Section 5.1
     "sec5-response-to-optimized-similar": (
-        "the runner 1.5 times faster after an optimized period than the design's V_r",
+        "the runner turning as under the saw-tooth but 1.5 times faster",
         lambda r: _edit(r, "fig9a_response", lambda t: t.assign(
-            response_runner_velocity_m_per_s=1.5 * t["design_runner_velocity_m_per_s"])),
+            response_peak_speed_m_per_s=1.5 * t["sawtooth_peak_speed_m_per_s"],
+            response_reversal_s=t["sawtooth_reversal_s"])),
     ),
     "sec5-1-acceleration-starts-at-velocity-maximum": ("default model run", lambda r: r),
     "sec5-1-stick-during-acceleration": ("default model run", lambda r: r),

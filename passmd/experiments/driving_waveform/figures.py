@@ -39,6 +39,7 @@ from passmd.experiments.driving_waveform.runs import (
     STEP_FREQUENCY,
     WINDOW_RESOLUTION,
     WINDOW_SAMPLES_PER_ACCELERATION,
+    _full_stroke_flyback,
     design_fields,
     designs,
     section5_fields,
@@ -382,29 +383,57 @@ fig9b_readings, fig10a_readings, fig10b_readings, fig10c_readings = (
     _at_every_mu(f) for f in (fig9b, fig10a, fig10b, fig10c))
 
 
-def fig9a_response(config: RunConfig) -> pd.DataFrame:
-    """The runner's response to the optimized waveform where it differs from the saw-tooth's: after
-    the fly-back that ends an optimized period (Fig. 9a's second), against the saw-tooth response
-    Eq. 15 is designed from, at every value of μ.
+def _settling_response(trace: dict, flyback_end: float, settling_time: float) -> dict:
+    """The runner's micro-vibration after a fly-back, from a zoomed trace reaching 1.5 t_s past it: its
+    largest speed over the settling time t_s, the time of its reversal (its velocity's first sign
+    change after the fly-back, which t_s is meant to land on) and its velocity where t_a starts (V_r)."""
+    t = np.asarray(trace["zoom_time_s"])
+    v = np.asarray(trace["zoom_runner_velocity_m_per_s"])
+    settling = (t >= flyback_end) & (t <= flyback_end + settling_time)
+    around = (t >= flyback_end) & (t <= flyback_end + 1.5 * settling_time)
+    tw, vw = t[around], v[around]
+    turns = np.flatnonzero(np.sign(vw[:-1]) * np.sign(vw[1:]) < 0)
+    reversal = (float(tw[turns[0]] - vw[turns[0]] * (tw[turns[0] + 1] - tw[turns[0]])
+                      / (vw[turns[0] + 1] - vw[turns[0]])) - flyback_end) if turns.size else math.nan
+    return {"peak_speed_m_per_s": float(np.abs(v[settling]).max()), "reversal_s": reversal,
+            "runner_velocity_m_per_s": float(np.interp(flyback_end + settling_time, t, v))}
 
-    Columns ``friction_coefficient``, the design's ``settling_time_s``,
-    ``micro_vibration_frequency_Hz`` and ``design_runner_velocity_m_per_s`` (V_r: the runner's
-    velocity t_s after the saw-tooth's first fly-back), and ``response_runner_velocity_m_per_s``
-    (the same t_s after the fly-back that follows an optimized period).
+
+#: Periods of the response runs: enough for the runner's response to a periodic waveform to settle.
+RESPONSE_PERIODS = MIN_PERIODS
+
+
+def fig9a_response(config: RunConfig) -> pd.DataFrame:
+    """The runner's response to the optimized waveform against its response to the saw-tooth, in
+    continued operation where a period is too short for the micro-vibration to die out: at the
+    frequency whose period is twice Eq. 15's t_s + t_a + fly-back (the ramp gets half of it), over
+    the settling time t_s after the last of :data:`RESPONSE_PERIODS` fly-backs, at every value of μ.
+
+    Columns ``friction_coefficient``, ``frequency_Hz``, the design's ``settling_time_s``,
+    ``micro_vibration_frequency_Hz`` and ``design_runner_velocity_m_per_s`` (V_r, from the 100 Hz
+    saw-tooth), and for the saw-tooth (``sawtooth_*``) and the optimized waveform (``response_*``):
+    ``peak_speed_m_per_s`` (the largest runner speed over t_s), ``reversal_s`` (when the runner
+    turns after the fly-back) and ``runner_velocity_m_per_s`` (where t_a starts).
     """
     rows = []
     for mu in FIG9A_FRICTION:
         c = section5_fields(friction_coefficient=mu)
         design = designs([c], config).iloc[0]
         fields = design_fields(design)
-        t_s, period = fields["settling_time"], 1.0 / STEP_FREQUENCY
-        trace = _trace(c, STEP_FREQUENCY, STEP_PERIODS, "optimized", fields,
-                       (2 * period - 5e-6, 2 * period + t_s + 5e-6), 400, 2000, config)
-        v_r = float(np.interp(2 * period + t_s, trace["zoom_time_s"], trace["zoom_runner_velocity_m_per_s"]))
-        rows.append({"friction_coefficient": mu, "settling_time_s": t_s,
-                     "micro_vibration_frequency_Hz": float(design["micro_vibration_frequency_Hz"]),
-                     "design_runner_velocity_m_per_s": float(design["runner_velocity_m_per_s"]),
-                     "response_runner_velocity_m_per_s": v_r})
+        t_s = fields["settling_time"]
+        needed = t_s + fields["acceleration_time"] + _full_stroke_flyback(c)
+        frequency = 1.0 / (2.0 * needed)
+        last = (RESPONSE_PERIODS - 1) / frequency  # the end of the last fly-back but one period
+        zoom = (last - 5e-6, last + 1.5 * t_s + 5e-6)
+        none = {"settling_time": 0.0, "acceleration_time": 0.0, "acceleration_amplitude": 0.0}
+        sawtooth = _trace(c, frequency, RESPONSE_PERIODS, "sawtooth", none, zoom, 400, 2000, config)
+        optimized = _trace(c, frequency, RESPONSE_PERIODS, "optimized", fields, zoom, 400, 2000, config)
+        row = {"friction_coefficient": mu, "frequency_Hz": frequency, "settling_time_s": t_s,
+               "micro_vibration_frequency_Hz": float(design["micro_vibration_frequency_Hz"]),
+               "design_runner_velocity_m_per_s": float(design["runner_velocity_m_per_s"])}
+        row.update({f"sawtooth_{k}": v for k, v in _settling_response(sawtooth, last, t_s).items()})
+        row.update({f"response_{k}": v for k, v in _settling_response(optimized, last, t_s).items()})
+        rows.append(row)
     return pd.DataFrame(rows)
 
 
