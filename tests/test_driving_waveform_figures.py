@@ -151,7 +151,8 @@ def test_fig10_steady_step_at_130_khz_is_converged(quick, monkeypatch, preload, 
     row = table[(table["frequency"] == 130e3) & (table["preload"] == preload) & (table["variant"] == variant)]
     assert len(row) == 1
     row = row.iloc[0]
-    point = {name: row[name] for name in inspect.signature(dw_runs.velocity_point).parameters}
+    point = {name: row[name] for name in inspect.signature(dw_runs.velocity_point).parameters
+             if name in row.index}  # a figure at Section 5's μ passes none
     default_simulate = dynamics.simulate
     monkeypatch.setattr(dynamics, "simulate", functools.partial(default_simulate,
                                                        scheme=time_steps.SCHEMES["fixed"].replace(dt=CONVERGED_DT)))

@@ -360,13 +360,15 @@ def test_evidence_functions_follow_the_checks(tmp_path):
 
 def test_joint_reading_is_chosen_among_covered_points(tmp_path):
     """The joint reading is chosen among the covered points (every claim resting on computed evidence
-    decided there): with 'ord' undecided at the fixed fly-back, the defaults are the only covered
-    point, so 'val', which holds only at the fixed fly-back, is not reproduced, and its verdict names
-    where it holds. Once 'ord' is decided there (it fails), the fixed fly-back is covered and chosen:
-    'val' is reproduced under the joint reading, and 'ord', failing at both points, is not."""
+    evaluated from runs there): with no run of 'ord' at the fixed fly-back (a lenient ledger), the
+    defaults are the only covered point, so 'val', which holds only at the fixed fly-back, is not
+    reproduced, and its verdict names where it holds. A claim the runs cannot decide there (it is
+    evaluated, undecided) leaves the point covered but not decided; once 'ord' is decided there (it
+    fails), the point is decided too. Either way the fixed fly-back is chosen: 'val' is reproduced under
+    the joint reading, and 'ord', failing at the defaults, is not."""
     claims = load_claims(_write(tmp_path, SYNTHETIC[:2]))
     module = types.ModuleType("synthetic_claims")
-    undecided = {"fixed": True}
+    at_fixed = {"ord": checks.NoRun("no run at the fixed fly-back")}
 
     @checks.extractor("val", depends_on=("flyback",))
     def _val(results, reading):
@@ -374,12 +376,12 @@ def test_joint_reading_is_chosen_among_covered_points(tmp_path):
 
     @checks.extractor("ord", depends_on=("flyback",))
     def _ord(results, reading):
-        if reading["flyback"] == "fixed" and undecided["fixed"]:
-            raise checks.NotEvaluable("the grid cannot locate it")
+        if reading["flyback"] == "fixed" and at_fixed["ord"] is not None:
+            raise at_fixed["ord"]
         return {"lhs": 0.5, "rhs": 1.0}
 
     module._val, module._ord = _val, _ord
-    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
+    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, strict=False, modules=[module])
     joint = evaluated.attrs["joint"]
     assert joint["described"] == "defaults" and joint["covered_points"] == joint["points"] // 2
     assert joint["chosen_from"] == joint["covered_points"]
@@ -388,10 +390,16 @@ def test_joint_reading_is_chosen_among_covered_points(tmp_path):
     assert "holds at fly-back rule = fixed" in by_id.at["val", "verdict"]
     assert by_id.at["val", "best_reading"] == "fly-back rule = fixed"
     assert by_id.at["val", "fraction_holds"] == 0.5
-    undecided["fixed"] = False
+    with pytest.raises(LookupError, match="no run at the fixed fly-back"):
+        ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])  # strict: a defect
+    at_fixed["ord"] = checks.NotEvaluable("the grid cannot locate it")
+    joint = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module]).attrs["joint"]
+    assert joint["covered_points"] == joint["points"] == joint["chosen_from"]
+    assert joint["decided_points"] == joint["points"] // 2 and joint["described"] == "fly-back rule = fixed"
+    at_fixed["ord"] = None
     evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
     assert evaluated.attrs["joint"]["described"] == "fly-back rule = fixed"
-    assert evaluated.attrs["joint"]["covered_points"] == evaluated.attrs["joint"]["points"]
+    assert evaluated.attrs["joint"]["decided_points"] == evaluated.attrs["joint"]["points"]
     by_id = evaluated.set_index("claim")
     assert by_id.at["val", "status"] == "reproduced under the joint reading"
     assert by_id.at["val", "verdict"].endswith("holds at the joint reading")
@@ -512,6 +520,40 @@ def test_joint_reading_is_the_argmax_with_ties_runner_ups_and_conflicts(tmp_path
     assert again.attrs["joint"]["holding"] == 3 and again.attrs["conflicts"] == []
 
 
+def test_conflicts_are_every_pair_never_holding_together_grouped_into_tensions():
+    """Every pair of claims that each hold somewhere but never together is listed, also where one is
+    undecided where the other holds; pairs are grouped by the axes that separate them, near-duplicate
+    rows (the same holding points) are linked, and a pair no single axis separates is described by the
+    combinations of values each side holds at."""
+    from passmd.ledger import readings
+    from passmd.ledger.joint import conflicting_pairs, tensions
+
+    space = readings.space()
+
+    def state(point, claim):
+        fixed, first = point["flyback"] == "fixed", point["ac_protocol"] == "first"
+        return {"a1": first, "a2": first, "b": not first, "c": fixed == first, "d": fixed != first,
+                "e": True if fixed else None, "f": not fixed}[claim]
+
+    names = ("a1", "a2", "b", "c", "d", "e", "f")
+    table = {i: {c: {True: "holds", False: "fails", None: "inconclusive"}[state(p, c)] for c in names}
+             for i, p in enumerate(space)}
+    states = {"space": space, "table": table}
+    pairs = conflicting_pairs(states)
+    assert sorted(tuple(p["claims"]) for p in pairs) == [("a1", "b"), ("a2", "b"), ("c", "d"), ("e", "f")]
+    found = {tuple(t["separated_by"]): t for t in tensions(states, pairs)}
+    protocol, flyback = readings.AXES["ac_protocol"].label, readings.AXES["flyback"].label
+    by_protocol = found[(protocol,)]
+    assert by_protocol["pairs"] == 2 and not by_protocol["jointly"]
+    assert [s["linked"] for s in by_protocol["sides"]] == [[["a1", "a2"]], []]
+    assert by_protocol["sides"][0]["holds_only_at"] == f"{protocol} = first"
+    both = found[(flyback, protocol)]
+    assert both["jointly"] and both["pairs"] == 1
+    assert both["sides"][0]["holds_only_at"] == (f"({flyback} = fixed, {protocol} = first) or "
+                                                 f"({flyback} = slew, {protocol} = steady)")
+    assert found[(flyback,)]["pairs"] == 1  # e is undecided where f holds: still never together
+
+
 def test_fragile_margin_and_informative_flags(tmp_path):
     """A claim holding at the defaults but failing at the joint reading's runner-ups is fragile (rule 1
     of passmd.ledger.rules); the margin is the deviation against the tolerance; an extractor marked not
@@ -561,6 +603,40 @@ def test_fragile_means_fragile():
     assert "within 25% of it" in fragility("not reproduced", fails, [], 1.1)  # a failure by a hair
     assert fragility("reproduced", holds, [], 1.0 - 2 * FRAGILE_MARGIN) == ""
     assert fragility("inconclusive", None, [("R1", fails)], 1.0) == ""
+
+
+def test_a_coarse_grid_decides_only_what_the_paper_grid_would():
+    """The coarse-grid rule of passmd.ledger.rules: a check holding on part of the paper's grid is
+    inconclusive; a pointwise failure there decides (failures_decide); a failure of a check of the whole
+    grid does not. The extractors wrap the quick grids and leave the paper's alone."""
+    from passmd.experiments.critical_amplitude import claims as ca_claims
+    from passmd.experiments.driving_waveform import claims_velocity
+    from passmd.experiments.driving_waveform.figures import FREQUENCIES
+    from passmd.ledger.verdicts import _evaluate_point
+
+    claim = {"id": "o", "check": "ordering", "relation": ">", "tolerance_num": math.nan,
+             "tolerance_kind": "", "paper_value_num": math.nan}
+    at = {"x": 1}
+
+    def state(ours):
+        return _evaluate_point(claim, lambda results: ours, (), {}, at)
+
+    holds, fails = {"lhs": 2.0, "rhs": 1.0}, {"lhs": 0.5, "rhs": 1.0}
+    assert state(holds).state == "holds" and state(fails).state == "fails"
+    part = state(checks.Subset(holds, "the paper's preloads 0.1 N"))
+    assert part.state == "inconclusive" and part.detail.startswith("holds on this table's part of the grid")
+    assert part.detail.endswith("which lacks the paper's preloads 0.1 N")
+    assert state(checks.Subset(fails, "0.1 N")).state == "fails"
+    assert state(checks.Subset(fails, "0.1 N", failures_decide=False)).state == "inconclusive"
+    scoped = state(checks.Subset(checks.Scoped(fails, "outside Eq. 15"), "0.1 N"))
+    assert scoped.state == "fails" and scoped.outside == "outside Eq. 15"
+    # the extractors' wrappers: the quick grids lack points of the paper's, the paper's lacks none
+    wrapped = ca_claims._on_paper_grid(holds, "fig5b", (0.2, 0.6, 1.0))
+    assert isinstance(wrapped, checks.Subset) and "0.1, 0.3" in wrapped.missing
+    assert ca_claims._on_paper_grid(holds, "fig6c", (0.1, 0.2, 0.3, 0.4, 0.5)) is holds
+    for profile, whole in (("quick", False), ("paper", True)):
+        part = pd.DataFrame({"frequency_kHz": FREQUENCIES[profile] / 1e3})
+        assert (claims_velocity.on_paper_grid(holds, part) is holds) == whole
 
 
 def test_design_is_the_full_product_and_skip_is_no_reading_of_eq15():
@@ -662,9 +738,13 @@ def test_any_category_change_fails_with_a_readable_diff(tmp_path):
     baseline_path = tmp_path / "baseline.csv"
     ledger.write_baseline(ledger.evaluate(claims, results, modules=[module]), baseline_path,
                           header="made by a test\non a day")
-    assert baseline_path.read_text().startswith("# made by a test\n# on a day\nclaim,status,readings\n")
-    # the readings each category was computed at (these synthetic claims depend on no axis)
+    assert baseline_path.read_text().startswith("# made by a test\n# on a day\nclaim,status,readings,states,"
+                                                "joint\n")
+    # the readings each category was computed at (these synthetic claims depend on no axis), the
+    # state at each, and the point besides the defaults its category was judged at
     assert ledger.load_baseline_readings(baseline_path)["val"] == ("defaults",)
+    assert ledger.load_baseline_states(baseline_path)["other"] == {"states": {"defaults": "inconclusive"},
+                                                                   "joint": "defaults"}
     baseline = ledger.load_baseline(baseline_path)
     assert baseline["val"] == "reproduced" and baseline["other"] == "inconclusive"
     ledger.check_categories(ledger.evaluate(claims, results, modules=[module]), baseline)  # unchanged: fine

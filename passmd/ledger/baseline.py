@@ -1,9 +1,10 @@
 """The ledger's regression baselines: each claim's category on a profile, with the readings it was
-computed at (``tests/ledger_baseline_<profile>.csv``).
+computed at, its state at each of them and the reading its category was judged at besides the
+defaults (``tests/ledger_baseline_<profile>.csv``).
 
 :func:`write_baseline` records an evaluated ledger (:func:`passmd.ledger.evaluation.evaluate`),
-:func:`load_baseline` and :func:`load_baseline_readings` read one back, and
-:func:`check_categories` fails with a readable diff when any claim changed category.
+:func:`load_baseline`, :func:`load_baseline_readings` and :func:`load_baseline_states` read one back,
+and :func:`check_categories` fails with a readable diff when any claim changed category.
 """
 
 from __future__ import annotations
@@ -15,11 +16,14 @@ import pandas as pd
 
 from passmd.ledger import readings
 
-__all__ = ["READINGS_SEPARATOR", "category_changes", "check_categories", "load_baseline",
-           "load_baseline_readings", "readings_of", "write_baseline"]
+__all__ = ["READINGS_SEPARATOR", "STATE_LETTERS", "category_changes", "check_categories", "load_baseline",
+           "load_baseline_readings", "load_baseline_states", "readings_of", "write_baseline"]
 
 #: Separator of the readings in a baseline's ``readings`` column.
 READINGS_SEPARATOR = " | "
+
+#: One letter per reading in a baseline's ``states`` column, in the order of its ``readings``.
+STATE_LETTERS = {"holds": "h", "fails": "f", "inconclusive": "?"}
 
 
 def readings_of(depends: tuple[str, ...]) -> tuple[str, ...]:
@@ -46,17 +50,42 @@ def load_baseline_readings(path) -> dict[str, tuple[str, ...]]:
             for claim, text in zip(table["claim"], table["readings"], strict=True)}
 
 
+def load_baseline_states(path) -> dict[str, dict]:
+    """``{claim id: {"states": {reading: state}, "joint": reading}}`` recorded in a baseline CSV: the
+    claim's state (``holds``, ``fails``, ``inconclusive``) at each of its readings and the reading of
+    its design its category was judged at besides the defaults (the joint reading's projection).
+    Empty when the baseline records no states."""
+    table = pd.read_csv(path, dtype=str, keep_default_na=False, comment="#")
+    if "states" not in table:
+        return {}
+    names = {letter: state for state, letter in STATE_LETTERS.items()}
+    return {claim: {"states": dict(zip(text.split(READINGS_SEPARATOR), (names[c] for c in letters),
+                                       strict=True)), "joint": joint}
+            for claim, text, letters, joint in zip(table["claim"], table["readings"], table["states"],
+                                                   table["joint"], strict=True)}
+
+
 def write_baseline(evaluated: pd.DataFrame, path, header: str = "") -> None:
-    """Write the claims' categories as a baseline CSV (``claim,status,readings``), atomically.
+    """Write the claims' categories as a baseline CSV (``claim,status,readings,states,joint``),
+    atomically.
 
     ``readings`` lists the readings each category was computed at (from the row's
     ``depends_on``), so that two baselines are compared only where they evaluated the same
-    readings. ``header`` (e.g. the command and date that produced it) is written as ``#`` lines.
+    readings; ``states`` the claim's state at each (:data:`STATE_LETTERS`, from the table's
+    ``points``), ``joint`` the reading of them its category was judged at besides the defaults
+    (the joint reading's projection; ``defaults`` for a study). ``header`` (e.g. the command and
+    date that produced it) is written as ``#`` lines.
     """
     path = Path(path)
     table = evaluated[["claim", "status"]].copy()
-    table["readings"] = [READINGS_SEPARATOR.join(readings_of(tuple(d for d in depends.split(";") if d)))
-                         for depends in evaluated["depends_on"]]
+    depends = [tuple(d for d in text.split(";") if d) for text in evaluated["depends_on"]]
+    table["readings"] = [READINGS_SEPARATOR.join(readings_of(d)) for d in depends]
+    states = {(p["claim"], p["reading"]): p["state"] for p in evaluated.attrs.get("points", [])}
+    table["states"] = ["".join(STATE_LETTERS[states.get((claim, r), "inconclusive")] for r in readings_of(d))
+                       for claim, d in zip(evaluated["claim"], depends, strict=True)]
+    joint = evaluated.attrs.get("joint", {}).get("reading")
+    table["joint"] = [readings.describe(readings.project(joint, d)) if joint and not study else "defaults"
+                      for d, study in zip(depends, evaluated["study_of"].astype(bool), strict=True)]
     tmp = path.with_name(f".{path.name}.tmp")
     with open(tmp, "w", encoding="utf-8", newline="") as fh:
         for line in header.splitlines():

@@ -24,7 +24,8 @@ An extractor raises :class:`NotEvaluable` (alias :data:`Inconclusive`) when the 
 cannot decide the claim (e.g. the quick profile's grid has no point where the claim speaks),
 :class:`NoRun` when a table lacks the run of a reading (a defect), and :class:`ClaimFails` when
 they decide it against the paper outright (a total failure is *not reproduced*); it returns
-:class:`Scoped` when the deciding data lie where a method the claim rests on is undefined.
+:class:`Scoped` when the deciding data lie where a method the claim rests on is undefined, and
+:class:`Subset` when its table holds only part of the grid the claim speaks of.
 """
 
 from __future__ import annotations
@@ -46,6 +47,7 @@ from passmd.ledger.tags import (  # re-exported: extractors import them from her
     NoRun,
     NotEvaluable,
     Scoped,
+    Subset,
     collect_claim_functions,
     evidence,
     experiment_claim,
@@ -65,6 +67,7 @@ __all__ = [
     "NotEvaluable",
     "Outcome",
     "Scoped",
+    "Subset",
     "check_claim",
     "check_ordering",
     "check_threshold",
@@ -361,7 +364,7 @@ def check_claim(claim: Mapping, ours) -> Outcome:
     """
     kind, relation = claim["check"], claim["relation"]
     tolerance, tolerance_kind = claim["tolerance_num"], claim["tolerance_kind"] or "rel"
-    if isinstance(ours, Scoped):  # where the deciding data lie does not change the check
+    while isinstance(ours, (Scoped, Subset)):  # where the data lie does not change the check
         ours = ours.ours
     if kind == "value":
         curve = None

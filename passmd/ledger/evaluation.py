@@ -42,6 +42,7 @@ from passmd.ledger.baseline import (  # re-exported: the tests and the command l
     check_categories,
     load_baseline,
     load_baseline_readings,
+    load_baseline_states,
     readings_of,
     write_baseline,
 )
@@ -82,6 +83,7 @@ __all__ = [
     "headline",
     "load_baseline",
     "load_baseline_readings",
+    "load_baseline_states",
     "orphan_extractors",
     "records",
     "result_sources",

@@ -15,6 +15,7 @@ ledger, :func:`joint_record` the joint reading as plain data.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Iterable, Mapping
 
 import pandas as pd
@@ -171,6 +172,18 @@ def _holding_values(holds: set, space: list, key: str) -> frozenset:
     return frozenset(space[i][key] for i in holds)
 
 
+def _joint_split(first: set, second: set, space: list) -> tuple[str, ...]:
+    """The fewest axes (the first such set in the order of the axes) on whose combined values the
+    points where two claims hold are disjoint; all axes at worst, since they never hold together."""
+    keys = tuple(readings.AXES)
+    for size in range(2, len(keys) + 1):
+        for subset in itertools.combinations(keys, size):
+            if not ({tuple(space[i][k] for k in subset) for i in first}
+                    & {tuple(space[i][k] for k in subset) for i in second}):
+                return subset
+    return keys
+
+
 def tensions(states: Mapping, pairs: list[dict]) -> list[dict]:
     """The conflicting pairs grouped into tensions by the readings that separate them.
 
@@ -191,9 +204,8 @@ def tensions(states: Mapping, pairs: list[dict]) -> list[dict]:
         split = tuple(k for k in readings.AXES
                       if not _holding_values(holds[a], space, k) & _holding_values(holds[b], space, k))
         jointly = not split
-        if jointly:  # no single axis: the axes along which they hold at different values, together
-            split = tuple(k for k in readings.AXES
-                          if _holding_values(holds[a], space, k) != _holding_values(holds[b], space, k))
+        if jointly:  # no single axis: the fewest axes whose combined values separate them
+            split = _joint_split(holds[a], holds[b], space)
         keyed.setdefault((jointly, split), []).append(pair)
     out = []
     for (jointly, split), group in keyed.items():
@@ -205,17 +217,27 @@ def tensions(states: Mapping, pairs: list[dict]) -> list[dict]:
         for component in components:
             sides: dict[tuple, list[str]] = {}
             for claim in sorted(component):
-                signature = tuple(tuple(sorted(_holding_values(holds[claim], space, k), key=str))
-                                  for k in split)
+                if jointly:  # the combinations of the axes' values it holds at, not each axis alone
+                    combos = {tuple(space[i][k] for k in split) for i in holds[claim]}
+                    signature = tuple(sorted(combos, key=str))
+                else:
+                    signature = tuple(tuple(sorted(_holding_values(holds[claim], space, k), key=str))
+                                      for k in split)
                 sides.setdefault(signature, []).append(claim)
             described = []
             for signature, claims_ in sides.items():
                 linked: dict[frozenset, list[str]] = {}
                 for claim in claims_:
                     linked.setdefault(frozenset(holds[claim]), []).append(claim)
-                where = "; ".join(f"{readings.AXES[k].label} = "
-                                  + " or ".join(readings.AXES[k].show(v) for v in values)
-                                  for k, values in zip(split, signature, strict=True))
+                if jointly:
+                    where = " or ".join(
+                        "(" + ", ".join(f"{readings.AXES[k].label} = {readings.AXES[k].show(v)}"
+                                        for k, v in zip(split, combo, strict=True)) + ")"
+                        for combo in signature)
+                else:
+                    where = "; ".join(f"{readings.AXES[k].label} = "
+                                      + " or ".join(readings.AXES[k].show(v) for v in values)
+                                      for k, values in zip(split, signature, strict=True))
                 described.append({"holds_only_at": where, "claims": claims_,
                                   "linked": [g for g in linked.values() if len(g) > 1]})
             n = sum(1 for p in group if set(p["claims"]) <= component)

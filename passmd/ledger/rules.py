@@ -1,8 +1,8 @@
-"""The ledger's three judging rules, stated once: experiments, studies and fragile verdicts.
+"""The ledger's judging rules, stated once: experiments, studies, fragile verdicts and coarse grids.
 
 The replication report quotes :data:`RULES` verbatim; the functions that apply them
-(:mod:`passmd.ledger.claims` for studies, :mod:`passmd.ledger.checks` for experiment claims,
-``passmd.ledger.verdicts`` for fragility) take their constants from here.
+(:mod:`passmd.ledger.claims` for studies, :mod:`passmd.ledger.checks` for experiment claims and
+coarse grids, ``passmd.ledger.verdicts`` for fragility) take their constants from here.
 
 Claims about the experiment
     A claim whose object is a measurement of [12] (an agreement with it, a discrepancy from it, or
@@ -28,6 +28,15 @@ Fragile verdicts
     FRAGILE_MARGIN for value, trend and approximate-ordering checks, and |switch − x_t| within
     FRAGILE_MARGIN·tolerance of the band's edge for threshold checks. A plain ordering (no
     tolerance) is fragile by rule (1) only.
+
+Coarse grids
+    A claim about the paper's whole grid (every preload, every amplitude below a threshold, every
+    frequency) is decided on a coarser profile's part of it only where the missing points cannot
+    change the verdict (:class:`passmd.ledger.checks.Subset`): a check that holds there is
+    inconclusive; a pointwise check that fails at a grid point is decided, each point being computed
+    as the paper profile computes it; a check of the grid as a whole (a deviation over the curve, a
+    trend, a maximum) is inconclusive either way. So where the quick profile decides a claim at a
+    reading, the paper profile decides it alike.
 """
 
 from __future__ import annotations
@@ -62,4 +71,11 @@ RULES = (
      f"{FRAGILE_MARGIN:.0%} of its tolerance (|deviation/tolerance − 1| < {FRAGILE_MARGIN:g} for value, "
      "trend and approximate checks; a threshold's observed switch within that share of the tolerance "
      "of the band's edge). A plain ordering has no tolerance and is fragile by (1) only."),
+    ("Coarse grids",
+     "A claim about the paper's whole grid (every preload, every amplitude below a threshold, every "
+     "frequency) is decided on a coarser profile's part of it only where the missing points cannot change "
+     "the verdict: a check that holds there is inconclusive; a pointwise check that fails at a grid point "
+     "is decided, each point being computed as the paper profile computes it; a check of the grid as a "
+     "whole (a deviation over the curve, a trend, a maximum) is inconclusive either way. So where the "
+     "quick profile decides a claim at a reading, the paper profile decides it alike."),
 )

@@ -28,6 +28,7 @@ __all__ = [
     "NoRun",
     "NotEvaluable",
     "Scoped",
+    "Subset",
     "collect_claim_functions",
     "evidence",
     "experiment_claim",
@@ -66,6 +67,19 @@ class Scoped:
 
     ours: object
     outside: str = ""
+
+
+@dataclass(frozen=True)
+class Subset:
+    """What an extractor returns when its claim speaks of the paper's whole grid (every preload,
+    every amplitude below a threshold, every frequency) and its table holds only part of it (a coarse
+    profile): a check that holds there is not decided (a missing grid point could fail it), nor one
+    that fails unless ``failures_decide`` (the failure is at a point the paper's grid has, computed
+    the same way); ``missing`` says what the table lacks."""
+
+    ours: object
+    missing: str
+    failures_decide: bool = True
 
 
 #: How the verdict of a claim about the experiment begins: the paper's text tabulates no measurement.

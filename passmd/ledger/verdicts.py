@@ -25,6 +25,7 @@ from passmd.ledger.checks import (
     NotEvaluable,
     Outcome,
     Scoped,
+    Subset,
     check_claim,
     format_number,
 )
@@ -78,11 +79,16 @@ class PointResult:
 
 
 def _evaluate_point(claim: Mapping, func: Callable, depends: tuple, results, reading: dict) -> PointResult:
+    subset = None
     try:
         ours = func(results, reading) if depends else func(results)
         outside = ""
-        if isinstance(ours, Scoped):
-            outside, ours = ours.outside, ours.ours
+        while isinstance(ours, (Subset, Scoped)):
+            if isinstance(ours, Subset):
+                subset = ours
+            else:
+                outside = ours.outside
+            ours = ours.ours
         outcome = check_claim(claim, ours)
     except NoRun as reason:
         return PointResult(reading, "inconclusive", None, f"no run: {reason}", no_run=True)
@@ -93,6 +99,10 @@ def _evaluate_point(claim: Mapping, func: Callable, depends: tuple, results, rea
     except Exception as err:
         raise ExtractorError(f"claim {claim['id']!r} ({claim['check']} check) at "
                              f"{readings.describe(reading)}: {err!r}") from err
+    if subset is not None and (outcome.passed or not subset.failures_decide):
+        verb = "holds" if outcome.passed else "fails"
+        return PointResult(reading, "inconclusive", None, f"{verb} on this table's part of the grid "
+                           f"({outcome.detail}), which lacks {subset.missing}")
     state = "holds" if outcome.passed else "fails"
     return PointResult(reading, state, outcome, outcome.detail, outside)
 

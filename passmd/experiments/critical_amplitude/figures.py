@@ -217,8 +217,6 @@ def _run_searches(points: list[dict], description: str, config: RunConfig) -> pd
             "flyback": frame["flyback"],
             "frequency_Hz": frame["frequency"],
             "damping_ratio": frame["damping_ratio"],
-            "friction_coefficient": (frame["friction_coefficient"].fillna(SECTION4_1_FRICTION)
-                                     if "friction_coefficient" in frame else SECTION4_1_FRICTION),
             "critical_amplitude_nm": frame["critical_amplitude_m"] * 1e9,
             "bracket_low_nm": frame["bracket_low_m"] * 1e9,
             "bracket_high_nm": frame["bracket_high_m"] * 1e9,
@@ -226,6 +224,8 @@ def _run_searches(points: list[dict], description: str, config: RunConfig) -> pd
             "wall_time_s": frame["wall_time_s"],
         }
     )
+    if "friction_coefficient" in frame:  # readings at another μ; the figures' runs are at Section 4.1's
+        out.insert(8, "friction_coefficient", frame["friction_coefficient"].fillna(SECTION4_1_FRICTION))
     out.attrs["sweep"] = frame.attrs.get("sweep", {})  # points computed / taken from the cache
     return out
 
@@ -427,11 +427,15 @@ _AC_AXES = ("flyback", "ac_protocol", "drive_frequency_s4", "damping_ratio", "fr
 def ac_readings(config: RunConfig, panel: str) -> pd.DataFrame:
     """The A_c searches of one panel (:data:`AC_PANELS`) at every point of the axes that change them:
     fly-back rule × A_c protocol × drive frequency × μ, and ζ for flexible actuators, on the profile's
-    preload grid (nm; the figure's own rows are the default reading's)."""
+    preload grid (nm; on the paper profile the figure's own rows are the default reading's).
+
+    Every profile searches to the paper profile's bracket, so that a preload of a coarser grid has the
+    A_c the paper profile computes there: where a coarse grid decides a claim, the paper's decides it
+    alike (:class:`passmd.ledger.checks.Subset`)."""
     s = _settings(config)
     contacts, radius, models = AC_PANELS[panel]
     points = [{"contacts": contacts, "actuator_model": model, "hemisphere_radius": radius,
-               "preload": float(p), "tolerance": s.tolerance, **combo}
+               "preload": float(p), "tolerance": PROFILE_SETTINGS["paper"].tolerance, **combo}
               for p in s.preloads[radius] for model in models for combo in _reading_points(model, _AC_AXES)]
     table = _run_searches(points, f"{panel} readings", config)
     table.insert(0, "figure", panel)
