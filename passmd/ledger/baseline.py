@@ -71,10 +71,11 @@ def write_baseline(evaluated: pd.DataFrame, path, header: str = "") -> None:
 
     ``readings`` lists the readings each category was computed at (from the row's
     ``depends_on``), so that two baselines are compared only where they evaluated the same
-    readings; ``states`` the claim's state at each (:data:`STATE_LETTERS`, from the table's
-    ``points``), ``joint`` the reading of them its category was judged at besides the defaults
-    (the joint reading's projection; ``defaults`` for a study). ``header`` (e.g. the command and
-    date that produced it) is written as ``#`` lines.
+    readings; ``states`` the claim's state at each
+    (:data:`passmd.ledger.baseline.STATE_LETTERS`, from the table's ``points``), ``joint`` the
+    reading of them its category was judged at besides the defaults (the joint reading's
+    projection; ``defaults`` for a study). ``header`` (e.g. the command and date that produced it)
+    is written as ``#`` lines.
     """
     path = Path(path)
     table = evaluated[["claim", "status"]].copy()

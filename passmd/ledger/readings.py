@@ -6,7 +6,7 @@ from Table 2, μ in Sections 4.1 and 5, the drive frequency of the force runs, w
 when t_s does not fit into a period). Each is declared here once as an :class:`Axis`: its
 default (the value the rest of the book uses), the values of its plausible range that we
 evaluate, the whole range in words, the source of that range, and the result tables whose runs
-it changes (:attr:`Axis.tables`).
+it changes (``Axis.tables``).
 
 A *reading* is one point of that space: ``{axis key: value}``. **A reading keeps the claim's
 object**: an axis may change only what the paper left unstated, never the thing a claim is
@@ -77,8 +77,8 @@ class Axis:
         return f"{text} {self.unit}".strip()
 
     def applies_to(self, claim: Mapping) -> bool:
-        """Whether a claims.csv row depends on this axis: it reads one of :attr:`tables` (its
-        ``requires``) and, with :attr:`only`, its column lists the value."""
+        """Whether a claims.csv row depends on this axis: it reads one of ``tables`` (its
+        ``requires``) and, with ``only``, its column lists the value."""
         if not set(str(claim["requires"]).split(";")) & set(self.tables):
             return False
         column, value = self.only if self.only else (None, None)

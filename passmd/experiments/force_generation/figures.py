@@ -356,7 +356,7 @@ READINGS_FRACTIONS = (0.5, 1.0)
 
 def fig7_readings(config: RunConfig) -> pd.DataFrame:
     """This paper's model (flexible actuators, μ = 0.2) at the Fig. 7 panels' preloads and
-    :data:`READINGS_FRACTIONS` of the stroke, at every point of the axes that change its runs:
+    ``READINGS_FRACTIONS`` of the stroke, at every point of the axes that change its runs:
     fly-back rule × actuator damping ζ × drive frequency (mN, nm; the default runs are the panels'
     own). Columns of :func:`fig7a`'s stall runs plus ``flyback`` and ``damping_ratio``."""
     model, mu, _ = MODELS[1]
