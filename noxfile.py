@@ -226,6 +226,7 @@ def book_check(session: nox.Session) -> None:
         "--toc", "book/_toc.yml", "--screenshots", SCREENSHOTS, *session.posargs,
     )
     session.run(
-        "pytest", "tests/test_book_check.py", "tests/test_build_book.py", "-p", "no:cacheprovider",
+        "pytest", "tests/test_book_check.py", "tests/test_build_book.py", "tests/test_replication_report.py",
+        "-p", "no:cacheprovider",
         env={"PASSMD_REQUIRE_BROWSER": "1", "MPLBACKEND": "Agg"},
     )

@@ -2,24 +2,29 @@
 
 Runs the command in a subprocess with an empty temporary simulation cache (numba's compiled
 kernels stay warm: they are cached next to the package, not in the simulation cache), and
-records its wall time, the CPU time of the command and its sweep workers, the machine's core
-count and its load average just before and after (the machine may be shared), the ledger's
-joint reading and headline counts. Each run is appended to ``--out`` (a JSON list), which the
+records its wall time against the budget :data:`BUDGET_S`, the CPU time of the command and its
+sweep workers, how many sweep points it computed, the machine's core count and its load average
+just before and after (the machine may be shared: a load above the core count stretches the wall
+time), the size of the assumption space it evaluated (points, covered, decided), the joint
+reading and the headline counts. Each run is appended to ``--out`` (a JSON list), which the
 book's execution statistics show.
 
-Usage::
+Usage (one command, from the repository root)::
 
-    python benchmarks/bench_ledger.py [--profile paper] [--out passmd/data/benchmarks/ledger.json]
-        [--cache-dir DIR]
+    python3 benchmarks/bench_ledger.py          # paper: appended to passmd/data/benchmarks/ledger.json
+    python3 benchmarks/bench_ledger.py --quick  # quick profile, written to a temporary file
 
-``--cache-dir`` names an empty directory to use as the cache and keep (e.g. to write a baseline
-from the same computation afterwards); by default a temporary one is used and removed.
+``--python`` names the interpreter that runs ``passmd`` (default: this one if it imports passmd,
+else the ``tests`` or ``book`` nox environment of the repository); ``--cache-dir`` an empty
+directory to use as the cache and keep (e.g. to write a baseline from the same computation
+afterwards); by default a temporary one is used and removed.
 """
 
 from __future__ import annotations
 
 import argparse
 import datetime
+import importlib.util
 import json
 import os
 import resource
@@ -29,31 +34,67 @@ import tempfile
 import time
 from pathlib import Path
 
-from passmd.runtime import provenance
+ROOT = Path(__file__).resolve().parents[1]
+#: The wall time a cold ledger of each profile should stay within on a quiet 2-core machine (s).
+BUDGET_S = {"paper": 360.0, "quick": 240.0}
 
 
-def measure(profile: str, cache_dir: str | None = None) -> dict:
-    load_before = os.getloadavg()
+def git_commit() -> str:
+    """The checked-out commit, with "(uncommitted changes)" for a dirty tree."""
+    def git(*args):
+        return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+
+    commit = git("rev-parse", "HEAD") or "unknown"
+    return commit + (" (uncommitted changes)" if git("status", "--porcelain", "--untracked-files=no") else "")
+
+
+def passmd_python(given: str | None) -> str:
+    """The interpreter that runs passmd: ``given``, this one if it imports passmd, else a nox
+    environment's."""
+    if given:
+        return given
+    if importlib.util.find_spec("passmd") is not None:
+        return sys.executable
+    for session in ("tests", "book"):
+        candidate = ROOT / ".nox" / session / "bin" / "python"
+        if candidate.is_file():
+            return str(candidate)
+    raise SystemExit("no Python that imports passmd: run `python3 -m nox -s tests --install-only` first, or "
+                     "give one with --python")
+
+
+def measure(profile: str, python: str, cache_dir: str | None = None) -> dict:
     if cache_dir is not None and Path(cache_dir).exists() and any(Path(cache_dir).iterdir()):
         raise SystemExit(f"--cache-dir {cache_dir} is not empty: the measurement must start cold")
     with tempfile.TemporaryDirectory(prefix="passmd-bench-ledger-") as temporary:
         cache = temporary if cache_dir is None else cache_dir
-        env = {**os.environ, "PASSMD_CACHE_DIR": cache}
+        log = Path(temporary) / "sweeps.jsonl"
+        env = {**os.environ, "PASSMD_CACHE_DIR": cache, "PASSMD_SWEEP_LOG": str(log)}
+        load_before = os.getloadavg()
         usage = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
-        done = subprocess.run([sys.executable, "-m", "passmd", "ledger", "--profile", profile, "--json"],
-                              env=env, capture_output=True, text=True, check=True)
+        done = subprocess.run([python, "-m", "passmd", "ledger", "--profile", profile, "--json"], cwd=ROOT,
+                              env=env, capture_output=True, text=True)
         wall = time.perf_counter() - start
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        load_after = os.getloadavg()
+        if done.returncode != 0:
+            sys.stderr.write(done.stderr[-4000:])
+            raise SystemExit(f"passmd ledger failed (exit status {done.returncode})")
+        lines = log.read_text(encoding="utf-8").splitlines() if log.exists() else []
+        sweeps = [json.loads(line) for line in lines]
     payload = json.loads(done.stdout)
     joint = payload["joint_reading"]
     return {
         "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        "profile": profile, "git_commit": provenance.stamp(profile)["git_commit"],
-        "wall_time_s": round(wall, 1),
+        "profile": profile, "git_commit": git_commit(),
+        "wall_time_s": round(wall, 1), "budget_s": BUDGET_S[profile],
         "cpu_time_s": round(after.ru_utime + after.ru_stime - usage.ru_utime - usage.ru_stime, 1),
+        "points_computed": sum(int(s.get("computed", 0)) for s in sweeps),
         "cores": os.cpu_count(), "load_average_before": [round(x, 2) for x in load_before],
-        "load_average_after": [round(x, 2) for x in os.getloadavg()],
+        "load_average_after": [round(x, 2) for x in load_after],
+        "space_points": joint["points"], "covered_points": joint["covered_points"],
+        "decided_points": joint["decided_points"],
         "joint_reading": joint["described"], "holding": joint["holding"], "claims": joint["claims"],
         "counts": payload["counts"],
     }
@@ -68,15 +109,28 @@ def append_run(out: Path, run: dict) -> None:
     tmp.write_text(json.dumps(runs, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
     tmp.replace(out)
     print(json.dumps(run, indent=1, ensure_ascii=False))
+    print(f"appended to {out}")
+
+
+def output(args) -> Path:
+    """``--out``, else the committed JSON for the paper profile and a temporary file for ``--quick``."""
+    if args.out:
+        return Path(args.out)
+    if args.quick:
+        return Path(tempfile.mkdtemp(prefix="passmd-bench-")) / f"{Path(__file__).stem}.json"
+    return ROOT / "passmd" / "data" / "benchmarks" / "ledger.json"
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--profile", default="paper", choices=("quick", "paper"))
-    parser.add_argument("--out", default="passmd/data/benchmarks/ledger.json")
+    parser.add_argument("--quick", action="store_true", help="the quick profile, written to a temporary file")
+    parser.add_argument("--profile", default=None, choices=("quick", "paper"), help="default: paper")
+    parser.add_argument("--out", default=None, help="JSON list the run is appended to")
     parser.add_argument("--cache-dir", default=None)
+    parser.add_argument("--python", default=None, help="interpreter that runs passmd")
     args = parser.parse_args()
-    append_run(Path(args.out), measure(args.profile, args.cache_dir))
+    profile = args.profile or ("quick" if args.quick else "paper")
+    append_run(output(args), measure(profile, passmd_python(args.python), args.cache_dir))
 
 
 if __name__ == "__main__":

@@ -114,7 +114,8 @@ def test_stated_numbers_of_the_paper():
         "fig9a-step-increase-46.8pct": 46.8, "fig9b-optimized-faster-below-110khz": 110,
         "fig9b-max-gain-2.5mm_s": 2.5, "fig10a-max-velocity-19mm_s": 19,
         "fig10a-0.1n-stick-lost-above-80khz": 80, "abstract-velocity-gain-15pct": 15,
-        "fig9b-sawtooth-velocity-16.5mm_s-at-110khz": 19 - 2.5,  # implied: Fig. 10a's 19 minus the 2.5 gain
+        # implied: Fig. 10a's 19 minus the 2.5 gain (a study: not a sentence of the paper)
+        "study-fig9b-sawtooth-velocity-16.5mm_s-at-110khz": 19 - 2.5,
     }
     for claim, value in stated.items():
         assert claims.at[claim, "paper_value_num"] == value, claim
@@ -357,12 +358,17 @@ def test_evidence_functions_follow_the_checks(tmp_path):
         "evidence not available on these results: no runs at 100 Hz")
 
 
-def test_joint_reading_and_uncovered_readings(tmp_path):
-    """A claim that fails at the defaults but holds at the joint reading is 'reproduced under the
-    joint reading'; one that fails at the defaults while the joint reading is not covered is 'not
-    reproduced': a failure is never promoted to inconclusive by an undecided other point."""
+def test_joint_reading_is_chosen_among_covered_points(tmp_path):
+    """The joint reading is chosen among the covered points (every claim resting on computed evidence
+    evaluated from runs there): with no run of 'ord' at the fixed fly-back (a lenient ledger), the
+    defaults are the only covered point, so 'val', which holds only at the fixed fly-back, is not
+    reproduced, and its verdict names where it holds. A claim the runs cannot decide there (it is
+    evaluated, undecided) leaves the point covered but not decided; once 'ord' is decided there (it
+    fails), the point is decided too. Either way the fixed fly-back is chosen: 'val' is reproduced under
+    the joint reading, and 'ord', failing at the defaults, is not."""
     claims = load_claims(_write(tmp_path, SYNTHETIC[:2]))
     module = types.ModuleType("synthetic_claims")
+    at_fixed = {"ord": checks.NoRun("no run at the fixed fly-back")}
 
     @checks.extractor("val", depends_on=("flyback",))
     def _val(results, reading):
@@ -370,28 +376,69 @@ def test_joint_reading_and_uncovered_readings(tmp_path):
 
     @checks.extractor("ord", depends_on=("flyback",))
     def _ord(results, reading):
-        if reading["flyback"] == "fixed":
-            raise checks.NotEvaluable("no fixed fly-back runs")
+        if reading["flyback"] == "fixed" and at_fixed["ord"] is not None:
+            raise at_fixed["ord"]
         return {"lhs": 0.5, "rhs": 1.0}
 
     module._val, module._ord = _val, _ord
+    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, strict=False, modules=[module])
+    joint = evaluated.attrs["joint"]
+    assert joint["described"] == "defaults" and joint["covered_points"] == joint["points"] // 2
+    assert joint["chosen_from"] == joint["covered_points"]
+    by_id = evaluated.set_index("claim")
+    assert by_id.at["val", "status"] == "not reproduced"
+    assert "holds at fly-back rule = fixed" in by_id.at["val", "verdict"]
+    assert by_id.at["val", "best_reading"] == "fly-back rule = fixed"
+    assert by_id.at["val", "fraction_holds"] == 0.5
+    with pytest.raises(LookupError, match="no run at the fixed fly-back"):
+        ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])  # strict: a defect
+    at_fixed["ord"] = checks.NotEvaluable("the grid cannot locate it")
+    joint = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module]).attrs["joint"]
+    assert joint["covered_points"] == joint["points"] == joint["chosen_from"]
+    assert joint["decided_points"] == joint["points"] // 2 and joint["described"] == "fly-back rule = fixed"
+    at_fixed["ord"] = None
     evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
     assert evaluated.attrs["joint"]["described"] == "fly-back rule = fixed"
-    evaluated = evaluated.set_index("claim")
-    assert evaluated.at["val", "status"] == "reproduced under the joint reading"
-    assert evaluated.at["val", "verdict"].endswith("holds at the joint reading")
-    assert evaluated.at["val", "best_reading"] == "fly-back rule = fixed"
-    assert evaluated.at["val", "fraction_holds"] == 0.5
-    assert evaluated.at["ord", "status"] == "not reproduced"
-    assert "the joint reading does not decide it" in evaluated.at["ord", "verdict"]
-    table = ledger.assumption_map(evaluated.reset_index())
+    assert evaluated.attrs["joint"]["decided_points"] == evaluated.attrs["joint"]["points"]
+    by_id = evaluated.set_index("claim")
+    assert by_id.at["val", "status"] == "reproduced under the joint reading"
+    assert by_id.at["val", "verdict"].endswith("holds at the joint reading")
+    assert by_id.at["ord", "status"] == "not reproduced"
+    assert "at the defaults and at the joint reading" in by_id.at["ord", "verdict"]
+    table = ledger.assumption_map(evaluated)
     assert list(table.columns) == ["claim", "defaults", "fly-back rule = fixed", "holds at", "best reading"]
     row = table.set_index("claim").loc["val"].tolist()
     assert row == ["fails", "holds", "1 of 2", "fly-back rule = fixed"]
-    html = ledger_views.assumption_map_styled(evaluated.reset_index()).to_html()
+    html = ledger_views.assumption_map_styled(evaluated).to_html()
     assert "R1: fly-back rule = fixed" in html
     assert ledger.depends_on("val", modules=[module]) == ("flyback",)
     assert ledger.claim_readings("val", modules=[module]) == ("defaults", "fly-back rule = fixed")
+
+
+def test_a_missing_run_or_an_undeclared_axis_stops_the_ledger(tmp_path):
+    """Declared = computed: an extractor that finds no run at a reading (NoRun), or that does not declare
+    an axis changing a table its claim reads, is a defect the strict ledger refuses; leniently the
+    missing run is an undecided point, named."""
+    rows = [_claim(id="val", check="value", paper_value="100", unit="nm", tolerance="0.05",
+                   tolerance_kind="rel", requires="fig7_readings")]
+    claims = load_claims(_write(tmp_path, rows))
+    module = types.ModuleType("synthetic_claims")
+
+    @checks.extractor("val", depends_on=("flyback", "force_frequency"))
+    def _val(results, reading):
+        if reading["force_frequency"] != 100.0:
+            raise checks.NoRun("no force runs at 1 kHz")
+        return 100.0
+
+    module._val = _val
+    with pytest.raises(LookupError, match="claim 'val' has no run at drive frequency, Section 4.2 = 1000 Hz"):
+        ledger.evaluate(claims, {"fig7_readings": pd.DataFrame()}, modules=[module])
+    lenient = ledger.evaluate(claims, {"fig7_readings": pd.DataFrame()}, modules=[module], strict=False)
+    assert "no run: no force runs at 1 kHz" in lenient.at[0, "evidence"]
+    module._val = checks.extractor("val", depends_on=("flyback",))(lambda results, reading: 100.0)
+    with pytest.raises(LookupError, match="claim 'val' reads tables that force_frequency changes, but its "
+                                          "extractor does not declare it"):
+        ledger.evaluate(claims, {"fig7_readings": pd.DataFrame()}, modules=[module])
 
 
 def _point(state, reading=None, score=math.nan):
@@ -473,9 +520,44 @@ def test_joint_reading_is_the_argmax_with_ties_runner_ups_and_conflicts(tmp_path
     assert again.attrs["joint"]["holding"] == 3 and again.attrs["conflicts"] == []
 
 
+def test_conflicts_are_every_pair_never_holding_together_grouped_into_tensions():
+    """Every pair of claims that each hold somewhere but never together is listed, also where one is
+    undecided where the other holds; pairs are grouped by the axes that separate them, near-duplicate
+    rows (the same holding points) are linked, and a pair no single axis separates is described by the
+    combinations of values each side holds at."""
+    from passmd.ledger import readings
+    from passmd.ledger.joint import conflicting_pairs, tensions
+
+    space = readings.space()
+
+    def state(point, claim):
+        fixed, first = point["flyback"] == "fixed", point["ac_protocol"] == "first"
+        return {"a1": first, "a2": first, "b": not first, "c": fixed == first, "d": fixed != first,
+                "e": True if fixed else None, "f": not fixed}[claim]
+
+    names = ("a1", "a2", "b", "c", "d", "e", "f")
+    table = {i: {c: {True: "holds", False: "fails", None: "inconclusive"}[state(p, c)] for c in names}
+             for i, p in enumerate(space)}
+    states = {"space": space, "table": table}
+    pairs = conflicting_pairs(states)
+    assert sorted(tuple(p["claims"]) for p in pairs) == [("a1", "b"), ("a2", "b"), ("c", "d"), ("e", "f")]
+    found = {tuple(t["separated_by"]): t for t in tensions(states, pairs)}
+    protocol, flyback = readings.AXES["ac_protocol"].label, readings.AXES["flyback"].label
+    by_protocol = found[(protocol,)]
+    assert by_protocol["pairs"] == 2 and not by_protocol["jointly"]
+    assert [s["linked"] for s in by_protocol["sides"]] == [[["a1", "a2"]], []]
+    assert by_protocol["sides"][0]["holds_only_at"] == f"{protocol} = first"
+    both = found[(flyback, protocol)]
+    assert both["jointly"] and both["pairs"] == 1
+    assert both["sides"][0]["holds_only_at"] == (f"({flyback} = fixed, {protocol} = first) or "
+                                                 f"({flyback} = slew, {protocol} = steady)")
+    assert found[(flyback,)]["pairs"] == 1  # e is undecided where f holds: still never together
+
+
 def test_fragile_margin_and_informative_flags(tmp_path):
-    """A claim holding at the defaults but failing at most of its readings is fragile; the margin is
-    the deviation against the tolerance; an extractor marked not informative says why."""
+    """A claim holding at the defaults but failing at the joint reading's runner-ups is fragile (rule 1
+    of passmd.ledger.rules); the margin is the deviation against the tolerance; an extractor marked not
+    informative says why."""
     claims = load_claims(_write(tmp_path, SYNTHETIC[:2]))
     module = types.ModuleType("synthetic_claims")
 
@@ -493,6 +575,7 @@ def test_fragile_margin_and_informative_flags(tmp_path):
     assert evaluated.at["val", "status"] == "reproduced"
     assert evaluated.at["val", "fails_at"] == 3 and evaluated.at["val", "decided_at"] == 4
     assert evaluated.at["val", "fragile"]
+    assert evaluated.at["val", "fragile_reason"].startswith("fails at the runner-up reading")
     assert evaluated.at["val", "margin_text"] == "3.0% against 5 %"
     assert evaluated.at["val", "margin"] == pytest.approx(0.6)
     assert not evaluated.at["ord", "fragile"] and not evaluated.at["ord", "informative"]
@@ -501,21 +584,102 @@ def test_fragile_margin_and_informative_flags(tmp_path):
     assert counts["fragile"] == 1 and counts["not informative"] == 1 and counts["reproduced"] == 2
 
 
+def test_fragile_means_fragile():
+    """passmd.ledger.rules: a verdict is fragile when the claim's holding at the point deciding its
+    category differs at a runner-up reading (undecided runner-ups do not count), or when its margin is
+    within FRAGILE_MARGIN of its tolerance; a failing verdict can be fragile too, an inconclusive one
+    cannot. Counter-examples: a margin at 0.5 of the tolerance and the same state at every runner-up."""
+    from passmd.ledger.rules import FRAGILE_MARGIN
+    from passmd.ledger.verdicts import fragility
+
+    holds, fails, undecided = _point("holds"), _point("fails"), _point("inconclusive")
+    assert fragility("reproduced", holds, [("R1", holds), ("R2", undecided)], 0.5) == ""
+    assert fragility("reproduced", holds, [("R1", fails)], 0.5).startswith(
+        "fails at the runner-up reading R1")
+    assert fragility("not reproduced", fails, [("R1", holds), ("R2", holds)], 3.0) == (
+        "holds at the runner-up reading R1 and 1 more")
+    near = 1.0 - FRAGILE_MARGIN / 2
+    assert "within 25% of it" in fragility("reproduced", holds, [], near)  # 8.8 % against a 10 % tolerance
+    assert "within 25% of it" in fragility("not reproduced", fails, [], 1.1)  # a failure by a hair
+    assert fragility("reproduced", holds, [], 1.0 - 2 * FRAGILE_MARGIN) == ""
+    assert fragility("inconclusive", None, [("R1", fails)], 1.0) == ""
+
+
+def test_a_coarse_grid_decides_only_what_the_paper_grid_would():
+    """The coarse-grid rule of passmd.ledger.rules: a check holding on part of the paper's grid is
+    inconclusive; a pointwise failure there decides (failures_decide); a failure of a check of the whole
+    grid does not. The extractors wrap the quick grids and leave the paper's alone."""
+    from passmd.experiments.critical_amplitude import claims as ca_claims
+    from passmd.experiments.driving_waveform import claims_velocity
+    from passmd.experiments.driving_waveform.figures import FREQUENCIES
+    from passmd.ledger.verdicts import _evaluate_point
+
+    claim = {"id": "o", "check": "ordering", "relation": ">", "tolerance_num": math.nan,
+             "tolerance_kind": "", "paper_value_num": math.nan}
+    at = {"x": 1}
+
+    def state(ours):
+        return _evaluate_point(claim, lambda results: ours, (), {}, at)
+
+    holds, fails = {"lhs": 2.0, "rhs": 1.0}, {"lhs": 0.5, "rhs": 1.0}
+    assert state(holds).state == "holds" and state(fails).state == "fails"
+    part = state(checks.Subset(holds, "the paper's preloads 0.1 N"))
+    assert part.state == "inconclusive" and part.detail.startswith("holds on this table's part of the grid")
+    assert part.detail.endswith("which lacks the paper's preloads 0.1 N")
+    assert state(checks.Subset(fails, "0.1 N")).state == "fails"
+    assert state(checks.Subset(fails, "0.1 N", failures_decide=False)).state == "inconclusive"
+    scoped = state(checks.Subset(checks.Scoped(fails, "outside Eq. 15"), "0.1 N"))
+    assert scoped.state == "fails" and scoped.outside == "outside Eq. 15"
+    # the extractors' wrappers: the quick grids lack points of the paper's, the paper's lacks none
+    wrapped = ca_claims._on_paper_grid(holds, "fig5b", (0.2, 0.6, 1.0))
+    assert isinstance(wrapped, checks.Subset) and "0.1, 0.3" in wrapped.missing
+    assert ca_claims._on_paper_grid(holds, "fig6c", (0.1, 0.2, 0.3, 0.4, 0.5)) is holds
+    for profile, whole in (("quick", False), ("paper", True)):
+        part = pd.DataFrame({"frequency_kHz": FREQUENCIES[profile] / 1e3})
+        assert (claims_velocity.on_paper_grid(holds, part) is holds) == whole
+
+
 def test_design_is_the_full_product_and_skip_is_no_reading_of_eq15():
-    """A claim is evaluated on the product of its axes (not one at a time), minus the axes open for
-    it; the short-period rule 'skip' (t_s = 0, no settling phase) is no reading of an Eq. 15 claim."""
+    """A claim is evaluated on the product of its axes (not one at a time); the short-period rule
+    'skip' (t_s = 0, no settling phase) is no reading of an Eq. 15 claim."""
     from passmd.ledger import readings
 
     points = readings.design(("flyback", "ac_protocol", "damping_ratio"))
     assert len(points) == 2 * 2 * 3 and points[0] == readings.default_reading()
     assert {"flyback": "fixed", "ac_protocol": "first"}.items() <= points[-1].items()
-    open_claim = readings.axis("damping_ratio").open_for[0]
-    assert len(readings.design(("flyback", "damping_ratio"), open_claim)) == 2
     for claim in ("fig9b-max-gain-2.5mm_s", "abstract-velocity-gain-15pct", "fig10a-max-velocity-19mm_s"):
         assert "short_period" in ledger.depends_on(claim)
-        assert {r["short_period"] for r in readings.design(ledger.depends_on(claim), claim)} == {"cut"}
+        assert {r["short_period"] for r in readings.design(ledger.depends_on(claim))} == {"cut"}
     assert "skip" in dict(readings.axis("short_period").not_readings)
     assert all(p["short_period"] != "skip" for p in readings.space())
+
+
+def test_every_claim_declares_exactly_the_axes_that_change_its_tables():
+    """Declared = computed: each claim of the paper is evaluated along exactly the axes that change the
+    result tables it reads (passmd.ledger.readings.applicable), so no claim is called independent of an
+    input its runs depend on; every axis with alternatives changes some claim's tables."""
+    from passmd.ledger import readings
+
+    claims = load_claims()
+    functions = ledger.claim_functions()
+    paper = claims[claims["study_of"] == ""]
+    for _, claim in paper.iterrows():
+        assert set(functions.depends_on[claim["id"]]) == set(readings.applicable(claim)), claim["id"]
+    used = {k for _, claim in paper.iterrows() for k in readings.applicable(claim)}
+    assert {k for k, a in readings.AXES.items() if a.alternatives} <= used
+    # μ changes every table a claim that assumes it reads; ζ only claims with flexible actuators
+    assumes_mu = paper["assumed"].str.split(";").map(lambda c: "friction_coefficient" in c)
+    assert all("friction_coefficient" in readings.applicable(c) for _, c in paper[assumes_mu].iterrows()
+               if c["id"] not in functions.experiment and c["requires"] != "closed_forms")
+    assert "damping_ratio" not in functions.depends_on["fig5b-rigid-ac-matches-eq7"]
+    assert "damping_ratio" in functions.depends_on["fig5b-flexible-above-rigid"]
+    # Section 5 drives at the full stroke, where the two fly-back rules are the same 2 µs
+    from passmd.experiments.driving_waveform.runs import section5_drive
+    from passmd.model import waveforms
+    for radius in (1e-3, 0.25e-3):
+        drive = section5_drive(radius)
+        full = drive.actuator.full_stroke_amplitude
+        assert waveforms.flyback_time(full, drive, "slew") == waveforms.flyback_time(full, drive, "fixed")
 
 
 def test_unknown_assumption_axis_is_refused():
@@ -539,7 +703,8 @@ def test_missing_extractor_is_an_error_unless_lenient(tmp_path):
 def test_claims_for_selects_a_chapters_rows():
     claims = load_claims()
     fig5 = ledger.claims_for(claims, ["fig5a", "fig5b"])
-    assert set(fig5["figure"]) == {"5a", "5b"} and len(fig5) == 4
+    assert set(fig5["figure"]) == {"5a", "5b"} and len(fig5) == 4  # their readings tables belong to them
+    assert set(fig5["requires"]) == {"fig5a_readings", "fig5b_readings"}
     # a claim needing fig7a and fig7b belongs to a chapter that has both
     assert "fig7-critical-amplitude-both-models" not in set(ledger.claims_for(claims, "fig7a")["id"])
     assert "fig7-critical-amplitude-both-models" in set(ledger.claims_for(claims, ["fig7a", "fig7b"])["id"])
@@ -573,9 +738,13 @@ def test_any_category_change_fails_with_a_readable_diff(tmp_path):
     baseline_path = tmp_path / "baseline.csv"
     ledger.write_baseline(ledger.evaluate(claims, results, modules=[module]), baseline_path,
                           header="made by a test\non a day")
-    assert baseline_path.read_text().startswith("# made by a test\n# on a day\nclaim,status,readings\n")
-    # the readings each category was computed at (these synthetic claims depend on no axis)
+    assert baseline_path.read_text().startswith("# made by a test\n# on a day\nclaim,status,readings,states,"
+                                                "joint\n")
+    # the readings each category was computed at (these synthetic claims depend on no axis), the
+    # state at each, and the point besides the defaults its category was judged at
     assert ledger.load_baseline_readings(baseline_path)["val"] == ("defaults",)
+    assert ledger.load_baseline_states(baseline_path)["other"] == {"states": {"defaults": "inconclusive"},
+                                                                   "joint": "defaults"}
     baseline = ledger.load_baseline(baseline_path)
     assert baseline["val"] == "reproduced" and baseline["other"] == "inconclusive"
     ledger.check_categories(ledger.evaluate(claims, results, modules=[module]), baseline)  # unchanged: fine
@@ -603,9 +772,9 @@ def test_collect_results_calls_every_figure_of_the_table(monkeypatch):
     table = {"fig5a": types.SimpleNamespace(compute=_fig5a)}
     monkeypatch.setattr(figures, "figure_names", lambda: list(table))
     monkeypatch.setattr(figures, "figure_spec", lambda name: table[name])
-    monkeypatch.setattr(ledger.force_generation, "fig7flyback", _fig5a)
+    monkeypatch.setattr(figures, "READING_TABLES", {"fig5a_readings": types.SimpleNamespace(compute=_fig5a)})
     results = ledger.collect_results(QUICK)
-    assert list(results) == ["fig5a", "closed_forms", "fig7flyback"]
+    assert list(results) == ["fig5a", "fig5a_readings", "closed_forms"]
     assert calls == [QUICK, QUICK]
     pd.testing.assert_frame_equal(results["closed_forms"], reference.tangential_stiffness_table())
     with pytest.raises(TypeError, match="config = 'quick' is not allowed: "
@@ -662,7 +831,8 @@ def test_real_extractors_live_in_the_figures_claim_modules():
     homes = {f.__module__ for f in found.extractors.values()}
     assert homes == {m.__name__ for m in figures.CLAIM_MODULES} | {"passmd.ledger.evaluation"}
     assert found.extractors["fig10b-r1-stiffer-contact"].__module__ == "passmd.ledger.evaluation"
-    assert found.depends_on["fig5a-no-step-below-50nm"] == ("flyback",)
+    assert found.depends_on["fig5a-no-step-below-50nm"] == (
+        "flyback", "ac_protocol", "drive_frequency_s4", "damping_ratio", "friction_coefficient")
     assert {"fig10a-1n-slower", "sec5-response-to-optimized-similar"} <= set(found.evidence)
     assert ledger.orphan_extractors() == []
     code = ("import sys; import " + ", ".join(m.__name__ for m in figures.CLAIM_MODULES)
@@ -742,36 +912,16 @@ def test_ledger_command_prints_categories_and_si_json(monkeypatch, capsys):
     assert stiffer["readings"] == {"defaults": "holds"} and stiffer["evidence"]
     waiting = claims["fig9a-standard-position-552nm"]
     assert waiting["category"] == "inconclusive" and waiting["paper_m"] == pytest.approx(552e-9)
-    categories = {k: n for k, n in payload["counts"].items() if k not in ("fragile", "not informative")}
-    assert sum(categories.values()) == len(claims)  # fragile and not informative count across categories
+    flags = ("fragile", "not informative", "about the experiment", "studies")
+    categories = {k: n for k, n in payload["counts"].items() if k not in flags}
+    # the categories count the claims of the paper; the studies are shown, never counted
+    assert sum(categories.values()) + payload["counts"]["studies"] == len(claims)
+    assert payload["counts"]["studies"] == int((load_claims()["study_of"] != "").sum()) > 0
     text = io.StringIO()
     assert cli.main(["ledger"], out=text) == 0
     assert "fig10b-r1-stiffer-contact: reproduced (closed form)" in text.getvalue()
     assert cli.main(["ledger", "--workers", "0"], out=io.StringIO()) == 2
     assert "--workers = 0 is out of range" in capsys.readouterr().err
-
-
-def test_open_claims_of_each_axis_are_exactly_those_not_evaluated_along_it():
-    """An axis with alternatives is still open for the claims it applies to whose extractor does not
-    read it. μ applies to every claim that assumes it (claims.csv ``assumed``); the actuator damping
-    ratio ζ to every claim with a flexible actuator. ``Axis.open_for`` must list exactly the rest, so
-    the report never calls a claim covered along an axis it was not evaluated at."""
-    from passmd.ledger import readings
-
-    claims = load_claims()
-    applies = {
-        "friction_coefficient": set(claims.loc[claims["assumed"].str.split(";").map(
-            lambda cols: "friction_coefficient" in cols), "id"]),
-        "damping_ratio": set(claims.loc[claims["actuator_model"].str.split(";").map(
-            lambda models: "flexible" in models), "id"]),
-    }
-    for key, ids in applies.items():
-        evaluated = {c for c in ids if key in ledger.depends_on(c)}
-        assert evaluated, f"no claim is evaluated along {key}"
-        assert set(readings.axis(key).open_for) == ids - evaluated, key
-        assert readings.axis(key).alternatives and readings.axis(key).open_reason, key
-    table = readings.space_table().set_index("key")
-    assert table.at["damping_ratio", "open for"].startswith("13 claims")
 
 
 def test_baseline_readings_of_a_claim_along_several_axes(tmp_path):
@@ -784,37 +934,33 @@ def test_baseline_readings_of_a_claim_along_several_axes(tmp_path):
     assert ledger.load_baseline(path) == {"val": "reproduced"}
 
 
-def test_flexible_ac_tables_hold_protocol_times_flyback_at_the_default_damping():
-    """At the drive frequency and the default ζ the A_c searches of flexible actuators cover
-    protocol × fly-back (the points the joint reading needs, e.g. the first fly-back with the fixed
-    fly-back); ζ's alternatives only with the steady protocol and the slew-rate fly-back. Rigid
-    actuators have no fly-back or ζ axis."""
+def test_reading_tables_hold_the_full_product():
+    """The A_c readings of a flexible panel hold every point of fly-back × A_c protocol × drive frequency
+    × ζ × μ, a rigid panel every point but ζ; the force readings every point of fly-back × ζ × drive
+    frequency; each default point is the figure's own run (the same sweep parameters)."""
     from passmd.experiments.critical_amplitude import figures as ca
     from passmd.ledger import readings
-    from passmd.model.defaults import PROTOCOL
 
-    zeta = readings.axis("damping_ratio").default
-    flexible = ca._protocols("flexible", (PROTOCOL.drive_frequency,))
-    points = {(c["protocol"], c["flyback"], c.get("damping_ratio", zeta)) for c in flexible}
-    expected = {(p, f, zeta) for p in ("steady", "first") for f in readings.axis("flyback").values()}
-    expected |= {("steady", "slew", z) for z in readings.axis("damping_ratio").alternatives}
-    assert points == expected and len(flexible) == len(expected)
-    assert {c["flyback"] for c in ca._protocols("rigid", (PROTOCOL.drive_frequency,))} == {"slew"}
+    rigid_axes = tuple(k for k in ca._AC_AXES if k != "damping_ratio")
+    for model, axes in (("flexible", ca._AC_AXES), ("rigid", rigid_axes)):
+        points = ca._reading_points(model, ca._AC_AXES)
+        assert len(points) == len({tuple(sorted(p.items())) for p in points}) == len(readings.design(axes))
+    figure_combos = ca._protocols("flexible", (100.0,))
+    default = ca._reading_points("flexible", ca._AC_AXES)[0]
+    zeta = default["damping_ratio"]
+    assert default in [{**c, "damping_ratio": c.get("damping_ratio", zeta)} for c in figure_combos]
 
 
-def test_force_panels_at_a_flyback_reading():
-    """The Fig. 7 panels at the fixed fly-back come from fig7flyback (flexible rows fixed, rigid rows
-    unchanged); without that table the reading is not covered."""
+def test_force_readings_at_a_reading():
+    """This paper's force runs at a reading come from fig7_readings by fly-back rule, ζ and frequency;
+    a reading the table lacks is a missing run, not an undecided point."""
     from passmd.experiments.force_generation import figures as fg
     from passmd.ledger import readings
 
-    panel = pd.DataFrame({"panel": ["fig7a"] * 2, "actuator_model": ["rigid", "flexible"]})
-    fixed = panel.assign(flyback=["slew", "fixed"])
-    fixed = pd.concat([fixed, fixed.assign(panel="fig7b")], ignore_index=True)
+    table = pd.DataFrame({"flyback": ["slew", "fixed"], "damping_ratio": [0.05, 0.05],
+                          "frequency_Hz": [100.0, 100.0], "generated_force_mN": [1.0, 2.0]})
     reading = {**readings.default_reading(), "flyback": "fixed"}
-    assert fg.panel_at({"fig7a": panel}, "fig7a") is panel
-    with pytest.raises(checks.NotEvaluable, match="needs results: fig7flyback"):
-        fg.panel_at({"fig7a": panel}, "fig7a", reading)
-    rows = fg.panel_at({"fig7a": panel, "fig7flyback": fixed}, "fig7a", reading)
-    assert rows["panel"].tolist() == ["fig7a"] * 2 and rows["flyback"].tolist() == ["slew", "fixed"]
-    assert "fig7flyback" in ledger.result_sources()
+    assert fg.readings_at({"fig7_readings": table}, reading)["generated_force_mN"].tolist() == [2.0]
+    with pytest.raises(checks.NoRun, match="ζ = 0.5"):
+        fg.readings_at({"fig7_readings": table}, {**reading, "damping_ratio": 0.5})
+    assert "fig7_readings" in ledger.result_sources()

@@ -81,6 +81,12 @@ EMPTY_BY_DESIGN: dict[str, dict[str, str]] = {
     "fig9a": {**dict.fromkeys(_SERIES, "per-period rows have no time series"),
               **dict.fromkeys(_PERIODS, "time-series rows have no period")},
     **{name: _DESIGN for name in ("fig9b", "fig10a", "fig10b", "fig10c")},
+    # the ledger's readings of the same runs at every point of the assumption space
+    **{f"{name}_readings": _CRITICAL for name in ("fig5b", "fig6a", "fig6b", "fig6c")},
+    "fig7_readings": _TAIL,
+    "fig9a_response": dict.fromkeys(("sawtooth_reversal_s", "response_reversal_s"),
+                                    "the runner need not turn within t_s after the fly-back"),
+    **{f"{name}_readings": _DESIGN for name in ("fig9b", "fig10a", "fig10b", "fig10c")},
     "mdr_convergence": {"fit_rel": "the power law is fitted on the larger spring counts only"},
     "mdr_cost": dict.fromkeys(("springs", "reversals", "max_depth", "overflows"),
                               "each contact model has its own cost parameters"),

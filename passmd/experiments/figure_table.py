@@ -11,6 +11,7 @@ book, ``passmd figure`` and the ledger all go through :func:`figure_data` and
 
 from __future__ import annotations
 
+import functools
 import importlib
 from collections.abc import Callable
 from types import ModuleType
@@ -35,7 +36,8 @@ from passmd.experiments.numerics import figures as numerics
 from passmd.runtime.config import RunConfig
 
 __all__ = [
-    "CLAIM_MODULES", "FIGURES", "FigureSpec", "figure_data", "figure_names", "figure_plot", "figure_spec",
+    "CLAIM_MODULES", "FIGURES", "READING_TABLES", "FigureSpec", "ReadingTable", "figure_data", "figure_names",
+    "figure_plot", "figure_spec",
 ]
 
 
@@ -149,6 +151,40 @@ FIGURES: tuple[FigureSpec, ...] = (
                "(beyond the paper)", "driving_waveform", waveform_studies.flexible_study,
                "driving_waveform:plot_flexible"),
 )
+
+class ReadingTable(NamedTuple):
+    """A table of the ledger's readings: every run some claims read, at every point of the axes of
+    :mod:`passmd.ledger.readings` that change it (the defaults are the figures' own runs)."""
+
+    key: str  #: result key, e.g. "fig5b_readings"
+    title: str  #: one line: what it holds
+    figures: tuple[str, ...]  #: the figures whose claims read it (a chapter's ledger rows)
+    compute: Callable[[RunConfig], pd.DataFrame]  #: run configuration -> tidy data
+
+
+#: Every table of the ledger's readings, by result key.
+READING_TABLES: dict[str, ReadingTable] = {
+    spec.key: spec
+    for spec in (
+        ReadingTable("fig5a_readings", "Fig. 5a's step against amplitude at every reading",
+                     ("fig5a",), critical_amplitude.fig5a_readings),
+        *(ReadingTable(f"{panel}_readings", f"Fig. {panel[3:]}'s A_c searches at every reading", (panel,),
+                       functools.partial(critical_amplitude.ac_readings, panel=panel))
+          for panel in critical_amplitude.AC_PANELS),
+        ReadingTable("fig7_readings", "This paper's force runs at half and full stroke at every reading",
+                     ("fig7a", "fig7b"), force_generation.fig7_readings),
+        ReadingTable("fig8a_readings", "Fig. 8a at every μ", ("fig8a",), driving_waveform.fig8a_readings),
+        ReadingTable("fig8b_readings", "Fig. 8b at every μ", ("fig8b",), driving_waveform.fig8b_readings),
+        ReadingTable("fig8b_window_readings", "Fig. 8b's fly-back window at every μ", ("fig8b_window",),
+                     driving_waveform.fig8b_window_readings),
+        ReadingTable("fig9a_response", "The response after an optimized period, at every μ", ("fig9a",),
+                     driving_waveform.fig9a_response),
+        ReadingTable("fig9b_readings", "Fig. 9b at every μ", ("fig9b",), driving_waveform.fig9b_readings),
+        ReadingTable("fig10a_readings", "Fig. 10a at every μ", ("fig10a",), driving_waveform.fig10a_readings),
+        ReadingTable("fig10b_readings", "Fig. 10b at every μ", ("fig10b",), driving_waveform.fig10b_readings),
+        ReadingTable("fig10c_readings", "Fig. 10c at every μ", ("fig10c",), driving_waveform.fig10c_readings),
+    )
+}
 
 #: The experiment modules whose functions carry claim extractors (Sections 4.1, 4.2, 5).
 CLAIM_MODULES: tuple[ModuleType, ...] = (critical_amplitude_claims, force_generation_claims,

@@ -1,19 +1,17 @@
-"""The numeric checks of the ledger, and the tags that mark a function as a claim's extractor.
+"""The numeric checks of the ledger.
 
 A claim of ``claims.csv`` (:mod:`passmd.ledger.claims`) names one of four kinds of check; each is a
 function here that compares *ours* (what an extractor computed from the result tables) with the
 paper and returns an :class:`Outcome`. :func:`check_claim` runs the check a claims.csv row names.
-
-Extractors are plain functions ``(results[, reading]) -> ours`` living next to their figure in
-:mod:`passmd.experiments`; :func:`extractor` and :func:`evidence` only tag them with their claim
-id (nothing is registered at import), and :func:`collect_claim_functions` finds the tagged
-functions of the modules it is given (the ledger passes ``passmd.experiments.figure_table.CLAIM_MODULES``).
+The tags that mark a function as a claim's extractor, and what an extractor may raise or return
+besides its numbers, are :mod:`passmd.ledger.tags` (re-exported here).
 
 What ``ours`` must be for each check kind
 -----------------------------------------
 ``value``
     A finite number in the claim's unit; for a claim with a ``reference`` curve,
-    ``{'x': array, 'y': array}`` (x inside the curve's range, y in the curve's unit).
+    ``{'x': array, 'y': array}`` (x inside the curve's range, y in the curve's unit), with
+    ``'reference'``: the curve at x when the extractor evaluates it at its reading (μ).
 ``ordering``
     ``{'lhs': a, 'rhs': b}``, numbers or equal-length arrays; the relation (``<``, ``>``,
     ``approx``) must hold at every element.
@@ -23,22 +21,39 @@ What ``ours`` must be for each check kind
     ``{'x': array, 'y': array}`` or ``{label: {'x': array, 'y': array}, ...}``.
 
 An extractor raises :class:`NotEvaluable` (alias :data:`Inconclusive`) when the results
-cannot decide the claim (e.g. the quick profile's grid has no point where the claim speaks,
-an extremum lies at the grid's edge), and :class:`ClaimFails` when they decide it against the
-paper outright (a total failure is *not reproduced*).
+cannot decide the claim (e.g. the quick profile's grid has no point where the claim speaks),
+:class:`NoRun` when a table lacks the run of a reading (a defect), and :class:`ClaimFails` when
+they decide it against the paper outright (a total failure is *not reproduced*); it returns
+:class:`Scoped` when the deciding data lie where a method the claim rests on is undefined, and
+:class:`Subset` when its table holds only part of the grid the claim speaks of.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
-from types import MappingProxyType
 
 import numpy as np
 
-from passmd.ledger import readings, reference
-from passmd.ledger.claims import CLAIM_ID, RELATIONS, TOLERANCE_KINDS
+from passmd.ledger import reference
+from passmd.ledger.claims import RELATIONS, TOLERANCE_KINDS
+from passmd.ledger.tags import (  # re-exported: extractors import them from here
+    NO_MEASURED_DATA,
+    ClaimFails,
+    ClaimFunctions,
+    ExtractorError,
+    Inconclusive,
+    NoRun,
+    NotEvaluable,
+    Scoped,
+    Subset,
+    collect_claim_functions,
+    evidence,
+    experiment_claim,
+    extractor,
+    no_measured_data,
+)
 from passmd.runtime.validation import check_choice
 
 __all__ = [
@@ -48,8 +63,11 @@ __all__ = [
     "ExtractorError",
     "Inconclusive",
     "NO_MEASURED_DATA",
+    "NoRun",
     "NotEvaluable",
     "Outcome",
+    "Scoped",
+    "Subset",
     "check_claim",
     "check_ordering",
     "check_threshold",
@@ -58,45 +76,12 @@ __all__ = [
     "collect_claim_functions",
     "curve_deviation",
     "evidence",
+    "experiment_claim",
     "extractor",
     "format_number",
     "no_measured_data",
+    "reference_table",
 ]
-
-
-class NotEvaluable(Exception):
-    """Raised by an extractor or a check when the results cannot decide a claim.
-
-    The claim is then *inconclusive* at that reading (an extremum at the edge of the grid,
-    non-finite values, a run that did not converge, a reading the tables hold no run for);
-    the message says what is missing.
-    """
-
-
-#: The name the verdict taxonomy uses for :class:`NotEvaluable`.
-Inconclusive = NotEvaluable
-
-
-#: How the verdict of a claim about the experiment begins: the paper's text tabulates no measurement.
-NO_MEASURED_DATA = "no measured data in the paper's text"
-
-
-def no_measured_data(what: str):
-    """Raise :class:`NotEvaluable` for a claim about the experiment: the paper's text gives none of
-    its measurements (``what`` names them), so no computation can decide the claim."""
-    raise NotEvaluable(f"{NO_MEASURED_DATA}: {what}")
-
-
-class ClaimFails(Exception):
-    """Raised by an extractor when the results decide the claim *against* the paper outright.
-
-    A total failure (e.g. no step up to the full stroke, no turning point where the paper
-    locates one) is *not reproduced*, never "not evaluated"; the message is the evidence.
-    """
-
-
-class ExtractorError(ValueError):
-    """An extractor failed, or returned something its claim's check cannot use."""
 
 
 @dataclass(frozen=True)
@@ -109,6 +94,10 @@ class Outcome:
     rel_deviation: float = math.nan
     detail: str = ""  # why it failed (or what was found)
     score: float = math.nan  # how far from holding: <= 1 holds (value, trend), 0 holds (others)
+    #: the margin against the tolerance: deviation / allowed deviation (value, approximate ordering),
+    #: the worst of counter-step / allowance and allowance / net change (trend), |switch − x_t| / band
+    #: (threshold); ≤ 1 within the tolerance; NaN without a tolerance (plain ordering)
+    ratio: float = math.nan
 
 
 def format_number(x) -> str:
@@ -203,7 +192,7 @@ def check_value(ours, paper_value=None, tolerance=0.0, tolerance_kind="rel", cur
     allowed = _allowance(tolerance, tolerance_kind, expected)
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(allowed > 0, deviation / allowed, np.where(deviation > 0, np.inf, 0.0))
-    return Outcome(passed, shown, abs_dev, rel_dev, detail, float(ratio.max()))
+    return Outcome(passed, shown, abs_dev, rel_dev, detail, float(ratio.max()), float(ratio.max()))
 
 
 #: How the ledger writes each ordering relation.
@@ -242,7 +231,12 @@ def check_ordering(ours, relation, tolerance=None, tolerance_kind="rel") -> Outc
         bad = int(np.flatnonzero(~ok)[0])
         detail = (f"lhs {symbol} rhs fails at {int((~ok).sum())} of {ok.size} point(s), e.g. "
                   f"{format_number(float(lhs[bad]))} vs {format_number(float(rhs[bad]))}")
-    return Outcome(bool(ok.all()), shown, abs_dev, rel_dev, detail, float((~ok).mean()))
+    ratio = math.nan
+    if relation == "approx":
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = float(np.max(np.where(margin > 0, np.abs(difference) / margin,
+                                          np.where(difference != 0, np.inf, 0.0))))
+    return Outcome(bool(ok.all()), shown, abs_dev, rel_dev, detail, float((~ok).mean()), ratio)
 
 
 def check_threshold(ours, relation, threshold, tolerance=0.0, tolerance_kind="abs") -> Outcome:
@@ -289,8 +283,9 @@ def check_threshold(ours, relation, threshold, tolerance=0.0, tolerance_kind="ab
         else "holds at every point")
     judged = side | (other if switch else np.zeros_like(side))
     wrong = (side & ~holds) | ((other & holds) if switch else np.zeros_like(side))
+    ratio = abs_dev / band if band > 0 and math.isfinite(abs_dev) else math.nan
     return Outcome(not problems, shown, abs_dev, abs_dev / abs(threshold) if threshold else math.nan, detail,
-                   float(wrong.sum() / max(int(judged.sum()), 1)))
+                   float(wrong.sum() / max(int(judged.sum()), 1)), ratio)
 
 
 def check_trend(ours, relation, tolerance=0.0, tolerance_kind="rel") -> Outcome:
@@ -308,7 +303,7 @@ def check_trend(ours, relation, tolerance=0.0, tolerance_kind="rel") -> Outcome:
     else:
         raise ValueError(f"ours must be {{'x', 'y'}} or {{label: {{'x', 'y'}}}}, got {ours!r}")
     sign = 1.0 if relation == "increasing" else -1.0
-    worst, worst_rel, problems, points, failing = 0.0, 0.0, [], 0, 0
+    worst, worst_rel, problems, points, failing, ratio = 0.0, 0.0, [], 0, 0, 0.0
     for label, data in series.items():
         x = _numbers(f"ours[{label!r}]['x']", _mapping("series", data, ("x", "y"))["x"])
         y = _numbers(f"ours[{label!r}]['y']", data["y"])
@@ -325,6 +320,9 @@ def check_trend(ours, relation, tolerance=0.0, tolerance_kind="rel") -> Outcome:
         worst_rel = max(worst_rel, counter / spread if spread > 0 else 0.0)
         name = f"series {label}: " if label else ""
         failing += int(counter > allowance or sign * (y[-1] - y[0]) <= allowance)
+        net = sign * (y[-1] - y[0])
+        ratio = max(ratio, counter / allowance if allowance > 0 else (math.inf if counter > 0 else 0.0),
+                    allowance / net if net > 0 else math.inf)
         if counter > allowance:
             problems.append(f"{name}steps against the trend by {format_number(counter)} > allowance "
                             f"{format_number(allowance)}")
@@ -334,16 +332,26 @@ def check_trend(ours, relation, tolerance=0.0, tolerance_kind="rel") -> Outcome:
     shown = (f"{relation} over {points} points" if not problems
              else f"largest counter-step {format_number(worst)}")
     detail = "; ".join(problems) if problems else f"largest counter-step {format_number(worst)}"
-    return Outcome(not problems, shown, worst, worst_rel, detail, failing / len(series))
+    return Outcome(not problems, shown, worst, worst_rel, detail, failing / len(series), ratio)
 
 
-def curve_deviation(x, y, curve: str, column: str) -> float:
+def reference_table(curve: str, friction_coefficient: float = reference.REFERENCE_FRICTION_COEFFICIENT):
+    """A closed-form reference table (:data:`passmd.ledger.reference.CURVES`) at μ: the committed file at
+    the reference μ, else computed by the same code (:func:`passmd.ledger.reference.closed_form_curves`)."""
+    if math.isclose(friction_coefficient, reference.REFERENCE_FRICTION_COEFFICIENT, rel_tol=1e-12):
+        return reference.load_reference_curve(curve)
+    return reference.closed_form_curves(curve, friction_coefficient)
+
+
+def curve_deviation(x, y, curve: str, column: str,
+                    friction_coefficient: float = reference.REFERENCE_FRICTION_COEFFICIENT) -> float:
     """Largest relative deviation in % of ``y`` from a reference curve at ``x``.
 
     Helper for extractors of ordering claims such as ``fig6a-rigid-ac-not-eq10``.
-    ``curve`` is a table of :data:`passmd.ledger.reference.CURVES` and ``column`` one of its columns.
+    ``curve`` is a table of :data:`passmd.ledger.reference.CURVES` and ``column`` one of its columns,
+    at μ = ``friction_coefficient`` (:func:`reference_table`).
     """
-    table = reference.load_reference_curve(curve)
+    table = reference_table(curve, friction_coefficient)
     outcome = check_value({"x": x, "y": y}, tolerance=0.0, curve=(table.iloc[:, 0], table[column]))
     return 100.0 * outcome.rel_deviation
 
@@ -356,9 +364,15 @@ def check_claim(claim: Mapping, ours) -> Outcome:
     """
     kind, relation = claim["check"], claim["relation"]
     tolerance, tolerance_kind = claim["tolerance_num"], claim["tolerance_kind"] or "rel"
+    while isinstance(ours, (Scoped, Subset)):  # where the data lie does not change the check
+        ours = ours.ours
     if kind == "value":
         curve = None
-        if claim["reference"]:
+        if claim["reference"] and isinstance(ours, Mapping) and "reference" in ours:
+            # the same closed form at the reading's μ, at ours' x (the extractor computed it)
+            curve = (np.asarray(ours["x"], float), np.asarray(ours["reference"], float))
+            ours = {"x": ours["x"], "y": ours["y"]}
+        elif claim["reference"]:
             filename, _, column = claim["reference"].partition(":")
             table = reference.load_reference_curve(filename)
             curve = (table.iloc[:, 0].to_numpy(), table[column].to_numpy())
@@ -368,117 +382,3 @@ def check_claim(claim: Mapping, ours) -> Outcome:
     if kind == "threshold":
         return check_threshold(ours, relation, claim["paper_value_num"], tolerance, tolerance_kind)
     return check_trend(ours, relation, tolerance, tolerance_kind)
-
-
-# ======================================================================================
-# Tags: which function extracts (or gives evidence for) which claim
-# ======================================================================================
-
-
-def _check_claim_id(claim_id) -> str:
-    if not isinstance(claim_id, str) or not CLAIM_ID.match(claim_id):
-        raise ValueError(f"claim_id = {claim_id!r} is not allowed: must be a claims.csv id slug")
-    return claim_id
-
-
-def extractor(claim_id: str, depends_on=(), *, not_informative: str = "") -> Callable[[Callable], Callable]:
-    """Decorator: tag ``func(results[, reading]) -> ours`` as the extractor of a claim.
-
-    ``ours`` must have the form the claim's check kind expects (module docstring) and be in
-    the claim's ``unit``. Raise :class:`NotEvaluable` when the results cannot decide the claim
-    (inconclusive) and :class:`ClaimFails` when they decide it against the paper outright.
-
-    ``depends_on`` names the axes of :data:`passmd.ledger.readings.AXES` the claim's result depends
-    on; the function then takes a second argument ``reading`` (``{axis: value}``) and is
-    evaluated at every reading of :func:`passmd.ledger.readings.design`.
-
-    ``not_informative`` says why the claim's check cannot fail on any result the model can
-    produce (a closed-form identity, a statement every finite contact stiffness satisfies at the
-    claim's amplitude); empty (the default) for a check some counter-example makes fail. The
-    ledger counts the non-informative claims apart.
-
-    The decorator only sets ``func.claim_extractor`` (the id), ``func.claim_depends_on`` and
-    ``func.not_informative``; :func:`collect_claim_functions` finds the tagged functions of a module.
-    """
-    _check_claim_id(claim_id)
-    depends = tuple(depends_on)
-    for key in depends:
-        readings.axis(key)  # ValueError naming the declared axes
-    if not isinstance(not_informative, str):
-        raise ValueError(f"not_informative = {not_informative!r} is not allowed: must be a reason (str), "
-                         "empty for an informative check")
-
-    def tag(func: Callable) -> Callable:
-        func.claim_extractor = claim_id
-        func.claim_depends_on = depends
-        func.not_informative = not_informative.strip()
-        return func
-
-    return tag
-
-
-def evidence(claim_id: str) -> Callable[[Callable], Callable]:
-    """Decorator: tag ``func(results) -> list[str]`` as the computed evidence of a claim.
-
-    Each string states one evaluated quantity with its value (e.g. "first-fly-back onset
-    within 0.4 % of Eq. 7"); the ledger shows them beside the claim's checks. Raise
-    :class:`NotEvaluable` when the results hold no data for them. Sets ``func.claim_evidence``.
-    """
-    _check_claim_id(claim_id)
-
-    def tag(func: Callable) -> Callable:
-        func.claim_evidence = claim_id
-        return func
-
-    return tag
-
-
-@dataclass(frozen=True)
-class ClaimFunctions:
-    """The tagged functions of some modules, by claim id (read-only mappings)."""
-
-    extractors: Mapping[str, Callable]
-    depends_on: Mapping[str, tuple[str, ...]]
-    evidence: Mapping[str, Callable]
-
-
-def _module_functions(module) -> Iterable[Callable]:
-    """The callables a module holds at its top level, and inside its top-level tuples (functions
-    made in a loop, e.g. one evidence function per claim of a table)."""
-    for value in vars(module).values():
-        if isinstance(value, tuple):
-            yield from (item for item in value if callable(item))
-        elif callable(value):
-            yield value
-
-
-def collect_claim_functions(modules: Iterable) -> ClaimFunctions:
-    """The extractors (with their ``depends_on``) and evidence functions defined in ``modules``.
-
-    Looks at every module-level function (and every function in a module-level tuple) tagged
-    by :func:`extractor` or :func:`evidence`; the same function reached twice (e.g. imported
-    into another of the modules) counts once.
-
-    Raises
-    ------
-    ValueError
-        When two different functions are tagged for the same claim id (naming both).
-    """
-    found: dict[str, dict[str, Callable]] = {"claim_extractor": {}, "claim_evidence": {}}
-    for module in modules:
-        for func in _module_functions(module):
-            for tag, by_id in found.items():
-                claim_id = getattr(func, tag, None)
-                if not isinstance(claim_id, str):
-                    continue
-                previous = by_id.setdefault(claim_id, func)
-                if previous is not func:
-                    raise ValueError(f"claim {claim_id!r} is claimed twice ({tag}): by "
-                                     f"{previous.__module__}.{previous.__qualname__} and "
-                                     f"{func.__module__}.{func.__qualname__}")
-    extractors = found["claim_extractor"]
-    return ClaimFunctions(
-        extractors=MappingProxyType(extractors),
-        depends_on=MappingProxyType({c: f.claim_depends_on for c, f in extractors.items()}),
-        evidence=MappingProxyType(found["claim_evidence"]),
-    )

@@ -28,11 +28,10 @@ __all__ = [
     "CONFIGURATION_COLUMNS",
     "RELATIONS",
     "STATUSES",
-    "SUBSTITUTE_PREFIX",
     "TOLERANCE_KINDS",
     "is_number",
+    "is_study",
     "load_claims",
-    "substitute_for",
     "tolerance_text",
 ]
 
@@ -45,7 +44,7 @@ CLAIM_COLUMNS = (
     "contacts", "actuator_model", "radius_mm", "preload_N", "friction_coefficient",
     "amplitude_nm", "frequency_Hz", "waveform", "assumed",
     "paper_value", "unit", "reference", "check", "relation", "tolerance", "tolerance_kind",
-    "tolerance_reason", "source_section", "source_quote", "notes", "reason",
+    "tolerance_reason", "source_section", "source_quote", "study_of", "notes", "reason",
 )
 #: The columns that state the configuration a claim is about.
 CONFIGURATION_COLUMNS = (
@@ -95,8 +94,8 @@ def _row_errors(row: Mapping[str, str], reference_dir: Path) -> list[str]:
         bad("id", "a slug of lower-case letters, digits, '.', '_', '-'")
     for column in ("figure", "quantity", "ours_definition", "check", "source_section", "source_quote",
                    "tolerance_reason"):
-        if column == "source_quote" and substitute_for(row):
-            continue  # a model-against-model substitute states no claim of the paper
+        if column == "source_quote" and row["study_of"]:
+            continue  # a study states no sentence of the paper (passmd.ledger.rules)
         if not row[column].strip():
             errors.append(f"{column} is empty: it is required")
     keys = [k for k in row["requires"].split(";") if k]
@@ -146,16 +145,9 @@ def _row_errors(row: Mapping[str, str], reference_dir: Path) -> list[str]:
     return errors
 
 
-#: How a row's ``notes`` begin when the row is our model-against-model substitute for a claim about
-#: the experiment (``Model-against-model substitute for 'claim-id': ...``): it has no quote of its own.
-SUBSTITUTE_PREFIX = "Model-against-model substitute for "
-_SUBSTITUTE = re.compile(rf"^{SUBSTITUTE_PREFIX}'([a-z0-9][a-z0-9._-]*)'")
-
-
-def substitute_for(row: Mapping[str, str]) -> str:
-    """The claim id a model-against-model substitute row stands in for; empty for a claim of the paper."""
-    match = _SUBSTITUTE.match(row["notes"])
-    return match.group(1) if match else ""
+def is_study(row: Mapping[str, str]) -> bool:
+    """Whether a claims.csv row is a study (no sentence of the paper; :mod:`passmd.ledger.rules`)."""
+    return bool(row["study_of"])
 
 
 def _reference_errors(spec: str, reference_dir: Path) -> list[str]:
@@ -206,10 +198,12 @@ def load_claims(path=None) -> pd.DataFrame:
     errors.extend(f"id {claim!r} appears more than once" for claim in duplicated)
     for _, row in claims.iterrows():
         errors.extend(f"row {row['id']!r}: {message}" for message in _row_errors(row, path.parent))
-        target = substitute_for(row)
-        if target and (target not in set(claims["id"]) or row["source_quote"]):
-            errors.append(f"row {row['id']!r}: notes = {SUBSTITUTE_PREFIX}{target!r} is not allowed: must "
-                          "name a claim id of this file, and a substitute row has an empty source_quote")
+        target = row["study_of"]
+        claims_of_the_paper = set(claims.loc[claims["study_of"] == "", "id"])
+        if target and (target not in claims_of_the_paper or row["source_quote"]):
+            errors.append(f"row {row['id']!r}: study_of = {target!r} is not allowed: must name a claim of "
+                          "this file that is not a study, and a study quotes no sentence (source_quote "
+                          "empty)")
     if errors:
         raise ValueError(f"{path.name} has {len(errors)} schema error(s):\n  " + "\n  ".join(errors))
     claims["paper_value_num"] = pd.to_numeric(claims["paper_value"].replace("", np.nan))

@@ -3,10 +3,13 @@
 Three pieces meet here:
 
 * **claims**: ``passmd/data/reference/claims.csv``, read and validated by
-  :func:`passmd.ledger.claims.load_claims`;
+  :func:`passmd.ledger.claims.load_claims`; rows without a quotation of the paper are studies,
+  shown and never counted (:mod:`passmd.ledger.rules`);
 * **results**: the figure table of ``passmd.experiments.figure_table`` (``fig5a`` … ``fig10c``, shared with
-  the book and the CLI) plus the ledger's own ``closed_forms`` table; :func:`collect_results`
-  computes every one for a run configuration, so a chapter never lists them;
+  the book and the CLI), the tables of the ledger's readings
+  (``passmd.experiments.figure_table.READING_TABLES``: every run at every point of the axes that
+  change it) and the ledger's own ``closed_forms`` table; :func:`collect_results` computes every
+  one for a run configuration, so a chapter never lists them;
 * **extractors**: functions ``(results[, reading]) -> ours`` tagged with
   :func:`passmd.ledger.checks.extractor` in the modules
   ``passmd.experiments.figure_table.CLAIM_MODULES`` lists
@@ -14,34 +17,49 @@ Three pieces meet here:
   needs (:mod:`passmd.ledger.checks` says what, for each check kind).
 
 :func:`evaluate` runs the checks over the readings of the assumption space
-(:mod:`passmd.ledger.readings`) and computes every claim's category: ``reproduced``,
-``reproduced under the joint reading``, ``not reproduced`` or ``inconclusive``, from the
-defaults and the joint reading of all claims (:mod:`passmd.ledger.joint`), with its
-evidence; no category is typed in. :mod:`passmd.report.ledger_views` presents them in the book;
-:func:`check_categories` compares them with a committed baseline in the tests, and
+(:mod:`passmd.ledger.readings`: each claim on the full product of the axes that change the
+tables it reads) and computes every claim's category: ``reproduced``, ``reproduced under the
+joint reading``, ``not reproduced`` or ``inconclusive``, from the defaults and the joint reading
+of all claims (:mod:`passmd.ledger.joint`), with its evidence, its fragility and the tensions
+between claims; no category is typed in. :mod:`passmd.report.ledger_views` presents them in the
+book; :mod:`passmd.ledger.baseline` compares them with a committed baseline in the tests, and
 :func:`records` gives them to ``passmd ledger --json``.
 """
 
 from __future__ import annotations
 
 import math
-import re
 import sys
 from collections.abc import Callable, Iterable, Mapping
-from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 from passmd.experiments import figure_table as figures
-from passmd.experiments.force_generation import figures as force_generation
 from passmd.ledger import readings, reference
+from passmd.ledger.baseline import (  # re-exported: the tests and the command line read them from here
+    READINGS_SEPARATOR,
+    category_changes,
+    check_categories,
+    load_baseline,
+    load_baseline_readings,
+    load_baseline_states,
+    readings_of,
+    write_baseline,
+)
 from passmd.ledger.checks import ClaimFunctions, collect_claim_functions, extractor
-from passmd.ledger.claims import is_number, load_claims
-from passmd.ledger.joint import _elsewhere, _map_columns, conflicting_pairs, joint_reading
+from passmd.ledger.claims import STATUSES, is_study, load_claims
+from passmd.ledger.export import SI_UNITS, records  # re-exported: passmd ledger --json
+from passmd.ledger.joint import (
+    _elsewhere,
+    _map_columns,
+    conflicting_pairs,
+    joint_reading,
+    state_table,
+    tensions,
+)
 from passmd.ledger.joint import joint_map as joint_map  # the ledger's views read it from here too
 from passmd.ledger.joint import joint_record as joint_record
-from passmd.ledger.verdicts import NO_EXTRACTOR, claim_points, claim_row, shown
+from passmd.ledger.verdicts import EXPERIMENT_BASIS, NO_EXTRACTOR, claim_points, claim_row
 from passmd.runtime.config import RunConfig
 
 __all__ = [
@@ -58,12 +76,14 @@ __all__ = [
     "claims_for",
     "closed_form_results",
     "collect_results",
+    "counted",
     "depends_on",
     "evaluate",
     "extractors",
     "headline",
     "load_baseline",
     "load_baseline_readings",
+    "load_baseline_states",
     "orphan_extractors",
     "records",
     "result_sources",
@@ -72,10 +92,10 @@ __all__ = [
 
 #: Columns of :func:`evaluate`'s result.
 LEDGER_COLUMNS = ("claim", "figure", "quantity", "paper", "ours", "unit", "abs_deviation", "rel_deviation",
-                  "tolerance", "status", "verdict", "evidence", "reason", "basis", "check", "depends_on",
-                  "readings", "holds_at", "fails_at", "decided_at", "fraction_holds", "best_reading",
-                  "default_state", "joint_state", "margin", "margin_text", "fragile", "informative",
-                  "not_informative", "note")
+                  "tolerance", "status", "verdict", "evidence", "reason", "basis", "study_of", "check",
+                  "depends_on", "readings", "holds_at", "fails_at", "decided_at", "fraction_holds",
+                  "best_reading", "default_state", "joint_state", "margin", "margin_text", "fragile",
+                  "fragile_reason", "outside", "informative", "not_informative", "note")
 
 
 # ======================================================================================
@@ -118,14 +138,14 @@ def _figure_source(name: str) -> Callable[[RunConfig], pd.DataFrame]:
 def result_sources() -> dict[str, Callable[[RunConfig], pd.DataFrame]]:
     """Every available result table: ``{key: compute(config) -> DataFrame}``.
 
-    The figures of ``passmd.experiments.figure_table`` (in the table's order) plus ``closed_forms``
-    (the closed-form tables some claims are checked against, :func:`closed_form_results`) and
-    ``fig7flyback`` (Figs. 7a and 7b with the fixed fly-back, the force claims' ``flyback``
-    readings: :func:`passmd.experiments.force_generation.figures.fig7flyback`).
+    The figures of ``passmd.experiments.figure_table`` (in the table's order), the tables of the
+    ledger's readings (``passmd.experiments.figure_table.READING_TABLES``: every run a claim reads,
+    at every point of the axes that change it) and ``closed_forms`` (the closed-form tables some
+    claims are checked against, :func:`closed_form_results`).
     """
     sources = {name: _figure_source(name) for name in figures.figure_names()}
+    sources.update({key: spec.compute for key, spec in figures.READING_TABLES.items()})
     sources["closed_forms"] = closed_form_results
-    sources["fig7flyback"] = force_generation.fig7flyback
     return sources
 
 
@@ -166,6 +186,56 @@ def collect_results(config: RunConfig, figures: Iterable[str] | None = None) -> 
 # ======================================================================================
 
 
+def counted(evaluated: pd.DataFrame) -> pd.DataFrame:
+    """The rows of an :func:`evaluate` result that are claims of the paper (studies left out)."""
+    return evaluated[evaluated["study_of"] == ""]
+
+
+def _design_problems(claim: Mapping, functions: ClaimFunctions, points) -> list[str]:
+    """Why a claim's evaluation is incomplete: its extractor does not declare an axis that changes a
+    table it reads (:func:`passmd.ledger.readings.applicable`), or a table holds no run at a point."""
+    problems = []
+    declared = functions.depends_on.get(claim["id"], ())
+    missing = [k for k in readings.applicable(claim) if k not in declared]
+    if claim["id"] in functions.extractors and missing:
+        problems.append(f"claim {claim['id']!r} reads tables that {', '.join(missing)} change"
+                        f"{'s' if len(missing) == 1 else ''}, but its extractor does not declare "
+                        f"{'it' if len(missing) == 1 else 'them'}")
+    problems.extend(f"claim {claim['id']!r} has no run at {readings.describe(p.reading)}: {p.detail}"
+                    for p in points if p.no_run)
+    return problems
+
+
+def _variants(evaluated: Mapping, computed: set, rows: list[dict], states: Mapping,
+              studies: Mapping) -> list[dict]:
+    """How the joint reading changes when rows are left out (the not-informative ones, and those
+    decided only where a method they rest on is undefined, e.g. Eq. 15) or when the studies (the
+    substitute and derived rows, never counted) are counted as claims."""
+    out = []
+    if studies:
+        with_studies = {**evaluated, **studies}
+        joint = joint_reading(with_studies, computed | set(studies), states=state_table(with_studies))
+        out.append({"left_out": "studies counted as claims", "claims_left_out": [],
+                    "claims_added": sorted(studies), "reading": joint["reading"],
+                    "described": joint["described"], "holding": joint["holding"], "claims": joint["claims"]})
+    for label, leave in (
+        ("not-informative rows left out", {r["claim"] for r in rows if not r["informative"]}),
+        ("rows decided only where a method they rest on is undefined left out",
+         {r["claim"] for r in rows if r["outside"]}),
+    ):
+        if not leave:
+            continue
+        kept = {c: v for c, v in evaluated.items() if c not in leave}
+        table = {"space": states["space"],
+                 "table": {i: {c: s for c, s in column.items() if c not in leave}
+                           for i, column in states["table"].items()}}
+        joint = joint_reading(kept, computed - leave, states=table)
+        out.append({"left_out": label, "claims_left_out": sorted(leave), "claims_added": [],
+                    "reading": joint["reading"], "described": joint["described"], "holding": joint["holding"],
+                    "claims": joint["claims"]})
+    return out
+
+
 def evaluate(
     claims: pd.DataFrame | None = None,
     results: Mapping[str, pd.DataFrame] | None = None,
@@ -177,9 +247,10 @@ def evaluate(
     """Evaluate every claim against the result tables, over its readings of the assumption space.
 
     Each claim is checked at every reading of :func:`passmd.ledger.readings.design` (the full product of the
-    axes its extractor depends on, the defaults first). The joint reading
-    (:func:`~passmd.ledger.joint.joint_reading`) is the point of the whole space where the most claims hold
-    together; each claim's category is computed from two points only, the defaults and the joint reading:
+    axes that change the tables it reads, the defaults first). The joint reading
+    (:func:`~passmd.ledger.joint.joint_reading`) is the covered point of the whole space where the
+    most claims hold together; each claim's category is computed from two points only, the defaults
+    and the joint reading:
 
     * ``reproduced``: the check holds at the defaults;
     * ``reproduced under the joint reading``: it does not hold at the defaults and holds at the
@@ -187,12 +258,14 @@ def evaluate(
     * ``not reproduced``: it fails at the defaults or at the joint reading and holds at neither (a
       total failure, e.g. no step up to the full stroke, is a failure); the verdict names another
       reading where it holds, if any, and the claims that reading breaks;
-    * ``inconclusive``: neither point decides it (an extremum at the grid's edge, non-finite
-      values, missing results, no run at that reading).
+    * ``inconclusive``: neither point decides it (an extremum the grid cannot locate, non-finite
+      values, missing results, no measured data for a claim about the experiment).
 
-    The table's ``attrs`` carry ``points`` (every claim at every evaluated reading), ``joint``
-    (:func:`~passmd.ledger.joint.joint_reading` without its state table) and ``conflicts``
-    (:func:`~passmd.ledger.joint.conflicting_pairs`).
+    Studies (rows without a quotation, :mod:`passmd.ledger.rules`) are checked at the defaults and
+    counted nowhere. The table's ``attrs`` carry ``points`` (every claim at every evaluated
+    reading), ``joint`` (:func:`~passmd.ledger.joint.joint_reading` without its state table, with
+    ``variants``: how it changes when rows are left out), ``conflicts``
+    (:func:`~passmd.ledger.joint.conflicting_pairs`) and ``tensions``.
 
     NaN never counts as holding (:class:`passmd.ledger.checks.NotEvaluable`). Claims whose ``requires``
     are only ``closed_forms`` have ``basis`` "closed form" and are not simulation results.
@@ -202,13 +275,15 @@ def evaluate(
     claims : pandas.DataFrame, optional
         From :func:`passmd.ledger.claims.load_claims` (the default: every claim of claims.csv).
     results : dict, optional
-        ``{figure key: DataFrame}``, e.g. from :func:`collect_results`; default
+        ``{result key: DataFrame}``, e.g. from :func:`collect_results`; default
         ``collect_results(config)``.
     config : passmd.runtime.config.RunConfig, optional
         The run configuration the results are computed with when ``results`` is not given.
     strict : bool
         If True (default), raise ``LookupError`` when a claim's results are present but no
-        extractor is tagged for it. If False, such claims are *inconclusive* with that note.
+        extractor is tagged for it, when its extractor does not declare an axis that changes a table
+        it reads, or when a table holds no run at one of its readings (a defect, never "not covered").
+        If False, such claims are evaluated as far as they go, a missing run inconclusive.
     modules : iterable of modules, optional
         Where the extractors and evidence functions are looked up; default :func:`claim_modules`.
 
@@ -219,12 +294,13 @@ def evaluate(
         ``abs_deviation`` (in ``unit``) and ``rel_deviation`` (fraction) where defined,
         ``status`` (the category, one of :data:`passmd.ledger.claims.STATUSES`), ``verdict`` (one
         computed line), ``evidence`` (computed lines, ``" | "``-separated), ``reason``
-        (claims.csv's human reason), ``basis``, ``readings`` (evaluated), ``holds_at`` (how
-        many hold), ``fails_at`` and ``decided_at`` (how many fail, of the decided ones),
-        ``fraction_holds``, ``best_reading``, ``depends_on``, ``default_state`` and
-        ``joint_state``, ``margin`` (the check's score at the defaults: deviation over tolerance
-        for value and trend checks) with ``margin_text``, ``fragile`` (holds at the defaults but
-        fails at the joint reading or at most of its decided readings), ``informative`` and
+        (claims.csv's human reason), ``basis``, ``study_of`` (the claim a study accompanies,
+        empty for a claim), ``readings`` (evaluated), ``holds_at`` (how many hold), ``fails_at``
+        and ``decided_at`` (how many fail, of the decided ones), ``fraction_holds``,
+        ``best_reading``, ``depends_on``, ``default_state`` and ``joint_state``, ``margin`` (the
+        check's ratio against its tolerance at the point deciding the category) with
+        ``margin_text``, ``fragile`` with ``fragile_reason`` (:mod:`passmd.ledger.rules`),
+        ``outside`` (where the deciding data lie outside a method's validity), ``informative`` and
         ``not_informative`` (why its check cannot fail, from the extractor).
     """
     if results is None:
@@ -233,42 +309,57 @@ def evaluate(
         results = collect_results(config)
     claims = load_claims() if claims is None else claims
     functions = claim_functions(modules)
-    evaluated = {}
-    problems = []
+    evaluated, problems = {}, []
     for _, claim in claims.iterrows():
         points, why = claim_points(claim, results, functions)
         if strict and why == NO_EXTRACTOR:
             problems.append(f"claim {claim['id']!r} has its results but no registered extractor")
+        if strict and not is_study(claim):
+            problems.extend(_design_problems(claim, functions, points))
         evaluated[claim["id"]] = (points, functions.depends_on.get(claim["id"], ()))
     if problems:
         raise LookupError("ledger evaluation is incomplete:\n  " + "\n  ".join(problems))
-    joint = joint_reading(evaluated)
-    states = joint["states"]
+    studies = {c for c, row in claims.set_index("id").iterrows() if is_study(row)}
+    claims_of_paper = {c: v for c, v in evaluated.items() if c not in studies}
+    computed = {c for c, (points, _) in claims_of_paper.items() if points and c not in functions.experiment}
+    states = state_table(claims_of_paper)
+    joint = joint_reading(claims_of_paper, computed, states=states)
+    runner_ups = tuple(r["reading"] for r in joint["runner_ups"])
     rows, point_rows = [], []
     for _, claim in claims.iterrows():
         points, depends = evaluated[claim["id"]]
-        row, _ = claim_row(claim, results, functions, joint=joint["reading"], points=points or None,
-                           elsewhere=_elsewhere(claim["id"], states, joint))
+        study = claim["id"] in studies
+        row, _ = claim_row(claim, results, functions, joint=None if study else joint["reading"],
+                           runner_ups=() if study else runner_ups, points=points or None,
+                           elsewhere="" if study else _elsewhere(claim["id"], joint["states"], joint))
         rows.append(row)
         point_rows.extend({"claim": claim["id"], "reading": readings.describe(p.reading),
                            "point": {k: p.reading[k] for k in depends if k in p.reading},
-                           "state": p.state, "detail": p.detail,
+                           "state": p.state, "detail": p.detail, "outside": p.outside,
                            "score": (p.outcome.score if p.outcome is not None
                                      and math.isfinite(p.outcome.score) else None)} for p in points)
     table = pd.DataFrame(rows, columns=list(LEDGER_COLUMNS))
     table.attrs["points"] = point_rows
-    table.attrs["joint"] = {k: v for k, v in joint.items() if k != "states"}
-    table.attrs["conflicts"] = conflicting_pairs(states)
+    conflicts = conflicting_pairs(joint["states"], computed)
+    table.attrs["joint"] = {**{k: v for k, v in joint.items() if k != "states"},
+                            "variants": _variants(claims_of_paper, computed,
+                                                  [r for r in rows if r["claim"] not in studies], states,
+                                                  {c: evaluated[c] for c in studies})}
+    table.attrs["conflicts"] = conflicts
+    table.attrs["tensions"] = tensions(joint["states"], conflicts)
     table.attrs["joint_map"] = _map_columns(joint)
     return table
 
 
 def headline(evaluated: pd.DataFrame) -> dict:
-    """Counts per category, plus the fragile rows and the rows whose check is not informative."""
-    from passmd.ledger.claims import STATUSES
-    counts = {s: int((evaluated["status"] == s).sum()) for s in STATUSES}
-    counts["fragile"] = int(evaluated["fragile"].astype(bool).sum())
-    counts["not informative"] = int((~evaluated["informative"].astype(bool)).sum())
+    """Counts per category of the claims of the paper, plus the fragile rows, the rows whose check is
+    not informative, the claims about the experiment and the studies (shown, not counted)."""
+    claims = counted(evaluated)
+    counts = {s: int((claims["status"] == s).sum()) for s in STATUSES}
+    counts["fragile"] = int(claims["fragile"].astype(bool).sum())
+    counts["not informative"] = int((~claims["informative"].astype(bool)).sum())
+    counts["about the experiment"] = int((claims["basis"] == EXPERIMENT_BASIS).sum())
+    counts["studies"] = int(len(evaluated) - len(claims))
     return counts
 
 
@@ -297,15 +388,22 @@ def assumption_map(evaluated: pd.DataFrame) -> pd.DataFrame:
     return table
 
 
-def claims_for(claims: pd.DataFrame, figures) -> pd.DataFrame:
-    """The claims that need only the given result keys, e.g. a chapter's own ledger rows.
+def _figures_of(key: str) -> tuple[str, ...]:
+    """The figures a result key belongs to: a reading table's figures, else the key itself."""
+    spec = figures.READING_TABLES.get(key)
+    return spec.figures if spec is not None else (key,)
 
-    ``claims_for(load_claims(), ["fig5a", "fig5b"])`` selects the claims whose ``requires``
-    are all among ``fig5a`` and ``fig5b``.
+
+def claims_for(claims: pd.DataFrame, figures) -> pd.DataFrame:
+    """The claims that need only the given figures' results, e.g. a chapter's own ledger rows.
+
+    ``claims_for(load_claims(), ["fig5a", "fig5b"])`` selects the claims whose ``requires`` are all
+    among ``fig5a`` and ``fig5b`` or the tables of their readings (e.g. ``fig5b_readings``).
     """
     keys = {figures} if isinstance(figures, str) else set(figures)
-    needed = claims["requires"].str.split(";").map(lambda parts: {p for p in parts if p})
-    return claims[needed.map(lambda parts: parts <= keys)].reset_index(drop=True)
+    needed = claims["requires"].str.split(";").map(lambda parts: [p for p in parts if p])
+    chosen = needed.map(lambda parts: all(set(_figures_of(p)) & keys for p in parts))
+    return claims[chosen].reset_index(drop=True)
 
 
 def chapter_rows(figures, config: RunConfig) -> pd.DataFrame:
@@ -333,135 +431,14 @@ def orphan_extractors(claims: pd.DataFrame | None = None, modules=None) -> list[
     return sorted(set(extractors(modules)) - ids)
 
 
-#: SI name and factor of each claim unit, for machine-readable output (keys carry the SI unit).
-SI_UNITS = {"nm": ("m", 1e-9), "mm/s": ("m_per_s", 1e-3), "kHz": ("Hz", 1e3), "mN": ("N", 1e-3),
-            "N/m": ("N_per_m", 1.0), "%": ("percent", 1.0), "µs": ("s", 1e-6), "periods": ("periods", 1.0),
-            "": ("", 1.0)}
-
-
-def records(evaluated: pd.DataFrame) -> list[dict]:
-    """The ledger as plain records with SI keys (``passmd ledger --json``).
-
-    Per claim: ``claim``, ``category``, ``basis``, ``verdict``, ``evidence`` (list),
-    ``reason``, ``depends_on`` (list), ``readings`` (``{reading: state}``), ``points`` (every
-    evaluated reading as ``{axis: value}`` of its axes, with state, score and detail),
-    ``default_state``, ``joint_state``, ``margin`` and ``margin_text``, ``fails_at`` of
-    ``decided_at``, ``fragile``, ``informative`` and ``not_informative``, ``fraction_holds``,
-    ``best_reading``, ``tolerance`` (as shown), and, where numeric, ``paper_<si>``,
-    ``ours_<si>`` and ``abs_deviation_<si>`` in SI units (e.g. ``ours_m``, ``paper_m_per_s``),
-    ``rel_deviation`` as a fraction. Non-numeric values are null, with ``ours_text`` as shown.
-    """
-    points = pd.DataFrame(evaluated.attrs.get("points", []),
-                          columns=["claim", "reading", "point", "state", "detail", "score"])
-    out = []
-    for row in evaluated.itertuples():
-        si, factor = SI_UNITS.get(row.unit, (re.sub(r"[^A-Za-z0-9]+", "_", row.unit), 1.0))
-        suffix = f"_{si}" if si else ""
-
-        def number(value, factor=factor):
-            if isinstance(value, (int, float, np.floating)) and not isinstance(value, bool):
-                return float(value) * factor if math.isfinite(value) else None
-            return None
-
-        paper = number(float(row.paper)) if is_number(str(row.paper)) else None
-        mine = points[points["claim"] == row.claim]
-        out.append({
-            "claim": row.claim, "figure": row.figure, "category": row.status, "basis": row.basis,
-            "verdict": row.verdict, "evidence": [e for e in row.evidence.split(" | ") if e],
-            "reason": row.reason, "depends_on": [d for d in row.depends_on.split(";") if d],
-            "readings": dict(zip(mine["reading"], mine["state"], strict=True)),
-            "points": [{"reading": p, "state": st, "detail": d,
-                        "score": float(sc) if sc is not None and math.isfinite(sc) else None}
-                       for p, st, sc, d in zip(mine["point"], mine["state"], mine["score"], mine["detail"],
-                                               strict=True)],
-            "default_state": row.default_state, "joint_state": row.joint_state,
-            "margin": None if not math.isfinite(row.margin) else float(row.margin),
-            "margin_text": row.margin_text, "fails_at": int(row.fails_at), "decided_at": int(row.decided_at),
-            "fragile": bool(row.fragile), "informative": bool(row.informative),
-            "not_informative": row.not_informative,
-            "fraction_holds": None if not math.isfinite(row.fraction_holds) else float(row.fraction_holds),
-            "best_reading": row.best_reading, "tolerance": row.tolerance, "check": row.check,
-            f"paper{suffix}": paper, f"ours{suffix}": number(row.ours), "ours_text": shown(row.ours),
-            f"abs_deviation{suffix}": number(row.abs_deviation),
-            "rel_deviation": None if not math.isfinite(row.rel_deviation) else float(row.rel_deviation),
-        })
-    return out
-
-
 # ======================================================================================
-# Baseline (regression tests)
+# Baseline (regression tests): passmd.ledger.baseline
 # ======================================================================================
-
-
-def load_baseline(path) -> dict[str, str]:
-    """``{claim id: category}`` from a baseline CSV written by :func:`write_baseline`."""
-    table = pd.read_csv(path, dtype=str, keep_default_na=False, comment="#")
-    return dict(zip(table["claim"], table["status"], strict=True))
-
-
-#: Separator of the readings in a baseline's ``readings`` column.
-READINGS_SEPARATOR = " | "
 
 
 def claim_readings(claim_id: str, modules=None) -> tuple[str, ...]:
     """The readings a claim is evaluated at now, in words (:func:`passmd.ledger.readings.describe`)."""
-    return tuple(readings.describe(r) for r in readings.design(depends_on(claim_id, modules), claim_id))
-
-
-def load_baseline_readings(path) -> dict[str, tuple[str, ...]]:
-    """``{claim id: readings}`` recorded in a baseline CSV (its ``readings`` column).
-
-    Empty when the baseline records no readings: the readings its categories were computed at
-    are then unknown, and no claim of it can be compared reading for reading.
-    """
-    table = pd.read_csv(path, dtype=str, keep_default_na=False, comment="#")
-    if "readings" not in table:
-        return {}
-    return {claim: tuple(text.split(READINGS_SEPARATOR))
-            for claim, text in zip(table["claim"], table["readings"], strict=True)}
-
-
-def write_baseline(evaluated: pd.DataFrame, path, header: str = "") -> None:
-    """Write the claims' categories as a baseline CSV (``claim,status,readings``), atomically.
-
-    ``readings`` lists the readings each category was computed at (:func:`claim_readings`), so
-    that two baselines are compared only where they evaluated the same readings. ``header``
-    (e.g. the command and date that produced it) is written as ``#`` comment lines.
-    """
-    path = Path(path)
-    table = evaluated[["claim", "status"]].copy()
-    table["readings"] = [READINGS_SEPARATOR.join(claim_readings(c)) for c in table["claim"]]
-    tmp = path.with_name(f".{path.name}.tmp")
-    with open(tmp, "w", encoding="utf-8", newline="") as fh:
-        for line in header.splitlines():
-            fh.write(f"# {line}\n")
-        table.to_csv(fh, index=False, lineterminator="\n")
-    tmp.replace(path)
-
-
-def category_changes(evaluated: pd.DataFrame, baseline: Mapping[str, str]) -> pd.DataFrame:
-    """Every claim whose category differs from ``baseline`` (or that appeared or disappeared).
-
-    Columns ``claim``, ``baseline``, ``now`` (``"missing"`` where absent) and ``verdict``.
-    """
-    current = dict(zip(evaluated["claim"], evaluated["status"], strict=True))
-    verdicts = dict(zip(evaluated["claim"], evaluated["verdict"], strict=True))
-    rows = []
-    for claim in list(baseline) + [c for c in current if c not in baseline]:
-        before, now = baseline.get(claim, "missing"), current.get(claim, "missing")
-        if before != now:
-            rows.append({"claim": claim, "baseline": before, "now": now,
-                         "verdict": verdicts.get(claim, "claim no longer in the ledger")})
-    return pd.DataFrame(rows, columns=["claim", "baseline", "now", "verdict"])
-
-
-def check_categories(evaluated: pd.DataFrame, baseline: Mapping[str, str]) -> None:
-    """Raise ``AssertionError`` with a readable diff when any claim changed category."""
-    changed = category_changes(evaluated, baseline)
-    if len(changed):
-        lines = [f"{r.claim}: {r.baseline} -> {r.now} ({r.verdict})" for r in changed.itertuples()]
-        raise AssertionError(f"{len(lines)} claim(s) changed category against the baseline:\n  "
-                             + "\n  ".join(lines))
+    return readings_of(depends_on(claim_id, modules))
 
 
 # ======================================================================================

@@ -1,34 +1,31 @@
 """The assumption space of the ledger: what the paper leaves open, and the readings we evaluate.
 
 The paper leaves some inputs of its claims unstated (the fly-back rule, how the critical
-amplitude was read off the runs, the drive frequency of Section 4, the actuator damping lost
-from Table 2, μ in Sections 4.1 and 5, what Eq. 15 does when t_s does not fit into a period).
-Each is declared here once as an :class:`Axis`: its default (the value the rest of the book
-uses), the values of its plausible range that we evaluate, the whole range in words, and the
-source of that range.
+amplitude was read off the runs, the drive frequency of Section 4.1, the actuator damping lost
+from Table 2, μ in Sections 4.1 and 5, the drive frequency of the force runs, what Eq. 15 does
+when t_s does not fit into a period). Each is declared here once as an :class:`Axis`: its
+default (the value the rest of the book uses), the values of its plausible range that we
+evaluate, the whole range in words, the source of that range, and the result tables whose runs
+it changes (``Axis.tables``).
 
 A *reading* is one point of that space: ``{axis key: value}``. **A reading keeps the claim's
-object**: an axis may change only what the paper left unstated (the fly-back, the damping, the
-drive frequency, μ, how A_c is read off the runs, how t_s is fitted into a short period), never
-the thing a claim is about. A value that would change the object is not a reading: it is listed
-in ``Axis.not_readings`` with the reason and shown as a study in its chapter. Setting t_s = 0
+object**: an axis may change only what the paper left unstated, never the thing a claim is
+about. A value that would change the object is not a reading: it is listed in
+``Axis.not_readings`` with the reason and shown as a study in its chapter. Setting t_s = 0
 wherever the settling time does not fit (``skip``) removes Eq. 15's settling phase from every
 period from 10 kHz up, so that waveform is not Eq. 15 and ``skip`` is no reading of the Eq. 15
 claims; the driving-waveform chapter keeps it as the study "what if the settling is dropped".
 
-The ledger evaluates every claim on the full product of the axes it depends on
-(:func:`design`: the defaults first), minus the axes declared open for it. An extractor
-declares the axes it reads with ``passmd.ledger.checks.extractor(id, depends_on=(...))`` and receives
-the reading as its ``reading`` argument; when the result tables hold no run at that reading it
-raises :class:`passmd.ledger.checks.NotEvaluable`, and that point counts as not covered. A claim that
-does not depend on an axis has the same state at every value of it, so every point of the whole
-space (:func:`space`) has a state for every claim (:func:`project`): that is what the joint
-reading of :mod:`passmd.ledger.evaluation` is chosen from.
-
-Axes declared with no evaluated alternative are listed in the report as open: the ledger cannot
-yet say whether a claim's verdict moves along them. An axis with alternatives can still be open for
-some claims it applies to (``Axis.open_for``, with its reason): their result tables hold no run at
-the alternatives, so they are evaluated at the default only.
+**Declared = computed.** A claim depends on an axis when it reads a result table whose runs the
+axis changes (:func:`applicable`): its extractor must declare exactly those axes
+(``passmd.ledger.checks.extractor(id, depends_on=(...))``), and the ledger evaluates it on the
+full product of their values (:func:`design`, the defaults first). Every table a claim reads
+holds a run at every point of that product; an extractor that finds none raises
+:class:`passmd.ledger.checks.NoRun`, which the ledger treats as a defect, never as "not
+covered". A claim has the same state at every value of an axis it does not depend on, so every
+point of the whole space (:func:`space`) has a state for every claim (:func:`project`): that is
+what the joint reading of :mod:`passmd.ledger.joint` is chosen from. An axis declared with no
+evaluated alternative (``short_period``) is listed in the report as open.
 """
 
 from __future__ import annotations
@@ -41,7 +38,19 @@ import pandas as pd
 
 from passmd.model.defaults import PROTOCOL
 
-__all__ = ["AXES", "Axis", "axis", "default_reading", "design", "describe", "project", "space", "space_table"]
+__all__ = ["AC_TABLES", "AXES", "Axis", "SECTION5_TABLES", "applicable", "axis", "default_reading", "design",
+           "describe", "project", "space", "space_table"]
+
+#: The result tables of the ledger's readings (``passmd.ledger.evaluation.result_sources``): the
+#: critical-amplitude searches of Figs. 5b and 6a–6c, the step against amplitude of Fig. 5a, this
+#: paper's force runs of Fig. 7, and Section 5's runs (Fig. 9a holds both μ itself). Each holds a
+#: run at every point of the axes that change it.
+AC_TABLES = ("fig5b_readings", "fig6a_readings", "fig6b_readings", "fig6c_readings")
+SECTION4_1_TABLES = ("fig5a_readings", *AC_TABLES)
+FORCE_TABLES = ("fig7_readings",)
+SECTION5_TABLES = ("fig8a_readings", "fig8b_readings", "fig8b_window_readings", "fig9a", "fig9a_response",
+                   "fig9b_readings", "fig10a_readings", "fig10b_readings", "fig10c_readings")
+VELOCITY_TABLES = ("fig9b_readings", "fig10a_readings", "fig10b_readings", "fig10c_readings")
 
 
 @dataclass(frozen=True)
@@ -55,9 +64,9 @@ class Axis:
     unit: str  # display unit of the values ('' for words)
     plausible_range: str  # the whole plausible range, in words
     source: str  # where that range comes from
+    tables: tuple = ()  # result keys whose runs the axis changes: a claim reading one depends on it
+    only: tuple = ()  # (claims.csv column, value): only claims whose column lists the value
     assumption_key: str = ""  # the key of the matching passmd.model.tables assumption, if any
-    open_for: tuple = ()  # claim ids the axis applies to but whose result tables lack its alternatives
-    open_reason: str = ""  # why those claims are not evaluated along the axis
     not_readings: tuple = ()  # (value, reason): values that would change a claim's object (studies only)
 
     def values(self) -> tuple:
@@ -66,6 +75,14 @@ class Axis:
     def show(self, value) -> str:
         text = f"{value:g}" if isinstance(value, float) else str(value)
         return f"{text} {self.unit}".strip()
+
+    def applies_to(self, claim: Mapping) -> bool:
+        """Whether a claims.csv row depends on this axis: it reads one of ``tables`` (its
+        ``requires``) and, with ``only``, its column lists the value."""
+        if not set(str(claim["requires"]).split(";")) & set(self.tables):
+            return False
+        column, value = self.only if self.only else (None, None)
+        return column is None or value in str(claim[column]).split(";")
 
 
 #: Every declared axis, in the order the report shows them.
@@ -81,13 +98,11 @@ AXES: dict[str, Axis] = {
             plausible_range="slew-rate limited (150 V/µs over 300 V_pp: 2 µs for the full stroke, less for "
             "smaller amplitudes) or a fixed fly-back of 1–2 µs at every amplitude",
             source="Section 2 states the amplifier's 150 V/µs and 300 V_pp but not the fly-back of the "
-            "simulated saw-tooth; 'fixed' is the full-stroke 2 µs at every amplitude",
+            "simulated saw-tooth; 'fixed' is the full-stroke 2 µs at every amplitude. It changes every run "
+            "below the full stroke, rigid or flexible (Section 4); Section 5 drives at the full stroke, "
+            "where both rules give 2 µs",
+            tables=(*SECTION4_1_TABLES, *FORCE_TABLES),
             assumption_key="flyback_duration",
-            open_for=("sec4-2-other-preloads-same-trend",
-                      "sec4-2-friction-and-actuator-dynamics-cause-discrepancy"),
-            open_reason="the preload grid (fig7grid) and the stall cycle (fig7cycle) of Section 4.2 are "
-            "computed with the slew-rate fly-back only; Figs. 7a and 7b are computed with both "
-            "(fig7flyback), so the claims read from them are evaluated along the axis",
         ),
         Axis(
             key="ac_protocol",
@@ -96,9 +111,10 @@ AXES: dict[str, Axis] = {
             alternatives=("first",),
             unit="",
             plausible_range="steady state of continued operation (last step of a 10-period run) or the "
-            "onset of full sliding in the first fly-back from virgin contacts",
+            "onset of full sliding in the first fly-back from virgin contacts (Fig. 5a: the first step)",
             source="Section 1 defines A_c by 'no measurable step'; Section 4.1 compares it with "
             "quasi-static onsets (Eqs. 7–12) without saying how it was read off the runs",
+            tables=SECTION4_1_TABLES,
             assumption_key="critical_amplitude_protocol",
         ),
         Axis(
@@ -109,6 +125,7 @@ AXES: dict[str, Axis] = {
             unit="Hz",
             plausible_range="a band around 100 Hz (50–200 Hz)",
             source="Section 4.1 does not state it; 100 Hz is Section 5.2's saw-tooth frequency (Fig. 9a)",
+            tables=SECTION4_1_TABLES,
             assumption_key="critical_amplitude_protocol",
         ),
         Axis(
@@ -120,6 +137,8 @@ AXES: dict[str, Axis] = {
             plausible_range="cut the settling time t_s to the time left in the period (t_s > 0 keeps "
             "Eq. 15's settling phase)",
             source="Section 5.2 says only that above 110 kHz there is 'not enough time for settling'",
+            tables=VELOCITY_TABLES,
+            only=("waveform", "optimized"),
             assumption_key="optimized_short_period",
             not_readings=(("skip", "t_s = 0 wherever the settling time does not fit removes Eq. 15's "
                            "settling phase from 10 kHz up: the waveform is no longer Eq. 15, so it is the "
@@ -132,18 +151,11 @@ AXES: dict[str, Axis] = {
             alternatives=(0.005, 0.5),  # the ends of the plausible range
             unit="",
             plausible_range="0.005–0.5 (a decade either side of a lightly damped piezo stack, Q = 10)",
-            source="Table 2's viscosity column c_p is lost in the available text",
+            source="Table 2's viscosity column c_p is lost in the available text; it changes every run of "
+            "flexible actuators",
+            tables=(*SECTION4_1_TABLES, *FORCE_TABLES),
+            only=("actuator_model", "flexible"),
             assumption_key="actuator_viscosity",
-            open_for=("fig5a-no-step-below-50nm", "fig7a-force-difference-115mn",
-                      "fig7a-discrepancy-grows-with-amplitude", "fig7b-discrepancy-grows-with-amplitude",
-                      "fig7-critical-amplitude-both-models",
-                      "sec4-2-friction-and-actuator-dynamics-cause-discrepancy",
-                      "sec4-2-other-preloads-same-trend", "fig7-rigid-mu03-flexible-mu02-onsets-agree",
-                      "fig7-force-grows-with-amplitude-above-onset", "fig7-force-grows-with-preload",
-                      "fig7-flexible-covers-experiment", "abstract-agreement-with-experiment",
-                      "fig6b-experiment-agreement"),
-            open_reason="Fig. 5a's amplitude grid and the Section 4.2 force runs are computed at the "
-            "default ζ only; the A_c searches of Figs. 5b, 6b and 6c run at both ends of the range",
         ),
         Axis(
             key="force_frequency",
@@ -153,6 +165,7 @@ AXES: dict[str, Axis] = {
             unit="Hz",
             plausible_range="90 Hz – 1.1 kHz",
             source="Section 4.2 does not state the saw-tooth frequency of the force runs",
+            tables=FORCE_TABLES,
             assumption_key="force_frequency",
         ),
         Axis(
@@ -162,36 +175,18 @@ AXES: dict[str, Axis] = {
             alternatives=(0.3,),  # the value Section 4.2 says [12] used
             unit="",
             plausible_range="0.2–0.3 (Section 4.2's measured 0.2 and the earlier model's 0.3)",
-            source="Sections 4.1 and 5 do not state μ; Section 4.2 uses 0.2 (Lübke [24]) and 0.3 ([12])",
-            open_for=("fig5a-no-step-below-50nm", "fig5b-rigid-ac-matches-eq7",
-                      "fig5b-flexible-ac-matches-eq8", "fig5b-flexible-above-rigid",
-                      "fig6a-rigid-ac-matches-eq11", "fig6a-rigid-ac-not-eq10",
-                      "fig6b-flexible-r1-ac-matches-eq12", "fig6c-flexible-r025-ac-matches-eq12",
-                      "fig8a-back-step", "sec5-response-to-optimized-similar",
-                      "fig9b-optimized-faster-below-110khz", "fig9b-max-gain-2.5mm_s",
-                      "fig9b-optimized-decreases-above-110khz", "fig9b-standard-increases-above-110khz",
-                      "fig9b-step-decreases-with-frequency", "fig9b-no-time-to-settle-above-110khz",
-                      "abstract-velocity-gain-15pct", "fig10a-max-velocity-19mm_s",
-                      "fig10a-max-velocity-at-110khz", "fig10a-1n-slower", "fig10a-1n-larger-back-step",
-                      "fig10a-0.1n-smaller-back-step", "fig10a-0.1n-stick-lost-above-80khz",
-                      "fig10a-0.1n-slightly-slower", "fig10b-r1-faster", "fig10b-r1-higher-max-frequency",
-                      "fig10b-r1-smaller-back-step", "fig10c-youngs-modulus-negligible",
-                      "conclusion-youngs-modulus-weaker-than-preload-and-radius",
-                      "fig9b-sawtooth-velocity-16.5mm_s-at-110khz",
-                      "fig10a-0.1n-maximum-at-or-below-80khz",
-                      "sec5-1-acceleration-starts-at-velocity-maximum",
-                      "sec5-1-stick-during-acceleration", "sec5-1-spring-deformed-to-ux-max-after-flyback",
-                      "sec5-1-fastest-at-end-of-acceleration", "sec5-1-runner-overshoots-in-slip",
-                      "fig8a-micro-vibration-damped-within-next-stick", "fig6b-flexible-r1-ac-not-eq13",
-                      "fig6c-flexible-r025-ac-not-eq13", "sec4-1-interaction-changes-ac",
-                      "fig6b-experiment-agreement"),
-            open_reason="Section 4.1's closed forms (Eqs. 7–14) are committed as reference curves at "
-            "μ = 0.2 only; the Fig. 8 traces and the resolved fly-back window are computed at μ = 0.2 "
-            "only (not extended yet); the frequency sweeps of Figs. 9b and 10 would double in cost. "
-            "Only the Fig. 9a runs are repeated at μ = 0.3",
+            source="Sections 4.1 and 5 do not state μ; Section 4.2 uses 0.2 (Lübke [24]) and 0.3 ([12]). The "
+            "closed forms of Eqs. 7–14 are evaluated at the same μ as the runs they are compared with",
+            tables=(*SECTION4_1_TABLES, *SECTION5_TABLES),
         ),
     )
 }
+
+
+def applicable(claim: Mapping) -> tuple[str, ...]:
+    """The axes a claims.csv row depends on (:meth:`Axis.applies_to`), in the order of :data:`AXES`:
+    its extractor must declare exactly these."""
+    return tuple(key for key, a in AXES.items() if a.applies_to(claim))
 
 
 def axis(key: str) -> Axis:
@@ -206,16 +201,17 @@ def default_reading() -> dict:
     return {key: a.default for key, a in AXES.items()}
 
 
-def design(depends_on: Iterable[str], claim_id: str | None = None) -> list[dict]:
+def design(depends_on: Iterable[str]) -> list[dict]:
     """The readings a claim depending on ``depends_on`` is evaluated at.
 
     The full product of the values (default and evaluated alternatives) of every axis in
-    ``depends_on``, except the axes declared open for ``claim_id`` (``Axis.open_for``), every
-    other axis at its default; the defaults first. Each reading is a full ``{axis key: value}``
-    dict.
+    ``depends_on``, every other axis at its default; the defaults first. Each reading is a full
+    ``{axis key: value}`` dict.
     """
     base = default_reading()
-    keys = [k for k in dict.fromkeys(depends_on) if claim_id is None or claim_id not in axis(k).open_for]
+    keys = list(dict.fromkeys(depends_on))
+    for key in keys:
+        axis(key)
     return [{**base, **dict(zip(keys, values, strict=True))}
             for values in itertools.product(*(axis(k).values() for k in keys))]
 
@@ -241,14 +237,13 @@ def describe(reading: Mapping, *, only_changed: bool = True) -> str:
 
 
 def space_table() -> pd.DataFrame:
-    """Every declared axis: default, evaluated alternatives, plausible range, its source, and the
-    claims it applies to that are not evaluated along it (``open for``, with the reason)."""
+    """Every declared axis: default, evaluated alternatives, plausible range, its source, the result
+    tables whose runs it changes, and the values that are not readings (with the reason)."""
     return pd.DataFrame([
         {"assumption": a.label, "key": a.key, "default": a.show(a.default),
-         "evaluated alternatives": ", ".join(a.show(v) for v in a.alternatives) or "none yet",
+         "evaluated alternatives": ", ".join(a.show(v) for v in a.alternatives) or "none (open)",
          "plausible range": a.plausible_range, "source": a.source,
-         "open for": (f"{len(a.open_for)} claims ({', '.join(a.open_for)}): {a.open_reason}"
-                      if a.open_for else ""),
+         "changes": ", ".join(a.tables) + (f" ({a.only[0]} {a.only[1]} only)" if a.only else ""),
          "not a reading": "; ".join(f"{a.show(v)}: {why}" for v, why in a.not_readings)}
         for a in AXES.values()
     ])

@@ -26,8 +26,11 @@ Two critical amplitudes, both found by bisection on the amplitude
 Search: bisection on the reproducible bracket [0, A_max] (A_max: the actuator's full
 stroke, Table 2). A = 0 makes no step and no slip, so only A_max is simulated to open the
 bracket; it halves until narrower than the tolerance, and reports the final bracket, its
-midpoint as A_c and the number of runs. Grids, figures and claims of Section 4.1 are in
-:mod:`passmd.experiments.critical_amplitude.figures`.
+midpoint as A_c and the number of runs. The steady-state search finds bisection's final
+bracket with fewer runs (:func:`search_amplitude`): above A_c the last step grows about 1 nm
+per nm of amplitude, so its linear extrapolation tells which of bisection's decisions need a
+run; whenever the step switches once on [0, A_max] the bracket is bisection's to the last bit.
+Grids, figures and claims of Section 4.1 are in :mod:`passmd.experiments.critical_amplitude.figures`.
 """
 
 from __future__ import annotations
@@ -52,6 +55,7 @@ __all__ = [
     "bisect_amplitude",
     "critical_amplitude",
     "first_flyback_slip",
+    "search_amplitude",
     "steady_step",
 ]
 
@@ -252,6 +256,101 @@ def bisect_amplitude(moves, upper: float, tolerance: float) -> dict:
     return {"critical_amplitude_m": 0.5 * (lo + hi), "bracket_low_m": lo, "bracket_high_m": hi, "runs": runs}
 
 
+def _bisection_cell(known: dict, upper: float, tolerance: float, guess: float):
+    """Bisection's final bracket on [0, upper], its decisions taken from ``known`` (evaluated
+    amplitudes), from monotonicity where an evaluated amplitude implies them, else predicted by
+    ``guess`` (the estimated switch). Returns ``(lo, hi, predicted)``: the final bracket with the
+    float values bisection computes, and the amplitudes whose decision was only predicted."""
+    resting = max((a for a, moved in known.items() if not moved), default=0.0)
+    moving = min((a for a, moved in known.items() if moved), default=upper)
+    lo, hi, predicted = 0.0, upper, []
+    while hi - lo > tolerance:
+        mid = 0.5 * (lo + hi)
+        if mid in known:
+            moved = known[mid]
+        elif mid <= resting or mid >= moving:
+            moved = mid >= moving
+        else:
+            moved = mid >= guess
+            predicted.append(mid)
+        lo, hi = (lo, mid) if moved else (mid, hi)
+    return lo, hi, predicted
+
+
+def _estimate_switch(measured: dict, lo: float, hi: float, slope: float | None) -> float:
+    """Where the measure crosses 0, from the two evaluated amplitudes nearest the bracket (lo, hi)
+    on the side where it is informative, or from one and the prior ``slope``; the midpoint when
+    neither gives a point strictly inside the bracket."""
+    sides = (sorted(a for a in measured if a >= hi), sorted((a for a in measured if a <= lo), reverse=True))
+    for near in sides:
+        points = [(a, measured[a]) for a in near if measured[a] is not None and math.isfinite(measured[a])]
+        if len(points) >= 2 and points[0][1] != points[-1][1]:  # the nearest and the farthest: a robust slope
+            (a0, m0), (a1, m1) = points[0], points[-1]
+            guess = a0 - m0 * (a1 - a0) / (m1 - m0)
+        elif len(points) == 1 and slope is not None and near is sides[0]:
+            guess = points[0][0] - points[0][1] / slope
+        else:
+            continue
+        if lo < guess < hi:
+            return guess
+    return 0.5 * (lo + hi)
+
+
+def search_amplitude(probe, upper: float, tolerance: float, *, slope: float | None = None) -> dict:
+    """The final bracket of :func:`bisect_amplitude`, found with fewer runs where the switch is single.
+
+    ``probe(A)`` returns ``(moves, measure)``: whether the drive moves at A, and a number that
+    crosses 0 near the switch, roughly linearly in A (e.g. the last step minus the measurable
+    step, positive above the switch; None where it says nothing). The search walks bisection's
+    path on [0, upper] and evaluates only the amplitudes whose decision it cannot infer: those
+    between the largest amplitude that rests and the smallest that moves, choosing them where the
+    measure's linear extrapolation (from two evaluated amplitudes on one side of the switch, or
+    one and the prior ``slope``) puts the switch. Whenever ``moves`` switches once on [0, upper]
+    (monotone in A) every decision of bisection's path is then the one bisection takes, so the
+    bracket, and the critical amplitude, are bisection's to the last bit; where it switches more
+    than once the result is one of the switches, with the same guarantee (rests at the bracket's
+    low end, moves at its high end, width ≤ ``tolerance``). ``runs`` counts the evaluations:
+    typically 4–6 instead of bisection's 1 + log2(upper/tolerance).
+    """
+    lo, hi = 0.0, check_positive("upper", upper, "m")
+    check_positive("tolerance", tolerance, "m")
+    floor = BISECTION_FLOOR_SPACINGS * float(np.spacing(hi))
+    if tolerance < floor:
+        raise ValueError(
+            f"tolerance (--tolerance) = {tolerance!r} m is out of range: must be >= {floor:.3g} m, "
+            f"{BISECTION_FLOOR_SPACINGS} float spacings of the amplitude {hi!r} m (a narrower bracket "
+            "cannot be represented)"
+        )
+    known, measured = {}, {}
+
+    def evaluate(amplitude):
+        known[amplitude], measured[amplitude] = probe(amplitude)
+
+    evaluate(upper)
+    if not known[upper]:
+        return {"critical_amplitude_m": math.nan, "bracket_low_m": upper, "bracket_high_m": math.nan,
+                "runs": 1}
+    known[0.0], measured[0.0] = False, None  # A = 0: no drive, no motion (never simulated)
+    widths = []
+    while True:
+        resting = max(a for a, moved in known.items() if not moved)
+        moving = min(a for a, moved in known.items() if moved)
+        widths.append(moving - resting)
+        if len(widths) > 2 and widths[-1] > 0.5 * widths[-3]:  # extrapolation stalls: halve instead
+            guess = 0.5 * (resting + moving)
+        else:
+            guess = _estimate_switch(measured, resting, moving, slope)
+        lo, hi, predicted = _bisection_cell(known, upper, tolerance, guess)
+        if not predicted:
+            return {"critical_amplitude_m": 0.5 * (lo + hi), "bracket_low_m": lo, "bracket_high_m": hi,
+                    "runs": len(known) - 1}
+        # the predicted ends of the final bracket settle every decision: first the end on the side
+        # where the measure is informative (if the prediction is wrong, it improves the estimate)
+        informative_moving = any(known[a] and measured[a] is not None for a in known)
+        ends = [a for a in ((hi, lo) if informative_moving else (lo, hi)) if a in predicted]
+        evaluate(ends[0])
+
+
 def critical_amplitude(
     drive: Drive,
     *,
@@ -307,21 +406,25 @@ def critical_amplitude(
     upper = drive.actuator.full_stroke_amplitude
     bar = _bisection_bar(upper, tolerance, progress)
 
-    def moves(amplitude):
-        if protocol == "steady":
+    def probe(amplitude):
+        if protocol == "steady":  # the last step grows about 1 nm per nm of amplitude above A_c
             out = steady_step(drive, amplitude, frequency, periods=int(periods), flyback=flyback)
             wall[0] += out["wall_time_s"]
             moved = out["last_step_m"] > threshold
-        else:
+            measure = out["last_step_m"] - threshold if moved else None
+        else:  # a run is short: plain bisection (the slip ratio's approach to 1 guides no better)
             out = first_flyback_slip(drive, amplitude, frequency, flyback=flyback)
             wall[0] += out["wall_time_s"]
-            moved = out["full_sliding"]
+            moved, measure = out["full_sliding"], None
         if bar is not None:
             bar.update(1)
-        return moved
+        return moved, measure
 
     try:
-        found = bisect_amplitude(moves, upper, tolerance)
+        if protocol == "steady":
+            found = search_amplitude(probe, upper, tolerance, slope=1.0)
+        else:
+            found = bisect_amplitude(lambda amplitude: probe(amplitude)[0], upper, tolerance)
     finally:
         if bar is not None:
             bar.close()

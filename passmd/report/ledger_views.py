@@ -15,12 +15,15 @@ import pandas as pd
 
 from passmd.ledger.checks import format_number
 from passmd.ledger.claims import STATUSES, tolerance_text
-from passmd.ledger.evaluation import assumption_map
+from passmd.ledger.evaluation import assumption_map, counted
+from passmd.ledger.rules import FRAGILE_MARGIN
+from passmd.ledger.verdicts import EXPERIMENT_BASIS
 from passmd.report.assumptions import all_assumptions
 from passmd.runtime.validation import check_choice
 
 __all__ = [
     "STATUS_COLOURS",
+    "STUDIES_ANCHOR",
     "assumption_map_styled",
     "assumptions_table",
     "category_anchor",
@@ -29,22 +32,73 @@ __all__ = [
     "headline_markdown",
     "sources_markdown",
     "styled",
+    "joint_sentences",
     "summary",
+    "tension_sentences",
 ]
 
 
 def summary(evaluated: pd.DataFrame) -> str:
     """One line such as ``"11 of 40 claims reproduced (1 a closed-form identity); 3 inconclusive"``.
 
-    Closed-form identities are counted apart: they are not simulation results.
+    Counts the claims of the paper only (studies are shown, never counted, :mod:`passmd.ledger.rules`);
+    closed-form identities are counted apart: they are not simulation results.
     """
-    counts = evaluated["status"].value_counts()
-    closed = int(((evaluated["status"] == "reproduced") & (evaluated["basis"] == "closed form")).sum())
-    text = f"{int(counts.get('reproduced', 0))} of {len(evaluated)} claims reproduced"
+    claims = counted(evaluated)
+    counts = claims["status"].value_counts()
+    closed = int(((claims["status"] == "reproduced") & (claims["basis"] == "closed form")).sum())
+    text = f"{int(counts.get('reproduced', 0))} of {len(claims)} claims reproduced"
     if closed:
         text += f" ({closed} of them a closed-form identity, not a simulation)"
     others = [f"{int(counts[s])} {s}" for s in STATUSES[1:] if counts.get(s, 0)]
-    return text + ("; " + ", ".join(others) if others else "")
+    studies = len(evaluated) - len(claims)
+    return (text + ("; " + ", ".join(others) if others else "")
+            + (f" ({studies} {'study' if studies == 1 else 'studies'} shown, not counted)"
+               if studies else ""))
+
+
+def joint_sentences(joint: Mapping) -> list[str]:
+    """The joint reading in sentences: where it is, how many claims hold there, the points it was
+    chosen from and stands for, its ties, its runner-ups with their margins, and how it changes when
+    rows are left out. The replication report and ``passmd ledger`` print these same sentences."""
+    lines = [
+        f"Joint reading: {joint['described']}, where {joint['holding']} of {joint['claims']} claims hold "
+        "together.",
+        f"It was chosen from {joint['chosen_from']} of the {joint['points']} points of the declared "
+        f"assumption space ({joint['covered_points']} covered: every claim resting on computed evidence "
+        f"evaluated there from its runs; {joint['decided_points']} decided: every such claim holds or fails "
+        f"there); {joint['equivalent_points']} of them give every claim the same state as it does.",
+        ("Tied with it: " + "; ".join(f"{t['described']} ({t['holding']})" for t in joint["ties"]) + "."
+         if joint["ties"] else "No other reading ties with it."),
+        ("Runner-ups: " + "; ".join(f"{r['described']} ({r['holding']} hold, {r['margin']} fewer)"
+                                    for r in joint["runner_ups"]) + "."
+         if joint["runner_ups"] else "No runner-up: every other reading holds as many claims."),
+    ]
+    for variant in joint.get("variants", []):
+        same = variant["reading"] == joint["reading"]
+        changed = len(variant["claims_left_out"]) or len(variant.get("claims_added", []))
+        lines.append(f"With the {variant['left_out']} ({changed}): "
+                     + ("the same reading" if same else variant["described"])
+                     + f", {variant['holding']} of {variant['claims']} holding.")
+    return lines
+
+
+def tension_sentences(evaluated: pd.DataFrame) -> list[str]:
+    """One sentence per tension (:func:`passmd.ledger.joint.tensions`): the readings that separate its
+    claims and where each side holds, near-duplicate rows linked with '='."""
+    out = []
+    for tension in evaluated.attrs.get("tensions", []):
+        sides = []
+        for side in tension["sides"]:
+            linked = {c for group in side["linked"] for c in group}
+            names = ([" = ".join(group) for group in side["linked"]]
+                     + [c for c in side["claims"] if c not in linked])
+            sides.append(f"{', '.join(names)} hold{'s' if len(names) == 1 and ' = ' not in names[0] else ''} "
+                         f"only at {side['holds_only_at']}")
+        how = "Separated jointly by" if tension.get("jointly") else "Separated by"
+        out.append(f"{how} {' and '.join(tension['separated_by'])} ({tension['pairs']} pair"
+                   f"{'s' if tension['pairs'] != 1 else ''}): " + "; ".join(sides) + ".")
+    return out
 
 
 def category_anchor(status: str) -> str:
@@ -58,30 +112,42 @@ def claim_anchor(claim_id: str) -> str:
     return "claim-" + re.sub(r"[^a-z0-9-]", "-", claim_id)
 
 
+#: The anchor of the studies in the replication report.
+STUDIES_ANCHOR = "ledger-studies"
+
+
 def headline_markdown(evaluated: pd.DataFrame, page: str = "replication_report", *, ref: bool = False) -> str:
-    """The per-category counts as MyST markdown, each linking to that category's claims.
+    """The per-category counts of the claims of the paper as MyST markdown, each linking to that
+    category's claims, with the fragile, not-informative and experiment rows and the studies.
 
     Links go to the targets :func:`details_markdown` writes: ``{ref}`` roles when ``ref`` is
     true (the book), markdown links to ``page.md#anchor`` otherwise.
     """
-    counts = evaluated["status"].value_counts()
+
+    def link(label, anchor):
+        return f"{{ref}}`{label} <{anchor}>`" if ref else f"[{label}]({page}.md#{anchor})"
+
+    claims = counted(evaluated)
+    counts = claims["status"].value_counts()
     parts = []
     for status in STATUSES:
         n = int(counts.get(status, 0))
-        label = f"{n} {status}"
-        if n and ref:
-            label = f"{{ref}}`{label} <{category_anchor(status)}>`"
-        elif n:
-            label = f"[{label}]({page}.md#{category_anchor(status)})"
-        parts.append(label)
-    closed = int(((evaluated["status"] == "reproduced") & (evaluated["basis"] == "closed form")).sum())
+        parts.append(link(f"{n} {status}", category_anchor(status)) if n else f"{n} {status}")
+    closed = int(((claims["status"] == "reproduced") & (claims["basis"] == "closed form")).sum())
     note = f" ({closed} of the reproduced a closed-form identity, not a simulation)" if closed else ""
-    flags = (f"; {int(evaluated['fragile'].astype(bool).sum())} fragile (hold at the defaults but fail at "
-             f"the joint reading or at most of their readings), "
-             f"{int((~evaluated['informative'].astype(bool)).sum())} not informative "
-             "(their check cannot fail)"
-             if "fragile" in evaluated else "")
-    return f"{len(evaluated)} claims: " + ", ".join(parts) + note + flags
+    flags = ""
+    if "fragile" in claims:
+        experiment = int((claims["basis"] == EXPERIMENT_BASIS).sum())
+        flags = (f"; {int(claims['fragile'].astype(bool).sum())} fragile (the verdict flips at a runner-up "
+                 "reading "
+                 f"or its margin is within {FRAGILE_MARGIN:.0%} of its tolerance), "
+                 f"{int((~claims['informative'].astype(bool)).sum())} not informative (their check cannot "
+                 "fail), "
+                 f"{experiment} about the experiment (no measured data in the text)")
+    studies = len(evaluated) - len(claims)
+    if studies:
+        flags += "; " + link(f"{studies} studies", STUDIES_ANCHOR) + " shown, not counted"
+    return f"{len(claims)} claims: " + ", ".join(parts) + note + flags
 
 
 #: Background colours of the categories in :func:`styled`.
@@ -109,8 +175,12 @@ def styled(evaluated: pd.DataFrame, *, links: bool = False):
         shown["margin"] = evaluated["margin_text"].to_numpy()
         shown["fails at"] = [f"{int(f)} of {int(d)}" if d else "—"
                              for f, d in zip(evaluated["fails_at"], evaluated["decided_at"], strict=True)]
-        shown["flags"] = [", ".join(([("fragile")] if fr else []) + ([] if inf else ["not informative"]))
-                          for fr, inf in zip(evaluated["fragile"], evaluated["informative"], strict=True)]
+        shown["flags"] = [", ".join((["fragile"] if fr else []) + ([] if inf else ["not informative"])
+                                    + (["Eq. 15 undefined"] if out else [])
+                                    + ([f"study of {of}"] if of else []))
+                          for fr, inf, out, of in zip(evaluated["fragile"], evaluated["informative"],
+                                                      evaluated["outside"], evaluated["study_of"],
+                                                      strict=True)]
     if links:
         shown["claim"] = [f'<a href="#{claim_anchor(c)}">{c}</a>' for c in evaluated["claim"]]
     shown["status"] = [s + (" (closed form)" if b == "closed form" else "")
@@ -133,48 +203,63 @@ def styled(evaluated: pd.DataFrame, *, links: bool = False):
     )
 
 
+def _details_block(row, claim, heading: str) -> str:
+    """One claim's (or study's) collapsed block: quote, verdict, flags, evidence, reason, configuration."""
+    section, check = _section_text(claim), _check_text(claim)
+    basis = " (closed form)" if row.basis == "closed form" else ""
+    lines = [f"({claim_anchor(row.claim)})=",
+             "```{admonition} " + f"{_md_escape(row.claim)}: {heading}{basis}",
+             ":class: dropdown",
+             ""]
+    if claim["source_quote"]:
+        lines += [f"*Paper* ({_md_escape(section)}): “{_md_escape(claim['source_quote'])}”", ""]
+    else:
+        lines += [f"*Study* (not a sentence of the paper, not counted) of {_md_escape(row.study_of)} "
+                  f"({_md_escape(section)}).", ""]
+    lines += [f"*Verdict (computed):* {_md_escape(row.verdict)}.", ""]
+    if row.basis == "closed form":
+        lines += ["*Basis:* a closed-form identity, not a simulation result.", ""]
+    if row.fragile:
+        lines += [f"*Fragile:* {_md_escape(row.fragile_reason)}.", ""]
+    if not row.informative:
+        lines += [f"*Not informative:* {_md_escape(row.not_informative)}.", ""]
+    if row.evidence:
+        lines += ["*Evidence (computed):*", ""]
+        lines += [f"- {_md_escape(item)}" for item in row.evidence.split(" | ")]
+        lines.append("")
+    if row.depends_on:
+        lines += [f"*Readings:* holds at {row.holds_at} of {row.readings}; best: "
+                  f"{_md_escape(row.best_reading)}.", ""]
+    if row.reason and row.status != "reproduced":
+        lines += [f"*Reason (our reading of the evidence):* {_md_escape(row.reason)}", ""]
+    lines += [f"*Configuration:* {_md_escape(_config_text(claim))}. "
+              f"*Ours:* {_md_escape(claim['ours_definition'])}. "
+              f"*Check:* {_md_escape(check)}. {_md_escape(claim['tolerance_reason'])}"]
+    if claim["notes"]:
+        lines += ["", f"*Notes:* {_md_escape(claim['notes'])}"]
+    lines.append("```")
+    return "\n".join(lines) + "\n"
+
+
 def details_markdown(evaluated: pd.DataFrame, claims: pd.DataFrame) -> str:
     """Per claim, a collapsed block with an anchor: verdict, quote, evidence, reason and source.
 
-    Claims are grouped by category; each group starts with the target of
-    :func:`category_anchor` (so the intro's headline can link to it) and each claim with the
-    target of :func:`claim_anchor` (the ledger table links to it). The blocks are dropdown
-    admonitions: closed until the reader opens them.
+    Claims are grouped by category, the studies after them (shown, not counted); each group starts
+    with the target of :func:`category_anchor` (or :data:`STUDIES_ANCHOR`, so the intro's headline
+    can link to it) and each row with the target of :func:`claim_anchor` (the ledger table links to
+    it). The blocks are dropdown admonitions: closed until the reader opens them.
     """
     by_id = claims.set_index("id")
     blocks = []
+    claims_of_paper, studies = counted(evaluated), evaluated[evaluated["study_of"] != ""]
     for status in STATUSES:
-        rows = evaluated[evaluated["status"] == status]
+        rows = claims_of_paper[claims_of_paper["status"] == status]
         blocks.append(f"({category_anchor(status)})=\n**{status.capitalize()}: {len(rows)}**\n")
-        for row in rows.itertuples():
-            claim = by_id.loc[row.claim]
-            section, check = _section_text(claim), _check_text(claim)
-            basis = " (closed form)" if row.basis == "closed form" else ""
-            lines = [f"({claim_anchor(row.claim)})=",
-                     "```{admonition} " + f"{_md_escape(row.claim)}: {status}{basis}",
-                     ":class: dropdown",
-                     "",
-                     f"*Paper* ({_md_escape(section)}): “{_md_escape(claim['source_quote'])}”", "",
-                     f"*Verdict (computed):* {_md_escape(row.verdict)}.", ""]
-            if row.basis == "closed form":
-                lines += ["*Basis:* a closed-form identity, not a simulation result.", ""]
-            if row.evidence:
-                lines.append("*Evidence (computed):*")
-                lines.append("")
-                lines += [f"- {_md_escape(item)}" for item in row.evidence.split(" | ")]
-                lines.append("")
-            if row.depends_on:
-                lines += [f"*Readings:* holds at {row.holds_at} of {row.readings}; best: "
-                          f"{_md_escape(row.best_reading)}.", ""]
-            if row.reason and status != "reproduced":
-                lines += [f"*Reason (our reading of the evidence):* {_md_escape(row.reason)}", ""]
-            lines += [f"*Configuration:* {_md_escape(_config_text(claim))}. "
-                      f"*Ours:* {_md_escape(claim['ours_definition'])}. "
-                      f"*Check:* {_md_escape(check)}. {_md_escape(claim['tolerance_reason'])}"]
-            if claim["notes"]:
-                lines += ["", f"*Notes:* {_md_escape(claim['notes'])}"]
-            lines.append("```")
-            blocks.append("\n".join(lines) + "\n")
+        blocks.extend(_details_block(row, by_id.loc[row.claim], status) for row in rows.itertuples())
+    if len(studies):
+        blocks.append(f"({STUDIES_ANCHOR})=\n**Studies (not counted): {len(studies)}**\n")
+        blocks.extend(_details_block(row, by_id.loc[row.claim], f"study, {row.status}")
+                      for row in studies.itertuples())
     return "\n".join(blocks)
 
 

@@ -21,17 +21,22 @@ _EPILOG = textwrap.dedent(f"""\
     {describe_default_cache_dir()}; the book built with nox uses ./{DEFAULT_CACHE_DIR}/
     of the repository) every figure's results at --profile and evaluates every claim of
     passmd/data/reference/claims.csv on the product of the readings of passmd.ledger.readings it
-    depends on; each category comes from the defaults and the joint reading (the point of the
-    assumption space where the most claims hold together).
+    depends on; each category comes from the defaults and the joint reading (the covered point of
+    the assumption space where the most claims hold together). Studies (rows that are not
+    sentences of the paper) are shown and never counted.
 
-    --json keys: profile, summary, counts{{category: n, fragile, not informative}},
-    joint_reading{{reading, described, holding, equivalent_points, claims, ties[], runner_ups[],
-    points}}, conflicting_pairs[{{claims, first_holds_at, second_holds_at, example}}],
-    claims[{{claim, category, basis, verdict, evidence[], reason, depends_on[],
-    readings{{reading: state}}, points[{{reading, state, score, detail}}], default_state,
-    joint_state, margin, margin_text, fails_at, decided_at, fragile, informative,
-    not_informative, fraction_holds, best_reading, tolerance, check, paper_<SI unit>,
-    ours_<SI unit>, ours_text, abs_deviation_<SI unit>, rel_deviation (fraction)}}]""")
+    --json keys: profile, summary, counts{{category: n, fragile, not informative, about the
+    experiment, studies}}, joint_reading{{reading, described, holding, equivalent_points, claims,
+    points, covered_points, decided_points, chosen_from, ties[], runner_ups[{{reading, described, holding,
+    equivalent_points, margin}}], variants[{{left_out, claims_left_out[], claims_added[], reading,
+    described, holding, claims}}]}}, conflicting_pairs[{{claims, first_holds_at, second_holds_at, example}}],
+    tensions[{{separated_by[], sides[{{holds_only_at, claims[], linked[]}}], pairs}}],
+    claims[{{claim, figure, category, basis, study_of, verdict, evidence[], reason, depends_on[],
+    readings{{reading: state}}, points[{{reading, state, score, detail, outside}}], default_state,
+    joint_state, margin, margin_text, fails_at, decided_at, fragile, fragile_reason, outside,
+    informative, not_informative, fraction_holds, best_reading, tolerance, check,
+    paper_<SI unit>, ours_<SI unit>, ours_text, abs_deviation_<SI unit>, rel_deviation
+    (fraction)}}]""")
 
 
 def add_parser(command) -> None:
@@ -90,18 +95,22 @@ def run_ledger(args, out) -> int:
     if args.json:
         emit_json({"command": "ledger", "profile": args.profile, "summary": ledger_views.summary(evaluated),
                    "counts": counts, "joint_reading": ledger.joint_record(joint),
-                   "conflicting_pairs": evaluated.attrs["conflicts"],
+                   "conflicting_pairs": evaluated.attrs["conflicts"], "tensions": evaluated.attrs["tensions"],
                    "claims": ledger.records(evaluated)}, out)
         return 0
     out.write(f"passmd ledger — profile {args.profile}: {ledger_views.summary(evaluated)}\n")
-    out.write(f"joint reading: {joint['described']} ({joint['holding']} of {joint['claims']} claims hold; "
-              f"{len(joint['ties'])} tied points)\n")
+    for line in ledger_views.joint_sentences(joint):
+        out.write(line + "\n")
     out.write("counts: " + ", ".join(f"{n} {s}" for s, n in counts.items()) + "\n")
-    for pair in evaluated.attrs["conflicts"]:
-        out.write(f"conflict: {pair['claims'][0]} / {pair['claims'][1]}\n")
+    out.write(f"{len(evaluated.attrs['conflicts'])} pairs of claims never hold together, in "
+              f"{len(evaluated.attrs['tensions'])} tensions:\n")
+    for line in ledger_views.tension_sentences(evaluated):
+        out.write(f"  {line}\n")
     for row in evaluated.itertuples():
         basis = " (closed form)" if row.basis == "closed form" else ""
-        out.write(f"\n{row.claim}: {row.status}{basis}\n  {row.verdict}\n")
+        study = f" (study of {row.study_of}, not counted)" if row.study_of else ""
+        fragile = f"\n  fragile: {row.fragile_reason}" if row.fragile else ""
+        out.write(f"\n{row.claim}: {row.status}{basis}{study}\n  {row.verdict}{fragile}\n")
         for item in (e for e in row.evidence.split(" | ") if e):
             out.write(f"  - {item}\n")
     return 0

@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from passmd.ledger import readings, reference
-from passmd.ledger.checks import ClaimFails, NotEvaluable
+from passmd.ledger.checks import ClaimFails, NoRun
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
 from passmd.model.tables import ACTUATOR_DAMPING_RATIO, PRELOAD_GRIDS, actuator_for_radius
@@ -37,8 +37,15 @@ from passmd.protocols.critical_amplitude import (
 from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
 
+#: μ of Section 4.1 (not stated there): the default of the ledger's axis ``friction_coefficient``.
+SECTION4_1_FRICTION = float(readings.axis("friction_coefficient").default)
+
 __all__ = [
+    "AC_PANELS",
     "FIG5A_DRIVE",
+    "SECTION4_1_FRICTION",
+    "ac_readings",
+    "fig5a_readings",
     "PROFILE_SETTINGS",
     "critical_amplitude_point",
     "fig56_frequency",
@@ -59,11 +66,14 @@ def paper_drive_for(
     hemisphere_radius: float,
     preload: float,
     damping_ratio: float = ACTUATOR_DAMPING_RATIO,
+    friction_coefficient: float = SECTION4_1_FRICTION,
 ) -> Drive:
-    """The Fig. 5/6 drive: Tables 1–2, free runner (no load cell), μ = 0.2, actuator damping ζ."""
+    """The Fig. 5/6 drive: Tables 1–2, free runner (no load cell), μ (default 0.2, Section 4.1's
+    unstated μ: ledger axis ``friction_coefficient``), actuator damping ζ."""
     return Drive(
         hemisphere_radius=hemisphere_radius,
         preload=preload,
+        friction_coefficient=friction_coefficient,
         contacts=contacts,
         actuator_model=actuator_model,
         actuator=actuator_for_radius(hemisphere_radius, damping_ratio=damping_ratio),
@@ -87,10 +97,12 @@ def critical_amplitude_point(
     damping_ratio: float = ACTUATOR_DAMPING_RATIO,
     periods: int = STEADY_PERIODS,
     threshold: float = STEP_THRESHOLD,
+    friction_coefficient: float = SECTION4_1_FRICTION,
 ) -> dict:
     """The A_c search (:func:`~passmd.protocols.critical_amplitude.critical_amplitude`) of
     :func:`paper_drive_for`: one sweep point, SI results."""
-    drive = paper_drive_for(contacts, actuator_model, hemisphere_radius, preload, damping_ratio)
+    drive = paper_drive_for(contacts, actuator_model, hemisphere_radius, preload, damping_ratio,
+                            friction_coefficient)
     return critical_amplitude(
         drive,
         protocol=protocol,
@@ -112,11 +124,13 @@ def step_point(
     flyback: str,
     damping_ratio: float = ACTUATOR_DAMPING_RATIO,
     periods: int = STEADY_PERIODS,
+    friction_coefficient: float = SECTION4_1_FRICTION,
 ) -> dict:
     """First and last step (m) and integration time (s) of a saw-tooth run of :func:`paper_drive_for`."""
     if amplitude == 0.0:  # x_p stays 0: nothing moves
         return {"first_step_m": 0.0, "last_step_m": 0.0, "wall_time_s": 0.0}
-    drive = paper_drive_for(contacts, actuator_model, hemisphere_radius, preload, damping_ratio)
+    drive = paper_drive_for(contacts, actuator_model, hemisphere_radius, preload, damping_ratio,
+                            friction_coefficient)
     out = steady_step(drive, amplitude, frequency, periods=periods, flyback=flyback)
     return {key: out[key] for key in ("first_step_m", "last_step_m", "wall_time_s")}
 
@@ -136,6 +150,7 @@ class ProfileSettings:
     amplitude_step: float  # amplitude grid step of Fig. 5a (m)
     damping_ratios: tuple  # actuator damping ratios ζ of the viscosity panel
     sensitivity_frequencies: tuple  # drive frequencies of the frequency panel (Hz)
+    readings_amplitude_step: float  # amplitude grid step of Fig. 5a's claim at every reading (m)
 
 
 #: Hemisphere radius (m) and preload (N) of Fig. 5a (Section 4.1), also used by the
@@ -150,6 +165,7 @@ PROFILE_SETTINGS = {
         amplitude_step=20e-9,
         damping_ratios=(0.005, 0.05, 0.5),
         sensitivity_frequencies=(PROTOCOL.drive_frequency, 1000.0),
+        readings_amplitude_step=20e-9,
     ),
     "paper": ProfileSettings(
         preloads={r: tuple(float(p) for p in grid) for r, grid in PRELOAD_GRIDS.items()},
@@ -158,6 +174,9 @@ PROFILE_SETTINGS = {
         amplitude_step=1e-9,
         damping_ratios=tuple(float(z) for z in ACTUATOR_DAMPING_RATIO * np.logspace(-1, 1, 5)),
         sensitivity_frequencies=(20.0, 50.0, PROTOCOL.drive_frequency, 200.0, 500.0, 1000.0),
+        # every other point of the figure's 1 nm grid: the nearest amplitudes the 50 ± 5 nm claim
+        # judges (44 and 56 nm) are on it
+        readings_amplitude_step=2e-9,
     ),
 }
 
@@ -167,18 +186,17 @@ def _settings(config: RunConfig) -> ProfileSettings:
 
 
 def _protocols(actuator_model: str, frequencies) -> list[dict]:
-    """The (protocol, fly-back, frequency[, ζ]) combinations drawn for an actuator model.
+    """The (protocol, fly-back, frequency[, ζ]) combinations the figures draw for an actuator model.
 
-    The ledger evaluates the A_c claims on the product of their axes (:mod:`passmd.ledger.readings`).
-    At ``PROTOCOL.drive_frequency`` and the default ζ the tables hold both protocols × (for
-    flexible actuators) both fly-back rules; the evaluated alternatives of ζ (Table 2's c_p is
-    lost) are searched with the steady protocol and the slew-rate fly-back, the other drive
-    frequencies of the band with the steady protocol, the slew-rate fly-back and the default ζ.
-    The other points of the product are not computed: the ledger counts them as not covered.
+    At ``PROTOCOL.drive_frequency`` and the default ζ both protocols × (for flexible actuators) both
+    fly-back rules; ζ's alternatives with the steady protocol and the slew-rate fly-back; the other
+    drive frequencies of the band with the steady protocol and the slew-rate fly-back. The ledger
+    evaluates the A_c claims on the full product of their axes, from :func:`ac_readings`, whose
+    default-reading runs are these.
     """
     combos = [{"protocol": "steady", "flyback": "slew", "frequency": float(f)} for f in frequencies]
     combos.append({"protocol": "first", "flyback": "slew", "frequency": PROTOCOL.drive_frequency})
-    if actuator_model == "flexible":  # the fly-back rule and ζ only matter for flexible actuators
+    if actuator_model == "flexible":  # the figures draw both rules and ζ's sensitivity for flexible ones
         combos.append({"protocol": "steady", "flyback": "fixed", "frequency": PROTOCOL.drive_frequency})
         combos.append({"protocol": "first", "flyback": "fixed", "frequency": PROTOCOL.drive_frequency})
         combos.extend({"protocol": "steady", "flyback": "slew", "frequency": PROTOCOL.drive_frequency,
@@ -206,6 +224,8 @@ def _run_searches(points: list[dict], description: str, config: RunConfig) -> pd
             "wall_time_s": frame["wall_time_s"],
         }
     )
+    if "friction_coefficient" in frame:  # readings at another μ; the figures' runs are at Section 4.1's
+        out.insert(8, "friction_coefficient", frame["friction_coefficient"].fillna(SECTION4_1_FRICTION))
     out.attrs["sweep"] = frame.attrs.get("sweep", {})  # points computed / taken from the cache
     return out
 
@@ -375,6 +395,83 @@ def fig56_frequency(config: RunConfig) -> pd.DataFrame:
 
 
 # --------------------------------------------------------------------------------------
+# The ledger's readings: every run of Figs. 5 and 6 at every point of the axes that change it
+# --------------------------------------------------------------------------------------
+
+#: The A_c panels of the ledger's readings: (contacts, radius (m), actuator models).
+AC_PANELS = {"fig5b": (1, 1.0e-3, ("rigid", "flexible")), "fig6a": (6, 1.0e-3, ("rigid",)),
+             "fig6b": (6, 1.0e-3, ("flexible",)), "fig6c": (6, 0.25e-3, ("flexible",))}
+
+
+def _reading_points(actuator_model: str, axes: tuple[str, ...]) -> list[dict]:
+    """Every point of the product of ``axes`` (:mod:`passmd.ledger.readings`) a run of this actuator
+    model depends on, as sweep parameters: ζ only for flexible actuators; μ only where it is not
+    the default, so the default runs are the figures' own (the same cache entries)."""
+    keys = [k for k in axes if actuator_model == "flexible" or k != "damping_ratio"]
+    names = {"flyback": "flyback", "ac_protocol": "protocol", "drive_frequency_s4": "frequency",
+             "damping_ratio": "damping_ratio", "friction_coefficient": "friction_coefficient"}
+    out = []
+    for reading in readings.design(keys):
+        point = {names[k]: reading[k] for k in keys}
+        point["frequency"] = float(point.get("frequency", PROTOCOL.drive_frequency))
+        point.setdefault("damping_ratio", ACTUATOR_DAMPING_RATIO)
+        if point.get("friction_coefficient", SECTION4_1_FRICTION) == SECTION4_1_FRICTION:
+            point.pop("friction_coefficient", None)
+        out.append(point)
+    return out
+
+
+_AC_AXES = ("flyback", "ac_protocol", "drive_frequency_s4", "damping_ratio", "friction_coefficient")
+
+
+def ac_readings(config: RunConfig, panel: str) -> pd.DataFrame:
+    """The A_c searches of one panel (:data:`AC_PANELS`) at every point of the axes that change them:
+    fly-back rule × A_c protocol × drive frequency × μ, and ζ for flexible actuators, on the profile's
+    preload grid (nm; on the paper profile the figure's own rows are the default reading's).
+
+    Every profile searches to the paper profile's bracket, so that a preload of a coarser grid has the
+    A_c the paper profile computes there: where a coarse grid decides a claim, the paper's decides it
+    alike (:class:`passmd.ledger.checks.Subset`)."""
+    s = _settings(config)
+    contacts, radius, models = AC_PANELS[panel]
+    points = [{"contacts": contacts, "actuator_model": model, "hemisphere_radius": radius,
+               "preload": float(p), "tolerance": PROFILE_SETTINGS["paper"].tolerance, **combo}
+              for p in s.preloads[radius] for model in models for combo in _reading_points(model, _AC_AXES)]
+    table = _run_searches(points, f"{panel} readings", config)
+    table.insert(0, "figure", panel)
+    return table
+
+
+def fig5a_readings(config: RunConfig) -> pd.DataFrame:
+    """Fig. 5a's flexible series at every point of the axes that change it (fly-back rule × drive
+    frequency × ζ × μ; both A_c protocols read the same runs: the first and the last step), on the
+    profile's claim grid of amplitudes (nm)."""
+    s = _settings(config)
+    radius, preload = FIG5A_DRIVE
+    a_max = actuator_for_radius(radius).full_stroke_amplitude
+    amplitudes = np.round(np.arange(0.0, a_max * (1 + 1e-9), s.readings_amplitude_step), 15)
+    combos = _reading_points("flexible",
+                             ("flyback", "drive_frequency_s4", "damping_ratio", "friction_coefficient"))
+    points = [{"contacts": 1, "actuator_model": "flexible", "hemisphere_radius": radius, "preload": preload,
+               "amplitude": float(a), **combo} for combo in combos for a in amplitudes]
+    for point in points:  # the figure's runs pass no ζ at the default: the same cache entries
+        if point["damping_ratio"] == ACTUATOR_DAMPING_RATIO:
+            point.pop("damping_ratio")
+    frame = sweep.run(step_point, points, description="fig5a readings", config=config)
+    table = pd.DataFrame({
+        "flyback": frame["flyback"], "frequency_Hz": frame["frequency"],
+        "damping_ratio": (frame["damping_ratio"].fillna(ACTUATOR_DAMPING_RATIO) if "damping_ratio" in frame
+                          else ACTUATOR_DAMPING_RATIO),
+        "friction_coefficient": (frame["friction_coefficient"].fillna(SECTION4_1_FRICTION)
+                                 if "friction_coefficient" in frame else SECTION4_1_FRICTION),
+        "amplitude_nm": frame["amplitude"] * 1e9, "first_step_nm": frame["first_step_m"] * 1e9,
+        "steady_step_nm": frame["last_step_m"] * 1e9, "threshold_nm": STEP_THRESHOLD * 1e9,
+    })
+    table.attrs["sweep"] = frame.attrs.get("sweep", {})
+    return table
+
+
+# --------------------------------------------------------------------------------------
 # One reading of the A_c protocol (the chapters' facts and the ledger's claims)
 # --------------------------------------------------------------------------------------
 
@@ -382,34 +479,39 @@ def fig56_frequency(config: RunConfig) -> pd.DataFrame:
 def primary(table: pd.DataFrame, actuator_model: str | None = None, reading=None) -> pd.DataFrame:
     """The rows of one reading of the A_c protocol (default: steady state,
     ``PROTOCOL.drive_frequency``, slew-rate fly-back, ζ =
-    :data:`~passmd.model.tables.ACTUATOR_DAMPING_RATIO`).
+    :data:`~passmd.model.tables.ACTUATOR_DAMPING_RATIO`, μ = 0.2).
 
     ``reading`` is a ledger reading (:mod:`passmd.ledger.readings`): its ``ac_protocol``,
-    ``flyback``, ``drive_frequency_s4`` and ``damping_ratio`` select the rows. The fly-back
-    rule and ζ apply to flexible actuators only (the rigid runs use the slew-rate fly-back). Raises
-    :class:`passmd.ledger.checks.NotEvaluable` when the table holds no run at that reading and
+    ``flyback``, ``drive_frequency_s4``, ``damping_ratio`` and ``friction_coefficient`` select the
+    rows (a table without a μ column holds μ = 0.2 only). ζ applies to flexible actuators only.
+    Raises :class:`passmd.ledger.checks.NoRun` when the table holds no run at that reading and
     :class:`passmd.ledger.checks.ClaimFails` when a preload makes no step up to the full stroke.
     """
     protocol, flyback, frequency = "steady", "slew", PROTOCOL.drive_frequency
-    zeta = ACTUATOR_DAMPING_RATIO
+    zeta, mu = ACTUATOR_DAMPING_RATIO, SECTION4_1_FRICTION
     if reading is not None:
         protocol, flyback = reading["ac_protocol"], reading["flyback"]
         frequency = float(reading["drive_frequency_s4"])
         zeta = float(reading.get("damping_ratio", zeta))
-    if actuator_model == "rigid":  # no actuator dynamics: neither the fly-back rule nor ζ applies
-        flyback, zeta = "slew", ACTUATOR_DAMPING_RATIO
+        mu = float(reading.get("friction_coefficient", mu))
+    if actuator_model == "rigid":  # no actuator dynamics: ζ does not apply
+        zeta = ACTUATOR_DAMPING_RATIO
+    friction = table["friction_coefficient"] if "friction_coefficient" in table else SECTION4_1_FRICTION
     rows = table[
         (table["protocol"] == protocol)
         & (table["flyback"] == flyback)
         & np.isclose(table["frequency_Hz"], frequency)
         & np.isclose(table["damping_ratio"], zeta, rtol=1e-9, atol=0)
+        & np.isclose(friction, mu, rtol=1e-9, atol=0)
     ]
     if actuator_model is not None:
         rows = rows[rows["actuator_model"] == actuator_model]
     rows = rows.sort_values("preload_N")
     if rows.empty:
-        raise NotEvaluable(f"no {protocol} A_c runs with the {flyback} fly-back at {frequency:g} Hz "
-                           f"and ζ = {zeta:g} on this grid")
+        what = f"{actuator_model} " if actuator_model else ""
+        raise NoRun(f"no {protocol} A_c runs of {what}actuators with the {flyback} fly-back at "
+                    f"{frequency:g} Hz, "
+                    f"ζ = {zeta:g} and μ = {mu:g} in the table")
     if rows["critical_amplitude_nm"].isna().any():
         where = rows.loc[rows["critical_amplitude_nm"].isna(), "preload_N"].tolist()
         raise ClaimFails(f"no step up to the full stroke at {', '.join(f'{p:g}' for p in where)} N "

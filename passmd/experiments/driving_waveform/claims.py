@@ -1,15 +1,17 @@
 """Claim extractors of Section 5.1: the driving waveform's time series (Figs. 8 and 9a).
 
 Decides the ledger's Section 5.1 rows (``passmd/data/reference/claims.csv``) from the time series
-of Figs. 8 and 9a and the resolved fly-back window (``fig8b_window``): the saw-tooth's back step
-and whether its micro-vibration dies within the next stick phase, the micro-vibration after the
-optimized waveform's acceleration against the saw-tooth's f_s, t_a starting at the runner's
-velocity maximum, stick during t_a, the contacts deformed to u_x,max after the fly-back, the
-runner fastest at the end of t_a and slipping forward further than the hemispheres move
-(Sub-phase II). Section 5.2's positions and velocities are in
-:mod:`passmd.experiments.driving_waveform.claims_velocity`. Each extractor reads the figure tables
-of :mod:`passmd.experiments.driving_waveform.figures` and returns what :mod:`passmd.ledger.checks`
-compares with the paper; too few samples in a phase make the claim inconclusive.
+of Figs. 8 and 9a and the resolved fly-back window (``fig8b_window``), each at the ledger's
+reading of μ (the readings tables ``fig8a_readings``, ``fig8b_readings``,
+``fig8b_window_readings``, ``fig9a_response``): the saw-tooth's back step; the consequence the
+paper draws from a micro-vibration not damped within the next stick phase (the runner's velocity
+stops growing with the frequency); the response to the optimized waveform against the saw-tooth's
+it is designed from (the runner velocity V_r of Eq. 15 after an optimized period); t_a starting
+at the runner's velocity maximum, stick during t_a, the contacts deformed to u_x,max after the
+fly-back, the runner fastest at the end of t_a and slipping forward further than the hemispheres
+move (Sub-phase II). Section 5.2's positions and velocities are in
+:mod:`passmd.experiments.driving_waveform.claims_velocity`. Too few samples in a phase make a
+claim inconclusive.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from passmd.experiments.driving_waveform.runs import (
     SECTION5_FRICTION,
     WINDOW_SAMPLES_PER_ACCELERATION,
 )
-from passmd.ledger.checks import NotEvaluable, evidence, extractor
+from passmd.ledger.checks import ClaimFails, NoRun, NotEvaluable, evidence, extractor
 from passmd.protocols.velocity import FULL_SLIDING_SHARE
 
 __all__ = ["optimized_period_timing"]
@@ -36,8 +38,22 @@ def _fig9a_run(results, waveform: str, reading=None) -> pd.DataFrame:
     table = at_section5_friction(results["fig9a"], mu)
     rows = table[(table["waveform"] == waveform) & (table["view"] == "period")].sort_values("period")
     if rows.empty:
-        raise NotEvaluable(f"no Fig. 9a {waveform} run at μ = {mu:g}")
+        raise NoRun(f"no Fig. 9a {waveform} run at μ = {mu:g}")
     return rows
+
+
+def at_mu(results, key: str, reading) -> pd.DataFrame:
+    """The rows of a Section 5 readings table (``<key>_readings``) at a reading's μ."""
+    table = results[f"{key}_readings"]
+    mu = float(reading["friction_coefficient"])
+    rows = table[np.isclose(table["friction_coefficient"], mu, rtol=1e-9, atol=0)]
+    if rows.empty:
+        raise NoRun(f"no {key} run at μ = {mu:g}")
+    return rows.drop(columns="friction_coefficient").reset_index(drop=True)
+
+
+#: The axis these claims depend on: Section 5's unstated μ.
+_AXES = ("friction_coefficient",)
 
 
 #: Why the Fig. 8a back-step and the full sliding after the fly-back cannot fail: at 202 nm the
@@ -52,19 +68,20 @@ _FLYBACK_SLIDES = ("holds for any contact stiffness down to a sixteenth of Table
                    "check still holds")
 
 
-@extractor("fig8a-back-step", not_informative=_FLYBACK_SLIDES)
-def _fig8a_back_step(results):
-    return {"lhs": float(results["fig8a"]["first_back_step_m"].iloc[0]) * 1e9, "rhs": 0.0}
+@extractor("fig8a-back-step", depends_on=_AXES, not_informative=_FLYBACK_SLIDES)
+def _fig8a_back_step(results, reading):
+    return {"lhs": float(at_mu(results, "fig8a", reading)["first_back_step_m"].iloc[0]) * 1e9, "rhs": 0.0}
 
 
-def optimized_period_timing(results) -> dict:
-    """Timing of the runner in the optimized period of Fig. 8b (µs), from the zoomed trace.
+def optimized_period_timing(results, reading=None) -> dict:
+    """Timing of the runner in the optimized period of Fig. 8b (µs), from the zoomed trace at a
+    reading's μ (default: the figure's own table).
 
     ``flyback_end`` (point 4 minus t_s), ``reversal`` (the runner's backward extreme between
     points 2 and 5, Section 5.1's point 3), ``point4`` (end of t_s, start of t_a), ``t_s`` and
     the design's ``f_s`` (Hz). Inconclusive when the trace or the points are missing.
     """
-    table = results["fig8b"]
+    table = results["fig8b"] if reading is None else at_mu(results, "fig8b", reading)
     points = table[table["view"] == "point"].set_index("point")
     zoom = table[table["view"] == "zoom"].sort_values("time_us")
     if zoom.empty or not {"2", "4", "5"} <= set(points.index.astype(str)):
@@ -80,26 +97,53 @@ def optimized_period_timing(results) -> dict:
             "f_s": float(points.at["4", "micro_vibration_frequency_Hz"])}
 
 
-@extractor("sec5-response-to-optimized-similar")
-def _response_similar(results):
-    # Eq. 15 is designed from the saw-tooth's micro-vibration f_s; the response that matters is the
-    # one after the two waveforms differ, i.e. after the acceleration t_a. Fig. 9a's optimized run
-    # measures f_s after its first acceleration, the saw-tooth run after its first fly-back.
-    f_s = {w: float(_fig9a_run(results, w)["micro_vibration_frequency_Hz"].iloc[0]) / 1e3
-           for w in ("optimized", "sawtooth")}
-    return {"lhs": f_s["optimized"], "rhs": f_s["sawtooth"]}
+def _response(results, reading) -> pd.Series:
+    table = results["fig9a_response"]
+    rows = table[np.isclose(table["friction_coefficient"], float(reading["friction_coefficient"]), rtol=1e-9,
+                            atol=0)]
+    if rows.empty:
+        raise NoRun(f"no response run at μ = {reading['friction_coefficient']:g}")
+    return rows.iloc[0]
+
+
+@extractor("sec5-response-to-optimized-similar", depends_on=_AXES)
+def _response_similar(results, reading):
+    # Eq. 15 is designed from the saw-tooth's micro-vibration after a fly-back: how fast the runner
+    # moves and when it turns (t_s lands on it). In continued operation, where a period is too short
+    # for the vibration to die out, the two waveforms leave the runner in different states: the
+    # largest speed over t_s after the last fly-back (mm/s) and, where the runner turns, when (µs),
+    # optimized against saw-tooth. A turn in one run and none in the other is a failure outright.
+    row = _response(results, reading)
+    turns = [bool(np.isfinite(row[f"{w}_reversal_s"])) for w in ("response", "sawtooth")]
+    if turns[0] != turns[1]:
+        turned = "after the optimized waveform's fly-back" if turns[0] else "after the saw-tooth's"
+        raise ClaimFails(f"the runner turns within 1.5 t_s only {turned}: the two responses differ in kind")
+    columns = ("peak_speed_m_per_s", "reversal_s") if turns[0] else ("peak_speed_m_per_s",)
+    scale = {"peak_speed_m_per_s": 1e3, "reversal_s": 1e6}
+    return {side: np.array([row[f"{w}_{c}"] * scale[c] for c in columns])
+            for side, w in (("lhs", "response"), ("rhs", "sawtooth"))}
 
 
 @evidence("sec5-response-to-optimized-similar")
 def _response_similar_evidence(results):
-    timing = optimized_period_timing(results)
-    return [f"the runner reverses {timing['reversal'] - timing['flyback_end']:.2f} µs after the fly-back, "
-            f"t_s = {timing['t_s']:.2f} µs (before t_a the two waveforms are the same)"]
+    from passmd.ledger.readings import default_reading
+
+    row = _response(results, default_reading())
+    return [f"at {row['frequency_Hz'] / 1e3:.3g} kHz, over t_s = {row['settling_time_s'] * 1e6:.2f} µs "
+            "after the last fly-back: largest speed "
+            f"{row['sawtooth_peak_speed_m_per_s'] * 1e3:.4g} mm/s (saw-tooth) against "
+            f"{row['response_peak_speed_m_per_s'] * 1e3:.4g} mm/s (optimized), reversal "
+            f"{row['sawtooth_reversal_s'] * 1e6:.2f} µs against {row['response_reversal_s'] * 1e6:.2f} µs; "
+            "V_r "
+            f"{row['sawtooth_runner_velocity_m_per_s'] * 1e3:.3g} against "
+            f"{row['response_runner_velocity_m_per_s'] * 1e3:.3g} mm/s; f_s = "
+            f"{row['micro_vibration_frequency_Hz'] / 1e3:.4g} kHz, set by the runner's mass and its "
+            "contacts' stiffness (defaults)"]
 
 
-@extractor("sec5-1-acceleration-starts-at-velocity-maximum")
-def _acceleration_phase(results):
-    timing = optimized_period_timing(results)
+@extractor("sec5-1-acceleration-starts-at-velocity-maximum", depends_on=_AXES)
+def _acceleration_phase(results, reading):
+    timing = optimized_period_timing(results, reading)
     return (timing["point4"] - timing["reversal"]) * 1e-6 * timing["f_s"]
 
 
@@ -110,13 +154,14 @@ def _acceleration_phase_evidence(results):
             f"t_s ends (point 4) at {t['point4']:.2f} µs; f_s = {t['f_s'] / 1e3:.4g} kHz"]
 
 
-def _window_phase(results, phases: tuple[str, ...]) -> pd.DataFrame:
-    """Rows of the resolved fly-back window (``fig8b_window``) in the given phases.
+def _window_phase(results, phases: tuple[str, ...], reading=None) -> pd.DataFrame:
+    """Rows of the resolved fly-back window (``fig8b_window``) in the given phases, at a reading's μ
+    (default: the figure's own table).
 
     Inconclusive when a phase holds fewer than :data:`WINDOW_SAMPLES_PER_ACCELERATION` // 2
     samples: the record then cannot resolve it.
     """
-    table = results["fig8b_window"]
+    table = results["fig8b_window"] if reading is None else at_mu(results, "fig8b_window", reading)
     rows = table[table["phase"].isin(phases)]
     for phase in phases:
         n = int((rows["phase"] == phase).sum())
@@ -125,11 +170,11 @@ def _window_phase(results, phases: tuple[str, ...]) -> pd.DataFrame:
     return rows
 
 
-@extractor("sec5-1-stick-during-acceleration")
-def _stick_during_acceleration(results):
+@extractor("sec5-1-stick-during-acceleration", depends_on=_AXES)
+def _stick_during_acceleration(results, reading):
     # Section 5.1 chooses V_a so that the runner still sticks during t_a: no contact group may
     # reach full sliding (slip share 1) between points 4 and 5.
-    rows = _window_phase(results, ("acceleration",))
+    rows = _window_phase(results, ("acceleration",), reading)
     share = float(rows[["slip_share_1", "slip_share_2"]].to_numpy().max())
     return {"lhs": share, "rhs": FULL_SLIDING_SHARE}
 
@@ -149,20 +194,21 @@ def _stick_during_acceleration_evidence(results):
     return lines
 
 
-@extractor("sec5-1-spring-deformed-to-ux-max-after-flyback", not_informative=_FLYBACK_SLIDES)
-def _deformed_to_ux_max(results):
+@extractor("sec5-1-spring-deformed-to-ux-max-after-flyback", depends_on=_AXES,
+           not_informative=_FLYBACK_SLIDES)
+def _deformed_to_ux_max(results, reading):
     # The contact's tangential displacement reaches u_x,max exactly when the whole contact slides
     # (slip share 1); every contact group must get there between the fly-back and the end of t_s.
-    rows = _window_phase(results, ("flyback", "settling"))
+    rows = _window_phase(results, ("flyback", "settling"), reading)
     return float(rows[["slip_share_1", "slip_share_2"]].max(axis=0).min())
 
 
-@extractor("sec5-1-fastest-at-end-of-acceleration")
-def _fastest_at_point5(results):
+@extractor("sec5-1-fastest-at-end-of-acceleration", depends_on=_AXES)
+def _fastest_at_point5(results, reading):
     # Section 5.1: at point 5 (end of t_a) the runner has its highest velocity. The time of the
     # runner's largest forward velocity from point 4 to the end of the window, after point 5, in
     # units of t_a; a maximum at the window's last sample does not locate it (inconclusive).
-    rows = _window_phase(results, ("acceleration", "after"))
+    rows = _window_phase(results, ("acceleration", "after"), reading)
     v = rows["runner_velocity_m_per_s"].to_numpy()
     k = int(np.argmax(v))
     if k == v.size - 1:
@@ -182,11 +228,11 @@ def _fastest_at_point5_evidence(results):
             f"{(rows['time_s'].iloc[k] - acc['acceleration_end_s'].iloc[0]) * 1e6:.2f} µs after point 5"]
 
 
-@extractor("sec5-1-runner-overshoots-in-slip")
-def _overshoot(results):
+@extractor("sec5-1-runner-overshoots-in-slip", depends_on=_AXES)
+def _overshoot(results, reading):
     # Sub-phase II: from point 4 to the runner's forward extreme after point 5, the runner moves
     # further than the hemispheres do over the same time (the acceleration Δ_a included).
-    table = results["fig8b"]
+    table = at_mu(results, "fig8b", reading)
     points = table[table["view"] == "point"].set_index("point")
     points.index = points.index.astype(str)
     zoom = table[table["view"] == "zoom"].sort_values("time_us")
@@ -203,44 +249,60 @@ def _overshoot(results):
             "rhs": float(extreme["piezo_position_nm"] - start["piezo_position_nm"])}
 
 
-#: The part of the period, before the next fly-back, over which the residual vibration is measured.
-_RESIDUAL_SHARE = 0.2
-#: Largest record spacing, in micro-vibration periods, at which a vibration's amplitude is read.
-_SAMPLES_PER_VIBRATION = 4
-#: 'Completely damped': the relative vibration has fallen below a tenth (20 dB) of its amplitude
-#: after the slip.
+#: 'Completely damped': the relative vibration has fallen below a tenth (20 dB) of its first swing.
 _DAMPED_SHARE = 0.1
 
 
-@extractor("fig8a-micro-vibration-damped-within-next-stick")
-def _micro_vibration_damped(results):
-    # Fig. 8a: the relative velocity runner − hemispheres right after the first slip (zoom view)
-    # against its largest value in the last fifth of the following stick phase (full view).
-    table = results["fig8a"]
-    points = table[table["view"] == "point"].set_index("point")
-    points.index = points.index.astype(str)
-    f_s = float(table["micro_vibration_frequency_Hz"].iloc[0])
-    full = table[table["view"] == "full"].sort_values("time_s")
-    zoom = table[table["view"] == "zoom"].sort_values("time_s")
-    if "1" not in points.index or full.empty or zoom.empty or not np.isfinite(f_s):
-        raise NotEvaluable("the Fig. 8a trace, its point 1 or its micro-vibration frequency is missing")
-    spacing = float(np.diff(full["time_s"].to_numpy()).max())
-    if spacing > 1.0 / (_SAMPLES_PER_VIBRATION * f_s):
-        raise NotEvaluable(f"the whole-run record ({spacing * 1e6:.3g} µs apart) cannot resolve the "
-                           f"{f_s / 1e3:.3g} kHz micro-vibration")
-
-    def relative(rows):
-        t = rows["time_s"].to_numpy()
-        hemispheres = np.gradient(rows["piezo_position_m"].to_numpy(), t)
-        return rows["runner_velocity_m_per_s"].to_numpy() - hemispheres
-
+def damping_time(fig8a_table: pd.DataFrame) -> tuple[float, bool]:
+    """How long after Fig. 8a's first fly-back the runner's vibration relative to the hemispheres takes
+    to fall below :data:`_DAMPED_SHARE` of its first swing and stay there for a whole micro-vibration
+    period (s), from the zoomed record; and whether it does so within the record (else the longest
+    time the record can tell, a lower bound, and False)."""
+    zoom = fig8a_table[fig8a_table["view"] == "zoom"].sort_values("time_s")
+    full = fig8a_table[fig8a_table["view"] == "full"]
+    f_s = float(fig8a_table["micro_vibration_frequency_Hz"].iloc[0])
+    if zoom.empty or full.empty or not np.isfinite(f_s):
+        raise NotEvaluable("the Fig. 8a trace or its micro-vibration frequency is missing")
     flyback_end = float(full["time_s"].max()) / 2.0  # the first of Fig. 8a's two periods ends here
-    period = flyback_end
-    after_slip = zoom[zoom["time_s"] > flyback_end]
-    late = full[(full["time_s"] >= flyback_end + (1 - _RESIDUAL_SHARE) * period)
-                & (full["time_s"] < flyback_end + period - (flyback_end - float(points.at["1", "time_s"])))]
-    if len(after_slip) < 3 or len(late) < 3:
-        raise NotEvaluable("too few samples after the slip or at the end of the following stick phase")
-    initial = float(np.abs(relative(after_slip)).max())
-    residual = float(np.abs(relative(late)).max())
-    return {"lhs": residual / initial, "rhs": _DAMPED_SHARE}
+    t = zoom["time_s"].to_numpy()
+    hemispheres = np.gradient(zoom["piezo_position_m"].to_numpy(), t)
+    relative = np.abs(zoom["runner_velocity_m_per_s"].to_numpy() - hemispheres)
+    after = t > flyback_end + 1e-6  # past the fly-back's corner
+    t, relative = t[after], relative[after]
+    period = 1.0 / f_s
+    if t.size < 3 or t[-1] - t[0] < 2 * period:
+        raise NotEvaluable("the zoomed record after the fly-back is shorter than two micro-vibration periods")
+    first = float(relative[t <= t[0] + period].max())
+    ends = np.searchsorted(t, t + period, side="right")
+    for i in np.flatnonzero(t + period <= t[-1]):
+        if relative[i:ends[i]].max() < _DAMPED_SHARE * first:
+            return float(t[i] - flyback_end), True
+    return float(t[-1] - period - flyback_end), False
+
+
+@extractor("fig8a-micro-vibration-damped-within-next-stick", depends_on=_AXES)
+def _micro_vibration_damped(results, reading):
+    # The conditional: where the micro-vibration is not damped within the stick phase of the next
+    # period, it "prevents the drives from controlling with a high frequency and thus high operational
+    # velocity". Fig. 8a's decay time tells from which frequency on the stick phase is too short;
+    # above it the runner's saw-tooth velocity must stop growing with the frequency. Ours: its rise
+    # from the first such grid frequency to the top of the grid (%), against 0.
+    decay, _ = damping_time(at_mu(results, "fig8a", reading))  # a lower bound if the record ends first
+    table = at_mu(results, "fig9b", reading)
+    saw = table[table["variant"] == "sawtooth"].sort_values("frequency")
+    undamped = saw[1.0 / saw["frequency"] - saw["flyback_time_s"] < decay]
+    if len(undamped) < 2:
+        raise NotEvaluable(f"fewer than two grid frequencies where the stick phase is shorter than the "
+                           f"{decay * 1e6:.3g} µs the micro-vibration needs to die out")
+    v = undamped["velocity_mm_per_s"].to_numpy()
+    return {"lhs": 100.0 * (v[-1] - v[0]) / abs(v[0]), "rhs": 0.0}
+
+
+@evidence("fig8a-micro-vibration-damped-within-next-stick")
+def _micro_vibration_evidence(results):
+    decay, within = damping_time(results["fig8a"])
+    return [f"the runner's vibration relative to the hemispheres falls below {_DAMPED_SHARE:.0%} of its "
+            "first swing for good "
+            + (f"{decay * 1e6:.3g} µs after Fig. 8a's fly-back" if within else
+               f"later than {decay * 1e6:.3g} µs after Fig. 8a's fly-back, the end of the record")
+            + f": not within the stick phase above {1e-3 / decay:.3g} kHz (defaults)"]

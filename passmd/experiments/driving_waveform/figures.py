@@ -39,6 +39,7 @@ from passmd.experiments.driving_waveform.runs import (
     STEP_FREQUENCY,
     WINDOW_RESOLUTION,
     WINDOW_SAMPLES_PER_ACCELERATION,
+    _full_stroke_flyback,
     design_fields,
     designs,
     section5_fields,
@@ -193,15 +194,15 @@ def _samples(profile: str) -> tuple[int, int]:
     return (400, 300) if profile == "quick" else (2000, 1500)
 
 
-def fig8a(config: RunConfig) -> pd.DataFrame:
+def fig8a(config: RunConfig, friction_coefficient: float = SECTION5_FRICTION) -> pd.DataFrame:
     """Saw-tooth response (100 Hz, two periods, Section 5 drive) with the contact status.
 
     Views: ``full`` (both periods), ``zoom`` (the first fly-back and the micro-vibration
     after it), ``point`` (points 1–4 of Section 5.1: end of stick, fastest backward motion,
     reversal, fastest forward motion). Constant columns: ``first_back_step_m`` and the
-    measured ``micro_vibration_frequency_Hz``.
+    measured ``micro_vibration_frequency_Hz``. ``friction_coefficient``: Section 5's unstated μ.
     """
-    c = section5_fields()
+    c = section5_fields(friction_coefficient=friction_coefficient)
     T = 1.0 / STEP_FREQUENCY
     trace = _trace(c, STEP_FREQUENCY, 2, "sawtooth", {"settling_time": 0.0, "acceleration_time": 0.0,
                                                     "acceleration_amplitude": 0.0},
@@ -219,7 +220,7 @@ def fig8a(config: RunConfig) -> pd.DataFrame:
     return _display(frame)
 
 
-def fig8b(config: RunConfig) -> pd.DataFrame:
+def fig8b(config: RunConfig, friction_coefficient: float = SECTION5_FRICTION) -> pd.DataFrame:
     """The optimized waveform of the Section 5 drive and the runner's response (100 Hz).
 
     Period 1 is a saw-tooth, period 2 optimized. Views ``full``, ``zoom`` (the fly-back,
@@ -228,8 +229,9 @@ def fig8b(config: RunConfig) -> pd.DataFrame:
     (``settling_time_s``, ``acceleration_time_s``, ``acceleration_amplitude_m``,
     ``acceleration_velocity_m_per_s``, ``micro_vibration_frequency_Hz``,
     ``design_runner_velocity_m_per_s`` (V_r of Eq. 15), ``presliding_m``, ``linear_frequency_Hz``).
+    ``friction_coefficient``: Section 5's unstated μ.
     """
-    c = section5_fields()
+    c = section5_fields(friction_coefficient=friction_coefficient)
     design = designs([c], config).iloc[0]
     fields = design_fields(design)
     T = 1.0 / STEP_FREQUENCY
@@ -253,7 +255,7 @@ def fig8b(config: RunConfig) -> pd.DataFrame:
     return _display(frame)
 
 
-def fig8b_window(config: RunConfig) -> pd.DataFrame:
+def fig8b_window(config: RunConfig, friction_coefficient: float = SECTION5_FRICTION) -> pd.DataFrame:
     """The fly-back and the acceleration t_a of Fig. 8b's optimized period, resolved inside t_a.
 
     One run of the Section 5 drive (0.4 N, 100 Hz, its own Eq. 15 design) integrated with the
@@ -263,9 +265,9 @@ def fig8b_window(config: RunConfig) -> pd.DataFrame:
     (:func:`~passmd.experiments.driving_waveform.runs.window_point`). Columns: ``time_s``,
     ``time_us``, runner and piezo positions (nm) and velocity, ``slip_share_1`` and
     ``slip_share_2``, ``phase`` (``flyback``, ``settling``, ``acceleration``, ``after``) and
-    the constant phase times (s) and record spacing.
+    the constant phase times (s) and record spacing. ``friction_coefficient``: Section 5's unstated μ.
     """
-    c = section5_fields()
+    c = section5_fields(friction_coefficient=friction_coefficient)
     fields = design_fields(designs([c], config).iloc[0])
     point = {**c, **fields, "resolution": WINDOW_RESOLUTION[config.profile],
              "samples_per_acceleration": WINDOW_SAMPLES_PER_ACCELERATION}
@@ -330,26 +332,109 @@ def at_section5_friction(frame: pd.DataFrame, friction_coefficient: float = SECT
     return frame[np.isclose(frame["friction_coefficient"], friction_coefficient, rtol=1e-9, atol=0)]
 
 
-def fig9b(config: RunConfig) -> pd.DataFrame:
-    """Steady velocity of the Section 5 drive over the frequency grid, every waveform variant."""
-    return velocity_table([section5_fields()], _frequencies(config.profile), config)
-
-
-def fig10a(config: RunConfig) -> pd.DataFrame:
-    """Steady velocity against frequency for F_p = 0.1, 0.4, 1 N (R = 1 mm, steel)."""
-    return velocity_table([section5_fields(preload=p) for p in FIG10A_PRELOADS], _frequencies(config.profile),
-                          config)
-
-
-def fig10b(config: RunConfig) -> pd.DataFrame:
-    """Steady velocity against frequency for R = 1 mm (A = 202 nm) and 0.25 mm (A = 96 nm), 0.4 N."""
-    return velocity_table([section5_fields(hemisphere_radius=r) for r in FIG10B_RADII],
+def fig9b(config: RunConfig, friction_coefficient: float = SECTION5_FRICTION) -> pd.DataFrame:
+    """Steady velocity of the Section 5 drive over the frequency grid, every waveform variant (μ:
+    Section 5's unstated friction coefficient)."""
+    return velocity_table([section5_fields(friction_coefficient=friction_coefficient)],
                           _frequencies(config.profile), config)
 
 
-def fig10c(config: RunConfig) -> pd.DataFrame:
+def fig10a(config: RunConfig, friction_coefficient: float = SECTION5_FRICTION) -> pd.DataFrame:
+    """Steady velocity against frequency for F_p = 0.1, 0.4, 1 N (R = 1 mm, steel)."""
+    return velocity_table([section5_fields(preload=p, friction_coefficient=friction_coefficient)
+                           for p in FIG10A_PRELOADS], _frequencies(config.profile), config)
+
+
+def fig10b(config: RunConfig, friction_coefficient: float = SECTION5_FRICTION) -> pd.DataFrame:
+    """Steady velocity against frequency for R = 1 mm (A = 202 nm) and 0.25 mm (A = 96 nm), 0.4 N."""
+    return velocity_table([section5_fields(hemisphere_radius=r, friction_coefficient=friction_coefficient)
+                           for r in FIG10B_RADII], _frequencies(config.profile), config)
+
+
+def fig10c(config: RunConfig, friction_coefficient: float = SECTION5_FRICTION) -> pd.DataFrame:
     """Steady velocity against frequency for a steel (210 GPa) and a molybdenum (310 GPa) runner."""
-    return velocity_table([section5_fields(runner=r) for r in RUNNERS], _frequencies(config.profile), config)
+    return velocity_table([section5_fields(runner=r, friction_coefficient=friction_coefficient)
+                           for r in RUNNERS], _frequencies(config.profile), config)
+
+
+# ======================================================================================
+# The ledger's readings of Section 5: every figure at every value of μ
+# ======================================================================================
+
+
+def _at_every_mu(compute):
+    """A readings table: ``compute(config, friction_coefficient=μ)`` at every value of the ledger's axis
+    ``friction_coefficient`` (Section 5's unstated μ), tagged with it."""
+
+    def readings_table(config: RunConfig) -> pd.DataFrame:
+        parts = [compute(config, friction_coefficient=mu).assign(friction_coefficient=mu)
+                 for mu in FIG9A_FRICTION]
+        return pd.concat(parts, ignore_index=True)
+
+    readings_table.__name__ = readings_table.__qualname__ = f"{compute.__name__}_readings"
+    readings_table.__doc__ = (f"{compute.__name__} at every value of μ (ledger readings), tagged "
+                              "``friction_coefficient``.")
+    return readings_table
+
+
+fig8a_readings, fig8b_readings, fig8b_window_readings = (
+    _at_every_mu(f) for f in (fig8a, fig8b, fig8b_window))
+fig9b_readings, fig10a_readings, fig10b_readings, fig10c_readings = (
+    _at_every_mu(f) for f in (fig9b, fig10a, fig10b, fig10c))
+
+
+def _settling_response(trace: dict, flyback_end: float, settling_time: float) -> dict:
+    """The runner's micro-vibration after a fly-back, from a zoomed trace reaching 1.5 t_s past it: its
+    largest speed over the settling time t_s, the time of its reversal (its velocity's first sign
+    change after the fly-back, which t_s is meant to land on) and its velocity where t_a starts (V_r)."""
+    t = np.asarray(trace["zoom_time_s"])
+    v = np.asarray(trace["zoom_runner_velocity_m_per_s"])
+    settling = (t >= flyback_end) & (t <= flyback_end + settling_time)
+    around = (t >= flyback_end) & (t <= flyback_end + 1.5 * settling_time)
+    tw, vw = t[around], v[around]
+    turns = np.flatnonzero(np.sign(vw[:-1]) * np.sign(vw[1:]) < 0)
+    reversal = (float(tw[turns[0]] - vw[turns[0]] * (tw[turns[0] + 1] - tw[turns[0]])
+                      / (vw[turns[0] + 1] - vw[turns[0]])) - flyback_end) if turns.size else math.nan
+    return {"peak_speed_m_per_s": float(np.abs(v[settling]).max()), "reversal_s": reversal,
+            "runner_velocity_m_per_s": float(np.interp(flyback_end + settling_time, t, v))}
+
+
+#: Periods of the response runs: enough for the runner's response to a periodic waveform to settle.
+RESPONSE_PERIODS = MIN_PERIODS
+
+
+def fig9a_response(config: RunConfig) -> pd.DataFrame:
+    """The runner's response to the optimized waveform against its response to the saw-tooth, in
+    continued operation where a period is too short for the micro-vibration to die out: at the
+    frequency whose period is twice Eq. 15's t_s + t_a + fly-back (the ramp gets half of it), over
+    the settling time t_s after the last of :data:`RESPONSE_PERIODS` fly-backs, at every value of μ.
+
+    Columns ``friction_coefficient``, ``frequency_Hz``, the design's ``settling_time_s``,
+    ``micro_vibration_frequency_Hz`` and ``design_runner_velocity_m_per_s`` (V_r, from the 100 Hz
+    saw-tooth), and for the saw-tooth (``sawtooth_*``) and the optimized waveform (``response_*``):
+    ``peak_speed_m_per_s`` (the largest runner speed over t_s), ``reversal_s`` (when the runner
+    turns after the fly-back) and ``runner_velocity_m_per_s`` (where t_a starts).
+    """
+    rows = []
+    for mu in FIG9A_FRICTION:
+        c = section5_fields(friction_coefficient=mu)
+        design = designs([c], config).iloc[0]
+        fields = design_fields(design)
+        t_s = fields["settling_time"]
+        needed = t_s + fields["acceleration_time"] + _full_stroke_flyback(c)
+        frequency = 1.0 / (2.0 * needed)
+        last = (RESPONSE_PERIODS - 1) / frequency  # the end of the last fly-back but one period
+        zoom = (last - 5e-6, last + 1.5 * t_s + 5e-6)
+        none = {"settling_time": 0.0, "acceleration_time": 0.0, "acceleration_amplitude": 0.0}
+        sawtooth = _trace(c, frequency, RESPONSE_PERIODS, "sawtooth", none, zoom, 400, 2000, config)
+        optimized = _trace(c, frequency, RESPONSE_PERIODS, "optimized", fields, zoom, 400, 2000, config)
+        row = {"friction_coefficient": mu, "frequency_Hz": frequency, "settling_time_s": t_s,
+               "micro_vibration_frequency_Hz": float(design["micro_vibration_frequency_Hz"]),
+               "design_runner_velocity_m_per_s": float(design["runner_velocity_m_per_s"])}
+        row.update({f"sawtooth_{k}": v for k, v in _settling_response(sawtooth, last, t_s).items()})
+        row.update({f"response_{k}": v for k, v in _settling_response(optimized, last, t_s).items()})
+        rows.append(row)
+    return pd.DataFrame(rows)
 
 
 # ======================================================================================

@@ -88,12 +88,13 @@ def design_point(hemisphere_radius: float, preload: float, runner: str, actuator
 
 def velocity_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
                    frequency: float, waveform: str, short_period: str, settling_time: float,
-                   acceleration_time: float, acceleration_amplitude: float) -> dict:
+                   acceleration_time: float, acceleration_amplitude: float,
+                   friction_coefficient: float = SECTION5_FRICTION) -> dict:
     """Steady velocity of one Section 5 drive, waveform and frequency at the full amplitude.
 
     :func:`passmd.protocols.velocity.steady_run`; the design fields are ignored for the saw-tooth.
     """
-    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
+    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model, friction_coefficient)
     design = None if waveform != "optimized" else make_design(settling_time, acceleration_time,
                                                                acceleration_amplitude)
     return steady_run(drive, drive.actuator.full_stroke_amplitude, frequency, waveform, short_period, design)
@@ -158,10 +159,14 @@ def trace_point(hemisphere_radius: float, preload: float, runner: str, actuator_
 
 
 def section5_fields(hemisphere_radius: float = 1e-3, preload: float = 0.4, runner: str = "steel",
-                    actuator_model: str = "rigid") -> dict:
-    """A drive configuration as plain sweep parameters (see :func:`section5_drive`)."""
-    return {"hemisphere_radius": float(hemisphere_radius), "preload": float(preload), "runner": runner,
-            "actuator_model": actuator_model}
+                    actuator_model: str = "rigid", friction_coefficient: float = SECTION5_FRICTION) -> dict:
+    """A drive configuration as plain sweep parameters (see :func:`section5_drive`); μ only when it is
+    not Section 5's default (so the default runs are the same cache entries whoever asks)."""
+    fields = {"hemisphere_radius": float(hemisphere_radius), "preload": float(preload), "runner": runner,
+              "actuator_model": actuator_model}
+    if float(friction_coefficient) != SECTION5_FRICTION:
+        fields["friction_coefficient"] = float(friction_coefficient)
+    return fields
 
 
 def designs(drives: list[dict], config: RunConfig) -> pd.DataFrame:
@@ -199,9 +204,23 @@ def velocity_table(drives: list[dict], frequencies, config: RunConfig) -> pd.Dat
     table["step_nm"] = table["step_m"] * 1e9
     table["back_step_nm"] = table["back_step_m"] * 1e9
     table["radius_mm"] = table["hemisphere_radius"] * 1e3
+    per_point = len(VARIANTS) * len(frequencies)
     table["micro_vibration_frequency_Hz"] = np.repeat(design_rows["micro_vibration_frequency_Hz"].to_numpy(),
-                                                      len(VARIANTS) * len(frequencies))
+                                                      per_point)
+    # Eq. 15 is defined where its settling time, acceleration and fly-back fit into the period
+    flyback = np.repeat([_full_stroke_flyback(c) for c in drives], per_point)
+    table["flyback_time_s"] = flyback
+    table["eq15_time_s"] = np.repeat([float(d["settling_time_s"]) + float(d["acceleration_time_s"])
+                                      for _, d in design_rows.iterrows()], per_point) + flyback
+    table["eq15_fits"] = table["eq15_time_s"].to_numpy() < 1.0 / table["frequency"].to_numpy()
     return table
+
+
+def _full_stroke_flyback(fields: dict) -> float:
+    """The fly-back at the full stroke of a Section 5 drive (s): both fly-back rules give the same."""
+    drive = section5_drive(fields["hemisphere_radius"], fields["preload"], fields["runner"],
+                           fields["actuator_model"], fields.get("friction_coefficient", SECTION5_FRICTION))
+    return waveforms.flyback_time(drive.actuator.full_stroke_amplitude, drive)
 
 
 #: Integration refinement of the fly-back window run (``simulate``'s ``resolution``: the
@@ -219,7 +238,8 @@ WINDOW_BEFORE, WINDOW_AFTER = 2e-6, 30e-6
 
 def window_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
                  settling_time: float, acceleration_time: float, acceleration_amplitude: float,
-                 resolution: float, samples_per_acceleration: int) -> dict:
+                 resolution: float, samples_per_acceleration: int,
+                 friction_coefficient: float = SECTION5_FRICTION) -> dict:
     """Fig. 8b's run (100 Hz, period 1 saw-tooth, period 2 optimized) resolved inside t_a.
 
     The run is integrated with the step divided by ``resolution`` and recorded every
@@ -229,7 +249,7 @@ def window_point(hemisphere_radius: float, preload: float, runner: str, actuator
     with the fly-back start and end, the start and end of t_a (s) and the largest record
     spacing inside t_a (``record_spacing_s``).
     """
-    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
+    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model, friction_coefficient)
     amplitude = drive.actuator.full_stroke_amplitude
     design = make_design(settling_time, acceleration_time, acceleration_amplitude)
     wave = make_waveform(drive, amplitude, STEP_FREQUENCY, 2, "optimized", "cut", design)

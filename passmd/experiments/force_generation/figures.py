@@ -24,10 +24,11 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from passmd.ledger.checks import NotEvaluable
+from passmd.ledger import readings
+from passmd.ledger.checks import NoRun
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive, paper_drive
-from passmd.model.tables import PRELOAD_GRIDS, Assumption
+from passmd.model.tables import ACTUATOR_DAMPING_RATIO, PRELOAD_GRIDS, Assumption, actuator_for_radius
 from passmd.model.theory import drive_theory
 from passmd.protocols import stall
 from passmd.protocols.critical_amplitude import critical_amplitude
@@ -58,14 +59,14 @@ __all__ = [
     "fig7a",
     "fig7b",
     "fig7cycle",
-    "fig7flyback",
+    "fig7_readings",
     "fig7freq",
     "fig7grid",
     "force_difference",
     "force_drive",
     "model_rows",
     "onset_point",
-    "panel_at",
+    "readings_at",
     "stall_point",
 ]
 
@@ -168,15 +169,18 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
 
 
 def force_drive(
-    hemisphere_radius: float, preload: float, actuator_model: str, friction_coefficient: float
+    hemisphere_radius: float, preload: float, actuator_model: str, friction_coefficient: float,
+    damping_ratio: float = ACTUATOR_DAMPING_RATIO,
 ) -> Drive:
-    """The Fig. 7 drive: Tables 1–2, six contacts, load cell engaged (Section 4.2)."""
+    """The Fig. 7 drive: Tables 1–2, six contacts, load cell engaged (Section 4.2); actuator damping ζ
+    (Table 2's lost c_p, ledger axis ``damping_ratio``)."""
     return paper_drive(
         hemisphere_radius,
         preload,
         actuator_model=actuator_model,
         friction_coefficient=friction_coefficient,
         load_cell=True,
+        actuator=actuator_for_radius(hemisphere_radius, damping_ratio=damping_ratio),
     )
 
 
@@ -193,10 +197,11 @@ def stall_point(
     amplitude_fraction: float,
     frequency: float,
     flyback: str = "slew",
+    damping_ratio: float = ACTUATOR_DAMPING_RATIO,
 ) -> dict:
-    """:func:`~passmd.protocols.stall.generated_force`
-    of the Fig. 7 drive at ``amplitude_fraction`` × A_max, with the ``flyback`` rule."""
-    drive = force_drive(hemisphere_radius, preload, actuator_model, friction_coefficient)
+    """:func:`~passmd.protocols.stall.generated_force` of the Fig. 7 drive at ``amplitude_fraction`` × A_max,
+    with the ``flyback`` rule and actuator damping ζ."""
+    drive = force_drive(hemisphere_radius, preload, actuator_model, friction_coefficient, damping_ratio)
     fraction = check_range("amplitude_fraction", amplitude_fraction, 0.0, 1.0)
     amplitude = fraction * drive.actuator.full_stroke_amplitude
     out = generated_force(drive, amplitude, frequency, flyback=flyback)
@@ -344,28 +349,43 @@ def fig7b(config: RunConfig) -> pd.DataFrame:
     return _panel("fig7b", config)
 
 
-def fig7flyback(config: RunConfig) -> pd.DataFrame:
-    """Figs. 7a and 7b with the fixed 2 µs fly-back (ledger axis ``flyback``): both panels' curves,
-    this paper's model with the fixed fly-back and the earlier one (rigid actuators, unchanged),
-    in the panels' format with a ``panel`` column (``fig7a``, ``fig7b``)."""
-    fractions = _settings(config.profile).panel_fractions
-    table = pd.concat([_curves_frame({PANELS[name][0]: PANELS[name][1]}, fractions, config, name,
-                                     flyback="fixed") for name in PANELS], ignore_index=True)
-    table.insert(1, "flyback", np.where(table["actuator_model"] == "flexible", "fixed", "slew"))
+#: Amplitudes of the ledger's readings of this paper's force runs, as fractions of A_max: the force's
+#: dependence on the amplitude (half and full stroke) and, at the full stroke, on the preload.
+READINGS_FRACTIONS = (0.5, 1.0)
+
+
+def fig7_readings(config: RunConfig) -> pd.DataFrame:
+    """This paper's model (flexible actuators, μ = 0.2) at the Fig. 7 panels' preloads and
+    ``READINGS_FRACTIONS`` of the stroke, at every point of the axes that change its runs:
+    fly-back rule × actuator damping ζ × drive frequency (mN, nm; the default runs are the panels'
+    own). Columns of :func:`fig7a`'s stall runs plus ``flyback`` and ``damping_ratio``."""
+    model, mu, _ = MODELS[1]
+    points = []
+    for reading in readings.design(("flyback", "damping_ratio", "force_frequency")):
+        zeta = float(reading["damping_ratio"])
+        points.extend(
+            {"hemisphere_radius": radius, "preload": float(p), "actuator_model": model,
+             "friction_coefficient": mu, "amplitude_fraction": float(a),
+             "frequency": float(reading["force_frequency"]), **_flyback(reading["flyback"]),
+             **({} if zeta == ACTUATOR_DAMPING_RATIO else {"damping_ratio": zeta})}
+            for radius, preloads in PANELS.values() for p in preloads for a in READINGS_FRACTIONS)
+    table = _stall_frame(points, "fig7 readings", config)
+    table.insert(0, "flyback", [p.get("flyback", "slew") for p in points])
+    table.insert(1, "damping_ratio", [p.get("damping_ratio", ACTUATOR_DAMPING_RATIO) for p in points])
     return table
 
 
-def panel_at(results, name: str, reading=None) -> pd.DataFrame:
-    """The table of panel ``name`` (``fig7a`` or ``fig7b``) at a ledger reading: the panel itself
-    at the slew-rate fly-back, its rows of ``fig7flyback`` at the fixed one. Raises
-    :class:`passmd.ledger.checks.NotEvaluable` when the results hold no such table."""
-    rule = "slew" if reading is None else reading["flyback"]
-    if rule == "slew":
-        return results[name]
-    if "fig7flyback" not in results:
-        raise NotEvaluable(f"no Fig. 7 runs with the {rule} fly-back (needs results: fig7flyback)")
-    table = results["fig7flyback"]
-    return table[(table["panel"] == name) & (table["flyback"].isin([rule, "slew"]))].reset_index(drop=True)
+def readings_at(results, reading) -> pd.DataFrame:
+    """The rows of ``fig7_readings`` at a ledger reading (fly-back rule, ζ, drive frequency). Raises
+    :class:`passmd.ledger.checks.NoRun` when the table holds none."""
+    table = results["fig7_readings"]
+    rows = table[(table["flyback"] == reading["flyback"])
+                 & np.isclose(table["damping_ratio"], float(reading["damping_ratio"]), rtol=1e-9, atol=0)
+                 & np.isclose(table["frequency_Hz"], float(reading["force_frequency"]), rtol=1e-9, atol=0)]
+    if rows.empty:
+        raise NoRun(f"no force runs of this paper's model with the {reading['flyback']} fly-back, "
+                    f"ζ = {reading['damping_ratio']:g} at {reading['force_frequency']:g} Hz")
+    return rows.reset_index(drop=True)
 
 
 def fig7grid(config: RunConfig) -> pd.DataFrame:

@@ -1,0 +1,120 @@
+"""The ledger's regression baselines: each claim's category on a profile, with the readings it was
+computed at, its state at each of them and the reading its category was judged at besides the
+defaults (``tests/ledger_baseline_<profile>.csv``).
+
+:func:`write_baseline` records an evaluated ledger (:func:`passmd.ledger.evaluation.evaluate`),
+:func:`load_baseline`, :func:`load_baseline_readings` and :func:`load_baseline_states` read one back,
+and :func:`check_categories` fails with a readable diff when any claim changed category.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+import pandas as pd
+
+from passmd.ledger import readings
+
+__all__ = ["READINGS_SEPARATOR", "STATE_LETTERS", "category_changes", "check_categories", "load_baseline",
+           "load_baseline_readings", "load_baseline_states", "readings_of", "write_baseline"]
+
+#: Separator of the readings in a baseline's ``readings`` column.
+READINGS_SEPARATOR = " | "
+
+#: One letter per reading in a baseline's ``states`` column, in the order of its ``readings``.
+STATE_LETTERS = {"holds": "h", "fails": "f", "inconclusive": "?"}
+
+
+def readings_of(depends: tuple[str, ...]) -> tuple[str, ...]:
+    """The readings a claim depending on ``depends`` is evaluated at, in words."""
+    return tuple(readings.describe(r) for r in readings.design(depends))
+
+
+def load_baseline(path) -> dict[str, str]:
+    """``{claim id: category}`` from a baseline CSV written by :func:`write_baseline`."""
+    table = pd.read_csv(path, dtype=str, keep_default_na=False, comment="#")
+    return dict(zip(table["claim"], table["status"], strict=True))
+
+
+def load_baseline_readings(path) -> dict[str, tuple[str, ...]]:
+    """``{claim id: readings}`` recorded in a baseline CSV (its ``readings`` column).
+
+    Empty when the baseline records no readings: the readings its categories were computed at
+    are then unknown, and no claim of it can be compared reading for reading.
+    """
+    table = pd.read_csv(path, dtype=str, keep_default_na=False, comment="#")
+    if "readings" not in table:
+        return {}
+    return {claim: tuple(text.split(READINGS_SEPARATOR))
+            for claim, text in zip(table["claim"], table["readings"], strict=True)}
+
+
+def load_baseline_states(path) -> dict[str, dict]:
+    """``{claim id: {"states": {reading: state}, "joint": reading}}`` recorded in a baseline CSV: the
+    claim's state (``holds``, ``fails``, ``inconclusive``) at each of its readings and the reading of
+    its design its category was judged at besides the defaults (the joint reading's projection).
+    Empty when the baseline records no states."""
+    table = pd.read_csv(path, dtype=str, keep_default_na=False, comment="#")
+    if "states" not in table:
+        return {}
+    names = {letter: state for state, letter in STATE_LETTERS.items()}
+    return {claim: {"states": dict(zip(text.split(READINGS_SEPARATOR), (names[c] for c in letters),
+                                       strict=True)), "joint": joint}
+            for claim, text, letters, joint in zip(table["claim"], table["readings"], table["states"],
+                                                   table["joint"], strict=True)}
+
+
+def write_baseline(evaluated: pd.DataFrame, path, header: str = "") -> None:
+    """Write the claims' categories as a baseline CSV (``claim,status,readings,states,joint``),
+    atomically.
+
+    ``readings`` lists the readings each category was computed at (from the row's
+    ``depends_on``), so that two baselines are compared only where they evaluated the same
+    readings; ``states`` the claim's state at each
+    (:data:`passmd.ledger.baseline.STATE_LETTERS`, from the table's ``points``), ``joint`` the
+    reading of them its category was judged at besides the defaults (the joint reading's
+    projection; ``defaults`` for a study). ``header`` (e.g. the command and date that produced it)
+    is written as ``#`` lines.
+    """
+    path = Path(path)
+    table = evaluated[["claim", "status"]].copy()
+    depends = [tuple(d for d in text.split(";") if d) for text in evaluated["depends_on"]]
+    table["readings"] = [READINGS_SEPARATOR.join(readings_of(d)) for d in depends]
+    states = {(p["claim"], p["reading"]): p["state"] for p in evaluated.attrs.get("points", [])}
+    table["states"] = ["".join(STATE_LETTERS[states.get((claim, r), "inconclusive")] for r in readings_of(d))
+                       for claim, d in zip(evaluated["claim"], depends, strict=True)]
+    joint = evaluated.attrs.get("joint", {}).get("reading")
+    table["joint"] = [readings.describe(readings.project(joint, d)) if joint and not study else "defaults"
+                      for d, study in zip(depends, evaluated["study_of"].astype(bool), strict=True)]
+    tmp = path.with_name(f".{path.name}.tmp")
+    with open(tmp, "w", encoding="utf-8", newline="") as fh:
+        for line in header.splitlines():
+            fh.write(f"# {line}\n")
+        table.to_csv(fh, index=False, lineterminator="\n")
+    tmp.replace(path)
+
+
+def category_changes(evaluated: pd.DataFrame, baseline: Mapping[str, str]) -> pd.DataFrame:
+    """Every claim whose category differs from ``baseline`` (or that appeared or disappeared).
+
+    Columns ``claim``, ``baseline``, ``now`` (``"missing"`` where absent) and ``verdict``.
+    """
+    current = dict(zip(evaluated["claim"], evaluated["status"], strict=True))
+    verdicts = dict(zip(evaluated["claim"], evaluated["verdict"], strict=True))
+    rows = []
+    for claim in list(baseline) + [c for c in current if c not in baseline]:
+        before, now = baseline.get(claim, "missing"), current.get(claim, "missing")
+        if before != now:
+            rows.append({"claim": claim, "baseline": before, "now": now,
+                         "verdict": verdicts.get(claim, "claim no longer in the ledger")})
+    return pd.DataFrame(rows, columns=["claim", "baseline", "now", "verdict"])
+
+
+def check_categories(evaluated: pd.DataFrame, baseline: Mapping[str, str]) -> None:
+    """Raise ``AssertionError`` with a readable diff when any claim changed category."""
+    changed = category_changes(evaluated, baseline)
+    if len(changed):
+        lines = [f"{r.claim}: {r.baseline} -> {r.now} ({r.verdict})" for r in changed.itertuples()]
+        raise AssertionError(f"{len(lines)} claim(s) changed category against the baseline:\n  "
+                             + "\n  ".join(lines))
