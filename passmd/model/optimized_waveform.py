@@ -23,6 +23,7 @@ from passmd.model.waveforms import (
     Waveform,
     _flyback_time,
     check_flyback_fits,
+    flyback_rule,
     piecewise_linear,
     sawtooth,
 )
@@ -173,7 +174,7 @@ def optimized_timing(
     frequency: float,
     drive: Drive,
     *,
-    flyback: str = "slew",
+    flyback=None,
     min_ramp_fraction: float = MIN_RAMP_FRACTION,
     short_period: str = "cut",
 ) -> dict:
@@ -211,9 +212,9 @@ def optimized_timing(
     A = check_range("amplitude", amplitude, 0.0, a_max, lower_open=True, unit="m")
     f = check_positive("frequency", frequency, "Hz")
     frac = check_range("min_ramp_fraction", min_ramp_fraction, 0.0, 1.0, lower_open=True, upper_open=True)
-    check_choice("flyback", flyback, ("slew", "fixed"))
+    rule = flyback_rule(drive, flyback)
     T = 1.0 / f
-    t_fb = _flyback_time(A, drive, flyback)
+    t_fb = _flyback_time(A, drive, rule)
     check_flyback_fits(t_fb, f)
     if design.acceleration_amplitude >= A:
         d_a = design.acceleration_amplitude
@@ -253,7 +254,7 @@ def optimized(
     *,
     design: OptimizedDesign | None = None,
     first_period: str = "sawtooth",
-    flyback: str = "slew",
+    flyback=None,
     settle_fraction: float = SETTLE_FRACTION,
     min_ramp_fraction: float = MIN_RAMP_FRACTION,
     short_period: str = "cut",
@@ -283,8 +284,9 @@ def optimized(
         frequencies) or chosen by hand.
     first_period : {"sawtooth", "optimized"}
         Shape of the first period.
-    flyback : {"slew", "fixed"}
-        Fly-back rule (:func:`~passmd.model.waveforms.flyback_time`).
+    flyback : {"slew", "fixed"} or float, optional
+        Fly-back rule overriding the drive's (default None: the drive's;
+        :func:`~passmd.model.waveforms.flyback_time`).
     settle_fraction : float
         Part of each period's slow ramp, at its end, used as the settle window.
     min_ramp_fraction : float

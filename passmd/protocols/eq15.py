@@ -78,7 +78,7 @@ def optimized_design(
     acceleration_velocity: float | None = None,
     presliding: float | None = None,
     response_frequency: float = RESPONSE_FREQUENCY,
-    flyback: str = "slew",
+    flyback=None,
 ) -> OptimizedDesign:
     """Derive t_s, t_a and Δ_a of the optimized waveform from a simulated saw-tooth response (Eq. 15).
 
@@ -106,8 +106,9 @@ def optimized_design(
     response_frequency : float
         Saw-tooth frequency of the analysed response (Hz); default the protocol's driving
         frequency (:data:`passmd.model.defaults.PROTOCOL`).
-    flyback : {"slew", "fixed"}
-        Fly-back rule of that saw-tooth (:func:`~passmd.model.waveforms.flyback_time`).
+    flyback : {"slew", "fixed"} or float, optional
+        Fly-back rule of that saw-tooth, overriding the drive's (default None: the drive's;
+        :func:`~passmd.model.waveforms.flyback_time`).
 
     Raises
     ------

@@ -193,14 +193,14 @@ def simulate(args, drive, options: RunOptions):
         # Eq. 15, designed from this drive's own simulated saw-tooth response (first period a
         # saw-tooth, as in the paper); a ValueError (e.g. Δ_a ≥ A) is a usage error
         kernels.notice_if_cold()  # the design simulates: every option is checked by now
-        design = eq15.optimized_design(amplitude, drive, flyback=args.flyback)
+        design = eq15.optimized_design(amplitude, drive)
         if given:  # the user's values replace the design's (its f_s, V_r, u_x,max stay as measured)
             design = replace(design, **given)
         wave = optimized_waveform.optimized(amplitude, frequency, drive, periods=args.periods,
-                                            flyback=args.flyback, design=design)
+                                            design=design)
     else:
         design = None
-        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=args.periods, flyback=args.flyback)
+        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=args.periods)
         kernels.notice_if_cold()  # after the last check of the options: a refusal stays one line
     result = dynamics.simulate(
         drive, wave, contact_model="exact" if springs is None else "discrete",
@@ -278,7 +278,7 @@ def run_run(args, out) -> int:
     check_run_bounds(summary, drive, float(summary["amplitude_m"]))
     write_outputs(args, result)
     if args.json:
-        emit_json({"command": "run", "waveform": args.waveform, "flyback": args.flyback,
+        emit_json({"command": "run", "waveform": args.waveform, "flyback": drive.amplifier.flyback,
                    "protocol": "steady" if args.steady else "from rest",
                    "drive": drive_record(drive), **summary}, out)
         return 0
