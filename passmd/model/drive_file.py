@@ -408,12 +408,15 @@ def _shown(value, spec: DriveKey) -> str:
     return _number(value)  # a bare number: SI
 
 
-def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None = None) -> str:
+def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None = None,
+               damping_ratio: float | None = None) -> str:
     """A commented drive file of ``drive``: :func:`load_drive` reads it back to an equal drive.
 
     Every key is written, with its symbol, meaning, unit and source (``sources`` by key,
-    else the paper's source of the default). The viscosity is written as given (c_p), not
-    as ζ, so that it reads back exactly.
+    else the paper's source of the default). The viscosity is written as given (c_p), so that
+    it reads back exactly; ``damping_ratio``: write this ζ instead, for a drive whose c_p is
+    2ζ√(k_p m_a) of its own k_p and m_a (it then reads back exactly too, and ``drive show``
+    derives c_p from it).
     """
     if not isinstance(drive, Drive):
         raise InputError(f"drive = {drive!r} is not a Drive", name="drive", value=drive)
@@ -434,6 +437,9 @@ def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None =
             lines += ["", f"[{head}]"] if head else [""]
             section = head
         value = _field(drive, key)
+        if key == "actuator.viscosity" and damping_ratio is not None:
+            key, name, value = "actuator.damping_ratio", "damping_ratio", float(damping_ratio)
+            spec = DRIVE_KEYS[key]
         unit = f" [{spec.unit}]" if spec.unit in _SI_UNITS and spec.unit else ""
         source = sources.get(key, spec.source)
         lines.append(f"{name or key} = {_shown(value, spec)}  # {spec.symbol}: {spec.text}{unit}; {source}")

@@ -54,17 +54,18 @@ The code: :mod:`~passmd.protocols.fit.measurements` (the measurement files),
 :mod:`~passmd.protocols.fit.result` (:class:`~passmd.protocols.fit.result.FitResult`, the fitted
 drive file); every public name is importable from ``passmd.protocols.fit``."""
 
-from passmd.protocols.fit.estimator import GLOBAL_STARTS, JACOBIAN_STEP, LOSSES, ROUGHNESS_LIMIT, fit
-from passmd.protocols.fit.estimator import LOCAL_EVALUATIONS as LOCAL_EVALUATIONS
-from passmd.protocols.fit.estimator import LOCAL_STARTS as LOCAL_STARTS
-from passmd.protocols.fit.estimator import PROFILE_STEPS as PROFILE_STEPS
-from passmd.protocols.fit.estimator import PROFILE_TOLERANCE as PROFILE_TOLERANCE
-from passmd.protocols.fit.estimator import REFIT_MARGIN as REFIT_MARGIN
-from passmd.protocols.fit.estimator import REFITS as REFITS
-from passmd.protocols.fit.estimator import SCAN_HALF_WIDTH as SCAN_HALF_WIDTH
-from passmd.protocols.fit.estimator import SCAN_ROUNDS as SCAN_ROUNDS
-from passmd.protocols.fit.estimator import SCAN_SPACING as SCAN_SPACING
-from passmd.protocols.fit.free_parameters import FREE_PARAMETERS, FreeParameter, default_bounds
+from passmd.protocols.fit.checks import check_rows
+from passmd.protocols.fit.estimator import (
+    DISTINCT,
+    GLOBAL_POINTS_PER_PARAMETER,
+    LOCAL_STARTS,
+    LOSSES,
+    MAX_BASINS,
+    REFIT_MARGIN,
+    REFITS,
+    fit,
+)
+from passmd.protocols.fit.free_parameters import FREE_PARAMETERS, KEEPS, FreeParameter, default_bounds
 from passmd.protocols.fit.measurements import ANNOTATIONS as ANNOTATIONS
 from passmd.protocols.fit.measurements import (
     CONDITIONS,
@@ -78,25 +79,50 @@ from passmd.protocols.fit.measurements import (
 from passmd.protocols.fit.measurements import MODELS as MODELS
 from passmd.protocols.fit.measurements import READINGS as READINGS
 from passmd.protocols.fit.prediction import predict, predict_point
-from passmd.protocols.fit.result import CORRELATION_LIMIT, FitResult, fitted_drive_file
+from passmd.protocols.fit.problem import GN_STEP_LIMIT, JACOBIAN_STEP, LOCAL_EVALUATIONS
+from passmd.protocols.fit.profiles import COMB_WINDOW, DEEP_LEVELS, FILL_SWING, FINE_SPACING, PROFILE_POINTS
+from passmd.protocols.fit.regions import BASIN_PROMINENCE
+from passmd.protocols.fit.result import (
+    CORRELATION_LIMIT,
+    REJECT_P,
+    FitResult,
+    fitted_drive_file,
+    goodness_of_fit,
+)
 from passmd.runtime.validation import InputError as InputError
 
 __all__ = [
+    "BASIN_PROMINENCE",
+    "COMB_WINDOW",
     "CONDITIONS",
     "CORRELATION_LIMIT",
+    "DEEP_LEVELS",
+    "DISTINCT",
+    "FILL_SWING",
+    "FINE_SPACING",
     "FREE_PARAMETERS",
-    "GLOBAL_STARTS",
+    "GLOBAL_POINTS_PER_PARAMETER",
+    "GN_STEP_LIMIT",
     "JACOBIAN_STEP",
+    "KEEPS",
+    "LOCAL_EVALUATIONS",
+    "LOCAL_STARTS",
     "LOSSES",
+    "MAX_BASINS",
     "MEASURED",
+    "PROFILE_POINTS",
+    "REFITS",
+    "REFIT_MARGIN",
+    "REJECT_P",
     "FitResult",
     "FreeParameter",
     "Measurements",
     "MeasurementError",
-    "ROUGHNESS_LIMIT",
+    "check_rows",
     "default_bounds",
     "fit",
     "fitted_drive_file",
+    "goodness_of_fit",
     "measurements_from_rows",
     "predict",
     "predict_point",
