@@ -80,7 +80,14 @@ from passmd.protocols.fit.measurements import MODELS as MODELS
 from passmd.protocols.fit.measurements import READINGS as READINGS
 from passmd.protocols.fit.prediction import predict, predict_point
 from passmd.protocols.fit.problem import GN_STEP_LIMIT, JACOBIAN_STEP, LOCAL_EVALUATIONS
-from passmd.protocols.fit.profiles import COMB_WINDOW, DEEP_LEVELS, FILL_SWING, FINE_SPACING, PROFILE_POINTS
+from passmd.protocols.fit.profiles import (
+    DEEP_LEVELS,
+    FILL_BATCH,
+    FILL_DROP,
+    FINE_SPACING,
+    PROFILE_MIN_POINTS,
+    PROFILE_SPACING,
+)
 from passmd.protocols.fit.regions import BASIN_PROMINENCE
 from passmd.protocols.fit.result import (
     CORRELATION_LIMIT,
@@ -93,12 +100,12 @@ from passmd.runtime.validation import InputError as InputError
 
 __all__ = [
     "BASIN_PROMINENCE",
-    "COMB_WINDOW",
     "CONDITIONS",
     "CORRELATION_LIMIT",
     "DEEP_LEVELS",
     "DISTINCT",
-    "FILL_SWING",
+    "FILL_BATCH",
+    "FILL_DROP",
     "FINE_SPACING",
     "FREE_PARAMETERS",
     "GLOBAL_POINTS_PER_PARAMETER",
@@ -110,7 +117,8 @@ __all__ = [
     "LOSSES",
     "MAX_BASINS",
     "MEASURED",
-    "PROFILE_POINTS",
+    "PROFILE_MIN_POINTS",
+    "PROFILE_SPACING",
     "REFITS",
     "REFIT_MARGIN",
     "REJECT_P",

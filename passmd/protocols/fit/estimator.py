@@ -51,7 +51,7 @@ GLOBAL_POINTS_PER_PARAMETER = 64
 #: Local searches from the best distinct points of the global pass.
 LOCAL_STARTS = 2
 #: Function evaluations of each of these first searches (the profiles then search the whole range).
-FIRST_SEARCH_EVALUATIONS = 15
+FIRST_SEARCH_EVALUATIONS = 8
 #: Least distance (in the unit box of the log bounds) between two starts of local searches.
 DISTINCT = 0.05
 #: New polishes when a point below the estimate turns up while the basins' intervals are computed.
@@ -153,7 +153,7 @@ def fit(
     f_max = float(np.max(data.frequency))
     box = _check_bounds(drive, names, bounds, f_max)
     check_rows(drive, data, box)
-    say = progress or (lambda line: None)
+    report = progress or (lambda line: None)
     lo = np.log([box[k][0] for k in names])
     hi = np.log([box[k][1] for k in names])
     x_start = np.clip(np.log([max(FREE_PARAMETERS[k].get(drive), 1e-300) for k in names]), lo, hi)
@@ -164,6 +164,9 @@ def fit(
         pool = cf.ProcessPoolExecutor(max_workers=config.workers, initializer=sweep._ignore_sigint)
         chosen = pool
     model = _Model(drive, data, names, reading, executor=chosen, cache=cache, config=config, keep=keep)
+    def say(line: str) -> None:
+        report(f"{line} ({model.evaluations} parameter sets so far)")
+
     try:
         problem = Problem(model, data, _weights(data), lo, hi, loss)
         return _fit(problem, drive, names, box, x_start, reading, keep, seed, say, t0)
@@ -226,10 +229,8 @@ def _regions(problem, profiles, basin_list, x_hat, cost, s2, threshold, say):
     """Per parameter: pieces (log), the walk profile's flatness at a bound, and every basin's local
     intervals."""
     cut = cost + threshold * s2
-    local = []
-    for k, (x_b, c_b) in enumerate(basin_list):
-        say(f"basin {k + 1}/{len(basin_list)}: local intervals")
-        local.append(regions.basin_interval(problem, x_b, c_b, s2, threshold))
+    say(f"local intervals of {len(basin_list)} basin(s)")
+    local = regions.basin_intervals(problem, basin_list, s2, threshold)
     out = []
     for j in range(problem.p):
         t, c, _ = profiles[j].arrays()
@@ -253,11 +254,13 @@ def _fit(problem: Problem, drive, names, box, x_start, reading, keep, seed, say,
     say(f"profiles over the whole bounds from cost {cost:.5g}")
     profiles = {j: prof.Profile(j) for j in range(p)}
     prof.coarse(problem, profiles, x_hat, cost)
-    swings = prof.swing(problem, profiles, x_hat)
-    x_hat, cost = problem.best()
-    s2 = _s2(problem, cost)
-    walked = prof.fill(problem, profiles, swings, cost + threshold * s2, threshold * s2)
-    say(f"profiles walked at {prof.FINE_SPACING:.0%} over {walked} intervals that may hold a minimum")
+
+    def level() -> float:
+        c = problem.best()[1]
+        return c + threshold * _s2(problem, c)
+
+    walked = prof.fill(problem, profiles, level, lambda: threshold * _s2(problem, problem.best()[1]))
+    say(f"profiles sampled at {prof.FINE_SPACING:.0%} over {walked} intervals that may hold a minimum")
     x_hat, cost = problem.best()
     prof.deepen(problem, profiles, cost + threshold * _s2(problem, cost), threshold * _s2(problem, cost))
     converged, notes = True, []

@@ -62,16 +62,22 @@ def predict_point(drive: Drive, kind: str, amplitude: float, frequency: float, r
     return {"prediction": float(found["generated_force_N"]), "settled": bool(found["converged"])}
 
 
-def _row_drive(drive: Drive, data: Measurements, i: int) -> Drive:
-    """Row i's drive: ``drive`` at the row's preload, radius (Table 2 actuator for another radius),
-    number of contacts and actuator model, where the row gives them."""
+def _row_changes(drive: Drive, data: Measurements, i: int) -> dict:
+    """What row i changes of ``drive``: its preload, radius (with Table 2's actuator for another
+    radius), number of contacts and actuator model, where the row gives them."""
     changes = dict(data.model[i]) if data.model else {}
     if math.isfinite(data.preload[i]):
         changes["preload"] = float(data.preload[i])
     radius = data.radius[i]
     if math.isfinite(radius) and not math.isclose(radius, drive.hemisphere_radius, rel_tol=1e-12):
-        changes["hemisphere_radius"] = float(data.radius[i])
-        changes["actuator"] = actuator_for_radius(float(data.radius[i]))
+        changes["hemisphere_radius"] = float(radius)
+        changes["actuator"] = actuator_for_radius(float(radius))
+    return changes
+
+
+def _row_drive(drive: Drive, data: Measurements, i: int) -> Drive:
+    """Row i's drive (:func:`_row_changes` applied to ``drive``)."""
+    changes = _row_changes(drive, data, i)
     return replace(drive, **changes) if changes else drive
 
 
@@ -80,15 +86,51 @@ def _row_drives(drive: Drive, data: Measurements) -> list[Drive]:
     return [_row_drive(drive, data, i) for i in range(len(data))]
 
 
+def drive_at(base: Drive, names: Sequence[str], values: Sequence[float], zeta: float | None) -> Drive:
+    """``base`` with the free parameters ``names`` at ``values`` (SI; applied in their order), and, when
+    ``zeta`` is given, the viscosity 2ζ√(k_p m_a) of the new k_p and m_a (the damping ratio held)."""
+    d = base
+    for p in sorted((FREE_PARAMETERS[n] for n in names), key=lambda p: p.order):
+        d = p.set(d, float(values[list(names).index(p.name)]), base)
+    if zeta is not None:
+        act = d.actuator
+        d = replace(d, actuator=replace(act, viscosity=2.0 * zeta * math.sqrt(act.stiffness * act.mass)))
+    return d
+
+
+def predict_set(drive: Drive, names: tuple, values: tuple, zeta: float | None, rows: tuple, reading: str
+                ) -> dict:
+    """The model's value of every row at one parameter set (a sweep function: one cache entry per set).
+
+    ``rows``: per measurement ``(kind, amplitude, frequency, changes)``, ``changes`` the row's
+    changes of the drive as (field, value) pairs (:func:`_row_changes`). Returns ``predictions``
+    (SI) and ``settled`` per row (:func:`predict_point`).
+    """
+    at = drive_at(drive, names, values, zeta)
+    predictions, settled = [], []
+    for kind, amplitude, frequency, changes in rows:
+        changes = dict(changes)
+        if "actuator" in changes:  # another radius: Table 2's actuator, then the fitted values on it
+            row = drive_at(replace(drive, **changes), names, values, zeta)
+        else:
+            row = replace(at, **changes) if changes else at
+        out = predict_point(row, kind, amplitude, frequency, reading if kind == "critical_amplitude" else "")
+        predictions.append(out["prediction"])
+        settled.append(out["settled"])
+    return {"predictions": predictions, "settled": settled}
+
+
 class _Model:
-    """Predictions of all rows at parameter vectors (log space), through the sweep engine."""
+    """Predictions of all rows at parameter vectors (log space), through the sweep engine: one sweep
+    point (and cache entry) per parameter vector."""
 
     def __init__(self, drive, data, names, reading, *, executor, cache, config, keep="damping_ratio"):
-        self.drive, self.data, self.names, self.reading = drive, data, names, reading
+        self.drive, self.data, self.names, self.reading = drive, data, list(names), reading
         self.executor, self.cache, self.config, self.keep = executor, cache, config, keep
-        self.params = sorted((FREE_PARAMETERS[n] for n in names), key=lambda p: p.order)
-        self.index = {n: k for k, n in enumerate(names)}
-        self.rows = _row_drives(replace(drive, allow_extrapolation=True), data)
+        self.base = replace(drive, allow_extrapolation=True)
+        self.rows = tuple((data.kind[i], float(np.nan_to_num(data.amplitude[i])), float(data.frequency[i]),
+                           tuple(sorted(_row_changes(self.base, data, i).items())))
+                          for i in range(len(data)))
         self.memo: dict[bytes, np.ndarray] = {}
         self.settled: dict[bytes, np.ndarray] = {}
         self.simulations = 0
@@ -101,37 +143,23 @@ class _Model:
             self.zeta = drive.actuator.damping_ratio
 
     def drive_at(self, x, base: Drive) -> Drive:
-        d = base
-        for p in self.params:
-            d = p.set(d, float(np.exp(x[self.index[p.name]])), base)
-        if self.zeta is not None:
-            act = d.actuator
-            viscosity = 2.0 * self.zeta * math.sqrt(act.stiffness * act.mass)
-            d = replace(d, actuator=replace(act, viscosity=viscosity))
-        return d
+        """``base`` at the log-parameter vector x."""
+        return drive_at(base, self.names, np.exp(np.asarray(x, float)).tolist(), self.zeta)
 
     def evaluate(self, xs: Sequence[np.ndarray]) -> list[np.ndarray]:
         """Predictions (SI, one array per vector); vectors already computed come from memory."""
         keys = [np.asarray(x, float).tobytes() for x in xs]
         todo = list(dict.fromkeys(k for k in keys if k not in self.memo))
         if todo:
-            points = []
-            for k in todo:
-                x = np.frombuffer(k)
-                for i, base in enumerate(self.rows):
-                    points.append({"drive": self.drive_at(x, base), "kind": self.data.kind[i],
-                                   "amplitude": float(np.nan_to_num(self.data.amplitude[i])),
-                                   "frequency": float(self.data.frequency[i]),
-                                   "reading": (self.reading if self.data.kind[i] == "critical_amplitude"
-                                               else "")})
-            frame = sweep.run(predict_point, points, executor=self.executor, cache=self.cache, progress=False,
+            points = [{"drive": self.base, "names": tuple(self.names),
+                       "values": tuple(np.exp(np.frombuffer(k)).tolist()), "zeta": self.zeta,
+                       "rows": self.rows, "reading": self.reading} for k in todo]
+            frame = sweep.run(predict_set, points, executor=self.executor, cache=self.cache, progress=False,
                               config=self.config)
-            values = frame["prediction"].to_numpy(float).reshape(len(todo), len(self.rows))
-            settled = frame["settled"].to_numpy(bool).reshape(len(todo), len(self.rows))
-            for k, v, s in zip(todo, values, settled, strict=True):
-                self.memo[k] = v
-                self.settled[k] = s
-            self.simulations += frame.attrs["sweep"]["computed"]
+            for k, v, s in zip(todo, frame["predictions"], frame["settled"], strict=True):
+                self.memo[k] = np.asarray(v, float)
+                self.settled[k] = np.asarray(s, bool)
+            self.simulations += frame.attrs["sweep"]["computed"] * len(self.rows)
             self.evaluations += len(todo)
         return [self.memo[k] for k in keys]
 

@@ -7,14 +7,15 @@ stiffness (the runner's residual vibration meets the next fly-back at a phase th
 k_p: a period of 7–12 % of k_p, ±1.5–3 nm at 100 Hz), so along k_p the cost is a comb whose teeth
 a local search or a local profile cannot see past. The profile is therefore built in stages:
 
-1. **Coarse**: :data:`PROFILE_POINTS` points evenly spaced in log over the whole bounds, walked
-   outward from the estimate (:func:`coarse`).
-2. **Swing**: a fine walk (:data:`FINE_SPACING`) of :data:`COMB_WINDOW` points either side of the
-   estimate measures how far the cost swings between neighbouring teeth (:func:`swing`).
-3. **Fill**: every coarse interval whose lower end lies within :data:`FILL_SWING` swings of the
-   95 % level may hold a tooth within the level that the coarse grid stepped over; it is sampled
-   at :data:`FINE_SPACING`, a fifth of the comb's shortest period (:func:`fill`).
-4. **Deepen**: around each local minimum within reach of the level the grid is halved
+1. **Coarse**: points :data:`PROFILE_SPACING` apart in log (at least :data:`PROFILE_MIN_POINTS`)
+   over the whole bounds, walked outward from the estimate (:func:`coarse`).
+2. **Fill**: a coarse interval may hold a tooth within the 95 % level that the coarse grid
+   stepped over. The lowest intervals of each parameter are sampled at :data:`FINE_SPACING` (a
+   fifth of the comb's shortest period) first; how far their fine points drop below the lower end
+   of their interval measures how deep a tooth can hide between two coarse points, and every
+   interval whose lower end lies within :data:`FILL_DROP` such drops above the level is sampled
+   too, most promising first, in batches of :data:`FILL_BATCH` (:func:`fill`).
+3. **Deepen**: around each local minimum within reach of the level the grid is halved
    :data:`DEEP_LEVELS` times (:func:`deepen`).
 
 Every point evaluated on the way joins the problem's archive, whose lowest point is the estimate.
@@ -23,27 +24,30 @@ Every point evaluated on the way joins the problem's archive, whose lowest point
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from passmd.protocols.fit.problem import Problem
 
-__all__ = ["COMB_WINDOW", "DEEP_LEVELS", "FILL_SWING", "FINE_SPACING", "PROFILE_POINTS", "Profile", "coarse",
-           "deepen", "fill", "swing", "walk"]
+__all__ = ["DEEP_LEVELS", "FILL_BATCH", "FILL_DROP", "FINE_SPACING", "PROFILE_MIN_POINTS", "PROFILE_SPACING",
+           "Profile", "coarse", "deepen", "fill", "walk"]
 
-#: Points of the coarse profile over a parameter's whole bounds (evenly spaced in log, both ends
-#: included): the k_p range of 4e4–6.5e8 N/m in steps of 23 %, enough to follow the cost's trend.
-PROFILE_POINTS = 48
+#: Spacing of the coarse profile over a parameter's whole bounds (log units: 16 %), so that of the two
+#: coarse points around any value one lies within 8 % of it, about one period of the comb.
+PROFILE_SPACING = 0.15
+#: Fewest points of a coarse profile (a narrow range still gets a profile).
+PROFILE_MIN_POINTS = 16
 #: Spacing of the fine profile (log units, 1 %): a fifth of the shortest period of the step's
 #: oscillation in k_p seen at 100 Hz (about 7 %), so every tooth of the comb holds several points.
 FINE_SPACING = 0.01
-#: Fine points either side of the estimate over which the profile's swing is measured (±6 %: most of
-#: a period of the comb).
-COMB_WINDOW = 6
-#: An interval of the coarse profile is sampled finely when its lower end is within this many swings
-#: of the profile near the estimate above the 95 % level (the comb's depth varies along k_p).
-FILL_SWING = 2.0
+#: Coarse intervals sampled per batch (per parameter in the first batch).
+FILL_BATCH = 4
+#: A coarse interval is sampled when its lower end lies within this many times the largest drop seen
+#: so far above the 95 % level: a tooth the coarse grid stepped over lies at most about one such drop
+#: below its interval's lower end.
+FILL_DROP = 2.0
 #: Halvings of the grid around a local minimum within reach of the 95 % level (to 0.25 %).
 DEEP_LEVELS = 2
 
@@ -87,33 +91,16 @@ def walk(problem: Problem, profiles: dict[int, Profile], walkers: list[tuple[int
 
 
 def coarse(problem: Problem, profiles: dict[int, Profile], x_hat: np.ndarray, cost: float) -> None:
-    """The coarse profile of every parameter: :data:`PROFILE_POINTS` over its bounds, walked outward
-    from the estimate on both sides."""
+    """The coarse profile of every parameter over its bounds (module docstring), walked outward from
+    the estimate on both sides."""
     walkers = []
     for j in range(problem.p):
         profiles[j].add(x_hat[j], cost, x_hat)
-        grid = np.linspace(problem.lo[j], problem.hi[j], PROFILE_POINTS)
+        points = max(PROFILE_MIN_POINTS, math.ceil((problem.hi[j] - problem.lo[j]) / PROFILE_SPACING) + 1)
+        grid = np.linspace(problem.lo[j], problem.hi[j], points)
         walkers.append((j, [float(t) for t in grid[grid > x_hat[j]]], x_hat))
         walkers.append((j, [float(t) for t in grid[grid < x_hat[j]][::-1]], x_hat))
     walk(problem, profiles, walkers)
-
-
-def swing(problem: Problem, profiles: dict[int, Profile], x_hat: np.ndarray) -> dict[int, float]:
-    """Per parameter, the swing of its profile (highest minus lowest cost) over a fine walk of
-    :data:`COMB_WINDOW` points either side of the estimate: how much the cost can change between two
-    points of the coarse grid without their showing it (the comb's depth near the minimum)."""
-    walkers = []
-    for j in range(problem.p):
-        for sign in (1.0, -1.0):
-            ts = [x_hat[j] + sign * k * FINE_SPACING for k in range(1, COMB_WINDOW + 1)]
-            walkers.append((j, [t for t in ts if problem.lo[j] <= t <= problem.hi[j]], x_hat))
-    walk(problem, profiles, walkers)
-    out = {}
-    for j in range(problem.p):
-        t, c, _ = profiles[j].arrays()
-        near = np.abs(t - x_hat[j]) <= COMB_WINDOW * FINE_SPACING * (1 + 1e-9)
-        out[j] = float(np.max(c[near]) - np.min(c[near])) if np.count_nonzero(near) > 1 else 0.0
-    return out
 
 
 def _projected(problem: Problem, x: np.ndarray, jac: np.ndarray) -> float:
@@ -125,32 +112,56 @@ def _projected(problem: Problem, x: np.ndarray, jac: np.ndarray) -> float:
     return float(np.sum((r + jac @ step) ** 2))
 
 
-def fill(problem: Problem, profiles: dict[int, Profile], swings: dict[int, float], cut: float,
-         margin: float) -> int:
-    """Sample at :data:`FINE_SPACING` every interval of a profile whose lower end lies within
-    ``cut`` + :data:`FILL_SWING` × the parameter's swing (:func:`swing`), so that no tooth of a comb
-    within the level is stepped over; returns the number of intervals sampled.
+def fill(problem: Problem, profiles: dict[int, Profile], level: Callable[[], float],
+         margin: Callable[[], float]) -> int:
+    """Sample at :data:`FINE_SPACING` the coarse intervals that may hold a minimum within the 95 % level
+    (module docstring), most promising first; returns the number of intervals sampled.
 
-    Each fine point is evaluated once, the others interpolated between the interval's ends, and
-    its cost projected through the nearer end's Jacobian of the others (one linear step); the
-    points whose projected cost is within ``cut + margin`` then get a Gauss–Newton step
-    (:meth:`~passmd.protocols.fit.problem.Problem.conditional`).
+    ``level()`` gives the current 95 % level, ``margin()`` the 95 % rise. First the
+    :data:`FILL_BATCH` lowest intervals of each parameter; then, batch by batch, every interval
+    whose lower end lies within :data:`FILL_DROP` × the largest drop seen so far (how far below the
+    lower end of its interval a sampled point went) above the level.
     """
+    done: set[tuple[int, float]] = set()
+    drops = dict.fromkeys(profiles, 0.0)
+    first = True
+    while True:
+        cut = level()
+        candidates = []
+        for j, profile in profiles.items():
+            t, c, xs = profile.arrays()
+            coarse = [k for k in range(t.size - 1) if t[k + 1] - t[k] > 1.5 * FINE_SPACING
+                      and (j, float(t[k])) not in done]
+            mine = sorted((min(c[k], c[k + 1]), j, k, t, c, xs) for k in coarse)
+            reach = cut + FILL_DROP * drops[j]
+            candidates += mine[:FILL_BATCH] if first else [m for m in mine if m[0] <= reach]
+        first = False
+        if not candidates:
+            return len(done)
+        candidates.sort(key=lambda item: item[0])
+        batch = candidates[:FILL_BATCH * (len(profiles) if len(done) == 0 else 1)]
+        done.update((j, float(t[k])) for _, j, k, t, _, _ in batch)
+        _sample(problem, profiles, [(j, t[k], t[k + 1], xs[k], xs[k + 1]) for _, j, k, t, _, xs in batch],
+                level() + margin())
+        for low, j, k, t, _, _ in batch:
+            tt, cc, _ = profiles[j].arrays()
+            inside = (tt > t[k]) & (tt < t[k + 1])
+            if inside.any():
+                drops[j] = max(drops[j], low - float(cc[inside].min()))
+
+
+def _sample(problem: Problem, profiles: dict[int, Profile], intervals, cut: float) -> None:
+    """Fine points of each interval (j, a, b, x_a, x_b), one evaluation each, the others interpolated
+    between the ends', and a Gauss–Newton step where the cost projected through the nearer end's
+    Jacobian of the others is within ``cut`` (:func:`fill`)."""
     jobs = []
-    for j, profile in profiles.items():
-        t, c, xs = profile.arrays()
-        for k in range(t.size - 1):
-            a, b = t[k], t[k + 1]
-            if b - a <= 1.5 * FINE_SPACING or min(c[k], c[k + 1]) > cut + FILL_SWING * swings[j]:
-                continue
-            m = math.ceil((b - a) / FINE_SPACING)
-            for i in range(1, m):
-                w = i / m
-                x = (1.0 - w) * xs[k] + w * xs[k + 1]
-                x[j] = a + w * (b - a)
-                jobs.append((j, x, xs[k] if w <= 0.5 else xs[k + 1]))
-    if not jobs:
-        return 0
+    for j, a, b, xa, xb in intervals:
+        m = math.ceil((b - a) / FINE_SPACING)
+        for i in range(1, m):
+            w = i / m
+            x = (1.0 - w) * xa + w * xb
+            x[j] = a + w * (b - a)
+            jobs.append((j, x, xa if w <= 0.5 else xb))
     cols = {j: [k for k in range(problem.p) if k != j] for j in profiles}
     ends = {(e.tobytes(), j): (e, j) for j, _, e in jobs}
     batch = [x for _, x, _ in jobs]
@@ -161,12 +172,11 @@ def fill(problem: Problem, profiles: dict[int, Profile], swings: dict[int, float
     tasks = []
     for j, x, e in jobs:
         profiles[j].add(x[j], problem.archive[x.tobytes()][1], x)
-        if _projected(problem, x, jacobians[(e.tobytes(), j)]) <= cut + margin:
+        if _projected(problem, x, jacobians[(e.tobytes(), j)]) <= cut:
             tasks.append((j, x[j], x))
     if tasks:
         for (j, t, _), (x, c) in zip(tasks, problem.conditional(tasks), strict=True):
             profiles[j].add(t, c, x)
-    return len(ends)
 
 
 def deepen(problem: Problem, profiles: dict[int, Profile], cut: float, margin: float) -> None:

@@ -4,7 +4,7 @@ A parameter's region is every value whose profile lies within the χ² quantile 
 (:func:`pieces` of the profile). A parameter whose profile is multimodal because *another*
 parameter is (a μ profile walked with k_p inside one tooth of its comb) is covered by the basins:
 every local minimum of any profile within the level (:func:`basins`, prominence at least
-:data:`BASIN_PROMINENCE`) adds its own local interval of each parameter (:func:`basin_interval`,
+:data:`BASIN_PROMINENCE`) adds its own local interval of each parameter (:func:`basin_intervals`,
 a profile end found on the signed root of the cost rise). The union of both, merged where they
 overlap, is the region; several separate pieces mean the parameter is known only to that set.
 :func:`separating_row` computes which one added measurement would best tell the basins apart.
@@ -17,8 +17,9 @@ import math
 import numpy as np
 
 from passmd.protocols.fit.problem import Problem
+from passmd.protocols.fit.profiles import FINE_SPACING as FINE
 
-__all__ = ["BASIN_PROMINENCE", "END_ITERATIONS", "END_TOLERANCE", "basin_interval", "basins", "merge",
+__all__ = ["BASIN_PROMINENCE", "END_ITERATIONS", "END_TOLERANCE", "basin_intervals", "basins", "merge",
            "pieces"]
 
 #: Least rise (in units of the residual variance s²) between a basin and a lower one: smaller dips
@@ -86,64 +87,90 @@ def basins(t: np.ndarray, c: np.ndarray, cut: float, prominence: float) -> list[
     return out
 
 
-def basin_interval(problem: Problem, x_b: np.ndarray, c_b: float, s2: float, threshold: float
-                   ) -> tuple[list[list[float]], list[bool]]:
-    """Each parameter's local 95 % interval around the basin minimum ``x_b`` (log): the end on either
-    side where the cost, re-minimised over the others (started on the covariance's regression
-    line), has risen by ``threshold`` · s². Returns the intervals and, per parameter, whether an
-    end reached a bound with the rise still below the threshold."""
-    _, jac = problem.fun_jac(x_b)
-    cov = s2 * np.linalg.pinv(jac.T @ jac)
+def basin_intervals(problem: Problem, basin_list: list[tuple[np.ndarray, float]], s2: float, threshold: float
+                    ) -> list[tuple[list[list[float]], list[bool]]]:
+    """Each basin's local 95 % interval of every parameter (log): the end on either side where the
+    cost, re-minimised over the others (started on the basin's covariance regression line), has
+    risen by ``threshold`` · s², found on the signed root of the rise (:data:`END_ITERATIONS` secant
+    steps, all ends of all basins in lockstep). Returns per basin the intervals and, per parameter,
+    whether an end reached a bound with the rise still below the threshold."""
     p = problem.p
-    intervals, flat = [], []
-    for j in range(p):
-        others = [k for k in range(p) if k != j]
-        slope = cov[others, j] / cov[j, j] if others and cov[j, j] > 0 else np.zeros(len(others))
-        se = math.sqrt(max(cov[j, j], 0.0))
-        ends, reached = [], False
-        for sign in (-1.0, 1.0):
-            end, at_bound = _end(problem, j, others, slope, x_b, c_b, s2, threshold, sign, se)
-            ends.append(end)
-            reached = reached or at_bound
-        intervals.append(sorted(ends))
-        flat.append(reached)
-    return intervals, flat
-
-
-def _end(problem, j, others, slope, x_b, c_b, s2, threshold, sign, se) -> tuple[float, bool]:
-    """One end of a basin's local interval (module docstring): (end, reached a bound)."""
-    limit = (problem.lo if sign < 0 else problem.hi)[j]
-    room = abs(limit - x_b[j])
-    if room <= 0.0:
-        return float(limit), False
-
-    def rise(delta):
-        x0 = np.array(x_b, float)
-        x0[j] = x_b[j] + sign * delta
-        if others:
-            x0[others] = np.clip(x_b[others] + slope * sign * delta, problem.lo[others], problem.hi[others])
-        (_, c), = problem.conditional([(j, x0[j], x0)])
-        return max((c - c_b) / s2, 0.0)
-
-    delta = min(max(math.sqrt(threshold) * se, 0.005), room) if math.isfinite(se) and se > 0 else room
-    inside, outside = (0.0, 0.0), None  # (delta, rise) below and above the threshold
+    ends = []
+    for b, (x_b, c_b) in enumerate(basin_list):
+        _, jac = problem.fun_jac(x_b)
+        cov = s2 * np.linalg.pinv(jac.T @ jac)
+        for j in range(p):
+            others = [k for k in range(p) if k != j]
+            slope = cov[others, j] / cov[j, j] if others and cov[j, j] > 0 else np.zeros(len(others))
+            se = math.sqrt(max(cov[j, j], 0.0))
+            for sign in (-1.0, 1.0):
+                ends.append(_End(problem, b, j, sign, others, slope, x_b, c_b, se, threshold))
     for _ in range(END_ITERATIONS + 1):
-        v = rise(delta)
+        active = [e for e in ends if e.result is None]
+        if not active:
+            break
+        results = problem.conditional([e.task() for e in active])
+        for e, (_, c) in zip(active, results, strict=True):
+            e.update(max((c - e.c_b) / s2, 0.0), threshold)
+    out = []
+    for b in range(len(basin_list)):
+        intervals, flat = [], []
+        for j in range(p):
+            pair = [e for e in ends if e.b == b and e.j == j]
+            intervals.append(sorted(e.final() for e in pair))
+            flat.append(any(e.at_bound for e in pair))
+        out.append((intervals, flat))
+    return out
+
+
+class _End:
+    """One end of a basin's local interval of parameter j on side ``sign`` (:func:`basin_intervals`)."""
+
+    def __init__(self, problem, b, j, sign, others, slope, x_b, c_b, se, threshold):
+        self.problem, self.b, self.j, self.sign, self.others, self.slope = problem, b, j, sign, others, slope
+        self.x_b, self.c_b = x_b, c_b
+        self.limit = float((problem.lo if sign < 0 else problem.hi)[j])
+        self.room = abs(self.limit - x_b[j])
+        self.inside, self.outside = (0.0, 0.0), None  # (delta, rise) below and above the threshold
+        self.at_bound = False
+        self.result = self.limit if self.room <= 0.0 else None
+        guess = math.sqrt(threshold) * se if math.isfinite(se) and se > 0 else self.room
+        self.delta = min(max(guess, 0.2 * FINE), self.room)
+
+    def task(self):
+        x0 = np.array(self.x_b, float)
+        x0[self.j] = self.x_b[self.j] + self.sign * self.delta
+        if self.others:
+            lo, hi = self.problem.lo[self.others], self.problem.hi[self.others]
+            x0[self.others] = np.clip(self.x_b[self.others] + self.slope * self.sign * self.delta, lo, hi)
+        return self.j, x0[self.j], x0
+
+    def update(self, v: float, threshold: float) -> None:
+        delta = self.delta
         if abs(v - threshold) <= END_TOLERANCE * threshold:
-            return float(x_b[j] + sign * delta), False
+            self.result = float(self.x_b[self.j] + self.sign * delta)
+            return
         if v < threshold:
-            inside = max(inside, (delta, v))
-            if delta >= room:
-                return float(limit), True
+            self.inside = max(self.inside, (delta, v))
+            if delta >= self.room:
+                self.result, self.at_bound = self.limit, True
+                return
+        elif self.outside is None or delta < self.outside[0]:
+            self.outside = (delta, v)
+        if self.outside is None:  # the signed root of the rise is about linear in delta: extrapolate
+            self.delta = min(self.room, delta * math.sqrt(threshold / max(v, 1e-12 * threshold)) * 1.05,
+                             4.0 * delta)
         else:
-            outside = (delta, v) if outside is None or delta < outside[0] else outside
-        if outside is None:  # the signed root of the rise is about linear in delta: extrapolate
-            delta = min(room, delta * math.sqrt(threshold / max(v, 1e-12 * threshold)) * 1.05, 4.0 * delta)
-        else:
-            a, b = math.sqrt(inside[1]), math.sqrt(outside[1])
-            delta = inside[0] + (outside[0] - inside[0]) * (math.sqrt(threshold) - a) / (b - a)
-    if outside is None:
-        return float(x_b[j] + sign * inside[0]), False
-    a, b = math.sqrt(inside[1]), math.sqrt(outside[1])
-    delta = inside[0] + (outside[0] - inside[0]) * (math.sqrt(threshold) - a) / (b - a)
-    return float(x_b[j] + sign * delta), False
+            self.delta = self._interpolated(threshold)
+
+    def _interpolated(self, threshold: float) -> float:
+        a, b = math.sqrt(self.inside[1]), math.sqrt(self.outside[1])
+        return self.inside[0] + (self.outside[0] - self.inside[0]) * (math.sqrt(threshold) - a) / (b - a)
+
+    def final(self) -> float:
+        if self.result is not None:
+            return self.result
+        if self.outside is None:
+            return float(self.x_b[self.j] + self.sign * self.inside[0])
+        threshold_delta = self.delta  # the last interpolation
+        return float(self.x_b[self.j] + self.sign * threshold_delta)

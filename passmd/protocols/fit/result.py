@@ -155,7 +155,9 @@ def _fixed(drive: Drive, names, keep: str) -> str:
         held = [h for h in held if h not in ("k_p", "m_a", "ζ")]
     moving = {"actuator.stiffness", "actuator.mass"} & set(names) and not {
         "actuator.viscosity", "actuator.damping_ratio"} & set(names)
-    held_text = ", ".join(held) + (f"; while k_p or m_a moves, {keep.replace('_', ' ')} stays" if moving else "")
+    held_text = ", ".join(held)
+    if moving:
+        held_text += f"; while k_p or m_a moves, {keep.replace('_', ' ')} stays"
     return (f"the fly-back rule ({flyback}; --flyback), the reading of each measured quantity (a step or "
             "velocity is the settled one of a running drive; position_nm a run of three periods from rest), "
             f"the parameters held fixed ({held_text}), the {drive.contacts}-contact arrangement and the "

@@ -1,0 +1,164 @@
+"""The calibration of the chapter "Design your own drive" and of the calibration chapter: measurements
+made by other means than the fit's forward model, and the fits' facts.
+
+A fit checked only on data its own forward model made hides what the model and the data do
+not share. :func:`independent_steps` makes steady steps another way: the integrator refined
+(:data:`REFINE`, the ``scheme`` "controlled" at a finer step and tighter local error), a run of
+:data:`PERIODS` periods from rest and its *last* step, and optionally another fly-back rule
+than the drive's (the mis-specified case a goodness-of-fit test must reject).
+:func:`synthetic_measurements` adds Gaussian noise of a stated sd. The example drive's round
+trip (:func:`calibrate`, :func:`heldback_predictions`) is what the design chapter shows.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from passmd.experiments.design.figures import FIT_FREQUENCY, NOISE_NM, PROFILE_SETTINGS, SEED, _run_config
+from passmd.model.drive_file import load_drive
+from passmd.model.parameters import Drive
+from passmd.model.tables import actuator_for_radius
+from passmd.model.waveforms import sawtooth
+from passmd.protocols import fit as fitting
+from passmd.runtime import sweep
+from passmd.runtime.config import RunConfig
+from passmd.solver import simulation as dynamics
+from passmd.solver.steps import SCHEMES
+
+__all__ = ["PERIODS", "REFINE", "calibrate", "fit_facts", "heldback_facts", "heldback_predictions",
+           "independent_step", "independent_steps", "load_fitted", "measurements_csv", "start_drive",
+           "synthetic_measurements"]
+
+#: Refinement of the integrator for the independent data (steps halved, local error 16× tighter).
+REFINE = 2.0
+#: Periods of the independent data's runs from rest; their last step is the measurement.
+PERIODS = 16
+
+
+def independent_step(drive: Drive, amplitude: float, frequency: float, periods: int = PERIODS,
+                     refine: float = REFINE, flyback=None) -> dict:
+    """The last step of a ``periods``-period saw-tooth run from rest with the refined integrator (a sweep
+    function): ``{"step_m": ...}``."""
+    wave = sawtooth(amplitude, frequency, drive, periods=periods, flyback=flyback)
+    result = dynamics.simulate(drive, wave, scheme=SCHEMES["controlled"].replace(refine=refine), max_points=2)
+    return {"step_m": float(result.step_sizes[-1])}
+
+
+def independent_steps(drive: Drive, conditions, *, flyback=None, config: RunConfig | None = None,
+                      executor: str | None = "serial", cache=False) -> np.ndarray:
+    """Steps (m) at ``conditions`` = [(preload N, amplitude m, frequency Hz), ...] of ``drive`` made by
+    :func:`independent_step` (``flyback`` overrides the drive's rule), through the sweep engine."""
+    points = [{"drive": replace(drive, preload=float(p)), "amplitude": float(a), "frequency": float(f),
+               "periods": PERIODS, "refine": REFINE, "flyback": flyback} for p, a, f in conditions]
+    frame = sweep.run(independent_step, points, executor=executor, cache=cache, progress=False, config=config)
+    return frame["step_m"].to_numpy(float)
+
+
+def start_drive(truth: Drive, profile: str) -> Drive:
+    """A designer's first guess: ``truth`` with each free parameter at the paper's value
+    (:data:`passmd.experiments.design.figures.START`)."""
+    drive = truth
+    for name in PROFILE_SETTINGS[profile].free:
+        if name == "friction_coefficient":
+            drive = replace(drive, friction_coefficient=Drive().friction_coefficient)
+        elif name == "actuator.stiffness":
+            table2 = actuator_for_radius(truth.hemisphere_radius).stiffness
+            drive = fitting.FREE_PARAMETERS[name].set(drive, table2, truth)
+    return drive
+
+
+def _measurements(points, truth: Drive, rng, config, flyback=None) -> fitting.Measurements:
+    """Steps at (frequency, preload, amplitude nm) points: :func:`independent_steps` below 1 kHz (the
+    steady-velocity protocol's step above, as a stand measures it there) plus noise of NOISE_NM."""
+    header = ["amplitude_nm", "preload_N", "frequency_Hz", "step_nm", "step_nm_sd"]
+    rows = [[repr(float(a)), repr(float(p)), repr(float(f)), "0", repr(NOISE_NM)] for f, p, a in points]
+    data = fitting.measurements_from_rows(header, rows, name="synthetic measurements")
+    low = [i for i, (f, _, _) in enumerate(points) if f < 1e3]
+    exact = fitting.predict(truth, data, config=config)  # the steady-velocity protocol above 1 kHz
+    if low:
+        conditions = [(points[i][1], points[i][2] * 1e-9, points[i][0]) for i in low]
+        exact[low] = independent_steps(truth, conditions, flyback=flyback, config=config, executor=None,
+                                       cache=True)
+    return replace(data, value=exact + rng.normal(0.0, NOISE_NM * 1e-9, exact.size))
+
+
+def synthetic_measurements(truth: Drive, profile: str, config: RunConfig | None = None, flyback=None
+                           ) -> tuple[fitting.Measurements, fitting.Measurements]:
+    """Steps of ``truth`` made independently of the fit's forward model (:func:`independent_steps`),
+    plus Gaussian noise of NOISE_NM (seed SEED): ``(fit data, held-back data)``; ``flyback``
+    overrides the drive's fly-back rule in the data (a mis-specified model)."""
+    s = PROFILE_SETTINGS[profile]
+    config = _run_config(config, profile)
+    rng = np.random.default_rng(SEED)
+    fit_points = [(FIT_FREQUENCY, p, a) for p in s.fit_preloads for a in s.fit_amplitudes_nm]
+    return (_measurements(fit_points, truth, rng, config, flyback),
+            _measurements(s.heldback, truth, rng, config, flyback))
+
+
+def measurements_csv(data: fitting.Measurements) -> str:
+    """The text of the measurement CSV that ``passmd fit`` reads
+    (:func:`passmd.protocols.fit.measurements.write_measurements`)."""
+    with tempfile.TemporaryDirectory(prefix="passmd-design-") as folder:
+        path = Path(folder) / "measurements.csv"
+        fitting.write_measurements(path, data)
+        return path.read_text(encoding="utf-8")
+
+
+def calibrate(start: Drive, data: fitting.Measurements, profile: str,
+              config: RunConfig | None = None) -> fitting.FitResult:
+    """The fit of the profile's free parameters to ``data`` from ``start`` (``passmd fit``'s defaults)."""
+    return fitting.fit(start, data, list(PROFILE_SETTINGS[profile].free), config=_run_config(config, profile))
+
+
+def load_fitted(text: str) -> Drive:
+    """The drive a drive file's text describes, read as ``--drive`` reads a file
+    (:func:`passmd.model.drive_file.load_drive`)."""
+    with tempfile.TemporaryDirectory(prefix="passmd-design-") as folder:
+        path = Path(folder) / "fitted-drive.toml"
+        path.write_text(text, encoding="utf-8")
+        return load_drive(path)
+
+
+def heldback_predictions(heldback: fitting.Measurements, drives: dict[str, Drive], profile: str,
+                         config: RunConfig | None = None) -> pd.DataFrame:
+    """The held-back measurements and each drive's prediction of them (nm), one row per point.
+
+    ``drives``: label -> drive (e.g. the first guess and the fitted drive); a column
+    ``<label>_nm`` each.
+    """
+    out = pd.DataFrame({"frequency_Hz": heldback.frequency, "preload_N": heldback.preload,
+                        "amplitude_nm": heldback.amplitude * 1e9, "measured_nm": heldback.value * 1e9,
+                        "sd_nm": heldback.sd * 1e9})
+    config = _run_config(config, profile)
+    for label, drive in drives.items():
+        out[f"{label}_nm"] = fitting.predict(drive, heldback, config=config) * 1e9
+    return out
+
+
+def fit_facts(result: fitting.FitResult, truth: Drive, start: Drive) -> pd.DataFrame:
+    """One row per free parameter: the value simulated (truth), the first guess, the estimate, its
+    local standard error, its 95 % region (pieces, and their hull) and whether the region holds the
+    truth (SI)."""
+    rows = []
+    for name in result.names:
+        p = fitting.FREE_PARAMETERS[name]
+        est = result.estimates[name]
+        low, high = est["interval"]
+        rows.append({"parameter": name, "symbol": p.symbol, "unit": p.unit, "truth": p.get(truth),
+                     "start": p.get(start), "estimate": est["value"], "stderr": est["stderr"],
+                     "low": low, "high": high, "pieces": len(est["intervals"]),
+                     "holds_truth": any(a <= p.get(truth) <= b for a, b in est["intervals"])})
+    return pd.DataFrame(rows)
+
+
+def heldback_facts(table: pd.DataFrame, labels=("start", "fitted")) -> dict:
+    """Root-mean-square deviation (nm) of each drive's predictions from the held-back measurements."""
+    out = {"heldback_points": len(table)}
+    for label in labels:
+        out[f"rms_{label}_nm"] = float(np.sqrt(np.mean((table[f"{label}_nm"] - table["measured_nm"]) ** 2)))
+    return out
