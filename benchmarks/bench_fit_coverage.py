@@ -41,6 +41,7 @@ import numpy as np
 from passmd.experiments.design.calibration import independent_steps
 from passmd.model.parameters import Drive
 from passmd.protocols import fit as F
+from passmd.protocols.fit.prediction import drive_at
 from passmd.runtime.config import RunConfig
 
 FREE = ("friction_coefficient", "actuator.stiffness")
@@ -60,13 +61,13 @@ def truths(draws: int) -> list[float]:
 
 def draw(seed: int, stiffness: float) -> dict:
     base = Drive()
-    stiff = F.FREE_PARAMETERS["actuator.stiffness"]
-    truth = stiff.set(base.replace(friction_coefficient=MU), stiffness, base)
+    # the drive the fit describes: k_p moved with the damping ratio held (ζ = 0.05, c_p follows)
+    truth = drive_at(base, list(FREE), [MU, stiffness], base.actuator.damping_ratio)
     conditions = [(p, a * 1e-9, FREQUENCY) for p in PRELOADS for a in AMPLITUDES_NM]
     steps = independent_steps(truth, conditions)
     values = steps + np.random.default_rng(seed).normal(0.0, NOISE_NM * 1e-9, steps.size)
     header = ["amplitude_nm", "preload_N", "frequency_Hz", "step_nm", "step_nm_sd"]
-    rows = [[repr(a * 1e9), repr(p), repr(f), repr(v * 1e9), repr(NOISE_NM)]
+    rows = [[repr(float(a * 1e9)), repr(p), repr(f), repr(float(v * 1e9)), repr(NOISE_NM)]
             for (p, a, f), v in zip(conditions, values, strict=True)]
     data = F.measurements_from_rows(header, rows, name=f"draw {seed}")
     with tempfile.TemporaryDirectory() as cache:

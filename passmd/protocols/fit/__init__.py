@@ -79,11 +79,14 @@ from passmd.protocols.fit.measurements import (
 from passmd.protocols.fit.measurements import MODELS as MODELS
 from passmd.protocols.fit.measurements import READINGS as READINGS
 from passmd.protocols.fit.prediction import predict, predict_point
-from passmd.protocols.fit.problem import GN_STEP_LIMIT, JACOBIAN_STEP, LOCAL_EVALUATIONS
+from passmd.protocols.fit.problem import GN_STEP_LIMIT, JACOBIAN_STEPS, LOCAL_EVALUATIONS
 from passmd.protocols.fit.profiles import (
-    DEEP_LEVELS,
+    BOTTOM_DROP,
+    BOTTOM_FIRST,
+    BOTTOM_RESOLUTION,
+    BOTTOM_STEPS,
     FILL_BATCH,
-    FILL_DROP,
+    FILL_SAFETY,
     FINE_SPACING,
     PROFILE_MIN_POINTS,
     PROFILE_SPACING,
@@ -99,18 +102,21 @@ from passmd.protocols.fit.result import (
 from passmd.runtime.validation import InputError as InputError
 
 __all__ = [
+    "BOTTOM_DROP",
+    "BOTTOM_FIRST",
+    "BOTTOM_RESOLUTION",
+    "BOTTOM_STEPS",
     "BASIN_PROMINENCE",
     "CONDITIONS",
     "CORRELATION_LIMIT",
-    "DEEP_LEVELS",
     "DISTINCT",
     "FILL_BATCH",
-    "FILL_DROP",
+    "FILL_SAFETY",
     "FINE_SPACING",
     "FREE_PARAMETERS",
     "GLOBAL_POINTS_PER_PARAMETER",
     "GN_STEP_LIMIT",
-    "JACOBIAN_STEP",
+    "JACOBIAN_STEPS",
     "KEEPS",
     "LOCAL_EVALUATIONS",
     "LOCAL_STARTS",

@@ -37,13 +37,13 @@ from passmd.protocols.fit.free_parameters import FREE_PARAMETERS, KEEPS, _check_
 from passmd.protocols.fit.measurements import READINGS, Measurements
 from passmd.protocols.fit.next_measurement import separating_row
 from passmd.protocols.fit.prediction import _Model
-from passmd.protocols.fit.problem import JACOBIAN_STEP, Problem
+from passmd.protocols.fit.problem import JACOBIAN_STEPS, Problem
 from passmd.protocols.fit.result import FitResult, goodness_of_fit, verdict
 from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
 from passmd.runtime.validation import InputError, check_choice
 
-__all__ = ["DISTINCT", "GLOBAL_POINTS_PER_PARAMETER", "JACOBIAN_STEP", "LOCAL_STARTS", "LOSSES", "REFITS",
+__all__ = ["DISTINCT", "GLOBAL_POINTS_PER_PARAMETER", "JACOBIAN_STEPS", "LOCAL_STARTS", "LOSSES", "REFITS",
            "REFIT_MARGIN", "fit"]
 
 #: Points of the global pass per free parameter (the Sobol design takes the next power of two).
@@ -261,8 +261,7 @@ def _fit(problem: Problem, drive, names, box, x_start, reading, keep, seed, say,
 
     walked = prof.fill(problem, profiles, level, lambda: threshold * _s2(problem, problem.best()[1]))
     say(f"profiles sampled at {prof.FINE_SPACING:.0%} over {walked} intervals that may hold a minimum")
-    x_hat, cost = problem.best()
-    prof.deepen(problem, profiles, cost + threshold * _s2(problem, cost), threshold * _s2(problem, cost))
+    prof.bottoms(problem, profiles, level, lambda: threshold * _s2(problem, problem.best()[1]))
     converged, notes = True, []
     for attempt in range(REFITS + 1):
         x_hat, cost = problem.local(problem.best()[0])

@@ -11,12 +11,13 @@ a local search or a local profile cannot see past. The profile is therefore buil
    over the whole bounds, walked outward from the estimate (:func:`coarse`).
 2. **Fill**: a coarse interval may hold a tooth within the 95 % level that the coarse grid
    stepped over. The lowest intervals of each parameter are sampled at :data:`FINE_SPACING` (a
-   fifth of the comb's shortest period) first; how far their fine points drop below the lower end
-   of their interval measures how deep a tooth can hide between two coarse points, and every
-   interval whose lower end lies within :data:`FILL_DROP` such drops above the level is sampled
-   too, most promising first, in batches of :data:`FILL_BATCH` (:func:`fill`).
-3. **Deepen**: around each local minimum within reach of the level the grid is halved
-   :data:`DEEP_LEVELS` times (:func:`deepen`).
+   fifth of the comb's shortest period) first; how far their fine points' predictions depart from
+   the straight line between the interval's ends measures each measurement's oscillation. Every
+   interval whose predictions, widened by :data:`FILL_SAFETY` × that amplitude, could reach a cost
+   within the level is sampled too, most promising first, in batches of :data:`FILL_BATCH`
+   (:func:`fill`): where the data cannot rule a tooth out, the profile looks.
+3. **Bottoms**: the bottom of every local minimum within reach of the level, by successive
+   parabolic interpolation inside the bracket of its neighbours (:func:`bottoms`).
 
 Every point evaluated on the way joins the problem's archive, whose lowest point is the estimate.
 """
@@ -31,8 +32,9 @@ import numpy as np
 
 from passmd.protocols.fit.problem import Problem
 
-__all__ = ["DEEP_LEVELS", "FILL_BATCH", "FILL_DROP", "FINE_SPACING", "PROFILE_MIN_POINTS", "PROFILE_SPACING",
-           "Profile", "coarse", "deepen", "fill", "walk"]
+__all__ = ["BOTTOM_DROP", "BOTTOM_FIRST", "BOTTOM_RESOLUTION", "BOTTOM_STEPS", "FILL_BATCH", "FILL_SAFETY",
+           "FINE_SPACING", "PROFILE_MIN_POINTS", "PROFILE_SPACING", "Profile", "bottoms", "coarse", "fill",
+           "walk"]
 
 #: Spacing of the coarse profile over a parameter's whole bounds (log units: 16 %), so that of the two
 #: coarse points around any value one lies within 8 % of it, about one period of the comb.
@@ -43,13 +45,19 @@ PROFILE_MIN_POINTS = 16
 #: oscillation in k_p seen at 100 Hz (about 7 %), so every tooth of the comb holds several points.
 FINE_SPACING = 0.01
 #: Coarse intervals sampled per batch (per parameter in the first batch).
-FILL_BATCH = 4
-#: A coarse interval is sampled when its lower end lies within this many times the largest drop seen
-#: so far above the 95 % level: a tooth the coarse grid stepped over lies at most about one such drop
-#: below its interval's lower end.
-FILL_DROP = 2.0
-#: Halvings of the grid around a local minimum within reach of the 95 % level (to 0.25 %).
-DEEP_LEVELS = 2
+FILL_BATCH = 6
+#: Factor on the measured amplitude of the predictions' oscillation when deciding whether an interval
+#: could hold a minimum (the amplitude varies along the range).
+FILL_SAFETY = 1.0
+#: Local minima of each profile whose bottoms are looked for first (:func:`bottoms`).
+BOTTOM_FIRST = 3
+#: A local minimum's bottom is looked for when its grid value lies within the 95 % level plus this
+#: many times the largest drop from a grid value to its bottom seen so far.
+BOTTOM_DROP = 2.0
+#: Points added per local minimum, each narrowing its bracket by parabolic interpolation.
+BOTTOM_STEPS = 6
+#: A bracket narrower than this (log units: 0.02 %) has found its bottom.
+BOTTOM_RESOLUTION = 2e-4
 
 
 @dataclass
@@ -112,42 +120,62 @@ def _projected(problem: Problem, x: np.ndarray, jac: np.ndarray) -> float:
     return float(np.sum((r + jac @ step) ** 2))
 
 
+def _reach(problem: Problem, pa: np.ndarray, pb: np.ndarray, comb: np.ndarray) -> float:
+    """The lowest cost the predictions between two profile points can reach if each measurement's
+    prediction stays within the span of its values there widened by ``comb`` (its oscillation's
+    amplitude)."""
+    low, high = np.minimum(pa, pb) - comb, np.maximum(pa, pb) + comb
+    y = problem.data.value
+    gap = np.maximum(0.0, np.maximum(low - y, y - high)) / problem.sigma
+    return float(np.sum(gap ** 2))
+
+
 def fill(problem: Problem, profiles: dict[int, Profile], level: Callable[[], float],
          margin: Callable[[], float]) -> int:
     """Sample at :data:`FINE_SPACING` the coarse intervals that may hold a minimum within the 95 % level
     (module docstring), most promising first; returns the number of intervals sampled.
 
     ``level()`` gives the current 95 % level, ``margin()`` the 95 % rise. First the
-    :data:`FILL_BATCH` lowest intervals of each parameter; then, batch by batch, every interval
-    whose lower end lies within :data:`FILL_DROP` × the largest drop seen so far (how far below the
-    lower end of its interval a sampled point went) above the level.
+    :data:`FILL_BATCH` lowest intervals of each parameter: their fine points measure how far each
+    measurement's prediction departs from the straight line between the interval's ends (the
+    amplitude of its oscillation). Then, batch by batch, every interval whose predictions, widened
+    by :data:`FILL_SAFETY` × that amplitude, could reach a cost within the level (:func:`_reach`).
     """
     done: set[tuple[int, float]] = set()
-    drops = dict.fromkeys(profiles, 0.0)
+    comb = {j: np.zeros(problem.n) for j in profiles}
     first = True
     while True:
         cut = level()
         candidates = []
         for j, profile in profiles.items():
             t, c, xs = profile.arrays()
-            coarse = [k for k in range(t.size - 1) if t[k + 1] - t[k] > 1.5 * FINE_SPACING
-                      and (j, float(t[k])) not in done]
-            mine = sorted((min(c[k], c[k + 1]), j, k, t, c, xs) for k in coarse)
-            reach = cut + FILL_DROP * drops[j]
-            candidates += mine[:FILL_BATCH] if first else [m for m in mine if m[0] <= reach]
-        first = False
+            mine = []
+            for k in range(t.size - 1):
+                if t[k + 1] - t[k] <= 1.5 * FINE_SPACING or (j, float(t[k])) in done:
+                    continue
+                if first:
+                    mine.append((min(c[k], c[k + 1]), j, k, t, xs))
+                    continue
+                pa, pb = problem.evaluate([xs[k], xs[k + 1]])
+                reach = _reach(problem, pa, pb, FILL_SAFETY * comb[j])
+                if reach <= cut:
+                    mine.append((reach, j, k, t, xs))
+            candidates += sorted(mine, key=lambda m: m[0])[:FILL_BATCH] if first else mine
         if not candidates:
             return len(done)
-        candidates.sort(key=lambda item: item[0])
-        batch = candidates[:FILL_BATCH * (len(profiles) if len(done) == 0 else 1)]
-        done.update((j, float(t[k])) for _, j, k, t, _, _ in batch)
-        _sample(problem, profiles, [(j, t[k], t[k + 1], xs[k], xs[k + 1]) for _, j, k, t, _, xs in batch],
-                level() + margin())
-        for low, j, k, t, _, _ in batch:
-            tt, cc, _ = profiles[j].arrays()
-            inside = (tt > t[k]) & (tt < t[k + 1])
-            if inside.any():
-                drops[j] = max(drops[j], low - float(cc[inside].min()))
+        batch = candidates if first else sorted(candidates, key=lambda m: m[0])[:FILL_BATCH]
+        first = False
+        done.update((j, float(t[k])) for _, j, k, t, _ in batch)
+        intervals = [(j, t[k], t[k + 1], xs[k], xs[k + 1]) for _, j, k, t, xs in batch]
+        _sample(problem, profiles, intervals, level() + margin())
+        for j, a, b, xa, xb in intervals:  # the oscillation's amplitude along the interval
+            pa, pb = problem.evaluate([xa, xb])
+            tt, _, xx = profiles[j].arrays()
+            for t_in, x_in in zip(tt, xx, strict=True):
+                if a < t_in < b:
+                    w = (t_in - a) / (b - a)
+                    line = (1.0 - w) * pa + w * pb
+                    comb[j] = np.maximum(comb[j], np.abs(problem.prediction(x_in) - line))
 
 
 def _sample(problem: Problem, profiles: dict[int, Profile], intervals, cut: float) -> None:
@@ -179,22 +207,65 @@ def _sample(problem: Problem, profiles: dict[int, Profile], intervals, cut: floa
             profiles[j].add(t, c, x)
 
 
-def deepen(problem: Problem, profiles: dict[int, Profile], cut: float, margin: float) -> None:
-    """Halve the grid :data:`DEEP_LEVELS` times next to each local minimum of a profile whose cost is
-    below ``cut + margin``, starting the others from the minimum's."""
-    for _ in range(DEEP_LEVELS):
-        tasks = []
+def _vertex(ta, ca, tb, cb, tc, cc) -> float:
+    """The abscissa of the parabola through three points (b the lowest, a < b < c), kept inside (a, c)
+    and away from b; the midpoint of the longer side when the parabola does not open upward."""
+    num = (tb - ta) ** 2 * (cb - cc) - (tb - tc) ** 2 * (cb - ca)
+    den = (tb - ta) * (cb - cc) - (tb - tc) * (cb - ca)
+    longer = 0.5 * (ta + tb) if tb - ta > tc - tb else 0.5 * (tb + tc)
+    if den == 0.0:
+        return longer
+    v = tb - 0.5 * num / den
+    if not (ta < v < tc) or abs(v - tb) < 0.01 * (tc - ta):
+        return longer
+    return v
+
+
+def bottoms(problem: Problem, profiles: dict[int, Profile], level: Callable[[], float],
+            margin: Callable[[], float]) -> None:
+    """Find the bottom of every local minimum of a profile that may lie within the 95 % level.
+
+    A tooth of the comb can be narrower than the fine grid (0.3 % of k_p at Δχ² = 3.84 for 15 steps
+    of six contacts at 0.5 nm), so a grid point can sit far up its flank. Each local minimum is
+    bracketed by its neighbours and narrowed by successive parabolic interpolation (each new point
+    with the others re-minimised), all minima in lockstep, until the bracket is narrower than
+    :data:`BOTTOM_RESOLUTION` or :data:`BOTTOM_STEPS` points were added. First the
+    :data:`BOTTOM_FIRST` lowest minima of each parameter; then every minimum whose grid value lies
+    within the level plus :data:`BOTTOM_DROP` × the largest drop from a grid value to its bottom seen
+    so far.
+    """
+    drop = dict.fromkeys(profiles, 0.0)
+    done: set[tuple[int, float]] = set()
+    first = True
+    while True:
+        cut = level() + margin()
+        chase = []
         for j, profile in profiles.items():
-            t, c, xs = profile.arrays()
-            for k in range(t.size):
-                if c[k] > cut + margin:
-                    continue
-                if (k > 0 and c[k - 1] < c[k]) or (k + 1 < t.size and c[k + 1] < c[k]):
-                    continue
-                for other in (k - 1, k + 1):
-                    if 0 <= other < t.size and abs(t[other] - t[k]) > 0.2 * FINE_SPACING:
-                        tasks.append((j, 0.5 * (t[k] + t[other]), xs[k]))
-        if not tasks:
+            t, c, _ = profile.arrays()
+            minima = [k for k in range(1, t.size - 1) if c[k] <= c[k - 1] and c[k] <= c[k + 1]
+                      and (j, float(t[k])) not in done]
+            minima.sort(key=lambda k: c[k])
+            reach = cut + BOTTOM_DROP * drop[j]
+            chosen = minima[:BOTTOM_FIRST] if first else [k for k in minima if c[k] <= reach]
+            chase += [(j, float(t[k - 1]), float(t[k + 1]), float(c[k])) for k in chosen]
+            done.update((j, float(t[k])) for k in chosen)
+        first = False
+        if not chase:
             return
-        for (j, t, _), (x, c) in zip(tasks, problem.conditional(tasks), strict=True):
-            profiles[j].add(t, c, x)
+        for _ in range(BOTTOM_STEPS):
+            tasks = []
+            for j, a, b, _ in chase:
+                t, c, xs = profiles[j].arrays()
+                inside = np.flatnonzero((t >= a) & (t <= b))
+                k = int(inside[np.argmin(c[inside])])
+                if k == 0 or k == t.size - 1 or t[k + 1] - t[k - 1] < BOTTOM_RESOLUTION:
+                    continue
+                v = _vertex(t[k - 1], c[k - 1], t[k], c[k], t[k + 1], c[k + 1])
+                tasks.append((j, v, xs[k]))
+            if not tasks:
+                break
+            for (j, v, _), (x, cost) in zip(tasks, problem.conditional(tasks), strict=True):
+                profiles[j].add(v, cost, x)
+        for j, a, b, grid in chase:
+            t, c, _ = profiles[j].arrays()
+            drop[j] = max(drop[j], grid - float(c[(t >= a) & (t <= b)].min()))
