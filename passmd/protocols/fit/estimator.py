@@ -1,10 +1,11 @@
 """The estimator of :func:`~passmd.protocols.fit.estimator.fit`: the whole range searched, then refined.
 
 1. **Global pass**: a scrambled Sobol design of :data:`GLOBAL_POINTS_PER_PARAMETER` points per free
-   parameter over the log box (rounded up to a power of two), one sweep.
+   parameter over the log box (rounded up to a power of two), one sweep. With one free parameter
+   the coarse profile of stage 3 (a grid over the whole bounds) is the global pass.
 2. **Local searches** (``scipy.optimize.least_squares``, trust-region reflective, log space) from
    the best :data:`LOCAL_STARTS` distinct points of the pass (at least :data:`DISTINCT` apart in
-   the unit box).
+   the unit box), :data:`FIRST_SEARCH_EVALUATIONS` evaluations each.
 3. **Profiles** of every parameter over its whole bounds (:mod:`passmd.protocols.fit.profiles`):
    coarse, then walked at 1 % wherever the comb of the step in k_p could hide a tooth within the
    95 % level, then refined around each low minimum.
@@ -43,8 +44,8 @@ from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
 from passmd.runtime.validation import InputError, check_choice
 
-__all__ = ["DISTINCT", "GLOBAL_POINTS_PER_PARAMETER", "JACOBIAN_STEPS", "LOCAL_STARTS", "LOSSES", "REFITS",
-           "REFIT_MARGIN", "fit"]
+__all__ = ["DISTINCT", "FIRST_SEARCH_EVALUATIONS", "GLOBAL_POINTS_PER_PARAMETER", "JACOBIAN_STEPS",
+           "LOCAL_STARTS", "LOSSES", "MAX_BASINS", "REFITS", "REFIT_MARGIN", "fit"]
 
 #: Points of the global pass per free parameter (the Sobol design takes the next power of two).
 GLOBAL_POINTS_PER_PARAMETER = 64
@@ -246,10 +247,13 @@ def _fit(problem: Problem, drive, names, box, x_start, reading, keep, seed, say,
     """The stages of the module docstring, then the result."""
     p = problem.p
     threshold = _threshold(problem)
-    picks = _global_pass(problem, x_start, seed, say)
-    for k, (x0, c0) in enumerate(picks):
-        say(f"local search {k + 1}/{len(picks)} from cost {c0:.4g}")
-        problem.local(x0, FIRST_SEARCH_EVALUATIONS)
+    if p == 1:  # the coarse profile over the whole bounds is the global pass
+        problem.costs([x_start])
+    else:
+        picks = _global_pass(problem, x_start, seed, say)
+        for k, (x0, c0) in enumerate(picks):
+            say(f"local search {k + 1}/{len(picks)} from cost {c0:.4g}")
+            problem.local(x0, FIRST_SEARCH_EVALUATIONS)
     x_hat, cost = problem.best()
     say(f"profiles over the whole bounds from cost {cost:.5g}")
     profiles = {j: prof.Profile(j) for j in range(p)}

@@ -32,9 +32,9 @@ import numpy as np
 
 from passmd.protocols.fit.problem import Problem
 
-__all__ = ["BOTTOM_DROP", "BOTTOM_FIRST", "BOTTOM_RESOLUTION", "BOTTOM_STEPS", "FILL_BATCH", "FILL_SAFETY",
-           "FINE_SPACING", "PROFILE_MIN_POINTS", "PROFILE_SPACING", "Profile", "bottoms", "coarse", "fill",
-           "walk"]
+__all__ = ["BOTTOM_DROP", "BOTTOM_FIRST", "BOTTOM_RESOLUTION", "BOTTOM_STEPS", "FILL_BATCH", "FILL_FIRST",
+           "FILL_SAFETY", "FINE_SPACING", "PROFILE_MIN_POINTS", "PROFILE_SPACING", "Profile", "bottoms",
+           "coarse", "fill", "walk"]
 
 #: Spacing of the coarse profile over a parameter's whole bounds (log units: 16 %), so that of the two
 #: coarse points around any value one lies within 8 % of it, about one period of the comb.
@@ -44,7 +44,9 @@ PROFILE_MIN_POINTS = 16
 #: Spacing of the fine profile (log units, 1 %): a fifth of the shortest period of the step's
 #: oscillation in k_p seen at 100 Hz (about 7 %), so every tooth of the comb holds several points.
 FINE_SPACING = 0.01
-#: Coarse intervals sampled per batch (per parameter in the first batch).
+#: Coarse intervals sampled first, per parameter (the lowest ones): they measure the oscillation.
+FILL_FIRST = 2
+#: Coarse intervals sampled per later batch.
 FILL_BATCH = 6
 #: Factor on the measured amplitude of the predictions' oscillation when deciding whether an interval
 #: could hold a minimum (the amplitude varies along the range).
@@ -136,7 +138,7 @@ def fill(problem: Problem, profiles: dict[int, Profile], level: Callable[[], flo
     (module docstring), most promising first; returns the number of intervals sampled.
 
     ``level()`` gives the current 95 % level, ``margin()`` the 95 % rise. First the
-    :data:`FILL_BATCH` lowest intervals of each parameter: their fine points measure how far each
+    :data:`FILL_FIRST` lowest intervals of each parameter: their fine points measure how far each
     measurement's prediction departs from the straight line between the interval's ends (the
     amplitude of its oscillation). Then, batch by batch, every interval whose predictions, widened
     by :data:`FILL_SAFETY` × that amplitude, could reach a cost within the level (:func:`_reach`).
@@ -160,7 +162,7 @@ def fill(problem: Problem, profiles: dict[int, Profile], level: Callable[[], flo
                 reach = _reach(problem, pa, pb, FILL_SAFETY * comb[j])
                 if reach <= cut:
                     mine.append((reach, j, k, t, xs))
-            candidates += sorted(mine, key=lambda m: m[0])[:FILL_BATCH] if first else mine
+            candidates += sorted(mine, key=lambda m: m[0])[:FILL_FIRST] if first else mine
         if not candidates:
             return len(done)
         batch = candidates if first else sorted(candidates, key=lambda m: m[0])[:FILL_BATCH]
