@@ -38,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from passmd.experiments.design.calibration import independent_steps
+from passmd.experiments.calibration.synthetic import independent_steps
 from passmd.model.parameters import Drive
 from passmd.protocols import fit as F
 from passmd.protocols.fit.prediction import drive_at

@@ -21,7 +21,7 @@ import pytest
 
 import passmd
 from passmd import cli
-from passmd.experiments.design.calibration import independent_steps
+from passmd.experiments.calibration.synthetic import independent_steps
 from passmd.model.parameters import Drive
 from passmd.model.tables import Amplifier
 from passmd.protocols import fit as F

@@ -1,13 +1,11 @@
-"""The calibration of the chapter "Design your own drive" and of the calibration chapter: measurements
-made by other means than the fit's forward model, and the fits' facts.
+"""The calibration of the chapter "Design your own drive": the example drive's measurements, its fit,
+and predictions of measurements held back from the fit.
 
-A fit checked only on data its own forward model made hides what the model and the data do
-not share. :func:`independent_steps` makes steady steps another way: the integrator refined
-(:data:`REFINE`, the ``scheme`` "controlled" at a finer step and tighter local error), a run of
-:data:`PERIODS` periods from rest and its *last* step, and optionally another fly-back rule
-than the drive's (the mis-specified case a goodness-of-fit test must reject).
-:func:`synthetic_measurements` adds Gaussian noise of a stated sd. The example drive's round
-trip (:func:`calibrate`, :func:`heldback_predictions`) is what the design chapter shows.
+The measurements are made by other means than the fit's forward model
+(:func:`passmd.experiments.calibration.synthetic.independent_steps`: the integrator refined, the last
+step of a long run) plus Gaussian noise of a stated sd; the unknown parameters are fitted from a
+designer's first guess (:data:`passmd.experiments.design.figures.START`), and the fitted drive file,
+read back, predicts the held-back points.
 """
 
 from __future__ import annotations
@@ -19,45 +17,16 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from passmd.experiments.calibration.synthetic import independent_steps
 from passmd.experiments.design.figures import FIT_FREQUENCY, NOISE_NM, PROFILE_SETTINGS, SEED, _run_config
 from passmd.model.drive_file import load_drive
 from passmd.model.parameters import Drive
 from passmd.model.tables import actuator_for_radius
-from passmd.model.waveforms import sawtooth
 from passmd.protocols import fit as fitting
-from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
-from passmd.solver import simulation as dynamics
-from passmd.solver.steps import SCHEMES
 
-__all__ = ["PERIODS", "REFINE", "calibrate", "fit_facts", "heldback_facts", "heldback_predictions",
-           "independent_step", "independent_steps", "load_fitted", "measurements_csv", "start_drive",
-           "synthetic_measurements"]
-
-#: Refinement of the integrator for the independent data (steps halved, local error 16× tighter).
-REFINE = 2.0
-#: Periods of the independent data's runs from rest; their last step is the measurement.
-PERIODS = 16
-
-
-def independent_step(drive: Drive, amplitude: float, frequency: float, periods: int = PERIODS,
-                     refine: float = REFINE, flyback=None) -> dict:
-    """The last step of a ``periods``-period saw-tooth run from rest with the refined integrator (a sweep
-    function): ``{"step_m": ...}``."""
-    wave = sawtooth(amplitude, frequency, drive, periods=periods, flyback=flyback)
-    result = dynamics.simulate(drive, wave, scheme=SCHEMES["controlled"].replace(refine=refine), max_points=2)
-    return {"step_m": float(result.step_sizes[-1])}
-
-
-def independent_steps(drive: Drive, conditions, *, flyback=None, config: RunConfig | None = None,
-                      executor: str | None = "serial", cache=False) -> np.ndarray:
-    """Steps (m) at ``conditions`` = [(preload N, amplitude m, frequency Hz), ...] of ``drive`` made by
-    :func:`independent_step` (``flyback`` overrides the drive's rule), through the sweep engine."""
-    points = [{"drive": replace(drive, preload=float(p)), "amplitude": float(a), "frequency": float(f),
-               "periods": PERIODS, "refine": REFINE, "flyback": flyback} for p, a, f in conditions]
-    frame = sweep.run(independent_step, points, executor=executor, cache=cache, progress=False, config=config)
-    return frame["step_m"].to_numpy(float)
-
+__all__ = ["calibrate", "fit_facts", "heldback_facts", "heldback_predictions", "load_fitted",
+           "measurements_csv", "start_drive", "synthetic_measurements"]
 
 def start_drive(truth: Drive, profile: str) -> Drive:
     """A designer's first guess: ``truth`` with each free parameter at the paper's value

@@ -307,6 +307,15 @@ def _result(problem, drive, names, box, profiles, basin_list, found, x_hat, cost
         t, c, _ = profiles[j].arrays()
         inside = [k for k in range(len(basin_list))
                   if any(a - 1e-12 <= basin_list[k][0][j] <= b + 1e-12 for a, b in parts)]
+        basins = [{"value": float(np.exp(basin_list[k][0][j])), "cost": float(basin_list[k][1])}
+                  for k in inside]
+        for a, b in parts:  # a piece without a listed basin: its lowest profile point is one
+            if not any(a - 1e-12 <= basin_list[k][0][j] <= b + 1e-12 for k in inside):
+                sel = (t >= a) & (t <= b)
+                if sel.any():
+                    low = int(np.flatnonzero(sel)[np.argmin(c[sel])])
+                    basins.append({"value": float(np.exp(t[low])), "cost": float(c[low])})
+        basins.sort(key=lambda item: item["value"])
         at_bound = x_hat[j] <= problem.lo[j] or x_hat[j] >= problem.hi[j]
         if at_bound:
             notes.append(f"{name} is at a bound of its range: widen --bounds")
@@ -315,8 +324,7 @@ def _result(problem, drive, names, box, profiles, basin_list, found, x_hat, cost
             "interval": ([float(np.exp(parts[0][0])), float(np.exp(parts[-1][1]))] if parts
                          else [value, value]),
             "intervals": [[float(np.exp(a)), float(np.exp(b))] for a, b in parts],
-            "basins": [{"value": float(np.exp(basin_list[k][0][j])), "cost": float(basin_list[k][1])}
-                       for k in inside],
+            "basins": basins,
             "unit": FREE_PARAMETERS[name].unit, "symbol": FREE_PARAMETERS[name].symbol,
             "bounds": list(box[name]), "flat_profile": bool(flat),
             "profile": {"value": np.exp(t).tolist(), "cost": c.tolist()},
@@ -341,5 +349,6 @@ def _result(problem, drive, names, box, profiles, basin_list, found, x_hat, cost
                      simulations=model.simulations, evaluations=model.evaluations,
                      wall_time_s=time.perf_counter() - t0, notes=list(dict.fromkeys(notes)),
                      converged=converged, goodness_of_fit=gof, next_measurement=suggestion, keep=keep,
+                     level=threshold,
                      basins=[{"parameters": dict(zip(names, np.exp(x).tolist(), strict=True)), "cost": c}
                              for x, c in basin_list])

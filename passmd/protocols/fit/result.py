@@ -61,6 +61,7 @@ class FitResult:
     next_measurement: dict | None = None  # the added row that best separates several basins
     keep: str = "damping_ratio"  # what of the damping stayed fixed while k_p or m_a moved
     basins: list[dict] = field(default_factory=list)  # every basin within the level: parameters, cost
+    level: float = 3.841  # the 95 % rise of a profile, in units of the residual variance s²
 
     @property
     def model_rejected(self) -> bool:
@@ -91,6 +92,7 @@ class FitResult:
             "basins": list(self.basins),
             "next_measurement": self.next_measurement,
             "keep": self.keep,
+            "level": self.level,
             "flyback": self.drive.amplifier.flyback,
             "converged": self.converged,
             "verdict": self.verdict,
