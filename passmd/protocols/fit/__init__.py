@@ -87,14 +87,17 @@ from passmd.protocols.fit.problem import GN_STEP_LIMIT, JACOBIAN_STEPS, LOCAL_EV
 from passmd.protocols.fit.profiles import (
     BOTTOM_DROP,
     BOTTOM_FIRST,
+    BOTTOM_MAX,
     BOTTOM_RESOLUTION,
     BOTTOM_STEPS,
     FILL_BATCH,
     FILL_FIRST,
     FILL_SAFETY,
     FINE_SPACING,
+    PROBE_POINTS,
     PROFILE_MIN_POINTS,
     PROFILE_SPACING,
+    SMOOTH_DEPARTURE,
 )
 from passmd.protocols.fit.regions import BASIN_PROMINENCE
 from passmd.protocols.fit.result import (
@@ -109,6 +112,7 @@ from passmd.runtime.validation import InputError as InputError
 __all__ = [
     "BOTTOM_DROP",
     "BOTTOM_FIRST",
+    "BOTTOM_MAX",
     "BOTTOM_RESOLUTION",
     "BOTTOM_STEPS",
     "BASIN_PROMINENCE",
@@ -129,11 +133,13 @@ __all__ = [
     "LOSSES",
     "MAX_BASINS",
     "MEASURED",
+    "PROBE_POINTS",
     "PROFILE_MIN_POINTS",
     "PROFILE_SPACING",
     "REFITS",
     "REFIT_MARGIN",
     "REJECT_P",
+    "SMOOTH_DEPARTURE",
     "FitResult",
     "FreeParameter",
     "Measurements",

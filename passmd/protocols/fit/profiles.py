@@ -10,7 +10,9 @@ a local search or a local profile cannot see past. The profile is therefore buil
 1. **Coarse**: points :data:`PROFILE_SPACING` apart in log (at least :data:`PROFILE_MIN_POINTS`)
    over the whole bounds, walked outward from the estimate (:func:`coarse`).
 2. **Fill**: a coarse interval may hold a tooth within the 95 % level that the coarse grid
-   stepped over. The lowest intervals of each parameter are sampled at :data:`FINE_SPACING` (a
+   stepped over. A few points in the lowest intervals first probe whether the profile is smooth
+   on the coarse grid (then nothing is sampled finely). Else the lowest intervals of each
+   parameter are sampled at :data:`FINE_SPACING` (a
    fifth of the comb's shortest period) first; how far their fine points' predictions depart from
    the straight line between the interval's ends measures each measurement's oscillation. Every
    interval whose predictions, widened by :data:`FILL_SAFETY` × that amplitude, could reach a cost
@@ -32,9 +34,9 @@ import numpy as np
 
 from passmd.protocols.fit.problem import Problem
 
-__all__ = ["BOTTOM_DROP", "BOTTOM_FIRST", "BOTTOM_RESOLUTION", "BOTTOM_STEPS", "FILL_BATCH", "FILL_FIRST",
-           "FILL_SAFETY", "FINE_SPACING", "PROFILE_MIN_POINTS", "PROFILE_SPACING", "Profile", "bottoms",
-           "coarse", "fill", "walk"]
+__all__ = ["BOTTOM_DROP", "BOTTOM_FIRST", "BOTTOM_MAX", "BOTTOM_RESOLUTION", "BOTTOM_STEPS", "FILL_BATCH",
+           "FILL_FIRST", "FILL_SAFETY", "FINE_SPACING", "PROBE_POINTS", "PROFILE_MIN_POINTS",
+           "PROFILE_SPACING", "SMOOTH_DEPARTURE", "Profile", "bottoms", "coarse", "fill", "walk"]
 
 #: Spacing of the coarse profile over a parameter's whole bounds (log units: 16 %), so that of the two
 #: coarse points around any value one lies within 8 % of it, about one period of the comb.
@@ -46,6 +48,11 @@ PROFILE_MIN_POINTS = 16
 FINE_SPACING = 0.01
 #: Coarse intervals sampled first, per parameter (the lowest ones): they measure the oscillation.
 FILL_FIRST = 2
+#: Points of each of the FILL_FIRST lowest coarse intervals that probe whether a profile is smooth.
+PROBE_POINTS = 3
+#: A profile is smooth on the coarse grid when its probe points' predictions depart from the straight
+#: line between their interval's ends by at most this many σ: no comb to sample finely.
+SMOOTH_DEPARTURE = 0.5
 #: Coarse intervals sampled per later batch.
 FILL_BATCH = 6
 #: Factor on the measured amplitude of the predictions' oscillation when deciding whether an interval
@@ -56,6 +63,8 @@ BOTTOM_FIRST = 3
 #: A local minimum's bottom is looked for when its grid value lies within the 95 % level plus this
 #: many times the largest drop from a grid value to its bottom seen so far.
 BOTTOM_DROP = 2.0
+#: Most local minima of one profile whose bottoms are looked for (the lowest).
+BOTTOM_MAX = 16
 #: Points added per local minimum, each narrowing its bracket by parabolic interpolation.
 BOTTOM_STEPS = 6
 #: A bracket narrower than this (log units: 0.02 %) has found its bottom.
@@ -137,7 +146,8 @@ def fill(problem: Problem, profiles: dict[int, Profile], level: Callable[[], flo
     """Sample at :data:`FINE_SPACING` the coarse intervals that may hold a minimum within the 95 % level
     (module docstring), most promising first; returns the number of intervals sampled.
 
-    ``level()`` gives the current 95 % level, ``margin()`` the 95 % rise. First the
+    ``level()`` gives the current 95 % level, ``margin()`` the 95 % rise. A parameter whose profile is
+    smooth on the coarse grid (:func:`_probe`) needs none. Else first the
     :data:`FILL_FIRST` lowest intervals of each parameter: their fine points measure how far each
     measurement's prediction departs from the straight line between the interval's ends (the
     amplitude of its oscillation). Then, batch by batch, every interval whose predictions, widened
@@ -145,11 +155,14 @@ def fill(problem: Problem, profiles: dict[int, Profile], level: Callable[[], flo
     """
     done: set[tuple[int, float]] = set()
     comb = {j: np.zeros(problem.n) for j in profiles}
+    smooth = _probe(problem, profiles)
     first = True
     while True:
         cut = level()
         candidates = []
         for j, profile in profiles.items():
+            if j in smooth:
+                continue
             t, c, xs = profile.arrays()
             mine = []
             for k in range(t.size - 1):
@@ -178,6 +191,32 @@ def fill(problem: Problem, profiles: dict[int, Profile], level: Callable[[], flo
                     w = (t_in - a) / (b - a)
                     line = (1.0 - w) * pa + w * pb
                     comb[j] = np.maximum(comb[j], np.abs(problem.prediction(x_in) - line))
+
+
+def _probe(problem: Problem, profiles: dict[int, Profile]) -> set[int]:
+    """The parameters whose profile is smooth on the coarse grid: in the :data:`FILL_FIRST` lowest
+    coarse intervals, :data:`PROBE_POINTS` evenly spaced points (the others interpolated, one
+    evaluation each) depart from the straight line between the interval's ends by at most
+    :data:`SMOOTH_DEPARTURE` σ in every measurement."""
+    jobs = []
+    for j, profile in profiles.items():
+        t, c, xs = profile.arrays()
+        lows = sorted((min(c[k], c[k + 1]), k) for k in range(t.size - 1)
+                      if t[k + 1] - t[k] > 1.5 * FINE_SPACING)
+        for _, k in lows[:FILL_FIRST]:
+            for i in range(1, PROBE_POINTS + 1):
+                w = i / (PROBE_POINTS + 1)
+                x = (1.0 - w) * xs[k] + w * xs[k + 1]
+                x[j] = t[k] + w * (t[k + 1] - t[k])
+                jobs.append((j, w, x, xs[k], xs[k + 1]))
+    values = problem.evaluate([x for _, _, x, _, _ in jobs])
+    departure = dict.fromkeys(profiles, 0.0)
+    for (j, w, x, xa, xb), v in zip(jobs, values, strict=True):
+        profiles[j].add(x[j], problem.archive[x.tobytes()][1], x)
+        pa, pb = problem.evaluate([xa, xb])
+        line = (1.0 - w) * pa + w * pb
+        departure[j] = max(departure[j], float(np.max(np.abs(v - line) / problem.sigma)))
+    return {j for j in profiles if departure[j] <= SMOOTH_DEPARTURE}
 
 
 def _sample(problem: Problem, profiles: dict[int, Profile], intervals, cut: float) -> None:
@@ -228,29 +267,31 @@ def bottoms(problem: Problem, profiles: dict[int, Profile], level: Callable[[], 
     """Find the bottom of every local minimum of a profile that may lie within the 95 % level.
 
     A tooth of the comb can be narrower than the fine grid (0.3 % of k_p at Δχ² = 3.84 for 15 steps
-    of six contacts at 0.5 nm), so a grid point can sit far up its flank. Each local minimum is
-    bracketed by its neighbours and narrowed by successive parabolic interpolation (each new point
-    with the others re-minimised), all minima in lockstep, until the bracket is narrower than
+    of six contacts at 0.5 nm), so a grid point can sit far up its flank. Each local minimum of the
+    profile as sampled so far (lower than one neighbour, not higher than the other) is bracketed by
+    its neighbours and narrowed by successive parabolic interpolation (each new point with the
+    others re-minimised), all minima in lockstep, until the bracket is narrower than
     :data:`BOTTOM_RESOLUTION` or :data:`BOTTOM_STEPS` points were added. First the
-    :data:`BOTTOM_FIRST` lowest minima of each parameter; then every minimum whose grid value lies
-    within the level plus :data:`BOTTOM_DROP` × the largest drop from a grid value to its bottom seen
-    so far.
+    :data:`BOTTOM_FIRST` lowest minima of each parameter; then every other minimum whose grid value
+    lies within the level plus :data:`BOTTOM_DROP` × the largest drop from a grid value to its bottom
+    seen so far, at most :data:`BOTTOM_MAX` per parameter in all.
     """
+    minima = {}
+    for j, profile in profiles.items():
+        t, c, _ = profile.arrays()
+        found = [(float(c[k]), float(t[k - 1]), float(t[k + 1])) for k in range(1, t.size - 1)
+                 if c[k] <= c[k - 1] and c[k] <= c[k + 1] and (c[k] < c[k - 1] or c[k] < c[k + 1])]
+        minima[j] = sorted(found)[:BOTTOM_MAX]
     drop = dict.fromkeys(profiles, 0.0)
-    done: set[tuple[int, float]] = set()
     first = True
     while True:
         cut = level() + margin()
         chase = []
-        for j, profile in profiles.items():
-            t, c, _ = profile.arrays()
-            minima = [k for k in range(1, t.size - 1) if c[k] <= c[k - 1] and c[k] <= c[k + 1]
-                      and (j, float(t[k])) not in done]
-            minima.sort(key=lambda k: c[k])
+        for j in profiles:
             reach = cut + BOTTOM_DROP * drop[j]
-            chosen = minima[:BOTTOM_FIRST] if first else [k for k in minima if c[k] <= reach]
-            chase += [(j, float(t[k - 1]), float(t[k + 1]), float(c[k])) for k in chosen]
-            done.update((j, float(t[k])) for k in chosen)
+            take = minima[j][:BOTTOM_FIRST] if first else [m for m in minima[j] if m[0] <= reach]
+            minima[j] = [m for m in minima[j] if m not in take]
+            chase += [(j, a, b, grid) for grid, a, b in take]
         first = False
         if not chase:
             return
