@@ -26,7 +26,7 @@ from passmd.protocols import fit as fitting
 from passmd.runtime.config import RunConfig
 
 __all__ = ["calibrate", "fit_facts", "heldback_facts", "heldback_predictions", "load_fitted",
-           "measurements_csv", "start_drive", "synthetic_measurements"]
+           "measurements_csv", "other_flyback_fit", "start_drive", "synthetic_measurements"]
 
 def start_drive(truth: Drive, profile: str) -> Drive:
     """A designer's first guess: ``truth`` with each free parameter at the paper's value
@@ -48,7 +48,7 @@ def _measurements(points, truth: Drive, rng, config, flyback=None) -> fitting.Me
     rows = [[repr(float(a)), repr(float(p)), repr(float(f)), "0", repr(NOISE_NM)] for f, p, a in points]
     data = fitting.measurements_from_rows(header, rows, name="synthetic measurements")
     low = [i for i, (f, _, _) in enumerate(points) if f < 1e3]
-    exact = fitting.predict(truth, data, config=config)  # the steady-velocity protocol above 1 kHz
+    exact = np.array(fitting.predict(truth, data, config=config))  # the steady-velocity protocol above 1 kHz
     if low:
         conditions = [(points[i][1], points[i][2] * 1e-9, points[i][0]) for i in low]
         exact[low] = independent_steps(truth, conditions, flyback=flyback, config=config, executor=None,
@@ -82,6 +82,15 @@ def calibrate(start: Drive, data: fitting.Measurements, profile: str,
               config: RunConfig | None = None) -> fitting.FitResult:
     """The fit of the profile's free parameters to ``data`` from ``start`` (``passmd fit``'s defaults)."""
     return fitting.fit(start, data, list(PROFILE_SETTINGS[profile].free), config=_run_config(config, profile))
+
+
+def other_flyback_fit(start: Drive, data: fitting.Measurements, profile: str,
+                      config: RunConfig | None = None) -> fitting.FitResult:
+    """μ fitted to ``data`` with the fly-back rule the data were not made with (``"fixed"`` for a drive
+    whose rule is ``"slew"``, else ``"slew"``): a wrong fixed assumption for the χ² test to judge."""
+    other = "fixed" if start.amplifier.flyback == "slew" else "slew"
+    wrong = replace(start, amplifier=replace(start.amplifier, flyback=other))
+    return fitting.fit(wrong, data, ["friction_coefficient"], config=_run_config(config, profile))
 
 
 def load_fitted(text: str) -> Drive:
