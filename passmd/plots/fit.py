@@ -53,7 +53,10 @@ def fit_figure(result) -> Figure:
         bottom.set_ylabel("residual / σ")
         bottom.set_xlabel("preload [N]" if by_preload else "amplitude [nm]")
     names = ", ".join(f"{n} = {result.estimates[n]['value']:.4g}" for n in result.names)
-    fig.suptitle(f"fit: {names}", fontsize="medium")
+    gof = getattr(result, "goodness_of_fit", {}) or {}
+    test = (f"; χ² = {gof['chi2']:.3g} on {gof['dof']} dof, p = {gof['p_value']:.2g}"
+            + (" (model rejected)" if gof.get("rejected") else "") if gof.get("testable") else "")
+    fig.suptitle(f"fitted {names}{test}", fontsize="medium")
     return fig
 
 

@@ -12,6 +12,7 @@ as a drive file whose every value names its source.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -40,7 +41,9 @@ class FitResult:
     drive: Drive  # the fitted drive (the given drive with the estimates)
     base: Drive  # the drive the fit started from
     names: list[str]  # free parameters, in the order given
-    estimates: dict[str, dict]  # name -> value, stderr, interval [low, high], unit (SI), bounds, flat
+    # name -> value, stderr (local), interval (the region's hull), intervals (its pieces), basins,
+    # profile {value, cost}, unit (SI), symbol, bounds, flat_profile
+    estimates: dict[str, dict]
     correlation: np.ndarray
     data: Measurements
     predicted: np.ndarray  # SI, per row
@@ -61,7 +64,7 @@ class FitResult:
     next_measurement: dict | None = None  # the added row that best separates several basins
     keep: str = "damping_ratio"  # what of the damping stayed fixed while k_p or m_a moved
     basins: list[dict] = field(default_factory=list)  # every basin within the level: parameters, cost
-    level: float = 3.841  # the 95 % rise of a profile, in units of the residual variance s²
+    level: float = math.nan  # the 95 % rise of a profile in units of s² (the estimator sets it)
 
     @property
     def model_rejected(self) -> bool:
