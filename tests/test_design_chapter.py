@@ -2,16 +2,12 @@
 
 from __future__ import annotations
 
-from dataclasses import replace
-from types import SimpleNamespace
-
 import numpy as np
 import pandas as pd
 import pytest
 
 from passmd.experiments.design import figures as design
 from passmd.model.drive_file import DRIVE_KEYS, DriveFileError, load_drive
-from passmd.protocols import fit as fitting
 from passmd.runtime.config import RunConfig
 
 
@@ -145,51 +141,3 @@ def test_ringing_facts_read_the_probe():
     assert facts["ring_left_nm"] == pytest.approx(5.0, rel=1e-3)
     assert facts["ring_quiet_ms"] == pytest.approx(15.0)
     assert facts["ring_next_ms"] == pytest.approx(9.999)
-
-
-def test_fit_facts_say_whether_the_interval_holds_the_truth():
-    truth, _ = design.example_drive()
-    start = design.start_drive(truth, "paper")
-    assert start.friction_coefficient == 0.2 and start.actuator.stiffness == pytest.approx(4.8333e6, rel=1e-4)
-    result = SimpleNamespace(names=["friction_coefficient", "actuator.stiffness"], estimates={
-        "friction_coefficient": {"value": 0.249, "stderr": 0.003, "interval": [0.243, 0.256]},
-        "actuator.stiffness": {"value": 4.0e6, "stderr": 1e5, "interval": [3.8e6, 4.2e6]}})
-    table = design.fit_facts(result, truth, start).set_index("parameter")
-    assert table.loc["friction_coefficient", "holds_truth"]
-    assert not table.loc["actuator.stiffness", "holds_truth"]  # 5e6 is outside 3.8–4.2e6
-    assert table.loc["actuator.stiffness", "start"] == pytest.approx(start.actuator.stiffness)
-
-
-def test_heldback_facts_rms():
-    table = pd.DataFrame({"measured_nm": [10.0, 20.0], "start_nm": [13.0, 16.0], "fitted_nm": [10.0, 21.0]})
-    facts = design.heldback_facts(table)
-    assert facts["rms_start_nm"] == pytest.approx(np.sqrt((9 + 16) / 2))
-    assert facts["rms_fitted_nm"] == pytest.approx(np.sqrt(0.5)) and facts["heldback_points"] == 2
-
-
-def test_fitted_drive_file_reads_back_to_the_fitted_drive():
-    truth, _ = design.example_drive()
-    fitted = replace(truth, friction_coefficient=0.2493217)
-    text = fitting.fitted_drive_file(fitted, "m.csv", ["friction_coefficient"])
-    assert design.load_fitted(text) == fitted
-    line = next(line for line in text.splitlines() if line.startswith("friction_coefficient"))
-    assert "fitted to m.csv by passmd fit" in line
-
-
-def test_synthetic_measurements_are_the_simulation_plus_the_stated_noise(tmp_path):
-    truth, _ = design.example_drive()
-    config = RunConfig(cache_dir=tmp_path)
-    data, held = design.synthetic_measurements(truth, "quick", config)
-    s = design.PROFILE_SETTINGS["quick"]
-    assert len(data) == len(s.fit_preloads) * len(s.fit_amplitudes_nm) and len(held) == len(s.heldback)
-    noise = np.random.default_rng(design.SEED).normal(0.0, design.NOISE_NM * 1e-9, len(data) + len(held))
-    exact = fitting.predict(truth, data, cache=False, executor="serial")
-    # the same simulation and the same draws: equal to round-off of the sum (values ~1e-7 m)
-    np.testing.assert_allclose(data.value, exact + noise[:len(data)], rtol=0, atol=1e-18)
-    assert np.all(data.sd == design.NOISE_NM * 1e-9) and data.known_sd
-    text = design.measurements_csv(data)
-    path = tmp_path / "m.csv"
-    path.write_text(text, encoding="utf-8")
-    back = fitting.read_measurements(path)
-    np.testing.assert_allclose(back.value, data.value, rtol=1e-15)  # repr() round trip
-    np.testing.assert_allclose(back.amplitude, data.amplitude, rtol=1e-15)

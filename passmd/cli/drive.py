@@ -12,11 +12,12 @@ import math
 from decimal import ROUND_CEILING, ROUND_FLOOR, Decimal
 
 from passmd.cli.errors import UsageError
-from passmd.cli.options import ACTUATOR_DYNAMICS, DRIVE_QUANTITIES, OPTION_FOR, QUANTITIES
-from passmd.cli.output import fmt
+from passmd.cli.options import ACTUATOR_DYNAMICS, DRIVE_QUANTITIES, OPTION_FOR, QUANTITIES, refuse_bare
+from passmd.cli.output import flyback_label, fmt
 from passmd.model.drive_file import DriveFileError, read_drive_file, resolve
 from passmd.model.parameters import Drive
-from passmd.runtime.units import dimension_name, from_si
+from passmd.model.tables import FLYBACK_RULES
+from passmd.runtime.units import QuantityError, dimension_name, from_si, parse_quantity
 from passmd.runtime.validation import InputError
 
 __all__ = ["build_drive", "drive_rows", "explain", "resolve_drive"]
@@ -70,6 +71,8 @@ def resolve_drive(args, **fixed) -> tuple[Drive, dict[str, str]]:
         values.pop("contact_groups", None)  # the option's preset replaces the file's groups
     if getattr(args, "actuator", None) is not None:
         values["actuator_model"], origins["actuator_model"] = args.actuator, "option --actuator"
+    if getattr(args, "flyback", None) is not None:
+        values["amplifier.flyback"], origins["amplifier.flyback"] = _flyback(args.flyback), "option --flyback"
     if getattr(args, "allow_extrapolation", False):
         values["allow_extrapolation"] = True
         origins.setdefault("allow_extrapolation", "option --allow-extrapolation")
@@ -80,6 +83,24 @@ def resolve_drive(args, **fixed) -> tuple[Drive, dict[str, str]]:
             # the file's groups: name the file
             raise DriveFileError(f"{path}: {exc}", name=exc.name, value=exc.value) from None
         raise
+
+
+def _flyback(raw: str) -> str | float:
+    """``--flyback``: ``slew``, ``fixed`` or a time with its unit (a bare number is refused: shown in us)."""
+    text = raw.strip()
+    if text in FLYBACK_RULES:
+        return text
+    try:
+        refuse_bare("--flyback", text, "us")
+        value = parse_quantity(text, "us", name="--flyback")
+    except QuantityError as exc:
+        if any(c.isdigit() for c in text):
+            raise UsageError(str(exc)) from None
+        raise UsageError(f"--flyback = {raw!r} is not allowed: must be slew, fixed or a time with its unit, "
+                         "e.g. 1.5us") from None
+    if not value > 0.0:
+        raise UsageError(f"--flyback = {raw!r} is out of range: must be > 0 us")
+    return value
 
 
 def build_drive(args, **fixed) -> Drive:
@@ -98,7 +119,8 @@ def drive_rows(drive: Drive) -> list[tuple[str, str]]:
                       f"μ = {drive.friction_coefficient:g}, m_r = {fmt(drive.runner_mass, 'g')}, "
                       f"E_1 = {fmt(e1.youngs_modulus, 'GPa')}, E_2 = {fmt(e2.youngs_modulus, 'GPa')}, "
                       f"ν = {e1.poissons_ratio:g}/{e2.poissons_ratio:g}")]
-    stroke = f"A_max = {fmt(act.full_stroke_amplitude, 'nm')}, SR = {amp.slew_rate / 1e6:.4g} V/µs"
+    stroke = (f"A_max = {fmt(act.full_stroke_amplitude, 'nm')}, SR = {amp.slew_rate / 1e6:.4g} V/µs, "
+              f"{flyback_label(amp.flyback)} fly-back")
     if drive.actuator_model == "flexible":
         rows.append(("actuators", f"k_p = {act.stiffness:.4g} N/m, m_a = {act.mass:.4g} kg, "
                                   f"c_p = {act.viscosity:.4g} kg/s (ζ = {act.damping_ratio:.3g}), {stroke}"))

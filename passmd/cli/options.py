@@ -176,6 +176,7 @@ QUANTITIES = {q.flag: q for q in (*DRIVE_QUANTITIES, AMPLITUDE, FREQUENCY, NORMA
 #: waveforms, contacts and protocols the commands pass their options to.
 OPTION_FOR: dict[str, str] = {
     **{q.field: q.flag for q in DRIVE_QUANTITIES},
+    "amplifier.flyback": "--flyback",
     "amplitude": AMPLITUDE.flag,
     "frequency": FREQUENCY.flag,
     "normal_force": NORMAL_FORCE.flag,
@@ -234,13 +235,19 @@ def add_drive_options(parser, *, contact_only: bool = False) -> None:
         if contact_only and q.flag not in ("--radius", "--mu", *MATERIAL_FLAGS):
             continue
         q.add(group)
+    if not contact_only:
+        group.add_argument("--flyback", metavar="RULE", default=None,
+                           help="fly-back of the saw-tooth: slew (slew-rate limited, A/A_max · V_pp/SR), "
+                                "fixed (the full-stroke V_pp/SR at every amplitude) or a stated time with "
+                                "its unit, e.g. 1.5us (default: the drive file's, else "
+                                f"{DEFAULT_DRIVE.amplifier.flyback})")
     group.add_argument("--allow-extrapolation", action="store_true",
                        help="accept parameters outside the plausible ranges around Tables 1–2 (soft limits; "
                             "hard limits, where the model breaks, stay) (default: off)")
 
 
 def add_simulation_options(parser, default_periods: int) -> None:
-    """Waveform, amplitude, frequency, periods, fly-back and contact model of a run."""
+    """Waveform, amplitude, frequency, periods and contact model of a run (the fly-back is the drive's)."""
     group = parser.add_argument_group("waveform and simulation")
     group.add_argument("--waveform", choices=("sawtooth", "optimized"), default="sawtooth",
                        help="driving waveform: the standard saw-tooth or the optimized waveform of Eq. 15, "
@@ -249,9 +256,6 @@ def add_simulation_options(parser, default_periods: int) -> None:
     FREQUENCY.add(group)
     group.add_argument("--periods", type=int, default=default_periods, metavar="N",
                        help=f"number of driving periods (default: {default_periods})")
-    group.add_argument("--flyback", choices=("slew", "fixed"), default="slew",
-                       help="fly-back duration: slew-rate limited (A/A_max · V_pp/SR) or the fixed "
-                            "full-stroke time (default: slew)")
     group.add_argument("--springs", type=int, default=None, metavar="N",
                        help="discrete MDR contacts with N springs (default: exact contact, N → ∞)")
 

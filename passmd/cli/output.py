@@ -39,6 +39,11 @@ def fmt(value_si: float, unit: str) -> str:
     return f"{from_si(value_si, unit):.6g} {unit}".rstrip()
 
 
+def flyback_label(rule) -> str:
+    """A fly-back rule for people: ``"slew"``, ``"fixed"`` or a stated time in µs (``"1.5 us"``)."""
+    return rule if isinstance(rule, str) else fmt(rule, "us")
+
+
 def plain(obj, where: str = "result"):
     """JSON-ready: numpy scalars/arrays to Python; a non-finite float is a :class:`ResultError`."""
     if isinstance(obj, dict):
@@ -128,6 +133,7 @@ def drive_record(drive: Drive) -> dict:
         "full_stroke_amplitude_m": act.full_stroke_amplitude,
         "amplifier_voltage_V": amp.peak_to_peak_voltage,
         "slew_rate_V_per_s": amp.slew_rate,
+        "flyback": amp.flyback,  # "slew", "fixed" or a stated time in s
         **({"contact_groups": [{"count": g.count, "load_share": g.load_share,
                                 "normal_force_N": g.normal_force, "radius_m": g.radius,
                                 "contact_angle_rad": g.contact_angle, "side": g.side}

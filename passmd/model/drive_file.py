@@ -44,6 +44,7 @@ from passmd.model.arrangement import FLAT, ContactGroup, preset_groups
 from passmd.model.parameters import PLAUSIBLE_RANGES, Drive
 from passmd.model.tables import (
     ACTUATOR_DAMPING_RATIO,
+    FLYBACK_RULES,
     TABLE2_RADII,
     Amplifier,
     actuator_for_radius,
@@ -133,6 +134,9 @@ DRIVE_KEYS: dict[str, DriveKey] = {k.key: k for k in (
              "Section 2", "amplifier.peak_to_peak_voltage"),
     DriveKey("amplifier.slew_rate", "V/s", "V/us", "SR", "amplifier slew rate", "Section 2",
              "amplifier.slew_rate"),
+    DriveKey("amplifier.flyback", "flyback", "us", "t_fb", "fly-back of the saw-tooth: \"slew\" (slew-rate "
+             "limited, (A/A_max)·V_pp/SR), \"fixed\" (the full-stroke V_pp/SR at every amplitude) or a "
+             "stated time (\"1.5 us\"; a bare number is s)", "assumed (Section 2 gives V_pp and SR)"),
 )}
 
 _SI_UNITS = {"m", "kg", "s", "N", "N/m", "kg/s", "Pa", "V", "V/s", "Hz", ""}
@@ -167,6 +171,8 @@ def _value(where: str, spec: DriveKey, raw, allow_extrapolation: bool):
         return raw
     if spec.unit == "groups":
         return _groups(where, raw, allow_extrapolation)
+    if spec.unit == "flyback":
+        return _flyback(label, spec, raw)
     if spec.unit == "choice":
         if isinstance(raw, str) and raw in spec.choices:
             return raw
@@ -192,6 +198,24 @@ def _value(where: str, spec: DriveKey, raw, allow_extrapolation: bool):
                           name=spec.key, value=raw, limits=exc.limits, soft=exc.soft) from None
     elif spec.key == "actuator.viscosity" and not value >= 0.0:
         raise _refuse(label, f"= {raw!r} is out of range: must be >= 0{si}", name=spec.key, value=raw)
+    return value
+
+
+def _flyback(label: str, spec: DriveKey, raw) -> str | float:
+    """A fly-back rule: ``"slew"``, ``"fixed"``, or a time (a string with a unit, or a bare number in s)."""
+    if isinstance(raw, str) and raw.strip() in FLYBACK_RULES:
+        return raw.strip()
+    if isinstance(raw, bool) or not isinstance(raw, (int, float, str)):
+        raise _refuse(label, f"= {raw!r}: must be \"slew\", \"fixed\" or a time, e.g. \"1.5 us\"",
+                      name=spec.key, value=raw)
+    try:
+        value = parse_quantity(raw, "s", name=label)
+    except QuantityError:
+        raise _refuse(label, f"= {raw!r}: must be \"slew\", \"fixed\" or a time, e.g. \"1.5 us\"",
+                      name=spec.key, value=raw) from None
+    if not (math.isfinite(value) and value > 0.0):
+        raise _refuse(label, f"= {raw!r} is out of range: must be > 0 s", name=spec.key, value=raw,
+                      limits=((">", 0.0),))
     return value
 
 
@@ -418,21 +442,25 @@ def _shown(value, spec: DriveKey) -> str:
         return "true" if value else "false"
     if isinstance(value, str):
         return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if spec.display and spec.display != spec.unit:
+    si_unit = "s" if spec.unit == "flyback" else spec.unit  # a stated fly-back time
+    if spec.display and spec.display != si_unit:
         from passmd.runtime.units import from_si
 
         text = f"{float(from_si(value, spec.display)):.12g} {spec.display}"
-        if parse_quantity(text, spec.unit) == value:
+        if parse_quantity(text, si_unit) == value:
             return f'"{text}"'
     return _number(value)  # a bare number: SI
 
 
-def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None = None) -> str:
+def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None = None,
+               damping_ratio: float | None = None) -> str:
     """A commented drive file of ``drive``: :func:`load_drive` reads it back to an equal drive.
 
     Every key is written, with its symbol, meaning, unit and source (``sources`` by key,
-    else the paper's source of the default). The viscosity is written as given (c_p), not
-    as ζ, so that it reads back exactly.
+    else the paper's source of the default). The viscosity is written as given (c_p), so that
+    it reads back exactly; ``damping_ratio``: write this ζ instead, for a drive whose c_p is
+    2ζ√(k_p m_a) of its own k_p and m_a (it then reads back exactly too, and ``drive show``
+    derives c_p from it).
     """
     if not isinstance(drive, Drive):
         raise InputError(f"drive = {drive!r} is not a Drive", name="drive", value=drive)
@@ -453,6 +481,9 @@ def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None =
             lines += ["", f"[{head}]"] if head else [""]
             section = head
         value = _field(drive, key)
+        if key == "actuator.viscosity" and damping_ratio is not None:
+            key, name, value = "actuator.damping_ratio", "damping_ratio", float(damping_ratio)
+            spec = DRIVE_KEYS[key]
         unit = f" [{spec.unit}]" if spec.unit in _SI_UNITS and spec.unit else ""
         source = sources.get(key, spec.source)
         lines.append(f"{name or key} = {_shown(value, spec)}  # {spec.symbol}: {spec.text}{unit}; {source}")

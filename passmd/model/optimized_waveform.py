@@ -29,6 +29,7 @@ from passmd.model.waveforms import (
     Waveform,
     _flyback_time,
     check_flyback_fits,
+    flyback_rule,
     piecewise_linear,
     sawtooth,
 )
@@ -182,7 +183,7 @@ class OptimizedDesign:
 
 
 def highest_fitting_frequency(design: OptimizedDesign, amplitude: float, drive: Drive, *,
-                              flyback: str = "slew", min_ramp_fraction: float = MIN_RAMP_FRACTION) -> float:
+                              flyback=None, min_ramp_fraction: float = MIN_RAMP_FRACTION) -> float:
     """Highest driving frequency (Hz) at which one Eq. 15 period fits whole (Fig. 8b).
 
     A period holds t_s, t_a, the slow ramp and the fly-back t_fb; the slow ramp keeps at least
@@ -201,8 +202,9 @@ def highest_fitting_frequency(design: OptimizedDesign, amplitude: float, drive: 
         Actuation amplitude A in m (sets the fly-back's duration).
     drive : Drive
         The drive (its amplifier's slew-rate limit).
-    flyback : {"slew", "fixed"}
-        Fly-back rule (:func:`passmd.model.waveforms.flyback_time`).
+    flyback : {"slew", "fixed"} or float, optional
+        Overrides the drive's fly-back rule (default None: the drive's;
+        :func:`passmd.model.waveforms.flyback_time`).
     min_ramp_fraction : float
         Least share of T − t_fb the slow ramp keeps (assumption ``optimized_short_period``).
     """
@@ -211,15 +213,14 @@ def highest_fitting_frequency(design: OptimizedDesign, amplitude: float, drive: 
     a_max = check_drive(drive).actuator.full_stroke_amplitude
     A = check_range("amplitude", amplitude, 0.0, a_max, lower_open=True, unit="m")
     frac = check_range("min_ramp_fraction", min_ramp_fraction, 0.0, 1.0, lower_open=True, upper_open=True)
-    check_choice("flyback", flyback, ("slew", "fixed"))
-    t_fb = _flyback_time(A, drive, flyback)
+    t_fb = _flyback_time(A, drive, flyback_rule(drive, flyback))
     need = design.settling_time + design.acceleration_time
     period = t_fb + max(need / (1.0 - frac), need + A / max_piezo_velocity(drive))
     return 1.0 / max(period, 2.0 * t_fb)
 
 
 def check_fits(design: OptimizedDesign, amplitude: float, frequency: float, drive: Drive, *,
-               flyback: str = "slew", min_ramp_fraction: float = MIN_RAMP_FRACTION) -> float:
+               flyback=None, min_ramp_fraction: float = MIN_RAMP_FRACTION) -> float:
     """``frequency`` if one Eq. 15 period fits whole at it, else a one-line refusal naming the
     highest frequency that fits (:func:`highest_fitting_frequency`).
 
@@ -252,7 +253,7 @@ def optimized_timing(
     frequency: float,
     drive: Drive,
     *,
-    flyback: str = "slew",
+    flyback=None,
     min_ramp_fraction: float = MIN_RAMP_FRACTION,
     short_period: str = "cut",
 ) -> dict:
@@ -291,9 +292,9 @@ def optimized_timing(
     A = check_range("amplitude", amplitude, 0.0, a_max, lower_open=True, unit="m")
     f = check_positive("frequency", frequency, "Hz")
     frac = check_range("min_ramp_fraction", min_ramp_fraction, 0.0, 1.0, lower_open=True, upper_open=True)
-    check_choice("flyback", flyback, ("slew", "fixed"))
+    rule = flyback_rule(drive, flyback)
     T = 1.0 / f
-    t_fb = _flyback_time(A, drive, flyback)
+    t_fb = _flyback_time(A, drive, rule)
     check_flyback_fits(t_fb, f)
     if design.acceleration_amplitude >= A:
         d_a = design.acceleration_amplitude
@@ -335,7 +336,7 @@ def optimized(
     *,
     design: OptimizedDesign | None = None,
     first_period: str = "sawtooth",
-    flyback: str = "slew",
+    flyback=None,
     settle_fraction: float = SETTLE_FRACTION,
     min_ramp_fraction: float = MIN_RAMP_FRACTION,
     short_period: str = "refuse",
@@ -365,8 +366,9 @@ def optimized(
         frequencies) or chosen by hand.
     first_period : {"sawtooth", "optimized"}
         Shape of the first period.
-    flyback : {"slew", "fixed"}
-        Fly-back rule (:func:`~passmd.model.waveforms.flyback_time`).
+    flyback : {"slew", "fixed"} or float, optional
+        Fly-back rule overriding the drive's (default None: the drive's;
+        :func:`~passmd.model.waveforms.flyback_time`).
     settle_fraction : float
         Part of each period's slow ramp, at its end, used as the settle window.
     min_ramp_fraction : float

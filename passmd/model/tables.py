@@ -23,6 +23,7 @@ from passmd.runtime.validation import shown as _plain
 __all__ = [
     "ACTUATOR_DAMPING_RATIO",
     "ASSUMPTIONS",
+    "FLYBACK_RULES",
     "Actuator",
     "Amplifier",
     "Assumption",
@@ -34,6 +35,7 @@ __all__ = [
     "TABLE2_RADII",
     "actuator_for_radius",
     "actuator_viscosity",
+    "check_flyback_rule",
     "parameter_table",
 ]
 
@@ -168,9 +170,28 @@ def actuator_viscosity(stiffness: float, mass: float, damping_ratio: float = ACT
     return 2.0 * check_range("damping_ratio", damping_ratio, 0.0, unit="–") * np.sqrt(stiffness * mass)
 
 
+#: Named fly-back rules of the saw-tooth's fast edge (Section 2; assumption ``flyback_duration``):
+#: ``"slew"``, slew-rate limited, (A/A_max)·V_pp/SR (shorter at small amplitudes); ``"fixed"``, the
+#: full-stroke time V_pp/SR at every amplitude. A rule may also be a stated time in s.
+FLYBACK_RULES = ("slew", "fixed")
+
+
+def check_flyback_rule(name: str, value) -> str | float:
+    """``value`` if it is a fly-back rule: ``"slew"``, ``"fixed"`` or a stated time (s, finite, > 0)."""
+    if isinstance(value, str):
+        if value in FLYBACK_RULES:
+            return value
+        raise InputError(f"{name} = {value!r} is not allowed: must be 'slew', 'fixed' or a time in s (> 0)",
+                         name=name, value=value)
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        raise InputError(f"{name} = {_plain(value)} is not allowed: must be 'slew', 'fixed' or a time in s "
+                         "(> 0)", name=name, value=value)
+    return check_positive(name, float(value), "s")
+
+
 @dataclass(frozen=True)
 class Amplifier:
-    """Driving electronics (Section 2)."""
+    """Driving electronics (Section 2) and the rule of the saw-tooth's fly-back they give."""
 
     peak_to_peak_voltage: float = field(
         default=300.0, metadata=_meta("V_pp", "V", "Section 2")
@@ -178,10 +199,16 @@ class Amplifier:
     slew_rate: float = field(
         default=150e6, metadata=_meta("SR", "V/s", "Section 2 (150 V/µs)")
     )  # typical slew rate
+    #: how long the fast edge takes (:data:`FLYBACK_RULES`, or a stated time in s)
+    flyback: str | float = field(
+        default="slew",
+        metadata=_meta("t_fb", "rule or s", "assumed (flyback_duration): Section 2 gives V_pp, SR"),
+    )
 
     def __post_init__(self):
         check_positive("peak_to_peak_voltage", self.peak_to_peak_voltage, "V")
         check_positive("slew_rate", self.slew_rate, "V/s")
+        object.__setattr__(self, "flyback", check_flyback_rule("flyback", self.flyback))
 
     @property
     def full_stroke_time(self) -> float:

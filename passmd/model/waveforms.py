@@ -22,10 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from passmd.model.parameters import PLAUSIBLE_RANGES, Drive, check_drive
-from passmd.model.tables import Assumption
+from passmd.model.tables import Assumption, check_flyback_rule
 from passmd.runtime.validation import (
     InputError,
-    check_choice,
     check_count,
     check_positive,
     check_range,
@@ -56,8 +55,8 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         unit="s",
         rationale=(
             "Section 2 gives 300 V_pp and 150 V/µs; a fly-back of amplitude A needs A/A_max of the "
-            "full 2 µs stroke. The alternative, a fixed 2 µs, is available (flyback='fixed') and "
-            "moves the critical amplitude by several nm."
+            "full 2 µs stroke. The alternatives, a fixed 2 µs or a stated time, are a drive's choice "
+            "(the drive file's amplifier.flyback, --flyback) and move the critical amplitude by several nm."
         ),
         sensitivity="Critical-amplitude chapters: A_c with both fly-back rules.",
     ),
@@ -168,7 +167,13 @@ class Waveform:
         )
 
 
-def flyback_time(amplitude: float, drive: Drive, flyback: str = "slew") -> float:
+def flyback_rule(drive: Drive, flyback=None) -> str | float:
+    """The fly-back rule a run of ``drive`` uses: ``flyback`` if given (an explicit override), else the
+    drive's own (:attr:`passmd.model.tables.Amplifier.flyback`): ``"slew"``, ``"fixed"`` or a time in s."""
+    return drive.amplifier.flyback if flyback is None else check_flyback_rule("flyback", flyback)
+
+
+def flyback_time(amplitude: float, drive: Drive, flyback=None) -> float:
     """Duration of the fast edge of a saw-tooth (Section 2).
 
     Parameters
@@ -176,22 +181,28 @@ def flyback_time(amplitude: float, drive: Drive, flyback: str = "slew") -> float
     amplitude : float
         Actuation amplitude A in m.
     drive : Drive
-        Supplies the amplifier (300 V_pp, 150 V/µs) and the actuator's full-stroke amplitude.
-    flyback : {"slew", "fixed"}
-        ``"slew"``: slew-rate limited, (A / A_max) · V_pp / SR (shorter at small A);
-        ``"fixed"``: the full-stroke time V_pp / SR (2 µs) at every amplitude.
+        Supplies the amplifier (300 V_pp, 150 V/µs, its fly-back rule) and the actuator's
+        full-stroke amplitude.
+    flyback : {"slew", "fixed"} or float, optional
+        Overrides the drive's rule (:attr:`passmd.model.tables.Amplifier.flyback`; default None:
+        the drive's). ``"slew"``: slew-rate limited, (A / A_max) · V_pp / SR (shorter at small A);
+        ``"fixed"``: the full-stroke time V_pp / SR (2 µs) at every amplitude; a number: that
+        time in s at every amplitude.
     """
-    check_choice("flyback", flyback, ("slew", "fixed"))
     check_drive(drive)
-    return _flyback_time(check_range("amplitude", amplitude, 0.0, unit="m"), drive, flyback)
+    rule = flyback_rule(drive, flyback)
+    return _flyback_time(check_range("amplitude", amplitude, 0.0, unit="m"), drive, rule)
 
 
-def _flyback_time(amplitude: float, drive: Drive, flyback: str) -> float:
-    """:func:`flyback_time` of arguments its caller has checked (A >= 0 in m, a Drive, a rule)."""
+def _flyback_time(amplitude: float, drive: Drive, flyback) -> float:
+    """:func:`flyback_time` of arguments its caller has checked (A >= 0 in m, a Drive, a rule or None)."""
+    rule = drive.amplifier.flyback if flyback is None else flyback
     full = drive.amplifier.full_stroke_time
-    if flyback == "fixed":
+    if rule == "fixed":
         return full
-    return amplitude / drive.actuator.full_stroke_amplitude * full
+    if rule == "slew":
+        return amplitude / drive.actuator.full_stroke_amplitude * full
+    return float(rule)
 
 
 #: Fewest spacings of double-precision time (at the run's end) a fly-back must last, so
@@ -220,7 +231,7 @@ def sawtooth(
     frequency: float,
     drive: Drive,
     periods: int = 3,
-    flyback: str = "slew",
+    flyback=None,
     settle_fraction: float = SETTLE_FRACTION,
 ) -> Waveform:
     """Standard saw-tooth: slow ramp 0 → A (stick), fast fly-back A → 0 (slip) (Fig. 1d, 3c).
@@ -235,8 +246,8 @@ def sawtooth(
         The drive (amplifier and actuator limits).
     periods : int
         Number of periods.
-    flyback : {"slew", "fixed"}
-        Fly-back rule, see :func:`flyback_time`.
+    flyback : {"slew", "fixed"} or float, optional
+        Fly-back rule overriding the drive's (default None: the drive's), see :func:`flyback_time`.
     settle_fraction : float
         Part of the ramp, at its end, used as the settle window.
     """
@@ -246,13 +257,13 @@ def sawtooth(
                                             allow_extrapolation=drive.allow_extrapolation)
     frac = check_range("settle_fraction", settle_fraction, 0.0, 1.0, lower_open=True, upper_open=True)
     periods = check_count("periods", periods)
-    check_choice("flyback", flyback, ("slew", "fixed"))
+    rule = flyback_rule(drive, flyback)
     T = 1.0 / f
-    t_fb = _flyback_time(A, drive, flyback)
+    t_fb = _flyback_time(A, drive, rule)
     if A == 0.0:
         t_fb = min(drive.amplifier.full_stroke_time, 0.5 * T)  # any edge: x_p stays 0
     check_flyback_fits(t_fb, f)
-    if A > 0.0 and flyback == "slew":
+    if A > 0.0 and rule == "slew":
         _check_flyback_resolved(t_fb, A, drive, T, periods)
     t_ramp = T - t_fb
     times, positions, windows, marks = [0.0], [0.0], [], []

@@ -121,7 +121,7 @@ def steady_step(
     frequency: float = PROTOCOL.drive_frequency,
     *,
     periods: int = STEADY_PERIODS,
-    flyback: str = "slew",
+    flyback=None,
 ) -> dict:
     """Step sizes of a saw-tooth run from rest; the last one is the steady-state step.
 
@@ -136,8 +136,9 @@ def steady_step(
     periods : int
         Periods of the run (>= 2); the steps are the changes of the settled position from
         one period to the next.
-    flyback : {"slew", "fixed"}
-        Fly-back rule (:func:`passmd.model.waveforms.flyback_time`).
+    flyback : {"slew", "fixed"} or float, optional
+        Fly-back rule overriding the drive's (default None: the drive's;
+        :func:`passmd.model.waveforms.flyback_time`).
 
     Returns
     -------
@@ -163,7 +164,7 @@ def first_flyback_slip(
     amplitude: float,
     frequency: float = PROTOCOL.drive_frequency,
     *,
-    flyback: str = "slew",
+    flyback=None,
     hold: float = FIRST_FLYBACK_HOLD,
 ) -> dict:
     """Whether every contact group slides fully in the first fly-back from virgin contacts.
@@ -356,7 +357,7 @@ def critical_amplitude(
     *,
     protocol: str = "steady",
     frequency: float = PROTOCOL.drive_frequency,
-    flyback: str = "slew",
+    flyback=None,
     periods: int = STEADY_PERIODS,
     threshold: float = STEP_THRESHOLD,
     tolerance: float = PROTOCOL.search_tolerance,
@@ -373,8 +374,9 @@ def critical_amplitude(
         exceeds ``threshold``) or the onset of full sliding in the first fly-back.
     frequency : float
         Drive frequency f of the saw-tooth (Hz).
-    flyback : {"slew", "fixed"}
-        Fly-back rule (:func:`passmd.model.waveforms.flyback_time`).
+    flyback : {"slew", "fixed"} or float, optional
+        Fly-back rule overriding the drive's (default None: the drive's;
+        :func:`passmd.model.waveforms.flyback_time`).
     periods : int
         Periods of a steady-state run (>= 2).
     threshold : float
@@ -394,7 +396,7 @@ def critical_amplitude(
     if not isinstance(drive, Drive):
         raise ValueError(f"drive = {drive!r} is not a Drive")
     check_choice("protocol", protocol, PROTOCOLS)
-    check_choice("flyback", flyback, ("slew", "fixed"))
+    flyback = waveforms.flyback_rule(drive, flyback)
     check_positive("frequency", frequency, "Hz")
     check_positive("tolerance", tolerance, "m")
     check_range("threshold", threshold, 0.0, lower_open=True, unit="m")

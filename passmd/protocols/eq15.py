@@ -52,7 +52,7 @@ def response_frequency(frequency: float, response: str = "paper") -> float:
 
 
 def design_at(amplitude: float, frequency: float, drive: Drive, *, response: str = "paper",
-              flyback: str = "slew") -> tuple[OptimizedDesign, float]:
+              flyback=None) -> tuple[OptimizedDesign, float]:
     """The Eq. 15 design for driving ``drive`` at ``amplitude`` and ``frequency``, and the highest
     frequency at which its period fits (:func:`~passmd.model.optimized_waveform.highest_fitting_frequency`).
 
@@ -114,7 +114,7 @@ def optimized_design(
     acceleration_velocity: float | None = None,
     presliding: float | None = None,
     response_frequency: float = RESPONSE_FREQUENCY,
-    flyback: str = "slew",
+    flyback=None,
 ) -> OptimizedDesign:
     """Derive t_s, t_a and Δ_a of the optimized waveform from a simulated saw-tooth response (Eq. 15).
 
@@ -142,8 +142,9 @@ def optimized_design(
     response_frequency : float
         Saw-tooth frequency of the analysed response (Hz); default the protocol's driving
         frequency (:data:`passmd.model.defaults.PROTOCOL`).
-    flyback : {"slew", "fixed"}
-        Fly-back rule of that saw-tooth (:func:`~passmd.model.waveforms.flyback_time`).
+    flyback : {"slew", "fixed"} or float, optional
+        Fly-back rule of that saw-tooth, overriding the drive's (default None: the drive's;
+        :func:`~passmd.model.waveforms.flyback_time`).
 
     Raises
     ------

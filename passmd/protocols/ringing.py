@@ -24,7 +24,7 @@ import numpy as np
 from passmd.model import theory, waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive, check_drive
-from passmd.runtime.validation import check_choice, check_positive, check_range
+from passmd.runtime.validation import check_positive, check_range
 from passmd.solver import simulation as dynamics
 
 __all__ = ["HOLD", "MEASURABLE", "SAMPLES_PER_CYCLE", "at_frequency", "left_after", "ringing_point",
@@ -46,7 +46,7 @@ _MIN_TURNS = 3
 
 
 def stick_ringing(drive: Drive, amplitude: float, frequency: float = PROTOCOL.drive_frequency, *,
-                  flyback: str = "slew", hold: float | None = None) -> dict:
+                  flyback=None, hold: float | None = None) -> dict:
     """The ringing after the first fly-back of a saw-tooth from rest (module docstring).
 
     Parameters
@@ -57,8 +57,9 @@ def stick_ringing(drive: Drive, amplitude: float, frequency: float = PROTOCOL.dr
         Saw-tooth amplitude A (m), 0 < A <= A_max.
     frequency : float
         Frequency of the saw-tooth period before the fly-back (Hz).
-    flyback : {"slew", "fixed"}
-        Fly-back rule (:func:`passmd.model.waveforms.flyback_time`).
+    flyback : {"slew", "fixed"} or float, optional
+        Overrides the drive's fly-back rule (default None: the drive's;
+        :func:`passmd.model.waveforms.flyback_time`).
     hold : float, optional
         Time (s) recorded after the fly-back; default max(:data:`HOLD`, 2/f).
 
@@ -76,7 +77,6 @@ def stick_ringing(drive: Drive, amplitude: float, frequency: float = PROTOCOL.dr
     A = check_range("amplitude", amplitude, 0.0, drive.actuator.full_stroke_amplitude, lower_open=True,
                     unit="m")
     f = check_positive("frequency", frequency, "Hz")
-    check_choice("flyback", flyback, ("slew", "fixed"))
     hold = max(HOLD, 2.0 / f) if hold is None else check_positive("hold", hold, "s")
     t_fb = waveforms.flyback_time(A, drive, flyback)
     waveforms.check_flyback_fits(t_fb, f)

@@ -62,7 +62,7 @@ from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
 from passmd.model.theory import friction_limit, normal_forces
 from passmd.protocols.critical_amplitude import critical_amplitude
-from passmd.runtime.validation import check_choice, check_positive, check_range
+from passmd.runtime.validation import check_positive, check_range
 from passmd.solver import simulation as dynamics
 from passmd.solver.steps import CONVERGED_ACCURACY
 
@@ -275,7 +275,7 @@ def generated_force(
     amplitude: float,
     frequency: float,
     *,
-    flyback: str = "slew",
+    flyback=None,
     initial_periods: int = INITIAL_PERIODS,
     max_periods: int = MAX_PERIODS,
     abs_tolerance: float = STALL_ABS_TOLERANCE,
@@ -293,8 +293,9 @@ def generated_force(
         Actuation amplitude A (m).
     frequency : float
         Driving frequency f (Hz).
-    flyback : {"slew", "fixed"}
-        Fly-back rule of :func:`passmd.model.waveforms.sawtooth`.
+    flyback : {"slew", "fixed"} or float, optional
+        Fly-back rule overriding the drive's (default None: the drive's;
+        :func:`passmd.model.waveforms.sawtooth`).
     initial_periods, max_periods : int
         Periods of the first run, lengthened until stall or until ``max_periods``.
     abs_tolerance, rel_tolerance : float
@@ -336,7 +337,7 @@ def generated_force(
     if not isinstance(drive, Drive):
         raise ValueError(f"drive = {drive!r} is not a Drive")
     check_positive("frequency", frequency, "Hz")
-    check_choice("flyback", flyback, ("slew", "fixed"))
+    flyback = waveforms.flyback_rule(drive, flyback)
     check_positive("abs_tolerance", abs_tolerance, "N")
     check_range("rel_tolerance", rel_tolerance, 0.0, 1.0, upper_open=True)
     for name, value in (("initial_periods", initial_periods), ("max_periods", max_periods)):

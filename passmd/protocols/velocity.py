@@ -14,6 +14,12 @@ Two measurements, as pure functions of a :class:`~passmd.model.parameters.Drive`
   quarter. For the optimized waveform the run also reports whether the contacts stick while
   the hemispheres accelerate (assumption ``stick_during_acceleration``).
 
+* **Steady step of a running drive** (:func:`settled_step`, what a test stand measures as "the
+  step" at low frequency): a saw-tooth from rest, period after period, until the last
+  :data:`SETTLED_STEPS` steps agree to :data:`STEP_ACCURACY`; the step is the last one. The first
+  step from rest differs from the steady one by the start-up transient (0.5–2 nm for the
+  six-contact flexible drive at 100 Hz), so a run from rest is a different measurement.
+
 Nothing here knows of figures, grids or the ledger.
 """
 
@@ -31,13 +37,17 @@ from passmd.solver.results import SimulationError
 __all__ = [
     "FULL_SLIDING_SHARE",
     "MAX_RECORD",
+    "MAX_SETTLE_PERIODS",
     "MIN_PERIODS",
     "SAMPLES_PER_ACCELERATION",
+    "SETTLED_STEPS",
     "STEADY_DRIFT_LIMIT",
     "STEADY_TIME",
+    "STEP_ACCURACY",
     "STEP_PERIODS",
     "STEP_PROTOCOL_BELOW",
     "make_waveform",
+    "settled_step",
     "steady_periods",
     "steady_run",
     "steady_velocity",
@@ -63,6 +73,15 @@ STEP_PERIODS = 3
 #: Below this frequency a velocity is measured from the steps (STEP_PERIODS periods, mean step × f),
 #: above it by the steady-velocity protocol (Hz).
 STEP_PROTOCOL_BELOW = 1e3
+#: Accuracy of a settled step (m): a fifth of the simulator's step convergence (0.05 nm, the
+#: integrator's stated accuracy), far below a measured step's scatter (≥ 0.1 nm).
+STEP_ACCURACY = 0.01e-9
+#: Consecutive steps that must agree to STEP_ACCURACY: three, so that one small change between two
+#: steps of a slowly turning transient is not taken for a settled step.
+SETTLED_STEPS = 3
+#: Most periods a settling run takes; a step still changing then is reported unsettled (the mean
+#: step of the run's second half, as the steady-velocity protocol measures it).
+MAX_SETTLE_PERIODS = 60
 
 
 def make_waveform(drive, amplitude, frequency, periods, waveform, short_period, design):
@@ -108,6 +127,56 @@ def step_run(drive, amplitude: float, frequency: float, waveform: str, design=No
     result = dynamics.simulate(drive, wave, max_points=2)
     return {"settled_positions_m": result.settled_positions, "mean_step_m": float(np.mean(result.step_sizes)),
             "final_position_m": result.final_position, "wall_time_s": result.wall_time}
+
+
+def settled_step(drive, amplitude: float, frequency: float, *, accuracy: float = STEP_ACCURACY,
+                 max_periods: int = MAX_SETTLE_PERIODS, flyback=None) -> dict:
+    """Steady step of a running saw-tooth drive: periods from rest until the step settles.
+
+    The run is continued period by period (:class:`passmd.solver.simulation.Simulation`) until
+    the last :data:`SETTLED_STEPS` steps (changes of the settled position from one period to the
+    next) lie within ``accuracy`` of each other; the step is the last one. A run that has not
+    settled after ``max_periods`` periods reports the mean step of its second half (the
+    steady-velocity protocol's reading) with ``settled`` False.
+
+    Parameters
+    ----------
+    drive : Drive
+        The drive (its fly-back rule unless ``flyback`` overrides it).
+    amplitude, frequency : float
+        Saw-tooth amplitude A (m) and frequency f (Hz).
+    accuracy : float
+        Largest spread of the last :data:`SETTLED_STEPS` steps (m).
+    max_periods : int
+        Most periods of the run (> :data:`SETTLED_STEPS`).
+    flyback : {"slew", "fixed"} or float, optional
+        Fly-back rule overriding the drive's.
+
+    Returns
+    -------
+    dict
+        ``step_m``, ``settled``, ``spread_m`` (of the last steps), ``periods``, ``first_step_m``
+        (the step across the first fly-back, from rest), ``wall_time_s``.
+    """
+    from passmd.runtime.validation import check_count, check_positive
+
+    check_positive("accuracy", accuracy, "m")
+    max_periods = check_count("max_periods", max_periods, SETTLED_STEPS + 2)
+    wave = waveforms.sawtooth(amplitude, frequency, drive, periods=max_periods, flyback=flyback)
+    run = dynamics.Simulation(drive, wave, max_points=2)
+    periods = SETTLED_STEPS + 1
+    while True:
+        run.run_to(periods)
+        steps = run.result().step_sizes
+        last = steps[-SETTLED_STEPS:]
+        spread = float(np.max(last) - np.min(last))
+        if spread <= accuracy or periods == max_periods:
+            break
+        periods += 1
+    settled = spread <= accuracy
+    step = float(steps[-1]) if settled else float(np.mean(steps[(steps.size - 1) // 2:]))
+    return {"step_m": step, "settled": bool(settled), "spread_m": spread, "periods": periods,
+            "first_step_m": float(steps[0]), "wall_time_s": run.wall_time}
 
 
 def steady_run(drive, amplitude: float, frequency: float, waveform: str, short_period: str,

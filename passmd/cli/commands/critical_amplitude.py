@@ -10,7 +10,16 @@ from passmd.cli.drive import build_drive, drive_rows
 from passmd.cli.errors import UsageError
 from passmd.cli.notes import ringing_text
 from passmd.cli.options import FREQUENCY, THRESHOLD, TOLERANCE, add_drive_options
-from passmd.cli.output import JSON_HELP, check_results, describe, drive_record, emit_json, emit_rows, fmt
+from passmd.cli.output import (
+    JSON_HELP,
+    check_results,
+    describe,
+    drive_record,
+    emit_json,
+    emit_rows,
+    flyback_label,
+    fmt,
+)
 from passmd.model.defaults import PROTOCOL
 from passmd.runtime.units import from_si
 
@@ -60,8 +69,6 @@ def add_parser(command) -> None:
                        help=f"periods of a steady-state run (default: {PROTOCOL.steady_periods})")
     THRESHOLD.add(group)
     TOLERANCE.add(group)
-    group.add_argument("--flyback", choices=("slew", "fixed"), default="slew",
-                       help="fly-back duration rule (default: slew)")
     group.add_argument("--analytic-only", action="store_true", help="skip the simulation (default: off)")
     p.add_argument("--json", action="store_true", help=JSON_HELP)
     p.set_defaults(handler=run_critical_amplitude)
@@ -84,7 +91,7 @@ def _search(args, drive) -> dict:
     kernels.notice_if_cold()
     # the book's search (critical-amplitude chapters): one protocol for users and book
     found = ca.critical_amplitude(
-        drive, protocol=args.protocol, frequency=frequency, flyback=args.flyback,
+        drive, protocol=args.protocol, frequency=frequency,
         periods=args.periods, threshold=threshold, tolerance=tolerance,
         progress="long",  # a long search's progress on stderr, also when it is not a terminal
     )
@@ -99,7 +106,7 @@ def _search(args, drive) -> dict:
         "tolerance_m": tolerance,
         "frequency_Hz": frequency,
         "periods": args.periods if args.protocol == "steady" else 1,
-        "flyback": args.flyback,
+        "flyback": drive.amplifier.flyback,
         "simulations": found["runs"],
         "wall_time_s": found["wall_time_s"],
         "ringing": _ringing(drive, value, frequency, args),
@@ -112,7 +119,7 @@ def _ringing(drive, found: float, frequency: float, args) -> dict:
     from passmd.protocols import ringing
 
     at = drive.actuator.full_stroke_amplitude if math.isnan(found) else found
-    ring = ringing.at_frequency(ringing.stick_ringing(drive, at, frequency, flyback=args.flyback), frequency)
+    ring = ringing.at_frequency(ringing.stick_ringing(drive, at, frequency), frequency)
     ring["ringing_affects_steps"] = ring["ringing_affects_steps"] and args.protocol == "steady"
     return {**{k: None if isinstance(v, float) and math.isnan(v) else v for k, v in ring.items()},
             "amplitude_m": at}
@@ -158,7 +165,7 @@ def _search_rows(record: dict, drive) -> list[tuple[str, str]]:
          if found is not None else
          f"none up to the full stroke {fmt(a_max, 'nm')} ({criterion})"),
         ("search", f"{record['protocol']}: {criterion}, "
-                   f"f = {fmt(record['frequency_Hz'], 'kHz')}, {record['flyback']} fly-back, "
+                   f"f = {fmt(record['frequency_Hz'], 'kHz')}, {flyback_label(record['flyback'])} fly-back, "
                    f"{record['simulations']} simulations"),
         ("runner ringing", f"at A = {fmt(record['ringing']['amplitude_m'], 'nm')}: "
                            + ringing_text(record["ringing"], f"the {record['protocol']} A_c"

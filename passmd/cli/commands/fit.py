@@ -8,7 +8,7 @@ import textwrap
 import time
 from pathlib import Path
 
-from passmd.cli.drive import build_drive
+from passmd.cli.drive import resolve_drive
 from passmd.cli.errors import OutputError, UsageError
 from passmd.cli.options import (
     DRIVE_QUANTITIES,
@@ -17,7 +17,16 @@ from passmd.cli.options import (
     add_sweep_options,
     refuse_bare,
 )
-from passmd.cli.output import JSON_HELP, check_results, describe, drive_record, emit_json, emit_rows, plain
+from passmd.cli.output import (
+    JSON_HELP,
+    check_results,
+    describe,
+    drive_record,
+    emit_json,
+    emit_rows,
+    flyback_label,
+    plain,
+)
 from passmd.runtime.units import from_si, parse_quantity
 
 __all__ = ["FREE_NAMES", "add_parser", "run_fit"]
@@ -25,27 +34,41 @@ __all__ = ["FREE_NAMES", "add_parser", "run_fit"]
 _EPILOG = textwrap.dedent("""\
     DATA.csv: one measurement a row; column names carry their units. Conditions:
     amplitude_nm, preload_N, frequency_Hz, radius_mm (preload and radius default to the
-    drive's; a critical amplitude's frequency to 100 Hz). Measured, one per row: step_nm,
-    velocity_mm_per_s, critical_amplitude_nm, force_N, position_nm, each with an optional <column>_sd
-    (given for every row or for none; without it each row weighs one unit of its column
-    and the residual scale is estimated).
+    drive's; a critical amplitude's frequency to 100 Hz). Measured, one per row: step_nm
+    (the settled step of a running drive: below 1 kHz the step once three consecutive steps
+    agree to 0.01 nm, above it the steady-velocity protocol's velocity / f),
+    velocity_mm_per_s (the same × f), critical_amplitude_nm, force_N, position_nm (the
+    position after three periods from rest, Fig. 9a: a measurement of a start, not of a
+    running drive), each with an optional <column>_sd (given for every row or for none;
+    without it each row weighs one unit of its column and the residual scale is estimated).
+    Every row is checked against the drive (stroke, fly-back within half a period, preload
+    and radius ranges) before anything is simulated.
 
-    The fit: a Sobol global pass over the bounds, then bounded weighted least squares in
-    log-parameter space (passmd.protocols.fit), every model evaluation a cached parallel
-    sweep; a parameter whose response oscillates on the Jacobian's scale is scanned first. Each
-    estimate comes with its standard error (Jacobian), a 95 % profile-likelihood interval and an
-    identifiability verdict (flat profile, or a correlation beyond ±0.95); a fit whose profiles meet a
-    lower cost than its estimate is reported as not converged, with no intervals claimed.
+    The fit (passmd.protocols.fit): a Sobol global pass of 64 points per free parameter over
+    the bounds, local least-squares searches in log-parameter space, then each parameter's
+    profile over its whole bounds (a comb of minima, as the step of flexible actuators has
+    in k_p, is sampled at 1 %). The estimate is the lowest point found. Each parameter's
+    95 % region is every value whose profile lies within the chi-square quantile of the
+    minimum: one interval, or several pieces when the data allow several basins (then the
+    one added measurement that separates them best is computed). With stated sd the
+    minimum is tested against chi-square with n - p degrees of freedom; below p = 0.01 the
+    model does not describe the data and no interval is called calibrated.
+    While k_p or m_a moves the damping ratio stays fixed, or c_p when the drive gives c_p.
 
     --out DIR writes fit.json (the --json report), fit.png (data against the fitted model,
-    with residuals) and fitted-drive.toml (the fitted drive, for --drive).
+    with residuals) and fitted-drive.toml (the fitted drive, every value with its source,
+    for --drive).
 
-    --json keys (SI units): estimates{name: value, stderr, interval[low, high], unit, ...},
-    residuals[...], correlation{parameters, matrix, limit}, identifiable, converged, verdict, cost,
-    residual_scale, degrees_of_freedom, drive{...}, wall_time_s""")
+    --json keys (SI units): estimates{name: value, stderr, interval[low, high] (the hull),
+    intervals[[low, high], ...], basins[{value, cost}], profile{value, cost}, unit, ...},
+    goodness_of_fit{chi2, dof, p_value, testable, rejected}, identifiable, model_rejected,
+    basins[...], next_measurement, residuals[...], correlation{parameters, matrix, limit},
+    converged, verdict, cost, residual_scale, degrees_of_freedom, flyback, keep, drive{...},
+    wall_time_s""")
 
 #: Free parameters as --free names them: the drive option without its dashes, or a derived one;
-#: each with its library name and the unit its --bounds and human output use.
+#: each with its library name (which --free takes too, as drive show and the drive file name it)
+#: and the unit its --bounds and human output use.
 FREE_NAMES: dict[str, tuple[str, str]] = {
     **{q.flag[2:]: (q.field, q.unit) for q in DRIVE_QUANTITIES
        if q.field in ("friction_coefficient", "actuator.stiffness", "actuator.mass", "actuator.viscosity",
@@ -54,6 +77,8 @@ FREE_NAMES: dict[str, tuple[str, str]] = {
     "flyback-time": ("flyback_time", "us"),
     "contact-stiffness-scale": ("contact_stiffness_scale", ""),
 }
+#: Every name --free and --bounds take: the option names above and the library's (drive-file) names.
+_ALIASES = {**{lib: name for name, (lib, _) in FREE_NAMES.items()}, **{name: name for name in FREE_NAMES}}
 _OUTPUTS = ("fit.json", "fit.png", "fitted-drive.toml")
 
 
@@ -62,7 +87,8 @@ def add_parser(command) -> None:
     p.add_argument("data", metavar="DATA.csv", help="the measurements (see below)")
     group = p.add_argument_group("fit")
     group.add_argument("--free", required=True, metavar="NAME[,NAME...]",
-                       help="parameters to fit (default: none; required): " + ", ".join(FREE_NAMES))
+                       help="parameters to fit, by option or drive-file name (default: none; required): "
+                            + ", ".join(f"{name} ({lib})" for name, (lib, _) in FREE_NAMES.items()))
     group.add_argument("--bounds", action="append", default=[], metavar="NAME=LOW..HIGH",
                        help="range of a free parameter, with a unit (a bare number is SI, refused where the "
                             "parameter is shown in another unit) (default: the plausible range)")
@@ -70,8 +96,6 @@ def add_parser(command) -> None:
                        help="how the simulator reads a critical amplitude (default: steady)")
     group.add_argument("--loss", choices=("linear", "soft_l1", "huber", "cauchy", "arctan"), default="linear",
                        help="robust loss of the estimate; intervals use least squares (default: linear)")
-    group.add_argument("--starts", type=int, default=16, metavar="N",
-                       help="points of the global pass, a power of two, 0 for none (default: 16)")
     add_drive_options(p)
     add_sweep_options(p)
     out = p.add_argument_group("output")
@@ -83,10 +107,14 @@ def add_parser(command) -> None:
 
 
 def _free(args) -> list[str]:
-    names = [n.strip() for n in args.free.split(",")]
-    for name in names:
-        if name not in FREE_NAMES:
-            raise UsageError(f"--free = {name!r} is not allowed: must be one of " + ", ".join(FREE_NAMES))
+    """The --free names as option names (a drive-file name is read as its option)."""
+    names = []
+    for text in args.free.split(","):
+        name = text.strip()
+        if name not in _ALIASES:
+            raise UsageError(f"--free = {name!r} is not allowed: must be one of "
+                             + ", ".join(f"{n} ({lib})" for n, (lib, _) in FREE_NAMES.items()))
+        names.append(_ALIASES[name])
     if len(set(names)) != len(names):
         raise UsageError(f"--free = {args.free!r} names a parameter twice")
     return names
@@ -97,7 +125,7 @@ def _bounds(args, names) -> dict[str, tuple[float, float]]:
     for text in args.bounds:
         name, sep, span = text.partition("=")
         low, dots, high = span.partition("..")
-        name = name.strip()
+        name = _ALIASES.get(name.strip(), name.strip())
         if not sep or not dots:
             raise UsageError(f"--bounds = {text!r} is not NAME=LOW..HIGH")
         if name not in names:
@@ -156,10 +184,8 @@ def run_fit(args, out) -> int:
 
     names = _free(args)
     bounds = _bounds(args, names)
-    drive = build_drive(args)
+    drive, sources = resolve_drive(args)
     target = _check_out(args)
-    if args.starts < 0 or (args.starts & (args.starts - 1)):
-        raise UsageError(f"--starts = {args.starts} is out of range: must be 0 or a power of two")
     try:
         data = fitting.read_measurements(args.data)
     except FileNotFoundError:
@@ -170,14 +196,19 @@ def run_fit(args, out) -> int:
         raise UsageError(f"DATA.csv = {args.data!r} is a directory") from None
     config = execution_config(args)
     library = {FREE_NAMES[n][0]: n for n in names}
+    # c_p stays fixed while k_p or m_a moves only when the user gave c_p (drive show: "given"/"option")
+    given_cp = sources.get("actuator.viscosity", "").startswith(("given", "option"))
     try:
         result = fitting.fit(drive, data, list(library), bounds=bounds, reading=args.reading, loss=args.loss,
-                             starts=args.starts, config=config, progress=_progress(config))
+                             keep="viscosity" if given_cp else "damping_ratio", config=config,
+                             progress=_progress(config))
+    except fitting.MeasurementError as exc:  # a row the drive cannot run: refused before any simulation
+        raise UsageError(str(exc)) from None
     except fitting.InputError as exc:
         if exc.name in ("free", "bounds", "data"):
             raise UsageError(str(exc).replace("free = ", "--free: ")) from None
         raise
-    text = fitting.fitted_drive_file(result.drive, Path(args.data).name, list(library))
+    text = fitting.fitted_drive_file(result, Path(args.data).name, sources)
     record = {"command": "fit", **result.report(), "drive": drive_record(result.drive)}
     check_results(record)
     if target is not None:
@@ -185,17 +216,32 @@ def run_fit(args, out) -> int:
     if args.json:
         emit_json(record, out)
         return 0
+    emit_rows(f"passmd fit — {describe(result.drive)}", _rows(result, library, data, target), out)
+    return 0
+
+
+def _rows(result, library: dict[str, str], data, target) -> list[tuple[str, str]]:
+    """The human report: each estimate with its 95 % region, the goodness of fit, the verdict."""
     rows = []
     for lib, name in library.items():
         est = result.estimates[lib]
         unit = FREE_NAMES[name][1]
-        low, high = (from_si(v, unit) for v in est["interval"])
-        rows.append((name, f"{from_si(est['value'], unit):.5g} ± {from_si(est['stderr'], unit):.2g} {unit}  "
-                           f"(95 % profile interval {low:.5g}–{high:.5g})".replace("  (", " (")))
-    rows.append(("fit", f"{len(data)} measurements, cost {result.cost:.4g}, {result.dof} degrees of freedom, "
-                        f"{result.simulations} simulations, {result.wall_time_s:.1f} s"))
+        shown = f" {unit}" if unit else ""
+        region = ", ".join(f"{from_si(a, unit):.5g}–{from_si(b, unit):.5g}" for a, b in est["intervals"])
+        pieces = len(est["intervals"])
+        rows.append((name, f"{from_si(est['value'], unit):.5g}{shown} (local standard error "
+                           f"{from_si(est['stderr'], unit):.2g}); 95 % region {region}{shown}"
+                           + (f" ({pieces} pieces, {len(est['basins'])} basins)" if pieces > 1 else "")))
+    gof = result.goodness_of_fit
+    test = (f"χ² = {gof['chi2']:.4g} on {gof['dof']} degrees of freedom, p = {gof['p_value']:.3g}"
+            + (" (the model does not describe the data)" if gof["rejected"] else "")
+            if gof["testable"] else "no sd given: residual scale estimated, no test possible")
+    rows.append(("goodness of fit", test))
+    rows.append(("fit", f"{len(data)} measurements, {result.dof} degrees of freedom, fly-back "
+                        f"{flyback_label(result.drive.amplifier.flyback)}, {result.simulations} simulations, "
+                        f"{result.wall_time_s:.1f} s"))
     rows.append(("verdict", result.verdict))
+    rows += [("note", note) for note in result.notes]
     if target is not None:
         rows.append(("written", ", ".join(str(target / n) for n in _OUTPUTS)))
-    emit_rows(f"passmd fit — {describe(result.drive)}", rows, out)
-    return 0
+    return rows

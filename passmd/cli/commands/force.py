@@ -78,7 +78,7 @@ def run_force(args, out) -> int:
     kernels.notice_if_cold()
     # the force-generation chapter's stall protocol: runs from rest, lengthened until stalled
     try:
-        found = stall.generated_force(drive, amplitude, frequency, flyback=args.flyback,
+        found = stall.generated_force(drive, amplitude, frequency,
                                       initial_periods=args.periods, max_periods=args.max_periods,
                                       progress="long")  # on stderr, also off a terminal
     except ValueError as exc:  # name the command's options, not the library's parameters
@@ -91,14 +91,14 @@ def run_force(args, out) -> int:
         from passmd.model import waveforms
         from passmd.solver import simulation as dynamics
 
-        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=found["periods"], flyback=args.flyback)
+        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=found["periods"])
         write_outputs(args, dynamics.simulate(drive, wave, max_points=args.max_points))
     force, bound = found["generated_force_N"], found["coulomb_bound_N"]
     # Only the runner's inertia carries a period mean past μΣF_N, in a run cut short while the
     # runner swings on the load cell: that reading is no generated force, and no force above
     # the Coulomb bound is reported.
     swinging = not found["converged"] and abs(force) > bound
-    record = {"command": "force", "waveform": "sawtooth", "flyback": args.flyback,
+    record = {"command": "force", "waveform": "sawtooth", "flyback": drive.amplifier.flyback,
               "amplitude_m": amplitude, "frequency_Hz": frequency, "drive": drive_record(drive), **found}
     if swinging:
         record["generated_force_N"] = None

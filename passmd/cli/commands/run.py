@@ -210,16 +210,16 @@ def simulate(args, drive, options: RunOptions):
         # Eq. 15, designed from this drive's own simulated saw-tooth response (first period a
         # saw-tooth, as in the paper); a ValueError (e.g. Δ_a ≥ A) is a usage error
         kernels.notice_if_cold()  # the design simulates: every option is checked by now
-        design = eq15.optimized_design(amplitude, drive, flyback=args.flyback, response_frequency=eq15.
+        design = eq15.optimized_design(amplitude, drive, response_frequency=eq15.
                                        response_frequency(frequency, args.design_response))
         if given:  # the user's values replace the design's (its f_s, V_r, u_x,max stay as measured)
             design = replace(design, **given)
         _check_eq15_fits(args, design, amplitude, frequency, drive)
         wave = optimized_waveform.optimized(amplitude, frequency, drive, periods=args.periods,
-                                            flyback=args.flyback, design=design)
+                                            design=design)
     else:
         design = None
-        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=args.periods, flyback=args.flyback)
+        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=args.periods)
         kernels.notice_if_cold()  # after the last check of the options: a refusal stays one line
     result = dynamics.simulate(
         drive, wave, contact_model="exact" if springs is None else "discrete",
@@ -233,9 +233,8 @@ def _check_eq15_fits(args, design, amplitude, frequency, drive) -> None:
     """Refuse a --frequency at which Eq. 15's period does not fit, naming the highest that does."""
     from passmd.model import optimized_waveform
 
-    f_max = optimized_waveform.highest_fitting_frequency(design, amplitude, drive, flyback=args.flyback)
-    if optimized_waveform.optimized_timing(design, amplitude, frequency, drive, flyback=args.flyback)[
-            "settling_fits"]:
+    f_max = optimized_waveform.highest_fitting_frequency(design, amplitude, drive)
+    if optimized_waveform.optimized_timing(design, amplitude, frequency, drive)["settling_fits"]:
         return
     source = "the options' t_s, t_a" if args.settling_time or args.acceleration_time else \
         f"the {hz(design.response_frequency)} saw-tooth response"
@@ -246,12 +245,12 @@ def _check_eq15_fits(args, design, amplitude, frequency, drive) -> None:
         f"the slow ramp (at least half of the rest) need a period of {1e6 / f_max:.4g} µs")
 
 
-def runner_ringing(drive, amplitude: float, frequency: float, flyback: str) -> dict:
+def runner_ringing(drive, amplitude: float, frequency: float) -> dict:
     """The runner's ringing after a saw-tooth fly-back of this run's amplitude and frequency and what
     of it is left at the next fly-back (:func:`passmd.protocols.ringing.at_frequency`)."""
     from passmd.protocols import ringing
 
-    probe = ringing.stick_ringing(drive, amplitude, frequency, flyback=flyback)
+    probe = ringing.stick_ringing(drive, amplitude, frequency)
     return {k: None if isinstance(v, float) and math.isnan(v) else v  # no swing: no frequency, no decay
             for k, v in ringing.at_frequency(probe, frequency).items()}
 
@@ -304,7 +303,7 @@ def run_run(args, out) -> int:
     check_memory(args)
     check_output_paths(args)
     result, design = simulate(args, drive, options)
-    ring = runner_ringing(drive, options.amplitude, options.frequency, args.flyback)  # a simulation too
+    ring = runner_ringing(drive, options.amplitude, options.frequency)  # a simulation too
     startup.resume()
     summary = result.summary()
     summary["wall_time_s"] = float(result.wall_time)
@@ -313,7 +312,7 @@ def run_run(args, out) -> int:
 
         summary["design"] = design.as_dict()
         summary["eq15_highest_frequency_Hz"] = highest_fitting_frequency(
-            design, float(summary["amplitude_m"]), drive, flyback=args.flyback)
+            design, float(summary["amplitude_m"]), drive)
         summary["design_given_by_options"] = [q.field for q in EQ15_OVERRIDES
                                               if getattr(args, q.dest) is not None]
     if args.steady:  # the book's steady-velocity protocol, on this same run
@@ -326,7 +325,7 @@ def run_run(args, out) -> int:
     check_run_bounds(summary, drive, float(summary["amplitude_m"]))
     write_outputs(args, result)
     if args.json:
-        emit_json({"command": "run", "waveform": args.waveform, "flyback": args.flyback,
+        emit_json({"command": "run", "waveform": args.waveform, "flyback": drive.amplifier.flyback,
                    "protocol": "steady" if args.steady else "from rest",
                    "drive": drive_record(drive), **summary}, out)
         return 0

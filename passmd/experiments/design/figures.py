@@ -7,17 +7,13 @@ critical amplitude, the step and velocity map, the Eq. 15 gain map and the stall
 :func:`passmd.protocols.fit.estimator.fit` (what ``passmd fit`` runs) for the calibration. One function
 per figure; the grids of each profile are in :data:`PROFILE_SETTINGS`.
 
-The calibration is a round trip: measurements of the example drive are simulated
-(:func:`synthetic_measurements`, Gaussian noise of :data:`NOISE_NM` with seed :data:`SEED`),
-the unknown parameters are fitted from a designer's first guess (:data:`START`: the paper's
-Table 1 friction coefficient, Table 2's stiffness for the radius), and the fitted drive predicts
-measurements that were held back from the fit.
+The calibration's settings are here (:data:`NOISE_NM`, :data:`SEED`, :data:`START`, each profile's
+free parameters and points); its functions are :mod:`passmd.experiments.design.calibration`.
 """
 
 from __future__ import annotations
 
 import math
-import tempfile
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -27,11 +23,9 @@ import pandas as pd
 from passmd.experiments.design.maps import compute_map
 from passmd.model import drive_file
 from passmd.model.defaults import PROTOCOL
-from passmd.model.drive_file import load_drive, parameter_rows, read_drive_file, resolve
+from passmd.model.drive_file import parameter_rows, read_drive_file, resolve
 from passmd.model.parameters import Drive
-from passmd.model.tables import actuator_for_radius
 from passmd.model.theory import contact_arrangement
-from passmd.protocols import fit as fitting
 from passmd.protocols import ringing, stall
 from passmd.runtime.config import PROFILES, RunConfig
 from passmd.runtime.units import from_si
@@ -44,22 +38,16 @@ __all__ = [
     "SEED",
     "START",
     "ProfileSettings",
-    "calibrate",
     "contact_table",
     "critical_amplitude_curve",
     "curve_facts",
     "curve_from_maps",
     "example_drive",
-    "fit_facts",
     "gain_facts",
     "gain_map",
-    "heldback_facts",
-    "heldback_predictions",
-    "load_fitted",
     "map_axes",
     "map_facts",
     "map_points",
-    "measurements_csv",
     "parameter_table",
     "preload_points",
     "ringing_facts",
@@ -67,9 +55,7 @@ __all__ = [
     "stall_force_curve",
     "stall_frame",
     "stall_points",
-    "start_drive",
     "step_velocity_map",
-    "synthetic_measurements",
 ]
 
 #: The example drive file (package data, so an installed wheel has it too; ``passmd drive template
@@ -306,77 +292,6 @@ def stall_frame(points: list[dict], table: pd.DataFrame) -> pd.DataFrame:
     })
 
 
-def start_drive(truth: Drive, profile: str) -> Drive:
-    """A designer's first guess: ``truth`` with each free parameter at the paper's value (:data:`START`)."""
-    drive = truth
-    for name in _settings(profile).free:
-        if name == "friction_coefficient":
-            drive = replace(drive, friction_coefficient=Drive().friction_coefficient)
-        elif name == "actuator.stiffness":
-            table2 = actuator_for_radius(truth.hemisphere_radius).stiffness
-            drive = fitting.FREE_PARAMETERS[name].set(drive, table2, truth)
-    return drive
-
-
-def _measurements(points, truth: Drive, rng, config) -> fitting.Measurements:
-    header = ["amplitude_nm", "preload_N", "frequency_Hz", "step_nm", "step_nm_sd"]
-    rows = [[repr(float(a)), repr(float(p)), repr(float(f)), "0", repr(NOISE_NM)] for f, p, a in points]
-    data = fitting.measurements_from_rows(header, rows, name="synthetic measurements")
-    exact = fitting.predict(truth, data, config=config)
-    return replace(data, value=exact + rng.normal(0.0, NOISE_NM * 1e-9, exact.size))
-
-
-def synthetic_measurements(truth: Drive, profile: str, config: RunConfig | None = None
-                           ) -> tuple[fitting.Measurements, fitting.Measurements]:
-    """Steps of ``truth`` simulated as ``passmd fit`` predicts them, plus Gaussian noise of
-    :data:`NOISE_NM` (seed :data:`SEED`): ``(fit data, held-back data)``."""
-    s = _settings(profile)
-    config = _run_config(config, profile)
-    rng = np.random.default_rng(SEED)
-    fit_points = [(FIT_FREQUENCY, p, a) for p in s.fit_preloads for a in s.fit_amplitudes_nm]
-    return _measurements(fit_points, truth, rng, config), _measurements(s.heldback, truth, rng, config)
-
-
-def measurements_csv(data: fitting.Measurements) -> str:
-    """The text of the measurement CSV that ``passmd fit`` reads
-    (:func:`passmd.protocols.fit.measurements.write_measurements`)."""
-    with tempfile.TemporaryDirectory(prefix="passmd-design-") as folder:
-        path = Path(folder) / "measurements.csv"
-        fitting.write_measurements(path, data)
-        return path.read_text(encoding="utf-8")
-
-
-def calibrate(start: Drive, data: fitting.Measurements, profile: str,
-              config: RunConfig | None = None) -> fitting.FitResult:
-    """The fit of the profile's free parameters to ``data`` from ``start`` (``passmd fit``'s defaults)."""
-    return fitting.fit(start, data, list(_settings(profile).free), config=_run_config(config, profile))
-
-
-def load_fitted(text: str) -> Drive:
-    """The drive a drive file's text describes, read as ``--drive`` reads a file
-    (:func:`passmd.model.drive_file.load_drive`)."""
-    with tempfile.TemporaryDirectory(prefix="passmd-design-") as folder:
-        path = Path(folder) / "fitted-drive.toml"
-        path.write_text(text, encoding="utf-8")
-        return load_drive(path)
-
-
-def heldback_predictions(heldback: fitting.Measurements, drives: dict[str, Drive], profile: str,
-                         config: RunConfig | None = None) -> pd.DataFrame:
-    """The held-back measurements and each drive's prediction of them (nm), one row per point.
-
-    ``drives``: label -> drive (e.g. the first guess and the fitted drive); a column
-    ``<label>_nm`` each.
-    """
-    out = pd.DataFrame({"frequency_Hz": heldback.frequency, "preload_N": heldback.preload,
-                        "amplitude_nm": heldback.amplitude * 1e9, "measured_nm": heldback.value * 1e9,
-                        "sd_nm": heldback.sd * 1e9})
-    config = _run_config(config, profile)
-    for label, drive in drives.items():
-        out[f"{label}_nm"] = fitting.predict(drive, heldback, config=config) * 1e9
-    return out
-
-
 # --------------------------------------------------------------------------------------
 # What the chapter quotes
 # --------------------------------------------------------------------------------------
@@ -407,28 +322,6 @@ def gain_facts(table: pd.DataFrame) -> dict:
         best, worst = int(np.nanargmax(gain)), int(np.nanargmin(gain))
         out.update(gain_max_mm_s=gain[best] * 1e3, gain_max_f_kHz=table["frequency_Hz"].iloc[best] / 1e3,
                    gain_max_A_nm=table["amplitude_m"].iloc[best] * 1e9, gain_min_mm_s=gain[worst] * 1e3)
-    return out
-
-
-def fit_facts(result: fitting.FitResult, truth: Drive, start: Drive) -> pd.DataFrame:
-    """One row per free parameter: the value simulated (truth), the first guess, the estimate,
-    its standard error and 95 % profile interval, and whether the interval holds the truth (SI)."""
-    rows = []
-    for name in result.names:
-        p = fitting.FREE_PARAMETERS[name]
-        est = result.estimates[name]
-        low, high = est["interval"]
-        rows.append({"parameter": name, "symbol": p.symbol, "unit": p.unit, "truth": p.get(truth),
-                     "start": p.get(start), "estimate": est["value"], "stderr": est["stderr"],
-                     "low": low, "high": high, "holds_truth": bool(low <= p.get(truth) <= high)})
-    return pd.DataFrame(rows)
-
-
-def heldback_facts(table: pd.DataFrame, labels=("start", "fitted")) -> dict:
-    """Root-mean-square deviation (nm) of each drive's predictions from the held-back measurements."""
-    out = {"heldback_points": len(table)}
-    for label in labels:
-        out[f"rms_{label}_nm"] = float(np.sqrt(np.mean((table[f"{label}_nm"] - table["measured_nm"]) ** 2)))
     return out
 
 

@@ -16,7 +16,7 @@ from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import PLAUSIBLE_RANGES, Drive, check_drive
 from passmd.runtime.validation import InputError
 
-__all__ = ['FREE_PARAMETERS', 'FreeParameter', 'default_bounds']
+__all__ = ['FREE_PARAMETERS', 'KEEPS', 'FreeParameter', 'default_bounds']
 
 @dataclass(frozen=True)
 class FreeParameter:
@@ -108,6 +108,9 @@ FREE_PARAMETERS: dict[str, FreeParameter] = {p.name: p for p in (
                   "factor on both Young's moduli (contact stiffness ∝ E*), relative to the drive's",
                   lambda d: 1.0, _scaled, _scale_bounds),
 )}
+#: What stays fixed of the actuator's damping when k_p or m_a is fitted (``fit(..., keep=...)``):
+#: the damping ratio ζ (c_p = 2ζ√(k_p m_a) follows, as a drive file derives it) or the viscosity c_p.
+KEEPS = ("damping_ratio", "viscosity")
 #: Free parameters that set the same drive field: at most one of each group.
 _SAME_FIELD = (("actuator.viscosity", "actuator.damping_ratio"), ("amplifier.slew_rate", "flyback_time"))
 
@@ -123,6 +126,10 @@ def _check_free(drive: Drive, free: Sequence[str]) -> list[str]:
                              + ", ".join(FREE_PARAMETERS), name="free", value=name)
         if names.count(name) > 1:
             raise InputError(f"free = {name!r} is given twice", name="free", value=name)
+        if name in ("flyback_time", "amplifier.slew_rate") and not isinstance(drive.amplifier.flyback, str):
+            raise InputError(f"free = {name!r} has no effect: the drive's fly-back is a stated time "
+                             f"({drive.amplifier.flyback:.4g} s, amplifier.flyback); give it the rule 'slew' "
+                             "or 'fixed' to fit the slew rate", name="free", value=name)
         if drive.actuator_model == "rigid" and name.startswith("actuator."):
             raise InputError(f"free = {name!r} has no effect on ideally rigid actuators (actuator_model = "
                              "'rigid'): free it with flexible actuators", name="free", value=name)

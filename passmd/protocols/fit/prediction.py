@@ -28,86 +28,138 @@ from passmd.runtime.validation import check_choice
 
 __all__ = ['predict', 'predict_point']
 
+#: Largest relative drift of a steady-velocity run (its fourth quarter against its third) whose
+#: velocity counts as steady; a larger one marks the prediction unsettled.
+STEADY_DRIFT = 0.01
+
+
 def predict_point(drive: Drive, kind: str, amplitude: float, frequency: float, reading: str) -> dict:
-    """The model's value of one measurement (SI): ``{"prediction": value}`` (a sweep function)."""
+    """The model's value of one measurement (SI), a sweep function: ``{"prediction": value,
+    "settled": bool}`` (``settled`` False: a step or velocity that had not settled by the end of its
+    run, module docstring of :mod:`passmd.protocols.fit.measurements`)."""
     from passmd.protocols import velocity
 
     if kind == "position":
         run = velocity.step_run(drive, amplitude, frequency, "sawtooth")
-        return {"prediction": float(run["final_position_m"])}
-    if kind in ("step", "velocity"):
+        return {"prediction": float(run["final_position_m"]), "settled": True}
+    if kind in ("step", "velocity"):  # of a running drive: settled below STEP_PROTOCOL_BELOW, else steady
         if frequency < velocity.STEP_PROTOCOL_BELOW:
-            step = velocity.step_run(drive, amplitude, frequency, "sawtooth")["mean_step_m"]
+            run = velocity.settled_step(drive, amplitude, frequency)
+            step, settled = run["step_m"], run["settled"]
         else:
-            step = velocity.steady_run(drive, amplitude, frequency, "sawtooth", "cut")["step_m"]
-        return {"prediction": float(step if kind == "step" else step * frequency)}
+            run = velocity.steady_run(drive, amplitude, frequency, "sawtooth", "cut")
+            step, settled = run["step_m"], abs(run["velocity_drift"]) <= STEADY_DRIFT
+        return {"prediction": float(step if kind == "step" else step * frequency), "settled": bool(settled)}
     if kind == "critical_amplitude":
         from passmd.protocols import critical_amplitude as ca
 
         found = ca.critical_amplitude(drive, protocol=reading, frequency=frequency, progress=False)
         value = found["critical_amplitude_m"]
-        return {"prediction": float(found["bracket_low_m"] if math.isnan(value) else value)}
+        return {"prediction": float(found["bracket_low_m"] if math.isnan(value) else value), "settled": True}
     from passmd.protocols import stall
 
     found = stall.generated_force(replace(drive, load_cell=True), amplitude, frequency, progress=False)
-    return {"prediction": float(found["generated_force_N"])}
+    return {"prediction": float(found["generated_force_N"]), "settled": bool(found["converged"])}
+
+
+def _row_changes(drive: Drive, data: Measurements, i: int) -> dict:
+    """What row i changes of ``drive``: its preload, radius (with Table 2's actuator for another
+    radius), number of contacts and actuator model, where the row gives them."""
+    changes = dict(data.model[i]) if data.model else {}
+    if math.isfinite(data.preload[i]):
+        changes["preload"] = float(data.preload[i])
+    radius = data.radius[i]
+    if math.isfinite(radius) and not math.isclose(radius, drive.hemisphere_radius, rel_tol=1e-12):
+        changes["hemisphere_radius"] = float(radius)
+        changes["actuator"] = actuator_for_radius(float(radius))
+    return changes
+
+
+def _row_drive(drive: Drive, data: Measurements, i: int) -> Drive:
+    """Row i's drive (:func:`_row_changes` applied to ``drive``)."""
+    changes = _row_changes(drive, data, i)
+    return replace(drive, **changes) if changes else drive
 
 
 def _row_drives(drive: Drive, data: Measurements) -> list[Drive]:
-    """Each row's drive: ``drive`` at the row's preload, radius (Table 2 actuator for another radius),
-    number of contacts and actuator model, where the row gives them."""
-    out = []
-    for i in range(len(data)):
-        changes = dict(data.model[i]) if data.model else {}
-        if math.isfinite(data.preload[i]):
-            changes["preload"] = float(data.preload[i])
-        if math.isfinite(data.radius[i]) and not math.isclose(data.radius[i], drive.hemisphere_radius,
-                                                               rel_tol=1e-12):
-            changes["hemisphere_radius"] = float(data.radius[i])
-            changes["actuator"] = actuator_for_radius(float(data.radius[i]))
-        out.append(replace(drive, **changes) if changes else drive)
-    return out
+    """Each row's drive (:func:`_row_drive`)."""
+    return [_row_drive(drive, data, i) for i in range(len(data))]
+
+
+def drive_at(base: Drive, names: Sequence[str], values: Sequence[float], zeta: float | None) -> Drive:
+    """``base`` with the free parameters ``names`` at ``values`` (SI; applied in their order), and, when
+    ``zeta`` is given, the viscosity 2ζ√(k_p m_a) of the new k_p and m_a (the damping ratio held)."""
+    d = base
+    for p in sorted((FREE_PARAMETERS[n] for n in names), key=lambda p: p.order):
+        d = p.set(d, float(values[list(names).index(p.name)]), base)
+    if zeta is not None:
+        act = d.actuator
+        d = replace(d, actuator=replace(act, viscosity=2.0 * zeta * math.sqrt(act.stiffness * act.mass)))
+    return d
+
+
+def predict_set(drive: Drive, names: tuple, values: tuple, zeta: float | None, rows: tuple, reading: str
+                ) -> dict:
+    """The model's value of every row at one parameter set (a sweep function: one cache entry per set).
+
+    ``rows``: per measurement ``(kind, amplitude, frequency, changes)``, ``changes`` the row's
+    changes of the drive as (field, value) pairs (:func:`_row_changes`). Returns ``predictions``
+    (SI) and ``settled`` per row (:func:`predict_point`).
+    """
+    at = drive_at(drive, names, values, zeta)
+    predictions, settled = [], []
+    for kind, amplitude, frequency, changes in rows:
+        changes = dict(changes)
+        if "actuator" in changes:  # another radius: Table 2's actuator, then the fitted values on it
+            row = drive_at(replace(drive, **changes), names, values, zeta)
+        else:
+            row = replace(at, **changes) if changes else at
+        out = predict_point(row, kind, amplitude, frequency, reading if kind == "critical_amplitude" else "")
+        predictions.append(out["prediction"])
+        settled.append(out["settled"])
+    return {"predictions": predictions, "settled": settled}
 
 
 class _Model:
-    """Predictions of all rows at parameter vectors (log space), through the sweep engine."""
+    """Predictions of all rows at parameter vectors (log space), through the sweep engine: one sweep
+    point (and cache entry) per parameter vector."""
 
-    def __init__(self, drive, data, names, reading, *, executor, cache, config):
-        self.drive, self.data, self.names, self.reading = drive, data, names, reading
-        self.executor, self.cache, self.config = executor, cache, config
-        self.params = sorted((FREE_PARAMETERS[n] for n in names), key=lambda p: p.order)
-        self.index = {n: k for k, n in enumerate(names)}
-        self.rows = _row_drives(replace(drive, allow_extrapolation=True), data)
+    def __init__(self, drive, data, names, reading, *, executor, cache, config, keep="damping_ratio"):
+        self.drive, self.data, self.names, self.reading = drive, data, list(names), reading
+        self.executor, self.cache, self.config, self.keep = executor, cache, config, keep
+        self.base = replace(drive, allow_extrapolation=True)
+        self.rows = tuple((data.kind[i], float(np.nan_to_num(data.amplitude[i])), float(data.frequency[i]),
+                           tuple(sorted(_row_changes(self.base, data, i).items())))
+                          for i in range(len(data)))
         self.memo: dict[bytes, np.ndarray] = {}
+        self.settled: dict[bytes, np.ndarray] = {}
         self.simulations = 0
         self.evaluations = 0
+        # the damping ratio a moving k_p or m_a keeps (keep="damping_ratio", unless the damping is free)
+        self.zeta = None
+        damping = {"actuator.viscosity", "actuator.damping_ratio"}
+        moving = {"actuator.stiffness", "actuator.mass"} & set(names)
+        if keep == "damping_ratio" and not damping & set(names) and moving:
+            self.zeta = drive.actuator.damping_ratio
 
     def drive_at(self, x, base: Drive) -> Drive:
-        d = base
-        for p in self.params:
-            d = p.set(d, float(np.exp(x[self.index[p.name]])), base)
-        return d
+        """``base`` at the log-parameter vector x."""
+        return drive_at(base, self.names, np.exp(np.asarray(x, float)).tolist(), self.zeta)
 
     def evaluate(self, xs: Sequence[np.ndarray]) -> list[np.ndarray]:
         """Predictions (SI, one array per vector); vectors already computed come from memory."""
         keys = [np.asarray(x, float).tobytes() for x in xs]
         todo = list(dict.fromkeys(k for k in keys if k not in self.memo))
         if todo:
-            points = []
-            for k in todo:
-                x = np.frombuffer(k)
-                for i, base in enumerate(self.rows):
-                    points.append({"drive": self.drive_at(x, base), "kind": self.data.kind[i],
-                                   "amplitude": float(np.nan_to_num(self.data.amplitude[i])),
-                                   "frequency": float(self.data.frequency[i]),
-                                   "reading": (self.reading if self.data.kind[i] == "critical_amplitude"
-                                               else "")})
-            frame = sweep.run(predict_point, points, executor=self.executor, cache=self.cache, progress=False,
+            points = [{"drive": self.base, "names": tuple(self.names),
+                       "values": tuple(np.exp(np.frombuffer(k)).tolist()), "zeta": self.zeta,
+                       "rows": self.rows, "reading": self.reading} for k in todo]
+            frame = sweep.run(predict_set, points, executor=self.executor, cache=self.cache, progress=False,
                               config=self.config)
-            values = frame["prediction"].to_numpy(float).reshape(len(todo), len(self.rows))
-            for k, v in zip(todo, values, strict=True):
-                self.memo[k] = v
-            self.simulations += frame.attrs["sweep"]["computed"]
+            for k, v, s in zip(todo, frame["predictions"], frame["settled"], strict=True):
+                self.memo[k] = np.asarray(v, float)
+                self.settled[k] = np.asarray(s, bool)
+            self.simulations += frame.attrs["sweep"]["computed"] * len(self.rows)
             self.evaluations += len(todo)
         return [self.memo[k] for k in keys]
 

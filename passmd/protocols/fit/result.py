@@ -1,16 +1,18 @@
-"""What a calibration returns: :class:`~passmd.protocols.fit.result.FitResult`, the identifiability verdict
-and the fitted drive file.
+"""What a calibration returns: :class:`~passmd.protocols.fit.result.FitResult`, the goodness of fit, the
+identifiability verdict and the fitted drive file.
 
-:class:`FitResult` holds the fitted drive, each estimate with its standard error and 95 %
-profile interval, the correlation matrix and the residuals; its verdict says which parameters
-the data do not determine (flat profile, rank-deficient Jacobian, or a correlation above
-:data:`CORRELATION_LIMIT`) and what data would help. :func:`fitted_drive_file` writes the fitted
-drive as a drive file that names the data as the fitted keys' source.
+:class:`FitResult` holds the fitted drive, each estimate with its local standard error, its 95 %
+region (the pieces of its profile within the χ² quantile, their hull, the basins inside), the
+correlation matrix, the residuals and the goodness-of-fit test (:func:`goodness_of_fit`). Its
+verdict (:func:`verdict`) says when the model does not describe the data (then no interval is
+calibrated), which parameters the data do not determine (a region reaching a bound, or several
+separate pieces) and which measurement would help. :func:`fitted_drive_file` writes the fitted drive
+as a drive file whose every value names its source.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -20,12 +22,16 @@ from passmd.protocols.fit.measurements import (
     Measurements,
 )
 
-__all__ = ['CORRELATION_LIMIT', 'FitResult', 'fitted_drive_file']
+__all__ = ['CORRELATION_LIMIT', 'REJECT_P', 'FitResult', 'fitted_drive_file', 'goodness_of_fit', 'verdict']
 
-#: The absolute correlation above which two free parameters are reported as not separable by the data.
-#: 0.95: their joint confidence region is then a ridge at least (1+0.95)/(1−0.95) ≈ 6 times
-#: longer than wide (eigenvalue ratio of the 2×2 correlation matrix; its axes √39 ≈ 6.2).
+#: The absolute correlation above which two free parameters are reported as traded off against each
+#: other: their joint confidence region is then a ridge at least (1+0.95)/(1−0.95) ≈ 6 times longer
+#: than wide (eigenvalue ratio of the 2×2 correlation matrix; its axes √39 ≈ 6.2). The profile
+#: regions account for it; the verdict names the pair and the remedy.
 CORRELATION_LIMIT = 0.95
+#: Below this p-value of the χ² test the model is taken not to describe the data (a 1 % test: a
+#: right model is rejected in 1 % of data sets).
+REJECT_P = 0.01
 
 
 @dataclass
@@ -35,7 +41,9 @@ class FitResult:
     drive: Drive  # the fitted drive (the given drive with the estimates)
     base: Drive  # the drive the fit started from
     names: list[str]  # free parameters, in the order given
-    estimates: dict[str, dict]  # name -> value, stderr, interval [low, high], unit (SI), bounds, flat
+    # name -> value, stderr (local), interval (the region's hull), intervals (its pieces), basins,
+    # profile {value, cost}, unit (SI), symbol, bounds, flat_profile
+    estimates: dict[str, dict]
     correlation: np.ndarray
     data: Measurements
     predicted: np.ndarray  # SI, per row
@@ -51,7 +59,17 @@ class FitResult:
     evaluations: int
     wall_time_s: float
     notes: list[str] = field(default_factory=list)
-    converged: bool = True  # False: a profile met a lower cost than the estimate (a local minimum)
+    converged: bool = True  # False: a lower point than the estimate turned up after the last search
+    goodness_of_fit: dict = field(default_factory=dict)  # goodness_of_fit(): chi2, dof, p_value, ...
+    next_measurement: dict | None = None  # the added row that best separates several basins
+    keep: str = "damping_ratio"  # what of the damping stayed fixed while k_p or m_a moved
+    basins: list[dict] = field(default_factory=list)  # every basin within the level: parameters, cost
+    level: float = math.nan  # the 95 % rise of a profile in units of s² (the estimator sets it)
+
+    @property
+    def model_rejected(self) -> bool:
+        """Whether the χ² test rejects the model (σ given, p below :data:`REJECT_P`)."""
+        return bool(self.goodness_of_fit.get("rejected", False))
 
     @property
     def residuals(self) -> np.ndarray:
@@ -72,6 +90,13 @@ class FitResult:
             "correlation": {"parameters": list(self.names), "matrix": self.correlation.tolist(),
                             "limit": CORRELATION_LIMIT},
             "identifiable": self.identifiable,
+            "model_rejected": self.model_rejected,
+            "goodness_of_fit": dict(self.goodness_of_fit),
+            "basins": list(self.basins),
+            "next_measurement": self.next_measurement,
+            "keep": self.keep,
+            "level": self.level,
+            "flyback": self.drive.amplifier.flyback,
             "converged": self.converged,
             "verdict": self.verdict,
             "cost": self.cost,
@@ -108,45 +133,143 @@ def _advice(data: Measurements) -> str:
     return "add " + ", ".join(tips)
 
 
-def _verdict(names, corr, flat, rank, data) -> tuple[bool, str]:
-    sentences = []
-    bad = set()
+def goodness_of_fit(cost: float, dof: int, known_sd: bool) -> dict:
+    """The χ² test of the minimum: with stated σ the minimum cost follows χ² with ``dof`` degrees of
+    freedom when the model is right; ``p_value`` is its upper tail (``scipy.stats.chi2.sf``) and
+    ``rejected`` is p < :data:`REJECT_P`. Without σ the residual scale is estimated from the same
+    residuals and no test can be made (``p_value`` None)."""
+    from scipy import stats
+
+    if not known_sd:
+        return {"chi2": None, "dof": dof, "p_value": None, "testable": False, "rejected": False}
+    p = float(stats.chi2.sf(cost, dof))
+    return {"chi2": float(cost), "dof": dof, "p_value": p, "testable": True, "rejected": p < REJECT_P}
+
+
+def _fixed(drive: Drive, names, keep: str) -> str:
+    """What the model holds fixed that could explain a misfit."""
+    rule = drive.amplifier.flyback
+    shown = {"slew": "'slew' (slew-rate limited, (A/A_max)·V_pp/SR)",
+             "fixed": "'fixed' (the full-stroke V_pp/SR)"}
+    flyback = shown[rule] if isinstance(rule, str) else f"a stated {rule * 1e6:.4g} µs"
+    held = [label for key, label in (("friction_coefficient", "μ"), ("actuator.stiffness", "k_p"),
+                                     ("actuator.mass", "m_a"), ("actuator.damping_ratio", "ζ"),
+                                     ("runner_mass", "m_r"), ("contact_stiffness_scale", "E_1, E_2"))
+            if key not in names and not (key == "actuator.damping_ratio" and "actuator.viscosity" in names)]
+    if drive.actuator_model == "rigid":
+        held = [h for h in held if h not in ("k_p", "m_a", "ζ")]
+    moving = {"actuator.stiffness", "actuator.mass"} & set(names) and not {
+        "actuator.viscosity", "actuator.damping_ratio"} & set(names)
+    held_text = ", ".join(held)
+    if moving:
+        held_text += f"; while k_p or m_a moves, {keep.replace('_', ' ')} stays"
+    return (f"the fly-back rule ({flyback}; --flyback), the reading of each measured quantity (a step or "
+            "velocity is the settled one of a running drive; position_nm a run of three periods from rest), "
+            f"the parameters held fixed ({held_text}), the {drive.contacts}-contact arrangement and the "
+            f"{drive.actuator_model} actuators")
+
+
+def _pieces_text(est: dict) -> str:
+    unit = f" {est['unit']}" if est["unit"] else ""
+    return ", ".join(f"{a:.4g}–{b:.4g}{unit}" for a, b in est["intervals"])
+
+
+def _separation(suggestion: dict | None, data: Measurements) -> str:
+    if not suggestion:
+        return _advice(data)
+    scale = {"step": (1e-9, "nm"), "velocity": (1e-3, "mm/s"), "position": (1e-9, "nm"), "force": (1.0, "N"),
+             "critical_amplitude": (1e-9, "nm")}[suggestion["kind"]]
+    values = ", ".join(f"{v / scale[0]:.4g}" for v in suggestion["predictions"])
+    amplitude = suggestion["amplitude_m"]
+    where = f"A = {amplitude * 1e9:.4g} nm, " if np.isfinite(amplitude) else ""
+    return (f"the one added measurement that would separate them best is {suggestion['column']} at {where}"
+            f"F_p = {suggestion['preload_N']:.4g} N, f = {suggestion['frequency_Hz']:.4g} Hz (predicted "
+            f"{values} {scale[1]} at the basins; it would exclude {suggestion['excluded']} of "
+            f"{suggestion['pairs']} basin pairs at its σ)")
+
+
+def verdict(names, estimates, corr, rank, data, gof, converged, suggestion, drive, keep) -> tuple[bool, str]:
+    """(identifiable, text): the goodness of fit, then what the data do not determine and what would."""
+    sentences, bad = [], set()
     advice = _advice(data)
+    if gof.get("testable"):
+        test = f"χ² = {gof['chi2']:.4g} on {gof['dof']} degrees of freedom, p = {gof['p_value']:.3g}"
+        if gof["rejected"]:
+            sentences.append(f"The model does not describe the data ({test} < {REJECT_P:g}): no interval is "
+                             "calibrated. What the model holds fixed may be wrong: "
+                             f"{_fixed(drive, names, keep)}.")
+            bad.update(names)
+    else:
+        test = "no standard deviations given: the residual scale was estimated from the residuals, so the " \
+               "goodness of fit cannot be tested"
+    if not converged:
+        sentences.append("Not converged to the global minimum: a point below the estimate turned up after "
+                         "the last search, so the regions may be incomplete.")
+        bad.update(names)
     if rank < len(names):
         sentences.append(f"The Jacobian has rank {rank} < {len(names)}: the data do not determine "
                          + " and ".join(names) + f" jointly; {advice}.")
         bad.update(names)
     for name in names:
-        if flat[name]:
-            sentences.append(f"{name} is not identifiable: its profile likelihood stays within the 95 % rise "
-                             f"up to a bound of its range; {advice}.")
+        est = estimates[name]
+        if est["flat_profile"]:
+            sentences.append(f"{name} is not identifiable: its 95 % region ({_pieces_text(est)}) reaches a "
+                             f"bound of its range; {advice}.")
+            bad.add(name)
+        elif len(est["intervals"]) > 1:
+            sentences.append(f"{name} is not uniquely identified: {len(est['basins'])} basins within the "
+                             f"95 % level, in {len(est['intervals'])} separate pieces ({_pieces_text(est)}); "
+                             f"{_separation(suggestion, data)}.")
             bad.add(name)
     for a in range(len(names)):
         for b in range(a + 1, len(names)):
             if abs(corr[a, b]) > CORRELATION_LIMIT:
-                sentences.append(f"{names[a]} and {names[b]} are not separable from these data (correlation "
-                                 f"{corr[a, b]:+.3f}, limit ±{CORRELATION_LIMIT:g}); {advice}.")
-                bad.update((names[a], names[b]))
+                sentences.append(f"{names[a]} and {names[b]} trade off against each other (local correlation "
+                                 f"{corr[a, b]:+.3f}); their regions are profiles, which allow for it; "
+                                 f"{advice} to narrow them.")
     if not bad:
-        return True, ("Every free parameter is identifiable: closed 95 % profile intervals and "
-                      f"|correlation| ≤ {CORRELATION_LIMIT:g}.")
-    return False, " ".join(sentences)
+        return True, (f"Every free parameter is identifiable: one closed 95 % region each, inside its bounds "
+                      f"({test}). " + " ".join(sentences)).strip()
+    return False, " ".join(sentences) + (f" ({test}.)" if not gof.get("rejected") else "")
 
 
-def fitted_drive_file(drive: Drive, data_name: str, free: Sequence[str]) -> str:
+def fitted_drive_file(result: FitResult, data_name: str, sources: dict | None = None) -> str:
     """The fitted drive as a drive file (:func:`passmd.model.drive_file.drive_toml`) that ``--drive`` and
-    :func:`passmd.model.drive_file.load_drive` read back; the fitted keys name the data (``data_name``)
-    as their source. ``free``: the fitted parameters' names
-    (:data:`~passmd.protocols.fit.free_parameters.FREE_PARAMETERS`)."""
+    :func:`passmd.model.drive_file.load_drive` read back to ``result.drive``.
+
+    ``sources``: where each of the starting drive's values came from, by drive-file key (as
+    :func:`passmd.model.drive_file.resolve` gives them: the user's file, an option, a default);
+    the fitted keys name ``data_name``. When k_p or m_a was fitted with the damping ratio held
+    (``result.keep``), the file gives ζ and the viscosity follows from it, as ``drive show``
+    derives it; else it gives c_p.
+    """
     from passmd.model.drive_file import DRIVE_KEYS, drive_toml
 
+    free = result.names
     fitted = {"actuator.damping_ratio": "actuator.viscosity", "flyback_time": "amplifier.slew_rate",
               "contact_stiffness_scale": "hemisphere_material.youngs_modulus"}
-    sources = {}
+    out = {key: text for key, text in (sources or {}).items() if key in DRIVE_KEYS}
+    by = f"fitted to {data_name} by passmd fit"
     for name in free:
         key = fitted.get(name, name)
         if key in DRIVE_KEYS:
-            sources[key] = f"fitted to {data_name} by passmd fit"
+            out[key] = by
+    if "actuator.damping_ratio" in free:
+        out["actuator.damping_ratio"] = by
+        out["actuator.viscosity"] = "derived from the fitted ζ: 2ζ√(k_p m_a)"
     if "contact_stiffness_scale" in free:
-        sources["runner_material.youngs_modulus"] = f"fitted to {data_name} by passmd fit (scale on E)"
-    return drive_toml(drive, sources, title=f"drive fitted by passmd fit to {data_name}")
+        out["runner_material.youngs_modulus"] = f"{by} (scale on E)"
+    moving = [n for n in ("actuator.stiffness", "actuator.mass") if n in free]
+    hold_zeta = (result.keep == "damping_ratio" and moving and "actuator.viscosity" not in free
+                 and "actuator.damping_ratio" not in free)
+    zeta = None
+    if hold_zeta:
+        zeta = result.base.actuator.damping_ratio
+        out["actuator.damping_ratio"] = (f"held while {' and '.join(moving)} was fitted (was: "
+                                         f"{out.get('actuator.damping_ratio', 'derived from c_p')})")
+        out["actuator.viscosity"] = "derived from ζ: 2ζ√(k_p m_a)"
+    elif moving and "actuator.viscosity" not in free and "actuator.damping_ratio" not in free:
+        out["actuator.viscosity"] = f"held while {' and '.join(moving)} was fitted (was: " \
+                                    f"{out.get('actuator.viscosity', 'given')})"
+    return drive_toml(result.drive, out, title=f"drive fitted by passmd fit to {data_name}",
+                      damping_ratio=zeta)

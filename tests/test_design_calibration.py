@@ -1,0 +1,76 @@
+"""The design chapter's calibration (passmd.experiments.design.calibration): measurements made by other
+means than the fit's model, the fits' facts, and the fitted drive file read back."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from passmd.experiments.calibration.synthetic import independent_steps
+from passmd.experiments.design import calibration
+from passmd.experiments.design import figures as design
+from passmd.protocols import fit as fitting
+from passmd.runtime.config import RunConfig
+
+
+def test_fit_facts_say_whether_the_region_holds_the_truth():
+    truth, _ = design.example_drive()
+    start = calibration.start_drive(truth, "paper")
+    assert start.friction_coefficient == 0.2 and start.actuator.stiffness == pytest.approx(4.8333e6, rel=1e-4)
+    result = SimpleNamespace(names=["friction_coefficient", "actuator.stiffness"], estimates={
+        "friction_coefficient": {"value": 0.249, "stderr": 0.003, "interval": [0.243, 0.256],
+                                 "intervals": [[0.243, 0.256]]},
+        "actuator.stiffness": {"value": 4.0e6, "stderr": 1e5, "interval": [3.8e6, 5.4e6],
+                               "intervals": [[3.8e6, 4.2e6], [5.2e6, 5.4e6]]}})
+    table = calibration.fit_facts(result, truth, start).set_index("parameter")
+    assert table.loc["friction_coefficient", "holds_truth"]
+    # 5e6 lies in the hull 3.8–5.4e6 but in none of its two pieces
+    assert not table.loc["actuator.stiffness", "holds_truth"]
+    assert table.loc["actuator.stiffness", "pieces"] == 2
+    assert table.loc["actuator.stiffness", "start"] == pytest.approx(start.actuator.stiffness)
+
+
+def test_heldback_facts_rms():
+    table = pd.DataFrame({"measured_nm": [10.0, 20.0], "start_nm": [13.0, 16.0], "fitted_nm": [10.0, 21.0]})
+    facts = calibration.heldback_facts(table)
+    assert facts["rms_start_nm"] == pytest.approx(np.sqrt((9 + 16) / 2))
+    assert facts["rms_fitted_nm"] == pytest.approx(np.sqrt(0.5)) and facts["heldback_points"] == 2
+
+
+def test_fitted_drive_file_reads_back_to_the_fitted_drive():
+    truth, sources = design.example_drive()
+    fitted = replace(truth, friction_coefficient=0.2493217)
+    result = SimpleNamespace(drive=fitted, base=truth, names=["friction_coefficient"], keep="damping_ratio")
+    text = fitting.fitted_drive_file(result, "m.csv", sources)
+    assert calibration.load_fitted(text) == fitted
+    line = {raw.split(" = ")[0]: raw for raw in text.splitlines() if " = " in raw}
+    assert "fitted to m.csv by passmd fit" in line["friction_coefficient"]
+    assert "given in" in line["runner_mass"] and "example_drive.toml" in line["runner_mass"]
+
+
+def test_synthetic_measurements_are_independent_steps_plus_the_stated_noise(tmp_path):
+    truth, _ = design.example_drive()
+    config = RunConfig(cache_dir=tmp_path)
+    data, held = calibration.synthetic_measurements(truth, "quick", config)
+    s = design.PROFILE_SETTINGS["quick"]
+    assert len(data) == len(s.fit_preloads) * len(s.fit_amplitudes_nm) and len(held) == len(s.heldback)
+    noise = np.random.default_rng(design.SEED).normal(0.0, design.NOISE_NM * 1e-9, len(data) + len(held))
+    conditions = [(p, a, f) for p, a, f in zip(data.preload, data.amplitude, data.frequency, strict=True)]
+    exact = independent_steps(truth, conditions)
+    # the same simulation and the same draws: equal to round-off of the sum (values ~1e-7 m)
+    np.testing.assert_allclose(data.value, exact + noise[:len(data)], rtol=0, atol=1e-18)
+    # not the fit's own forward model: the refined integrator moves these steps by up to 0.12 nm (the
+    # default scheme's error for this drive), well below the noise's σ (1 nm)
+    own = fitting.predict(truth, data, cache=False, executor="serial")
+    assert np.max(np.abs(exact - own)) < 0.2 * design.NOISE_NM * 1e-9 and np.any(exact != own)
+    assert np.all(data.sd == design.NOISE_NM * 1e-9) and data.known_sd
+    text = calibration.measurements_csv(data)
+    path = tmp_path / "m.csv"
+    path.write_text(text, encoding="utf-8")
+    back = fitting.read_measurements(path)
+    np.testing.assert_allclose(back.value, data.value, rtol=1e-15)  # repr() round trip
+    np.testing.assert_allclose(back.amplitude, data.amplitude, rtol=1e-15)
