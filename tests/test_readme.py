@@ -81,5 +81,5 @@ def test_reliability_counts_are_the_suites_own():
     assert f"hypothesis suites: {examples} command lines per run" in section
     assert f"hypothesis suites of {examples} generated drive" in section
     flat = " ".join(section.split())
-    for kind in ("drive file", "measurement file", "reference table", "cache entry"):
+    for kind in ("drive file", "measurement file", "reference table", "benchmark record", "cache entry"):
         assert f"a {kind} up to {format_size(LIMITS[kind])}" in flat, kind

@@ -9,12 +9,14 @@ and :func:`check_categories` fails with a readable diff when any claim changed c
 
 from __future__ import annotations
 
+import io
 from collections.abc import Mapping
 from pathlib import Path
 
 import pandas as pd
 
 from passmd.ledger import readings
+from passmd.runtime.inputs import read_text
 
 __all__ = ["READINGS_SEPARATOR", "STATE_LETTERS", "category_changes", "check_categories", "load_baseline",
            "load_baseline_readings", "load_baseline_states", "readings_of", "write_baseline"]
@@ -31,9 +33,15 @@ def readings_of(depends: tuple[str, ...]) -> tuple[str, ...]:
     return tuple(readings.describe(r) for r in readings.design(depends))
 
 
+def _read(path) -> pd.DataFrame:
+    """A baseline CSV, read from a regular file of at most ``LIMITS["reference table"]`` bytes."""
+    text = read_text(path, "reference table")
+    return pd.read_csv(io.StringIO(text), dtype=str, keep_default_na=False, comment="#")
+
+
 def load_baseline(path) -> dict[str, str]:
     """``{claim id: category}`` from a baseline CSV written by :func:`write_baseline`."""
-    table = pd.read_csv(path, dtype=str, keep_default_na=False, comment="#")
+    table = _read(path)
     return dict(zip(table["claim"], table["status"], strict=True))
 
 
@@ -43,7 +51,7 @@ def load_baseline_readings(path) -> dict[str, tuple[str, ...]]:
     Empty when the baseline records no readings: the readings its categories were computed at
     are then unknown, and no claim of it can be compared reading for reading.
     """
-    table = pd.read_csv(path, dtype=str, keep_default_na=False, comment="#")
+    table = _read(path)
     if "readings" not in table:
         return {}
     return {claim: tuple(text.split(READINGS_SEPARATOR))
@@ -55,7 +63,7 @@ def load_baseline_states(path) -> dict[str, dict]:
     claim's state (``holds``, ``fails``, ``inconclusive``) at each of its readings and the reading of
     its design its category was judged at besides the defaults (the joint reading's projection).
     Empty when the baseline records no states."""
-    table = pd.read_csv(path, dtype=str, keep_default_na=False, comment="#")
+    table = _read(path)
     if "states" not in table:
         return {}
     names = {letter: state for state, letter in STATE_LETTERS.items()}

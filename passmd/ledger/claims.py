@@ -10,6 +10,7 @@ kinds and relations) and :mod:`passmd.ledger.evaluation` (the categories).
 
 from __future__ import annotations
 
+import io
 import math
 import re
 from collections.abc import Mapping
@@ -19,6 +20,7 @@ import numpy as np
 import pandas as pd
 
 from passmd.ledger import reference
+from passmd.runtime.inputs import read_text
 
 __all__ = [
     "CHECK_KINDS",
@@ -157,7 +159,7 @@ def _reference_errors(spec: str, reference_dir: Path) -> list[str]:
     path = reference_dir / filename
     if not path.is_file():
         return [f"reference file {path} does not exist"]
-    columns = pd.read_csv(path, comment="#", nrows=0).columns
+    columns = pd.read_csv(io.StringIO(read_text(path, "reference table")), comment="#", nrows=0).columns
     if column not in columns:
         return [f"reference column {column!r} is not in {filename} (columns: {', '.join(columns)})"]
     return []
@@ -188,7 +190,7 @@ def load_claims(path=None) -> pd.DataFrame:
     path = Path(path) if path is not None else CLAIMS_PATH
     if not path.is_file():
         raise FileNotFoundError(f"claims file {path} does not exist")
-    claims = pd.read_csv(path, dtype=str, keep_default_na=False, encoding="utf-8")
+    claims = pd.read_csv(io.StringIO(read_text(path, "reference table")), dtype=str, keep_default_na=False)
     missing = [c for c in CLAIM_COLUMNS if c not in claims.columns]
     if missing:
         raise ValueError(f"{path.name} is missing required columns: {', '.join(missing)}")

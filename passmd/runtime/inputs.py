@@ -17,7 +17,7 @@ import stat
 
 from passmd.runtime.validation import InputError
 
-__all__ = ["LIMITS", "RefusedFile", "decode_text", "format_size", "read_bounded"]
+__all__ = ["LIMITS", "RefusedFile", "decode_text", "format_size", "read_bounded", "read_text"]
 
 _MiB = 2**20
 #: The largest file of each kind the package reads, in bytes (README, "Reliability"): far
@@ -25,7 +25,8 @@ _MiB = 2**20
 LIMITS: dict[str, int] = {
     "drive file": _MiB,  # a drive file is a few hundred bytes of TOML
     "measurement file": 100 * _MiB,  # about two million rows of measurements
-    "reference table": 16 * _MiB,  # the reference curves are a few kB
+    "reference table": 16 * _MiB,  # the reference curves, claims table and baselines are a few kB
+    "benchmark record": 16 * _MiB,  # a benchmark's JSON: tens of kB
     "cache entry": 2**30,  # one sweep point's result, arrays included
     "cache marker": 4096,  # CACHEDIR.TAG: a few lines
 }
@@ -197,3 +198,9 @@ def decode_text(data: bytes, label: str, kind: str) -> str:
         line = data[:exc.start].count(b"\n") + 1
         raise RefusedFile(f"{label}: not UTF-8 text: byte 0x{data[exc.start]:02x} on line {line} (a {kind} "
                           "must be UTF-8 text)", path=label, reason="encoding") from None
+
+
+def read_text(path, kind: str, *, label: str | None = None) -> str:
+    """The text of the regular file ``path`` of ``kind``: :func:`read_bounded`, then :func:`decode_text`."""
+    label = str(path) if label is None else label
+    return decode_text(read_bounded(path, kind, label=label), label, kind)

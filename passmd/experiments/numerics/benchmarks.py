@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from passmd.runtime.inputs import read_text
 from passmd.runtime.validation import check_choice
 
 #: Benchmark results shipped with the package (``passmd/data/benchmarks/<name>.json``).
@@ -43,11 +44,11 @@ def benchmark_results(name: str, path: str | Path | None = None) -> dict:
             raise FileNotFoundError(
                 f"{resource} is missing: run `python benchmarks/bench_{name}.py` in the repository"
             )
-        return json.loads(resource.read_text(encoding="utf-8"))
+        return json.loads(read_text(Path(str(resource)), "benchmark record"))
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"{path} is missing: run `python benchmarks/bench_{name}.py --out {path}`")
-    return json.loads(path.read_text(encoding="utf-8"))
+    return json.loads(read_text(path, "benchmark record"))
 
 
 def benchmark_table(path: str | Path | None = None) -> pd.DataFrame:
