@@ -59,8 +59,8 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-__all__ = ["CONTACT_PRESETS", "DRIVE_KEYS", "EXAMPLE_DRIVE_FILE", "DriveFileError", "DriveKey", "drive_toml",
-           "load_drive", "parameter_rows", "read_drive_file", "resolve"]
+__all__ = ["CONTACT_PRESETS", "DRIVE_KEYS", "EXAMPLE_DRIVE_FILE", "JOINT_READING_FILE", "DriveFileError",
+           "DriveKey", "drive_toml", "load_drive", "parameter_rows", "read_drive_file", "resolve"]
 
 
 class DriveFileError(InputError):
@@ -86,6 +86,9 @@ _DEFAULT = Drive()
 #: has it; ``passmd drive template --example`` prints it).
 EXAMPLE_DRIVE_FILE = Path(os.fspath(resources.files("passmd") / "data" / "drives"
                                     / "example_drive.toml"))
+#: The paper's drive under the replication ledger's joint reading, paper profile (package data;
+#: ``passmd drive template --joint-reading`` prints it, :mod:`passmd.ledger.joint_drive` writes it).
+JOINT_READING_FILE = EXAMPLE_DRIVE_FILE.with_name("joint_reading.toml")
 #: The paper's two contact arrangements, by name (Section 4.1).
 CONTACT_PRESETS = {"one": 1, "paper-six": 6}
 

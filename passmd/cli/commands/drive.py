@@ -17,6 +17,9 @@ _EPILOG = textwrap.dedent("""\
     worked example of the book's chapter "Design your own drive" (a drive that is not the
     paper's, its guide written as [[contact_groups]]):
     passmd drive template --example > example_drive.toml
+    With --joint-reading, the paper's drive under the replication ledger's joint reading of
+    the paper profile (its protocol options in the header; passmd ledger --write-drive FILE
+    writes the one of a ledger run): passmd drive template --joint-reading > joint.toml
     show: every parameter of the drive (--drive FILE and the options) with its unit and
     where it came from: given in the file, an option, or the paper (Table 1, Table 2 for
     the radius, interpolated between its rows; the viscosity derived from ζ).
@@ -35,9 +38,13 @@ def add_parser(command) -> None:
     sub = p.add_subparsers(dest="action", metavar="ACTION", required=True)
     template = sub.add_parser("template", help="print a drive file of the paper's drive (TOML)",
                               description="print a commented drive file of the paper's drive (TOML)")
-    template.add_argument("--example", action="store_true",
-                          help="print the book's example drive (chapter 'Design your own drive') instead of "
-                               "the paper's drive (default: off)")
+    shipped = template.add_mutually_exclusive_group()
+    shipped.add_argument("--example", action="store_true",
+                         help="print the book's example drive (chapter 'Design your own drive') instead of "
+                              "the paper's drive (default: off)")
+    shipped.add_argument("--joint-reading", action="store_true",
+                         help="print the paper's drive under the replication ledger's joint reading "
+                              "(paper profile) instead (default: off)")
     template.set_defaults(handler=run_template)
     show = sub.add_parser("show", help="every parameter of a drive, its unit and where it came from",
                           description="every parameter of a drive, its unit and where it came from")
@@ -47,10 +54,11 @@ def add_parser(command) -> None:
 
 
 def run_template(args, out) -> int:
-    from passmd.model.drive_file import EXAMPLE_DRIVE_FILE, drive_toml, resolve
+    from passmd.model.drive_file import EXAMPLE_DRIVE_FILE, JOINT_READING_FILE, drive_toml, resolve
+    from passmd.runtime.inputs import read_text
 
-    if args.example:  # the shipped file itself, with its comments
-        out.write(EXAMPLE_DRIVE_FILE.read_text(encoding="utf-8"))
+    if args.example or args.joint_reading:  # the shipped file itself, with its comments
+        out.write(read_text(EXAMPLE_DRIVE_FILE if args.example else JOINT_READING_FILE, "drive file"))
         return 0
     drive, sources = resolve({})
     sources = {key: text[len("default ("):-1] if text.startswith("default (") else text

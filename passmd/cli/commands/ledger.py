@@ -45,42 +45,61 @@ def add_parser(command) -> None:
                    help="resolution: quick (CI) or paper (the paper's grids) (default: quick)")
     p.add_argument("--write-baseline", metavar="CSV", default=None, action=FilePath,
                    help="also write the categories as a baseline CSV (default: none)")
+    p.add_argument("--write-drive", metavar="TOML", default=None, action=FilePath,
+                   help="also write the joint reading as a drive file: its drive axes as keys, its "
+                        "protocol axes as the commands' options in its header (default: none)")
     add_sweep_options(p)
     p.add_argument("--json", action="store_true", help=JSON_HELP)
     p.set_defaults(handler=run_ledger)
 
 
-def _check_baseline(args, config) -> None:
-    """--write-baseline, before the ledger is computed: a file in an existing directory, not the
-    claims table the ledger reads, the sweep log or the file standard output goes to."""
+def _check_outputs(args, config) -> None:
+    """--write-baseline and --write-drive, before the ledger is computed: files in existing
+    directories, not the claims table the ledger reads, the sweep log or the file standard output
+    goes to, nor each other."""
     from passmd.ledger.claims import CLAIMS_PATH
 
-    name = args.write_baseline
-    if name is None:
+    names = {option: name for option, name in (("--write-baseline", args.write_baseline),
+                                               ("--write-drive", args.write_drive)) if name is not None}
+    if not names:
         return
-    check_output_file("--write-baseline", name)
-    check_outputs({f"--write-baseline {name}": name,
+    for option, name in names.items():
+        check_output_file(option, name)
+    check_outputs({**{f"{option} {name}": name for option, name in names.items()},
                    f"{ENVIRONMENT['sweep_log']} {config.sweep_log}": config.sweep_log},
                   inputs={f"the claims table {CLAIMS_PATH}": CLAIMS_PATH})
+
+
+def _write(option: str, name: str, write) -> None:
+    """``write(tmp)`` into ``name`` atomically; an OS error is one line naming ``option``."""
+    try:
+        write_atomically(name, write)
+    except BrokenPipeError as exc:
+        raise PipeClosed() from exc
+    except OSError as exc:
+        raise OutputError(f"cannot write {option} {name}: {exc.strerror or exc}") from exc
 
 
 def _write_baseline(ledger, evaluated, args) -> None:
     header = (f"ledger categories, {args.profile} profile; produced {datetime.date.today().isoformat()} by\n"
               f"passmd ledger --profile {args.profile} --write-baseline {args.write_baseline}")
-    try:
-        write_atomically(args.write_baseline,
-                         lambda tmp: ledger.write_baseline(evaluated, tmp, header=header))
-    except BrokenPipeError as exc:
-        raise PipeClosed() from exc
-    except OSError as exc:
-        raise OutputError(f"cannot write --write-baseline {args.write_baseline}: "
-                          f"{exc.strerror or exc}") from exc
+    _write("--write-baseline", args.write_baseline,
+           lambda tmp: ledger.write_baseline(evaluated, tmp, header=header))
+
+
+def _write_drive(joint, args) -> None:
+    from pathlib import Path
+
+    from passmd.ledger.joint_drive import joint_drive_file
+
+    text = joint_drive_file(joint["reading"], args.profile)
+    _write("--write-drive", args.write_drive, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
 
 
 def run_ledger(args, out) -> int:
     """Every claim of the paper with its computed category, values and evidence (Sections 4–6)."""
     config = run_config(args)
-    _check_baseline(args, config)  # (before the ledger's modules load)
+    _check_outputs(args, config)  # (before the ledger's modules load)
     from passmd.ledger import evaluation as ledger
     from passmd.report import ledger_views
 
@@ -92,6 +111,8 @@ def run_ledger(args, out) -> int:
         _write_baseline(ledger, evaluated, args)
     counts = ledger.headline(evaluated)
     joint = evaluated.attrs["joint"]
+    if args.write_drive:
+        _write_drive(joint, args)
     if args.json:
         emit_json({"command": "ledger", "profile": args.profile, "summary": ledger_views.summary(evaluated),
                    "counts": counts, "joint_reading": ledger.joint_record(joint),

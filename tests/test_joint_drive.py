@@ -1,0 +1,98 @@
+"""The ledger's joint reading as a drive file (``passmd ledger --write-drive``) and the shipped
+``passmd/data/drives/joint_reading.toml``: the paper profile's joint reading, as its baseline
+records it, written as the command writes it and read back as ``--drive`` reads it."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from passmd import cli
+from passmd.ledger import readings
+from passmd.ledger.joint_drive import joint_drive, joint_drive_file, reading_from_baseline
+from passmd.model.drive_file import JOINT_READING_FILE as SHIPPED
+from passmd.model.drive_file import load_drive
+
+BASELINES = Path(__file__).parent
+
+
+def test_the_shipped_file_is_the_paper_baselines_joint_reading():
+    """Regenerate with
+    ``passmd ledger --profile paper --write-drive passmd/data/drives/joint_reading.toml``."""
+    reading = reading_from_baseline(BASELINES / "ledger_baseline_paper.csv")
+    assert SHIPPED.read_text(encoding="utf-8") == joint_drive_file(reading, "paper")
+
+
+def test_the_shipped_file_reads_back_to_the_reading_with_its_protocol_options():
+    reading = reading_from_baseline(BASELINES / "ledger_baseline_paper.csv")
+    drive = load_drive(SHIPPED)
+    assert drive == joint_drive(reading)
+    assert drive.amplifier.flyback == reading["flyback"]
+    assert drive.friction_coefficient == reading["friction_coefficient"]
+    assert drive.actuator.damping_ratio == pytest.approx(reading["damping_ratio"], rel=1e-12)
+    header = SHIPPED.read_text(encoding="utf-8").splitlines()[:6]
+    assert any(f"--protocol {reading['ac_protocol']} --frequency {reading['drive_frequency_s4']:g}Hz" in line
+               for line in header)
+    force = f"passmd force --drive FILE --frequency {reading['force_frequency']:g}Hz"
+    assert any(force in line for line in header)
+
+
+def test_drive_template_prints_the_shipped_file():
+    out = io.StringIO()
+    assert cli.main(["drive", "template", "--joint-reading"], out=out) == 0
+    assert out.getvalue() == SHIPPED.read_text(encoding="utf-8")
+
+
+def test_a_drive_axis_left_at_its_default_is_the_papers_drive():
+    """The defaults are the paper's drive: every drive axis at its default changes nothing."""
+    default = joint_drive(readings.default_reading())
+    assert default == joint_drive({})
+    assert joint_drive({"friction_coefficient": 0.3}) == replace(default, friction_coefficient=0.3)
+    assert joint_drive({"flyback": "fixed"}).amplifier.flyback == "fixed"
+
+
+def _baseline(tmp_path, joints):
+    text = "claim,status,readings,states,joint\n" + "".join(
+        f"c{i},reproduced,defaults,h,{joint}\n" for i, joint in enumerate(joints))
+    path = tmp_path / "baseline.csv"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_reading_from_baseline_is_the_union_of_the_claims_projections(tmp_path):
+    path = _baseline(tmp_path, ["defaults", "fly-back rule = fixed",
+                                "\"μ in Sections 4.1 and 5 = 0.3\""])
+    assert reading_from_baseline(path) == {**readings.default_reading(), "flyback": "fixed",
+                                           "friction_coefficient": 0.3}
+
+
+@pytest.mark.parametrize("joints, message", [
+    (["fly-back rule = fixed", "fly-back rule = slew"], "disagree on fly-back rule"),
+    (["fly-back rule = sometimes"], "is no declared axis value"),
+], ids=["disagreeing", "undeclared"])
+def test_reading_from_baseline_refuses_what_is_no_joint_reading(tmp_path, joints, message):
+    with pytest.raises(ValueError, match=message):
+        reading_from_baseline(_baseline(tmp_path, joints))
+
+
+def test_a_baseline_without_states_has_no_joint_reading(tmp_path):
+    path = tmp_path / "old.csv"
+    path.write_text("claim,status\nc0,reproduced\n", encoding="utf-8")
+    with pytest.raises(ValueError, match="records no joint reading"):
+        reading_from_baseline(path)
+
+
+@pytest.mark.slow
+def test_the_command_writes_the_joint_reading_of_its_ledger(tmp_path):
+    """``passmd ledger --profile quick --write-drive`` writes the quick ledger's joint reading (the one
+    its baseline records; the quick ledger test keeps the baseline current)."""
+    target = tmp_path / "joint.toml"
+    with contextlib.redirect_stderr(io.StringIO()):
+        status = cli.main(["ledger", "--profile", "quick", "--write-drive", str(target)], out=io.StringIO())
+    assert status == 0
+    reading = reading_from_baseline(BASELINES / "ledger_baseline_quick.csv")
+    assert target.read_text(encoding="utf-8") == joint_drive_file(reading, "quick")
