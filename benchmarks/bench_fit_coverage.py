@@ -19,8 +19,11 @@ Usage::
     python benchmarks/bench_fit_coverage.py [--quick] [--draws 40]
         [--out passmd/data/benchmarks/fit_coverage.json]
 
-``--quick`` fits 4 draws (the CI-sized run); the machine's load average is recorded beside the
-times (the 2-core machine may be shared).
+``--quick`` fits 4 draws (the CI-sized run) and writes to a temporary file unless ``--out`` is
+given; the machine's load average is recorded beside the times (the 2-core machine may be
+shared). The draws run in a stratified order (the ends of the k_p range first, then the middles
+of the gaps), and the JSON is rewritten after each: a run stopped early leaves a record of the
+draws done (``draws_done`` of ``draws``) that still spreads over the whole range.
 """
 
 from __future__ import annotations
@@ -57,6 +60,27 @@ def truths(draws: int) -> list[float]:
     """The actuator stiffness of each draw: log-evenly spread over STIFFNESS_RANGE (cell midpoints)."""
     low, high = STIFFNESS_RANGE
     return [float(low * (high / low) ** ((k + 0.5) / draws)) for k in range(draws)]
+
+
+def stratified(count: int) -> list[int]:
+    """0 … count-1 in an order whose every prefix spreads over the range: 0, count-1, then the
+    middles of the largest gaps left."""
+    order, seen = [], set()
+    queue = [(0, count - 1)]
+    for k in (0, count - 1):
+        if k not in seen:
+            order.append(k)
+            seen.add(k)
+    while queue:
+        queue.sort(key=lambda gap: gap[0] - gap[1])  # widest gap first
+        low, high = queue.pop(0)
+        if high - low < 2:
+            continue
+        mid = (low + high) // 2
+        order.append(mid)
+        seen.add(mid)
+        queue += [(low, mid), (mid, high)]
+    return order
 
 
 def draw(seed: int, stiffness: float) -> dict:
@@ -115,39 +139,57 @@ def summary(draws: list[dict]) -> dict:
     }
 
 
-def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--draws", type=int, default=40)
-    parser.add_argument("--quick", action="store_true", help="4 draws (the CI-sized run)")
-    parser.add_argument("--out", default="passmd/data/benchmarks/fit_coverage.json")
-    args = parser.parse_args()
-    count = 4 if args.quick else args.draws
-    start = time.perf_counter()
-    load_before = os.getloadavg()
-    draws = []
-    for seed, stiffness in enumerate(truths(count)):
-        load = os.getloadavg()
-        draws.append({**draw(seed, stiffness), "load_average_before": list(load)})
-        d = draws[-1]
-        print(f"draw {seed + 1}/{count}: k_p = {stiffness:.4g} N/m, {d['verdict']}, holds {d['holds']}, "
-              f"p = {d['p_value']:.3g}, {d['wall_time_s']:.0f} s (load {load[0]:.1f})", file=sys.stderr,
-              flush=True)
-    record = {
+def record_of(draws: list[dict], count: int, args, start: float, load_before) -> dict:
+    return {
         "benchmark": "coverage of the fit's 95 % regions: μ and k_p of six flexible contacts, steady steps",
         "model": "six contacts, flexible actuators, R = 1 mm, ζ = 0.05 (Tables 1-2)",
         "data": "steady steps by the refined integrator (refine = 2), last step of 16 periods from rest",
         "free": list(FREE), "mu": MU, "stiffness_range_N_per_m": list(STIFFNESS_RANGE), "draws": count,
-        "quick": bool(args.quick), "noise_nm": NOISE_NM, "preloads_N": list(PRELOADS),
+        "draws_done": len(draws), "quick": bool(args.quick), "noise_nm": NOISE_NM,
+        "preloads_N": list(PRELOADS),
         "amplitudes_nm": list(AMPLITUDES_NM), "frequency_Hz": FREQUENCY, "nominal": 0.95,
         **summary(draws), "wall_time_s": time.perf_counter() - start, "cpus": os.cpu_count(),
         "load_average_before": list(load_before), "load_average_after": list(os.getloadavg()),
         "python": platform.python_version(), "machine": platform.machine(), "per_draw": draws,
     }
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--draws", type=int, default=40)
+    parser.add_argument("--quick", action="store_true",
+                        help="4 draws (the CI-sized run), to a temporary file")
+    parser.add_argument("--out", default=None,
+                        help="JSON record (default: passmd/data/benchmarks/fit_coverage.json; --quick: a "
+                             "temporary file)")
+    args = parser.parse_args()
+    count = 4 if args.quick else args.draws
+    if count < 1:
+        parser.error(f"--draws {count} is out of range: must be >= 1")
+    if args.out is None:
+        args.out = (os.path.join(tempfile.mkdtemp(prefix="bench-fit-coverage-"), "fit_coverage.json")
+                    if args.quick else "passmd/data/benchmarks/fit_coverage.json")
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
+    start = time.perf_counter()
+    load_before = os.getloadavg()
+    stiffnesses = truths(count)
+    draws = []
+    for done, seed in enumerate(stratified(count), 1):
+        load = os.getloadavg()
+        draws.append({**draw(seed, stiffnesses[seed]), "load_average_before": list(load)})
+        d = draws[-1]
+        print(f"draw {done}/{count} (seed {seed}): k_p = {stiffnesses[seed]:.4g} N/m, {d['verdict']}, "
+              f"holds {d['holds']}, p = {d['p_value']:.3g}, {d['wall_time_s']:.0f} s (load {load[0]:.1f})",
+              file=sys.stderr, flush=True)
+        tmp = out.with_name(f".{out.name}.tmp")
+        tmp.write_text(json.dumps(record_of(draws, count, args, start, load_before), indent=2) + "\n",
+                       encoding="utf-8")
+        os.replace(tmp, out)  # a reader never sees a half-written record
+    record = record_of(draws, count, args, start, load_before)
     shown = ("coverage", "coverage_both", "verdicts", "identifiable_but_missed", "median_wall_time_s")
     print(json.dumps({k: record[k] for k in shown}, indent=2))
+    print(f"written: {out}", file=sys.stderr)
     return 0
 
 
