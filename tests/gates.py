@@ -6,7 +6,8 @@
 * ``spawn``: in the command, after a process pool forked its first worker (the pool is starting);
 * ``worker``: in a worker, before its initializer ran (it has just been forked);
 * ``point``: in a worker, before a sweep point whose ``frequency`` is above ``GATE_ABOVE_HZ``
-  (default 0: every point) is computed (the pool is running);
+  (default 0: every point; a point without one, e.g. a fit's parameter set, always) is computed
+  (the pool is running);
 * ``evaluate``: in the command, before a fit's second model evaluation (its pool is idle
   between two sweeps);
 * ``shutdown``: in the command, before a process pool's first shut-down (the pool is stopping).
@@ -41,7 +42,7 @@ def reached(directory: Path, moment: str) -> list[int]:
 
 def gated_call(func, point):
     """``passmd.runtime.sweep._call`` with the ``point`` gate (runs in the worker)."""
-    if point.get("frequency", 0.0) > float(os.environ.get("GATE_ABOVE_HZ", "0")):
+    if point.get("frequency", float("inf")) > float(os.environ.get("GATE_ABOVE_HZ", "0")):
         gate("point")
     return func(**point)
 

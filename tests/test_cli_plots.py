@@ -203,12 +203,12 @@ def test_fit_png_is_written_and_labelled(tmp_path, monkeypatch):
     data = F.Measurements(**{**vars(data), "value": F.predict(truth, data, executor="serial",
                                                                cache=tmp_path / "cache")})
     F.write_measurements(tmp_path / "data.csv", data)
-    status, text = run_cli("fit", str(tmp_path / "data.csv"), "--free", "mu", *CHEAP, "--starts", "1",
+    status, text = run_cli("fit", str(tmp_path / "data.csv"), "--free", "mu", *CHEAP,
                            "--executor", "serial", "--out", str(tmp_path / "out"))
     assert status == 0, text
     png_shows_something(tmp_path / "out" / "fit.png")
     result = passmd.fit(Drive(contacts=1, actuator_model="rigid"), data, ["friction_coefficient"],
-                        starts=1, executor="serial", cache=tmp_path / "cache")
+                        executor="serial", cache=tmp_path / "cache")
     texts = readable(fit_figure(result))
     assert texts["suptitle"].strip() and texts["legend"]
     assert math.isfinite(result.estimates["friction_coefficient"]["value"])

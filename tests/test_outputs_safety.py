@@ -634,7 +634,7 @@ GATES_PY = Path(__file__).with_name("gates.py")
 POOL_SWEEP = ["sweep", "velocity", "--vary", "frequency=100Hz..400Hz:4", "--contacts", "1", "--actuator",
               "rigid", "--workers", "2"]
 #: A fit of one parameter to three steps, on the same drive, in a pool of two workers.
-POOL_FIT = ["fit", "data.csv", "--free", "mu", "--contacts", "1", "--actuator", "rigid", "--starts", "0",
+POOL_FIT = ["fit", "data.csv", "--free", "mu", "--contacts", "1", "--actuator", "rigid",
             "--executor", "process", "--workers", "2"]
 FIT_DATA = "amplitude_nm,frequency_Hz,step_nm\n100,1000,64.25\n150,1000,116.9\n200,1000,169.6\n"
 #: moment: (the gates the command stops at, the markers to see before the signal: tests/gates.py)
@@ -643,7 +643,9 @@ MOMENTS = {
     "points running": ("point", ("point", "point")),  # both workers inside a point
     "pool shutting down": ("shutdown", ("shutdown",)),  # every point done, the pool stopping
 }
-FIT_MOMENTS = {**MOMENTS, "between two sweeps": ("evaluate", ("evaluate",))}  # the pool idle
+#: a fit's first sweep is its start values, one parameter set: one worker inside a point
+FIT_MOMENTS = {**MOMENTS, "points running": ("point", ("point",)),
+               "between two sweeps": ("evaluate", ("evaluate",))}  # the pool idle
 
 
 def _descendants(pid: int) -> set[int]:

@@ -25,7 +25,7 @@ from passmd.protocols import fit as fitting
 from passmd.protocols.fit.prediction import drive_at
 from passmd.runtime.config import RunConfig
 
-__all__ = ["COMB", "FLYBACK", "comb_fit", "flyback_fits", "join"]
+__all__ = ["COMB", "FLYBACK", "comb_fit", "flyback_fits", "join", "region_text"]
 
 #: The comb example: one flexible contact (Table 1–2, R = 1 mm), k_p = 5e6 N/m, three steps at 0.4 N,
 #: 100 Hz, 1 nm noise.
@@ -79,3 +79,10 @@ def flyback_fits(config: RunConfig | None = None) -> dict:
     right = fitting.fit(base.replace(amplifier=Amplifier(flyback=FLYBACK["data_rule"])), data,
                         ["friction_coefficient"], config=config)
     return {"truth": truth, "data": data, "wrong": wrong, "right": right}
+
+
+def region_text(estimate: dict, scale: float = 1.0, unit: str = "") -> str:
+    """A fit's 95 % region as the chapter writes it: its pieces ``"a–b, c–d unit"``, the values
+    divided by ``scale`` (``estimate``: one entry of :attr:`FitResult.estimates`)."""
+    text = ", ".join(f"{a / scale:.4g}–{b / scale:.4g}" for a, b in estimate["intervals"])
+    return f"{text} {unit}" if unit else text
