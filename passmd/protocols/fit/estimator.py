@@ -273,6 +273,8 @@ def _fit(problem: Problem, drive, names, box, x_start, reading, keep, seed, say,
         say("estimate " + ", ".join(f"{k} = {v:.5g}" for k, v in zip(names, np.exp(x_hat), strict=True))
             + f", cost {cost:.5g}; {len(basin_list)} basin(s) within the 95 % level")
         found = _regions(problem, profiles, basin_list, x_hat, cost, s2, threshold, say)
+        # the regions' points can form new local minima of a profile: their bottoms too
+        prof.bottoms(problem, profiles, level, lambda: threshold * _s2(problem, problem.best()[1]))
         lowest = problem.best()[1]
         if lowest >= cost - REFIT_MARGIN * s2:
             break
