@@ -97,6 +97,11 @@ def test_template_is_the_papers_drive_with_units_and_sources(tmp_path, capsys):
     ("load_cell = 1\n", ("load_cell = 1: must be true or false",)),
     ("[actuator]\nviscosity = 0.1\ndamping_ratio = 0.1\n", ("both given",)),
     ("preload = \n", ("not a TOML file",)),
+    # a quantity derived from a key (ζ from c_p) names the key as the file has it, not an option
+    ("[actuator]\nviscosity = 8.0\n", ("the damping ratio", "derived from actuator.viscosity = 8.0",
+                                        "is 10.58", "must be <= 10",
+                                        "lower actuator.viscosity to at most 7.563 (SI)",
+                                        "allow_extrapolation = true")),
 ])
 def test_refused_file_is_one_line_naming_file_key_and_range(text, fragments, tmp_path, capsys):
     path = tmp_path / "bad.toml"

@@ -29,7 +29,6 @@ import pytest
 from passmd import cli
 from passmd.cli import options
 from passmd.cli.commands import run as run_command
-from passmd.cli.drive import _safe
 from passmd.cli.parser import make_parser
 from passmd.model import optimized_waveform, waveforms
 from passmd.model.mdr_contact import MDRContact
@@ -37,7 +36,7 @@ from passmd.model.parameters import PLAUSIBLE_RANGES, Drive, check_plausible
 from passmd.model.tables import Actuator, actuator_viscosity, parameter_table
 from passmd.protocols import eq15
 from passmd.runtime.config import RunConfig
-from passmd.runtime.validation import InputError
+from passmd.runtime.validation import InputError, safe_bound
 
 #: What a message must never show: numpy reprs, and the package's field paths and
 #: snake_case names (``actuator.damping_ratio``, ``acceleration_amplitude``).
@@ -166,7 +165,7 @@ def test_eq15_advice_holds():
 ])
 def test_limits_are_rounded_on_their_safe_side(op, bound, shown):
     """A rounded lower limit is not below the exact one, a rounded upper one not above it."""
-    assert _safe(op, bound) == shown
+    assert safe_bound(op, bound) == shown
     assert (float(shown) >= bound) if op.startswith(">") else (float(shown) <= bound)
 
 

@@ -8,17 +8,14 @@ functions the options reach) is said again with the option that set it, as typed
 
 from __future__ import annotations
 
-import math
-from decimal import ROUND_CEILING, ROUND_FLOOR, Decimal
-
 from passmd.cli.errors import UsageError
 from passmd.cli.options import ACTUATOR_DYNAMICS, DRIVE_QUANTITIES, OPTION_FOR, QUANTITIES, refuse_bare
 from passmd.cli.output import flyback_label, fmt
-from passmd.model.drive_file import DriveFileError, read_drive_file, resolve
+from passmd.model.drive_file import DriveFileError, file_message, read_drive_file, resolve
 from passmd.model.parameters import Drive
 from passmd.model.tables import FLYBACK_RULES
 from passmd.runtime.units import QuantityError, dimension_name, from_si, parse_quantity
-from passmd.runtime.validation import InputError
+from passmd.runtime.validation import LIMIT_VERBS, InputError, safe_bound
 
 __all__ = ["build_drive", "drive_rows", "explain", "resolve_drive"]
 
@@ -79,9 +76,10 @@ def resolve_drive(args, **fixed) -> tuple[Drive, dict[str, str]]:
     try:
         return resolve(values, origins, **fixed)
     except InputError as exc:
-        if exc.name == "contact_groups" and "contact_groups" in values and path is not None:
-            # the file's groups: name the file
-            raise DriveFileError(f"{path}: {exc}", name=exc.name, value=exc.value) from None
+        inputs = {exc.name, exc.source, *(exc.sources or ())} - {None}
+        if path is not None and any(origins.get(key) == f"given in {path}" for key in inputs):
+            # a value of the file (or one derived from it, e.g. ζ from c_p): name the file
+            raise DriveFileError(f"{path}: {file_message(exc)}", name=exc.name, value=exc.value) from None
         raise
 
 
@@ -134,8 +132,6 @@ def drive_rows(drive: Drive) -> list[tuple[str, str]]:
 # --------------------------------------------------------------------------------------
 
 #: How to move an option to meet a limit on it.
-_VERBS = {">": "raise {} above", ">=": "raise {} to at least", "<": "lower {} below",
-          "<=": "lower {} to at most"}
 
 
 def explain(exc: ValueError, args) -> str:
@@ -173,7 +169,7 @@ def _rephrase(exc: InputError, args) -> str | None:
         shown = f"{from_si(value, unit) if unit else value:.4g}{_suffix(unit or exc.unit)}"
         text = (f"{exc.quantity} derived from {flag} {_typed(flag, args, exc.source_value)} is {shown}, "
                 f"out of range: must be {_limits(exc.limits, unit, exc.unit)}{why}")
-        remedies = [f"{_VERBS[op].format(flag)} {_bound(op, bound, _quantity_unit(flag), '')}"
+        remedies = [f"{LIMIT_VERBS[op].format(flag)} {_bound(op, bound, _quantity_unit(flag), '')}"
                     for op, bound in exc.source_limits[:1]] + ([lifted] if lifted else [])
         return text + (f"; {', or '.join(remedies)}" if remedies else "")
     flag = _flag(exc.name, args)
@@ -237,18 +233,4 @@ def _limits(limits, unit: str, si_unit: str) -> str:
 def _bound(op: str, bound: float, unit: str, si_unit: str) -> str:
     """One limit's bound in ``unit`` (else SI), 4 digits rounded on its safe side, with the unit."""
     value = float(from_si(float(bound), unit)) if unit else float(bound)
-    return f"{_safe(op, value)}{_suffix(unit or si_unit)}"
-
-
-def _safe(op: str, bound: float, digits: int = 4) -> str:
-    """``bound`` to ``digits`` significant digits, rounded so that the stated limit stays true.
-
-    A lower limit (``>``, ``>=``) is rounded up, an upper one down: any value the rounded
-    limit allows, the exact one allows too.
-    """
-    if bound == 0.0 or not math.isfinite(bound):
-        return f"{bound:g}"
-    exact = Decimal(bound)
-    step = Decimal(1).scaleb(exact.adjusted() - digits + 1)
-    rounded = exact.quantize(step, rounding=ROUND_CEILING if op.startswith(">") else ROUND_FLOOR)
-    return f"{float(rounded):.{digits}g}"
+    return f"{safe_bound(op, value)}{_suffix(unit or si_unit)}"

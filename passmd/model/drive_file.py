@@ -52,7 +52,7 @@ from passmd.model.tables import (
 )
 from passmd.runtime.inputs import RefusedFile, decode_text, read_bounded
 from passmd.runtime.units import QuantityError, parse_angle, parse_quantity
-from passmd.runtime.validation import InputError
+from passmd.runtime.validation import LIMIT_VERBS, InputError, safe_bound, shown
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -60,7 +60,8 @@ else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 __all__ = ["CONTACT_PRESETS", "DRIVE_KEYS", "EXAMPLE_DRIVE_FILE", "JOINT_READING_FILE", "DriveFileError",
-           "DriveKey", "drive_toml", "load_drive", "parameter_rows", "read_drive_file", "resolve"]
+           "DriveKey", "drive_toml", "file_message", "load_drive", "parameter_rows", "read_drive_file",
+           "resolve"]
 
 
 class DriveFileError(InputError):
@@ -418,7 +419,22 @@ def load_drive(path, **fixed) -> Drive:
     except DriveFileError:
         raise
     except InputError as exc:
-        raise DriveFileError(f"{path}: {exc}", name=exc.name, value=exc.value) from None
+        raise DriveFileError(f"{path}: {file_message(exc)}", name=exc.name, value=exc.value) from None
+
+
+def file_message(exc: InputError) -> str:
+    """``exc`` in a drive file's terms: a quantity derived from a key (the damping ratio from
+    ``actuator.viscosity``) names the key, its value as read and the key's limit in SI."""
+    if not (exc.quantity and exc.source and exc.limits):
+        return str(exc)
+    unit = f" {exc.unit}" if exc.unit and exc.unit != "–" else ""
+    limits = " and ".join(f"{op} {safe_bound(op, bound)}{unit}" for op, bound in exc.limits)
+    text = (f"{exc.quantity} derived from {exc.source} = {shown(exc.source_value)} is "
+            f"{float(exc.value):.4g}, out of range: must be {limits}" + (f" ({exc.why})" if exc.why else ""))
+    remedies = [f"{LIMIT_VERBS[op].format(exc.source)} {safe_bound(op, bound)} (SI)"
+                for op, bound in exc.source_limits[:1]]
+    remedies += ["allow_extrapolation = true goes beyond it"] if exc.soft else []
+    return text + (f"; {', or '.join(remedies)}" if remedies else "")
 
 
 def parameter_rows(drive: Drive, sources: dict | None = None) -> list[dict]:

@@ -12,7 +12,7 @@ the user's terms (the command line names the option the value came from).
 from __future__ import annotations
 
 import math
-from decimal import Decimal, localcontext
+from decimal import ROUND_CEILING, ROUND_FLOOR, Decimal, localcontext
 from numbers import Real
 
 import numpy as np
@@ -210,3 +210,22 @@ def check_array(name: str, values, lower=None, upper=None, *, lower_open=False, 
             f"finite number{rng}{suffix}", name=name, value=first, unit=unit,
             limits=limits_of(lower, upper, lower_open, False))
     return arr
+
+
+#: How to move an input to satisfy a limit, by the limit's operator (``{}``: the input's name).
+LIMIT_VERBS = {">": "raise {} above", ">=": "raise {} to at least", "<": "lower {} below",
+               "<=": "lower {} to at most"}
+
+
+def safe_bound(op: str, bound: float, digits: int = 4) -> str:
+    """``bound`` to ``digits`` significant digits, rounded so that the stated limit stays true.
+
+    A lower limit (``>``, ``>=``) is rounded up, an upper one down: any value the rounded
+    limit allows, the exact one allows too.
+    """
+    if bound == 0.0 or not math.isfinite(bound):
+        return f"{bound:g}"
+    exact = Decimal(bound)
+    step = Decimal(1).scaleb(exact.adjusted() - digits + 1)
+    rounded = exact.quantize(step, rounding=ROUND_CEILING if op.startswith(">") else ROUND_FLOOR)
+    return f"{float(rounded):.{digits}g}"
