@@ -213,6 +213,21 @@ def first_flyback_slip(
     }
 
 
+def _check_bracket(upper: float, tolerance: float) -> float:
+    """``upper`` (m) after checking that a bracket of width ``tolerance`` can be represented below it."""
+    hi = check_positive("upper", upper, "m")
+    check_positive("tolerance", tolerance, "m")
+    floor = BISECTION_FLOOR_SPACINGS * float(np.spacing(hi))
+    if tolerance < floor:
+        raise ValueError(
+            f"tolerance (--tolerance) = {tolerance!r} m is out of range: must be >= {floor:.3g} m, "
+            f"{BISECTION_FLOOR_SPACINGS} float spacings of the amplitude {hi!r} m (a narrower bracket "
+            "cannot be represented)"
+        )
+    return hi
+
+
+
 def bisect_amplitude(moves, upper: float, tolerance: float) -> dict:
     """Smallest amplitude in (0, upper] at which ``moves(A)`` turns true, by bisection.
 
@@ -230,15 +245,7 @@ def bisect_amplitude(moves, upper: float, tolerance: float) -> dict:
         ``moves(upper)`` is false), ``bracket_low_m``, ``bracket_high_m`` (NaN when
         ``moves(upper)`` is false), ``runs`` (evaluations of ``moves``).
     """
-    lo, hi = 0.0, check_positive("upper", upper, "m")
-    check_positive("tolerance", tolerance, "m")
-    floor = BISECTION_FLOOR_SPACINGS * float(np.spacing(hi))
-    if tolerance < floor:
-        raise ValueError(
-            f"tolerance (--tolerance) = {tolerance!r} m is out of range: must be >= {floor:.3g} m, "
-            f"{BISECTION_FLOOR_SPACINGS} float spacings of the amplitude {hi!r} m (a narrower bracket "
-            "cannot be represented)"
-        )
+    lo, hi = 0.0, _check_bracket(upper, tolerance)
     runs = 1
     if not moves(hi):
         return {
@@ -313,15 +320,7 @@ def search_amplitude(probe, upper: float, tolerance: float, *, slope: float | No
     low end, moves at its high end, width ≤ ``tolerance``). ``runs`` counts the evaluations:
     typically 4–6 instead of bisection's 1 + log2(upper/tolerance).
     """
-    lo, hi = 0.0, check_positive("upper", upper, "m")
-    check_positive("tolerance", tolerance, "m")
-    floor = BISECTION_FLOOR_SPACINGS * float(np.spacing(hi))
-    if tolerance < floor:
-        raise ValueError(
-            f"tolerance (--tolerance) = {tolerance!r} m is out of range: must be >= {floor:.3g} m, "
-            f"{BISECTION_FLOOR_SPACINGS} float spacings of the amplitude {hi!r} m (a narrower bracket "
-            "cannot be represented)"
-        )
+    lo, hi = 0.0, _check_bracket(upper, tolerance)
     known, measured = {}, {}
 
     def evaluate(amplitude):
