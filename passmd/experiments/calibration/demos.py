@@ -83,6 +83,6 @@ def flyback_fits(config: RunConfig | None = None) -> dict:
 
 def region_text(estimate: dict, scale: float = 1.0, unit: str = "") -> str:
     """A fit's 95 % region as the chapter writes it: its pieces ``"a–b, c–d unit"``, the values
-    divided by ``scale`` (``estimate``: one entry of :attr:`FitResult.estimates`)."""
+    divided by ``scale`` (``estimate``: one entry of ``FitResult.estimates``)."""
     text = ", ".join(f"{a / scale:.4g}–{b / scale:.4g}" for a, b in estimate["intervals"])
     return f"{text} {unit}" if unit else text

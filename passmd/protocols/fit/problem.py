@@ -1,6 +1,6 @@
 """The weighted least-squares problem of a calibration in log-parameter space, and its searches.
 
-:class:`Problem` turns the model's predictions (:class:`~passmd.protocols.fit.prediction._Model`,
+:class:`Problem` turns the model's predictions (the private ``passmd.protocols.fit.prediction._Model``,
 one cached sweep per call) into weighted residuals and costs, keeps every parameter vector it
 evaluated with its cost (:attr:`Problem.archive`: the estimate is the lowest point seen
 anywhere), and runs the two searches the estimator builds on: a bounded local least-squares

@@ -147,11 +147,11 @@ def fill(problem: Problem, profiles: dict[int, Profile], level: Callable[[], flo
     (module docstring), most promising first; returns the number of intervals sampled.
 
     ``level()`` gives the current 95 % level, ``margin()`` the 95 % rise. A parameter whose profile is
-    smooth on the coarse grid (:func:`_probe`) needs none. Else first the
+    smooth on the coarse grid (``_probe``) needs none. Else first the
     :data:`FILL_FIRST` lowest intervals of each parameter: their fine points measure how far each
     measurement's prediction departs from the straight line between the interval's ends (the
     amplitude of its oscillation). Then, batch by batch, every interval whose predictions, widened
-    by :data:`FILL_SAFETY` × that amplitude, could reach a cost within the level (:func:`_reach`).
+    by :data:`FILL_SAFETY` × that amplitude, could reach a cost within the level (``_reach``).
     """
     done: set[tuple[int, float]] = set()
     comb = {j: np.zeros(problem.n) for j in profiles}
