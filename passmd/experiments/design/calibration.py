@@ -42,7 +42,8 @@ def start_drive(truth: Drive, profile: str) -> Drive:
 
 
 def _measurements(points, truth: Drive, rng, config, flyback=None) -> fitting.Measurements:
-    """Steps at (frequency, preload, amplitude nm) points: :func:`~passmd.experiments.calibration.synthetic.independent_steps` below 1 kHz (the
+    """Steps at (frequency, preload, amplitude nm) points:
+    :func:`~passmd.experiments.calibration.synthetic.independent_steps` below 1 kHz (the
     steady-velocity protocol's step above, as a stand measures it there) plus noise of NOISE_NM."""
     header = ["amplitude_nm", "preload_N", "frequency_Hz", "step_nm", "step_nm_sd"]
     rows = [[repr(float(a)), repr(float(p)), repr(float(f)), "0", repr(NOISE_NM)] for f, p, a in points]
@@ -58,8 +59,8 @@ def _measurements(points, truth: Drive, rng, config, flyback=None) -> fitting.Me
 
 def synthetic_measurements(truth: Drive, profile: str, config: RunConfig | None = None, flyback=None
                            ) -> tuple[fitting.Measurements, fitting.Measurements]:
-    """Steps of ``truth`` made independently of the fit's forward model (:func:`~passmd.experiments.calibration.synthetic.independent_steps`),
-    plus Gaussian noise of NOISE_NM (seed SEED): ``(fit data, held-back data)``; ``flyback``
+    """Steps of ``truth`` made independently of the fit's forward model
+    (:func:`~passmd.experiments.calibration.synthetic.independent_steps`), plus Gaussian noise of NOISE_NM (seed SEED): ``(fit data, held-back data)``; ``flyback``
     overrides the drive's fly-back rule in the data (a mis-specified model)."""
     s = PROFILE_SETTINGS[profile]
     config = _run_config(config, profile)

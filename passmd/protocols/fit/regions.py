@@ -7,7 +7,8 @@ every local minimum of any profile within the level (:func:`basins`, prominence 
 :data:`BASIN_PROMINENCE`) adds its own local interval of each parameter (:func:`basin_intervals`,
 a profile end found on the signed root of the cost rise). The union of both, merged where they
 overlap, is the region; several separate pieces mean the parameter is known only to that set.
-:func:`~passmd.protocols.fit.next_measurement.separating_row` computes which one added measurement would best tell the basins apart.
+:func:`~passmd.protocols.fit.next_measurement.separating_row` computes which one added measurement
+would best tell the basins apart.
 """
 
 from __future__ import annotations
