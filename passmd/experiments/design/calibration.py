@@ -60,8 +60,9 @@ def _measurements(points, truth: Drive, rng, config, flyback=None) -> fitting.Me
 def synthetic_measurements(truth: Drive, profile: str, config: RunConfig | None = None, flyback=None
                            ) -> tuple[fitting.Measurements, fitting.Measurements]:
     """Steps of ``truth`` made independently of the fit's forward model
-    (:func:`~passmd.experiments.calibration.synthetic.independent_steps`), plus Gaussian noise of NOISE_NM (seed SEED): ``(fit data, held-back data)``; ``flyback``
-    overrides the drive's fly-back rule in the data (a mis-specified model)."""
+    (:func:`~passmd.experiments.calibration.synthetic.independent_steps`), plus Gaussian noise of
+    NOISE_NM (seed SEED): ``(fit data, held-back data)``; ``flyback`` overrides the drive's fly-back
+    rule in the data (a mis-specified model)."""
     s = PROFILE_SETTINGS[profile]
     config = _run_config(config, profile)
     rng = np.random.default_rng(SEED)
