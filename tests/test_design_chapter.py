@@ -122,7 +122,7 @@ def _curve(steady, closed=(30.0, 50.0, 70.0, 90.0), left=(2.0, 0.1, 3.0, 4.0)):
 def test_curve_facts_say_where_the_closed_form_is_exceeded_and_how_often_the_curve_turns():
     below = design.curve_facts(_curve([20.0, 40.0, 60.0, 80.0]))
     assert below["ca_closed_above"] == 4 and below["ca_turns"] == 0 and below["ca_ringing_points"] == 3
-    # the kind of drive: steady A_c above the closed form at one preload, turning twice
+    # a drive whose steady A_c exceeds the closed form at one preload and turns twice
     jagged = design.curve_facts(_curve([20.0, 55.0, 52.0, 80.0]))
     assert jagged["ca_closed_above"] == 3 and jagged["ca_excess_nm"] == pytest.approx(5.0)
     assert jagged["ca_excess_at_N"] == 0.4 and jagged["ca_turns"] == 2
