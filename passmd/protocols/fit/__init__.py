@@ -38,9 +38,11 @@ tooth of a comb of minima could hide within the 95 % level, the bottom of every 
 estimate is the lowest point found anywhere.
 
 Uncertainty (:mod:`~passmd.protocols.fit.regions`): a parameter's 95 % region is every value whose
-profile, or the local profile of a basin (a local minimum within the level), lies within the 95 %
-quantile of χ²₁ (σ given) or F(1, n − p) (σ estimated, the cost in units of the residual variance)
-above the minimum: one interval, or several separate pieces. Several pieces mean the parameter is
+profile, or the local profile of a basin (a local minimum within the level), lies within
+:func:`~passmd.protocols.fit.estimator.region_level` above the minimum — the 95 % quantile of χ²
+with p degrees of freedom for p free parameters (σ given), or p · F(p, n − p) (σ estimated, the
+cost in units of the residual variance): the projection of the joint 95 % region, one interval or
+several separate pieces. Several pieces mean the parameter is
 not uniquely identified; :func:`~passmd.protocols.fit.next_measurement.separating_row` computes the
 added row that best separates the basins. A region reaching a bound means not identifiable. With σ
 given, the minimum is tested against χ² with n − p degrees of freedom
@@ -68,6 +70,7 @@ from passmd.protocols.fit.estimator import (
     REFIT_MARGIN,
     REFITS,
     fit,
+    region_level,
 )
 from passmd.protocols.fit.free_parameters import FREE_PARAMETERS, KEEPS, FreeParameter, default_bounds
 from passmd.protocols.fit.measurements import ANNOTATIONS as ANNOTATIONS
@@ -153,5 +156,6 @@ __all__ = [
     "predict",
     "predict_point",
     "read_measurements",
+    "region_level",
     "write_measurements",
 ]

@@ -15,8 +15,8 @@
    below the estimate restarts stage 4 from it (:data:`REFITS` times at most).
 
 The 95 % region of a parameter is every value whose profile (or a basin's local interval) lies
-within the χ²₁ quantile (σ given) or F(1, n − p) quantile (σ estimated) of the minimum: possibly
-several pieces. With stated σ the minimum cost is tested against χ²_{n−p}
+within :func:`region_level` of the minimum — the 95 % quantile of χ²_p (σ given) or p · F(p, n − p)
+(σ estimated), p free parameters: the projection of the joint 95 % region, possibly several pieces. With stated σ the minimum cost is tested against χ²_{n−p}
 (:func:`~passmd.protocols.fit.result.goodness_of_fit`).
 """
 
@@ -46,7 +46,7 @@ from passmd.runtime.config import RunConfig
 from passmd.runtime.validation import InputError, check_choice
 
 __all__ = ["DISTINCT", "FIRST_SEARCH_EVALUATIONS", "GLOBAL_POINTS_PER_PARAMETER", "JACOBIAN_STEPS",
-           "LOCAL_STARTS", "LOSSES", "MAX_BASINS", "REFITS", "REFIT_MARGIN", "fit"]
+           "LOCAL_STARTS", "LOSSES", "MAX_BASINS", "REFITS", "REFIT_MARGIN", "fit", "region_level"]
 
 #: Points of the global pass per free parameter (the Sobol design takes the next power of two).
 GLOBAL_POINTS_PER_PARAMETER = 64
@@ -195,13 +195,26 @@ def _global_pass(problem: Problem, x_start: np.ndarray, seed: int, say) -> list[
     return picks
 
 
-def _threshold(problem: Problem) -> float:
-    """The 95 % rise of a profile in units of s²: χ²₁ (σ given) or F(1, n − p) (σ estimated)."""
+def region_level(free: int, n: int, known_sd: bool) -> float:
+    """The 95 % rise of a profile above the minimum, in units of s²: the 95 % quantile of χ² with
+    ``free`` degrees of freedom (σ given), or ``free`` · F(free, n − free) (σ estimated).
+
+    A parameter's region is then the projection of the joint 95 % region of all free parameters.
+    The per-parameter level (χ²₁) assumes a cost that is quadratic near its minimum; on a comb of
+    minima (the step in k_p) the minimum is the best of several teeth and χ²₁ regions cover the
+    truth too rarely (``benchmarks/bench_fit_coverage.py`` records both levels).
+    """
     from scipy import stats
 
-    if problem.data.known_sd:
-        return float(stats.chi2.ppf(0.95, 1))
-    return float(stats.f.ppf(0.95, 1, problem.n - problem.p))
+    if free < 1 or n <= free:
+        raise InputError(f"free = {free}, n = {n}: need 1 <= free < n", name="free", value=free)
+    if known_sd:
+        return float(stats.chi2.ppf(0.95, free))
+    return float(free * stats.f.ppf(0.95, free, n - free))
+
+
+def _threshold(problem: Problem) -> float:
+    return region_level(problem.p, problem.n, problem.data.known_sd)
 
 
 def _s2(problem: Problem, cost: float) -> float:
