@@ -10,9 +10,10 @@ seed per draw) is added and its sd stated. Each draw is fitted from the drive's 
 k_p = 6.5e6 N/m) with the default bounds, on a process pool over all cores and an empty result
 cache. Counted: how often each parameter's reported 95 % region (all its pieces) holds the truth,
 how often both do, how often the truth lies in the joint 95 % region (its cost within the level
-of the minimum, ``truth_rise`` per draw), how often the verdict is identifiable / not uniquely identified (several
-basins) / not identifiable / model rejected (χ² test, p < 0.01), and how often a draw is called
-identifiable while a region misses the truth (which must never happen); the median wall time.
+of the minimum, ``truth_rise`` per draw), how often the verdict is identifiable / not uniquely
+identified (several basins) / not identifiable / model rejected (χ² test, p < 0.01), and how often
+a draw is called identifiable while a region misses the truth (which must never happen); the
+median wall time.
 Nominal coverage of a region: 0.95.
 
 Usage::

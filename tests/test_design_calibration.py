@@ -13,14 +13,18 @@ import pytest
 from passmd.experiments.calibration.synthetic import independent_steps
 from passmd.experiments.design import calibration
 from passmd.experiments.design import figures as design
+from passmd.model.parameters import Drive
+from passmd.model.tables import actuator_for_radius
 from passmd.protocols import fit as fitting
 from passmd.runtime.config import RunConfig
 
 
 def test_fit_facts_say_whether_the_region_holds_the_truth():
     truth, _ = design.example_drive()
-    start = calibration.start_drive(truth, "paper")
-    assert start.friction_coefficient == 0.2 and start.actuator.stiffness == pytest.approx(4.8333e6, rel=1e-4)
+    start = calibration.start_drive(truth, ("friction_coefficient", "actuator.stiffness"))
+    # the first guess is the paper's: μ of Table 1, k_p of Table 2 for the drive's radius
+    assert start.friction_coefficient == Drive().friction_coefficient
+    assert start.actuator.stiffness == pytest.approx(actuator_for_radius(truth.hemisphere_radius).stiffness)
     result = SimpleNamespace(names=["friction_coefficient", "actuator.stiffness"], estimates={
         "friction_coefficient": {"value": 0.249, "stderr": 0.003, "interval": [0.243, 0.256],
                                  "intervals": [[0.243, 0.256]]},

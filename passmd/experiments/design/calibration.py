@@ -11,6 +11,7 @@ read back, predicts the held-back points.
 from __future__ import annotations
 
 import tempfile
+from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 
@@ -28,16 +29,19 @@ from passmd.runtime.config import RunConfig
 __all__ = ["calibrate", "fit_facts", "heldback_facts", "heldback_predictions", "load_fitted",
            "measurements_csv", "other_flyback_fit", "start_drive", "synthetic_measurements"]
 
-def start_drive(truth: Drive, profile: str) -> Drive:
-    """A designer's first guess: ``truth`` with each free parameter at the paper's value
-    (:data:`passmd.experiments.design.figures.START`)."""
+def start_drive(truth: Drive, free: Sequence[str]) -> Drive:
+    """A designer's first guess: ``truth`` with each parameter named in ``free`` at the paper's value
+    (μ of Table 1; k_p of Table 2 for the drive's radius, c_p kept)."""
     drive = truth
-    for name in PROFILE_SETTINGS[profile].free:
+    for name in free:
         if name == "friction_coefficient":
             drive = replace(drive, friction_coefficient=Drive().friction_coefficient)
         elif name == "actuator.stiffness":
             table2 = actuator_for_radius(truth.hemisphere_radius).stiffness
             drive = fitting.FREE_PARAMETERS[name].set(drive, table2, truth)
+        else:
+            raise ValueError(f"free = {name!r}: the example's first guess knows friction_coefficient and "
+                             "actuator.stiffness")
     return drive
 
 

@@ -9,14 +9,20 @@
 3. **Profiles** of every parameter over its whole bounds (:mod:`passmd.protocols.fit.profiles`):
    coarse, then walked at 1 % wherever the comb of the step in k_p could hide a tooth within the
    95 % level, then refined around each low minimum.
-4. **Basins**: the local minima of every profile within the level; the lowest point found
+4. **Polish** (three or more free parameters): the profile's inner minimisation is one
+   Gauss–Newton step of the others from the neighbouring point; with two or more others the
+   teeth of the comb are curved valleys in their plane, and that step can stop on a valley's wall.
+   A full local search starts from each of the :data:`MAX_BASINS` lowest distinct local minima of
+   the profiles within twice the 95 % rise of the best cost (:func:`_polish`).
+5. **Basins**: the local minima of every profile within the level; the lowest point found
    anywhere is polished by a local search and is the estimate. Each basin adds the local
    interval of every parameter (:mod:`passmd.protocols.fit.regions`); a point met on the way
-   below the estimate restarts stage 4 from it (:data:`REFITS` times at most).
+   below the estimate restarts stage 5 from it (:data:`REFITS` times at most).
 
 The 95 % region of a parameter is every value whose profile (or a basin's local interval) lies
 within :func:`region_level` of the minimum — the 95 % quantile of χ²_p (σ given) or p · F(p, n − p)
-(σ estimated), p free parameters: the projection of the joint 95 % region, possibly several pieces. With stated σ the minimum cost is tested against χ²_{n−p}
+(σ estimated), p free parameters: the projection of the joint 95 % region, possibly several
+pieces. With stated σ the minimum cost is tested against χ²_{n−p}
 (:func:`~passmd.protocols.fit.result.goodness_of_fit`).
 """
 
@@ -253,6 +259,26 @@ def _regions(problem, profiles, basin_list, x_hat, cost, s2, threshold, say):
     return out
 
 
+def _polish(problem: Problem, profiles: dict[int, prof.Profile], cut: float, say) -> None:
+    """Full local searches from the lowest distinct local minima of the profiles at or below ``cut``
+    (module docstring, stage 4)."""
+    found = []
+    for profile in profiles.values():
+        t, c, xs = profile.arrays()
+        found += [(c[k], xs[k]) for k in range(1, t.size - 1)
+                  if c[k] <= cut and c[k] <= c[k - 1] and c[k] <= c[k + 1]]
+    found.sort(key=lambda item: item[0])
+    starts: list[np.ndarray] = []
+    for _, x in found:
+        if all(np.max(np.abs(x - y)) > 1.5 * prof.FINE_SPACING for y in starts):
+            starts.append(x)
+        if len(starts) == MAX_BASINS:
+            break
+    for k, x in enumerate(starts):
+        say(f"polish {k + 1}/{len(starts)}: a local search from a minimum of the profiles")
+        problem.local(x)
+
+
 def _fit(problem: Problem, drive, names, box, x_start, reading, keep, seed, say, t0) -> FitResult:
     """The stages of the module docstring, then the result."""
     p = problem.p
@@ -276,6 +302,8 @@ def _fit(problem: Problem, drive, names, box, x_start, reading, keep, seed, say,
     walked = prof.fill(problem, profiles, level, lambda: threshold * _s2(problem, problem.best()[1]))
     say(f"profiles sampled at {prof.FINE_SPACING:.0%} over {walked} intervals that may hold a minimum")
     prof.bottoms(problem, profiles, level, lambda: threshold * _s2(problem, problem.best()[1]))
+    if p >= 3:
+        _polish(problem, profiles, level() + threshold * _s2(problem, problem.best()[1]), say)
     converged, notes = True, []
     for attempt in range(REFITS + 1):
         x_hat, cost = problem.local(problem.best()[0])
