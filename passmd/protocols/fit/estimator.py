@@ -208,7 +208,7 @@ def region_level(free: int, n: int, known_sd: bool) -> float:
     A parameter's region is then the projection of the joint 95 % region of all free parameters.
     The per-parameter level (χ²₁) assumes a cost that is quadratic near its minimum; on a comb of
     minima (the step in k_p) the minimum is the best of several teeth and χ²₁ regions cover the
-    truth too rarely (``benchmarks/bench_fit_coverage.py`` records both levels).
+    truth too rarely (``benchmarks/bench_fit_coverage.py`` counts how often each covers it).
     """
     from scipy import stats
 
