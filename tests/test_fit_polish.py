@@ -20,8 +20,8 @@ class _Valley:
 
     def evaluate(self, xs):
         self.evaluations += len(xs)
-        return [self.data.value + np.array([10.0 * (x[1] - x[0] ** 2), 1.0 - x[0], 10.0 * (x[2] - x[0] ** 2), 0.0])
-                for x in xs]
+        valley = [np.array([10 * (x[1] - x[0] ** 2), 1 - x[0], 10 * (x[2] - x[0] ** 2), 0.0]) for x in xs]
+        return [self.data.value + r for r in valley]
 
 
 def _problem() -> Problem:
