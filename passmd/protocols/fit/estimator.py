@@ -12,8 +12,9 @@
 4. **Polish** (three or more free parameters): the profile's inner minimisation is one
    Gauss–Newton step of the others from the neighbouring point; with two or more others the
    teeth of the comb are curved valleys in their plane, and that step can stop on a valley's wall.
-   A full local search starts from each of the :data:`MAX_BASINS` lowest distinct local minima of
-   the profiles within twice the 95 % rise of the best cost (:func:`_polish`).
+   A full local search starts from :data:`MAX_BASINS` distinct local minima of the profiles
+   within twice the 95 % rise of the best cost: those whose Gauss–Newton step in all free
+   parameters projects the lowest cost (:func:`_polish`).
 5. **Basins**: the local minima of every profile within the level; the lowest point found
    anywhere is polished by a local search and is the estimate. Each basin adds the local
    interval of every parameter (:mod:`passmd.protocols.fit.regions`); a point met on the way
@@ -52,7 +53,8 @@ from passmd.runtime.config import RunConfig
 from passmd.runtime.validation import InputError, check_choice
 
 __all__ = ["DISTINCT", "FIRST_SEARCH_EVALUATIONS", "GLOBAL_POINTS_PER_PARAMETER", "JACOBIAN_STEPS",
-           "LOCAL_STARTS", "LOSSES", "MAX_BASINS", "REFITS", "REFIT_MARGIN", "fit", "region_level"]
+           "LOCAL_STARTS", "LOSSES", "MAX_BASINS", "POLISH_CANDIDATES", "REFITS", "REFIT_MARGIN", "fit",
+           "region_level"]
 
 #: Points of the global pass per free parameter (the Sobol design takes the next power of two).
 GLOBAL_POINTS_PER_PARAMETER = 64
@@ -67,8 +69,12 @@ REFITS = 2
 #: A point counts as lower than the estimate when below it by more than this many s² (a third of
 #: the 95 % rise: not a rounding effect).
 REFIT_MARGIN = 0.5
-#: At most this many basins (the lowest) get their own local intervals.
+#: At most this many basins (the lowest) get their own local intervals; as many local searches
+#: polish the profiles' minima when three or more parameters are free.
 MAX_BASINS = 8
+#: The lowest distinct minima of the profiles whose projected Gauss–Newton cost ranks them for the
+#: polish (three or more free parameters).
+POLISH_CANDIDATES = 32
 #: Robust losses of ``scipy.optimize.least_squares`` (the intervals use the plain sum of squares).
 LOSSES = ("linear", "soft_l1", "huber", "cauchy", "arctan")
 
@@ -260,8 +266,10 @@ def _regions(problem, profiles, basin_list, x_hat, cost, s2, threshold, say):
 
 
 def _polish(problem: Problem, profiles: dict[int, prof.Profile], cut: float, say) -> None:
-    """Full local searches from the lowest distinct local minima of the profiles at or below ``cut``
-    (module docstring, stage 4)."""
+    """Full local searches from the low local minima of the profiles at or below ``cut`` (module
+    docstring, stage 4): of the :data:`POLISH_CANDIDATES` lowest distinct ones, the
+    :data:`MAX_BASINS` whose Gauss–Newton step in all free parameters projects the lowest cost (a
+    point on a valley's wall projects a drop, a valley's bottom none)."""
     found = []
     for profile in profiles.values():
         t, c, xs = profile.arrays()
@@ -272,10 +280,15 @@ def _polish(problem: Problem, profiles: dict[int, prof.Profile], cut: float, say
     for _, x in found:
         if all(np.max(np.abs(x - y)) > 1.5 * prof.FINE_SPACING for y in starts):
             starts.append(x)
-        if len(starts) == MAX_BASINS:
+        if len(starts) == POLISH_CANDIDATES:
             break
-    for k, x in enumerate(starts):
-        say(f"polish {k + 1}/{len(starts)}: a local search from a minimum of the profiles")
+    if not starts:
+        return
+    problem.evaluate([v for x in starts for v in (x, *problem._steps(x, range(problem.p)))])  # one sweep
+    projected = [prof.projected_cost(problem, x, problem.fun_jac(x)[1]) for x in starts]
+    chosen = [starts[k] for k in np.argsort(projected, kind="stable")[:MAX_BASINS]]
+    for k, x in enumerate(chosen):
+        say(f"polish {k + 1}/{len(chosen)}: a local search from a minimum of the profiles")
         problem.local(x)
 
 

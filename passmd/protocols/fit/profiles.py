@@ -36,7 +36,8 @@ from passmd.protocols.fit.problem import Problem
 
 __all__ = ["BOTTOM_DROP", "BOTTOM_FIRST", "BOTTOM_MAX", "BOTTOM_RESOLUTION", "BOTTOM_STEPS", "FILL_BATCH",
            "FILL_FIRST", "FILL_SAFETY", "FINE_SPACING", "PROBE_POINTS", "PROFILE_MIN_POINTS",
-           "PROFILE_SPACING", "SMOOTH_DEPARTURE", "Profile", "bottoms", "coarse", "fill", "walk"]
+           "PROFILE_SPACING", "SMOOTH_DEPARTURE", "Profile", "bottoms", "coarse", "fill", "projected_cost",
+           "walk"]
 
 #: Spacing of the coarse profile over a parameter's whole bounds (log units: 16 %), so that of the two
 #: coarse points around any value one lies within 8 % of it, about one period of the comb.
@@ -122,7 +123,7 @@ def coarse(problem: Problem, profiles: dict[int, Profile], x_hat: np.ndarray, co
     walk(problem, profiles, walkers)
 
 
-def _projected(problem: Problem, x: np.ndarray, jac: np.ndarray) -> float:
+def projected_cost(problem: Problem, x: np.ndarray, jac: np.ndarray) -> float:
     """The cost at ``x`` after a linear least-squares step of the Jacobian ``jac``'s columns."""
     r = problem.residual(problem.prediction(x))
     if jac.shape[1] == 0:
@@ -241,7 +242,7 @@ def _sample(problem: Problem, profiles: dict[int, Profile], intervals, cut: floa
     tasks = []
     for j, x, e in jobs:
         profiles[j].add(x[j], problem.archive[x.tobytes()][1], x)
-        if _projected(problem, x, jacobians[(e.tobytes(), j)]) <= cut:
+        if projected_cost(problem, x, jacobians[(e.tobytes(), j)]) <= cut:
             tasks.append((j, x[j], x))
     if tasks:
         for (j, t, _), (x, c) in zip(tasks, problem.conditional(tasks), strict=True):
