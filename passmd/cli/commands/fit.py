@@ -48,8 +48,9 @@ _EPILOG = textwrap.dedent("""\
     the bounds, local least-squares searches in log-parameter space, then each parameter's
     profile over its whole bounds (a comb of minima, as the step of flexible actuators has
     in k_p, is sampled at 1 %). The estimate is the lowest point found. Each parameter's
-    95 % region is every value whose profile lies within the chi-square quantile of the
-    minimum: one interval, or several pieces when the data allow several basins (then the
+    95 % region is every value whose profile lies within the 95 % chi-square quantile (as
+    many degrees of freedom as free parameters) of the minimum, the projection of the joint
+    95 % region: one interval, or several pieces when the data allow several basins (then the
     one added measurement that separates them best is computed). With stated sd the
     minimum is tested against chi-square with n - p degrees of freedom; below p = 0.01 the
     model does not describe the data and no interval is called calibrated.
