@@ -44,7 +44,8 @@ def test_figure_data_takes_a_run_configuration():
 
 
 def test_claim_modules_are_the_experiment_modules_with_extractors():
-    """Every experiment module that tags a claim extractor is listed, and only those."""
+    """Every experiment module that tags a claim extractor is found (by its name, claims*.py), and
+    only those."""
     package = Path(figures.__file__).parent
     tagged = {"passmd." + ".".join(path.relative_to(package.parent).with_suffix("").parts)
               for path in package.rglob("*.py")

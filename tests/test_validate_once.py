@@ -1,106 +1,158 @@
-"""Inputs are validated once, at the boundary (the standards: records validate on construction,
-public functions check their arguments, internal code trusts them).
+"""Inputs are validated at the boundary, once (the standards: records validate on construction,
+public functions check their arguments, internal code trusts them), as a user sees it.
 
-The walk of ``passmd run --preload 0.4N`` from the option to the simulation kernel checks the
-preload's range exactly twice: the option, in the user's unit (``passmd.cli.options``), and the
-:class:`~passmd.model.parameters.Drive` record it becomes. --frequency and --amplitude are checked by
-the option and then by the public :func:`~passmd.model.waveforms.sawtooth` (and the amplitude by the
-:class:`~passmd.model.waveforms.Waveform` record), not again by the command. The checks are counted by
-tracing calls of the check helpers of :mod:`passmd.runtime.validation` and of
-:meth:`~passmd.model.parameters.PlausibleRange.check` (outermost calls only: a helper calling another
-counts once).
+- A refused option is one line naming the option as typed, its value and the allowed range.
+- The range that line states is the range that holds all the way to the simulation: a value on
+  the stated bound runs to the end, a value just past it is refused by the option. A check inside
+  the package with another range (or with the default plausible ranges where the user lifted them
+  with ``--allow-extrapolation``) would refuse a value the option accepted, or a run the user
+  asked for.
+- A drive built with ``allow_extrapolation=True`` is trusted by everything it reaches (its
+  contacts, its waveform, the simulation); the public constructors given bare numbers check them.
+
+Runs are one period of a one-contact rigid drive (cheap); each runs to its printed result.
 """
 
 from __future__ import annotations
 
 import contextlib
 import io
-import sys
+import json
+import math
+import re
 
+import numpy as np
 import pytest
 
-import passmd.runtime.validation as validation
+import passmd
 from passmd import cli
 from passmd.model.mdr_contact import MDRContact
-from passmd.model.parameters import Drive, PlausibleRange
-from passmd.solver import simulation as dynamics
 
-#: The check helpers whose calls are counted, by code object.
-CHECKS = {function.__code__: label for label, function in (
-    ("check_range", validation.check_range), ("check_positive", validation.check_positive),
-    ("check_array", validation.check_array), ("check_count", validation.check_count),
-    ("check_choice", validation.check_choice), ("PlausibleRange.check", PlausibleRange.check))}
+#: One run, cheap enough to repeat for every case (a saw-tooth period of a rigid one-contact drive).
+CHEAP = ["--contacts", "1", "--actuator", "rigid", "--periods", "1", "--max-points", "10", "--json"]
 
+#: SI per unit of the units the cases type.
+SI = {"N": 1.0, "mm": 1e-3, "g": 1e-3, "kHz": 1e3, "nm": 1e-9, "": 1.0}
 
-@contextlib.contextmanager
-def traced_checks():
-    """Record ``(helper, name, caller)`` of every outermost check helper call in the block."""
-    calls = []
+#: (option, a value far out of range as a user might type it, the unit, where the JSON output
+#: shows the value in SI). Both sides of a range where both are limited.
+CASES = [
+    ("--preload", "1e9", "N", ("drive", "preload_N")),
+    ("--preload", "1e-9", "N", ("drive", "preload_N")),
+    ("--radius", "1e9", "mm", ("drive", "hemisphere_radius_m")),
+    ("--mu", "1e9", "", ("drive", "friction_coefficient")),
+    ("--runner-mass", "1e9", "g", ("drive", "runner_mass_kg")),
+    ("--runner-mass", "1e-9", "g", ("drive", "runner_mass_kg")),
+    ("--frequency", "1e-4", "kHz", ("frequency_Hz",)),
+    ("--amplitude", "1e9", "nm", ("amplitude_m",)),
+]
+IDS = [f"{flag}={value}" for flag, value, _, _ in CASES]
 
-    def profile(frame, event, arg):
-        if event == "call" and frame.f_code in CHECKS and frame.f_back.f_code not in CHECKS:
-            caller = frame.f_back.f_code
-            calls.append((CHECKS[frame.f_code], str(frame.f_locals.get("name")), caller.co_qualname))
-
-    previous = sys.getprofile()
-    sys.setprofile(profile)
-    try:
-        yield calls
-    finally:
-        sys.setprofile(previous)
-
-
-class _KernelReached(BaseException):
-    """The simulation was set up (its contacts built) and about to run the kernel."""
+#: A range refusal: the option as typed, its value in the option's unit, the bound and its unit.
+REFUSAL = re.compile(r"^passmd run: error: (?P<flag>--[a-z-]+) = (?P<value>\S+)(?: (?P<unit>[^\s(,;]+))? "
+                     r"is out of range: must be (?P<op><=|>=|<|>) (?P<bound>\S+?)"
+                     r"(?: (?P<bound_unit>[^\s(,;]+))?(?: \(|,|;|$)")
 
 
-def _stop_before_the_kernel(self, periods):
-    raise _KernelReached
+def run(argv):
+    """(status, stdout, stderr) of ``passmd argv`` in this process."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            status = cli.main(list(argv))
+        except SystemExit as exc:  # argparse
+            status = exc.code
+    return status, out.getvalue(), err.getvalue()
 
 
-@pytest.fixture(scope="module")
-def run_walk():
-    """Every check of ``passmd run --preload 0.4N --frequency 2kHz --amplitude 150nm``, the run
-    stopped where the kernel would start (after the simulation's contacts are built)."""
-    argv = ["run", "--preload", "0.4N", "--frequency", "2kHz", "--amplitude", "150nm", "--periods", "1"]
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(dynamics.Simulation, "run_to", _stop_before_the_kernel)
-        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()) as err:
-            with traced_checks() as calls, pytest.raises(_KernelReached):
-                cli.main(argv)
-    assert "error" not in err.getvalue(), err.getvalue()
-    return calls
+def refusal(argv) -> re.Match:
+    """The one line refusing ``argv``, parsed."""
+    status, out, err = run(argv)
+    assert status == 2 and out == "", (status, out, err)
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    match = REFUSAL.match(err)
+    assert match, err
+    return match
 
 
-def test_the_preload_is_range_checked_at_the_option_and_in_the_drive_only(run_walk):
-    preload = [(helper, caller) for helper, name, caller in run_walk if "preload" in name]
-    assert preload == [("PlausibleRange.check", "Quantity.parse"),  # --preload, in N, as typed
-                       ("PlausibleRange.check", "Drive.__post_init__")], preload
-    # what the simulation derives from the checked drive (each contact's force, radius, moduli)
-    # is not checked again on its way to the kernel
-    derived = [(name, caller) for _, name, caller in run_walk
-               if name in ("normal_force", "radius", "E_star", "G_star", "mu")]
-    assert derived == [], derived
+def shown_in_json(out: str, path) -> float:
+    value = json.loads(out)
+    for key in path:
+        value = value[key]
+    return value
 
 
-def test_frequency_and_amplitude_are_checked_at_the_option_and_by_the_waveform_only(run_walk):
-    frequency = [(name, caller) for _, name, caller in run_walk if name in ("--frequency", "frequency")]
-    assert frequency == [("--frequency", "Quantity.parse"), ("frequency", "sawtooth")], frequency
-    amplitude = [(name, caller) for _, name, caller in run_walk if name in ("--amplitude", "amplitude")]
-    assert amplitude == [("--amplitude", "Quantity.parse"), ("amplitude", "sawtooth"),
-                         ("amplitude", "Waveform.__post_init__")], amplitude
+@pytest.mark.parametrize(("flag", "value", "unit", "path"), CASES, ids=IDS)
+def test_a_refused_option_is_one_line_naming_it_as_typed_its_value_and_its_range(flag, value, unit, path):
+    line = refusal(["run", flag, f"{value}{unit}", *CHEAP])
+    assert line["flag"] == flag
+    assert float(line["value"]) == float(value)  # the value as typed, in the unit typed
+    assert (line["unit"] or "") == unit and (line["bound_unit"] or "") == unit
+    assert math.isfinite(float(line["bound"]))
 
 
-def test_a_drives_contact_is_built_from_the_drive_without_checking_it_again():
-    """MDRContact.for_drive trusts the drive's checked force, radius and moduli; the public
-    constructor with bare floats checks them."""
-    drive = Drive()
-    with traced_checks() as calls:
-        contact = MDRContact.for_drive(drive, side=1)
-    rechecked = [call for call in calls if call[1] in ("normal_force", "radius", "E_star", "G_star", "mu")]
-    assert rechecked == [], rechecked
-    with traced_checks() as calls:
-        same = MDRContact(contact.normal_force, drive.hemisphere_radius, contact.E_star, contact.G_star,
-                          drive.friction_coefficient)
-    assert {name for _, name, _ in calls} >= {"normal_force", "radius", "E_star", "G_star", "mu"}
-    assert (same.params == contact.params).all()  # the same contact either way, bit for bit
+@pytest.mark.parametrize(("flag", "value", "unit", "path"), CASES, ids=IDS)
+def test_the_range_a_refusal_states_is_the_range_that_holds_up_to_the_result(flag, value, unit, path):
+    line = refusal(["run", flag, f"{value}{unit}", *CHEAP])
+    bound, op = float(line["bound"]), line["op"]
+    # on the bound as the message shows it (just inside an open one): the whole run, every check
+    # inside the package included, accepts it
+    inside = line["bound"] if op in ("<=", ">=") else repr(bound * (1 - 1e-6 if op == "<" else 1 + 1e-6))
+    status, out, err = run(["run", flag, f"{inside}{unit}", *CHEAP])
+    assert status == 0, err
+    assert shown_in_json(out, path) == pytest.approx(float(inside) * SI[unit], rel=1e-12)
+    # just past it: refused by the option, with the same range
+    past = bound * (1 + 1e-6) if op.startswith("<") else bound * (1 - 1e-6)
+    again = refusal(["run", flag, f"{past!r}{unit}", *CHEAP])
+    assert (again["flag"], again["op"], again["bound"]) == (flag, op, line["bound"])
+
+
+SOFT = [case for case in CASES if case[0] != "--amplitude"]  # the full stroke is a hard limit
+
+
+@pytest.mark.parametrize(("flag", "value", "unit", "path"), SOFT, ids=[f"{c[0]}={c[1]}" for c in SOFT])
+def test_allow_extrapolation_holds_all_the_way_to_the_result(flag, value, unit, path):
+    """Past a plausible range, --allow-extrapolation reaches every check the value meets: the run
+    ends with the value as typed, not with a refusal from inside the package."""
+    line = refusal(["run", flag, f"{value}{unit}", *CHEAP])
+    assert line.string.rstrip().endswith("--allow-extrapolation goes beyond it"), line.string
+    beyond = float(line["bound"]) * (1.5 if line["op"].startswith("<") else 1 / 1.5)
+    status, out, err = run(["run", flag, f"{beyond!r}{unit}", "--allow-extrapolation", *CHEAP])
+    assert status == 0, err
+    assert shown_in_json(out, path) == pytest.approx(beyond * SI[unit], rel=1e-12)
+    result = json.loads(out)
+    assert all(math.isfinite(x) for x in result["settled_positions_m"]), result
+
+
+def test_an_extrapolating_drive_is_trusted_by_its_contacts_waveform_and_simulation():
+    """Beyond the plausible preload, friction and frequency (each lifted by the drive's
+    ``allow_extrapolation``), nothing the drive reaches refuses it again."""
+    with pytest.raises(ValueError, match=r"^preload = 150\.0 is out of range: must be <= 100 N"):
+        passmd.Drive(contacts=1, actuator_model="rigid", preload=150.0)
+    drive = passmd.Drive(contacts=1, actuator_model="rigid", preload=150.0, friction_coefficient=1.5,
+                         allow_extrapolation=True)
+    contact = MDRContact.for_drive(drive)
+    assert contact.normal_force == pytest.approx(150.0, rel=1e-12)
+    wave = passmd.sawtooth(100e-9, 0.5, drive, periods=1)  # 0.5 Hz: below the plausible 1 Hz
+    result = passmd.simulate(drive, wave, max_points=10)
+    assert np.isfinite(result.runner_position).all() and result.settled_positions[-1] > 0.0
+
+
+def test_a_drives_contact_is_the_one_the_public_constructor_builds():
+    """The contact of a drive is the contact its checked numbers describe, bit for bit."""
+    drive = passmd.Drive()
+    contact = MDRContact.for_drive(drive, side=1)
+    same = MDRContact(contact.normal_force, drive.hemisphere_radius, contact.E_star, contact.G_star,
+                      drive.friction_coefficient)
+    assert (same.params == contact.params).all()
+
+
+@pytest.mark.parametrize(("position", "name"), list(enumerate(["normal_force", "radius", "E_star",
+                                                                "G_star", "mu"])))
+def test_the_public_contact_constructor_checks_each_bare_number(position, name):
+    contact = MDRContact.for_drive(passmd.Drive())
+    numbers = [contact.normal_force, contact.hemisphere_radius, contact.E_star, contact.G_star,
+               contact.friction_coefficient]
+    numbers[position] = -1.0
+    with pytest.raises(ValueError, match=rf"^{name} = -1\.0 is out of range"):
+        MDRContact(*numbers)

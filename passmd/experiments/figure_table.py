@@ -6,28 +6,27 @@ columns plus display columns) and its plot function (DataFrame → matplotlib Fi
 book, ``passmd figure`` and the ledger all go through :func:`figure_data` and
 :func:`figure_plot`, so one code path produces every figure.
 
-:data:`CLAIM_MODULES` lists the experiment modules that hold claim extractors.
+:data:`CLAIM_MODULES` holds the experiment modules with claim extractors, found by name.
 """
 
 from __future__ import annotations
 
 import functools
 import importlib
+import pkgutil
+import re
 from collections.abc import Callable
+from pathlib import Path
 from types import ModuleType
 from typing import NamedTuple
 
 import pandas as pd
 
-from passmd.experiments.critical_amplitude import claims as critical_amplitude_claims
 from passmd.experiments.critical_amplitude import facts as critical_amplitude_facts
 from passmd.experiments.critical_amplitude import figures as critical_amplitude
-from passmd.experiments.driving_waveform import claims as driving_waveform_claims
-from passmd.experiments.driving_waveform import claims_velocity as driving_waveform_velocity_claims
 from passmd.experiments.driving_waveform import facts as waveform_facts
 from passmd.experiments.driving_waveform import figures as driving_waveform
 from passmd.experiments.driving_waveform import studies as waveform_studies
-from passmd.experiments.force_generation import claims as force_generation_claims
 from passmd.experiments.force_generation import facts as force_facts
 from passmd.experiments.force_generation import figures as force_generation
 from passmd.experiments.mdr_validation import figures as mdr
@@ -186,9 +185,19 @@ READING_TABLES: dict[str, ReadingTable] = {
     )
 }
 
-#: The experiment modules whose functions carry claim extractors (Sections 4.1, 4.2, 5).
-CLAIM_MODULES: tuple[ModuleType, ...] = (critical_amplitude_claims, force_generation_claims,
-                                         driving_waveform_claims, driving_waveform_velocity_claims)
+
+def _claim_modules() -> tuple[ModuleType, ...]:
+    """Every chapter's ``claims.py`` and ``claims_<topic>.py``, found by their names."""
+    chapters = Path(__file__).parent
+    return tuple(importlib.import_module(f"passmd.experiments.{chapter.name}.{module.name}")
+                 for chapter in pkgutil.iter_modules([str(chapters)]) if chapter.ispkg
+                 for module in pkgutil.iter_modules([str(chapters / chapter.name)])
+                 if re.fullmatch(r"claims(_\w+)?", module.name))
+
+
+#: The experiment modules whose functions carry claim extractors (Sections 4.1, 4.2, 5): every
+#: chapter's ``claims.py`` and ``claims_<topic>.py``.
+CLAIM_MODULES: tuple[ModuleType, ...] = _claim_modules()
 
 _BY_NAME = {spec.name: spec for spec in FIGURES}
 
