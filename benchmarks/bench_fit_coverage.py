@@ -5,7 +5,7 @@ actuators, ζ = 0.05) at 100 Hz, three preloads (0.2, 0.4, 0.6 N) and five ampli
 with μ = 0.25 and an actuator stiffness spread over 3e6–1e7 N/m (log-evenly, one value per
 draw), by other means than the fit's own forward model: the integrator refined twofold
 (``scheme`` "controlled" with ``refine=2``) and the last step of a 16-period run from rest
-(:func:`passmd.experiments.design.calibration.independent_steps`). Gaussian noise of 0.5 nm (a new
+(:func:`passmd.experiments.calibration.synthetic.independent_steps`). Gaussian noise of 0.5 nm (a new
 seed per draw) is added and its sd stated. Each draw is fitted from the drive's defaults (μ = 0.2,
 k_p = 6.5e6 N/m) with the default bounds, on a process pool over all cores and an empty result
 cache. Counted: how often each parameter's reported 95 % region (all its pieces) holds the truth,
