@@ -58,9 +58,9 @@ TARGET_S = 180.0
 SETTINGS = {
     "full": {"drive": Drive(), "free": FREE, "preloads": (0.2, 0.4, 0.6),
              "amplitudes_nm": (110.0, 130.0, 150.0, 170.0, 190.0),
-             "label": "six contacts, flexible actuators, 15 steady steps"},
+             "label": "μ and k_p, six contacts, flexible actuators, 15 steady steps"},
     "quick": {"drive": Drive(contacts=1), "free": FREE, "preloads": (0.3, 0.5),
-              "amplitudes_nm": (120.0, 160.0, 200.0), "label": "one flexible contact, 6 steps"},
+              "amplitudes_nm": (120.0, 160.0, 200.0), "label": "μ and k_p, one flexible contact, 6 steps"},
     "smoke": {"drive": Drive(contacts=1, actuator_model="rigid"), "free": FREE[:1], "preloads": (0.4,),
               "amplitudes_nm": (120.0, 160.0, 200.0), "label": "μ alone, one rigid contact, 3 steps"},
 }
@@ -122,7 +122,7 @@ def main() -> int:
         load_after = os.getloadavg()
     row_s = statistics.median(row_times)
     record = {
-        "benchmark": f"fit: {', '.join(free)}; {setting['label']}",
+        "benchmark": f"fit: {setting['label']}",
         "quick": bool(args.quick),
         "smoke": bool(args.smoke),
         "wall_time_s": wall,
