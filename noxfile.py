@@ -48,7 +48,8 @@ def benchmarks_smoke(session: nox.Session) -> None:
     """
     # the tests session's install; nox for bench_book.py, which lists the book session
     session.install("-e", ".[test]", "nox>=2024.10")
-    env = {"MPLBACKEND": "Agg", "PASSMD_CACHE_DIR": CACHE_DIR}
+    # the scripts' temporary outputs land in the session's folder, not the system's
+    env = {"MPLBACKEND": "Agg", "PASSMD_CACHE_DIR": CACHE_DIR, "TMPDIR": session.create_tmp()}
     for script in sorted(glob.glob(os.path.join("benchmarks", "*.py"))):
         start = time.monotonic()
         session.run("python", script, "--smoke", env=env, silent=True)

@@ -119,8 +119,12 @@ def old_kernel_source(commit: str) -> str:
     moved = moved_since(commit)
     then = next((old for old, new in moved.items() if new == KERNEL_PATH), KERNEL_PATH)
     modules = {_module(old): _module(new) for old, new in moved.items() if old.endswith(".py")}
+    try:
+        source = _git("show", f"{commit}:{then}")
+    except subprocess.CalledProcessError:
+        raise SystemExit(f"--old-kernel {commit}: that commit has no {then} (the kernel's path)") from None
     return re.sub(r"^(\s*(?:from|import)\s+)(passmd[\w.]*)", lambda m: m[1] + modules.get(m[2], m[2]),
-                  _git("show", f"{commit}:{then}"), flags=re.MULTILINE)
+                  source, flags=re.MULTILINE)
 
 
 def old_kernel(commit: str):
