@@ -79,8 +79,6 @@ KERNEL_CONFIGS = [(6, "flexible", "exact", "controlled"), (6, "rigid", "exact", 
                   (6, "flexible", "exact", "adaptive"), (6, "flexible", "discrete", "controlled"),
                   (1, "flexible", "exact", "quasi-static")]
 ROOT = Path(__file__).resolve().parents[1]
-
-
 #: The current kernel's path; at an older commit it may have lived elsewhere (:func:`moved_since`).
 KERNEL_PATH = "passmd/solver/kernels.py"
 
