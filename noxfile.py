@@ -1,6 +1,7 @@
-"""Sessions: ``tests`` (pytest), ``wheel`` (the built wheel installed and run outside the
-repository), ``citation`` (CITATION.cff against its schema), ``book`` (executed Jupyter
-Book), ``book_check`` (rendered pages in headless Chromium), ``lint`` (ruff).
+"""Sessions: ``tests`` (pytest), ``benchmarks_smoke`` (every benchmark's ``--smoke``), ``wheel``
+(the built wheel installed and run outside the repository), ``citation`` (CITATION.cff against
+its schema), ``book`` (executed Jupyter Book), ``book_check`` (rendered pages in headless
+Chromium), ``lint`` (ruff).
 
 Every session installs the package and its dependencies itself; a machine with
 Python and nox needs nothing else. uv is used to create the environments when it is
@@ -35,6 +36,24 @@ def tests(session: nox.Session) -> None:
     """Run the test suite (unit, physics, regression, CLI and ledger tests)."""
     session.install("-e", ".[test]")
     session.run("pytest", *session.posargs, env={"MPLBACKEND": "Agg", "PASSMD_CACHE_DIR": CACHE_DIR})
+
+
+@nox.session(python=PYTHON)
+def benchmarks_smoke(session: nox.Session) -> None:
+    """Run every script of ``benchmarks/`` with ``--smoke``: its real code once on its smallest
+    input, seconds each, written to a temporary file; a broken default fails the session.
+
+    Run it after ``tests``: ``bench_ledger.py --smoke`` reads the quick ledger from the
+    simulation cache the tests filled. The times it prints are no measurements.
+    """
+    # the tests session's install; nox for bench_book.py, which lists the book session
+    session.install("-e", ".[test]", "nox>=2024.10")
+    # the scripts' temporary outputs land in the session's folder, not the system's
+    env = {"MPLBACKEND": "Agg", "PASSMD_CACHE_DIR": CACHE_DIR, "TMPDIR": session.create_tmp()}
+    for script in sorted(glob.glob(os.path.join("benchmarks", "*.py"))):
+        start = time.monotonic()
+        session.run("python", script, "--smoke", env=env, silent=True)
+        session.log(f"{script} --smoke: {time.monotonic() - start:.1f} s")
 
 
 @nox.session(python=PYTHON)

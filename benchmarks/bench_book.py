@@ -11,6 +11,13 @@ Usage (one command, from the repository root; nox installs the book's environmen
 
     python3 benchmarks/bench_book.py            # paper profile: appended to passmd/data/benchmarks/book.json
     python3 benchmarks/bench_book.py --quick    # the quick profile, written to a temporary file
+    python3 benchmarks/bench_book.py --smoke    # seconds: what a build needs, to a temporary file
+
+``--smoke`` builds nothing (a build takes minutes): it resolves what a measurement needs before
+it starts (nox, its ``book`` session, the book's table of contents, the folder of the default
+``--out``, the profile's budget), times the build's first step, nox reading the noxfile
+(``nox --list -s book``), and appends that record to a temporary file. ``bench_ledger.py
+--smoke`` runs the build's first part, ``passmd ledger``.
 """
 
 from __future__ import annotations
@@ -44,11 +51,15 @@ def nox_command() -> list[str]:
     raise SystemExit("nox is not installed: python3 -m pip install nox uv")
 
 
+def book_command(profile: str) -> list[str]:
+    """The cold build of ``profile`` that :func:`measure` times."""
+    return [*nox_command(), "-s", "book", "--", "--cold", "--profile", profile]
+
+
 def measure(profile: str) -> dict:
     load_before = os.getloadavg()
     start = time.perf_counter()
-    done = subprocess.run([*nox_command(), "-s", "book", "--", "--cold", "--profile", profile], cwd=ROOT,
-                          capture_output=True, text=True)
+    done = subprocess.run(book_command(profile), cwd=ROOT, capture_output=True, text=True)
     wall = time.perf_counter() - start
     load_after = os.getloadavg()
     if done.returncode != 0:
@@ -68,15 +79,38 @@ def measure(profile: str) -> dict:
     }
 
 
+def smoke(profile: str) -> dict:
+    """What :func:`measure` needs before the build starts, and the time of nox reading the noxfile."""
+    command = book_command(profile)
+    for needed in (ROOT / "book" / "_toc.yml", ROOT / "passmd" / "data" / "benchmarks"):
+        if not needed.exists():
+            raise SystemExit(f"{needed} is missing: a build cannot run or be recorded")
+    start = time.perf_counter()
+    listed = subprocess.run([*nox_command(), "--list", "--json", "-s", "book"], cwd=ROOT,
+                            capture_output=True, text=True)
+    wall = time.perf_counter() - start
+    if listed.returncode != 0:
+        raise SystemExit(f"nox has no book session: {' '.join(listed.stderr.split())}")
+    return {
+        "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "profile": profile, "smoke": True, "git_commit": git_commit(), "command": command,
+        "nox_list_s": round(wall, 2), "budget_s": BUDGET_S[profile], "cores": os.cpu_count(),
+        "load_average": [round(x, 2) for x in os.getloadavg()],
+    }
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="the quick profile, written to a temporary file")
+    size = parser.add_mutually_exclusive_group()
+    size.add_argument("--quick", action="store_true", help="the quick profile, written to a temporary file")
+    size.add_argument("--smoke", action="store_true",
+                      help="resolve what a build needs and time nox reading the noxfile, to a temporary "
+                           "file; builds nothing")
     parser.add_argument("--profile", default=None, choices=("quick", "paper"), help="default: paper")
     parser.add_argument("--out", default=None, help="JSON list the run is appended to")
     args = parser.parse_args()
     profile = args.profile or ("quick" if args.quick else "paper")
-    out = output(args) if args.out or args.quick else ROOT / "passmd" / "data" / "benchmarks" / "book.json"
-    append_run(out, measure(profile))
+    append_run(output(args, "book"), smoke(profile) if args.smoke else measure(profile))
 
 
 if __name__ == "__main__":

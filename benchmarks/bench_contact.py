@@ -11,6 +11,11 @@ untimed warm-up.
 Usage::
 
     python benchmarks/bench_contact.py [--repeats 7] [--out passmd/data/benchmarks/contact.json]
+    python benchmarks/bench_contact.py --smoke   # seconds, to a temporary file
+
+``--smoke`` runs every case once on paths of :data:`SMOKE_POINTS` samples and the smallest
+discrete model, written to a temporary file: it checks that the script works, its times mean
+nothing.
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ import argparse
 import json
 import platform
 import statistics
+import tempfile
 import time
 from pathlib import Path
 
@@ -41,6 +47,8 @@ from passmd.model.theory import contact_moduli, normal_forces
 SPRINGS = (100, 200, 1000, 10000)
 PATH_POINTS = 1_000_000  # samples of the exact model's path
 SPRING_UPDATES = 200_000_000  # N × calls per discrete run (≈ 0.1–0.3 s each)
+SMOKE_POINTS = 20_000  # samples of each path with --smoke
+ROOT = Path(__file__).resolve().parents[1]
 
 
 @njit(cache=True)
@@ -91,16 +99,17 @@ def _time(run, args, state, repeats):
     return times
 
 
-def bench(repeats: int) -> list[dict]:
+def bench(repeats: int, points: int = PATH_POINTS, springs=SPRINGS,
+          spring_updates: int = SPRING_UPDATES) -> list[dict]:
     drive = Drive()
     E_star, G_star = contact_moduli(drive)
     F_N = float(normal_forces(drive.preload, drive.contacts)[0])
     args = (F_N, drive.hemisphere_radius, E_star, G_star, drive.friction_coefficient)
     u_max = MDRContact(*args).presliding
-    path = oscillating_path(u_max)
+    path = oscillating_path(u_max, points)
     rows = []
 
-    ring = ring_down_path(u_max)
+    ring = ring_down_path(u_max, points)
     params, state = contact_arrays("exact", *args, capacity=1024)
     P, S = stack_contacts([(params, state)])
     cases = [
@@ -118,9 +127,9 @@ def bench(repeats: int) -> list[dict]:
         rows.append(_row("exact", None, kernel, us.size, times, path=name, reversals=probe.reversal_count,
                          max_depth=probe.max_depth, overflows=probe.overflow_count))
 
-    for n in SPRINGS:
+    for n in springs:
         params, state = contact_arrays("discrete", *args, springs=n)
-        calls = min(path.size, SPRING_UPDATES // n)
+        calls = min(path.size, spring_updates // n)
         stride = max(1, path.size // calls)
         us = np.ascontiguousarray(path[::stride][:calls])
         _run_update(params, state, us[:10])
@@ -144,10 +153,21 @@ def _row(model, springs, kernel, calls, times, **extra) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=7, help="timed repeats per case (median reported)")
-    ap.add_argument("--out", type=Path,
-                    default=Path(__file__).resolve().parents[1] / "passmd/data/benchmarks/contact.json")
+    ap.add_argument("--smoke", action="store_true",
+                    help="every case once on short paths, to a temporary file: checks the script runs, "
+                         "measures nothing")
+    ap.add_argument("--out", type=Path, default=None,
+                    help="JSON written (default: passmd/data/benchmarks/contact.json; --smoke: a "
+                         "temporary file)")
     args = ap.parse_args(argv)
-    rows = bench(args.repeats)
+    if args.smoke:
+        args.repeats = 1
+        rows = bench(1, SMOKE_POINTS, SPRINGS[:1], SMOKE_POINTS * SPRINGS[0])
+    else:
+        rows = bench(args.repeats)
+    if args.out is None:
+        args.out = (Path(tempfile.mkdtemp(prefix="passmd-bench-")) / "contact.json" if args.smoke
+                    else ROOT / "passmd/data/benchmarks/contact.json")
     print(f"{'model':>9} {'N':>6} {'kernel':>19} {'path':>12} {'calls':>9} {'ns/call median':>15} "
           f"{'ns/call min':>12} {'reversals':>10} {'max depth':>10}")
     for r in rows:

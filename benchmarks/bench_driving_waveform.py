@@ -17,6 +17,11 @@ Usage::
 
     python benchmarks/bench_driving_waveform.py [--repeats 5] [--profile paper]
         [--out passmd/data/benchmarks/driving_waveform.json]
+    python benchmarks/bench_driving_waveform.py --smoke   # seconds, to a temporary file
+
+``--smoke`` is ``--repeats 1 --profile quick`` written to a temporary file: every block and
+every panel and study, on the quick grids; it checks that the script works, its times mean
+nothing.
 """
 
 from __future__ import annotations
@@ -36,6 +41,7 @@ from passmd.model.defaults import PROTOCOL
 from passmd.runtime.config import RunConfig
 
 PANELS = ("fig8a", "fig8b", "fig9a", "fig9b", "fig10a", "fig10b", "fig10c")
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def _timed(func, repeats: int) -> dict:
@@ -95,8 +101,18 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--profile", choices=("quick", "paper"), default="paper")
-    parser.add_argument("--out", type=Path, default=Path("passmd/data/benchmarks/driving_waveform.json"))
+    parser.add_argument("--smoke", action="store_true",
+                        help="--repeats 1 --profile quick, to a temporary file: checks the script runs, "
+                             "measures nothing")
+    parser.add_argument("--out", type=Path, default=None,
+                        help="JSON written (default: passmd/data/benchmarks/driving_waveform.json; --smoke: "
+                             "a temporary file)")
     args = parser.parse_args()
+    if args.smoke:
+        args.repeats, args.profile = 1, "quick"
+    if args.out is None:
+        args.out = (Path(tempfile.mkdtemp(prefix="passmd-bench-")) / "driving_waveform.json" if args.smoke
+                    else ROOT / "passmd/data/benchmarks/driving_waveform.json")
     result = {
         "machine": {"python": platform.python_version(), "processor": platform.processor(),
                     "cpus": os.cpu_count()},
@@ -109,6 +125,7 @@ def main() -> None:
         print(f"cold {args.profile:5s} {name:20s} {wall:8.2f} s")
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(result, indent=2) + "\n")
+    print(f"written {args.out}")
 
 
 if __name__ == "__main__":

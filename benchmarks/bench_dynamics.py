@@ -12,10 +12,12 @@ the largest difference of the settled positions of the three periods from the fi
 step's.
 
 Kernel comparison: the kernel of :data:`OLD_KERNEL_COMMIT` (one numba function before its
-split into inline helpers, loaded from ``git show`` into a module of its own) and the current
-one run the same configurations in alternation in this one process, each first in every other
-pair; the medians of their wall times, their ratio (current / old), and whether the two runs
-agree to the last bit.
+split into inline helpers, loaded from ``git show`` at the path it had then, its imports of
+modules moved since renamed, into a module of its own) and the current one run the same
+configurations in alternation in this one process, each first in every other pair; the
+medians of their wall times, their ratio (current / old), and whether the two runs agree to
+the last bit. Without that commit in the checkout's history (a shallow clone, an unpacked
+sdist) the comparison is skipped with a line saying so.
 
 Start-up: the median time from launching ``passmd run --periods 1`` to its first
 integrator step (warm: bytecode and numba caches written by an untimed first launch),
@@ -25,6 +27,12 @@ command-line and dynamics modules. The machine's load average is recorded with t
 Usage::
 
     python benchmarks/bench_dynamics.py [--repeats 5] [--out passmd/data/benchmarks/dynamics.json]
+    python benchmarks/bench_dynamics.py --smoke   # seconds: every part once, to a temporary file
+
+``--smoke`` runs every part on its smallest input (one rigid contact with the fixed and the
+controlled step, one repeat, one old/new kernel pair on one configuration when the history
+holds the old commit, one launch) and writes to a temporary file: it checks that the script
+and its defaults work, its times mean nothing.
 """
 
 from __future__ import annotations
@@ -34,6 +42,7 @@ import importlib.util
 import json
 import os
 import platform
+import re
 import statistics
 import subprocess
 import sys
@@ -70,13 +79,56 @@ KERNEL_CONFIGS = [(6, "flexible", "exact", "controlled"), (6, "rigid", "exact", 
                   (6, "flexible", "exact", "adaptive"), (6, "flexible", "discrete", "controlled"),
                   (1, "flexible", "exact", "quasi-static")]
 ROOT = Path(__file__).resolve().parents[1]
+#: The current kernel's path; at an older commit it may have lived elsewhere (:func:`moved_since`).
+KERNEL_PATH = "passmd/solver/kernels.py"
+
+
+def _git(*args: str) -> str:
+    return subprocess.run(["git", "-C", str(ROOT), *args], capture_output=True, text=True, check=True).stdout
+
+
+def in_history(commit: str) -> bool:
+    """Whether this checkout's git history holds ``commit`` (not in a shallow clone, an sdist or a wheel)."""
+    try:
+        _git("cat-file", "-e", f"{commit}^{{commit}}")
+    except (OSError, subprocess.CalledProcessError):
+        return False
+    return True
+
+
+def moved_since(commit: str) -> dict[str, str]:
+    """Files of ``passmd/`` moved since ``commit``: {path then: path now}, each commit's renames in turn."""
+    now: dict[str, str] = {}
+    for line in _git("log", "--reverse", "-M", "--name-status", "--format=", f"{commit}..HEAD", "--",
+                     "passmd").splitlines():
+        status, *paths = line.split("\t")
+        if status.startswith("R"):
+            origin = next((then for then, path in now.items() if path == paths[0]), paths[0])
+            now[origin] = paths[1]
+    return now
+
+
+def _module(path: str) -> str:
+    return path.removesuffix(".py").removesuffix("/__init__").replace("/", ".")
+
+
+def old_kernel_source(commit: str) -> str:
+    """The kernel of ``commit`` (at its path then), its imports of moved passmd modules renamed to today's."""
+    moved = moved_since(commit)
+    then = next((old for old, new in moved.items() if new == KERNEL_PATH), KERNEL_PATH)
+    modules = {_module(old): _module(new) for old, new in moved.items() if old.endswith(".py")}
+    try:
+        source = _git("show", f"{commit}:{then}")
+    except subprocess.CalledProcessError:
+        raise SystemExit(f"--old-kernel {commit}: that commit has no {then} (the kernel's path)") from None
+    return re.sub(r"^(\s*(?:from|import)\s+)(passmd[\w.]*)", lambda m: m[1] + modules.get(m[2], m[2]),
+                  source, flags=re.MULTILINE)
 
 
 def old_kernel(commit: str):
-    """``passmd/solver/kernels.py`` of ``commit`` as a module of its own (in a temporary
+    """The kernel of ``commit`` (:func:`old_kernel_source`) as a module of its own (in a temporary
     directory, so that its numba cache does not touch the package's)."""
-    source = subprocess.run(["git", "-C", str(ROOT), "show", f"{commit}:passmd/solver/kernels.py"],
-                            capture_output=True, text=True, check=True).stdout
+    source = old_kernel_source(commit)
     path = Path(tempfile.mkdtemp(prefix="passmd-old-kernel-")) / "passmd_old_kernel.py"
     path.write_text(source)
     spec = importlib.util.spec_from_file_location("passmd_old_kernel", path)
@@ -107,13 +159,13 @@ def _outcome(res) -> tuple:
             res.final_state.tobytes(), res.runner_position.tobytes(), tuple(sorted(res.energy.items())))
 
 
-def compare_kernels(commit: str, pairs: int, springs: int = 200) -> list:
-    """Old and current kernel on :data:`KERNEL_CONFIGS`, timed in ``pairs`` alternating pairs
-    (each kernel first in every other one): medians (ms per 100 Hz period), their ratio, and
-    whether the results are identical to the last bit."""
+def compare_kernels(commit: str, pairs: int, configs=KERNEL_CONFIGS, springs: int = 200) -> list:
+    """Old and current kernel on ``configs``, timed in ``pairs`` alternating pairs (each kernel
+    first in every other one): medians (ms per 100 Hz period), their ratio, and whether the
+    results are identical to the last bit."""
     old = old_kernel(commit)
     rows = []
-    for contacts, model, contact, scheme in KERNEL_CONFIGS:
+    for contacts, model, contact, scheme in configs:
         drive = Drive(contacts=contacts, actuator_model=model)
         kw = dict(contact_model=contact, springs=springs, scheme=scheme, max_points=2000)
         wf = waveforms.sawtooth(150e-9, PROTOCOL.drive_frequency, drive, periods=PERIODS)
@@ -287,26 +339,47 @@ def markdown(rows: list) -> str:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5, help="timed repeats per configuration (median)")
-    ap.add_argument("--old-kernel", default=OLD_KERNEL_COMMIT,
-                    help="commit whose kernel the current one is timed against")
+    ap.add_argument("--old-kernel", default=None,
+                    help="commit whose kernel the current one is timed against (default: OLD_KERNEL_COMMIT, "
+                         "skipped when this checkout's history lacks it)")
     ap.add_argument("--kernel-pairs", type=int, default=40,
                     help="timed old/new pairs per configuration of the kernel comparison (even: each "
                          "kernel first in half of them)")
     ap.add_argument("--kernel-only", action="store_true", help="only the kernel comparison (not written)")
-    ap.add_argument("--out", type=Path,
-                    default=Path(__file__).resolve().parents[1] / "passmd/data/benchmarks/dynamics.json")
+    ap.add_argument("--smoke", action="store_true",
+                    help="every part on its smallest input (one contact, one repeat, one kernel pair, one "
+                         "launch), written to a temporary file: checks the script runs, measures nothing")
+    ap.add_argument("--out", type=Path, default=None,
+                    help="JSON written (default: passmd/data/benchmarks/dynamics.json; --smoke: a "
+                         "temporary file)")
     args = ap.parse_args(argv)
     if args.kernel_pairs < 2 or args.kernel_pairs % 2:
         ap.error(f"--kernel-pairs {args.kernel_pairs} is out of range: must be an even number >= 2")
+    configs, kernel_configs = CONFIGS, KERNEL_CONFIGS
+    if args.smoke:
+        args.repeats, args.kernel_pairs = 1, 2
+        # one rigid contact (the fixed step first: the reference); the cheapest kernel comparison
+        configs, kernel_configs = CONFIGS[:2], KERNEL_CONFIGS[-1:]
+    if args.out is None:
+        args.out = (Path(tempfile.mkdtemp(prefix="passmd-bench-")) / "dynamics.json" if args.smoke
+                    else ROOT / "passmd/data/benchmarks/dynamics.json")
     load_before = os.getloadavg()
-    kernels = compare_kernels(args.old_kernel, args.kernel_pairs)
-    for r in kernels:
+    commit = args.old_kernel or OLD_KERNEL_COMMIT
+    if in_history(commit):
+        kernels = compare_kernels(commit, args.kernel_pairs, kernel_configs)
+    elif args.old_kernel:
+        ap.error(f"--old-kernel {commit} is not a commit of this checkout's git history")
+    else:
+        print(f"kernel comparison skipped: --old-kernel {commit[:12]} is not in this checkout's git history "
+              "(a shallow clone or no repository); fetch it (git fetch --unshallow) to compare")
+        kernels = None
+    for r in kernels or []:
         print(f"kernel {r['contacts']} {r['actuator']} {r['contact_model']} {r['step']}: old "
               f"{r['old_ms_per_100Hz_period']:.3f} ms, new {r['new_ms_per_100Hz_period']:.3f} ms per period, "
               f"new/old {r['new_over_old']:.3f}, identical: {r['identical']}")
     if args.kernel_only:
         return 0
-    rows = [bench(c, m, k, control, args.repeats) for c, m, k, control in CONFIGS]
+    rows = [bench(c, m, k, control, args.repeats) for c, m, k, control in configs]
     start = startup(args.repeats)
     spread = across_processes(args.repeats, args.repeats)
     print(markdown(rows))
@@ -329,10 +402,9 @@ def main(argv=None) -> int:
     print(f"{spread['configuration']}: {spread['median_ms_per_100Hz_period']:.3f} ms per period, median of "
           f"{len(spread['ms_per_100Hz_period_per_process'])} processes "
           f"({', '.join(f'{v:.2f}' for v in spread['ms_per_100Hz_period_per_process'])})")
-    args.out.write_text(json.dumps({"meta": meta, "rows": rows, "startup": start,
-                                    "across_processes": spread,
-                                    "kernel_comparison": {"old_commit": args.old_kernel, "rows": kernels}},
-                                   indent=2))
+    comparison = {"old_commit": commit, "rows": kernels} if kernels is not None else None
+    args.out.write_text(json.dumps({"meta": meta, "rows": rows, "startup": start, "across_processes": spread,
+                                    "kernel_comparison": comparison}, indent=2))
     print(f"written {args.out}")
     return 0
 

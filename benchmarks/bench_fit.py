@@ -10,7 +10,7 @@ estimator's grids are sized against them: 180 s on two cores holds about
 Then the fit: the steps of the Table 1–2 drive (R = 1 mm, six contacts, flexible actuators, ζ = 0.05)
 at 100 Hz, three preloads (0.2, 0.4, 0.6 N) and five amplitudes (110–190 nm), made at μ = 0.25,
 k_p = 5e6 N/m by the refined integrator (the last step of a 16-period run,
-:func:`passmd.experiments.design.calibration.independent_steps`) plus 0.5 nm Gaussian noise (seed 0,
+:func:`passmd.experiments.calibration.synthetic.independent_steps`) plus 0.5 nm Gaussian noise (seed 0,
 sd stated); μ and k_p are fitted from the drive's defaults (μ = 0.2, k_p = 6.5e6 N/m) with the default
 bounds, on a process pool over all cores and an empty result cache (a fresh temporary directory;
 the compiled kernels are cached by numba). Its wall time covers everything ``passmd fit`` computes.
@@ -18,11 +18,14 @@ The record says whether the regions hold the truth, the verdict and the goodness
 parameter sets per stage, and the machine's load average before and after (the 2-core machine
 may be shared: the times are not proof of speed when it is loaded).
 
-``--quick``: one flexible contact and six steps (the CI-sized run of the same machinery).
+``--quick``: one flexible contact and six steps (a small run of the same machinery).
+``--smoke``: μ alone of one rigid contact from three steps, written to a temporary file: the
+same steps (data, row timing, parameter sets, the whole fit, the record) in seconds; it checks
+that the script works, its times and regions mean nothing.
 
 Usage::
 
-    python benchmarks/bench_fit.py [--quick] [--out passmd/data/benchmarks/fit.json]
+    python benchmarks/bench_fit.py [--quick | --smoke] [--out passmd/data/benchmarks/fit.json]
 """
 
 from __future__ import annotations
@@ -48,23 +51,39 @@ from passmd.runtime.config import RunConfig
 
 FREE = ("friction_coefficient", "actuator.stiffness")
 TRUTH = {"friction_coefficient": 0.25, "actuator.stiffness": 5e6}
+#: Where the fit starts: the drive's defaults.
+START = {"friction_coefficient": 0.2, "actuator.stiffness": 6.5e6}
 NOISE_NM = 0.5
 TARGET_S = 180.0
 SETTINGS = {
-    "full": {"drive": Drive(), "preloads": (0.2, 0.4, 0.6),
-             "amplitudes_nm": (110.0, 130.0, 150.0, 170.0, 190.0)},
-    "quick": {"drive": Drive(contacts=1), "preloads": (0.3, 0.5), "amplitudes_nm": (120.0, 160.0, 200.0)},
+    "full": {"drive": Drive(), "free": FREE, "preloads": (0.2, 0.4, 0.6),
+             "amplitudes_nm": (110.0, 130.0, 150.0, 170.0, 190.0),
+             "label": "μ and k_p, six contacts, flexible actuators, 15 steady steps"},
+    "quick": {"drive": Drive(contacts=1), "free": FREE, "preloads": (0.3, 0.5),
+              "amplitudes_nm": (120.0, 160.0, 200.0), "label": "μ and k_p, one flexible contact, 6 steps"},
+    "smoke": {"drive": Drive(contacts=1, actuator_model="rigid"), "free": FREE[:1], "preloads": (0.4,),
+              "amplitudes_nm": (120.0, 160.0, 200.0), "label": "μ alone, one rigid contact, 3 steps"},
 }
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="one flexible contact, six steps")
-    parser.add_argument("--out", default="passmd/data/benchmarks/fit.json")
+    size = parser.add_mutually_exclusive_group()
+    size.add_argument("--quick", action="store_true", help="one flexible contact, six steps")
+    size.add_argument("--smoke", action="store_true",
+                      help="μ alone, one rigid contact, three steps, to a temporary file: checks the script "
+                           "runs, measures nothing")
+    parser.add_argument("--out", default=None,
+                        help="JSON written (default: passmd/data/benchmarks/fit.json; --smoke: a temporary "
+                             "file)")
     args = parser.parse_args()
-    setting = SETTINGS["quick" if args.quick else "full"]
-    base = setting["drive"]
-    truth = drive_at(base, list(FREE), [TRUTH[n] for n in FREE], base.actuator.damping_ratio)
+    setting = SETTINGS["smoke" if args.smoke else "quick" if args.quick else "full"]
+    if args.out is None:
+        args.out = (Path(tempfile.mkdtemp(prefix="passmd-bench-")) / "fit.json" if args.smoke
+                    else ROOT / "passmd/data/benchmarks/fit.json")
+    base, free = setting["drive"], setting["free"]
+    truth = drive_at(base, list(free), [TRUTH[n] for n in free], base.actuator.damping_ratio)
     conditions = [(p, a * 1e-9, 100.0) for p in setting["preloads"] for a in setting["amplitudes_nm"]]
     steps = independent_steps(truth, conditions)
     noisy = steps + np.random.default_rng(0).normal(0.0, NOISE_NM * 1e-9, steps.size)
@@ -83,9 +102,10 @@ def main() -> int:
         config = RunConfig(cache_dir=Path(cache))
         from passmd.protocols.fit.prediction import _Model
 
-        model = _Model(base, data, list(FREE), "steady", executor=None, cache=cache, config=config)
+        model = _Model(base, data, list(free), "steady", executor=None, cache=cache, config=config)
+        x_start = np.log([START[n] for n in free])
         start = time.perf_counter()
-        model.evaluate([np.log([0.2 + 0.001 * k, 6.5e6]) for k in range(8)])
+        model.evaluate([x_start + 0.005 * k * np.eye(len(free))[0] for k in range(8)])  # eight μ
         set_s = (time.perf_counter() - start) / 8
 
     stages: list[tuple[float, str]] = []
@@ -97,14 +117,14 @@ def main() -> int:
             stages.append((time.perf_counter() - start, line))
             print(f"fit: {line} [{time.perf_counter() - start:.0f} s]", file=sys.stderr, flush=True)
 
-        result = F.fit(base, data, list(FREE), config=RunConfig(cache_dir=Path(cache)), progress=progress)
+        result = F.fit(base, data, list(free), config=RunConfig(cache_dir=Path(cache)), progress=progress)
         wall = time.perf_counter() - start
         load_after = os.getloadavg()
     row_s = statistics.median(row_times)
     record = {
-        "benchmark": ("fit: μ and k_p, " + ("one flexible contact, 6 steps" if args.quick
-                                            else "six contacts, flexible actuators, 15 steady steps")),
+        "benchmark": f"fit: {setting['label']}",
         "quick": bool(args.quick),
+        "smoke": bool(args.smoke),
         "wall_time_s": wall,
         "target_s": TARGET_S,
         "row_evaluation_s": row_s,
@@ -114,11 +134,11 @@ def main() -> int:
         "model_evaluations": result.evaluations,
         "simulations": result.simulations,
         "stages": [{"t_s": t, "line": line} for t, line in stages],
-        "truth": TRUTH,
-        "estimates": {n: result.estimates[n]["value"] for n in FREE},
-        "intervals": {n: result.estimates[n]["intervals"] for n in FREE},
+        "truth": {n: TRUTH[n] for n in free},
+        "estimates": {n: result.estimates[n]["value"] for n in free},
+        "intervals": {n: result.estimates[n]["intervals"] for n in free},
         "regions_hold_truth": {n: any(a <= TRUTH[n] <= b for a, b in result.estimates[n]["intervals"])
-                               for n in FREE},
+                               for n in free},
         "identifiable": result.identifiable,
         "goodness_of_fit": result.goodness_of_fit,
         "verdict": result.verdict,
@@ -135,6 +155,7 @@ def main() -> int:
     shown = ("wall_time_s", "row_evaluation_s", "parameter_set_s", "budget_parameter_sets",
              "model_evaluations", "regions_hold_truth", "load_average_before", "load_average_after")
     print(json.dumps({k: record[k] for k in shown}, indent=2))
+    print(f"written {out}")
     return 0
 
 

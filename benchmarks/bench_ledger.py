@@ -13,6 +13,13 @@ Usage (one command, from the repository root)::
 
     python3 benchmarks/bench_ledger.py          # paper: appended to passmd/data/benchmarks/ledger.json
     python3 benchmarks/bench_ledger.py --quick  # quick profile, written to a temporary file
+    python3 benchmarks/bench_ledger.py --smoke  # quick profile from the warm cache, temporary file
+
+``--smoke`` runs the same command and record on the quick profile with the simulation cache it
+would use anyway (``--cache-dir``, else ``$PASSMD_CACHE_DIR``, which nox points at the
+repository's ``.passmd-cache/``, else the user cache folder), not an empty one: seconds once the
+tests have filled that cache, the quick profile's minutes when they have not. It checks that the
+script works; its times mean nothing.
 
 ``--python`` names the interpreter that runs ``passmd`` (default: this one if it imports passmd,
 else the ``tests`` or ``book`` nox environment of the repository); ``--cache-dir`` an empty
@@ -63,13 +70,16 @@ def passmd_python(given: str | None) -> str:
                      "give one with --python")
 
 
-def measure(profile: str, python: str, cache_dir: str | None = None) -> dict:
-    if cache_dir is not None and Path(cache_dir).exists() and any(Path(cache_dir).iterdir()):
+def measure(profile: str, python: str, cache_dir: str | None = None, cold: bool = True) -> dict:
+    """One ``passmd ledger``: with an empty cache (``cache_dir``, else a temporary one) when ``cold``,
+    else with ``cache_dir`` or the command's own default cache as it is."""
+    if cold and cache_dir is not None and Path(cache_dir).exists() and any(Path(cache_dir).iterdir()):
         raise SystemExit(f"--cache-dir {cache_dir} is not empty: the measurement must start cold")
     with tempfile.TemporaryDirectory(prefix="passmd-bench-ledger-") as temporary:
-        cache = temporary if cache_dir is None else cache_dir
         log = Path(temporary) / "sweeps.jsonl"
-        env = {**os.environ, "PASSMD_CACHE_DIR": cache, "PASSMD_SWEEP_LOG": str(log)}
+        env = {**os.environ, "PASSMD_SWEEP_LOG": str(log)}
+        if cache_dir is not None or cold:
+            env["PASSMD_CACHE_DIR"] = cache_dir or temporary
         load_before = os.getloadavg()
         usage = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
@@ -87,7 +97,7 @@ def measure(profile: str, python: str, cache_dir: str | None = None) -> dict:
     joint = payload["joint_reading"]
     return {
         "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        "profile": profile, "git_commit": git_commit(),
+        "profile": profile, "cold": cold, "git_commit": git_commit(),
         "wall_time_s": round(wall, 1), "budget_s": BUDGET_S[profile],
         "cpu_time_s": round(after.ru_utime + after.ru_stime - usage.ru_utime - usage.ru_stime, 1),
         "points_computed": sum(int(s.get("computed", 0)) for s in sweeps),
@@ -112,25 +122,32 @@ def append_run(out: Path, run: dict) -> None:
     print(f"appended to {out}")
 
 
-def output(args) -> Path:
-    """``--out``, else the committed JSON for the paper profile and a temporary file for ``--quick``."""
+def output(args, name: str = "ledger") -> Path:
+    """``--out``, else a temporary file for ``--quick`` and ``--smoke`` and the committed
+    ``passmd/data/benchmarks/<name>.json`` otherwise."""
     if args.out:
         return Path(args.out)
-    if args.quick:
-        return Path(tempfile.mkdtemp(prefix="passmd-bench-")) / f"{Path(__file__).stem}.json"
-    return ROOT / "passmd" / "data" / "benchmarks" / "ledger.json"
+    if args.quick or args.smoke:
+        return Path(tempfile.mkdtemp(prefix="passmd-bench-")) / f"{name}.json"
+    return ROOT / "passmd" / "data" / "benchmarks" / f"{name}.json"
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="the quick profile, written to a temporary file")
+    size = parser.add_mutually_exclusive_group()
+    size.add_argument("--quick", action="store_true", help="the quick profile, written to a temporary file")
+    size.add_argument("--smoke", action="store_true",
+                      help="the quick profile from the warm cache, to a temporary file: checks the script "
+                           "runs, measures nothing")
     parser.add_argument("--profile", default=None, choices=("quick", "paper"), help="default: paper")
     parser.add_argument("--out", default=None, help="JSON list the run is appended to")
-    parser.add_argument("--cache-dir", default=None)
+    parser.add_argument("--cache-dir", default=None,
+                        help="cache folder (must be empty, and is kept; --smoke: used as it is)")
     parser.add_argument("--python", default=None, help="interpreter that runs passmd")
     args = parser.parse_args()
-    profile = args.profile or ("quick" if args.quick else "paper")
-    append_run(output(args), measure(profile, passmd_python(args.python), args.cache_dir))
+    profile = "quick" if args.smoke else args.profile or ("quick" if args.quick else "paper")
+    run = measure(profile, passmd_python(args.python), args.cache_dir, cold=not args.smoke)
+    append_run(output(args), run)
 
 
 if __name__ == "__main__":

@@ -26,6 +26,10 @@ Usage::
 
     python benchmarks/bench_sweep_map.py [--frequencies 24] [--amplitudes 24]
         [--out passmd/data/benchmarks/sweep_map.json]
+    python benchmarks/bench_sweep_map.py --smoke   # seconds, to a temporary file
+
+``--smoke`` is a 2 × 2 map (``--frequencies 2 --amplitudes 2``) through every part, written to a
+temporary file: it checks that the script works, its times mean nothing.
 """
 
 from __future__ import annotations
@@ -53,6 +57,7 @@ from passmd.runtime.config import RunConfig
 #: Targets of the map on the 2-core machine (s).
 COLD_TARGET_S = 60.0
 CACHED_TARGET_S = 5.0
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def drive() -> Drive:
@@ -128,8 +133,17 @@ def main() -> None:
     parser.add_argument("--frequencies", type=int, default=24)
     parser.add_argument("--amplitudes", type=int, default=24)
     parser.add_argument("--workers", type=int, default=None)
-    parser.add_argument("--out", type=Path, default=Path("passmd/data/benchmarks/sweep_map.json"))
+    parser.add_argument("--smoke", action="store_true",
+                        help="a 2 x 2 map, to a temporary file: checks the script runs, measures nothing")
+    parser.add_argument("--out", type=Path, default=None,
+                        help="JSON written (default: passmd/data/benchmarks/sweep_map.json; --smoke: a "
+                             "temporary file)")
     args = parser.parse_args()
+    if args.smoke:
+        args.frequencies = args.amplitudes = 2
+    if args.out is None:
+        args.out = (Path(tempfile.mkdtemp(prefix="passmd-bench-")) / "sweep_map.json" if args.smoke
+                    else ROOT / "passmd/data/benchmarks/sweep_map.json")
     grid = points(args.frequencies, args.amplitudes)
     d = grid[0]["drive"]
     steady_point(d, grid[0]["amplitude"], 1e3)  # warm-up: numba kernels compiled or loaded
@@ -158,6 +172,7 @@ def main() -> None:
               f"load {row['load_average_before'][0]:.2f} -> {row['load_average_after'][0]:.2f}")
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(result, indent=2) + "\n")
+    print(f"written {args.out}")
 
 
 if __name__ == "__main__":
