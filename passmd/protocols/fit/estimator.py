@@ -14,7 +14,7 @@
    teeth of the comb are curved valleys in their plane, and that step can stop on a valley's wall.
    A full local search starts from :data:`MAX_BASINS` distinct local minima of the profiles
    within twice the 95 % rise of the best cost: those whose Gauss–Newton step in all free
-   parameters projects the lowest cost (:func:`_polish`).
+   parameters projects the lowest cost.
 5. **Basins**: the local minima of every profile within the level; the lowest point found
    anywhere is polished by a local search and is the estimate. Each basin adds the local
    interval of every parameter (:mod:`passmd.protocols.fit.regions`); a point met on the way
