@@ -58,7 +58,7 @@ def blocks(repeats: int) -> dict:
     from passmd.experiments.driving_waveform import runs as dw_runs
     from passmd.model import optimized_waveform
     from passmd.protocols import eq15
-    from passmd.solver import simulation as dynamics
+    from passmd.solver import simulation
 
     drive = dw_runs.section5_drive()
     amplitude = drive.actuator.full_stroke_amplitude
@@ -73,7 +73,7 @@ def blocks(repeats: int) -> dict:
                     **dw_runs.section5_fields(), frequency=f, waveform=w, short_period=r, **fields),
                 repeats)
     wave = optimized_waveform.optimized(amplitude, PROTOCOL.drive_frequency, drive, periods=3, design=design)
-    out["step_100hz"] = _timed(lambda: dynamics.simulate(drive, wave, max_points=2), repeats)
+    out["step_100hz"] = _timed(lambda: simulation.simulate(drive, wave, max_points=2), repeats)
     return out
 
 

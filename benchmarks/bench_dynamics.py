@@ -56,7 +56,7 @@ import numpy as np
 from passmd.model import waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 
 CONFIGS = [
     (contacts, model, contact, control)
@@ -141,17 +141,17 @@ def old_kernel(commit: str):
 def running(module):
     """:mod:`passmd.solver.simulation` integrates with ``module``'s kernel (None: the current one); the
     argument records are rebuilt as that module's NamedTuples."""
-    current = dynamics.kern.integrate
+    current = simulation.kern.integrate
     if module is not None:
         def integrate(segments, mechanics, control, contacts, buffers, limit):
             return module.integrate(module.Segments(*segments), module.Mechanics(*mechanics),
                                     module.StepControl(*control), module.Contacts(*contacts),
                                     module.Buffers(*buffers), limit)
-        dynamics.kern.integrate = integrate
+        simulation.kern.integrate = integrate
     try:
         yield
     finally:
-        dynamics.kern.integrate = current
+        simulation.kern.integrate = current
 
 
 def _outcome(res) -> tuple:
@@ -177,7 +177,7 @@ def compare_kernels(commit: str, pairs: int, configs=KERNEL_CONFIGS, springs: in
             pair = (("old", old), ("new", None)) if i % 2 else (("new", None), ("old", old))
             for name, module in pair:
                 with running(module):
-                    res = dynamics.simulate(drive, wf, **kw)
+                    res = simulation.simulate(drive, wf, **kw)
                 if i:  # the first round compiles
                     walls[name].append(res.wall_time)
                 outcome[name] = _outcome(res)
@@ -267,11 +267,11 @@ def bench(contacts: int, model: str, contact: str, control: str, repeats: int, s
     drive = Drive(contacts=contacts, actuator_model=model)
     kw = dict(contact_model=contact, springs=springs, scheme=control)
     warm = waveforms.sawtooth(150e-9, 10e3, drive, periods=1)
-    dynamics.simulate(drive, warm, **kw)  # compile
+    simulation.simulate(drive, warm, **kw)  # compile
     wf = waveforms.sawtooth(150e-9, PROTOCOL.drive_frequency, drive, periods=PERIODS)
     walls = []
     for _ in range(repeats):
-        res = dynamics.simulate(drive, wf, max_points=2000, **kw)
+        res = simulation.simulate(drive, wf, max_points=2000, **kw)
         walls.append(res.wall_time)
     if control == "fixed":
         _REFERENCE[(contacts, model, contact)] = res.settled_positions
@@ -297,13 +297,13 @@ def bench(contacts: int, model: str, contact: str, control: str, repeats: int, s
 # contacts, flexible actuators, exact contact, in a process of its own
 _ONE_PROCESS = """
 import json, statistics, sys
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 from passmd.model import waveforms
 from passmd.model.parameters import Drive
 d = Drive(contacts=6, actuator_model="flexible")
 wf = waveforms.sawtooth(150e-9, float(sys.argv[1]), d, periods=int(sys.argv[2]))
-dynamics.simulate(d, wf, max_points=2000)
-walls = [dynamics.simulate(d, wf, max_points=2000).wall_time for _ in range(int(sys.argv[3]))]
+simulation.simulate(d, wf, max_points=2000)
+walls = [simulation.simulate(d, wf, max_points=2000).wall_time for _ in range(int(sys.argv[3]))]
 print(json.dumps(statistics.median(walls) / int(sys.argv[2]) * 1e3))
 """
 

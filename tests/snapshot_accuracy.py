@@ -19,7 +19,7 @@ import pytest
 from passmd.experiments.numerics import accuracy as acc
 from passmd.model.parameters import Drive
 from passmd.runtime.config import RunConfig
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 from passmd.solver.steps import DEFAULT_SCHEME, resolve_scheme
 
 #: Columns computed without the integrator (inputs, closed forms, booleans): rounding only.
@@ -88,13 +88,13 @@ def numeric(frame):
 def finer_run(factor: float = FINER):
     """Within the block every simulation runs ``factor`` times finer.
 
-    Patches ``dynamics.Simulation``, which ``dynamics.simulate`` and the stall protocol
+    Patches ``simulation.Simulation``, which ``simulation.simulate`` and the stall protocol
     construct: each run's scheme is refined by ``factor`` (:class:`passmd.solver.steps.Scheme`
     ``refine``: explicit steps divided by it, the error-controlled step's local tolerance by its
     fourth power, so that step shrinks about ``factor`` times); a fixed ``dt`` is divided by it.
     Sweeps inside must run serially with a cache of their own (:func:`finer_config`).
     """
-    default = dynamics.Simulation
+    default = simulation.Simulation
 
     class Finer(default):
         def __init__(self, *args, scheme=DEFAULT_SCHEME, **kwargs):
@@ -106,7 +106,7 @@ def finer_run(factor: float = FINER):
             super().__init__(*args, scheme=finer, **kwargs)
 
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(dynamics, "Simulation", Finer)
+        patch.setattr(simulation, "Simulation", Finer)
         yield
 
 

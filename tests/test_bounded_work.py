@@ -48,7 +48,7 @@ _RUNNER = """
 import sys
 from passmd import cli
 from passmd.solver import kernels as kern
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 
 integrate = kern.integrate
 def announced(*args):

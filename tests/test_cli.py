@@ -211,10 +211,10 @@ def test_contact_human_output():
 
 def simulate_summary(drive, amplitude, frequency, periods, flyback="slew", springs=None):
     from passmd.model import waveforms
-    from passmd.solver import simulation as dynamics
+    from passmd.solver import simulation
 
     wave = waveforms.sawtooth(amplitude, frequency, drive, periods=periods, flyback=flyback)
-    result = dynamics.simulate(drive, wave, contact_model="exact" if springs is None else "discrete",
+    result = simulation.simulate(drive, wave, contact_model="exact" if springs is None else "discrete",
                                springs=springs or 200)
     return result.summary()
 
@@ -239,14 +239,14 @@ def test_run_optimized_waveform_matches_api():
     """`run --waveform optimized` drives the runner with the Eq. 15 waveform designed from the drive."""
     from passmd.model import optimized_waveform
     from passmd.protocols import eq15
-    from passmd.solver import simulation as dynamics
+    from passmd.solver import simulation
 
     data = run_json("run", "--waveform", "optimized", "--actuator", "rigid", "--periods", "3")
     drive = Drive(actuator_model="rigid")
     amplitude = drive.actuator.full_stroke_amplitude
     design = eq15.optimized_design(amplitude, drive)
     wave = optimized_waveform.optimized(amplitude, 100.0, drive, periods=3, design=design)
-    result = dynamics.simulate(drive, wave)
+    result = simulation.simulate(drive, wave)
     assert data["waveform"] == "optimized"
     assert data["final_position_m"] == result.final_position  # same code path, bit for bit
 
@@ -521,13 +521,13 @@ def test_cache_command_info_prune_clear(tmp_path):
 
 
 def test_failed_simulation_exits_1(monkeypatch, capsys):
-    from passmd.solver import simulation as dynamics
+    from passmd.solver import simulation
     from passmd.solver.results import SimulationError
 
     def diverge(*args, **kwargs):
         raise SimulationError("simulation diverged at integrator step 12")
 
-    monkeypatch.setattr(dynamics, "simulate", diverge)
+    monkeypatch.setattr(simulation, "simulate", diverge)
     status, out = run_cli("run", "--periods", "1")
     err = capsys.readouterr().err
     assert status == 1 and out == ""
@@ -543,10 +543,10 @@ def test_run_pauses_the_collector_until_its_simulation_has_run(monkeypatch, tmp_
     """Imports and kernel loading run without automatic collection; the outputs (pandas,
     matplotlib) and whatever follows the command run with it."""
     from passmd.cli.commands import run as run_command
-    from passmd.solver import simulation as dynamics
+    from passmd.solver import simulation
 
     enabled = {}
-    simulate, write_outputs = dynamics.simulate, run_command.write_outputs
+    simulate, write_outputs = simulation.simulate, run_command.write_outputs
 
     def spy_simulate(*args, **kwargs):
         enabled["simulation"] = gc.isenabled()
@@ -556,7 +556,7 @@ def test_run_pauses_the_collector_until_its_simulation_has_run(monkeypatch, tmp_
         enabled["outputs"] = gc.isenabled()
         return write_outputs(*args, **kwargs)
 
-    monkeypatch.setattr(dynamics, "simulate", spy_simulate)
+    monkeypatch.setattr(simulation, "simulate", spy_simulate)
     monkeypatch.setattr(run_command, "write_outputs", spy_write_outputs)
     assert gc.isenabled()
     # (an in-process Ctrl-C test earlier in the session may have frozen objects: count from here)

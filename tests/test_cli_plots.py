@@ -87,13 +87,13 @@ def readable(fig) -> dict:
 def test_run_plot_names_positions_time_and_the_run(tmp_path):
     from passmd.model import waveforms
     from passmd.plots.trace import positions_figure
-    from passmd.solver import simulation as dynamics
+    from passmd.solver import simulation
 
     status, text = run_cli("run", *CHEAP, "--periods", "2", "--plot", str(tmp_path / "run.png"))
     assert status == 0, text
     png_shows_something(tmp_path / "run.png")
     drive = Drive(contacts=1, actuator_model="rigid")
-    result = dynamics.simulate(drive, waveforms.sawtooth(drive.actuator.full_stroke_amplitude, 100.0, drive,
+    result = simulation.simulate(drive, waveforms.sawtooth(drive.actuator.full_stroke_amplitude, 100.0, drive,
                                                          periods=2), max_points=200)
     texts = readable(positions_figure(result, "sawtooth, A = 202 nm"))
     ax = positions_figure(result, "t").axes[0]

@@ -27,7 +27,7 @@ from passmd.model.optimized_waveform import OptimizedDesign, max_piezo_velocity,
 from passmd.plots import driving_waveform as plots
 from passmd.protocols import eq15
 from passmd.runtime.config import RunConfig
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 from passmd.solver import steps as time_steps
 
 PANELS = ("fig8a", "fig8b", "fig9a", "fig9b", "fig10a", "fig10b", "fig10c")
@@ -153,8 +153,8 @@ def test_fig10_steady_step_at_130_khz_is_converged(quick, monkeypatch, preload, 
     row = row.iloc[0]
     point = {name: row[name] for name in inspect.signature(dw_runs.velocity_point).parameters
              if name in row.index}  # a figure at Section 5's μ passes none
-    default_simulate = dynamics.simulate
-    monkeypatch.setattr(dynamics, "simulate", functools.partial(default_simulate,
+    default_simulate = simulation.simulate
+    monkeypatch.setattr(simulation, "simulate", functools.partial(default_simulate,
                                                        scheme=time_steps.SCHEMES["fixed"].replace(dt=CONVERGED_DT)))
     converged = dw_runs.velocity_point(**point)
     assert converged["periods"] == row["periods"]
@@ -208,8 +208,8 @@ def test_carrying_the_runner_then_stopping_beats_the_sawtooth():
     design = eq15.optimized_design(amplitude, drive)
     carry = OptimizedDesign(0.75 / design.micro_vibration_frequency, 0.9 * amplitude / 3e-3,
                             0.9 * amplitude)
-    saw = dynamics.simulate(drive, waveforms.sawtooth(amplitude, dw_runs.STEP_FREQUENCY, drive, periods=3))
-    opt = dynamics.simulate(drive, optimized(amplitude, dw_runs.STEP_FREQUENCY, drive, periods=3,
+    saw = simulation.simulate(drive, waveforms.sawtooth(amplitude, dw_runs.STEP_FREQUENCY, drive, periods=3))
+    opt = simulation.simulate(drive, optimized(amplitude, dw_runs.STEP_FREQUENCY, drive, periods=3,
                                              design=carry))
     assert np.mean(opt.step_sizes) > 1.2 * np.mean(saw.step_sizes)
 

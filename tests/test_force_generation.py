@@ -24,7 +24,7 @@ from passmd.model.defaults import PROTOCOL
 from passmd.plots import force_generation as fg_plots
 from passmd.protocols import stall
 from passmd.runtime.config import RunConfig
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 
 FIGURES = ("fig7a", "fig7b", "fig7grid", "fig7freq", "fig7cycle")
 #: The plot of each figure (the figure table pairs them the same way).
@@ -141,7 +141,7 @@ def test_stall_result_is_the_run_from_rest_of_its_length(model, mu, preload, fra
     if not out["converged"]:
         assert periods == limits["max_periods"]
     wave = waveforms.sawtooth(amplitude, fg.FORCE_FREQUENCY, drive, periods=periods)
-    run = dynamics.simulate(drive, wave, max_points=2)
+    run = simulation.simulate(drive, wave, max_points=2)
     forces = drive.load_cell_stiffness * run.period_mean_position
     assert out["generated_force_N"] == forces[-1]
     assert out["mean_friction_N"] == run.period_mean_friction[-1]

@@ -44,7 +44,7 @@ from passmd.model import waveforms
 from passmd.model.parameters import Drive
 from passmd.runtime import progress as _progress
 from passmd.runtime import sweep
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 
 #: Generous limits: a refusal or a one-period run takes seconds (start-up included).
 QUICK_S = 120
@@ -401,19 +401,19 @@ def test_work_estimate_counts_the_springs(monkeypatch):
     """The same drive and waveform: 10 000 discrete springs are 1 + 10 000/SPRINGS_PER_STEP times
     the work per step of the exact contact."""
     seen = {}
-    original = dynamics._integrate_in_chunks
+    original = simulation._integrate_in_chunks
 
     def record(arguments, waveform, expected, step_work, progress):
         seen["work"] = step_work
         return original(arguments, waveform, expected, step_work, progress)
 
-    monkeypatch.setattr(dynamics, "_integrate_in_chunks", record)
+    monkeypatch.setattr(simulation, "_integrate_in_chunks", record)
     drive = Drive(contacts=1)
     wave = waveforms.sawtooth(drive.actuator.full_stroke_amplitude, 10e3, drive, periods=1)
-    dynamics.simulate(drive, wave, max_points=10)
+    simulation.simulate(drive, wave, max_points=10)
     assert seen["work"] == 1.0
-    dynamics.simulate(drive, wave, contact_model="discrete", springs=10_000, max_points=10)
-    assert seen["work"] == 1.0 + 10_000 / dynamics.SPRINGS_PER_STEP
+    simulation.simulate(drive, wave, contact_model="discrete", springs=10_000, max_points=10)
+    assert seen["work"] == 1.0 + 10_000 / simulation.SPRINGS_PER_STEP
 
 
 @pytest.mark.parametrize("json_output", [False, True])
@@ -426,15 +426,15 @@ def test_short_run_shows_no_progress(tmp_path, json_output):
 def test_library_runs_stay_quiet_off_a_terminal(monkeypatch, capsys):
     """Without ``progress="long"`` (the command line's choice) a long run prints nothing off a
     terminal: the book's notebooks treat any stderr output as a warning."""
-    monkeypatch.setattr(dynamics, "PROGRESS_MIN_WORK", 0.0)
+    monkeypatch.setattr(simulation, "PROGRESS_MIN_WORK", 0.0)
     monkeypatch.setattr(_progress, "DELAY", 0.0)
     monkeypatch.setattr(_progress, "LINE_INTERVAL", 0.0)
-    monkeypatch.setattr(dynamics, "CHUNK_STEPS", 200)
+    monkeypatch.setattr(simulation, "CHUNK_STEPS", 200)
     drive = Drive(contacts=1)
     wave = waveforms.sawtooth(drive.actuator.full_stroke_amplitude, 10e3, drive, periods=2)
-    dynamics.simulate(drive, wave, max_points=10)
+    simulation.simulate(drive, wave, max_points=10)
     assert capsys.readouterr().err == ""
-    dynamics.simulate(drive, wave, max_points=10, progress="long")
+    simulation.simulate(drive, wave, max_points=10, progress="long")
     captured = capsys.readouterr()
     lines = captured.err.splitlines()
     assert lines and all(line.startswith("simulation: ") and "periods)" in line for line in lines), lines

@@ -44,7 +44,7 @@ from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
 from passmd.model.tables import Assumption
 from passmd.runtime.validation import check_choice, check_positive, check_range
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 
 __all__ = [
     "ASSUMPTIONS",
@@ -149,7 +149,7 @@ def steady_step(
     if int(periods) != periods or periods < 2:
         raise ValueError(f"periods = {periods!r} is out of range: must be an integer >= 2")
     wave = waveforms.sawtooth(amplitude, frequency, drive, periods=int(periods), flyback=flyback)
-    result = dynamics.simulate(drive, wave, max_points=2)
+    result = simulation.simulate(drive, wave, max_points=2)
     steps = result.step_sizes
     return {
         "steps_m": steps.tolist(),
@@ -204,7 +204,7 @@ def first_flyback_slip(
         slip_mark=t_ramp,
         kind="first fly-back",
     )
-    result = dynamics.simulate(drive, wave, max_points=2)
+    result = simulation.simulate(drive, wave, max_points=2)
     peak = result.peak_force_ratio[0]  # every integrator step from the fly-back on
     return {
         "peak_force_ratio": peak.tolist(),

@@ -20,7 +20,7 @@ from passmd.model.waveforms import sawtooth
 from passmd.protocols import fit as fitting
 from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 from passmd.solver.steps import SCHEMES
 
 __all__ = ["PERIODS", "REFINE", "independent_step", "independent_steps", "noisy_steps"]
@@ -36,7 +36,8 @@ def independent_step(drive: Drive, amplitude: float, frequency: float, periods: 
     """The last step of a ``periods``-period saw-tooth run from rest with the refined integrator (a sweep
     function): ``{"step_m": ...}``."""
     wave = sawtooth(amplitude, frequency, drive, periods=periods, flyback=flyback)
-    result = dynamics.simulate(drive, wave, scheme=SCHEMES["controlled"].replace(refine=refine), max_points=2)
+    scheme = SCHEMES["controlled"].replace(refine=refine)
+    result = simulation.simulate(drive, wave, scheme=scheme, max_points=2)
     return {"step_m": float(result.step_sizes[-1])}
 
 

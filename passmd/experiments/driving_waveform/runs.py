@@ -29,7 +29,7 @@ from passmd.protocols.velocity import (
 from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
 from passmd.runtime.validation import check_choice
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 from passmd.solver import steps as time_steps
 from passmd.solver.results import SimulationError
 
@@ -120,7 +120,7 @@ def trace_point(hemisphere_radius: float, preload: float, runner: str, actuator_
         settling_time, acceleration_time, acceleration_amplitude)
     wave = make_waveform(drive, amplitude, frequency, periods, waveform, "cut", design)
     samples = int(math.ceil(wave.duration * theory.runner_frequency(drive) * 200)) + 1
-    result = dynamics.simulate(drive, wave, max_points=max(samples, 2000))
+    result = simulation.simulate(drive, wave, max_points=max(samples, 2000))
     t = result.time
     period = 1.0 / frequency
     v_p = wave.velocity(t)
@@ -260,7 +260,7 @@ def window_point(hemisphere_radius: float, preload: float, runner: str, actuator
     end_a = start_a + timing["acceleration_time_s"]
     points = int(math.ceil(wave.duration * samples_per_acceleration / timing["acceleration_time_s"])) + 1
     refined = time_steps.SCHEMES["controlled"].replace(refine=resolution)
-    result = dynamics.simulate(drive, wave, scheme=refined, max_points=points)
+    result = simulation.simulate(drive, wave, scheme=refined, max_points=points)
     t = result.time
     keep = (t >= period - flyback - WINDOW_BEFORE) & (t <= end_a + WINDOW_AFTER)
     inside = t[(t >= start_a) & (t <= end_a)]

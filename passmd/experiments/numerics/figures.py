@@ -18,7 +18,7 @@ from passmd.model.parameters import Amplifier, Drive, Material
 from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
 from passmd.runtime.validation import check_choice, check_count, check_range
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 from passmd.solver import steps as time_steps
 
 #: Configurations the numerics are shown for: (label, contacts, actuator model).
@@ -59,7 +59,7 @@ def convergence_point(contacts: int, actuator_model: str, step_control: str, res
                   actuator_model=actuator_model)
     wf = waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
     scheme = STEP_CONTROLS[step_control].replace(refine=resolution)
-    res = dynamics.simulate(drive, wf, scheme=scheme, max_points=2)
+    res = simulation.simulate(drive, wf, scheme=scheme, max_points=2)
     return {"fine_step_s": res.fine_step, "coarse_step_s": res.coarse_step, "steps": res.steps,
             "rejected_steps": res.rejected_steps, "final_position_m": res.final_position}
 
@@ -150,7 +150,7 @@ def energy_balance_table(
         drive = Drive(contacts=contacts, actuator_model=model)
         wf = waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
         for contact in ("exact", "discrete"):
-            res = dynamics.simulate(drive, wf, contact_model=contact, springs=PROTOCOL.springs,
+            res = simulation.simulate(drive, wf, contact_model=contact, springs=PROTOCOL.springs,
                                     max_points=2, scheme=scheme)
             bal = res.energy_balance()
             rows.append({"configuration": label, "contact_model": contact, **bal})
@@ -171,7 +171,7 @@ def settle_fraction_sensitivity(
         drive = Drive(contacts=contacts, actuator_model=model)
         for fraction in fractions:
             wf = waveforms.sawtooth(amplitude, frequency, drive, periods=periods, settle_fraction=fraction)
-            res = dynamics.simulate(drive, wf, max_points=2)
+            res = simulation.simulate(drive, wf, max_points=2)
             rows.append({"configuration": label, "settle_fraction": float(fraction),
                          "mean_step_m": float(res.step_sizes.mean())})
     return pd.DataFrame(rows)
@@ -269,7 +269,7 @@ def rigid_coulomb_limit(
                 # the fixed step of the stiffened runner mode: its error shrinks with the
                 # stiffness, as the gap it measures does (the error-controlled step's absolute
                 # tolerance would not, and would set a floor under the fitted rate)
-                res = dynamics.simulate(drive, wf, max_points=2,
+                res = simulation.simulate(drive, wf, max_points=2,
                                         scheme=time_steps.SCHEMES["fixed"].replace(refine=resolution))
                 step = float(res.step_sizes[-1])
                 rows.append({
