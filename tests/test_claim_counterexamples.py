@@ -22,8 +22,7 @@ from passmd.experiments.driving_waveform import claims_velocity as dw_claims
 from passmd.experiments.driving_waveform.figures import FREQUENCIES
 from passmd.experiments.driving_waveform.runs import section5_drive
 from passmd.experiments.force_generation.figures import EARLIER, THIS
-from passmd.ledger import checks, readings, reference
-from passmd.ledger import evaluation as ledger
+from passmd.ledger import checks, evaluation, readings, reference
 from passmd.ledger.checks import NO_MEASURED_DATA, ClaimFails, NotEvaluable, check_claim
 from passmd.ledger.claims import load_claims
 from passmd.model import theory
@@ -507,7 +506,7 @@ COUNTER_EXAMPLES = {
 
 
 def test_every_extractor_has_a_counter_example_or_is_marked_not_informative():
-    functions = ledger.extractors()
+    functions = evaluation.extractors()
     marked = {c for c, f in functions.items() if f.not_informative}
     informative = set(functions) - marked - set(EXPERIMENT_CLAIMS)
     assert sorted(informative - set(COUNTER_EXAMPLES)) == [], (
@@ -520,7 +519,7 @@ def test_every_extractor_has_a_counter_example_or_is_marked_not_informative():
         "sec5-1-spring-deformed-to-ux-max-after-flyback",
         "fig9b-standard-increases-above-110khz",
     }
-    assert set(EXPERIMENT_CLAIMS) == ledger.claim_functions().experiment
+    assert set(EXPERIMENT_CLAIMS) == evaluation.claim_functions().experiment
     assert all(len(functions[c].not_informative) > 40 for c in marked), (
         "a not-informative mark needs its reason"
     )
@@ -529,7 +528,7 @@ def test_every_extractor_has_a_counter_example_or_is_marked_not_informative():
 @pytest.mark.parametrize("claim_id", EXPERIMENT_CLAIMS)
 def test_experiment_claims_are_inconclusive_for_want_of_data(claim_id):
     with pytest.raises(NotEvaluable, match=NO_MEASURED_DATA):
-        ledger.extractors()[claim_id]({})
+        evaluation.extractors()[claim_id]({})
 
 
 def test_not_informative_reasons_hold():
@@ -548,7 +547,7 @@ def test_not_informative_reasons_hold():
 
 @pytest.fixture(scope="module")
 def quick_results():
-    return ledger.collect_results(RunConfig(profile="quick"))
+    return evaluation.collect_results(RunConfig(profile="quick"))
 
 
 @pytest.fixture(scope="module")
@@ -560,7 +559,7 @@ def claims():
 @pytest.mark.parametrize("claim_id", sorted(COUNTER_EXAMPLES))
 def test_check_fails_on_its_counter_example(claim_id, quick_results, claims):
     description, build = COUNTER_EXAMPLES[claim_id]
-    func = ledger.extractors()[claim_id]
+    func = evaluation.extractors()[claim_id]
     results = build(quick_results)
     try:
         ours = func(results, readings.default_reading()) if func.claim_depends_on else func(results)

@@ -18,7 +18,7 @@ import snapshot_accuracy as snap
 from passmd.experiments import figure_table as figures
 from passmd.experiments.critical_amplitude import facts as ca_facts
 from passmd.experiments.critical_amplitude import figures as ca
-from passmd.ledger import evaluation as ledger
+from passmd.ledger import evaluation
 from passmd.model import waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.theory import drive_theory, runner_frequency
@@ -355,10 +355,11 @@ def test_ledger_rows_of_figs_5_and_6():
     deviation over the whole curve); every failure on it is a failure at a preload of the paper's grid.
     The experiment row has no measured data in the paper's text."""
     keys = ["fig5a", "fig5b", "fig6a", "fig6b", "fig6c"]
-    claims = ledger.claims_for(ledger.load_claims(), keys)
+    claims = evaluation.claims_for(evaluation.load_claims(), keys)
     assert len(claims) == 12
-    results = ledger.collect_results(RunConfig(profile="quick"), [*keys, *(f"{k}_readings" for k in keys)])
-    evaluated = ledger.evaluate(claims, results)
+    figures_read = [*keys, *(f"{k}_readings" for k in keys)]
+    results = evaluation.collect_results(RunConfig(profile="quick"), figures_read)
+    evaluated = evaluation.evaluate(claims, results)
     experiment = evaluated["claim"] == "fig6b-experiment-agreement"
     assert evaluated.loc[experiment, "verdict"].str.contains("no measured data").all()
     simulated = evaluated[~experiment]

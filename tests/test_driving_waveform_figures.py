@@ -355,11 +355,10 @@ def test_acceleration_slip_and_window_facts(quick):
 
 
 def test_fig9a_facts_agree_with_the_ledger(quick):
-    from passmd.ledger import evaluation as ledger
-    from passmd.ledger import readings
+    from passmd.ledger import evaluation, readings
 
     facts = wf.fig9a_facts(quick["fig9a"])
-    extract = ledger.extractors()
+    extract = evaluation.extractors()
     reading = readings.default_reading()
     assert facts["x3_saw_nm"] == pytest.approx(extract["fig9a-standard-position-552nm"](
         {"fig9a": quick["fig9a"]}, reading), rel=1e-12)

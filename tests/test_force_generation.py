@@ -17,8 +17,7 @@ import snapshot_accuracy as snap
 
 from passmd.experiments.force_generation import facts as ff
 from passmd.experiments.force_generation import figures as fg
-from passmd.ledger import checks
-from passmd.ledger import evaluation as ledger
+from passmd.ledger import checks, evaluation
 from passmd.model import waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.plots import force_generation as fg_plots
@@ -299,7 +298,7 @@ def test_ledger_rows_of_fig7(quick):
     decided by a model standing in for it); this paper's force depends on the amplitude and the preload
     at every reading; the model-against-model comparisons are studies, shown and not counted."""
     keys = ["fig7a", "fig7b"]
-    claims = ledger.claims_for(ledger.load_claims(), keys)
+    claims = evaluation.claims_for(evaluation.load_claims(), keys)
     assert set(claims["id"]) == {
         "fig7a-force-difference-115mn", "fig7a-discrepancy-grows-with-amplitude",
         "fig7b-discrepancy-grows-with-amplitude", "fig7-critical-amplitude-both-models",
@@ -309,7 +308,7 @@ def test_ledger_rows_of_fig7(quick):
     }
     results = {k: quick[k] for k in ("fig7a", "fig7b")}
     results["fig7_readings"] = fg.fig7_readings(RunConfig(profile="quick"))
-    evaluated = ledger.evaluate(claims, results)
+    evaluated = evaluation.evaluate(claims, results)
     status = dict(zip(evaluated["claim"], evaluated["status"], strict=True))
     verdict = dict(zip(evaluated["claim"], evaluated["verdict"], strict=True))
     for claim in ("fig7-critical-amplitude-both-models", "fig7-flexible-covers-experiment",
@@ -328,7 +327,7 @@ def test_ledger_rows_of_fig7(quick):
     assert status["study-fig7a-model-difference-grows"] == "reproduced"
     assert status["study-fig7b-model-difference-grows"] == "reproduced"
     assert status["study-fig7-onsets-earlier-against-this-model"] == "not reproduced"
-    assert ledger.headline(evaluated)["studies"] == 4
+    assert evaluation.headline(evaluated)["studies"] == 4
 
 
 def test_force_difference_study_uses_only_stalled_pairs(quick):
@@ -336,7 +335,7 @@ def test_force_difference_study_uses_only_stalled_pairs(quick):
     full = np.isclose(table["amplitude_fraction"], 1.0) & np.isclose(table["preload_N"], 0.8)
     table.loc[full & (table["actuator_model"] == "flexible"), "converged"] = False
     with pytest.raises(checks.NotEvaluable):
-        ledger.extractors()["study-fig7a-model-difference-115mn"]({"fig7a": table})
+        evaluation.extractors()["study-fig7a-model-difference-115mn"]({"fig7a": table})
 
 
 # --------------------------------------------------------------------------------------
@@ -368,7 +367,7 @@ def test_stall_summary_counts_the_panels(quick):
 
 def test_full_stroke_facts_agree_with_the_115mn_extractor(quick):
     facts = ff.full_stroke_facts(quick["fig7a"], paper_difference_mN=100.0)
-    extracted = ledger.extractors()["study-fig7a-model-difference-115mn"]({"fig7a": quick["fig7a"]})
+    extracted = evaluation.extractors()["study-fig7a-model-difference-115mn"]({"fig7a": quick["fig7a"]})
     assert facts["diff_full_mN"] == pytest.approx(extracted, rel=1e-12)
     assert facts["F_full_rigid_mN"] - facts["F_full_flex_mN"] == pytest.approx(extracted, rel=1e-12)
     assert facts["diff_full_dev_pct"] == pytest.approx(abs(extracted - 100.0), rel=1e-12)

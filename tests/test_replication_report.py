@@ -23,8 +23,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from passmd.ledger import checks
-from passmd.ledger import evaluation as ledger
+from passmd.ledger import checks, evaluation
 from passmd.ledger.claims import CLAIM_COLUMNS
 from passmd.report import ledger_views
 
@@ -62,9 +61,9 @@ def _synthetic(tmp_path, monkeypatch):
     from passmd.ledger import claims as claims_module
 
     monkeypatch.setattr(claims_module, "CLAIMS_PATH", path)
-    monkeypatch.setattr(ledger, "load_claims", lambda path_=None: claims_module.load_claims(path))
-    monkeypatch.setattr(ledger, "claim_modules", lambda: (module,))
-    monkeypatch.setattr(ledger, "collect_results", lambda config, figures=None: {"fig5a": pd.DataFrame()})
+    monkeypatch.setattr(evaluation, "load_claims", lambda path_=None: claims_module.load_claims(path))
+    monkeypatch.setattr(evaluation, "claim_modules", lambda: (module,))
+    monkeypatch.setattr(evaluation, "collect_results", lambda config, figures=None: {"fig5a": pd.DataFrame()})
 
 
 def test_cli_text_and_json_state_the_joint_reading_as_the_report_does(tmp_path, monkeypatch):

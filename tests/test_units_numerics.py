@@ -39,7 +39,7 @@ from hypothesis import strategies as st
 from passmd import cli
 from passmd.cli.result_bounds import EMPTY_BY_DESIGN, ResultError, check_table
 from passmd.experiments import figure_table as figures
-from passmd.ledger import evaluation as ledger
+from passmd.ledger import evaluation
 from passmd.model import hertz, theory
 from passmd.model.parameters import Drive
 from passmd.model.tables import RUBY, STEEL
@@ -470,11 +470,11 @@ def test_figure_with_a_nan_result_exits_1_naming_the_figure_and_column(nan_figur
 @pytest.mark.parametrize("json_output", [True, False], ids=["json", "text"])
 def test_ledger_with_a_nan_result_exits_1_naming_the_table_and_column(monkeypatch, tmp_path, json_output):
     def damaged(config):
-        table = ledger.closed_form_results(config).copy()
+        table = evaluation.closed_form_results(config).copy()
         table.loc[2, "tangential_stiffness_N_per_m"] = np.nan
         return {"closed_forms": table}
 
-    monkeypatch.setattr(ledger, "collect_results", damaged)
+    monkeypatch.setattr(evaluation, "collect_results", damaged)
     baseline = tmp_path / "baseline.csv"
     status, out, err = run_in_process(["ledger", "--write-baseline", str(baseline),
                                        *(["--json"] if json_output else [])])
