@@ -539,14 +539,14 @@ def scratch(tmp_path_factory):
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(argv=command_lines())
 def test_generated_command_lines_end_cleanly(scratch, argv):
-    from passmd.experiments import figure_table as figures
+    from passmd.experiments import figure_table
     from passmd.protocols import critical_amplitude, stall
 
     # the long computations are replaced by a marker: reaching them means every check passed
     with mock.patch.object(run_command, "simulate", _reached), \
             mock.patch.object(critical_amplitude, "critical_amplitude", _reached), \
             mock.patch.object(stall, "generated_force", _reached), \
-            mock.patch.object(figures, "figure_data", _reached):
+            mock.patch.object(figure_table, "figure_data", _reached):
         try:
             status, out, err, caught = run_main(argv, env={"PASSMD_CACHE_DIR": str(scratch / "cache")})
         except _Reached:

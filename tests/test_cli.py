@@ -428,13 +428,13 @@ def fake_figure(monkeypatch):
     """The figure table holds one stand-in panel, fig99z (computed at a RunConfig)."""
     from types import SimpleNamespace
 
-    from passmd.experiments import figure_table as figures
+    from passmd.experiments import figure_table
 
     spec = SimpleNamespace(name="fig99z", title="a stand-in panel")
-    monkeypatch.setattr(figures, "figure_names", lambda: ["fig99z"])
-    monkeypatch.setattr(figures, "figure_spec", lambda name: spec)
-    monkeypatch.setattr(figures, "figure_data", fake_figure_data)
-    monkeypatch.setattr(figures, "figure_plot", fake_figure_plot)
+    monkeypatch.setattr(figure_table, "figure_names", lambda: ["fig99z"])
+    monkeypatch.setattr(figure_table, "figure_spec", lambda name: spec)
+    monkeypatch.setattr(figure_table, "figure_data", fake_figure_data)
+    monkeypatch.setattr(figure_table, "figure_plot", fake_figure_plot)
     monkeypatch.delenv("PASSMD_EXECUTOR", raising=False)
     return spec
 

@@ -15,7 +15,7 @@ import pandas as pd
 import pytest
 import snapshot_accuracy as snap
 
-from passmd.experiments import figure_table as figures
+from passmd.experiments import figure_table
 from passmd.experiments.critical_amplitude import facts as ca_facts
 from passmd.experiments.critical_amplitude import figures as ca
 from passmd.ledger import evaluation
@@ -32,7 +32,7 @@ NM = 1e9
 @pytest.fixture(scope="module")
 def quick():
     """Quick data of every panel (computed once; the sweep cache makes reruns cheap)."""
-    return {name: figures.figure_data(name, RunConfig(profile="quick")) for name in PANELS}
+    return {name: figure_table.figure_data(name, RunConfig(profile="quick")) for name in PANELS}
 
 
 # --------------------------------------------------------------------------------------
@@ -239,18 +239,18 @@ def test_larger_threshold_gives_larger_steady_amplitude():
 
 
 def test_every_panel_is_in_the_figure_table_with_its_chapter():
-    names = figures.figure_names()
+    names = figure_table.figure_names()
     for name in PANELS:
         assert name in names
-        assert figures.figure_spec(name).chapter in ("critical_amplitude_one", "critical_amplitude_six")
+        assert figure_table.figure_spec(name).chapter in ("critical_amplitude_one", "critical_amplitude_six")
 
 
 def test_figures_are_listed_in_the_books_order():
     """Chapters follow book/_toc.yml; study panels of Figs. 5-6 (fig56_*) come after fig6c, before fig7a."""
     toc = (Path(__file__).resolve().parents[1] / "book" / "_toc.yml").read_text()
     files = re.findall(r"^\s*- file: (\w+)", toc, flags=re.M)
-    names = figures.figure_names()
-    positions = [files.index(figures.figure_spec(name).chapter) for name in names]
+    names = figure_table.figure_names()
+    positions = [files.index(figure_table.figure_spec(name).chapter) for name in names]
     assert positions == sorted(positions)
     assert names.index("fig6c") < names.index("fig56_frequency") < names.index("fig7a")
     assert names.index("fig9b") < names.index("fig10a")
@@ -299,7 +299,7 @@ def test_plots_draw_every_panel(quick, name):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig = figures.figure_plot(name, quick[name])
+    fig = figure_table.figure_plot(name, quick[name])
     assert fig.axes and all(ax.has_data() for ax in fig.axes)
     plt.close(fig)
 
@@ -337,7 +337,7 @@ def test_finer_run_passes_the_snapshots(tmp_path_factory, dataframe_regression):
     snapshot check: the snapshots lock the physics to the stated accuracy, not one scheme."""
     config = snap.finer_config(tmp_path_factory.mktemp("finer-cache"))
     with snap.finer_run():
-        finer = {name: figures.figure_data(name, config) for name in PANELS}
+        finer = {name: figure_table.figure_data(name, config) for name in PANELS}
     for name in PANELS:
         check(dataframe_regression, name, locked(finer[name]))
 
@@ -447,7 +447,7 @@ def test_flyback_steps_ratchet_below_eq7():
     assert below["step_nm"].iloc[-1] < first["threshold_nm"]  # 2 nm below A_c: no steady step
     import matplotlib.pyplot as plt
 
-    fig = figures.figure_plot("fig5_flyback_steps", steps)
+    fig = figure_table.figure_plot("fig5_flyback_steps", steps)
     assert fig.axes[0].has_data()
     plt.close(fig)
 

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd.experiments import figure_table as figures
+from passmd.experiments import figure_table
 from passmd.ledger import checks, evaluation, reference
 from passmd.ledger.claims import CHECK_KINDS, CLAIM_COLUMNS, load_claims
 from passmd.report import ledger_views
@@ -772,9 +772,10 @@ def test_collect_results_calls_every_figure_of_the_table(monkeypatch):
         return pd.DataFrame({"amplitude_nm": [1.0]})
 
     table = {"fig5a": types.SimpleNamespace(compute=_fig5a)}
-    monkeypatch.setattr(figures, "figure_names", lambda: list(table))
-    monkeypatch.setattr(figures, "figure_spec", lambda name: table[name])
-    monkeypatch.setattr(figures, "READING_TABLES", {"fig5a_readings": types.SimpleNamespace(compute=_fig5a)})
+    monkeypatch.setattr(figure_table, "figure_names", lambda: list(table))
+    monkeypatch.setattr(figure_table, "figure_spec", lambda name: table[name])
+    reading_tables = {"fig5a_readings": types.SimpleNamespace(compute=_fig5a)}
+    monkeypatch.setattr(figure_table, "READING_TABLES", reading_tables)
     results = evaluation.collect_results(QUICK)
     assert list(results) == ["fig5a", "fig5a_readings", "closed_forms"]
     assert calls == [QUICK, QUICK]
@@ -831,13 +832,13 @@ def test_real_extractors_live_in_the_figures_claim_modules():
     closed-form one), and the experiments do not import the ledger (the layers are one-way)."""
     found = evaluation.claim_functions()
     homes = {f.__module__ for f in found.extractors.values()}
-    assert homes == {m.__name__ for m in figures.CLAIM_MODULES} | {"passmd.ledger.evaluation"}
+    assert homes == {m.__name__ for m in figure_table.CLAIM_MODULES} | {"passmd.ledger.evaluation"}
     assert found.extractors["fig10b-r1-stiffer-contact"].__module__ == "passmd.ledger.evaluation"
     assert found.depends_on["fig5a-no-step-below-50nm"] == (
         "flyback", "ac_protocol", "drive_frequency_s4", "damping_ratio", "friction_coefficient")
     assert {"fig10a-1n-slower", "sec5-response-to-optimized-similar"} <= set(found.evidence)
     assert evaluation.orphan_extractors() == []
-    code = ("import sys; import " + ", ".join(m.__name__ for m in figures.CLAIM_MODULES)
+    code = ("import sys; import " + ", ".join(m.__name__ for m in figure_table.CLAIM_MODULES)
             + "; print(sorted(m for m in sys.modules if m.startswith('passmd.ledger.evaluation')))")
     imported = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert imported.stdout.strip() == "[]"

@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd.experiments import figure_table as figures
+from passmd.experiments import figure_table
 from passmd.experiments.mdr_validation import figures as mdr
 from passmd.experiments.model import figures as model
 from passmd.experiments.numerics import benchmarks as numerics_benchmarks
@@ -37,9 +37,9 @@ CHEAP = (
 def test_cheap_figures_compute_and_draw(name):
     import matplotlib.pyplot as plt
 
-    data = figures.figure_data(name, QUICK)
+    data = figure_table.figure_data(name, QUICK)
     assert len(data) > 0
-    fig = figures.figure_plot(name, data)
+    fig = figure_table.figure_plot(name, data)
     assert fig.axes
     plt.close(fig)
 

@@ -504,7 +504,7 @@ _SWEEP_RUNNER = textwrap.dedent("""
     import sys, types
     sys.path.insert(0, sys.argv[1])
     import slow_points
-    from passmd.experiments import figure_table as figures
+    from passmd.experiments import figure_table
     from passmd.runtime import sweep
     from passmd.cli import main
 
@@ -512,9 +512,9 @@ _SWEEP_RUNNER = textwrap.dedent("""
         return sweep.run(slow_points.point, sweep.grid(x=[1, 2, 3, 4]), executor="process", workers=3,
                          config=config)
 
-    figures.figure_names = lambda: ["fig99z"]
-    figures.figure_spec = lambda name: types.SimpleNamespace(name=name, title="stand-in")
-    figures.figure_data = figure_data
+    figure_table.figure_names = lambda: ["fig99z"]
+    figure_table.figure_spec = lambda name: types.SimpleNamespace(name=name, title="stand-in")
+    figure_table.figure_data = figure_data
     sys.exit(main(sys.argv[2:]))
 """)
 
