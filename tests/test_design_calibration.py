@@ -15,7 +15,7 @@ from passmd.experiments.design import calibration
 from passmd.experiments.design import figures as design
 from passmd.model.parameters import Drive
 from passmd.model.tables import actuator_for_radius
-from passmd.protocols import fit as fitting
+from passmd.protocols import fit
 from passmd.runtime.config import RunConfig
 
 
@@ -49,7 +49,7 @@ def test_fitted_drive_file_reads_back_to_the_fitted_drive():
     truth, sources = design.example_drive()
     fitted = replace(truth, friction_coefficient=0.2493217)
     result = SimpleNamespace(drive=fitted, base=truth, names=["friction_coefficient"], keep="damping_ratio")
-    text = fitting.fitted_drive_file(result, "m.csv", sources)
+    text = fit.fitted_drive_file(result, "m.csv", sources)
     assert calibration.load_fitted(text) == fitted
     line = {raw.split(" = ")[0]: raw for raw in text.splitlines() if " = " in raw}
     assert "fitted to m.csv by passmd fit" in line["friction_coefficient"]
@@ -69,12 +69,12 @@ def test_synthetic_measurements_are_independent_steps_plus_the_stated_noise(tmp_
     np.testing.assert_allclose(data.value, exact + noise[:len(data)], rtol=0, atol=1e-18)
     # not the fit's own forward model: the refined integrator moves these steps by up to 0.12 nm (the
     # default scheme's error for this drive), well below the noise's σ (1 nm)
-    own = fitting.predict(truth, data, cache=False, executor="serial")
+    own = fit.predict(truth, data, cache=False, executor="serial")
     assert np.max(np.abs(exact - own)) < 0.2 * design.NOISE_NM * 1e-9 and np.any(exact != own)
     assert np.all(data.sd == design.NOISE_NM * 1e-9) and data.known_sd
     text = calibration.measurements_csv(data)
     path = tmp_path / "m.csv"
     path.write_text(text, encoding="utf-8")
-    back = fitting.read_measurements(path)
+    back = fit.read_measurements(path)
     np.testing.assert_allclose(back.value, data.value, rtol=1e-15)  # repr() round trip
     np.testing.assert_allclose(back.amplitude, data.amplitude, rtol=1e-15)

@@ -17,8 +17,7 @@ from passmd.model.drive_file import drive_toml, load_drive
 from passmd.model.parameters import Drive
 from passmd.model.tables import Amplifier
 from passmd.protocols import critical_amplitude as ca
-from passmd.protocols import fit as F
-from passmd.protocols import velocity
+from passmd.protocols import fit, velocity
 
 
 def run(argv, capsys):
@@ -138,6 +137,6 @@ def test_a_bad_flyback_option_is_one_line(value, fragment, capsys):
 
 
 def test_a_stated_flyback_cannot_have_its_slew_rate_fitted():
-    data = F.measurements_from_rows(["amplitude_nm", "frequency_Hz", "step_nm"], [["100", "100", "1"]] * 3)
+    data = fit.measurements_from_rows(["amplitude_nm", "frequency_Hz", "step_nm"], [["100", "100", "1"]] * 3)
     with pytest.raises(ValueError, match="has no effect: the drive's fly-back is a stated time"):
-        F.fit(with_rule(1.5e-6), data, ["flyback_time"], executor="serial", cache=False)
+        fit.fit(with_rule(1.5e-6), data, ["flyback_time"], executor="serial", cache=False)

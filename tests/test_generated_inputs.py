@@ -182,12 +182,12 @@ def measurement_files(draw) -> bytes:
 @FUZZ
 @given(data=measurement_files())
 def test_generated_measurement_files_end_cleanly(folder, data):
-    from passmd.protocols import fit as fitting
+    from passmd.protocols import fit
 
     path = folder / "data.csv"
     path.write_bytes(data)
     argv = ["fit", str(path), "--free", "mu"]
-    with mock.patch.object(fitting, "fit", _reached):  # reaching the fit: every check passed
+    with mock.patch.object(fit, "fit", _reached):  # reaching the fit: every check passed
         try:
             status, out, err, caught = run_main(argv)
         except _Reached:

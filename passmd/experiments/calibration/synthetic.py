@@ -17,7 +17,7 @@ import numpy as np
 
 from passmd.model.parameters import Drive
 from passmd.model.waveforms import sawtooth
-from passmd.protocols import fit as fitting
+from passmd.protocols import fit
 from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
 from passmd.solver import simulation
@@ -53,7 +53,7 @@ def independent_steps(drive: Drive, conditions, *, flyback=None, config: RunConf
 
 def noisy_steps(drive: Drive, conditions, sd_nm: float, seed: int, *, flyback=None, name: str = "data",
                 config: RunConfig | None = None, executor: str | None = "serial", cache=False
-                ) -> fitting.Measurements:
+                ) -> fit.Measurements:
     """:func:`independent_steps` plus Gaussian noise of ``sd_nm`` (numpy's default generator, ``seed``), as
     measurements with that sd stated (``step_nm``, ``step_nm_sd``)."""
     exact = independent_steps(drive, conditions, flyback=flyback, config=config, executor=executor,
@@ -62,4 +62,4 @@ def noisy_steps(drive: Drive, conditions, sd_nm: float, seed: int, *, flyback=No
     header = ["amplitude_nm", "preload_N", "frequency_Hz", "step_nm", "step_nm_sd"]
     rows = [[repr(float(a * 1e9)), repr(float(p)), repr(float(f)), repr(float(v * 1e9)), repr(float(sd_nm))]
             for (p, a, f), v in zip(conditions, noisy, strict=True)]
-    return fitting.measurements_from_rows(header, rows, name=name)
+    return fit.measurements_from_rows(header, rows, name=name)
