@@ -310,11 +310,11 @@ def test_critical_amplitude_analytic_only():
 def test_critical_amplitude_is_the_books_search():
     """`critical-amplitude` reports what passmd.experiments.critical_amplitude.figures finds, bracket
     included."""
-    from passmd.experiments.critical_amplitude import figures as ca
+    from passmd.experiments.critical_amplitude import figures
 
     data = run_json("critical-amplitude", "--contacts", "1", "--actuator", "rigid", "--tolerance", "2nm")
     drive = Drive(contacts=1, actuator_model="rigid")
-    found = ca.critical_amplitude(drive, tolerance=2e-9)
+    found = figures.critical_amplitude(drive, tolerance=2e-9)
     assert data["critical_amplitude_m"] == found["critical_amplitude_m"]
     assert data["bracket_m"] == [found["bracket_low_m"], found["bracket_high_m"]]
     assert 0 < data["bracket_m"][1] - data["bracket_m"][0] <= 2e-9
@@ -323,13 +323,15 @@ def test_critical_amplitude_is_the_books_search():
 
 
 def test_critical_amplitude_defaults_are_the_books():
-    from passmd.protocols import critical_amplitude as ca
+    from passmd.protocols import critical_amplitude
 
     # the CLI's defaults are the protocol record's; the book's search must use the same values
-    assert (PROTOCOL.steady_periods, PROTOCOL.step_threshold) == (ca.STEADY_PERIODS, ca.STEP_THRESHOLD)
+    assert PROTOCOL.steady_periods == critical_amplitude.STEADY_PERIODS
+    assert PROTOCOL.step_threshold == critical_amplitude.STEP_THRESHOLD
     data = run_json("critical-amplitude", "--contacts", "1", "--actuator", "rigid", "--tolerance", "5nm")
-    assert data["threshold_m"] == ca.STEP_THRESHOLD and data["frequency_Hz"] == PROTOCOL.drive_frequency
-    tolerance = inspect.signature(ca.critical_amplitude).parameters["tolerance"].default
+    assert data["threshold_m"] == critical_amplitude.STEP_THRESHOLD
+    assert data["frequency_Hz"] == PROTOCOL.drive_frequency
+    tolerance = inspect.signature(critical_amplitude.critical_amplitude).parameters["tolerance"].default
     assert tolerance == PROTOCOL.search_tolerance
 
 

@@ -16,8 +16,7 @@ from passmd.model import waveforms
 from passmd.model.drive_file import drive_toml, load_drive
 from passmd.model.parameters import Drive
 from passmd.model.tables import Amplifier
-from passmd.protocols import critical_amplitude as ca
-from passmd.protocols import fit, velocity
+from passmd.protocols import critical_amplitude, fit, velocity
 
 
 def run(argv, capsys):
@@ -80,13 +79,13 @@ def test_the_default_keyword_gives_the_results_of_the_explicit_slew_rule():
     """Every library function's flyback= defaults to the drive's rule, which is "slew" unless the drive
     says otherwise: the results are bit for bit those of the explicit rule."""
     drive = Drive(contacts=1)
-    default, explicit = ca.steady_step(drive, 120e-9, periods=3), ca.steady_step(drive, 120e-9, periods=3,
-                                                                                flyback="slew")
+    default = critical_amplitude.steady_step(drive, 120e-9, periods=3)
+    explicit = critical_amplitude.steady_step(drive, 120e-9, periods=3, flyback="slew")
     assert default["steps_m"] == explicit["steps_m"]
-    fixed = ca.steady_step(with_rule("fixed", drive), 120e-9, periods=3)
-    explicit = ca.steady_step(drive, 120e-9, periods=3, flyback="fixed")
+    fixed = critical_amplitude.steady_step(with_rule("fixed", drive), 120e-9, periods=3)
+    explicit = critical_amplitude.steady_step(drive, 120e-9, periods=3, flyback="fixed")
     assert fixed["steps_m"] == explicit["steps_m"]
-    assert fixed["steps_m"] != ca.steady_step(drive, 120e-9, periods=3)["steps_m"]  # the rule matters
+    assert fixed["steps_m"] != default["steps_m"]  # the rule matters
     settled = velocity.settled_step(with_rule("fixed", drive), 120e-9, 100.0)
     assert settled["step_m"] == velocity.settled_step(drive, 120e-9, 100.0, flyback="fixed")["step_m"]
 

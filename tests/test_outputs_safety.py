@@ -611,14 +611,14 @@ def test_sigterm_handler_is_removed_after_the_command(monkeypatch):
 def test_critical_amplitude_search_shows_progress_off_a_terminal(monkeypatch, capsys):
     """The A_c bisection counts its runs on stderr with ``progress="long"`` (the command line's
     choice), and stays quiet off a terminal without it (the book's notebooks)."""
-    from passmd.protocols import critical_amplitude as ca
+    from passmd.protocols import critical_amplitude
 
     monkeypatch.setattr(_progress, "DELAY", 0.0)
     monkeypatch.setattr(_progress, "LINE_INTERVAL", 0.0)
     drive = Drive(contacts=1, actuator_model="rigid")
-    ca.critical_amplitude(drive, protocol="first", tolerance=20e-9)
+    critical_amplitude.critical_amplitude(drive, protocol="first", tolerance=20e-9)
     assert capsys.readouterr().err == ""
-    found = ca.critical_amplitude(drive, protocol="first", tolerance=20e-9, progress="long")
+    found = critical_amplitude.critical_amplitude(drive, protocol="first", tolerance=20e-9, progress="long")
     captured = capsys.readouterr()
     lines = captured.err.splitlines()
     assert lines and all(line.startswith("critical amplitude: ") for line in lines), lines
