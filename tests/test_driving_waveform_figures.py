@@ -27,8 +27,7 @@ from passmd.model.optimized_waveform import OptimizedDesign, max_piezo_velocity,
 from passmd.plots import driving_waveform as plots
 from passmd.protocols import eq15
 from passmd.runtime.config import RunConfig
-from passmd.solver import simulation
-from passmd.solver import steps as time_steps
+from passmd.solver import simulation, steps
 
 PANELS = ("fig8a", "fig8b", "fig9a", "fig9b", "fig10a", "fig10b", "fig10c")
 #: The quick profile, as the tests run every panel.
@@ -155,11 +154,11 @@ def test_fig10_steady_step_at_130_khz_is_converged(quick, monkeypatch, preload, 
              if name in row.index}  # a figure at Section 5's μ passes none
     default_simulate = simulation.simulate
     monkeypatch.setattr(simulation, "simulate", functools.partial(default_simulate,
-                                                       scheme=time_steps.SCHEMES["fixed"].replace(dt=CONVERGED_DT)))
+                                                       scheme=steps.SCHEMES["fixed"].replace(dt=CONVERGED_DT)))
     converged = dw_runs.velocity_point(**point)
     assert converged["periods"] == row["periods"]
-    assert abs(row["step_m"] - converged["step_m"]) < time_steps.CONVERGED_ACCURACY
-    assert abs(row["back_step_m"] - converged["back_step_m"]) < time_steps.CONVERGED_ACCURACY
+    assert abs(row["step_m"] - converged["step_m"]) < steps.CONVERGED_ACCURACY
+    assert abs(row["back_step_m"] - converged["back_step_m"]) < steps.CONVERGED_ACCURACY
 
 
 def test_every_panel_plots(quick):

@@ -11,8 +11,7 @@ from passmd.model import theory, waveforms
 from passmd.model.contact import contact_arrays, contact_stiffness, stack_contacts
 from passmd.model.parameters import Drive
 from passmd.solver import setup as run_setup
-from passmd.solver import simulation
-from passmd.solver import steps as time_steps
+from passmd.solver import simulation, steps
 from passmd.solver.results import SimulationError
 from passmd.solver.steps import SCHEMES
 
@@ -148,7 +147,7 @@ def test_error_controlled_energy_balance_at_100_hz(contacts, model):
 def test_divergence_is_reported(monkeypatch):
     d = one_contact("flexible")
     wf = waveforms.sawtooth(100e-9, F_TEST, d, periods=1)
-    plan_dt = time_steps.step_plan(d, 3e6, 3e6).stability_limit
+    plan_dt = steps.step_plan(d, 3e6, 3e6).stability_limit
     monkeypatch.setattr(run_setup, "STABILITY_MARGIN", 100.0)  # let an unstable step through
     with pytest.raises(SimulationError, match=r"diverged at integrator step \d+.*time step"):
         simulation.simulate(d, wf, scheme=SCHEMES["fixed"].replace(dt=5 * plan_dt))
@@ -199,14 +198,14 @@ def test_bad_inputs():
 @pytest.mark.parametrize("name", list(SCHEMES))
 def test_every_scheme_runs_and_agrees(model, name):
     """Each named scheme integrates a 2-period run to within the converged accuracy
-    (time_steps.CONVERGED_ACCURACY) of the fixed fine step; error control rejects steps only
+    (steps.CONVERGED_ACCURACY) of the fixed fine step; error control rejects steps only
     where it is on."""
     d = one_contact(model)
     wf = waveforms.sawtooth(150e-9, F_TEST, d, periods=2)
     ref = simulation.simulate(d, wf, scheme="fixed", max_points=2)
     res = simulation.simulate(d, wf, scheme=name, max_points=2)
     np.testing.assert_allclose(res.settled_positions, ref.settled_positions, rtol=0,
-                               atol=time_steps.CONVERGED_ACCURACY)
+                               atol=steps.CONVERGED_ACCURACY)
     if name != "controlled":
         assert res.rejected_steps == 0
     assert res.fine_step == ref.fine_step
@@ -250,7 +249,7 @@ def test_default_step_converged_to_005_nm():
     default = df[df["resolution"] == 1.0]
     assert set(default["step_control"]) == {"controlled", "adaptive", "fixed"}
     assert len(default[default["step_control"] == "controlled"]) == 4  # every configuration
-    assert (default["error_m"].abs() < time_steps.CONVERGED_ACCURACY).all(), default
+    assert (default["error_m"].abs() < steps.CONVERGED_ACCURACY).all(), default
 
 
 def test_contact_memory_never_overflows_in_a_100_hz_period():
@@ -346,10 +345,10 @@ def test_continued_simulation_bad_use():
 def test_continued_simulation_is_refused_as_the_shorter_run(monkeypatch):
     """The step budget applies to the periods asked for, as to a waveform of that length."""
     d = one_contact()
-    monkeypatch.setattr(time_steps, "MAX_STEPS", 5000.0)  # ≈ 2070 steps per period: 2 periods fit
+    monkeypatch.setattr(steps, "MAX_STEPS", 5000.0)  # ≈ 2070 steps per period: 2 periods fit
     sim = simulation.Simulation(d, waveforms.sawtooth(20e-9, F_TEST, d, periods=3))
     sim.run_to(2)
-    with pytest.raises(time_steps.WorkLimitError, match=r"\(--periods\) = 3 must be <= 2"):
+    with pytest.raises(steps.WorkLimitError, match=r"\(--periods\) = 3 must be <= 2"):
         sim.run_to(3)
     assert sim.periods_done == 2
 
@@ -367,8 +366,8 @@ def test_expected_steps_match_the_run(scheme):
         rows = [contact_arrays("exact", F, d.hemisphere_radius, E, G, d.friction_coefficient) for F in forces]
         params, _ = stack_contacts(rows)
         ks = np.array([contact_stiffness(params[g]) for g in range(len(rows))])
-        plan = time_steps.step_plan(d, ks.max(), float(np.sum(mult * ks)))
-        est = time_steps.expected_steps(wf, plan, res.fine_step, res.coarse_step).sum()
+        plan = steps.step_plan(d, ks.max(), float(np.sum(mult * ks)))
+        est = steps.expected_steps(wf, plan, res.fine_step, res.coarse_step).sum()
         if scheme == "controlled":
             assert res.steps < est
             continue
@@ -380,12 +379,12 @@ def test_expected_steps_match_the_run(scheme):
 def test_run_beyond_the_step_budget_is_refused_before_it_starts(monkeypatch):
     d = one_contact()
     wf = waveforms.sawtooth(20e-9, F_TEST, d, periods=3)
-    monkeypatch.setattr(time_steps, "MAX_STEPS", 5000.0)  # ≈ 2070 steps per period: 2 periods fit
+    monkeypatch.setattr(steps, "MAX_STEPS", 5000.0)  # ≈ 2070 steps per period: 2 periods fit
     refused = r"budget of 5e\+03 steps .*\(--periods\) = 3 must be <= 2"
-    with pytest.raises(time_steps.WorkLimitError, match=refused):
+    with pytest.raises(steps.WorkLimitError, match=refused):
         simulation.simulate(d, wf)
-    monkeypatch.setattr(time_steps, "MAX_STEPS", 10.0)  # not even one period fits: name the step
-    with pytest.raises(time_steps.WorkLimitError, match=r"runner_mass \(--runner-mass\)"):
+    monkeypatch.setattr(steps, "MAX_STEPS", 10.0)  # not even one period fits: name the step
+    with pytest.raises(steps.WorkLimitError, match=r"runner_mass \(--runner-mass\)"):
         simulation.simulate(d, wf)
 
 
@@ -393,13 +392,13 @@ def test_step_below_the_time_resolution_is_refused():
     d = one_contact()
     # a 1e-18 m saw-tooth flies back in 1e-17 s: 40 steps of 2.5e-19 s cannot advance t ≈ 1 ms
     wf = waveforms.sawtooth(1e-18, F_TEST, d, periods=2)
-    with pytest.raises(time_steps.WorkLimitError, match=r"float spacings of t .*--amplitude.*--slew-rate"):
+    with pytest.raises(steps.WorkLimitError, match=r"float spacings of t .*--amplitude.*--slew-rate"):
         simulation.simulate(d, wf)
     light = one_contact(runner_mass=1e-33, allow_extrapolation=True)  # past the plausible range on purpose
-    with pytest.raises(time_steps.WorkLimitError, match=r"runner_mass \(--runner-mass\) = 1e-33"):
+    with pytest.raises(steps.WorkLimitError, match=r"runner_mass \(--runner-mass\) = 1e-33"):
         simulation.simulate(light, waveforms.sawtooth(20e-9, F_TEST, light, periods=2))
     flexible = one_contact("flexible")
-    with pytest.raises(time_steps.WorkLimitError, match=r"dt = 1e-22 s"):
+    with pytest.raises(steps.WorkLimitError, match=r"dt = 1e-22 s"):
         simulation.simulate(flexible, waveforms.sawtooth(20e-9, F_TEST, flexible, periods=2),
                           scheme=SCHEMES["fixed"].replace(dt=1e-22))
 
@@ -477,8 +476,8 @@ def test_error_controlled_step_matches_the_fixed_fine_step(contacts, model, cont
     ctrl = simulation.simulate(d, wf, contact_model=contact, max_points=2)
     assert ctrl.steps < ref.steps / 5
     np.testing.assert_allclose(ctrl.settled_positions, ref.settled_positions, rtol=0,
-                               atol=time_steps.CONVERGED_ACCURACY)
-    np.testing.assert_allclose(ctrl.back_steps, ref.back_steps, rtol=0, atol=time_steps.CONVERGED_ACCURACY)
+                               atol=steps.CONVERGED_ACCURACY)
+    np.testing.assert_allclose(ctrl.back_steps, ref.back_steps, rtol=0, atol=steps.CONVERGED_ACCURACY)
     assert abs(ctrl.energy_balance()["relative_residual"]) < 1e-4
 
 
@@ -492,7 +491,7 @@ def test_error_controlled_step_converges():
     runs = {r: simulation.simulate(d, wf, scheme=SCHEMES["controlled"].replace(refine=r), max_points=2)
             for r in (0.5, 1.0, 2.0)}
     err = {r: abs(run.final_position - ref) for r, run in runs.items()}
-    assert err[1.0] < time_steps.CONVERGED_ACCURACY
+    assert err[1.0] < steps.CONVERGED_ACCURACY
     assert err[2.0] < err[1.0] < err[0.5]
     assert runs[0.5].steps < runs[1.0].steps < runs[2.0].steps
 
@@ -522,7 +521,7 @@ def test_error_controlled_samples_at_their_own_times(model):
         np.testing.assert_allclose(np.diff(ctrl.time), wf.duration / 20000, rtol=1e-6)
     x = np.interp(ctrl.time, ref.time, ref.runner_position)
     v = np.interp(ctrl.time, ref.time, ref.runner_velocity)
-    assert np.abs(ctrl.runner_position - x).max() < time_steps.CONVERGED_ACCURACY
+    assert np.abs(ctrl.runner_position - x).max() < steps.CONVERGED_ACCURACY
     assert np.abs(ctrl.runner_velocity - v).max() < 0.01 * np.ptp(ref.runner_velocity)
 
 

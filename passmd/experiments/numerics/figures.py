@@ -18,8 +18,7 @@ from passmd.model.parameters import Amplifier, Drive, Material
 from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
 from passmd.runtime.validation import check_choice, check_count, check_range
-from passmd.solver import simulation
-from passmd.solver import steps as time_steps
+from passmd.solver import simulation, steps
 
 #: Configurations the numerics are shown for: (label, contacts, actuator model).
 CONFIGURATIONS = (
@@ -36,10 +35,10 @@ RESOLUTIONS = {"quick": (0.5, 1.0, 2.0, 4.0), "paper": (0.25, 0.5, 1.0, 2.0, 4.0
 #: Step controls of :func:`convergence_study` by name: the integration schemes
 #: (:data:`passmd.solver.steps.SCHEMES`) it compares.
 STEP_CONTROLS = {
-    "controlled": time_steps.SCHEMES["controlled"],  # the default: error-controlled steps
-    "adaptive": time_steps.SCHEMES["adaptive"],  # explicit adaptive step (fine while ringing, coarse after)
-    "quasi-static": time_steps.SCHEMES["quasi-static"],  # m_a neglected, fixed runner step
-    "fixed": time_steps.SCHEMES["fixed"],  # the fine step throughout: the reference scheme
+    "controlled": steps.SCHEMES["controlled"],  # the default: error-controlled steps
+    "adaptive": steps.SCHEMES["adaptive"],  # explicit adaptive step (fine while ringing, coarse after)
+    "quasi-static": steps.SCHEMES["quasi-static"],  # m_a neglected, fixed runner step
+    "fixed": steps.SCHEMES["fixed"],  # the fine step throughout: the reference scheme
 }
 #: Step controls that differ for rigid actuators (they have no actuator mode to adapt to: their
 #: explicit adaptive and quasi-static steps are the fixed one).
@@ -144,7 +143,7 @@ def energy_balance_table(
     error-controlled one with the explicit "adaptive" one: the fixed fine step for rigid
     actuators, adaptive for flexible ones).
     """
-    scheme = time_steps.resolve_scheme(scheme).replace(refine=resolution)
+    scheme = steps.resolve_scheme(scheme).replace(refine=resolution)
     rows = []
     for label, contacts, model in CONFIGURATIONS:
         drive = Drive(contacts=contacts, actuator_model=model)
@@ -270,7 +269,7 @@ def rigid_coulomb_limit(
                 # stiffness, as the gap it measures does (the error-controlled step's absolute
                 # tolerance would not, and would set a floor under the fitted rate)
                 res = simulation.simulate(drive, wf, max_points=2,
-                                        scheme=time_steps.SCHEMES["fixed"].replace(refine=resolution))
+                                        scheme=steps.SCHEMES["fixed"].replace(refine=resolution))
                 step = float(res.step_sizes[-1])
                 rows.append({
                     "configuration": f"{'six contacts' if n == 6 else 'one contact'}, {label} fly-back",
