@@ -56,7 +56,7 @@ import numpy as np
 from passmd.model import waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
-from passmd.solver import simulation
+from passmd.solver import kernels, simulation
 
 CONFIGS = [
     (contacts, model, contact, control)
@@ -141,17 +141,17 @@ def old_kernel(commit: str):
 def running(module):
     """:mod:`passmd.solver.simulation` integrates with ``module``'s kernel (None: the current one); the
     argument records are rebuilt as that module's NamedTuples."""
-    current = simulation.kern.integrate
+    current = kernels.integrate
     if module is not None:
         def integrate(segments, mechanics, control, contacts, buffers, limit):
             return module.integrate(module.Segments(*segments), module.Mechanics(*mechanics),
                                     module.StepControl(*control), module.Contacts(*contacts),
                                     module.Buffers(*buffers), limit)
-        simulation.kern.integrate = integrate
+        kernels.integrate = integrate
     try:
         yield
     finally:
-        simulation.kern.integrate = current
+        kernels.integrate = current
 
 
 def _outcome(res) -> tuple:

@@ -155,19 +155,19 @@ def test_divergence_is_reported(monkeypatch):
 
 def test_kernel_wrapper_refuses_a_wrong_array_naming_it(monkeypatch):
     """The compiled loop does no bounds checks: its Python wrapper checks every array first."""
-    from passmd.solver import kernels as kern
+    from passmd.solver import kernels
 
     seen = []
-    integrate = kern.integrate
+    integrate = kernels.integrate
 
     def capture(*args):
         seen.append(args)
         return integrate(*args)
 
-    monkeypatch.setattr(kern, "integrate", capture)
+    monkeypatch.setattr(kernels, "integrate", capture)
     run(one_contact(), 50e-9, periods=1)
     segments, mechanics, control, contacts, buffers, limit = seen[0]
-    narrow = buffers._replace(per=np.zeros((1, kern.PER_COLUMNS - 1)))
+    narrow = buffers._replace(per=np.zeros((1, kernels.PER_COLUMNS - 1)))
     with pytest.raises(ValueError, match=r"buffers\.per has shape \(1, 7\), must be \(1, 8\)"):
         integrate(segments, mechanics, control, contacts, narrow, limit)
     ints = segments._replace(t0=segments.t0.astype(np.int64))
