@@ -42,8 +42,7 @@ from passmd.cli.streams import write_atomically
 from passmd.ledger.claims import CLAIMS_PATH
 from passmd.model import waveforms
 from passmd.model.parameters import Drive
-from passmd.runtime import progress as _progress
-from passmd.runtime import sweep
+from passmd.runtime import progress, sweep
 from passmd.solver import simulation
 
 #: Generous limits: a refusal or a one-period run takes seconds (start-up included).
@@ -427,8 +426,8 @@ def test_library_runs_stay_quiet_off_a_terminal(monkeypatch, capsys):
     """Without ``progress="long"`` (the command line's choice) a long run prints nothing off a
     terminal: the book's notebooks treat any stderr output as a warning."""
     monkeypatch.setattr(simulation, "PROGRESS_MIN_WORK", 0.0)
-    monkeypatch.setattr(_progress, "DELAY", 0.0)
-    monkeypatch.setattr(_progress, "LINE_INTERVAL", 0.0)
+    monkeypatch.setattr(progress, "DELAY", 0.0)
+    monkeypatch.setattr(progress, "LINE_INTERVAL", 0.0)
     monkeypatch.setattr(simulation, "CHUNK_STEPS", 200)
     drive = Drive(contacts=1)
     wave = waveforms.sawtooth(drive.actuator.full_stroke_amplitude, 10e3, drive, periods=2)
@@ -455,7 +454,7 @@ def test_a_terminal_gets_a_bar_redrawn_in_place():
             pass
 
     terminal = Terminal()
-    bar = _progress.bar(4, unit="point", desc="sweep", delay=0.0, stream=terminal)
+    bar = progress.bar(4, unit="point", desc="sweep", delay=0.0, stream=terminal)
     bar.update(2)
     bar.refresh()
     bar.close()
@@ -468,8 +467,8 @@ def slow_point(x):
 
 
 def test_sweep_progress_lines_off_a_terminal(monkeypatch, capsys):
-    monkeypatch.setattr(_progress, "DELAY", 0.0)
-    monkeypatch.setattr(_progress, "LINE_INTERVAL", 0.0)
+    monkeypatch.setattr(progress, "DELAY", 0.0)
+    monkeypatch.setattr(progress, "LINE_INTERVAL", 0.0)
     points = sweep.grid(x=[1, 2, 3, 4])
     sweep.run(slow_point, points, executor="serial", cache=False)  # default: on a terminal only
     assert capsys.readouterr().err == ""
@@ -613,8 +612,8 @@ def test_critical_amplitude_search_shows_progress_off_a_terminal(monkeypatch, ca
     choice), and stays quiet off a terminal without it (the book's notebooks)."""
     from passmd.protocols import critical_amplitude
 
-    monkeypatch.setattr(_progress, "DELAY", 0.0)
-    monkeypatch.setattr(_progress, "LINE_INTERVAL", 0.0)
+    monkeypatch.setattr(progress, "DELAY", 0.0)
+    monkeypatch.setattr(progress, "LINE_INTERVAL", 0.0)
     drive = Drive(contacts=1, actuator_model="rigid")
     critical_amplitude.critical_amplitude(drive, protocol="first", tolerance=20e-9)
     assert capsys.readouterr().err == ""
@@ -713,9 +712,9 @@ def test_a_signal_at_any_moment_of_a_fit_is_one_line(tmp_path, moment, sig):
 
 def test_time_left_waits_for_a_few_units():
     """No estimate from the first units (they carry the start-up); the average rate after them."""
-    assert _progress.time_left(12.0, 1, 12, "run") == f"time left known after {_progress.MIN_DONE} runs"
-    assert _progress.time_left(9.0, 3, 6, "point", lambda s: f"{s:.0f} s") == "about 18 s left"
-    assert _progress.time_left(9.0, 3, None, "point") == "time left unknown"
+    assert progress.time_left(12.0, 1, 12, "run") == f"time left known after {progress.MIN_DONE} runs"
+    assert progress.time_left(9.0, 3, 6, "point", lambda s: f"{s:.0f} s") == "about 18 s left"
+    assert progress.time_left(9.0, 3, None, "point") == "time left unknown"
     class Terminal:
         text = ""
 
@@ -732,7 +731,7 @@ def test_time_left_waits_for_a_few_units():
             return self.text
 
     terminal = Terminal()
-    bar = _progress.bar(13, unit="run", desc="critical amplitude", delay=0.0, stream=terminal)
+    bar = progress.bar(13, unit="run", desc="critical amplitude", delay=0.0, stream=terminal)
     bar.update(1)
     bar.refresh()
     assert "time left known after 3 runs" in terminal.getvalue() and "about" not in terminal.getvalue()

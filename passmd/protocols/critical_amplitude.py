@@ -433,15 +433,15 @@ def critical_amplitude(
     return found
 
 
-def _bisection_bar(upper: float, tolerance: float, progress: bool | str | None):
+def _bisection_bar(upper: float, tolerance: float, show: bool | str | None):
     """A progress bar over the bisection's runs (1 + halvings of ``upper`` down to ``tolerance``)."""
     import sys
 
-    from passmd.runtime import progress as _progress
+    from passmd.runtime import progress
 
-    if progress is False or sys.stderr is None or _progress.in_worker():
+    if show is False or sys.stderr is None or progress.in_worker():
         return None
-    if progress is None and not _progress.is_terminal(sys.stderr):
+    if show is None and not progress.is_terminal(sys.stderr):
         return None
     runs = 1 + max(0, math.ceil(math.log2(upper / tolerance)))
-    return _progress.bar(runs, unit="run", desc="critical amplitude")
+    return progress.bar(runs, unit="run", desc="critical amplitude")

@@ -67,24 +67,24 @@ SPRINGS_PER_STEP = 100
 PROGRESS_MIN_WORK = 2e6
 
 
-def _progress_bar(work: float, waveform: Waveform, progress: bool | str | None):
+def _progress_bar(work: float, waveform: Waveform, show: bool | str | None):
     """Progress over simulated periods on stderr (:func:`passmd.runtime.progress.bar`), or None.
 
-    ``work``: the run's expected work in steps of the exact contact. None: runs of more than
+    ``work``: the run's expected work in steps of the exact contact. ``show`` None: runs of more than
     :data:`PROGRESS_MIN_WORK` when stderr is a terminal; ``"long"``: those runs whatever stderr
     is (off a terminal, a line every few seconds); True: every run at once; False: none.
     """
-    from passmd.runtime import progress as _progress
+    from passmd.runtime import progress
 
-    if progress is False or sys.stderr is None:
+    if show is False or sys.stderr is None:
         return None
-    if progress is not True:
-        if work < PROGRESS_MIN_WORK or _progress.in_worker():
+    if show is not True:
+        if work < PROGRESS_MIN_WORK or progress.in_worker():
             return None
-        if progress is None and not _progress.is_terminal(sys.stderr):
+        if show is None and not progress.is_terminal(sys.stderr):
             return None
-    return _progress.bar(waveform.periods, unit="period", desc="simulation", fractional=True,
-                         delay=0.0 if progress is True else None)
+    return progress.bar(waveform.periods, unit="period", desc="simulation", fractional=True,
+                        delay=0.0 if show is True else None)
 
 
 def simulate(drive: Drive, waveform: Waveform, **options) -> SimulationResult:
