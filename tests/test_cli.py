@@ -482,9 +482,9 @@ def test_figure_reads_the_environment_once_and_its_options_win(fake_figure, tmp_
 @pytest.mark.parametrize("how", ["a file", "read-only"])
 def test_figure_with_an_unwritable_cache_keeps_its_result(fake_figure, tmp_path, monkeypatch, capsys, how):
     """The cache cannot be written: one warning line, the figure is still computed and written."""
-    from passmd.runtime.cache import store as cache_store
+    from passmd.runtime.cache import store
 
-    monkeypatch.setattr(cache_store, "_REPORTED_UNWRITABLE", set())
+    monkeypatch.setattr(store, "_REPORTED_UNWRITABLE", set())
     cache_dir = tmp_path / "cache"
     if how == "a file":
         cache_dir.write_text("not a directory")
