@@ -32,7 +32,7 @@ from hypothesis import strategies as st
 
 from passmd import cli
 from passmd.cli import kernels, options
-from passmd.cli.commands import run as run_command
+from passmd.cli.commands import run
 from passmd.model.mdr_contact import MDRContact
 from passmd.model.parameters import Drive
 from passmd.model.tables import Actuator, Amplifier, Material
@@ -199,7 +199,7 @@ def test_interrupted_run_does_not_claim_a_cache():
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    with mock.patch.object(run_command, "simulate", interrupted):
+    with mock.patch.object(run, "simulate", interrupted):
         status, _, err, _ = run_main(["run"])
     assert status == 130 and err == "passmd run: interrupted\n"
 
@@ -543,7 +543,7 @@ def test_generated_command_lines_end_cleanly(scratch, argv):
     from passmd.protocols import critical_amplitude, stall
 
     # the long computations are replaced by a marker: reaching them means every check passed
-    with mock.patch.object(run_command, "simulate", _reached), \
+    with mock.patch.object(run, "simulate", _reached), \
             mock.patch.object(critical_amplitude, "critical_amplitude", _reached), \
             mock.patch.object(stall, "generated_force", _reached), \
             mock.patch.object(figure_table, "figure_data", _reached):

@@ -544,11 +544,11 @@ def test_failed_simulation_exits_1(monkeypatch, capsys):
 def test_run_pauses_the_collector_until_its_simulation_has_run(monkeypatch, tmp_path):
     """Imports and kernel loading run without automatic collection; the outputs (pandas,
     matplotlib) and whatever follows the command run with it."""
-    from passmd.cli.commands import run as run_command
+    from passmd.cli.commands import run
     from passmd.solver import simulation
 
     enabled = {}
-    simulate, write_outputs = simulation.simulate, run_command.write_outputs
+    simulate, write_outputs = simulation.simulate, run.write_outputs
 
     def spy_simulate(*args, **kwargs):
         enabled["simulation"] = gc.isenabled()
@@ -559,7 +559,7 @@ def test_run_pauses_the_collector_until_its_simulation_has_run(monkeypatch, tmp_
         return write_outputs(*args, **kwargs)
 
     monkeypatch.setattr(simulation, "simulate", spy_simulate)
-    monkeypatch.setattr(run_command, "write_outputs", spy_write_outputs)
+    monkeypatch.setattr(run, "write_outputs", spy_write_outputs)
     assert gc.isenabled()
     # (an in-process Ctrl-C test earlier in the session may have frozen objects: count from here)
     frozen = gc.get_freeze_count()

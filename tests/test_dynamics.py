@@ -10,9 +10,9 @@ import pytest
 from passmd.model import theory, waveforms
 from passmd.model.contact import contact_arrays, contact_stiffness, stack_contacts
 from passmd.model.parameters import Drive
-from passmd.solver import setup as run_setup
 from passmd.solver import simulation, steps
 from passmd.solver.results import SimulationError
+from passmd.solver.setup import contact_groups
 from passmd.solver.steps import SCHEMES
 
 F_TEST = 1000.0  # Hz: 1 ms periods keep tests fast; the runner mode (~5-11 kHz) settles within
@@ -148,7 +148,7 @@ def test_divergence_is_reported(monkeypatch):
     d = one_contact("flexible")
     wf = waveforms.sawtooth(100e-9, F_TEST, d, periods=1)
     plan_dt = steps.step_plan(d, 3e6, 3e6).stability_limit
-    monkeypatch.setattr(run_setup, "STABILITY_MARGIN", 100.0)  # let an unstable step through
+    monkeypatch.setattr("passmd.solver.setup.STABILITY_MARGIN", 100.0)  # let an unstable step through
     with pytest.raises(SimulationError, match=r"diverged at integrator step \d+.*time step"):
         simulation.simulate(d, wf, scheme=SCHEMES["fixed"].replace(dt=5 * plan_dt))
 
@@ -362,7 +362,7 @@ def test_expected_steps_match_the_run(scheme):
         wf = waveforms.sawtooth(202e-9, 100.0, d, periods=1)
         res = simulation.simulate(d, wf, scheme=scheme)
         E, G = theory.contact_moduli(d)
-        forces, mult = run_setup.contact_groups(d)
+        forces, mult = contact_groups(d)
         rows = [contact_arrays("exact", F, d.hemisphere_radius, E, G, d.friction_coefficient) for F in forces]
         params, _ = stack_contacts(rows)
         ks = np.array([contact_stiffness(params[g]) for g in range(len(rows))])
