@@ -366,14 +366,14 @@ def main(argv=None) -> int:
     load_before = os.getloadavg()
     commit = args.old_kernel or OLD_KERNEL_COMMIT
     if in_history(commit):
-        kernels = compare_kernels(commit, args.kernel_pairs, kernel_configs)
+        kernel_rows = compare_kernels(commit, args.kernel_pairs, kernel_configs)
     elif args.old_kernel:
         ap.error(f"--old-kernel {commit} is not a commit of this checkout's git history")
     else:
         print(f"kernel comparison skipped: --old-kernel {commit[:12]} is not in this checkout's git history "
               "(a shallow clone or no repository); fetch it (git fetch --unshallow) to compare")
-        kernels = None
-    for r in kernels or []:
+        kernel_rows = None
+    for r in kernel_rows or []:
         print(f"kernel {r['contacts']} {r['actuator']} {r['contact_model']} {r['step']}: old "
               f"{r['old_ms_per_100Hz_period']:.3f} ms, new {r['new_ms_per_100Hz_period']:.3f} ms per period, "
               f"new/old {r['new_over_old']:.3f}, identical: {r['identical']}")
@@ -402,7 +402,7 @@ def main(argv=None) -> int:
     print(f"{spread['configuration']}: {spread['median_ms_per_100Hz_period']:.3f} ms per period, median of "
           f"{len(spread['ms_per_100Hz_period_per_process'])} processes "
           f"({', '.join(f'{v:.2f}' for v in spread['ms_per_100Hz_period_per_process'])})")
-    comparison = {"old_commit": commit, "rows": kernels} if kernels is not None else None
+    comparison = {"old_commit": commit, "rows": kernel_rows} if kernel_rows is not None else None
     args.out.write_text(json.dumps({"meta": meta, "rows": rows, "startup": start, "across_processes": spread,
                                     "kernel_comparison": comparison}, indent=2))
     print(f"written {args.out}")
