@@ -55,12 +55,12 @@ def _timed(func, repeats: int) -> dict:
 
 
 def blocks(repeats: int) -> dict:
-    from passmd.experiments.driving_waveform import runs as dw_runs
+    from passmd.experiments.driving_waveform import runs
     from passmd.model import optimized_waveform
     from passmd.protocols import eq15
-    from passmd.solver import simulation as dynamics
+    from passmd.solver import simulation
 
-    drive = dw_runs.section5_drive()
+    drive = runs.section5_drive()
     amplitude = drive.actuator.full_stroke_amplitude
     design = eq15.optimized_design(amplitude, drive)
     fields = {"settling_time": design.settling_time, "acceleration_time": design.acceleration_time,
@@ -69,11 +69,11 @@ def blocks(repeats: int) -> dict:
     for f in (1e3, 110e3):
         for waveform, rule in (("sawtooth", ""), ("optimized", "cut")):
             out[f"steady_{waveform}_{f / 1e3:g}kHz"] = _timed(
-                lambda f=f, w=waveform, r=rule: dw_runs.velocity_point(
-                    **dw_runs.section5_fields(), frequency=f, waveform=w, short_period=r, **fields),
+                lambda f=f, w=waveform, r=rule: runs.velocity_point(
+                    **runs.section5_fields(), frequency=f, waveform=w, short_period=r, **fields),
                 repeats)
     wave = optimized_waveform.optimized(amplitude, PROTOCOL.drive_frequency, drive, periods=3, design=design)
-    out["step_100hz"] = _timed(lambda: dynamics.simulate(drive, wave, max_points=2), repeats)
+    out["step_100hz"] = _timed(lambda: simulation.simulate(drive, wave, max_points=2), repeats)
     return out
 
 

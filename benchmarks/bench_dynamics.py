@@ -56,7 +56,7 @@ import numpy as np
 from passmd.model import waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
-from passmd.solver import simulation as dynamics
+from passmd.solver import kernels, simulation
 
 CONFIGS = [
     (contacts, model, contact, control)
@@ -141,17 +141,17 @@ def old_kernel(commit: str):
 def running(module):
     """:mod:`passmd.solver.simulation` integrates with ``module``'s kernel (None: the current one); the
     argument records are rebuilt as that module's NamedTuples."""
-    current = dynamics.kern.integrate
+    current = kernels.integrate
     if module is not None:
         def integrate(segments, mechanics, control, contacts, buffers, limit):
             return module.integrate(module.Segments(*segments), module.Mechanics(*mechanics),
                                     module.StepControl(*control), module.Contacts(*contacts),
                                     module.Buffers(*buffers), limit)
-        dynamics.kern.integrate = integrate
+        kernels.integrate = integrate
     try:
         yield
     finally:
-        dynamics.kern.integrate = current
+        kernels.integrate = current
 
 
 def _outcome(res) -> tuple:
@@ -177,7 +177,7 @@ def compare_kernels(commit: str, pairs: int, configs=KERNEL_CONFIGS, springs: in
             pair = (("old", old), ("new", None)) if i % 2 else (("new", None), ("old", old))
             for name, module in pair:
                 with running(module):
-                    res = dynamics.simulate(drive, wf, **kw)
+                    res = simulation.simulate(drive, wf, **kw)
                 if i:  # the first round compiles
                     walls[name].append(res.wall_time)
                 outcome[name] = _outcome(res)
@@ -267,11 +267,11 @@ def bench(contacts: int, model: str, contact: str, control: str, repeats: int, s
     drive = Drive(contacts=contacts, actuator_model=model)
     kw = dict(contact_model=contact, springs=springs, scheme=control)
     warm = waveforms.sawtooth(150e-9, 10e3, drive, periods=1)
-    dynamics.simulate(drive, warm, **kw)  # compile
+    simulation.simulate(drive, warm, **kw)  # compile
     wf = waveforms.sawtooth(150e-9, PROTOCOL.drive_frequency, drive, periods=PERIODS)
     walls = []
     for _ in range(repeats):
-        res = dynamics.simulate(drive, wf, max_points=2000, **kw)
+        res = simulation.simulate(drive, wf, max_points=2000, **kw)
         walls.append(res.wall_time)
     if control == "fixed":
         _REFERENCE[(contacts, model, contact)] = res.settled_positions
@@ -297,13 +297,13 @@ def bench(contacts: int, model: str, contact: str, control: str, repeats: int, s
 # contacts, flexible actuators, exact contact, in a process of its own
 _ONE_PROCESS = """
 import json, statistics, sys
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 from passmd.model import waveforms
 from passmd.model.parameters import Drive
 d = Drive(contacts=6, actuator_model="flexible")
 wf = waveforms.sawtooth(150e-9, float(sys.argv[1]), d, periods=int(sys.argv[2]))
-dynamics.simulate(d, wf, max_points=2000)
-walls = [dynamics.simulate(d, wf, max_points=2000).wall_time for _ in range(int(sys.argv[3]))]
+simulation.simulate(d, wf, max_points=2000)
+walls = [simulation.simulate(d, wf, max_points=2000).wall_time for _ in range(int(sys.argv[3]))]
 print(json.dumps(statistics.median(walls) / int(sys.argv[2]) * 1e3))
 """
 
@@ -366,14 +366,14 @@ def main(argv=None) -> int:
     load_before = os.getloadavg()
     commit = args.old_kernel or OLD_KERNEL_COMMIT
     if in_history(commit):
-        kernels = compare_kernels(commit, args.kernel_pairs, kernel_configs)
+        kernel_rows = compare_kernels(commit, args.kernel_pairs, kernel_configs)
     elif args.old_kernel:
         ap.error(f"--old-kernel {commit} is not a commit of this checkout's git history")
     else:
         print(f"kernel comparison skipped: --old-kernel {commit[:12]} is not in this checkout's git history "
               "(a shallow clone or no repository); fetch it (git fetch --unshallow) to compare")
-        kernels = None
-    for r in kernels or []:
+        kernel_rows = None
+    for r in kernel_rows or []:
         print(f"kernel {r['contacts']} {r['actuator']} {r['contact_model']} {r['step']}: old "
               f"{r['old_ms_per_100Hz_period']:.3f} ms, new {r['new_ms_per_100Hz_period']:.3f} ms per period, "
               f"new/old {r['new_over_old']:.3f}, identical: {r['identical']}")
@@ -402,7 +402,7 @@ def main(argv=None) -> int:
     print(f"{spread['configuration']}: {spread['median_ms_per_100Hz_period']:.3f} ms per period, median of "
           f"{len(spread['ms_per_100Hz_period_per_process'])} processes "
           f"({', '.join(f'{v:.2f}' for v in spread['ms_per_100Hz_period_per_process'])})")
-    comparison = {"old_commit": commit, "rows": kernels} if kernels is not None else None
+    comparison = {"old_commit": commit, "rows": kernel_rows} if kernel_rows is not None else None
     args.out.write_text(json.dumps({"meta": meta, "rows": rows, "startup": start, "across_processes": spread,
                                     "kernel_comparison": comparison}, indent=2))
     print(f"written {args.out}")

@@ -44,8 +44,7 @@ import numpy as np
 
 from passmd.experiments.calibration.synthetic import independent_steps
 from passmd.model.parameters import Drive
-from passmd.protocols import fit as F
-from passmd.protocols import velocity
+from passmd.protocols import fit, velocity
 from passmd.protocols.fit.prediction import drive_at
 from passmd.runtime.config import RunConfig
 
@@ -90,7 +89,7 @@ def main() -> int:
     header = ["amplitude_nm", "preload_N", "frequency_Hz", "step_nm", "step_nm_sd"]
     rows = [[repr(float(a * 1e9)), repr(p), repr(f), repr(float(v * 1e9)), repr(NOISE_NM)]
             for (p, a, f), v in zip(conditions, noisy, strict=True)]
-    data = F.measurements_from_rows(header, rows, name="bench_fit data")
+    data = fit.measurements_from_rows(header, rows, name="bench_fit data")
 
     load_row = os.getloadavg()
     row_times = []
@@ -117,7 +116,7 @@ def main() -> int:
             stages.append((time.perf_counter() - start, line))
             print(f"fit: {line} [{time.perf_counter() - start:.0f} s]", file=sys.stderr, flush=True)
 
-        result = F.fit(base, data, list(free), config=RunConfig(cache_dir=Path(cache)), progress=progress)
+        result = fit.fit(base, data, list(free), config=RunConfig(cache_dir=Path(cache)), progress=progress)
         wall = time.perf_counter() - start
         load_after = os.getloadavg()
     row_s = statistics.median(row_times)

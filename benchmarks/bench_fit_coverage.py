@@ -48,7 +48,7 @@ import numpy as np
 
 from passmd.experiments.calibration.synthetic import independent_steps
 from passmd.model.parameters import Drive
-from passmd.protocols import fit as F
+from passmd.protocols import fit
 from passmd.protocols.fit.prediction import drive_at
 from passmd.runtime.config import RunConfig
 
@@ -109,15 +109,15 @@ def draw(seed: int, stiffness: float, setting: dict = SETTINGS["full"]) -> dict:
     header = ["amplitude_nm", "preload_N", "frequency_Hz", "step_nm", "step_nm_sd"]
     rows = [[repr(float(a * 1e9)), repr(p), repr(f), repr(float(v * 1e9)), repr(NOISE_NM)]
             for (p, a, f), v in zip(conditions, values, strict=True)]
-    data = F.measurements_from_rows(header, rows, name=f"draw {seed}")
+    data = fit.measurements_from_rows(header, rows, name=f"draw {seed}")
     with tempfile.TemporaryDirectory() as cache:
         start = time.perf_counter()
         config = RunConfig(cache_dir=Path(cache))
-        result = F.fit(base, data, free, config=config)
+        result = fit.fit(base, data, free, config=config)
         wall = time.perf_counter() - start
         # the joint rise of the cost at the truth (the fit's forward model): inside the joint 95 %
         # region when at most the level; every parameter's region then holds its truth too
-        at_truth = float(np.sum(((F.predict(truth, data, config=config) - data.value) / data.sd) ** 2))
+        at_truth = float(np.sum(((fit.predict(truth, data, config=config) - data.value) / data.sd) ** 2))
     holds = {n: any(a <= truth_values[n] <= b for a, b in result.estimates[n]["intervals"]) for n in free}
     pieces = {n: len(result.estimates[n]["intervals"]) for n in free}
     flat = any(result.estimates[n]["flat_profile"] for n in free)
@@ -155,7 +155,7 @@ def summary(draws: list[dict]) -> dict:
         "verdicts": {v: share(sum(d["verdict"] == v for d in draws)) for v in verdicts},
         "identifiable_but_missed": sum(d["verdict"] == "identifiable" and not all(d["holds"].values())
                                        for d in draws),
-        "rejected_at_1_percent": share(sum(d["p_value"] < F.REJECT_P for d in draws)),
+        "rejected_at_1_percent": share(sum(d["p_value"] < fit.REJECT_P for d in draws)),
         "median_wall_time_s": statistics.median(d["wall_time_s"] for d in draws),
         "median_evaluations": statistics.median(d["evaluations"] for d in draws),
     }

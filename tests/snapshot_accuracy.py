@@ -16,10 +16,10 @@ import contextlib
 
 import pytest
 
-from passmd.experiments.numerics import accuracy as acc
+from passmd.experiments.numerics import accuracy
 from passmd.model.parameters import Drive
 from passmd.runtime.config import RunConfig
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 from passmd.solver.steps import DEFAULT_SCHEME, resolve_scheme
 
 #: Columns computed without the integrator (inputs, closed forms, booleans): rounding only.
@@ -31,17 +31,17 @@ FINER = 2.0
 
 
 def position(scale: float = 1.0) -> dict:
-    return {"rtol": 0.0, "atol": acc.POSITION_ACCURACY * scale}
+    return {"rtol": 0.0, "atol": accuracy.POSITION_ACCURACY * scale}
 
 
 def force(scale: float = 1.0) -> dict:
-    return {"rtol": acc.STALL_FORCE_RTOL, "atol": acc.FORCE_ACCURACY * scale}
+    return {"rtol": accuracy.STALL_FORCE_RTOL, "atol": accuracy.FORCE_ACCURACY * scale}
 
 
 def critical_amplitude(bracket_width: float, scale: float = 1.0) -> dict:
     """A critical amplitude or onset found to ``bracket_width`` (m), in units of ``scale`` per m."""
-    width = acc.CRITICAL_AMPLITUDE_BRACKETS * bracket_width
-    return {"rtol": 0.0, "atol": (width + acc.POSITION_ACCURACY) * scale}
+    width = accuracy.CRITICAL_AMPLITUDE_BRACKETS * bracket_width
+    return {"rtol": 0.0, "atol": (width + accuracy.POSITION_ACCURACY) * scale}
 
 
 def tolerances(columns, *, amplitudes=(), bracket_width: float = 0.0, forces_in_length=()) -> dict:
@@ -59,17 +59,18 @@ def tolerances(columns, *, amplitudes=(), bracket_width: float = 0.0, forces_in_
         if col in amplitudes:
             out[col] = critical_amplitude(bracket_width, nano)
         elif col in forces_in_length:
-            out[col] = {"rtol": acc.STALL_FORCE_RTOL, "atol": acc.FORCE_ACCURACY / LOAD_CELL_STIFFNESS * nano}
+            atol = accuracy.FORCE_ACCURACY / LOAD_CELL_STIFFNESS * nano
+            out[col] = {"rtol": accuracy.STALL_FORCE_RTOL, "atol": atol}
         elif col.endswith("_m_per_s"):
-            out[col] = {"rtol": 0.0, "atol": acc.VELOCITY_ACCURACY}
+            out[col] = {"rtol": 0.0, "atol": accuracy.VELOCITY_ACCURACY}
         elif col.endswith(("_m", "_nm")):
             out[col] = position(nano)
         elif col.endswith(("_N", "_mN")):
             out[col] = force(1e3 if col.endswith("_mN") else 1.0)
         elif col.endswith(("_Hz", "_s", "_us")):
-            out[col] = {"rtol": acc.FREQUENCY_RTOL, "atol": 0.0}
+            out[col] = {"rtol": accuracy.FREQUENCY_RTOL, "atol": 0.0}
         elif "slip_share" in col:
-            out[col] = {"rtol": 0.0, "atol": acc.SLIP_SHARE_ACCURACY}
+            out[col] = {"rtol": 0.0, "atol": accuracy.SLIP_SHARE_ACCURACY}
         else:
             out[col] = dict(EXACT)
     return out
@@ -88,13 +89,13 @@ def numeric(frame):
 def finer_run(factor: float = FINER):
     """Within the block every simulation runs ``factor`` times finer.
 
-    Patches ``dynamics.Simulation``, which ``dynamics.simulate`` and the stall protocol
+    Patches ``simulation.Simulation``, which ``simulation.simulate`` and the stall protocol
     construct: each run's scheme is refined by ``factor`` (:class:`passmd.solver.steps.Scheme`
     ``refine``: explicit steps divided by it, the error-controlled step's local tolerance by its
     fourth power, so that step shrinks about ``factor`` times); a fixed ``dt`` is divided by it.
     Sweeps inside must run serially with a cache of their own (:func:`finer_config`).
     """
-    default = dynamics.Simulation
+    default = simulation.Simulation
 
     class Finer(default):
         def __init__(self, *args, scheme=DEFAULT_SCHEME, **kwargs):
@@ -106,7 +107,7 @@ def finer_run(factor: float = FINER):
             super().__init__(*args, scheme=finer, **kwargs)
 
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(dynamics, "Simulation", Finer)
+        patch.setattr(simulation, "Simulation", Finer)
         yield
 
 

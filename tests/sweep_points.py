@@ -32,10 +32,10 @@ def sawtooth_point(drive: Drive, amplitude: float, frequency: float, periods: in
     exact MDR contacts, else N discrete springs.
     """
     from passmd.model import waveforms
-    from passmd.solver import simulation as dynamics
+    from passmd.solver import simulation
 
     wave = waveforms.sawtooth(amplitude, frequency, drive, periods=periods, flyback=flyback)
-    result = dynamics.simulate(drive, wave, contact_model="exact" if springs is None else "discrete",
+    result = simulation.simulate(drive, wave, contact_model="exact" if springs is None else "discrete",
                                springs=PROTOCOL.springs if springs is None else springs, max_points=2)
     summary = result.summary()
     del summary["periods"]  # an input of the point, already a column

@@ -32,7 +32,7 @@ from hypothesis import strategies as st
 
 from passmd import cli
 from passmd.cli import kernels, options
-from passmd.cli.commands import run as run_command
+from passmd.cli.commands import run
 from passmd.model.mdr_contact import MDRContact
 from passmd.model.parameters import Drive
 from passmd.model.tables import Actuator, Amplifier, Material
@@ -199,7 +199,7 @@ def test_interrupted_run_does_not_claim_a_cache():
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    with mock.patch.object(run_command, "simulate", interrupted):
+    with mock.patch.object(run, "simulate", interrupted):
         status, _, err, _ = run_main(["run"])
     assert status == 130 and err == "passmd run: interrupted\n"
 
@@ -340,7 +340,7 @@ def test_an_unknown_column_in_another_unit_names_the_known_one(tmp_path, column,
 def test_too_many_workers_are_capped_with_one_line(monkeypatch):
     """Above two per usable core, one line names the option or the variable as typed and the count
     run; the command then goes on (here: up to its computation, which gets the capped count)."""
-    from passmd.experiments.design import maps as design_maps
+    from passmd.experiments.design import maps
 
     monkeypatch.setattr("passmd.cli.configuration.usable_cores", lambda: 2)
     seen = []
@@ -349,7 +349,7 @@ def test_too_many_workers_are_capped_with_one_line(monkeypatch):
         seen.append(config.workers)
         raise _Reached
 
-    monkeypatch.setattr(design_maps, "compute_map", compute_map)
+    monkeypatch.setattr(maps, "compute_map", compute_map)
     argv = ["sweep", "velocity", "--vary", "frequency=100Hz..5kHz:log:3"]
     for extra, env, typed in ((["--workers", "64"], {}, "--workers 64"),
                               ([], {"PASSMD_WORKERS": "9"}, "PASSMD_WORKERS = 9")):
@@ -539,14 +539,14 @@ def scratch(tmp_path_factory):
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(argv=command_lines())
 def test_generated_command_lines_end_cleanly(scratch, argv):
-    from passmd.experiments import figure_table as figures
+    from passmd.experiments import figure_table
     from passmd.protocols import critical_amplitude, stall
 
     # the long computations are replaced by a marker: reaching them means every check passed
-    with mock.patch.object(run_command, "simulate", _reached), \
+    with mock.patch.object(run, "simulate", _reached), \
             mock.patch.object(critical_amplitude, "critical_amplitude", _reached), \
             mock.patch.object(stall, "generated_force", _reached), \
-            mock.patch.object(figures, "figure_data", _reached):
+            mock.patch.object(figure_table, "figure_data", _reached):
         try:
             status, out, err, caught = run_main(argv, env={"PASSMD_CACHE_DIR": str(scratch / "cache")})
         except _Reached:

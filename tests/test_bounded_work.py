@@ -47,16 +47,16 @@ def test_former_hangs_end_with_a_one_line_error(argv, option):
 _RUNNER = """
 import sys
 from passmd import cli
-from passmd.solver import kernels as kern
-from passmd.solver import simulation as dynamics
+from passmd.solver import kernels
+from passmd.solver import simulation
 
-integrate = kern.integrate
+integrate = kernels.integrate
 def announced(*args):
     sys.stderr.write("KERNEL\\n")
     sys.stderr.flush()
-    kern.integrate = integrate
+    kernels.integrate = integrate
     return integrate(*args)
-kern.integrate = announced
+kernels.integrate = announced
 sys.exit(cli.main(sys.argv[1:]))
 """
 

@@ -10,9 +10,8 @@ import pytest
 
 import passmd
 from passmd.model.parameters import Drive
-from passmd.runtime import cache as cache_module
+from passmd.runtime import cache
 from passmd.runtime.cache import Cache, canonical, code_fingerprint, default_cache_dir
-from passmd.runtime.cache import store as cache_store
 from passmd.runtime.config import RunConfig
 
 
@@ -119,7 +118,7 @@ def test_no_entry_can_run_code_when_read(marked, tmp_path):
     key = store.key(point_function, {"x": 9})
     store.path(key).parent.mkdir(parents=True, exist_ok=True)
     store.path(key).write_bytes(pickle.dumps({"key": key, "value": Exploit()}))
-    with pytest.warns(cache_module.CacheWarning, match="not a passmd cache entry") as record:
+    with pytest.warns(cache.CacheWarning, match="not a passmd cache entry") as record:
         assert store.get(key, "miss") == "miss"
         assert store.put(key, {"y": 9}) is False  # the same path: reported once, not replaced
     assert len(record) == 1
@@ -129,7 +128,7 @@ def test_no_entry_can_run_code_when_read(marked, tmp_path):
     store.path(key).unlink()
     store.put(key, {"y": np.arange(3.0)})
     data = store.path(key).read_bytes()
-    assert data.startswith(cache_module.MAGIC) and b"pickle" not in data
+    assert data.startswith(cache.MAGIC) and b"pickle" not in data
 
 
 def test_flipped_byte_is_detected_removed_and_recomputed(store):
@@ -138,7 +137,7 @@ def test_flipped_byte_is_detected_removed_and_recomputed(store):
     data = bytearray(store.path(key).read_bytes())
     data[-17] ^= 0x40  # one bit inside the stored array
     store.path(key).write_bytes(bytes(data))
-    with pytest.warns(cache_module.CacheWarning, match="checksum mismatch") as record:
+    with pytest.warns(cache.CacheWarning, match="checksum mismatch") as record:
         assert store.get(key, "miss") == "miss"
     assert len(record) == 1  # reported once
     assert not store.path(key).exists()
@@ -150,7 +149,7 @@ def test_scalar_in_the_header_is_covered_by_the_checksum(store):
     data = store.path(key).read_bytes()
     hexed = float.hex(0.25).encode()
     store.path(key).write_bytes(data.replace(hexed, float.hex(0.5).encode()))
-    with pytest.warns(cache_module.CacheWarning, match="checksum"):
+    with pytest.warns(cache.CacheWarning, match="checksum"):
         assert key not in store
 
 
@@ -161,7 +160,7 @@ def test_a_sweep_recomputes_a_corrupt_entry_with_one_warning(store):
     first = sweep.run(point_function, points, executor="serial", cache=store, progress=False)
     victim = store.path(store.key(point_function, points[0]))
     victim.write_bytes(victim.read_bytes()[:-3])  # truncated
-    with pytest.warns(cache_module.CacheWarning) as record:
+    with pytest.warns(cache.CacheWarning) as record:
         again = sweep.run(point_function, points, executor="serial", cache=store, progress=False)
     assert len(record) == 1 and "unusable" in str(record[0].message)
     assert again.attrs["sweep"]["computed"] == 1
@@ -174,7 +173,7 @@ def test_a_sweep_recomputes_a_corrupt_entry_with_one_warning(store):
 def test_unwritable_cache_warns_once_and_keeps_the_result(tmp_path, monkeypatch, how):
     from passmd.runtime import sweep
 
-    monkeypatch.setattr(cache_store, "_REPORTED_UNWRITABLE", set())
+    monkeypatch.setattr(cache.store, "_REPORTED_UNWRITABLE", set())
     directory = tmp_path / "cache"
     if how == "read-only":
         if os.geteuid() == 0:
@@ -187,16 +186,16 @@ def test_unwritable_cache_warns_once_and_keeps_the_result(tmp_path, monkeypatch,
         def full(*args, **kwargs):
             raise OSError(28, "No space left on device")
 
-        monkeypatch.setattr(cache_store.os, "fsync", full)
+        monkeypatch.setattr(cache.store.os, "fsync", full)
     else:  # another user's directory, also when the tests run as root
         def denied(*args, **kwargs):
             raise PermissionError(13, "Permission denied")
 
-        monkeypatch.setattr(cache_store.tempfile, "mkstemp", denied)
+        monkeypatch.setattr(cache.store.tempfile, "mkstemp", denied)
     store = Cache(directory)
     points = [{"x": float(x)} for x in range(4)]
     try:
-        with pytest.warns(cache_module.CacheWarning, match="continuing without the cache") as record:
+        with pytest.warns(cache.CacheWarning, match="continuing without the cache") as record:
             frame = sweep.run(point_function, points, executor="serial", cache=store, progress=False)
     finally:
         if how == "read-only":
@@ -229,7 +228,7 @@ def test_interrupted_write_leaves_no_entry(store, monkeypatch):
     def crash(src, dst):
         raise KeyboardInterrupt  # the process dies exactly here
 
-    monkeypatch.setattr(cache_store.os, "replace", crash)
+    monkeypatch.setattr(cache.store.os, "replace", crash)
     with pytest.raises(KeyboardInterrupt):
         store.put(key, {"y": 2})
     monkeypatch.undo()
@@ -259,7 +258,7 @@ def test_corrupt_entry_is_a_miss(marked, content):
     key = store.key(point_function, {"x": 4})
     store.path(key).parent.mkdir(parents=True, exist_ok=True)
     store.path(key).write_bytes(content)
-    with pytest.warns(cache_module.CacheWarning, match="unusable.*removed; recomputing"):
+    with pytest.warns(cache.CacheWarning, match="unusable.*removed; recomputing"):
         assert store.get(key, "miss") == "miss"
     assert not store.path(key).exists()
     store.put(key, {"y": 4})  # the recomputed value takes its place
@@ -273,7 +272,7 @@ def test_a_file_at_an_entry_path_without_the_magic_line_is_left_alone(marked, co
     key = store.key(point_function, {"x": 4})
     store.path(key).parent.mkdir(parents=True, exist_ok=True)
     store.path(key).write_bytes(content)
-    with pytest.warns(cache_module.CacheWarning, match="not a passmd cache entry.*left in place"):
+    with pytest.warns(cache.CacheWarning, match="not a passmd cache entry.*left in place"):
         assert store.get(key, "miss") == "miss"
     assert store.put(key, {"y": 4}) is False
     assert store.path(key).read_bytes() == content
@@ -288,7 +287,7 @@ def test_entry_under_wrong_key_is_a_miss(store):
     store.put(key_a, {"y": 5})
     store.path(key_b).parent.mkdir(parents=True, exist_ok=True)
     shutil.copy(store.path(key_a), store.path(key_b))  # a misplaced file is not trusted
-    with pytest.warns(cache_module.CacheWarning, match="another key"):
+    with pytest.warns(cache.CacheWarning, match="another key"):
         assert key_b not in store
     assert not store.path(key_b).exists() and store.get(key_a) == {"y": 5}
 
@@ -347,6 +346,6 @@ def test_entry_of_another_function_is_recomputed(store):
 
     key = store.key(point_function, {"x": 1.0})
     store.put(key, {"full_time_s": 1.0}, function="somewhere:else")
-    with pytest.warns(cache_module.CacheWarning, match="written by 'somewhere:else'"):
+    with pytest.warns(cache.CacheWarning, match="written by 'somewhere:else'"):
         frame = sweep.run(point_function, [{"x": 1.0}], executor="serial", cache=store, progress=False)
     assert frame["y"].tolist() == [1.0] and frame.attrs["sweep"]["computed"] == 1

@@ -27,11 +27,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from passmd.runtime import cache as cache_module
-from passmd.runtime import sweep
+from passmd.runtime import cache, sweep
 from passmd.runtime.cache import MAGIC, MARKER_NAME, Cache, CacheWarning, CorruptEntry, NotACache
-from passmd.runtime.cache import entry as cache_entry
-from passmd.runtime.cache import store as cache_store
 
 FUZZ = int(os.environ.get("PASSMD_CACHE_FUZZ_EXAMPLES", "40"))
 FUZZ_SETTINGS = settings(max_examples=FUZZ, deadline=None,
@@ -266,7 +263,7 @@ def test_prune_removes_only_stale_or_unreadable_entries(tmp_path, json_flag):
     fresh.parent.mkdir(exist_ok=True)
     fresh.write_bytes(b"x")
     stale.write_bytes(b"x")
-    past = time.time() - 2 * cache_module.STALE_TEMP_SECONDS
+    past = time.time() - 2 * cache.STALE_TEMP_SECONDS
     os.utime(stale, (past, past))
     status, out, err = cli("prune", "--cache-dir", str(folder), *(["--json"] if json_flag else []))
     assert status == 0 and err == ""
@@ -352,7 +349,7 @@ def test_a_header_nested_200000_levels_is_removed_and_recomputed(tmp_path):
 def test_a_value_nested_deeper_than_the_limit_is_refused_when_stored_and_removed_when_read(tmp_path):
     store = marked_cache(tmp_path / "cache")
     deep = value = []
-    for _ in range(cache_module.MAX_DEPTH - 1):
+    for _ in range(cache.MAX_DEPTH - 1):
         value = [value]
     assert store.put(KEY_A, value) and store.get(KEY_A) == value  # at the limit: stored and read
     with pytest.raises(TypeError, match="nests deeper than 64 levels"):
@@ -361,7 +358,7 @@ def test_a_value_nested_deeper_than_the_limit_is_refused_when_stored_and_removed
     with pytest.raises(TypeError, match="nests deeper"):
         store.put(KEY_B, deep)
     node = {"t": "none"}
-    for _ in range(cache_module.MAX_DEPTH + 5):  # deep in the value tree, shallow for JSON
+    for _ in range(cache.MAX_DEPTH + 5):  # deep in the value tree, shallow for JSON
         node = {"t": "list", "v": [node]}
     header = json.dumps({"format": 1, "key": KEY_B, "value": node}).encode()
     store.path(KEY_B).parent.mkdir(exist_ok=True)
@@ -374,9 +371,9 @@ def test_a_value_nested_deeper_than_the_limit_is_refused_when_stored_and_removed
 def test_a_header_above_the_size_limit_is_removed_unparsed(tmp_path):
     """Valid JSON with a valid checksum, one byte above 16 MiB: refused by its announced size."""
     store = marked_cache(tmp_path / "cache")
-    pad = cache_module.MAX_HEADER_BYTES - len(KEY_A) - 47
+    pad = cache.MAX_HEADER_BYTES - len(KEY_A) - 47
     big = b'{"format":1,"key":"' + KEY_A.encode() + b'","value":{"t":"str","v":"' + b"x" * pad + b'"}}'
-    assert len(big) == cache_module.MAX_HEADER_BYTES + 1
+    assert len(big) == cache.MAX_HEADER_BYTES + 1
     store.path(KEY_A).parent.mkdir(exist_ok=True)
     store.path(KEY_A).write_bytes(craft(KEY_A, big))
     assert store.info()["unreadable"] == 1
@@ -387,13 +384,13 @@ def test_a_header_above_the_size_limit_is_removed_unparsed(tmp_path):
 
 def test_a_result_above_the_size_limits_is_kept_not_cached(tmp_path, monkeypatch):
     store = marked_cache(tmp_path / "cache")
-    monkeypatch.setattr(cache_entry, "MAX_ENTRY_BYTES", 10_000)
+    monkeypatch.setattr(cache.entry, "MAX_ENTRY_BYTES", 10_000)
     too_large = "is not cached: its .* bytes are above the 10000-byte limit"
     with pytest.warns(CacheWarning, match=too_large) as record:
         frame = sweep.run(point_function, [{"x": np.zeros(2000)}, {"x": np.ones(2000)}], executor="serial",
                           cache=store, progress=False)
     assert len(record) == 1 and len(frame) == 2 and store.entries() == []
-    monkeypatch.setattr(cache_entry, "MAX_HEADER_BYTES", 100)
+    monkeypatch.setattr(cache.entry, "MAX_HEADER_BYTES", 100)
     with pytest.warns(CacheWarning, match="header of .* bytes is above the 100-byte limit"):
         assert store.put(KEY_A, {"y": list(range(50))}, function="other") is False
 
@@ -405,7 +402,7 @@ def test_an_entry_above_the_size_limit_is_removed_unread(tmp_path):
     path.parent.mkdir(exist_ok=True)
     with open(path, "wb") as fh:
         fh.write(MAGIC)
-        fh.truncate(cache_module.MAX_ENTRY_BYTES + 1)
+        fh.truncate(cache.MAX_ENTRY_BYTES + 1)
     assert store.info()["unreadable"] == 1
     with pytest.warns(CacheWarning, match="above the 1073741824-byte limit.*removed"):
         assert store.get(KEY_A, "miss") == "miss"
@@ -477,7 +474,7 @@ def test_put_removes_its_temporary_file_on_any_exception(tmp_path, monkeypatch, 
     def interrupted(*args, **kwargs):
         raise exception
 
-    monkeypatch.setattr(cache_store.os, where, interrupted)
+    monkeypatch.setattr(cache.store.os, where, interrupted)
     with pytest.raises(exception):
         store.put(KEY_A, {"y": 1.0})
     monkeypatch.undo()
@@ -549,7 +546,7 @@ def test_a_process_killed_during_a_write_leaves_a_temporary_file_that_prune_remo
     (leftover,) = folder.glob("??/.*.tmp")
     status, out, _ = cli("prune", "--cache-dir", str(folder), "--json")
     assert status == 0 and json.loads(out)["removed"] == 0 and leftover.exists()  # may be a write under way
-    past = time.time() - 2 * cache_module.STALE_TEMP_SECONDS
+    past = time.time() - 2 * cache.STALE_TEMP_SECONDS
     os.utime(leftover, (past, past))
     status, out, _ = cli("prune", "--cache-dir", str(folder), "--json")
     assert status == 0 and json.loads(out)["removed"] == 1 and not leftover.exists()
@@ -605,13 +602,13 @@ def _content_bytes(content, key, depth, noise, current, user):
         return MAGIC + noise
     if content in ("entry-current", "entry-other-code"):
         fingerprint = current if content == "entry-current" else "0" * 64
-        return cache_module.encode_entry(key, {"y": noise.hex()}, fingerprint=fingerprint)
+        return cache.encode_entry(key, {"y": noise.hex()}, fingerprint=fingerprint)
     if content == "foreign-key":
-        return cache_module.encode_entry("f" * 64, {"y": 1.0}, fingerprint=current)
+        return cache.encode_entry("f" * 64, {"y": 1.0}, fingerprint=current)
     if content == "deep":
         return craft(key, deep_header(key, depth))
     if content == "big-header":
-        return MAGIC + f"{'0' * 64} {cache_module.MAX_HEADER_BYTES + 1}\n".encode() + noise
+        return MAGIC + f"{'0' * 64} {cache.MAX_HEADER_BYTES + 1}\n".encode() + noise
     return None
 
 
@@ -627,7 +624,7 @@ def build(root: Path, items, store: Cache, user: Path) -> dict:
         if data is not None:
             path.write_bytes(data)
             if location == "own-temp-stale":
-                past = time.time() - 2 * cache_module.STALE_TEMP_SECONDS
+                past = time.time() - 2 * cache.STALE_TEMP_SECONDS
                 os.utime(path, (past, past))
         elif content == "fifo":
             os.mkfifo(path)
@@ -745,7 +742,7 @@ def test_generated_folders_without_the_marker_are_never_touched(items):
 @given(data=st.one_of(st.binary(max_size=200), st.binary(max_size=200).map(lambda b: MAGIC + b)))
 def test_generated_bytes_decode_to_a_value_or_a_corrupt_entry(data):
     try:
-        cache_module.decode_entry(data, KEY_A)
+        cache.decode_entry(data, KEY_A)
     except CorruptEntry:
         pass
 
@@ -773,7 +770,7 @@ arrays = st.fixed_dictionaries({"t": st.just("array"),
 def test_generated_headers_with_a_valid_checksum_decode_to_a_value_or_a_corrupt_entry(value, payload):
     header = json.dumps({"format": 1, "key": KEY_A, "value": value}).encode()
     try:
-        cache_module.decode_entry(craft(KEY_A, header, payload), KEY_A)
+        cache.decode_entry(craft(KEY_A, header, payload), KEY_A)
     except CorruptEntry:
         pass
 

@@ -18,12 +18,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd.experiments.driving_waveform import claims_velocity as dw_claims
+from passmd.experiments.driving_waveform import claims_velocity
 from passmd.experiments.driving_waveform.figures import FREQUENCIES
 from passmd.experiments.driving_waveform.runs import section5_drive
 from passmd.experiments.force_generation.figures import EARLIER, THIS
-from passmd.ledger import checks, readings, reference
-from passmd.ledger import evaluation as ledger
+from passmd.ledger import checks, evaluation, readings, reference
 from passmd.ledger.checks import NO_MEASURED_DATA, ClaimFails, NotEvaluable, check_claim
 from passmd.ledger.claims import load_claims
 from passmd.model import theory
@@ -507,7 +506,7 @@ COUNTER_EXAMPLES = {
 
 
 def test_every_extractor_has_a_counter_example_or_is_marked_not_informative():
-    functions = ledger.extractors()
+    functions = evaluation.extractors()
     marked = {c for c, f in functions.items() if f.not_informative}
     informative = set(functions) - marked - set(EXPERIMENT_CLAIMS)
     assert sorted(informative - set(COUNTER_EXAMPLES)) == [], (
@@ -520,7 +519,7 @@ def test_every_extractor_has_a_counter_example_or_is_marked_not_informative():
         "sec5-1-spring-deformed-to-ux-max-after-flyback",
         "fig9b-standard-increases-above-110khz",
     }
-    assert set(EXPERIMENT_CLAIMS) == ledger.claim_functions().experiment
+    assert set(EXPERIMENT_CLAIMS) == evaluation.claim_functions().experiment
     assert all(len(functions[c].not_informative) > 40 for c in marked), (
         "a not-informative mark needs its reason"
     )
@@ -529,7 +528,7 @@ def test_every_extractor_has_a_counter_example_or_is_marked_not_informative():
 @pytest.mark.parametrize("claim_id", EXPERIMENT_CLAIMS)
 def test_experiment_claims_are_inconclusive_for_want_of_data(claim_id):
     with pytest.raises(NotEvaluable, match=NO_MEASURED_DATA):
-        ledger.extractors()[claim_id]({})
+        evaluation.extractors()[claim_id]({})
 
 
 def test_not_informative_reasons_hold():
@@ -548,7 +547,7 @@ def test_not_informative_reasons_hold():
 
 @pytest.fixture(scope="module")
 def quick_results():
-    return ledger.collect_results(RunConfig(profile="quick"))
+    return evaluation.collect_results(RunConfig(profile="quick"))
 
 
 @pytest.fixture(scope="module")
@@ -560,7 +559,7 @@ def claims():
 @pytest.mark.parametrize("claim_id", sorted(COUNTER_EXAMPLES))
 def test_check_fails_on_its_counter_example(claim_id, quick_results, claims):
     description, build = COUNTER_EXAMPLES[claim_id]
-    func = ledger.extractors()[claim_id]
+    func = evaluation.extractors()[claim_id]
     results = build(quick_results)
     try:
         ours = func(results, readings.default_reading()) if func.claim_depends_on else func(results)
@@ -625,36 +624,36 @@ def test_a_maximum_is_located_to_the_grids_resolution():
     grid point is the location, edges included; the reachable maximum is the largest up to 110 kHz."""
     coarse = [1, 20, 60, 100, 110, 120, 130]
     edge = _velocities(coarse, [5.0, 3.0, 2.0, 1.0, 0.5, 0.4, 0.2])
-    assert dw_claims.maximum_location(edge) == (1.0, 1.0, 20.0)
-    assert dw_claims._located(edge, 105, 115, "110 ± 5 kHz") == 1.0
+    assert claims_velocity.maximum_location(edge) == (1.0, 1.0, 20.0)
+    assert claims_velocity._located(edge, 105, 115, "110 ± 5 kHz") == 1.0
     near = _velocities(coarse, [0.1, 1.0, 2.0, 5.0, 3.0, 0.4, 0.2])
     with pytest.raises(NotEvaluable, match="could move it into"):
-        dw_claims._located(near, 105, 115, "110 ± 5 kHz")
+        claims_velocity._located(near, 105, 115, "110 ± 5 kHz")
     paper = FREQUENCIES["paper"] / 1e3
     rising = _velocities(paper, paper)  # still rising at 130 kHz
-    assert dw_claims.maximum_location(rising) == (130.0, 130.0, 130.0)
-    assert dw_claims.controllable_maximum(rising)["frequency_kHz"] == 110.0
+    assert claims_velocity.maximum_location(rising) == (130.0, 130.0, 130.0)
+    assert claims_velocity.controllable_maximum(rising)["frequency_kHz"] == 110.0
     with pytest.raises(NotEvaluable, match="lacks some of the paper's frequencies"):
-        dw_claims._maxima(near)
+        claims_velocity._maxima(near)
 
 
 def test_a_decision_where_eq15_is_undefined_says_so():
     """The frequencies that decide a claim all lie where Eq. 15 does not fit the period: the verdict
     names it (a Scoped result); one of them where it fits is enough to rest on Eq. 15."""
     part = _velocities([1, 5, 10, 110], [1.0, 2.0, 3.0, 4.0], fits=np.array([1, 1, 0, 0], bool))
-    assert dw_claims.eq15_scope(part, [1.0]) == ""
-    assert dw_claims.eq15_scope(part, [10.0, 1.0]) == ""
-    scope = dw_claims.eq15_scope(part, [110.0])
+    assert claims_velocity.eq15_scope(part, [1.0]) == ""
+    assert claims_velocity.eq15_scope(part, [10.0, 1.0]) == ""
+    scope = claims_velocity.eq15_scope(part, [110.0])
     assert scope.startswith("Eq. 15 is undefined") and "above 5 kHz" in scope
-    scoped = dw_claims._scoped({"lhs": 1.0, "rhs": 2.0}, scope)
+    scoped = claims_velocity._scoped({"lhs": 1.0, "rhs": 2.0}, scope)
     assert isinstance(scoped, checks.Scoped) and scoped.outside == scope
-    assert dw_claims._scoped(1.0, "", scope) == 1.0
+    assert claims_velocity._scoped(1.0, "", scope) == 1.0
 
 
 def test_the_stick_edge_is_where_stick_is_lost_for_good():
     f = [1, 20, 60, 100, 110, 120]
-    assert dw_claims.stick_edge(_velocities(f, f, stick=np.array([0, 1, 1, 1, 0, 0], bool))) == 100.0
+    assert claims_velocity.stick_edge(_velocities(f, f, stick=np.array([0, 1, 1, 1, 0, 0], bool))) == 100.0
     with pytest.raises(ClaimFails, match="still sticks"):
-        dw_claims.stick_edge(_velocities(f, f, stick=np.array([0, 1, 1, 1, 1, 1], bool)))
+        claims_velocity.stick_edge(_velocities(f, f, stick=np.array([0, 1, 1, 1, 1, 1], bool)))
     with pytest.raises(ClaimFails, match="every grid frequency"):
-        dw_claims.stick_edge(_velocities(f, f, stick=np.zeros(6, bool)))
+        claims_velocity.stick_edge(_velocities(f, f, stick=np.zeros(6, bool)))

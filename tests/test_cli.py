@@ -211,10 +211,10 @@ def test_contact_human_output():
 
 def simulate_summary(drive, amplitude, frequency, periods, flyback="slew", springs=None):
     from passmd.model import waveforms
-    from passmd.solver import simulation as dynamics
+    from passmd.solver import simulation
 
     wave = waveforms.sawtooth(amplitude, frequency, drive, periods=periods, flyback=flyback)
-    result = dynamics.simulate(drive, wave, contact_model="exact" if springs is None else "discrete",
+    result = simulation.simulate(drive, wave, contact_model="exact" if springs is None else "discrete",
                                springs=springs or 200)
     return result.summary()
 
@@ -239,14 +239,14 @@ def test_run_optimized_waveform_matches_api():
     """`run --waveform optimized` drives the runner with the Eq. 15 waveform designed from the drive."""
     from passmd.model import optimized_waveform
     from passmd.protocols import eq15
-    from passmd.solver import simulation as dynamics
+    from passmd.solver import simulation
 
     data = run_json("run", "--waveform", "optimized", "--actuator", "rigid", "--periods", "3")
     drive = Drive(actuator_model="rigid")
     amplitude = drive.actuator.full_stroke_amplitude
     design = eq15.optimized_design(amplitude, drive)
     wave = optimized_waveform.optimized(amplitude, 100.0, drive, periods=3, design=design)
-    result = dynamics.simulate(drive, wave)
+    result = simulation.simulate(drive, wave)
     assert data["waveform"] == "optimized"
     assert data["final_position_m"] == result.final_position  # same code path, bit for bit
 
@@ -310,11 +310,11 @@ def test_critical_amplitude_analytic_only():
 def test_critical_amplitude_is_the_books_search():
     """`critical-amplitude` reports what passmd.experiments.critical_amplitude.figures finds, bracket
     included."""
-    from passmd.experiments.critical_amplitude import figures as ca
+    from passmd.experiments.critical_amplitude import figures
 
     data = run_json("critical-amplitude", "--contacts", "1", "--actuator", "rigid", "--tolerance", "2nm")
     drive = Drive(contacts=1, actuator_model="rigid")
-    found = ca.critical_amplitude(drive, tolerance=2e-9)
+    found = figures.critical_amplitude(drive, tolerance=2e-9)
     assert data["critical_amplitude_m"] == found["critical_amplitude_m"]
     assert data["bracket_m"] == [found["bracket_low_m"], found["bracket_high_m"]]
     assert 0 < data["bracket_m"][1] - data["bracket_m"][0] <= 2e-9
@@ -323,13 +323,15 @@ def test_critical_amplitude_is_the_books_search():
 
 
 def test_critical_amplitude_defaults_are_the_books():
-    from passmd.protocols import critical_amplitude as ca
+    from passmd.protocols import critical_amplitude
 
     # the CLI's defaults are the protocol record's; the book's search must use the same values
-    assert (PROTOCOL.steady_periods, PROTOCOL.step_threshold) == (ca.STEADY_PERIODS, ca.STEP_THRESHOLD)
+    assert PROTOCOL.steady_periods == critical_amplitude.STEADY_PERIODS
+    assert PROTOCOL.step_threshold == critical_amplitude.STEP_THRESHOLD
     data = run_json("critical-amplitude", "--contacts", "1", "--actuator", "rigid", "--tolerance", "5nm")
-    assert data["threshold_m"] == ca.STEP_THRESHOLD and data["frequency_Hz"] == PROTOCOL.drive_frequency
-    tolerance = inspect.signature(ca.critical_amplitude).parameters["tolerance"].default
+    assert data["threshold_m"] == critical_amplitude.STEP_THRESHOLD
+    assert data["frequency_Hz"] == PROTOCOL.drive_frequency
+    tolerance = inspect.signature(critical_amplitude.critical_amplitude).parameters["tolerance"].default
     assert tolerance == PROTOCOL.search_tolerance
 
 
@@ -428,13 +430,13 @@ def fake_figure(monkeypatch):
     """The figure table holds one stand-in panel, fig99z (computed at a RunConfig)."""
     from types import SimpleNamespace
 
-    from passmd.experiments import figure_table as figures
+    from passmd.experiments import figure_table
 
     spec = SimpleNamespace(name="fig99z", title="a stand-in panel")
-    monkeypatch.setattr(figures, "figure_names", lambda: ["fig99z"])
-    monkeypatch.setattr(figures, "figure_spec", lambda name: spec)
-    monkeypatch.setattr(figures, "figure_data", fake_figure_data)
-    monkeypatch.setattr(figures, "figure_plot", fake_figure_plot)
+    monkeypatch.setattr(figure_table, "figure_names", lambda: ["fig99z"])
+    monkeypatch.setattr(figure_table, "figure_spec", lambda name: spec)
+    monkeypatch.setattr(figure_table, "figure_data", fake_figure_data)
+    monkeypatch.setattr(figure_table, "figure_plot", fake_figure_plot)
     monkeypatch.delenv("PASSMD_EXECUTOR", raising=False)
     return spec
 
@@ -480,9 +482,9 @@ def test_figure_reads_the_environment_once_and_its_options_win(fake_figure, tmp_
 @pytest.mark.parametrize("how", ["a file", "read-only"])
 def test_figure_with_an_unwritable_cache_keeps_its_result(fake_figure, tmp_path, monkeypatch, capsys, how):
     """The cache cannot be written: one warning line, the figure is still computed and written."""
-    from passmd.runtime.cache import store as cache_store
+    from passmd.runtime.cache import store
 
-    monkeypatch.setattr(cache_store, "_REPORTED_UNWRITABLE", set())
+    monkeypatch.setattr(store, "_REPORTED_UNWRITABLE", set())
     cache_dir = tmp_path / "cache"
     if how == "a file":
         cache_dir.write_text("not a directory")
@@ -521,13 +523,13 @@ def test_cache_command_info_prune_clear(tmp_path):
 
 
 def test_failed_simulation_exits_1(monkeypatch, capsys):
-    from passmd.solver import simulation as dynamics
+    from passmd.solver import simulation
     from passmd.solver.results import SimulationError
 
     def diverge(*args, **kwargs):
         raise SimulationError("simulation diverged at integrator step 12")
 
-    monkeypatch.setattr(dynamics, "simulate", diverge)
+    monkeypatch.setattr(simulation, "simulate", diverge)
     status, out = run_cli("run", "--periods", "1")
     err = capsys.readouterr().err
     assert status == 1 and out == ""
@@ -542,11 +544,11 @@ def test_failed_simulation_exits_1(monkeypatch, capsys):
 def test_run_pauses_the_collector_until_its_simulation_has_run(monkeypatch, tmp_path):
     """Imports and kernel loading run without automatic collection; the outputs (pandas,
     matplotlib) and whatever follows the command run with it."""
-    from passmd.cli.commands import run as run_command
-    from passmd.solver import simulation as dynamics
+    from passmd.cli.commands import run
+    from passmd.solver import simulation
 
     enabled = {}
-    simulate, write_outputs = dynamics.simulate, run_command.write_outputs
+    simulate, write_outputs = simulation.simulate, run.write_outputs
 
     def spy_simulate(*args, **kwargs):
         enabled["simulation"] = gc.isenabled()
@@ -556,8 +558,8 @@ def test_run_pauses_the_collector_until_its_simulation_has_run(monkeypatch, tmp_
         enabled["outputs"] = gc.isenabled()
         return write_outputs(*args, **kwargs)
 
-    monkeypatch.setattr(dynamics, "simulate", spy_simulate)
-    monkeypatch.setattr(run_command, "write_outputs", spy_write_outputs)
+    monkeypatch.setattr(simulation, "simulate", spy_simulate)
+    monkeypatch.setattr(run, "write_outputs", spy_write_outputs)
     assert gc.isenabled()
     # (an in-process Ctrl-C test earlier in the session may have frozen objects: count from here)
     frozen = gc.get_freeze_count()

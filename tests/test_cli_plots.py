@@ -87,13 +87,13 @@ def readable(fig) -> dict:
 def test_run_plot_names_positions_time_and_the_run(tmp_path):
     from passmd.model import waveforms
     from passmd.plots.trace import positions_figure
-    from passmd.solver import simulation as dynamics
+    from passmd.solver import simulation
 
     status, text = run_cli("run", *CHEAP, "--periods", "2", "--plot", str(tmp_path / "run.png"))
     assert status == 0, text
     png_shows_something(tmp_path / "run.png")
     drive = Drive(contacts=1, actuator_model="rigid")
-    result = dynamics.simulate(drive, waveforms.sawtooth(drive.actuator.full_stroke_amplitude, 100.0, drive,
+    result = simulation.simulate(drive, waveforms.sawtooth(drive.actuator.full_stroke_amplitude, 100.0, drive,
                                                          periods=2), max_points=200)
     texts = readable(positions_figure(result, "sawtooth, A = 202 nm"))
     ax = positions_figure(result, "t").axes[0]
@@ -193,16 +193,16 @@ def test_diverging_map_is_symmetric_about_zero_and_names_missing_cells():
 def test_fit_png_is_written_and_labelled(tmp_path, monkeypatch):
     import passmd
     from passmd.plots.fit import fit_figure
-    from passmd.protocols import fit as F
+    from passmd.protocols import fit
 
     monkeypatch.setenv("PASSMD_CACHE_DIR", str(tmp_path / "cache"))
     truth = Drive(contacts=1, actuator_model="rigid", friction_coefficient=0.25)
     rows = [[str(a), str(p), "100", "0", "0.5"] for p in (0.2, 0.4) for a in (60, 120)]
     header = ["amplitude_nm", "preload_N", "frequency_Hz", "step_nm", "step_nm_sd"]
-    data = F.measurements_from_rows(header, rows)
-    data = F.Measurements(**{**vars(data), "value": F.predict(truth, data, executor="serial",
+    data = fit.measurements_from_rows(header, rows)
+    data = fit.Measurements(**{**vars(data), "value": fit.predict(truth, data, executor="serial",
                                                                cache=tmp_path / "cache")})
-    F.write_measurements(tmp_path / "data.csv", data)
+    fit.write_measurements(tmp_path / "data.csv", data)
     status, text = run_cli("fit", str(tmp_path / "data.csv"), "--free", "mu", *CHEAP,
                            "--executor", "serial", "--out", str(tmp_path / "out"))
     assert status == 0, text

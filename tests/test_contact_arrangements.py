@@ -23,7 +23,7 @@ from passmd.model.theory import (
     friction_limit,
     runner_frequency,
 )
-from passmd.protocols import critical_amplitude as search
+from passmd.protocols import critical_amplitude
 
 #: The search's final bracket, as in tests/test_critical_amplitude.py.
 TOLERANCE = 0.5e-9
@@ -122,7 +122,7 @@ def test_first_flyback_onset_is_the_largest_presliding(groups):
     """As the six-contact test: all contacts slide only when the one with the largest u_x,max does."""
     drive = Drive(actuator_model="rigid", contact_groups=groups)
     onset = first_flyback_critical_amplitude(drive)
-    out = search.critical_amplitude(drive, protocol="first", tolerance=TOLERANCE)
+    out = critical_amplitude.critical_amplitude(drive, protocol="first", tolerance=TOLERANCE)
     allowed = TOLERANCE / 2 + _startup_vibration(drive, onset, PROTOCOL.drive_frequency) + 0.05e-9
     assert abs(out["critical_amplitude_m"] - onset) <= allowed
 
@@ -131,7 +131,8 @@ def test_steady_state_of_two_groups_follows_eq11():
     """As the six-contact test (Fig. 6a): within 10 % of Eq. 11, nearer it than either group's u_x,max."""
     drive = Drive(actuator_model="rigid", contact_groups=ONE_AND_THREE)
     theory = drive_theory(drive)
-    found = search.critical_amplitude(drive, protocol="steady", tolerance=TOLERANCE)["critical_amplitude_m"]
+    found = critical_amplitude.critical_amplitude(drive, protocol="steady",
+                                                  tolerance=TOLERANCE)["critical_amplitude_m"]
     dev = abs(found / theory["critical_amplitude_rigid_m"] - 1)
     assert dev < 0.1
     assert dev < min(abs(found / u - 1) for u in theory["presliding_m"])

@@ -15,14 +15,13 @@ import pandas as pd
 import pytest
 import snapshot_accuracy as snap
 
-from passmd.experiments import figure_table as figures
-from passmd.experiments.critical_amplitude import facts as ca_facts
-from passmd.experiments.critical_amplitude import figures as ca
-from passmd.ledger import evaluation as ledger
+from passmd.experiments import figure_table
+from passmd.experiments.critical_amplitude import facts, figures
+from passmd.ledger import evaluation
 from passmd.model import waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.theory import drive_theory, runner_frequency
-from passmd.protocols import critical_amplitude as search
+from passmd.protocols import critical_amplitude
 from passmd.runtime.config import RunConfig
 
 PANELS = ("fig5a", "fig5b", "fig6a", "fig6b", "fig6c", "fig56_viscosity", "fig56_frequency")
@@ -32,7 +31,7 @@ NM = 1e9
 @pytest.fixture(scope="module")
 def quick():
     """Quick data of every panel (computed once; the sweep cache makes reruns cheap)."""
-    return {name: figures.figure_data(name, RunConfig(profile="quick")) for name in PANELS}
+    return {name: figure_table.figure_data(name, RunConfig(profile="quick")) for name in PANELS}
 
 
 # --------------------------------------------------------------------------------------
@@ -48,7 +47,7 @@ def test_bisection_brackets_the_switch_and_counts_runs():
         calls.append(a)
         return a >= switch
 
-    out = search.bisect_amplitude(moves, 202e-9, 0.1e-9)
+    out = critical_amplitude.bisect_amplitude(moves, 202e-9, 0.1e-9)
     assert out["bracket_low_m"] < switch <= out["bracket_high_m"]
     assert out["bracket_high_m"] - out["bracket_low_m"] <= 0.1e-9
     assert out["critical_amplitude_m"] == pytest.approx(0.5 * (out["bracket_low_m"] + out["bracket_high_m"]))
@@ -72,8 +71,8 @@ def test_guided_search_returns_bisections_bracket_with_fewer_runs():
             moved = a >= switch
             return moved, slope * (a - switch) + rng.uniform(-1e-11, 1e-11) if moved else None
 
-        found = search.search_amplitude(probe, upper, tolerance, slope=1.0)
-        plain = search.bisect_amplitude(lambda a, switch=switch: a >= switch, upper, tolerance)
+        found = critical_amplitude.search_amplitude(probe, upper, tolerance, slope=1.0)
+        plain = critical_amplitude.bisect_amplitude(lambda a, switch=switch: a >= switch, upper, tolerance)
         assert found == {**plain, "runs": found["runs"]}
         runs.append(found["runs"] / plain["runs"])
     assert np.median(runs) < 0.6
@@ -83,14 +82,15 @@ def test_guided_search_returns_bisections_bracket_with_fewer_runs():
         moved = switches[0] <= a < switches[1] or a >= switches[2]
         return moved, a - switches[2] if moved else None
 
-    found = search.search_amplitude(several, 202e-9, 0.1e-9, slope=1.0)
+    found = critical_amplitude.search_amplitude(several, 202e-9, 0.1e-9, slope=1.0)
     assert not several(found["bracket_low_m"])[0] and several(found["bracket_high_m"])[0]
     assert found["bracket_high_m"] - found["bracket_low_m"] <= 0.1e-9
-    assert math.isnan(search.search_amplitude(lambda a: (False, None), 96e-9, 0.5e-9)["critical_amplitude_m"])
+    never = critical_amplitude.search_amplitude(lambda a: (False, None), 96e-9, 0.5e-9)
+    assert math.isnan(never["critical_amplitude_m"])
 
 
 def test_bisection_without_motion_at_full_stroke_reports_nan():
-    out = search.bisect_amplitude(lambda a: False, 96e-9, 0.5e-9)
+    out = critical_amplitude.bisect_amplitude(lambda a: False, 96e-9, 0.5e-9)
     assert math.isnan(out["critical_amplitude_m"]) and math.isnan(out["bracket_high_m"])
     assert out["bracket_low_m"] == 96e-9 and out["runs"] == 1
 
@@ -107,21 +107,22 @@ def test_bisection_without_motion_at_full_stroke_reports_nan():
     ],
 )
 def test_bad_search_input_names_the_parameter(kwargs, name):
-    drive = ca.paper_drive_for(1, "rigid", 1e-3, 0.4)
+    drive = figures.paper_drive_for(1, "rigid", 1e-3, 0.4)
     with pytest.raises(ValueError, match=name):
-        search.critical_amplitude(drive, **kwargs)
+        critical_amplitude.critical_amplitude(drive, **kwargs)
 
 
 def test_bad_first_flyback_input_names_the_parameter():
-    drive = ca.paper_drive_for(1, "rigid", 1e-3, 0.4)
+    drive = figures.paper_drive_for(1, "rigid", 1e-3, 0.4)
     with pytest.raises(ValueError, match="amplitude"):
-        search.first_flyback_slip(drive, 0.0)
+        critical_amplitude.first_flyback_slip(drive, 0.0)
     with pytest.raises(ValueError, match="amplitude"):
-        search.first_flyback_slip(drive, 1e-6)  # beyond the 202 nm full stroke
+        critical_amplitude.first_flyback_slip(drive, 1e-6)  # beyond the 202 nm full stroke
     with pytest.raises(ValueError, match="frequency"):
-        search.first_flyback_slip(drive, 40e-9, frequency=2e6)  # 0.4 µs fly-back > half a 0.5 µs period
+        # a 0.4 µs fly-back is more than half a 0.5 µs period
+        critical_amplitude.first_flyback_slip(drive, 40e-9, frequency=2e6)
     with pytest.raises(ValueError, match="profile"):
-        ca.fig5b(RunConfig(profile="fast"))
+        figures.fig5b(RunConfig(profile="fast"))
 
 
 # --------------------------------------------------------------------------------------
@@ -142,9 +143,9 @@ def test_one_contact_rigid_first_flyback_onset_is_eq7():
     Allowed error: half the final bracket, the start-up vibration of the runner A f/ω_r, and the
     runner's own motion during the fly-back, at most ½ (μF_N/m_r) t_fb².
     """
-    drive = ca.paper_drive_for(1, "rigid", 1e-3, 0.4)
+    drive = figures.paper_drive_for(1, "rigid", 1e-3, 0.4)
     eq7 = drive_theory(drive)["critical_amplitude_rigid_m"]
-    out = search.critical_amplitude(drive, protocol="first", tolerance=TOLERANCE)
+    out = critical_amplitude.critical_amplitude(drive, protocol="first", tolerance=TOLERANCE)
     t_fb = waveforms.flyback_time(eq7, drive)
     pull = 0.5 * drive.friction_coefficient * drive.preload / drive.runner_mass * t_fb**2
     allowed = TOLERANCE / 2 + _startup_vibration(drive, eq7, PROTOCOL.drive_frequency) + pull
@@ -159,9 +160,9 @@ def test_one_contact_flexible_quasistatic_first_flyback_onset_is_eq8():
     fly-back's corners leave, at most the piezo speed over the actuator's angular frequency
     (A/t_fb)/ω_a ≈ 1.5 nm at 0.4 N: together 3.3 % of Eq. 8.
     """
-    drive = ca.paper_drive_for(1, "flexible", 1e-3, 0.4)
+    drive = figures.paper_drive_for(1, "flexible", 1e-3, 0.4)
     eq8 = drive_theory(drive)["critical_amplitude_flexible_m"]
-    out = search.critical_amplitude(drive, protocol="first", flyback="fixed", tolerance=TOLERANCE)
+    out = critical_amplitude.critical_amplitude(drive, protocol="first", flyback="fixed", tolerance=TOLERANCE)
     omega_a = np.sqrt(drive.actuator.stiffness / drive.actuator.mass)
     ringing = eq8 / drive.amplifier.full_stroke_time / omega_a
     allowed = TOLERANCE / 2 + _startup_vibration(drive, eq8, PROTOCOL.drive_frequency) + ringing
@@ -171,24 +172,24 @@ def test_one_contact_flexible_quasistatic_first_flyback_onset_is_eq8():
 
 def test_slew_rate_flyback_rings_the_actuator_and_lowers_the_onset():
     """A fly-back shorter than the actuator period (slew rate, 0.4 µs vs 0.33 µs) lowers A_c below Eq. 8."""
-    drive = ca.paper_drive_for(1, "flexible", 1e-3, 0.4)
-    slew = search.critical_amplitude(drive, protocol="first", flyback="slew", tolerance=0.5e-9)
-    fixed = search.critical_amplitude(drive, protocol="first", flyback="fixed", tolerance=0.5e-9)
+    drive = figures.paper_drive_for(1, "flexible", 1e-3, 0.4)
+    slew = critical_amplitude.critical_amplitude(drive, protocol="first", flyback="slew", tolerance=0.5e-9)
+    fixed = critical_amplitude.critical_amplitude(drive, protocol="first", flyback="fixed", tolerance=0.5e-9)
     assert slew["critical_amplitude_m"] < fixed["critical_amplitude_m"] - 2e-9
 
 
 def test_six_contacts_rigid_first_flyback_onset_follows_the_stiffer_side():
     """From virgin contacts all six slide only when the more loaded side 1 does: u_x,max,1 (Eq. 10)."""
-    drive = ca.paper_drive_for(6, "rigid", 1e-3, 0.4)
+    drive = figures.paper_drive_for(6, "rigid", 1e-3, 0.4)
     u1, u2 = drive_theory(drive)["presliding_m"]
-    out = search.critical_amplitude(drive, protocol="first", tolerance=TOLERANCE)
+    out = critical_amplitude.critical_amplitude(drive, protocol="first", tolerance=TOLERANCE)
     allowed = TOLERANCE / 2 + _startup_vibration(drive, u1, PROTOCOL.drive_frequency) + 0.05e-9
     assert abs(out["critical_amplitude_m"] - u1) <= allowed  # 0.05 nm: runner motion in t_fb
 
 
 def test_six_contacts_rigid_steady_state_is_closest_to_eq11(quick):
     """Done-when: the steady-state A_c of six rigid contacts lies nearer Eq. 11 than either Eq. 10 side."""
-    table = ca.primary(quick["fig6a"], "rigid")
+    table = figures.primary(quick["fig6a"], "rigid")
     ac = table["critical_amplitude_nm"].to_numpy()
     dev = {
         c: np.max(np.abs(ac / table[c].to_numpy() - 1))
@@ -205,30 +206,30 @@ def test_steady_state_runs_are_long_enough(quick):
     rows = rows[(rows["protocol"] == "steady") & np.isclose(rows["frequency_Hz"], PROTOCOL.drive_frequency)]
     assert len(rows) == 4
     for row in rows.itertuples():
-        drive = ca.paper_drive_for(row.contacts, row.actuator_model, 1e-3, row.preload_N)
-        below = search.steady_step(drive, 0.8 * row.critical_amplitude_nm / NM)
-        above = search.steady_step(drive, 1.2 * row.critical_amplitude_nm / NM)
+        drive = figures.paper_drive_for(row.contacts, row.actuator_model, 1e-3, row.preload_N)
+        below = critical_amplitude.steady_step(drive, 0.8 * row.critical_amplitude_nm / NM)
+        above = critical_amplitude.steady_step(drive, 1.2 * row.critical_amplitude_nm / NM)
         assert abs(below["last_step_m"]) < 0.2e-9, row
         steps = np.array(above["steps_m"])
-        assert steps[-1] > search.STEP_THRESHOLD and abs(steps[-1] - steps[-2]) < 0.01e-9, row
+        assert steps[-1] > critical_amplitude.STEP_THRESHOLD and abs(steps[-1] - steps[-2]) < 0.01e-9, row
 
 
 def test_first_flyback_onset_does_not_depend_on_low_drive_frequencies(quick):
     """50–200 Hz: the first-fly-back onset moves by less than the start-up vibration plus the bracket."""
     rows = quick["fig56_frequency"]
     first = rows[rows["protocol"] == "first"]
-    drive = ca.paper_drive_for(1, "rigid", 1e-3, 0.4)
-    a = search.critical_amplitude(drive, protocol="first", frequency=50.0, tolerance=0.5e-9)
-    b = search.critical_amplitude(drive, protocol="first", frequency=200.0, tolerance=0.5e-9)
+    drive = figures.paper_drive_for(1, "rigid", 1e-3, 0.4)
+    a = critical_amplitude.critical_amplitude(drive, protocol="first", frequency=50.0, tolerance=0.5e-9)
+    b = critical_amplitude.critical_amplitude(drive, protocol="first", frequency=200.0, tolerance=0.5e-9)
     vib = _startup_vibration(drive, 40e-9, 200.0) + _startup_vibration(drive, 40e-9, 50.0)
     assert abs(a["critical_amplitude_m"] - b["critical_amplitude_m"]) <= 0.5e-9 + vib
     assert len(first) > 0
 
 
 def test_larger_threshold_gives_larger_steady_amplitude():
-    drive = ca.paper_drive_for(1, "rigid", 1e-3, 0.4)
-    small = search.critical_amplitude(drive, threshold=0.5e-9, tolerance=0.2e-9)
-    large = search.critical_amplitude(drive, threshold=3e-9, tolerance=0.2e-9)
+    drive = figures.paper_drive_for(1, "rigid", 1e-3, 0.4)
+    small = critical_amplitude.critical_amplitude(drive, threshold=0.5e-9, tolerance=0.2e-9)
+    large = critical_amplitude.critical_amplitude(drive, threshold=3e-9, tolerance=0.2e-9)
     # above the onset the step grows ~1 nm per nm: 2.5 nm more threshold, ~2.5 nm more A_c
     assert large["critical_amplitude_m"] - small["critical_amplitude_m"] == pytest.approx(2.5e-9, abs=0.6e-9)
 
@@ -239,18 +240,18 @@ def test_larger_threshold_gives_larger_steady_amplitude():
 
 
 def test_every_panel_is_in_the_figure_table_with_its_chapter():
-    names = figures.figure_names()
+    names = figure_table.figure_names()
     for name in PANELS:
         assert name in names
-        assert figures.figure_spec(name).chapter in ("critical_amplitude_one", "critical_amplitude_six")
+        assert figure_table.figure_spec(name).chapter in ("critical_amplitude_one", "critical_amplitude_six")
 
 
 def test_figures_are_listed_in_the_books_order():
     """Chapters follow book/_toc.yml; study panels of Figs. 5-6 (fig56_*) come after fig6c, before fig7a."""
     toc = (Path(__file__).resolve().parents[1] / "book" / "_toc.yml").read_text()
     files = re.findall(r"^\s*- file: (\w+)", toc, flags=re.M)
-    names = figures.figure_names()
-    positions = [files.index(figures.figure_spec(name).chapter) for name in names]
+    names = figure_table.figure_names()
+    positions = [files.index(figure_table.figure_spec(name).chapter) for name in names]
     assert positions == sorted(positions)
     assert names.index("fig6c") < names.index("fig56_frequency") < names.index("fig7a")
     assert names.index("fig9b") < names.index("fig10a")
@@ -270,7 +271,8 @@ def test_searches_report_brackets(quick):
         table = quick[name]
         assert table["critical_amplitude_nm"].notna().all(), name
         width = table["bracket_high_nm"] - table["bracket_low_nm"]
-        assert (width > 0).all() and (width <= ca.PROFILE_SETTINGS["quick"].tolerance * NM + 1e-9).all(), name
+        tolerance_nm = figures.PROFILE_SETTINGS["quick"].tolerance * NM
+        assert (width > 0).all() and (width <= tolerance_nm + 1e-9).all(), name
         assert (
             (table["bracket_low_nm"] < table["critical_amplitude_nm"])
             & (table["critical_amplitude_nm"] < table["bracket_high_nm"])
@@ -299,7 +301,7 @@ def test_plots_draw_every_panel(quick, name):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig = figures.figure_plot(name, quick[name])
+    fig = figure_table.figure_plot(name, quick[name])
     assert fig.axes and all(ax.has_data() for ax in fig.axes)
     plt.close(fig)
 
@@ -317,7 +319,7 @@ def check(dataframe_regression, name, table):
     """Critical amplitudes to one quick bracket width (plus the position accuracy), steps to the
     position accuracy, closed forms and inputs exactly (``snapshot_accuracy``)."""
     tolerances = snap.tolerances(table.columns, amplitudes=("critical_amplitude_nm",),
-                                 bracket_width=ca.PROFILE_SETTINGS["quick"].tolerance)
+                                 bracket_width=figures.PROFILE_SETTINGS["quick"].tolerance)
     for col in table.columns:
         closed_form = col.startswith("u_x_") or col.endswith(("closed_form_nm", "threshold_nm"))
         if closed_form or col == "amplitude_nm":
@@ -337,7 +339,7 @@ def test_finer_run_passes_the_snapshots(tmp_path_factory, dataframe_regression):
     snapshot check: the snapshots lock the physics to the stated accuracy, not one scheme."""
     config = snap.finer_config(tmp_path_factory.mktemp("finer-cache"))
     with snap.finer_run():
-        finer = {name: figures.figure_data(name, config) for name in PANELS}
+        finer = {name: figure_table.figure_data(name, config) for name in PANELS}
     for name in PANELS:
         check(dataframe_regression, name, locked(finer[name]))
 
@@ -355,10 +357,11 @@ def test_ledger_rows_of_figs_5_and_6():
     deviation over the whole curve); every failure on it is a failure at a preload of the paper's grid.
     The experiment row has no measured data in the paper's text."""
     keys = ["fig5a", "fig5b", "fig6a", "fig6b", "fig6c"]
-    claims = ledger.claims_for(ledger.load_claims(), keys)
+    claims = evaluation.claims_for(evaluation.load_claims(), keys)
     assert len(claims) == 12
-    results = ledger.collect_results(RunConfig(profile="quick"), [*keys, *(f"{k}_readings" for k in keys)])
-    evaluated = ledger.evaluate(claims, results)
+    figures_read = [*keys, *(f"{k}_readings" for k in keys)]
+    results = evaluation.collect_results(RunConfig(profile="quick"), figures_read)
+    evaluated = evaluation.evaluate(claims, results)
     experiment = evaluated["claim"] == "fig6b-experiment-agreement"
     assert evaluated.loc[experiment, "verdict"].str.contains("no measured data").all()
     simulated = evaluated[~experiment]
@@ -382,12 +385,12 @@ def test_ledger_rows_of_figs_5_and_6():
 def test_step_onset_is_where_the_step_stays_above_the_threshold():
     rows = pd.DataFrame({"amplitude_nm": [0.0, 10.0, 20.0, 30.0, 40.0],
                          "steady_step_nm": [0.0, 0.6, 0.1, 0.7, 1.5], "threshold_nm": 0.5})
-    assert ca_facts.step_onset(rows) == 30.0  # 10 nm is above δ once, but the step falls back
-    assert math.isnan(ca_facts.step_onset(rows.assign(steady_step_nm=0.0)))
+    assert facts.step_onset(rows) == 30.0  # 10 nm is above δ once, but the step falls back
+    assert math.isnan(facts.step_onset(rows.assign(steady_step_nm=0.0)))
 
 
 def test_fig5a_facts(quick):
-    found = ca_facts.fig5a_facts(quick["fig5a"])
+    found = facts.fig5a_facts(quick["fig5a"])
     assert found["onset_rigid"] <= found["eq7_04"] + 20  # the quick grid's 20 nm step
     assert found["onset_flex_fixed"] >= found["onset_flex_slew"]  # the slew-rate fly-back rings the actuator
     assert found["eq8_04"] > found["eq7_04"]
@@ -396,57 +399,57 @@ def test_fig5a_facts(quick):
 
 def test_deviations_from_the_closed_forms(quick):
     closed = {"rigid": "u_x_max_nm", "flexible": "u_x_max_plus_u_x_a_nm"}
-    dev = ca_facts.closed_form_deviations(quick["fig5b"], closed)
-    largest, mean = ca_facts.series_deviation(dev, "rigid", "first", "slew")
+    dev = facts.closed_form_deviations(quick["fig5b"], closed)
+    largest, mean = facts.series_deviation(dev, "rigid", "first", "slew")
     assert largest < 2.0 and abs(mean) <= largest  # first-fly-back onset of a rigid actuator: Eq. 7
-    assert ca_facts.side_of(-3.25) == "3.2 % below" and ca_facts.side_of(1.0) == "1.0 % above"
-    assert math.isnan(ca_facts.band_spread(quick["fig5b"], "rigid"))  # the quick profile runs 100 Hz only
+    assert facts.side_of(-3.25) == "3.2 % below" and facts.side_of(1.0) == "1.0 % above"
+    assert math.isnan(facts.band_spread(quick["fig5b"], "rigid"))  # the quick profile runs 100 Hz only
     columns = {"Eq. 11": "u_x_max_e_nm", "Eq. 10, side 1": "u_x_max_1_nm"}
-    six = ca_facts.deviation_table(quick["fig6a"], columns)
-    assert ca_facts.deviation_at(six, "steady", "slew", "Eq. 11: largest |dev| (%)") < ca_facts.deviation_at(
+    six = facts.deviation_table(quick["fig6a"], columns)
+    assert facts.deviation_at(six, "steady", "slew", "Eq. 11: largest |dev| (%)") < facts.deviation_at(
         six, "steady", "slew", "Eq. 10, side 1: largest |dev| (%)")
 
 
 def test_spans_and_values_of_the_sensitivity_panels(quick):
     freq = quick["fig56_frequency"]
-    low, high = ca_facts.ac_span(freq, 6, "first", actuator_model="rigid")
-    assert low <= high and ca_facts.ac_range(freq, 6, "first", actuator_model="rigid") == high - low
-    at_drive = ca_facts.ac_at(freq, 6, "rigid", "steady", PROTOCOL.drive_frequency)
-    primary = ca.primary(freq, "rigid").query("contacts == 6")
+    low, high = facts.ac_span(freq, 6, "first", actuator_model="rigid")
+    assert low <= high and facts.ac_range(freq, 6, "first", actuator_model="rigid") == high - low
+    at_drive = facts.ac_at(freq, 6, "rigid", "steady", PROTOCOL.drive_frequency)
+    primary = figures.primary(freq, "rigid").query("contacts == 6")
     assert low > 0 and at_drive == float(primary["critical_amplitude_nm"].iloc[0])
     visc = quick["fig56_viscosity"]
-    lo, hi = ca_facts.ac_span(visc, 6, "steady", flyback="fixed")
+    lo, hi = facts.ac_span(visc, 6, "steady", flyback="fixed")
     assert 0 < lo <= hi
 
 
 def test_slew_and_protocol_facts():
-    slew = ca_facts.slew_facts()
+    slew = facts.slew_facts()
     # 2 µs full-stroke time over A_max: 202 nm (R = 1 mm) and 96 nm (R = 0.25 mm)
     assert slew["ns_per_nm_b"] == pytest.approx(2000 / 202, rel=1e-9)
     assert slew["ns_per_nm_c"] == pytest.approx(2000 / 96, rel=1e-9)
-    found = ca_facts.protocol_facts(RunConfig(profile="quick"))
-    assert found["tol_nm"] == pytest.approx(0.5) and found["periods"] == search.STEADY_PERIODS
+    found = facts.protocol_facts(RunConfig(profile="quick"))
+    assert found["tol_nm"] == pytest.approx(0.5) and found["periods"] == critical_amplitude.STEADY_PERIODS
     assert found["flyback_us_40"] == pytest.approx(40 / 202 * 2, rel=1e-9)
-    assert ca_facts.band_text(RunConfig(profile="paper"))["band_here"] == "as in this build"
+    assert facts.band_text(RunConfig(profile="paper"))["band_here"] == "as in this build"
 
 
 def test_continued_operation_strains_the_sides_against_each_other(quick):
     """Below the steady-state A_c the two sides end every period pushing against each other."""
-    prestrain = ca_facts.side_prestrain(quick["fig56_frequency"])
-    assert len(prestrain) == search.STEADY_PERIODS
+    prestrain = facts.side_prestrain(quick["fig56_frequency"])
+    assert len(prestrain) == critical_amplitude.STEADY_PERIODS
     last = prestrain.iloc[-1]
     assert last["side 1: T_1 / μF_N1"] < 0 < last["side 2: T_2 / μF_N2"]
 
 
 def test_flyback_steps_ratchet_below_eq7():
-    steps = ca_facts.fig5_flyback_steps(RunConfig(profile="quick"))
+    steps = facts.fig5_flyback_steps(RunConfig(profile="quick"))
     first = steps.iloc[0]
     assert first["steady_ac_nm"] < first["u_x_max_nm"]
     below = steps[steps["amplitude_nm"] == steps["amplitude_nm"].unique()[0]]
     assert below["step_nm"].iloc[-1] < first["threshold_nm"]  # 2 nm below A_c: no steady step
     import matplotlib.pyplot as plt
 
-    fig = figures.figure_plot("fig5_flyback_steps", steps)
+    fig = figure_table.figure_plot("fig5_flyback_steps", steps)
     assert fig.axes[0].has_data()
     plt.close(fig)
 
@@ -454,23 +457,23 @@ def test_flyback_steps_ratchet_below_eq7():
 def test_paragraph_facts_of_both_chapters(quick):
     """Every fact function the chapters glue returns finite numbers or a sentence, on the quick data."""
     quick_config = RunConfig(profile="quick")
-    found = ca_facts.fig5b_facts(quick["fig5b"], quick_config)
+    found = facts.fig5b_facts(quick["fig5b"], quick_config)
     assert found["first_rigid_max"] < 2.0 and found["steady_rigid_mean"].endswith(("below", "above"))
     assert "quick profile runs 100 Hz only" in found["band_rigid"]
     columns = {"Eq. 11": "u_x_max_e_nm", "Eq. 10, side 1": "u_x_max_1_nm", "Eq. 10, side 2": "u_x_max_2_nm"}
-    six = ca_facts.fig6a_facts(ca_facts.deviation_table(quick["fig6a"], columns), quick_config)
+    six = facts.fig6a_facts(facts.deviation_table(quick["fig6a"], columns), quick_config)
     assert six["a_e"] < min(six["a_1"], six["a_2"]) and six["a_band"].startswith("(the quick profile")
     flexible = {"Eq. 12": "u_x_max_e_star_nm", "Eq. 13, side 1": "u_x_max_1_star_nm"}
-    dev6 = pd.concat([ca_facts.deviation_table(quick[n], flexible).assign(figure=n)
+    dev6 = pd.concat([facts.deviation_table(quick[n], flexible).assign(figure=n)
                       for n in ("fig6b", "fig6c")])
-    bc = ca_facts.fig6bc_facts(dev6)
+    bc = facts.fig6bc_facts(dev6)
     assert set(bc) == {f"{k}_{s}" for k in "bc" for s in ("slew", "fixed", "first_fixed")}
-    visc = ca_facts.viscosity_facts(quick["fig56_viscosity"])
+    visc = facts.viscosity_facts(quick["fig56_viscosity"])
     assert visc["v6_fixed_lo"] <= visc["v6_fixed_hi"] and visc["eq8_04"] > visc["eq12_04"]
-    freq = ca_facts.frequency_facts(quick["fig56_frequency"], quick_config)
+    freq = facts.frequency_facts(quick["fig56_frequency"], quick_config)
     assert freq["f_hi"] == 1000.0 and freq["first_span"] >= 0
     assert freq["first_band"].endswith("Figs. 5b and 6.)")
     table = pd.DataFrame({"side 1: T_1 / μF_N1": [-0.1], "side 2: T_2 / μF_N2": [0.1]})
     table.attrs["amplitude_nm"] = 23.9
     expected = {"prestrain_amplitude": 23.9, "prestrain_1": -0.1, "prestrain_2": 0.1}
-    assert ca_facts.prestrain_facts(table) == expected
+    assert facts.prestrain_facts(table) == expected

@@ -11,16 +11,15 @@ import pandas as pd
 import pytest
 
 from passmd.experiments.calibration.synthetic import independent_steps
-from passmd.experiments.design import calibration
-from passmd.experiments.design import figures as design
+from passmd.experiments.design import calibration, figures
 from passmd.model.parameters import Drive
 from passmd.model.tables import actuator_for_radius
-from passmd.protocols import fit as fitting
+from passmd.protocols import fit
 from passmd.runtime.config import RunConfig
 
 
 def test_fit_facts_say_whether_the_region_holds_the_truth():
-    truth, _ = design.example_drive()
+    truth, _ = figures.example_drive()
     start = calibration.start_drive(truth, ("friction_coefficient", "actuator.stiffness"))
     # the first guess is the paper's: μ of Table 1, k_p of Table 2 for the drive's radius
     assert start.friction_coefficient == Drive().friction_coefficient
@@ -46,10 +45,10 @@ def test_heldback_facts_rms():
 
 
 def test_fitted_drive_file_reads_back_to_the_fitted_drive():
-    truth, sources = design.example_drive()
+    truth, sources = figures.example_drive()
     fitted = replace(truth, friction_coefficient=0.2493217)
     result = SimpleNamespace(drive=fitted, base=truth, names=["friction_coefficient"], keep="damping_ratio")
-    text = fitting.fitted_drive_file(result, "m.csv", sources)
+    text = fit.fitted_drive_file(result, "m.csv", sources)
     assert calibration.load_fitted(text) == fitted
     line = {raw.split(" = ")[0]: raw for raw in text.splitlines() if " = " in raw}
     assert "fitted to m.csv by passmd fit" in line["friction_coefficient"]
@@ -57,24 +56,24 @@ def test_fitted_drive_file_reads_back_to_the_fitted_drive():
 
 
 def test_synthetic_measurements_are_independent_steps_plus_the_stated_noise(tmp_path):
-    truth, _ = design.example_drive()
+    truth, _ = figures.example_drive()
     config = RunConfig(cache_dir=tmp_path)
     data, held = calibration.synthetic_measurements(truth, "quick", config)
-    s = design.PROFILE_SETTINGS["quick"]
+    s = figures.PROFILE_SETTINGS["quick"]
     assert len(data) == len(s.fit_preloads) * len(s.fit_amplitudes_nm) and len(held) == len(s.heldback)
-    noise = np.random.default_rng(design.SEED).normal(0.0, design.NOISE_NM * 1e-9, len(data) + len(held))
+    noise = np.random.default_rng(figures.SEED).normal(0.0, figures.NOISE_NM * 1e-9, len(data) + len(held))
     conditions = [(p, a, f) for p, a, f in zip(data.preload, data.amplitude, data.frequency, strict=True)]
     exact = independent_steps(truth, conditions)
     # the same simulation and the same draws: equal to round-off of the sum (values ~1e-7 m)
     np.testing.assert_allclose(data.value, exact + noise[:len(data)], rtol=0, atol=1e-18)
     # not the fit's own forward model: the refined integrator moves these steps by up to 0.12 nm (the
     # default scheme's error for this drive), well below the noise's σ (1 nm)
-    own = fitting.predict(truth, data, cache=False, executor="serial")
-    assert np.max(np.abs(exact - own)) < 0.2 * design.NOISE_NM * 1e-9 and np.any(exact != own)
-    assert np.all(data.sd == design.NOISE_NM * 1e-9) and data.known_sd
+    own = fit.predict(truth, data, cache=False, executor="serial")
+    assert np.max(np.abs(exact - own)) < 0.2 * figures.NOISE_NM * 1e-9 and np.any(exact != own)
+    assert np.all(data.sd == figures.NOISE_NM * 1e-9) and data.known_sd
     text = calibration.measurements_csv(data)
     path = tmp_path / "m.csv"
     path.write_text(text, encoding="utf-8")
-    back = fitting.read_measurements(path)
+    back = fit.read_measurements(path)
     np.testing.assert_allclose(back.value, data.value, rtol=1e-15)  # repr() round trip
     np.testing.assert_allclose(back.amplitude, data.amplitude, rtol=1e-15)

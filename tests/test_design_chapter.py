@@ -6,14 +6,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd.experiments.design import figures as design
+from passmd.experiments.design import figures
 from passmd.model.drive_file import DRIVE_KEYS, DriveFileError, load_drive
 from passmd.runtime.config import RunConfig
 
 
 def test_example_drive_is_the_chapter_drive_with_sources():
-    drive, sources = design.example_drive()
-    assert design.EXAMPLE_DRIVE_FILE.is_file()  # package data: an installed wheel has it too
+    drive, sources = figures.example_drive()
+    assert figures.EXAMPLE_DRIVE_FILE.is_file()  # package data: an installed wheel has it too
     assert (drive.hemisphere_radius, drive.preload, drive.friction_coefficient) == (0.5e-3, 0.6, 0.25)
     assert (drive.actuator.stiffness, drive.actuator.mass, drive.runner_mass) == (5e6, 2e-6, 5e-3)
     assert drive.contacts == 6 and drive.actuator_model == "flexible" and not drive.allow_extrapolation
@@ -24,7 +24,7 @@ def test_example_drive_is_the_chapter_drive_with_sources():
 
 def test_example_mass_is_inside_the_plausible_range_and_a_heavier_one_is_not(tmp_path):
     """The example needs no allow_extrapolation; the benchmark's 1.5e-5 kg would."""
-    text = design.EXAMPLE_DRIVE_FILE.read_text(encoding="utf-8")
+    text = figures.EXAMPLE_DRIVE_FILE.read_text(encoding="utf-8")
     heavy = tmp_path / "heavy.toml"
     heavy.write_text(text.replace('mass = "2e-6 kg"', 'mass = "1.5e-5 kg"'), encoding="utf-8")
     with pytest.raises(DriveFileError, match="actuator.mass.*out of range"):
@@ -32,8 +32,8 @@ def test_example_mass_is_inside_the_plausible_range_and_a_heavier_one_is_not(tmp
 
 
 def test_parameter_table_has_every_drive_show_row():
-    drive, sources = design.example_drive()
-    table = design.parameter_table(drive, sources).set_index("key")
+    drive, sources = figures.example_drive()
+    table = figures.parameter_table(drive, sources).set_index("key")
     assert list(table.index) == list(DRIVE_KEYS)
     assert table.loc["hemisphere_radius", ["value", "unit"]].tolist() == ["0.5", "mm"]
     assert table.loc["actuator.full_stroke_amplitude", "value"] == "131.3"  # Table 2 at 0.5 mm
@@ -43,32 +43,32 @@ def test_parameter_table_has_every_drive_show_row():
 
 @pytest.mark.parametrize("profile", ["quick", "paper"])
 def test_map_grid_runs_frequency_slow_amplitude_fast(profile):
-    drive, _ = design.example_drive()
-    s = design.PROFILE_SETTINGS[profile]
-    points = design.map_points(drive, profile)
+    drive, _ = figures.example_drive()
+    s = figures.PROFILE_SETTINGS[profile]
+    points = figures.map_points(drive, profile)
     assert len(points) == s.map_frequencies * s.map_amplitudes
     f = np.array([p["frequency_Hz"] for p in points]).reshape(s.map_frequencies, s.map_amplitudes)
     a = np.array([p["amplitude_m"] for p in points]).reshape(s.map_frequencies, s.map_amplitudes)
     assert np.all(f == f[:, :1]) and np.all(np.diff(f[:, 0]) > 0)
     assert np.all(a == a[:1, :]) and np.all(np.diff(a[0]) > 0)
-    np.testing.assert_allclose([f[0, 0], f[-1, 0]], design.MAP_FREQUENCY_RANGE, rtol=1e-12)  # round-off
-    np.testing.assert_allclose([a[0, 0], a[0, -1]], [design.MAP_AMPLITUDE_LOW,
+    np.testing.assert_allclose([f[0, 0], f[-1, 0]], figures.MAP_FREQUENCY_RANGE, rtol=1e-12)  # round-off
+    np.testing.assert_allclose([a[0, 0], a[0, -1]], [figures.MAP_AMPLITUDE_LOW,
                                                      drive.actuator.full_stroke_amplitude], rtol=1e-12)
 
 
 @pytest.mark.parametrize("profile", ["quick", "paper"])
 def test_stall_curve_holds_the_drives_own_preload(profile):
     """The chapter quotes the stall force at the example drive's preload: every profile computes it."""
-    drive, _ = design.example_drive()
-    assert drive.preload in design.PROFILE_SETTINGS[profile].stall_preloads
+    drive, _ = figures.example_drive()
+    assert drive.preload in figures.PROFILE_SETTINGS[profile].stall_preloads
 
 
 def test_profile_executor_applies_only_where_none_was_chosen():
-    assert design._run_config(RunConfig(), "quick").executor == "serial"
-    assert design._run_config(RunConfig(executor="process"), "quick").executor == "process"
-    assert design._run_config(RunConfig(), "paper").executor is None
+    assert figures._run_config(RunConfig(), "quick").executor == "serial"
+    assert figures._run_config(RunConfig(executor="process"), "quick").executor == "process"
+    assert figures._run_config(RunConfig(), "paper").executor is None
     with pytest.raises(ValueError, match="profile = 'fast'"):
-        design._run_config(RunConfig(), "fast")
+        figures._run_config(RunConfig(), "fast")
 
 
 def _map_table(velocities, frequencies, amplitudes):
@@ -82,7 +82,7 @@ def test_map_facts_find_the_fastest_point_and_the_top_row():
     # amplitudes 5 nm apart: only the largest is the top row (an absolute tolerance of 1e-8 m would
     # take both)
     table = _map_table([1e-4, 2e-4, 5e-3, 4e-3], [100.0, 1e4], [95e-9, 100e-9])
-    facts = design.map_facts(table)
+    facts = figures.map_facts(table)
     assert facts["v_max_mm_s"] == pytest.approx(5.0) and facts["v_max_f_kHz"] == pytest.approx(10.0)
     assert facts["v_max_A_nm"] == pytest.approx(95.0) and facts["A_top_nm"] == pytest.approx(100.0)
     assert facts["step_low_f_nm"] == pytest.approx(2e-4 / 100 * 1e9)  # largest amplitude, lowest f
@@ -93,19 +93,19 @@ def test_map_facts_find_the_fastest_point_and_the_top_row():
 def test_gain_facts_count_missing_waveforms_and_signs():
     table = pd.DataFrame({"frequency_Hz": [1e3, 1e3, 1e4, 1e4], "amplitude_m": [5e-8, 1e-7, 5e-8, 1e-7],
                           "gain_m_per_s": [None, -1e-3, 2e-3, 5e-4]})
-    facts = design.gain_facts(table)
+    facts = figures.gain_facts(table)
     counts = (facts["gain_points"], facts["gain_designed"], facts["gain_none"], facts["gain_faster"])
     assert counts == (4, 3, 1, 2)
     assert facts["gain_max_mm_s"] == pytest.approx(2.0) and facts["gain_max_f_kHz"] == pytest.approx(10.0)
     assert facts["gain_min_mm_s"] == pytest.approx(-1.0)
-    none = design.gain_facts(table.assign(gain_m_per_s=[None] * 4))
+    none = figures.gain_facts(table.assign(gain_m_per_s=[None] * 4))
     assert none["gain_designed"] == 0 and "gain_max_mm_s" not in none
 
 
 def test_contact_table_is_eq1_for_the_example_guide():
     """The example writes the paper's guide as groups: F_p/(2 sin 45°) and F_p/(4 sin 45°) per contact."""
-    drive, _ = design.example_drive()
-    table = design.contact_table(drive)
+    drive, _ = figures.example_drive()
+    table = figures.contact_table(drive)
     assert table["side"].tolist() == [1, 2] and table["contacts"].tolist() == [2, 4]
     assert table["contact angle α [°]"].tolist() == pytest.approx([45.0, 45.0])
     sin45 = np.sin(np.pi / 4)
@@ -120,15 +120,15 @@ def _curve(steady, closed=(30.0, 50.0, 70.0, 90.0), left=(2.0, 0.1, 3.0, 4.0)):
 
 
 def test_curve_facts_say_where_the_closed_form_is_exceeded_and_how_often_the_curve_turns():
-    below = design.curve_facts(_curve([20.0, 40.0, 60.0, 80.0]))
+    below = figures.curve_facts(_curve([20.0, 40.0, 60.0, 80.0]))
     assert below["ca_closed_above"] == 4 and below["ca_turns"] == 0 and below["ca_ringing_points"] == 3
     # a drive whose steady A_c exceeds the closed form at one preload and turns twice
-    jagged = design.curve_facts(_curve([20.0, 55.0, 52.0, 80.0]))
+    jagged = figures.curve_facts(_curve([20.0, 55.0, 52.0, 80.0]))
     assert jagged["ca_closed_above"] == 3 and jagged["ca_excess_nm"] == pytest.approx(5.0)
     assert jagged["ca_excess_at_N"] == 0.4 and jagged["ca_turns"] == 2
     assert jagged["ca_ringing_left_nm"] == 4.0
     # a dip within the measurable step is no turn
-    assert design.curve_facts(_curve([20.0, 40.0, 39.8, 80.0]))["ca_turns"] == 0
+    assert figures.curve_facts(_curve([20.0, 40.0, 39.8, 80.0]))["ca_turns"] == 0
 
 
 def test_ringing_facts_read_the_probe():
@@ -136,7 +136,7 @@ def test_ringing_facts_read_the_probe():
              "ringing_hold_s": 20e-3, "flyback_time_s": 1e-6,
              "swing_times_s": np.array([1e-4, 5e-3, 9.999e-3, 15e-3]),
              "swing_amplitudes_m": np.array([40e-9, 10e-9, 5e-9, 0.4e-9])}
-    facts = design.ringing_facts(probe, 100.0)
+    facts = figures.ringing_facts(probe, 100.0)
     assert facts["ring_f_kHz"] == 5.0 and facts["ring_amp_nm"] == pytest.approx(40.0)
     assert facts["ring_left_nm"] == pytest.approx(5.0, rel=1e-3)
     assert facts["ring_quiet_ms"] == pytest.approx(15.0)

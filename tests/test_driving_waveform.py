@@ -21,7 +21,7 @@ from passmd.model.optimized_waveform import (
 )
 from passmd.model.parameters import paper_drive
 from passmd.protocols import eq15
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 
 A = 202e-9  # m, the paper's full amplitude for R = 1 mm
 #: The saw-tooth frequency of the design and of Fig. 9a (Hz).
@@ -191,7 +191,7 @@ def test_waveform_needs_a_design(drive):
 
 
 def test_optimized_run_from_rest(design, drive):
-    res = dynamics.simulate(drive, optimized(A, F_STEP, drive, periods=3, design=design))
+    res = simulation.simulate(drive, optimized(A, F_STEP, drive, periods=3, design=design))
     assert res.settled_positions.shape == (3,)
     assert np.all(np.isfinite(res.settled_positions)) and np.all(res.step_sizes > 0)
 

@@ -16,19 +16,14 @@ import pandas as pd
 import pytest
 import snapshot_accuracy as snap
 
-from passmd.experiments.driving_waveform import claims_velocity as dw_claims
-from passmd.experiments.driving_waveform import facts as wf
-from passmd.experiments.driving_waveform import figures as dw
-from passmd.experiments.driving_waveform import runs as dw_runs
-from passmd.experiments.driving_waveform import studies
+from passmd.experiments.driving_waveform import claims_velocity, facts, figures, runs, studies
 from passmd.model import theory, waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.optimized_waveform import OptimizedDesign, max_piezo_velocity, optimized
-from passmd.plots import driving_waveform as plots
+from passmd.plots import driving_waveform
 from passmd.protocols import eq15
 from passmd.runtime.config import RunConfig
-from passmd.solver import simulation as dynamics
-from passmd.solver import steps as time_steps
+from passmd.solver import simulation, steps
 
 PANELS = ("fig8a", "fig8b", "fig9a", "fig9b", "fig10a", "fig10b", "fig10c")
 #: The quick profile, as the tests run every panel.
@@ -41,7 +36,7 @@ SNAPSHOTS = {**{f"test_response_snapshot_{n}_": n for n in ("fig8a", "fig8b")},
 
 @pytest.fixture(scope="module")
 def quick():
-    return {name: getattr(dw, name)(QUICK) for name in PANELS}
+    return {name: getattr(figures, name)(QUICK) for name in PANELS}
 
 
 POINT_COLUMNS = ("time_s", "piezo_position_m", "runner_position_m", "runner_velocity_m_per_s", "slip_share_1",
@@ -50,7 +45,7 @@ VELOCITY_COLUMNS = ("frequency", "preload", "hemisphere_radius", "velocity_m_per
                     "settling_time_s", "acceleration_time_s", "settling_fits", "stick_during_acceleration",
                     "max_slip_share_acceleration", "micro_vibration_frequency_Hz")
 #: The Section 5 drive (Fig. 9b's): the other velocity panels lock only their other drives.
-SECTION5 = dw_runs.section5_fields()
+SECTION5 = runs.section5_fields()
 
 
 def _response(frame):
@@ -117,7 +112,7 @@ def test_finer_run_passes_the_snapshots(tmp_path_factory, dataframe_regression):
     snapshot check: the snapshots lock the physics to the stated accuracy, not one scheme."""
     config = snap.finer_config(tmp_path_factory.mktemp("finer-cache"))
     with snap.finer_run():
-        finer = {name: getattr(dw, name)(config) for name in set(SNAPSHOTS.values())}
+        finer = {name: getattr(figures, name)(config) for name in set(SNAPSHOTS.values())}
     for basename, name in SNAPSHOTS.items():
         check(dataframe_regression, basename, locked(name, finer[name]))
 
@@ -151,28 +146,28 @@ def test_fig10_steady_step_at_130_khz_is_converged(quick, monkeypatch, preload, 
     row = table[(table["frequency"] == 130e3) & (table["preload"] == preload) & (table["variant"] == variant)]
     assert len(row) == 1
     row = row.iloc[0]
-    point = {name: row[name] for name in inspect.signature(dw_runs.velocity_point).parameters
+    point = {name: row[name] for name in inspect.signature(runs.velocity_point).parameters
              if name in row.index}  # a figure at Section 5's μ passes none
-    default_simulate = dynamics.simulate
-    monkeypatch.setattr(dynamics, "simulate", functools.partial(default_simulate,
-                                                       scheme=time_steps.SCHEMES["fixed"].replace(dt=CONVERGED_DT)))
-    converged = dw_runs.velocity_point(**point)
+    default_simulate = simulation.simulate
+    monkeypatch.setattr(simulation, "simulate", functools.partial(default_simulate,
+                                                       scheme=steps.SCHEMES["fixed"].replace(dt=CONVERGED_DT)))
+    converged = runs.velocity_point(**point)
     assert converged["periods"] == row["periods"]
-    assert abs(row["step_m"] - converged["step_m"]) < time_steps.CONVERGED_ACCURACY
-    assert abs(row["back_step_m"] - converged["back_step_m"]) < time_steps.CONVERGED_ACCURACY
+    assert abs(row["step_m"] - converged["step_m"]) < steps.CONVERGED_ACCURACY
+    assert abs(row["back_step_m"] - converged["back_step_m"]) < steps.CONVERGED_ACCURACY
 
 
 def test_every_panel_plots(quick):
     for name in PANELS:
-        fig = getattr(plots, f"plot_{name}")(quick[name])
+        fig = getattr(driving_waveform, f"plot_{name}")(quick[name])
         assert fig.axes, name
 
 
 def test_fig9a_plot_shows_section5_friction_only(quick):
     frame = quick["fig9a"]
-    assert set(frame.loc[frame["section5_friction"], "friction_coefficient"]) == {dw_runs.SECTION5_FRICTION}
-    assert len(dw.FIG9A_FRICTION) > 1 and not frame["section5_friction"].all()
-    fig = plots.plot_fig9a(frame)
+    assert set(frame.loc[frame["section5_friction"], "friction_coefficient"]) == {runs.SECTION5_FRICTION}
+    assert len(figures.FIG9A_FRICTION) > 1 and not frame["section5_friction"].all()
+    fig = driving_waveform.plot_fig9a(frame)
     # one runner trace and one set of settled positions per waveform, plus the piezo: μ = 0.2 runs only
     assert len(fig.axes[0].lines) == 2 * 2 + 1
 
@@ -189,7 +184,7 @@ def test_eq15_waveform_makes_a_smaller_step_at_100hz(quick):
     are already close to full sliding, and Δ_a ≈ u_x,max pushes them over it). This test locks
     that finding; if the model changes so that the heuristic wins, the chapter must change.
     """
-    periods = dw.at_section5_friction(quick["fig9a"][quick["fig9a"]["view"] == "period"])
+    periods = figures.at_section5_friction(quick["fig9a"][quick["fig9a"]["view"] == "period"])
     step = {w: np.mean(np.diff(p.sort_values("period")["settled_position_m"].to_numpy()))
             for w, p in periods.groupby("waveform")}
     assert step["optimized"] < step["sawtooth"]
@@ -203,13 +198,13 @@ def test_carrying_the_runner_then_stopping_beats_the_sawtooth():
     vibration (fastest forward motion, point 4), carry the runner at a velocity friction can
     give it (μΣF_N/m_r ≈ 75 m/s² over a few nm), stop: the runner slides on. +20 % is a
     conservative floor for hand-picked numbers (the optimiser finds ≈ +50 %)."""
-    drive = dw_runs.section5_drive()
+    drive = runs.section5_drive()
     amplitude = drive.actuator.full_stroke_amplitude
     design = eq15.optimized_design(amplitude, drive)
     carry = OptimizedDesign(0.75 / design.micro_vibration_frequency, 0.9 * amplitude / 3e-3,
                             0.9 * amplitude)
-    saw = dynamics.simulate(drive, waveforms.sawtooth(amplitude, dw_runs.STEP_FREQUENCY, drive, periods=3))
-    opt = dynamics.simulate(drive, optimized(amplitude, dw_runs.STEP_FREQUENCY, drive, periods=3,
+    saw = simulation.simulate(drive, waveforms.sawtooth(amplitude, runs.STEP_FREQUENCY, drive, periods=3))
+    opt = simulation.simulate(drive, optimized(amplitude, runs.STEP_FREQUENCY, drive, periods=3,
                                              design=carry))
     assert np.mean(opt.step_sizes) > 1.2 * np.mean(saw.step_sizes)
 
@@ -218,8 +213,8 @@ def test_micro_vibration_to_linear_frequency_ratio_is_universal_for_rigid_drives
     """After a full slide the swing back is a Masing branch from full sliding; with the
     amplitude well above u_x,max its shape scales with u_x,max and μF_N, so f_s / f_lin is the
     same for every preload and radius (the start velocity, a_f·t_fb, is ~1 % of the swing's)."""
-    table = dw_runs.designs([dw_runs.section5_fields(preload=p) for p in (0.1, 1.0)]
-                       + [dw_runs.section5_fields(hemisphere_radius=0.25e-3)], QUICK)
+    table = runs.designs([runs.section5_fields(preload=p) for p in (0.1, 1.0)]
+                       + [runs.section5_fields(hemisphere_radius=0.25e-3)], QUICK)
     ratio = table["micro_vibration_frequency_Hz"] / table["linear_frequency_Hz"]
     assert ratio.max() - ratio.min() < 2e-3  # 0.2 %: the residual start-velocity effect
     assert np.sqrt(2 / 3) < ratio.min() and ratio.max() < 1.0
@@ -242,7 +237,7 @@ def test_settling_fits_only_at_low_frequency(quick):
     # what the paper's 110 kHz would need: t_fb + 1/(2 f_s) within 1/(110 kHz)
     f_s = float(opt["micro_vibration_frequency_Hz"].iloc[0])
     assert 2e-6 + 0.5 / f_s > 1 / 110e3
-    assert f_s == pytest.approx(theory.runner_frequency(dw_runs.section5_drive()), rel=0.2)
+    assert f_s == pytest.approx(theory.runner_frequency(runs.section5_drive()), rel=0.2)
 
 
 def test_numerical_optimum_beats_heuristic_and_sawtooth():
@@ -251,7 +246,7 @@ def test_numerical_optimum_beats_heuristic_and_sawtooth():
     assert low["velocity_optimum_m_per_s"] > 1.2 * low["velocity_sawtooth_m_per_s"]
     assert np.all(table["velocity_optimum_m_per_s"] > table["velocity_eq15_m_per_s"])
     # every optimum respects the amplifier
-    v_max = max_piezo_velocity(dw_runs.section5_drive())
+    v_max = max_piezo_velocity(runs.section5_drive())
     assert np.all(table["optimum_acceleration_velocity_m_per_s"] <= v_max * (1 + 1e-12))
 
 
@@ -279,39 +274,40 @@ def test_reachable_maximum_is_the_largest_up_to_the_control_limit():
     """The reachable maximal velocity is the largest up to the paper's 110 kHz control limit, wherever
     it lies (an edge included); the largest over the whole range is still defined."""
     inside = _velocity_series([1, 50, 110, 130], [0.1, 10.0, 19.0, 12.0])
-    assert dw_claims.controllable_maximum(inside)["frequency_kHz"] == 110.0
+    assert claims_velocity.controllable_maximum(inside)["frequency_kHz"] == 110.0
     at_edge = _velocity_series([1, 50, 110, 130], [0.2, 0.1, -1.0, -2.0])
-    assert dw_claims.controllable_maximum(at_edge)["frequency_kHz"] == 1.0
+    assert claims_velocity.controllable_maximum(at_edge)["frequency_kHz"] == 1.0
     beyond = _velocity_series([1, 50, 110, 130], [0.2, 0.1, 1.0, 2.0])
-    assert dw_claims.controllable_maximum(beyond)["frequency_kHz"] == 110.0
-    assert dw.range_maximum(beyond)["frequency_kHz"] == 130.0
+    assert claims_velocity.controllable_maximum(beyond)["frequency_kHz"] == 110.0
+    assert figures.range_maximum(beyond)["frequency_kHz"] == 130.0
 
 
 def test_turning_point_needs_a_rise_then_a_fall_where_the_paper_puts_it():
     from passmd.ledger.checks import ClaimFails
 
     rise_fall = _velocity_series([1, 60, 105, 110, 115, 130], [0.1, 8.0, 18.0, 19.0, 18.5, 15.0])
-    assert dw_claims.turning_point(rise_fall, 110.0)["frequency_kHz"].tolist() == [110.0, 115.0, 130.0]
+    assert claims_velocity.turning_point(rise_fall, 110.0)["frequency_kHz"].tolist() == [110.0, 115.0, 130.0]
     with pytest.raises(ClaimFails, match="no rise before the fall"):
-        dw_claims.turning_point(_velocity_series([1, 20, 110, 130], [0.2, -0.1, -4.0, -6.0]), 110.0)
+        claims_velocity.turning_point(_velocity_series([1, 20, 110, 130], [0.2, -0.1, -4.0, -6.0]), 110.0)
     with pytest.raises(ClaimFails, match="never begins decreasing"):
-        dw_claims.turning_point(_velocity_series([1, 20, 110, 130], [0.2, 3.0, 20.0, 25.0]), 110.0)
+        claims_velocity.turning_point(_velocity_series([1, 20, 110, 130], [0.2, 3.0, 20.0, 25.0]), 110.0)
+    series = _velocity_series([1, 60, 100, 110, 130], [0.2, 9.0, 5.0, 4.0, 3.0])
     with pytest.raises(ClaimFails, match="turns at 60 kHz"):
-        dw_claims.turning_point(_velocity_series([1, 60, 100, 110, 130], [0.2, 9.0, 5.0, 4.0, 3.0]), 110.0)
+        claims_velocity.turning_point(series, 110.0)
 
 
 def test_flyback_window_resolves_the_acceleration():
     """``fig8b_window`` (ledger rows of Section 5.1's stick condition): t_a, about 0.2 µs and shorter
     than the default step, holds at least ten records, and every phase of the window is present."""
-    frame = dw.fig8b_window(QUICK)
+    frame = figures.fig8b_window(QUICK)
     row = frame.iloc[0]
     t_a = row["acceleration_end_s"] - row["acceleration_start_s"]
     # records fall on integration steps: at most one step (t_a / 20) off the nominal t_a / 10
-    assert row["record_spacing_s"] <= 1.5 * t_a / dw_runs.WINDOW_SAMPLES_PER_ACCELERATION
+    assert row["record_spacing_s"] <= 1.5 * t_a / runs.WINDOW_SAMPLES_PER_ACCELERATION
     counts = frame["phase"].value_counts()
-    assert counts["acceleration"] >= dw_runs.WINDOW_SAMPLES_PER_ACCELERATION - 1
+    assert counts["acceleration"] >= runs.WINDOW_SAMPLES_PER_ACCELERATION - 1
     assert {"before", "flyback", "settling", "after"} <= set(counts.index)
-    assert plots.plot_fig8b_window(frame).axes
+    assert driving_waveform.plot_fig8b_window(frame).axes
 
 
 # --------------------------------------------------------------------------------------
@@ -320,98 +316,97 @@ def test_flyback_window_resolves_the_acceleration():
 
 
 def test_design_facts_and_table(quick):
-    drive = dw_runs.section5_drive()
-    design = dw_runs.designs([dw_runs.section5_fields()], QUICK).iloc[0]
-    facts = wf.design_facts(design, drive)
-    assert facts["f_ratio"] == pytest.approx(facts["f_s_kHz"] / facts["f_lin_kHz"], rel=1e-12)
-    assert facts["A_nm"] == pytest.approx(drive.actuator.full_stroke_amplitude * 1e9, rel=1e-12)
+    drive = runs.section5_drive()
+    design = runs.designs([runs.section5_fields()], QUICK).iloc[0]
+    found = facts.design_facts(design, drive)
+    assert found["f_ratio"] == pytest.approx(found["f_s_kHz"] / found["f_lin_kHz"], rel=1e-12)
+    assert found["A_nm"] == pytest.approx(drive.actuator.full_stroke_amplitude * 1e9, rel=1e-12)
     # a_f = μ ΣF_N / m_r over two contacts at F_N1 and four at F_N2 (Eq. 1)
     f_n = theory.drive_theory(drive)["normal_force_N"]
-    assert facts["a_f"] == pytest.approx(0.2 * (2 * f_n[0] + 4 * f_n[1]) / drive.runner_mass, rel=1e-12)
-    table = wf.design_table(design)
-    assert table.set_index("unit").loc["µs", "value"].tolist() == [facts["t_s_us"], facts["t_a_us"]]
+    assert found["a_f"] == pytest.approx(0.2 * (2 * f_n[0] + 4 * f_n[1]) / drive.runner_mass, rel=1e-12)
+    table = facts.design_table(design)
+    assert table.set_index("unit").loc["µs", "value"].tolist() == [found["t_s_us"], found["t_a_us"]]
 
 
 def test_fig8a_facts_follow_the_points(quick):
-    facts = wf.fig8a_facts(quick["fig8a"], dw_runs.section5_drive())
+    found = facts.fig8a_facts(quick["fig8a"], runs.section5_drive())
     # the runner reverses before it moves forward fastest, both within the micro-vibration's first cycle
-    assert 0 < facts["t3_after_us"] < facts["t4_after_us"] < 1e3 / 5.0
-    assert facts["back_step_nm"] > 0
-    assert 0 <= facts["share3_side1"] <= facts["share3_side2"] <= 1
+    assert 0 < found["t3_after_us"] < found["t4_after_us"] < 1e3 / 5.0
+    assert found["back_step_nm"] > 0
+    assert 0 <= found["share3_side1"] <= found["share3_side2"] <= 1
 
 
 def test_acceleration_slip_and_window_facts(quick):
-    slip = wf.acceleration_slip(quick["fig9b"])
+    slip = facts.acceleration_slip(quick["fig9b"])
     fits = quick["fig9b"][(quick["fig9b"]["variant"] == "optimized") & quick["fig9b"]["settling_fits"]]
     assert slip["frequencies_kHz"] == list(fits["frequency_kHz"])
     window = pd.DataFrame({"phase": ["flyback", "settling", "acceleration", "acceleration", "after"],
                            "slip_share_1": [1.0, 0.5, 0.2, 0.3, 1.0],
                            "slip_share_2": [0.7, 0.9, 0.1, 1.0, 0.0],
                            "record_spacing_s": 2e-8})
-    facts = wf.window_facts(window)
-    assert facts["window_flyback_share"] == 0.9 and not facts["flyback_full"]
-    assert facts["window_acceleration_share"] == 1.0 and facts["acceleration_full"]
-    assert facts["window_spacing_ns"] == pytest.approx(20.0)
+    found = facts.window_facts(window)
+    assert found["window_flyback_share"] == 0.9 and not found["flyback_full"]
+    assert found["window_acceleration_share"] == 1.0 and found["acceleration_full"]
+    assert found["window_spacing_ns"] == pytest.approx(20.0)
 
 
 def test_fig9a_facts_agree_with_the_ledger(quick):
-    from passmd.ledger import evaluation as ledger
-    from passmd.ledger import readings
+    from passmd.ledger import evaluation, readings
 
-    facts = wf.fig9a_facts(quick["fig9a"])
-    extract = ledger.extractors()
+    found = facts.fig9a_facts(quick["fig9a"])
+    extract = evaluation.extractors()
     reading = readings.default_reading()
-    assert facts["x3_saw_nm"] == pytest.approx(extract["fig9a-standard-position-552nm"](
+    assert found["x3_saw_nm"] == pytest.approx(extract["fig9a-standard-position-552nm"](
         {"fig9a": quick["fig9a"]}, reading), rel=1e-12)
-    assert facts["increase_pct"] == pytest.approx(extract["fig9a-step-increase-46.8pct"](
+    assert found["increase_pct"] == pytest.approx(extract["fig9a-step-increase-46.8pct"](
         {"fig9a": quick["fig9a"]}, reading), rel=1e-12)
     # the paper's own numbers: (716 − 552)/(552 − 202) = 46.9 %, its reported 46.8 % within rounding
-    assert wf.step_increase_pct(552.0, 716.0, 202.0) == pytest.approx(46.857, abs=1e-3)
+    assert facts.step_increase_pct(552.0, 716.0, 202.0) == pytest.approx(46.857, abs=1e-3)
 
 
 def test_startup_and_fig9b_facts(quick):
     table = quick["fig9b"]
-    start = wf.startup_facts(table)
+    start = facts.startup_facts(table)
     assert start["max_drift_pct"] < 0.5  # as test_velocity_runs_are_steady_and_consistent
-    design = dw_runs.designs([dw_runs.section5_fields()], QUICK).iloc[0]
-    facts = wf.fig9b_facts(table, design, dw_runs.section5_drive())
+    design = runs.designs([runs.section5_fields()], QUICK).iloc[0]
+    found = facts.fig9b_facts(table, design, runs.section5_drive())
     # t_s would fit at 110 kHz only with f_s ≥ 1 / (2 t_s,max): above the measured f_s by the factor's root
-    assert facts["f_s_needed_kHz"] == pytest.approx(0.5e-3 / (facts["t_s_room_us"] * 1e-6), rel=1e-12)
-    assert facts["stiffness_factor"] > 1
-    assert facts["fit_limit_kHz"] < dw.PAPER_MAXIMUM_KHZ
+    assert found["f_s_needed_kHz"] == pytest.approx(0.5e-3 / (found["t_s_room_us"] * 1e-6), rel=1e-12)
+    assert found["stiffness_factor"] > 1
+    assert found["fit_limit_kHz"] < figures.PAPER_MAXIMUM_KHZ
     saw = table[table["variant"] == "sawtooth"].set_index("frequency")
-    assert facts["saw_step_1k"] == saw.loc[1e3, "step_nm"]
-    assert facts["saw_step_130k"] == saw.loc[130e3, "step_nm"]
+    assert found["saw_step_1k"] == saw.loc[1e3, "step_nm"]
+    assert found["saw_step_130k"] == saw.loc[130e3, "step_nm"]
 
 
 def test_reachable_table_and_stick_lost(quick):
-    table = wf.reachable_table(quick["fig10a"], "preload")
-    assert len(table) == len(dw.FIG10A_PRELOADS) * 3
+    table = facts.reachable_table(quick["fig10a"], "preload")
+    assert len(table) == len(figures.FIG10A_PRELOADS) * 3
     best = table[(table["preload"] == 0.4) & (table["variant"] == "sawtooth")].iloc[0]
     f10a = quick["fig10a"]
     saw = f10a[(f10a["variant"] == "sawtooth") & np.isclose(f10a["preload"], 0.4)]
     assert best["max velocity (mm/s)"] == saw["velocity_mm_per_s"].max()
-    lost = wf.stick_lost(quick["fig10a"])
+    lost = facts.stick_lost(quick["fig10a"])
     assert set(lost["with_full_settling"]) <= set(lost["all"])
 
 
 def test_optimum_and_flexible_facts():
     optimum = studies.numerical_optimum(QUICK)
-    design = dw_runs.designs([dw_runs.section5_fields()], QUICK).iloc[0]
-    a_f = wf.friction_acceleration(dw_runs.section5_drive())
-    facts = wf.optimum_facts(optimum, design, a_f)
-    low = wf.optimum_at(optimum)
-    assert low["frequency"] == dw_runs.STEP_FREQUENCY and low["actuator_model"] == "rigid"
-    assert facts["opt_gain_100"] > 20  # the optimum beats the saw-tooth (test above: by > 20 %)
+    design = runs.designs([runs.section5_fields()], QUICK).iloc[0]
+    a_f = facts.friction_acceleration(runs.section5_drive())
+    found = facts.optimum_facts(optimum, design, a_f)
+    low = facts.optimum_at(optimum)
+    assert low["frequency"] == runs.STEP_FREQUENCY and low["actuator_model"] == "rigid"
+    assert found["opt_gain_100"] > 20  # the optimum beats the saw-tooth (test above: by > 20 %)
     t_a = design["acceleration_time_s"]
-    assert facts["ta_ratio"] == pytest.approx(facts["opt_ta_us"] * 1e-6 / t_a, rel=1e-12)
-    assert facts["slide_nm"] == pytest.approx((facts["opt_va_mm_s"] * 1e-3) ** 2 / (2 * a_f) * 1e9, rel=1e-12)
-    shown = wf.optimum_table(optimum)
-    assert shown["V_a (mm/s)"].iloc[0] == pytest.approx(facts["opt_va_mm_s"], rel=1e-12)
-    carried = wf.carried_steps(optimum)
+    assert found["ta_ratio"] == pytest.approx(found["opt_ta_us"] * 1e-6 / t_a, rel=1e-12)
+    assert found["slide_nm"] == pytest.approx((found["opt_va_mm_s"] * 1e-3) ** 2 / (2 * a_f) * 1e9, rel=1e-12)
+    shown = facts.optimum_table(optimum)
+    assert shown["V_a (mm/s)"].iloc[0] == pytest.approx(found["opt_va_mm_s"], rel=1e-12)
+    carried = facts.carried_steps(optimum)
     assert carried["actuators"].tolist() == ["rigid", "flexible"]
     assert carried.iloc[0]["gain (%)"] > 20
-    flexible = dw_runs.designs([dw_runs.section5_fields(actuator_model="flexible")], QUICK).iloc[0]
-    flex = wf.flexible_facts(optimum, flexible, carried, dw_runs.section5_drive())
+    flexible = runs.designs([runs.section5_fields(actuator_model="flexible")], QUICK).iloc[0]
+    flex = facts.flexible_facts(optimum, flexible, carried, runs.section5_drive())
     assert np.isnan(flex["flex_opt_gain"])  # the quick profile does not optimise flexible actuators
-    assert flex["f_s_flex_kHz"] < wf.design_facts(design, dw_runs.section5_drive())["f_s_kHz"]
+    assert flex["f_s_flex_kHz"] < facts.design_facts(design, runs.section5_drive())["f_s_kHz"]

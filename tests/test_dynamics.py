@@ -10,10 +10,9 @@ import pytest
 from passmd.model import theory, waveforms
 from passmd.model.contact import contact_arrays, contact_stiffness, stack_contacts
 from passmd.model.parameters import Drive
-from passmd.solver import setup as run_setup
-from passmd.solver import simulation as dynamics
-from passmd.solver import steps as time_steps
+from passmd.solver import simulation, steps
 from passmd.solver.results import SimulationError
+from passmd.solver.setup import contact_groups
 from passmd.solver.steps import SCHEMES
 
 F_TEST = 1000.0  # Hz: 1 ms periods keep tests fast; the runner mode (~5-11 kHz) settles within
@@ -29,7 +28,7 @@ def presliding(drive):
 
 def run(drive, amplitude, periods=4, frequency=F_TEST, **kw):
     wf = waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
-    return dynamics.simulate(drive, wf, **kw)
+    return simulation.simulate(drive, wf, **kw)
 
 
 def test_rigid_one_contact_no_step_below_presliding():
@@ -55,8 +54,8 @@ def test_rigid_one_contact_step_grows_one_for_one_above_presliding():
 def test_mirrored_waveform_mirrors_motion(model):
     d = one_contact(model)
     wf = waveforms.sawtooth(3 * presliding(d), F_TEST, d, periods=3)
-    fwd = dynamics.simulate(d, wf)
-    back = dynamics.simulate(d, wf.mirrored())
+    fwd = simulation.simulate(d, wf)
+    back = simulation.simulate(d, wf.mirrored())
     # the exact contact is odd in u, so the mirrored run is the negated run up to rounding
     np.testing.assert_allclose(back.settled_positions, -fwd.settled_positions, rtol=1e-9, atol=1e-18)
 
@@ -64,8 +63,8 @@ def test_mirrored_waveform_mirrors_motion(model):
 def test_six_contacts_do_not_rely_on_shared_side_state():
     d = Drive(actuator_model="flexible")
     wf = waveforms.sawtooth(120e-9, F_TEST, d, periods=3)
-    shared = dynamics.simulate(d, wf)
-    separate = dynamics.simulate(d, wf, share_side_state=False)
+    shared = simulation.simulate(d, wf)
+    separate = simulation.simulate(d, wf, share_side_state=False)
     # same physics, six states instead of two: only summation order differs
     np.testing.assert_allclose(separate.settled_positions, shared.settled_positions, rtol=1e-9, atol=1e-15)
 
@@ -109,8 +108,8 @@ def test_time_step_convergence(model):
     """Halving the step changes the 3-period step size by < 0.5 % (model chapter: convergence shown)."""
     d = Drive(contacts=1, actuator_model=model)
     wf = waveforms.sawtooth(120e-9, F_TEST, d, periods=3)
-    coarse = dynamics.simulate(d, wf).final_position
-    fine = dynamics.simulate(d, wf, scheme=SCHEMES["controlled"].replace(refine=2.0)).final_position
+    coarse = simulation.simulate(d, wf).final_position
+    fine = simulation.simulate(d, wf, scheme=SCHEMES["controlled"].replace(refine=2.0)).final_position
     assert abs(fine - coarse) < 0.005 * abs(fine)
 
 
@@ -121,7 +120,7 @@ def test_energy_balance(model, contact):
     """W_in = E_kin + E_el + Σ∫T du + W_damp; the residual is the integrator's O(dt²) error."""
     d = Drive(actuator_model=model)
     wf = waveforms.sawtooth(120e-9, F_TEST, d, periods=2)
-    res = dynamics.simulate(d, wf, contact_model=contact, springs=200)
+    res = simulation.simulate(d, wf, contact_model=contact, springs=200)
     bal = res.energy_balance()
     assert bal["input_work"] > 0 and bal["contact_work"] > 0
     assert abs(bal["relative_residual"]) < 1e-3
@@ -148,27 +147,27 @@ def test_error_controlled_energy_balance_at_100_hz(contacts, model):
 def test_divergence_is_reported(monkeypatch):
     d = one_contact("flexible")
     wf = waveforms.sawtooth(100e-9, F_TEST, d, periods=1)
-    plan_dt = time_steps.step_plan(d, 3e6, 3e6).stability_limit
-    monkeypatch.setattr(run_setup, "STABILITY_MARGIN", 100.0)  # let an unstable step through
+    plan_dt = steps.step_plan(d, 3e6, 3e6).stability_limit
+    monkeypatch.setattr("passmd.solver.setup.STABILITY_MARGIN", 100.0)  # let an unstable step through
     with pytest.raises(SimulationError, match=r"diverged at integrator step \d+.*time step"):
-        dynamics.simulate(d, wf, scheme=SCHEMES["fixed"].replace(dt=5 * plan_dt))
+        simulation.simulate(d, wf, scheme=SCHEMES["fixed"].replace(dt=5 * plan_dt))
 
 
 def test_kernel_wrapper_refuses_a_wrong_array_naming_it(monkeypatch):
     """The compiled loop does no bounds checks: its Python wrapper checks every array first."""
-    from passmd.solver import kernels as kern
+    from passmd.solver import kernels
 
     seen = []
-    integrate = kern.integrate
+    integrate = kernels.integrate
 
     def capture(*args):
         seen.append(args)
         return integrate(*args)
 
-    monkeypatch.setattr(kern, "integrate", capture)
+    monkeypatch.setattr(kernels, "integrate", capture)
     run(one_contact(), 50e-9, periods=1)
     segments, mechanics, control, contacts, buffers, limit = seen[0]
-    narrow = buffers._replace(per=np.zeros((1, kern.PER_COLUMNS - 1)))
+    narrow = buffers._replace(per=np.zeros((1, kernels.PER_COLUMNS - 1)))
     with pytest.raises(ValueError, match=r"buffers\.per has shape \(1, 7\), must be \(1, 8\)"):
         integrate(segments, mechanics, control, contacts, narrow, limit)
     ints = segments._replace(t0=segments.t0.astype(np.int64))
@@ -188,9 +187,9 @@ def test_bad_inputs():
         waveforms.piecewise_linear([0, 6e-4, 4e-4, 1e-3], [0, 1e-8, 2e-8, 0], F_TEST, 1, (1e-4, 2e-4), 6e-4)
     wf = waveforms.sawtooth(10e-9, F_TEST, d)
     with pytest.raises(ValueError, match=r"^dt = 1e-05 is out of range: .*stable"):
-        dynamics.simulate(one_contact("flexible"), wf, scheme=SCHEMES["fixed"].replace(dt=1e-5))
+        simulation.simulate(one_contact("flexible"), wf, scheme=SCHEMES["fixed"].replace(dt=1e-5))
     with pytest.raises(ValueError, match=r"^contact_model = 'soft'"):
-        dynamics.simulate(d, wf, contact_model="soft")
+        simulation.simulate(d, wf, contact_model="soft")
     with pytest.raises(ValueError, match=r"^frequency = 400000.0 is out of range"):
         waveforms.sawtooth(202e-9, 4e5, Drive())
 
@@ -199,14 +198,14 @@ def test_bad_inputs():
 @pytest.mark.parametrize("name", list(SCHEMES))
 def test_every_scheme_runs_and_agrees(model, name):
     """Each named scheme integrates a 2-period run to within the converged accuracy
-    (time_steps.CONVERGED_ACCURACY) of the fixed fine step; error control rejects steps only
+    (steps.CONVERGED_ACCURACY) of the fixed fine step; error control rejects steps only
     where it is on."""
     d = one_contact(model)
     wf = waveforms.sawtooth(150e-9, F_TEST, d, periods=2)
-    ref = dynamics.simulate(d, wf, scheme="fixed", max_points=2)
-    res = dynamics.simulate(d, wf, scheme=name, max_points=2)
+    ref = simulation.simulate(d, wf, scheme="fixed", max_points=2)
+    res = simulation.simulate(d, wf, scheme=name, max_points=2)
     np.testing.assert_allclose(res.settled_positions, ref.settled_positions, rtol=0,
-                               atol=time_steps.CONVERGED_ACCURACY)
+                               atol=steps.CONVERGED_ACCURACY)
     if name != "controlled":
         assert res.rejected_steps == 0
     assert res.fine_step == ref.fine_step
@@ -218,7 +217,7 @@ def test_bad_scheme_is_one_line_naming_it():
     d = one_contact()
     wf = waveforms.sawtooth(50e-9, F_TEST, d, periods=1)
     with pytest.raises(ValueError) as err:
-        dynamics.simulate(d, wf, scheme="verlet")
+        simulation.simulate(d, wf, scheme="verlet")
     message = str(err.value)
     assert message == ("scheme = 'verlet' is not allowed: must be one of 'controlled', 'adaptive', "
                        "'quasi-static', 'fixed' or a passmd.solver.steps.Scheme")
@@ -250,7 +249,7 @@ def test_default_step_converged_to_005_nm():
     default = df[df["resolution"] == 1.0]
     assert set(default["step_control"]) == {"controlled", "adaptive", "fixed"}
     assert len(default[default["step_control"] == "controlled"]) == 4  # every configuration
-    assert (default["error_m"].abs() < time_steps.CONVERGED_ACCURACY).all(), default
+    assert (default["error_m"].abs() < steps.CONVERGED_ACCURACY).all(), default
 
 
 def test_contact_memory_never_overflows_in_a_100_hz_period():
@@ -279,9 +278,9 @@ def test_chunked_run_is_bit_identical(monkeypatch, model, contacts, scheme):
     from its carried state: the run must be the uninterrupted run to the last bit."""
     d = Drive(actuator_model=model, contacts=contacts)
     wf = waveforms.sawtooth(150e-9, F_TEST, d, periods=3)
-    whole = dynamics.simulate(d, wf, max_points=3000, scheme=scheme)
-    monkeypatch.setattr(dynamics, "CHUNK_STEPS", 997)  # prime: pauses land everywhere
-    chunked = dynamics.simulate(d, wf, max_points=3000, scheme=scheme)
+    whole = simulation.simulate(d, wf, max_points=3000, scheme=scheme)
+    monkeypatch.setattr(simulation, "CHUNK_STEPS", 997)  # prime: pauses land everywhere
+    chunked = simulation.simulate(d, wf, max_points=3000, scheme=scheme)
     assert chunked.steps == whole.steps and chunked.fine_steps == whole.fine_steps
     assert chunked.rejected_steps == whole.rejected_steps
     for name in FIELDS:
@@ -302,14 +301,14 @@ PERIOD_FIELDS = ("settled_positions", "back_steps", "peak_force_ratio", "period_
 def test_continued_simulation_is_the_shorter_run(monkeypatch, model, contacts, scheme):
     """A saw-tooth run stopped after n periods is the n-period run to the last bit, and running
     on (in several calls, with pauses anywhere) gives the run of the whole waveform."""
-    monkeypatch.setattr(dynamics, "CHUNK_STEPS", 997)  # pauses also inside pieces
+    monkeypatch.setattr(simulation, "CHUNK_STEPS", 997)  # pauses also inside pieces
     d = Drive(actuator_model=model, contacts=contacts)
     wave = waveforms.sawtooth(150e-9, F_TEST, d, periods=5)
-    sim = dynamics.Simulation(d, wave, max_points=3000, scheme=scheme)
+    sim = simulation.Simulation(d, wave, max_points=3000, scheme=scheme)
     sim.run_to(2)
     early = sim.result()
     kept = {name: getattr(early, name).copy() for name in PERIOD_FIELDS}
-    short = dynamics.simulate(d, waveforms.sawtooth(150e-9, F_TEST, d, periods=2), max_points=3000,
+    short = simulation.simulate(d, waveforms.sawtooth(150e-9, F_TEST, d, periods=2), max_points=3000,
                               scheme=scheme)
     np.testing.assert_array_equal(early.waveform.times, short.waveform.times)
     np.testing.assert_array_equal(early.waveform.positions, short.waveform.positions)
@@ -322,7 +321,7 @@ def test_continued_simulation_is_the_shorter_run(monkeypatch, model, contacts, s
     sim.run_to(3)
     sim.run_to(3)  # already there: nothing to do
     sim.run_to(5)
-    whole = dynamics.simulate(d, wave, max_points=3000, scheme=scheme)
+    whole = simulation.simulate(d, wave, max_points=3000, scheme=scheme)
     continued = sim.result()
     assert continued.waveform is wave and continued.steps == whole.steps
     for name in FIELDS:
@@ -334,7 +333,7 @@ def test_continued_simulation_is_the_shorter_run(monkeypatch, model, contacts, s
 
 def test_continued_simulation_bad_use():
     d = one_contact()
-    sim = dynamics.Simulation(d, waveforms.sawtooth(50e-9, F_TEST, d, periods=3))
+    sim = simulation.Simulation(d, waveforms.sawtooth(50e-9, F_TEST, d, periods=3))
     with pytest.raises(ValueError, match=r"call run_to first"):
         sim.result()
     with pytest.raises(ValueError, match=r"^periods = 4 is out of range: the waveform has 3 periods"):
@@ -346,10 +345,10 @@ def test_continued_simulation_bad_use():
 def test_continued_simulation_is_refused_as_the_shorter_run(monkeypatch):
     """The step budget applies to the periods asked for, as to a waveform of that length."""
     d = one_contact()
-    monkeypatch.setattr(time_steps, "MAX_STEPS", 5000.0)  # ≈ 2070 steps per period: 2 periods fit
-    sim = dynamics.Simulation(d, waveforms.sawtooth(20e-9, F_TEST, d, periods=3))
+    monkeypatch.setattr(steps, "MAX_STEPS", 5000.0)  # ≈ 2070 steps per period: 2 periods fit
+    sim = simulation.Simulation(d, waveforms.sawtooth(20e-9, F_TEST, d, periods=3))
     sim.run_to(2)
-    with pytest.raises(time_steps.WorkLimitError, match=r"\(--periods\) = 3 must be <= 2"):
+    with pytest.raises(steps.WorkLimitError, match=r"\(--periods\) = 3 must be <= 2"):
         sim.run_to(3)
     assert sim.periods_done == 2
 
@@ -361,14 +360,14 @@ def test_expected_steps_match_the_run(scheme):
     for model in ("rigid", "flexible"):
         d = Drive(actuator_model=model)
         wf = waveforms.sawtooth(202e-9, 100.0, d, periods=1)
-        res = dynamics.simulate(d, wf, scheme=scheme)
+        res = simulation.simulate(d, wf, scheme=scheme)
         E, G = theory.contact_moduli(d)
-        forces, mult = run_setup.contact_groups(d)
+        forces, mult = contact_groups(d)
         rows = [contact_arrays("exact", F, d.hemisphere_radius, E, G, d.friction_coefficient) for F in forces]
         params, _ = stack_contacts(rows)
         ks = np.array([contact_stiffness(params[g]) for g in range(len(rows))])
-        plan = time_steps.step_plan(d, ks.max(), float(np.sum(mult * ks)))
-        est = time_steps.expected_steps(wf, plan, res.fine_step, res.coarse_step).sum()
+        plan = steps.step_plan(d, ks.max(), float(np.sum(mult * ks)))
+        est = steps.expected_steps(wf, plan, res.fine_step, res.coarse_step).sum()
         if scheme == "controlled":
             assert res.steps < est
             continue
@@ -380,37 +379,37 @@ def test_expected_steps_match_the_run(scheme):
 def test_run_beyond_the_step_budget_is_refused_before_it_starts(monkeypatch):
     d = one_contact()
     wf = waveforms.sawtooth(20e-9, F_TEST, d, periods=3)
-    monkeypatch.setattr(time_steps, "MAX_STEPS", 5000.0)  # ≈ 2070 steps per period: 2 periods fit
+    monkeypatch.setattr(steps, "MAX_STEPS", 5000.0)  # ≈ 2070 steps per period: 2 periods fit
     refused = r"budget of 5e\+03 steps .*\(--periods\) = 3 must be <= 2"
-    with pytest.raises(time_steps.WorkLimitError, match=refused):
-        dynamics.simulate(d, wf)
-    monkeypatch.setattr(time_steps, "MAX_STEPS", 10.0)  # not even one period fits: name the step
-    with pytest.raises(time_steps.WorkLimitError, match=r"runner_mass \(--runner-mass\)"):
-        dynamics.simulate(d, wf)
+    with pytest.raises(steps.WorkLimitError, match=refused):
+        simulation.simulate(d, wf)
+    monkeypatch.setattr(steps, "MAX_STEPS", 10.0)  # not even one period fits: name the step
+    with pytest.raises(steps.WorkLimitError, match=r"runner_mass \(--runner-mass\)"):
+        simulation.simulate(d, wf)
 
 
 def test_step_below_the_time_resolution_is_refused():
     d = one_contact()
     # a 1e-18 m saw-tooth flies back in 1e-17 s: 40 steps of 2.5e-19 s cannot advance t ≈ 1 ms
     wf = waveforms.sawtooth(1e-18, F_TEST, d, periods=2)
-    with pytest.raises(time_steps.WorkLimitError, match=r"float spacings of t .*--amplitude.*--slew-rate"):
-        dynamics.simulate(d, wf)
+    with pytest.raises(steps.WorkLimitError, match=r"float spacings of t .*--amplitude.*--slew-rate"):
+        simulation.simulate(d, wf)
     light = one_contact(runner_mass=1e-33, allow_extrapolation=True)  # past the plausible range on purpose
-    with pytest.raises(time_steps.WorkLimitError, match=r"runner_mass \(--runner-mass\) = 1e-33"):
-        dynamics.simulate(light, waveforms.sawtooth(20e-9, F_TEST, light, periods=2))
+    with pytest.raises(steps.WorkLimitError, match=r"runner_mass \(--runner-mass\) = 1e-33"):
+        simulation.simulate(light, waveforms.sawtooth(20e-9, F_TEST, light, periods=2))
     flexible = one_contact("flexible")
-    with pytest.raises(time_steps.WorkLimitError, match=r"dt = 1e-22 s"):
-        dynamics.simulate(flexible, waveforms.sawtooth(20e-9, F_TEST, flexible, periods=2),
+    with pytest.raises(steps.WorkLimitError, match=r"dt = 1e-22 s"):
+        simulation.simulate(flexible, waveforms.sawtooth(20e-9, F_TEST, flexible, periods=2),
                           scheme=SCHEMES["fixed"].replace(dt=1e-22))
 
 
 def test_progress_bar_on_request(monkeypatch, capsys):
     d = one_contact()
     wf = waveforms.sawtooth(20e-9, F_TEST, d, periods=3)
-    monkeypatch.setattr(dynamics, "CHUNK_STEPS", 500)
-    dynamics.simulate(d, wf, progress=True)
+    monkeypatch.setattr(simulation, "CHUNK_STEPS", 500)
+    simulation.simulate(d, wf, progress=True)
     assert "period" in capsys.readouterr().err
-    dynamics.simulate(d, wf)  # default: a short run, and stderr is not a terminal here
+    simulation.simulate(d, wf)  # default: a short run, and stderr is not a terminal here
     assert capsys.readouterr().err == ""
 
 
@@ -426,8 +425,8 @@ def test_quasi_static_step_matches_the_fixed_fine_step(contacts, contact):
     (the reference scheme), at the full stroke where the slips are largest."""
     d = Drive(contacts=contacts, actuator_model="flexible")
     wf = waveforms.sawtooth(202e-9, 100.0, d, periods=3)
-    ref = dynamics.simulate(d, wf, scheme="fixed", contact_model=contact, max_points=2)
-    quasi = dynamics.simulate(d, wf, contact_model=contact, max_points=2, scheme="quasi-static")
+    ref = simulation.simulate(d, wf, scheme="fixed", contact_model=contact, max_points=2)
+    quasi = simulation.simulate(d, wf, contact_model=contact, max_points=2, scheme="quasi-static")
     assert quasi.steps < ref.steps / 50
     np.testing.assert_allclose(quasi.settled_positions, ref.settled_positions, rtol=0, atol=0.05e-9)
     assert abs(quasi.energy_balance()["relative_residual"]) < 1e-4
@@ -436,9 +435,9 @@ def test_quasi_static_step_matches_the_fixed_fine_step(contacts, contact):
 def test_quasi_static_step_chunked_is_bit_identical(monkeypatch):
     d = Drive(actuator_model="flexible")
     wf = waveforms.sawtooth(150e-9, F_TEST, d, periods=3)
-    whole = dynamics.simulate(d, wf, max_points=3000, scheme="quasi-static")
-    monkeypatch.setattr(dynamics, "CHUNK_STEPS", 997)
-    chunked = dynamics.simulate(d, wf, max_points=3000, scheme="quasi-static")
+    whole = simulation.simulate(d, wf, max_points=3000, scheme="quasi-static")
+    monkeypatch.setattr(simulation, "CHUNK_STEPS", 997)
+    chunked = simulation.simulate(d, wf, max_points=3000, scheme="quasi-static")
     for name in FIELDS:
         np.testing.assert_array_equal(getattr(chunked, name), getattr(whole, name), err_msg=name)
     assert chunked.energy == whole.energy
@@ -449,7 +448,7 @@ def test_quasi_static_step_converges():
     (second order), measured against resolution 8."""
     d = Drive(contacts=1, actuator_model="flexible")
     wf = waveforms.sawtooth(150e-9, 100.0, d, periods=3)
-    pos = {r: dynamics.simulate(d, wf, scheme=SCHEMES["quasi-static"].replace(refine=r),
+    pos = {r: simulation.simulate(d, wf, scheme=SCHEMES["quasi-static"].replace(refine=r),
                                 max_points=2).final_position
            for r in (1.0, 2.0, 8.0)}
     e1, e2 = abs(pos[1.0] - pos[8.0]), abs(pos[2.0] - pos[8.0])
@@ -473,12 +472,12 @@ def test_error_controlled_step_matches_the_fixed_fine_step(contacts, model, cont
     the reference scheme, with far fewer steps, and an energy balance closed to 1e-4."""
     d = Drive(contacts=contacts, actuator_model=model)
     wf = waveforms.sawtooth(202e-9, 100.0, d, periods=3)
-    ref = dynamics.simulate(d, wf, scheme="fixed", contact_model=contact, max_points=2)
-    ctrl = dynamics.simulate(d, wf, contact_model=contact, max_points=2)
+    ref = simulation.simulate(d, wf, scheme="fixed", contact_model=contact, max_points=2)
+    ctrl = simulation.simulate(d, wf, contact_model=contact, max_points=2)
     assert ctrl.steps < ref.steps / 5
     np.testing.assert_allclose(ctrl.settled_positions, ref.settled_positions, rtol=0,
-                               atol=time_steps.CONVERGED_ACCURACY)
-    np.testing.assert_allclose(ctrl.back_steps, ref.back_steps, rtol=0, atol=time_steps.CONVERGED_ACCURACY)
+                               atol=steps.CONVERGED_ACCURACY)
+    np.testing.assert_allclose(ctrl.back_steps, ref.back_steps, rtol=0, atol=steps.CONVERGED_ACCURACY)
     assert abs(ctrl.energy_balance()["relative_residual"]) < 1e-4
 
 
@@ -488,11 +487,11 @@ def test_error_controlled_step_converges():
     CONVERGED_ACCURACY."""
     d = Drive(contacts=6, actuator_model="rigid")
     wf = waveforms.sawtooth(150e-9, 100.0, d, periods=3)
-    ref = dynamics.simulate(d, wf, scheme=SCHEMES["fixed"].replace(refine=4.0), max_points=2).final_position
-    runs = {r: dynamics.simulate(d, wf, scheme=SCHEMES["controlled"].replace(refine=r), max_points=2)
+    ref = simulation.simulate(d, wf, scheme=SCHEMES["fixed"].replace(refine=4.0), max_points=2).final_position
+    runs = {r: simulation.simulate(d, wf, scheme=SCHEMES["controlled"].replace(refine=r), max_points=2)
             for r in (0.5, 1.0, 2.0)}
     err = {r: abs(run.final_position - ref) for r, run in runs.items()}
-    assert err[1.0] < time_steps.CONVERGED_ACCURACY
+    assert err[1.0] < steps.CONVERGED_ACCURACY
     assert err[2.0] < err[1.0] < err[0.5]
     assert runs[0.5].steps < runs[1.0].steps < runs[2.0].steps
 
@@ -501,9 +500,9 @@ def test_error_controlled_step_rejects_and_counts():
     """Steps whose error estimate exceeds the tolerance are retried shorter (the slip at each
     fly-back forces some); they are counted in ``steps`` and in ``rejected_steps``."""
     d = Drive(contacts=6, actuator_model="rigid")
-    res = dynamics.simulate(d, waveforms.sawtooth(150e-9, 100.0, d, periods=2), max_points=2)
+    res = simulation.simulate(d, waveforms.sawtooth(150e-9, 100.0, d, periods=2), max_points=2)
     assert 0 < res.rejected_steps < res.steps / 2
-    fixed = dynamics.simulate(d, waveforms.sawtooth(150e-9, 100.0, d, periods=2), max_points=2,
+    fixed = simulation.simulate(d, waveforms.sawtooth(150e-9, 100.0, d, periods=2), max_points=2,
                               scheme="adaptive")
     assert fixed.rejected_steps == 0
 
@@ -516,13 +515,13 @@ def test_error_controlled_samples_at_their_own_times(model):
     samples, 1 µs apart, is itself accurate to a few pm at the ≈ 11 kHz ringing)."""
     d = Drive(contacts=6, actuator_model=model)
     wf = waveforms.sawtooth(150e-9, 100.0, d, periods=2)
-    ref = dynamics.simulate(d, wf, scheme="fixed", max_points=20001)
-    ctrl = dynamics.simulate(d, wf, max_points=20001)
+    ref = simulation.simulate(d, wf, scheme="fixed", max_points=20001)
+    ctrl = simulation.simulate(d, wf, max_points=20001)
     if model == "rigid":  # (flexible: samples in the fine steps after a corner are at step ends)
         np.testing.assert_allclose(np.diff(ctrl.time), wf.duration / 20000, rtol=1e-6)
     x = np.interp(ctrl.time, ref.time, ref.runner_position)
     v = np.interp(ctrl.time, ref.time, ref.runner_velocity)
-    assert np.abs(ctrl.runner_position - x).max() < time_steps.CONVERGED_ACCURACY
+    assert np.abs(ctrl.runner_position - x).max() < steps.CONVERGED_ACCURACY
     assert np.abs(ctrl.runner_velocity - v).max() < 0.01 * np.ptp(ref.runner_velocity)
 
 
@@ -532,7 +531,7 @@ def test_error_controlled_reversals_keep_the_contact_dissipation():
     (the Masing loops' dissipation grows with the cube of their amplitude)."""
     d = Drive(contacts=6, actuator_model="rigid")
     wf = waveforms.sawtooth(150e-9, 100.0, d, periods=3)
-    ref = dynamics.simulate(d, wf, scheme="fixed", max_points=2)
-    ctrl = dynamics.simulate(d, wf, max_points=2)
+    ref = simulation.simulate(d, wf, scheme="fixed", max_points=2)
+    ctrl = simulation.simulate(d, wf, max_points=2)
     assert ctrl.energy["contact"] == pytest.approx(ref.energy["contact"], rel=1e-3)
     assert sum(m["reversals"] for m in ctrl.contact_memory) > 0

@@ -9,48 +9,48 @@ from pathlib import Path
 
 import pytest
 
-from passmd.experiments import figure_table as figures
+from passmd.experiments import figure_table
 from passmd.runtime.config import RunConfig
 
 BOOK = Path(__file__).resolve().parents[1] / "book"
 
 
 def test_names_are_unique_and_in_table_order():
-    names = figures.figure_names()
-    assert names == [spec.name for spec in figures.FIGURES]
+    names = figure_table.figure_names()
+    assert names == [spec.name for spec in figure_table.FIGURES]
     assert len(set(names)) == len(names)
 
 
 def test_every_figure_a_chapter_draws_is_in_the_table():
     """A chapter draws figures only through figure_plot, with names that the table holds for it."""
-    for spec in figures.FIGURES:
+    for spec in figure_table.FIGURES:
         assert (BOOK / f"{spec.chapter}.md").exists(), spec
     for chapter in BOOK.glob("*.md"):
         text = chapter.read_text()
         for name in re.findall(r"figure_plot\(\"(\w+)\"", text):
-            assert figures.figure_spec(name).chapter == chapter.stem, (chapter.name, name)
+            assert figure_table.figure_spec(name).chapter == chapter.stem, (chapter.name, name)
 
 
 def test_unknown_figure_names_the_known_ones():
     with pytest.raises(ValueError, match="figure = .fig99z. is not available: must be one of model_sawtooth"):
-        figures.figure_spec("fig99z")
+        figure_table.figure_spec("fig99z")
 
 
 def test_figure_data_takes_a_run_configuration():
     with pytest.raises(ValueError, match="config = 'quick' is not a RunConfig"):
-        figures.figure_data("fig5a", "quick")
+        figure_table.figure_data("fig5a", "quick")
     with pytest.raises(ValueError, match="profile = 'fast'"):
-        figures.figure_data("fig5a", RunConfig(profile="fast"))
+        figure_table.figure_data("fig5a", RunConfig(profile="fast"))
 
 
 def test_claim_modules_are_the_experiment_modules_with_extractors():
     """Every experiment module that tags a claim extractor is found (by its name, claims*.py), and
     only those."""
-    package = Path(figures.__file__).parent
+    package = Path(figure_table.__file__).parent
     tagged = {"passmd." + ".".join(path.relative_to(package.parent).with_suffix("").parts)
               for path in package.rglob("*.py")
               if re.search(r"^@(register_)?extractor\(", path.read_text(), flags=re.M)}
-    assert {module.__name__ for module in figures.CLAIM_MODULES} == tagged
+    assert {module.__name__ for module in figure_table.CLAIM_MODULES} == tagged
 
 
 @pytest.mark.parametrize("module", ["passmd.experiments.critical_amplitude.figures",

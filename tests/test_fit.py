@@ -24,7 +24,7 @@ from passmd import cli
 from passmd.experiments.calibration.synthetic import independent_steps
 from passmd.model.parameters import Drive
 from passmd.model.tables import Amplifier
-from passmd.protocols import fit as F
+from passmd.protocols import fit
 from passmd.protocols.fit.prediction import drive_at
 
 RIGID = Drive(contacts=1, actuator_model="rigid")
@@ -34,7 +34,7 @@ NOISE_NM = 0.5
 
 
 def _data(truth: Drive, preloads, amplitudes, seed: int, sd: float = NOISE_NM, flyback=None,
-          values=None) -> F.Measurements:
+          values=None) -> fit.Measurements:
     """Steps of ``truth`` made independently of the fit's model (``flyback`` overrides its rule), plus
     Gaussian noise of ``sd`` nm, stated in the file."""
     conditions = [(p, a * 1e-9, 100.0) for p in preloads for a in amplitudes]
@@ -42,7 +42,7 @@ def _data(truth: Drive, preloads, amplitudes, seed: int, sd: float = NOISE_NM, f
     noisy = exact + np.random.default_rng(seed).normal(0.0, sd * 1e-9, exact.size)
     rows = [[repr(a * 1e9), repr(p), repr(f), repr(float(v * 1e9)), repr(sd)]
             for (p, a, f), v in zip(conditions, noisy, strict=True)]
-    return F.measurements_from_rows(HEADER, rows)
+    return fit.measurements_from_rows(HEADER, rows)
 
 
 def _holds(result, name: str, value: float) -> bool:
@@ -54,13 +54,13 @@ def test_round_trip_region_holds_the_true_friction_coefficient():
     estimate within 3 local standard errors, and the χ² test passes (the model describes the data)."""
     truth = RIGID.replace(friction_coefficient=0.25)
     data = _data(truth, (0.2, 0.4), (60, 100, 140), seed=3)
-    result = F.fit(RIGID, data, ["friction_coefficient"], executor="serial", cache=False)
+    result = fit.fit(RIGID, data, ["friction_coefficient"], executor="serial", cache=False)
     est = result.estimates["friction_coefficient"]
     assert len(est["intervals"]) == 1 and _holds(result, "friction_coefficient", 0.25)
     assert abs(est["value"] - 0.25) < 3 * est["stderr"]
     assert est["interval"] == est["intervals"][0]
     assert result.identifiable and result.converged and not result.model_rejected
-    assert result.goodness_of_fit["p_value"] > F.REJECT_P and result.goodness_of_fit["dof"] == 5
+    assert result.goodness_of_fit["p_value"] > fit.REJECT_P and result.goodness_of_fit["dof"] == 5
     assert result.drive.friction_coefficient == pytest.approx(est["value"], rel=1e-12)
     # the estimate is the lowest point the fit saw: no point of any profile lies below it
     assert result.cost <= min(est["profile"]["cost"]) + 1e-9
@@ -72,7 +72,7 @@ def test_a_biased_model_leaves_the_truth_outside_and_the_test_rejects_it():
     truth = RIGID.replace(friction_coefficient=0.25)
     data = _data(truth, (0.2, 0.4), (60, 100, 140), seed=3)
     biased = replace(data, preload=data.preload * 2.0)
-    result = F.fit(RIGID, biased, ["friction_coefficient"], executor="serial", cache=False)
+    result = fit.fit(RIGID, biased, ["friction_coefficient"], executor="serial", cache=False)
     assert not _holds(result, "friction_coefficient", 0.25)
     assert result.model_rejected and not result.identifiable
     assert "does not describe the data" in result.verdict and "fly-back rule" in result.verdict
@@ -82,7 +82,7 @@ def test_a_biased_model_leaves_the_truth_outside_and_the_test_rejects_it():
 def test_steps_falling_with_amplitude_are_never_called_identifiable():
     """Nonsense data (steps that fall as the amplitude rises) fit no drive: rejected, not identifiable."""
     data = _data(RIGID, (0.4,), (60, 100, 140, 180), seed=0, values=[90e-9, 70e-9, 50e-9, 30e-9])
-    result = F.fit(RIGID, data, ["friction_coefficient"], executor="serial", cache=False)
+    result = fit.fit(RIGID, data, ["friction_coefficient"], executor="serial", cache=False)
     assert result.model_rejected and not result.identifiable
     assert result.report()["identifiable"] is False and result.report()["model_rejected"] is True
 
@@ -91,7 +91,7 @@ def test_without_sd_the_goodness_of_fit_cannot_be_tested():
     truth = RIGID.replace(friction_coefficient=0.25)
     data = _data(truth, (0.2, 0.4), (60, 100, 140), seed=3)
     unknown = replace(data, sd=np.full(len(data), np.nan))
-    result = F.fit(RIGID, unknown, ["friction_coefficient"], executor="serial", cache=False)
+    result = fit.fit(RIGID, unknown, ["friction_coefficient"], executor="serial", cache=False)
     gof = result.goodness_of_fit
     assert gof["testable"] is False and gof["p_value"] is None and not result.model_rejected
     assert "cannot be tested" in result.verdict
@@ -103,7 +103,7 @@ def test_a_parameter_the_data_cannot_see_is_reported_not_identifiable():
     its whole range, a tenth of the noise: its region reaches a bound and the verdict says so."""
     truth = RIGID.replace(friction_coefficient=0.25)
     data = _data(truth, (0.4,), (60, 100, 140, 180), seed=5)
-    result = F.fit(RIGID, data, ["friction_coefficient", "flyback_time"], executor="serial", cache=False)
+    result = fit.fit(RIGID, data, ["friction_coefficient", "flyback_time"], executor="serial", cache=False)
     assert not result.identifiable
     assert result.estimates["flyback_time"]["flat_profile"]
     assert "flyback_time is not identifiable" in result.verdict
@@ -125,7 +125,7 @@ def test_a_comb_in_k_p_gives_separate_pieces_and_the_row_that_separates_them():
     flexible = Drive(contacts=1)
     truth = drive_at(flexible, ["actuator.stiffness"], [5e6], flexible.actuator.damping_ratio)
     data = _data(truth, (0.4,), (120, 160, 200), seed=1, sd=1.0)
-    result = F.fit(flexible, data, ["actuator.stiffness"], executor="serial", cache=False)
+    result = fit.fit(flexible, data, ["actuator.stiffness"], executor="serial", cache=False)
     est = result.estimates["actuator.stiffness"]
     assert len(est["intervals"]) >= 2 and _holds(result, "actuator.stiffness", 5e6)
     assert est["interval"] == [est["intervals"][0][0], est["intervals"][-1][1]]
@@ -147,10 +147,10 @@ def test_a_wrong_flyback_rule_is_rejected_by_the_goodness_of_fit_test():
     six = Drive()
     truth = six.replace(friction_coefficient=0.25)
     data = _data(truth, (0.2, 0.4, 0.6), (110, 140, 170, 200), seed=2, flyback="fixed")
-    wrong = F.fit(six, data, ["friction_coefficient"])
+    wrong = fit.fit(six, data, ["friction_coefficient"])
     assert wrong.model_rejected and not wrong.identifiable
     assert "fly-back rule ('slew'" in wrong.verdict
-    right = F.fit(six.replace(amplifier=Amplifier(flyback="fixed")), data, ["friction_coefficient"])
+    right = fit.fit(six.replace(amplifier=Amplifier(flyback="fixed")), data, ["friction_coefficient"])
     assert not right.model_rejected and _holds(right, "friction_coefficient", 0.25)
     assert right.report()["flyback"] == "fixed"
 
@@ -166,7 +166,7 @@ def test_six_contacts_friction_and_stiffness_never_identifiable_with_a_region_th
     names = ["friction_coefficient", "actuator.stiffness"]
     truth = drive_at(six, names, [0.25, stiffness], six.actuator.damping_ratio)
     data = _data(truth, (0.2, 0.4, 0.6), (110, 140, 170, 200), seed=seed)
-    result = F.fit(six, data, names)
+    result = fit.fit(six, data, names)
     holds = _holds(result, names[0], 0.25) and _holds(result, names[1], stiffness)
     assert holds or not result.identifiable, result.verdict
 
@@ -190,9 +190,9 @@ def test_rows_the_drive_cannot_run_are_refused_before_any_simulation(monkeypatch
         (["100", "0.4", "100", "200", "50"], "column radius_mm = 200 is out of range: must be <= 100 mm"),
     ]
     for bad, fragment in cases:
-        data = F.measurements_from_rows(header, [good, good, bad], name="mine.csv")
-        with pytest.raises(F.MeasurementError) as caught:
-            F.fit(Drive(), data, ["friction_coefficient"], executor="serial", cache=False)
+        data = fit.measurements_from_rows(header, [good, good, bad], name="mine.csv")
+        with pytest.raises(fit.MeasurementError) as caught:
+            fit.fit(Drive(), data, ["friction_coefficient"], executor="serial", cache=False)
         message = str(caught.value)
         assert message.startswith("mine.csv row 3 (line 4), ") and fragment in message, message
         assert "\n" not in message
@@ -200,10 +200,10 @@ def test_rows_the_drive_cannot_run_are_refused_before_any_simulation(monkeypatch
 
 def test_a_free_flyback_is_checked_at_its_longest():
     """A row whose period holds the drive's fly-back but not the longest the bounds allow is refused."""
-    data = F.measurements_from_rows(["amplitude_nm", "frequency_Hz", "step_nm"],
+    data = fit.measurements_from_rows(["amplitude_nm", "frequency_Hz", "step_nm"],
                                     [["100", "1e5", "1"], ["100", "100", "1"], ["150", "100", "2"]])
-    with pytest.raises(F.MeasurementError, match="for the slew-limited fly-back"):
-        F.fit(RIGID, data, ["flyback_time"], bounds={"flyback_time": (1e-7, 2e-5)}, executor="serial",
+    with pytest.raises(fit.MeasurementError, match="for the slew-limited fly-back"):
+        fit.fit(RIGID, data, ["flyback_time"], bounds={"flyback_time": (1e-7, 2e-5)}, executor="serial",
               cache=False)
 
 
@@ -240,8 +240,8 @@ def test_free_takes_the_names_drive_show_uses():
 def test_malformed_files_get_one_line_naming_row_and_column(tmp_path, text, fragment):
     path = tmp_path / "data.csv"
     path.write_text(text)
-    with pytest.raises(F.MeasurementError) as info:
-        F.read_measurements(path)
+    with pytest.raises(fit.MeasurementError) as info:
+        fit.read_measurements(path)
     message = str(info.value)
     assert fragment in message and "\n" not in message
 
@@ -250,7 +250,7 @@ def test_a_well_formed_file_reads_in_si(tmp_path):
     path = tmp_path / "data.csv"
     path.write_text("amplitude_nm,preload_N,frequency_Hz,velocity_mm_per_s,critical_amplitude_nm\n"
                     "100,0.4,1000,0.05,\n,0.3,,,48\n")
-    data = F.read_measurements(path)
+    data = fit.read_measurements(path)
     assert data.kind == ("velocity", "critical_amplitude")
     assert data.value == pytest.approx([0.05e-3, 48e-9], rel=1e-12)
     assert data.frequency[1] == 100.0  # a critical amplitude's default frequency (Section 4.1)
@@ -275,7 +275,7 @@ def test_the_papers_numbers_read_as_measurements():
     with the drive model it was stated for (a row without it would be fitted with the wrong drive)."""
     from passmd.ledger.reference import REFERENCE_DIR
 
-    data = F.read_measurements(REFERENCE_DIR / "paper_as_data.csv")
+    data = fit.read_measurements(REFERENCE_DIR / "paper_as_data.csv")
     assert data.kind == ("critical_amplitude", "position")
     assert data.model == ({"contacts": 1, "actuator_model": "flexible"},
                           {"contacts": 6, "actuator_model": "rigid"})
@@ -303,9 +303,9 @@ def test_help_gives_every_option_a_default():
 
 def test_every_measured_quantity_has_a_plot_label():
     """The figure labels each measured column; a new quantity without a label fails the --out figure."""
-    from passmd.plots import fit as plot
+    import passmd.plots.fit
 
-    assert set(F.MEASURED) <= set(plot._LABELS)
+    assert set(fit.MEASURED) <= set(passmd.plots.fit._LABELS)
 
 
 MINE = """\
@@ -337,7 +337,7 @@ def test_the_fitted_drive_file_is_the_fit(tmp_path, monkeypatch):
     names = ["friction_coefficient", "actuator.stiffness"]
     truth = drive_at(base, names, [0.25, 5e6], base.actuator.damping_ratio)
     data = _data(truth, (0.3, 0.5), (120, 160, 200), seed=4)
-    F.write_measurements(tmp_path / "data.csv", data)
+    fit.write_measurements(tmp_path / "data.csv", data)
     out = tmp_path / "out"
     status, text = _run(["fit", str(tmp_path / "data.csv"), "--drive", str(mine), "--free",
                          "friction_coefficient,actuator-stiffness", "--executor", "serial", "--json", "--out",

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from passmd.protocols import fit as F
+from passmd.protocols import fit
 from passmd.protocols.fit import estimator
-from passmd.protocols.fit import profiles as prof
 from passmd.protocols.fit.problem import Problem
+from passmd.protocols.fit.profiles import Profile
 
 
 class _Valley:
@@ -26,7 +26,7 @@ class _Valley:
 
 def _problem() -> Problem:
     header = ["amplitude_nm", "preload_N", "frequency_Hz", "step_nm"]
-    data = F.measurements_from_rows(header, [["100", "0.4", "100", "50"]] * 4, name="valley")
+    data = fit.measurements_from_rows(header, [["100", "0.4", "100", "50"]] * 4, name="valley")
     return Problem(_Valley(data), data, np.ones(4), np.full(3, -2.0), np.full(3, 2.0), "linear")
 
 
@@ -38,7 +38,7 @@ def test_polish_reaches_the_valley_floor_that_one_gauss_newton_step_misses():
     # held) stays at x0 = -1, cost ≥ 4
     (_, stepped), = problem.conditional([(0, wall[0], wall)])
     assert stepped >= 4.0 - 1e-9
-    profiles = {j: prof.Profile(j) for j in range(3)}
+    profiles = {j: Profile(j) for j in range(3)}
     for t, c in ((-1.1, cost + 1.0), (-1.0, cost), (-0.9, cost + 1.0)):  # a local minimum of x0's profile
         x = wall.copy()
         x[0] = t
@@ -50,7 +50,7 @@ def test_polish_reaches_the_valley_floor_that_one_gauss_newton_step_misses():
 
 def test_polish_ignores_minima_above_the_cut_and_repeats_of_one_basin():
     problem = _problem()
-    profiles = {j: prof.Profile(j) for j in range(3)}
+    profiles = {j: Profile(j) for j in range(3)}
     base = np.array([-1.0, 1.0, 1.0])
     for t, c in ((-1.1, 9.0), (-1.0, 5.0), (-0.9, 9.0)):
         x = base.copy()
@@ -59,7 +59,7 @@ def test_polish_ignores_minima_above_the_cut_and_repeats_of_one_basin():
     estimator._polish(problem, profiles, cut=4.0, say=lambda line: None)
     assert problem.model.evaluations == 0  # above the cut: no search
     lines = []
-    twin = {j: prof.Profile(j) for j in range(3)}
+    twin = {j: Profile(j) for j in range(3)}
     for j in (0, 1):  # the same point is a minimum of two profiles: one search
         for dt, c in ((-0.1, 9.0), (0.0, 5.0), (0.1, 9.0)):
             x = base.copy()

@@ -16,9 +16,7 @@ from passmd.model import waveforms
 from passmd.model.drive_file import drive_toml, load_drive
 from passmd.model.parameters import Drive
 from passmd.model.tables import Amplifier
-from passmd.protocols import critical_amplitude as ca
-from passmd.protocols import fit as F
-from passmd.protocols import velocity
+from passmd.protocols import critical_amplitude, fit, velocity
 
 
 def run(argv, capsys):
@@ -81,13 +79,13 @@ def test_the_default_keyword_gives_the_results_of_the_explicit_slew_rule():
     """Every library function's flyback= defaults to the drive's rule, which is "slew" unless the drive
     says otherwise: the results are bit for bit those of the explicit rule."""
     drive = Drive(contacts=1)
-    default, explicit = ca.steady_step(drive, 120e-9, periods=3), ca.steady_step(drive, 120e-9, periods=3,
-                                                                                flyback="slew")
+    default = critical_amplitude.steady_step(drive, 120e-9, periods=3)
+    explicit = critical_amplitude.steady_step(drive, 120e-9, periods=3, flyback="slew")
     assert default["steps_m"] == explicit["steps_m"]
-    fixed = ca.steady_step(with_rule("fixed", drive), 120e-9, periods=3)
-    explicit = ca.steady_step(drive, 120e-9, periods=3, flyback="fixed")
+    fixed = critical_amplitude.steady_step(with_rule("fixed", drive), 120e-9, periods=3)
+    explicit = critical_amplitude.steady_step(drive, 120e-9, periods=3, flyback="fixed")
     assert fixed["steps_m"] == explicit["steps_m"]
-    assert fixed["steps_m"] != ca.steady_step(drive, 120e-9, periods=3)["steps_m"]  # the rule matters
+    assert fixed["steps_m"] != default["steps_m"]  # the rule matters
     settled = velocity.settled_step(with_rule("fixed", drive), 120e-9, 100.0)
     assert settled["step_m"] == velocity.settled_step(drive, 120e-9, 100.0, flyback="fixed")["step_m"]
 
@@ -138,6 +136,6 @@ def test_a_bad_flyback_option_is_one_line(value, fragment, capsys):
 
 
 def test_a_stated_flyback_cannot_have_its_slew_rate_fitted():
-    data = F.measurements_from_rows(["amplitude_nm", "frequency_Hz", "step_nm"], [["100", "100", "1"]] * 3)
+    data = fit.measurements_from_rows(["amplitude_nm", "frequency_Hz", "step_nm"], [["100", "100", "1"]] * 3)
     with pytest.raises(ValueError, match="has no effect: the drive's fly-back is a stated time"):
-        F.fit(with_rule(1.5e-6), data, ["flyback_time"], executor="serial", cache=False)
+        fit.fit(with_rule(1.5e-6), data, ["flyback_time"], executor="serial", cache=False)

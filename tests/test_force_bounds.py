@@ -4,7 +4,7 @@ Over one period m_r Δv = T (F̄_fric − k·x̄_r) and each contact's friction 
 stall (periodic, Δv = 0) has k·x̄_r = F̄_fric ≤ μΣF_N: the stall force, and the force any
 credible extrapolation leads to, stay within μΣF_N. Results are compared with μΣF_N plus the
 integrator's accuracy (:func:`passmd.protocols.stall.bound_margin`, k times the 0.05 nm of
-``time_steps.CONVERGED_ACCURACY``): that is the only slack a computed result has.
+``passmd.solver.steps.CONVERGED_ACCURACY``): that is the only slack a computed result has.
 """
 
 from __future__ import annotations

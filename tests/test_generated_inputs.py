@@ -182,12 +182,12 @@ def measurement_files(draw) -> bytes:
 @FUZZ
 @given(data=measurement_files())
 def test_generated_measurement_files_end_cleanly(folder, data):
-    from passmd.protocols import fit as fitting
+    from passmd.protocols import fit
 
     path = folder / "data.csv"
     path.write_bytes(data)
     argv = ["fit", str(path), "--free", "mu"]
-    with mock.patch.object(fitting, "fit", _reached):  # reaching the fit: every check passed
+    with mock.patch.object(fit, "fit", _reached):  # reaching the fit: every check passed
         try:
             status, out, err, caught = run_main(argv)
         except _Reached:
@@ -238,11 +238,11 @@ def vary_specs(draw) -> str:
        specs=st.one_of(*(st.lists(vary_specs(), min_size=n, max_size=n) for n in (1, 2))),
        as_json=st.booleans())
 def test_generated_vary_specifications_end_cleanly(quantity, specs, as_json):
-    from passmd.experiments.design import maps as design_maps
+    from passmd.experiments.design import maps
 
     argv = ["sweep", quantity, *(a for spec in specs for a in ("--vary", spec))]
     argv += ["--json"] if as_json else []
-    with mock.patch.object(design_maps, "compute_map", _reached):  # reaching the map: every check passed
+    with mock.patch.object(maps, "compute_map", _reached):  # reaching the map: every check passed
         try:
             status, out, err, caught = run_main(argv)
         except _Reached:

@@ -14,8 +14,7 @@ import pytest
 from passmd import cli
 from passmd.ledger import readings
 from passmd.ledger.joint_drive import joint_drive, joint_drive_file, reading_from_baseline
-from passmd.model.drive_file import JOINT_READING_FILE as SHIPPED
-from passmd.model.drive_file import load_drive
+from passmd.model.drive_file import JOINT_READING_FILE, load_drive
 
 BASELINES = Path(__file__).parent
 
@@ -24,17 +23,17 @@ def test_the_shipped_file_is_the_paper_baselines_joint_reading():
     """Regenerate with
     ``passmd ledger --profile paper --write-drive passmd/data/drives/joint_reading.toml``."""
     reading = reading_from_baseline(BASELINES / "ledger_baseline_paper.csv")
-    assert SHIPPED.read_text(encoding="utf-8") == joint_drive_file(reading, "paper")
+    assert JOINT_READING_FILE.read_text(encoding="utf-8") == joint_drive_file(reading, "paper")
 
 
 def test_the_shipped_file_reads_back_to_the_reading_with_its_protocol_options():
     reading = reading_from_baseline(BASELINES / "ledger_baseline_paper.csv")
-    drive = load_drive(SHIPPED)
+    drive = load_drive(JOINT_READING_FILE)
     assert drive == joint_drive(reading)
     assert drive.amplifier.flyback == reading["flyback"]
     assert drive.friction_coefficient == reading["friction_coefficient"]
     assert drive.actuator.damping_ratio == pytest.approx(reading["damping_ratio"], rel=1e-12)
-    header = SHIPPED.read_text(encoding="utf-8").splitlines()[:6]
+    header = JOINT_READING_FILE.read_text(encoding="utf-8").splitlines()[:6]
     assert any(f"--protocol {reading['ac_protocol']} --frequency {reading['drive_frequency_s4']:g}Hz" in line
                for line in header)
     force = f"passmd force --drive FILE --frequency {reading['force_frequency']:g}Hz"
@@ -44,7 +43,7 @@ def test_the_shipped_file_reads_back_to_the_reading_with_its_protocol_options():
 def test_drive_template_prints_the_shipped_file():
     out = io.StringIO()
     assert cli.main(["drive", "template", "--joint-reading"], out=out) == 0
-    assert out.getvalue() == SHIPPED.read_text(encoding="utf-8")
+    assert out.getvalue() == JOINT_READING_FILE.read_text(encoding="utf-8")
 
 
 def test_a_drive_axis_left_at_its_default_is_the_papers_drive():

@@ -17,9 +17,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd.experiments import figure_table as figures
-from passmd.ledger import checks, reference
-from passmd.ledger import evaluation as ledger
+from passmd.experiments import figure_table
+from passmd.ledger import checks, evaluation, reference
 from passmd.ledger.claims import CHECK_KINDS, CLAIM_COLUMNS, load_claims
 from passmd.report import ledger_views
 from passmd.runtime.config import RunConfig
@@ -287,9 +286,9 @@ def test_curve_deviation_helper():
 
 def test_evaluate_computes_categories(tmp_path):
     claims = load_claims(_write(tmp_path, SYNTHETIC))
-    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[_good_module()])
+    evaluated = evaluation.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[_good_module()])
     evaluated = evaluated.set_index("claim")
-    assert list(evaluated.reset_index().columns) == list(ledger.LEDGER_COLUMNS)
+    assert list(evaluated.reset_index().columns) == list(evaluation.LEDGER_COLUMNS)
     assert evaluated.at["val", "verdict"] == "within 3 % at the defaults"
     assert evaluated.at["val", "paper"] == "100" and evaluated.at["val", "ours"] == 103.0
     assert evaluated.at["val", "tolerance"] == "5 %"
@@ -310,11 +309,11 @@ def test_evaluate_computes_the_results_from_a_config_when_none_are_given(tmp_pat
         configs.append(config)
         return {"fig5a": pd.DataFrame()}
 
-    monkeypatch.setattr(ledger, "collect_results", collect)
-    evaluated = ledger.evaluate(claims, config=QUICK, modules=[_good_module()])
+    monkeypatch.setattr(evaluation, "collect_results", collect)
+    evaluated = evaluation.evaluate(claims, config=QUICK, modules=[_good_module()])
     assert configs == [QUICK] and evaluated.at[0, "status"] == "reproduced"
     with pytest.raises(ValueError, match="needs results or a config"):
-        ledger.evaluate(claims, modules=[_good_module()])
+        evaluation.evaluate(claims, modules=[_good_module()])
 
 
 def test_failures_are_not_reproduced_with_their_evidence(tmp_path):
@@ -328,7 +327,8 @@ def test_failures_are_not_reproduced_with_their_evidence(tmp_path):
         raise checks.ClaimFails("no step up to the full stroke")
 
     _tag(module, "thr", total_failure)
-    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame(), "fig9b": pd.DataFrame()}, modules=[module])
+    tables = {"fig5a": pd.DataFrame(), "fig9b": pd.DataFrame()}
+    evaluated = evaluation.evaluate(claims, tables, modules=[module])
     evaluated = evaluated.set_index("claim")
     assert evaluated.at["val", "status"] == "not reproduced"
     assert "deviation 20 % exceeds the tolerance 5 %" in evaluated.at["val", "evidence"]
@@ -351,7 +351,7 @@ def test_evidence_functions_follow_the_checks(tmp_path):
         raise checks.NotEvaluable("no runs at 100 Hz")
 
     module.ord_evidence = ord_evidence
-    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module]).set_index("claim")
+    evaluated = evaluation.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module]).set_index("claim")
     assert evaluated.at["val", "evidence"].split(" | ") == [
         "defaults: holds (ours 103 nm; deviation 3 % within the tolerance 5 %)", "step 103 nm at 100 Hz"]
     assert evaluated.at["ord", "evidence"].endswith(
@@ -381,7 +381,7 @@ def test_joint_reading_is_chosen_among_covered_points(tmp_path):
         return {"lhs": 0.5, "rhs": 1.0}
 
     module._val, module._ord = _val, _ord
-    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, strict=False, modules=[module])
+    evaluated = evaluation.evaluate(claims, {"fig5a": pd.DataFrame()}, strict=False, modules=[module])
     joint = evaluated.attrs["joint"]
     assert joint["described"] == "defaults" and joint["covered_points"] == joint["points"] // 2
     assert joint["chosen_from"] == joint["covered_points"]
@@ -391,13 +391,13 @@ def test_joint_reading_is_chosen_among_covered_points(tmp_path):
     assert by_id.at["val", "best_reading"] == "fly-back rule = fixed"
     assert by_id.at["val", "fraction_holds"] == 0.5
     with pytest.raises(LookupError, match="no run at the fixed fly-back"):
-        ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])  # strict: a defect
+        evaluation.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])  # strict: a defect
     at_fixed["ord"] = checks.NotEvaluable("the grid cannot locate it")
-    joint = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module]).attrs["joint"]
+    joint = evaluation.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module]).attrs["joint"]
     assert joint["covered_points"] == joint["points"] == joint["chosen_from"]
     assert joint["decided_points"] == joint["points"] // 2 and joint["described"] == "fly-back rule = fixed"
     at_fixed["ord"] = None
-    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
+    evaluated = evaluation.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
     assert evaluated.attrs["joint"]["described"] == "fly-back rule = fixed"
     assert evaluated.attrs["joint"]["decided_points"] == evaluated.attrs["joint"]["points"]
     by_id = evaluated.set_index("claim")
@@ -405,14 +405,14 @@ def test_joint_reading_is_chosen_among_covered_points(tmp_path):
     assert by_id.at["val", "verdict"].endswith("holds at the joint reading")
     assert by_id.at["ord", "status"] == "not reproduced"
     assert "at the defaults and at the joint reading" in by_id.at["ord", "verdict"]
-    table = ledger.assumption_map(evaluated)
+    table = evaluation.assumption_map(evaluated)
     assert list(table.columns) == ["claim", "defaults", "fly-back rule = fixed", "holds at", "best reading"]
     row = table.set_index("claim").loc["val"].tolist()
     assert row == ["fails", "holds", "1 of 2", "fly-back rule = fixed"]
     html = ledger_views.assumption_map_styled(evaluated).to_html()
     assert "R1: fly-back rule = fixed" in html
-    assert ledger.depends_on("val", modules=[module]) == ("flyback",)
-    assert ledger.claim_readings("val", modules=[module]) == ("defaults", "fly-back rule = fixed")
+    assert evaluation.depends_on("val", modules=[module]) == ("flyback",)
+    assert evaluation.claim_readings("val", modules=[module]) == ("defaults", "fly-back rule = fixed")
 
 
 def test_a_missing_run_or_an_undeclared_axis_stops_the_ledger(tmp_path):
@@ -432,13 +432,13 @@ def test_a_missing_run_or_an_undeclared_axis_stops_the_ledger(tmp_path):
 
     module._val = _val
     with pytest.raises(LookupError, match="claim 'val' has no run at drive frequency, Section 4.2 = 1000 Hz"):
-        ledger.evaluate(claims, {"fig7_readings": pd.DataFrame()}, modules=[module])
-    lenient = ledger.evaluate(claims, {"fig7_readings": pd.DataFrame()}, modules=[module], strict=False)
+        evaluation.evaluate(claims, {"fig7_readings": pd.DataFrame()}, modules=[module])
+    lenient = evaluation.evaluate(claims, {"fig7_readings": pd.DataFrame()}, modules=[module], strict=False)
     assert "no run: no force runs at 1 kHz" in lenient.at[0, "evidence"]
     module._val = checks.extractor("val", depends_on=("flyback",))(lambda results, reading: 100.0)
     with pytest.raises(LookupError, match="claim 'val' reads tables that force_frequency changes, but its "
                                           "extractor does not declare it"):
-        ledger.evaluate(claims, {"fig7_readings": pd.DataFrame()}, modules=[module])
+        evaluation.evaluate(claims, {"fig7_readings": pd.DataFrame()}, modules=[module])
 
 
 def _point(state, reading=None, score=math.nan):
@@ -489,7 +489,7 @@ def test_joint_reading_is_the_argmax_with_ties_runner_ups_and_conflicts(tmp_path
         return {"lhs": 2.0, "rhs": 1.0}
 
     module._a, module._b, module._c = _a, _b, _c
-    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
+    evaluated = evaluation.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
     joint = evaluated.attrs["joint"]
     assert joint["described"] == "defaults" and joint["holding"] == 2 and joint["claims"] == 3
     # (slew, steady) and (fixed, steady) give every claim the same states: one reading, the defaults
@@ -503,7 +503,7 @@ def test_joint_reading_is_the_argmax_with_ties_runner_ups_and_conflicts(tmp_path
     assert ("holds at fly-back rule = fixed; how A_c is read = first, which breaks b"
             in by_id.at["a", "verdict"])
     assert by_id.at["a", "readings"] == 4 and by_id.at["a", "fails_at"] == 3  # the full product, 2 × 2
-    table = ledger.joint_map(evaluated)
+    table = evaluation.joint_map(evaluated)
     both = "fly-back rule = fixed; how A_c is read = first"
     assert list(table.columns) == ["joint reading: defaults", both,
                                    "how A_c is read = first"]
@@ -516,7 +516,7 @@ def test_joint_reading_is_the_argmax_with_ties_runner_ups_and_conflicts(tmp_path
     # counter-example: once 'a' holds everywhere, the three hold together and nothing conflicts
     module._a = checks.extractor("a", depends_on=("flyback", "ac_protocol"))(
         lambda results, reading: {"lhs": 2.0, "rhs": 1.0})
-    again = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
+    again = evaluation.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
     assert again.attrs["joint"]["holding"] == 3 and again.attrs["conflicts"] == []
 
 
@@ -571,7 +571,7 @@ def test_fragile_margin_and_informative_flags(tmp_path):
     _ord = checks.extractor("ord")(_ord)
     _ord.not_informative = "holds for any finite stiffness"
     module._val, module._ord = _val, _ord
-    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module]).set_index("claim")
+    evaluated = evaluation.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module]).set_index("claim")
     assert evaluated.at["val", "status"] == "reproduced"
     assert evaluated.at["val", "fails_at"] == 3 and evaluated.at["val", "decided_at"] == 4
     assert evaluated.at["val", "fragile"]
@@ -580,7 +580,7 @@ def test_fragile_margin_and_informative_flags(tmp_path):
     assert evaluated.at["val", "margin"] == pytest.approx(0.6)
     assert not evaluated.at["ord", "fragile"] and not evaluated.at["ord", "informative"]
     assert evaluated.at["ord", "not_informative"] == "holds for any finite stiffness"
-    counts = ledger.headline(evaluated.reset_index())
+    counts = evaluation.headline(evaluated.reset_index())
     assert counts["fragile"] == 1 and counts["not informative"] == 1 and counts["reproduced"] == 2
 
 
@@ -609,7 +609,7 @@ def test_a_coarse_grid_decides_only_what_the_paper_grid_would():
     """The coarse-grid rule of passmd.ledger.rules: a check holding on part of the paper's grid is
     inconclusive; a pointwise failure there decides (failures_decide); a failure of a check of the whole
     grid does not. The extractors wrap the quick grids and leave the paper's alone."""
-    from passmd.experiments.critical_amplitude import claims as ca_claims
+    from passmd.experiments.critical_amplitude import claims
     from passmd.experiments.driving_waveform import claims_velocity
     from passmd.experiments.driving_waveform.figures import FREQUENCIES
     from passmd.ledger.verdicts import _evaluate_point
@@ -631,9 +631,9 @@ def test_a_coarse_grid_decides_only_what_the_paper_grid_would():
     scoped = state(checks.Subset(checks.Scoped(fails, "outside Eq. 15"), "0.1 N"))
     assert scoped.state == "fails" and scoped.outside == "outside Eq. 15"
     # the extractors' wrappers: the quick grids lack points of the paper's, the paper's lacks none
-    wrapped = ca_claims._on_paper_grid(holds, "fig5b", (0.2, 0.6, 1.0))
+    wrapped = claims._on_paper_grid(holds, "fig5b", (0.2, 0.6, 1.0))
     assert isinstance(wrapped, checks.Subset) and "0.1, 0.3" in wrapped.missing
-    assert ca_claims._on_paper_grid(holds, "fig6c", (0.1, 0.2, 0.3, 0.4, 0.5)) is holds
+    assert claims._on_paper_grid(holds, "fig6c", (0.1, 0.2, 0.3, 0.4, 0.5)) is holds
     for profile, whole in (("quick", False), ("paper", True)):
         part = pd.DataFrame({"frequency_kHz": FREQUENCIES[profile] / 1e3})
         assert (claims_velocity.on_paper_grid(holds, part) is holds) == whole
@@ -648,8 +648,8 @@ def test_design_is_the_full_product_and_skip_is_no_reading_of_eq15():
     assert len(points) == 2 * 2 * 3 and points[0] == readings.default_reading()
     assert {"flyback": "fixed", "ac_protocol": "first"}.items() <= points[-1].items()
     for claim in ("fig9b-max-gain-2.5mm_s", "abstract-velocity-gain-15pct", "fig10a-max-velocity-19mm_s"):
-        assert "short_period" in ledger.depends_on(claim)
-        assert {r["short_period"] for r in readings.design(ledger.depends_on(claim))} == {"cut"}
+        assert "short_period" in evaluation.depends_on(claim)
+        assert {r["short_period"] for r in readings.design(evaluation.depends_on(claim))} == {"cut"}
     assert "skip" in dict(readings.axis("short_period").not_readings)
     assert all(p["short_period"] != "skip" for p in readings.space())
 
@@ -661,7 +661,7 @@ def test_every_claim_declares_exactly_the_axes_that_change_its_tables():
     from passmd.ledger import readings
 
     claims = load_claims()
-    functions = ledger.claim_functions()
+    functions = evaluation.claim_functions()
     paper = claims[claims["study_of"] == ""]
     for _, claim in paper.iterrows():
         assert set(functions.depends_on[claim["id"]]) == set(readings.applicable(claim)), claim["id"]
@@ -692,22 +692,23 @@ def test_missing_extractor_is_an_error_unless_lenient(tmp_path):
     module = _tag(_tag(types.ModuleType("synthetic_claims"), "val", lambda results: 100.0),
                   "typo", lambda results: 1.0)
     with pytest.raises(LookupError, match="claim 'ord' has its results but no registered extractor"):
-        ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
-    lenient = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, strict=False, modules=[module])
+        evaluation.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
+    lenient = evaluation.evaluate(claims, {"fig5a": pd.DataFrame()}, strict=False, modules=[module])
     lenient = lenient.set_index("claim")
     assert lenient.at["ord", "verdict"] == "no extractor registered"
     assert lenient.at["ord", "status"] == "inconclusive"
-    assert ledger.orphan_extractors(claims, modules=[module]) == ["typo"]
+    assert evaluation.orphan_extractors(claims, modules=[module]) == ["typo"]
 
 
 def test_claims_for_selects_a_chapters_rows():
     claims = load_claims()
-    fig5 = ledger.claims_for(claims, ["fig5a", "fig5b"])
+    fig5 = evaluation.claims_for(claims, ["fig5a", "fig5b"])
     assert set(fig5["figure"]) == {"5a", "5b"} and len(fig5) == 4  # their readings tables belong to them
     assert set(fig5["requires"]) == {"fig5a_readings", "fig5b_readings"}
     # a claim needing fig7a and fig7b belongs to a chapter that has both
-    assert "fig7-critical-amplitude-both-models" not in set(ledger.claims_for(claims, "fig7a")["id"])
-    assert "fig7-critical-amplitude-both-models" in set(ledger.claims_for(claims, ["fig7a", "fig7b"])["id"])
+    assert "fig7-critical-amplitude-both-models" not in set(evaluation.claims_for(claims, "fig7a")["id"])
+    both = evaluation.claims_for(claims, ["fig7a", "fig7b"])
+    assert "fig7-critical-amplitude-both-models" in set(both["id"])
 
 
 def test_extractor_errors_name_the_claim(tmp_path):
@@ -715,7 +716,7 @@ def test_extractor_errors_name_the_claim(tmp_path):
     module = _tag(types.ModuleType("synthetic_claims"), "ord",
                   lambda results: results["fig5a"]["missing_column"])
     with pytest.raises(checks.ExtractorError, match="claim 'ord' \\(ordering check\\)"):
-        ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
+        evaluation.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
 
 
 def test_not_evaluable_from_extractor(tmp_path):
@@ -725,7 +726,7 @@ def test_not_evaluable_from_extractor(tmp_path):
         raise checks.NotEvaluable("quick grid has no point at 100 Hz")
 
     module = _tag(types.ModuleType("synthetic_claims"), "val", _coarse)
-    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
+    evaluated = evaluation.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[module])
     assert evaluated.at[0, "status"] == "inconclusive"
     assert evaluated.at[0, "verdict"] == "not decided at the defaults: quick grid has no point at 100 Hz"
 
@@ -736,25 +737,26 @@ def test_any_category_change_fails_with_a_readable_diff(tmp_path):
     module = _good_module()
     results = {"fig5a": pd.DataFrame()}
     baseline_path = tmp_path / "baseline.csv"
-    ledger.write_baseline(ledger.evaluate(claims, results, modules=[module]), baseline_path,
+    evaluation.write_baseline(evaluation.evaluate(claims, results, modules=[module]), baseline_path,
                           header="made by a test\non a day")
     assert baseline_path.read_text().startswith("# made by a test\n# on a day\nclaim,status,readings,states,"
                                                 "joint\n")
     # the readings each category was computed at (these synthetic claims depend on no axis), the
     # state at each, and the point besides the defaults its category was judged at
-    assert ledger.load_baseline_readings(baseline_path)["val"] == ("defaults",)
-    assert ledger.load_baseline_states(baseline_path)["other"] == {"states": {"defaults": "inconclusive"},
+    assert evaluation.load_baseline_readings(baseline_path)["val"] == ("defaults",)
+    assert evaluation.load_baseline_states(baseline_path)["other"] == {"states": {"defaults": "inconclusive"},
                                                                    "joint": "defaults"}
-    baseline = ledger.load_baseline(baseline_path)
+    baseline = evaluation.load_baseline(baseline_path)
     assert baseline["val"] == "reproduced" and baseline["other"] == "inconclusive"
-    ledger.check_categories(ledger.evaluate(claims, results, modules=[module]), baseline)  # unchanged: fine
+    unchanged = evaluation.evaluate(claims, results, modules=[module])
+    evaluation.check_categories(unchanged, baseline)  # unchanged: fine
     _tag(module, "val", lambda results: 90.0)  # the model drifts 10 % away from the paper
     with pytest.raises(AssertionError, match="val: reproduced -> not reproduced"):
-        ledger.check_categories(ledger.evaluate(claims, results, modules=[module]), baseline)
+        evaluation.check_categories(evaluation.evaluate(claims, results, modules=[module]), baseline)
     # an inconclusive claim that becomes decidable is a change too (review it, then record it)
     _tag(module, "val", lambda results: 100.0)
-    changed = ledger.category_changes(
-        ledger.evaluate(claims, {**results, "fig9b": pd.DataFrame()}, modules=[module]), baseline)
+    changed = evaluation.category_changes(
+        evaluation.evaluate(claims, {**results, "fig9b": pd.DataFrame()}, modules=[module]), baseline)
     assert changed[["claim", "baseline", "now"]].values.tolist() == [["other", "inconclusive", "reproduced"]]
 
 
@@ -770,21 +772,22 @@ def test_collect_results_calls_every_figure_of_the_table(monkeypatch):
         return pd.DataFrame({"amplitude_nm": [1.0]})
 
     table = {"fig5a": types.SimpleNamespace(compute=_fig5a)}
-    monkeypatch.setattr(figures, "figure_names", lambda: list(table))
-    monkeypatch.setattr(figures, "figure_spec", lambda name: table[name])
-    monkeypatch.setattr(figures, "READING_TABLES", {"fig5a_readings": types.SimpleNamespace(compute=_fig5a)})
-    results = ledger.collect_results(QUICK)
+    monkeypatch.setattr(figure_table, "figure_names", lambda: list(table))
+    monkeypatch.setattr(figure_table, "figure_spec", lambda name: table[name])
+    reading_tables = {"fig5a_readings": types.SimpleNamespace(compute=_fig5a)}
+    monkeypatch.setattr(figure_table, "READING_TABLES", reading_tables)
+    results = evaluation.collect_results(QUICK)
     assert list(results) == ["fig5a", "fig5a_readings", "closed_forms"]
     assert calls == [QUICK, QUICK]
     pd.testing.assert_frame_equal(results["closed_forms"], reference.tangential_stiffness_table())
     with pytest.raises(TypeError, match="config = 'quick' is not allowed: "
                        "must be a passmd.runtime.config.RunConfig"):
-        ledger.collect_results("quick")
+        evaluation.collect_results("quick")
     with pytest.raises(ValueError, match="are not available"):
-        ledger.collect_results(QUICK, figures=["fig9z"])
+        evaluation.collect_results(QUICK, figures=["fig9z"])
     table["fig5b"] = types.SimpleNamespace(compute=lambda config: [1, 2])
     with pytest.raises(TypeError, match="not a DataFrame"):
-        ledger.collect_results(QUICK, figures=["fig5b"])
+        evaluation.collect_results(QUICK, figures=["fig5b"])
 
 
 def test_tags_only_mark_the_function():
@@ -798,7 +801,7 @@ def test_tags_only_mark_the_function():
 
     assert checks.extractor("x", depends_on=["flyback"])(first) is first
     assert (first.claim_extractor, first.claim_depends_on) == ("x", ("flyback",))
-    assert "x" not in ledger.extractors()  # tagging registers nothing anywhere
+    assert "x" not in evaluation.extractors()  # tagging registers nothing anywhere
 
 
 def test_collect_claim_functions_finds_each_claim_once():
@@ -827,15 +830,15 @@ def test_real_extractors_live_in_the_figures_claim_modules():
     """Every extractor of the package is found in passmd.experiments.figure_table.CLAIM_MODULES (and the
     ledger's own
     closed-form one), and the experiments do not import the ledger (the layers are one-way)."""
-    found = ledger.claim_functions()
+    found = evaluation.claim_functions()
     homes = {f.__module__ for f in found.extractors.values()}
-    assert homes == {m.__name__ for m in figures.CLAIM_MODULES} | {"passmd.ledger.evaluation"}
+    assert homes == {m.__name__ for m in figure_table.CLAIM_MODULES} | {"passmd.ledger.evaluation"}
     assert found.extractors["fig10b-r1-stiffer-contact"].__module__ == "passmd.ledger.evaluation"
     assert found.depends_on["fig5a-no-step-below-50nm"] == (
         "flyback", "ac_protocol", "drive_frequency_s4", "damping_ratio", "friction_coefficient")
     assert {"fig10a-1n-slower", "sec5-response-to-optimized-similar"} <= set(found.evidence)
-    assert ledger.orphan_extractors() == []
-    code = ("import sys; import " + ", ".join(m.__name__ for m in figures.CLAIM_MODULES)
+    assert evaluation.orphan_extractors() == []
+    code = ("import sys; import " + ", ".join(m.__name__ for m in figure_table.CLAIM_MODULES)
             + "; print(sorted(m for m in sys.modules if m.startswith('passmd.ledger.evaluation')))")
     imported = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert imported.stdout.strip() == "[]"
@@ -843,8 +846,8 @@ def test_real_extractors_live_in_the_figures_claim_modules():
 
 def test_real_ledger_closed_form_claim_is_labelled_and_the_rest_wait():
     claims = load_claims()
-    results = {"closed_forms": ledger.closed_form_results(QUICK)}
-    evaluated = ledger.evaluate(claims, results).set_index("claim")
+    results = {"closed_forms": evaluation.closed_form_results(QUICK)}
+    evaluated = evaluation.evaluate(claims, results).set_index("claim")
     assert evaluated.at["fig10b-r1-stiffer-contact", "status"] == "reproduced"
     assert evaluated.at["fig10b-r1-stiffer-contact", "basis"] == "closed form"
     others = evaluated.drop(index="fig10b-r1-stiffer-contact")
@@ -856,7 +859,7 @@ def test_real_ledger_closed_form_claim_is_labelled_and_the_rest_wait():
 
 def test_styled_one_line_per_claim_and_details(tmp_path):
     claims = load_claims(_write(tmp_path, SYNTHETIC))
-    evaluated = ledger.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[_good_module({"val": 150.0})])
+    evaluated = evaluation.evaluate(claims, {"fig5a": pd.DataFrame()}, modules=[_good_module({"val": 150.0})])
     html = ledger_views.styled(evaluated, links=True).to_html()
     assert 'class="passmd-ledger"' in html and 'href="#claim-val"' in html
     for status in ("reproduced", "not reproduced", "inconclusive"):
@@ -898,9 +901,9 @@ def test_ledger_command_prints_categories_and_si_json(monkeypatch, capsys):
 
     def closed_forms_only(config):
         calls.append(config.profile)
-        return {"closed_forms": ledger.closed_form_results(config)}
+        return {"closed_forms": evaluation.closed_form_results(config)}
 
-    monkeypatch.setattr(ledger, "collect_results", closed_forms_only)
+    monkeypatch.setattr(evaluation, "collect_results", closed_forms_only)
     out = io.StringIO()
     assert cli.main(["ledger", "--profile", "paper", "--json"], out=out) == 0
     payload = json.loads(out.getvalue())
@@ -926,27 +929,27 @@ def test_ledger_command_prints_categories_and_si_json(monkeypatch, capsys):
 
 def test_baseline_readings_of_a_claim_along_several_axes(tmp_path):
     """A baseline records every reading of a claim's design; one without the column records none."""
-    readings_ = ledger.claim_readings("fig6b-flexible-r1-ac-matches-eq12")
+    readings_ = evaluation.claim_readings("fig6b-flexible-r1-ac-matches-eq12")
     assert readings_[0] == "defaults" and "actuator damping ratio ζ = 0.005" in readings_
     path = tmp_path / "old.csv"
     path.write_text("# made before readings were recorded\nclaim,status\nval,reproduced\n", encoding="utf-8")
-    assert ledger.load_baseline_readings(path) == {}
-    assert ledger.load_baseline(path) == {"val": "reproduced"}
+    assert evaluation.load_baseline_readings(path) == {}
+    assert evaluation.load_baseline(path) == {"val": "reproduced"}
 
 
 def test_reading_tables_hold_the_full_product():
     """The A_c readings of a flexible panel hold every point of fly-back × A_c protocol × drive frequency
     × ζ × μ, a rigid panel every point but ζ; the force readings every point of fly-back × ζ × drive
     frequency; each default point is the figure's own run (the same sweep parameters)."""
-    from passmd.experiments.critical_amplitude import figures as ca
+    from passmd.experiments.critical_amplitude import figures
     from passmd.ledger import readings
 
-    rigid_axes = tuple(k for k in ca._AC_AXES if k != "damping_ratio")
-    for model, axes in (("flexible", ca._AC_AXES), ("rigid", rigid_axes)):
-        points = ca._reading_points(model, ca._AC_AXES)
+    rigid_axes = tuple(k for k in figures._AC_AXES if k != "damping_ratio")
+    for model, axes in (("flexible", figures._AC_AXES), ("rigid", rigid_axes)):
+        points = figures._reading_points(model, figures._AC_AXES)
         assert len(points) == len({tuple(sorted(p.items())) for p in points}) == len(readings.design(axes))
-    figure_combos = ca._protocols("flexible", (100.0,))
-    default = ca._reading_points("flexible", ca._AC_AXES)[0]
+    figure_combos = figures._protocols("flexible", (100.0,))
+    default = figures._reading_points("flexible", figures._AC_AXES)[0]
     zeta = default["damping_ratio"]
     assert default in [{**c, "damping_ratio": c.get("damping_ratio", zeta)} for c in figure_combos]
 
@@ -954,13 +957,13 @@ def test_reading_tables_hold_the_full_product():
 def test_force_readings_at_a_reading():
     """This paper's force runs at a reading come from fig7_readings by fly-back rule, ζ and frequency;
     a reading the table lacks is a missing run, not an undecided point."""
-    from passmd.experiments.force_generation import figures as fg
+    from passmd.experiments.force_generation import figures
     from passmd.ledger import readings
 
     table = pd.DataFrame({"flyback": ["slew", "fixed"], "damping_ratio": [0.05, 0.05],
                           "frequency_Hz": [100.0, 100.0], "generated_force_mN": [1.0, 2.0]})
     reading = {**readings.default_reading(), "flyback": "fixed"}
-    assert fg.readings_at({"fig7_readings": table}, reading)["generated_force_mN"].tolist() == [2.0]
+    assert figures.readings_at({"fig7_readings": table}, reading)["generated_force_mN"].tolist() == [2.0]
     with pytest.raises(checks.NoRun, match="ζ = 0.5"):
-        fg.readings_at({"fig7_readings": table}, {**reading, "damping_ratio": 0.5})
-    assert "fig7_readings" in ledger.result_sources()
+        figures.readings_at({"fig7_readings": table}, {**reading, "damping_ratio": 0.5})
+    assert "fig7_readings" in evaluation.result_sources()

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import pytest
 
-from passmd.ledger import evaluation as ledger
+from passmd.ledger import evaluation
 from passmd.ledger.claims import load_claims
 from passmd.runtime.config import PROFILES, RunConfig
 
@@ -40,13 +40,14 @@ BASELINES = {profile: Path(__file__).with_name(f"ledger_baseline_{profile}.csv")
 def _evaluate(profile: str):
     """Every claim evaluated on ``profile`` (strict: a computed figure's claim needs an extractor)."""
     claims = load_claims()
-    return claims, ledger.evaluate(claims, ledger.collect_results(RunConfig(profile=profile)), strict=True)
+    results = evaluation.collect_results(RunConfig(profile=profile))
+    return claims, evaluation.evaluate(claims, results, strict=True)
 
 
 def _check_baseline(profile: str, claims, evaluated) -> dict[str, str]:
-    baseline = ledger.load_baseline(BASELINES[profile])
+    baseline = evaluation.load_baseline(BASELINES[profile])
     assert set(baseline) == set(claims["id"]), f"the {profile} baseline and claims.csv list different claims"
-    ledger.check_categories(evaluated, baseline)
+    evaluation.check_categories(evaluated, baseline)
     return baseline
 
 
@@ -56,9 +57,9 @@ def test_quick_ledger_keeps_every_category():
     if os.environ.get("PASSMD_UPDATE_LEDGER_BASELINE") == "1":
         header = (f"ledger categories, quick profile; produced {datetime.date.today().isoformat()} by\n"
                   "PASSMD_UPDATE_LEDGER_BASELINE=1 pytest tests/test_ledger_quick.py")
-        ledger.write_baseline(evaluated, BASELINES["quick"], header=header)
+        evaluation.write_baseline(evaluated, BASELINES["quick"], header=header)
     baseline = _check_baseline("quick", claims, evaluated)
-    assert ledger.orphan_extractors(claims) == [], "extractors tagged for ids not in claims.csv"
+    assert evaluation.orphan_extractors(claims) == [], "extractors tagged for ids not in claims.csv"
     # The claim computed from closed forms needs no figure: it must always be reproduced.
     assert baseline["fig10b-r1-stiffer-contact"] == "reproduced"
 
@@ -76,7 +77,8 @@ def profile_comparison() -> tuple[list[str], dict[str, str]]:
     A claim is comparable when both baselines record it at the same readings (their ``readings``
     column): both profiles compute every claim on the full product of its axes, so every claim is.
     """
-    quick_readings, paper_readings = (ledger.load_baseline_readings(BASELINES[p]) for p in ("quick", "paper"))
+    quick_readings, paper_readings = (evaluation.load_baseline_readings(BASELINES[p])
+                                      for p in ("quick", "paper"))
     assert quick_readings and paper_readings, "a baseline does not record its readings"
     comparable, not_recorded = [], {}
     for claim, readings in quick_readings.items():
@@ -95,11 +97,11 @@ def test_profiles_agree_or_quick_is_inconclusive():
     baseline's there; both record every claim at the same readings (the whole product of its axes,
     on either profile). Categories: a quick *reproduced* is the paper's, and so is any quick category
     decided at both its points when the paper's joint reading projects onto the same point."""
-    quick, paper = (ledger.load_baseline(BASELINES[p]) for p in ("quick", "paper"))
+    quick, paper = (evaluation.load_baseline(BASELINES[p]) for p in ("quick", "paper"))
     assert set(paper) == set(quick), "the two baselines list different claims"
     comparable, not_recorded = profile_comparison()
     assert not not_recorded, not_recorded
-    states = {p: ledger.load_baseline_states(BASELINES[p]) for p in ("quick", "paper")}
+    states = {p: evaluation.load_baseline_states(BASELINES[p]) for p in ("quick", "paper")}
     assert states["quick"] and states["paper"], "a baseline does not record its states"
     disagree, decided = [], 0
     for claim in comparable:

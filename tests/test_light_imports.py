@@ -86,14 +86,14 @@ def test_command_line_parser_loads_no_heavy_module_nor_the_simulator():
 _RUN_PROBE = """
 import contextlib, io, json, sys
 from passmd import cli
-from passmd.solver import kernels as kern
+from passmd.solver import kernels
 heavy = json.loads(sys.argv[1])
 loaded = {}
-integrate = kern.integrate
+integrate = kernels.integrate
 def first_step(*args, **kwargs):
     loaded.setdefault("first_step", [m for m in heavy if m in sys.modules])
     return integrate(*args, **kwargs)
-kern.integrate = first_step
+kernels.integrate = first_step
 with contextlib.redirect_stdout(io.StringIO()):
     status = cli.main(sys.argv[2:])
 loaded["end"] = [m for m in heavy if m in sys.modules]

@@ -28,7 +28,7 @@ import pytest
 
 from passmd import cli
 from passmd.cli import options
-from passmd.cli.commands import run as run_command
+from passmd.cli.commands import run
 from passmd.cli.parser import make_parser
 from passmd.model import optimized_waveform, waveforms
 from passmd.model.mdr_contact import MDRContact
@@ -203,7 +203,7 @@ def test_the_option_list_is_read_from_the_parser():
 @pytest.mark.parametrize("flag", RUN_OPTIONS)
 def test_every_numeric_run_option_is_named_when_refused(flag, value, json_flag):
     argv = ["run", f"{flag}={value}", "--load-cell", *json_flag]  # --load-cell: its stiffness applies
-    with mock.patch.object(run_command, "simulate", _reached):
+    with mock.patch.object(run, "simulate", _reached):
         try:
             status, out, err = run_main(argv)
         except _Reached:

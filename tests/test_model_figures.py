@@ -7,12 +7,51 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd.experiments import figure_table as figures
-from passmd.experiments.mdr_validation import figures as mdr
-from passmd.experiments.model import figures as model
-from passmd.experiments.numerics import benchmarks as numerics_benchmarks
-from passmd.experiments.numerics import facts as numerics_facts
-from passmd.experiments.numerics import figures as numerics
+from passmd.experiments import figure_table
+from passmd.experiments.mdr_validation.figures import (
+    HYSTERESIS_TURNS,
+    contact_facts,
+    cost_facts,
+    hysteresis_facts,
+    mdr_convergence,
+    mdr_cost,
+    mdr_hysteresis,
+    mdr_normal,
+    mdr_virgin,
+    normal_facts,
+    virgin_facts,
+)
+from passmd.experiments.model.figures import (
+    MODEL_PRELOAD,
+    SAWTOOTH_PERIODS,
+    actuator_row,
+    closed_form_rows,
+    model_drive,
+    model_mdr_loop,
+    model_sawtooth,
+    normal_force_balance,
+)
+from passmd.experiments.numerics.benchmarks import benchmark_table
+from passmd.experiments.numerics.facts import (
+    CONTROLLED_FIT_COARSEST,
+    TARGET_MS_PER_PERIOD,
+    benchmark_facts,
+    convergence_facts,
+    coulomb_rising_gaps,
+    coulomb_side,
+    energy_facts,
+    fitted_order_above_floor,
+    settle_facts,
+    step_plan_table,
+)
+from passmd.experiments.numerics.figures import (
+    CONFIGURATIONS,
+    REFERENCE_CONTROL,
+    RIGID_STEP_CONTROLS,
+    STEP_CONTROLS,
+    convergence_study,
+    energy_balance_table,
+)
 from passmd.model import theory
 from passmd.model.defaults import PROTOCOL
 from passmd.report import publish
@@ -37,18 +76,18 @@ CHEAP = (
 def test_cheap_figures_compute_and_draw(name):
     import matplotlib.pyplot as plt
 
-    data = figures.figure_data(name, QUICK)
+    data = figure_table.figure_data(name, QUICK)
     assert len(data) > 0
-    fig = figures.figure_plot(name, data)
+    fig = figure_table.figure_plot(name, data)
     assert fig.axes
     plt.close(fig)
 
 
 def test_sawtooth_is_the_full_stroke_at_the_drive_frequency():
-    wave = model.model_sawtooth(QUICK)
-    drive = model.model_drive()
+    wave = model_sawtooth(QUICK)
+    drive = model_drive()
     assert wave["x_p_m"].max() == pytest.approx(drive.actuator.full_stroke_amplitude, rel=1e-12)
-    assert wave["time_s"].max() == pytest.approx(model.SAWTOOTH_PERIODS / PROTOCOL.drive_frequency, rel=1e-12)
+    assert wave["time_s"].max() == pytest.approx(SAWTOOTH_PERIODS / PROTOCOL.drive_frequency, rel=1e-12)
     # the fly-back is the amplifier's slew-limited time: 300 V at 150 V/µs = 2 µs at full stroke
     assert wave["flyback_time_s"].iloc[0] == pytest.approx(2e-6, rel=1e-9)
     assert 0 < wave["ramp_end_s"].iloc[0] < 1 / PROTOCOL.drive_frequency
@@ -56,14 +95,14 @@ def test_sawtooth_is_the_full_stroke_at_the_drive_frequency():
 
 def test_normal_forces_balance_the_preload_on_both_sides():
     """Eq. 1: 2 F_N1 sin 45° = 4 F_N2 sin 45° = F_p."""
-    balance = model.normal_force_balance(model.model_drive())
-    assert balance["balance_right_N"] == pytest.approx(model.MODEL_PRELOAD, rel=1e-12)
-    assert balance["balance_left_N"] == pytest.approx(model.MODEL_PRELOAD, rel=1e-12)
+    balance = normal_force_balance(model_drive())
+    assert balance["balance_right_N"] == pytest.approx(MODEL_PRELOAD, rel=1e-12)
+    assert balance["balance_left_N"] == pytest.approx(MODEL_PRELOAD, rel=1e-12)
     assert balance["normal_force_1_N"] == pytest.approx(2 * balance["normal_force_2_N"], rel=1e-12)
 
 
 def test_mdr_loop_stays_within_the_sliding_force_and_matches_hertz():
-    loop = model.model_mdr_loop(QUICK)
+    loop = model_mdr_loop(QUICK)
     first = loop.iloc[0]
     assert np.abs(loop["force_exact_N"]).max() <= first["sliding_force_N"] * (1 + 1e-12)
     # 0.8 u_x,max never reaches full sliding: the exact loop stays strictly inside ±μF_N
@@ -76,24 +115,24 @@ def test_mdr_loop_stays_within_the_sliding_force_and_matches_hertz():
 
 
 def test_closed_form_rows_are_drive_theory_formatted():
-    drive = model.model_drive()
-    rows = model.closed_form_rows(drive)
+    drive = model_drive()
+    rows = closed_form_rows(drive)
     th = theory.drive_theory(drive)
     assert rows["u_x,max,e rigid (nm), Eq. 11"] == f"{th['critical_amplitude_rigid_m'] * 1e9:.4g}"
     assert len(rows["F_N1, F_N2 (N)"].split(", ")) == 2
-    assert model.actuator_row(drive)["drive"] == "R = 1 mm"
-    assert model.actuator_row(model.model_drive(0.25e-3))["m_a (g)"] == "1.1e-05"  # Table 2 as printed
+    assert actuator_row(drive)["drive"] == "R = 1 mm"
+    assert actuator_row(model_drive(0.25e-3))["m_a (g)"] == "1.1e-05"  # Table 2 as printed
 
 
 def test_hysteresis_turns_are_named_once_each():
-    loop = mdr.mdr_hysteresis(QUICK)
+    loop = mdr_hysteresis(QUICK)
     named = loop[loop["turn"] != ""]
-    assert list(named["turn"]) == list(mdr.HYSTERESIS_TURNS)
+    assert list(named["turn"]) == list(HYSTERESIS_TURNS)
     assert named["u_m"].iloc[0] > 0 > named["u_m"].iloc[1]  # A then −A
 
 
 def test_mdr_convergence_has_the_midpoint_rules_order():
-    conv = mdr.mdr_convergence(QUICK)
+    conv = mdr_convergence(QUICK)
     assert conv["fitted_order"].iloc[0] == pytest.approx(2.0, abs=0.3)
     assert conv.loc[conv["springs"] < 100, "fit_rel"].isna().all()
 
@@ -106,19 +145,19 @@ def test_assumption_list_escapes_markup():
 
 
 def test_mdr_facts_come_from_the_figure_data():
-    normal = mdr.mdr_normal(QUICK)
-    facts = mdr.normal_facts(normal)
+    normal = mdr_normal(QUICK)
+    facts = normal_facts(normal)
     # the midpoint rule's error falls with N: 20 springs worst, 1000 best, at every depth
     assert facts["normal_err_20"] > facts["normal_err_100"] > facts["normal_err_1000"] > 0
     assert facts["normal_err_end_1000"] <= facts["normal_err_1000"]
-    virgin = mdr.virgin_facts(mdr.mdr_virgin(QUICK))
+    virgin = virgin_facts(mdr_virgin(QUICK))
     assert virgin["virgin_err_exact"] < 1e-12  # rounding: the exact contact is Cattaneo-Mindlin
     assert virgin["virgin_err_20"] > virgin["virgin_err_1000"]
-    loop = mdr.hysteresis_facts(mdr.mdr_hysteresis(QUICK))
+    loop = hysteresis_facts(mdr_hysteresis(QUICK))
     assert loop["loop_err_exact"] < 1e-12 and loop["loop_err_1000"] < 0.5  # % of μF_N
-    cost = mdr.cost_facts(mdr.mdr_cost(QUICK))
+    cost = cost_facts(mdr_cost(QUICK))
     assert cost["ring_depth"] >= 1 and cost["per_spring_ns"] > 0 and cost["cost_ratio_1000"] > 1
-    contact = mdr.contact_facts()
+    contact = contact_facts()
     assert contact["sliding_force_mN"] == pytest.approx(0.2 * contact["normal_force_N"] * 1e3, rel=1e-12)
 
 
@@ -128,7 +167,7 @@ def _synthetic_convergence(controlled_error):
     rows = []
     per_step = {"controlled": 50, "adaptive": 100, "fixed": 1000, "quasi-static": 20}
     for label in ("six contacts, flexible", "six contacts, rigid"):
-        controls = numerics.STEP_CONTROLS if "flexible" in label else numerics.RIGID_STEP_CONTROLS
+        controls = STEP_CONTROLS if "flexible" in label else RIGID_STEP_CONTROLS
         for control in controls:
             for r in (0.25, 0.5, 1.0, 2.0, 4.0):
                 steps = per_step[control] * r
@@ -142,7 +181,7 @@ def _synthetic_convergence(controlled_error):
 def test_convergence_facts_on_a_second_order_table():
     """Synthetic errors falling exactly as h² (explicit) and h³ (error-controlled): the fitted
     orders are 2 and 3, the savings the step ratios."""
-    facts = numerics_facts.convergence_facts(_synthetic_convergence(lambda r: -2e-10 * r**-3.0))
+    facts = convergence_facts(_synthetic_convergence(lambda r: -2e-10 * r**-3.0))
     assert facts["conv_order"] == pytest.approx(2.0, rel=1e-9)
     assert facts["quasi_order"] == pytest.approx(2.0, rel=1e-9)
     assert facts["conv_max_err_nm"] == pytest.approx(0.1, rel=1e-9)
@@ -182,47 +221,47 @@ def test_controlled_order_is_fitted_above_its_floor():
     a h³ error that levels off at 1e-11 m and is flat below resolution 0.5 still fits as 3."""
 
     def error(r):
-        if r < numerics_facts.CONTROLLED_FIT_COARSEST:
+        if r < CONTROLLED_FIT_COARSEST:
             return 8e-10  # the longest step binds: no longer the tolerance's error
         return max(1e-10 * r**-3.0, 1e-11)
 
     conv = _synthetic_convergence(error)
-    facts = numerics_facts.convergence_facts(conv)
+    facts = convergence_facts(conv)
     assert facts["ctrl_order"] == pytest.approx(3.0, rel=1e-9)
     assert facts["ctrl_floor_nm"] == pytest.approx(0.01, rel=1e-9)
     # without those exclusions the same runs fit far from 3
     controlled = conv[conv["step_control"] == "controlled"]
-    assert numerics_facts.fitted_order_above_floor(controlled, factor=0.0, coarsest=0.0)[0] < 2.0
+    assert fitted_order_above_floor(controlled, factor=0.0, coarsest=0.0)[0] < 2.0
     flat = controlled.assign(error_m=1e-11)
     with pytest.raises(ValueError, match=r"only 0 resolution\(s\) with an error above 3 times the floor"):
-        numerics_facts.fitted_order_above_floor(flat)
+        fitted_order_above_floor(flat)
 
 
 def test_convergence_reference_is_the_reference_controls_finest_run():
     """Each configuration runs the applicable step controls plus its reference control, and its
     reference is that control's finest run, whatever order the controls are listed in."""
-    conv = numerics.convergence_study(periods=1, resolutions=(1.0, 2.0), step_controls=("controlled",))
-    for label, _, actuator_model in numerics.CONFIGURATIONS:
+    conv = convergence_study(periods=1, resolutions=(1.0, 2.0), step_controls=("controlled",))
+    for label, _, actuator_model in CONFIGURATIONS:
         rows = conv[conv["configuration"] == label]
-        reference = numerics.REFERENCE_CONTROL[actuator_model]
+        reference = REFERENCE_CONTROL[actuator_model]
         assert set(rows["step_control"]) == {"controlled", reference}
         zero = rows[rows["error_m"] == 0.0]
         assert list(zero["step_control"]) == [reference] and list(zero["resolution"]) == [2.0]
     assert (conv.loc[conv["step_control"] == "controlled", "rejected_steps"] > 0).all()
     with pytest.raises(ValueError, match=r"^step_controls = 'implicit'"):
-        numerics.convergence_study(step_controls=("implicit",))
+        convergence_study(step_controls=("implicit",))
 
 
 def test_energy_facts_compare_the_same_runs():
     energy = pd.DataFrame({"configuration": ["a", "a", "b"], "contact_model": ["exact", "discrete", "exact"],
                            "relative_residual": [-4e-7, 1e-6, 2e-7]})
     explicit = energy.assign(relative_residual=[2e-6, -1e-7, 4e-6])
-    facts = numerics_facts.energy_facts(energy, explicit)
+    facts = energy_facts(energy, explicit)
     assert facts == pytest.approx({"energy_max_rel": 1e-6, "energy_exact_max_rel": 4e-7,
                                    "energy_discrete_max_rel": 1e-6, "energy_explicit_max_rel": 4e-6,
                                    "energy_tighter": 4.0, "energy_ratio_min": 0.05, "energy_ratio_max": 10.0})
     with pytest.raises(ValueError, match="explicit must list the same runs"):
-        numerics_facts.energy_facts(energy, explicit.iloc[::-1])
+        energy_facts(energy, explicit.iloc[::-1])
 
 
 def test_energy_balance_of_the_default_scheme_is_as_tight_as_the_explicit_ones():
@@ -231,8 +270,8 @@ def test_energy_balance_of_the_default_scheme_is_as_tight_as_the_explicit_ones()
     runs is at most theirs (and both stay far inside the 1e-3 the integrator tests allow).
     Simpson's rule for the work terms of a long step makes that possible; with the
     trapezoidal rule the default's largest residual was several times theirs."""
-    default = numerics.energy_balance_table(periods=2)["relative_residual"].abs()
-    explicit = numerics.energy_balance_table(periods=2, scheme="adaptive")["relative_residual"].abs()
+    default = energy_balance_table(periods=2)["relative_residual"].abs()
+    explicit = energy_balance_table(periods=2, scheme="adaptive")["relative_residual"].abs()
     assert default.max() <= explicit.max(), (default.max(), explicit.max())
     assert explicit.max() < 1e-3
 
@@ -245,27 +284,27 @@ def test_settle_and_coulomb_texts():
             "mean_step_m": [100e-9, 101e-9, 50e-9, 50e-9],
         }
     )
-    facts = numerics_facts.settle_facts(sens)
+    facts = settle_facts(sens)
     assert facts["settle_spread_nm"] == pytest.approx(1.0) and facts["settle_spread_rel"] == pytest.approx(
         100 / 100.5
     )
     gaps = pd.DataFrame(
         {"configuration": ["c"] * 3, "scale": [1.0, 4.0, 16.0], "difference_m": [-3e-9, -1e-9, -2e-9]}
     )
-    assert numerics_facts.coulomb_side(gaps) == "below"
-    assert numerics_facts.coulomb_rising_gaps(gaps) == ["c: 1.000 nm at k = 4 → 2.000 nm at k = 16"]
+    assert coulomb_side(gaps) == "below"
+    assert coulomb_rising_gaps(gaps) == ["c: 1.000 nm at k = 4 → 2.000 nm at k = 16"]
 
 
 def test_step_plan_and_benchmark_facts():
-    plan = numerics_facts.step_plan_table()
-    assert list(plan["configuration"]) == [c[0] for c in numerics.CONFIGURATIONS]
+    plan = step_plan_table()
+    assert list(plan["configuration"]) == [c[0] for c in CONFIGURATIONS]
     assert (plan["fine step (ns)"] < plan["stability limit 2/ω (ns)"]).all()
     # the error-controlled step may grow far beyond the explicit steps (the runner mode is exact)
     assert (plan["longest controlled step (ns)"] > plan["coarse step (ns)"]).all()
-    facts = numerics_facts.benchmark_facts(numerics_benchmarks.benchmark_table())
+    facts = benchmark_facts(benchmark_table())
     assert facts["bench_six_flex_ms"] > 0 and facts["bench_fixed_ns"] > 0
     # the default (error-controlled) row, not the explicit adaptive one it replaced
     assert facts["bench_six_flex_ms"] < facts["bench_six_flex_adaptive_ms"]
     assert facts["bench_periods"] >= 1
     assert facts["bench_processes"] >= 1 and facts["bench_six_flex_processes_ms"] > 0
-    assert facts["target_ms_per_period"] == numerics_facts.TARGET_MS_PER_PERIOD
+    assert facts["target_ms_per_period"] == TARGET_MS_PER_PERIOD

@@ -42,9 +42,8 @@ from passmd.cli.streams import write_atomically
 from passmd.ledger.claims import CLAIMS_PATH
 from passmd.model import waveforms
 from passmd.model.parameters import Drive
-from passmd.runtime import progress as _progress
-from passmd.runtime import sweep
-from passmd.solver import simulation as dynamics
+from passmd.runtime import progress, sweep
+from passmd.solver import simulation
 
 #: Generous limits: a refusal or a one-period run takes seconds (start-up included).
 QUICK_S = 120
@@ -401,19 +400,19 @@ def test_work_estimate_counts_the_springs(monkeypatch):
     """The same drive and waveform: 10 000 discrete springs are 1 + 10 000/SPRINGS_PER_STEP times
     the work per step of the exact contact."""
     seen = {}
-    original = dynamics._integrate_in_chunks
+    original = simulation._integrate_in_chunks
 
     def record(arguments, waveform, expected, step_work, progress):
         seen["work"] = step_work
         return original(arguments, waveform, expected, step_work, progress)
 
-    monkeypatch.setattr(dynamics, "_integrate_in_chunks", record)
+    monkeypatch.setattr(simulation, "_integrate_in_chunks", record)
     drive = Drive(contacts=1)
     wave = waveforms.sawtooth(drive.actuator.full_stroke_amplitude, 10e3, drive, periods=1)
-    dynamics.simulate(drive, wave, max_points=10)
+    simulation.simulate(drive, wave, max_points=10)
     assert seen["work"] == 1.0
-    dynamics.simulate(drive, wave, contact_model="discrete", springs=10_000, max_points=10)
-    assert seen["work"] == 1.0 + 10_000 / dynamics.SPRINGS_PER_STEP
+    simulation.simulate(drive, wave, contact_model="discrete", springs=10_000, max_points=10)
+    assert seen["work"] == 1.0 + 10_000 / simulation.SPRINGS_PER_STEP
 
 
 @pytest.mark.parametrize("json_output", [False, True])
@@ -426,15 +425,15 @@ def test_short_run_shows_no_progress(tmp_path, json_output):
 def test_library_runs_stay_quiet_off_a_terminal(monkeypatch, capsys):
     """Without ``progress="long"`` (the command line's choice) a long run prints nothing off a
     terminal: the book's notebooks treat any stderr output as a warning."""
-    monkeypatch.setattr(dynamics, "PROGRESS_MIN_WORK", 0.0)
-    monkeypatch.setattr(_progress, "DELAY", 0.0)
-    monkeypatch.setattr(_progress, "LINE_INTERVAL", 0.0)
-    monkeypatch.setattr(dynamics, "CHUNK_STEPS", 200)
+    monkeypatch.setattr(simulation, "PROGRESS_MIN_WORK", 0.0)
+    monkeypatch.setattr(progress, "DELAY", 0.0)
+    monkeypatch.setattr(progress, "LINE_INTERVAL", 0.0)
+    monkeypatch.setattr(simulation, "CHUNK_STEPS", 200)
     drive = Drive(contacts=1)
     wave = waveforms.sawtooth(drive.actuator.full_stroke_amplitude, 10e3, drive, periods=2)
-    dynamics.simulate(drive, wave, max_points=10)
+    simulation.simulate(drive, wave, max_points=10)
     assert capsys.readouterr().err == ""
-    dynamics.simulate(drive, wave, max_points=10, progress="long")
+    simulation.simulate(drive, wave, max_points=10, progress="long")
     captured = capsys.readouterr()
     lines = captured.err.splitlines()
     assert lines and all(line.startswith("simulation: ") and "periods)" in line for line in lines), lines
@@ -455,7 +454,7 @@ def test_a_terminal_gets_a_bar_redrawn_in_place():
             pass
 
     terminal = Terminal()
-    bar = _progress.bar(4, unit="point", desc="sweep", delay=0.0, stream=terminal)
+    bar = progress.bar(4, unit="point", desc="sweep", delay=0.0, stream=terminal)
     bar.update(2)
     bar.refresh()
     bar.close()
@@ -468,8 +467,8 @@ def slow_point(x):
 
 
 def test_sweep_progress_lines_off_a_terminal(monkeypatch, capsys):
-    monkeypatch.setattr(_progress, "DELAY", 0.0)
-    monkeypatch.setattr(_progress, "LINE_INTERVAL", 0.0)
+    monkeypatch.setattr(progress, "DELAY", 0.0)
+    monkeypatch.setattr(progress, "LINE_INTERVAL", 0.0)
     points = sweep.grid(x=[1, 2, 3, 4])
     sweep.run(slow_point, points, executor="serial", cache=False)  # default: on a terminal only
     assert capsys.readouterr().err == ""
@@ -504,7 +503,7 @@ _SWEEP_RUNNER = textwrap.dedent("""
     import sys, types
     sys.path.insert(0, sys.argv[1])
     import slow_points
-    from passmd.experiments import figure_table as figures
+    from passmd.experiments import figure_table
     from passmd.runtime import sweep
     from passmd.cli import main
 
@@ -512,9 +511,9 @@ _SWEEP_RUNNER = textwrap.dedent("""
         return sweep.run(slow_points.point, sweep.grid(x=[1, 2, 3, 4]), executor="process", workers=3,
                          config=config)
 
-    figures.figure_names = lambda: ["fig99z"]
-    figures.figure_spec = lambda name: types.SimpleNamespace(name=name, title="stand-in")
-    figures.figure_data = figure_data
+    figure_table.figure_names = lambda: ["fig99z"]
+    figure_table.figure_spec = lambda name: types.SimpleNamespace(name=name, title="stand-in")
+    figure_table.figure_data = figure_data
     sys.exit(main(sys.argv[2:]))
 """)
 
@@ -611,14 +610,14 @@ def test_sigterm_handler_is_removed_after_the_command(monkeypatch):
 def test_critical_amplitude_search_shows_progress_off_a_terminal(monkeypatch, capsys):
     """The A_c bisection counts its runs on stderr with ``progress="long"`` (the command line's
     choice), and stays quiet off a terminal without it (the book's notebooks)."""
-    from passmd.protocols import critical_amplitude as ca
+    from passmd.protocols import critical_amplitude
 
-    monkeypatch.setattr(_progress, "DELAY", 0.0)
-    monkeypatch.setattr(_progress, "LINE_INTERVAL", 0.0)
+    monkeypatch.setattr(progress, "DELAY", 0.0)
+    monkeypatch.setattr(progress, "LINE_INTERVAL", 0.0)
     drive = Drive(contacts=1, actuator_model="rigid")
-    ca.critical_amplitude(drive, protocol="first", tolerance=20e-9)
+    critical_amplitude.critical_amplitude(drive, protocol="first", tolerance=20e-9)
     assert capsys.readouterr().err == ""
-    found = ca.critical_amplitude(drive, protocol="first", tolerance=20e-9, progress="long")
+    found = critical_amplitude.critical_amplitude(drive, protocol="first", tolerance=20e-9, progress="long")
     captured = capsys.readouterr()
     lines = captured.err.splitlines()
     assert lines and all(line.startswith("critical amplitude: ") for line in lines), lines
@@ -713,9 +712,9 @@ def test_a_signal_at_any_moment_of_a_fit_is_one_line(tmp_path, moment, sig):
 
 def test_time_left_waits_for_a_few_units():
     """No estimate from the first units (they carry the start-up); the average rate after them."""
-    assert _progress.time_left(12.0, 1, 12, "run") == f"time left known after {_progress.MIN_DONE} runs"
-    assert _progress.time_left(9.0, 3, 6, "point", lambda s: f"{s:.0f} s") == "about 18 s left"
-    assert _progress.time_left(9.0, 3, None, "point") == "time left unknown"
+    assert progress.time_left(12.0, 1, 12, "run") == f"time left known after {progress.MIN_DONE} runs"
+    assert progress.time_left(9.0, 3, 6, "point", lambda s: f"{s:.0f} s") == "about 18 s left"
+    assert progress.time_left(9.0, 3, None, "point") == "time left unknown"
     class Terminal:
         text = ""
 
@@ -732,7 +731,7 @@ def test_time_left_waits_for_a_few_units():
             return self.text
 
     terminal = Terminal()
-    bar = _progress.bar(13, unit="run", desc="critical amplitude", delay=0.0, stream=terminal)
+    bar = progress.bar(13, unit="run", desc="critical amplitude", delay=0.0, stream=terminal)
     bar.update(1)
     bar.refresh()
     assert "time left known after 3 runs" in terminal.getvalue() and "about" not in terminal.getvalue()

@@ -23,8 +23,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from passmd.ledger import checks
-from passmd.ledger import evaluation as ledger
+from passmd.ledger import checks, evaluation
 from passmd.ledger.claims import CLAIM_COLUMNS
 from passmd.report import ledger_views
 
@@ -59,12 +58,12 @@ def _synthetic(tmp_path, monkeypatch):
     module.b = checks.extractor("b", depends_on=("ac_protocol",))(
         lambda results, reading: {"lhs": 2.0 if reading["ac_protocol"] == "steady" else 0.5, "rhs": 1.0})
     module.c = checks.extractor("c")(lambda results: {"lhs": 2.0, "rhs": 1.0})
-    from passmd.ledger import claims as claims_module
+    from passmd.ledger import claims
 
-    monkeypatch.setattr(claims_module, "CLAIMS_PATH", path)
-    monkeypatch.setattr(ledger, "load_claims", lambda path_=None: claims_module.load_claims(path))
-    monkeypatch.setattr(ledger, "claim_modules", lambda: (module,))
-    monkeypatch.setattr(ledger, "collect_results", lambda config, figures=None: {"fig5a": pd.DataFrame()})
+    monkeypatch.setattr(claims, "CLAIMS_PATH", path)
+    monkeypatch.setattr(evaluation, "load_claims", lambda path_=None: claims.load_claims(path))
+    monkeypatch.setattr(evaluation, "claim_modules", lambda: (module,))
+    monkeypatch.setattr(evaluation, "collect_results", lambda config, figures=None: {"fig5a": pd.DataFrame()})
 
 
 def test_cli_text_and_json_state_the_joint_reading_as_the_report_does(tmp_path, monkeypatch):

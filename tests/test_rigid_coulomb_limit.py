@@ -8,27 +8,27 @@ step of :func:`passmd.model.theory.coulomb_sawtooth_step`, which no part of the 
 import numpy as np
 import pytest
 
-from passmd.experiments.numerics import figures as numerics
+from passmd.experiments.numerics import figures
 from passmd.model import theory
 from passmd.model.parameters import Drive
 
 
 @pytest.fixture(scope="module")
 def limit():
-    table = numerics.rigid_coulomb_limit()
-    return table, numerics.coulomb_limit_rates(table).set_index("configuration")
+    table = figures.rigid_coulomb_limit()
+    return table, figures.coulomb_limit_rates(table).set_index("configuration")
 
 
 def test_stiffened_drive_scales_both_moduli_exactly():
     base = Drive(actuator_model="rigid")
     E, G = theory.contact_moduli(base)
-    E64, G64 = theory.contact_moduli(numerics.stiffened_drive(base, 64.0))
+    E64, G64 = theory.contact_moduli(figures.stiffened_drive(base, 64.0))
     assert E64 == pytest.approx(64.0 * E, rel=1e-12) and G64 == pytest.approx(64.0 * G, rel=1e-12)
     # the presliding length (Eq. 7) falls as k^(−2/3): 64^(2/3) = 16
-    u, u64 = (theory.drive_theory(d)["presliding_m"][0] for d in (base, numerics.stiffened_drive(base, 64.0)))
+    u, u64 = (theory.drive_theory(d)["presliding_m"][0] for d in (base, figures.stiffened_drive(base, 64.0)))
     assert u / u64 == pytest.approx(16.0, rel=1e-12)
     with pytest.raises(ValueError, match="scale"):
-        numerics.stiffened_drive(base, 0.0)
+        figures.stiffened_drive(base, 0.0)
 
 
 def test_paper_flyback_difference_decreases_monotonically(limit):
@@ -49,7 +49,7 @@ def test_observed_rate_matches_presliding_scaling(limit):
     contact radius); a fitted rate inside it is closer to 2/3 than to either. The fit over
     three decades of k absorbs the next-order terms that bend the local slope."""
     _, rates = limit
-    assert numerics.EXPECTED_COULOMB_RATE == pytest.approx(2.0 / 3.0)
+    assert figures.EXPECTED_COULOMB_RATE == pytest.approx(2.0 / 3.0)
     for label, rate in rates["rate"].items():
         assert 0.5 < rate < 5.0 / 6.0, (label, rate)
 

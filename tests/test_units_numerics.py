@@ -38,8 +38,8 @@ from hypothesis import strategies as st
 
 from passmd import cli
 from passmd.cli.result_bounds import EMPTY_BY_DESIGN, ResultError, check_table
-from passmd.experiments import figure_table as figures
-from passmd.ledger import evaluation as ledger
+from passmd.experiments import figure_table
+from passmd.ledger import evaluation
 from passmd.model import hertz, theory
 from passmd.model.parameters import Drive
 from passmd.model.tables import RUBY, STEEL
@@ -450,10 +450,11 @@ def nan_figure(monkeypatch):
     spec = SimpleNamespace(name="fig99z", title="a stand-in panel")
     frame = pd.DataFrame({"amplitude_nm": [10.0, 20.0, 30.0], "steady_step_nm": [0.0, np.nan, 5.0],
                           "actuator_model": ["rigid"] * 3})
-    monkeypatch.setattr(figures, "figure_names", lambda: ["fig99z"])
-    monkeypatch.setattr(figures, "figure_spec", lambda name: spec)
-    monkeypatch.setattr(figures, "figure_data", lambda name, config: frame)
-    monkeypatch.setattr(figures, "figure_plot", lambda name, data: pytest.fail("plotted a non-finite result"))
+    monkeypatch.setattr(figure_table, "figure_names", lambda: ["fig99z"])
+    monkeypatch.setattr(figure_table, "figure_spec", lambda name: spec)
+    monkeypatch.setattr(figure_table, "figure_data", lambda name, config: frame)
+    monkeypatch.setattr(figure_table, "figure_plot",
+                        lambda name, data: pytest.fail("plotted a non-finite result"))
     return frame
 
 
@@ -470,11 +471,11 @@ def test_figure_with_a_nan_result_exits_1_naming_the_figure_and_column(nan_figur
 @pytest.mark.parametrize("json_output", [True, False], ids=["json", "text"])
 def test_ledger_with_a_nan_result_exits_1_naming_the_table_and_column(monkeypatch, tmp_path, json_output):
     def damaged(config):
-        table = ledger.closed_form_results(config).copy()
+        table = evaluation.closed_form_results(config).copy()
         table.loc[2, "tangential_stiffness_N_per_m"] = np.nan
         return {"closed_forms": table}
 
-    monkeypatch.setattr(ledger, "collect_results", damaged)
+    monkeypatch.setattr(evaluation, "collect_results", damaged)
     baseline = tmp_path / "baseline.csv"
     status, out, err = run_in_process(["ledger", "--write-baseline", str(baseline),
                                        *(["--json"] if json_output else [])])
@@ -486,7 +487,7 @@ def test_ledger_with_a_nan_result_exits_1_naming_the_table_and_column(monkeypatc
 def test_cells_empty_by_design_pass_and_infinities_never_do():
     """A figure's declared empty cells (e.g. no critical amplitude up to the full stroke) pass;
     the same NaN in an undeclared figure, or an infinity anywhere, is refused."""
-    assert set(EMPTY_BY_DESIGN) <= set(figures.figure_names()) | set(figures.READING_TABLES)
+    assert set(EMPTY_BY_DESIGN) <= set(figure_table.figure_names()) | set(figure_table.READING_TABLES)
     frame = pd.DataFrame({"preload_N": [0.1, 0.2], "critical_amplitude_nm": [25.0, np.nan],
                           "bracket_high_nm": [26.0, np.nan], "actuator_model": ["rigid", "rigid"]})
     check_table("fig5b", frame)

@@ -72,10 +72,10 @@ def ringing_rows(axes, spec, table, resolution, shown) -> list[tuple[str, str]]:
              f"when the next fly-back starts (more than the {MEASURABLE * 1e9:g} nm measurable step), so the "
              f"{spec.label} there depends on where in its swing the runner is")]
     if len(axes) == 1:
-        from passmd.protocols.ringing import turns as find_turns
+        from passmd.protocols import ringing
 
         values = table[spec.column]
-        turns = find_turns(values, resolution)
+        turns = ringing.turns(values, resolution)
         if turns:
             near = [k for k in (turns[0] - 1, turns[0], turns[0] + 1) if 0 <= k < len(values)]
             where = ", ".join(f"{float(values.iloc[k]) / spec.scale:.4g} {spec.unit} at "

@@ -94,7 +94,7 @@ class Quantity:
             scale = si_factor(self.unit)
             PLAUSIBLE_RANGES[self.plausible].check(
                 self.flag, value, allow_extrapolation=bool(getattr(args, "allow_extrapolation", False)),
-                shown=self.flag, scale=scale, unit=self.unit, hint="--allow-extrapolation")
+                flag=self.flag, scale=scale, unit=self.unit, hint="--allow-extrapolation")
             return value
         shown = to_display(value, self.unit)  # the parsed value itself, in the unit shown
         check_range(self.flag, shown, self.lower, self.upper, lower_open=self.lower_open,

@@ -34,7 +34,7 @@ from collections.abc import Callable, Iterable, Mapping
 
 import pandas as pd
 
-from passmd.experiments import figure_table as figures
+from passmd.experiments import figure_table
 from passmd.ledger import readings, reference
 from passmd.ledger.baseline import (  # re-exported: the tests and the command line read them from here
     READINGS_SEPARATOR,
@@ -106,7 +106,7 @@ LEDGER_COLUMNS = ("claim", "figure", "quantity", "paper", "ours", "unit", "abs_d
 def claim_modules() -> tuple:
     """The modules holding claim extractors: ``passmd.experiments.figure_table.CLAIM_MODULES`` and this one
     (the closed-form claim's extractor)."""
-    return (*figures.CLAIM_MODULES, sys.modules[__name__])
+    return (*figure_table.CLAIM_MODULES, sys.modules[__name__])
 
 
 def claim_functions(modules: Iterable | None = None) -> ClaimFunctions:
@@ -132,7 +132,7 @@ def _check_config(config) -> RunConfig:
 
 
 def _figure_source(name: str) -> Callable[[RunConfig], pd.DataFrame]:
-    return figures.figure_spec(name).compute
+    return figure_table.figure_spec(name).compute
 
 
 def result_sources() -> dict[str, Callable[[RunConfig], pd.DataFrame]]:
@@ -143,8 +143,8 @@ def result_sources() -> dict[str, Callable[[RunConfig], pd.DataFrame]]:
     at every point of the axes that change it) and ``closed_forms`` (the closed-form tables some
     claims are checked against, :func:`closed_form_results`).
     """
-    sources = {name: _figure_source(name) for name in figures.figure_names()}
-    sources.update({key: spec.compute for key, spec in figures.READING_TABLES.items()})
+    sources = {name: _figure_source(name) for name in figure_table.figure_names()}
+    sources.update({key: spec.compute for key, spec in figure_table.READING_TABLES.items()})
     sources["closed_forms"] = closed_form_results
     return sources
 
@@ -390,7 +390,7 @@ def assumption_map(evaluated: pd.DataFrame) -> pd.DataFrame:
 
 def _figures_of(key: str) -> tuple[str, ...]:
     """The figures a result key belongs to: a reading table's figures, else the key itself."""
-    spec = figures.READING_TABLES.get(key)
+    spec = figure_table.READING_TABLES.get(key)
     return spec.figures if spec is not None else (key,)
 
 

@@ -27,8 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from passmd.model.tables import Assumption, _meta
-from passmd.runtime.validation import InputError, check_positive, check_range
-from passmd.runtime.validation import shown as _plain
+from passmd.runtime.validation import InputError, check_positive, check_range, shown
 
 __all__ = [
     "ASSUMPTIONS",
@@ -109,7 +108,7 @@ class ContactGroup:
     def __post_init__(self):
         if isinstance(self.count, (bool, np.bool_)) or not isinstance(self.count, (int, np.integer)) \
                 or self.count < 1:
-            raise InputError(f"count = {_plain(self.count)} is not allowed: must be an integer >= 1",
+            raise InputError(f"count = {shown(self.count)} is not allowed: must be an integer >= 1",
                              name="count", value=self.count)
         object.__setattr__(self, "count", int(self.count))
         if self.load_share is not None and self.normal_force is not None:
@@ -126,7 +125,7 @@ class ContactGroup:
         object.__setattr__(self, "contact_angle", angle)
         if self.side is not None and (isinstance(self.side, (bool, np.bool_)) or not isinstance(
                 self.side, (int, np.integer)) or self.side not in SIDES):
-            raise InputError(f"side = {_plain(self.side)} is not allowed: must be 1 or 2 (the side of the "
+            raise InputError(f"side = {shown(self.side)} is not allowed: must be 1 or 2 (the side of the "
                              "runner the group presses on)", name="side", value=self.side)
         if self.side is not None:
             object.__setattr__(self, "side", int(self.side))

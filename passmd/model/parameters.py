@@ -38,8 +38,14 @@ from passmd.model.tables import (
 # passmd.experiments.driving_waveform.figures); they are documented in passmd.model.tables.
 from passmd.model.tables import MOLYBDENUM as MOLYBDENUM
 from passmd.model.theory import contact_layout, contact_moduli
-from passmd.runtime.validation import InputError, check_choice, check_positive, check_range, format_number
-from passmd.runtime.validation import shown as _plain
+from passmd.runtime.validation import (
+    InputError,
+    check_choice,
+    check_positive,
+    check_range,
+    format_number,
+    shown,
+)
 
 __all__ = [
     "ASSUMPTIONS",
@@ -98,7 +104,7 @@ class Drive:
 
     def __post_init__(self):
         if not isinstance(self.allow_extrapolation, bool):
-            raise InputError(f"allow_extrapolation = {_plain(self.allow_extrapolation)} is not allowed: "
+            raise InputError(f"allow_extrapolation = {shown(self.allow_extrapolation)} is not allowed: "
                              "must be True or False", name="allow_extrapolation",
                              value=self.allow_extrapolation)
         # each number once, against its range (a hard limit > 0 and the plausible range)
@@ -108,31 +114,31 @@ class Drive:
                                          allow_extrapolation=self.allow_extrapolation)
         if not isinstance(self.contact_groups, tuple) or not all(
                 isinstance(g, ContactGroup) for g in self.contact_groups):
-            raise InputError(f"contact_groups = {_plain(self.contact_groups)} is not allowed: must be a "
+            raise InputError(f"contact_groups = {shown(self.contact_groups)} is not allowed: must be a "
                              "tuple of ContactGroup", name="contact_groups", value=self.contact_groups)
         if self.contact_groups:
             object.__setattr__(self, "contacts", sum(g.count for g in self.contact_groups))
             arrangement.check_balance(self.preload, self.contact_groups)
         elif not isinstance(self.contacts, (int, np.integer)) or isinstance(self.contacts, (bool, np.bool_)) \
                 or self.contacts not in (1, 6):
-            raise InputError(f"contacts = {_plain(self.contacts)} is not allowed: must be one of 1, 6",
+            raise InputError(f"contacts = {shown(self.contacts)} is not allowed: must be one of 1, 6",
                              name="contacts", value=self.contacts)
         check_choice("actuator_model", self.actuator_model, ("rigid", "flexible"))
         if not isinstance(self.load_cell, bool):
-            raise InputError(f"load_cell = {_plain(self.load_cell)} is not allowed: must be True or False",
+            raise InputError(f"load_cell = {shown(self.load_cell)} is not allowed: must be True or False",
                              name="load_cell", value=self.load_cell)
         for name in ("hemisphere_material", "runner_material"):
             if not isinstance(getattr(self, name), Material):
-                raise InputError(f"{name} = {_plain(getattr(self, name))} is not a Material", name=name,
+                raise InputError(f"{name} = {shown(getattr(self, name))} is not a Material", name=name,
                                  value=getattr(self, name))
         if self.actuator is None:
             actuator = _table2_actuator(self.hemisphere_radius, ACTUATOR_DAMPING_RATIO)
             object.__setattr__(self, "actuator", actuator)
         elif not isinstance(self.actuator, Actuator):
-            raise InputError(f"actuator = {_plain(self.actuator)} is not an Actuator", name="actuator",
+            raise InputError(f"actuator = {shown(self.actuator)} is not an Actuator", name="actuator",
                              value=self.actuator)
         if not isinstance(self.amplifier, Amplifier):
-            raise InputError(f"amplifier = {_plain(self.amplifier)} is not an Amplifier", name="amplifier",
+            raise InputError(f"amplifier = {shown(self.amplifier)} is not an Amplifier", name="amplifier",
                              value=self.amplifier)
         if isinstance(self.contacts, np.integer):
             object.__setattr__(self, "contacts", int(self.contacts))
@@ -178,15 +184,15 @@ class PlausibleRange:
     hard_low_open: bool = True  # a hard lower bound of 0 is excluded (positive quantities)
     hard_reason: str = ""  # why the hard limits, when it differs from ``reason``
 
-    def check(self, name: str, value, *, allow_extrapolation: bool = False, shown: str | None = None,
+    def check(self, name: str, value, *, allow_extrapolation: bool = False, flag: str | None = None,
               scale: float = 1.0, unit: str | None = None, hint: str = "allow_extrapolation=True") -> float:
         """``float(value)`` if plausible, else ``ValueError`` naming the value, limit and why.
 
-        ``shown``/``scale``/``unit`` let the CLI report an option in its display unit
+        ``flag``/``scale``/``unit`` let the CLI report an option as typed, in its display unit
         (``value`` and the bounds are divided by ``scale``).
         """
         v = check_range(name, value, unit=self.unit)  # a finite real number
-        label, unit = (shown or name), (self.unit if unit is None else unit)
+        label, unit = (flag or name), (self.unit if unit is None else unit)
         u = f" {unit}" if unit and unit != "–" else ""
 
         def refuse(op: str, bound: float, kind: str) -> InputError:
@@ -194,7 +200,7 @@ class PlausibleRange:
             if kind == "hard limit" and lo == 0.0 and op.startswith(">"):
                 why = "a physical quantity of this kind is positive"
             soft = kind == "plausible range"
-            shown_value = f"{format_number(v, scale)}{u}" if shown else _plain(value)  # CLI: display unit
+            shown_value = f"{format_number(v, scale)}{u}" if flag else shown(value)  # CLI: display unit
             limit = f"{op} {format_number(bound, scale)}{u}"
             return InputError(f"{label} = {shown_value} is out of range: must be {limit} "
                               f"({kind}: {why}){f'; {hint} goes beyond it' if soft else ''}",
@@ -323,7 +329,7 @@ def check_contact_plausible(normal_force: float, radius: float, E_star: float, *
 def check_drive(drive) -> Drive:
     """``drive`` if it is a :class:`Drive`, else ``ValueError`` naming it (public functions' check)."""
     if not isinstance(drive, Drive):
-        raise InputError(f"drive = {_plain(drive)} is not a Drive", name="drive", value=drive)
+        raise InputError(f"drive = {shown(drive)} is not a Drive", name="drive", value=drive)
     return drive
 
 
@@ -390,7 +396,7 @@ def paper_drive(hemisphere_radius: float = 1.0e-3, preload: float = 0.4, **chang
     radius = check_positive("hemisphere_radius", hemisphere_radius, "m")
     if not any(np.isclose(radius, r, rtol=1e-9, atol=0) for r in TABLE2_RADII):
         raise ValueError(
-            f"hemisphere_radius = {_plain(hemisphere_radius)} is not a paper radius: must be one of "
+            f"hemisphere_radius = {shown(hemisphere_radius)} is not a paper radius: must be one of "
             + ", ".join(f"{r:g}" for r in sorted(TABLE2_RADII))
             + " (m)"
         )

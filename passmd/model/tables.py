@@ -17,8 +17,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from passmd.runtime.validation import InputError, check_positive, check_range
-from passmd.runtime.validation import shown as _plain
+from passmd.runtime.validation import InputError, check_positive, check_range, shown
 
 __all__ = [
     "ACTUATOR_DAMPING_RATIO",
@@ -184,7 +183,7 @@ def check_flyback_rule(name: str, value) -> str | float:
         raise InputError(f"{name} = {value!r} is not allowed: must be 'slew', 'fixed' or a time in s (> 0)",
                          name=name, value=value)
     if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise InputError(f"{name} = {_plain(value)} is not allowed: must be 'slew', 'fixed' or a time in s "
+        raise InputError(f"{name} = {shown(value)} is not allowed: must be 'slew', 'fixed' or a time in s "
                          "(> 0)", name=name, value=value)
     return check_positive(name, float(value), "s")
 
@@ -278,7 +277,7 @@ def parameter_table(record) -> list[dict]:
     The book renders these rows instead of retyping Tables 1–2.
     """
     if not hasattr(record, "__dataclass_fields__") or isinstance(record, type):
-        raise InputError(f"record = {_plain(record)} is not a parameter record (a Drive, Material, Actuator "
+        raise InputError(f"record = {shown(record)} is not a parameter record (a Drive, Material, Actuator "
                          "or Amplifier)", name="record", value=record)
     rows: list[dict] = []
     for f in fields(record):

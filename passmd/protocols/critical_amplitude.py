@@ -44,7 +44,7 @@ from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
 from passmd.model.tables import Assumption
 from passmd.runtime.validation import check_choice, check_positive, check_range
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 
 __all__ = [
     "ASSUMPTIONS",
@@ -149,7 +149,7 @@ def steady_step(
     if int(periods) != periods or periods < 2:
         raise ValueError(f"periods = {periods!r} is out of range: must be an integer >= 2")
     wave = waveforms.sawtooth(amplitude, frequency, drive, periods=int(periods), flyback=flyback)
-    result = dynamics.simulate(drive, wave, max_points=2)
+    result = simulation.simulate(drive, wave, max_points=2)
     steps = result.step_sizes
     return {
         "steps_m": steps.tolist(),
@@ -204,7 +204,7 @@ def first_flyback_slip(
         slip_mark=t_ramp,
         kind="first fly-back",
     )
-    result = dynamics.simulate(drive, wave, max_points=2)
+    result = simulation.simulate(drive, wave, max_points=2)
     peak = result.peak_force_ratio[0]  # every integrator step from the fly-back on
     return {
         "peak_force_ratio": peak.tolist(),
@@ -433,15 +433,15 @@ def critical_amplitude(
     return found
 
 
-def _bisection_bar(upper: float, tolerance: float, progress: bool | str | None):
+def _bisection_bar(upper: float, tolerance: float, show: bool | str | None):
     """A progress bar over the bisection's runs (1 + halvings of ``upper`` down to ``tolerance``)."""
     import sys
 
-    from passmd.runtime import progress as _progress
+    from passmd.runtime import progress
 
-    if progress is False or sys.stderr is None or _progress.in_worker():
+    if show is False or sys.stderr is None or progress.in_worker():
         return None
-    if progress is None and not _progress.is_terminal(sys.stderr):
+    if show is None and not progress.is_terminal(sys.stderr):
         return None
     runs = 1 + max(0, math.ceil(math.log2(upper / tolerance)))
-    return _progress.bar(runs, unit="run", desc="critical amplitude")
+    return progress.bar(runs, unit="run", desc="critical amplitude")

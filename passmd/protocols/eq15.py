@@ -22,7 +22,7 @@ from passmd.model.optimized_waveform import (
 from passmd.model.parameters import Drive, check_drive
 from passmd.model.waveforms import sawtooth
 from passmd.runtime.validation import InputError, check_choice, check_positive, check_range, shown
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 
 __all__ = ["DESIGN_RESPONSES", "MIN_SAMPLES", "SAMPLES_PER_VIBRATION", "design_at",
            "micro_vibration_frequency", "optimized_design", "response_frequency"]
@@ -165,7 +165,7 @@ def optimized_design(
     f_ref = check_positive("response_frequency", response_frequency, "Hz")
     wave = sawtooth(amplitude, f_ref, drive, periods=2, flyback=flyback)
     samples = int(np.ceil(wave.duration * theory.runner_frequency(drive) * SAMPLES_PER_VIBRATION)) + 1
-    result = dynamics.simulate(drive, wave, max_points=max(samples, MIN_SAMPLES))
+    result = simulation.simulate(drive, wave, max_points=max(samples, MIN_SAMPLES))
     flyback_end = wave.period  # the first fly-back ends with the first period
     try:
         f_s, _ = micro_vibration_frequency(

@@ -32,15 +32,14 @@ from dataclasses import dataclass
 
 from passmd.model import theory
 from passmd.model.parameters import Drive
-from passmd.protocols import critical_amplitude as ca
-from passmd.protocols import eq15, ringing, stall, velocity
+from passmd.protocols import critical_amplitude, eq15, ringing, stall, velocity
 from passmd.runtime.validation import InputError, check_choice
 
 __all__ = ["MAP_QUANTITIES", "READINGS", "MapQuantity", "critical_amplitude_point", "gain_point",
            "stall_point", "steady_point", "with_ringing"]
 
 #: Readings of the simulated critical amplitude (:data:`passmd.protocols.critical_amplitude.PROTOCOLS`).
-READINGS = ca.PROTOCOLS
+READINGS = critical_amplitude.PROTOCOLS
 
 
 def steady_point(drive: Drive, amplitude: float, frequency: float, waveform: str = "sawtooth",
@@ -98,7 +97,7 @@ def critical_amplitude_point(drive: Drive, frequency: float, reading: str = "ste
     ``ringing_affects_steps`` says whether a measurable swing is left at the next fly-back (the
     first reading has no earlier fly-back, so it never does).
     """
-    found = ca.critical_amplitude(drive, protocol=reading, frequency=frequency)
+    found = critical_amplitude.critical_amplitude(drive, protocol=reading, frequency=frequency)
     for key in ("critical_amplitude_m", "bracket_high_m"):  # NaN: no onset up to the full stroke
         if math.isnan(found[key]):
             found[key] = None

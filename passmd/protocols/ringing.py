@@ -25,7 +25,7 @@ from passmd.model import theory, waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive, check_drive
 from passmd.runtime.validation import check_positive, check_range
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 
 __all__ = ["HOLD", "MEASURABLE", "SAMPLES_PER_CYCLE", "at_frequency", "left_after", "ringing_point",
            "stick_ringing", "turns"]
@@ -87,7 +87,7 @@ def stick_ringing(drive: Drive, amplitude: float, frequency: float = PROTOCOL.dr
                                       settle_window=(0.8 * t_ramp, t_ramp), slip_mark=t_ramp,
                                       kind="ringing probe")
     samples = int(math.ceil(wave.duration * theory.runner_frequency(drive) * SAMPLES_PER_CYCLE)) + 1
-    result = dynamics.simulate(drive, wave, max_points=max(samples, 1000))
+    result = simulation.simulate(drive, wave, max_points=max(samples, 1000))
     turns, times, swings = _swings(result.time, result.runner_position, result.runner_velocity, end)
     out = {"ringing_frequency_Hz": math.nan, "ringing_amplitude_m": 0.0, "ringing_decay_time_s": math.nan,
            "ringing_hold_s": hold, "flyback_time_s": t_fb, "swing_times_s": times,

@@ -63,7 +63,7 @@ from passmd.model.parameters import Drive
 from passmd.model.theory import friction_limit, normal_forces
 from passmd.protocols.critical_amplitude import critical_amplitude
 from passmd.runtime.validation import check_positive, check_range
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 from passmd.solver.steps import CONVERGED_ACCURACY
 
 __all__ = [
@@ -354,7 +354,7 @@ def generated_force(
     # rest (the saw-tooth's breakpoints of period j do not depend on the number of periods),
     # so each check sees the forces a run of that length from rest would give.
     longest = waveforms.sawtooth(amplitude, frequency, drive, periods=int(max_periods), flyback=flyback)
-    run = dynamics.Simulation(drive, longest, max_points=2, progress=progress)
+    run = simulation.Simulation(drive, longest, max_points=2, progress=progress)
     periods = int(initial_periods)
     while True:
         run.run_to(periods)
@@ -439,7 +439,7 @@ def stall_cycle(
         )
     drive = drive if drive.load_cell else drive.replace(load_cell=True)
     wave = waveforms.sawtooth(amplitude, frequency, drive, periods=int(periods))
-    result = dynamics.simulate(drive, wave, max_points=int(periods) * int(samples_per_period) + 1)
+    result = simulation.simulate(drive, wave, max_points=int(periods) * int(samples_per_period) + 1)
     start, end = wave.slip_marks[-2], wave.slip_marks[-1]
     spacing = float(result.time[1] - result.time[0])
     first = int(np.searchsorted(result.time, start, side="right")) - 1  # last sample before the fly-back

@@ -31,7 +31,7 @@ import numpy as np
 
 from passmd.model import optimized_waveform, waveforms
 from passmd.runtime.validation import check_choice
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 from passmd.solver.results import SimulationError
 
 __all__ = [
@@ -124,7 +124,7 @@ def step_run(drive, amplitude: float, frequency: float, waveform: str, design=No
     i.e. across the optimized slips), ``final_position_m`` and ``wall_time_s``.
     """
     wave = make_waveform(drive, amplitude, frequency, periods, waveform, "cut", design)
-    result = dynamics.simulate(drive, wave, max_points=2)
+    result = simulation.simulate(drive, wave, max_points=2)
     return {"settled_positions_m": result.settled_positions, "mean_step_m": float(np.mean(result.step_sizes)),
             "final_position_m": result.final_position, "wall_time_s": result.wall_time}
 
@@ -163,7 +163,7 @@ def settled_step(drive, amplitude: float, frequency: float, *, accuracy: float =
     check_positive("accuracy", accuracy, "m")
     max_periods = check_count("max_periods", max_periods, SETTLED_STEPS + 2)
     wave = waveforms.sawtooth(amplitude, frequency, drive, periods=max_periods, flyback=flyback)
-    run = dynamics.Simulation(drive, wave, max_points=2)
+    run = simulation.Simulation(drive, wave, max_points=2)
     periods = SETTLED_STEPS + 1
     while True:
         run.run_to(periods)
@@ -208,7 +208,7 @@ def steady_run(drive, amplitude: float, frequency: float, waveform: str, short_p
     else:
         check_choice("waveform", waveform, ("sawtooth", "optimized"))
     wave = make_waveform(drive, amplitude, frequency, periods, waveform, short_period, design)
-    result = dynamics.simulate(drive, wave, max_points=max_points)
+    result = simulation.simulate(drive, wave, max_points=max_points)
     out.update(steady_velocity(result))
     half = periods // 2
     out["step_m"] = out["velocity_m_per_s"] / frequency
@@ -238,8 +238,8 @@ def waveform_velocity(drive, amplitude: float, frequency: float, waveform: str, 
     """
     if frequency < STEP_PROTOCOL_BELOW:
         wave = make_waveform(drive, amplitude, frequency, STEP_PERIODS, waveform, short_period, design)
-        return float(np.mean(dynamics.simulate(drive, wave, max_points=2).step_sizes) * frequency)
+        return float(np.mean(simulation.simulate(drive, wave, max_points=2).step_sizes) * frequency)
     periods = steady_periods(frequency)
     wave = make_waveform(drive, amplitude, frequency, periods, waveform, short_period, design)
-    return steady_velocity(dynamics.simulate(drive, wave, max_points=2))["velocity_m_per_s"]
+    return steady_velocity(simulation.simulate(drive, wave, max_points=2))["velocity_m_per_s"]
 

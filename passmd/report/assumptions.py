@@ -10,9 +10,9 @@ from __future__ import annotations
 
 from types import ModuleType
 
-from passmd.experiments.driving_waveform import figures as driving_waveform
-from passmd.experiments.driving_waveform import studies as waveform_studies
-from passmd.experiments.force_generation import figures as force_generation
+import passmd.experiments.driving_waveform.figures
+import passmd.experiments.driving_waveform.studies
+import passmd.experiments.force_generation.figures
 from passmd.ledger import reference
 from passmd.model import arrangement, contact, optimized_waveform, parameters, tables, waveforms
 from passmd.model.tables import Assumption
@@ -30,9 +30,9 @@ ASSUMPTION_MODULES: tuple[ModuleType, ...] = (
     waveforms,
     reference,
     critical_amplitude,
-    driving_waveform,
-    force_generation,
-    waveform_studies,
+    passmd.experiments.driving_waveform.figures,
+    passmd.experiments.force_generation.figures,
+    passmd.experiments.driving_waveform.studies,
     optimized_waveform,
 )
 

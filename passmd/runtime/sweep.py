@@ -45,10 +45,10 @@ from collections.abc import Callable, Mapping, Sequence
 
 import pandas as pd
 
-from passmd.runtime import progress as _progress
 from passmd.runtime.cache import Cache, CacheWarning, Unfingerprintable, function_code, function_name
 from passmd.runtime.config import EXECUTORS, MAX_WORKERS, RunConfig, useful_workers
 from passmd.runtime.extras import install_hint
+from passmd.runtime.progress import bar, in_worker, is_terminal
 from passmd.runtime.validation import check_choice
 
 __all__ = ["EXECUTORS", "grid", "process_pool", "progress_enabled", "run"]
@@ -75,7 +75,7 @@ def progress_enabled(progress: bool | None = None, stream=None) -> bool:
     """Whether to show progress: ``progress`` if given, else whether ``stream`` is a TTY."""
     if progress is not None:
         return bool(progress)
-    return _progress.is_terminal(sys.stderr if stream is None else stream)
+    return is_terminal(sys.stderr if stream is None else stream)
 
 
 def _call(func, point):
@@ -430,14 +430,14 @@ def run(
     cached = _cached(store, func, keys)
     todo = [i for i in range(len(points)) if i not in cached]
 
-    shown = bool(todo) and progress_enabled(progress) and not _progress.in_worker()
-    bar = _progress.bar(len(points), initial=len(cached), desc=label, unit="point") if shown else _NoBar()
-    collect = _Collector(func, points, keys, store, bar)
+    shown = bool(todo) and progress_enabled(progress) and not in_worker()
+    points_bar = bar(len(points), initial=len(cached), desc=label, unit="point") if shown else _NoBar()
+    collect = _Collector(func, points, keys, store, points_bar)
     try:
         if todo:
             _execute(executor, func, todo, points, collect, workers, scheduler)
     finally:
-        bar.close()
+        points_bar.close()
 
     results = {**cached, **collect.results}
     frame = pd.DataFrame([{**points[i], **results[i]} for i in range(len(points))])

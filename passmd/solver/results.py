@@ -13,7 +13,7 @@ import numpy as np
 
 from passmd.model.parameters import Drive
 from passmd.model.waveforms import Waveform
-from passmd.solver import kernels as kern
+from passmd.solver import kernels
 
 
 class SimulationError(RuntimeError):
@@ -167,18 +167,18 @@ class SimulationResult:
         return pd.DataFrame(data)
 
 
-def measures(buffers: kern.Buffers, periods: int, n_rec: int) -> dict:
+def measures(buffers: kernels.Buffers, periods: int, n_rec: int) -> dict:
     """The recorded series, measures of the first ``periods`` periods, energies and state of a
     run stopped after them (fields of :class:`SimulationResult`)."""
     per, energy = buffers.per[:periods], buffers.energy
     rec = buffers.record[:n_rec]
-    window_len = per[:, kern.PER_WINDOW_LENGTH]
+    window_len = per[:, kernels.PER_WINDOW_LENGTH]
     if np.any(window_len <= 0):
         raise SimulationError(
             "a period has an empty settle window; the waveform's phase marks are inconsistent"
         )
-    settled = per[:, kern.PER_WINDOW_INTEGRAL] / window_len + per[:, kern.PER_WINDOW_END_XP]
-    duration = per[:, kern.PER_DURATION]
+    settled = per[:, kernels.PER_WINDOW_INTEGRAL] / window_len + per[:, kernels.PER_WINDOW_END_XP]
+    duration = per[:, kernels.PER_DURATION]
     return dict(
         time=rec[:, 0].copy(),
         piezo_position=rec[:, 1].copy(),
@@ -188,14 +188,14 @@ def measures(buffers: kern.Buffers, periods: int, n_rec: int) -> dict:
         friction_force=rec[:, 5::3].T.copy(),
         slip_share=rec[:, 6::3].T.copy(),
         settled_positions=settled,
-        back_steps=per[:, kern.PER_MARK_XR] - per[:, kern.PER_MIN_XR],
+        back_steps=per[:, kernels.PER_MARK_XR] - per[:, kernels.PER_MIN_XR],
         peak_force_ratio=buffers.peak[:periods].copy(),
-        period_mean_position=per[:, kern.PER_XR_INTEGRAL] / duration,
-        period_mean_friction=per[:, kern.PER_FRICTION_INTEGRAL] / duration,
+        period_mean_position=per[:, kernels.PER_XR_INTEGRAL] / duration,
+        period_mean_friction=per[:, kernels.PER_FRICTION_INTEGRAL] / duration,
         energy={
-            "input": float(energy[kern.EN_INPUT]),
-            "damping": float(energy[kern.EN_DAMPING]),
-            "contact": float(energy[kern.EN_CONTACT]),
+            "input": float(energy[kernels.EN_INPUT]),
+            "damping": float(energy[kernels.EN_DAMPING]),
+            "contact": float(energy[kernels.EN_CONTACT]),
         },
         final_state=buffers.y.copy(),
     )

@@ -41,7 +41,7 @@ from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
 from passmd.model.waveforms import Waveform
 from passmd.runtime.validation import check_choice, check_count
-from passmd.solver import kernels as kern
+from passmd.solver import kernels
 from passmd.solver.results import SimulationError, SimulationResult, measures
 from passmd.solver.setup import contact_rows, linear_stiffness, scheme_steps
 from passmd.solver.steps import (
@@ -67,24 +67,24 @@ SPRINGS_PER_STEP = 100
 PROGRESS_MIN_WORK = 2e6
 
 
-def _progress_bar(work: float, waveform: Waveform, progress: bool | str | None):
+def _progress_bar(work: float, waveform: Waveform, show: bool | str | None):
     """Progress over simulated periods on stderr (:func:`passmd.runtime.progress.bar`), or None.
 
-    ``work``: the run's expected work in steps of the exact contact. None: runs of more than
+    ``work``: the run's expected work in steps of the exact contact. ``show`` None: runs of more than
     :data:`PROGRESS_MIN_WORK` when stderr is a terminal; ``"long"``: those runs whatever stderr
     is (off a terminal, a line every few seconds); True: every run at once; False: none.
     """
-    from passmd.runtime import progress as _progress
+    from passmd.runtime import progress
 
-    if progress is False or sys.stderr is None:
+    if show is False or sys.stderr is None:
         return None
-    if progress is not True:
-        if work < PROGRESS_MIN_WORK or _progress.in_worker():
+    if show is not True:
+        if work < PROGRESS_MIN_WORK or progress.in_worker():
             return None
-        if progress is None and not _progress.is_terminal(sys.stderr):
+        if show is None and not progress.is_terminal(sys.stderr):
             return None
-    return _progress.bar(waveform.periods, unit="period", desc="simulation", fractional=True,
-                         delay=0.0 if progress is True else None)
+    return progress.bar(waveform.periods, unit="period", desc="simulation", fractional=True,
+                        delay=0.0 if show is True else None)
 
 
 def simulate(drive: Drive, waveform: Waveform, **options) -> SimulationResult:
@@ -198,19 +198,19 @@ class Simulation:
         G = multiplicity.size
         # work of one step in steps of the exact contact: every spring of a discrete contact counts
         self._step_work = 1.0 + (G * springs / SPRINGS_PER_STEP if contact_model == "discrete" else 0.0)
-        self._buffers = kern.Buffers(
+        self._buffers = kernels.Buffers(
             y=np.zeros(2 + 2 * G),
-            work=np.zeros((kern.WORK_ROWS, G)),
-            carry=np.zeros(kern.CARRY_SIZE),
+            work=np.zeros((kernels.WORK_ROWS, G)),
+            carry=np.zeros(kernels.CARRY_SIZE),
             record=np.empty((int(max_points), 4 + 3 * G)),
-            per=np.zeros((waveform.periods, kern.PER_COLUMNS)),
+            per=np.zeros((waveform.periods, kernels.PER_COLUMNS)),
             peak=np.zeros((waveform.periods, G)),
-            energy=np.zeros(kern.EN_COLUMNS),
+            energy=np.zeros(kernels.EN_COLUMNS),
         )
         self._segments = segments(waveform, steps.fine, steps.coarse, steps.quiet, steps.longest)
         # pieces of the first n periods: the first _ends[n − 1] (a piece's period never decreases)
         self._ends = np.searchsorted(self._segments.period, np.arange(1, waveform.periods + 1), side="left")
-        self._mechanics = kern.Mechanics(
+        self._mechanics = kernels.Mechanics(
             drive.runner_mass,
             drive.effective_load_cell_stiffness,
             multiplicity.astype(float),
@@ -220,12 +220,13 @@ class Simulation:
             drive.actuator.viscosity,
             linear_stiffness(drive, multiplicity, k_contacts) if steps.controlled else 0.0,
         )
-        self._control = kern.StepControl(
+        self._control = kernels.StepControl(
             plan.activity_threshold, plan.quiet_steps, steps.quasi_static,
             waveform.duration / (max_points - 1),
             LOCAL_ERROR_TOLERANCE / scheme.refine**4 if steps.controlled else 0.0,
         )
-        self._contacts = kern.Contacts(params, state, np.array([sliding_force(params[g]) for g in range(G)]))
+        sliding = np.array([sliding_force(params[g]) for g in range(G)])
+        self._contacts = kernels.Contacts(params, state, sliding)
         self.periods_done = 0
         self.wall_time = 0.0
         self._counts = (0, 0, 0)  # integrator steps, rows recorded, fine steps
@@ -268,7 +269,7 @@ class Simulation:
         n, end = leading.periods, int(self._ends[leading.periods - 1])
         b = self._buffers
         arguments = (
-            kern.Segments(*(column[:end] for column in self._segments)),
+            kernels.Segments(*(column[:end] for column in self._segments)),
             self._mechanics,
             self._control,
             self._contacts,
@@ -281,7 +282,7 @@ class Simulation:
             )
         finally:
             self.wall_time += _time.perf_counter() - start
-        if status != kern.STATUS_OK:
+        if status != kernels.STATUS_OK:
             self._failed = True
             y, plan = b.y, self._plan
             raise SimulationError(
@@ -316,7 +317,7 @@ class Simulation:
             coarse_step=float(self._coarse_step),
             wall_time=self.wall_time,
             contact_memory=[memory_diagnostics(self._params[g], self._state[g]) for g in range(G)],
-            rejected_steps=int(self._buffers.carry[kern.C_REJECTED]),
+            rejected_steps=int(self._buffers.carry[kernels.C_REJECTED]),
         )
 
 
@@ -333,12 +334,12 @@ def _integrate_in_chunks(arguments: tuple, waveform: Waveform, expected: float, 
     try:
         limit = chunk
         while True:
-            status, steps, n_rec, fine_steps = kern.integrate(*arguments, limit)
-            if status != kern.STATUS_PAUSED:
+            status, steps, n_rec, fine_steps = kernels.integrate(*arguments, limit)
+            if status != kernels.STATUS_PAUSED:
                 return status, steps, n_rec, fine_steps
             limit = steps + chunk
             if bar is not None:
-                bar.update(min(carry[kern.C_TIME] / waveform.period, waveform.periods) - bar.n)
+                bar.update(min(carry[kernels.C_TIME] / waveform.period, waveform.periods) - bar.n)
     finally:
         if bar is not None:
             bar.close()

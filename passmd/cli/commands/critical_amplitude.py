@@ -76,7 +76,7 @@ def add_parser(command) -> None:
 
 def _search(args, drive) -> dict:
     """The simulated A_c of the book's search (every option checked, searched unless --analytic-only)."""
-    from passmd.protocols import critical_amplitude as ca
+    from passmd.protocols import critical_amplitude
 
     if args.periods < 2:
         raise UsageError(f"--periods = {args.periods} is out of range: a step needs >= 2 periods")
@@ -90,7 +90,7 @@ def _search(args, drive) -> dict:
         return {}
     kernels.notice_if_cold()
     # the book's search (critical-amplitude chapters): one protocol for users and book
-    found = ca.critical_amplitude(
+    found = critical_amplitude.critical_amplitude(
         drive, protocol=args.protocol, frequency=frequency,
         periods=args.periods, threshold=threshold, tolerance=tolerance,
         progress="long",  # a long search's progress on stderr, also when it is not a terminal

@@ -45,12 +45,12 @@ def add_parser(command) -> None:
     p.set_defaults(handler=run_figure)
 
 
-def _list(figures, names, args, out) -> int:
+def _list(figure_table, names, args, out) -> int:
     if args.json:
         emit_json({"command": "figure", "figures": names}, out)
     else:
         for name in names:
-            out.write(f"{name}  {figures.figure_spec(name).title}\n")
+            out.write(f"{name}  {figure_table.figure_spec(name).title}\n")
         if not names:
             out.write("no figure is available\n")
     return 0
@@ -76,7 +76,7 @@ def _check_out(args, config) -> None:
                   | {f"{ENVIRONMENT['sweep_log']} {config.sweep_log}": config.sweep_log})
 
 
-def _write(figures, provenance, args, data) -> tuple[Path, Path]:
+def _write(figure_table, provenance, args, data) -> tuple[Path, Path]:
     """NAME.csv (with the provenance header) and NAME.png in --out, each written atomically."""
     target = Path(args.out)
     csv_path, png_path = target / f"{args.name}.csv", target / f"{args.name}.png"
@@ -89,7 +89,7 @@ def _write(figures, provenance, args, data) -> tuple[Path, Path]:
                 data.to_csv(fh, index=False, lineterminator="\n")
 
         write_atomically(csv_path, write_csv)
-        fig = figures.figure_plot(args.name, data)
+        fig = figure_table.figure_plot(args.name, data)
         write_atomically(png_path, lambda tmp: fig.savefig(
             tmp, dpi=150, format="png", metadata={"Description": provenance.summary(args.profile)}))
     except BrokenPipeError as exc:  # (--out /dev/fd: a reader that went away)
@@ -103,18 +103,18 @@ def _write(figures, provenance, args, data) -> tuple[Path, Path]:
 
 
 def run_figure(args, out) -> int:
-    from passmd.experiments import figure_table as figures
+    from passmd.experiments import figure_table
     from passmd.runtime import provenance
 
-    names = figures.figure_names()
+    names = figure_table.figure_names()
     if args.name == "list":
-        return _list(figures, names, args, out)
+        return _list(figure_table, names, args, out)
     _check_name(args, names)
     config = run_config(args)
     _check_out(args, config)
-    data = figures.figure_data(args.name, config)
+    data = figure_table.figure_data(args.name, config)
     check_table(args.name, data)  # finite before anything is written, as run and theory check theirs
-    csv_path, png_path = _write(figures, provenance, args, data)
+    csv_path, png_path = _write(figure_table, provenance, args, data)
     record = {"command": "figure", "name": args.name, "profile": args.profile, "rows": len(data),
               "columns": list(map(str, data.columns)), "csv": str(csv_path), "png": str(png_path)}
     if args.json:

@@ -181,17 +181,17 @@ def _write(target: Path, result, record: dict, text: str) -> None:
 
 def run_fit(args, out) -> int:
     from passmd.cli.configuration import execution_config
-    from passmd.protocols import fit as fitting
+    from passmd.protocols import fit
 
     names = _free(args)
     bounds = _bounds(args, names)
     drive, sources = resolve_drive(args)
     target = _check_out(args)
     try:
-        data = fitting.read_measurements(args.data)
+        data = fit.read_measurements(args.data)
     except FileNotFoundError:
         raise UsageError(f"DATA.csv = {args.data!r}: no such file") from None
-    except fitting.MeasurementError as exc:
+    except fit.MeasurementError as exc:
         raise UsageError(str(exc)) from None
     except IsADirectoryError:
         raise UsageError(f"DATA.csv = {args.data!r} is a directory") from None
@@ -200,16 +200,16 @@ def run_fit(args, out) -> int:
     # c_p stays fixed while k_p or m_a moves only when the user gave c_p (drive show: "given"/"option")
     given_cp = sources.get("actuator.viscosity", "").startswith(("given", "option"))
     try:
-        result = fitting.fit(drive, data, list(library), bounds=bounds, reading=args.reading, loss=args.loss,
+        result = fit.fit(drive, data, list(library), bounds=bounds, reading=args.reading, loss=args.loss,
                              keep="viscosity" if given_cp else "damping_ratio", config=config,
                              progress=_progress(config))
-    except fitting.MeasurementError as exc:  # a row the drive cannot run: refused before any simulation
+    except fit.MeasurementError as exc:  # a row the drive cannot run: refused before any simulation
         raise UsageError(str(exc)) from None
-    except fitting.InputError as exc:
+    except fit.InputError as exc:
         if exc.name in ("free", "bounds", "data"):
             raise UsageError(str(exc).replace("free = ", "--free: ")) from None
         raise
-    text = fitting.fitted_drive_file(result, Path(args.data).name, sources)
+    text = fit.fitted_drive_file(result, Path(args.data).name, sources)
     record = {"command": "fit", **result.report(), "drive": drive_record(result.drive)}
     check_results(record)
     if target is not None:

@@ -89,10 +89,10 @@ def run_force(args, out) -> int:
     check_results(found)
     if args.csv or args.plot:  # the reported run again, for its time series
         from passmd.model import waveforms
-        from passmd.solver import simulation as dynamics
+        from passmd.solver import simulation
 
         wave = waveforms.sawtooth(amplitude, frequency, drive, periods=found["periods"])
-        write_outputs(args, dynamics.simulate(drive, wave, max_points=args.max_points))
+        write_outputs(args, simulation.simulate(drive, wave, max_points=args.max_points))
     force, bound = found["generated_force_N"], found["coulomb_bound_N"]
     # Only the runner's inertia carries a period mean past μΣF_N, in a run cut short while the
     # runner swings on the load cell: that reading is no generated force, and no force above

@@ -80,11 +80,11 @@ def _write(option: str, name: str, write) -> None:
         raise OutputError(f"cannot write {option} {name}: {exc.strerror or exc}") from exc
 
 
-def _write_baseline(ledger, evaluated, args) -> None:
+def _write_baseline(evaluation, evaluated, args) -> None:
     header = (f"ledger categories, {args.profile} profile; produced {datetime.date.today().isoformat()} by\n"
               f"passmd ledger --profile {args.profile} --write-baseline {args.write_baseline}")
     _write("--write-baseline", args.write_baseline,
-           lambda tmp: ledger.write_baseline(evaluated, tmp, header=header))
+           lambda tmp: evaluation.write_baseline(evaluated, tmp, header=header))
 
 
 def _write_drive(joint, args) -> None:
@@ -100,24 +100,24 @@ def run_ledger(args, out) -> int:
     """Every claim of the paper with its computed category, values and evidence (Sections 4–6)."""
     config = run_config(args)
     _check_outputs(args, config)  # (before the ledger's modules load)
-    from passmd.ledger import evaluation as ledger
+    from passmd.ledger import evaluation
     from passmd.report import ledger_views
 
-    results = ledger.collect_results(config)
+    results = evaluation.collect_results(config)
     for name, table in results.items():  # finite before anything is written, as run and theory check
         check_table(name, table)
-    evaluated = ledger.evaluate(results=results)
+    evaluated = evaluation.evaluate(results=results)
     if args.write_baseline:
-        _write_baseline(ledger, evaluated, args)
-    counts = ledger.headline(evaluated)
+        _write_baseline(evaluation, evaluated, args)
+    counts = evaluation.headline(evaluated)
     joint = evaluated.attrs["joint"]
     if args.write_drive:
         _write_drive(joint, args)
     if args.json:
         emit_json({"command": "ledger", "profile": args.profile, "summary": ledger_views.summary(evaluated),
-                   "counts": counts, "joint_reading": ledger.joint_record(joint),
+                   "counts": counts, "joint_reading": evaluation.joint_record(joint),
                    "conflicting_pairs": evaluated.attrs["conflicts"], "tensions": evaluated.attrs["tensions"],
-                   "claims": ledger.records(evaluated)}, out)
+                   "claims": evaluation.records(evaluated)}, out)
         return 0
     out.write(f"passmd ledger — profile {args.profile}: {ledger_views.summary(evaluated)}\n")
     for line in ledger_views.joint_sentences(joint):

@@ -203,7 +203,7 @@ def simulate(args, drive, options: RunOptions):
     startup.load_numba_without_blas_probe()
     from passmd.model import optimized_waveform, waveforms
     from passmd.protocols import eq15
-    from passmd.solver import simulation as dynamics
+    from passmd.solver import simulation
 
     amplitude, frequency, springs, given = options
     if args.waveform == "optimized":
@@ -221,7 +221,7 @@ def simulate(args, drive, options: RunOptions):
         design = None
         wave = waveforms.sawtooth(amplitude, frequency, drive, periods=args.periods)
         kernels.notice_if_cold()  # after the last check of the options: a refusal stays one line
-    result = dynamics.simulate(
+    result = simulation.simulate(
         drive, wave, contact_model="exact" if springs is None else "discrete",
         springs=PROTOCOL.springs if springs is None else springs, max_points=args.max_points,
         progress="long",  # a long run's progress on stderr, also when it is not a terminal

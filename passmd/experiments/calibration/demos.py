@@ -21,7 +21,7 @@ import numpy as np
 from passmd.experiments.calibration.synthetic import noisy_steps
 from passmd.model.parameters import Drive
 from passmd.model.tables import Amplifier
-from passmd.protocols import fit as fitting
+from passmd.protocols import fit
 from passmd.protocols.fit.prediction import drive_at
 from passmd.runtime.config import RunConfig
 
@@ -37,7 +37,7 @@ FLYBACK = {"friction_coefficient": 0.25, "preloads": (0.3, 0.5), "amplitudes_nm"
            "frequency": 100.0, "sd_nm": 0.5, "seed": 2, "data_rule": "fixed"}
 
 
-def join(first: fitting.Measurements, second: fitting.Measurements) -> fitting.Measurements:
+def join(first: fit.Measurements, second: fit.Measurements) -> fit.Measurements:
     """The rows of ``first`` followed by those of ``second`` (both with or both without sd)."""
     arrays = {k: np.concatenate([getattr(first, k), getattr(second, k)])
               for k in ("value", "sd", "amplitude", "frequency", "preload", "radius")}
@@ -54,7 +54,7 @@ def comb_fit(config: RunConfig | None = None) -> dict:
     truth = drive_at(base, ["actuator.stiffness"], [COMB["stiffness"]], base.actuator.damping_ratio)
     conditions = [(COMB["preload"], a * 1e-9, COMB["frequency"]) for a in COMB["amplitudes_nm"]]
     data = noisy_steps(truth, conditions, COMB["sd_nm"], COMB["seed"], name="three steps", config=config)
-    first = fitting.fit(base, data, ["actuator.stiffness"], config=config)
+    first = fit.fit(base, data, ["actuator.stiffness"], config=config)
     out = {"truth": truth, "data": data, "first": first, "row": first.next_measurement, "added": None,
            "second": None}
     row = first.next_measurement
@@ -62,7 +62,7 @@ def comb_fit(config: RunConfig | None = None) -> dict:
         where = [(row["preload_N"], row["amplitude_m"], row["frequency_Hz"])]
         added = noisy_steps(truth, where, COMB["sd_nm"], COMB["added_seed"], name="added step", config=config)
         both = join(data, added)
-        out.update(added=added, second=fitting.fit(base, both, ["actuator.stiffness"], config=config))
+        out.update(added=added, second=fit.fit(base, both, ["actuator.stiffness"], config=config))
     return out
 
 
@@ -75,8 +75,8 @@ def flyback_fits(config: RunConfig | None = None) -> dict:
                   for a in FLYBACK["amplitudes_nm"]]
     data = noisy_steps(truth, conditions, FLYBACK["sd_nm"], FLYBACK["seed"], flyback=FLYBACK["data_rule"],
                        name="steps made with the fixed fly-back", config=config)
-    wrong = fitting.fit(base, data, ["friction_coefficient"], config=config)
-    right = fitting.fit(base.replace(amplifier=Amplifier(flyback=FLYBACK["data_rule"])), data,
+    wrong = fit.fit(base, data, ["friction_coefficient"], config=config)
+    right = fit.fit(base.replace(amplifier=Amplifier(flyback=FLYBACK["data_rule"])), data,
                         ["friction_coefficient"], config=config)
     return {"truth": truth, "data": data, "wrong": wrong, "right": right}
 

@@ -17,10 +17,10 @@ import numpy as np
 
 from passmd.model.parameters import Drive
 from passmd.model.waveforms import sawtooth
-from passmd.protocols import fit as fitting
+from passmd.protocols import fit
 from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 from passmd.solver.steps import SCHEMES
 
 __all__ = ["PERIODS", "REFINE", "independent_step", "independent_steps", "noisy_steps"]
@@ -36,7 +36,8 @@ def independent_step(drive: Drive, amplitude: float, frequency: float, periods: 
     """The last step of a ``periods``-period saw-tooth run from rest with the refined integrator (a sweep
     function): ``{"step_m": ...}``."""
     wave = sawtooth(amplitude, frequency, drive, periods=periods, flyback=flyback)
-    result = dynamics.simulate(drive, wave, scheme=SCHEMES["controlled"].replace(refine=refine), max_points=2)
+    scheme = SCHEMES["controlled"].replace(refine=refine)
+    result = simulation.simulate(drive, wave, scheme=scheme, max_points=2)
     return {"step_m": float(result.step_sizes[-1])}
 
 
@@ -52,7 +53,7 @@ def independent_steps(drive: Drive, conditions, *, flyback=None, config: RunConf
 
 def noisy_steps(drive: Drive, conditions, sd_nm: float, seed: int, *, flyback=None, name: str = "data",
                 config: RunConfig | None = None, executor: str | None = "serial", cache=False
-                ) -> fitting.Measurements:
+                ) -> fit.Measurements:
     """:func:`independent_steps` plus Gaussian noise of ``sd_nm`` (numpy's default generator, ``seed``), as
     measurements with that sd stated (``step_nm``, ``step_nm_sd``)."""
     exact = independent_steps(drive, conditions, flyback=flyback, config=config, executor=executor,
@@ -61,4 +62,4 @@ def noisy_steps(drive: Drive, conditions, sd_nm: float, seed: int, *, flyback=No
     header = ["amplitude_nm", "preload_N", "frequency_Hz", "step_nm", "step_nm_sd"]
     rows = [[repr(float(a * 1e9)), repr(float(p)), repr(float(f)), repr(float(v * 1e9)), repr(float(sd_nm))]
             for (p, a, f), v in zip(conditions, noisy, strict=True)]
-    return fitting.measurements_from_rows(header, rows, name=name)
+    return fit.measurements_from_rows(header, rows, name=name)

@@ -220,14 +220,14 @@ def side_prestrain(frequency_table: pd.DataFrame, fraction: float = 0.97) -> pd.
     """
     from passmd.model import waveforms
     from passmd.model.theory import drive_theory
-    from passmd.solver import simulation as dynamics
+    from passmd.solver import simulation
 
     rigid = paper_drive_for(6, "rigid", *FIG5A_DRIVE)
     steady = primary(frequency_table, "rigid")
     steady_ac = float(steady[steady["contacts"] == 6]["critical_amplitude_nm"].iloc[0]) * 1e-9
     amplitude = fraction * steady_ac
     wave = waveforms.sawtooth(amplitude, PROTOCOL.drive_frequency, rigid, periods=STEADY_PERIODS)
-    run = dynamics.simulate(rigid, wave, max_points=200_001)
+    run = simulation.simulate(rigid, wave, max_points=200_001)
     sliding = np.array([f * rigid.friction_coefficient for f in drive_theory(rigid)["normal_force_N"]])
     rows = []
     for k, (t0, t1) in enumerate(wave.settle_windows, start=1):

@@ -23,7 +23,7 @@ from passmd.experiments.design.figures import FIT_FREQUENCY, NOISE_NM, PROFILE_S
 from passmd.model.drive_file import load_drive
 from passmd.model.parameters import Drive
 from passmd.model.tables import actuator_for_radius
-from passmd.protocols import fit as fitting
+from passmd.protocols import fit
 from passmd.runtime.config import RunConfig
 
 __all__ = ["calibrate", "fit_facts", "heldback_facts", "heldback_predictions", "load_fitted",
@@ -38,22 +38,22 @@ def start_drive(truth: Drive, free: Sequence[str]) -> Drive:
             drive = replace(drive, friction_coefficient=Drive().friction_coefficient)
         elif name == "actuator.stiffness":
             table2 = actuator_for_radius(truth.hemisphere_radius).stiffness
-            drive = fitting.FREE_PARAMETERS[name].set(drive, table2, truth)
+            drive = fit.FREE_PARAMETERS[name].set(drive, table2, truth)
         else:
             raise ValueError(f"free = {name!r}: the example's first guess knows friction_coefficient and "
                              "actuator.stiffness")
     return drive
 
 
-def _measurements(points, truth: Drive, rng, config, flyback=None) -> fitting.Measurements:
+def _measurements(points, truth: Drive, rng, config, flyback=None) -> fit.Measurements:
     """Steps at (frequency, preload, amplitude nm) points:
     :func:`~passmd.experiments.calibration.synthetic.independent_steps` below 1 kHz (the
     steady-velocity protocol's step above, as a stand measures it there) plus noise of NOISE_NM."""
     header = ["amplitude_nm", "preload_N", "frequency_Hz", "step_nm", "step_nm_sd"]
     rows = [[repr(float(a)), repr(float(p)), repr(float(f)), "0", repr(NOISE_NM)] for f, p, a in points]
-    data = fitting.measurements_from_rows(header, rows, name="synthetic measurements")
+    data = fit.measurements_from_rows(header, rows, name="synthetic measurements")
     low = [i for i, (f, _, _) in enumerate(points) if f < 1e3]
-    exact = np.array(fitting.predict(truth, data, config=config))  # the steady-velocity protocol above 1 kHz
+    exact = np.array(fit.predict(truth, data, config=config))  # the steady-velocity protocol above 1 kHz
     if low:
         conditions = [(points[i][1], points[i][2] * 1e-9, points[i][0]) for i in low]
         exact[low] = independent_steps(truth, conditions, flyback=flyback, config=config, executor=None,
@@ -62,7 +62,7 @@ def _measurements(points, truth: Drive, rng, config, flyback=None) -> fitting.Me
 
 
 def synthetic_measurements(truth: Drive, profile: str, config: RunConfig | None = None, flyback=None
-                           ) -> tuple[fitting.Measurements, fitting.Measurements]:
+                           ) -> tuple[fit.Measurements, fit.Measurements]:
     """Steps of ``truth`` made independently of the fit's forward model
     (:func:`~passmd.experiments.calibration.synthetic.independent_steps`), plus Gaussian noise of
     NOISE_NM (seed SEED): ``(fit data, held-back data)``; ``flyback`` overrides the drive's fly-back
@@ -75,28 +75,28 @@ def synthetic_measurements(truth: Drive, profile: str, config: RunConfig | None 
             _measurements(s.heldback, truth, rng, config, flyback))
 
 
-def measurements_csv(data: fitting.Measurements) -> str:
+def measurements_csv(data: fit.Measurements) -> str:
     """The text of the measurement CSV that ``passmd fit`` reads
     (:func:`passmd.protocols.fit.measurements.write_measurements`)."""
     with tempfile.TemporaryDirectory(prefix="passmd-design-") as folder:
         path = Path(folder) / "measurements.csv"
-        fitting.write_measurements(path, data)
+        fit.write_measurements(path, data)
         return path.read_text(encoding="utf-8")
 
 
-def calibrate(start: Drive, data: fitting.Measurements, profile: str,
-              config: RunConfig | None = None) -> fitting.FitResult:
+def calibrate(start: Drive, data: fit.Measurements, profile: str,
+              config: RunConfig | None = None) -> fit.FitResult:
     """The fit of the profile's free parameters to ``data`` from ``start`` (``passmd fit``'s defaults)."""
-    return fitting.fit(start, data, list(PROFILE_SETTINGS[profile].free), config=_run_config(config, profile))
+    return fit.fit(start, data, list(PROFILE_SETTINGS[profile].free), config=_run_config(config, profile))
 
 
-def other_flyback_fit(start: Drive, data: fitting.Measurements, profile: str,
-                      config: RunConfig | None = None) -> fitting.FitResult:
+def other_flyback_fit(start: Drive, data: fit.Measurements, profile: str,
+                      config: RunConfig | None = None) -> fit.FitResult:
     """μ fitted to ``data`` with the fly-back rule the data were not made with (``"fixed"`` for a drive
     whose rule is ``"slew"``, else ``"slew"``): a wrong fixed assumption for the χ² test to judge."""
     other = "fixed" if start.amplifier.flyback == "slew" else "slew"
     wrong = replace(start, amplifier=replace(start.amplifier, flyback=other))
-    return fitting.fit(wrong, data, ["friction_coefficient"], config=_run_config(config, profile))
+    return fit.fit(wrong, data, ["friction_coefficient"], config=_run_config(config, profile))
 
 
 def load_fitted(text: str) -> Drive:
@@ -108,7 +108,7 @@ def load_fitted(text: str) -> Drive:
         return load_drive(path)
 
 
-def heldback_predictions(heldback: fitting.Measurements, drives: dict[str, Drive], profile: str,
+def heldback_predictions(heldback: fit.Measurements, drives: dict[str, Drive], profile: str,
                          config: RunConfig | None = None) -> pd.DataFrame:
     """The held-back measurements and each drive's prediction of them (nm), one row per point.
 
@@ -120,17 +120,17 @@ def heldback_predictions(heldback: fitting.Measurements, drives: dict[str, Drive
                         "sd_nm": heldback.sd * 1e9})
     config = _run_config(config, profile)
     for label, drive in drives.items():
-        out[f"{label}_nm"] = fitting.predict(drive, heldback, config=config) * 1e9
+        out[f"{label}_nm"] = fit.predict(drive, heldback, config=config) * 1e9
     return out
 
 
-def fit_facts(result: fitting.FitResult, truth: Drive, start: Drive) -> pd.DataFrame:
+def fit_facts(result: fit.FitResult, truth: Drive, start: Drive) -> pd.DataFrame:
     """One row per free parameter: the value simulated (truth), the first guess, the estimate, its
     local standard error, its 95 % region (pieces, and their hull) and whether the region holds the
     truth (SI)."""
     rows = []
     for name in result.names:
-        p = fitting.FREE_PARAMETERS[name]
+        p = fit.FREE_PARAMETERS[name]
         est = result.estimates[name]
         low, high = est["interval"]
         rows.append({"parameter": name, "symbol": p.symbol, "unit": p.unit, "truth": p.get(truth),

@@ -29,8 +29,7 @@ from passmd.protocols.velocity import (
 from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
 from passmd.runtime.validation import check_choice
-from passmd.solver import simulation as dynamics
-from passmd.solver import steps as time_steps
+from passmd.solver import simulation, steps
 from passmd.solver.results import SimulationError
 
 #: Driving frequency of Figs. 8 and 9a (Hz).
@@ -120,7 +119,7 @@ def trace_point(hemisphere_radius: float, preload: float, runner: str, actuator_
         settling_time, acceleration_time, acceleration_amplitude)
     wave = make_waveform(drive, amplitude, frequency, periods, waveform, "cut", design)
     samples = int(math.ceil(wave.duration * theory.runner_frequency(drive) * 200)) + 1
-    result = dynamics.simulate(drive, wave, max_points=max(samples, 2000))
+    result = simulation.simulate(drive, wave, max_points=max(samples, 2000))
     t = result.time
     period = 1.0 / frequency
     v_p = wave.velocity(t)
@@ -225,7 +224,7 @@ def _full_stroke_flyback(fields: dict) -> float:
 
 #: Integration refinement of the fly-back window run (``simulate``'s ``resolution``: the
 #: error-controlled step's tolerance divided by its fourth power, so the step by about this):
-#: t_a (about 0.2 µs) spans at least ``time_steps.MIN_SEGMENT_STEPS`` steps like every piece,
+#: t_a (about 0.2 µs) spans at least ``passmd.solver.steps.MIN_SEGMENT_STEPS`` steps like every piece,
 #: and the refinement keeps the steps around it (the fly-back's slip and the settling t_s)
 #: as fine as t_a's.
 WINDOW_RESOLUTION = {"quick": 20.0, "paper": 40.0}
@@ -259,8 +258,8 @@ def window_point(hemisphere_radius: float, preload: float, runner: str, actuator
     start_a = period + timing["settling_time_s"]
     end_a = start_a + timing["acceleration_time_s"]
     points = int(math.ceil(wave.duration * samples_per_acceleration / timing["acceleration_time_s"])) + 1
-    refined = time_steps.SCHEMES["controlled"].replace(refine=resolution)
-    result = dynamics.simulate(drive, wave, scheme=refined, max_points=points)
+    refined = steps.SCHEMES["controlled"].replace(refine=resolution)
+    result = simulation.simulate(drive, wave, scheme=refined, max_points=points)
     t = result.time
     keep = (t >= period - flyback - WINDOW_BEFORE) & (t <= end_a + WINDOW_AFTER)
     inside = t[(t >= start_a) & (t <= end_a)]

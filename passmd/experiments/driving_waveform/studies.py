@@ -38,7 +38,7 @@ from passmd.protocols.velocity import (
 )
 from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
-from passmd.solver import simulation as dynamics
+from passmd.solver import simulation
 
 
 def step_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
@@ -244,7 +244,7 @@ def startup_point(hemisphere_radius: float, preload: float, runner: str, actuato
         settling_time, acceleration_time, acceleration_amplitude)
     wave = make_waveform(drive, drive.actuator.full_stroke_amplitude, frequency, steady_periods(frequency),
                          waveform, short_period, design)
-    result = dynamics.simulate(drive, wave, max_points=2)
+    result = simulation.simulate(drive, wave, max_points=2)
     return {"period_mean_position_m": result.period_mean_position,
             "settled_positions_m": result.settled_positions}
 

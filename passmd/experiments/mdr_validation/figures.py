@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from passmd.experiments.mdr_validation import closed_forms as mv
+from passmd.experiments.mdr_validation import closed_forms
 from passmd.experiments.numerics.benchmarks import benchmark_results
 from passmd.model.defaults import PROTOCOL
 from passmd.model.mdr_contact import MDRContact
@@ -53,7 +53,7 @@ def mdr_springs(config: RunConfig) -> pd.DataFrame:
     indentation (m),
     the hemisphere radius (m) and μ."""
     drive, exact = Drive(), validation_contact()
-    df = mv.spring_picture(drive)
+    df = closed_forms.spring_picture(drive)
     df["indentation_m"] = exact.indentation
     df["hemisphere_radius_m"] = drive.hemisphere_radius
     df["friction_coefficient"] = drive.friction_coefficient
@@ -63,13 +63,13 @@ def mdr_springs(config: RunConfig) -> pd.DataFrame:
 def mdr_normal(config: RunConfig) -> pd.DataFrame:
     """:func:`passmd.experiments.mdr_validation.closed_forms.normal_validation` for
     :data:`VALIDATION_SPRINGS`."""
-    return mv.normal_validation(Drive(), springs=VALIDATION_SPRINGS)
+    return closed_forms.normal_validation(Drive(), springs=VALIDATION_SPRINGS)
 
 
 def mdr_virgin(config: RunConfig) -> pd.DataFrame:
     """:func:`passmd.experiments.mdr_validation.closed_forms.virgin_validation` plus ``sliding_force_N``
     (μF_N)."""
-    df = mv.virgin_validation(Drive(), springs=VALIDATION_SPRINGS)
+    df = closed_forms.virgin_validation(Drive(), springs=VALIDATION_SPRINGS)
     df["sliding_force_N"] = validation_contact().sliding_force
     return df
 
@@ -78,9 +78,9 @@ def mdr_hysteresis(config: RunConfig) -> pd.DataFrame:
     """:func:`passmd.experiments.mdr_validation.closed_forms.hysteresis_validation` plus ``turn``: the
     name of each
     turning point (:data:`HYSTERESIS_TURNS`) on the first row that reaches it, else ``""``."""
-    df = mv.hysteresis_validation(Drive(), springs=HYSTERESIS_SPRINGS)
+    df = closed_forms.hysteresis_validation(Drive(), springs=HYSTERESIS_SPRINGS)
     u_max = validation_contact().presliding
-    _, _, turns = mv.hysteresis_path()
+    _, _, turns = closed_forms.hysteresis_path()
     df["turn"] = ""
     for name, t in zip(HYSTERESIS_TURNS, turns[1:5], strict=True):
         first = df.index[np.isclose(df["u_m"], t * u_max, rtol=1e-12, atol=0)][0]
@@ -96,11 +96,11 @@ def mdr_convergence(config: RunConfig) -> pd.DataFrame:
     ``fit_rel`` the
     least-squares power law of ``max_error_rel`` over those N (NaN below).
     """
-    df = mv.convergence_validation(Drive())
+    df = closed_forms.convergence_validation(Drive())
     fit = df["springs"] >= 100
     coef = np.polyfit(np.log(df.loc[fit, "springs"]), np.log(df.loc[fit, "max_error_rel"]), 1)
     df["fit_rel"] = np.where(fit, np.exp(np.polyval(coef, np.log(df["springs"]))), np.nan)
-    df["fitted_order"] = mv.fitted_order(df)
+    df["fitted_order"] = closed_forms.fitted_order(df)
     return df
 
 
@@ -170,7 +170,8 @@ def hysteresis_facts(loop: pd.DataFrame) -> dict:
 def convergence_facts(conv: pd.DataFrame, default_springs: int = PROTOCOL.springs) -> dict:
     """Fitted order, the largest deviation (%) at 1000 springs and at ``default_springs`` (the
     discrete contact's default number of springs, ``PROTOCOL.springs``)."""
-    at_default = mv.convergence_validation(Drive(), springs=(default_springs,))["max_error_rel"].iloc[0]
+    validation = closed_forms.convergence_validation(Drive(), springs=(default_springs,))
+    at_default = validation["max_error_rel"].iloc[0]
     return {
         "conv_order": conv["fitted_order"].iloc[0],
         "conv_err_1000": conv.loc[conv["springs"] == 1000, "max_error_rel"].iloc[0] * 100,

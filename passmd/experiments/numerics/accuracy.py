@@ -9,12 +9,12 @@ them (``tests/snapshot_accuracy.py``), and the chapters quote them.
 from __future__ import annotations
 
 from passmd.protocols import stall
-from passmd.solver import steps as time_steps
+from passmd.solver import steps
 
 #: Positions, steps and back-steps (m): :data:`passmd.solver.steps.CONVERGED_ACCURACY`, the
 #: settled position's distance from a much finer run. Halving the step moved no quick step,
 #: back-step or settled position (Figs. 5a, 7–10) by more than 0.012 nm.
-POSITION_ACCURACY = time_steps.CONVERGED_ACCURACY
+POSITION_ACCURACY = steps.CONVERGED_ACCURACY
 #: Stall forces (N): the stall criterion's absolute tolerance
 #: (:data:`passmd.protocols.stall.STALL_ABS_TOLERANCE`) — a finer run may stop a few periods
 #: earlier or later, anywhere within it — plus :data:`STALL_FORCE_RTOL` of the force. The

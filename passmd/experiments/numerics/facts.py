@@ -16,7 +16,7 @@ from passmd.experiments.numerics.figures import CONFIGURATIONS, EXPECTED_COULOMB
 from passmd.model import theory
 from passmd.model.parameters import Drive
 from passmd.runtime.units import from_si
-from passmd.solver import steps as time_steps
+from passmd.solver import steps
 from passmd.solver.setup import contact_groups
 
 
@@ -33,7 +33,7 @@ def step_plan_table() -> pd.DataFrame:
         drive = Drive(contacts=contacts, actuator_model=model)
         k_max = theory.drive_theory(drive)["tangential_stiffness_N_per_m"]
         _, mult = contact_groups(drive)
-        plan = time_steps.step_plan(drive, max(k_max), float(np.dot(mult, k_max)))
+        plan = steps.step_plan(drive, max(k_max), float(np.dot(mult, k_max)))
         rows.append({
             "configuration": label,
             "stiffest mode (kHz)": from_si(plan.stiffest_frequency, "kHz"),
@@ -114,7 +114,7 @@ def convergence_facts(conv: pd.DataFrame) -> dict:
     adaptive = adaptive.set_index(["configuration", "resolution"])["final_position_m"]
     fixed = conv[(conv["step_control"] == "fixed") & conv["configuration"].str.contains("flexible")]
     fixed = fixed.set_index(["configuration", "resolution"])["final_position_m"]
-    steps = conv[conv["resolution"] == 1.0].set_index(["configuration", "step_control"])["steps"]
+    counts = conv[conv["resolution"] == 1.0].set_index(["configuration", "step_control"])["steps"]
     six, six_rigid = "six contacts, flexible", "six contacts, rigid"
     return {
         "conv_order": fitted_convergence_order(explicit),
@@ -122,17 +122,17 @@ def convergence_facts(conv: pd.DataFrame) -> dict:
         "quasi_max_err_nm": float(np.abs(quasi[quasi["resolution"] == 1.0]["error_m"]).max() * 1e9),
         "conv_max_err_nm": float(np.abs(default["error_m"]).max() * 1e9),
         "adaptive_vs_fixed_nm": float(np.abs(adaptive.reindex(fixed.index) - fixed).max() * 1e9),
-        "adaptive_saving": float(steps[(six, "fixed")] / steps[(six, "adaptive")]),
-        "quasi_saving": float(steps[(six, "adaptive")] / steps[(six, "quasi-static")]),
+        "adaptive_saving": float(counts[(six, "fixed")] / counts[(six, "adaptive")]),
+        "quasi_saving": float(counts[(six, "adaptive")] / counts[(six, "quasi-static")]),
         "ctrl_order": ctrl_order,
         "ctrl_floor_nm": ctrl_floor * 1e9,
         "ctrl_floor_rigid_nm": float(np.abs(ctrl_finest[~ctrl_flexible]["error_m"]).max() * 1e9),
         "ctrl_floor_flexible_nm": float(np.abs(ctrl_finest[ctrl_flexible]["error_m"]).max() * 1e9),
         "ctrl_max_err_nm": float(np.abs(ctrl_default["error_m"]).max() * 1e9),
         "ctrl_rejected_pct": float((ctrl_default["rejected_steps"] / ctrl_default["steps"]).max() * 100),
-        "ctrl_saving_adaptive": float(steps[(six, "adaptive")] / steps[(six, "controlled")]),
-        "ctrl_saving_fixed": float(steps[(six, "fixed")] / steps[(six, "controlled")]),
-        "ctrl_saving_rigid": float(steps[(six_rigid, "fixed")] / steps[(six_rigid, "controlled")]),
+        "ctrl_saving_adaptive": float(counts[(six, "adaptive")] / counts[(six, "controlled")]),
+        "ctrl_saving_fixed": float(counts[(six, "fixed")] / counts[(six, "controlled")]),
+        "ctrl_saving_rigid": float(counts[(six_rigid, "fixed")] / counts[(six_rigid, "controlled")]),
     }
 
 

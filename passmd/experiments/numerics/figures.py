@@ -18,8 +18,7 @@ from passmd.model.parameters import Amplifier, Drive, Material
 from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
 from passmd.runtime.validation import check_choice, check_count, check_range
-from passmd.solver import simulation as dynamics
-from passmd.solver import steps as time_steps
+from passmd.solver import simulation, steps
 
 #: Configurations the numerics are shown for: (label, contacts, actuator model).
 CONFIGURATIONS = (
@@ -36,10 +35,10 @@ RESOLUTIONS = {"quick": (0.5, 1.0, 2.0, 4.0), "paper": (0.25, 0.5, 1.0, 2.0, 4.0
 #: Step controls of :func:`convergence_study` by name: the integration schemes
 #: (:data:`passmd.solver.steps.SCHEMES`) it compares.
 STEP_CONTROLS = {
-    "controlled": time_steps.SCHEMES["controlled"],  # the default: error-controlled steps
-    "adaptive": time_steps.SCHEMES["adaptive"],  # explicit adaptive step (fine while ringing, coarse after)
-    "quasi-static": time_steps.SCHEMES["quasi-static"],  # m_a neglected, fixed runner step
-    "fixed": time_steps.SCHEMES["fixed"],  # the fine step throughout: the reference scheme
+    "controlled": steps.SCHEMES["controlled"],  # the default: error-controlled steps
+    "adaptive": steps.SCHEMES["adaptive"],  # explicit adaptive step (fine while ringing, coarse after)
+    "quasi-static": steps.SCHEMES["quasi-static"],  # m_a neglected, fixed runner step
+    "fixed": steps.SCHEMES["fixed"],  # the fine step throughout: the reference scheme
 }
 #: Step controls that differ for rigid actuators (they have no actuator mode to adapt to: their
 #: explicit adaptive and quasi-static steps are the fixed one).
@@ -59,7 +58,7 @@ def convergence_point(contacts: int, actuator_model: str, step_control: str, res
                   actuator_model=actuator_model)
     wf = waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
     scheme = STEP_CONTROLS[step_control].replace(refine=resolution)
-    res = dynamics.simulate(drive, wf, scheme=scheme, max_points=2)
+    res = simulation.simulate(drive, wf, scheme=scheme, max_points=2)
     return {"fine_step_s": res.fine_step, "coarse_step_s": res.coarse_step, "steps": res.steps,
             "rejected_steps": res.rejected_steps, "final_position_m": res.final_position}
 
@@ -144,13 +143,13 @@ def energy_balance_table(
     error-controlled one with the explicit "adaptive" one: the fixed fine step for rigid
     actuators, adaptive for flexible ones).
     """
-    scheme = time_steps.resolve_scheme(scheme).replace(refine=resolution)
+    scheme = steps.resolve_scheme(scheme).replace(refine=resolution)
     rows = []
     for label, contacts, model in CONFIGURATIONS:
         drive = Drive(contacts=contacts, actuator_model=model)
         wf = waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
         for contact in ("exact", "discrete"):
-            res = dynamics.simulate(drive, wf, contact_model=contact, springs=PROTOCOL.springs,
+            res = simulation.simulate(drive, wf, contact_model=contact, springs=PROTOCOL.springs,
                                     max_points=2, scheme=scheme)
             bal = res.energy_balance()
             rows.append({"configuration": label, "contact_model": contact, **bal})
@@ -171,7 +170,7 @@ def settle_fraction_sensitivity(
         drive = Drive(contacts=contacts, actuator_model=model)
         for fraction in fractions:
             wf = waveforms.sawtooth(amplitude, frequency, drive, periods=periods, settle_fraction=fraction)
-            res = dynamics.simulate(drive, wf, max_points=2)
+            res = simulation.simulate(drive, wf, max_points=2)
             rows.append({"configuration": label, "settle_fraction": float(fraction),
                          "mean_step_m": float(res.step_sizes.mean())})
     return pd.DataFrame(rows)
@@ -269,8 +268,8 @@ def rigid_coulomb_limit(
                 # the fixed step of the stiffened runner mode: its error shrinks with the
                 # stiffness, as the gap it measures does (the error-controlled step's absolute
                 # tolerance would not, and would set a floor under the fitted rate)
-                res = dynamics.simulate(drive, wf, max_points=2,
-                                        scheme=time_steps.SCHEMES["fixed"].replace(refine=resolution))
+                res = simulation.simulate(drive, wf, max_points=2,
+                                        scheme=steps.SCHEMES["fixed"].replace(refine=resolution))
                 step = float(res.step_sizes[-1])
                 rows.append({
                     "configuration": f"{'six contacts' if n == 6 else 'one contact'}, {label} fly-back",

@@ -39,7 +39,6 @@ from dataclasses import replace
 import numpy as np
 
 from passmd.model.parameters import Drive, check_drive
-from passmd.protocols.fit import profiles as prof
 from passmd.protocols.fit import regions
 from passmd.protocols.fit.checks import check_rows
 from passmd.protocols.fit.free_parameters import FREE_PARAMETERS, KEEPS, _check_free, default_bounds
@@ -47,6 +46,7 @@ from passmd.protocols.fit.measurements import READINGS, Measurements
 from passmd.protocols.fit.next_measurement import separating_row
 from passmd.protocols.fit.prediction import _Model
 from passmd.protocols.fit.problem import JACOBIAN_STEPS, Problem
+from passmd.protocols.fit.profiles import FINE_SPACING, Profile, bottoms, coarse, fill, projected_cost
 from passmd.protocols.fit.result import FitResult, goodness_of_fit, verdict
 from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
@@ -233,7 +233,7 @@ def _s2(problem: Problem, cost: float) -> float:
     return 1.0 if problem.data.known_sd else max(cost, 1e-300) / (problem.n - problem.p)
 
 
-def _basins(problem: Problem, profiles: dict[int, prof.Profile], cut: float, s2: float
+def _basins(problem: Problem, profiles: dict[int, Profile], cut: float, s2: float
             ) -> list[tuple[np.ndarray, float]]:
     """The distinct local minima of all profiles at or below ``cut`` (lowest first)."""
     found = []
@@ -243,7 +243,7 @@ def _basins(problem: Problem, profiles: dict[int, prof.Profile], cut: float, s2:
     found.sort(key=lambda item: item[1])
     out: list[tuple[np.ndarray, float]] = []
     for x, c in found:
-        if all(np.max(np.abs(x - y)) > 1.5 * prof.FINE_SPACING for y, _ in out) and len(out) < MAX_BASINS:
+        if all(np.max(np.abs(x - y)) > 1.5 * FINE_SPACING for y, _ in out) and len(out) < MAX_BASINS:
             out.append((x, c))
     return out
 
@@ -261,11 +261,11 @@ def _regions(problem, profiles, basin_list, x_hat, cost, s2, threshold, say):
         walk_flat = bool(parts) and (parts[0][0] <= problem.lo[j] or parts[-1][1] >= problem.hi[j])
         parts += [intervals[j] for intervals, _ in local]
         flat = walk_flat or any(f[j] for _, f in local)
-        out.append((regions.merge(parts, gap=0.5 * prof.FINE_SPACING), flat))
+        out.append((regions.merge(parts, gap=0.5 * FINE_SPACING), flat))
     return out
 
 
-def _polish(problem: Problem, profiles: dict[int, prof.Profile], cut: float, say) -> None:
+def _polish(problem: Problem, profiles: dict[int, Profile], cut: float, say) -> None:
     """Full local searches from the low local minima of the profiles at or below ``cut`` (module
     docstring, stage 4): of the :data:`POLISH_CANDIDATES` lowest distinct ones, the
     :data:`MAX_BASINS` whose Gauss–Newton step in all free parameters projects the lowest cost (a
@@ -278,14 +278,14 @@ def _polish(problem: Problem, profiles: dict[int, prof.Profile], cut: float, say
     found.sort(key=lambda item: item[0])
     starts: list[np.ndarray] = []
     for _, x in found:
-        if all(np.max(np.abs(x - y)) > 1.5 * prof.FINE_SPACING for y in starts):
+        if all(np.max(np.abs(x - y)) > 1.5 * FINE_SPACING for y in starts):
             starts.append(x)
         if len(starts) == POLISH_CANDIDATES:
             break
     if not starts:
         return
     problem.evaluate([v for x in starts for v in (x, *problem._steps(x, range(problem.p)))])  # one sweep
-    projected = [prof.projected_cost(problem, x, problem.fun_jac(x)[1]) for x in starts]
+    projected = [projected_cost(problem, x, problem.fun_jac(x)[1]) for x in starts]
     chosen = [starts[k] for k in np.argsort(projected, kind="stable")[:MAX_BASINS]]
     for k, x in enumerate(chosen):
         say(f"polish {k + 1}/{len(chosen)}: a local search from a minimum of the profiles")
@@ -305,16 +305,16 @@ def _fit(problem: Problem, drive, names, box, x_start, reading, keep, seed, say,
             problem.local(x0, FIRST_SEARCH_EVALUATIONS)
     x_hat, cost = problem.best()
     say(f"profiles over the whole bounds from cost {cost:.5g}")
-    profiles = {j: prof.Profile(j) for j in range(p)}
-    prof.coarse(problem, profiles, x_hat, cost)
+    profiles = {j: Profile(j) for j in range(p)}
+    coarse(problem, profiles, x_hat, cost)
 
     def level() -> float:
         c = problem.best()[1]
         return c + threshold * _s2(problem, c)
 
-    walked = prof.fill(problem, profiles, level, lambda: threshold * _s2(problem, problem.best()[1]))
-    say(f"profiles sampled at {prof.FINE_SPACING:.0%} over {walked} intervals that may hold a minimum")
-    prof.bottoms(problem, profiles, level, lambda: threshold * _s2(problem, problem.best()[1]))
+    walked = fill(problem, profiles, level, lambda: threshold * _s2(problem, problem.best()[1]))
+    say(f"profiles sampled at {FINE_SPACING:.0%} over {walked} intervals that may hold a minimum")
+    bottoms(problem, profiles, level, lambda: threshold * _s2(problem, problem.best()[1]))
     if p >= 3:
         _polish(problem, profiles, level() + threshold * _s2(problem, problem.best()[1]), say)
     converged, notes = True, []
@@ -328,7 +328,7 @@ def _fit(problem: Problem, drive, names, box, x_start, reading, keep, seed, say,
             + f", cost {cost:.5g}; {len(basin_list)} basin(s) within the 95 % level")
         found = _regions(problem, profiles, basin_list, x_hat, cost, s2, threshold, say)
         # the regions' points can form new local minima of a profile: their bottoms too
-        prof.bottoms(problem, profiles, level, lambda: threshold * _s2(problem, problem.best()[1]))
+        bottoms(problem, profiles, level, lambda: threshold * _s2(problem, problem.best()[1]))
         lowest = problem.best()[1]
         if lowest >= cost - REFIT_MARGIN * s2:
             break

@@ -51,9 +51,10 @@ def predict_point(drive: Drive, kind: str, amplitude: float, frequency: float, r
             step, settled = run["step_m"], abs(run["velocity_drift"]) <= STEADY_DRIFT
         return {"prediction": float(step if kind == "step" else step * frequency), "settled": bool(settled)}
     if kind == "critical_amplitude":
-        from passmd.protocols import critical_amplitude as ca
+        from passmd.protocols import critical_amplitude
 
-        found = ca.critical_amplitude(drive, protocol=reading, frequency=frequency, progress=False)
+        found = critical_amplitude.critical_amplitude(drive, protocol=reading, frequency=frequency,
+                                                      progress=False)
         value = found["critical_amplitude_m"]
         return {"prediction": float(found["bracket_low_m"] if math.isnan(value) else value), "settled": True}
     from passmd.protocols import stall

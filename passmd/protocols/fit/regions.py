@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from passmd.protocols.fit.problem import Problem
-from passmd.protocols.fit.profiles import FINE_SPACING as FINE
+from passmd.protocols.fit.profiles import FINE_SPACING
 
 __all__ = ["BASIN_PROMINENCE", "END_ITERATIONS", "END_TOLERANCE", "basin_intervals", "basins", "merge",
            "pieces"]
@@ -136,7 +136,7 @@ class _End:
         self.at_bound = False
         self.result = self.limit if self.room <= 0.0 else None
         guess = math.sqrt(threshold) * se if math.isfinite(se) and se > 0 else self.room
-        self.delta = min(max(guess, 0.2 * FINE), self.room)
+        self.delta = min(max(guess, 0.2 * FINE_SPACING), self.room)
 
     def task(self):
         x0 = np.array(self.x_b, float)
