@@ -11,16 +11,14 @@ symmetric about it; a sweep's title names what varies and not the value it had i
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 import math
 
 import numpy as np
 import pandas as pd
 import pytest
+from cli_runs import run_main
 
-from passmd import cli
 from passmd.model.parameters import Drive
 
 #: A drive whose runs cost milliseconds: one contact, rigid actuators.
@@ -28,13 +26,8 @@ CHEAP = ("--contacts", "1", "--actuator", "rigid")
 
 
 def run_cli(*argv) -> tuple[int, str]:
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            status = cli.main(list(argv))
-        except SystemExit as exc:
-            status = exc.code
-    return status, out.getvalue() + err.getvalue()
+    status, out, err = run_main(argv)
+    return status, out + err
 
 
 def png_shows_something(path) -> None:

@@ -12,15 +12,14 @@ are deterministic.
 from __future__ import annotations
 
 import argparse
-import io
 import json
 from dataclasses import replace
 
 import numpy as np
 import pytest
+from cli_runs import run_main
 
 import passmd
-from passmd import cli
 from passmd.experiments.calibration.synthetic import independent_steps
 from passmd.model.parameters import Drive
 from passmd.model.tables import Amplifier
@@ -258,16 +257,8 @@ def test_a_well_formed_file_reads_in_si(tmp_path):
 
 
 def _run(argv) -> tuple[int, str]:
-    out = io.StringIO()
-    import contextlib
-
-    err = io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            status = cli.main(list(argv))
-        except SystemExit as exc:  # --help
-            status = exc.code
-    return status, out.getvalue() + err.getvalue()
+    status, out, err = run_main(argv)
+    return status, out + err
 
 
 def test_the_papers_numbers_read_as_measurements():

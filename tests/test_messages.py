@@ -13,8 +13,6 @@ parameter, with plain numbers.
 
 from __future__ import annotations
 
-import contextlib
-import io
 import math
 import os
 import pickle
@@ -25,8 +23,8 @@ from unittest import mock
 
 import numpy as np
 import pytest
+from cli_runs import run_main
 
-from passmd import cli
 from passmd.cli import options
 from passmd.cli.commands import run
 from passmd.cli.parser import make_parser
@@ -58,17 +56,6 @@ def run_process(argv, env, cwd):
     done = subprocess.run([sys.executable, "-m", "passmd", *argv], capture_output=True, text=True,
                           env=full_env, cwd=cwd, timeout=300)
     return done.returncode, done.stdout, done.stderr
-
-
-def run_main(argv):
-    """(status, stdout, stderr) of ``passmd argv`` in this process."""
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            status = cli.main(list(argv))
-        except SystemExit as exc:  # argparse
-            status = exc.code
-    return status, out.getvalue(), err.getvalue()
 
 
 # --------------------------------------------------------------------------------------

@@ -15,17 +15,15 @@ Runs are one period of a one-contact rigid drive (cheap); each runs to its print
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 import math
 import re
 
 import numpy as np
 import pytest
+from cli_runs import run_main
 
 import passmd
-from passmd import cli
 from passmd.model.mdr_contact import MDRContact
 
 #: One run, cheap enough to repeat for every case (a saw-tooth period of a rigid one-contact drive).
@@ -54,20 +52,9 @@ REFUSAL = re.compile(r"^passmd run: error: (?P<flag>--[a-z-]+) = (?P<value>\S+)(
                      r"(?: (?P<bound_unit>[^\s(,;]+))?(?: \(|,|;|$)")
 
 
-def run(argv):
-    """(status, stdout, stderr) of ``passmd argv`` in this process."""
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            status = cli.main(list(argv))
-        except SystemExit as exc:  # argparse
-            status = exc.code
-    return status, out.getvalue(), err.getvalue()
-
-
 def refusal(argv) -> re.Match:
     """The one line refusing ``argv``, parsed."""
-    status, out, err = run(argv)
+    status, out, err = run_main(argv)
     assert status == 2 and out == "", (status, out, err)
     assert err.count("\n") == 1 and "Traceback" not in err, err
     match = REFUSAL.match(err)
@@ -98,7 +85,7 @@ def test_the_range_a_refusal_states_is_the_range_that_holds_up_to_the_result(fla
     # on the bound as the message shows it (just inside an open one): the whole run, every check
     # inside the package included, accepts it
     inside = line["bound"] if op in ("<=", ">=") else repr(bound * (1 - 1e-6 if op == "<" else 1 + 1e-6))
-    status, out, err = run(["run", flag, f"{inside}{unit}", *CHEAP])
+    status, out, err = run_main(["run", flag, f"{inside}{unit}", *CHEAP])
     assert status == 0, err
     assert shown_in_json(out, path) == pytest.approx(float(inside) * SI[unit], rel=1e-12)
     # just past it: refused by the option, with the same range
@@ -117,7 +104,7 @@ def test_allow_extrapolation_holds_all_the_way_to_the_result(flag, value, unit, 
     line = refusal(["run", flag, f"{value}{unit}", *CHEAP])
     assert line.string.rstrip().endswith("--allow-extrapolation goes beyond it"), line.string
     beyond = float(line["bound"]) * (1.5 if line["op"].startswith("<") else 1 / 1.5)
-    status, out, err = run(["run", flag, f"{beyond!r}{unit}", "--allow-extrapolation", *CHEAP])
+    status, out, err = run_main(["run", flag, f"{beyond!r}{unit}", "--allow-extrapolation", *CHEAP])
     assert status == 0, err
     assert shown_in_json(out, path) == pytest.approx(beyond * SI[unit], rel=1e-12)
     result = json.loads(out)
