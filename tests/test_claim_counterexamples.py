@@ -22,10 +22,11 @@ from passmd.experiments.driving_waveform import claims_velocity
 from passmd.experiments.driving_waveform.figures import FREQUENCIES
 from passmd.experiments.driving_waveform.runs import section5_drive
 from passmd.experiments.force_generation.figures import EARLIER, THIS
-from passmd.ledger import checks, evaluation, readings, reference
+from passmd.ledger import checks, readings, reference
 from passmd.ledger.checks import NO_MEASURED_DATA, ClaimFails, NotEvaluable, check_claim
 from passmd.ledger.claims import load_claims
 from passmd.model import theory
+from passmd.report import evaluation
 from passmd.runtime.config import RunConfig
 
 #: Claims about the experiment of [12]: inconclusive whatever the model computes (passmd.ledger.rules).

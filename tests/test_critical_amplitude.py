@@ -17,11 +17,11 @@ import snapshot_accuracy as snap
 
 from passmd.experiments import figure_table
 from passmd.experiments.critical_amplitude import facts, figures
-from passmd.ledger import evaluation
 from passmd.model import waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.theory import drive_theory, runner_frequency
 from passmd.protocols import critical_amplitude
+from passmd.report import evaluation
 from passmd.runtime.config import RunConfig
 
 PANELS = ("fig5a", "fig5b", "fig6a", "fig6b", "fig6c", "fig56_viscosity", "fig56_frequency")

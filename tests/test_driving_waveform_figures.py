@@ -351,7 +351,8 @@ def test_acceleration_slip_and_window_facts(quick):
 
 
 def test_fig9a_facts_agree_with_the_ledger(quick):
-    from passmd.ledger import evaluation, readings
+    from passmd.ledger import readings
+    from passmd.report import evaluation
 
     found = facts.fig9a_facts(quick["fig9a"])
     extract = evaluation.extractors()

@@ -54,7 +54,7 @@ def test_claim_modules_are_the_experiment_modules_with_extractors():
 
 
 @pytest.mark.parametrize("module", ["passmd.experiments.critical_amplitude.figures",
-                                    "passmd.experiments.figure_table", "passmd.ledger.evaluation",
+                                    "passmd.experiments.figure_table", "passmd.report.evaluation",
                                     "passmd.protocols.critical_amplitude"])
 def test_computing_loads_no_plotting(module):
     """Figure data, the ledger and the protocols load no matplotlib: the figure table names each

@@ -16,11 +16,12 @@ import pytest
 import snapshot_accuracy as snap
 
 from passmd.experiments.force_generation import facts, figures
-from passmd.ledger import checks, evaluation
+from passmd.ledger import checks
 from passmd.model import waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.plots.force_generation import plot_cycle, plot_frequency, plot_grid, plot_panel
 from passmd.protocols import stall
+from passmd.report import evaluation
 from passmd.runtime.config import RunConfig
 from passmd.solver import simulation
 

@@ -18,9 +18,9 @@ import pandas as pd
 import pytest
 
 from passmd.experiments import figure_table
-from passmd.ledger import checks, evaluation, reference
+from passmd.ledger import checks, reference
 from passmd.ledger.claims import CHECK_KINDS, CLAIM_COLUMNS, load_claims
-from passmd.report import ledger_views
+from passmd.report import evaluation, ledger_views
 from passmd.runtime.config import RunConfig
 
 QUICK, PAPER_PROFILE = RunConfig(profile="quick"), RunConfig(profile="paper")
@@ -832,14 +832,14 @@ def test_real_extractors_live_in_the_figures_claim_modules():
     closed-form one), and the experiments do not import the ledger (the layers are one-way)."""
     found = evaluation.claim_functions()
     homes = {f.__module__ for f in found.extractors.values()}
-    assert homes == {m.__name__ for m in figure_table.CLAIM_MODULES} | {"passmd.ledger.evaluation"}
-    assert found.extractors["fig10b-r1-stiffer-contact"].__module__ == "passmd.ledger.evaluation"
+    assert homes == {m.__name__ for m in figure_table.CLAIM_MODULES} | {"passmd.report.evaluation"}
+    assert found.extractors["fig10b-r1-stiffer-contact"].__module__ == "passmd.report.evaluation"
     assert found.depends_on["fig5a-no-step-below-50nm"] == (
         "flyback", "ac_protocol", "drive_frequency_s4", "damping_ratio", "friction_coefficient")
     assert {"fig10a-1n-slower", "sec5-response-to-optimized-similar"} <= set(found.evidence)
     assert evaluation.orphan_extractors() == []
     code = ("import sys; import " + ", ".join(m.__name__ for m in figure_table.CLAIM_MODULES)
-            + "; print(sorted(m for m in sys.modules if m.startswith('passmd.ledger.evaluation')))")
+            + "; print(sorted(m for m in sys.modules if m.startswith('passmd.report.evaluation')))")
     imported = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert imported.stdout.strip() == "[]"
 

@@ -29,8 +29,8 @@ from pathlib import Path
 
 import pytest
 
-from passmd.ledger import evaluation
 from passmd.ledger.claims import load_claims
+from passmd.report import evaluation
 from passmd.runtime.config import PROFILES, RunConfig
 
 BASELINES = {profile: Path(__file__).with_name(f"ledger_baseline_{profile}.csv")

@@ -201,7 +201,7 @@ def test_replaced_file_keeps_its_permissions(tmp_path):
 
 def test_a_writers_own_temporary_files_are_removed_when_it_is_interrupted(tmp_path):
     """A writer that makes its own temporary beside the file it was given (as
-    ``passmd.ledger.evaluation.write_baseline`` does) and is interrupted leaves nothing behind."""
+    ``passmd.report.evaluation.write_baseline`` does) and is interrupted leaves nothing behind."""
     (tmp_path / "kept.txt").write_text("mine\n")
 
     def interrupted(tmp):

@@ -23,9 +23,9 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from passmd.ledger import checks, evaluation
+from passmd.ledger import checks
 from passmd.ledger.claims import CLAIM_COLUMNS
-from passmd.report import ledger_views
+from passmd.report import evaluation, ledger_views
 
 ROOT = Path(__file__).resolve().parents[1]
 REPORT_HTML = ROOT / "book" / "_build" / "html" / "replication_report.html"

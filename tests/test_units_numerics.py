@@ -39,10 +39,10 @@ from hypothesis import strategies as st
 from passmd import cli
 from passmd.cli.result_bounds import EMPTY_BY_DESIGN, ResultError, check_table
 from passmd.experiments import figure_table
-from passmd.ledger import evaluation
 from passmd.model import hertz, theory
 from passmd.model.parameters import Drive
 from passmd.model.tables import RUBY, STEEL
+from passmd.report import evaluation
 from passmd.runtime.units import _CYCLE_UNITS, QuantityError, parse_quantity, registry, to_display
 from passmd.runtime.validation import check_array, check_range, format_number
 

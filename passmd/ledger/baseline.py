@@ -2,7 +2,7 @@
 computed at, its state at each of them and the reading its category was judged at besides the
 defaults (``tests/ledger_baseline_<profile>.csv``).
 
-:func:`write_baseline` records an evaluated ledger (:func:`passmd.ledger.evaluation.evaluate`),
+:func:`write_baseline` records an evaluated ledger (:func:`passmd.report.evaluation.evaluate`),
 :func:`load_baseline`, :func:`load_baseline_readings` and :func:`load_baseline_states` read one back,
 and :func:`check_categories` fails with a readable diff when any claim changed category.
 """

@@ -5,7 +5,7 @@ columns are documented in ``passmd/data/reference/README.md``. :func:`load_claim
 checks every row against the schema (ids, configuration values, check kinds and relations,
 tolerances with their kind and reason, reference curves, sources), naming each error with its
 row. The constants here are the schema's vocabulary, shared by :mod:`passmd.ledger.checks` (the check
-kinds and relations) and :mod:`passmd.ledger.evaluation` (the categories).
+kinds and relations) and :mod:`passmd.report.evaluation` (the categories).
 """
 
 from __future__ import annotations

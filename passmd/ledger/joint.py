@@ -10,7 +10,7 @@ ties and its runner-ups with their margins; points where all claims agree are on
 :func:`tensions` groups them by the readings that separate them, with near-duplicate rows (the
 same holding points) linked. :func:`joint_map` gives the claims × readings map of an evaluated
 ledger, :func:`joint_record` the joint reading as plain data.
-:func:`passmd.ledger.evaluation.evaluate` calls them.
+:func:`passmd.report.evaluation.evaluate` calls them.
 """
 
 from __future__ import annotations

@@ -41,7 +41,7 @@ from passmd.model.defaults import PROTOCOL
 __all__ = ["AC_TABLES", "AXES", "Axis", "SECTION5_TABLES", "applicable", "axis", "default_reading", "design",
            "describe", "project", "space", "space_table"]
 
-#: The result tables of the ledger's readings (``passmd.ledger.evaluation.result_sources``): the
+#: The result tables of the ledger's readings (``passmd.report.evaluation.result_sources``): the
 #: critical-amplitude searches of Figs. 5b and 6a–6c, the step against amplitude of Fig. 5a, this
 #: paper's force runs of Fig. 7, and Section 5's runs (Fig. 9a holds both μ itself). Each holds a
 #: run at every point of the axes that change it.

@@ -55,7 +55,7 @@ class NoRun(NotEvaluable):
 
     Every table a claim reads must hold a run at every point of its design
     (:func:`passmd.ledger.readings.design`): a missing run is a defect of the tables, which
-    :func:`passmd.ledger.evaluation.evaluate` refuses (``strict``), never a "not covered" point.
+    :func:`passmd.report.evaluation.evaluate` refuses (``strict``), never a "not covered" point.
     """
 
 

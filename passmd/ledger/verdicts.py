@@ -1,6 +1,6 @@
 """One claim over its readings: the check at each reading, the category, the verdict line.
 
-The ledger (:func:`passmd.ledger.evaluation.evaluate`) calls :func:`claim_points` for every claim: the
+The ledger (:func:`passmd.report.evaluation.evaluate`) calls :func:`claim_points` for every claim: the
 claim's extractor is run at each reading of :func:`passmd.ledger.readings.design` (the full product of
 the axes it depends on, the defaults first) and its check applied
 (:func:`passmd.ledger.checks.check_claim`). Once the joint reading of all claims is known,
@@ -265,7 +265,7 @@ def fragility(status: str, decisive: PointResult | None, runner_ups: list[tuple[
 def claim_row(claim: Mapping, results, functions: ClaimFunctions, *, joint: Mapping | None = None,
               runner_ups: tuple = (), points: list[PointResult] | None = None,
               elsewhere: str = "") -> tuple[dict, list[PointResult]]:
-    """One claim's ledger row (:data:`passmd.ledger.evaluation.LEDGER_COLUMNS`) and its points (empty when
+    """One claim's ledger row (:data:`passmd.report.evaluation.LEDGER_COLUMNS`) and its points (empty when
     the claim is not evaluated: results missing, or no extractor).
 
     ``joint`` is the joint reading of the whole space (default: the defaults) and ``runner_ups``

@@ -1,2 +1,2 @@
-"""The book and the command line's presentation: the figure table, the ledger's views,
-the chapters' helpers and the table of assumptions."""
+"""The book and the command line's presentation: the ledger's evaluation over every chapter's
+results and its views, the chapters' helpers and the table of assumptions."""

@@ -1,6 +1,6 @@
 """The ledger in the book: headline, one-line table, per-claim details, assumption map, sources.
 
-Presentation only: every function takes a table computed by :func:`passmd.ledger.evaluation.evaluate`
+Presentation only: every function takes a table computed by :func:`passmd.report.evaluation.evaluate`
 (or claims from :func:`passmd.ledger.claims.load_claims`) and returns text, MyST markdown or a pandas
 ``Styler``; nothing here computes a category.
 """
@@ -15,10 +15,10 @@ import pandas as pd
 
 from passmd.ledger.checks import format_number
 from passmd.ledger.claims import STATUSES, tolerance_text
-from passmd.ledger.evaluation import assumption_map, counted
 from passmd.ledger.rules import FRAGILE_MARGIN
 from passmd.ledger.verdicts import EXPERIMENT_BASIS
 from passmd.report.assumptions import all_assumptions
+from passmd.report.evaluation import assumption_map, counted
 from passmd.runtime.validation import check_choice
 
 __all__ = [
@@ -264,7 +264,7 @@ def details_markdown(evaluated: pd.DataFrame, claims: pd.DataFrame) -> str:
 
 
 def assumption_map_styled(evaluated: pd.DataFrame):
-    """:func:`passmd.ledger.evaluation.assumption_map` as a compact coloured table (✓ holds, ✗ fails, ?
+    """:func:`passmd.report.evaluation.assumption_map` as a compact coloured table (✓ holds, ✗ fails, ?
     inconclusive).
 
     The columns are numbered readings; the caption lists what each number means, so the table

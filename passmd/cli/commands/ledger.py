@@ -100,8 +100,7 @@ def run_ledger(args, out) -> int:
     """Every claim of the paper with its computed category, values and evidence (Sections 4–6)."""
     config = run_config(args)
     _check_outputs(args, config)  # (before the ledger's modules load)
-    from passmd.ledger import evaluation
-    from passmd.report import ledger_views
+    from passmd.report import evaluation, ledger_views
 
     results = evaluation.collect_results(config)
     for name, table in results.items():  # finite before anything is written, as run and theory check

@@ -1,4 +1,4 @@
-"""The replication ledger: the paper's claims, checked against our computed results.
+"""The replication ledger: every claim of the paper, checked against the chapters' computed results.
 
 Three pieces meet here:
 
