@@ -191,7 +191,7 @@ def test_unwritable_cache_warns_once_and_keeps_the_result(tmp_path, monkeypatch,
         def denied(*args, **kwargs):
             raise PermissionError(13, "Permission denied")
 
-        monkeypatch.setattr(cache.store.tempfile, "mkstemp", denied)
+        monkeypatch.setattr(cache.layout.tempfile, "mkstemp", denied)
     store = Cache(directory)
     points = [{"x": float(x)} for x in range(4)]
     try:

@@ -11,6 +11,7 @@ in :mod:`passmd.runtime.cache`).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import stat
@@ -105,15 +106,29 @@ def _read_marker(directory: Path) -> str | None:
     return None
 
 
+@contextlib.contextmanager
+def _temporary(folder: Path, prefix: str, data: bytes):
+    """A new file ``<prefix><random>.tmp`` in ``folder`` holding ``data``, flushed to disk, for
+    the block to move into place; removed on leaving it (also on ``KeyboardInterrupt`` or what
+    a SIGTERM handler raises) unless moved."""
+    fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=".tmp", dir=folder)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        yield tmp
+    finally:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+
+
 def _write_marker(directory: Path) -> None:
     """Write the marker atomically without replacing a file already there."""
     marker = directory / MARKER_NAME
-    fd, tmp = tempfile.mkstemp(prefix=f".{MARKER_NAME}-", suffix=".tmp", dir=directory)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(_MARKER_TEXT)
-            fh.flush()
-            os.fsync(fh.fileno())
+    with _temporary(directory, f".{MARKER_NAME}-", _MARKER_TEXT) as tmp:
         os.chmod(tmp, 0o644)
         try:
             os.link(tmp, marker)  # atomic, and fails where a marker (or any file) is already
@@ -122,11 +137,6 @@ def _write_marker(directory: Path) -> None:
         except OSError:  # a file system without hard links
             if not os.path.lexists(marker):
                 os.replace(tmp, marker)
-    finally:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
 
 
 def _unlink(path: Path) -> bool:
