@@ -221,24 +221,6 @@ def test_prune_and_info(store, tmp_path):
     assert store.get(store.key(point_function, {"x": 2})) == {"y": 2}
 
 
-def test_interrupted_write_leaves_no_entry(store, monkeypatch):
-    """A crash between writing the temporary file and the rename leaves no (corrupt) entry."""
-    key = store.key(point_function, {"x": 2})
-
-    def crash(src, dst):
-        raise KeyboardInterrupt  # the process dies exactly here
-
-    monkeypatch.setattr(cache.store.os, "replace", crash)
-    with pytest.raises(KeyboardInterrupt):
-        store.put(key, {"y": 2})
-    monkeypatch.undo()
-    assert key not in store
-    assert not store.path(key).exists()
-    assert list(store.path(key).parent.iterdir()) == []  # the temporary file is cleaned up
-    store.put(key, {"y": 2})
-    assert store.get(key) == {"y": 2}
-
-
 def test_killed_write_leftover_is_ignored(store):
     """A hard kill can leave a temporary file; it is never read as an entry."""
     key = store.key(point_function, {"x": 3})

@@ -1,12 +1,6 @@
-"""The cache directory on disk: its marker, the names it owns and what lies at an entry's path.
-
-A cache directory carries the marker ``CACHEDIR.TAG`` naming the format; it holds
-two-hex-digit subfolders of entries ``<key[:2]>/<key>.pmc`` and its own temporary files.
-:func:`inspect_directory` tells a marked cache from an empty, adoptable or foreign directory,
-:func:`owned` refuses a foreign one (:class:`NotACache`), and the private helpers walk the
-directory, examine a path without following links or blocking on devices, and write the
-marker atomically. Nothing here deletes a file that is not the cache's own (the rules are
-in :mod:`passmd.runtime.cache`).
+"""The cache directory on disk (rules in :mod:`passmd.runtime.cache`): its marker, the names it
+owns, what lies at an entry's path (never following a link or blocking on a device) and the
+state of a directory (:func:`inspect_directory`; :func:`owned` refuses a foreign one).
 """
 
 from __future__ import annotations

@@ -1,14 +1,5 @@
-"""The cache itself: :class:`~passmd.runtime.cache.store.Cache` reads and writes checked entries in a
-directory it owns.
-
-A :class:`Cache` makes the key of a call (function, parameters, code fingerprints), finds an
-entry's file, marks or adopts its directory on first use, reads an entry back (an unusable
-one is reported with a :class:`CacheWarning`, removed and treated as a miss) and writes one
-atomically (temporary file, ``fsync``, ``os.replace``); a cache it cannot write is reported
-once per directory and the caller keeps its result. Its methods ``info``, ``prune`` and
-``clear`` (``passmd cache info|prune|clear``) refuse a directory that is not a passmd cache
-(:class:`~passmd.runtime.cache.layout.NotACache`) and remove only the cache's own files. The
-default directory is the user's cache folder (:func:`default_cache_dir`).
+"""The cache itself: :class:`Cache` keys, reads and writes checked entries in a directory it
+owns, and summarises, prunes or clears it (rules in :mod:`passmd.runtime.cache`).
 """
 
 from __future__ import annotations
