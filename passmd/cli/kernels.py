@@ -2,9 +2,9 @@
 
 The first simulation after installing (or after the kernels' source changed) compiles the
 numba kernels once, which takes ≈ 15–20 s on a laptop core; without a word the command looks
-hung. numba alone knows when it compiles (a miss in its on-disk cache, which it keys by the
-source's content): :func:`notice_on_compile` listens for the ``"numba:compile"`` event numba
-broadcasts then, and writes the notice at the first one of the command.
+hung. numba alone knows when it compiles (a miss in its on-disk cache, whatever the cache is
+keyed by): :func:`notice_on_compile` listens for the ``"numba:compile"`` event numba broadcasts
+then, and writes the notice at the first one of the command.
 """
 
 from __future__ import annotations
