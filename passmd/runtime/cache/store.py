@@ -314,37 +314,6 @@ class Cache:
         if not owned(self.directory):
             return summary
         for kind, path in _walk(self.directory):
-            if kind == "foreign":
-                summary["foreign"] += 1
-                continue
-            try:
-                size = os.lstat(path).st_size
-                found, data = _examine(path, read=True) if kind == "candidate" else ("temp", None)
-            except FileNotFoundError:
-                continue
-            except OSError:
-                summary["unreadable"] += 1
-                continue
-            if found in ("missing", "foreign"):
-                summary["foreign"] += found == "foreign"
-                continue
-            summary["bytes"] += size
-            if found == "temp":
-                summary["leftovers"] += 1
-                continue
-            try:
-                if found == "bad":
-                    raise CorruptEntry(data)
-                header = _split_entry(data)[0]
-            except CorruptEntry:
-                summary["unreadable"] += 1
-                continue
-            summary["entries"] += 1
-            summary["current_code" if header.get("code") == self.fingerprint else "other_code"] += 1
-            name = str(header.get("function") or "?")
-            summary["functions"][name] = summary["functions"].get(name, 0) + 1
-        return summary
-        for kind, path in _walk(self.directory):
             try:
                 size = os.lstat(path).st_size
                 found, data = _examine(path, read=True) if kind == "candidate" else (kind, None)
