@@ -1,23 +1,19 @@
-"""Start-up of a command: the cyclic garbage collector waits until the modules are loaded.
+"""Start-up of a command: three measured tricks (``benchmarks/bench_startup.py`` times each
+against the same launch without it; CONTRIBUTING, "Start-up", has the numbers).
 
-Starting ``passmd run`` imports numpy and numba and loads the simulator's compiled kernels
-from numba's on-disk cache: hundreds of thousands of long-lived objects and next to no
-garbage. Left on, the cyclic collector traverses them again and again while they are
-created (about 250 collections, 50 ms of the 0.6 s from launch to the first integrator
-step; ``startup`` in ``benchmarks/bench_dynamics.py`` measures that time).
-
-:func:`pause` stops automatic collection when :func:`passmd.cli.main` starts; :func:`resume`
-turns it back on before a command's handler runs, or, for a command whose parser sets
-``resumes_collector`` (``run``), when the handler calls it after its simulation, and moves
-what was allocated meanwhile into the oldest generation. Reference counting frees memory
-as usual while collection is paused; only reference cycles wait for the next full
-collection. A collector the caller had turned off stays off.
-
-At exit the interpreter collects once more, through everything the command loaded: about
-0.2 s after ``passmd run`` has printed its result. :func:`skip_exit_collection` freezes the
-objects then (:func:`gc.freeze`, as a Ctrl-C does in :func:`passmd.cli.main`), so the
-process ends at once; the operating system reclaims its memory. Commands write their files
-explicitly (atomically), never from a finalizer.
+* :func:`pause` stops automatic cyclic garbage collection when :func:`passmd.cli.main` starts
+  (imports of numpy, numba and the compiled kernels create hundreds of thousands of
+  long-lived objects and next to no garbage); :func:`resume` turns it back on before a
+  command's handler runs or, for a parser that sets ``resumes_collector`` (``run``), when the
+  handler calls it after its simulation, moving what was allocated meanwhile into the oldest
+  generation. Reference counting frees memory meanwhile; a collector the caller had turned
+  off stays off.
+* :func:`skip_exit_collection` freezes the objects at exit (:func:`gc.freeze`, as a Ctrl-C does
+  in :func:`passmd.cli.main`) instead of collecting through everything the command loaded;
+  the operating system reclaims the memory. Commands write their files explicitly
+  (atomically), never from a finalizer.
+* :func:`load_numba_without_blas_probe` spares a command that only runs the kernels the
+  import of scipy.linalg that numba makes to probe for BLAS.
 """
 
 from __future__ import annotations

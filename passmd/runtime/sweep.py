@@ -61,14 +61,10 @@ def grid(**axes) -> list[dict]:
     [{'preload': 0.1, 'contacts': 1}, {'preload': 0.1, 'contacts': 6}, \
 {'preload': 0.2, 'contacts': 1}, {'preload': 0.2, 'contacts': 6}]
     """
-    names = list(axes)
-    values = []
-    for name in names:
-        axis = axes[name]
+    for name, axis in axes.items():
         if isinstance(axis, (str, bytes)) or not hasattr(axis, "__iter__"):
             raise ValueError(f"{name} = {axis!r} is not a sequence of values: give a list of values")
-        values.append(list(axis))
-    return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*values)]
+    return [dict(zip(axes, combo, strict=True)) for combo in itertools.product(*map(list, axes.values()))]
 
 
 def progress_enabled(progress: bool | None = None, stream=None) -> bool:
@@ -131,14 +127,10 @@ def _check_points(points) -> list[dict]:
 
 
 def _make_cache(cache) -> Cache | None:
-    if cache is True:
-        return Cache()
-    if cache is False or cache is None:
-        return None
-    if isinstance(cache, Cache):
-        return cache
-    if isinstance(cache, (str, os.PathLike)):
-        return Cache(cache)
+    if cache is True or isinstance(cache, (str, os.PathLike)):
+        return Cache(None if cache is True else cache)
+    if cache is False or cache is None or isinstance(cache, Cache):
+        return cache or None
     raise ValueError(f"cache = {cache!r} is not allowed: must be True, False, a Cache or a directory")
 
 
@@ -148,8 +140,7 @@ class _NoBar:
     def update(self, n: int = 1) -> None:
         pass
 
-    def close(self) -> None:
-        pass
+    close = update
 
 
 class _Collector:
@@ -315,28 +306,15 @@ def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> No
         from distributed import Client, LocalCluster, as_completed
     except ImportError as exc:  # pragma: no cover - dask is a declared extra
         raise ImportError(f"executor='dask' needs dask.distributed: {install_hint('dask')}") from exc
-    cluster = None
-    if scheduler:
-        client = Client(scheduler)
-    else:
-        cluster = LocalCluster(
-            n_workers=workers,
-            threads_per_worker=1,
-            dashboard_address=None,
-            silence_logs=logging.ERROR,
-        )
-        client = Client(cluster)
+    cluster = None if scheduler else LocalCluster(n_workers=workers, threads_per_worker=1,
+                                                  dashboard_address=None, silence_logs=logging.ERROR)
+    client = Client(scheduler or cluster)
     futures = {}
     try:
         futures = {client.submit(_call, func, points[i], pure=False): i for i in todo}
         _collect_completed(futures, as_completed, points, collect)
     except BaseException:
-        for future, i in futures.items():
-            if i not in collect.results and future.status == "finished":
-                try:
-                    collect.done(i, future.result())
-                except Exception:
-                    pass
+        _harvest(futures, collect)
         client.cancel(list(futures))
         raise
     finally:

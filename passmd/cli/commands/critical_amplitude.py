@@ -88,7 +88,7 @@ def _search(args, drive) -> dict:
     frequency = FREQUENCY.parse_or(args, PROTOCOL.drive_frequency)
     if args.analytic_only:
         return {}
-    kernels.notice_if_cold()
+    kernels.notice_on_compile()
     # the book's search (critical-amplitude chapters): one protocol for users and book
     found = critical_amplitude.critical_amplitude(
         drive, protocol=args.protocol, frequency=frequency,

@@ -75,7 +75,7 @@ def run_force(args, out) -> int:
 
     drive = build_drive(args, load_cell=True)
     amplitude, frequency = _check_options(args, drive)
-    kernels.notice_if_cold()
+    kernels.notice_on_compile()
     # the force-generation chapter's stall protocol: runs from rest, lengthened until stalled
     try:
         found = stall.generated_force(drive, amplitude, frequency,

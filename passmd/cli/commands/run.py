@@ -209,7 +209,7 @@ def simulate(args, drive, options: RunOptions):
     if args.waveform == "optimized":
         # Eq. 15, designed from this drive's own simulated saw-tooth response (first period a
         # saw-tooth, as in the paper); a ValueError (e.g. Δ_a ≥ A) is a usage error
-        kernels.notice_if_cold()  # the design simulates: every option is checked by now
+        kernels.notice_on_compile()  # the design simulates: every option is checked by now
         design = eq15.optimized_design(amplitude, drive, response_frequency=eq15.
                                        response_frequency(frequency, args.design_response))
         if given:  # the user's values replace the design's (its f_s, V_r, u_x,max stay as measured)
@@ -220,7 +220,7 @@ def simulate(args, drive, options: RunOptions):
     else:
         design = None
         wave = waveforms.sawtooth(amplitude, frequency, drive, periods=args.periods)
-        kernels.notice_if_cold()  # after the last check of the options: a refusal stays one line
+        kernels.notice_on_compile()  # after the last check of the options: a refusal stays one line
     result = simulation.simulate(
         drive, wave, contact_model="exact" if springs is None else "discrete",
         springs=PROTOCOL.springs if springs is None else springs, max_points=args.max_points,

@@ -1,10 +1,6 @@
-"""The bytes of one cache entry: a checksummed JSON header and the raw bytes of its arrays.
-
-:func:`encode_entry` writes a value tree of ``None``, booleans, integers, floats (exact, as
-``float.hex``), strings, lists, tuples, string-keyed dicts and numeric NumPy arrays or
-scalars; :func:`decode_entry` checks the magic line, the size limits, the checksum and every
-node and raises :class:`CorruptEntry` otherwise. Reading parses JSON and copies bytes into
-arrays: no entry can run code. The format is described in :mod:`passmd.runtime.cache`.
+"""The bytes of one cache entry (format and rules in :mod:`passmd.runtime.cache`):
+:func:`encode_entry` writes a checksummed JSON header and the raw bytes of its arrays,
+:func:`decode_entry` checks every part and raises :class:`CorruptEntry` otherwise.
 """
 
 from __future__ import annotations

@@ -1,11 +1,5 @@
-"""What a cache key hashes: parameters, the package's code and the swept function's own code.
-
-:func:`canonical` turns a parameter value into a deterministic JSON form (floats by ``repr``,
-arrays by dtype, shape and bytes, dataclasses field by field); :func:`code_fingerprint`
-hashes every ``passmd/**/*.py`` file, so an edit of the package changes every key;
-:func:`function_code` hashes a user's function (bytecode, defaults, closure, plain-valued
-globals and the user code it calls) and raises :class:`Unfingerprintable` for one whose
-state cannot be hashed; :func:`function_name` names a function in a key.
+"""What a cache key hashes: parameters (:func:`canonical`), the package's code
+(:func:`code_fingerprint`) and the swept function's own code (:func:`function_code`).
 """
 
 from __future__ import annotations

@@ -1,16 +1,11 @@
-"""The cache directory on disk: its marker, the names it owns and what lies at an entry's path.
-
-A cache directory carries the marker ``CACHEDIR.TAG`` naming the format; it holds
-two-hex-digit subfolders of entries ``<key[:2]>/<key>.pmc`` and its own temporary files.
-:func:`inspect_directory` tells a marked cache from an empty, adoptable or foreign directory,
-:func:`owned` refuses a foreign one (:class:`NotACache`), and the private helpers walk the
-directory, examine a path without following links or blocking on devices, and write the
-marker atomically. Nothing here deletes a file that is not the cache's own (the rules are
-in :mod:`passmd.runtime.cache`).
+"""The cache directory on disk (rules in :mod:`passmd.runtime.cache`): its marker, the names it
+owns, what lies at an entry's path (never following a link or blocking on a device) and the
+state of a directory (:func:`inspect_directory`; :func:`owned` refuses a foreign one).
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import stat
@@ -105,15 +100,29 @@ def _read_marker(directory: Path) -> str | None:
     return None
 
 
+@contextlib.contextmanager
+def _temporary(folder: Path, prefix: str, data: bytes):
+    """A new file ``<prefix><random>.tmp`` in ``folder`` holding ``data``, flushed to disk, for
+    the block to move into place; removed on leaving it (also on ``KeyboardInterrupt`` or what
+    a SIGTERM handler raises) unless moved."""
+    fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=".tmp", dir=folder)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        yield tmp
+    finally:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+
+
 def _write_marker(directory: Path) -> None:
     """Write the marker atomically without replacing a file already there."""
     marker = directory / MARKER_NAME
-    fd, tmp = tempfile.mkstemp(prefix=f".{MARKER_NAME}-", suffix=".tmp", dir=directory)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(_MARKER_TEXT)
-            fh.flush()
-            os.fsync(fh.fileno())
+    with _temporary(directory, f".{MARKER_NAME}-", _MARKER_TEXT) as tmp:
         os.chmod(tmp, 0o644)
         try:
             os.link(tmp, marker)  # atomic, and fails where a marker (or any file) is already
@@ -122,11 +131,6 @@ def _write_marker(directory: Path) -> None:
         except OSError:  # a file system without hard links
             if not os.path.lexists(marker):
                 os.replace(tmp, marker)
-    finally:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
 
 
 def _unlink(path: Path) -> bool:

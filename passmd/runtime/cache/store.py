@@ -1,13 +1,5 @@
-"""The cache itself: :class:`~passmd.runtime.cache.store.Cache` reads and writes checked entries in a
-directory it owns.
-
-A :class:`Cache` makes the key of a call (function, parameters, code fingerprints), finds an
-entry's file, marks or adopts its directory on first use, reads an entry back (an unusable
-one is reported with a :class:`CacheWarning`, removed and treated as a miss) and writes one
-atomically (temporary file, ``fsync``, ``os.replace``); a cache it cannot write is reported
-once per directory and the caller keeps its result. Its maintenance methods run
-:mod:`passmd.runtime.cache.maintenance`. The default directory is the user's cache folder
-(:func:`default_cache_dir`).
+"""The cache itself: :class:`Cache` keys, reads and writes checked entries in a directory it
+owns, and summarises, prunes or clears it (rules in :mod:`passmd.runtime.cache`).
 """
 
 from __future__ import annotations
@@ -16,31 +8,37 @@ import hashlib
 import json
 import os
 import stat
-import tempfile
+import time
 import warnings
 from collections.abc import Mapping
 from pathlib import Path
 
 import platformdirs
 
-from passmd.runtime.cache import maintenance
-from passmd.runtime.cache.entry import CorruptEntry, _TooLarge, decode_entry, encode_entry
+from passmd.runtime.cache.entry import CorruptEntry, _split_entry, _TooLarge, decode_entry, encode_entry
 from passmd.runtime.cache.keys import canonical, code_fingerprint, function_code, function_name
 from passmd.runtime.cache.layout import (
     ENTRY_SUFFIX,
     _check_key,
     _examine,
+    _temporary,
     _unlink,
+    _walk,
     _write_marker,
     inspect_directory,
+    owned,
 )
 
-__all__ = ["DEFAULT_CACHE_DIR", "Cache", "CacheWarning", "default_cache_dir", "describe_default_cache_dir"]
+__all__ = ["DEFAULT_CACHE_DIR", "STALE_TEMP_SECONDS", "Cache", "CacheWarning", "default_cache_dir",
+           "describe_default_cache_dir"]
 
 #: Name of the project-local cache folder the book and the tests use (``noxfile.py`` sets
 #: ``PASSMD_CACHE_DIR`` to it at the repository's root); ignored by git.
 DEFAULT_CACHE_DIR = ".passmd-cache"
 _MISS = object()
+#: Age after which ``prune`` removes one of the cache's temporary files (a write takes
+#: milliseconds; an older one was left by a process killed outright).
+STALE_TEMP_SECONDS = 600.0
 #: Directories already reported as unusable in this process (one warning each).
 _REPORTED_UNWRITABLE: set[str] = set()
 
@@ -273,7 +271,6 @@ class Cache:
             return False
         if not self._ready(create=True):
             return False
-        tmp = None
         try:
             if not self._subfolder(target.parent, create=True):
                 return False
@@ -281,38 +278,120 @@ class Cache:
             if kind == "foreign":
                 self._report_path(target, found)
                 return False
-            fd, tmp = tempfile.mkstemp(prefix=f".{key[:16]}-", suffix=".tmp", dir=target.parent)
-            with os.fdopen(fd, "wb") as fh:
-                fh.write(data)
-                fh.flush()
-                os.fsync(fh.fileno())
-            os.replace(tmp, target)
-            tmp = None
+            with _temporary(target.parent, f".{key[:16]}-", data) as tmp:
+                os.replace(tmp, target)
         except OSError as exc:
             self._report_unusable(f"cannot write the cache {self.directory}: {exc.strerror or exc}")
             return False
-        finally:  # also on KeyboardInterrupt and what a SIGTERM handler raises
-            if tmp is not None:
-                try:
-                    os.unlink(tmp)
-                except OSError:
-                    pass
         return True
 
-    # ---- the whole directory -------------------------------------------------------
+    # ---- the whole directory (passmd cache info|prune|clear) ---------------------
 
     def entries(self) -> list[Path]:
         """Paths of all complete entries: regular files at entries' paths with the magic line."""
-        return maintenance.entries(self.directory)
+        found = []
+        for kind, path in _walk(self.directory):
+            try:
+                if kind == "candidate" and _examine(path, read=False)[0] == "entry":
+                    found.append(path)
+            except OSError:
+                continue
+        return found
 
     def info(self) -> dict:
-        """Summary of the directory (:func:`~passmd.runtime.cache.maintenance.info`)."""
-        return maintenance.info(self.directory, self.fingerprint)
+        """Summary of the directory: entries, bytes, entries per code fingerprint and function.
+
+        Unreadable entries, the cache's own temporary files (``leftovers``) and files that are
+        not the cache's (``foreign``, never touched) are counted apart; nothing is removed.
+
+        Raises
+        ------
+        NotACache
+            The directory exists, is not empty and has no marker of this format.
+        """
+        summary = {"directory": str(self.directory), "entries": 0, "bytes": 0, "current_code": 0,
+                   "other_code": 0, "unreadable": 0, "leftovers": 0, "foreign": 0, "functions": {}}
+        if not owned(self.directory):
+            return summary
+        for kind, path in _walk(self.directory):
+            try:
+                size = os.lstat(path).st_size
+                found, data = _examine(path, read=True) if kind == "candidate" else (kind, None)
+                if found == "bad":
+                    raise CorruptEntry(data)
+                header = _split_entry(data)[0] if found == "entry" else None
+            except FileNotFoundError:
+                continue
+            except (OSError, CorruptEntry):
+                summary["unreadable"] += 1
+                summary["bytes"] += 0 if kind == "foreign" else size
+                continue
+            if found in ("foreign", "missing"):
+                summary["foreign"] += found == "foreign"
+                continue
+            summary["bytes"] += size
+            if found == "temp":
+                summary["leftovers"] += 1
+                continue
+            summary["entries"] += 1
+            summary["current_code" if header.get("code") == self.fingerprint else "other_code"] += 1
+            name = str(header.get("function") or "?")
+            summary["functions"][name] = summary["functions"].get(name, 0) + 1
+        return summary
 
     def prune(self) -> int:
-        """Remove what the current code cannot read (:func:`~passmd.runtime.cache.maintenance.prune`)."""
-        return maintenance.prune(self.directory, self.fingerprint)
+        """Remove entries of other code fingerprints, unreadable entries, stale temporary files.
+
+        Returns the number of files removed. Entries of the current code, temporary files
+        younger than :data:`STALE_TEMP_SECONDS` (a write in progress) and files that are not
+        the cache's stay.
+
+        Raises
+        ------
+        NotACache
+            The directory exists, is not empty and has no marker of this format.
+        """
+        now = time.time()
+
+        def doomed(kind: str, path: Path) -> bool:
+            if kind == "temp":
+                return now - os.lstat(path).st_mtime > STALE_TEMP_SECONDS
+            if kind != "candidate":
+                return False
+            found, data = _examine(path, read=True)
+            if found != "entry":
+                return found == "bad"
+            try:
+                return _split_entry(data)[0].get("code") != self.fingerprint
+            except CorruptEntry:
+                return True
+
+        return self._remove(doomed)
 
     def clear(self) -> int:
-        """Remove every entry and temporary file (:func:`~passmd.runtime.cache.maintenance.clear`)."""
-        return maintenance.clear(self.directory)
+        """Remove every entry (readable or not) and temporary file of the cache.
+
+        Returns the number of files removed; files that are not the cache's stay. A write in
+        progress meanwhile loses its entry (reported by that writer, which keeps its result).
+
+        Raises
+        ------
+        NotACache
+            The directory exists, is not empty and has no marker of this format.
+        """
+        return self._remove(lambda kind, path: kind == "temp" or (
+            kind == "candidate" and _examine(path, read=False)[0] in ("entry", "bad")))
+
+    def _remove(self, doomed) -> int:
+        """Unlink each of the cache's own files for which ``doomed(kind, path)`` holds; the count
+        (a folder that is not a cache is refused, a file gone meanwhile skipped)."""
+        if not owned(self.directory):
+            return 0
+        removed = 0
+        for kind, path in _walk(self.directory):
+            try:
+                if doomed(kind, path):
+                    removed += _unlink(path)
+            except FileNotFoundError:
+                continue
+        return removed
