@@ -187,9 +187,9 @@ def run_time_text(seconds: float, counts: list[int]) -> str:
     text = f"executing this chapter took {seconds:.1f} s of wall time in this build (kernel start included). "
     if not sweeps:
         return text + "It ran no simulation sweep."
-    return text + (f"Its {sweeps} simulation sweep(s) needed {cached + computed} points: {computed} computed, "
-                   f"{cached} taken from the simulation cache (filled by passmd ledger earlier in this build, "
-                   "or by an earlier build); a build from a cold cache computes every point.")
+    return text + (f"Its {sweeps} simulation sweep(s) needed {cached + computed} points: {computed} "
+                   f"computed, {cached} taken from the simulation cache (filled by passmd ledger earlier in "
+                   "this build, or by an earlier build); a build from a cold cache computes every point.")
 
 
 def _add_run_time(app, doctree) -> None:
@@ -211,8 +211,8 @@ def _add_run_time(app, doctree) -> None:
     text += [nodes.Text("Profile "), nodes.literal(text=current_profile()),
              nodes.Text(": " + run_time_text(executed["runtime"], counts))]
     if STATISTICS_PAGE in app.env.found_docs:
-        link = pending_xref(refdomain="std", reftype="doc", reftarget=f"/{STATISTICS_PAGE}", refexplicit=False,
-                            refdoc=docname, refwarn=True)
+        link = pending_xref(refdomain="std", reftype="doc", reftarget=f"/{STATISTICS_PAGE}",
+                            refexplicit=False, refdoc=docname, refwarn=True)
         link += nodes.inline(text=STATISTICS_PAGE)
         text += [nodes.Text(" The page "), link,
                  nodes.Text(" tabulates every chapter's run time and what a build from a cold cache costs.")]
