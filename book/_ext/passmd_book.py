@@ -85,6 +85,12 @@ def expectation(docname: str) -> str:
     return f"figures={len(figures)} ledger={int(ledger)}"
 
 
+def _expect_every_page(app, env) -> None:
+    """Compute every page's expectation once, before the writers (forked when parallel) need it."""
+    for docname in env.found_docs:
+        expectation(docname)
+
+
 def _add_expectation(app, pagename: str, templatename, context: dict, doctree) -> None:
     if doctree is not None:
         context["metatags"] = context.get("metatags", "") + (
@@ -241,6 +247,7 @@ def setup(app):
     app.connect("source-read", _point_log_at_page)
     app.connect("doctree-resolved", _fill_tables)
     app.connect("doctree-read", _add_run_time, priority=400)  # before the page's table of contents
+    app.connect("env-updated", _expect_every_page)
     app.connect("html-page-context", _add_expectation)
     app.add_node(sweep_table_placeholder)
     app.add_directive("passmd-sweep-table", SweepTable)
