@@ -18,7 +18,8 @@ The record says whether the regions hold the truth, the verdict and the goodness
 parameter sets per stage, and the machine's load average before and after (the 2-core machine
 may be shared: the times are not proof of speed when it is loaded).
 
-``--quick``: one flexible contact and six steps (a small run of the same machinery).
+``--quick``: one flexible contact and six steps (a small run of the same machinery), written to a
+temporary file unless ``--out`` is given.
 ``--smoke``: μ alone of one rigid contact from three steps, written to a temporary file: the
 same steps (data, row timing, parameter sets, the whole fit, the record) in seconds; it checks
 that the script works, its times and regions mean nothing.
@@ -48,6 +49,9 @@ from passmd.protocols import fit, velocity
 from passmd.protocols.fit.prediction import drive_at
 from passmd.runtime.config import RunConfig
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_ledger import output  # noqa: E402  (a sibling script: --out, or a temporary file for --quick, --smoke)
+
 FREE = ("friction_coefficient", "actuator.stiffness")
 TRUTH = {"friction_coefficient": 0.25, "actuator.stiffness": 5e6}
 #: Where the fit starts: the drive's defaults.
@@ -63,24 +67,21 @@ SETTINGS = {
     "smoke": {"drive": Drive(contacts=1, actuator_model="rigid"), "free": FREE[:1], "preloads": (0.4,),
               "amplitudes_nm": (120.0, 160.0, 200.0), "label": "μ alone, one rigid contact, 3 steps"},
 }
-ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     size = parser.add_mutually_exclusive_group()
-    size.add_argument("--quick", action="store_true", help="one flexible contact, six steps")
+    size.add_argument("--quick", action="store_true",
+                      help="one flexible contact, six steps, to a temporary file")
     size.add_argument("--smoke", action="store_true",
                       help="μ alone, one rigid contact, three steps, to a temporary file: checks the script "
                            "runs, measures nothing")
     parser.add_argument("--out", default=None,
-                        help="JSON written (default: passmd/data/benchmarks/fit.json; --smoke: a temporary "
-                             "file)")
+                        help="JSON written (default: passmd/data/benchmarks/fit.json; --quick, --smoke: a "
+                             "temporary file)")
     args = parser.parse_args()
     setting = SETTINGS["smoke" if args.smoke else "quick" if args.quick else "full"]
-    if args.out is None:
-        args.out = (Path(tempfile.mkdtemp(prefix="passmd-bench-")) / "fit.json" if args.smoke
-                    else ROOT / "passmd/data/benchmarks/fit.json")
     base, free = setting["drive"], setting["free"]
     truth = drive_at(base, list(free), [TRUTH[n] for n in free], base.actuator.damping_ratio)
     conditions = [(p, a * 1e-9, 100.0) for p in setting["preloads"] for a in setting["amplitudes_nm"]]
@@ -148,7 +149,7 @@ def main() -> int:
         "python": platform.python_version(),
         "machine": platform.machine(),
     }
-    out = Path(args.out)
+    out = output(args, "fit")
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
     shown = ("wall_time_s", "row_evaluation_s", "parameter_set_s", "budget_parameter_sets",

@@ -7,6 +7,7 @@ longer resolves fails here too), and its docstring must say what its smoke run c
 
 from __future__ import annotations
 
+import argparse
 import ast
 import re
 import subprocess
@@ -32,3 +33,15 @@ def test_script_offers_smoke(script):
     assert option, f"{script.name} has no --smoke:\n{done.stdout}"
     docstring = ast.get_docstring(ast.parse(script.read_text(encoding="utf-8"))) or ""
     assert "--smoke" in docstring, f"{script.name}'s docstring does not say what --smoke checks"
+
+
+def test_quick_and_smoke_runs_never_write_over_the_committed_records():
+    sys.path.insert(0, str(SCRIPTS[0].parent))
+    from bench_ledger import ROOT, output
+
+    committed = ROOT / "passmd" / "data" / "benchmarks"
+    run = {"out": None, "quick": False, "smoke": False}
+    assert output(argparse.Namespace(**run), "fit") == committed / "fit.json"
+    for mode in ("quick", "smoke"):
+        assert committed not in output(argparse.Namespace(**{**run, mode: True}), "fit").parents
+    assert output(argparse.Namespace(**{**run, "quick": True, "out": "x.json"}), "fit") == Path("x.json")

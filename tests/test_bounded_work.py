@@ -48,7 +48,6 @@ _RUNNER = """
 import sys
 from passmd import cli
 from passmd.solver import kernels
-from passmd.solver import simulation
 
 integrate = kernels.integrate
 def announced(*args):

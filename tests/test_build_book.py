@@ -1,10 +1,12 @@
-"""The book's build wrapper (tools/build_book.py): chapters executed in parallel, failures kept.
+"""The book's build wrapper (tools/build_book.py) and extension (book/_ext/passmd_book.py).
 
 ``nox -s book`` runs ``jupyter-book build`` through ``tools/build_book.py --jobs N`` so that
 Sphinx reads (executes) several chapters at once. These tests build a generated tiny book
-with the book's own Sphinx extension: it must be read in parallel, and a chapter that writes
-to stderr in a forked reader must still fail the ``-W`` build. They need jupyter-book and
-are skipped without it, except under ``nox -s book_check`` (PASSMD_REQUIRE_BROWSER=1).
+with the book's own Sphinx extension: it must be read in parallel, a chapter that writes
+to stderr in a forked reader must still fail the ``-W`` build, and an executed chapter that
+ran a sweep ends with the generated Run time section. The extension's ``passmd-expect`` tag
+follows the figure table and the ledger's claims. They need jupyter-book and are skipped
+without it, except under ``nox -s book_check`` (PASSMD_REQUIRE_BROWSER=1).
 """
 
 from __future__ import annotations
@@ -50,10 +52,18 @@ def _tiny_book(folder: Path, *, stderr_cell: bool) -> Path:
     for i in range(PAGES):
         body = f"# Page {i}\n\ntext\n"
         if i == PAGES - 1:
-            code = "import sys; print('oops', file=sys.stderr)" if stderr_cell else "print(6 * 7)"
+            code = "import sys; print('oops', file=sys.stderr)" if stderr_cell else SWEEP_CELL
             body = header + body + "\n```{code-cell} ipython3\n" + code + "\n```\n"
         (folder / f"page{i}.md").write_text(body, encoding="utf-8")
     return folder
+
+
+#: A chapter's cell that runs a sweep of three points, logged where the book's extension points
+#: the page's sweep log.
+SWEEP_CELL = """from passmd.report.publish import book_config
+from passmd.runtime.sweep import run
+run(lambda x: {"y": x * x}, [{"x": 1}, {"x": 2}, {"x": 3}], executor="serial", cache=False,
+    config=book_config())"""
 
 
 def _build(book: Path) -> subprocess.CompletedProcess:
@@ -67,12 +77,59 @@ def _build(book: Path) -> subprocess.CompletedProcess:
 
 def test_chapters_are_read_in_parallel(tmp_path):
     _require_jupyter_book()
-    result = _build(_tiny_book(tmp_path / "good", stderr_cell=False))
+    book = _tiny_book(tmp_path / "good", stderr_cell=False)
+    result = _build(book)
     log = result.stdout + result.stderr
     assert result.returncode == 0, log[-3000:]
     assert "doing serial read" not in log
     # Sphinx names each parallel chunk by its first and last document, e.g. "index .. page2".
     assert " .. page" in log, log[-3000:]
+    # the executed page that ran a sweep ends with its Run time section; the others have none
+    html = {i: (book / "_build" / "html" / f"page{i}.html").read_text(encoding="utf-8") for i in range(PAGES)}
+    assert "Run time" in html[PAGES - 1]
+    sweeps = "Its 1 simulation sweep(s) needed 3 points: 3 computed, 0 taken from the simulation cache"
+    assert sweeps in html[PAGES - 1]
+    assert not any("Run time" in html[i] for i in range(PAGES - 1))
+    # no page of the tiny book is in the figure table: it expects no figure and no ledger
+    assert all('<meta name="passmd-expect" content="figures=0 ledger=0"' in page for page in html.values())
+
+
+def _extension():
+    _require_jupyter_book()
+    sys.path.insert(0, str(ROOT / "book" / "_ext"))
+    import passmd_book
+
+    return passmd_book
+
+
+def _expect(page: str) -> dict[str, int]:
+    figures, ledger = (int(item.partition("=")[2]) for item in _extension().expectation(page).split())
+    return {"figures": figures, "ledger": ledger}
+
+
+def test_a_page_expects_its_rows_of_the_figure_table():
+    from passmd.experiments.figure_table import FIGURES
+
+    for chapter in {spec.chapter for spec in FIGURES}:
+        assert _expect(chapter)["figures"] == sum(spec.chapter == chapter for spec in FIGURES)
+    assert _expect("api") == {"figures": 0, "ledger": 0}  # a page without figures
+    assert _expect(_extension().LEDGER_PAGE)["ledger"] == 1  # the whole ledger
+
+
+def test_a_page_expects_a_ledger_where_the_ledger_judges_claims_of_its_figures():
+    from passmd.experiments.figure_table import FIGURES, READING_TABLES
+    from passmd.ledger.evaluation import load_claims
+
+    chapter_of = {spec.name: spec.chapter for spec in FIGURES}
+    judged = set()
+    for requires in load_claims()["requires"]:
+        for key in filter(None, requires.split(";")):
+            for figure in READING_TABLES[key].figures if key in READING_TABLES else (key,):
+                judged.add(chapter_of.get(figure))
+    judged.discard(None)
+    assert judged  # the ledger judges some chapter's figures
+    for chapter in set(chapter_of.values()):
+        assert _expect(chapter)["ledger"] == (chapter in judged), chapter
 
 
 def test_a_warning_in_a_parallel_reader_fails_the_build(tmp_path):

@@ -29,11 +29,12 @@ all network requests blocked) with the system's Chromium driven by selenium, and
   clientWidth``). The page-width rule misses these: a clipped or internally scrolling block
   leaves the page's width intact.
 
-What a page must show comes from its ``passmd-expect`` meta tag, set in the chapter's front
-matter (``myst: html_meta: passmd-expect: "figures=2 ledger=1"``); pages without it must have
-at least one figure and one ledger table. A full-page screenshot of every page is saved: the
-page laid out in a window of :data:`WINDOW_WIDTH` px, as tall as the page, so the picture is
-what a reader scrolling down that window sees (no horizontal shift, nothing cut at the edges).
+What a page must show comes from its ``passmd-expect`` meta tag (``"figures=2 ledger=1"``),
+which the book's extension (``book/_ext/passmd_book.py``) generates from the figure table and the
+ledger; pages without it must have at least one figure and one ledger table. A full-page
+screenshot of every page is saved: the page laid out in a window of :data:`WINDOW_WIDTH` px, as
+tall as the page, so the picture is what a reader scrolling down that window sees (no horizontal
+shift, nothing cut at the edges).
 
 Usage: ``python tools/check_rendered_book.py book/_build/html --toc book/_toc.yml
 --screenshots artifacts/screenshots`` (``nox -s book_check`` runs this).

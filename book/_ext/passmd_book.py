@@ -1,4 +1,4 @@
-"""Sphinx extension of the passmd book: provenance footer and per-chapter sweep statistics.
+"""Sphinx extension of the passmd book: provenance footer, run time and expectations per page.
 
 * The footer (``html_theme_options["extra_footer"]``) gets the ``passmd`` version, git
   commit and profile of the build (:func:`passmd.runtime.provenance.summary`), the same line every
@@ -12,6 +12,13 @@
   figure before the chapters (``$PASSMD_BOOK_PREFETCH_LOG``).
   The logs are cleared when a build starts: the counts are complete because ``nox -s book``
   builds with ``--all`` (every page read and executed).
+* Each chapter page (one with figures in :data:`passmd.experiments.figure_table.FIGURES` or
+  one that ran a sweep; not the root page) ends with a generated "Run time" section: the
+  profile, myst-nb's execution time of the page and its sweep counts, the facts the execution
+  statistics page tabulates for every page.
+* Every page gets a ``passmd-expect`` meta tag for ``tools/check_rendered_book.py``
+  (:func:`expectation`): the figures the figure table registers for the page and whether the
+  ledger judges claims of them.
 * Docstrings write absolute values as ``|x|`` (plain text, as ``help()`` shows them); for
   the API page the bars are escaped outside inline literals and roles, where
   reStructuredText would read ``|x|`` as a substitution.
@@ -19,6 +26,7 @@
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import re
@@ -33,6 +41,10 @@ SWEEP_LOG_ENV = "PASSMD_SWEEP_LOG"
 #: JSON file with that run's wall time (``{"wall_seconds": ...}``).
 PREFETCH_LOG_ENV = "PASSMD_BOOK_PREFETCH_LOG"
 PREFETCH_TIME_ENV = "PASSMD_BOOK_PREFETCH_TIME"
+#: The page that shows the whole ledger (every claim), where the ledger's links point.
+LEDGER_PAGE = "replication_report"
+#: The execution statistics page, which each chapter's Run time section links to.
+STATISTICS_PAGE = "execution_statistics"
 #: Extensions that work on merged build state only but do not declare it: Sphinx would read
 #: (execute) the chapters one at a time because of them (``tools/build_book.py --jobs``).
 UNDECLARED_PARALLEL_SAFE = (
@@ -44,6 +56,45 @@ UNDECLARED_PARALLEL_SAFE = (
 
 def _log_dir(app) -> Path:
     return Path(app.outdir).parent / "passmd-sweeps"
+
+
+def _log_of(app, docname: str) -> Path:
+    return _log_dir(app) / (docname.replace("/", "__") + ".jsonl")
+
+
+@functools.cache
+def chapter_figures(docname: str) -> tuple[str, ...]:
+    """The figures the figure table registers for a page (its ``chapter``)."""
+    from passmd.experiments.figure_table import FIGURES
+
+    return tuple(spec.name for spec in FIGURES if spec.chapter == docname)
+
+
+@functools.cache
+def expectation(docname: str) -> str:
+    """The ``passmd-expect`` value of a page, e.g. ``"figures=3 ledger=1"``.
+
+    ``figures``: the page's rows of the figure table (:func:`chapter_figures`); ``ledger``: 1 on
+    :data:`LEDGER_PAGE` and where the ledger judges claims that need only those figures'
+    results (:func:`passmd.ledger.evaluation.claims_for`), else 0.
+    """
+    from passmd.ledger.evaluation import claims_for, load_claims
+
+    figures = chapter_figures(docname)
+    ledger = docname == LEDGER_PAGE or bool(figures) and not claims_for(load_claims(), figures).empty
+    return f"figures={len(figures)} ledger={int(ledger)}"
+
+
+def _expect_every_page(app, env) -> None:
+    """Compute every page's expectation once, before the writers (forked when parallel) need it."""
+    for docname in env.found_docs:
+        expectation(docname)
+
+
+def _add_expectation(app, pagename: str, templatename, context: dict, doctree) -> None:
+    if doctree is not None:
+        context["metatags"] = context.get("metatags", "") + (
+            f'<meta name="passmd-expect" content="{expectation(pagename)}" />\n')
 
 
 def _add_footer(app, config) -> None:
@@ -65,7 +116,7 @@ def _clear_logs(app) -> None:
 
 
 def _point_log_at_page(app, docname: str, source: list[str]) -> None:
-    os.environ[SWEEP_LOG_ENV] = str(_log_dir(app) / (docname.replace("/", "__") + ".jsonl"))
+    os.environ[SWEEP_LOG_ENV] = str(_log_of(app, docname))
 
 
 class sweep_table_placeholder(nodes.General, nodes.Element):
@@ -121,7 +172,7 @@ def _fill_tables(app, doctree, docname: str) -> None:
     if prefetch and Path(prefetch).is_file():
         logs.append((_prefetch_label(), Path(prefetch)))
     for docname_of_page in sorted(app.env.found_docs):
-        path = _log_dir(app) / (docname_of_page.replace("/", "__") + ".jsonl")
+        path = _log_of(app, docname_of_page)
         if path.is_file():
             title = app.env.titles.get(docname_of_page)
             logs.append((title.astext() if title is not None else docname_of_page, path))
@@ -134,6 +185,48 @@ def _fill_tables(app, doctree, docname: str) -> None:
     header = ["run", "sweeps", "points from the cache", "points computed"]
     for placeholder in placeholders:
         placeholder.replace_self(_table(rows, header))
+
+
+def run_time_text(seconds: float, counts: list[int]) -> str:
+    """What a chapter's Run time section says after its profile: execution time and sweeps."""
+    sweeps, cached, computed = counts
+    text = f"executing this chapter took {seconds:.1f} s of wall time in this build (kernel start included). "
+    if not sweeps:
+        return text + "It ran no simulation sweep."
+    return text + (f"Its {sweeps} simulation sweep(s) needed {cached + computed} points: {computed} "
+                   f"computed, {cached} taken from the simulation cache (filled by passmd ledger earlier in "
+                   "this build, or by an earlier build); a build from a cold cache computes every point.")
+
+
+def _add_run_time(app, doctree) -> None:
+    """Append the "Run time" section to an executed chapter page (figures or sweeps; not the root)."""
+    from myst_nb.sphinx_ import NbMetadataCollector
+    from sphinx.addnodes import pending_xref
+
+    from passmd.report.publish import current_profile
+
+    docname = app.env.docname
+    executed = NbMetadataCollector.get_exec_data(app.env, docname)
+    log = _log_of(app, docname)
+    counts = _counts(log) if log.is_file() else [0, 0, 0]
+    page = doctree.next_node(nodes.section)
+    if (not executed or executed.get("runtime") is None or docname == app.config.root_doc or page is None
+            or not (chapter_figures(docname) or counts[0])):
+        return
+    text = nodes.paragraph()
+    text += [nodes.Text("Profile "), nodes.literal(text=current_profile()),
+             nodes.Text(": " + run_time_text(executed["runtime"], counts))]
+    if STATISTICS_PAGE in app.env.found_docs:
+        link = pending_xref(refdomain="std", reftype="doc", reftarget=f"/{STATISTICS_PAGE}",
+                            refexplicit=False, refdoc=docname, refwarn=True)
+        link += nodes.inline(text=STATISTICS_PAGE)
+        text += [nodes.Text(" The page "), link,
+                 nodes.Text(" tabulates every chapter's run time and what a build from a cold cache costs.")]
+    section = nodes.section(names=["run time"])
+    section += nodes.title(text="Run time")
+    section += text
+    page += section
+    doctree.note_implicit_target(section, section)
 
 
 _BACKTICK_SPAN = re.compile(r"(`[^`]*`)")
@@ -153,6 +246,9 @@ def setup(app):
     app.connect("builder-inited", _clear_logs)
     app.connect("source-read", _point_log_at_page)
     app.connect("doctree-resolved", _fill_tables)
+    app.connect("doctree-read", _add_run_time, priority=400)  # before the page's table of contents
+    app.connect("env-updated", _expect_every_page)
+    app.connect("html-page-context", _add_expectation)
     app.add_node(sweep_table_placeholder)
     app.add_directive("passmd-sweep-table", SweepTable)
     for name in UNDECLARED_PARALLEL_SAFE:
