@@ -76,9 +76,9 @@ def expectation(docname: str) -> str:
 
     ``figures``: the page's rows of the figure table (:func:`chapter_figures`); ``ledger``: 1 on
     :data:`LEDGER_PAGE` and where the ledger judges claims that need only those figures'
-    results (:func:`passmd.ledger.evaluation.claims_for`), else 0.
+    results (:func:`passmd.report.evaluation.claims_for`), else 0.
     """
-    from passmd.ledger.evaluation import claims_for, load_claims
+    from passmd.report.evaluation import claims_for, load_claims
 
     figures = chapter_figures(docname)
     ledger = docname == LEDGER_PAGE or bool(figures) and not claims_for(load_claims(), figures).empty
