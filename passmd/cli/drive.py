@@ -9,7 +9,7 @@ functions the options reach) is said again with the option that set it, as typed
 from __future__ import annotations
 
 from passmd.cli.errors import UsageError
-from passmd.cli.options import ACTUATOR_DYNAMICS, DRIVE_QUANTITIES, OPTION_FOR, QUANTITIES, refuse_bare
+from passmd.cli.options import ACTUATOR_DYNAMICS, DRIVE_QUANTITIES, OPTION_FOR, QUANTITIES
 from passmd.cli.output import flyback_label, fmt
 from passmd.model.drive_file import DriveFileError, file_message, read_drive_file, resolve
 from passmd.model.parameters import Drive
@@ -89,7 +89,6 @@ def _flyback(raw: str) -> str | float:
     if text in FLYBACK_RULES:
         return text
     try:
-        refuse_bare("--flyback", text, "us")
         value = parse_quantity(text, "us", name="--flyback")
     except QuantityError as exc:
         if any(c.isdigit() for c in text):
