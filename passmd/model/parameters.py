@@ -3,12 +3,13 @@ plausible ranges.
 
 A :class:`Drive` gathers the geometry, preload, friction, masses, model choices and the parts of
 :mod:`passmd.model.tables` (materials, Table 2 actuator, amplifier); its contacts are the paper's
-one or six (Eq. 1) or any arrangement of :class:`ContactGroup` s. Every number of a drive is
-checked on construction against :data:`PLAUSIBLE_RANGES`: hard limits where the model's physics
-breaks (positive quantities, a Hertz contact radius a <= R/10), soft limits two decades around
-Tables 1–2 where it was checked, which ``allow_extrapolation`` lifts. The library and the command
-line check against this one table. All quantities are SI; :func:`paper_drive` gives the paper's
-drive for one of Table 2's radii.
+one or six (Eq. 1) or any arrangement of :class:`ContactGroup` s, whose normal forces and
+moduli the drive computes once (:attr:`Drive.contact_layout`, :attr:`Drive.contact_moduli`).
+Every number of a drive is checked on construction against :data:`PLAUSIBLE_RANGES`: hard limits
+where the model's physics breaks (positive quantities, a Hertz contact radius a <= R/10), soft
+limits two decades around Tables 1–2 where it was checked, which ``allow_extrapolation`` lifts.
+The library and the command line check against this one table. All quantities are SI;
+:func:`paper_drive` gives the paper's drive for one of Table 2's radii.
 """
 
 from __future__ import annotations
@@ -51,10 +52,10 @@ from passmd.runtime.validation import (
 __all__ = [
     "ASSUMPTIONS",
     "CONTACT_RADIUS_RATIO_LIMIT",
-    "ContactLayout",
     "HERTZ_PRESSURE_LIMIT",
     "PLAUSIBLE_RANGES",
     "ContactGroup",
+    "ContactLayout",
     "Drive",
     "PlausibleRange",
     "check_contact_plausible",
