@@ -18,8 +18,8 @@ from passmd.runtime.units import QuantityError, dimension_name, from_si, parse_q
         ("0.25mm", "mm", 0.25e-3),
         ("0.25 mm", "mm", 0.25e-3),
         ("250um", "mm", 250e-6),
-        ("0.25", "mm", 0.25e-3),  # bare number: the display unit
-        (0.25, "mm", 0.25e-3),
+        ("0.4", "N", 0.4),  # a bare number: SI, where the unit is SI
+        (0.4, "N", 0.4),
         ("1e-3 m", "mm", 1e-3),
         ("202nm", "nm", 202e-9),
         ("-10nm", "nm", -10e-9),
@@ -27,7 +27,7 @@ from passmd.runtime.units import QuantityError, dimension_name, from_si, parse_q
         ("100 Hz", "kHz", 100.0),
         ("310GPa", "GPa", 310e9),
         ("3 mN", "N", 3e-3),
-        ("2.2e-5", "g", 2.2e-8),
+        ("2.2e-5 g", "g", 2.2e-8),
         ("6.5e6", "N/m", 6.5e6),
         ("6.5 MN/m", "N/m", 6.5e6),
         ("0.1 kg/s", "kg/s", 0.1),
@@ -50,6 +50,11 @@ def test_parse_quantity_to_si(text, unit, expected):
         ("abc", "mm", "is not a quantity"),
         ("nan", "mm", "is not a quantity"),
         ("", "N", "is not a quantity"),
+        ("0.25", "mm", "--radius = 0.25 has no unit: write one, e.g. 0.25m or 0.25mm (an option shown in mm "
+                       "takes no bare number; a bare number is SI only where the option is shown in SI)"),
+        (0.25, "mm", "--radius = 0.25 has no unit"),
+        ("40", "kHz", "--radius = 40 has no unit: write one, e.g. 40Hz or 40kHz"),
+        ("1e999", "mm", "--radius = 1e999 has no unit"),
     ],
 )
 def test_parse_quantity_errors_name_option_value_and_unit(text, unit, fragment):
@@ -68,7 +73,9 @@ def test_parse_quantity_rejects_non_finite_and_bool():
 
 
 def test_parse_quantities_list():
-    assert parse_quantities("0nm,30nm,-10nm,45", "nm", name="--path") == [0.0, 30e-9, -10e-9, 45e-9]
+    assert parse_quantities("0nm,30nm,-10nm,45nm", "nm", name="--path") == [0.0, 30e-9, -10e-9, 45e-9]
+    with pytest.raises(QuantityError, match="^--path = 45 has no unit"):
+        parse_quantities("0nm,45", "nm", name="--path")
     assert parse_quantities("0.01um, 20 nm", "nm") == [10e-9, 20e-9]
     with pytest.raises(QuantityError, match="comma-separated"):
         parse_quantities("0nm,,3nm", "nm", name="--path")

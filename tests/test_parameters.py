@@ -27,6 +27,19 @@ def test_table2_actuators():
     assert a1.damping_ratio == pytest.approx(0.05, rel=1e-12)
 
 
+def test_drive_holds_its_eq1_layout_once_and_read_only():
+    """Eq. 1 on construction: F_p/(2 sin 45°) on the two contacts of side 1, F_p/(4 sin 45°) on the
+    four of side 2; a caller cannot alter the drive's copy, and a changed preload gives a new one."""
+    drive = Drive(preload=0.4)
+    forces, counts, radii = drive.contact_layout
+    s45 = np.sin(np.pi / 4)
+    assert forces.tolist() == [0.4 / 2 / s45, 0.4 / 4 / s45] and counts.tolist() == [2, 4]
+    assert radii.tolist() == [drive.hemisphere_radius] * 2
+    with pytest.raises(ValueError, match="read-only"):
+        forces[0] = 1.0
+    assert drive.replace(preload=0.8).contact_layout.normal_forces.tolist() == (2 * forces).tolist()
+
+
 def test_drive_defaults_are_the_paper_drive():
     d = paper_drive()
     assert d.runner_mass == 3e-3 and d.load_cell_stiffness == 2.5e4

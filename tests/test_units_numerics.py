@@ -175,20 +175,22 @@ _NUMBERS = st.decimals(min_value="1e-6", max_value="1e6", allow_nan=False, allow
        prefix=_PREFIXES, space=st.sampled_from(["", " "]))
 def test_frequency_grammar_is_physical_or_refused(number, unit, prefix, space):
     """Hypothesis over the frequency grammar (number, optional prefix, cycle or angular unit, or
-    a bare number in kHz): the value is the physical one, or a one-line refusal; never a 2π factor."""
+    a bare number, refused in kHz): the value is the physical one, or a one-line refusal; never a 2π
+    factor."""
     space = " " if unit[:1].isdigit() else space  # "2 1/s": "21/s" would be 21 per second
     text = f"{number}{space}{prefix if unit and unit[0].isalpha() else ''}{unit}"
     try:
         value = parse_quantity(text, "kHz", name="--frequency")
     except QuantityError as exc:
         message = str(exc)
-        assert "\n" not in message and message.startswith(f"--frequency = {text!r}")
+        shown = text.strip() if not unit else repr(text)  # a bare number is refused as typed
+        assert "\n" not in message and message.startswith(f"--frequency = {shown}")
+        assert unit or "has no unit" in message
         return
     pint_unit = f"{prefix}{unit}" if unit and unit[0].isalpha() else unit
     assert unit not in ANGULAR, f"angular rate {text!r} accepted as {value} Hz"
-    if not unit:
-        hz = 1e3  # a bare number is in the display unit, kHz
-    elif pint_unit in CYCLES:
+    assert unit, f"bare number {text!r} read in kHz"
+    if pint_unit in CYCLES:
         hz = CYCLES[pint_unit]
     else:  # a prefixed cycle unit: the prefix times the hand-typed size
         hz = {"k": 1e3, "M": 1e6, "m": 1e-3}[prefix] * CYCLES[unit]
@@ -286,7 +288,7 @@ def test_validation_messages_show_numpy_values_as_numbers():
 def test_display_value_of_a_parsed_quantity_is_the_typed_number(number, unit):
     """Range checks compare ``to_display(parse_quantity(text))``: the typed number itself for a
     plain number, within one unit in the last place of it otherwise (never a rounded copy)."""
-    value = parse_quantity(f"{number}", unit)
+    value = parse_quantity(f"{number}{unit}", unit)
     shown = to_display(value, unit)
     if not unit:
         assert shown == value == float(number)

@@ -12,7 +12,7 @@ Subcommands::
     passmd cache                the on-disk simulation cache: info, clear, prune
 
 Quantities accept units (``0.4N``, ``1mm``, ``0.25 mm``, ``202nm``, ``100kHz``,
-``310GPa``); a bare number is read in the unit ``--help`` shows. Human output uses nm,
+``310GPa``); a bare number is SI, refused where ``--help`` shows another unit. Human output uses nm,
 N, mm and kHz; ``--json`` prints one JSON object in SI units whose keys carry the unit.
 
 Exit status: 0 success, 2 usage error (unknown option, wrong unit, out-of-range value,

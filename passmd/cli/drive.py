@@ -9,13 +9,13 @@ functions the options reach) is said again with the option that set it, as typed
 from __future__ import annotations
 
 from passmd.cli.errors import UsageError
-from passmd.cli.options import ACTUATOR_DYNAMICS, DRIVE_QUANTITIES, OPTION_FOR, QUANTITIES, refuse_bare
+from passmd.cli.options import ACTUATOR_DYNAMICS, DRIVE_QUANTITIES, OPTION_FOR, QUANTITIES
 from passmd.cli.output import flyback_label, fmt
-from passmd.model.drive_file import DriveFileError, file_message, read_drive_file, resolve
+from passmd.model.drive_file import DriveFileError, read_drive_file, resolve
 from passmd.model.parameters import Drive
 from passmd.model.tables import FLYBACK_RULES
 from passmd.runtime.units import QuantityError, dimension_name, from_si, parse_quantity
-from passmd.runtime.validation import LIMIT_VERBS, InputError, safe_bound
+from passmd.runtime.validation import LIMIT_VERBS, InputError, file_message, safe_bound
 
 __all__ = ["build_drive", "drive_rows", "explain", "resolve_drive"]
 
@@ -89,7 +89,6 @@ def _flyback(raw: str) -> str | float:
     if text in FLYBACK_RULES:
         return text
     try:
-        refuse_bare("--flyback", text, "us")
         value = parse_quantity(text, "us", name="--flyback")
     except QuantityError as exc:
         if any(c.isdigit() for c in text):

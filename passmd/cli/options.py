@@ -1,9 +1,9 @@
 """The commands' options: quantities with units, and the option groups the commands share.
 
 A :class:`Quantity` is one option that takes a number with a unit (``0.4N``, ``1mm``,
-``202nm``). A bare number is read in SI units, as in a drive file; an option whose help
-shows another unit (mm, nm, kHz, g, GPa, V/us) refuses a bare number and asks for the unit,
-so that no number is ever read in a unit the user did not write.
+``202nm``). A bare number is SI, as in a drive file: an option whose help shows another unit
+(mm, nm, kHz, g, GPa, V/us) refuses it and asks for the unit
+(:func:`passmd.runtime.units.parse_quantity`).
 Its default text is computed from the defaults it stands for (:data:`DEFAULT_DRIVE`,
 :data:`passmd.model.defaults.PROTOCOL`), never retyped.
 """
@@ -11,7 +11,6 @@ Its default text is computed from the defaults it stands for (:data:`DEFAULT_DRI
 from __future__ import annotations
 
 import argparse
-import re
 from dataclasses import dataclass
 
 from passmd.cli.output import JSON_HELP, fmt
@@ -20,36 +19,16 @@ from passmd.model.parameters import PLAUSIBLE_RANGES, Drive
 from passmd.model.tables import ACTUATOR_DAMPING_RATIO
 from passmd.runtime.cache import describe_default_cache_dir
 from passmd.runtime.config import ENVIRONMENT, MAX_WORKERS, WORKERS_PER_CORE
-from passmd.runtime.units import QuantityError, parse_quantity, si_factor, to_display
+from passmd.runtime.units import parse_quantity, si_factor, to_display
 from passmd.runtime.validation import check_range
 
 __all__ = ["ACTUATOR_DYNAMICS", "AMPLITUDE", "CACHE_DIR_HELP", "DEFAULT_DRIVE", "DRIVE_QUANTITIES",
            "FREQUENCY", "MATERIAL_FLAGS", "NORMAL_FORCE", "OPTION_FOR", "QUANTITIES", "THRESHOLD",
            "TOLERANCE", "DirectoryPath", "FilePath", "Quantity", "add_drive_options",
-           "add_output_options", "add_simulation_options", "add_sweep_options", "refuse_bare"]
+           "add_output_options", "add_simulation_options", "add_sweep_options"]
 
 #: The drive every option replaces a part of (Tables 1–2 at R = 1 mm, F_p = 0.4 N, μ = 0.2).
 DEFAULT_DRIVE = Drive()
-
-#: A number without a unit (as passmd.runtime.units reads one; "nan" and "inf" are not numbers there).
-_BARE = re.compile(r"^[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?$")
-#: The SI unit of each display unit that is not SI (for the bare-number message).
-_SI_UNIT = {"mm": "m", "nm": "m", "kHz": "Hz", "g": "kg", "GPa": "Pa", "V/us": "V/s", "us": "s"}
-
-
-def refuse_bare(flag: str, raw, unit: str) -> None:
-    """Refuse a bare number (``QuantityError``) for an option shown in a unit that is not SI.
-
-    A bare number is read in SI units; where the option's help shows another unit (mm, nm,
-    kHz, g, GPa, V/us) it is refused, naming both units, so that it is never read in a unit
-    the user did not write.
-    """
-    text = str(raw).strip()
-    if _BARE.match(text) and si_factor(unit) != 1.0:
-        raise QuantityError(f"{flag} = {text} has no unit: write one, e.g. {text}{_SI_UNIT.get(unit, '')} "
-                            f"or {text}{unit} (an option shown in {unit} takes no bare number; a bare number "
-                            "is SI only where the option is shown in SI)")
-
 
 @dataclass(frozen=True)
 class Quantity:
@@ -88,7 +67,6 @@ class Quantity:
         raw = getattr(args, self.dest)
         if raw is None:
             return None
-        refuse_bare(self.flag, raw, self.unit)
         value = parse_quantity(raw, self.unit, name=self.flag)
         if self.plausible is not None:
             scale = si_factor(self.unit)

@@ -74,7 +74,6 @@ from passmd.model.contact_kernels import (
 from passmd.model.hertz import _hertz_contact_radius
 from passmd.model.parameters import Drive
 from passmd.model.tables import Assumption
-from passmd.model.theory import contact_moduli
 from passmd.runtime.validation import check_choice, check_positive
 
 if TYPE_CHECKING:  # pandas is imported where a DataFrame is built (start-up time)
@@ -225,7 +224,7 @@ def drive_contact_arrays(drive: Drive, normal_force: float, radius: float, sprin
     The :class:`~passmd.model.parameters.Drive` checked its contacts' force, radius, moduli and
     friction coefficient on construction, so only ``springs`` is checked here.
     """
-    E_star, G_star = contact_moduli(drive)
+    E_star, G_star = drive.contact_moduli
     model = "exact" if springs is None else "discrete"
     springs = None if springs is None else check_springs(springs)
     return unchecked_contact_arrays(model, float(normal_force), float(radius), E_star, G_star,

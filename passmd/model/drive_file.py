@@ -41,18 +41,18 @@ from importlib import resources
 from pathlib import Path
 
 from passmd.model.arrangement import FLAT, ContactGroup, preset_groups
-from passmd.model.parameters import PLAUSIBLE_RANGES, Drive
+from passmd.model.parameters import PLAUSIBLE_RANGES, Drive, check_drive
 from passmd.model.tables import (
     ACTUATOR_DAMPING_RATIO,
     FLYBACK_RULES,
-    TABLE2_RADII,
     Amplifier,
     actuator_for_radius,
     actuator_viscosity,
+    table2_source,
 )
 from passmd.runtime.inputs import RefusedFile, decode_text, read_bounded
-from passmd.runtime.units import QuantityError, parse_angle, parse_quantity
-from passmd.runtime.validation import LIMIT_VERBS, InputError, safe_bound, shown
+from passmd.runtime.units import QuantityError, from_si, parse_angle, parse_quantity
+from passmd.runtime.validation import InputError, file_message
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -60,7 +60,7 @@ else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 __all__ = ["CONTACT_PRESETS", "DRIVE_KEYS", "EXAMPLE_DRIVE_FILE", "JOINT_READING_FILE", "DriveFileError",
-           "DriveKey", "drive_toml", "file_message", "load_drive", "parameter_rows", "read_drive_file",
+           "DriveKey", "drive_toml", "load_drive", "parameter_rows", "read_drive_file",
            "resolve"]
 
 
@@ -78,8 +78,12 @@ class DriveKey:
     symbol: str
     text: str
     source: str  # where the default comes from
-    plausible: str | None = None  # key of PLAUSIBLE_RANGES
+    plausible: str | None = None  # key of PLAUSIBLE_RANGES; None: the key's own (a material's for both)
     choices: tuple = ()
+
+    def __post_init__(self):
+        own = self.key.replace("hemisphere_material.", "material.").replace("runner_material.", "material.")
+        object.__setattr__(self, "plausible", self.plausible or (own if own in PLAUSIBLE_RANGES else None))
 
 
 _DEFAULT = Drive()
@@ -103,41 +107,34 @@ DRIVE_KEYS: dict[str, DriveKey] = {k.key: k for k in (
              "side's Σ n F_N sin α must balance the preload (Eq. 1)", "instead of contacts"),
     DriveKey("actuator_model", "choice", "", "–", "\"flexible\" (mass–spring–damper) or \"rigid\" actuators",
              "Section 3.1", choices=("flexible", "rigid")),
-    DriveKey("hemisphere_radius", "m", "mm", "R", "radius of the hemispheres", "Table 1",
-             "hemisphere_radius"),
-    DriveKey("preload", "N", "N", "F_p", "preload", "Section 4", "preload"),
-    DriveKey("friction_coefficient", "", "", "μ", "friction coefficient", "Table 1; Section 4.2",
-             "friction_coefficient"),
-    DriveKey("runner_mass", "kg", "g", "m_r", "runner mass", "Table 1", "runner_mass"),
-    DriveKey("load_cell_stiffness", "N/m", "N/m", "k", "load cell stiffness", "Table 1",
-             "load_cell_stiffness"),
+    DriveKey("hemisphere_radius", "m", "mm", "R", "radius of the hemispheres", "Table 1"),
+    DriveKey("preload", "N", "N", "F_p", "preload", "Section 4"),
+    DriveKey("friction_coefficient", "", "", "μ", "friction coefficient", "Table 1; Section 4.2"),
+    DriveKey("runner_mass", "kg", "g", "m_r", "runner mass", "Table 1"),
+    DriveKey("load_cell_stiffness", "N/m", "N/m", "k", "load cell stiffness", "Table 1"),
     DriveKey("load_cell", "bool", "", "–", "the runner pushes against the load cell", "Section 4.2"),
     DriveKey("allow_extrapolation", "bool", "", "–", "accept values outside the plausible ranges "
              "(soft limits only)", "default"),
     DriveKey("hemisphere_material.name", "str", "", "–", "name of the hemispheres' material", "Table 1"),
     DriveKey("hemisphere_material.youngs_modulus", "Pa", "GPa", "E_1", "Young's modulus of the hemispheres",
-             "Table 1", "material.youngs_modulus"),
+             "Table 1"),
     DriveKey("hemisphere_material.poissons_ratio", "", "", "ν_1", "Poisson's ratio of the hemispheres",
-             "Table 1", "material.poissons_ratio"),
+             "Table 1"),
     DriveKey("runner_material.name", "str", "", "–", "name of the runner's material", "Table 1"),
-    DriveKey("runner_material.youngs_modulus", "Pa", "GPa", "E_2", "Young's modulus of the runner", "Table 1",
-             "material.youngs_modulus"),
-    DriveKey("runner_material.poissons_ratio", "", "", "ν_2", "Poisson's ratio of the runner", "Table 1",
-             "material.poissons_ratio"),
-    DriveKey("actuator.stiffness", "N/m", "N/m", "k_p", "actuator stiffness", "Table 2",
-             "actuator.stiffness"),
-    DriveKey("actuator.mass", "kg", "kg", "m_a", "actuator mass", "Table 2 (as printed)", "actuator.mass"),
+    DriveKey("runner_material.youngs_modulus", "Pa", "GPa", "E_2", "Young's modulus of the runner",
+             "Table 1"),
+    DriveKey("runner_material.poissons_ratio", "", "", "ν_2", "Poisson's ratio of the runner", "Table 1"),
+    DriveKey("actuator.stiffness", "N/m", "N/m", "k_p", "actuator stiffness", "Table 2"),
+    DriveKey("actuator.mass", "kg", "kg", "m_a", "actuator mass", "Table 2 (as printed)"),
     DriveKey("actuator.viscosity", "kg/s", "kg/s", "c_p", "actuator viscosity (or give damping_ratio)",
              f"derived from ζ = {ACTUATOR_DAMPING_RATIO:g}"),
     DriveKey("actuator.damping_ratio", "", "", "ζ", "damping ratio of the bare actuator, "
-             "c_p = 2ζ√(k_p m_a) (or give viscosity)", "assumed (Table 2's column is lost)",
-             "actuator.damping_ratio"),
+             "c_p = 2ζ√(k_p m_a) (or give viscosity)", "assumed (Table 2's column is lost)"),
     DriveKey("actuator.full_stroke_amplitude", "m", "nm", "A_max", "actuation amplitude at the full voltage",
-             "Table 2", "actuator.full_stroke_amplitude"),
+             "Table 2"),
     DriveKey("amplifier.peak_to_peak_voltage", "V", "V", "V_pp", "amplifier peak-to-peak voltage",
-             "Section 2", "amplifier.peak_to_peak_voltage"),
-    DriveKey("amplifier.slew_rate", "V/s", "V/us", "SR", "amplifier slew rate", "Section 2",
-             "amplifier.slew_rate"),
+             "Section 2"),
+    DriveKey("amplifier.slew_rate", "V/s", "V/us", "SR", "amplifier slew rate", "Section 2"),
     DriveKey("amplifier.flyback", "flyback", "us", "t_fb", "fly-back of the saw-tooth: \"slew\" (slew-rate "
              "limited, (A/A_max)·V_pp/SR), \"fixed\" (the full-stroke V_pp/SR at every amplitude) or a "
              "stated time (\"1.5 us\"; a bare number is s)", "assumed (Section 2 gives V_pp and SR)"),
@@ -164,31 +161,30 @@ def _refuse(where: str, text: str, **kw) -> DriveFileError:
 
 def _value(where: str, spec: DriveKey, raw, allow_extrapolation: bool):
     """The SI value (or string/bool) of one key, checked; ``where`` is ``"file: key"``."""
-    label = f"{where}"
     if spec.unit == "bool":
         if not isinstance(raw, bool):
-            raise _refuse(label, f"= {raw!r}: must be true or false", name=spec.key, value=raw)
+            raise _refuse(where, f"= {raw!r}: must be true or false", name=spec.key, value=raw)
         return raw
     if spec.unit == "str":
         if not isinstance(raw, str):
-            raise _refuse(label, f"= {raw!r}: must be a string", name=spec.key, value=raw)
+            raise _refuse(where, f"= {raw!r}: must be a string", name=spec.key, value=raw)
         return raw
     if spec.unit == "groups":
         return _groups(where, raw, allow_extrapolation)
     if spec.unit == "flyback":
-        return _flyback(label, spec, raw)
+        return _flyback(where, spec, raw)
     if spec.unit == "choice":
         if isinstance(raw, str) and raw in spec.choices:
             return raw
         if spec.key == "contacts" and not isinstance(raw, bool) and raw in CONTACT_PRESETS.values():
             return {1: "one", 6: "paper-six"}[raw]
-        raise _refuse(label, f"= {raw!r}: must be one of {', '.join(repr(c) for c in spec.choices)}",
+        raise _refuse(where, f"= {raw!r}: must be one of {', '.join(repr(c) for c in spec.choices)}",
                       name=spec.key, value=raw)
     if isinstance(raw, bool) or not isinstance(raw, (int, float, str)):
-        raise _refuse(label, f"= {raw!r}: must be a number (SI, {spec.unit or 'plain'}) or a string with "
+        raise _refuse(where, f"= {raw!r}: must be a number (SI, {spec.unit or 'plain'}) or a string with "
                              f"a unit, e.g. \"1 {spec.display or spec.unit}\"", name=spec.key, value=raw)
     try:
-        value = parse_quantity(raw, spec.unit, name=label)
+        value = parse_quantity(raw, spec.unit, name=where)
     except QuantityError as exc:
         raise DriveFileError(str(exc), name=spec.key, value=raw) from None
     si = f" {spec.unit}" if spec.unit else ""
@@ -198,10 +194,10 @@ def _value(where: str, spec: DriveKey, raw, allow_extrapolation: bool):
         except InputError as exc:
             limits = " and ".join(f"{op} {bound:.4g}{si}" for op, bound in exc.limits)
             hint = "; allow_extrapolation = true goes beyond it" if exc.soft else ""
-            raise _refuse(label, f"= {raw!r} is out of range: must be {limits} ({exc.why}){hint}",
+            raise _refuse(where, f"= {raw!r} is out of range: must be {limits} ({exc.why}){hint}",
                           name=spec.key, value=raw, limits=exc.limits, soft=exc.soft) from None
     elif spec.key == "actuator.viscosity" and not value >= 0.0:
-        raise _refuse(label, f"= {raw!r} is out of range: must be >= 0{si}", name=spec.key, value=raw)
+        raise _refuse(where, f"= {raw!r} is out of range: must be >= 0{si}", name=spec.key, value=raw)
     return value
 
 
@@ -209,14 +205,14 @@ def _flyback(label: str, spec: DriveKey, raw) -> str | float:
     """A fly-back rule: ``"slew"``, ``"fixed"``, or a time (a string with a unit, or a bare number in s)."""
     if isinstance(raw, str) and raw.strip() in FLYBACK_RULES:
         return raw.strip()
-    if isinstance(raw, bool) or not isinstance(raw, (int, float, str)):
-        raise _refuse(label, f"= {raw!r}: must be \"slew\", \"fixed\" or a time, e.g. \"1.5 us\"",
+    refused = _refuse(label, f"= {raw!r}: must be \"slew\", \"fixed\" or a time, e.g. \"1.5 us\"",
                       name=spec.key, value=raw)
+    if isinstance(raw, bool) or not isinstance(raw, (int, float, str)):
+        raise refused
     try:
         value = parse_quantity(raw, "s", name=label)
     except QuantityError:
-        raise _refuse(label, f"= {raw!r}: must be \"slew\", \"fixed\" or a time, e.g. \"1.5 us\"",
-                      name=spec.key, value=raw) from None
+        raise refused from None
     if not (math.isfinite(value) and value > 0.0):
         raise _refuse(label, f"= {raw!r} is out of range: must be > 0 s", name=spec.key, value=raw,
                       limits=((">", 0.0),))
@@ -241,14 +237,12 @@ def _groups(where: str, raw, allow_extrapolation: bool) -> tuple:
             raise _refuse(f"{label}.{unknown[0]}", f"is not a key of a contact group: the known keys are "
                           f"{', '.join(_GROUP_KEYS)}", name="contact_groups", value=table)
         values = {}
-        for key in ("count", "side"):
+        for key, allowed, rule in (("count", None, "must be an integer >= 1"), ("side", (1, 2), "must be 1 "
+                                   "or 2 (the side of the runner the group presses on)")):
             value = table.get(key)
             if key in table or key == "count":
-                allowed = (1, 2) if key == "side" else None
                 if isinstance(value, bool) or not isinstance(value, int) or value < 1 or (
                         allowed and value not in allowed):
-                    rule = "must be 1 or 2 (the side of the runner the group presses on)" if allowed else \
-                        "must be an integer >= 1"
                     raise _refuse(f"{label}.{key}", f"= {value!r}: {rule}", name="contact_groups",
                                   value=value)
                 values[key] = value
@@ -322,15 +316,6 @@ def read_drive_file(path, *, allow_extrapolation: bool | None = None) -> dict:
     return values
 
 
-def _table2_source(radius: float) -> str:
-    radii = sorted(TABLE2_RADII)
-    if any(math.isclose(radius, r, rel_tol=1e-9) for r in radii):
-        return f"Table 2 (R = {radius * 1e3:g} mm)"
-    if radii[0] < radius < radii[-1]:
-        return f"Table 2 interpolated at R = {radius * 1e3:.4g} mm"
-    return f"Table 2 clamped (R = {radius * 1e3:.4g} mm outside {radii[0] * 1e3:g}–{radii[-1] * 1e3:g} mm)"
-
-
 def resolve(values: dict, origins: dict | None = None, **fixed) -> tuple[Drive, dict]:
     """The drive ``values`` describe, and where each of its parameters came from.
 
@@ -350,12 +335,10 @@ def resolve(values: dict, origins: dict | None = None, **fixed) -> tuple[Drive, 
 
     radius = get("hemisphere_radius")
     base = actuator_for_radius(radius)
-    table2 = _table2_source(radius)
+    table2 = table2_source(radius)
     act = {name: values.get(f"actuator.{name}", getattr(base, name))
            for name in ("stiffness", "mass", "full_stroke_amplitude")}
-    for name in act:
-        if f"actuator.{name}" not in values:
-            sources[f"actuator.{name}"] = table2
+    sources.update({f"actuator.{name}": table2 for name in act if f"actuator.{name}" not in values})
     zeta = values.get("actuator.damping_ratio", ACTUATOR_DAMPING_RATIO)
     if "actuator.viscosity" in values:
         viscosity = values["actuator.viscosity"]
@@ -422,31 +405,12 @@ def load_drive(path, **fixed) -> Drive:
         raise DriveFileError(f"{path}: {file_message(exc)}", name=exc.name, value=exc.value) from None
 
 
-def file_message(exc: InputError) -> str:
-    """``exc`` in a drive file's terms: a quantity derived from a key (the damping ratio from
-    ``actuator.viscosity``) names the key, its value as read and the key's limit in SI."""
-    if not (exc.quantity and exc.source and exc.limits):
-        return str(exc)
-    unit = f" {exc.unit}" if exc.unit and exc.unit != "–" else ""
-    limits = " and ".join(f"{op} {safe_bound(op, bound)}{unit}" for op, bound in exc.limits)
-    text = (f"{exc.quantity} derived from {exc.source} = {shown(exc.source_value)} is "
-            f"{float(exc.value):.4g}, out of range: must be {limits}" + (f" ({exc.why})" if exc.why else ""))
-    remedies = [f"{LIMIT_VERBS[op].format(exc.source)} {safe_bound(op, bound)} (SI)"
-                for op, bound in exc.source_limits[:1]]
-    remedies += ["allow_extrapolation = true goes beyond it"] if exc.soft else []
-    return text + (f"; {', or '.join(remedies)}" if remedies else "")
-
-
 def parameter_rows(drive: Drive, sources: dict | None = None) -> list[dict]:
     """Every drive-file key of ``drive``: value (SI), unit, symbol, meaning and source."""
     sources = sources or {}
-    rows = []
-    for key, spec in DRIVE_KEYS.items():
-        unit = spec.unit if spec.unit in _SI_UNITS else ""
-        rows.append({"key": key, "value": _field(drive, key), "unit": unit,
-                     "display_unit": spec.display, "symbol": spec.symbol, "meaning": spec.text,
-                     "source": sources.get(key, spec.source)})
-    return rows
+    return [{"key": key, "value": _field(drive, key), "unit": spec.unit if spec.unit in _SI_UNITS else "",
+             "display_unit": spec.display, "symbol": spec.symbol, "meaning": spec.text,
+             "source": sources.get(key, spec.source)} for key, spec in DRIVE_KEYS.items()]
 
 
 def _number(value: float) -> str:
@@ -463,8 +427,6 @@ def _shown(value, spec: DriveKey) -> str:
         return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
     si_unit = "s" if spec.unit == "flyback" else spec.unit  # a stated fly-back time
     if spec.display and spec.display != si_unit:
-        from passmd.runtime.units import from_si
-
         text = f"{float(from_si(value, spec.display)):.12g} {spec.display}"
         if parse_quantity(text, si_unit) == value:
             return f'"{text}"'
@@ -481,8 +443,7 @@ def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None =
     2ζ√(k_p m_a) of its own k_p and m_a (it then reads back exactly too, and ``drive show``
     derives c_p from it).
     """
-    if not isinstance(drive, Drive):
-        raise InputError(f"drive = {drive!r} is not a Drive", name="drive", value=drive)
+    check_drive(drive)
     sources = sources or {}
     lines = [f"# {title or 'passmd drive file'}",
              "# Values: a string with a unit (\"0.5 mm\", \"1.5e-5 kg\") or a bare number in SI units.",

@@ -45,7 +45,6 @@ from passmd.model.contact_kernels import (
     contact_update,
 )
 from passmd.model.parameters import Drive, check_contact_plausible, check_drive
-from passmd.model.theory import contact_layout, contact_moduli
 from passmd.runtime.validation import check_array, check_range
 
 if TYPE_CHECKING:  # pandas is imported where a DataFrame is built (start-up time)
@@ -126,7 +125,7 @@ class MDRContact:
         one-contact drive has side 0 only; a drive with ``contact_groups`` has one side per group
         (its own F_N and radius).
         """
-        forces, _, radii = contact_layout(check_drive(drive))
+        forces, _, radii = check_drive(drive).contact_layout
         if isinstance(side, bool) or side not in range(len(forces)):
             raise ValueError(
                 f"side = {side!r} is out of range: must be one of {list(range(len(forces)))} "
@@ -137,7 +136,7 @@ class MDRContact:
             capacity = check_capacity(capacity)
         else:
             springs = check_springs(springs)
-        E_star, G_star = contact_moduli(drive)
+        E_star, G_star = drive.contact_moduli
         F, R, mu = float(forces[side]), float(radii[side]), drive.friction_coefficient
         # the drive checked its contacts' force, radius and moduli (and a <= R/10): built unchecked
         contact = cls.__new__(cls)

@@ -3,23 +3,26 @@ plausible ranges.
 
 A :class:`Drive` gathers the geometry, preload, friction, masses, model choices and the parts of
 :mod:`passmd.model.tables` (materials, Table 2 actuator, amplifier); its contacts are the paper's
-one or six (Eq. 1) or any arrangement of :class:`ContactGroup` s. Every number of a drive is
-checked on construction against :data:`PLAUSIBLE_RANGES`: hard limits where the model's physics
-breaks (positive quantities, a Hertz contact radius a <= R/10), soft limits two decades around
-Tables 1–2 where it was checked, which ``allow_extrapolation`` lifts. The library and the command
-line check against this one table. All quantities are SI; :func:`paper_drive` gives the paper's
-drive for one of Table 2's radii.
+one or six (Eq. 1) or any arrangement of :class:`ContactGroup` s, whose normal forces and
+moduli the drive computes once (:attr:`Drive.contact_layout`, :attr:`Drive.contact_moduli`).
+Every number of a drive is checked on construction against :data:`PLAUSIBLE_RANGES`: hard limits
+where the model's physics breaks (positive quantities, a Hertz contact radius a <= R/10), soft
+limits two decades around Tables 1–2 where it was checked, which ``allow_extrapolation`` lifts.
+The library and the command line check against this one table. All quantities are SI;
+:func:`paper_drive` gives the paper's drive for one of Table 2's radii.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import NamedTuple
 
 import numpy as np
 
 from passmd.model import arrangement
 from passmd.model.arrangement import PAPER_SIX as PAPER_SIX
-from passmd.model.arrangement import ContactGroup
+from passmd.model.arrangement import ContactGroup, group_normal_forces, preset_groups
+from passmd.model.hertz import _require_normal, _shear, _youngs
 from passmd.model.tables import (
     ACTUATOR_DAMPING_RATIO,
     RUBY,
@@ -37,7 +40,6 @@ from passmd.model.tables import (
 # that still name this module for them (passmd.experiments.numerics.figures and
 # passmd.experiments.driving_waveform.figures); they are documented in passmd.model.tables.
 from passmd.model.tables import MOLYBDENUM as MOLYBDENUM
-from passmd.model.theory import contact_layout, contact_moduli
 from passmd.runtime.validation import (
     InputError,
     check_choice,
@@ -53,6 +55,7 @@ __all__ = [
     "HERTZ_PRESSURE_LIMIT",
     "PLAUSIBLE_RANGES",
     "ContactGroup",
+    "ContactLayout",
     "Drive",
     "PlausibleRange",
     "check_contact_plausible",
@@ -60,6 +63,18 @@ __all__ = [
     "check_plausible",
     "paper_drive",
 ]
+
+
+class ContactLayout(NamedTuple):
+    """A drive's contact groups (Eq. 1), one entry per group, read-only arrays.
+
+    One contact: ``([F_p], [1], [R])``; the paper's six: ``([F_N1, F_N2], [2, 4], [R, R])``;
+    a drive with ``contact_groups``: one entry per :class:`~passmd.model.arrangement.ContactGroup`.
+    """
+
+    normal_forces: np.ndarray  # normal force per contact, N (Eq. 1)
+    counts: np.ndarray  # contacts per group (float, as the kernels take it)
+    radii: np.ndarray  # hemisphere radius of each group, m
 
 
 @dataclass(frozen=True)
@@ -143,6 +158,10 @@ class Drive:
         if isinstance(self.contacts, np.integer):
             object.__setattr__(self, "contacts", int(self.contacts))
         _check_parts_plausible(self, allow_extrapolation=self.allow_extrapolation)
+        # computed once here, each a normal double (else refused naming the inputs), then trusted
+        object.__setattr__(self, "_contact_moduli", _moduli(self))
+        object.__setattr__(self, "_contact_layout", _layout(self))
+        _check_contacts_plausible(self, allow_extrapolation=self.allow_extrapolation)
 
     def replace(self, **changes) -> Drive:
         """A copy with some fields changed (validated again).
@@ -158,6 +177,43 @@ class Drive:
     def effective_load_cell_stiffness(self) -> float:
         """k if the load cell is engaged, else 0 (free runner)."""
         return self.load_cell_stiffness if self.load_cell else 0.0
+
+    @property
+    def contact_layout(self) -> ContactLayout:
+        """Normal force per contact (Eq. 1), contacts and hemisphere radius of each contact group."""
+        return self._contact_layout
+
+    @property
+    def contact_moduli(self) -> tuple[float, float]:
+        """(E*, G*) of the hemisphere/runner pair, Pa (Eq. 4)."""
+        return self._contact_moduli
+
+
+def _moduli(drive: Drive) -> tuple[float, float]:
+    """(E*, G*) of a drive's materials (checked by the drive), each a normal double."""
+    h, r = drive.hemisphere_material, drive.runner_material
+    args = (h.youngs_modulus, h.poissons_ratio, r.youngs_modulus, r.poissons_ratio)
+    E_star, G_star = float(_youngs(*args)), float(_shear(*args))
+    moduli = (("hemisphere_material.youngs_modulus", h.youngs_modulus, "Pa"),
+              ("runner_material.youngs_modulus", r.youngs_modulus, "Pa"))
+    _require_normal(E_star, "E*", "Pa", moduli)
+    _require_normal(G_star, "G*", "Pa", moduli)
+    return E_star, G_star
+
+
+def _layout(drive: Drive) -> ContactLayout:
+    """Eq. 1 for a drive's groups (the paper's one or six as theirs), each force a normal double."""
+    groups = drive.contact_groups or preset_groups(drive.contacts)
+    # the paper's six: F_p/(2 sin 45°), F_p/(4 sin 45°) exactly
+    forces = group_normal_forces(np.asarray(float(drive.preload)), groups)
+    for force in reversed(forces):  # the paper's six: the smaller F_N2 first
+        _require_normal(force, "the normal force per contact", "N", (("preload", drive.preload, "N"),))
+    R = float(drive.hemisphere_radius)
+    arrays = (np.array([float(f) for f in forces]), np.array([g.count for g in groups], dtype=float),
+              np.array([R if g.radius is None else float(g.radius) for g in groups]))
+    for a in arrays:
+        a.setflags(write=False)
+    return ContactLayout(*arrays)
 
 
 # --------------------------------------------------------------------------------------
@@ -349,6 +405,7 @@ def check_plausible(drive: Drive, *, allow_extrapolation: bool = False) -> None:
                  "load_cell_stiffness"):
         PLAUSIBLE_RANGES[name].check(name, getattr(drive, name), allow_extrapolation=allow_extrapolation)
     _check_parts_plausible(drive, allow_extrapolation=allow_extrapolation)
+    _check_contacts_plausible(drive, allow_extrapolation=allow_extrapolation)
 
 
 def _check_parts_plausible(drive: Drive, *, allow_extrapolation: bool) -> None:
@@ -371,20 +428,21 @@ def _check_parts_plausible(drive: Drive, *, allow_extrapolation: bool) -> None:
                                               **kw)
     for name in ("peak_to_peak_voltage", "slew_rate"):
         r[f"amplifier.{name}"].check(f"amplifier.{name}", getattr(amp, name), **kw)
-    E_star, _ = contact_moduli(drive)
-    forces, _, radii = contact_layout(drive)  # Eq. 1; the most loaded contact first (it fails first)
+
+
+def _check_contacts_plausible(drive: Drive, *, allow_extrapolation: bool) -> None:
+    """Each contact group of a drive against Hertz's assumptions (:func:`check_contact_plausible`)."""
+    E_star, _ = drive.contact_moduli
+    forces, _, radii = drive.contact_layout  # Eq. 1; the most loaded contact first (it fails first)
     for g in np.argsort(-forces / radii ** 2, kind="stable"):  # a/R and p0 grow as (F/R²)^(1/3)
-        check_contact_plausible(forces[g], radii[g], E_star, names="preload, hemisphere_radius, "
-                                "materials", sources=_CONTACT_SOURCES, **kw)
+        check_contact_plausible(forces[g], radii[g], E_star, names="preload, hemisphere_radius, materials",
+                                sources=_CONTACT_SOURCES, allow_extrapolation=allow_extrapolation)
 
 
 #: The drive's fields the Hertz contact of :func:`check_contact_plausible` depends on.
 _CONTACT_SOURCES = ("preload", "hemisphere_radius", "hemisphere_material.youngs_modulus",
                     "hemisphere_material.poissons_ratio", "runner_material.youngs_modulus",
                     "runner_material.poissons_ratio")
-
-
-
 
 
 def paper_drive(hemisphere_radius: float = 1.0e-3, preload: float = 0.4, **changes) -> Drive:

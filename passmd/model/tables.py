@@ -13,6 +13,7 @@ parts is :class:`passmd.model.parameters.Drive`.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, fields
 
 import numpy as np
@@ -36,6 +37,7 @@ __all__ = [
     "actuator_viscosity",
     "check_flyback_rule",
     "parameter_table",
+    "table2_source",
 ]
 
 
@@ -151,6 +153,16 @@ def actuator_for_radius(
     """
     radius = check_positive("hemisphere_radius", hemisphere_radius, "m")
     return _table2_actuator(radius, check_range("damping_ratio", damping_ratio, 0.0, unit="–"))
+
+
+def table2_source(radius: float) -> str:
+    """Where a radius's actuator comes from in Table 2: a row, interpolated or clamped."""
+    radii = sorted(TABLE2_RADII)
+    if any(math.isclose(radius, r, rel_tol=1e-9) for r in radii):
+        return f"Table 2 (R = {radius * 1e3:g} mm)"
+    if radii[0] < radius < radii[-1]:
+        return f"Table 2 interpolated at R = {radius * 1e3:.4g} mm"
+    return f"Table 2 clamped (R = {radius * 1e3:.4g} mm outside {radii[0] * 1e3:g}–{radii[-1] * 1e3:g} mm)"
 
 
 def _table2_actuator(radius: float, zeta: float) -> Actuator:

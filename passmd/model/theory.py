@@ -1,42 +1,33 @@
 """The paper's closed forms for a whole drive: Eq. 1's normal forces and Eqs. 7–14.
 
-The normal force per contact (Eq. 1), the effective moduli of a drive's material pair, the
-presliding displacement (Eqs. 7, 10), the actuator's deformation (Eqs. 9, 14), Teidelt's
-combination of the two contact sides (Eqs. 11, 12), all of them for one drive
-(:func:`drive_theory`), the runner's natural frequency on its contacts, the total friction limit
-and the rigid Coulomb limit of a saw-tooth drive. They build on the single-contact closed forms
-of :mod:`passmd.model.hertz` (its MDR conventions for E* and G*). Every function is vectorised
-and uses SI units; the public ones check their arguments (``ValueError``/``TypeError`` naming the
-parameter, its value and the allowed range) and refuse a result that double precision cannot
-hold to its full relative precision (below the smallest normal double, 2.2e-308). The drive's
-closed forms name the drive's parameters instead.
+The normal force per contact (Eq. 1), the presliding displacement (Eqs. 7, 10), the actuator's
+deformation (Eqs. 9, 14), Teidelt's combination of the two contact sides (Eqs. 11, 12), all of
+them for one drive (:func:`drive_theory`, from the Eq. 1 layout and moduli the
+:class:`~passmd.model.parameters.Drive` computed once), the runner's natural frequency on its
+contacts, the total friction limit and the rigid Coulomb limit of a saw-tooth drive. They build on
+the single-contact closed forms of :mod:`passmd.model.hertz` (its MDR conventions for E* and G*).
+Every function is vectorised and uses SI units; the public ones check their arguments
+(``ValueError``/``TypeError`` naming the parameter, its value and the allowed range) and refuse a
+result that double precision cannot hold to its full relative precision (below the smallest
+normal double, 2.2e-308). The drive's closed forms name the drive's parameters instead.
 """
 
 from __future__ import annotations
 
 import reprlib
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from passmd.model.arrangement import group_normal_forces, group_sides, preset_groups
-from passmd.model.defaults import PROTOCOL
-from passmd.model.hertz import _TINY, _hertz_cube, _positive, _require_normal, _shear, _youngs
+from passmd.model.arrangement import group_sides, preset_groups
+from passmd.model.hertz import _TINY, _hertz_cube, _positive, _require_normal
+from passmd.model.parameters import ContactLayout, Drive
 from passmd.runtime.validation import check_array
 
-if TYPE_CHECKING:  # the closed forms read a drive's fields; parameters imports this module
-    from passmd.model.parameters import Drive
-
 SIN45 = np.sin(np.pi / 4)
-#: The fields of a drive the closed forms read (a drive is checked for them, not for its class:
-#: passmd.model.parameters imports this module).
-_DRIVE_FIELDS = ("preload", "contacts", "hemisphere_radius", "friction_coefficient", "hemisphere_material",
-                 "runner_material", "actuator", "actuator_model", "runner_mass",
-                 "effective_load_cell_stiffness")
 
 
 def _check_drive(drive) -> None:
-    if not all(hasattr(drive, field) for field in _DRIVE_FIELDS):
+    if not isinstance(drive, Drive):
         raise TypeError(f"drive = {reprlib.repr(drive)} is not allowed: "
                         "must be a passmd.model.parameters.Drive")
 
@@ -50,20 +41,9 @@ def _check_contacts(contacts) -> int:
 
 
 def contact_moduli(drive: Drive) -> tuple[float, float]:
-    """(E*, G*) of the hemisphere/runner pair of a drive, in Pa."""
+    """(E*, G*) of the hemisphere/runner pair of a drive, in Pa (:attr:`Drive.contact_moduli`)."""
     _check_drive(drive)
-    return _contact_moduli(drive)
-
-
-def _contact_moduli(drive: Drive) -> tuple[float, float]:
-    h, r = drive.hemisphere_material, drive.runner_material
-    args = (h.youngs_modulus, h.poissons_ratio, r.youngs_modulus, r.poissons_ratio)
-    E_star, G_star = float(_youngs(*args)), float(_shear(*args))
-    moduli = (("hemisphere_material.youngs_modulus", h.youngs_modulus, "Pa"),
-              ("runner_material.youngs_modulus", r.youngs_modulus, "Pa"))
-    _require_normal(E_star, "E*", "Pa", moduli)
-    _require_normal(G_star, "G*", "Pa", moduli)
-    return E_star, G_star
+    return drive.contact_moduli
 
 
 def normal_forces(preload, contacts: int = 6):
@@ -179,11 +159,10 @@ def drive_theory(drive: Drive) -> dict:
     ``analytic_critical_amplitude_m`` (the one matching ``drive.actuator_model``).
     """
     _check_drive(drive)
-    E_star, G_star = _contact_moduli(drive)
+    E_star, G_star = drive.contact_moduli
     mu = drive.friction_coefficient
     act = drive.actuator
-    forces, _, R = contact_layout(drive)
-    R = R if getattr(drive, "contact_groups", ()) else drive.hemisphere_radius  # the paper's: one R
+    forces, _, R = drive.contact_layout
     preload = ("preload", drive.preload, "N")
     a = _drive_contact_radius(drive, forces, E_star, R)
     u_max = _presliding(forces, R, E_star, G_star, mu)
@@ -236,49 +215,24 @@ def first_flyback_critical_amplitude(drive: Drive) -> float:
     return float(np.max(drive_theory(drive)["presliding_m"]))
 
 
-def _drive_contact_radius(drive: Drive, forces: np.ndarray, E_star: float, radii=None) -> np.ndarray:
+def _drive_contact_radius(drive: Drive, forces: np.ndarray, E_star: float, radii) -> np.ndarray:
     """Hertz contact radius per group of a (validated) drive; its cube a normal double (else refused)."""
-    cube = _hertz_cube(forces, drive.hemisphere_radius if radii is None else radii, E_star)
+    cube = _hertz_cube(forces, radii, E_star)
     _require_normal(cube, "the Hertz contact radius cubed, 3 F_N R / (4 E*),", "m^3",
                     (("preload", drive.preload, "N"), ("hemisphere_radius", drive.hemisphere_radius, "m"),
                      ("E*", E_star, "Pa")))
     return np.cbrt(cube)
 
 
-def _drive_forces(drive: Drive) -> tuple:
-    """Eq. 1 for a (validated) drive, each force a normal double (else refused naming the preload)."""
-    F = np.asarray(float(drive.preload))
-    groups = getattr(drive, "contact_groups", ()) or preset_groups(drive.contacts)
-    forces = group_normal_forces(F, groups)  # the paper's six: F_p/(2 sin 45°), F_p/(4 sin 45°) exactly
-    for force in reversed(forces):  # the paper's six: the smaller F_N2 first
-        _require_normal(force, "the normal force per contact", "N", (("preload", drive.preload, "N"),))
-    return forces
-
-
-def _multiplicity(drive: Drive) -> tuple:
-    groups = getattr(drive, "contact_groups", ())
-    if groups:
-        return tuple(g.count for g in groups)
-    return (1,) if drive.contacts == 1 else PROTOCOL.contacts_per_side
-
-
-def _radii(drive: Drive) -> np.ndarray:
-    groups = getattr(drive, "contact_groups", ())
-    R = float(drive.hemisphere_radius)
-    return np.array([R if not groups or g.radius is None else float(g.radius) for g in groups] if groups
-                    else [R] * len(_multiplicity(drive)))
-
-
-def contact_layout(drive: Drive) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def contact_layout(drive: Drive) -> ContactLayout:
     """The drive's contact groups: normal force per contact (N, Eq. 1), contacts per group, and
-    the hemispheres' radius of each group (m).
+    the hemispheres' radius of each group (m); the drive computed them (:attr:`Drive.contact_layout`).
 
     One contact: ``([F_p], [1], [R])``; the paper's six: ``([F_N1, F_N2], [2, 4], [R, R])``;
     a drive with ``contact_groups``: one entry per :class:`~passmd.model.parameters.ContactGroup`.
     """
     _check_drive(drive)
-    forces = np.array([float(f) for f in _drive_forces(drive)])
-    return forces, np.array(_multiplicity(drive), dtype=float), _radii(drive)
+    return drive.contact_layout
 
 
 def contact_arrangement(drive: Drive) -> list[dict]:
@@ -291,8 +245,8 @@ def contact_arrangement(drive: Drive) -> list[dict]:
     ``preload_share_N`` (n F_N sin α, what the group carries of its side's F_p).
     """
     _check_drive(drive)
-    groups = getattr(drive, "contact_groups", ()) or preset_groups(drive.contacts)
-    forces, counts, radii = contact_layout(drive)
+    groups = drive.contact_groups or preset_groups(drive.contacts)
+    forces, counts, radii = drive.contact_layout
     rows = []
     for g, side, F, n, R in zip(groups, group_sides(groups), forces, counts, radii, strict=True):
         source = ("normal_force" if g.normal_force is not None else
@@ -310,12 +264,10 @@ def runner_frequency(drive: Drive) -> float:
     load cell when engaged. This is the micro-vibration frequency's linear estimate.
     """
     _check_drive(drive)
-    E_star, G_star = _contact_moduli(drive)
-    forces, _, radii = contact_layout(drive)
-    radii = radii if getattr(drive, "contact_groups", ()) else drive.hemisphere_radius
+    E_star, G_star = drive.contact_moduli
+    forces, counts, radii = drive.contact_layout
     stiffness = 2.0 * _drive_contact_radius(drive, forces, E_star, radii) * G_star  # 2aG* per group
-    multiplicity = _multiplicity(drive)
-    k_total = sum(m * float(k) for m, k in zip(multiplicity, stiffness, strict=True))
+    k_total = sum(int(m) * float(k) for m, k in zip(counts, stiffness, strict=True))
     k_total += drive.effective_load_cell_stiffness
     return float(np.sqrt(k_total / drive.runner_mass) / (2 * np.pi))
 
@@ -326,10 +278,9 @@ def friction_limit(drive: Drive) -> float:
     Six contacts: μ (2 F_N1 + 4 F_N2) = 2√2 μ F_p; one contact: μ F_p.
     """
     _check_drive(drive)
-    forces = _drive_forces(drive)
-    multiplicity = _multiplicity(drive)
-    return float(drive.friction_coefficient * sum(m * float(F) for m, F in zip(multiplicity, forces,
-                                                                                  strict=True)))
+    forces, counts, _ = drive.contact_layout
+    return float(drive.friction_coefficient * sum(int(m) * float(F) for m, F in zip(counts, forces,
+                                                                                       strict=True)))
 
 
 def coulomb_sawtooth_step(amplitude, frequency, flyback_time, friction_force, runner_mass):

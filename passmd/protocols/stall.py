@@ -60,7 +60,7 @@ import numpy as np
 from passmd.model import waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
-from passmd.model.theory import friction_limit, normal_forces
+from passmd.model.theory import friction_limit
 from passmd.protocols.critical_amplitude import critical_amplitude
 from passmd.runtime.validation import check_positive, check_range
 from passmd.solver import simulation
@@ -453,7 +453,7 @@ def stall_cycle(
     friction = result.friction_force[:, sel] * n[:, None]
     deflection = x_p[None, :] - result.actuator_position[:, sel]
     slip = result.slip_share[:, sel]
-    forces = np.asarray(normal_forces(drive.preload, 6), dtype=float)
+    forces = drive.contact_layout.normal_forces  # Eq. 1, as the simulation's groups
     capacity = float(drive.friction_coefficient * np.sum(n * forces))
     out = {
         "time_s": t,

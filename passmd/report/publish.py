@@ -8,7 +8,8 @@
   the ``passmd`` version, git commit and profile (:mod:`passmd.runtime.provenance`), optionally
   with the data link. The CSV files carry the same three facts as ``#`` header lines.
 * :func:`to_unit` and :func:`format_quantity` convert SI values to the units shown at the
-  edges (nm, N, mN, mm, kHz, mm/s, ...); conversions are done by ``pint``.
+  edges (nm, N, mN, mm, kHz, mm/s, ...) with the package's converter,
+  :func:`passmd.runtime.units.from_si`.
 * :func:`parameter_frame`, :func:`assumptions_frame` and :func:`implementations` turn the
   package's own records (parameter sets, the assumptions registry, the functions that
   implement each equation) into tables, so the book never retypes them.
@@ -24,12 +25,12 @@ import importlib
 import inspect
 import os
 import re
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
 from passmd.runtime import provenance
+from passmd.runtime.units import from_si
 from passmd.runtime.validation import check_choice
 
 __all__ = [
@@ -170,31 +171,14 @@ def text_link(text: str, filename: str, *, label: str | None = None, root=None) 
     return Markdown(f"{{download}}`{shown} </{_DATA_SUBDIR.as_posix()}/{filename}>`")
 
 
-@lru_cache(maxsize=1)
-def _registry():
-    import pint
-
-    return pint.UnitRegistry()
-
-
-@lru_cache(maxsize=64)
-def _si_factor(unit: str) -> float:
-    """Size of one ``unit`` in SI base units (e.g. 1e-9 for nm, 1e3 for kHz)."""
-    try:
-        quantity = _registry().Quantity(1.0, unit).to_base_units()
-    except Exception as err:  # pint raises several error types for unknown units
-        raise ValueError(f"unit = {unit!r} is not a unit pint understands") from err
-    return float(quantity.magnitude)
-
-
 def to_unit(value_si, unit: str):
     """Convert an SI value (scalar or array) to ``unit`` (e.g. m → ``"nm"``, Hz → ``"kHz"``).
 
     The caller must pass a value in the SI unit of the same dimension (m, kg, s, N, Hz, m/s,
-    N/m, ...); only the scale is converted. Returns a float for a scalar, an array otherwise.
+    N/m, ...); only the scale is converted (:func:`passmd.runtime.units.from_si`). Returns a
+    float for a scalar, an array otherwise.
     """
-    factor = _si_factor(unit)
-    result = np.asarray(value_si, dtype=float) / factor
+    result = from_si(np.asarray(value_si, dtype=float), unit)
     return float(result) if result.ndim == 0 else result
 
 

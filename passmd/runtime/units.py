@@ -3,7 +3,9 @@
 Inside the package everything is SI. Users type quantities with units —
 ``0.4N``, ``1mm``, ``0.25 mm``, ``202nm``, ``100kHz``, ``310GPa`` — which
 :func:`parse_quantity` converts to SI with the units library `pint`. A bare number
-is read in the *display unit* the option documents (``--radius 0.25`` is 0.25 mm).
+is SI: it is read where the expected unit is SI (``--preload 0.4``, a drive file's
+``preload = 0.4``) and refused where the expected unit is another (``--radius 0.25``,
+shown in mm, asks for ``0.25mm``), so no number is ever read in a unit nobody wrote.
 A quantity of the wrong dimension (``--radius 3N``) raises :class:`QuantityError`,
 a :class:`ValueError` naming the option, the value and the expected unit.
 
@@ -123,11 +125,15 @@ def registry() -> pint.UnitRegistry:  # noqa: F821 - pint is imported on first u
     return pint.UnitRegistry()
 
 
+@functools.lru_cache(maxsize=64)
 def _si_factor(unit: str) -> float:
-    """SI magnitude of one ``unit`` (``"nm"`` → 1e-9)."""
+    """SI magnitude of one ``unit`` (``"nm"`` → 1e-9); ``QuantityError`` for a unit pint does not know."""
     factor = _DISPLAY_FACTORS.get(unit)
     if factor is None:
-        factor = registry().Quantity(1.0, _unit(unit)).to_base_units().magnitude
+        try:
+            factor = registry().Quantity(1.0, _unit(unit)).to_base_units().magnitude
+        except Exception as err:  # pint raises several error types for unknown units
+            raise QuantityError(f"unit = {unit!r} is not a unit pint understands") from err
     return factor
 
 
@@ -171,7 +177,7 @@ def parse_quantity(text, unit: str, *, name: str = "value") -> float:
     ----------
     text : str or real
         ``"0.25mm"``, ``"0.25 mm"``, ``"250um"``, or a bare number (``"0.25"`` or
-        ``0.25``) which is read in ``unit``.
+        ``0.25``), which is SI: read where ``unit`` is SI, refused where it is not.
     unit : str
         The display unit (``"mm"``, ``"nm"``, ``"N"``, ``"kHz"``, ``"GPa"``, ``"g"``,
         ``"N/m"``, ``"kg/s"``; ``""`` for a plain number). It also fixes the
@@ -188,9 +194,10 @@ def parse_quantity(text, unit: str, *, name: str = "value") -> float:
     ------
     QuantityError
         If the text is not a finite number with an optional unit, the unit is
-        unknown, or its dimension differs from ``unit``'s.
+        unknown, or its dimension differs from ``unit``'s; or a bare number where ``unit``
+        is not SI (naming ``name``, the number and both units it may be written in).
     """
-    shown = f" (a bare number is read in {unit})" if unit else ""
+    shown = f" (a bare number is read in {unit})" if unit and _DISPLAY_FACTORS.get(unit) == 1.0 else ""
     if isinstance(text, bool):
         raise QuantityError(f"{name} = {text!r} is not a quantity: give a number{shown}")
     if isinstance(text, (int, float)):
@@ -204,10 +211,14 @@ def parse_quantity(text, unit: str, *, name: str = "value") -> float:
                 f"e.g. {example}{shown}"
             )
         number_text, unit_text = match.group(1), match.group(2)
+    if not unit_text and _si_factor(unit) != 1.0 and _QUANTITY.match(str(text)):  # bare, unit not SI
+        typed, si = str(text).strip(), _DISPLAY_BASES.get(unit, "")
+        raise QuantityError(f"{name} = {typed} has no unit: write one, e.g. {typed}{si} or {typed}{unit} "
+                            f"(an option shown in {unit} takes no bare number; a bare number is SI only "
+                            "where the option is shown in SI)")
     if not math.isfinite(float(number_text)):
         raise QuantityError(f"{name} = {text!r} is not a finite number")
-    if not unit_text:
-        # a bare number is in the display unit: no registry needed
+    if not unit_text:  # a bare number in an SI unit: no registry needed
         return float(Decimal(number_text) * Decimal(repr(float(_si_factor(unit)))))
     base = _DISPLAY_BASES.get(unit_text)
     if base is not None and base == _DISPLAY_BASES.get(unit):
@@ -336,7 +347,7 @@ def parse_angle(text, *, name: str = "angle") -> float:
 def parse_quantities(text: str, unit: str, *, name: str = "value") -> list[float]:
     """Read a comma-separated list of quantities (``"0nm,30nm,-10nm,45nm"``) into SI.
 
-    Each element follows :func:`parse_quantity`; bare numbers are in ``unit``.
+    Each element follows :func:`parse_quantity` (a bare number is SI, refused where ``unit`` is not).
     """
     parts = str(text).split(",")
     if not parts or any(not p.strip() for p in parts):

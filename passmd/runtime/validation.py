@@ -229,3 +229,19 @@ def safe_bound(op: str, bound: float, digits: int = 4) -> str:
     step = Decimal(1).scaleb(exact.adjusted() - digits + 1)
     rounded = exact.quantize(step, rounding=ROUND_CEILING if op.startswith(">") else ROUND_FLOOR)
     return f"{float(rounded):.{digits}g}"
+
+
+def file_message(exc: InputError) -> str:
+    """``exc`` in a drive file's terms: a quantity derived from a key (the damping ratio from
+    ``actuator.viscosity``, :meth:`InputError.derived_from`) names the key, its value as read and
+    the key's limit in SI."""
+    if not (exc.quantity and exc.source and exc.limits):
+        return str(exc)
+    unit = f" {exc.unit}" if exc.unit and exc.unit != "–" else ""
+    limits = " and ".join(f"{op} {safe_bound(op, bound)}{unit}" for op, bound in exc.limits)
+    text = (f"{exc.quantity} derived from {exc.source} = {shown(exc.source_value)} is "
+            f"{float(exc.value):.4g}, out of range: must be {limits}" + (f" ({exc.why})" if exc.why else ""))
+    remedies = [f"{LIMIT_VERBS[op].format(exc.source)} {safe_bound(op, bound)} (SI)"
+                for op, bound in exc.source_limits[:1]]
+    remedies += ["allow_extrapolation = true goes beyond it"] if exc.soft else []
+    return text + (f"; {', or '.join(remedies)}" if remedies else "")

@@ -14,7 +14,6 @@ import numpy as np
 
 from passmd.model.contact import drive_contact_arrays, stack_contacts
 from passmd.model.parameters import Drive
-from passmd.model.theory import contact_layout
 from passmd.solver.steps import Scheme, StepPlan
 
 #: Verlet is stable for ω dt < 2; a given step (``Scheme.dt``) must keep
@@ -22,26 +21,30 @@ from passmd.solver.steps import Scheme, StepPlan
 STABILITY_MARGIN = 0.9
 
 
+def _groups(drive: Drive, share_side_state: bool):
+    """Normal force, multiplicity and radius of each group of the drive's layout (Eq. 1); with
+    ``share_side_state=False`` every contact is a group of one."""
+    forces, multiplicity, radii = drive.contact_layout
+    if share_side_state:  # the drive's arrays are read-only; numba compiles the kernels for writable ones
+        return forces, multiplicity.copy(), radii
+    per = multiplicity.astype(int)
+    return np.repeat(forces, per), np.ones(int(per.sum())), np.repeat(radii, per)
+
+
 def contact_groups(drive: Drive, share_side_state: bool = True):
     """Normal force and multiplicity of each contact group (Eq. 1; any arrangement,
-    :func:`passmd.model.theory.contact_layout`).
+    :attr:`passmd.model.parameters.Drive.contact_layout`).
 
     With ``share_side_state=False`` every contact is a group of one, so that results do not
     rely on the by-symmetry sharing of one state per group.
     """
-    forces, multiplicity, _ = contact_layout(drive)
-    if share_side_state:
-        return forces, multiplicity
-    return np.repeat(forces, multiplicity.astype(int)), np.ones(int(multiplicity.sum()))
+    return _groups(drive, share_side_state)[:2]
 
 
 def contact_rows(drive: Drive, contact_model: str, springs: int, share_side_state: bool):
     """Contact parameters and state of every group (:func:`passmd.model.contact.stack_contacts`) and
     the groups' multiplicities (:func:`contact_groups`)."""
-    forces, multiplicity = contact_groups(drive, share_side_state)
-    _, counts, radii = contact_layout(drive)
-    if not share_side_state:
-        radii = np.repeat(radii, counts.astype(int))
+    forces, multiplicity, radii = _groups(drive, share_side_state)
     discrete = springs if contact_model == "discrete" else None
     rows = [drive_contact_arrays(drive, F, R, discrete) for F, R in zip(forces, radii, strict=True)]
     params, state = stack_contacts(rows)

@@ -8,7 +8,7 @@ import numpy as np
 
 from passmd.cli.drive import build_drive
 from passmd.cli.errors import UsageError
-from passmd.cli.options import DEFAULT_DRIVE, NORMAL_FORCE, add_drive_options, refuse_bare
+from passmd.cli.options import DEFAULT_DRIVE, NORMAL_FORCE, add_drive_options
 from passmd.cli.output import JSON_HELP, check_results, emit_json, fmt
 from passmd.model.parameters import check_contact_plausible
 from passmd.runtime.units import from_si, parse_quantities
@@ -56,8 +56,6 @@ def run_contact(args, out) -> int:
 
     if args.path is None:
         raise UsageError("--path is required, e.g. --path 0nm,30nm,-10nm,45nm")
-    for part in args.path.split(","):
-        refuse_bare("--path", part, "nm") if part.strip() else None
     path = parse_quantities(args.path, "nm", name="--path")
     normal = NORMAL_FORCE.parse_or(args, DEFAULT_DRIVE.preload)
     springs = check_springs(args.springs)

@@ -15,7 +15,6 @@ from passmd.cli.options import (
     DirectoryPath,
     add_drive_options,
     add_sweep_options,
-    refuse_bare,
 )
 from passmd.cli.output import (
     JSON_HELP,
@@ -133,8 +132,6 @@ def _bounds(args, names) -> dict[str, tuple[float, float]]:
             raise UsageError(f"--bounds = {text!r} names {name!r}, which is not in --free "
                              f"({', '.join(names)})")
         unit = FREE_NAMES[name][1]
-        for v in (low, high):
-            refuse_bare(f"--bounds {name}", v, unit)
         lo, hi = (parse_quantity(v.strip(), unit, name=f"--bounds {name}") for v in (low, high))
         if not 0 < lo < hi:
             raise UsageError(f"--bounds = {text!r} is out of range: must be 0 < LOW < HIGH")
