@@ -118,7 +118,7 @@ def test_a_page_expects_its_rows_of_the_figure_table():
 
 def test_a_page_expects_a_ledger_where_the_ledger_judges_claims_of_its_figures():
     from passmd.experiments.figure_table import FIGURES, READING_TABLES
-    from passmd.ledger.evaluation import load_claims
+    from passmd.ledger.claims import load_claims
 
     chapter_of = {spec.name: spec.chapter for spec in FIGURES}
     judged = set()
