@@ -26,6 +26,7 @@ from passmd.cli.output import (
     flyback_label,
     plain,
 )
+from passmd.protocols.fit.free_parameters import FREE_PARAMETERS
 from passmd.runtime.units import from_si, parse_quantity
 
 __all__ = ["FREE_NAMES", "add_parser", "run_fit"]
@@ -66,16 +67,16 @@ _EPILOG = textwrap.dedent("""\
     converged, verdict, cost, residual_scale, degrees_of_freedom, flyback, keep, drive{...},
     wall_time_s""")
 
-#: Free parameters as --free names them: the drive option without its dashes, or a derived one;
-#: each with its library name (which --free takes too, as drive show and the drive file name it)
-#: and the unit its --bounds and human output use.
+#: Free parameters (:data:`passmd.protocols.fit.FREE_PARAMETERS`) as --free names them: the drive
+#: option without its dashes, or the library name's last part with dashes; each with its library
+#: name (which --free takes too, as drive show and the drive file name it) and the unit its
+#: --bounds and human output use (the option's, else the SI unit, µs for a time).
+_OPTION_OF = {q.field: (q.flag[2:], q.unit) for q in DRIVE_QUANTITIES}
 FREE_NAMES: dict[str, tuple[str, str]] = {
-    **{q.flag[2:]: (q.field, q.unit) for q in DRIVE_QUANTITIES
-       if q.field in ("friction_coefficient", "actuator.stiffness", "actuator.mass", "actuator.viscosity",
-                      "runner_mass", "amplifier.slew_rate")},
-    "damping-ratio": ("actuator.damping_ratio", ""),
-    "flyback-time": ("flyback_time", "us"),
-    "contact-stiffness-scale": ("contact_stiffness_scale", ""),
+    option: (lib, unit)
+    for lib, free in FREE_PARAMETERS.items()
+    for option, unit in [_OPTION_OF.get(lib, (lib.rpartition(".")[2].replace("_", "-"),
+                                              "us" if free.unit == "s" else free.unit))]
 }
 #: Every name --free and --bounds take: the option names above and the library's (drive-file) names.
 _ALIASES = {**{lib: name for name, (lib, _) in FREE_NAMES.items()}, **{name: name for name in FREE_NAMES}}

@@ -60,104 +60,41 @@ The code: :mod:`~passmd.protocols.fit.measurements` (the measurement files),
 :mod:`~passmd.protocols.fit.result` (:class:`~passmd.protocols.fit.result.FitResult`, the fitted
 drive file); every public name is importable from ``passmd.protocols.fit``."""
 
-from passmd.protocols.fit.checks import check_rows
-from passmd.protocols.fit.estimator import (
-    DISTINCT,
-    GLOBAL_POINTS_PER_PARAMETER,
-    LOCAL_STARTS,
-    LOSSES,
-    MAX_BASINS,
-    POLISH_CANDIDATES,
-    REFIT_MARGIN,
-    REFITS,
-    fit,
-    region_level,
-)
-from passmd.protocols.fit.free_parameters import FREE_PARAMETERS, KEEPS, FreeParameter, default_bounds
-from passmd.protocols.fit.measurements import ANNOTATIONS as ANNOTATIONS
-from passmd.protocols.fit.measurements import (
-    CONDITIONS,
-    MEASURED,
-    MeasurementError,
-    Measurements,
-    measurements_from_rows,
-    read_measurements,
-    write_measurements,
-)
-from passmd.protocols.fit.measurements import MODELS as MODELS
-from passmd.protocols.fit.measurements import READINGS as READINGS
-from passmd.protocols.fit.prediction import predict, predict_point
-from passmd.protocols.fit.problem import GN_STEP_LIMIT, JACOBIAN_STEPS, LOCAL_EVALUATIONS
-from passmd.protocols.fit.profiles import (
-    BOTTOM_DROP,
-    BOTTOM_FIRST,
-    BOTTOM_MAX,
-    BOTTOM_RESOLUTION,
-    BOTTOM_STEPS,
-    FILL_BATCH,
-    FILL_FIRST,
-    FILL_SAFETY,
-    FINE_SPACING,
-    PROBE_POINTS,
-    PROFILE_MIN_POINTS,
-    PROFILE_SPACING,
-    SMOOTH_DEPARTURE,
-)
-from passmd.protocols.fit.regions import BASIN_PROMINENCE
-from passmd.protocols.fit.result import (
-    CORRELATION_LIMIT,
-    REJECT_P,
-    FitResult,
-    fitted_drive_file,
-    goodness_of_fit,
-)
-from passmd.runtime.validation import InputError as InputError
+import importlib
 
-__all__ = [
-    "BOTTOM_DROP",
-    "BOTTOM_FIRST",
-    "BOTTOM_MAX",
-    "BOTTOM_RESOLUTION",
-    "BOTTOM_STEPS",
-    "BASIN_PROMINENCE",
-    "CONDITIONS",
-    "CORRELATION_LIMIT",
-    "DISTINCT",
-    "FILL_BATCH",
-    "FILL_FIRST",
-    "FILL_SAFETY",
-    "FINE_SPACING",
-    "FREE_PARAMETERS",
-    "GLOBAL_POINTS_PER_PARAMETER",
-    "GN_STEP_LIMIT",
-    "JACOBIAN_STEPS",
-    "KEEPS",
-    "LOCAL_EVALUATIONS",
-    "LOCAL_STARTS",
-    "LOSSES",
-    "MAX_BASINS",
-    "MEASURED",
-    "POLISH_CANDIDATES",
-    "PROBE_POINTS",
-    "PROFILE_MIN_POINTS",
-    "PROFILE_SPACING",
-    "REFITS",
-    "REFIT_MARGIN",
-    "REJECT_P",
-    "SMOOTH_DEPARTURE",
-    "FitResult",
-    "FreeParameter",
-    "Measurements",
-    "MeasurementError",
-    "check_rows",
-    "default_bounds",
-    "fit",
-    "fitted_drive_file",
-    "goodness_of_fit",
-    "measurements_from_rows",
-    "predict",
-    "predict_point",
-    "read_measurements",
-    "region_level",
-    "write_measurements",
-]
+#: Every public name, by the module that defines it. They load on first use (module
+#: ``__getattr__``, PEP 562): the command line builds ``--free`` from :data:`FREE_PARAMETERS`
+#: without importing the estimator and the simulator.
+_MODULES = {
+    "checks": ("check_rows",),
+    "estimator": ("DISTINCT", "GLOBAL_POINTS_PER_PARAMETER", "LOCAL_STARTS", "LOSSES", "MAX_BASINS",
+                  "POLISH_CANDIDATES", "REFIT_MARGIN", "REFITS", "fit", "region_level"),
+    "free_parameters": ("FREE_PARAMETERS", "KEEPS", "FreeParameter", "default_bounds"),
+    "measurements": ("CONDITIONS", "MEASURED", "MeasurementError", "Measurements", "measurements_from_rows",
+                     "read_measurements", "write_measurements"),
+    "prediction": ("predict", "predict_point"),
+    "problem": ("GN_STEP_LIMIT", "JACOBIAN_STEPS", "LOCAL_EVALUATIONS"),
+    "profiles": ("BOTTOM_DROP", "BOTTOM_FIRST", "BOTTOM_MAX", "BOTTOM_RESOLUTION", "BOTTOM_STEPS", "FILL_BATCH",
+                 "FILL_FIRST", "FILL_SAFETY", "FINE_SPACING", "PROBE_POINTS", "PROFILE_MIN_POINTS",
+                 "PROFILE_SPACING", "SMOOTH_DEPARTURE"),
+    "regions": ("BASIN_PROMINENCE",),
+    "result": ("CORRELATION_LIMIT", "REJECT_P", "FitResult", "fitted_drive_file", "goodness_of_fit"),
+}
+_MODULE_OF = {name: f"passmd.protocols.fit.{module}" for module, names in _MODULES.items() for name in names}
+#: Names of other modules, importable from here too and documented where they are defined.
+_MODULE_OF.update({"ANNOTATIONS": "passmd.protocols.fit.measurements", "MODELS": "passmd.protocols.fit.measurements",
+                   "READINGS": "passmd.protocols.fit.measurements", "InputError": "passmd.runtime.validation"})
+
+__all__ = sorted(name for names in _MODULES.values() for name in names)
+
+
+def __getattr__(name: str):
+    if name in _MODULE_OF:
+        value = getattr(importlib.import_module(_MODULE_OF[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'passmd.protocols.fit' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_MODULE_OF))
