@@ -70,20 +70,20 @@ _MODULES = {
     "estimator": ("DISTINCT", "GLOBAL_POINTS_PER_PARAMETER", "LOCAL_STARTS", "LOSSES", "MAX_BASINS",
                   "POLISH_CANDIDATES", "REFIT_MARGIN", "REFITS", "fit", "region_level"),
     "free_parameters": ("FREE_PARAMETERS", "KEEPS", "FreeParameter", "default_bounds"),
-    "measurements": ("CONDITIONS", "MEASURED", "MeasurementError", "Measurements", "measurements_from_rows",
-                     "read_measurements", "write_measurements"),
+    "measurements": ("CONDITIONS", "MEASURED", "MeasurementError", "Measurements",
+                     "measurements_from_rows", "read_measurements", "write_measurements"),
     "prediction": ("predict", "predict_point"),
     "problem": ("GN_STEP_LIMIT", "JACOBIAN_STEPS", "LOCAL_EVALUATIONS"),
-    "profiles": ("BOTTOM_DROP", "BOTTOM_FIRST", "BOTTOM_MAX", "BOTTOM_RESOLUTION", "BOTTOM_STEPS", "FILL_BATCH",
-                 "FILL_FIRST", "FILL_SAFETY", "FINE_SPACING", "PROBE_POINTS", "PROFILE_MIN_POINTS",
-                 "PROFILE_SPACING", "SMOOTH_DEPARTURE"),
+    "profiles": ("BOTTOM_DROP", "BOTTOM_FIRST", "BOTTOM_MAX", "BOTTOM_RESOLUTION", "BOTTOM_STEPS",
+                 "FILL_BATCH", "FILL_FIRST", "FILL_SAFETY", "FINE_SPACING", "PROBE_POINTS",
+                 "PROFILE_MIN_POINTS", "PROFILE_SPACING", "SMOOTH_DEPARTURE"),
     "regions": ("BASIN_PROMINENCE",),
     "result": ("CORRELATION_LIMIT", "REJECT_P", "FitResult", "fitted_drive_file", "goodness_of_fit"),
 }
 _MODULE_OF = {name: f"passmd.protocols.fit.{module}" for module, names in _MODULES.items() for name in names}
 #: Names of other modules, importable from here too and documented where they are defined.
-_MODULE_OF.update({"ANNOTATIONS": "passmd.protocols.fit.measurements", "MODELS": "passmd.protocols.fit.measurements",
-                   "READINGS": "passmd.protocols.fit.measurements", "InputError": "passmd.runtime.validation"})
+_MODULE_OF.update(dict.fromkeys(("ANNOTATIONS", "MODELS", "READINGS"), "passmd.protocols.fit.measurements"))
+_MODULE_OF["InputError"] = "passmd.runtime.validation"
 
 __all__ = sorted(name for names in _MODULES.values() for name in names)
 
