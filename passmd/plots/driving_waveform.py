@@ -189,7 +189,7 @@ def plot_fig10c(df):
 
 
 # --------------------------------------------------------------------------------------
-# Beyond the paper (passmd.experiments.driving_waveform.studies)
+# Beyond the paper (passmd.experiments.driving_waveform.figures_studies)
 # --------------------------------------------------------------------------------------
 
 

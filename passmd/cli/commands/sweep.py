@@ -463,8 +463,7 @@ def _check_values(args, column: str, table) -> None:
 
 
 def run_sweep(args, out) -> int:
-    from passmd.experiments.design.maps import compute_map
-    from passmd.protocols.maps import MAP_QUANTITIES
+    from passmd.protocols.maps import MAP_QUANTITIES, compute_map
 
     spec = MAP_QUANTITIES[args.quantity]
     _check_options(args)

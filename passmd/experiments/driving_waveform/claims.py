@@ -22,7 +22,7 @@ import pandas as pd
 from passmd.experiments.driving_waveform.figures import (
     at_section5_friction,
 )
-from passmd.experiments.driving_waveform.runs import (
+from passmd.experiments.driving_waveform.figures_runs import (
     SECTION5_FRICTION,
     WINDOW_SAMPLES_PER_ACCELERATION,
 )

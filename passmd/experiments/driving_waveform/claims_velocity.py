@@ -27,8 +27,8 @@ import pandas as pd
 
 from passmd.experiments.driving_waveform.claims import _fig9a_run
 from passmd.experiments.driving_waveform.figures import FREQUENCIES, PAPER_MAXIMUM_KHZ
-from passmd.experiments.driving_waveform.runs import variant_name
-from passmd.experiments.numerics.accuracy import POSITION_ACCURACY, VELOCITY_ACCURACY
+from passmd.experiments.driving_waveform.figures_runs import variant_name
+from passmd.experiments.model_numerics.facts import POSITION_ACCURACY, VELOCITY_ACCURACY
 from passmd.ledger.checks import ClaimFails, NoRun, NotEvaluable, Scoped, Subset, evidence, extractor
 
 __all__ = ["GRID_STEP_KHZ", "at_frequency", "complete_grid", "controllable_maximum", "eq15_scope",
@@ -336,7 +336,7 @@ def _fig10a_fmax(results, reading):
 
 
 #: What two values of a column of the velocity tables must differ by to be told apart: the stated
-#: accuracy of the integrator (passmd.experiments.numerics.accuracy), in the column's unit.
+#: accuracy of the integrator (passmd.experiments.model_numerics.facts), in the column's unit.
 _RESOLUTION = {"back_step_nm": POSITION_ACCURACY * 1e9, "velocity_mm_per_s": VELOCITY_ACCURACY * 1e3}
 
 
