@@ -55,6 +55,7 @@ def on_paper_grid(ours, key: str, preloads, failures_decide: bool = True):
 
 
 def ac_curve(results, key: str, actuator_model: str, reading) -> dict:
+    """A_c of one panel's readings at a reading: ``{"x": preloads (N), "y": A_c (nm)}``."""
     rows = primary(results[f"{key}_readings"], actuator_model, reading)
     return {"x": rows["preload_N"].to_numpy(), "y": rows["critical_amplitude_nm"].to_numpy()}
 

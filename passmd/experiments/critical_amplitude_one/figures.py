@@ -40,9 +40,9 @@ from passmd.runtime.config import RunConfig
 SECTION4_1_FRICTION = float(readings.axis("friction_coefficient").default)
 
 __all__ = [
-    "AC_PANELS", "FIG5A_DRIVE", "FIGURES", "PROFILE_SETTINGS", "READING_TABLES", "SECTION4_1_FRICTION",
-    "ac_readings", "critical_amplitude_point", "fig5_flyback_steps", "fig5a", "fig5a_readings", "fig5b",
-    "paper_drive_for", "preload_figure", "primary", "run_searches", "step_point",
+    "AC_PANELS", "FIG5A_DRIVE", "FIGURES", "FLYBACK_STEPS_TOLERANCE", "PROFILE_SETTINGS", "READING_TABLES",
+    "SECTION4_1_FRICTION", "ac_readings", "critical_amplitude_point", "fig5_flyback_steps", "fig5a",
+    "fig5a_readings", "fig5b", "paper_drive_for", "preload_figure", "primary", "run_searches", "step_point",
 ]
 
 def paper_drive_for(

@@ -56,7 +56,7 @@ def start_drive(truth: Drive, free: Sequence[str]) -> Drive:
 
 def _measurements(points, truth: Drive, rng, config, flyback=None) -> fit.Measurements:
     """Steps at (frequency, preload, amplitude nm) points:
-    :func:`~passmd.experiments.calibration.synthetic.independent_steps` below 1 kHz (the
+    :func:`~passmd.protocols.synthetic.independent_steps` below 1 kHz (the
     steady-velocity protocol's step above, as a stand measures it there) plus noise of NOISE_NM."""
     header = ["amplitude_nm", "preload_N", "frequency_Hz", "step_nm", "step_nm_sd"]
     rows = [[repr(float(a)), repr(float(p)), repr(float(f)), "0", repr(NOISE_NM)] for f, p, a in points]
@@ -73,7 +73,7 @@ def _measurements(points, truth: Drive, rng, config, flyback=None) -> fit.Measur
 def synthetic_measurements(truth: Drive, profile: str, config: RunConfig | None = None, flyback=None
                            ) -> tuple[fit.Measurements, fit.Measurements]:
     """Steps of ``truth`` made independently of the fit's forward model
-    (:func:`~passmd.experiments.calibration.synthetic.independent_steps`), plus Gaussian noise of
+    (:func:`~passmd.protocols.synthetic.independent_steps`), plus Gaussian noise of
     NOISE_NM (seed SEED): ``(fit data, held-back data)``; ``flyback`` overrides the drive's fly-back
     rule in the data (a mis-specified model)."""
     s = PROFILE_SETTINGS[profile]
@@ -186,10 +186,11 @@ def gain_facts(table: pd.DataFrame) -> dict:
 
 
 def curve_facts(curve: pd.DataFrame) -> dict:
-    """What the chapter says of A_c against preload, all read off ``curve`` (:func:`curve_from_maps`):
-    at how many preloads the closed form lies at or above both simulated readings, where the steady
-    reading exceeds it most (nm, N), how often the steady curve turns (changes beyond the
-    measurable step) and at how many preloads the runner still rings at the next fly-back."""
+    """What the chapter says of A_c against preload, all read off ``curve``
+    (:func:`~passmd.experiments.design_your_drive.figures.curve_from_maps`): at how many preloads the
+    closed form lies at or above both simulated readings, where the steady reading exceeds it most
+    (nm, N), how often the steady curve turns (changes beyond the measurable step) and at how many
+    preloads the runner still rings at the next fly-back."""
     closed, steady, first = (curve[c].to_numpy(float) for c in ("closed_form_nm", "steady_nm", "first_nm"))
     above = (closed >= steady) & (closed >= first)
     excess = steady - closed

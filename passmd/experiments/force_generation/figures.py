@@ -456,9 +456,9 @@ def force_difference(table: pd.DataFrame, preload: float) -> pd.DataFrame:
 def fig7_difference(config: RunConfig) -> pd.DataFrame:
     """F_gen(rigid, μ = 0.3) − F_gen(flexible, μ = 0.2) against A at every preload of Fig. 7.
 
-    One row per amplitude at which both models stalled (:func:`panel_differences` of the
-    panels fig7a and fig7b), with the panel, its radius and the preload, and the lower and
-    higher of the two models' onsets of force generation at that preload (mN, nm).
+    One row per amplitude at which both models stalled (fig7a's and fig7b's panel differences), with
+    the panel, its radius and the preload, and the lower and higher of the two models' onsets of force
+    generation at that preload (mN, nm).
     """
     data = {"fig7a": fig7a(config), "fig7b": fig7b(config)}
     rows = []

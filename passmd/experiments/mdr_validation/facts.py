@@ -30,7 +30,8 @@ def contact_facts() -> dict:
 
 
 def normal_facts(normal: pd.DataFrame) -> dict:
-    """Largest and full-depth |F_MDR/F_Hertz − 1| (%) per spring count of :func:`mdr_normal`,
+    """Largest and full-depth |F_MDR/F_Hertz − 1| (%) per spring count of
+    :func:`~passmd.experiments.mdr_validation.figures.mdr_normal`,
     and the deviation (%) of the 1000-spring contact's own indentation from Hertz'."""
     facts = {}
     for n in VALIDATION_SPRINGS:
@@ -43,7 +44,8 @@ def normal_facts(normal: pd.DataFrame) -> dict:
 
 
 def virgin_facts(virgin: pd.DataFrame) -> dict:
-    """Largest |T − T_CM| / μF_N of the exact contact and (in %) of each discrete one (:func:`mdr_virgin`)."""
+    """Largest |T − T_CM| / μF_N of the exact contact and (in %) of each discrete one
+    (:func:`~passmd.experiments.mdr_validation.figures.mdr_virgin`)."""
     sliding = virgin["sliding_force_N"].iloc[0]
 
     def largest(column):
@@ -56,7 +58,7 @@ def virgin_facts(virgin: pd.DataFrame) -> dict:
 
 def hysteresis_facts(loop: pd.DataFrame) -> dict:
     """Largest deviation from Masing relative to μF_N: exact contact, and discrete in %
-    (:func:`mdr_hysteresis`)."""
+    (:func:`~passmd.experiments.mdr_validation.figures.mdr_hysteresis`)."""
     sliding = validation_contact().sliding_force
     return {
         "loop_err_exact": (np.abs(loop["exact_N"] - loop["masing_N"]) / sliding).max(),

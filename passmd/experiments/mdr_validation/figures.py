@@ -248,7 +248,7 @@ def fitted_order(errors: pd.DataFrame, column: str = "max_error_rel", min_spring
 VALIDATION_SPRINGS = (20, 100, 1000)
 #: Spring count of the discrete contact in the hysteresis comparison.
 HYSTERESIS_SPRINGS = 1000
-#: Names of the turning points 1–4 of :func:`passmd.experiments.mdr_validation.hysteresis_path`.
+#: Names of the turning points 1–4 of :func:`hysteresis_path`.
 HYSTERESIS_TURNS = ("A", "−A", "B", "C")
 
 
@@ -258,7 +258,7 @@ def validation_contact(springs: int | None = None) -> MDRContact:
 
 
 def mdr_springs(config: RunConfig) -> pd.DataFrame:
-    """:func:`passmd.experiments.mdr_validation.spring_picture` plus the exact contact's
+    """:func:`spring_picture` plus the exact contact's
     indentation (m),
     the hemisphere radius (m) and μ."""
     drive, exact = Drive(), validation_contact()
@@ -270,13 +270,13 @@ def mdr_springs(config: RunConfig) -> pd.DataFrame:
 
 
 def mdr_normal(config: RunConfig) -> pd.DataFrame:
-    """:func:`passmd.experiments.mdr_validation.normal_validation` for
+    """:func:`normal_validation` for
     :data:`VALIDATION_SPRINGS`."""
     return normal_validation(Drive(), springs=VALIDATION_SPRINGS)
 
 
 def mdr_virgin(config: RunConfig) -> pd.DataFrame:
-    """:func:`passmd.experiments.mdr_validation.virgin_validation` plus ``sliding_force_N``
+    """:func:`virgin_validation` plus ``sliding_force_N``
     (μF_N)."""
     df = virgin_validation(Drive(), springs=VALIDATION_SPRINGS)
     df["sliding_force_N"] = validation_contact().sliding_force
@@ -284,7 +284,7 @@ def mdr_virgin(config: RunConfig) -> pd.DataFrame:
 
 
 def mdr_hysteresis(config: RunConfig) -> pd.DataFrame:
-    """:func:`passmd.experiments.mdr_validation.hysteresis_validation` plus ``turn``: the
+    """:func:`hysteresis_validation` plus ``turn``: the
     name of each
     turning point (:data:`HYSTERESIS_TURNS`) on the first row that reaches it, else ``""``."""
     df = hysteresis_validation(Drive(), springs=HYSTERESIS_SPRINGS)
@@ -298,10 +298,10 @@ def mdr_hysteresis(config: RunConfig) -> pd.DataFrame:
 
 
 def mdr_convergence(config: RunConfig) -> pd.DataFrame:
-    """:func:`passmd.experiments.mdr_validation.convergence_validation` plus the fitted
+    """:func:`convergence_validation` plus the fitted
     order and its line.
 
-    ``fitted_order`` is :func:`passmd.experiments.mdr_validation.fitted_order` (N ≥ 100);
+    ``fitted_order`` is :func:`fitted_order` (N ≥ 100);
     ``fit_rel`` the
     least-squares power law of ``max_error_rel`` over those N (NaN below).
     """
