@@ -6,11 +6,11 @@ Timed blocks (each repeated, median and fastest reported; numba compiles in an u
 * ``design``: :func:`passmd.protocols.eq15.optimized_design` of the Section 5 drive (two 100 Hz
   saw-tooth periods recorded densely, f_s and V_r measured, Eq. 15);
 * ``steady_sawtooth_<f>`` / ``steady_optimized_<f>``: one steady-velocity point
-  (:func:`passmd.experiments.driving_waveform.runs.velocity_point`) at 1 kHz and 110 kHz;
+  (:func:`passmd.experiments.driving_waveform.figures_runs.velocity_point`) at 1 kHz and 110 kHz;
 * ``step_100hz``: one Fig. 9a protocol run (three 100 Hz periods, rigid actuators).
 
 Then, once, with an empty temporary simulation cache: every panel (``figure_data``) and the
-studies beyond the paper (:mod:`passmd.experiments.driving_waveform.studies`) at ``--profile``,
+studies beyond the paper (:mod:`passmd.experiments.driving_waveform.figures_studies`) at ``--profile``,
 as wall time of this process plus its sweep workers.
 
 Usage::
@@ -35,7 +35,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from passmd.experiments.driving_waveform import studies
+from passmd.experiments.driving_waveform import figures_studies
 from passmd.experiments.figure_table import figure_data
 from passmd.model.defaults import PROTOCOL
 from passmd.runtime.config import RunConfig
@@ -55,12 +55,12 @@ def _timed(func, repeats: int) -> dict:
 
 
 def blocks(repeats: int) -> dict:
-    from passmd.experiments.driving_waveform import runs
+    from passmd.experiments.driving_waveform import figures_runs
     from passmd.model import optimized_waveform
     from passmd.protocols import eq15
     from passmd.solver import simulation
 
-    drive = runs.section5_drive()
+    drive = figures_runs.section5_drive()
     amplitude = drive.actuator.full_stroke_amplitude
     design = eq15.optimized_design(amplitude, drive)
     fields = {"settling_time": design.settling_time, "acceleration_time": design.acceleration_time,
@@ -69,8 +69,8 @@ def blocks(repeats: int) -> dict:
     for f in (1e3, 110e3):
         for waveform, rule in (("sawtooth", ""), ("optimized", "cut")):
             out[f"steady_{waveform}_{f / 1e3:g}kHz"] = _timed(
-                lambda f=f, w=waveform, r=rule: runs.velocity_point(
-                    **runs.section5_fields(), frequency=f, waveform=w, short_period=r, **fields),
+                lambda f=f, w=waveform, r=rule: figures_runs.velocity_point(
+                    **figures_runs.section5_fields(), frequency=f, waveform=w, short_period=r, **fields),
                 repeats)
     wave = optimized_waveform.optimized(amplitude, PROTOCOL.drive_frequency, drive, periods=3, design=design)
     out["step_100hz"] = _timed(lambda: simulation.simulate(drive, wave, max_points=2), repeats)
@@ -86,10 +86,10 @@ def cold_profile(profile: str) -> dict:
             start = time.perf_counter()
             figure_data(name, config)
             out[name] = time.perf_counter() - start
-        for name, call in (("settling_scan", lambda: studies.settling_scan(config)),
-                           ("numerical_optimum", lambda: studies.numerical_optimum(config)),
-                           ("flexible_study", lambda: studies.flexible_study(config)),
-                           ("startup_transient", lambda: studies.startup_transient(config, 110e3))):
+        for name, call in (("settling_scan", lambda: figures_studies.settling_scan(config)),
+                           ("numerical_optimum", lambda: figures_studies.numerical_optimum(config)),
+                           ("flexible_study", lambda: figures_studies.flexible_study(config)),
+                           ("startup_transient", lambda: figures_studies.startup_transient(config, 110e3))):
             start = time.perf_counter()
             call()
             out[name] = time.perf_counter() - start

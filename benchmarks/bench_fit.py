@@ -10,7 +10,7 @@ estimator's grids are sized against them: 180 s on two cores holds about
 Then the fit: the steps of the Table 1–2 drive (R = 1 mm, six contacts, flexible actuators, ζ = 0.05)
 at 100 Hz, three preloads (0.2, 0.4, 0.6 N) and five amplitudes (110–190 nm), made at μ = 0.25,
 k_p = 5e6 N/m by the refined integrator (the last step of a 16-period run,
-:func:`passmd.experiments.calibration.synthetic.independent_steps`) plus 0.5 nm Gaussian noise (seed 0,
+:func:`passmd.protocols.synthetic.independent_steps`) plus 0.5 nm Gaussian noise (seed 0,
 sd stated); μ and k_p are fitted from the drive's defaults (μ = 0.2, k_p = 6.5e6 N/m) with the default
 bounds, on a process pool over all cores and an empty result cache (a fresh temporary directory;
 the compiled kernels are cached by numba). Its wall time covers everything ``passmd fit`` computes.
@@ -43,10 +43,10 @@ from pathlib import Path
 
 import numpy as np
 
-from passmd.experiments.calibration.synthetic import independent_steps
 from passmd.model.parameters import Drive
 from passmd.protocols import fit, velocity
 from passmd.protocols.fit.prediction import drive_at
+from passmd.protocols.synthetic import independent_steps
 from passmd.runtime.config import RunConfig
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))

@@ -5,7 +5,7 @@ actuators, ζ = 0.05) at 100 Hz, three preloads (0.2, 0.4, 0.6 N) and five ampli
 with μ = 0.25 and an actuator stiffness spread over 3e6–1e7 N/m (log-evenly, one value per
 draw), by other means than the fit's own forward model: the integrator refined twofold
 (``scheme`` "controlled" with ``refine=2``) and the last step of a 16-period run from rest
-(:func:`passmd.experiments.calibration.synthetic.independent_steps`). Gaussian noise of 0.5 nm (a new
+(:func:`passmd.protocols.synthetic.independent_steps`). Gaussian noise of 0.5 nm (a new
 seed per draw) is added and its sd stated. Each draw is fitted from the drive's defaults (μ = 0.2,
 k_p = 6.5e6 N/m) with the default bounds, on a process pool over all cores and an empty result
 cache. Counted: how often each parameter's reported 95 % region (all its pieces) holds the truth,
@@ -46,10 +46,10 @@ from pathlib import Path
 
 import numpy as np
 
-from passmd.experiments.calibration.synthetic import independent_steps
 from passmd.model.parameters import Drive
 from passmd.protocols import fit
 from passmd.protocols.fit.prediction import drive_at
+from passmd.protocols.synthetic import independent_steps
 from passmd.runtime.config import RunConfig
 
 FREE = ("friction_coefficient", "actuator.stiffness")

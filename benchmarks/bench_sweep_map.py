@@ -4,13 +4,13 @@ The drive: R = 0.5 mm, F_p = 0.6 N, k_p = 5e6 N/m, m_a = 1.5e-5 kg (outside Tabl
 extrapolated), c_p from ζ, m_r = 5 g, μ = 0.25, six contacts, flexible actuators; the
 full stroke is Table 2's for R = 0.5 mm. The map: steady velocity
 (:func:`passmd.protocols.maps.steady_point`) on a log grid of frequencies × a linear grid of
-amplitudes up to the full stroke, through :func:`passmd.experiments.design.maps.compute_map` (process
+amplitudes up to the full stroke, through :func:`passmd.protocols.maps.compute_map` (process
 pool over all cores), as ``passmd sweep velocity`` runs it.
 
 Measured, each once, as wall time (the load average, 1/5/15 min, before and after each: on a
 shared machine it says how many cores the map actually had):
 
-* ``cold`` / ``cached``: :func:`~passmd.experiments.design.maps.compute_map` in this process with an
+* ``cold`` / ``cached``: :func:`~passmd.protocols.maps.compute_map` in this process with an
   empty result cache (numba kernels compiled beforehand, in an untimed warm-up), then the same
   map again, every point from the cache;
 * ``cli_cold`` / ``cli_cached``: the same map as a user runs it, ``passmd sweep velocity
@@ -48,10 +48,9 @@ from pathlib import Path
 
 import numpy as np
 
-from passmd.experiments.design.maps import compute_map
 from passmd.model.parameters import Drive
 from passmd.model.tables import actuator_for_radius, actuator_viscosity
-from passmd.protocols.maps import steady_point
+from passmd.protocols.maps import compute_map, steady_point
 from passmd.runtime.config import RunConfig
 
 #: Targets of the map on the 2-core machine (s).

@@ -62,7 +62,7 @@ _API = {
     "drive_toml": "passmd.model.drive_file",
     "EXAMPLE_DRIVE_FILE": "passmd.model.drive_file",
     "contact_arrangement": "passmd.model.theory",
-    "compute_map": "passmd.experiments.design.maps",
+    "compute_map": "passmd.protocols.maps",
     "stick_ringing": "passmd.protocols.ringing",
     "fit": "passmd.protocols.fit",
     "read_measurements": "passmd.protocols.fit",

@@ -1,7 +1,7 @@
 """What the regression snapshots compare with: the stated accuracies, and the one finer run.
 
 Every snapshot check takes its tolerances from :func:`tolerances`, which maps a column to the
-accuracy :mod:`passmd.experiments.numerics.accuracy` states for its quantity (positions, forces,
+accuracy :mod:`passmd.experiments.model_numerics.facts` states for its quantity (positions, forces,
 velocities, frequencies and times, slip shares, critical amplitudes). A column the integrator
 does not compute (inputs, closed forms, flags) is compared to :data:`EXACT`: only
 floating-point rounding may differ. So a snapshot locks the physics to the integrator's
@@ -16,7 +16,7 @@ import contextlib
 
 import pytest
 
-from passmd.experiments.numerics import accuracy
+from passmd.experiments.model_numerics import facts
 from passmd.model.parameters import Drive
 from passmd.runtime.config import RunConfig
 from passmd.solver import simulation
@@ -31,17 +31,17 @@ FINER = 2.0
 
 
 def position(scale: float = 1.0) -> dict:
-    return {"rtol": 0.0, "atol": accuracy.POSITION_ACCURACY * scale}
+    return {"rtol": 0.0, "atol": facts.POSITION_ACCURACY * scale}
 
 
 def force(scale: float = 1.0) -> dict:
-    return {"rtol": accuracy.STALL_FORCE_RTOL, "atol": accuracy.FORCE_ACCURACY * scale}
+    return {"rtol": facts.STALL_FORCE_RTOL, "atol": facts.FORCE_ACCURACY * scale}
 
 
 def critical_amplitude(bracket_width: float, scale: float = 1.0) -> dict:
     """A critical amplitude or onset found to ``bracket_width`` (m), in units of ``scale`` per m."""
-    width = accuracy.CRITICAL_AMPLITUDE_BRACKETS * bracket_width
-    return {"rtol": 0.0, "atol": (width + accuracy.POSITION_ACCURACY) * scale}
+    width = facts.CRITICAL_AMPLITUDE_BRACKETS * bracket_width
+    return {"rtol": 0.0, "atol": (width + facts.POSITION_ACCURACY) * scale}
 
 
 def tolerances(columns, *, amplitudes=(), bracket_width: float = 0.0, forces_in_length=()) -> dict:
@@ -59,18 +59,18 @@ def tolerances(columns, *, amplitudes=(), bracket_width: float = 0.0, forces_in_
         if col in amplitudes:
             out[col] = critical_amplitude(bracket_width, nano)
         elif col in forces_in_length:
-            atol = accuracy.FORCE_ACCURACY / LOAD_CELL_STIFFNESS * nano
-            out[col] = {"rtol": accuracy.STALL_FORCE_RTOL, "atol": atol}
+            atol = facts.FORCE_ACCURACY / LOAD_CELL_STIFFNESS * nano
+            out[col] = {"rtol": facts.STALL_FORCE_RTOL, "atol": atol}
         elif col.endswith("_m_per_s"):
-            out[col] = {"rtol": 0.0, "atol": accuracy.VELOCITY_ACCURACY}
+            out[col] = {"rtol": 0.0, "atol": facts.VELOCITY_ACCURACY}
         elif col.endswith(("_m", "_nm")):
             out[col] = position(nano)
         elif col.endswith(("_N", "_mN")):
             out[col] = force(1e3 if col.endswith("_mN") else 1.0)
         elif col.endswith(("_Hz", "_s", "_us")):
-            out[col] = {"rtol": accuracy.FREQUENCY_RTOL, "atol": 0.0}
+            out[col] = {"rtol": facts.FREQUENCY_RTOL, "atol": 0.0}
         elif "slip_share" in col:
-            out[col] = {"rtol": 0.0, "atol": accuracy.SLIP_SHARE_ACCURACY}
+            out[col] = {"rtol": 0.0, "atol": facts.SLIP_SHARE_ACCURACY}
         else:
             out[col] = dict(EXACT)
     return out

@@ -341,7 +341,7 @@ def test_an_unknown_column_in_another_unit_names_the_known_one(tmp_path, column,
 def test_too_many_workers_are_capped_with_one_line(monkeypatch):
     """Above two per usable core, one line names the option or the variable as typed and the count
     run; the command then goes on (here: up to its computation, which gets the capped count)."""
-    from passmd.experiments.design import maps
+    from passmd.protocols import maps
 
     monkeypatch.setattr("passmd.cli.configuration.usable_cores", lambda: 2)
     seen = []

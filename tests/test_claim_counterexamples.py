@@ -20,7 +20,7 @@ import pytest
 
 from passmd.experiments.driving_waveform import claims_velocity
 from passmd.experiments.driving_waveform.figures import FREQUENCIES
-from passmd.experiments.driving_waveform.runs import section5_drive
+from passmd.experiments.driving_waveform.figures_runs import section5_drive
 from passmd.experiments.force_generation.figures import EARLIER, THIS
 from passmd.ledger import checks, readings, reference
 from passmd.ledger.checks import NO_MEASURED_DATA, ClaimFails, NotEvaluable, check_claim

@@ -308,9 +308,9 @@ def test_critical_amplitude_analytic_only():
 
 
 def test_critical_amplitude_is_the_books_search():
-    """`critical-amplitude` reports what passmd.experiments.critical_amplitude.figures finds, bracket
+    """`critical-amplitude` reports what passmd.experiments.critical_amplitude_one.figures finds, bracket
     included."""
-    from passmd.experiments.critical_amplitude import figures
+    from passmd.experiments.critical_amplitude_one import figures
 
     data = run_json("critical-amplitude", "--contacts", "1", "--actuator", "rigid", "--tolerance", "2nm")
     drive = Drive(contacts=1, actuator_model="rigid")

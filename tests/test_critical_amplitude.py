@@ -16,7 +16,21 @@ import pytest
 import snapshot_accuracy as snap
 
 from passmd.experiments import figure_table
-from passmd.experiments.critical_amplitude import facts, figures
+from passmd.experiments.critical_amplitude_one import facts, figures
+from passmd.experiments.critical_amplitude_six.facts import (
+    ac_at,
+    ac_range,
+    ac_span,
+    deviation_at,
+    deviation_table,
+    fig6a_facts,
+    fig6bc_facts,
+    frequency_facts,
+    prestrain_facts,
+    side_prestrain,
+    slew_facts,
+    viscosity_facts,
+)
 from passmd.model import waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.theory import drive_theory, runner_frequency
@@ -405,25 +419,25 @@ def test_deviations_from_the_closed_forms(quick):
     assert facts.side_of(-3.25) == "3.2 % below" and facts.side_of(1.0) == "1.0 % above"
     assert math.isnan(facts.band_spread(quick["fig5b"], "rigid"))  # the quick profile runs 100 Hz only
     columns = {"Eq. 11": "u_x_max_e_nm", "Eq. 10, side 1": "u_x_max_1_nm"}
-    six = facts.deviation_table(quick["fig6a"], columns)
-    assert facts.deviation_at(six, "steady", "slew", "Eq. 11: largest |dev| (%)") < facts.deviation_at(
+    six = deviation_table(quick["fig6a"], columns)
+    assert deviation_at(six, "steady", "slew", "Eq. 11: largest |dev| (%)") < deviation_at(
         six, "steady", "slew", "Eq. 10, side 1: largest |dev| (%)")
 
 
 def test_spans_and_values_of_the_sensitivity_panels(quick):
     freq = quick["fig56_frequency"]
-    low, high = facts.ac_span(freq, 6, "first", actuator_model="rigid")
-    assert low <= high and facts.ac_range(freq, 6, "first", actuator_model="rigid") == high - low
-    at_drive = facts.ac_at(freq, 6, "rigid", "steady", PROTOCOL.drive_frequency)
+    low, high = ac_span(freq, 6, "first", actuator_model="rigid")
+    assert low <= high and ac_range(freq, 6, "first", actuator_model="rigid") == high - low
+    at_drive = ac_at(freq, 6, "rigid", "steady", PROTOCOL.drive_frequency)
     primary = figures.primary(freq, "rigid").query("contacts == 6")
     assert low > 0 and at_drive == float(primary["critical_amplitude_nm"].iloc[0])
     visc = quick["fig56_viscosity"]
-    lo, hi = facts.ac_span(visc, 6, "steady", flyback="fixed")
+    lo, hi = ac_span(visc, 6, "steady", flyback="fixed")
     assert 0 < lo <= hi
 
 
 def test_slew_and_protocol_facts():
-    slew = facts.slew_facts()
+    slew = slew_facts()
     # 2 µs full-stroke time over A_max: 202 nm (R = 1 mm) and 96 nm (R = 0.25 mm)
     assert slew["ns_per_nm_b"] == pytest.approx(2000 / 202, rel=1e-9)
     assert slew["ns_per_nm_c"] == pytest.approx(2000 / 96, rel=1e-9)
@@ -435,14 +449,14 @@ def test_slew_and_protocol_facts():
 
 def test_continued_operation_strains_the_sides_against_each_other(quick):
     """Below the steady-state A_c the two sides end every period pushing against each other."""
-    prestrain = facts.side_prestrain(quick["fig56_frequency"])
+    prestrain = side_prestrain(quick["fig56_frequency"])
     assert len(prestrain) == critical_amplitude.STEADY_PERIODS
     last = prestrain.iloc[-1]
     assert last["side 1: T_1 / μF_N1"] < 0 < last["side 2: T_2 / μF_N2"]
 
 
 def test_flyback_steps_ratchet_below_eq7():
-    steps = facts.fig5_flyback_steps(RunConfig(profile="quick"))
+    steps = figures.fig5_flyback_steps(RunConfig(profile="quick"))
     first = steps.iloc[0]
     assert first["steady_ac_nm"] < first["u_x_max_nm"]
     below = steps[steps["amplitude_nm"] == steps["amplitude_nm"].unique()[0]]
@@ -461,19 +475,19 @@ def test_paragraph_facts_of_both_chapters(quick):
     assert found["first_rigid_max"] < 2.0 and found["steady_rigid_mean"].endswith(("below", "above"))
     assert "quick profile runs 100 Hz only" in found["band_rigid"]
     columns = {"Eq. 11": "u_x_max_e_nm", "Eq. 10, side 1": "u_x_max_1_nm", "Eq. 10, side 2": "u_x_max_2_nm"}
-    six = facts.fig6a_facts(facts.deviation_table(quick["fig6a"], columns), quick_config)
+    six = fig6a_facts(deviation_table(quick["fig6a"], columns), quick_config)
     assert six["a_e"] < min(six["a_1"], six["a_2"]) and six["a_band"].startswith("(the quick profile")
     flexible = {"Eq. 12": "u_x_max_e_star_nm", "Eq. 13, side 1": "u_x_max_1_star_nm"}
-    dev6 = pd.concat([facts.deviation_table(quick[n], flexible).assign(figure=n)
+    dev6 = pd.concat([deviation_table(quick[n], flexible).assign(figure=n)
                       for n in ("fig6b", "fig6c")])
-    bc = facts.fig6bc_facts(dev6)
+    bc = fig6bc_facts(dev6)
     assert set(bc) == {f"{k}_{s}" for k in "bc" for s in ("slew", "fixed", "first_fixed")}
-    visc = facts.viscosity_facts(quick["fig56_viscosity"])
+    visc = viscosity_facts(quick["fig56_viscosity"])
     assert visc["v6_fixed_lo"] <= visc["v6_fixed_hi"] and visc["eq8_04"] > visc["eq12_04"]
-    freq = facts.frequency_facts(quick["fig56_frequency"], quick_config)
+    freq = frequency_facts(quick["fig56_frequency"], quick_config)
     assert freq["f_hi"] == 1000.0 and freq["first_span"] >= 0
     assert freq["first_band"].endswith("Figs. 5b and 6.)")
     table = pd.DataFrame({"side 1: T_1 / μF_N1": [-0.1], "side 2: T_2 / μF_N2": [0.1]})
     table.attrs["amplitude_nm"] = 23.9
     expected = {"prestrain_amplitude": 23.9, "prestrain_1": -0.1, "prestrain_2": 0.1}
-    assert facts.prestrain_facts(table) == expected
+    assert prestrain_facts(table) == expected

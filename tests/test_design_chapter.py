@@ -1,4 +1,4 @@
-"""The data functions of the chapter "Design your own drive" (passmd.experiments.design.figures)."""
+"""The data and fact functions of the chapter "Design your own drive" (experiments/design_your_drive)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd.experiments.design import figures
+from passmd.experiments.design_your_drive import facts, figures
 from passmd.model.drive_file import DRIVE_KEYS, DriveFileError, load_drive
 from passmd.runtime.config import RunConfig
 
@@ -82,23 +82,23 @@ def test_map_facts_find_the_fastest_point_and_the_top_row():
     # amplitudes 5 nm apart: only the largest is the top row (an absolute tolerance of 1e-8 m would
     # take both)
     table = _map_table([1e-4, 2e-4, 5e-3, 4e-3], [100.0, 1e4], [95e-9, 100e-9])
-    facts = figures.map_facts(table)
-    assert facts["v_max_mm_s"] == pytest.approx(5.0) and facts["v_max_f_kHz"] == pytest.approx(10.0)
-    assert facts["v_max_A_nm"] == pytest.approx(95.0) and facts["A_top_nm"] == pytest.approx(100.0)
-    assert facts["step_low_f_nm"] == pytest.approx(2e-4 / 100 * 1e9)  # largest amplitude, lowest f
-    assert facts["step_high_f_nm"] == pytest.approx(4e-3 / 1e4 * 1e9)
-    assert facts["map_points"] == 4
+    found = facts.map_facts(table)
+    assert found["v_max_mm_s"] == pytest.approx(5.0) and found["v_max_f_kHz"] == pytest.approx(10.0)
+    assert found["v_max_A_nm"] == pytest.approx(95.0) and found["A_top_nm"] == pytest.approx(100.0)
+    assert found["step_low_f_nm"] == pytest.approx(2e-4 / 100 * 1e9)  # largest amplitude, lowest f
+    assert found["step_high_f_nm"] == pytest.approx(4e-3 / 1e4 * 1e9)
+    assert found["map_points"] == 4
 
 
 def test_gain_facts_count_missing_waveforms_and_signs():
     table = pd.DataFrame({"frequency_Hz": [1e3, 1e3, 1e4, 1e4], "amplitude_m": [5e-8, 1e-7, 5e-8, 1e-7],
                           "gain_m_per_s": [None, -1e-3, 2e-3, 5e-4]})
-    facts = figures.gain_facts(table)
-    counts = (facts["gain_points"], facts["gain_designed"], facts["gain_none"], facts["gain_faster"])
+    found = facts.gain_facts(table)
+    counts = (found["gain_points"], found["gain_designed"], found["gain_none"], found["gain_faster"])
     assert counts == (4, 3, 1, 2)
-    assert facts["gain_max_mm_s"] == pytest.approx(2.0) and facts["gain_max_f_kHz"] == pytest.approx(10.0)
-    assert facts["gain_min_mm_s"] == pytest.approx(-1.0)
-    none = figures.gain_facts(table.assign(gain_m_per_s=[None] * 4))
+    assert found["gain_max_mm_s"] == pytest.approx(2.0) and found["gain_max_f_kHz"] == pytest.approx(10.0)
+    assert found["gain_min_mm_s"] == pytest.approx(-1.0)
+    none = facts.gain_facts(table.assign(gain_m_per_s=[None] * 4))
     assert none["gain_designed"] == 0 and "gain_max_mm_s" not in none
 
 
@@ -120,15 +120,15 @@ def _curve(steady, closed=(30.0, 50.0, 70.0, 90.0), left=(2.0, 0.1, 3.0, 4.0)):
 
 
 def test_curve_facts_say_where_the_closed_form_is_exceeded_and_how_often_the_curve_turns():
-    below = figures.curve_facts(_curve([20.0, 40.0, 60.0, 80.0]))
+    below = facts.curve_facts(_curve([20.0, 40.0, 60.0, 80.0]))
     assert below["ca_closed_above"] == 4 and below["ca_turns"] == 0 and below["ca_ringing_points"] == 3
     # a drive whose steady A_c exceeds the closed form at one preload and turns twice
-    jagged = figures.curve_facts(_curve([20.0, 55.0, 52.0, 80.0]))
+    jagged = facts.curve_facts(_curve([20.0, 55.0, 52.0, 80.0]))
     assert jagged["ca_closed_above"] == 3 and jagged["ca_excess_nm"] == pytest.approx(5.0)
     assert jagged["ca_excess_at_N"] == 0.4 and jagged["ca_turns"] == 2
     assert jagged["ca_ringing_left_nm"] == 4.0
     # a dip within the measurable step is no turn
-    assert figures.curve_facts(_curve([20.0, 40.0, 39.8, 80.0]))["ca_turns"] == 0
+    assert facts.curve_facts(_curve([20.0, 40.0, 39.8, 80.0]))["ca_turns"] == 0
 
 
 def test_ringing_facts_read_the_probe():
@@ -136,8 +136,8 @@ def test_ringing_facts_read_the_probe():
              "ringing_hold_s": 20e-3, "flyback_time_s": 1e-6,
              "swing_times_s": np.array([1e-4, 5e-3, 9.999e-3, 15e-3]),
              "swing_amplitudes_m": np.array([40e-9, 10e-9, 5e-9, 0.4e-9])}
-    facts = figures.ringing_facts(probe, 100.0)
-    assert facts["ring_f_kHz"] == 5.0 and facts["ring_amp_nm"] == pytest.approx(40.0)
-    assert facts["ring_left_nm"] == pytest.approx(5.0, rel=1e-3)
-    assert facts["ring_quiet_ms"] == pytest.approx(15.0)
-    assert facts["ring_next_ms"] == pytest.approx(9.999)
+    found = facts.ringing_facts(probe, 100.0)
+    assert found["ring_f_kHz"] == 5.0 and found["ring_amp_nm"] == pytest.approx(40.0)
+    assert found["ring_left_nm"] == pytest.approx(5.0, rel=1e-3)
+    assert found["ring_quiet_ms"] == pytest.approx(15.0)
+    assert found["ring_next_ms"] == pytest.approx(9.999)

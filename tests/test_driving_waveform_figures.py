@@ -3,7 +3,7 @@
 Every panel is computed once per session (module fixture; the sweep cache makes reruns
 cheap). The snapshots lock what the chapter reads — the points of Fig. 8, the settled
 positions of Fig. 9a, the steady velocities and steps of Figs. 9b–10, each drive's row once —
-to the accuracies :mod:`passmd.experiments.numerics.accuracy` states for the default integrator
+to the accuracies :mod:`passmd.experiments.model_numerics.facts` states for the default integrator
 (``snapshot_accuracy.tolerances``); ``test_finer_run_passes_the_snapshots`` shows a run with
 the step halved passes them too.
 """
@@ -16,7 +16,7 @@ import pandas as pd
 import pytest
 import snapshot_accuracy as snap
 
-from passmd.experiments.driving_waveform import claims_velocity, facts, figures, runs, studies
+from passmd.experiments.driving_waveform import claims_velocity, facts, figures, figures_runs, figures_studies
 from passmd.model import theory, waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.optimized_waveform import OptimizedDesign, max_piezo_velocity, optimized
@@ -45,7 +45,7 @@ VELOCITY_COLUMNS = ("frequency", "preload", "hemisphere_radius", "velocity_m_per
                     "settling_time_s", "acceleration_time_s", "settling_fits", "stick_during_acceleration",
                     "max_slip_share_acceleration", "micro_vibration_frequency_Hz")
 #: The Section 5 drive (Fig. 9b's): the other velocity panels lock only their other drives.
-SECTION5 = runs.section5_fields()
+SECTION5 = figures_runs.section5_fields()
 
 
 def _response(frame):
@@ -146,12 +146,12 @@ def test_fig10_steady_step_at_130_khz_is_converged(quick, monkeypatch, preload, 
     row = table[(table["frequency"] == 130e3) & (table["preload"] == preload) & (table["variant"] == variant)]
     assert len(row) == 1
     row = row.iloc[0]
-    point = {name: row[name] for name in inspect.signature(runs.velocity_point).parameters
+    point = {name: row[name] for name in inspect.signature(figures_runs.velocity_point).parameters
              if name in row.index}  # a figure at Section 5's μ passes none
     default_simulate = simulation.simulate
     monkeypatch.setattr(simulation, "simulate", functools.partial(default_simulate,
                                                        scheme=steps.SCHEMES["fixed"].replace(dt=CONVERGED_DT)))
-    converged = runs.velocity_point(**point)
+    converged = figures_runs.velocity_point(**point)
     assert converged["periods"] == row["periods"]
     assert abs(row["step_m"] - converged["step_m"]) < steps.CONVERGED_ACCURACY
     assert abs(row["back_step_m"] - converged["back_step_m"]) < steps.CONVERGED_ACCURACY
@@ -165,7 +165,8 @@ def test_every_panel_plots(quick):
 
 def test_fig9a_plot_shows_section5_friction_only(quick):
     frame = quick["fig9a"]
-    assert set(frame.loc[frame["section5_friction"], "friction_coefficient"]) == {runs.SECTION5_FRICTION}
+    section5 = frame.loc[frame["section5_friction"], "friction_coefficient"]
+    assert set(section5) == {figures_runs.SECTION5_FRICTION}
     assert len(figures.FIG9A_FRICTION) > 1 and not frame["section5_friction"].all()
     fig = driving_waveform.plot_fig9a(frame)
     # one runner trace and one set of settled positions per waveform, plus the piezo: μ = 0.2 runs only
@@ -198,13 +199,14 @@ def test_carrying_the_runner_then_stopping_beats_the_sawtooth():
     vibration (fastest forward motion, point 4), carry the runner at a velocity friction can
     give it (μΣF_N/m_r ≈ 75 m/s² over a few nm), stop: the runner slides on. +20 % is a
     conservative floor for hand-picked numbers (the optimiser finds ≈ +50 %)."""
-    drive = runs.section5_drive()
+    drive = figures_runs.section5_drive()
     amplitude = drive.actuator.full_stroke_amplitude
     design = eq15.optimized_design(amplitude, drive)
     carry = OptimizedDesign(0.75 / design.micro_vibration_frequency, 0.9 * amplitude / 3e-3,
                             0.9 * amplitude)
-    saw = simulation.simulate(drive, waveforms.sawtooth(amplitude, runs.STEP_FREQUENCY, drive, periods=3))
-    opt = simulation.simulate(drive, optimized(amplitude, runs.STEP_FREQUENCY, drive, periods=3,
+    frequency = figures_runs.STEP_FREQUENCY
+    saw = simulation.simulate(drive, waveforms.sawtooth(amplitude, frequency, drive, periods=3))
+    opt = simulation.simulate(drive, optimized(amplitude, frequency, drive, periods=3,
                                              design=carry))
     assert np.mean(opt.step_sizes) > 1.2 * np.mean(saw.step_sizes)
 
@@ -213,8 +215,8 @@ def test_micro_vibration_to_linear_frequency_ratio_is_universal_for_rigid_drives
     """After a full slide the swing back is a Masing branch from full sliding; with the
     amplitude well above u_x,max its shape scales with u_x,max and μF_N, so f_s / f_lin is the
     same for every preload and radius (the start velocity, a_f·t_fb, is ~1 % of the swing's)."""
-    table = runs.designs([runs.section5_fields(preload=p) for p in (0.1, 1.0)]
-                       + [runs.section5_fields(hemisphere_radius=0.25e-3)], QUICK)
+    table = figures_runs.designs([figures_runs.section5_fields(preload=p) for p in (0.1, 1.0)]
+                       + [figures_runs.section5_fields(hemisphere_radius=0.25e-3)], QUICK)
     ratio = table["micro_vibration_frequency_Hz"] / table["linear_frequency_Hz"]
     assert ratio.max() - ratio.min() < 2e-3  # 0.2 %: the residual start-velocity effect
     assert np.sqrt(2 / 3) < ratio.min() and ratio.max() < 1.0
@@ -237,24 +239,24 @@ def test_settling_fits_only_at_low_frequency(quick):
     # what the paper's 110 kHz would need: t_fb + 1/(2 f_s) within 1/(110 kHz)
     f_s = float(opt["micro_vibration_frequency_Hz"].iloc[0])
     assert 2e-6 + 0.5 / f_s > 1 / 110e3
-    assert f_s == pytest.approx(theory.runner_frequency(runs.section5_drive()), rel=0.2)
+    assert f_s == pytest.approx(theory.runner_frequency(figures_runs.section5_drive()), rel=0.2)
 
 
 def test_numerical_optimum_beats_heuristic_and_sawtooth():
-    table = studies.numerical_optimum(QUICK)
+    table = figures_studies.numerical_optimum(QUICK)
     low = table[table["frequency"] == PROTOCOL.drive_frequency].iloc[0]
     assert low["velocity_optimum_m_per_s"] > 1.2 * low["velocity_sawtooth_m_per_s"]
     assert np.all(table["velocity_optimum_m_per_s"] > table["velocity_eq15_m_per_s"])
     # every optimum respects the amplifier
-    v_max = max_piezo_velocity(runs.section5_drive())
+    v_max = max_piezo_velocity(figures_runs.section5_drive())
     assert np.all(table["optimum_acceleration_velocity_m_per_s"] <= v_max * (1 + 1e-12))
 
 
 def test_flexible_study_and_scan_run(quick):
-    flex = studies.flexible_study(QUICK)
+    flex = figures_studies.flexible_study(QUICK)
     assert set(flex["actuator_model"]) == {"rigid", "flexible"}
     assert np.all(np.isfinite(flex["velocity_m_per_s"]))
-    scan = studies.settling_scan(QUICK)
+    scan = figures_studies.settling_scan(QUICK)
     # Eq. 15's t_s (half a cycle) is where the step is smallest in the scan
     worst = scan.loc[scan["step_nm"].idxmin(), "settling_cycles"]
     assert worst == pytest.approx(scan["eq15_settling_cycles"].iloc[0], abs=0.25)
@@ -303,9 +305,9 @@ def test_flyback_window_resolves_the_acceleration():
     row = frame.iloc[0]
     t_a = row["acceleration_end_s"] - row["acceleration_start_s"]
     # records fall on integration steps: at most one step (t_a / 20) off the nominal t_a / 10
-    assert row["record_spacing_s"] <= 1.5 * t_a / runs.WINDOW_SAMPLES_PER_ACCELERATION
+    assert row["record_spacing_s"] <= 1.5 * t_a / figures_runs.WINDOW_SAMPLES_PER_ACCELERATION
     counts = frame["phase"].value_counts()
-    assert counts["acceleration"] >= runs.WINDOW_SAMPLES_PER_ACCELERATION - 1
+    assert counts["acceleration"] >= figures_runs.WINDOW_SAMPLES_PER_ACCELERATION - 1
     assert {"before", "flyback", "settling", "after"} <= set(counts.index)
     assert driving_waveform.plot_fig8b_window(frame).axes
 
@@ -316,8 +318,8 @@ def test_flyback_window_resolves_the_acceleration():
 
 
 def test_design_facts_and_table(quick):
-    drive = runs.section5_drive()
-    design = runs.designs([runs.section5_fields()], QUICK).iloc[0]
+    drive = figures_runs.section5_drive()
+    design = figures_runs.designs([figures_runs.section5_fields()], QUICK).iloc[0]
     found = facts.design_facts(design, drive)
     assert found["f_ratio"] == pytest.approx(found["f_s_kHz"] / found["f_lin_kHz"], rel=1e-12)
     assert found["A_nm"] == pytest.approx(drive.actuator.full_stroke_amplitude * 1e9, rel=1e-12)
@@ -329,7 +331,7 @@ def test_design_facts_and_table(quick):
 
 
 def test_fig8a_facts_follow_the_points(quick):
-    found = facts.fig8a_facts(quick["fig8a"], runs.section5_drive())
+    found = facts.fig8a_facts(quick["fig8a"], figures_runs.section5_drive())
     # the runner reverses before it moves forward fastest, both within the micro-vibration's first cycle
     assert 0 < found["t3_after_us"] < found["t4_after_us"] < 1e3 / 5.0
     assert found["back_step_nm"] > 0
@@ -369,8 +371,8 @@ def test_startup_and_fig9b_facts(quick):
     table = quick["fig9b"]
     start = facts.startup_facts(table)
     assert start["max_drift_pct"] < 0.5  # as test_velocity_runs_are_steady_and_consistent
-    design = runs.designs([runs.section5_fields()], QUICK).iloc[0]
-    found = facts.fig9b_facts(table, design, runs.section5_drive())
+    design = figures_runs.designs([figures_runs.section5_fields()], QUICK).iloc[0]
+    found = facts.fig9b_facts(table, design, figures_runs.section5_drive())
     # t_s would fit at 110 kHz only with f_s ≥ 1 / (2 t_s,max): above the measured f_s by the factor's root
     assert found["f_s_needed_kHz"] == pytest.approx(0.5e-3 / (found["t_s_room_us"] * 1e-6), rel=1e-12)
     assert found["stiffness_factor"] > 1
@@ -392,12 +394,12 @@ def test_reachable_table_and_stick_lost(quick):
 
 
 def test_optimum_and_flexible_facts():
-    optimum = studies.numerical_optimum(QUICK)
-    design = runs.designs([runs.section5_fields()], QUICK).iloc[0]
-    a_f = facts.friction_acceleration(runs.section5_drive())
+    optimum = figures_studies.numerical_optimum(QUICK)
+    design = figures_runs.designs([figures_runs.section5_fields()], QUICK).iloc[0]
+    a_f = facts.friction_acceleration(figures_runs.section5_drive())
     found = facts.optimum_facts(optimum, design, a_f)
     low = facts.optimum_at(optimum)
-    assert low["frequency"] == runs.STEP_FREQUENCY and low["actuator_model"] == "rigid"
+    assert low["frequency"] == figures_runs.STEP_FREQUENCY and low["actuator_model"] == "rigid"
     assert found["opt_gain_100"] > 20  # the optimum beats the saw-tooth (test above: by > 20 %)
     t_a = design["acceleration_time_s"]
     assert found["ta_ratio"] == pytest.approx(found["opt_ta_us"] * 1e-6 / t_a, rel=1e-12)
@@ -407,7 +409,7 @@ def test_optimum_and_flexible_facts():
     carried = facts.carried_steps(optimum)
     assert carried["actuators"].tolist() == ["rigid", "flexible"]
     assert carried.iloc[0]["gain (%)"] > 20
-    flexible = runs.designs([runs.section5_fields(actuator_model="flexible")], QUICK).iloc[0]
-    flex = facts.flexible_facts(optimum, flexible, carried, runs.section5_drive())
+    flexible = figures_runs.designs([figures_runs.section5_fields(actuator_model="flexible")], QUICK).iloc[0]
+    flex = facts.flexible_facts(optimum, flexible, carried, figures_runs.section5_drive())
     assert np.isnan(flex["flex_opt_gain"])  # the quick profile does not optimise flexible actuators
-    assert flex["f_s_flex_kHz"] < facts.design_facts(design, runs.section5_drive())["f_s_kHz"]
+    assert flex["f_s_flex_kHz"] < facts.design_facts(design, figures_runs.section5_drive())["f_s_kHz"]

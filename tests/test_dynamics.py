@@ -243,7 +243,7 @@ def test_default_step_converged_to_005_nm():
     within it of the reference, the fixed (rigid) or explicit adaptive (flexible) step 4×
     finer: that run's O(dt²) error is 16× smaller than at the default step, so it stands in
     for dt → 0."""
-    from passmd.experiments.numerics.figures import convergence_study
+    from passmd.experiments.model_numerics.figures import convergence_study
 
     df = convergence_study(resolutions=(1.0, 4.0), step_controls=("controlled", "adaptive"))
     default = df[df["resolution"] == 1.0]

@@ -53,7 +53,7 @@ def test_claim_modules_are_the_experiment_modules_with_extractors():
     assert {module.__name__ for module in figure_table.CLAIM_MODULES} == tagged
 
 
-@pytest.mark.parametrize("module", ["passmd.experiments.critical_amplitude.figures",
+@pytest.mark.parametrize("module", ["passmd.experiments.critical_amplitude_one.figures",
                                     "passmd.experiments.figure_table", "passmd.report.evaluation",
                                     "passmd.protocols.critical_amplitude"])
 def test_computing_loads_no_plotting(module):

@@ -1,6 +1,6 @@
 """Calibration (passmd.protocols.fit, ``passmd fit``): round trips on data made by other means than the
 fit's own forward model (the integrator refined twofold and the last step of a 16-period run,
-:func:`passmd.experiments.design.calibration.independent_steps`), the goodness-of-fit test, regions of
+:func:`passmd.experiments.design_your_drive.facts.independent_steps`), the goodness-of-fit test, regions of
 several pieces, the identifiability verdict, rows checked before anything is simulated, and
 malformed measurement files.
 
@@ -20,11 +20,11 @@ import pytest
 from cli_runs import run_main
 
 import passmd
-from passmd.experiments.calibration.synthetic import independent_steps
 from passmd.model.parameters import Drive
 from passmd.model.tables import Amplifier
 from passmd.protocols import fit
 from passmd.protocols.fit.prediction import drive_at
+from passmd.protocols.synthetic import independent_steps
 
 RIGID = Drive(contacts=1, actuator_model="rigid")
 HEADER = ["amplitude_nm", "preload_N", "frequency_Hz", "step_nm", "step_nm_sd"]

@@ -1,7 +1,7 @@
 """Force generation (Fig. 7): stall criterion, physics at stall, quick-profile snapshots, ledger rows.
 
 The snapshots lock the stall forces, steps and onsets of Fig. 7 and the measures of its stall
-cycles to the accuracies :mod:`passmd.experiments.numerics.accuracy` states for the default integrator
+cycles to the accuracies :mod:`passmd.experiments.model_numerics.facts` states for the default integrator
 (``snapshot_accuracy.tolerances``: forces to the stall criterion's tolerance, onsets to one
 bracket width); ``test_finer_run_passes_the_snapshots`` shows a run with the step halved
 passes them too. Not locked: how the protocol got there (periods integrated, brackets,
@@ -502,7 +502,7 @@ def test_protocol_facts_and_published_data(quick):
 
 def test_difference_figure_holds_every_preload_with_the_onsets(quick):
     """The fig7_difference table: the panel differences of every preload, the onsets shading them."""
-    table = facts.fig7_difference(RunConfig(profile="quick"))
+    table = figures.fig7_difference(RunConfig(profile="quick"))
     differences = facts.panel_differences(quick)
     keys = {f"{p} {x:g} N" for p, x in zip(table["panel"], table["preload_N"], strict=True)}
     assert keys <= set(differences)

@@ -238,7 +238,7 @@ def vary_specs(draw) -> str:
        specs=st.one_of(*(st.lists(vary_specs(), min_size=n, max_size=n) for n in (1, 2))),
        as_json=st.booleans())
 def test_generated_vary_specifications_end_cleanly(quantity, specs, as_json):
-    from passmd.experiments.design import maps
+    from passmd.protocols import maps
 
     argv = ["sweep", quantity, *(a for spec in specs for a in ("--vary", spec))]
     argv += ["--json"] if as_json else []

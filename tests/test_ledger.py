@@ -609,7 +609,7 @@ def test_a_coarse_grid_decides_only_what_the_paper_grid_would():
     """The coarse-grid rule of passmd.ledger.rules: a check holding on part of the paper's grid is
     inconclusive; a pointwise failure there decides (failures_decide); a failure of a check of the whole
     grid does not. The extractors wrap the quick grids and leave the paper's alone."""
-    from passmd.experiments.critical_amplitude import claims
+    from passmd.experiments.critical_amplitude_one import claims
     from passmd.experiments.driving_waveform import claims_velocity
     from passmd.experiments.driving_waveform.figures import FREQUENCIES
     from passmd.ledger.verdicts import _evaluate_point
@@ -631,9 +631,9 @@ def test_a_coarse_grid_decides_only_what_the_paper_grid_would():
     scoped = state(checks.Subset(checks.Scoped(fails, "outside Eq. 15"), "0.1 N"))
     assert scoped.state == "fails" and scoped.outside == "outside Eq. 15"
     # the extractors' wrappers: the quick grids lack points of the paper's, the paper's lacks none
-    wrapped = claims._on_paper_grid(holds, "fig5b", (0.2, 0.6, 1.0))
+    wrapped = claims.on_paper_grid(holds, "fig5b", (0.2, 0.6, 1.0))
     assert isinstance(wrapped, checks.Subset) and "0.1, 0.3" in wrapped.missing
-    assert claims._on_paper_grid(holds, "fig6c", (0.1, 0.2, 0.3, 0.4, 0.5)) is holds
+    assert claims.on_paper_grid(holds, "fig6c", (0.1, 0.2, 0.3, 0.4, 0.5)) is holds
     for profile, whole in (("quick", False), ("paper", True)):
         part = pd.DataFrame({"frequency_kHz": FREQUENCIES[profile] / 1e3})
         assert (claims_velocity.on_paper_grid(holds, part) is holds) == whole
@@ -674,7 +674,7 @@ def test_every_claim_declares_exactly_the_axes_that_change_its_tables():
     assert "damping_ratio" not in functions.depends_on["fig5b-rigid-ac-matches-eq7"]
     assert "damping_ratio" in functions.depends_on["fig5b-flexible-above-rigid"]
     # Section 5 drives at the full stroke, where the two fly-back rules are the same 2 µs
-    from passmd.experiments.driving_waveform.runs import section5_drive
+    from passmd.experiments.driving_waveform.figures_runs import section5_drive
     from passmd.model import waveforms
     for radius in (1e-3, 0.25e-3):
         drive = section5_drive(radius)
@@ -941,7 +941,7 @@ def test_reading_tables_hold_the_full_product():
     """The A_c readings of a flexible panel hold every point of fly-back × A_c protocol × drive frequency
     × ζ × μ, a rigid panel every point but ζ; the force readings every point of fly-back × ζ × drive
     frequency; each default point is the figure's own run (the same sweep parameters)."""
-    from passmd.experiments.critical_amplitude import figures
+    from passmd.experiments.critical_amplitude_one import figures
     from passmd.ledger import readings
 
     rigid_axes = tuple(k for k in figures._AC_AXES if k != "damping_ratio")

@@ -12,7 +12,7 @@ between machines:
 import numpy as np
 import pytest
 
-from passmd.experiments.mdr_validation import closed_forms
+from passmd.experiments.mdr_validation import figures
 from passmd.model import theory
 from passmd.model.parameters import Drive
 
@@ -41,7 +41,7 @@ def tolerances(df):
 
 
 def test_spring_picture(dataframe_regression):
-    df = closed_forms.spring_picture()
+    df = figures.spring_picture()
     assert df["normal_force_N"].sum() == pytest.approx(F_N, rel=ROUND)
     # tangential spring forces never exceed μ times their normal force (Eq. 6 stick condition)
     limit = DRIVE.friction_coefficient * df["normal_force_N"] * (1 + ROUND)
@@ -56,7 +56,7 @@ def test_spring_picture(dataframe_regression):
 
 
 def test_normal_validation(dataframe_regression):
-    df = closed_forms.normal_validation()
+    df = figures.normal_validation()
     # the grid's rim is at the Hertz radius of 2 F_N1: there d_max gives exactly the midpoint-rule
     # error of the parabola's integral, 1/(2 N^2)
     for n in (20, 100, 1000):
@@ -66,7 +66,7 @@ def test_normal_validation(dataframe_regression):
 
 
 def test_virgin_validation(dataframe_regression):
-    df = closed_forms.virgin_validation()
+    df = figures.virgin_validation()
     np.testing.assert_allclose(df["exact_N"], df["cattaneo_mindlin_N"], rtol=0, atol=ROUND * F_S)
     np.testing.assert_allclose(df["discrete_1000_N"], df["cattaneo_mindlin_N"], rtol=0, atol=DISCRETE * F_S)
     assert df["slip_share_exact"].iloc[0] == 0.0 and df["slip_share_exact"].iloc[-1] == 1.0
@@ -74,7 +74,7 @@ def test_virgin_validation(dataframe_regression):
 
 
 def test_hysteresis_validation(dataframe_regression):
-    df = closed_forms.hysteresis_validation()
+    df = figures.hysteresis_validation()
     np.testing.assert_allclose(df["exact_N"], df["masing_N"], rtol=0, atol=ROUND * F_S)
     np.testing.assert_allclose(df["discrete_1000_N"], df["masing_N"], rtol=0, atol=DISCRETE * F_S)
     # both loops close: back at A the force is the virgin value at A again; at B after C too
@@ -86,14 +86,14 @@ def test_hysteresis_validation(dataframe_regression):
 
 def test_hysteresis_path_rejects_a_minor_loop_outside_the_major_one():
     with pytest.raises(ValueError, match="minor loop"):
-        closed_forms.hysteresis_path(amplitude=0.5, minor_top=0.6)
+        figures.hysteresis_path(amplitude=0.5, minor_top=0.6)
 
 
 def test_convergence(dataframe_regression):
-    df = closed_forms.convergence_validation()
+    df = figures.convergence_validation()
     assert (df["max_error_rel"].diff().dropna() < 0).all()  # monotone in N
     assert df.loc[df["springs"] >= 1000, "max_error_rel"].max() < DISCRETE
     # N^-2 is the midpoint rule's order; the stick/slip kinks could lower it, the fit shows they
     # do not. ±0.2 covers the scatter of a log-log fit over 7 points.
-    assert closed_forms.fitted_order(df) == pytest.approx(2.0, abs=0.2)
+    assert figures.fitted_order(df) == pytest.approx(2.0, abs=0.2)
     dataframe_regression.check(df, tolerances=tolerances(df))

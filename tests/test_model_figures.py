@@ -8,34 +8,35 @@ import pandas as pd
 import pytest
 
 from passmd.experiments import figure_table
-from passmd.experiments.mdr_validation.figures import (
-    HYSTERESIS_TURNS,
+from passmd.experiments.mdr_validation.facts import (
     contact_facts,
     cost_facts,
     hysteresis_facts,
+    normal_facts,
+    virgin_facts,
+)
+from passmd.experiments.mdr_validation.figures import (
+    HYSTERESIS_TURNS,
     mdr_convergence,
     mdr_cost,
     mdr_hysteresis,
     mdr_normal,
     mdr_virgin,
-    normal_facts,
-    virgin_facts,
 )
+from passmd.experiments.model.facts import actuator_row, closed_form_rows
 from passmd.experiments.model.figures import (
     MODEL_PRELOAD,
     SAWTOOTH_PERIODS,
-    actuator_row,
-    closed_form_rows,
     model_drive,
     model_mdr_loop,
     model_sawtooth,
     normal_force_balance,
 )
-from passmd.experiments.numerics.benchmarks import benchmark_table
-from passmd.experiments.numerics.facts import (
+from passmd.experiments.model_numerics.facts import (
     CONTROLLED_FIT_COARSEST,
     TARGET_MS_PER_PERIOD,
     benchmark_facts,
+    benchmark_table,
     convergence_facts,
     coulomb_rising_gaps,
     coulomb_side,
@@ -44,7 +45,7 @@ from passmd.experiments.numerics.facts import (
     settle_facts,
     step_plan_table,
 )
-from passmd.experiments.numerics.figures import (
+from passmd.experiments.model_numerics.figures import (
     CONFIGURATIONS,
     REFERENCE_CONTROL,
     RIGID_STEP_CONTROLS,

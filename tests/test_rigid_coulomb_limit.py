@@ -8,7 +8,7 @@ step of :func:`passmd.model.theory.coulomb_sawtooth_step`, which no part of the 
 import numpy as np
 import pytest
 
-from passmd.experiments.numerics import figures
+from passmd.experiments.model_numerics import figures
 from passmd.model import theory
 from passmd.model.parameters import Drive
 

@@ -363,13 +363,12 @@ def test_ctrl_c_stops_a_process_pool_sweep_and_rerun_resumes(tmp_path):
 
 
 # --------------------------------------------------------------------------------------
-# Design maps (passmd.experiments.design.maps): the protocols' quantities through the sweep engine
+# Design maps (passmd.protocols.maps): the protocols' quantities through the sweep engine
 # --------------------------------------------------------------------------------------
 
 
 def test_compute_map_keeps_grid_order_and_the_caller_s_columns(store):
-    from passmd.experiments.design.maps import compute_map
-    from passmd.protocols.maps import critical_amplitude_point, steady_point
+    from passmd.protocols.maps import compute_map, critical_amplitude_point, steady_point
 
     drive = Drive(contacts=1, actuator_model="rigid")
     points = [{"drive": drive, "frequency": f, "amplitude": a, "f_kHz": f / 1e3, "a_nm": a * 1e9}

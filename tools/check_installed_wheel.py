@@ -47,7 +47,7 @@ def main(argv: list[str] | None = None) -> int:
     repo = args.repo.resolve()
 
     import passmd
-    from passmd.experiments.numerics import benchmarks
+    from passmd.experiments.model_numerics import facts
     from passmd.ledger import reference
     from passmd.ledger.claims import CLAIMS_PATH, load_claims
     from passmd.runtime import provenance
@@ -71,8 +71,8 @@ def main(argv: list[str] | None = None) -> int:
     for name in reference.CURVES:
         table = reference.load_reference_curve(name)
         print(f"reference.load_reference_curve({name!r}): {len(table)} rows")
-    for name in benchmarks.BENCHMARKS:
-        print(f"benchmarks.benchmark_results({name!r}): keys {', '.join(benchmarks.benchmark_results(name))}")
+    for name in facts.BENCHMARKS:
+        print(f"facts.benchmark_results({name!r}): keys {', '.join(facts.benchmark_results(name))}")
 
     cache = ["--cache-dir", str(args.ledger_cache)] if args.ledger_cache else []
     ledger_out = json.loads(_run(exe, "ledger", "--profile", "quick", "--json", *cache))

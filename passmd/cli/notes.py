@@ -50,7 +50,7 @@ def eq15_rows(args, table) -> list[tuple[str, str]]:
 
 def ringing_rows(axes, spec, table, resolution, shown) -> list[tuple[str, str]]:
     """The runner's ringing where it affects a sweep's values (``ringing_*`` columns of
-    :func:`passmd.experiments.design.maps.compute_map`), and the turns of a curve it explains.
+    :func:`passmd.protocols.maps.compute_map`), and the turns of a curve it explains.
 
     ``spec``: the quantity (its column, label, unit, scale); ``resolution``: each point's value
     resolution (SI); ``shown(axis, value)``: an axis value as the sweep writes it.

@@ -1,13 +1,51 @@
-"""Experiments: the grids, figure data, claim extractors and chapter facts of each paper section.
+"""Experiments: one package per book chapter that computes something, ``experiments/<book-stem>/``.
 
-Each topic module turns the protocols of :mod:`passmd.protocols` into the tidy DataFrames of
-the paper's figures, one compute function ``compute(config: RunConfig) -> DataFrame`` per
-panel, and the small tested functions whose results the chapters quote; the claim extractors
-of a section sit beside its topic module in ``<topic>_claims`` (the modules
-:data:`passmd.experiments.figure_table.CLAIM_MODULES` lists). The figure table that names every panel, its
-chapter and its plot is :mod:`passmd.experiments.figure_table`; nothing here imports ``passmd.plots``.
+Every chapter package has the same modules: ``figures.py`` (the chapter's compute functions, run
+configuration → tidy DataFrame, and its rows of the figure table: a tuple ``FIGURES`` of
+:class:`FigureSpec` and, where the ledger reads runs beyond the figures', ``READING_TABLES`` of
+:class:`ReadingTable`), ``facts.py`` (the numbers and short texts the chapter's prose quotes) and,
+where the chapter judges claims of the paper, ``claims.py`` (the ledger's claim extractors). A module
+that would pass 500 lines splits by topic as ``<module>_<topic>.py``. Code several chapters or the
+command line share lives in :mod:`passmd.protocols`. :mod:`passmd.experiments.figure_table` assembles
+the figure table from the chapters in :data:`~passmd.experiments.figure_table.CHAPTERS` (the book's
+order) and finds the claim modules; nothing here imports ``passmd.plots``.
 
 Profiles (:data:`passmd.runtime.config.PROFILES`): ``quick`` (CI regression tests, minutes for
-everything) and ``paper`` (the paper's grids; the book's default). Each topic module
-defines what a profile means for it.
+everything) and ``paper`` (the paper's grids; the book's default). Each chapter defines what a
+profile means for it.
 """
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from typing import NamedTuple
+
+__all__ = ["FigureSpec", "ReadingTable"]
+
+
+class FigureSpec(NamedTuple):
+    """One figure panel of the book."""
+
+    name: str  #: paper name, e.g. "fig5b"
+    title: str  #: one line: what the panel shows
+    chapter: str  #: book chapter file stem that shows it
+    compute: Callable  #: run configuration -> tidy data (pandas.DataFrame)
+    #: ``"module:function"`` of ``passmd.plots`` drawing the data (a matplotlib Figure); named,
+    #: not imported, so that computing a figure's data (the ledger, the sweeps) loads no matplotlib
+    plot: str
+
+    def plot_function(self) -> Callable:
+        """The plot function of :attr:`plot`, imported on first use."""
+        module, _, name = self.plot.partition(":")
+        return getattr(importlib.import_module(f"passmd.plots.{module}"), name)
+
+
+class ReadingTable(NamedTuple):
+    """A table of the ledger's readings: every run some claims read, at every point of the axes of
+    :mod:`passmd.ledger.readings` that change it (the defaults are the figures' own runs)."""
+
+    key: str  #: result key, e.g. "fig5b_readings"
+    title: str  #: one line: what it holds
+    figures: tuple[str, ...]  #: the figures whose claims read it (a chapter's ledger rows)
+    compute: Callable  #: run configuration -> tidy data (pandas.DataFrame)

@@ -37,7 +37,7 @@ from passmd.model.tables import (
 )
 
 # Amplifier, Material, STEEL, Assumption and MOLYBDENUM stay importable from here for the modules
-# that still name this module for them (passmd.experiments.numerics.figures and
+# that still name this module for them (passmd.experiments.model_numerics.figures and
 # passmd.experiments.driving_waveform.figures); they are documented in passmd.model.tables.
 from passmd.model.tables import MOLYBDENUM as MOLYBDENUM
 from passmd.runtime.validation import (

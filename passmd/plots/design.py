@@ -1,4 +1,5 @@
-"""Figures of the chapter "Design your own drive" (data from :mod:`passmd.experiments.design.figures`).
+"""Figures of the chapter "Design your own drive" (data from
+:mod:`passmd.experiments.design_your_drive.figures`).
 
 The maps are drawn by :func:`passmd.plots.sweep_map.map_figure`, as ``passmd sweep`` draws them
 (:func:`design_map`); here also are the figures a map does not cover.

@@ -189,7 +189,7 @@ def plot_fig10c(df):
 
 
 # --------------------------------------------------------------------------------------
-# Beyond the paper (passmd.experiments.driving_waveform.studies)
+# Beyond the paper (passmd.experiments.driving_waveform.figures_studies)
 # --------------------------------------------------------------------------------------
 
 
@@ -225,7 +225,7 @@ def plot_settling_scan(scans: dict):
 
 def plot_settling_scans(df):
     """:func:`plot_settling_scan` of the tidy table of
-    :func:`passmd.experiments.driving_waveform.facts.settling_scans` (one curve per ``series``)."""
+    :func:`passmd.experiments.driving_waveform.figures_studies.settling_scans` (one curve per ``series``)."""
     return plot_settling_scan({label: part for label, part in df.groupby("series", sort=False)})
 
 

@@ -200,7 +200,7 @@ def plot_cycle(df: pd.DataFrame, zoom_us: float = 400.0):
 def plot_fig7_difference(df: pd.DataFrame):
     """F_gen(rigid, μ = 0.3) − F_gen(flexible, μ = 0.2) against A, one axes per panel.
 
-    ``df`` is :func:`passmd.experiments.force_generation.facts.fig7_difference`: one curve per preload,
+    ``df`` is :func:`passmd.experiments.force_generation.figures.fig7_difference`: one curve per preload,
     the amplitudes between the two models' onsets shaded.
     """
     names = list(dict.fromkeys(df["panel"]))

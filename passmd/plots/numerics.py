@@ -17,7 +17,7 @@ CONVERGED_STEP_NM = CONVERGED_ACCURACY * 1e9
 
 
 #: Legend name of each step control of the convergence figure
-#: (:data:`passmd.experiments.numerics.figures.STEP_CONTROLS`) and its line style and marker.
+#: (:data:`passmd.experiments.model_numerics.figures.STEP_CONTROLS`) and its line style and marker.
 STEP_CONTROL_STYLES = {
     "controlled": ("error-controlled (default)", "-", "o"),
     "adaptive": ("explicit adaptive", "--", "s"),

@@ -30,7 +30,8 @@ midpoint as A_c and the number of runs. The steady-state search finds bisection'
 bracket with fewer runs (:func:`search_amplitude`): above A_c the last step grows about 1 nm
 per nm of amplitude, so its linear extrapolation tells which of bisection's decisions need a
 run; whenever the step switches once on [0, A_max] the bracket is bisection's to the last bit.
-Grids, figures and claims of Section 4.1 are in :mod:`passmd.experiments.critical_amplitude.figures`.
+Grids, figures and claims of Section 4.1 are in :mod:`passmd.experiments.critical_amplitude_one.figures` and
+:mod:`passmd.experiments.critical_amplitude_six.figures`.
 """
 
 from __future__ import annotations

@@ -11,7 +11,7 @@ from __future__ import annotations
 from types import ModuleType
 
 import passmd.experiments.driving_waveform.figures
-import passmd.experiments.driving_waveform.studies
+import passmd.experiments.driving_waveform.figures_studies
 import passmd.experiments.force_generation.figures
 from passmd.ledger import reference
 from passmd.model import arrangement, contact, optimized_waveform, parameters, tables, waveforms
@@ -32,7 +32,7 @@ ASSUMPTION_MODULES: tuple[ModuleType, ...] = (
     critical_amplitude,
     passmd.experiments.driving_waveform.figures,
     passmd.experiments.force_generation.figures,
-    passmd.experiments.driving_waveform.studies,
+    passmd.experiments.driving_waveform.figures_studies,
     optimized_waveform,
 )
 

@@ -463,8 +463,7 @@ def _check_values(args, column: str, table) -> None:
 
 
 def run_sweep(args, out) -> int:
-    from passmd.experiments.design.maps import compute_map
-    from passmd.protocols.maps import MAP_QUANTITIES
+    from passmd.protocols.maps import MAP_QUANTITIES, compute_map
 
     spec = MAP_QUANTITIES[args.quantity]
     _check_options(args)
@@ -476,7 +475,6 @@ def run_sweep(args, out) -> int:
                         waveform=args.waveform or "sawtooth", design_response=args.design_response or "paper",
                         config=config)
     _check_values(args, spec.column, table)
-    varied = [a.name for a in axes]
     title = sweep_title(spec, axes, base)
     record = _record(args, axes, table, spec, base)
     if args.out is not None:
@@ -497,5 +495,5 @@ def run_sweep(args, out) -> int:
         rows += missing_rows(args, table, record["missing_values"])
     if "files" in record:
         rows.append(("written", ", ".join(record["files"].values())))
-    emit_rows(f"passmd sweep {args.quantity} — {describe(base, omit=varied)}", rows, out)
+    emit_rows(f"passmd sweep {args.quantity} — {describe(base, omit=[a.name for a in axes])}", rows, out)
     return 0

@@ -1,2 +1,1 @@
-"""The calibration chapter: data made by other means than the fit's forward model, and the fits that
-show what a calibration can and cannot tell (a comb of minima, a wrong fly-back rule)."""
+"""The calibration chapter (beyond the paper): fitting the unknowns of Sections 2–3 to measured steps."""

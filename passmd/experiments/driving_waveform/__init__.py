@@ -1,2 +1,1 @@
-"""Section 5, driving waveform (Figs. 8–10): figure data, claim
-extractors, the facts the chapter quotes and studies beyond the paper."""
+"""The driving-waveform chapter, Section 5: Eq. 15's optimized waveform against the saw-tooth (Figs. 8–10)."""

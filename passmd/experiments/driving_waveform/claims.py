@@ -9,7 +9,7 @@ stops growing with the frequency); the response to the optimized waveform agains
 it is designed from (the runner velocity V_r of Eq. 15 after an optimized period); t_a starting
 at the runner's velocity maximum, stick during t_a, the contacts deformed to u_x,max after the
 fly-back, the runner fastest at the end of t_a and slipping forward further than the hemispheres
-move (Sub-phase II). Section 5.2's positions and velocities are in
+move (Sub-phase II); Fig. 9a's final positions and step increase. Section 5.2's velocities are in
 :mod:`passmd.experiments.driving_waveform.claims_velocity`. Too few samples in a phase make a
 claim inconclusive.
 """
@@ -22,11 +22,12 @@ import pandas as pd
 from passmd.experiments.driving_waveform.figures import (
     at_section5_friction,
 )
-from passmd.experiments.driving_waveform.runs import (
+from passmd.experiments.driving_waveform.figures_runs import (
     SECTION5_FRICTION,
     WINDOW_SAMPLES_PER_ACCELERATION,
 )
 from passmd.ledger.checks import ClaimFails, NoRun, NotEvaluable, evidence, extractor
+from passmd.ledger.readings import default_reading
 from passmd.protocols.velocity import FULL_SLIDING_SHARE
 
 __all__ = ["optimized_period_timing"]
@@ -54,6 +55,30 @@ def at_mu(results, key: str, reading) -> pd.DataFrame:
 
 #: The axis these claims depend on: Section 5's unstated μ.
 _AXES = ("friction_coefficient",)
+
+
+@extractor("fig9a-standard-position-552nm", depends_on=_AXES)
+def _fig9a_standard(results, reading):
+    return float(_fig9a_run(results, "sawtooth", reading)["settled_position_m"].iloc[-1]) * 1e9
+
+
+@extractor("fig9a-optimized-position-716nm", depends_on=_AXES)
+def _fig9a_optimized(results, reading):
+    return float(_fig9a_run(results, "optimized", reading)["settled_position_m"].iloc[-1]) * 1e9
+
+
+@extractor("fig9a-step-increase-46.8pct", depends_on=_AXES)
+def _fig9a_increase(results, reading):
+    std = _fig9a_run(results, "sawtooth", reading)["settled_position_m"].to_numpy()
+    opt = _fig9a_run(results, "optimized", reading)["settled_position_m"].to_numpy()
+    return 100.0 * (opt[-1] - std[-1]) / (std[-1] - std[0])
+
+
+@extractor("fig9a-optimized-step-larger", depends_on=_AXES)
+def _fig9a_step_larger(results, reading):
+    steps = {w: float(np.mean(np.diff(_fig9a_run(results, w, reading)["settled_position_m"].to_numpy())))
+             * 1e9 for w in ("optimized", "sawtooth")}
+    return {"lhs": steps["optimized"], "rhs": steps["sawtooth"]}
 
 
 #: Why the Fig. 8a back-step and the full sliding after the fly-back cannot fail: at 202 nm the
@@ -126,8 +151,6 @@ def _response_similar(results, reading):
 
 @evidence("sec5-response-to-optimized-similar")
 def _response_similar_evidence(results):
-    from passmd.ledger.readings import default_reading
-
     row = _response(results, default_reading())
     return [f"at {row['frequency_Hz'] / 1e3:.3g} kHz, over t_s = {row['settling_time_s'] * 1e6:.2f} µs "
             "after the last fly-back: largest speed "

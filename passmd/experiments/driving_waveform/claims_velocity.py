@@ -1,13 +1,12 @@
-"""Claim extractors of Section 5.2: positions and steady velocities (Figs. 9a, 9b and 10).
+"""Claim extractors of Section 5.2: steady velocities (Figs. 9b and 10).
 
-Decides the ledger's Section 5.2 rows (``passmd/data/reference/claims.csv``), and the abstract's
-and conclusion's claims drawn from them, from Fig. 9a's three periods and the steady velocities of
-Figs. 9b and 10, each at the ledger's reading of μ (the readings tables
-``fig9b_readings`` … ``fig10c_readings``) and of the short-period rule of the optimized waveform:
-final positions and step increase, the velocity gain, the saw-tooth's step and velocity, the
-frequencies where the velocity turns and where t_s no longer fits, the reachable maxima of Fig. 10
-and their orderings over preload, radius and runner material, the 0.1 N maximum at the loss of
-stick.
+Decides the ledger's Section 5.2 velocity rows (``passmd/data/reference/claims.csv``; Fig. 9a's
+positions are :mod:`passmd.experiments.driving_waveform.claims`'), and the abstract's and conclusion's
+claims drawn from them, from the steady velocities of Figs. 9b and 10, each at the ledger's reading
+of μ (the readings tables ``fig9b_readings`` … ``fig10c_readings``) and of the short-period rule of
+the optimized waveform: the velocity gain, the saw-tooth's step and velocity, the frequencies where
+the velocity turns and where t_s no longer fits, the reachable maxima of Fig. 10 and their orderings
+over preload, radius and runner material, the 0.1 N maximum at the loss of stick.
 
 The reachable maximal velocity of a series is its largest steady velocity over the paper's
 controllable range, the grid frequencies up to 110 kHz ("it is impossible to control the drives
@@ -25,11 +24,11 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from passmd.experiments.driving_waveform.claims import _fig9a_run
 from passmd.experiments.driving_waveform.figures import FREQUENCIES, PAPER_MAXIMUM_KHZ
-from passmd.experiments.driving_waveform.runs import variant_name
-from passmd.experiments.numerics.accuracy import POSITION_ACCURACY, VELOCITY_ACCURACY
+from passmd.experiments.driving_waveform.figures_runs import variant_name
+from passmd.experiments.model_numerics.facts import POSITION_ACCURACY, VELOCITY_ACCURACY
 from passmd.ledger.checks import ClaimFails, NoRun, NotEvaluable, Scoped, Subset, evidence, extractor
+from passmd.ledger.readings import default_reading
 
 __all__ = ["GRID_STEP_KHZ", "at_frequency", "complete_grid", "controllable_maximum", "eq15_scope",
            "maximum_location", "on_paper_grid", "stick_edge", "turning_point"]
@@ -156,34 +155,6 @@ def at_frequency(part: pd.DataFrame, frequency_kHz: float) -> pd.Series:
     return rows.iloc[0]
 
 
-#: Axis of passmd.ledger.readings the Fig. 9a claims depend on: Section 5's unstated μ.
-_FIG9A_AXES = ("friction_coefficient",)
-
-
-@extractor("fig9a-standard-position-552nm", depends_on=_FIG9A_AXES)
-def _fig9a_standard(results, reading):
-    return float(_fig9a_run(results, "sawtooth", reading)["settled_position_m"].iloc[-1]) * 1e9
-
-
-@extractor("fig9a-optimized-position-716nm", depends_on=_FIG9A_AXES)
-def _fig9a_optimized(results, reading):
-    return float(_fig9a_run(results, "optimized", reading)["settled_position_m"].iloc[-1]) * 1e9
-
-
-@extractor("fig9a-step-increase-46.8pct", depends_on=_FIG9A_AXES)
-def _fig9a_increase(results, reading):
-    std = _fig9a_run(results, "sawtooth", reading)["settled_position_m"].to_numpy()
-    opt = _fig9a_run(results, "optimized", reading)["settled_position_m"].to_numpy()
-    return 100.0 * (opt[-1] - std[-1]) / (std[-1] - std[0])
-
-
-@extractor("fig9a-optimized-step-larger", depends_on=_FIG9A_AXES)
-def _fig9a_step_larger(results, reading):
-    steps = {w: float(np.mean(np.diff(_fig9a_run(results, w, reading)["settled_position_m"].to_numpy())))
-             * 1e9 for w in ("optimized", "sawtooth")}
-    return {"lhs": steps["optimized"], "rhs": steps["sawtooth"]}
-
-
 def _fig9b_pair(results, reading):
     saw = _series(results, "fig9b", "sawtooth", reading)
     opt = _series(results, "fig9b", _optimized(reading), reading)
@@ -278,8 +249,6 @@ def _fig9b_std_increases(results, reading):
 
 @evidence("fig9b-standard-increases-above-110khz")
 def _fig9b_std_evidence(results):
-    from passmd.ledger.readings import default_reading
-
     part = _series(results, "fig9b", "sawtooth", default_reading())
     part = part[part["frequency_kHz"] >= PAPER_MAXIMUM_KHZ - 1e-9]
     step = part["step_nm"].to_numpy()
@@ -297,8 +266,6 @@ def _fig9b_step_decreases(results, reading):
 
 @extractor("study-fig9b-sawtooth-velocity-16.5mm_s-at-110khz")
 def _fig9b_sawtooth_110(results):
-    from passmd.ledger.readings import default_reading
-
     part = _series(results, "fig9b", "sawtooth", default_reading())
     return float(at_frequency(part, PAPER_MAXIMUM_KHZ)["velocity_mm_per_s"])
 
@@ -336,7 +303,7 @@ def _fig10a_fmax(results, reading):
 
 
 #: What two values of a column of the velocity tables must differ by to be told apart: the stated
-#: accuracy of the integrator (passmd.experiments.numerics.accuracy), in the column's unit.
+#: accuracy of the integrator (passmd.experiments.model_numerics.facts), in the column's unit.
 _RESOLUTION = {"back_step_nm": POSITION_ACCURACY * 1e9, "velocity_mm_per_s": VELOCITY_ACCURACY * 1e3}
 
 
@@ -410,8 +377,6 @@ def _fig10a_01n_at_80(results, reading):
 
 @evidence("fig10a-0.1n-maximum-at-or-below-80khz")
 def _fig10a_01n_at_80_evidence(results):
-    from passmd.ledger.readings import default_reading
-
     part = _fig10a_part(results, 0.1, default_reading())
     fits = part.loc[part["eq15_fits"].astype(bool), "frequency_kHz"]
     stick = part.loc[part["stick_during_acceleration"].astype(bool), "frequency_kHz"]
@@ -482,8 +447,6 @@ def _conclusion_youngs(results, reading):
 # Evidence: the reachable maxima the Fig. 10 orderings compare, at the defaults.
 
 def _maxima_evidence(results, key, column, unit, pairs):
-    from passmd.ledger.readings import default_reading
-
     out = []
     for where in pairs:
         part = _series(results, key, "optimized", default_reading(), **where)

@@ -1,8 +1,8 @@
 """Facts the driving-waveform chapter reads from the data of Figs. 8–10 and the studies (Section 5).
 
-Small functions of the figures' tidy tables (:mod:`passmd.experiments.driving_waveform.figures`) and of
-the studies beyond the paper (:mod:`passmd.experiments.driving_waveform.studies`) that return the numbers
-and tables the chapter glues into its prose: the Eq. 15 design, the response of Fig. 8a, the
+Small functions of the figures' tidy tables (:mod:`passmd.experiments.driving_waveform.figures`) and
+of the studies beyond the paper (:mod:`passmd.experiments.driving_waveform.figures_studies`) that return
+the numbers and tables the chapter glues into its prose: the Eq. 15 design, the response of Fig. 8a, the
 resolved fly-back window, the positions of Fig. 9a, the velocities of Fig. 9b, the reachable
 maxima of Fig. 10 and the numerical optimum on rigid and flexible actuators. Display units: nm,
 µs, kHz, mm/s, %.
@@ -20,14 +20,13 @@ from passmd.experiments.driving_waveform.figures import (
     at_section5_friction,
     range_maximum,
 )
-from passmd.experiments.driving_waveform.runs import (
+from passmd.experiments.driving_waveform.figures_runs import (
     STEP_FREQUENCY,
     section5_fields,
 )
-from passmd.experiments.driving_waveform.studies import numerical_optimum, settling_scan, step_point
+from passmd.experiments.driving_waveform.figures_studies import optimum_at, step_point
 from passmd.model import theory, waveforms
 from passmd.model.parameters import Drive
-from passmd.runtime.config import RunConfig
 
 
 def friction_acceleration(drive: Drive) -> float:
@@ -37,7 +36,7 @@ def friction_acceleration(drive: Drive) -> float:
 
 
 def design_facts(design: pd.Series, drive: Drive) -> dict:
-    """The Eq. 15 design of a drive (a :func:`~passmd.experiments.driving_waveform.runs.designs` row)
+    """The Eq. 15 design of a drive (a :func:`~passmd.experiments.driving_waveform.figures_runs.designs` row)
     and the
     drive's numbers behind it."""
     presliding = theory.drive_theory(drive)["presliding_m"]
@@ -183,17 +182,8 @@ def stick_lost(fig10a_data: pd.DataFrame, preload: float = min(FIG10A_PRELOADS))
             "with_full_settling": list(lost[lost["settling_fits"].astype(bool)]["frequency_kHz"])}
 
 
-def optimum_at(optimum: pd.DataFrame, frequency: float = STEP_FREQUENCY, actuator_model: str = "rigid"
-               ) -> pd.Series:
-    """The :func:`~passmd.experiments.driving_waveform.studies.numerical_optimum` row of one actuator
-    model at one
-    frequency (default: rigid, 100 Hz)."""
-    rows = optimum[(optimum["actuator_model"] == actuator_model) & (optimum["frequency"] == frequency)]
-    return rows.iloc[0]
-
-
 def optimum_table(optimum: pd.DataFrame) -> pd.DataFrame:
-    """The :func:`~passmd.experiments.driving_waveform.studies.numerical_optimum` table as the chapter
+    """The :func:`~passmd.experiments.driving_waveform.figures_studies.numerical_optimum` table as the chapter
     shows it
     (mm/s, nm, cycles of f_s)."""
     shown = optimum[["actuator_model", "frequency_kHz", "velocity_sawtooth_mm_per_s",
@@ -209,7 +199,7 @@ def optimum_table(optimum: pd.DataFrame) -> pd.DataFrame:
 
 def optimum_facts(optimum: pd.DataFrame, design: pd.Series, a_f: float) -> dict:
     """The rigid optimum at 100 Hz against the saw-tooth and the Eq. 15 ``design`` (a
-    :func:`~passmd.experiments.driving_waveform.runs.designs` row): its gain (%), t_s (cycles), V_a
+    :func:`~passmd.experiments.driving_waveform.figures_runs.designs` row): its gain (%), t_s (cycles), V_a
     (mm/s), Δ_a (nm), t_a (µs and × Eq. 15's), the slide V_a²/2a_f (nm, ``a_f`` the friction
     acceleration), Eq. 15's V_a over the optimum's, the gain per period (nm); and the gain (%) at
     the highest frequency optimised (kHz)."""
@@ -268,19 +258,4 @@ def flexible_facts(optimum: pd.DataFrame, flexible_design: pd.Series, carried: p
                           if len(flexible) else float("nan")),
     }
 
-
-def settling_scans(config: RunConfig) -> pd.DataFrame:
-    """Step at 100 Hz against the settling time, with Eq. 15's acceleration and with the optimum's.
-
-    The two :func:`~passmd.experiments.driving_waveform.studies.settling_scan` tables, tagged with a
-    ``series`` label: Eq. 15's t_a and Δ_a, and the acceleration time and amplitude of the
-    numerical optimum at 100 Hz (:func:`optimum_at`).
-    """
-    low = optimum_at(numerical_optimum(config))
-    scans = {
-        "Eq. 15's t_a, Δ_a": settling_scan(config),
-        "optimum's V_a, Δ_a (100 Hz)": settling_scan(config, low["optimum_acceleration_time_s"],
-                                                     low["optimum_acceleration_amplitude_m"]),
-    }
-    return pd.concat([scan.assign(series=label) for label, scan in scans.items()], ignore_index=True)
 

@@ -10,18 +10,18 @@ The velocities are measured by the protocol of :mod:`passmd.protocols.velocity` 
 (settled positions of the first and last period) includes the start-up and is kept as
 ``simulator_mean_velocity_m_per_s`` for comparison.
 
-Figures (``compute(config: RunConfig) -> DataFrame``, in the figure table of
-:mod:`passmd.experiments.figure_table`):
+Figures (``compute(config: RunConfig) -> DataFrame``, the chapter's rows :data:`FIGURES` of the figure
+table, with the studies'):
 ``fig8a`` saw-tooth response with contact status; ``fig8b`` the optimized waveform with
 t_s, t_a, Δ_a; ``fig9a`` runner position over three 100 Hz periods, both waveforms;
 ``fig9b`` steady velocity against frequency, both waveforms; ``fig10a``–``fig10c`` the
 optimized waveform's velocity for three preloads, two radii, two runner materials.
 
 The drives, their Eq. 15 designs and the runs the figures tabulate (the sweep's point
-functions): :mod:`passmd.experiments.driving_waveform.runs`.
+functions): :mod:`passmd.experiments.driving_waveform.figures_runs`.
 
-Beyond the paper (flexible actuators, the settling time, a numerical optimum of the
-waveform): :mod:`passmd.experiments.driving_waveform.studies`; the numbers the chapter reads from both:
+Beyond the paper (flexible actuators, the settling time, a numerical optimum of the waveform):
+:mod:`passmd.experiments.driving_waveform.figures_studies`; the numbers the chapter reads from both:
 :mod:`passmd.experiments.driving_waveform.facts`; the ledger's claims on Figs. 8–10:
 :mod:`passmd.experiments.driving_waveform.claims`.
 """
@@ -33,7 +33,8 @@ import math
 import numpy as np
 import pandas as pd
 
-from passmd.experiments.driving_waveform.runs import (
+from passmd.experiments import FigureSpec, ReadingTable
+from passmd.experiments.driving_waveform.figures_runs import (
     RUNNERS,
     SECTION5_FRICTION,
     STEP_FREQUENCY,
@@ -47,15 +48,16 @@ from passmd.experiments.driving_waveform.runs import (
     velocity_table,
     window_point,
 )
+from passmd.experiments.driving_waveform.figures_studies import (
+    flexible_study,
+    numerical_optimum,
+    settling_scans,
+    startup_transient,
+)
 from passmd.ledger import readings
 from passmd.ledger.checks import NotEvaluable
 from passmd.model.parameters import Assumption
-from passmd.protocols.velocity import (
-    FULL_SLIDING_SHARE,
-    MIN_PERIODS,
-    STEADY_TIME,
-    STEP_PERIODS,
-)
+from passmd.protocols.velocity import FULL_SLIDING_SHARE, MIN_PERIODS, STEADY_TIME, STEP_PERIODS
 from passmd.runtime import sweep
 from passmd.runtime.config import PROFILES, RunConfig
 from passmd.runtime.validation import check_choice
@@ -259,10 +261,10 @@ def fig8b_window(config: RunConfig, friction_coefficient: float = SECTION5_FRICT
     """The fly-back and the acceleration t_a of Fig. 8b's optimized period, resolved inside t_a.
 
     One run of the Section 5 drive (0.4 N, 100 Hz, its own Eq. 15 design) integrated with the
-    step divided by :data:`~passmd.experiments.driving_waveform.runs.WINDOW_RESOLUTION` and
+    step divided by :data:`~passmd.experiments.driving_waveform.figures_runs.WINDOW_RESOLUTION` and
     recorded every t_a /
-    :data:`~passmd.experiments.driving_waveform.runs.WINDOW_SAMPLES_PER_ACCELERATION`
-    (:func:`~passmd.experiments.driving_waveform.runs.window_point`). Columns: ``time_s``,
+    :data:`~passmd.experiments.driving_waveform.figures_runs.WINDOW_SAMPLES_PER_ACCELERATION`
+    (:func:`~passmd.experiments.driving_waveform.figures_runs.window_point`). Columns: ``time_s``,
     ``time_us``, runner and piezo positions (nm) and velocity, ``slip_share_1`` and
     ``slip_share_2``, ``phase`` (``flyback``, ``settling``, ``acceleration``, ``after``) and
     the constant phase times (s) and record spacing. ``friction_coefficient``: Section 5's unstated μ.
@@ -450,3 +452,40 @@ def range_maximum(part: pd.DataFrame) -> pd.Series:
     if not np.all(np.isfinite(part["velocity_mm_per_s"].to_numpy(dtype=float))):
         raise NotEvaluable("non-finite velocities on the frequency grid")
     return part.loc[part["velocity_mm_per_s"].idxmax()]
+
+
+#: The chapter's rows of the figure table.
+FIGURES = tuple(FigureSpec(name, title, "driving_waveform", compute, f"driving_waveform:{plot}") for
+                name, title, compute, plot in (
+    ("fig8a", "Runner response to two saw-tooth periods, with the contact status", fig8a, "plot_fig8a"),
+    ("fig8b", "The optimized waveform (Eq. 15) with t_s, t_a and Δ_a", fig8b, "plot_fig8b"),
+    ("fig8b_window", "Fig. 8b's fly-back and acceleration t_a, resolved in time", fig8b_window,
+     "plot_fig8b_window"),
+    ("fig9a", "Runner position over three 100 Hz periods, saw-tooth and optimized", fig9a, "plot_fig9a"),
+    ("study_startup", "Velocity period by period from rest at 110 kHz (steady-velocity protocol)",
+     startup_transient, "plot_startup"),
+    ("fig9b", "Steady velocity against driving frequency, saw-tooth and optimized", fig9b, "plot_fig9b"),
+    ("fig10a", "Velocity of the optimized waveform for preloads 0.1, 0.4, 1 N", fig10a, "plot_fig10a"),
+    ("fig10b", "Velocity of the optimized waveform for R = 1 mm and 0.25 mm", fig10b, "plot_fig10b"),
+    ("fig10c", "Velocity of the optimized waveform, steel and molybdenum runner", fig10c, "plot_fig10c"),
+    ("study_settling_scan", "Step at 100 Hz against the settling time, Eq. 15's and the optimum's "
+     "acceleration (beyond the paper)", settling_scans, "plot_settling_scans"),
+    ("study_optimum", "Velocity of Eq. 15's design and of a numerical optimum relative to the "
+     "saw-tooth (beyond the paper)", numerical_optimum, "plot_optimum"),
+    ("study_flexible", "Gain of the optimized waveform with rigid and flexible actuators "
+     "(beyond the paper)", flexible_study, "plot_flexible"),
+))
+
+#: The ledger's readings of the chapter's figures: each at every μ.
+READING_TABLES = (
+    ReadingTable("fig8a_readings", "Fig. 8a at every μ", ("fig8a",), fig8a_readings),
+    ReadingTable("fig8b_readings", "Fig. 8b at every μ", ("fig8b",), fig8b_readings),
+    ReadingTable("fig8b_window_readings", "Fig. 8b's fly-back window at every μ", ("fig8b_window",),
+                 fig8b_window_readings),
+    ReadingTable("fig9a_response", "The response after an optimized period, at every μ", ("fig9a",),
+                 fig9a_response),
+    ReadingTable("fig9b_readings", "Fig. 9b at every μ", ("fig9b",), fig9b_readings),
+    ReadingTable("fig10a_readings", "Fig. 10a at every μ", ("fig10a",), fig10a_readings),
+    ReadingTable("fig10b_readings", "Fig. 10b at every μ", ("fig10b",), fig10b_readings),
+    ReadingTable("fig10c_readings", "Fig. 10c at every μ", ("fig10c",), fig10c_readings),
+)

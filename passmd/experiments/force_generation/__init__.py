@@ -1,2 +1,1 @@
-"""Section 4.2, force generation (Fig. 7): figure data, claim
-extractors and the facts the chapter quotes."""
+"""The force-generation chapter, Section 4.2: the force generated against the load cell (Fig. 7)."""

@@ -21,14 +21,11 @@ from passmd.experiments.force_generation.figures import (
     PANELS,
     PANELS_FULL_STROKE_NM,
     THIS,
-    fig7a,
-    fig7b,
     force_difference,
     force_drive,
 )
 from passmd.model.theory import normal_forces, runner_frequency
 from passmd.protocols import stall
-from passmd.runtime.config import RunConfig
 
 #: Columns of the figure data that are timings of this machine, left out of the published data.
 TIMING_COLUMNS = ("cpu_time_s", "onset_cpu_time_s")
@@ -117,28 +114,6 @@ def panel_differences(data: dict) -> dict:
     """:func:`~passmd.experiments.force_generation.figures.force_difference` of every preload of both Fig. 7
     panels, keyed ``"<panel> <preload> N"``."""
     return {f"{name} {p:g} N": force_difference(data[name], p) for name in PANELS for p in PANELS[name][1]}
-
-
-def fig7_difference(config: RunConfig) -> pd.DataFrame:
-    """F_gen(rigid, μ = 0.3) − F_gen(flexible, μ = 0.2) against A at every preload of Fig. 7.
-
-    One row per amplitude at which both models stalled (:func:`panel_differences` of the
-    panels fig7a and fig7b), with the panel, its radius and the preload, and the lower and
-    higher of the two models' onsets of force generation at that preload (mN, nm).
-    """
-    data = {"fig7a": fig7a(config), "fig7b": fig7b(config)}
-    rows = []
-    for name, (_, preloads) in PANELS.items():
-        frame = data[name]
-        for preload in preloads:
-            part = frame[np.isclose(frame["preload_N"], preload)]
-            onsets = part.drop_duplicates(["actuator_model", "friction_coefficient"])["onset_nm"]
-            rows.append(force_difference(frame, preload).assign(
-                panel=name, radius_mm=float(frame["radius_mm"].iloc[0]), preload_N=float(preload),
-                onset_low_nm=float(onsets.min()), onset_high_nm=float(onsets.max())))
-    columns = ["panel", "radius_mm", "preload_N", "amplitude_nm", "difference_mN", "onset_low_nm",
-               "onset_high_nm"]
-    return pd.concat(rows, ignore_index=True)[columns]
 
 
 def onset_table(panels: pd.DataFrame) -> pd.DataFrame:

@@ -3,17 +3,15 @@
 The measurement itself — runs from rest against the load cell until the steps stall, the
 stall criterion and the onset of force generation — is the protocol of
 :mod:`passmd.protocols.stall`. This module runs it over the grids of the figures (through
-the sweep engine, cached); the ledger's claims on the figures' data are
-:mod:`passmd.experiments.force_generation.claims`, the numbers the chapter reads
-:mod:`passmd.experiments.force_generation.facts`. By momentum balance over a periodic (stalled)
-cycle F_gen equals the mean total friction force on the runner; the tests check that.
+the sweep engine, cached). By momentum balance over a periodic (stalled) cycle F_gen equals the
+mean total friction force on the runner; the tests check that.
 
 Figures: ``fig7a`` (R = 1 mm, 0.3 and 0.8 N), ``fig7b`` (R = 0.25 mm, 0.2 and 0.4 N), each
 with the earlier model (rigid actuators, μ = 0.3, [12]) and this paper's (flexible, μ = 0.2);
-``fig7grid`` (every preload of both radii); ``fig7freq`` (F_gen against the drive frequency)
-and ``fig7cycle`` (one period at stall, rigid/flexible × μ = 0.2/0.3, the physics of the
-difference). Each compute function takes the run configuration
-(:class:`passmd.runtime.config.RunConfig`) and returns a tidy DataFrame in display units.
+``fig7_difference`` (their difference); ``fig7grid`` (every preload of both radii); ``fig7freq`` (F_gen
+against the drive frequency) and ``fig7cycle`` (one period at stall, rigid/flexible × μ = 0.2/0.3, the
+physics of the difference). Each compute function takes the run configuration and returns a tidy
+DataFrame in display units.
 """
 
 from __future__ import annotations
@@ -24,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from passmd.experiments import FigureSpec, ReadingTable
 from passmd.ledger import readings
 from passmd.ledger.checks import NoRun
 from passmd.model.defaults import PROTOCOL
@@ -46,28 +45,10 @@ from passmd.runtime.config import PROFILES, RunConfig
 from passmd.runtime.validation import check_choice, check_range
 
 __all__ = [
-    "CYCLE_COMBINATIONS",
-    "EARLIER",
-    "FORCE_FREQUENCY",
-    "MODELS",
-    "ONSET_TOLERANCE",
-    "PANELS",
-    "PANELS_FULL_STROKE_NM",
-    "PROFILE_SETTINGS",
-    "THIS",
-    "cycle_point",
-    "fig7a",
-    "fig7b",
-    "fig7cycle",
-    "fig7_readings",
-    "fig7freq",
-    "fig7grid",
-    "force_difference",
-    "force_drive",
-    "model_rows",
-    "onset_point",
-    "readings_at",
-    "stall_point",
+    "CYCLE_COMBINATIONS", "EARLIER", "FIGURES", "FORCE_FREQUENCY", "MODELS", "ONSET_TOLERANCE",
+    "PANELS", "PANELS_FULL_STROKE_NM", "PROFILE_SETTINGS", "READING_TABLES", "THIS", "cycle_point",
+    "fig7_difference", "fig7_readings", "fig7a", "fig7b", "fig7cycle", "fig7freq", "fig7grid",
+    "force_difference", "force_drive", "model_rows", "onset_point", "readings_at", "stall_point",
 ]
 
 #: Saw-tooth frequency of every force run (Hz): Section 5.2's 100 Hz (Fig. 9a), as in the
@@ -174,19 +155,9 @@ def force_drive(
 ) -> Drive:
     """The Fig. 7 drive: Tables 1–2, six contacts, load cell engaged (Section 4.2); actuator damping ζ
     (Table 2's lost c_p, ledger axis ``damping_ratio``)."""
-    return paper_drive(
-        hemisphere_radius,
-        preload,
-        actuator_model=actuator_model,
-        friction_coefficient=friction_coefficient,
-        load_cell=True,
-        actuator=actuator_for_radius(hemisphere_radius, damping_ratio=damping_ratio),
-    )
-
-
-# --------------------------------------------------------------------------------------
-# Sweep point functions (top level, scalar keyword arguments: picklable and cacheable)
-# --------------------------------------------------------------------------------------
+    return paper_drive(hemisphere_radius, preload, actuator_model=actuator_model,
+                       friction_coefficient=friction_coefficient, load_cell=True,
+                       actuator=actuator_for_radius(hemisphere_radius, damping_ratio=damping_ratio))
 
 
 def stall_point(
@@ -247,11 +218,6 @@ def cycle_point(
                        int(samples_per_period))
 
 
-# --------------------------------------------------------------------------------------
-# Figure data
-# --------------------------------------------------------------------------------------
-
-
 def _settings(profile: str) -> ProfileSettings:
     return PROFILE_SETTINGS[check_choice("profile", profile, PROFILES)]
 
@@ -260,52 +226,46 @@ def _stall_frame(points: list[dict], description: str, config: RunConfig) -> pd.
     """Stall runs through the sweep engine; tidy frame in display units (nm, mN)."""
     f = sweep.run(stall_point, points, description=description, config=config)
     labels = {(m, mu): label for m, mu, label in MODELS}
-    return pd.DataFrame(
-        {
-            "radius_mm": f["hemisphere_radius"] * 1e3,
-            "preload_N": f["preload"],
-            "actuator_model": f["actuator_model"],
-            "friction_coefficient": f["friction_coefficient"],
-            "model": [labels.get((m, mu), f"{m} actuators, μ = {mu:g}")
-                      for m, mu in zip(f["actuator_model"], f["friction_coefficient"], strict=True)],
-            "frequency_Hz": f["frequency"],
-            "amplitude_fraction": f["amplitude_fraction"],
-            "amplitude_nm": f["amplitude_m"] * 1e9,
-            "generated_force_mN": f["generated_force_N"] * 1e3,
-            "converged": f["converged"].astype(bool),
-            "periods": f["periods"].astype(int),
-            "periods_simulated": f["periods_simulated"].astype(int),
-            "remaining_force_mN": f["remaining_force_N"].astype(float) * 1e3,  # None: not estimated
-            "force_spread_mN": f["force_spread_N"] * 1e3,
-            "mean_friction_mN": f["mean_friction_N"] * 1e3,
-            "piezo_mean_force_mN": f["piezo_mean_force_N"] * 1e3,
-            "net_displacement_nm": f["net_displacement_m"] * 1e9,
-            "last_step_nm": f["last_step_m"] * 1e9,
-            "cpu_time_s": f["cpu_time_s"],
-        }
-    )
+    return pd.DataFrame({
+        "radius_mm": f["hemisphere_radius"] * 1e3,
+        "preload_N": f["preload"],
+        "actuator_model": f["actuator_model"],
+        "friction_coefficient": f["friction_coefficient"],
+        "model": [labels.get((m, mu), f"{m} actuators, μ = {mu:g}")
+                  for m, mu in zip(f["actuator_model"], f["friction_coefficient"], strict=True)],
+        "frequency_Hz": f["frequency"],
+        "amplitude_fraction": f["amplitude_fraction"],
+        "amplitude_nm": f["amplitude_m"] * 1e9,
+        "generated_force_mN": f["generated_force_N"] * 1e3,
+        "converged": f["converged"].astype(bool),
+        "periods": f["periods"].astype(int),
+        "periods_simulated": f["periods_simulated"].astype(int),
+        "remaining_force_mN": f["remaining_force_N"].astype(float) * 1e3,  # None: not estimated
+        "force_spread_mN": f["force_spread_N"] * 1e3,
+        "mean_friction_mN": f["mean_friction_N"] * 1e3,
+        "piezo_mean_force_mN": f["piezo_mean_force_N"] * 1e3,
+        "net_displacement_nm": f["net_displacement_m"] * 1e9,
+        "last_step_nm": f["last_step_m"] * 1e9,
+        "cpu_time_s": f["cpu_time_s"],
+    })
 
 
 def _onset_frame(curves: list[tuple], config: RunConfig) -> pd.DataFrame:
-    points = [
-        {"hemisphere_radius": r, "preload": float(p), "actuator_model": m, "friction_coefficient": mu,
-         "frequency": FORCE_FREQUENCY, "tolerance": ONSET_TOLERANCE[config.profile], **_flyback(fb)}
-        for r, p, m, mu, fb in curves
-    ]
+    points = [{"hemisphere_radius": r, "preload": float(p), "actuator_model": m, "friction_coefficient": mu,
+               "frequency": FORCE_FREQUENCY, "tolerance": ONSET_TOLERANCE[config.profile], **_flyback(fb)}
+              for r, p, m, mu, fb in curves]
     f = sweep.run(onset_point, points, description="fig7 onsets", config=config)
-    return pd.DataFrame(
-        {
-            "radius_mm": f["hemisphere_radius"] * 1e3,
-            "preload_N": f["preload"],
-            "actuator_model": f["actuator_model"],
-            "friction_coefficient": f["friction_coefficient"],
-            "onset_nm": f["critical_amplitude_m"] * 1e9,
-            "onset_low_nm": f["bracket_low_m"] * 1e9,
-            "onset_high_nm": f["bracket_high_m"] * 1e9,
-            "analytic_onset_nm": f["analytic_critical_amplitude_m"] * 1e9,
-            "onset_cpu_time_s": f["wall_time_s"],
-        }
-    )
+    return pd.DataFrame({
+        "radius_mm": f["hemisphere_radius"] * 1e3,
+        "preload_N": f["preload"],
+        "actuator_model": f["actuator_model"],
+        "friction_coefficient": f["friction_coefficient"],
+        "onset_nm": f["critical_amplitude_m"] * 1e9,
+        "onset_low_nm": f["bracket_low_m"] * 1e9,
+        "onset_high_nm": f["bracket_high_m"] * 1e9,
+        "analytic_onset_nm": f["analytic_critical_amplitude_m"] * 1e9,
+        "onset_cpu_time_s": f["wall_time_s"],
+    })
 
 
 def _flyback(rule: str) -> dict:
@@ -321,11 +281,9 @@ def _curves_frame(radius_preloads: dict, fractions, config: RunConfig, panel: st
     their runs use the slew-rate one)."""
     curves = [(r, float(p), m, mu, flyback if m == "flexible" else "slew")
               for r, preloads in radius_preloads.items() for p in preloads for m, mu, *_ in models]
-    points = [
-        {"hemisphere_radius": r, "preload": p, "actuator_model": m, "friction_coefficient": mu,
-         "amplitude_fraction": float(a), "frequency": FORCE_FREQUENCY, **_flyback(fb)}
-        for r, p, m, mu, fb in curves for a in fractions
-    ]
+    points = [{"hemisphere_radius": r, "preload": p, "actuator_model": m, "friction_coefficient": mu,
+               "amplitude_fraction": float(a), "frequency": FORCE_FREQUENCY, **_flyback(fb)}
+              for r, p, m, mu, fb in curves for a in fractions]
     stalls = _stall_frame(points, panel, config)
     onsets = _onset_frame(curves, config)
     keys = ["radius_mm", "preload_N", "actuator_model", "friction_coefficient"]
@@ -468,10 +426,6 @@ def fig7cycle(config: RunConfig) -> pd.DataFrame:
     return out
 
 
-# --------------------------------------------------------------------------------------
-# The two models compared (the chapter's facts and the ledger's claims)
-# --------------------------------------------------------------------------------------
-
 #: The earlier model of [12] (rigid actuators, μ = 0.3) and this paper's (flexible, μ = 0.2).
 EARLIER, THIS = MODELS[0][:2], MODELS[1][:2]
 
@@ -495,5 +449,51 @@ def force_difference(table: pd.DataFrame, preload: float) -> pd.DataFrame:
     return pd.DataFrame({
         "amplitude_nm": this.loc[common, "amplitude_nm"].to_numpy(),
         "difference_mN": (earlier.loc[common, "generated_force_mN"]
-                          - this.loc[common, "generated_force_mN"]).to_numpy(),
+                      - this.loc[common, "generated_force_mN"]).to_numpy(),
     })
+
+
+def fig7_difference(config: RunConfig) -> pd.DataFrame:
+    """F_gen(rigid, μ = 0.3) − F_gen(flexible, μ = 0.2) against A at every preload of Fig. 7.
+
+    One row per amplitude at which both models stalled (fig7a's and fig7b's panel differences), with
+    the panel, its radius and the preload, and the lower and higher of the two models' onsets of force
+    generation at that preload (mN, nm).
+    """
+    data = {"fig7a": fig7a(config), "fig7b": fig7b(config)}
+    rows = []
+    for name, (_, preloads) in PANELS.items():
+        frame = data[name]
+        for preload in preloads:
+            part = frame[np.isclose(frame["preload_N"], preload)]
+            onsets = part.drop_duplicates(["actuator_model", "friction_coefficient"])["onset_nm"]
+            rows.append(force_difference(frame, preload).assign(
+                panel=name, radius_mm=float(frame["radius_mm"].iloc[0]), preload_N=float(preload),
+                onset_low_nm=float(onsets.min()), onset_high_nm=float(onsets.max())))
+    columns = ["panel", "radius_mm", "preload_N", "amplitude_nm", "difference_mN", "onset_low_nm",
+               "onset_high_nm"]
+    return pd.concat(rows, ignore_index=True)[columns]
+
+
+#: The chapter's rows of the figure table.
+FIGURES = (
+    FigureSpec("fig7a", "Generated force against amplitude, R = 1 mm, 0.3 and 0.8 N",
+               "force_generation", fig7a, "force_generation:plot_panel"),
+    FigureSpec("fig7b", "Generated force against amplitude, R = 0.25 mm, 0.2 and 0.4 N",
+               "force_generation", fig7b, "force_generation:plot_panel"),
+    FigureSpec("fig7_difference", "F_gen(rigid, μ = 0.3) − F_gen(flexible, μ = 0.2) against amplitude, "
+               "each preload of Fig. 7", "force_generation", fig7_difference,
+               "force_generation:plot_fig7_difference"),
+    FigureSpec("fig7cycle", "One period at stall, rigid/flexible × μ = 0.3/0.2, R = 1 mm, A_max",
+               "force_generation", fig7cycle, "force_generation:plot_cycle"),
+    FigureSpec("fig7freq", "Generated force at full amplitude against the drive frequency",
+               "force_generation", fig7freq, "force_generation:plot_frequency"),
+    FigureSpec("fig7grid", "Generated force for every preload of both radii (beyond the paper)",
+               "force_generation", fig7grid, "force_generation:plot_grid"),
+)
+
+#: The ledger's readings of the chapter's figures.
+READING_TABLES = (
+    ReadingTable("fig7_readings", "This paper's force runs at half and full stroke at every reading",
+                 ("fig7a", "fig7b"), fig7_readings),
+)

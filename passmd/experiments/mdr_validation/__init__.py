@@ -1,2 +1,1 @@
-"""The MDR-validation chapter: the contact model against the closed
-forms (figure data and the comparisons behind it)."""
+"""The MDR-validation chapter (Section 2, Eqs. 4–6): the contact model against the closed forms."""

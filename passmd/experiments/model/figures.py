@@ -12,7 +12,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from passmd.experiments.critical_amplitude.figures import FIG5A_DRIVE
+from passmd.experiments import FigureSpec
+from passmd.experiments.critical_amplitude_one.figures import FIG5A_DRIVE
 from passmd.model import hertz, theory
 from passmd.model.defaults import PROTOCOL
 from passmd.model.mdr_contact import MDRContact
@@ -22,12 +23,11 @@ from passmd.runtime.config import RunConfig
 from passmd.runtime.units import from_si
 
 __all__ = [
+    "FIGURES",
     "MODEL_PRELOAD",
     "MODEL_RADIUS",
     "MDR_LOOP_SPRINGS",
     "SAWTOOTH_PERIODS",
-    "actuator_row",
-    "closed_form_rows",
     "model_cross_section",
     "model_drive",
     "model_free_body",
@@ -154,39 +154,14 @@ def model_mdr_loop(config: RunConfig) -> pd.DataFrame:
     )
 
 
-def closed_form_rows(drive: Drive) -> dict[str, str]:
-    """The closed forms of Section 4 for a six-contact drive, formatted for the model chapter.
-
-    Values of :func:`passmd.model.theory.drive_theory` (Eqs. 1, 4, 7, 9–14) and the runner's
-    frequency on its contacts, in display units, 4 significant digits (2aG*: 3), two sides
-    joined by ", ".
-    """
-    th = theory.drive_theory(drive)
-
-    def join(values, unit, digits=4):
-        return ", ".join(f"{from_si(v, unit):.{digits}g}" for v in values)
-
-    return {
-        "E* (GPa)": f"{from_si(th['E_star_Pa'], 'GPa'):.4g}",
-        "G* (GPa)": f"{from_si(th['G_star_Pa'], 'GPa'):.4g}",
-        "F_N1, F_N2 (N)": join(th["normal_force_N"], "N"),
-        "a₁, a₂ (µm)": join(th["contact_radius_m"], "um"),
-        "2aG* per contact (N/m)": join(th["tangential_stiffness_N_per_m"], "N/m", 3),
-        "u_x,max,1, u_x,max,2 (nm), Eq. 10": join(th["presliding_m"], "nm"),
-        "u_x,a,1, u_x,a,2 (nm), Eq. 14": join(th["actuator_deformation_m"], "nm"),
-        "u_x,max,e rigid (nm), Eq. 11": f"{from_si(th['critical_amplitude_rigid_m'], 'nm'):.4g}",
-        "u*_x,max,e flexible (nm), Eq. 12": f"{from_si(th['critical_amplitude_flexible_m'], 'nm'):.4g}",
-        "runner on its contacts (kHz)": f"{from_si(theory.runner_frequency(drive), 'kHz'):.4g}",
-    }
-
-
-def actuator_row(drive: Drive) -> dict[str, str]:
-    """Table 2's actuator of a drive and its bare natural frequency √(k_p/m_a)/2π, formatted."""
-    actuator = drive.actuator
-    return {
-        "drive": f"R = {from_si(drive.hemisphere_radius, 'mm'):.3g} mm",
-        "k_p (N/m)": f"{actuator.stiffness:.3g}",
-        "m_a (g)": f"{from_si(actuator.mass, 'g'):.3g}",
-        "bare actuator √(k_p/m_a)/2π (MHz)": f"{actuator.natural_frequency / 1e6:.3g}",
-        "damping ratio ζ (assumed)": f"{actuator.damping_ratio:.3g}",
-    }
+#: The chapter's rows of the figure table.
+FIGURES = (
+    FigureSpec("model_sawtooth", "Saw-tooth piezo position x_p(t) at full stroke (Figs. 1d, 3c)",
+               "model", model_sawtooth, "model:plot_sawtooth"),
+    FigureSpec("model_free_body", "Free-body diagram of the macroscopic model, Eqs. 2-3 (Fig. 3a, schematic)",
+               "model", model_free_body, "model:plot_free_body"),
+    FigureSpec("model_cross_section", "Cross-section of the runner with the normal forces of Eq. 1 (Fig. 3b)",
+               "model", model_cross_section, "model:plot_cross_section"),
+    FigureSpec("model_mdr_loop", "The 1-D MDR contact and its force loop, exact and 50 springs (Fig. 4)",
+               "model", model_mdr_loop, "model:plot_mdr_loop"),
+)

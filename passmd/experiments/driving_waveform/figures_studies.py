@@ -4,7 +4,8 @@ Section 6's outlook asks how the actuators' dynamics affect the new waveform; a 
 also has to say how much Eq. 15's heuristic leaves on the table. Built on the figure machinery of
 :mod:`passmd.experiments.driving_waveform.figures` (same drives, designs, protocols and cache):
 
-* :func:`settling_scan` — the 100 Hz step against the settling time t_s;
+* :func:`settling_scan` — the 100 Hz step against the settling time t_s (:func:`settling_scans`: with
+  Eq. 15's acceleration and with the optimum's);
 * :func:`numerical_optimum` — scipy's differential evolution over (t_s, V_a, Δ_a) against
   the Eq. 15 design and the saw-tooth, at a few frequencies;
 * :func:`flexible_study` — the same comparison with flexible actuators;
@@ -16,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from passmd.experiments.driving_waveform.runs import (
+from passmd.experiments.driving_waveform.figures_runs import (
     STEP_FREQUENCY,
     VARIANTS,
     design_fields,
@@ -277,3 +278,27 @@ def startup_transient(config: RunConfig, frequency: float = 110e3) -> pd.DataFra
     table["velocity_mm_per_s"] = table["velocity_m_per_s"] * 1e3
     table["settled_velocity_mm_per_s"] = table["settled_velocity_m_per_s"] * 1e3
     return table
+
+
+def optimum_at(optimum: pd.DataFrame, frequency: float = STEP_FREQUENCY, actuator_model: str = "rigid"
+               ) -> pd.Series:
+    """The :func:`numerical_optimum` row of one actuator model at one frequency (default: rigid,
+    100 Hz)."""
+    rows = optimum[(optimum["actuator_model"] == actuator_model) & (optimum["frequency"] == frequency)]
+    return rows.iloc[0]
+
+
+def settling_scans(config: RunConfig) -> pd.DataFrame:
+    """Step at 100 Hz against the settling time, with Eq. 15's acceleration and with the optimum's.
+
+    The two :func:`settling_scan` tables, tagged with a
+    ``series`` label: Eq. 15's t_a and Δ_a, and the acceleration time and amplitude of the
+    numerical optimum at 100 Hz (:func:`optimum_at`).
+    """
+    low = optimum_at(numerical_optimum(config))
+    scans = {
+        "Eq. 15's t_a, Δ_a": settling_scan(config),
+        "optimum's V_a, Δ_a (100 Hz)": settling_scan(config, low["optimum_acceleration_time_s"],
+                                                     low["optimum_acceleration_amplitude_m"]),
+    }
+    return pd.concat([scan.assign(series=label) for label, scan in scans.items()], ignore_index=True)

@@ -7,7 +7,7 @@ velocity of one drive, waveform and frequency (:func:`velocity_point`, tabulated
 :func:`velocity_table`), the time series of one run from rest (:func:`trace_point`) and Fig. 8b's
 run resolved inside the acceleration t_a (:func:`window_point`). The figures of
 :mod:`passmd.experiments.driving_waveform.figures` and the studies of
-:mod:`passmd.experiments.driving_waveform.studies` are tables of these runs.
+:mod:`passmd.experiments.driving_waveform.figures_studies` are tables of these runs.
 """
 
 from __future__ import annotations

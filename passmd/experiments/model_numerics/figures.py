@@ -1,10 +1,9 @@
 """Trust in the integrator: time-step convergence, energy balance, settle windows, the rigid Coulomb limit.
 
 These are not paper figures; they back every figure's numbers. Each function returns a
-tidy DataFrame in SI units. The accuracies the integrator states for the figures are in
-:mod:`passmd.experiments.numerics.accuracy`, the numbers the chapter quotes from these tables in
-:mod:`passmd.experiments.numerics.facts`, the stored speed benchmarks in
-:mod:`passmd.experiments.numerics.benchmarks`.
+tidy DataFrame in SI units. The accuracies the integrator states for the figures, the numbers the
+chapter quotes from these tables and the stored speed benchmarks are in
+:mod:`passmd.experiments.model_numerics.facts`.
 """
 
 from __future__ import annotations
@@ -12,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from passmd.experiments import FigureSpec
 from passmd.model import theory, waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Amplifier, Drive, Material
@@ -46,7 +46,7 @@ RIGID_STEP_CONTROLS = ("controlled", "fixed")
 #: The step control whose finest run is a configuration's reference, by actuator model: the fixed
 #: fine step (rigid) and the explicit adaptive step (flexible: there the fixed fine step runs only
 #: up to resolution 2; how closely the two agree is ``adaptive_vs_fixed_nm`` of
-#: :func:`~passmd.experiments.numerics.facts.convergence_facts`).
+#: :func:`~passmd.experiments.model_numerics.facts.convergence_facts`).
 REFERENCE_CONTROL = {"rigid": "fixed", "flexible": "adaptive"}
 
 
@@ -333,3 +333,12 @@ def model_coulomb_limit(config: RunConfig) -> pd.DataFrame:
     table["rate"] = table["configuration"].map(rates["rate"])
     table["expected_rate"] = EXPECTED_COULOMB_RATE
     return table
+
+
+#: The chapter's rows of the figure table.
+FIGURES = (
+    FigureSpec("model_convergence", "Time-step convergence of the runner position after three periods",
+               "model_numerics", model_convergence, "numerics:plot_convergence"),
+    FigureSpec("model_coulomb_limit", "Simulated step against the rigid Coulomb limit, stiffened contacts",
+               "model_numerics", model_coulomb_limit, "numerics:plot_coulomb_limit"),
+)

@@ -1,28 +1,126 @@
-"""Facts the numerics section quotes (glue names → numbers), each from its table.
+"""Facts the numerics chapter quotes (glue names → numbers), the integrator's stated accuracies and the
+stored speed benchmarks.
 
-Small functions of the tidy tables of :mod:`passmd.experiments.numerics.figures` (convergence,
+Small functions of the tidy tables of :mod:`passmd.experiments.model_numerics.figures` (convergence,
 energy balance, settle windows, rigid Coulomb limit) and of the stored speed benchmark
-(:mod:`passmd.experiments.numerics.benchmarks`): the integrator's step plan per configuration,
-fitted convergence orders and error floors, energy residuals, Coulomb-limit gaps and rates, and
-the speed numbers against their targets. Display units: nm, µs, ns, ms, %.
+(:func:`benchmark_table`): the integrator's step plan per configuration, fitted convergence orders and
+error floors, energy residuals, Coulomb-limit gaps and rates, and the speed numbers against their
+targets. Display units: nm, µs, ns, ms, %.
+
+The accuracies the default integrator guarantees for what the figures report (``*_ACCURACY``,
+``*_RTOL``) are checked by running the quick figure data again with the step halved (error-controlled
+tolerance ÷ 16): every reported value moves by well under its stated accuracy, so any integrator at
+least as accurate reproduces the figures within them. The regression snapshots compare with them
+(``tests/snapshot_accuracy.py``), the claims and the chapters quote them.
+
+The benchmark scripts' stored results (``benchmarks/bench_<name>.py``, written to the package data
+``passmd/data/benchmarks/<name>.json``) are read by :func:`benchmark_results`; speed is measured by
+those scripts, never by the tests.
 """
 
 from __future__ import annotations
 
+import json
+from importlib import resources
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 
-from passmd.experiments.numerics.figures import CONFIGURATIONS, EXPECTED_COULOMB_RATE
+from passmd.experiments.model_numerics.figures import CONFIGURATIONS, EXPECTED_COULOMB_RATE
 from passmd.model import theory
 from passmd.model.parameters import Drive
+from passmd.protocols import stall
+from passmd.runtime.inputs import read_text
 from passmd.runtime.units import from_si
+from passmd.runtime.validation import check_choice
 from passmd.solver import steps
 from passmd.solver.setup import contact_groups
+
+#: Positions, steps and back-steps (m): :data:`passmd.solver.steps.CONVERGED_ACCURACY`, the
+#: settled position's distance from a much finer run. Halving the step moved no quick step,
+#: back-step or settled position (Figs. 5a, 7–10) by more than 0.012 nm.
+POSITION_ACCURACY = steps.CONVERGED_ACCURACY
+#: Stall forces (N): the stall criterion's absolute tolerance
+#: (:data:`passmd.protocols.stall.STALL_ABS_TOLERANCE`) — a finer run may stop a few periods
+#: earlier or later, anywhere within it — plus :data:`STALL_FORCE_RTOL` of the force. The
+#: integrator's own share, k_l·POSITION_ACCURACY ≈ 1 µN, is far below; halving the step moved
+#: no quick force of Fig. 7 by more than 0.018 mN.
+FORCE_ACCURACY = stall.STALL_ABS_TOLERANCE
+#: Relative part of the stall-force accuracy (:data:`passmd.protocols.stall.STALL_REL_TOLERANCE`).
+STALL_FORCE_RTOL = stall.STALL_REL_TOLERANCE
+#: Steady velocities (m/s): a step per period accurate to POSITION_ACCURACY at the fastest
+#: step frequency of Figs. 9b–10 (130 kHz), 6.5 µm/s. Halving the step moved none by more
+#: than 1.4 µm/s.
+VELOCITY_ACCURACY = POSITION_ACCURACY * 130e3
+#: Micro-vibration frequencies and times (Eq. 15's t_s, t_a; turning points; the stall cycle's
+#: full-slip time), relative: read off the recorded samples, so quantised to the record
+#: spacing, which follows the step. Halving the step moved f_s and Eq. 15's times by at most
+#: 3.2e-6 and the full-slip time by one record spacing, 1.5e-4; 1e-3 leaves a factor 6.
+FREQUENCY_RTOL = 1e-3
+#: Slip shares (fraction of a contact's radius sliding): they change fastest at the turning
+#: points where Fig. 8 reads them, by up to 0.006 when the step was halved (their means and
+#: maxima over a phase by 0.0004); 0.02 leaves a factor 3.
+SLIP_SHARE_ACCURACY = 0.02
+#: Critical amplitudes and force onsets, in final bracket widths of their search (its
+#: ``tolerance``) plus POSITION_ACCURACY: the integrator's error can flip a bisection decision
+#: only at an amplitude within that error of the switch, which moves the reported midpoint by
+#: one width. Halving the step changed no quick critical amplitude or onset (Figs. 5–7).
+CRITICAL_AMPLITUDE_BRACKETS = 1.0
+
+#: Benchmark results shipped with the package (``passmd/data/benchmarks/<name>.json``).
+BENCHMARKS = ("contact", "driving_waveform", "dynamics", "fit", "fit_coverage")
+
+
+def benchmark_results(name: str, path: str | Path | None = None) -> dict:
+    """One benchmark script's last results (``benchmarks/bench_<name>.py``), as stored.
+
+    Parameters
+    ----------
+    name : {"contact", "driving_waveform", "dynamics", "fit", "fit_coverage"}
+        The benchmark (``fit_coverage``: ``benchmarks/bench_fit_coverage.py``).
+    path : path-like, optional
+        A results file to read instead of the one installed with the package
+        (``passmd/data/benchmarks/<name>.json``, package data, which the benchmark
+        scripts write by default when run from the repository).
+
+    Returns
+    -------
+    dict
+        As the script wrote it (``{"meta": {...}, "rows": [...]}`` for the speed benchmarks).
+    """
+    check_choice("name", name, BENCHMARKS)
+    if path is None:
+        resource = resources.files("passmd") / "data" / "benchmarks" / f"{name}.json"
+        if not resource.is_file():
+            raise FileNotFoundError(
+                f"{resource} is missing: run `python benchmarks/bench_{name}.py` in the repository"
+            )
+        return json.loads(read_text(Path(str(resource)), "benchmark record"))
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"{path} is missing: run `python benchmarks/bench_{name}.py --out {path}`")
+    return json.loads(read_text(path, "benchmark record"))
+
+
+def benchmark_table(path: str | Path | None = None) -> pd.DataFrame:
+    """The speed benchmark's last results (``benchmarks/bench_dynamics.py``), as a table.
+
+    Reads :func:`benchmark_results` ``("dynamics", path)``; ``df.attrs["meta"]`` holds the
+    machine and settings it was measured with, ``df.attrs["across_processes"]`` the headline
+    configuration timed in several fresh processes (empty if the file predates it).
+    """
+    data = benchmark_results("dynamics", path)
+    df = pd.DataFrame(data["rows"])
+    df.attrs["meta"] = data.get("meta", {})
+    df.attrs["across_processes"] = data.get("across_processes", {})
+    return df
+
 
 
 def step_plan_table() -> pd.DataFrame:
     """The integrator's steps (:func:`passmd.solver.steps.step_plan`) for each of
-    :data:`~passmd.experiments.numerics.figures.CONFIGURATIONS`.
+    :data:`~passmd.experiments.model_numerics.figures.CONFIGURATIONS`.
 
     Columns: ``configuration``, stiffest mode (kHz), stability limit 2/ω, fine and coarse step and
     the longest error-controlled step (ns; :data:`passmd.solver.steps.LONGEST_OMEGA_DT` over the
@@ -88,7 +186,7 @@ def fitted_order_above_floor(rows: pd.DataFrame, factor: float = FLOOR_FACTOR,
 
 def convergence_facts(conv: pd.DataFrame) -> dict:
     """Numbers the convergence paragraphs quote
-    (:func:`~passmd.experiments.numerics.figures.model_convergence`).
+    (:func:`~passmd.experiments.model_numerics.figures.model_convergence`).
 
     Explicit schemes (adaptive and fixed): ``conv_order`` and ``conv_max_err_nm``, their order
     and largest error at the default step (nm); ``adaptive_vs_fixed_nm``, their largest
@@ -138,7 +236,7 @@ def convergence_facts(conv: pd.DataFrame) -> dict:
 
 def energy_facts(energy: pd.DataFrame, explicit: pd.DataFrame) -> dict:
     """Numbers of the energy-balance paragraph, from two
-    :func:`~passmd.experiments.numerics.figures.energy_balance_table` runs.
+    :func:`~passmd.experiments.model_numerics.figures.energy_balance_table` runs.
 
     ``energy`` is the default (error-controlled) scheme, ``explicit`` the same runs with
     ``scheme="adaptive"``. Returns the largest |relative residual| of ``energy``
@@ -165,7 +263,7 @@ def energy_facts(energy: pd.DataFrame, explicit: pd.DataFrame) -> dict:
 
 def settle_facts(sens: pd.DataFrame) -> dict:
     """Largest spread of the mean step over the settle windows: nm and % of the mean
-    (:func:`~passmd.experiments.numerics.figures.settle_fraction_sensitivity`)."""
+    (:func:`~passmd.experiments.model_numerics.figures.settle_fraction_sensitivity`)."""
     spread = sens.groupby("configuration")["mean_step_m"].agg(lambda v: v.max() - v.min())
     mean = sens.groupby("configuration")["mean_step_m"].mean()
     return {"settle_spread_nm": float(spread.max() * 1e9),
@@ -174,7 +272,7 @@ def settle_facts(sens: pd.DataFrame) -> dict:
 
 def coulomb_facts(coulomb: pd.DataFrame, refined: pd.DataFrame) -> dict:
     """Numbers the Coulomb-limit paragraph quotes, from
-    :func:`~passmd.experiments.numerics.figures.model_coulomb_limit` and the same run at half the
+    :func:`~passmd.experiments.model_numerics.figures.model_coulomb_limit` and the same run at half the
     time step (``refined``): gaps (nm, % of A_c), fly-back times (µs), rates."""
     k = np.array(sorted(coulomb["scale"].unique()))
     by = coulomb.set_index(["configuration", "scale"])
@@ -226,7 +324,7 @@ TARGET_MS_PER_PERIOD, TARGET_NS_PER_STEP = 1.0, 25.0
 
 def benchmark_facts(bench: pd.DataFrame) -> dict:
     """The speed numbers the performance paragraph quotes, from
-    :func:`~passmd.experiments.numerics.benchmarks.benchmark_table`: ms per 100 Hz period (six
+    :func:`~benchmark_table`: ms per 100 Hz period (six
     flexible contacts, exact contact) with the default error-controlled step and with the
     explicit adaptive one, the periods each timed run lasted, the same default-step
     configuration's median over fresh processes and their number (``bench_six_flex_processes_ms``,

@@ -1,4 +1,4 @@
-"""What a calibration can and cannot tell, on data with known parameters (the calibration chapter).
+"""The calibration chapter's fits: what a calibration can and cannot tell, on data with known parameters.
 
 * :func:`comb_fit`: the actuator stiffness of one flexible contact from three steps at one preload.
   The step oscillates in k_p, so several teeth of the comb fit the data within the 95 % level: the
@@ -9,7 +9,8 @@
   and with the right rule.
 
 The data are made by other means than the fit's forward model
-(:func:`passmd.experiments.calibration.synthetic.noisy_steps`).
+(:func:`passmd.protocols.synthetic.noisy_steps`). The chapter draws each fit with
+:mod:`passmd.plots.fit` (a fit result, not a table), so :data:`FIGURES` holds no row.
 """
 
 from __future__ import annotations
@@ -18,14 +19,14 @@ from dataclasses import replace
 
 import numpy as np
 
-from passmd.experiments.calibration.synthetic import noisy_steps
 from passmd.model.parameters import Drive
 from passmd.model.tables import Amplifier
 from passmd.protocols import fit
 from passmd.protocols.fit.prediction import drive_at
+from passmd.protocols.synthetic import noisy_steps
 from passmd.runtime.config import RunConfig
 
-__all__ = ["COMB", "FLYBACK", "comb_fit", "flyback_fits", "join", "region_text"]
+__all__ = ["COMB", "FIGURES", "FLYBACK", "comb_fit", "flyback_fits", "join"]
 
 #: The comb example: one flexible contact (Table 1–2, R = 1 mm), k_p = 5e6 N/m, three steps at 0.4 N,
 #: 100 Hz, 1 nm noise.
@@ -81,8 +82,5 @@ def flyback_fits(config: RunConfig | None = None) -> dict:
     return {"truth": truth, "data": data, "wrong": wrong, "right": right}
 
 
-def region_text(estimate: dict, scale: float = 1.0, unit: str = "") -> str:
-    """A fit's 95 % region as the chapter writes it: its pieces ``"a–b, c–d unit"``, the values
-    divided by ``scale`` (``estimate``: one entry of ``FitResult.estimates``)."""
-    text = ", ".join(f"{a / scale:.4g}–{b / scale:.4g}" for a, b in estimate["intervals"])
-    return f"{text} {unit}" if unit else text
+#: The chapter's rows of the figure table: none (its figures draw fit results, :mod:`passmd.plots.fit`).
+FIGURES = ()

@@ -1,4 +1,5 @@
-"""Measurements made by other means than the fit's forward model.
+"""Measurements made by other means than the fit's forward model (the calibration chapters' data and the
+fit's tests and benchmarks).
 
 A fit checked only on data its own forward model made hides what the model and the data do not
 share (a protocol, a resolution, a fixed assumption). :func:`independent_steps` makes steps another

@@ -1,34 +1,33 @@
-"""Critical actuation amplitude: grids, figures and claims of Figs. 5 and 6 (Section 4.1).
+"""Critical actuation amplitude, one contact: Figs. 5a and 5b (Section 4.1), and the A_c runs of Section 4.1.
 
 The paper finds the critical amplitude A_c with its dynamic simulation and compares it with
 closed forms: Eq. 7 (one contact, rigid actuator), Eq. 8 (one contact, flexible), Eq. 11
 (six contacts, rigid) and Eq. 12 (six contacts, flexible). The search itself (both
 protocols, the bisection, the step threshold) is :mod:`passmd.protocols.critical_amplitude`;
 this module runs it over the preload grids of a resolution profile through
-:mod:`passmd.runtime.sweep`; the claim extractors of Section 4.1 are
-:mod:`passmd.experiments.critical_amplitude.claims`, the facts the chapters quote
-:mod:`passmd.experiments.critical_amplitude.facts`.
+:mod:`passmd.runtime.sweep` for both chapters of Section 4.1 (the six-contact chapter,
+:mod:`passmd.experiments.critical_amplitude_six.figures`, draws its panels with the drives,
+profiles, searches and readings defined here).
 
-Figures (rows of :mod:`passmd.experiments.figure_table`): ``fig5a`` (step vs amplitude), ``fig5b`` (one
-contact, A_c vs preload), ``fig6a``–``fig6c`` (six contacts), and two sensitivity panels
-beyond the paper, ``fig56_viscosity`` (A_c vs actuator viscosity c_p) and
-``fig56_frequency`` (A_c vs drive frequency). Each compute function takes a
+Figures: ``fig5a`` (step vs amplitude), ``fig5_flyback_steps`` (the step across each fly-back) and
+``fig5b`` (one contact, A_c vs preload). Each compute function takes a
 :class:`~passmd.runtime.config.RunConfig` and returns a tidy DataFrame (lengths in nm)."""
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
+from passmd.experiments import FigureSpec, ReadingTable
 from passmd.ledger import readings, reference
 from passmd.ledger.checks import ClaimFails, NoRun
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
 from passmd.model.tables import ACTUATOR_DAMPING_RATIO, PRELOAD_GRIDS, actuator_for_radius
 from passmd.protocols.critical_amplitude import (
-    PROTOCOLS,
     STEADY_PERIODS,
     STEP_THRESHOLD,
     critical_amplitude,
@@ -41,23 +40,9 @@ from passmd.runtime.config import RunConfig
 SECTION4_1_FRICTION = float(readings.axis("friction_coefficient").default)
 
 __all__ = [
-    "AC_PANELS",
-    "FIG5A_DRIVE",
-    "SECTION4_1_FRICTION",
-    "ac_readings",
-    "fig5a_readings",
-    "PROFILE_SETTINGS",
-    "critical_amplitude_point",
-    "fig56_frequency",
-    "fig56_viscosity",
-    "fig5a",
-    "fig5b",
-    "fig6a",
-    "fig6b",
-    "fig6c",
-    "paper_drive_for",
-    "primary",
-    "step_point",
+    "AC_PANELS", "FIG5A_DRIVE", "FIGURES", "FLYBACK_STEPS_TOLERANCE", "PROFILE_SETTINGS", "READING_TABLES",
+    "SECTION4_1_FRICTION", "ac_readings", "critical_amplitude_point", "fig5_flyback_steps", "fig5a",
+    "fig5a_readings", "fig5b", "paper_drive_for", "preload_figure", "primary", "run_searches", "step_point",
 ]
 
 def paper_drive_for(
@@ -204,7 +189,7 @@ def _protocols(actuator_model: str, frequencies) -> list[dict]:
     return combos
 
 
-def _run_searches(points: list[dict], description: str, config: RunConfig) -> pd.DataFrame:
+def run_searches(points: list[dict], description: str, config: RunConfig) -> pd.DataFrame:
     """Run critical-amplitude searches through the sweep engine; tidy frame in nm."""
     frame = sweep.run(critical_amplitude_point, points, description=description, config=config)
     out = pd.DataFrame(
@@ -230,7 +215,7 @@ def _run_searches(points: list[dict], description: str, config: RunConfig) -> pd
     return out
 
 
-def _preload_figure(config: RunConfig, contacts: int, radius: float, models, curve: str) -> pd.DataFrame:
+def preload_figure(config: RunConfig, contacts: int, radius: float, models, curve: str) -> pd.DataFrame:
     s = _settings(config)
     points = [
         {
@@ -246,7 +231,7 @@ def _preload_figure(config: RunConfig, contacts: int, radius: float, models, cur
         for model in models
         for combo in _protocols(model, s.frequencies)
     ]
-    table = _run_searches(points, curve.split("_")[0], config)
+    table = run_searches(points, curve.split("_")[0], config)
     closed = reference.closed_form_curves(curve)
     merged = table.merge(closed, on="preload_N", how="left", validate="many_to_one")
     merged.attrs = table.attrs
@@ -301,96 +286,41 @@ def fig5a(config: RunConfig) -> pd.DataFrame:
 
 def fig5b(config: RunConfig) -> pd.DataFrame:
     """Fig. 5b: A_c against preload, one contact, rigid and flexible, with Eqs. 7 and 8 (nm)."""
-    return _preload_figure(config, 1, 1.0e-3, ("rigid", "flexible"), "fig5b_closed_form")
+    return preload_figure(config, 1, 1.0e-3, ("rigid", "flexible"), "fig5b_closed_form")
 
 
-def fig6a(config: RunConfig) -> pd.DataFrame:
-    """Fig. 6a: A_c against preload, six contacts, rigid actuators, with Eqs. 10 and 11 (nm)."""
-    return _preload_figure(config, 6, 1.0e-3, ("rigid",), "fig6a_closed_form")
+#: Tolerance of the steady-state search of the per-fly-back figure (m).
+FLYBACK_STEPS_TOLERANCE = 0.2e-9
 
 
-def fig6b(config: RunConfig) -> pd.DataFrame:
-    """Fig. 6b: A_c against preload, six contacts, flexible actuators, R = 1 mm, with Eqs. 12–14 (nm)."""
-    return _preload_figure(config, 6, 1.0e-3, ("flexible",), "fig6b_closed_form")
+def fig5_flyback_steps(config: RunConfig) -> pd.DataFrame:
+    """Step across each fly-back of a run from rest, one contact, rigid actuator, 0.4 N, R = 1 mm.
 
+    Four amplitudes: 2 nm below the steady-state A_c (searched to
+    :data:`FLYBACK_STEPS_TOLERANCE`), midway between it and u_x,max (Eq. 7), 0.2 nm below
+    u_x,max and 3 nm above it. The same on every profile.
 
-def fig6c(config: RunConfig) -> pd.DataFrame:
-    """Fig. 6c: A_c against preload, six contacts, flexible actuators, R = 0.25 mm, with Eqs. 12–14 (nm)."""
-    return _preload_figure(config, 6, 0.25e-3, ("flexible",), "fig6c_closed_form")
-
-
-def _closed_form_at(contacts: int, actuator_model: str, radius: float, preload: float) -> float:
-    """Eq. 7/8 (one contact) or Eq. 11/12 (six contacts) in nm, from passmd.model.theory."""
+    Returns
+    -------
+    DataFrame
+        One row per amplitude and fly-back: ``amplitude_nm``, ``flyback`` (1, 2, ...),
+        ``step_nm``; scalars ``steady_ac_nm``, ``u_x_max_nm``, ``threshold_nm``.
+    """
     from passmd.model.theory import drive_theory
 
-    drive = paper_drive_for(contacts, actuator_model, radius, preload)
-    return drive_theory(drive)["analytic_critical_amplitude_m"] * 1e9
-
-
-def fig56_viscosity(config: RunConfig) -> pd.DataFrame:
-    """Beyond the paper: A_c of flexible actuators against c_p (a decade either side of the default).
-
-    One and six contacts, F_p = 0.4 N, R = 1 mm; both protocols and both fly-back rules.
-    ``actuator_viscosity_kg_per_s`` is c_p = 2ζ√(k_p m_a); ``closed_form_nm`` is Eq. 8
-    (one contact) or Eq. 12 (six), which do not depend on c_p.
-    """
-    s = _settings(config)
-    radius, preload = FIG5A_DRIVE
-    points = [
-        {
-            "contacts": n,
-            "actuator_model": "flexible",
-            "hemisphere_radius": radius,
-            "preload": preload,
-            "protocol": protocol,
-            "frequency": PROTOCOL.drive_frequency,
-            "flyback": flyback,
-            "tolerance": s.tolerance,
-            "damping_ratio": float(z),
-        }
-        for n in (1, 6)
-        for z in s.damping_ratios
-        for protocol in PROTOCOLS
-        for flyback in ("slew", "fixed")
-    ]
-    table = _run_searches(points, "fig56_viscosity", config)
-    table["actuator_viscosity_kg_per_s"] = [
-        actuator_for_radius(radius, damping_ratio=z).viscosity for z in table["damping_ratio"]
-    ]
-    table["closed_form_nm"] = [_closed_form_at(n, "flexible", radius, preload) for n in table["contacts"]]
-    return table
-
-
-def fig56_frequency(config: RunConfig) -> pd.DataFrame:
-    """Beyond the paper: A_c (both protocols) against the drive frequency of the runs.
-
-    One and six contacts, rigid and flexible (slew-rate fly-back), F_p = 0.4 N, R = 1 mm;
-    ``closed_form_nm`` is Eq. 7/8 (one contact) or Eq. 11/12 (six).
-    """
-    s = _settings(config)
-    radius, preload = FIG5A_DRIVE
-    points = [
-        {
-            "contacts": n,
-            "actuator_model": model,
-            "hemisphere_radius": radius,
-            "preload": preload,
-            "protocol": protocol,
-            "frequency": float(f),
-            "flyback": "slew",
-            "tolerance": s.tolerance,
-            "damping_ratio": ACTUATOR_DAMPING_RATIO,
-        }
-        for n in (1, 6)
-        for model in ("rigid", "flexible")
-        for protocol in PROTOCOLS
-        for f in s.sensitivity_frequencies
-    ]
-    table = _run_searches(points, "fig56_frequency", config)
-    table["closed_form_nm"] = [
-        _closed_form_at(n, m, radius, preload)
-        for n, m in zip(table["contacts"], table["actuator_model"], strict=True)
-    ]
+    rigid = paper_drive_for(1, "rigid", *FIG5A_DRIVE)
+    u_max = drive_theory(rigid)["critical_amplitude_rigid_m"]
+    steady_ac = critical_amplitude(rigid, tolerance=FLYBACK_STEPS_TOLERANCE)["critical_amplitude_m"]
+    amplitudes = [steady_ac - 2e-9, 0.5 * (steady_ac + u_max), u_max - 0.2e-9, u_max + 3e-9]
+    frames = []
+    for a in amplitudes:
+        steps = np.array(steady_step(rigid, a)["steps_m"]) * 1e9
+        frames.append(pd.DataFrame({"amplitude_nm": a * 1e9, "flyback": np.arange(1, steps.size + 1),
+                                    "step_nm": steps}))
+    table = pd.concat(frames, ignore_index=True)
+    table["steady_ac_nm"] = steady_ac * 1e9
+    table["u_x_max_nm"] = u_max * 1e9
+    table["threshold_nm"] = STEP_THRESHOLD * 1e9
     return table
 
 
@@ -437,7 +367,7 @@ def ac_readings(config: RunConfig, panel: str) -> pd.DataFrame:
     points = [{"contacts": contacts, "actuator_model": model, "hemisphere_radius": radius,
                "preload": float(p), "tolerance": PROFILE_SETTINGS["paper"].tolerance, **combo}
               for p in s.preloads[radius] for model in models for combo in _reading_points(model, _AC_AXES)]
-    table = _run_searches(points, f"{panel} readings", config)
+    table = run_searches(points, f"{panel} readings", config)
     table.insert(0, "figure", panel)
     return table
 
@@ -517,3 +447,22 @@ def primary(table: pd.DataFrame, actuator_model: str | None = None, reading=None
         raise ClaimFails(f"no step up to the full stroke at {', '.join(f'{p:g}' for p in where)} N "
                          "(A_c above A_max)")
     return rows
+
+
+#: The chapter's rows of the figure table.
+FIGURES = (
+    FigureSpec("fig5a", "Step size against actuation amplitude, one contact, 0.4 N, R = 1 mm",
+               "critical_amplitude_one", fig5a, "critical_amplitude:plot_fig5a"),
+    FigureSpec("fig5_flyback_steps", "Step across each fly-back of a run from rest, rigid, 0.4 N, R = 1 mm",
+               "critical_amplitude_one", fig5_flyback_steps, "critical_amplitude:plot_flyback_steps"),
+    FigureSpec("fig5b", "Critical amplitude against preload, one contact, R = 1 mm",
+               "critical_amplitude_one", fig5b, "critical_amplitude:plot_fig5b"),
+)
+
+#: The ledger's readings of the chapter's figures.
+READING_TABLES = (
+    ReadingTable("fig5a_readings", "Fig. 5a's step against amplitude at every reading", ("fig5a",),
+                 fig5a_readings),
+    ReadingTable("fig5b_readings", "Fig. 5b's A_c searches at every reading", ("fig5b",),
+                 functools.partial(ac_readings, panel="fig5b")),
+)

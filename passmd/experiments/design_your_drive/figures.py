@@ -2,13 +2,16 @@
 
 The drive is a drive file shipped with the package (:data:`EXAMPLE_DRIVE_FILE`), read as
 ``passmd --drive FILE`` reads it. Every figure's data comes from the functions a designer
-calls: :func:`passmd.experiments.design.maps.compute_map` (what ``passmd sweep`` runs) for the
+calls: :func:`passmd.protocols.maps.compute_map` (what ``passmd sweep`` runs) for the
 critical amplitude, the step and velocity map, the Eq. 15 gain map and the stall force, and
 :func:`passmd.protocols.fit.estimator.fit` (what ``passmd fit`` runs) for the calibration. One function
 per figure; the grids of each profile are in :data:`PROFILE_SETTINGS`.
 
 The calibration's settings are here (:data:`NOISE_NM`, :data:`SEED`, :data:`START`, each profile's
-free parameters and points); its functions are :mod:`passmd.experiments.design.calibration`.
+free parameters and points); its functions, and what the chapter quotes of each figure, are
+:mod:`passmd.experiments.design_your_drive.facts`. The chapter draws its figures from these tables
+with :mod:`passmd.plots.design` (maps with their quantity and title, the fit's results), as a designer
+would, so :data:`FIGURES` holds no row: the figure table is also every result the ledger computes.
 """
 
 from __future__ import annotations
@@ -20,18 +23,19 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from passmd.experiments.design.maps import compute_map
 from passmd.model import drive_file
 from passmd.model.defaults import PROTOCOL
 from passmd.model.drive_file import parameter_rows, read_drive_file, resolve
 from passmd.model.parameters import Drive
 from passmd.model.theory import contact_arrangement
-from passmd.protocols import ringing, stall
+from passmd.protocols import stall
+from passmd.protocols.maps import compute_map
 from passmd.runtime.config import PROFILES, RunConfig
 from passmd.runtime.units import from_si
 from passmd.runtime.validation import check_choice
 
 __all__ = [
+    "FIGURES",
     "EXAMPLE_DRIVE_FILE",
     "NOISE_NM",
     "PROFILE_SETTINGS",
@@ -40,17 +44,13 @@ __all__ = [
     "ProfileSettings",
     "contact_table",
     "critical_amplitude_curve",
-    "curve_facts",
     "curve_from_maps",
     "example_drive",
-    "gain_facts",
     "gain_map",
     "map_axes",
-    "map_facts",
     "map_points",
     "parameter_table",
     "preload_points",
-    "ringing_facts",
     "run_config",
     "stall_force_curve",
     "stall_frame",
@@ -294,66 +294,5 @@ def stall_frame(points: list[dict], table: pd.DataFrame) -> pd.DataFrame:
     })
 
 
-# --------------------------------------------------------------------------------------
-# What the chapter quotes
-# --------------------------------------------------------------------------------------
-
-
-def map_facts(table: pd.DataFrame) -> dict:
-    """The step/velocity map's extremes: the fastest point, and the step at the grid's lowest and
-    highest frequency at the largest amplitude (nm, mm/s, kHz)."""
-    v = table["velocity_m_per_s"].to_numpy(float)
-    best = int(np.nanargmax(v))
-    a = table["amplitude_m"].to_numpy(float)
-    top = table[np.isclose(a, a.max(), rtol=1e-9, atol=0.0)].sort_values("frequency_Hz")  # the largest only
-    return {"v_max_mm_s": v[best] * 1e3, "v_max_f_kHz": table["frequency_Hz"].iloc[best] / 1e3,
-            "v_max_A_nm": table["amplitude_m"].iloc[best] * 1e9,
-            "step_low_f_nm": top["step_m"].iloc[0] * 1e9, "step_high_f_nm": top["step_m"].iloc[-1] * 1e9,
-            "f_low_kHz": top["frequency_Hz"].iloc[0] / 1e3, "f_high_kHz": top["frequency_Hz"].iloc[-1] / 1e3,
-            "A_top_nm": top["amplitude_m"].iloc[0] * 1e9, "map_points": len(table)}
-
-
-def gain_facts(table: pd.DataFrame) -> dict:
-    """How the Eq. 15 waveform compares with the saw-tooth over the map: points with a waveform,
-    how many of them are faster, the largest gain and loss (mm/s) and where the gain is largest."""
-    gain = np.array([np.nan if g is None else float(g) for g in table["gain_m_per_s"]])
-    valid = np.isfinite(gain)
-    out = {"gain_points": len(table), "gain_designed": int(valid.sum()), "gain_none": int((~valid).sum()),
-           "gain_faster": int((gain[valid] > 0).sum())}
-    if valid.any():
-        best, worst = int(np.nanargmax(gain)), int(np.nanargmin(gain))
-        out.update(gain_max_mm_s=gain[best] * 1e3, gain_max_f_kHz=table["frequency_Hz"].iloc[best] / 1e3,
-                   gain_max_A_nm=table["amplitude_m"].iloc[best] * 1e9, gain_min_mm_s=gain[worst] * 1e3)
-    return out
-
-
-def curve_facts(curve: pd.DataFrame) -> dict:
-    """What the chapter says of A_c against preload, all read off ``curve`` (:func:`curve_from_maps`):
-    at how many preloads the closed form lies at or above both simulated readings, where the steady
-    reading exceeds it most (nm, N), how often the steady curve turns (changes beyond the
-    measurable step) and at how many preloads the runner still rings at the next fly-back."""
-    closed, steady, first = (curve[c].to_numpy(float) for c in ("closed_form_nm", "steady_nm", "first_nm"))
-    above = (closed >= steady) & (closed >= first)
-    excess = steady - closed
-    worst = int(np.nanargmax(excess))
-    turns = ringing.turns(steady, [PROTOCOL.step_threshold * 1e9] * len(steady))
-    return {"ca_points": len(curve), "ca_closed_above": int(above.sum()),
-            "ca_excess_nm": float(excess[worst]), "ca_excess_at_N": float(curve["preload_N"].iloc[worst]),
-            "ca_turns": len(turns), "ca_ringing_points": int(curve["ringing_affects"].sum()),
-            "ca_ringing_left_nm": float(np.nanmax(curve["ringing_left_nm"]))}
-
-
-def ringing_facts(probe: dict, frequency: float) -> dict:
-    """The ringing after a fly-back (:func:`passmd.protocols.ringing.stick_ringing`) as the chapter
-    quotes it: frequency (kHz), first swing (nm), 1/e time (ms), swing left at the next fly-back at
-    ``frequency`` (nm) and the longest period at which that is below the measurable step (ms; NaN
-    if the swing stays above it while recorded)."""
-    at = ringing.at_frequency(probe, frequency)
-    swings, times = np.asarray(probe["swing_amplitudes_m"]), np.asarray(probe["swing_times_s"])
-    below = np.flatnonzero(swings < ringing.MEASURABLE)
-    return {"ring_f_kHz": probe["ringing_frequency_Hz"] / 1e3,
-            "ring_amp_nm": probe["ringing_amplitude_m"] * 1e9,
-            "ring_decay_ms": probe["ringing_decay_time_s"] * 1e3,
-            "ring_left_nm": at["ringing_at_next_flyback_m"] * 1e9,
-            "ring_hold_ms": probe["ringing_hold_s"] * 1e3, "ring_next_ms": at["next_flyback_after_s"] * 1e3,
-            "ring_quiet_ms": float(times[below[0]] * 1e3) if below.size else math.nan}
+#: The chapter's rows of the figure table: none (see the module's docstring).
+FIGURES = ()

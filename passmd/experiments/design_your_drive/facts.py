@@ -1,15 +1,16 @@
-"""The calibration of the chapter "Design your own drive": the example drive's measurements, its fit,
-and predictions of measurements held back from the fit.
+"""What the chapter "Design your own drive" quotes: each map's and curve's numbers, and its calibration
+(the example drive's measurements, its fit, and predictions of measurements held back from the fit).
 
 The measurements are made by other means than the fit's forward model
-(:func:`passmd.experiments.calibration.synthetic.independent_steps`: the integrator refined, the last
+(:func:`passmd.protocols.synthetic.independent_steps`: the integrator refined, the last
 step of a long run) plus Gaussian noise of a stated sd; the unknown parameters are fitted from a
-designer's first guess (:data:`passmd.experiments.design.figures.START`), and the fitted drive file,
-read back, predicts the held-back points.
+designer's first guess (:data:`passmd.experiments.design_your_drive.figures.START`), and the fitted drive
+file, read back, predicts the held-back points.
 """
 
 from __future__ import annotations
 
+import math
 import tempfile
 from collections.abc import Sequence
 from dataclasses import replace
@@ -18,16 +19,24 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from passmd.experiments.calibration.synthetic import independent_steps
-from passmd.experiments.design.figures import FIT_FREQUENCY, NOISE_NM, PROFILE_SETTINGS, SEED, _run_config
+from passmd.experiments.design_your_drive.figures import (
+    FIT_FREQUENCY,
+    NOISE_NM,
+    PROFILE_SETTINGS,
+    SEED,
+    _run_config,
+)
+from passmd.model.defaults import PROTOCOL
 from passmd.model.drive_file import load_drive
 from passmd.model.parameters import Drive
 from passmd.model.tables import actuator_for_radius
-from passmd.protocols import fit
+from passmd.protocols import fit, ringing
+from passmd.protocols.synthetic import independent_steps
 from passmd.runtime.config import RunConfig
 
-__all__ = ["calibrate", "fit_facts", "heldback_facts", "heldback_predictions", "load_fitted",
-           "measurements_csv", "other_flyback_fit", "start_drive", "synthetic_measurements"]
+__all__ = ["calibrate", "curve_facts", "fit_facts", "gain_facts", "heldback_facts", "heldback_predictions",
+           "load_fitted", "map_facts", "measurements_csv", "other_flyback_fit", "ringing_facts",
+           "start_drive", "synthetic_measurements"]
 
 def start_drive(truth: Drive, free: Sequence[str]) -> Drive:
     """A designer's first guess: ``truth`` with each parameter named in ``free`` at the paper's value
@@ -47,7 +56,7 @@ def start_drive(truth: Drive, free: Sequence[str]) -> Drive:
 
 def _measurements(points, truth: Drive, rng, config, flyback=None) -> fit.Measurements:
     """Steps at (frequency, preload, amplitude nm) points:
-    :func:`~passmd.experiments.calibration.synthetic.independent_steps` below 1 kHz (the
+    :func:`~passmd.protocols.synthetic.independent_steps` below 1 kHz (the
     steady-velocity protocol's step above, as a stand measures it there) plus noise of NOISE_NM."""
     header = ["amplitude_nm", "preload_N", "frequency_Hz", "step_nm", "step_nm_sd"]
     rows = [[repr(float(a)), repr(float(p)), repr(float(f)), "0", repr(NOISE_NM)] for f, p, a in points]
@@ -64,7 +73,7 @@ def _measurements(points, truth: Drive, rng, config, flyback=None) -> fit.Measur
 def synthetic_measurements(truth: Drive, profile: str, config: RunConfig | None = None, flyback=None
                            ) -> tuple[fit.Measurements, fit.Measurements]:
     """Steps of ``truth`` made independently of the fit's forward model
-    (:func:`~passmd.experiments.calibration.synthetic.independent_steps`), plus Gaussian noise of
+    (:func:`~passmd.protocols.synthetic.independent_steps`), plus Gaussian noise of
     NOISE_NM (seed SEED): ``(fit data, held-back data)``; ``flyback`` overrides the drive's fly-back
     rule in the data (a mis-specified model)."""
     s = PROFILE_SETTINGS[profile]
@@ -146,3 +155,64 @@ def heldback_facts(table: pd.DataFrame, labels=("start", "fitted")) -> dict:
     for label in labels:
         out[f"rms_{label}_nm"] = float(np.sqrt(np.mean((table[f"{label}_nm"] - table["measured_nm"]) ** 2)))
     return out
+
+
+def map_facts(table: pd.DataFrame) -> dict:
+    """The step/velocity map's extremes: the fastest point, and the step at the grid's lowest and
+    highest frequency at the largest amplitude (nm, mm/s, kHz)."""
+    v = table["velocity_m_per_s"].to_numpy(float)
+    best = int(np.nanargmax(v))
+    a = table["amplitude_m"].to_numpy(float)
+    top = table[np.isclose(a, a.max(), rtol=1e-9, atol=0.0)].sort_values("frequency_Hz")  # the largest only
+    return {"v_max_mm_s": v[best] * 1e3, "v_max_f_kHz": table["frequency_Hz"].iloc[best] / 1e3,
+            "v_max_A_nm": table["amplitude_m"].iloc[best] * 1e9,
+            "step_low_f_nm": top["step_m"].iloc[0] * 1e9, "step_high_f_nm": top["step_m"].iloc[-1] * 1e9,
+            "f_low_kHz": top["frequency_Hz"].iloc[0] / 1e3, "f_high_kHz": top["frequency_Hz"].iloc[-1] / 1e3,
+            "A_top_nm": top["amplitude_m"].iloc[0] * 1e9, "map_points": len(table)}
+
+
+def gain_facts(table: pd.DataFrame) -> dict:
+    """How the Eq. 15 waveform compares with the saw-tooth over the map: points with a waveform,
+    how many of them are faster, the largest gain and loss (mm/s) and where the gain is largest."""
+    gain = np.array([np.nan if g is None else float(g) for g in table["gain_m_per_s"]])
+    valid = np.isfinite(gain)
+    out = {"gain_points": len(table), "gain_designed": int(valid.sum()), "gain_none": int((~valid).sum()),
+           "gain_faster": int((gain[valid] > 0).sum())}
+    if valid.any():
+        best, worst = int(np.nanargmax(gain)), int(np.nanargmin(gain))
+        out.update(gain_max_mm_s=gain[best] * 1e3, gain_max_f_kHz=table["frequency_Hz"].iloc[best] / 1e3,
+                   gain_max_A_nm=table["amplitude_m"].iloc[best] * 1e9, gain_min_mm_s=gain[worst] * 1e3)
+    return out
+
+
+def curve_facts(curve: pd.DataFrame) -> dict:
+    """What the chapter says of A_c against preload, all read off ``curve``
+    (:func:`~passmd.experiments.design_your_drive.figures.curve_from_maps`): at how many preloads the
+    closed form lies at or above both simulated readings, where the steady reading exceeds it most
+    (nm, N), how often the steady curve turns (changes beyond the measurable step) and at how many
+    preloads the runner still rings at the next fly-back."""
+    closed, steady, first = (curve[c].to_numpy(float) for c in ("closed_form_nm", "steady_nm", "first_nm"))
+    above = (closed >= steady) & (closed >= first)
+    excess = steady - closed
+    worst = int(np.nanargmax(excess))
+    turns = ringing.turns(steady, [PROTOCOL.step_threshold * 1e9] * len(steady))
+    return {"ca_points": len(curve), "ca_closed_above": int(above.sum()),
+            "ca_excess_nm": float(excess[worst]), "ca_excess_at_N": float(curve["preload_N"].iloc[worst]),
+            "ca_turns": len(turns), "ca_ringing_points": int(curve["ringing_affects"].sum()),
+            "ca_ringing_left_nm": float(np.nanmax(curve["ringing_left_nm"]))}
+
+
+def ringing_facts(probe: dict, frequency: float) -> dict:
+    """The ringing after a fly-back (:func:`passmd.protocols.ringing.stick_ringing`) as the chapter
+    quotes it: frequency (kHz), first swing (nm), 1/e time (ms), swing left at the next fly-back at
+    ``frequency`` (nm) and the longest period at which that is below the measurable step (ms; NaN
+    if the swing stays above it while recorded)."""
+    at = ringing.at_frequency(probe, frequency)
+    swings, times = np.asarray(probe["swing_amplitudes_m"]), np.asarray(probe["swing_times_s"])
+    below = np.flatnonzero(swings < ringing.MEASURABLE)
+    return {"ring_f_kHz": probe["ringing_frequency_Hz"] / 1e3,
+            "ring_amp_nm": probe["ringing_amplitude_m"] * 1e9,
+            "ring_decay_ms": probe["ringing_decay_time_s"] * 1e3,
+            "ring_left_nm": at["ringing_at_next_flyback_m"] * 1e9,
+            "ring_hold_ms": probe["ringing_hold_s"] * 1e3, "ring_next_ms": at["next_flyback_after_s"] * 1e3,
+            "ring_quiet_ms": float(times[below[0]] * 1e3) if below.size else math.nan}

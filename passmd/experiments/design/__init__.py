@@ -1,1 +1,0 @@
-"""The chapter "Design your own drive": the worked example and design maps."""

@@ -1,0 +1,1 @@
+"""The numerics chapter (beside Sections 2–3): trust in the integrator (convergence, energy, cost)."""

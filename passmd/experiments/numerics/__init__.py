@@ -1,1 +1,0 @@
-"""The numerics chapter: trust in the integrator (convergence, energy, cost)."""
