@@ -20,7 +20,7 @@ import pandas as pd
 
 from passmd.experiments import FigureSpec
 from passmd.experiments.model_numerics.facts import benchmark_results
-from passmd.model import hertz, theory
+from passmd.model import hertz
 from passmd.model.mdr_contact import MDRContact
 from passmd.model.parameters import Drive
 from passmd.runtime.config import RunConfig
@@ -74,9 +74,9 @@ def normal_validation(drive: Drive | None = None, springs=(20, 100, 1000), point
         ``indentation_m``, ``hertz_N`` and, per N, ``mdr_<N>_N`` and ``rel_error_<N>``.
     """
     drive = Drive() if drive is None else drive
-    E_star, _ = theory.contact_moduli(drive)
+    E_star, _ = drive.contact_moduli
     R = drive.hemisphere_radius
-    F_max = 2.0 * float(theory.normal_forces(drive.preload, drive.contacts)[0])
+    F_max = 2.0 * float(drive.contact_layout.normal_forces[0])
     a_max = float(hertz.hertz_contact_radius(F_max, R, E_star))
     d = np.linspace(1.0, points, points) / points * a_max**2 / R
     out = {"indentation_m": d, "hertz_N": 4.0 / 3.0 * E_star * np.sqrt(R) * d**1.5}

@@ -89,7 +89,7 @@ def normal_force_balance(drive: Drive) -> dict:
         ``balance_right_N`` (2 F_N1 sin 45°) and ``balance_left_N`` (4 F_N2 sin 45°), both
         equal to F_p.
     """
-    f1, f2 = (float(f) for f in theory.normal_forces(drive.preload, 6))
+    f1, f2 = (float(f) for f in drive.contact_layout.normal_forces)
     return {
         "preload_N": drive.preload,
         "normal_force_1_N": f1,
@@ -124,8 +124,8 @@ def model_mdr_loop(config: RunConfig) -> pd.DataFrame:
         ``presliding_m`` (u_x,max), ``sliding_force_N`` (μF_N), ``springs``.
     """
     drive = model_drive()
-    f1 = float(theory.normal_forces(drive.preload, 6)[0])
-    e_star, g_star = theory.contact_moduli(drive)
+    f1 = float(drive.contact_layout.normal_forces[0])
+    e_star, g_star = drive.contact_moduli
     radius = drive.hemisphere_radius
     mu = drive.friction_coefficient
     u_max = float(theory.presliding_displacement(f1, radius, e_star, g_star, mu))
