@@ -41,7 +41,8 @@ def _check_contacts(contacts) -> int:
 
 
 def contact_moduli(drive: Drive) -> tuple[float, float]:
-    """(E*, G*) of the hemisphere/runner pair of a drive, in Pa (:attr:`Drive.contact_moduli`)."""
+    """(E*, G*) of the hemisphere/runner pair of a drive, in Pa
+    (:attr:`~passmd.model.parameters.Drive.contact_moduli`)."""
     _check_drive(drive)
     return drive.contact_moduli
 
@@ -226,7 +227,8 @@ def _drive_contact_radius(drive: Drive, forces: np.ndarray, E_star: float, radii
 
 def contact_layout(drive: Drive) -> ContactLayout:
     """The drive's contact groups: normal force per contact (N, Eq. 1), contacts per group, and
-    the hemispheres' radius of each group (m); the drive computed them (:attr:`Drive.contact_layout`).
+    the hemispheres' radius of each group (m); the drive computed them
+    (:attr:`~passmd.model.parameters.Drive.contact_layout`).
 
     One contact: ``([F_p], [1], [R])``; the paper's six: ``([F_N1, F_N2], [2, 4], [R, R])``;
     a drive with ``contact_groups``: one entry per :class:`~passmd.model.parameters.ContactGroup`.

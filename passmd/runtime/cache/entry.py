@@ -1,6 +1,7 @@
 """The bytes of one cache entry (format and rules in :mod:`passmd.runtime.cache`):
-:func:`encode_entry` writes a checksummed JSON header and the raw bytes of its arrays,
-:func:`decode_entry` checks every part and raises :class:`CorruptEntry` otherwise.
+:func:`~passmd.runtime.cache.entry.encode_entry` writes a checksummed JSON header and the raw bytes
+of its arrays, :func:`~passmd.runtime.cache.entry.decode_entry` checks every part and raises
+:class:`~passmd.runtime.cache.entry.CorruptEntry` otherwise.
 """
 
 from __future__ import annotations

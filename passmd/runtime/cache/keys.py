@@ -1,5 +1,6 @@
-"""What a cache key hashes: parameters (:func:`canonical`), the package's code
-(:func:`code_fingerprint`) and the swept function's own code (:func:`function_code`).
+"""What a cache key hashes: parameters (:func:`~passmd.runtime.cache.keys.canonical`), the package's
+code (:func:`~passmd.runtime.cache.keys.code_fingerprint`) and the swept function's own code
+(:func:`~passmd.runtime.cache.keys.function_code`).
 """
 
 from __future__ import annotations

@@ -1,6 +1,7 @@
-"""The cache directory on disk (rules in :mod:`passmd.runtime.cache`): its marker, the names it
-owns, what lies at an entry's path (never following a link or blocking on a device) and the
-state of a directory (:func:`inspect_directory`; :func:`owned` refuses a foreign one).
+"""The cache directory on disk (rules in :mod:`passmd.runtime.cache`): its marker, the names it owns,
+what lies at an entry's path (never following a link or blocking on a device) and the state of a
+directory (:func:`~passmd.runtime.cache.layout.inspect_directory`;
+:func:`~passmd.runtime.cache.layout.owned` refuses a foreign one).
 """
 
 from __future__ import annotations

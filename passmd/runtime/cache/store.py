@@ -1,5 +1,5 @@
-"""The cache itself: :class:`Cache` keys, reads and writes checked entries in a directory it
-owns, and summarises, prunes or clears it (rules in :mod:`passmd.runtime.cache`).
+"""The cache itself: :class:`~passmd.runtime.cache.store.Cache` keys, reads and writes checked entries
+in a directory it owns, and summarises, prunes or clears it (rules in :mod:`passmd.runtime.cache`).
 """
 
 from __future__ import annotations
