@@ -41,8 +41,10 @@ def _check_contacts(contacts) -> int:
 
 
 def contact_moduli(drive: Drive) -> tuple[float, float]:
-    """(E*, G*) of the hemisphere/runner pair of a drive, in Pa
-    (:attr:`~passmd.model.parameters.Drive.contact_moduli`)."""
+    """(E*, G*) of the hemisphere/runner pair of a drive, in Pa (Eq. 4), as the drive computed them.
+
+    The drive's own :attr:`~passmd.model.parameters.Drive.contact_moduli`.
+    """
     _check_drive(drive)
     return drive.contact_moduli
 
