@@ -17,7 +17,6 @@ from passmd.model.parameters import PAPER_SIX, ContactGroup, Drive
 from passmd.model.theory import (
     _six_contact_forces,
     contact_arrangement,
-    contact_layout,
     drive_theory,
     first_flyback_critical_amplitude,
     friction_limit,
@@ -54,8 +53,8 @@ def test_paper_six_groups_give_eq1_to_the_last_bit(preload):
     """Two contacts at 45° on one side, four on the other: F_p/(2 sin 45°), F_p/(4 sin 45°) exactly."""
     eq1 = [float(f) for f in _six_contact_forces(np.asarray(preload))]
     for drive in (Drive(preload=preload), Drive(preload=preload, contact_groups=PAPER_SIX)):
-        assert contact_layout(drive)[0].tolist() == eq1
-    assert contact_layout(Drive(preload=preload, contacts=1))[0].tolist() == [preload]
+        assert drive.contact_layout.normal_forces.tolist() == eq1
+    assert Drive(preload=preload, contacts=1).contact_layout.normal_forces.tolist() == [preload]
     assert ONE_CONTACT[0].contact_angle == math.pi / 2
 
 
@@ -74,7 +73,7 @@ def test_contact_angle_sets_the_normal_force():
     with pytest.raises(ValueError, match=r"contact_groups\[0\]: side is not given"):
         Drive(contact_groups=mixed)
     mixed = (ContactGroup(1, side=1), *mixed[1:])
-    forces = contact_layout(Drive(contact_groups=mixed))[0]
+    forces = Drive(contact_groups=mixed).contact_layout.normal_forces
     assert forces[2] == pytest.approx((0.4 - 2 * 0.12) / (2 * math.sin(math.pi / 3)), rel=1e-14)
     assert side_loads(0.4, mixed) == pytest.approx({1: 0.4, 2: 0.4}, rel=1e-14)
 

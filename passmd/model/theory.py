@@ -20,7 +20,7 @@ import numpy as np
 
 from passmd.model.arrangement import group_sides, preset_groups
 from passmd.model.hertz import _TINY, _hertz_cube, _positive, _require_normal
-from passmd.model.parameters import ContactLayout, Drive
+from passmd.model.parameters import Drive
 from passmd.runtime.validation import check_array
 
 SIN45 = np.sin(np.pi / 4)
@@ -225,18 +225,6 @@ def _drive_contact_radius(drive: Drive, forces: np.ndarray, E_star: float, radii
                     (("preload", drive.preload, "N"), ("hemisphere_radius", drive.hemisphere_radius, "m"),
                      ("E*", E_star, "Pa")))
     return np.cbrt(cube)
-
-
-def contact_layout(drive: Drive) -> ContactLayout:
-    """The drive's contact groups: normal force per contact (N, Eq. 1), contacts per group, and
-    the hemispheres' radius of each group (m); the drive computed them
-    (:attr:`~passmd.model.parameters.Drive.contact_layout`).
-
-    One contact: ``([F_p], [1], [R])``; the paper's six: ``([F_N1, F_N2], [2, 4], [R, R])``;
-    a drive with ``contact_groups``: one entry per :class:`~passmd.model.parameters.ContactGroup`.
-    """
-    _check_drive(drive)
-    return drive.contact_layout
 
 
 def contact_arrangement(drive: Drive) -> list[dict]:
