@@ -1,16 +1,16 @@
-"""Cost of the driving-waveform chapter: its building blocks (medians of repeated runs) and one
-cold computation of every Fig. 8–10 panel and study at a profile.
+"""Cost of Section 5's chapters (driving waveform, velocity, beyond the paper): their building
+blocks (medians of repeated runs) and one cold computation of every Fig. 8–10 panel and study at a profile.
 
 Timed blocks (each repeated, median and fastest reported; numba compiles in an untimed warm-up):
 
 * ``design``: :func:`passmd.protocols.eq15.optimized_design` of the Section 5 drive (two 100 Hz
   saw-tooth periods recorded densely, f_s and V_r measured, Eq. 15);
 * ``steady_sawtooth_<f>`` / ``steady_optimized_<f>``: one steady-velocity point
-  (:func:`passmd.experiments.driving_waveform.figures_runs.velocity_point`) at 1 kHz and 110 kHz;
+  (:func:`passmd.protocols.section5.velocity_point`) at 1 kHz and 110 kHz;
 * ``step_100hz``: one Fig. 9a protocol run (three 100 Hz periods, rigid actuators).
 
 Then, once, with an empty temporary simulation cache: every panel (``figure_data``) and the
-studies beyond the paper (:mod:`passmd.experiments.driving_waveform.figures_studies`) at ``--profile``,
+studies beyond the paper (:mod:`passmd.experiments.waveform_optimum.figures`) at ``--profile``,
 as wall time of this process plus its sweep workers.
 
 Usage::
@@ -35,8 +35,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from passmd.experiments.driving_waveform import figures_studies
 from passmd.experiments.figure_table import figure_data
+from passmd.experiments.waveform_optimum.figures import flexible_study, numerical_optimum, settling_scan
+from passmd.experiments.waveform_velocity.figures import startup_transient
 from passmd.model.defaults import PROTOCOL
 from passmd.runtime.config import RunConfig
 
@@ -55,12 +56,13 @@ def _timed(func, repeats: int) -> dict:
 
 
 def blocks(repeats: int) -> dict:
-    from passmd.experiments.driving_waveform import figures_runs
+    from passmd.experiments.driving_waveform.figures import section5_fields
     from passmd.model import optimized_waveform
     from passmd.protocols import eq15
+    from passmd.protocols.section5 import section5_drive, velocity_point
     from passmd.solver import simulation
 
-    drive = figures_runs.section5_drive()
+    drive = section5_drive(**section5_fields())
     amplitude = drive.actuator.full_stroke_amplitude
     design = eq15.optimized_design(amplitude, drive)
     fields = {"settling_time": design.settling_time, "acceleration_time": design.acceleration_time,
@@ -69,8 +71,8 @@ def blocks(repeats: int) -> dict:
     for f in (1e3, 110e3):
         for waveform, rule in (("sawtooth", ""), ("optimized", "cut")):
             out[f"steady_{waveform}_{f / 1e3:g}kHz"] = _timed(
-                lambda f=f, w=waveform, r=rule: figures_runs.velocity_point(
-                    **figures_runs.section5_fields(), frequency=f, waveform=w, short_period=r, **fields),
+                lambda f=f, w=waveform, r=rule: velocity_point(
+                    **section5_fields(), frequency=f, waveform=w, short_period=r, **fields),
                 repeats)
     wave = optimized_waveform.optimized(amplitude, PROTOCOL.drive_frequency, drive, periods=3, design=design)
     out["step_100hz"] = _timed(lambda: simulation.simulate(drive, wave, max_points=2), repeats)
@@ -86,10 +88,10 @@ def cold_profile(profile: str) -> dict:
             start = time.perf_counter()
             figure_data(name, config)
             out[name] = time.perf_counter() - start
-        for name, call in (("settling_scan", lambda: figures_studies.settling_scan(config)),
-                           ("numerical_optimum", lambda: figures_studies.numerical_optimum(config)),
-                           ("flexible_study", lambda: figures_studies.flexible_study(config)),
-                           ("startup_transient", lambda: figures_studies.startup_transient(config, 110e3))):
+        for name, call in (("settling_scan", lambda: settling_scan(config)),
+                           ("numerical_optimum", lambda: numerical_optimum(config)),
+                           ("flexible_study", lambda: flexible_study(config)),
+                           ("startup_transient", lambda: startup_transient(config, 110e3))):
             start = time.perf_counter()
             call()
             out[name] = time.perf_counter() - start

@@ -12,10 +12,9 @@ from passmd.report import evaluation
 
 ROOT = Path(__file__).resolve().parents[1]
 EXPERIMENTS = ROOT / "passmd" / "experiments"
-#: The modules every chapter package has; ``claims.py`` where the chapter judges claims; a module over
-#: 500 lines splits by topic as ``<module>_<topic>.py``.
+#: The modules every chapter package has, and ``claims.py`` where the chapter judges claims: no others.
 REQUIRED = {"__init__.py", "figures.py", "facts.py"}
-MODULE = re.compile(r"(__init__|(figures|facts|claims)(_[a-z0-9]+)*)\.py")
+MODULE = re.compile(r"__init__\.py|(figures|facts|claims)\.py")
 
 
 def _toc_chapters() -> list[str]:
@@ -39,9 +38,6 @@ def test_every_chapter_folder_has_the_same_modules():
         names = {p.name for p in folder.glob("*.py")}
         assert REQUIRED <= names, (folder.name, REQUIRED - names)
         assert all(MODULE.fullmatch(name) for name in names), (folder.name, sorted(names))
-        for name in names:  # a topic module only beside the module it splits
-            role = name.split("_")[0].removesuffix(".py")
-            assert name == "__init__.py" or f"{role}.py" in names, (folder.name, name)
         docstring = (folder / "__init__.py").read_text().strip()
         assert docstring.startswith('"""') and docstring.count("\n") == 0, folder.name
 
@@ -70,7 +66,7 @@ def test_every_claim_extractor_reads_registered_results_of_its_chapter():
         assert not unknown, (claim_id, unknown)
         if function.__module__.startswith("passmd.experiments."):
             chapter = function.__module__.split(".")[2]
-            assert MODULE.fullmatch(function.__module__.split(".")[3] + ".py").group(2) == "claims"
+            assert function.__module__.split(".")[3] == "claims", function.__module__
             assert chapter in {chapter_of.get(key) for key in required}, (claim_id, chapter, required)
 
 

@@ -18,14 +18,23 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from passmd.experiments.driving_waveform import claims_velocity
-from passmd.experiments.driving_waveform.figures import FREQUENCIES
-from passmd.experiments.driving_waveform.figures_runs import section5_drive
+from passmd.experiments.driving_waveform.figures import section5_fields
 from passmd.experiments.force_generation.figures import EARLIER, THIS
+from passmd.experiments.waveform_velocity.claims import (
+    _located,
+    _maxima,
+    _scoped,
+    controllable_maximum,
+    eq15_scope,
+    maximum_location,
+    stick_edge,
+)
+from passmd.experiments.waveform_velocity.figures import FREQUENCIES
 from passmd.ledger import checks, readings, reference
 from passmd.ledger.checks import NO_MEASURED_DATA, ClaimFails, NotEvaluable, check_claim
 from passmd.ledger.claims import load_claims
 from passmd.model import theory
+from passmd.protocols.section5 import section5_drive
 from passmd.report import evaluation
 from passmd.runtime.config import RunConfig
 
@@ -541,7 +550,7 @@ def test_not_informative_reasons_hold():
     }
     np.testing.assert_allclose(k[1.0] / k[0.25], 4 ** (1 / 3), rtol=1e-12)
     # the 202 nm fly-back is at least six times either side's presliding u_x,max (Eq. 10) at 0.4 N
-    drive = section5_drive()
+    drive = section5_drive(**section5_fields())
     presliding = np.asarray(theory.drive_theory(drive)["presliding_m"])
     assert drive.actuator.full_stroke_amplitude > 6 * presliding.max()
 
@@ -625,36 +634,36 @@ def test_a_maximum_is_located_to_the_grids_resolution():
     grid point is the location, edges included; the reachable maximum is the largest up to 110 kHz."""
     coarse = [1, 20, 60, 100, 110, 120, 130]
     edge = _velocities(coarse, [5.0, 3.0, 2.0, 1.0, 0.5, 0.4, 0.2])
-    assert claims_velocity.maximum_location(edge) == (1.0, 1.0, 20.0)
-    assert claims_velocity._located(edge, 105, 115, "110 ± 5 kHz") == 1.0
+    assert maximum_location(edge) == (1.0, 1.0, 20.0)
+    assert _located(edge, 105, 115, "110 ± 5 kHz") == 1.0
     near = _velocities(coarse, [0.1, 1.0, 2.0, 5.0, 3.0, 0.4, 0.2])
     with pytest.raises(NotEvaluable, match="could move it into"):
-        claims_velocity._located(near, 105, 115, "110 ± 5 kHz")
+        _located(near, 105, 115, "110 ± 5 kHz")
     paper = FREQUENCIES["paper"] / 1e3
     rising = _velocities(paper, paper)  # still rising at 130 kHz
-    assert claims_velocity.maximum_location(rising) == (130.0, 130.0, 130.0)
-    assert claims_velocity.controllable_maximum(rising)["frequency_kHz"] == 110.0
+    assert maximum_location(rising) == (130.0, 130.0, 130.0)
+    assert controllable_maximum(rising)["frequency_kHz"] == 110.0
     with pytest.raises(NotEvaluable, match="lacks some of the paper's frequencies"):
-        claims_velocity._maxima(near)
+        _maxima(near)
 
 
 def test_a_decision_where_eq15_is_undefined_says_so():
     """The frequencies that decide a claim all lie where Eq. 15 does not fit the period: the verdict
     names it (a Scoped result); one of them where it fits is enough to rest on Eq. 15."""
     part = _velocities([1, 5, 10, 110], [1.0, 2.0, 3.0, 4.0], fits=np.array([1, 1, 0, 0], bool))
-    assert claims_velocity.eq15_scope(part, [1.0]) == ""
-    assert claims_velocity.eq15_scope(part, [10.0, 1.0]) == ""
-    scope = claims_velocity.eq15_scope(part, [110.0])
+    assert eq15_scope(part, [1.0]) == ""
+    assert eq15_scope(part, [10.0, 1.0]) == ""
+    scope = eq15_scope(part, [110.0])
     assert scope.startswith("Eq. 15 is undefined") and "above 5 kHz" in scope
-    scoped = claims_velocity._scoped({"lhs": 1.0, "rhs": 2.0}, scope)
+    scoped = _scoped({"lhs": 1.0, "rhs": 2.0}, scope)
     assert isinstance(scoped, checks.Scoped) and scoped.outside == scope
-    assert claims_velocity._scoped(1.0, "", scope) == 1.0
+    assert _scoped(1.0, "", scope) == 1.0
 
 
 def test_the_stick_edge_is_where_stick_is_lost_for_good():
     f = [1, 20, 60, 100, 110, 120]
-    assert claims_velocity.stick_edge(_velocities(f, f, stick=np.array([0, 1, 1, 1, 0, 0], bool))) == 100.0
+    assert stick_edge(_velocities(f, f, stick=np.array([0, 1, 1, 1, 0, 0], bool))) == 100.0
     with pytest.raises(ClaimFails, match="still sticks"):
-        claims_velocity.stick_edge(_velocities(f, f, stick=np.array([0, 1, 1, 1, 1, 1], bool)))
+        stick_edge(_velocities(f, f, stick=np.array([0, 1, 1, 1, 1, 1], bool)))
     with pytest.raises(ClaimFails, match="every grid frequency"):
-        claims_velocity.stick_edge(_velocities(f, f, stick=np.zeros(6, bool)))
+        stick_edge(_velocities(f, f, stick=np.zeros(6, bool)))

@@ -610,8 +610,8 @@ def test_a_coarse_grid_decides_only_what_the_paper_grid_would():
     inconclusive; a pointwise failure there decides (failures_decide); a failure of a check of the whole
     grid does not. The extractors wrap the quick grids and leave the paper's alone."""
     from passmd.experiments.critical_amplitude_one import claims
-    from passmd.experiments.driving_waveform import claims_velocity
-    from passmd.experiments.driving_waveform.figures import FREQUENCIES
+    from passmd.experiments.waveform_velocity.claims import on_paper_grid
+    from passmd.experiments.waveform_velocity.figures import FREQUENCIES
     from passmd.ledger.verdicts import _evaluate_point
 
     claim = {"id": "o", "check": "ordering", "relation": ">", "tolerance_num": math.nan,
@@ -636,7 +636,7 @@ def test_a_coarse_grid_decides_only_what_the_paper_grid_would():
     assert claims.on_paper_grid(holds, "fig6c", (0.1, 0.2, 0.3, 0.4, 0.5)) is holds
     for profile, whole in (("quick", False), ("paper", True)):
         part = pd.DataFrame({"frequency_kHz": FREQUENCIES[profile] / 1e3})
-        assert (claims_velocity.on_paper_grid(holds, part) is holds) == whole
+        assert (on_paper_grid(holds, part) is holds) == whole
 
 
 def test_design_is_the_full_product_and_skip_is_no_reading_of_eq15():
@@ -674,10 +674,11 @@ def test_every_claim_declares_exactly_the_axes_that_change_its_tables():
     assert "damping_ratio" not in functions.depends_on["fig5b-rigid-ac-matches-eq7"]
     assert "damping_ratio" in functions.depends_on["fig5b-flexible-above-rigid"]
     # Section 5 drives at the full stroke, where the two fly-back rules are the same 2 µs
-    from passmd.experiments.driving_waveform.figures_runs import section5_drive
+    from passmd.experiments.driving_waveform.figures import section5_fields
     from passmd.model import waveforms
+    from passmd.protocols.section5 import section5_drive
     for radius in (1e-3, 0.25e-3):
-        drive = section5_drive(radius)
+        drive = section5_drive(**section5_fields(radius))
         full = drive.actuator.full_stroke_amplitude
         assert waveforms.flyback_time(full, drive, "slew") == waveforms.flyback_time(full, drive, "fixed")
 

@@ -8,15 +8,12 @@ code path produces every figure.
 
 The rows are each chapter's own: :data:`FIGURES` and :data:`READING_TABLES` join the ``FIGURES`` and
 ``READING_TABLES`` tuples of the ``figures.py`` of every chapter in :data:`CHAPTERS` (the book's
-order, ``book/_toc.yml``); :data:`CLAIM_MODULES` holds every chapter's ``claims.py`` and
-``claims_<topic>.py``, found by name.
+order, ``book/_toc.yml``); :data:`CLAIM_MODULES` holds every chapter's ``claims.py``.
 """
 
 from __future__ import annotations
 
 import importlib
-import pkgutil
-import re
 from pathlib import Path
 from types import ModuleType
 
@@ -33,17 +30,16 @@ __all__ = [
 #: The book chapters that compute something, in the book's order (``book/_toc.yml``): each is a
 #: package ``passmd.experiments.<chapter>`` of the same modules.
 CHAPTERS = ("model", "model_numerics", "mdr_validation", "critical_amplitude_one", "critical_amplitude_six",
-            "force_generation", "driving_waveform", "design_your_drive", "calibration")
+            "force_generation", "driving_waveform", "waveform_velocity", "waveform_optimum",
+            "design_your_drive", "calibration")
 
 
 def chapter_modules(role: str) -> tuple[ModuleType, ...]:
-    """The modules ``<role>.py`` and ``<role>_<topic>.py`` of every chapter of :data:`CHAPTERS`, in
-    the book's order (``role``: ``"figures"``, ``"facts"`` or ``"claims"``)."""
+    """The module ``<role>.py`` of every chapter of :data:`CHAPTERS` that has one, in the book's
+    order (``role``: ``"figures"``, ``"facts"`` or ``"claims"``)."""
     chapters = Path(__file__).parent
-    return tuple(importlib.import_module(f"passmd.experiments.{chapter}.{module.name}")
-                 for chapter in CHAPTERS
-                 for module in sorted(pkgutil.iter_modules([str(chapters / chapter)]), key=lambda m: m.name)
-                 if re.fullmatch(rf"{role}(_\w+)?", module.name))
+    return tuple(importlib.import_module(f"passmd.experiments.{chapter}.{role}")
+                 for chapter in CHAPTERS if (chapters / chapter / f"{role}.py").is_file())
 
 
 #: Every figure of the book, in the book's chapter order: the ``FIGURES`` of each chapter's
@@ -57,7 +53,7 @@ READING_TABLES: dict[str, ReadingTable] = {
     spec.key: spec for module in chapter_modules("figures") for spec in getattr(module, "READING_TABLES", ())}
 
 #: The experiment modules whose functions carry claim extractors (Sections 4.1, 4.2, 5): every
-#: chapter's ``claims.py`` and ``claims_<topic>.py``.
+#: chapter's ``claims.py``.
 CLAIM_MODULES: tuple[ModuleType, ...] = chapter_modules("claims")
 
 _BY_NAME = {spec.name: spec for spec in FIGURES}

@@ -1,7 +1,9 @@
-"""Plots of the driving-waveform chapter (Figs. 8–10 and the studies beyond the paper).
+"""Plots of Section 5's chapters (Figs. 8–10 and the studies beyond the paper).
 
-Each function takes the tidy DataFrame of :mod:`passmd.experiments.driving_waveform.figures` and
-returns a matplotlib Figure; axes in nm, µs/ms, kHz and mm/s.
+Each function takes the tidy DataFrame of a figure of :mod:`passmd.experiments.driving_waveform`
+(Figs. 8, 9a), :mod:`passmd.experiments.waveform_velocity` (Figs. 9b, 10) or
+:mod:`passmd.experiments.waveform_optimum` (the studies) and returns a matplotlib Figure; axes in nm,
+µs/ms, kHz and mm/s.
 """
 
 from __future__ import annotations
@@ -189,7 +191,7 @@ def plot_fig10c(df):
 
 
 # --------------------------------------------------------------------------------------
-# Beyond the paper (passmd.experiments.driving_waveform.figures_studies)
+# Beyond the paper (passmd.experiments.waveform_optimum.figures)
 # --------------------------------------------------------------------------------------
 
 
@@ -225,7 +227,7 @@ def plot_settling_scan(scans: dict):
 
 def plot_settling_scans(df):
     """:func:`plot_settling_scan` of the tidy table of
-    :func:`passmd.experiments.driving_waveform.figures_studies.settling_scans` (one curve per ``series``)."""
+    :func:`passmd.experiments.waveform_optimum.figures.settling_scans` (one curve per ``series``)."""
     return plot_settling_scan({label: part for label, part in df.groupby("series", sort=False)})
 
 

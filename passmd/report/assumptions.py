@@ -10,9 +10,9 @@ from __future__ import annotations
 
 from types import ModuleType
 
-import passmd.experiments.driving_waveform.figures
-import passmd.experiments.driving_waveform.figures_studies
 import passmd.experiments.force_generation.figures
+import passmd.experiments.waveform_optimum.figures
+import passmd.experiments.waveform_velocity.figures
 from passmd.ledger import reference
 from passmd.model import arrangement, contact, optimized_waveform, parameters, tables, waveforms
 from passmd.model.tables import Assumption
@@ -30,9 +30,9 @@ ASSUMPTION_MODULES: tuple[ModuleType, ...] = (
     waveforms,
     reference,
     critical_amplitude,
-    passmd.experiments.driving_waveform.figures,
+    passmd.experiments.waveform_velocity.figures,
     passmd.experiments.force_generation.figures,
-    passmd.experiments.driving_waveform.figures_studies,
+    passmd.experiments.waveform_optimum.figures,
     optimized_waveform,
 )
 

@@ -1,1 +1,1 @@
-"""The driving-waveform chapter, Section 5: Eq. 15's optimized waveform against the saw-tooth (Figs. 8–10)."""
+"""The driving-waveform chapter, Section 5.1: Eq. 15's waveform against the saw-tooth (Figs. 8, 9a)."""

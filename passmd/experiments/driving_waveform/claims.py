@@ -10,7 +10,7 @@ it is designed from (the runner velocity V_r of Eq. 15 after an optimized period
 at the runner's velocity maximum, stick during t_a, the contacts deformed to u_x,max after the
 fly-back, the runner fastest at the end of t_a and slipping forward further than the hemispheres
 move (Sub-phase II); Fig. 9a's final positions and step increase. Section 5.2's velocities are in
-:mod:`passmd.experiments.driving_waveform.claims_velocity`. Too few samples in a phase make a
+:mod:`passmd.experiments.waveform_velocity.claims`. Too few samples in a phase make a
 claim inconclusive.
 """
 
@@ -19,15 +19,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from passmd.experiments.driving_waveform.figures import (
-    at_section5_friction,
-)
-from passmd.experiments.driving_waveform.figures_runs import (
-    SECTION5_FRICTION,
-    WINDOW_SAMPLES_PER_ACCELERATION,
-)
+from passmd.experiments.driving_waveform.figures import SECTION5_FRICTION, at_section5_friction
 from passmd.ledger.checks import ClaimFails, NoRun, NotEvaluable, evidence, extractor
 from passmd.ledger.readings import default_reading
+from passmd.protocols.section5 import WINDOW_SAMPLES_PER_ACCELERATION
 from passmd.protocols.velocity import FULL_SLIDING_SHARE
 
 __all__ = ["optimized_period_timing"]

@@ -1,29 +1,16 @@
-"""Driving waveform: Figs. 8–10 (Section 5) and two studies beyond the paper.
+"""Driving waveform, Section 5.1: Eq. 15's waveform against the saw-tooth at 100 Hz (Figs. 8, 9a).
 
 Section 5 drives the six-contact drive with rigid actuators (R = 1 mm, F_p = 0.4 N,
-A = 202 nm, μ = 0.2 assumed) with the standard saw-tooth and with the optimized waveform
+A = 202 nm, μ assumed) with the standard saw-tooth and with the optimized waveform
 of Eq. 15 (:func:`passmd.model.optimized_waveform.optimized`), designed once per drive from its own
-100 Hz saw-tooth response (:func:`passmd.protocols.eq15.optimized_design`).
+100 Hz saw-tooth response (:func:`passmd.protocols.eq15.optimized_design`). The runs are those of
+:mod:`passmd.protocols.section5`; this module supplies Section 5's unstated μ
+(:data:`SECTION5_FRICTION`, the ledger's reading) through :func:`section5_fields`.
 
-The velocities are measured by the protocol of :mod:`passmd.protocols.velocity` (the
-*steady* velocity at kHz frequencies, the steps at 100 Hz); ``SimulationResult.mean_velocity``
-(settled positions of the first and last period) includes the start-up and is kept as
-``simulator_mean_velocity_m_per_s`` for comparison.
-
-Figures (``compute(config: RunConfig) -> DataFrame``, the chapter's rows :data:`FIGURES` of the figure
-table, with the studies'):
-``fig8a`` saw-tooth response with contact status; ``fig8b`` the optimized waveform with
-t_s, t_a, Δ_a; ``fig9a`` runner position over three 100 Hz periods, both waveforms;
-``fig9b`` steady velocity against frequency, both waveforms; ``fig10a``–``fig10c`` the
-optimized waveform's velocity for three preloads, two radii, two runner materials.
-
-The drives, their Eq. 15 designs and the runs the figures tabulate (the sweep's point
-functions): :mod:`passmd.experiments.driving_waveform.figures_runs`.
-
-Beyond the paper (flexible actuators, the settling time, a numerical optimum of the waveform):
-:mod:`passmd.experiments.driving_waveform.figures_studies`; the numbers the chapter reads from both:
-:mod:`passmd.experiments.driving_waveform.facts`; the ledger's claims on Figs. 8–10:
-:mod:`passmd.experiments.driving_waveform.claims`.
+Figures (rows of the figure table): ``fig8a`` saw-tooth response with contact status; ``fig8b`` the
+optimized waveform with t_s, t_a, Δ_a; ``fig8b_window`` its fly-back and acceleration resolved in
+time; ``fig9a`` runner position over three 100 Hz periods, both waveforms. The velocities over
+frequency (Figs. 9b, 10) are :mod:`passmd.experiments.waveform_velocity`'s.
 """
 
 from __future__ import annotations
@@ -34,102 +21,35 @@ import numpy as np
 import pandas as pd
 
 from passmd.experiments import FigureSpec, ReadingTable
-from passmd.experiments.driving_waveform.figures_runs import (
-    RUNNERS,
-    SECTION5_FRICTION,
+from passmd.ledger import readings
+from passmd.protocols.section5 import (
     STEP_FREQUENCY,
     WINDOW_RESOLUTION,
     WINDOW_SAMPLES_PER_ACCELERATION,
-    _full_stroke_flyback,
     design_fields,
     designs,
-    section5_fields,
+    full_stroke_flyback,
     trace_point,
-    velocity_table,
     window_point,
 )
-from passmd.experiments.driving_waveform.figures_studies import (
-    flexible_study,
-    numerical_optimum,
-    settling_scans,
-    startup_transient,
-)
-from passmd.ledger import readings
-from passmd.ledger.checks import NotEvaluable
-from passmd.model.parameters import Assumption
-from passmd.protocols.velocity import FULL_SLIDING_SHARE, MIN_PERIODS, STEADY_TIME, STEP_PERIODS
+from passmd.protocols.velocity import FULL_SLIDING_SHARE, MIN_PERIODS, STEP_PERIODS
 from passmd.runtime import sweep
 from passmd.runtime.config import PROFILES, RunConfig
 from passmd.runtime.validation import check_choice
 
-#: Fig. 9b/10 frequency grids (Hz): the paper's "1 to 130 kHz with a step of 5 kHz".
-FREQUENCIES = {
-    "paper": np.array([1e3] + [5e3 * k for k in range(1, 27)]),
-    "quick": np.array([1e3, 20e3, 60e3, 100e3, 110e3, 120e3, 130e3]),
-}
-#: Preloads of Fig. 10a (N) and radii of Fig. 10b (m).
-FIG10A_PRELOADS = (0.1, 0.4, 1.0)
-FIG10B_RADII = (1e-3, 0.25e-3)
+#: μ of Section 5 (not stated there): the default of the ledger's axis ``friction_coefficient``.
+SECTION5_FRICTION = float(readings.axis("friction_coefficient").default)
 #: μ of the Fig. 9a runs: the default and the ledger's evaluated alternatives (Section 4.2's 0.3).
 FIG9A_FRICTION = tuple(float(mu) for mu in readings.axis("friction_coefficient").values())
 
-ASSUMPTIONS: tuple[Assumption, ...] = (
-    Assumption(
-        key="frequency_grid",
-        symbol="f",
-        value="1, 5, 10, …, 130 kHz",
-        unit="kHz",
-        rationale=(
-            "'from 1 to 130 kHz with a step of 5 kHz' (Section 5.2) does not say whether the grid is "
-            "1, 6, 11, … or 1, 5, 10, …; the second contains the 80 and 110 kHz the text names."
-        ),
-        sensitivity="Only where a threshold falls between grid points (±5 kHz).",
-    ),
-    Assumption(
-        key="steady_velocity",
-        symbol="v̄",
-        value=(
-            f"slope of the period-mean runner position over the second half of a run of "
-            f"max({MIN_PERIODS}, f·{STEADY_TIME * 1e3:g} ms) periods from rest"
-        ),
-        unit="mm/s",
-        rationale=(
-            "The paper calls the velocity 'a multiple of the driving frequency and step size' without "
-            "saying over which periods. At 100 kHz there is no stick phase and the runner needs ~1 ms "
-            "from rest to its steady velocity; the steady velocity is what a user of the drive sees."
-        ),
-        sensitivity="Driving-waveform chapter: third against fourth quarter of each run (velocity_drift).",
-    ),
-    Assumption(
-        key="controllable_frequency",
-        symbol="f_max",
-        value="the frequency of the largest steady velocity on the grid",
-        unit="kHz",
-        rationale=(
-            "Section 5.2 reads the 'reachable maximal velocity' 'at maximal controllable frequencies' "
-            "(0.4 N: 19 mm/s at 110 kHz), beyond which the velocity drops; the model has no chaos "
-            "criterion of its own."
-        ),
-        sensitivity="Fig. 10b's ordering of maximal controllable frequencies only.",
-    ),
-    Assumption(
-        key="stick_during_acceleration",
-        symbol="–",
-        value="no contact group reaches full sliding (slip share 1) during t_a, second half of the run",
-        unit="–",
-        rationale=(
-            "Section 5.1's stick condition u ≤ u_x,max: the contacts must not slide fully while the "
-            "hemispheres accelerate the runner. Partial slip of the contact's rim is not a relative "
-            "slip of runner and hemisphere."
-        ),
-        sensitivity="Fig. 10a's 0.1 N stick threshold.",
-    ),
-)
 
-
-def _frequencies(profile: str) -> np.ndarray:
-    check_choice("profile", profile, PROFILES)
-    return FREQUENCIES[profile]
+def section5_fields(hemisphere_radius: float = 1e-3, preload: float = 0.4, runner: str = "steel",
+                    actuator_model: str = "rigid", friction_coefficient: float = SECTION5_FRICTION) -> dict:
+    """A Section 5 drive as the plain sweep parameters of :func:`passmd.protocols.section5.section5_drive`
+    (its arguments), by default Section 5's: R = 1 mm, F_p = 0.4 N, steel runner, rigid actuators and
+    the ledger's reading of μ (:data:`SECTION5_FRICTION`)."""
+    return {"hemisphere_radius": float(hemisphere_radius), "preload": float(preload), "runner": runner,
+            "actuator_model": actuator_model, "friction_coefficient": float(friction_coefficient)}
 
 
 def _trace(c: dict, frequency: float, periods: int, waveform: str, fields: dict, zoom: tuple[float, float],
@@ -187,7 +107,7 @@ def _display(frame: pd.DataFrame) -> pd.DataFrame:
 
 
 # ======================================================================================
-# Figures 8–10
+# Figures 8 and 9a
 # ======================================================================================
 
 
@@ -261,10 +181,10 @@ def fig8b_window(config: RunConfig, friction_coefficient: float = SECTION5_FRICT
     """The fly-back and the acceleration t_a of Fig. 8b's optimized period, resolved inside t_a.
 
     One run of the Section 5 drive (0.4 N, 100 Hz, its own Eq. 15 design) integrated with the
-    step divided by :data:`~passmd.experiments.driving_waveform.figures_runs.WINDOW_RESOLUTION` and
+    step divided by :data:`~passmd.protocols.section5.WINDOW_RESOLUTION` and
     recorded every t_a /
-    :data:`~passmd.experiments.driving_waveform.figures_runs.WINDOW_SAMPLES_PER_ACCELERATION`
-    (:func:`~passmd.experiments.driving_waveform.figures_runs.window_point`). Columns: ``time_s``,
+    :data:`~passmd.protocols.section5.WINDOW_SAMPLES_PER_ACCELERATION`
+    (:func:`~passmd.protocols.section5.window_point`). Columns: ``time_s``,
     ``time_us``, runner and piezo positions (nm) and velocity, ``slip_share_1`` and
     ``slip_share_2``, ``phase`` (``flyback``, ``settling``, ``acceleration``, ``after``) and
     the constant phase times (s) and record spacing. ``friction_coefficient``: Section 5's unstated μ.
@@ -308,7 +228,7 @@ def fig9a(config: RunConfig) -> pd.DataFrame:
     full, _ = _samples(config.profile)
     parts = []
     for mu in FIG9A_FRICTION:
-        c = {**section5_fields(), "friction_coefficient": mu}
+        c = section5_fields(friction_coefficient=mu)
         fields = design_fields(designs([c], config).iloc[0])
         for waveform in ("sawtooth", "optimized"):
             trace = _trace(c, STEP_FREQUENCY, STEP_PERIODS, waveform, fields, (0.0, 1e-3), full, 2, config)
@@ -334,37 +254,12 @@ def at_section5_friction(frame: pd.DataFrame, friction_coefficient: float = SECT
     return frame[np.isclose(frame["friction_coefficient"], friction_coefficient, rtol=1e-9, atol=0)]
 
 
-def fig9b(config: RunConfig, friction_coefficient: float = SECTION5_FRICTION) -> pd.DataFrame:
-    """Steady velocity of the Section 5 drive over the frequency grid, every waveform variant (μ:
-    Section 5's unstated friction coefficient)."""
-    return velocity_table([section5_fields(friction_coefficient=friction_coefficient)],
-                          _frequencies(config.profile), config)
-
-
-def fig10a(config: RunConfig, friction_coefficient: float = SECTION5_FRICTION) -> pd.DataFrame:
-    """Steady velocity against frequency for F_p = 0.1, 0.4, 1 N (R = 1 mm, steel)."""
-    return velocity_table([section5_fields(preload=p, friction_coefficient=friction_coefficient)
-                           for p in FIG10A_PRELOADS], _frequencies(config.profile), config)
-
-
-def fig10b(config: RunConfig, friction_coefficient: float = SECTION5_FRICTION) -> pd.DataFrame:
-    """Steady velocity against frequency for R = 1 mm (A = 202 nm) and 0.25 mm (A = 96 nm), 0.4 N."""
-    return velocity_table([section5_fields(hemisphere_radius=r, friction_coefficient=friction_coefficient)
-                           for r in FIG10B_RADII], _frequencies(config.profile), config)
-
-
-def fig10c(config: RunConfig, friction_coefficient: float = SECTION5_FRICTION) -> pd.DataFrame:
-    """Steady velocity against frequency for a steel (210 GPa) and a molybdenum (310 GPa) runner."""
-    return velocity_table([section5_fields(runner=r, friction_coefficient=friction_coefficient)
-                           for r in RUNNERS], _frequencies(config.profile), config)
-
-
 # ======================================================================================
-# The ledger's readings of Section 5: every figure at every value of μ
+# The ledger's readings of Section 5.1: every figure at every value of μ
 # ======================================================================================
 
 
-def _at_every_mu(compute):
+def at_every_mu(compute):
     """A readings table: ``compute(config, friction_coefficient=μ)`` at every value of the ledger's axis
     ``friction_coefficient`` (Section 5's unstated μ), tagged with it."""
 
@@ -380,9 +275,7 @@ def _at_every_mu(compute):
 
 
 fig8a_readings, fig8b_readings, fig8b_window_readings = (
-    _at_every_mu(f) for f in (fig8a, fig8b, fig8b_window))
-fig9b_readings, fig10a_readings, fig10b_readings, fig10c_readings = (
-    _at_every_mu(f) for f in (fig9b, fig10a, fig10b, fig10c))
+    at_every_mu(f) for f in (fig8a, fig8b, fig8b_window))
 
 
 def _settling_response(trace: dict, flyback_end: float, settling_time: float) -> dict:
@@ -423,7 +316,7 @@ def fig9a_response(config: RunConfig) -> pd.DataFrame:
         design = designs([c], config).iloc[0]
         fields = design_fields(design)
         t_s = fields["settling_time"]
-        needed = t_s + fields["acceleration_time"] + _full_stroke_flyback(c)
+        needed = t_s + fields["acceleration_time"] + full_stroke_flyback(c)
         frequency = 1.0 / (2.0 * needed)
         last = (RESPONSE_PERIODS - 1) / frequency  # the end of the last fly-back but one period
         zoom = (last - 5e-6, last + 1.5 * t_s + 5e-6)
@@ -439,21 +332,6 @@ def fig9a_response(config: RunConfig) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-# ======================================================================================
-# Readings of the velocity tables (the chapter's facts and the ledger's claims)
-# ======================================================================================
-
-#: Frequency at which Section 5.2 reads the reachable maximal velocity at 0.4 N (kHz).
-PAPER_MAXIMUM_KHZ = 110.0
-
-
-def range_maximum(part: pd.DataFrame) -> pd.Series:
-    """The row of the largest steady velocity over the whole frequency grid (edges included)."""
-    if not np.all(np.isfinite(part["velocity_mm_per_s"].to_numpy(dtype=float))):
-        raise NotEvaluable("non-finite velocities on the frequency grid")
-    return part.loc[part["velocity_mm_per_s"].idxmax()]
-
-
 #: The chapter's rows of the figure table.
 FIGURES = tuple(FigureSpec(name, title, "driving_waveform", compute, f"driving_waveform:{plot}") for
                 name, title, compute, plot in (
@@ -462,18 +340,6 @@ FIGURES = tuple(FigureSpec(name, title, "driving_waveform", compute, f"driving_w
     ("fig8b_window", "Fig. 8b's fly-back and acceleration t_a, resolved in time", fig8b_window,
      "plot_fig8b_window"),
     ("fig9a", "Runner position over three 100 Hz periods, saw-tooth and optimized", fig9a, "plot_fig9a"),
-    ("study_startup", "Velocity period by period from rest at 110 kHz (steady-velocity protocol)",
-     startup_transient, "plot_startup"),
-    ("fig9b", "Steady velocity against driving frequency, saw-tooth and optimized", fig9b, "plot_fig9b"),
-    ("fig10a", "Velocity of the optimized waveform for preloads 0.1, 0.4, 1 N", fig10a, "plot_fig10a"),
-    ("fig10b", "Velocity of the optimized waveform for R = 1 mm and 0.25 mm", fig10b, "plot_fig10b"),
-    ("fig10c", "Velocity of the optimized waveform, steel and molybdenum runner", fig10c, "plot_fig10c"),
-    ("study_settling_scan", "Step at 100 Hz against the settling time, Eq. 15's and the optimum's "
-     "acceleration (beyond the paper)", settling_scans, "plot_settling_scans"),
-    ("study_optimum", "Velocity of Eq. 15's design and of a numerical optimum relative to the "
-     "saw-tooth (beyond the paper)", numerical_optimum, "plot_optimum"),
-    ("study_flexible", "Gain of the optimized waveform with rigid and flexible actuators "
-     "(beyond the paper)", flexible_study, "plot_flexible"),
 ))
 
 #: The ledger's readings of the chapter's figures: each at every μ.
@@ -484,8 +350,4 @@ READING_TABLES = (
                  fig8b_window_readings),
     ReadingTable("fig9a_response", "The response after an optimized period, at every μ", ("fig9a",),
                  fig9a_response),
-    ReadingTable("fig9b_readings", "Fig. 9b at every μ", ("fig9b",), fig9b_readings),
-    ReadingTable("fig10a_readings", "Fig. 10a at every μ", ("fig10a",), fig10a_readings),
-    ReadingTable("fig10b_readings", "Fig. 10b at every μ", ("fig10b",), fig10b_readings),
-    ReadingTable("fig10c_readings", "Fig. 10c at every μ", ("fig10c",), fig10c_readings),
 )

@@ -1,13 +1,14 @@
 """Section 5's runs: its drives, their Eq. 15 designs and the sweep's point functions.
 
-The drive of Section 5 (:func:`section5_drive`, as plain sweep parameters
-:func:`section5_fields`), its Eq. 15 design (:func:`design_point`, :func:`designs`), and the
-point functions the sweep sends to worker processes (so they are top level): the steady
-velocity of one drive, waveform and frequency (:func:`velocity_point`, tabulated over a grid by
-:func:`velocity_table`), the time series of one run from rest (:func:`trace_point`) and Fig. 8b's
-run resolved inside the acceleration t_a (:func:`window_point`). The figures of
-:mod:`passmd.experiments.driving_waveform.figures` and the studies of
-:mod:`passmd.experiments.driving_waveform.figures_studies` are tables of these runs.
+The drive of Section 5 (:func:`section5_drive`), its Eq. 15 design (:func:`design_point`,
+:func:`designs`), and the point functions the sweep sends to worker processes (so they are top
+level): the steady velocity of one drive, waveform and frequency (:func:`velocity_point`, tabulated
+over a grid by :func:`velocity_table`), the time series of one run from rest (:func:`trace_point`)
+and Fig. 8b's run resolved inside the acceleration t_a (:func:`window_point`). Section 5 does not
+state μ, so every function here takes it: the driving-waveform chapters supply the ledger's reading
+(:func:`passmd.experiments.driving_waveform.figures.section5_fields`), and all three of them
+(:mod:`passmd.experiments.driving_waveform`, :mod:`passmd.experiments.waveform_velocity`,
+:mod:`passmd.experiments.waveform_optimum`) tabulate these runs.
 """
 
 from __future__ import annotations
@@ -17,7 +18,6 @@ import math
 import numpy as np
 import pandas as pd
 
-from passmd.ledger import readings
 from passmd.model import optimized_waveform, theory, waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import MOLYBDENUM, STEEL, Drive, paper_drive
@@ -36,8 +36,6 @@ from passmd.solver.results import SimulationError
 STEP_FREQUENCY = PROTOCOL.drive_frequency
 #: Runner materials of Fig. 10c.
 RUNNERS = {"steel": STEEL, "molybdenum": MOLYBDENUM}
-#: μ of Section 5 (not stated there): the default of the ledger's axis ``friction_coefficient``.
-SECTION5_FRICTION = float(readings.axis("friction_coefficient").default)
 #: Waveform variants of Figs. 9b and 10: (waveform, short_period rule). ``skip`` (t_s = 0 where the
 #: settling time does not fit) is the chapter's study "what if the settling is dropped": it removes
 #: Eq. 15's settling phase, so it is no ledger reading of the Eq. 15 claims (passmd.ledger.readings).
@@ -51,9 +49,9 @@ def variant_name(waveform: str, short_period: str) -> str:
     return "optimized_skip" if short_period == "skip" else "optimized"
 
 
-def section5_drive(hemisphere_radius: float = 1e-3, preload: float = 0.4, runner: str = "steel",
-                   actuator_model: str = "rigid", friction_coefficient: float = SECTION5_FRICTION) -> Drive:
-    """The drive of Section 5: six contacts, Table 1–2 parameters, free runner, μ = 0.2.
+def section5_drive(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
+                   friction_coefficient: float) -> Drive:
+    """The drive of Section 5: six contacts, Table 1–2 parameters, free runner.
 
     ``runner`` names the runner material (``"steel"``, Table 1, or ``"molybdenum"``,
     Fig. 10c); ``actuator_model`` is ``"rigid"`` in the paper. ``friction_coefficient`` is
@@ -71,7 +69,7 @@ def make_design(settling_time: float, acceleration_time: float,
 
 
 def design_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
-                 friction_coefficient: float = SECTION5_FRICTION) -> dict:
+                 friction_coefficient: float) -> dict:
     """Eq. 15 design of a drive at its full amplitude (:func:`passmd.protocols.eq15.optimized_design`).
 
     Returns the design's :meth:`~passmd.model.optimized_waveform.OptimizedDesign.as_dict` plus the amplitude
@@ -88,7 +86,7 @@ def design_point(hemisphere_radius: float, preload: float, runner: str, actuator
 def velocity_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
                    frequency: float, waveform: str, short_period: str, settling_time: float,
                    acceleration_time: float, acceleration_amplitude: float,
-                   friction_coefficient: float = SECTION5_FRICTION) -> dict:
+                   friction_coefficient: float) -> dict:
     """Steady velocity of one Section 5 drive, waveform and frequency at the full amplitude.
 
     :func:`passmd.protocols.velocity.steady_run`; the design fields are ignored for the saw-tooth.
@@ -103,7 +101,7 @@ def trace_point(hemisphere_radius: float, preload: float, runner: str, actuator_
                 frequency: float, periods: int, waveform: str, settling_time: float,
                 acceleration_time: float, acceleration_amplitude: float, zoom_start: float,
                 zoom_end: float, full_samples: int, zoom_samples: int,
-                friction_coefficient: float = SECTION5_FRICTION) -> dict:
+                friction_coefficient: float) -> dict:
     """Time series of one run from rest, for the time-domain figures (Figs. 8, 9a).
 
     The run is recorded at ≥ 200 samples per linear runner-vibration period and returned
@@ -157,19 +155,9 @@ def trace_point(hemisphere_radius: float, preload: float, runner: str, actuator_
     return out
 
 
-def section5_fields(hemisphere_radius: float = 1e-3, preload: float = 0.4, runner: str = "steel",
-                    actuator_model: str = "rigid", friction_coefficient: float = SECTION5_FRICTION) -> dict:
-    """A drive configuration as plain sweep parameters (see :func:`section5_drive`); μ only when it is
-    not Section 5's default (so the default runs are the same cache entries whoever asks)."""
-    fields = {"hemisphere_radius": float(hemisphere_radius), "preload": float(preload), "runner": runner,
-              "actuator_model": actuator_model}
-    if float(friction_coefficient) != SECTION5_FRICTION:
-        fields["friction_coefficient"] = float(friction_coefficient)
-    return fields
-
-
 def designs(drives: list[dict], config: RunConfig) -> pd.DataFrame:
-    """Eq. 15 design of each drive (:func:`section5_fields`, :func:`design_point`), one row each, cached."""
+    """Eq. 15 design of each drive (plain sweep parameters of :func:`section5_drive`; :func:`design_point`),
+    one row each, cached."""
     return sweep.run(design_point, [dict(c) for c in drives], description="waveform design", config=config)
 
 
@@ -207,7 +195,7 @@ def velocity_table(drives: list[dict], frequencies, config: RunConfig) -> pd.Dat
     table["micro_vibration_frequency_Hz"] = np.repeat(design_rows["micro_vibration_frequency_Hz"].to_numpy(),
                                                       per_point)
     # Eq. 15 is defined where its settling time, acceleration and fly-back fit into the period
-    flyback = np.repeat([_full_stroke_flyback(c) for c in drives], per_point)
+    flyback = np.repeat([full_stroke_flyback(c) for c in drives], per_point)
     table["flyback_time_s"] = flyback
     table["eq15_time_s"] = np.repeat([float(d["settling_time_s"]) + float(d["acceleration_time_s"])
                                       for _, d in design_rows.iterrows()], per_point) + flyback
@@ -215,10 +203,10 @@ def velocity_table(drives: list[dict], frequencies, config: RunConfig) -> pd.Dat
     return table
 
 
-def _full_stroke_flyback(fields: dict) -> float:
+def full_stroke_flyback(fields: dict) -> float:
     """The fly-back at the full stroke of a Section 5 drive (s): both fly-back rules give the same."""
     drive = section5_drive(fields["hemisphere_radius"], fields["preload"], fields["runner"],
-                           fields["actuator_model"], fields.get("friction_coefficient", SECTION5_FRICTION))
+                           fields["actuator_model"], fields["friction_coefficient"])
     return waveforms.flyback_time(drive.actuator.full_stroke_amplitude, drive)
 
 
@@ -238,7 +226,7 @@ WINDOW_BEFORE, WINDOW_AFTER = 2e-6, 30e-6
 def window_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
                  settling_time: float, acceleration_time: float, acceleration_amplitude: float,
                  resolution: float, samples_per_acceleration: int,
-                 friction_coefficient: float = SECTION5_FRICTION) -> dict:
+                 friction_coefficient: float) -> dict:
     """Fig. 8b's run (100 Hz, period 1 saw-tooth, period 2 optimized) resolved inside t_a.
 
     The run is integrated with the step divided by ``resolution`` and recorded every

@@ -24,11 +24,11 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from passmd.experiments.driving_waveform.figures import FREQUENCIES, PAPER_MAXIMUM_KHZ
-from passmd.experiments.driving_waveform.figures_runs import variant_name
 from passmd.experiments.model_numerics.facts import POSITION_ACCURACY, VELOCITY_ACCURACY
+from passmd.experiments.waveform_velocity.figures import FREQUENCIES, PAPER_MAXIMUM_KHZ
 from passmd.ledger.checks import ClaimFails, NoRun, NotEvaluable, Scoped, Subset, evidence, extractor
 from passmd.ledger.readings import default_reading
+from passmd.protocols.section5 import variant_name
 
 __all__ = ["GRID_STEP_KHZ", "at_frequency", "complete_grid", "controllable_maximum", "eq15_scope",
            "maximum_location", "on_paper_grid", "stick_edge", "turning_point"]

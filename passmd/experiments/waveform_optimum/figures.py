@@ -1,15 +1,15 @@
-"""Driving waveform, beyond the paper: settling time, numerical optimum, flexible actuators.
+"""Beyond the paper: the settling time, a numerical optimum of (t_s, V_a, Δ_a), flexible actuators.
 
 Section 6's outlook asks how the actuators' dynamics affect the new waveform; a replication
-also has to say how much Eq. 15's heuristic leaves on the table. Built on the figure machinery of
-:mod:`passmd.experiments.driving_waveform.figures` (same drives, designs, protocols and cache):
+also has to say how much Eq. 15's heuristic leaves on the table. Built on the runs of
+:mod:`passmd.protocols.section5` at the Section 5 drive of :mod:`passmd.experiments.driving_waveform`
+(same drives, designs, protocols and cache):
 
 * :func:`settling_scan` — the 100 Hz step against the settling time t_s (:func:`settling_scans`: with
   Eq. 15's acceleration and with the optimum's);
 * :func:`numerical_optimum` — scipy's differential evolution over (t_s, V_a, Δ_a) against
   the Eq. 15 design and the saw-tooth, at a few frequencies;
-* :func:`flexible_study` — the same comparison with flexible actuators;
-* :func:`startup_transient` — why velocities at kHz frequencies are read at steady state.
+* :func:`flexible_study` — the same comparison with flexible actuators.
 """
 
 from __future__ import annotations
@@ -17,36 +17,35 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from passmd.experiments.driving_waveform.figures_runs import (
+from passmd.experiments import FigureSpec
+from passmd.experiments.driving_waveform.figures import section5_fields
+from passmd.model import optimized_waveform
+from passmd.model.tables import Assumption
+from passmd.protocols.section5 import (
     STEP_FREQUENCY,
     VARIANTS,
     design_fields,
     designs,
     make_design,
     section5_drive,
-    section5_fields,
     variant_name,
 )
-from passmd.model import optimized_waveform
-from passmd.model.tables import Assumption
 from passmd.protocols.velocity import (
     STEP_PERIODS,
     STEP_PROTOCOL_BELOW,
-    make_waveform,
-    steady_periods,
     step_run,
     waveform_velocity,
 )
 from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
-from passmd.solver import simulation
 
 
 def step_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
                frequency: float, waveform: str, settling_time: float, acceleration_time: float,
-               acceleration_amplitude: float, periods: int = STEP_PERIODS) -> dict:
+               acceleration_amplitude: float, friction_coefficient: float,
+               periods: int = STEP_PERIODS) -> dict:
     """Fig. 9a protocol (:func:`passmd.protocols.velocity.step_run`), Section 5 drive, full amplitude."""
-    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
+    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model, friction_coefficient)
     design = None if waveform == "sawtooth" else make_design(
         settling_time, acceleration_time, acceleration_amplitude)
     return step_run(drive, drive.actuator.full_stroke_amplitude, frequency, waveform, design, periods)
@@ -54,13 +53,17 @@ def step_point(hemisphere_radius: float, preload: float, runner: str, actuator_m
 
 #: Differential-evolution budgets (population size factor, generations) per profile.
 OPTIMIZER_BUDGET = {"paper": (10, 30), "quick": (5, 4)}
+
 #: Frequencies of the numerical optimisation per profile (Hz), rigid and flexible actuators.
 OPTIMUM_FREQUENCIES = {
     "paper": {"rigid": (STEP_FREQUENCY, 1e3, 10e3, 50e3, 110e3), "flexible": (STEP_FREQUENCY,)},
     "quick": {"rigid": (STEP_FREQUENCY, 110e3), "flexible": ()},
 }
+
+
 #: Frequencies of the flexible-actuator study per profile (Hz).
 FLEXIBLE_FREQUENCIES = {"paper": (STEP_FREQUENCY, 1e3, 10e3, 50e3, 110e3), "quick": (STEP_FREQUENCY, 110e3)}
+
 #: Points of the settling-time scan over [0, 2/f_s] per profile.
 SCAN_POINTS = {"paper": 41, "quick": 9}
 
@@ -88,7 +91,7 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
 def optimum_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
                   frequency: float, settling_time: float, acceleration_time: float,
                   acceleration_amplitude: float, micro_vibration_frequency: float, popsize: int,
-                  maxiter: int, seed: int = 0) -> dict:
+                  maxiter: int, friction_coefficient: float, seed: int = 0) -> dict:
     """Best (t_s, V_a, Δ_a) for the velocity at one frequency, by differential evolution.
 
     The given design (Eq. 15, with its measured f_s) is evaluated by the same protocol for
@@ -103,7 +106,7 @@ def optimum_point(hemisphere_radius: float, preload: float, runner: str, actuato
     """
     from scipy.optimize import differential_evolution
 
-    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
+    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model, friction_coefficient)
     amplitude = drive.actuator.full_stroke_amplitude
     v_max = optimized_waveform.max_piezo_velocity(drive)
     period = 1.0 / frequency
@@ -226,58 +229,14 @@ def flexible_study(config: RunConfig) -> pd.DataFrame:
 
 def study_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str, frequency: float,
                 waveform: str, short_period: str, settling_time: float, acceleration_time: float,
-                acceleration_amplitude: float, design_from: str) -> dict:
+                acceleration_amplitude: float, design_from: str, friction_coefficient: float) -> dict:
     """Velocity of one case of :func:`flexible_study` (``design_from`` labels the design's drive)."""
-    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
+    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model, friction_coefficient)
     design = None if waveform == "sawtooth" else make_design(
         settling_time, acceleration_time, acceleration_amplitude)
     v = waveform_velocity(drive, drive.actuator.full_stroke_amplitude, frequency, waveform, design,
                           short_period)
     return {"velocity_m_per_s": v}
-
-
-def startup_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
-                  frequency: float, waveform: str, short_period: str, settling_time: float,
-                  acceleration_time: float, acceleration_amplitude: float) -> dict:
-    """Period-mean runner positions of a steady-velocity run from rest (the start-up transient)."""
-    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model)
-    design = None if waveform == "sawtooth" else make_design(
-        settling_time, acceleration_time, acceleration_amplitude)
-    wave = make_waveform(drive, drive.actuator.full_stroke_amplitude, frequency, steady_periods(frequency),
-                         waveform, short_period, design)
-    result = simulation.simulate(drive, wave, max_points=2)
-    return {"period_mean_position_m": result.period_mean_position,
-            "settled_positions_m": result.settled_positions}
-
-
-def startup_transient(config: RunConfig, frequency: float = 110e3) -> pd.DataFrame:
-    """The runner's velocity period by period from rest at ``frequency`` (Section 5 drive).
-
-    One row per period and waveform variant: ``time_s`` (end of the period), ``velocity_m_per_s``
-    (difference of consecutive period-mean positions over T) and ``settled_velocity_m_per_s``
-    (the same from the settled positions, which assume a stick phase).
-    """
-    c = section5_fields()
-    fields = design_fields(designs([c], config).iloc[0])
-    points = [{**c, "frequency": float(frequency), "waveform": w, "short_period": r, **fields}
-              for w, r in VARIANTS]
-    runs = sweep.run(startup_point, points, description="start-up", config=config)
-    parts = []
-    for _, run in runs.iterrows():
-        means = np.asarray(run["period_mean_position_m"])
-        settled = np.asarray(run["settled_positions_m"])
-        k = np.arange(1, means.size)
-        parts.append(pd.DataFrame({
-            "variant": variant_name(run["waveform"], run["short_period"]),
-            "period": k + 1, "time_s": (k + 1) / frequency,
-            "velocity_m_per_s": np.diff(means) * frequency,
-            "settled_velocity_m_per_s": np.diff(settled) * frequency,
-        }))
-    table = pd.concat(parts, ignore_index=True)
-    table["time_ms"] = table["time_s"] * 1e3
-    table["velocity_mm_per_s"] = table["velocity_m_per_s"] * 1e3
-    table["settled_velocity_mm_per_s"] = table["settled_velocity_m_per_s"] * 1e3
-    return table
 
 
 def optimum_at(optimum: pd.DataFrame, frequency: float = STEP_FREQUENCY, actuator_model: str = "rigid"
@@ -302,3 +261,15 @@ def settling_scans(config: RunConfig) -> pd.DataFrame:
                                                      low["optimum_acceleration_amplitude_m"]),
     }
     return pd.concat([scan.assign(series=label) for label, scan in scans.items()], ignore_index=True)
+
+
+#: The chapter's rows of the figure table.
+FIGURES = tuple(FigureSpec(name, title, "waveform_optimum", compute, f"driving_waveform:{plot}") for
+                name, title, compute, plot in (
+    ("study_settling_scan", "Step at 100 Hz against the settling time, Eq. 15's and the optimum's "
+     "acceleration (beyond the paper)", settling_scans, "plot_settling_scans"),
+    ("study_optimum", "Velocity of Eq. 15's design and of a numerical optimum relative to the "
+     "saw-tooth (beyond the paper)", numerical_optimum, "plot_optimum"),
+    ("study_flexible", "Gain of the optimized waveform with rigid and flexible actuators "
+     "(beyond the paper)", flexible_study, "plot_flexible"),
+))
