@@ -14,7 +14,7 @@ about. A value that would change the object is not a reading: it is listed in
 ``Axis.not_readings`` with the reason and shown as a study in its chapter. Setting t_s = 0
 wherever the settling time does not fit (``skip``) removes Eq. 15's settling phase from every
 period from 10 kHz up, so that waveform is not Eq. 15 and ``skip`` is no reading of the Eq. 15
-claims; the driving-waveform chapter keeps it as the study "what if the settling is dropped".
+claims; the velocity chapter keeps it as the study "what if the settling is dropped".
 
 **Declared = computed.** A claim depends on an axis when it reads a result table whose runs the
 axis changes (:func:`applicable`): its extractor must declare exactly those axes
@@ -142,7 +142,7 @@ AXES: dict[str, Axis] = {
             assumption_key="optimized_short_period",
             not_readings=(("skip", "t_s = 0 wherever the settling time does not fit removes Eq. 15's "
                            "settling phase from 10 kHz up: the waveform is no longer Eq. 15, so it is the "
-                           "driving-waveform chapter's study 'what if the settling is dropped'"),),
+                           "velocity chapter's study 'what if the settling is dropped'"),),
         ),
         Axis(
             key="damping_ratio",

@@ -11,7 +11,7 @@ measured, Eq. 15 applied) is :func:`passmd.protocols.eq15.optimized_design`.
 Eq. 15's period needs t_s + t_a, the fly-back and a slow ramp: above
 :func:`highest_fitting_frequency` it does not fit. :func:`optimized` then refuses (one line
 naming that frequency) unless a truncated waveform is asked for by name (``short_period="cut"``
-or ``"skip"``, the driving-waveform chapter's study of Fig. 9b above 110 kHz), whose ``kind``
+or ``"skip"``, the velocity chapter's study of Fig. 9b above 110 kHz), whose ``kind``
 says it is truncated.
 """
 
@@ -72,7 +72,7 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
             "reads the response at the driving frequency instead, whose vibration cycle the next "
             "fly-back cuts short as f approaches f_s."
         ),
-        sensitivity="Driving-waveform chapter: step at 100 Hz against t_s over two vibration periods.",
+        sensitivity="Chapter Beyond Eq. (15): step at 100 Hz against t_s over two vibration periods.",
     ),
     Assumption(
         key="optimized_free_parameter",
@@ -89,7 +89,7 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
             "with x_p, so all contacts share u; the side with the smaller normal force slips "
             "first, hence its u_x,max."
         ),
-        sensitivity="Driving-waveform chapter: scipy optimisation over t_s, t_a, Δ_a.",
+        sensitivity="Chapter Beyond Eq. (15): scipy optimisation over t_s, t_a, Δ_a.",
     ),
     Assumption(
         key="optimized_first_period",
@@ -118,7 +118,7 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
             "(default) is the reading that makes the velocity decrease; skipping it is the "
             "alternative. Both never violate the slew-rate limit and never fail."
         ),
-        sensitivity="Driving-waveform chapter: Fig. 9b and the settling-fits flag per frequency.",
+        sensitivity="Velocity chapter: Fig. 9b and the settling-fits flag per frequency.",
     ),
 )
 

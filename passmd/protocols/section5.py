@@ -5,7 +5,7 @@ The drive of Section 5 (:func:`section5_drive`), its Eq. 15 design (:func:`desig
 level): the steady velocity of one drive, waveform and frequency (:func:`velocity_point`, tabulated
 over a grid by :func:`velocity_table`), the time series of one run from rest (:func:`trace_point`)
 and Fig. 8b's run resolved inside the acceleration t_a (:func:`window_point`). Section 5 does not
-state μ, so every function here takes it: the driving-waveform chapters supply the ledger's reading
+state μ, so every function here takes it: Section 5's chapters supply the ledger's reading
 (:func:`passmd.experiments.driving_waveform.figures.section5_fields`), and all three of them
 (:mod:`passmd.experiments.driving_waveform`, :mod:`passmd.experiments.waveform_velocity`,
 :mod:`passmd.experiments.waveform_optimum`) tabulate these runs.

@@ -66,7 +66,7 @@ _NAMES = "NAME: " + ", ".join(AXES) + "."
 _EPILOG = textwrap.dedent("""\
     QUANTITY is one of:
 
-    - velocity, step, back-step: the steady-velocity protocol of the driving-waveform chapter:
+    - velocity, step, back-step: the steady-velocity protocol of Section 5.2's velocity chapter:
       max(20, f·5 ms) periods from rest, the slope of the period-mean position over the second
       half; step = velocity/f
     - critical-amplitude: simulated A_c, --reading steady (last step of a saw-tooth run exceeds

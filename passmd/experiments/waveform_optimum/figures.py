@@ -83,7 +83,7 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
             "numbers of Fig. 8b are kept, only chosen by the optimiser instead of Eq. 15; the "
             "amplifier's slew-rate limit bounds V_a, the period bounds t_s."
         ),
-        sensitivity="Driving-waveform chapter: the optimum's parameters per frequency.",
+        sensitivity="Chapter Beyond Eq. (15): the optimum's parameters per frequency.",
     ),
 )
 

@@ -79,7 +79,7 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
             "saying over which periods. At 100 kHz there is no stick phase and the runner needs ~1 ms "
             "from rest to its steady velocity; the steady velocity is what a user of the drive sees."
         ),
-        sensitivity="Driving-waveform chapter: third against fourth quarter of each run (velocity_drift).",
+        sensitivity="Velocity chapter: third against fourth quarter of each run (velocity_drift).",
     ),
     Assumption(
         key="controllable_frequency",
