@@ -1,8 +1,8 @@
 """Plots of Section 5's chapters (Figs. 8–10 and the studies beyond the paper).
 
-Each function takes the tidy DataFrame of a figure of :mod:`passmd.experiments.driving_waveform`
-(Figs. 8, 9a), :mod:`passmd.experiments.waveform_velocity` (Figs. 9b, 10) or
-:mod:`passmd.experiments.waveform_optimum` (the studies) and returns a matplotlib Figure; axes in nm,
+Each function takes the tidy DataFrame of a figure of :mod:`passmd.experiments.driving_waveform.figures`
+(Figs. 8, 9a), :mod:`passmd.experiments.waveform_velocity.figures` (Figs. 9b, 10) or
+:mod:`passmd.experiments.waveform_optimum.figures` (the studies) and returns a matplotlib Figure; axes in nm,
 µs/ms, kHz and mm/s.
 """
 

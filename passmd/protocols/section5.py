@@ -7,8 +7,8 @@ over a grid by :func:`velocity_table`), the time series of one run from rest (:f
 and Fig. 8b's run resolved inside the acceleration t_a (:func:`window_point`). Section 5 does not
 state μ, so every function here takes it: Section 5's chapters supply the ledger's reading
 (:func:`passmd.experiments.driving_waveform.figures.section5_fields`), and all three of them
-(:mod:`passmd.experiments.driving_waveform`, :mod:`passmd.experiments.waveform_velocity`,
-:mod:`passmd.experiments.waveform_optimum`) tabulate these runs.
+(:mod:`passmd.experiments.driving_waveform.figures`, :mod:`passmd.experiments.waveform_velocity.figures`,
+:mod:`passmd.experiments.waveform_optimum.figures`) tabulate these runs.
 """
 
 from __future__ import annotations

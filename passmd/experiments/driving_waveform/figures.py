@@ -10,7 +10,7 @@ of Eq. 15 (:func:`passmd.model.optimized_waveform.optimized`), designed once per
 Figures (rows of the figure table): ``fig8a`` saw-tooth response with contact status; ``fig8b`` the
 optimized waveform with t_s, t_a, Δ_a; ``fig8b_window`` its fly-back and acceleration resolved in
 time; ``fig9a`` runner position over three 100 Hz periods, both waveforms. The velocities over
-frequency (Figs. 9b, 10) are :mod:`passmd.experiments.waveform_velocity`'s.
+frequency (Figs. 9b, 10) are :mod:`passmd.experiments.waveform_velocity.figures`'s.
 """
 
 from __future__ import annotations

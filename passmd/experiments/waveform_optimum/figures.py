@@ -2,7 +2,7 @@
 
 Section 6's outlook asks how the actuators' dynamics affect the new waveform; a replication
 also has to say how much Eq. 15's heuristic leaves on the table. Built on the runs of
-:mod:`passmd.protocols.section5` at the Section 5 drive of :mod:`passmd.experiments.driving_waveform`
+:mod:`passmd.protocols.section5` at the Section 5 drive of :mod:`passmd.experiments.driving_waveform.figures`
 (same drives, designs, protocols and cache):
 
 * :func:`settling_scan` — the 100 Hz step against the settling time t_s (:func:`settling_scans`: with

@@ -1,6 +1,6 @@
 """Velocity against driving frequency, Section 5.2: the saw-tooth and Eq. 15's waveform (Figs. 9b, 10).
 
-The Section 5 drive of :mod:`passmd.experiments.driving_waveform` (its μ, designs and runs), driven
+The Section 5 drive of :mod:`passmd.experiments.driving_waveform.figures` (its μ, designs and runs), driven
 over the paper's frequency grid with the saw-tooth and with its Eq. 15 design under either
 short-period rule, and Fig. 10's drives with other preloads, radii and runner materials, each with
 its own design. The velocities are measured by the protocol of :mod:`passmd.protocols.velocity`
