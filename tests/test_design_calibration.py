@@ -1,5 +1,5 @@
-"""The design chapter's calibration (passmd.experiments.design_your_drive: figures and facts): measurements made
-by other means than the fit's model, the fits' facts, and the fitted drive file read back."""
+"""The design chapter's calibration (passmd.experiments.design_your_drive): measurements made by other
+means than the fit's model, the fits' facts, and the fitted drive file read back."""
 
 from __future__ import annotations
 
