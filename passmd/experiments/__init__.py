@@ -2,7 +2,8 @@
 
 Every chapter package has the same modules: ``figures.py`` (the chapter's compute functions, run
 configuration → tidy DataFrame, and its rows of the figure table: a tuple ``FIGURES`` of
-:class:`FigureSpec` and, where the ledger reads runs beyond the figures', ``READING_TABLES`` of
+:class:`FigureSpec`, one per figure the chapter shows (the ledger computes only the tables its claims
+require, so a row costs it nothing unless a claim reads it) and, where the ledger reads runs beyond the figures', ``READING_TABLES`` of
 :class:`ReadingTable`), ``facts.py`` (the numbers and short texts the chapter's prose quotes) and,
 where the chapter judges claims of the paper, ``claims.py`` (the ledger's claim extractors). A module
 that would pass 500 lines splits by topic as ``<module>_<topic>.py``. Code several chapters or the
