@@ -64,11 +64,11 @@ def test_stall_curve_holds_the_drives_own_preload(profile):
 
 
 def test_profile_executor_applies_only_where_none_was_chosen():
-    assert figures._run_config(RunConfig(), "quick").executor == "serial"
-    assert figures._run_config(RunConfig(executor="process"), "quick").executor == "process"
-    assert figures._run_config(RunConfig(), "paper").executor is None
+    assert figures.run_config(RunConfig(), "quick").executor == "serial"
+    assert figures.run_config(RunConfig(executor="process"), "quick").executor == "process"
+    assert figures.run_config(RunConfig(), "paper").executor is None
     with pytest.raises(ValueError, match="profile = 'fast'"):
-        figures._run_config(RunConfig(), "fast")
+        figures.run_config(RunConfig(), "fast")
 
 
 def _map_table(velocities, frequencies, amplitudes):

@@ -2,14 +2,15 @@
 
 Every chapter package has the same modules: ``figures.py`` (the chapter's compute functions, run
 configuration → tidy DataFrame, and its rows of the figure table: a tuple ``FIGURES`` of
-:class:`FigureSpec`, one per figure the chapter shows (the ledger computes only the tables its claims
-require, so a row costs it nothing unless a claim reads it) and, where the ledger reads runs beyond the figures', ``READING_TABLES`` of
-:class:`ReadingTable`), ``facts.py`` (the numbers and short texts the chapter's prose quotes) and,
-where the chapter judges claims of the paper, ``claims.py`` (the ledger's claim extractors). A module
-that would pass 500 lines splits by topic as ``<module>_<topic>.py``. Code several chapters or the
-command line share lives in :mod:`passmd.protocols`. :mod:`passmd.experiments.figure_table` assembles
-the figure table from the chapters in :data:`~passmd.experiments.figure_table.CHAPTERS` (the book's
-order) and finds the claim modules; nothing here imports ``passmd.plots``.
+:class:`FigureSpec`, one per figure the chapter shows, and, where the ledger reads runs beyond the
+figures', ``READING_TABLES`` of :class:`ReadingTable`; the ledger computes only the tables its claims
+require, so a row no claim reads costs it nothing), ``facts.py`` (the numbers and short texts the
+chapter's prose quotes) and, where the chapter judges claims of the paper, ``claims.py`` (the ledger's
+claim extractors). A module that would pass 500 lines splits by topic as ``<module>_<topic>.py``.
+Code several chapters or the command line share lives in :mod:`passmd.protocols`.
+:mod:`passmd.experiments.figure_table` assembles the figure table from the chapters in
+:data:`~passmd.experiments.figure_table.CHAPTERS` (the book's order) and finds the claim modules;
+nothing here imports ``passmd.plots``.
 
 Profiles (:data:`passmd.runtime.config.PROFILES`): ``quick`` (CI regression tests, minutes for
 everything) and ``paper`` (the paper's grids; the book's default). Each chapter defines what a

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from passmd.experiments.design_your_drive.figures import _run_config
+from passmd.experiments.design_your_drive.figures import run_config
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
 from passmd.protocols import fit, ringing
@@ -41,7 +41,7 @@ def other_flyback_fit(start: Drive, data: fit.Measurements, profile: str,
     whose rule is ``"slew"``, else ``"slew"``): a wrong fixed assumption for the χ² test to judge."""
     other = "fixed" if start.amplifier.flyback == "slew" else "slew"
     wrong = replace(start, amplifier=replace(start.amplifier, flyback=other))
-    return fit.fit(wrong, data, ["friction_coefficient"], config=_run_config(config, profile))
+    return fit.fit(wrong, data, ["friction_coefficient"], config=run_config(config, profile))
 
 
 def fit_facts(result: fit.FitResult, truth: Drive, start: Drive) -> pd.DataFrame:

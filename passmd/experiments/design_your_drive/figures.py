@@ -118,8 +118,9 @@ def _settings(profile: str) -> ProfileSettings:
     return PROFILE_SETTINGS[check_choice("profile", profile, PROFILES)]
 
 
-def _run_config(config: RunConfig | None, profile: str) -> RunConfig:
-    """``config`` with the profile's executor where it names none (an explicit choice wins)."""
+def run_config(config: RunConfig | None, profile: str) -> RunConfig:
+    """The run configuration of the chapter's sweeps on ``profile``: ``config`` with the profile's
+    executor (:data:`PROFILE_SETTINGS`) where it names none (an explicit choice wins)."""
     config = RunConfig() if config is None else config
     executor = _settings(profile).executor
     if config.executor is None and config.scheduler is None and executor is not None:
@@ -163,11 +164,6 @@ def _group_text(group: dict) -> str:
     text += f", R = {group['radius'] * 1e3:.4g} mm" if "radius" in group else ""
     text += f", F_N/F_p = {group['load_share']:.4g}" if "load_share" in group else ""
     return text + (f", F_N = {group['normal_force']:.4g} N" if "normal_force" in group else "")
-
-
-def run_config(config: RunConfig | None, profile: str) -> RunConfig:
-    """The run configuration of the chapter's sweeps on ``profile`` (:data:`PROFILE_SETTINGS`)."""
-    return _run_config(config, profile)
 
 
 def contact_table(drive: Drive) -> pd.DataFrame:
@@ -219,7 +215,7 @@ def critical_amplitude_curve(drive: Drive, profile: str, config: RunConfig | Non
     """A_c against preload at Section 4.1's frequency: the closed form (Eqs. 7–8, 11–12) and the
     two simulated readings (``steady``, ``first``), as ``passmd sweep critical-amplitude``
     (:func:`curve_from_maps`)."""
-    config = _run_config(config, profile)
+    config = run_config(config, profile)
     points = preload_points(drive, profile)
     steady, first = (compute_map("critical-amplitude", points, reading=reading, config=config,
                                  description=f"A_c ({reading}) against preload")
@@ -244,13 +240,13 @@ def map_points(drive: Drive, profile: str) -> list[dict]:
 
 def step_velocity_map(drive: Drive, profile: str, config: RunConfig | None = None) -> pd.DataFrame:
     """Steady velocity, step and back-step of the saw-tooth over the map grid (``passmd sweep velocity``)."""
-    return compute_map("velocity", map_points(drive, profile), config=_run_config(config, profile),
+    return compute_map("velocity", map_points(drive, profile), config=run_config(config, profile),
                        description="step/velocity map")
 
 
 def gain_map(drive: Drive, profile: str, config: RunConfig | None = None) -> pd.DataFrame:
     """Eq. 15 waveform's steady velocity minus the saw-tooth's over the map grid (``passmd sweep gain``)."""
-    return compute_map("gain", map_points(drive, profile), config=_run_config(config, profile),
+    return compute_map("gain", map_points(drive, profile), config=run_config(config, profile),
                        description="Eq. 15 gain map")
 
 
@@ -268,7 +264,7 @@ def stall_force_curve(drive: Drive, profile: str, config: RunConfig | None = Non
     """Generated force at stall against the amplitude at Section 4.2's frequency, per preload
     (``passmd sweep stall-force``), with the Coulomb bound μ·ΣF_N of each preload (:func:`stall_frame`)."""
     points = stall_points(drive, profile)
-    table = compute_map("stall-force", points, config=_run_config(config, profile), description="stall force")
+    table = compute_map("stall-force", points, config=run_config(config, profile), description="stall force")
     return stall_frame(points, table)
 
 
@@ -338,7 +334,7 @@ def synthetic_measurements(truth: Drive, profile: str, config: RunConfig | None 
     NOISE_NM (seed SEED): ``(fit data, held-back data)``; ``flyback`` overrides the drive's fly-back
     rule in the data (a mis-specified model)."""
     s = PROFILE_SETTINGS[profile]
-    config = _run_config(config, profile)
+    config = run_config(config, profile)
     rng = np.random.default_rng(SEED)
     fit_points = [(FIT_FREQUENCY, p, a) for p in s.fit_preloads for a in s.fit_amplitudes_nm]
     return (_measurements(fit_points, truth, rng, config, flyback),
@@ -348,7 +344,7 @@ def synthetic_measurements(truth: Drive, profile: str, config: RunConfig | None 
 def calibrate(start: Drive, data: fit.Measurements, profile: str,
               config: RunConfig | None = None) -> fit.FitResult:
     """The fit of the profile's free parameters to ``data`` from ``start`` (``passmd fit``'s defaults)."""
-    return fit.fit(start, data, list(PROFILE_SETTINGS[profile].free), config=_run_config(config, profile))
+    return fit.fit(start, data, list(PROFILE_SETTINGS[profile].free), config=run_config(config, profile))
 
 
 def load_fitted(text: str) -> Drive:
@@ -370,7 +366,7 @@ def heldback_predictions(heldback: fit.Measurements, drives: dict[str, Drive], p
     out = pd.DataFrame({"frequency_Hz": heldback.frequency, "preload_N": heldback.preload,
                         "amplitude_nm": heldback.amplitude * 1e9, "measured_nm": heldback.value * 1e9,
                         "sd_nm": heldback.sd * 1e9})
-    config = _run_config(config, profile)
+    config = run_config(config, profile)
     for label, drive in drives.items():
         out[f"{label}_nm"] = fit.predict(drive, heldback, config=config) * 1e9
     out.attrs["labels"] = {label: HELDBACK_LABELS.get(label, label) for label in drives}

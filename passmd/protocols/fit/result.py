@@ -106,12 +106,8 @@ class FitResult:
 
     def report(self) -> dict:
         """The JSON report (SI units; keys as the command line's --json)."""
-        rows = []
-        for i in range(len(self.data)):
-            scale, unit = self.data.display(i)
-            rows.append({"line": self.data.line[i], "quantity": self.data.column[i],
-                         "measured": self.data.value[i] / scale, "predicted": self.predicted[i] / scale,
-                         "unit": unit, "normalized_residual": float(self.residuals[i])})
+        rows = self.residual_table()[["line", "quantity", "measured", "predicted", "unit",
+                                      "normalized_residual"]].to_dict("records")
         return {
             "estimates": {n: {k: v for k, v in self.estimates[n].items()} for n in self.names},
             "residuals": rows,
