@@ -765,8 +765,8 @@ def test_any_category_change_fails_with_a_readable_diff(tmp_path):
 # --------------------------------------------------------------------------------------
 
 def test_collect_results_computes_what_the_claims_require_and_any_figure_named(monkeypatch):
-    """By default only the tables claims.csv's ``requires`` name are computed (fig6b and its readings
-    are, a chapter's other figure is not); an explicit list may name any available table."""
+    """By default only the tables claims.csv's ``requires`` name (fig6b_readings) and their figures
+    (fig6b) are computed, a chapter's other figure is not; an explicit list may name any table."""
     calls = []
 
     def _computed(config):
@@ -780,8 +780,8 @@ def test_collect_results_computes_what_the_claims_require_and_any_figure_named(m
              "fig6b": types.SimpleNamespace(compute=_computed)}
     monkeypatch.setattr(figure_table, "figure_names", lambda: list(table))
     monkeypatch.setattr(figure_table, "figure_spec", lambda name: table[name])
-    reading_tables = {"fig6b_readings": types.SimpleNamespace(compute=_computed),
-                      "fig99_readings": types.SimpleNamespace(compute=_not_required)}
+    reading_tables = {"fig6b_readings": types.SimpleNamespace(compute=_computed, figures=("fig6b",)),
+                      "fig99_readings": types.SimpleNamespace(compute=_not_required, figures=("fig99",))}
     monkeypatch.setattr(figure_table, "READING_TABLES", reading_tables)
     assert list(evaluation.result_sources()) == [*table, *reading_tables, "closed_forms"]
     results = evaluation.collect_results(QUICK)
@@ -801,9 +801,13 @@ def test_collect_results_computes_what_the_claims_require_and_any_figure_named(m
 
 
 def test_the_default_results_are_every_table_a_claim_requires_and_no_other(monkeypatch):
-    """The ledger's default tables are the union of claims.csv's ``requires`` (each available), so
-    the figures only a chapter shows (the design maps, the calibration fits) cost it nothing."""
-    required = {key for keys in load_claims()["requires"] for key in keys.split(";") if key}
+    """The ledger's default tables are the union of claims.csv's ``requires`` (each available) and the
+    figures of its reading tables (their defaults, e.g. the fig8a an evidence line reads), so the
+    figures only a chapter shows (the design maps, the calibration fits) cost it nothing."""
+    named = {key for keys in load_claims()["requires"] for key in keys.split(";") if key}
+    required = named | {name for key in named if key in figure_table.READING_TABLES
+                        for name in figure_table.READING_TABLES[key].figures}
+    assert "fig8a" in required - named
     computed = []
     sources = {key: (lambda config, key=key: computed.append(key) or pd.DataFrame())
                for key in evaluation.result_sources()}

@@ -160,8 +160,9 @@ def collect_results(config: RunConfig, figures: Iterable[str] | None = None) -> 
         selects the grids of each figure.
     figures : iterable of str, optional
         Only these keys (each must be available, any of :func:`result_sources`); default the
-        keys claims.csv's ``requires`` name (:func:`passmd.ledger.claims.load_claims`), in the
-        order of :func:`result_sources`.
+        keys claims.csv's ``requires`` name (:func:`passmd.ledger.claims.load_claims`) and the
+        figures of the reading tables among them (their runs at the defaults, which extractors
+        and evidence read), in the order of :func:`result_sources`.
 
     Returns
     -------
@@ -173,6 +174,7 @@ def collect_results(config: RunConfig, figures: Iterable[str] | None = None) -> 
     available = result_sources()
     if figures is None:
         required = {key for keys in load_claims()["requires"] for key in keys.split(";")}
+        required |= {name for key in required for name in _figures_of(key)}  # a reading table's defaults
         keys = [key for key in available if key in required]
     else:
         keys = list(figures)
