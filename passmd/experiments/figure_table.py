@@ -5,7 +5,7 @@ which chapter shows it, and gives its compute function (run configuration → ti
 columns plus display columns) and its plot function (DataFrame → matplotlib Figure). The book,
 ``passmd figure`` and the ledger all go through :func:`figure_data` and :func:`figure_plot`, so one
 code path produces every figure. Every figure a chapter shows is a row; the ledger computes only the
-rows (and reading tables) its claims require (``requires`` in claims.csv).
+rows and reading tables its claims require (``requires`` in claims.csv, and the reading tables' figures).
 
 The rows are each chapter's own: :data:`FIGURES` and :data:`READING_TABLES` join the ``FIGURES`` and
 ``READING_TABLES`` tuples of the ``figures.py`` of every chapter in :data:`CHAPTERS` (the book's

@@ -9,8 +9,8 @@ Three pieces meet here:
   the book and the CLI), the tables of the ledger's readings
   (``passmd.experiments.figure_table.READING_TABLES``: every run at every point of the axes that
   change it) and the ledger's own ``closed_forms`` table; :func:`collect_results` computes those
-  the claims require (claims.csv's ``requires``), so a chapter never lists them and its other
-  figures cost the ledger nothing;
+  the claims require (claims.csv's ``requires``, with the figures of its reading tables), so a
+  chapter never lists them and its other figures cost the ledger nothing;
 * **extractors**: functions ``(results[, reading]) -> ours`` tagged with
   :func:`passmd.ledger.checks.extractor` in the modules
   ``passmd.experiments.figure_table.CLAIM_MODULES`` lists
