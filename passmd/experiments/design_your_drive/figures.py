@@ -387,13 +387,17 @@ HELDBACK_LABELS = {"start": "first guess (paper's values)", "fitted": "fitted dr
 
 
 def _calibration(config: RunConfig) -> tuple[fit.FitResult, Drive, pd.DataFrame]:
-    """The chapter's calibration on ``config.profile``: the fit from the first guess, the example drive
+    """The chapter's calibration on ``config.profile``: the fit from the first guess (of the measurements
+    as ``passmd fit`` reads them from their file: the amplitudes pass through nm), the example drive
     that made the data, and the held-back measurements with each drive's prediction."""
     truth, sources = example_drive()
     start = start_drive(truth, _settings(config.profile).free)
     data, heldback = synthetic_measurements(truth, config.profile, config)
-    result = calibrate(start, data, config.profile, config)
-    fitted = load_fitted(fit.fitted_drive_file(result, "measurements.csv", sources))
+    with tempfile.TemporaryDirectory(prefix="passmd-design-") as folder:  # read back as the page reads it
+        path = Path(folder) / "design_measurements.csv"
+        fit.write_measurements(path, data)
+        result = calibrate(start, fit.read_measurements(path), config.profile, config)
+    fitted = load_fitted(fit.fitted_drive_file(result, "design_measurements.csv", sources))
     return result, truth, heldback_predictions(heldback, {"start": start, "fitted": fitted}, config.profile,
                                                config)
 
