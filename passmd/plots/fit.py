@@ -8,6 +8,8 @@ critical amplitudes), one colour per preload; below, the residuals over their σ
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 from matplotlib.figure import Figure
 
@@ -49,7 +51,8 @@ def fit_figure(table) -> Figure:
     gof = table.attrs.get("goodness_of_fit") or {}
     test = (f"; χ² = {gof['chi2']:.3g} on {gof['dof']} dof, p = {gof['p_value']:.2g}"
             + (" (model rejected)" if gof.get("rejected") else "") if gof.get("testable") else "")
-    fig.suptitle(table.attrs.get("title") or f"fitted {names}{test}", fontsize="medium")
+    title = table.attrs.get("title") or f"fitted {names}{test}"
+    fig.suptitle(textwrap.fill(title, 64 * len(columns)), fontsize="medium")  # within the figure's width
     return fig
 
 
