@@ -168,7 +168,7 @@ def book(session: nox.Session) -> None:
     ``nox -s book -- --profile quick`` builds on the quick profile (CI); default ``paper``.
     Every chapter is executed on every build (``execute_notebooks: force``); a cell error or
     any warning fails the build. Simulation results are reused from passmd's on-disk cache,
-    which ``passmd ledger`` fills first (every figure); the chapters then run one per core.
+    which ``passmd ledger`` fills first (every table a claim reads); the chapters then run one per core.
     ``-- --cold`` measures a cold build: empty simulation and numba caches (fresh temporary
     folders; your caches are left alone) and no previous build output.
     """
@@ -200,7 +200,7 @@ def book(session: nox.Session) -> None:
         shutil.rmtree(os.path.join("book", "_build"), ignore_errors=True)
     start = time.monotonic()
     # Every figure's sweeps first, in one process whose sweeps keep every core busy
-    # (`passmd ledger` evaluates every claim, hence computes every figure); the chapters
+    # (`passmd ledger` evaluates every claim, hence computes every table a claim reads); the chapters
     # then take their results from the cache and are executed several at a time (Sphinx's
     # parallel reading, tools/build_book.py). The ledger's sweep counts are the first row
     # of the book's execution statistics.
@@ -211,7 +211,7 @@ def book(session: nox.Session) -> None:
     for old in (prefetch_log, prefetch_time):
         if os.path.exists(old):
             os.remove(old)
-    session.log(f"computing every figure of the {profile} profile first (passmd ledger; shown on failure)")
+    session.log(f"computing every table the claims read ({profile} profile) first (passmd ledger)")
     session.run("python", "-m", "passmd", "ledger", "--profile", profile, "--json", silent=True,
                 env={**env, "PASSMD_SWEEP_LOG": prefetch_log})
     with open(prefetch_time, "w", encoding="utf-8") as fh:

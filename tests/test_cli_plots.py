@@ -202,6 +202,6 @@ def test_fit_png_is_written_and_labelled(tmp_path, monkeypatch):
     png_shows_something(tmp_path / "out" / "fit.png")
     result = passmd.fit(Drive(contacts=1, actuator_model="rigid"), data, ["friction_coefficient"],
                         executor="serial", cache=tmp_path / "cache")
-    texts = readable(fit_figure(result))
+    texts = readable(fit_figure(result.residual_table()))
     assert texts["suptitle"].strip() and texts["legend"]
     assert math.isfinite(result.estimates["friction_coefficient"]["value"])

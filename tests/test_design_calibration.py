@@ -1,4 +1,4 @@
-"""The design chapter's calibration (passmd.experiments.design_your_drive.facts): measurements made by other
+"""The design chapter's calibration (passmd.experiments.design_your_drive): measurements made by other
 means than the fit's model, the fits' facts, and the fitted drive file read back."""
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from passmd.runtime.config import RunConfig
 
 def test_fit_facts_say_whether_the_region_holds_the_truth():
     truth, _ = figures.example_drive()
-    start = facts.start_drive(truth, ("friction_coefficient", "actuator.stiffness"))
+    start = figures.start_drive(truth, ("friction_coefficient", "actuator.stiffness"))
     # the first guess is the paper's: μ of Table 1, k_p of Table 2 for the drive's radius
     assert start.friction_coefficient == Drive().friction_coefficient
     assert start.actuator.stiffness == pytest.approx(actuator_for_radius(truth.hemisphere_radius).stiffness)
@@ -49,7 +49,7 @@ def test_fitted_drive_file_reads_back_to_the_fitted_drive():
     fitted = replace(truth, friction_coefficient=0.2493217)
     result = SimpleNamespace(drive=fitted, base=truth, names=["friction_coefficient"], keep="damping_ratio")
     text = fit.fitted_drive_file(result, "m.csv", sources)
-    assert facts.load_fitted(text) == fitted
+    assert figures.load_fitted(text) == fitted
     line = {raw.split(" = ")[0]: raw for raw in text.splitlines() if " = " in raw}
     assert "fitted to m.csv by passmd fit" in line["friction_coefficient"]
     assert "given in" in line["runner_mass"] and "example_drive.toml" in line["runner_mass"]
@@ -58,7 +58,7 @@ def test_fitted_drive_file_reads_back_to_the_fitted_drive():
 def test_synthetic_measurements_are_independent_steps_plus_the_stated_noise(tmp_path):
     truth, _ = figures.example_drive()
     config = RunConfig(cache_dir=tmp_path)
-    data, held = facts.synthetic_measurements(truth, "quick", config)
+    data, held = figures.synthetic_measurements(truth, "quick", config)
     s = figures.PROFILE_SETTINGS["quick"]
     assert len(data) == len(s.fit_preloads) * len(s.fit_amplitudes_nm) and len(held) == len(s.heldback)
     noise = np.random.default_rng(figures.SEED).normal(0.0, figures.NOISE_NM * 1e-9, len(data) + len(held))

@@ -6,6 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from passmd.experiments import figure_table
 from passmd.experiments.design_your_drive import facts, figures
 from passmd.model.drive_file import DRIVE_KEYS, DriveFileError, load_drive
 from passmd.runtime.config import RunConfig
@@ -64,11 +65,11 @@ def test_stall_curve_holds_the_drives_own_preload(profile):
 
 
 def test_profile_executor_applies_only_where_none_was_chosen():
-    assert figures._run_config(RunConfig(), "quick").executor == "serial"
-    assert figures._run_config(RunConfig(executor="process"), "quick").executor == "process"
-    assert figures._run_config(RunConfig(), "paper").executor is None
+    assert figures.run_config(RunConfig(), "quick").executor == "serial"
+    assert figures.run_config(RunConfig(executor="process"), "quick").executor == "process"
+    assert figures.run_config(RunConfig(), "paper").executor is None
     with pytest.raises(ValueError, match="profile = 'fast'"):
-        figures._run_config(RunConfig(), "fast")
+        figures.run_config(RunConfig(), "fast")
 
 
 def _map_table(velocities, frequencies, amplitudes):
@@ -141,3 +142,16 @@ def test_ringing_facts_read_the_probe():
     assert found["ring_left_nm"] == pytest.approx(5.0, rel=1e-3)
     assert found["ring_quiet_ms"] == pytest.approx(15.0)
     assert found["ring_next_ms"] == pytest.approx(9.999)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", [spec.name for spec in figure_table.FIGURES
+                                  if spec.chapter in ("design_your_drive", "calibration")])
+def test_every_row_of_the_design_and_calibration_pages_is_a_passmd_figure(name, tmp_path):
+    """`passmd figure NAME --profile quick` computes each row's table (finite, but for the cells its
+    row leaves empty by design) and draws it; the table holds what its plot reads."""
+    from passmd import cli
+
+    assert cli.main(["figure", name, "--profile", "quick", "--out", str(tmp_path)]) == 0
+    written = pd.read_csv(tmp_path / f"{name}.csv", comment="#")
+    assert len(written) > 0 and (tmp_path / f"{name}.png").stat().st_size > 0

@@ -70,3 +70,13 @@ def test_plots_do_not_import_experiments():
             "print(any(m.startswith('passmd.experiments') for m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+@pytest.mark.parametrize("chapter", ["design_your_drive", "calibration"])
+def test_a_page_drawing_the_tables_it_computed_draws_each_of_its_rows_once(chapter):
+    """These pages compute their tables with the rows' own functions and draw each one through
+    figure_plot by name, once, and nothing else: the page's generated figure count is what it shows."""
+    text = (BOOK / f"{chapter}.md").read_text()
+    drawn = re.findall(r"figure_plot\(\"(\w+)\"", text)
+    assert sorted(drawn) == sorted(spec.name for spec in figure_table.FIGURES if spec.chapter == chapter)
+    assert text.count("show_figure(") == len(drawn) == len(re.findall(r"show_figure\(figure_plot\(", text))

@@ -765,22 +765,32 @@ def test_any_category_change_fails_with_a_readable_diff(tmp_path):
 # extractor tags, results, presentation
 # --------------------------------------------------------------------------------------
 
-def test_collect_results_calls_every_figure_of_the_table(monkeypatch):
+def test_collect_results_computes_what_the_claims_require_and_any_figure_named(monkeypatch):
+    """By default only the tables claims.csv's ``requires`` name (fig6b_readings) and their figures
+    (fig6b) are computed, a chapter's other figure is not; an explicit list may name any table."""
     calls = []
 
-    def _fig5a(config):
+    def _computed(config):
         calls.append(config)
         return pd.DataFrame({"amplitude_nm": [1.0]})
 
-    table = {"fig5a": types.SimpleNamespace(compute=_fig5a)}
+    def _not_required(config):
+        raise AssertionError("a figure no claim requires was computed")
+
+    table = {"design_example": types.SimpleNamespace(compute=_not_required),
+             "fig6b": types.SimpleNamespace(compute=_computed)}
     monkeypatch.setattr(figure_table, "figure_names", lambda: list(table))
     monkeypatch.setattr(figure_table, "figure_spec", lambda name: table[name])
-    reading_tables = {"fig5a_readings": types.SimpleNamespace(compute=_fig5a)}
+    reading_tables = {"fig6b_readings": types.SimpleNamespace(compute=_computed, figures=("fig6b",)),
+                      "fig99_readings": types.SimpleNamespace(compute=_not_required, figures=("fig99",))}
     monkeypatch.setattr(figure_table, "READING_TABLES", reading_tables)
+    assert list(evaluation.result_sources()) == [*table, *reading_tables, "closed_forms"]
     results = evaluation.collect_results(QUICK)
-    assert list(results) == ["fig5a", "fig5a_readings", "closed_forms"]
+    assert list(results) == ["fig6b", "fig6b_readings", "closed_forms"]
     assert calls == [QUICK, QUICK]
     pd.testing.assert_frame_equal(results["closed_forms"], reference.tangential_stiffness_table())
+    with pytest.raises(AssertionError, match="no claim requires"):
+        evaluation.collect_results(QUICK, figures=["design_example"])
     with pytest.raises(TypeError, match="config = 'quick' is not allowed: "
                        "must be a passmd.runtime.config.RunConfig"):
         evaluation.collect_results("quick")
@@ -789,6 +799,24 @@ def test_collect_results_calls_every_figure_of_the_table(monkeypatch):
     table["fig5b"] = types.SimpleNamespace(compute=lambda config: [1, 2])
     with pytest.raises(TypeError, match="not a DataFrame"):
         evaluation.collect_results(QUICK, figures=["fig5b"])
+
+
+def test_the_default_results_are_every_table_a_claim_requires_and_no_other(monkeypatch):
+    """The ledger's default tables are the union of claims.csv's ``requires`` (each available) and the
+    figures of its reading tables (their defaults, e.g. the fig8a an evidence line reads), so the
+    figures only a chapter shows (the design maps, the calibration fits) cost it nothing."""
+    named = {key for keys in load_claims()["requires"] for key in keys.split(";") if key}
+    required = named | {name for key in named if key in figure_table.READING_TABLES
+                        for name in figure_table.READING_TABLES[key].figures}
+    assert "fig8a" in required - named
+    computed = []
+    sources = {key: (lambda config, key=key: computed.append(key) or pd.DataFrame())
+               for key in evaluation.result_sources()}
+    assert required <= set(sources)
+    monkeypatch.setattr(evaluation, "result_sources", lambda: sources)
+    evaluation.collect_results(QUICK)
+    assert set(computed) == required
+    assert not any(key.startswith(("design_", "calibration_")) for key in computed)
 
 
 def test_tags_only_mark_the_function():

@@ -9,7 +9,7 @@
 * The ``passmd-sweep-table`` directive is replaced, once every page has been read, by a
   table of those counts per page (so its own position in the reading order does not matter),
   after a first row for the ``passmd ledger`` run with which ``nox -s book`` computes every
-  figure before the chapters (``$PASSMD_BOOK_PREFETCH_LOG``).
+  table a claim reads before the chapters (``$PASSMD_BOOK_PREFETCH_LOG``).
   The logs are cleared when a build starts: the counts are complete because ``nox -s book``
   builds with ``--all`` (every page read and executed).
 * Each chapter page (one with figures in :data:`passmd.experiments.figure_table.FIGURES` or
@@ -37,7 +37,7 @@ from sphinx.util.docutils import SphinxDirective
 
 SWEEP_LOG_ENV = "PASSMD_SWEEP_LOG"
 #: Set by ``nox -s book``: the sweep log of the ``passmd ledger`` run that computes every
-#: figure before the chapters are executed (its counts are the table's first row), and a
+#: table a claim reads before the chapters are executed (its counts are the table's first row), and a
 #: JSON file with that run's wall time (``{"wall_seconds": ...}``).
 PREFETCH_LOG_ENV = "PASSMD_BOOK_PREFETCH_LOG"
 PREFETCH_TIME_ENV = "PASSMD_BOOK_PREFETCH_TIME"

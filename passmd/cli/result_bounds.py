@@ -70,6 +70,13 @@ _DESIGN = dict.fromkeys(("flyback_time_s", "settling_time_s", "acceleration_time
                          "acceleration_amplitude_m", "ramp_time_s", "max_slip_share_acceleration"),
                         "saw-tooth rows have no Eq. 15 design")
 
+# The design chapter's example drive: a runner that does not ring after the fly-back has no ringing
+# frequency or decay; where Eq. 15 gives no waveform (the row's note says why) it has no design or velocity.
+_NO_RING = dict.fromkeys(("ringing_frequency_Hz", "ringing_decay_time_s"), "the runner does not ring")
+_NO_EQ15 = dict.fromkeys(("optimized_velocity_m_per_s", "gain_m_per_s", "settling_time_s",
+                          "acceleration_time_s", "acceleration_amplitude_m", "response_frequency_Hz",
+                          "eq15_highest_frequency_Hz"), "Eq. 15 gives no waveform at this point")
+
 #: Cells a figure leaves empty (NaN) by design, ``{figure: {column: why}}``: a quantity that does
 #: not exist for that row. Every other numeric cell of a result table must be finite.
 EMPTY_BY_DESIGN: dict[str, dict[str, str]] = {
@@ -87,6 +94,11 @@ EMPTY_BY_DESIGN: dict[str, dict[str, str]] = {
     "fig9a_response": dict.fromkeys(("sawtooth_reversal_s", "response_reversal_s"),
                                     "the runner need not turn within t_s after the fly-back"),
     **{f"{name}_readings": _DESIGN for name in ("fig9b", "fig10a", "fig10b", "fig10c")},
+    "design_critical_amplitude": {**dict.fromkeys(("steady_nm", "first_nm"), "no step up to the full stroke"),
+                                  **_NO_RING},
+    **dict.fromkeys(("design_step_map", "design_velocity_map"), _NO_RING),
+    "design_gain_map": {**_NO_EQ15, **_NO_RING},
+    "calibration_paper_mu": {"amplitude_nm": "a critical amplitude is measured over the amplitude, at none"},
     "mdr_convergence": {"fit_rel": "the power law is fitted on the larger spring counts only"},
     "mdr_cost": dict.fromkeys(("springs", "reversals", "max_depth", "overflows"),
                               "each contact model has its own cost parameters"),

@@ -2,10 +2,12 @@
 
 Every chapter package has the same modules: ``figures.py`` (the chapter's compute functions, run
 configuration → tidy DataFrame, and its rows of the figure table: a tuple ``FIGURES`` of
-:class:`FigureSpec` and, where the ledger reads runs beyond the figures', ``READING_TABLES`` of
-:class:`ReadingTable`), ``facts.py`` (the numbers and short texts the chapter's prose quotes) and,
-where the chapter judges claims of the paper, ``claims.py`` (the ledger's claim extractors), and no
-other module. Code several chapters or the command line share lives in :mod:`passmd.protocols`.
+:class:`FigureSpec`, one per figure the chapter shows, and, where the ledger reads runs beyond the
+figures', ``READING_TABLES`` of :class:`ReadingTable`; the ledger computes only the tables its claims
+require, so a row no claim reads costs it nothing), ``facts.py`` (the numbers and short texts the
+chapter's prose quotes) and, where the chapter judges claims of the paper, ``claims.py`` (the ledger's
+claim extractors), and no other module. Code several chapters or the command line share lives in
+:mod:`passmd.protocols`.
 :mod:`passmd.experiments.figure_table` assembles the figure table from the chapters in
 :data:`~passmd.experiments.figure_table.CHAPTERS` (the book's order) and finds the claim modules;
 nothing here imports ``passmd.plots``.

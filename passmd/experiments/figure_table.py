@@ -4,7 +4,8 @@ Each row (:class:`~passmd.experiments.FigureSpec`) names a panel, says in one li
 which chapter shows it, and gives its compute function (run configuration → tidy DataFrame, SI
 columns plus display columns) and its plot function (DataFrame → matplotlib Figure). The book,
 ``passmd figure`` and the ledger all go through :func:`figure_data` and :func:`figure_plot`, so one
-code path produces every figure.
+code path produces every figure. Every figure a chapter shows is a row; the ledger computes only the
+rows and reading tables its claims require (``requires`` in claims.csv, and the reading tables' figures).
 
 The rows are each chapter's own: :data:`FIGURES` and :data:`READING_TABLES` join the ``FIGURES`` and
 ``READING_TABLES`` tuples of the ``figures.py`` of every chapter in :data:`CHAPTERS` (the book's

@@ -14,8 +14,8 @@ from passmd.model.defaults import PROTOCOL
 from passmd.plots.sweep_map import MapAxis, cell_marks, map_figure
 from passmd.protocols.maps import MAP_QUANTITIES
 
-__all__ = ["critical_amplitude_figure", "design_map", "heldback_figure", "ringing_figure",
-           "stall_force_figure"]
+__all__ = ["critical_amplitude_figure", "design_map", "gain_map_figure", "heldback_figure", "ringing_figure",
+           "stall_force_figure", "step_map_figure", "velocity_map_figure"]
 
 #: The maps' axes: frequency (log) and amplitude, as ``passmd sweep --vary frequency=...:log --vary
 #: amplitude=...`` draws them.
@@ -38,18 +38,36 @@ def design_map(table, quantity: str, title: str) -> Figure:
     return map_figure(table, list(MAP_AXES), value, title, marks=marks)
 
 
-def ringing_figure(probe: dict, frequencies, measurable: float) -> Figure:
+def step_map_figure(table) -> Figure:
+    """The saw-tooth's steady step over the map grid (a ``velocity`` map, :func:`design_map`)."""
+    return design_map(table, "step", "example drive: step of the saw-tooth over frequency × amplitude")
+
+
+def velocity_map_figure(table) -> Figure:
+    """The saw-tooth's steady velocity over the map grid (a ``velocity`` map, :func:`design_map`)."""
+    return design_map(table, "velocity",
+                      "example drive: velocity of the saw-tooth over frequency × amplitude")
+
+
+def gain_map_figure(table) -> Figure:
+    """Eq. 15's steady velocity minus the saw-tooth's over the grid (a ``gain`` map, :func:`design_map`)."""
+    return design_map(table, "gain", "example drive: Eq. 15 waveform minus saw-tooth")
+
+
+def ringing_figure(table) -> Figure:
     """The runner's swing after a fly-back against the time since (log axes), the measurable step,
-    and where the next fly-back comes at each of ``frequencies`` (Hz)."""
+    and where the next fly-back comes at each frequency of ``attrs["next_flyback_Hz"]``
+    (:func:`passmd.experiments.design_your_drive.figures.ringing_frame`)."""
     fig = Figure(figsize=(6.4, 4.0), layout="constrained")
     ax = fig.add_subplot()
-    t_ms = np.asarray(probe["swing_times_s"]) * 1e3
-    ax.loglog(t_ms, np.asarray(probe["swing_amplitudes_m"]) * 1e9, "-", lw=1.2,
-              label=f"runner swing after the fly-back ({probe['ringing_frequency_Hz'] / 1e3:.3g} kHz)")
+    t_ms = table["swing_times_s"].to_numpy(float) * 1e3
+    ax.loglog(t_ms, table["swing_amplitudes_m"].to_numpy(float) * 1e9, "-", lw=1.2,
+              label=f"runner swing after the fly-back ({table.attrs['ringing_frequency_Hz'] / 1e3:.3g} kHz)")
+    measurable = table.attrs["measurable_m"]
     ax.axhline(measurable * 1e9, color="grey", ls="--", lw=0.8,
                label=f"measurable step ({measurable * 1e9:g} nm)")
-    for k, f in enumerate(frequencies):
-        delay = (1.0 / f - probe["flyback_time_s"]) * 1e3
+    for k, f in enumerate(table.attrs["next_flyback_Hz"]):
+        delay = (1.0 / f - table.attrs["flyback_time_s"]) * 1e3
         ax.axvline(delay, color=f"C{k + 1}", ls=":", lw=1.0, label=f"next fly-back at {f:g} Hz")
     ax.set_xlabel("time after the fly-back [ms]")
     ax.set_ylabel("swing of the runner [nm]")
@@ -62,9 +80,11 @@ _READINGS = (("closed_form_nm", "closed form (Eqs. 7–8, 11–12)", "--"),
              ("steady_nm", "simulated, steady", "o-"))
 
 
-def critical_amplitude_figure(table, full_stroke_nm: float) -> Figure:
-    """The three readings of A_c against preload, with the full stroke as a ceiling; steady points
-    that the runner's ringing affects (a measurable swing left at the next fly-back) ringed."""
+def critical_amplitude_figure(table) -> Figure:
+    """The three readings of A_c against preload, with the full stroke (``attrs["full_stroke_nm"]``) as
+    a ceiling; steady points that the runner's ringing affects (a measurable swing left at the next
+    fly-back) ringed."""
+    full_stroke_nm = table.attrs["full_stroke_nm"]
     fig = Figure(figsize=(6.4, 4.4), layout="constrained")
     ax = fig.add_subplot()
     for column, label, style in _READINGS:
@@ -106,11 +126,12 @@ def stall_force_figure(table) -> Figure:
     return fig
 
 
-def heldback_figure(table, labels: dict[str, str]) -> Figure:
+def heldback_figure(table) -> Figure:
     """Held-back measurements (with ±1 σ) against each drive's prediction, one slot per point.
 
-    ``labels``: prediction column stem (``<stem>_nm``) -> legend text.
+    ``attrs["labels"]``: prediction column stem (``<stem>_nm``) -> legend text.
     """
+    labels = table.attrs["labels"]
     fig = Figure(figsize=(7.2, 4.2), layout="constrained")
     ax = fig.add_subplot()
     x = np.arange(len(table))

@@ -8,8 +8,9 @@ Three pieces meet here:
 * **results**: the figure table of ``passmd.experiments.figure_table`` (``fig5a`` … ``fig10c``, shared with
   the book and the CLI), the tables of the ledger's readings
   (``passmd.experiments.figure_table.READING_TABLES``: every run at every point of the axes that
-  change it) and the ledger's own ``closed_forms`` table; :func:`collect_results` computes every
-  one for a run configuration, so a chapter never lists them;
+  change it) and the ledger's own ``closed_forms`` table; :func:`collect_results` computes those
+  the claims require (claims.csv's ``requires``, with the figures of its reading tables), so a
+  chapter never lists them and its other figures cost the ledger nothing;
 * **extractors**: functions ``(results[, reading]) -> ours`` tagged with
   :func:`passmd.ledger.checks.extractor` in the modules
   ``passmd.experiments.figure_table.CLAIM_MODULES`` lists
@@ -150,7 +151,7 @@ def result_sources() -> dict[str, Callable[[RunConfig], pd.DataFrame]]:
 
 
 def collect_results(config: RunConfig, figures: Iterable[str] | None = None) -> dict[str, pd.DataFrame]:
-    """Compute every available result table: the ledger's single entry point.
+    """Compute the result tables the claims require: the ledger's single entry point.
 
     Parameters
     ----------
@@ -158,7 +159,10 @@ def collect_results(config: RunConfig, figures: Iterable[str] | None = None) -> 
         How to run; its ``profile`` (``"quick"`` for CI, ``"paper"`` for the paper's grids)
         selects the grids of each figure.
     figures : iterable of str, optional
-        Only these keys (each must be available); default all of :func:`result_sources`.
+        Only these keys (each must be available, any of :func:`result_sources`); default the
+        keys claims.csv's ``requires`` name (:func:`passmd.ledger.claims.load_claims`) and the
+        figures of the reading tables among them (their runs at the defaults, which extractors
+        and evidence read), in the order of :func:`result_sources`.
 
     Returns
     -------
@@ -168,7 +172,12 @@ def collect_results(config: RunConfig, figures: Iterable[str] | None = None) -> 
     """
     _check_config(config)
     available = result_sources()
-    keys = list(available) if figures is None else list(figures)
+    if figures is None:
+        required = {key for keys in load_claims()["requires"] for key in keys.split(";")}
+        required |= {name for key in required for name in _figures_of(key)}  # a reading table's defaults
+        keys = [key for key in available if key in required]
+    else:
+        keys = list(figures)
     unknown = [k for k in keys if k not in available]
     if unknown:
         raise ValueError(f"figures = {unknown!r} are not available: must be among {', '.join(available)}")

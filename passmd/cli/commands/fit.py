@@ -166,7 +166,7 @@ def _write(target: Path, result, record: dict, text: str) -> None:
     from passmd.cli.streams import write_atomically
     from passmd.plots.fit import fit_figure
 
-    fig = fit_figure(result)  # before any file is written: a failing figure leaves none
+    fig = fit_figure(result.residual_table())  # before any file is written: a failing figure leaves none
     try:
         target.mkdir(exist_ok=True)
         write_atomically(target / "fit.json",

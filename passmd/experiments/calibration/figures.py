@@ -8,9 +8,13 @@
   fly-back, fitted with the slew-rate rule (a wrong fixed assumption the χ² test must reject)
   and with the right rule.
 
-The data are made by other means than the fit's forward model
-(:func:`passmd.protocols.synthetic.noisy_steps`). The chapter draws each fit with
-:mod:`passmd.plots.fit` (a fit result, not a table), so :data:`FIGURES` holds no row.
+* :func:`paper_fit`: one unknown of the paper fitted to the numbers its text states
+  (:data:`PAPER_DATA`).
+
+The comb's and the fly-back's data are made by other means than the fit's forward model
+(:func:`passmd.protocols.synthetic.noisy_steps`). :data:`FIGURES` holds a row per figure the chapter
+shows: a fit's tables (:meth:`~passmd.protocols.fit.result.FitResult.profile_table`, :func:`fit_table`),
+drawn by :mod:`passmd.plots.fit`; the ledger computes none of them (no claim requires them).
 """
 
 from __future__ import annotations
@@ -18,7 +22,10 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
+import pandas as pd
 
+from passmd.experiments import FigureSpec
+from passmd.ledger.reference import REFERENCE_DIR
 from passmd.model.parameters import Drive
 from passmd.model.tables import Amplifier
 from passmd.protocols import fit
@@ -26,7 +33,8 @@ from passmd.protocols.fit.prediction import drive_at
 from passmd.protocols.synthetic import noisy_steps
 from passmd.runtime.config import RunConfig
 
-__all__ = ["COMB", "FIGURES", "FLYBACK", "comb_fit", "flyback_fits", "join"]
+__all__ = ["COMB", "FIGURES", "FLYBACK", "PAPER_DATA", "PAPER_TITLE", "WRONG_TITLE", "comb_fit",
+           "comb_profile", "fit_table", "flyback_fits", "join", "paper_fit"]
 
 #: The comb example: one flexible contact (Table 1–2, R = 1 mm), k_p = 5e6 N/m, three steps at 0.4 N,
 #: 100 Hz, 1 nm noise.
@@ -82,5 +90,42 @@ def flyback_fits(config: RunConfig | None = None) -> dict:
     return {"truth": truth, "data": data, "wrong": wrong, "right": right}
 
 
-#: The chapter's rows of the figure table: none (its figures draw fit results, :mod:`passmd.plots.fit`).
-FIGURES = ()
+#: The paper's stated numbers as measurements (rules in ``passmd/data/reference/README.md``).
+PAPER_DATA = REFERENCE_DIR / "paper_as_data.csv"
+#: Titles of the fit figures: the rejected fly-back fit, and μ fitted to the paper's numbers.
+WRONG_TITLE = "Steps made with the fixed fly-back against the model with the slew-rate fly-back (μ fitted)"
+PAPER_TITLE = "Paper's numbers against the model with the fitted μ (others at the book's defaults)"
+
+
+def paper_fit(name: str, config: RunConfig | None = None) -> fit.FitResult:
+    """The parameter ``name`` of the book's default drive fitted alone to :data:`PAPER_DATA`."""
+    return fit.fit(Drive(), fit.read_measurements(PAPER_DATA), [name], config=config)
+
+
+def comb_profile(result: fit.FitResult) -> pd.DataFrame:
+    """The profile of k_p of a comb fit, with the k_p that made the data (:data:`COMB`)."""
+    table = result.profile_table("actuator.stiffness")
+    table.attrs["truth"] = COMB["stiffness"]
+    return table
+
+
+def fit_table(result: fit.FitResult, title: str) -> pd.DataFrame:
+    """A fit's :meth:`~passmd.protocols.fit.result.FitResult.residual_table` drawn under ``title``."""
+    table = result.residual_table()
+    table.attrs["title"] = title
+    return table
+
+
+#: The chapter's rows of the figure table: every figure it shows.
+FIGURES = (
+    FigureSpec("calibration_comb_profile", "Profile of k_p from three steps: a comb of minima, a region in "
+               "pieces", "calibration", lambda c: comb_profile(comb_fit(c)["first"]), "fit:profile_figure"),
+    FigureSpec("calibration_comb_profile_added", "Profile of k_p with the added measurement the first fit "
+               "named", "calibration", lambda c: comb_profile(comb_fit(c)["second"]), "fit:profile_figure"),
+    FigureSpec("calibration_wrong_flyback", "Steps made with the fixed fly-back, fitted with the slew-rate "
+               "one: a rejected fit", "calibration",
+               lambda c: fit_table(flyback_fits(c)["wrong"], WRONG_TITLE), "fit:fit_figure"),
+    FigureSpec("calibration_paper_mu", "The paper's stated numbers against the model with μ fitted to them",
+               "calibration", lambda c: fit_table(paper_fit("friction_coefficient", c), PAPER_TITLE),
+               "fit:fit_figure"),
+)

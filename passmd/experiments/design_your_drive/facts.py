@@ -1,87 +1,29 @@
 """What the chapter "Design your own drive" quotes: each map's and curve's numbers, and its calibration
-(the example drive's measurements, its fit, and predictions of measurements held back from the fit).
+(the fit's estimates against the values that made the data, the held-back predictions' misfit, the
+measurements as ``passmd fit`` reads them, and the fit with the other fly-back rule).
 
-The measurements are made by other means than the fit's forward model
-(:func:`passmd.protocols.synthetic.independent_steps`: the integrator refined, the last
-step of a long run) plus Gaussian noise of a stated sd; the unknown parameters are fitted from a
-designer's first guess (:data:`passmd.experiments.design_your_drive.figures.START`), and the fitted drive
-file, read back, predicts the held-back points.
+The data of every figure, the calibration's included, are
+:mod:`passmd.experiments.design_your_drive.figures`.
 """
 
 from __future__ import annotations
 
 import math
 import tempfile
-from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from passmd.experiments.design_your_drive.figures import (
-    FIT_FREQUENCY,
-    NOISE_NM,
-    PROFILE_SETTINGS,
-    SEED,
-    _run_config,
-)
+from passmd.experiments.design_your_drive.figures import run_config
 from passmd.model.defaults import PROTOCOL
-from passmd.model.drive_file import load_drive
 from passmd.model.parameters import Drive
-from passmd.model.tables import actuator_for_radius
 from passmd.protocols import fit, ringing
-from passmd.protocols.synthetic import independent_steps
 from passmd.runtime.config import RunConfig
 
-__all__ = ["calibrate", "curve_facts", "fit_facts", "gain_facts", "heldback_facts", "heldback_predictions",
-           "load_fitted", "map_facts", "measurements_csv", "other_flyback_fit", "ringing_facts",
-           "start_drive", "synthetic_measurements"]
-
-def start_drive(truth: Drive, free: Sequence[str]) -> Drive:
-    """A designer's first guess: ``truth`` with each parameter named in ``free`` at the paper's value
-    (μ of Table 1; k_p of Table 2 for the drive's radius, c_p kept)."""
-    drive = truth
-    for name in free:
-        if name == "friction_coefficient":
-            drive = replace(drive, friction_coefficient=Drive().friction_coefficient)
-        elif name == "actuator.stiffness":
-            table2 = actuator_for_radius(truth.hemisphere_radius).stiffness
-            drive = fit.FREE_PARAMETERS[name].set(drive, table2, truth)
-        else:
-            raise ValueError(f"free = {name!r}: the example's first guess knows friction_coefficient and "
-                             "actuator.stiffness")
-    return drive
-
-
-def _measurements(points, truth: Drive, rng, config, flyback=None) -> fit.Measurements:
-    """Steps at (frequency, preload, amplitude nm) points:
-    :func:`~passmd.protocols.synthetic.independent_steps` below 1 kHz (the
-    steady-velocity protocol's step above, as a stand measures it there) plus noise of NOISE_NM."""
-    header = ["amplitude_nm", "preload_N", "frequency_Hz", "step_nm", "step_nm_sd"]
-    rows = [[repr(float(a)), repr(float(p)), repr(float(f)), "0", repr(NOISE_NM)] for f, p, a in points]
-    data = fit.measurements_from_rows(header, rows, name="synthetic measurements")
-    low = [i for i, (f, _, _) in enumerate(points) if f < 1e3]
-    exact = np.array(fit.predict(truth, data, config=config))  # the steady-velocity protocol above 1 kHz
-    if low:
-        conditions = [(points[i][1], points[i][2] * 1e-9, points[i][0]) for i in low]
-        exact[low] = independent_steps(truth, conditions, flyback=flyback, config=config, executor=None,
-                                       cache=True)
-    return replace(data, value=exact + rng.normal(0.0, NOISE_NM * 1e-9, exact.size))
-
-
-def synthetic_measurements(truth: Drive, profile: str, config: RunConfig | None = None, flyback=None
-                           ) -> tuple[fit.Measurements, fit.Measurements]:
-    """Steps of ``truth`` made independently of the fit's forward model
-    (:func:`~passmd.protocols.synthetic.independent_steps`), plus Gaussian noise of
-    NOISE_NM (seed SEED): ``(fit data, held-back data)``; ``flyback`` overrides the drive's fly-back
-    rule in the data (a mis-specified model)."""
-    s = PROFILE_SETTINGS[profile]
-    config = _run_config(config, profile)
-    rng = np.random.default_rng(SEED)
-    fit_points = [(FIT_FREQUENCY, p, a) for p in s.fit_preloads for a in s.fit_amplitudes_nm]
-    return (_measurements(fit_points, truth, rng, config, flyback),
-            _measurements(s.heldback, truth, rng, config, flyback))
+__all__ = ["curve_facts", "fit_facts", "gain_facts", "heldback_facts", "map_facts", "measurements_csv",
+           "other_flyback_fit", "ringing_facts"]
 
 
 def measurements_csv(data: fit.Measurements) -> str:
@@ -93,44 +35,13 @@ def measurements_csv(data: fit.Measurements) -> str:
         return path.read_text(encoding="utf-8")
 
 
-def calibrate(start: Drive, data: fit.Measurements, profile: str,
-              config: RunConfig | None = None) -> fit.FitResult:
-    """The fit of the profile's free parameters to ``data`` from ``start`` (``passmd fit``'s defaults)."""
-    return fit.fit(start, data, list(PROFILE_SETTINGS[profile].free), config=_run_config(config, profile))
-
-
 def other_flyback_fit(start: Drive, data: fit.Measurements, profile: str,
                       config: RunConfig | None = None) -> fit.FitResult:
     """μ fitted to ``data`` with the fly-back rule the data were not made with (``"fixed"`` for a drive
     whose rule is ``"slew"``, else ``"slew"``): a wrong fixed assumption for the χ² test to judge."""
     other = "fixed" if start.amplifier.flyback == "slew" else "slew"
     wrong = replace(start, amplifier=replace(start.amplifier, flyback=other))
-    return fit.fit(wrong, data, ["friction_coefficient"], config=_run_config(config, profile))
-
-
-def load_fitted(text: str) -> Drive:
-    """The drive a drive file's text describes, read as ``--drive`` reads a file
-    (:func:`passmd.model.drive_file.load_drive`)."""
-    with tempfile.TemporaryDirectory(prefix="passmd-design-") as folder:
-        path = Path(folder) / "fitted-drive.toml"
-        path.write_text(text, encoding="utf-8")
-        return load_drive(path)
-
-
-def heldback_predictions(heldback: fit.Measurements, drives: dict[str, Drive], profile: str,
-                         config: RunConfig | None = None) -> pd.DataFrame:
-    """The held-back measurements and each drive's prediction of them (nm), one row per point.
-
-    ``drives``: label -> drive (e.g. the first guess and the fitted drive); a column
-    ``<label>_nm`` each.
-    """
-    out = pd.DataFrame({"frequency_Hz": heldback.frequency, "preload_N": heldback.preload,
-                        "amplitude_nm": heldback.amplitude * 1e9, "measured_nm": heldback.value * 1e9,
-                        "sd_nm": heldback.sd * 1e9})
-    config = _run_config(config, profile)
-    for label, drive in drives.items():
-        out[f"{label}_nm"] = fit.predict(drive, heldback, config=config) * 1e9
-    return out
+    return fit.fit(wrong, data, ["friction_coefficient"], config=run_config(config, profile))
 
 
 def fit_facts(result: fit.FitResult, truth: Drive, start: Drive) -> pd.DataFrame:

@@ -3,59 +3,49 @@
 The drive is a drive file shipped with the package (:data:`EXAMPLE_DRIVE_FILE`), read as
 ``passmd --drive FILE`` reads it. Every figure's data comes from the functions a designer
 calls: :func:`passmd.protocols.maps.compute_map` (what ``passmd sweep`` runs) for the
-critical amplitude, the step and velocity map, the Eq. 15 gain map and the stall force, and
-:func:`passmd.protocols.fit.estimator.fit` (what ``passmd fit`` runs) for the calibration. One function
-per figure; the grids of each profile are in :data:`PROFILE_SETTINGS`.
+critical amplitude, the step and velocity map, the Eq. 15 gain map and the stall force,
+:func:`passmd.protocols.ringing.stick_ringing` for the ringing, and
+:func:`passmd.protocols.fit.estimator.fit` (what ``passmd fit`` runs) for the calibration. The grids
+of each profile are in :data:`PROFILE_SETTINGS`; the calibration's settings are here
+(:data:`NOISE_NM`, :data:`SEED`, :data:`START`, each profile's free parameters and points).
 
-The calibration's settings are here (:data:`NOISE_NM`, :data:`SEED`, :data:`START`, each profile's
-free parameters and points); its functions, and what the chapter quotes of each figure, are
-:mod:`passmd.experiments.design_your_drive.facts`. The chapter draws its figures from these tables
-with :mod:`passmd.plots.design` (maps with their quantity and title, the fit's results), as a designer
-would, so :data:`FIGURES` holds no row: the figure table is also every result the ledger computes.
+:data:`FIGURES` holds a row per figure the chapter shows, each computed on the example drive at the
+configuration's profile (the sweep cache serves the page's own runs); the ledger computes none of
+them (no claim requires them). What the chapter quotes of each figure is
+:mod:`passmd.experiments.design_your_drive.facts`.
 """
 
 from __future__ import annotations
 
 import math
+import tempfile
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from passmd.experiments import FigureSpec
 from passmd.model import drive_file
 from passmd.model.defaults import PROTOCOL
-from passmd.model.drive_file import parameter_rows, read_drive_file, resolve
+from passmd.model.drive_file import load_drive, parameter_rows, read_drive_file, resolve
 from passmd.model.parameters import Drive
+from passmd.model.tables import actuator_for_radius
 from passmd.model.theory import contact_arrangement
-from passmd.protocols import stall
+from passmd.protocols import fit, ringing, stall
 from passmd.protocols.maps import compute_map
+from passmd.protocols.synthetic import independent_steps
 from passmd.runtime.config import PROFILES, RunConfig
 from passmd.runtime.units import from_si
 from passmd.runtime.validation import check_choice
 
 __all__ = [
-    "FIGURES",
-    "EXAMPLE_DRIVE_FILE",
-    "NOISE_NM",
-    "PROFILE_SETTINGS",
-    "SEED",
-    "START",
-    "ProfileSettings",
-    "contact_table",
-    "critical_amplitude_curve",
-    "curve_from_maps",
-    "example_drive",
-    "gain_map",
-    "map_axes",
-    "map_points",
-    "parameter_table",
-    "preload_points",
-    "run_config",
-    "stall_force_curve",
-    "stall_frame",
-    "stall_points",
-    "step_velocity_map",
+    "EXAMPLE_DRIVE_FILE", "FIGURES", "HELDBACK_LABELS", "NOISE_NM", "PROFILE_SETTINGS", "SEED", "START",
+    "ProfileSettings", "calibrate", "contact_table", "critical_amplitude_curve", "curve_from_maps",
+    "example_drive", "gain_map", "heldback_predictions", "load_fitted", "map_axes", "map_points",
+    "parameter_table", "preload_points", "profile_of", "ringing_frame", "run_config", "stall_force_curve",
+    "stall_frame", "stall_points", "start_drive", "step_velocity_map", "synthetic_measurements",
 ]
 
 #: The example drive file (package data, so an installed wheel has it too; ``passmd drive template
@@ -128,8 +118,9 @@ def _settings(profile: str) -> ProfileSettings:
     return PROFILE_SETTINGS[check_choice("profile", profile, PROFILES)]
 
 
-def _run_config(config: RunConfig | None, profile: str) -> RunConfig:
-    """``config`` with the profile's executor where it names none (an explicit choice wins)."""
+def run_config(config: RunConfig | None, profile: str) -> RunConfig:
+    """The run configuration of the chapter's sweeps on ``profile``: ``config`` with the profile's
+    executor (:data:`PROFILE_SETTINGS`) where it names none (an explicit choice wins)."""
     config = RunConfig() if config is None else config
     executor = _settings(profile).executor
     if config.executor is None and config.scheduler is None and executor is not None:
@@ -175,11 +166,6 @@ def _group_text(group: dict) -> str:
     return text + (f", F_N = {group['normal_force']:.4g} N" if "normal_force" in group else "")
 
 
-def run_config(config: RunConfig | None, profile: str) -> RunConfig:
-    """The run configuration of the chapter's sweeps on ``profile`` (:data:`PROFILE_SETTINGS`)."""
-    return _run_config(config, profile)
-
-
 def contact_table(drive: Drive) -> pd.DataFrame:
     """Each contact group of ``drive`` as ``passmd drive show`` lists it: side, count, contact angle,
     radius, normal force per contact and where it comes from (given, or Eq. 1's balance)."""
@@ -201,8 +187,9 @@ def preload_points(drive: Drive, profile: str) -> list[dict]:
              "preload_N": float(p)} for p in _settings(profile).preloads]
 
 
-def curve_from_maps(steady: pd.DataFrame, first: pd.DataFrame) -> pd.DataFrame:
-    """A_c against preload from the two ``critical-amplitude`` maps (readings ``steady``, ``first``).
+def curve_from_maps(steady: pd.DataFrame, first: pd.DataFrame, full_stroke: float) -> pd.DataFrame:
+    """A_c against preload from the two ``critical-amplitude`` maps (readings ``steady``, ``first``),
+    with the actuator's ``full_stroke`` (m) as ``attrs["full_stroke_nm"]``.
 
     Columns (nm, N, Hz): ``preload_N``, ``closed_form_nm``, ``steady_nm``, ``first_nm``, and the
     runner's ringing at the steady A_c (:func:`passmd.protocols.ringing.at_frequency`):
@@ -212,7 +199,7 @@ def curve_from_maps(steady: pd.DataFrame, first: pd.DataFrame) -> pd.DataFrame:
     def nm(values):
         return [math.nan if v is None else float(v) * 1e9 for v in values]
 
-    return pd.DataFrame({
+    curve = pd.DataFrame({
         "preload_N": steady["preload_N"].to_numpy(float),
         "closed_form_nm": steady["analytic_critical_amplitude_m"].to_numpy(float) * 1e9,
         "steady_nm": nm(steady["critical_amplitude_m"]), "first_nm": nm(first["critical_amplitude_m"]),
@@ -220,18 +207,20 @@ def curve_from_maps(steady: pd.DataFrame, first: pd.DataFrame) -> pd.DataFrame:
         "ringing_amplitude_nm": nm(steady["ringing_amplitude_m"]),
         "ringing_left_nm": nm(steady["ringing_at_next_flyback_m"]),
         "ringing_affects": steady["ringing_affects_steps"].astype(bool).to_numpy()})
+    curve.attrs["full_stroke_nm"] = full_stroke * 1e9
+    return curve
 
 
 def critical_amplitude_curve(drive: Drive, profile: str, config: RunConfig | None = None) -> pd.DataFrame:
     """A_c against preload at Section 4.1's frequency: the closed form (Eqs. 7–8, 11–12) and the
     two simulated readings (``steady``, ``first``), as ``passmd sweep critical-amplitude``
     (:func:`curve_from_maps`)."""
-    config = _run_config(config, profile)
+    config = run_config(config, profile)
     points = preload_points(drive, profile)
     steady, first = (compute_map("critical-amplitude", points, reading=reading, config=config,
                                  description=f"A_c ({reading}) against preload")
                      for reading in ("steady", "first"))
-    return curve_from_maps(steady, first)
+    return curve_from_maps(steady, first, drive.actuator.full_stroke_amplitude)
 
 
 def map_axes(drive: Drive, profile: str) -> tuple[np.ndarray, np.ndarray]:
@@ -251,13 +240,13 @@ def map_points(drive: Drive, profile: str) -> list[dict]:
 
 def step_velocity_map(drive: Drive, profile: str, config: RunConfig | None = None) -> pd.DataFrame:
     """Steady velocity, step and back-step of the saw-tooth over the map grid (``passmd sweep velocity``)."""
-    return compute_map("velocity", map_points(drive, profile), config=_run_config(config, profile),
+    return compute_map("velocity", map_points(drive, profile), config=run_config(config, profile),
                        description="step/velocity map")
 
 
 def gain_map(drive: Drive, profile: str, config: RunConfig | None = None) -> pd.DataFrame:
     """Eq. 15 waveform's steady velocity minus the saw-tooth's over the map grid (``passmd sweep gain``)."""
-    return compute_map("gain", map_points(drive, profile), config=_run_config(config, profile),
+    return compute_map("gain", map_points(drive, profile), config=run_config(config, profile),
                        description="Eq. 15 gain map")
 
 
@@ -275,7 +264,7 @@ def stall_force_curve(drive: Drive, profile: str, config: RunConfig | None = Non
     """Generated force at stall against the amplitude at Section 4.2's frequency, per preload
     (``passmd sweep stall-force``), with the Coulomb bound μ·ΣF_N of each preload (:func:`stall_frame`)."""
     points = stall_points(drive, profile)
-    table = compute_map("stall-force", points, config=_run_config(config, profile), description="stall force")
+    table = compute_map("stall-force", points, config=run_config(config, profile), description="stall force")
     return stall_frame(points, table)
 
 
@@ -294,5 +283,164 @@ def stall_frame(points: list[dict], table: pd.DataFrame) -> pd.DataFrame:
     })
 
 
-#: The chapter's rows of the figure table: none (see the module's docstring).
-FIGURES = ()
+def ringing_frame(probe: dict) -> pd.DataFrame:
+    """The swing of a :func:`~passmd.protocols.ringing.stick_ringing` probe against the time since the
+    fly-back (``swing_times_s``, ``swing_amplitudes_m``); ``attrs``: its ``ringing_frequency_Hz`` and
+    ``flyback_time_s``, the measurable step (``measurable_m``) and the drive frequencies whose next
+    fly-back the chapter marks (``next_flyback_Hz``: Section 4.1's and 1 kHz)."""
+    frame = pd.DataFrame({key: np.asarray(probe[key]) for key in ("swing_times_s", "swing_amplitudes_m")})
+    frame.attrs.update(ringing_frequency_Hz=probe["ringing_frequency_Hz"], measurable_m=ringing.MEASURABLE,
+                       flyback_time_s=probe["flyback_time_s"],
+                       next_flyback_Hz=(PROTOCOL.drive_frequency, 1e3))
+    return frame
+
+
+def start_drive(truth: Drive, free: Sequence[str]) -> Drive:
+    """A designer's first guess: ``truth`` with each parameter named in ``free`` at the paper's value
+    (μ of Table 1; k_p of Table 2 for the drive's radius, c_p kept)."""
+    drive = truth
+    for name in free:
+        if name == "friction_coefficient":
+            drive = replace(drive, friction_coefficient=Drive().friction_coefficient)
+        elif name == "actuator.stiffness":
+            table2 = actuator_for_radius(truth.hemisphere_radius).stiffness
+            drive = fit.FREE_PARAMETERS[name].set(drive, table2, truth)
+        else:
+            raise ValueError(f"free = {name!r}: the example's first guess knows friction_coefficient and "
+                             "actuator.stiffness")
+    return drive
+
+
+def _measurements(points, truth: Drive, rng, config, flyback=None) -> fit.Measurements:
+    """Steps at (frequency, preload, amplitude nm) points:
+    :func:`~passmd.protocols.synthetic.independent_steps` below 1 kHz (the
+    steady-velocity protocol's step above, as a stand measures it there) plus noise of NOISE_NM."""
+    header = ["amplitude_nm", "preload_N", "frequency_Hz", "step_nm", "step_nm_sd"]
+    rows = [[repr(float(a)), repr(float(p)), repr(float(f)), "0", repr(NOISE_NM)] for f, p, a in points]
+    data = fit.measurements_from_rows(header, rows, name="synthetic measurements")
+    low = [i for i, (f, _, _) in enumerate(points) if f < 1e3]
+    exact = np.array(fit.predict(truth, data, config=config))  # the steady-velocity protocol above 1 kHz
+    if low:
+        conditions = [(points[i][1], points[i][2] * 1e-9, points[i][0]) for i in low]
+        exact[low] = independent_steps(truth, conditions, flyback=flyback, config=config, executor=None,
+                                       cache=True)
+    return replace(data, value=exact + rng.normal(0.0, NOISE_NM * 1e-9, exact.size))
+
+
+def synthetic_measurements(truth: Drive, profile: str, config: RunConfig | None = None, flyback=None
+                           ) -> tuple[fit.Measurements, fit.Measurements]:
+    """Steps of ``truth`` made independently of the fit's forward model
+    (:func:`~passmd.protocols.synthetic.independent_steps`), plus Gaussian noise of
+    NOISE_NM (seed SEED): ``(fit data, held-back data)``; ``flyback`` overrides the drive's fly-back
+    rule in the data (a mis-specified model)."""
+    s = PROFILE_SETTINGS[profile]
+    config = run_config(config, profile)
+    rng = np.random.default_rng(SEED)
+    fit_points = [(FIT_FREQUENCY, p, a) for p in s.fit_preloads for a in s.fit_amplitudes_nm]
+    return (_measurements(fit_points, truth, rng, config, flyback),
+            _measurements(s.heldback, truth, rng, config, flyback))
+
+
+def calibrate(start: Drive, data: fit.Measurements, profile: str,
+              config: RunConfig | None = None) -> fit.FitResult:
+    """The fit of the profile's free parameters to ``data`` from ``start`` (``passmd fit``'s defaults)."""
+    return fit.fit(start, data, list(PROFILE_SETTINGS[profile].free), config=run_config(config, profile))
+
+
+def load_fitted(text: str) -> Drive:
+    """The drive a drive file's text describes, read as ``--drive`` reads a file
+    (:func:`passmd.model.drive_file.load_drive`)."""
+    with tempfile.TemporaryDirectory(prefix="passmd-design-") as folder:
+        path = Path(folder) / "fitted-drive.toml"
+        path.write_text(text, encoding="utf-8")
+        return load_drive(path)
+
+
+def heldback_predictions(heldback: fit.Measurements, drives: dict[str, Drive], profile: str,
+                         config: RunConfig | None = None) -> pd.DataFrame:
+    """The held-back measurements and each drive's prediction of them (nm), one row per point.
+
+    ``drives``: label -> drive (e.g. the first guess and the fitted drive); a column
+    ``<label>_nm`` each, and the legend text of each in ``attrs["labels"]`` (:data:`HELDBACK_LABELS`).
+    """
+    out = pd.DataFrame({"frequency_Hz": heldback.frequency, "preload_N": heldback.preload,
+                        "amplitude_nm": heldback.amplitude * 1e9, "measured_nm": heldback.value * 1e9,
+                        "sd_nm": heldback.sd * 1e9})
+    config = run_config(config, profile)
+    for label, drive in drives.items():
+        out[f"{label}_nm"] = fit.predict(drive, heldback, config=config) * 1e9
+    out.attrs["labels"] = {label: HELDBACK_LABELS.get(label, label) for label in drives}
+    return out
+
+
+def profile_of(result: fit.FitResult, truth: Drive) -> pd.DataFrame:
+    """The profile of the last free parameter of ``result``
+    (:meth:`~passmd.protocols.fit.result.FitResult.profile_table`) with the value ``truth`` has."""
+    name = result.names[-1]
+    table = result.profile_table(name)
+    table.attrs["truth"] = fit.FREE_PARAMETERS[name].get(truth)
+    return table
+
+
+#: Legend text of the held-back predictions, by drive label (:func:`heldback_predictions`).
+HELDBACK_LABELS = {"start": "first guess (paper's values)", "fitted": "fitted drive file"}
+
+
+def _calibration(config: RunConfig) -> tuple[fit.FitResult, Drive, pd.DataFrame]:
+    """The chapter's calibration on ``config.profile``: the fit from the first guess (of the measurements
+    as ``passmd fit`` reads them from their file: the amplitudes pass through nm), the example drive
+    that made the data, and the held-back measurements with each drive's prediction."""
+    truth, sources = example_drive()
+    start = start_drive(truth, _settings(config.profile).free)
+    data, heldback = synthetic_measurements(truth, config.profile, config)
+    with tempfile.TemporaryDirectory(prefix="passmd-design-") as folder:  # read back as the page reads it
+        path = Path(folder) / "design_measurements.csv"
+        fit.write_measurements(path, data)
+        result = calibrate(start, fit.read_measurements(path), config.profile, config)
+    fitted = load_fitted(fit.fitted_drive_file(result, "design_measurements.csv", sources))
+    return result, truth, heldback_predictions(heldback, {"start": start, "fitted": fitted}, config.profile,
+                                               config)
+
+
+def _no_drive(table: pd.DataFrame) -> pd.DataFrame:
+    return table.drop(columns=["drive"], errors="ignore")
+
+
+def _example() -> Drive:
+    return example_drive()[0]
+
+
+def _ringing(config: RunConfig) -> pd.DataFrame:
+    drive = _example()
+    return ringing_frame(ringing.stick_ringing(drive, drive.actuator.full_stroke_amplitude,
+                                               frequency=PROTOCOL.drive_frequency))
+
+
+def _example_row(name: str, title: str, compute, plot: str) -> FigureSpec:
+    return FigureSpec(name, title, "design_your_drive", compute, plot)
+
+
+#: The chapter's rows of the figure table: every figure it shows, on the example drive.
+FIGURES = (
+    _example_row("design_critical_amplitude", "Example drive: A_c against preload, closed form and the two "
+                 "simulated readings", lambda c: critical_amplitude_curve(_example(), c.profile, c),
+                 "design:critical_amplitude_figure"),
+    _example_row("design_ringing", "Example drive: the runner's swing after a fly-back against time",
+                 _ringing, "design:ringing_figure"),
+    _example_row("design_step_map", "Example drive: steady step of the saw-tooth over frequency × amplitude",
+                 lambda c: _no_drive(step_velocity_map(_example(), c.profile, c)), "design:step_map_figure"),
+    _example_row("design_velocity_map", "Example drive: steady velocity of the saw-tooth over frequency × "
+                 "amplitude", lambda c: _no_drive(step_velocity_map(_example(), c.profile, c)),
+                 "design:velocity_map_figure"),
+    _example_row("design_gain_map", "Example drive: Eq. 15 waveform's steady velocity minus the saw-tooth's",
+                 lambda c: _no_drive(gain_map(_example(), c.profile, c)), "design:gain_map_figure"),
+    _example_row("design_stall_force", "Example drive: stall force against amplitude, with μ·ΣF_N",
+                 lambda c: stall_force_curve(_example(), c.profile, c), "design:stall_force_figure"),
+    _example_row("design_fit", "Example drive's calibration: synthetic steps against the fitted model",
+                 lambda c: _calibration(c)[0].residual_table(), "fit:fit_figure"),
+    _example_row("design_profile", "Example drive's calibration: the profile of the last free parameter",
+                 lambda c: profile_of(*_calibration(c)[:2]),
+                 "fit:profile_figure"),
+    _example_row("design_heldback", "Example drive: held-back steps against the first guess and the fitted "
+                 "drive", lambda c: _calibration(c)[2], "design:heldback_figure"),
+)

@@ -16,6 +16,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+import pandas as pd
 
 from passmd.model.parameters import Drive
 from passmd.protocols.fit.measurements import (
@@ -76,14 +77,37 @@ class FitResult:
         """(measured − predicted) / σ per row."""
         return (self.data.value - self.predicted) / self.weights
 
+    def residual_table(self) -> pd.DataFrame:
+        """One row per measurement, values in its column's display unit (``unit``): the preload (the
+        drive's where the row gives none), the amplitude (nm), measured, sd, predicted and the
+        normalised residual. ``attrs``: the ``estimates`` (name -> value, SI) and ``goodness_of_fit``."""
+        data = self.data
+        scale, unit = zip(*(data.display(i) for i in range(len(data))), strict=True)
+        table = pd.DataFrame({
+            "line": data.line, "quantity": data.column, "kind": data.kind, "unit": unit,
+            "preload_N": np.where(np.isfinite(data.preload), data.preload, self.base.preload),
+            "amplitude_nm": data.amplitude * 1e9, "measured": data.value / scale, "sd": data.sd / scale,
+            "predicted": self.predicted / scale, "normalized_residual": self.residuals})
+        table.attrs.update(estimates={n: self.estimates[n]["value"] for n in self.names},
+                           goodness_of_fit=dict(self.goodness_of_fit))
+        return table
+
+    def profile_table(self, name: str) -> pd.DataFrame:
+        """The profile of the free parameter ``name``: ``value`` (SI), ``cost`` and ``rise`` (the cost
+        above the minimum in units of s²). ``attrs``: ``parameter``, ``unit``, ``level`` (the 95 %
+        rise), ``intervals`` (the region's pieces) and ``basins`` (their values)."""
+        est = self.estimates[name]
+        table = pd.DataFrame({"value": est["profile"]["value"], "cost": est["profile"]["cost"]})
+        table["rise"] = (table["cost"] - self.cost) / self.scale ** 2
+        table.attrs.update(parameter=name, unit=est["unit"], level=self.level,
+                           intervals=[tuple(piece) for piece in est["intervals"]],
+                           basins=[basin["value"] for basin in est["basins"]])
+        return table
+
     def report(self) -> dict:
         """The JSON report (SI units; keys as the command line's --json)."""
-        rows = []
-        for i in range(len(self.data)):
-            scale, unit = self.data.display(i)
-            rows.append({"line": self.data.line[i], "quantity": self.data.column[i],
-                         "measured": self.data.value[i] / scale, "predicted": self.predicted[i] / scale,
-                         "unit": unit, "normalized_residual": float(self.residuals[i])})
+        rows = self.residual_table()[["line", "quantity", "measured", "predicted", "unit",
+                                      "normalized_residual"]].to_dict("records")
         return {
             "estimates": {n: {k: v for k, v in self.estimates[n].items()} for n in self.names},
             "residuals": rows,
