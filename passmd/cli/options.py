@@ -55,12 +55,8 @@ class Quantity:
     def add(self, parser) -> None:
         unit = f"[{self.unit}]" if si_factor(self.unit) == 1.0 else f"[{self.unit}; unit required]"
         unit = unit if self.unit else "[-]"
-        parser.add_argument(
-            self.flag,
-            metavar=self.symbol,
-            default=None,
-            help=f"{self.text} {unit} (default: {self.default})",
-        )
+        parser.add_argument(self.flag, metavar=self.symbol, default=None,
+                            help=f"{self.text} {unit} (default: {self.default})")
 
     def parse(self, args) -> float | None:
         """SI value of the option, ``None`` if not given; range checked in display units."""

@@ -433,13 +433,5 @@ def optimized(
         parts_x.append(rest.positions[1:])
         windows.append(offset + rest.settle_windows)
         marks.append(offset + rest.slip_marks)
-    return Waveform(
-        np.concatenate(parts_t),
-        np.concatenate(parts_x),
-        T,
-        periods,
-        np.concatenate(windows),
-        np.concatenate(marks),
-        kind,
-        A,
-    )
+    return Waveform(np.concatenate(parts_t), np.concatenate(parts_x), T, periods, np.concatenate(windows),
+                    np.concatenate(marks), kind, A)

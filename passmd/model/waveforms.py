@@ -155,16 +155,8 @@ class Waveform:
 
     def mirrored(self) -> Waveform:
         """The same waveform with x_p → −x_p (drives the runner the other way)."""
-        return Waveform(
-            self.times,
-            -self.positions,
-            self.period,
-            self.periods,
-            self.settle_windows,
-            self.slip_marks,
-            self.kind,
-            self.amplitude,
-        )
+        return Waveform(self.times, -self.positions, self.period, self.periods, self.settle_windows,
+                        self.slip_marks, self.kind, self.amplitude)
 
 
 def flyback_rule(drive: Drive, flyback=None) -> str | float:
@@ -275,16 +267,8 @@ def sawtooth(
         positions += [A * (1.0 - frac), A, 0.0]
         windows.append((ws, we))
         marks.append(we)
-    return Waveform(
-        np.array(times),
-        np.array(positions),
-        T,
-        periods,
-        np.array(windows),
-        np.array(marks),
-        "sawtooth",
-        A,
-    )
+    return Waveform(np.array(times), np.array(positions), T, periods, np.array(windows), np.array(marks),
+                    "sawtooth", A)
 
 
 def check_flyback_fits(t_fb: float, frequency: float) -> None:

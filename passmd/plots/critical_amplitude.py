@@ -37,15 +37,8 @@ def _band(ax, rows: pd.DataFrame, colour: str, label: str) -> None:
     if freqs.size < 2:
         return
     spread = steady.groupby("preload_N")["critical_amplitude_nm"].agg(["min", "max"])
-    ax.fill_between(
-        spread.index,
-        spread["min"],
-        spread["max"],
-        color=colour,
-        alpha=0.15,
-        lw=0,
-        label=f"{label}, {freqs.min():g}–{freqs.max():g} Hz",
-    )
+    ax.fill_between(spread.index, spread["min"], spread["max"], color=colour, alpha=0.15, lw=0,
+                    label=f"{label}, {freqs.min():g}–{freqs.max():g} Hz")
 
 
 def _simulated(ax, rows: pd.DataFrame, colour: str, name: str, flexible: bool) -> None:
@@ -56,45 +49,19 @@ def _simulated(ax, rows: pd.DataFrame, colour: str, name: str, flexible: bool) -
     if "damping_ratio" in rows:
         rows = rows[np.isclose(rows["damping_ratio"], ACTUATOR_DAMPING_RATIO, rtol=1e-9, atol=0)]
     main = _steady(rows, "slew")
-    ax.plot(
-        main["preload_N"],
-        main["critical_amplitude_nm"],
-        "o-",
-        color=colour,
-        ms=4,
-        label=f"{name}, steady state {PROTOCOL.drive_frequency:g} Hz",
-    )
+    ax.plot(main["preload_N"], main["critical_amplitude_nm"], "o-", color=colour, ms=4,
+            label=f"{name}, steady state {PROTOCOL.drive_frequency:g} Hz")
     _band(ax, rows, colour, f"{name}, steady state")
     first = _first(rows, "slew")
-    ax.plot(
-        first["preload_N"],
-        first["critical_amplitude_nm"],
-        "s",
-        mfc="none",
-        color=colour,
-        ms=5,
-        label=f"{name}, first fly-back",
-    )
+    ax.plot(first["preload_N"], first["critical_amplitude_nm"], "s", mfc="none", color=colour, ms=5,
+            label=f"{name}, first fly-back")
     if flexible:
         fixed = _steady(rows, "fixed")
-        ax.plot(
-            fixed["preload_N"],
-            fixed["critical_amplitude_nm"],
-            "^--",
-            color=colour,
-            ms=4,
-            lw=0.8,
-            label=f"{name}, steady state, 2 µs fly-back",
-        )
+        ax.plot(fixed["preload_N"], fixed["critical_amplitude_nm"], "^--", color=colour, ms=4, lw=0.8,
+                label=f"{name}, steady state, 2 µs fly-back")
         first_fixed = _first(rows, "fixed")
-        ax.plot(
-            first_fixed["preload_N"],
-            first_fixed["critical_amplitude_nm"],
-            "x",
-            color=colour,
-            ms=5,
-            label=f"{name}, first fly-back, 2 µs fly-back",
-        )
+        ax.plot(first_fixed["preload_N"], first_fixed["critical_amplitude_nm"], "x", color=colour, ms=5,
+                label=f"{name}, first fly-back, 2 µs fly-back")
 
 
 def _closed(ax, rows: pd.DataFrame, column: str, colour: str, label: str, style: str = "--") -> None:
@@ -128,36 +95,15 @@ def plot_fig5a(df: pd.DataFrame):
         for (model, flyback), rows in df.groupby(["actuator_model", "flyback"], sort=False):
             colour, name = styles[(model, flyback)]
             rows = rows.sort_values("amplitude_nm")
-            ax.plot(
-                rows["amplitude_nm"],
-                rows["steady_step_nm"],
-                "-",
-                color=colour,
-                lw=1.4,
-                label=f"{name}: steady-state step",
-            )
-            ax.plot(
-                rows["amplitude_nm"],
-                rows["first_step_nm"],
-                ":",
-                color=colour,
-                lw=1.2,
-                label=f"{name}: first step",
-            )
-        ax.axhline(
-            first["threshold_nm"],
-            color="tab:red",
-            lw=0.8,
-            label=f"measurable step {first['threshold_nm']:g} nm",
-        )
+            ax.plot(rows["amplitude_nm"], rows["steady_step_nm"], "-", color=colour, lw=1.4,
+                    label=f"{name}: steady-state step")
+            ax.plot(rows["amplitude_nm"], rows["first_step_nm"], ":", color=colour, lw=1.2,
+                    label=f"{name}: first step")
+        ax.axhline(first["threshold_nm"], color="tab:red", lw=0.8,
+                   label=f"measurable step {first['threshold_nm']:g} nm")
         ax.axvline(first["u_x_max_nm"], color="tab:green", ls="--", lw=0.8, label="$u_{x,max}$ (Eq. 7)")
-        ax.axvline(
-            first["u_x_max_plus_u_x_a_nm"],
-            color="black",
-            ls="--",
-            lw=0.8,
-            label="$u_{x,max} + u_{x,a}$ (Eq. 8)",
-        )
+        ax.axvline(first["u_x_max_plus_u_x_a_nm"], color="black", ls="--", lw=0.8,
+                   label="$u_{x,max} + u_{x,a}$ (Eq. 8)")
         ax.set_xlabel("actuation amplitude $A$ (nm)")
         ax.set_ylabel("step size (nm)")
         ax.grid(alpha=0.3)
@@ -234,14 +180,8 @@ def plot_viscosity(df: pd.DataFrame):
             sel = rows[(rows["protocol"] == protocol) & (rows["flyback"] == flyback)].sort_values(
                 "actuator_viscosity_kg_per_s"
             )
-            ax.plot(
-                sel["actuator_viscosity_kg_per_s"],
-                sel["critical_amplitude_nm"],
-                style,
-                color=colour,
-                ms=4,
-                label=label,
-            )
+            ax.plot(sel["actuator_viscosity_kg_per_s"], sel["critical_amplitude_nm"], style, color=colour,
+                    ms=4, label=label)
         if len(rows):
             eq = "Eq. 8" if n == 1 else "Eq. 12"
             closed = rows["closed_form_nm"].iloc[0]
@@ -275,20 +215,12 @@ def plot_frequency(df: pd.DataFrame):
             sel = rows[rows["actuator_model"] == model].sort_values("frequency_Hz")
             if not len(sel):
                 continue
-            for protocol, style, label in (
-                ("steady", "o-", "steady state"),
-                ("first", "s:", "first fly-back"),
-            ):
+            for protocol, style, label in (("steady", "o-", "steady state"),
+                                           ("first", "s:", "first fly-back")):
                 part = sel[sel["protocol"] == protocol]
-                ax.plot(
-                    part["frequency_Hz"],
-                    part["critical_amplitude_nm"],
-                    style,
-                    color=COLOURS[model],
-                    ms=4,
-                    mfc=COLOURS[model] if protocol == "steady" else "none",
-                    label=f"$A_c$ {model}, {label}",
-                )
+                ax.plot(part["frequency_Hz"], part["critical_amplitude_nm"], style, color=COLOURS[model],
+                        ms=4, mfc=COLOURS[model] if protocol == "steady" else "none",
+                        label=f"$A_c$ {model}, {label}")
             eq = {
                 (1, "rigid"): "Eq. 7",
                 (1, "flexible"): "Eq. 8",

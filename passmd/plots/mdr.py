@@ -51,13 +51,8 @@ def plot_springs(df: pd.DataFrame):
     )
     limit = from_si(first["friction_coefficient"] * df["normal_force_N"].to_numpy(), "mN")
     bx.fill_between(x_um, -limit, limit, color="0.9", label=r"stick range $\pm\mu f_{z,i}$")
-    bx.scatter(
-        x_um,
-        from_si(df["tangential_force_N"].to_numpy(), "mN"),
-        c=[_COLOURS[s] for s in status],
-        s=18,
-        zorder=3,
-    )
+    bx.scatter(x_um, from_si(df["tangential_force_N"].to_numpy(), "mN"), c=[_COLOURS[s] for s in status],
+               s=18, zorder=3)
     bx.axhline(0, color="0.5", lw=0.5)
     bx.set_xlabel("spring position x (µm)")
     bx.set_ylabel("$f_{x,i}$ (mN)")
@@ -100,14 +95,8 @@ def plot_virgin(df: pd.DataFrame):
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(9, 3.6))
     ax.plot(u_nm, from_si(df["cattaneo_mindlin_N"], "mN"), "k-", lw=2.5, alpha=0.35, label="Cattaneo–Mindlin")
     ax.plot(u_nm, from_si(df["exact_N"], "mN"), "C0-", lw=1, label="exact MDR")
-    ax.plot(
-        u_nm[::4],
-        from_si(df[f"discrete_{counts[0]}_N"][::4], "mN"),
-        "C3o",
-        ms=4,
-        mfc="none",
-        label=f"discrete, N = {counts[0]}",
-    )
+    ax.plot(u_nm[::4], from_si(df[f"discrete_{counts[0]}_N"][::4], "mN"), "C3o", ms=4, mfc="none",
+            label=f"discrete, N = {counts[0]}")
     ax.set_xlabel("tangential displacement u (nm)")
     ax.set_ylabel("friction force T (mN)")
     ax.legend()
@@ -130,12 +119,8 @@ def plot_hysteresis(df: pd.DataFrame):
     ax.plot(u_nm, from_si(df["exact_N"], "mN"), "C0-", lw=1, label="exact MDR")
     ax.plot(u_nm[::5], from_si(df[f"discrete_{n}_N"][::5], "mN"), "C3.", ms=4, label=f"discrete, N = {n}")
     for row in df[df["turn"] != ""].itertuples():
-        ax.annotate(
-            row.turn,
-            (from_si(row.u_m, "nm"), from_si(row.exact_N, "mN")),
-            textcoords="offset points",
-            xytext=(6, -4),
-        )
+        ax.annotate(row.turn, (from_si(row.u_m, "nm"), from_si(row.exact_N, "mN")),
+                    textcoords="offset points", xytext=(6, -4))
     ax.set_xlabel("tangential displacement u (nm)")
     ax.set_ylabel("friction force T (mN)")
     ax.legend(loc="upper left", fontsize=8)
@@ -167,12 +152,8 @@ def plot_cost(df: pd.DataFrame):
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.loglog(disc["springs"], disc["ns_per_call_median"], "o-", label="discrete MDR, contact_update")
     for _, row in exact.iterrows():
-        ax.axhline(
-            row["ns_per_call_median"],
-            ls="--" if row["path"] == "ring-down" else "-",
-            color="C1",
-            label=f"exact MDR, {row['path']} path",
-        )
+        ax.axhline(row["ns_per_call_median"], ls="--" if row["path"] == "ring-down" else "-", color="C1",
+                   label=f"exact MDR, {row['path']} path")
     ax.set_xlabel("springs N")
     ax.set_ylabel("cost per call (ns)")
     ax.legend()

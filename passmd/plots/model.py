@@ -24,20 +24,11 @@ def plot_sawtooth(df: pd.DataFrame):
     ax.set_xlabel("time $t$ (ms)")
     ax.set_ylabel("piezo position $x_p$ (nm)")
     ax.set_ylim(-20, from_si(amplitude, "nm") * 1.25)
-    ax.annotate(
-        "stick phase: slow ramp",
-        xy=(from_si(0.45 * ramp_end, "ms"), from_si(0.45 * amplitude, "nm")),
-        xytext=(0.5, 215),
-        arrowprops={"arrowstyle": "->"},
-        fontsize=9,
-    )
-    ax.annotate(
-        "slip phase: fly-back",
-        xy=(from_si(ramp_end, "ms"), from_si(0.6 * amplitude, "nm")),
-        xytext=(12.5, 215),
-        arrowprops={"arrowstyle": "->"},
-        fontsize=9,
-    )
+    ax.annotate("stick phase: slow ramp",
+                xy=(from_si(0.45 * ramp_end, "ms"), from_si(0.45 * amplitude, "nm")), xytext=(0.5, 215),
+                arrowprops={"arrowstyle": "->"}, fontsize=9)
+    ax.annotate("slip phase: fly-back", xy=(from_si(ramp_end, "ms"), from_si(0.6 * amplitude, "nm")),
+                xytext=(12.5, 215), arrowprops={"arrowstyle": "->"}, fontsize=9)
     # Zoom on the first fly-back, which lasts microseconds in a period of milliseconds.
     inset = ax.inset_axes([0.72, 0.2, 0.25, 0.5])
     zoom = (t > ramp_end - 3e-6) & (t < ramp_end + 5e-6)
@@ -63,12 +54,8 @@ def _damper(ax, x0, x1, y, width=0.22):
     xm = 0.5 * (x0 + x1)
     ax.plot([x0, xm - 0.05], [y, y], color="k", lw=1.2)
     ax.plot([xm - 0.05, xm - 0.05], [y - width, y + width], color="k", lw=1.2)
-    ax.plot(
-        [xm - 0.25, xm + 0.25, xm + 0.25, xm - 0.25],
-        [y - 1.4 * width, y - 1.4 * width, y + 1.4 * width, y + 1.4 * width],
-        color="k",
-        lw=1.2,
-    )
+    ax.plot([xm - 0.25, xm + 0.25, xm + 0.25, xm - 0.25],
+            [y - 1.4 * width, y - 1.4 * width, y + 1.4 * width, y + 1.4 * width], color="k", lw=1.2)
     ax.plot([xm + 0.25, x1], [y, y], color="k", lw=1.2)
 
 
@@ -124,12 +111,8 @@ def plot_free_body(df: pd.DataFrame):
         ax.text(7.25, yf, f"${count}F_{{f{label}}}$", color="C3", va="center", fontsize=10)
         # normal force pressing the hemisphere onto the runner
         top = y + sgn * 0.45
-        ax.annotate(
-            "",
-            xy=(6.6, top),
-            xytext=(6.6, top + sgn * 0.7),
-            arrowprops={"arrowstyle": "->", "color": "C2", "lw": 1.2},
-        )
+        ax.annotate("", xy=(6.6, top), xytext=(6.6, top + sgn * 0.7),
+                    arrowprops={"arrowstyle": "->", "color": "C2", "lw": 1.2})
         ax.text(6.7, top + sgn * 0.45, f"$F_{{N{label}}}$", color="C2", va="center", fontsize=10)
         _coordinate(ax, 5.2, top + sgn * 0.3, f"$x_{{a{label}}}$")
     ax.set_xlim(0.4, 10.8)
@@ -161,29 +144,15 @@ def plot_cross_section(df: pd.DataFrame):
         # actuator block behind the hemisphere, oriented along the normal
         bx, by = cx + 2 * r * nx, cy + 2 * r * ny
         ax.add_patch(
-            patches.Rectangle(
-                (bx - 0.25, by - 0.12),
-                0.5,
-                0.24,
-                angle=np.degrees(np.arctan2(ny, nx)) + 90,
-                rotation_point=(bx, by),
-                fc="#f2e0c9",
-                ec="k",
-            )
+            patches.Rectangle((bx - 0.25, by - 0.12), 0.5, 0.24, angle=np.degrees(np.arctan2(ny, nx)) + 90,
+                              rotation_point=(bx, by), fc="#f2e0c9", ec="k")
         )
         tip = (cx + 0.02 * nx, cy + 0.02 * ny)
         tail = (cx + 1.1 * nx, cy + 1.1 * ny)
         ax.annotate("", xy=tip, xytext=tail, arrowprops={"arrowstyle": "->", "color": "C2", "lw": 1.5})
         label = f"$F_{{N{side}}}$" + (" (×2 along the runner)" if n == 2 else "")
-        ax.text(
-            tail[0] + 0.05 * np.sign(nx),
-            tail[1] + 0.08 * np.sign(ny),
-            label,
-            color="C2",
-            ha="left" if nx > 0 else "right",
-            va="center",
-            fontsize=9,
-        )
+        ax.text(tail[0] + 0.05 * np.sign(nx), tail[1] + 0.08 * np.sign(ny), label, color="C2",
+                ha="left" if nx > 0 else "right", va="center", fontsize=9)
     ax.annotate("", xy=(-1.55, 0), xytext=(-2.4, 0), arrowprops={"arrowstyle": "-|>", "lw": 2})
     ax.text(-2.4, 0.15, "preload $F_p$\n(left holder on\nlinear bearing)", fontsize=9, va="bottom")
     ax.plot([2.0, 2.0], [-1.3, 1.3], color="k", lw=2)
@@ -202,29 +171,16 @@ def plot_mdr_loop(df: pd.DataFrame):
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.8))
     # (a) the MDR picture: parabola g(x) - d over a row of springs.
     x = np.linspace(-1.6 * a, 1.6 * a, 400)
-    ax1.plot(
-        from_si(x, "um"),
-        from_si(x**2 / radius - d, "nm"),
-        color="C3",
-        lw=2,
-        label="profile $g(x) - d$, $R_1 = R/2$",
-    )
+    ax1.plot(from_si(x, "um"), from_si(x**2 / radius - d, "nm"), color="C3", lw=2,
+             label="profile $g(x) - d$, $R_1 = R/2$")
     base = -1.6 * d
     for xi in np.linspace(-1.5 * a, 1.5 * a, 31):
         top = min(0.0, xi**2 / radius - d)
-        ax1.plot(
-            from_si(np.array([xi, xi]), "um"),
-            from_si(np.array([base, top]), "nm"),
-            color="C0" if top < 0 else "0.6",
-            lw=1.2,
-        )
+        ax1.plot(from_si(np.array([xi, xi]), "um"), from_si(np.array([base, top]), "nm"),
+                 color="C0" if top < 0 else "0.6", lw=1.2)
     ax1.axhline(0, color="0.6", lw=0.8, ls=":")
-    ax1.annotate(
-        "",
-        xy=(from_si(a, "um"), from_si(-1.15 * d, "nm")),
-        xytext=(from_si(-a, "um"), from_si(-1.15 * d, "nm")),
-        arrowprops={"arrowstyle": "<->"},
-    )
+    ax1.annotate("", xy=(from_si(a, "um"), from_si(-1.15 * d, "nm")),
+                 xytext=(from_si(-a, "um"), from_si(-1.15 * d, "nm")), arrowprops={"arrowstyle": "<->"})
     ax1.text(0, from_si(-1.3 * d, "nm"), "$2a$", ha="center", va="top")
     ax1.set_xlabel("$x$ (µm)")
     ax1.set_ylabel("height (nm)")
@@ -234,14 +190,8 @@ def plot_mdr_loop(df: pd.DataFrame):
     ax2.plot(
         df["u_nm"], df["force_exact_mN"], color="C0", lw=2, label="exact limit (Cattaneo–Mindlin, Masing)"
     )
-    ax2.plot(
-        df["u_nm"],
-        df[f"force_{springs}_springs_mN"],
-        color="C1",
-        lw=1,
-        ls="--",
-        label=f"{springs} springs (Eqs. 4–6)",
-    )
+    ax2.plot(df["u_nm"], df[f"force_{springs}_springs_mN"], color="C1", lw=1, ls="--",
+             label=f"{springs} springs (Eqs. 4–6)")
     limit = first["sliding_force_N"]
     for sgn in (1, -1):
         ax2.axhline(from_si(sgn * limit, "mN"), color="0.5", ls=":", lw=1)

@@ -59,22 +59,14 @@ def plot_coulomb_limit(df: pd.DataFrame):
     """|simulated − Coulomb step| against the factor on the contact moduli, with the expected slope."""
     fig, ax = plt.subplots(figsize=(6.4, 4))
     for label, g in df.groupby("configuration", sort=False):
-        ax.loglog(
-            g["scale"],
-            np.abs(g["difference_m"]) * 1e9,
-            "o-",
-            label=f"{label} (rate {float(g['rate'].iloc[0]):.2f})",
-        )
+        ax.loglog(g["scale"], np.abs(g["difference_m"]) * 1e9, "o-",
+                  label=f"{label} (rate {float(g['rate'].iloc[0]):.2f})")
     k = np.array(sorted(df["scale"].unique()))
     first = df[df["scale"] == k[0]]
     ref = float(np.abs(first["difference_m"]).max() * 1e9)
     expected = float(df["expected_rate"].iloc[0])
-    ax.loglog(
-        k,
-        ref * (k / k[0]) ** -expected,
-        "k:",
-        label=f"slope −{expected:.2f} (presliding $\\propto k^{{-2/3}}$)",
-    )
+    ax.loglog(k, ref * (k / k[0]) ** -expected, "k:",
+              label=f"slope −{expected:.2f} (presliding $\\propto k^{{-2/3}}$)")
     ax.set_xlabel("factor k on the contact moduli E*, G*")
     ax.set_ylabel("|simulated step − Coulomb step| (nm)")
     ax.legend(fontsize=7)

@@ -196,15 +196,10 @@ def first_flyback_slip(
             "take less than half a period"
         )
     period = t_ramp + t_fb + hold
-    wave = waveforms.piecewise_linear(
-        [0.0, 0.8 * t_ramp, t_ramp, t_ramp + t_fb, period],
-        [0.0, 0.8 * A, A, 0.0, 0.0],
-        1.0 / period,
-        1,
-        settle_window=(0.8 * t_ramp, t_ramp),
-        slip_mark=t_ramp,
-        kind="first fly-back",
-    )
+    wave = waveforms.piecewise_linear([0.0, 0.8 * t_ramp, t_ramp, t_ramp + t_fb, period],
+                                      [0.0, 0.8 * A, A, 0.0, 0.0], 1.0 / period, 1,
+                                      settle_window=(0.8 * t_ramp, t_ramp), slip_mark=t_ramp,
+                                      kind="first fly-back")
     result = simulation.simulate(drive, wave, max_points=2)
     peak = result.peak_force_ratio[0]  # every integrator step from the fly-back on
     return {

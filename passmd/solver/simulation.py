@@ -198,15 +198,12 @@ class Simulation:
         G = multiplicity.size
         # work of one step in steps of the exact contact: every spring of a discrete contact counts
         self._step_work = 1.0 + (G * springs / SPRINGS_PER_STEP if contact_model == "discrete" else 0.0)
-        self._buffers = kernels.Buffers(
-            y=np.zeros(2 + 2 * G),
-            work=np.zeros((kernels.WORK_ROWS, G)),
-            carry=np.zeros(kernels.CARRY_SIZE),
-            record=np.empty((int(max_points), 4 + 3 * G)),
-            per=np.zeros((waveform.periods, kernels.PER_COLUMNS)),
-            peak=np.zeros((waveform.periods, G)),
-            energy=np.zeros(kernels.EN_COLUMNS),
-        )
+        self._buffers = kernels.Buffers(y=np.zeros(2 + 2 * G), work=np.zeros((kernels.WORK_ROWS, G)),
+                                        carry=np.zeros(kernels.CARRY_SIZE),
+                                        record=np.empty((int(max_points), 4 + 3 * G)),
+                                        per=np.zeros((waveform.periods, kernels.PER_COLUMNS)),
+                                        peak=np.zeros((waveform.periods, G)),
+                                        energy=np.zeros(kernels.EN_COLUMNS))
         self._segments = segments(waveform, steps.fine, steps.coarse, steps.quiet, steps.longest)
         # pieces of the first n periods: the first _ends[n − 1] (a piece's period never decreases)
         self._ends = np.searchsorted(self._segments.period, np.arange(1, waveform.periods + 1), side="left")

@@ -198,16 +198,8 @@ def step_plan(
         dt = 2 * np.pi / omega / STEPS_PER_RUNNER_PERIOD / refine
         coarse, threshold, quiet = dt, 0.0, 0
     quasi = 2 * np.pi / omega_runner / STEPS_PER_QUASI_RUNNER_PERIOD / refine
-    return StepPlan(
-        float(dt),
-        float(max(coarse, dt)),
-        float(omega / (2 * np.pi)),
-        float(2.0 / omega),
-        float(threshold),
-        quiet,
-        float(max(quasi, dt)),
-        float(LONGEST_OMEGA_DT / omega_runner),
-    )
+    return StepPlan(float(dt), float(max(coarse, dt)), float(omega / (2 * np.pi)), float(2.0 / omega),
+                    float(threshold), quiet, float(max(quasi, dt)), float(LONGEST_OMEGA_DT / omega_runner))
 
 
 def segments(

@@ -55,14 +55,9 @@ def paper_drive_for(
 ) -> Drive:
     """The Fig. 5/6 drive: Tables 1–2, free runner (no load cell), μ (default 0.2, Section 4.1's
     unstated μ: ledger axis ``friction_coefficient``), actuator damping ζ."""
-    return Drive(
-        hemisphere_radius=hemisphere_radius,
-        preload=preload,
-        friction_coefficient=friction_coefficient,
-        contacts=contacts,
-        actuator_model=actuator_model,
-        actuator=actuator_for_radius(hemisphere_radius, damping_ratio=damping_ratio),
-    )
+    return Drive(hemisphere_radius=hemisphere_radius, preload=preload,
+                 friction_coefficient=friction_coefficient, contacts=contacts, actuator_model=actuator_model,
+                 actuator=actuator_for_radius(hemisphere_radius, damping_ratio=damping_ratio))
 
 
 # --------------------------------------------------------------------------------------
@@ -88,15 +83,8 @@ def critical_amplitude_point(
     :func:`paper_drive_for`: one sweep point, SI results."""
     drive = paper_drive_for(contacts, actuator_model, hemisphere_radius, preload, damping_ratio,
                             friction_coefficient)
-    return critical_amplitude(
-        drive,
-        protocol=protocol,
-        frequency=frequency,
-        flyback=flyback,
-        periods=periods,
-        threshold=threshold,
-        tolerance=tolerance,
-    )
+    return critical_amplitude(drive, protocol=protocol, frequency=frequency, flyback=flyback, periods=periods,
+                              threshold=threshold, tolerance=tolerance)
 
 
 def step_point(
@@ -143,15 +131,11 @@ class ProfileSettings:
 FIG5A_DRIVE = (1.0e-3, 0.4)
 
 PROFILE_SETTINGS = {
-    "quick": ProfileSettings(
-        preloads={1.0e-3: (0.2, 0.6, 1.0), 0.25e-3: (0.2, 0.4)},
-        frequencies=(PROTOCOL.drive_frequency,),
-        tolerance=0.5e-9,
-        amplitude_step=20e-9,
-        damping_ratios=(0.005, 0.05, 0.5),
-        sensitivity_frequencies=(PROTOCOL.drive_frequency, 1000.0),
-        readings_amplitude_step=20e-9,
-    ),
+    "quick": ProfileSettings(preloads={1.0e-3: (0.2, 0.6, 1.0), 0.25e-3: (0.2, 0.4)},
+                             frequencies=(PROTOCOL.drive_frequency,), tolerance=0.5e-9, amplitude_step=20e-9,
+                             damping_ratios=(0.005, 0.05, 0.5),
+                             sensitivity_frequencies=(PROTOCOL.drive_frequency, 1000.0),
+                             readings_amplitude_step=20e-9),
     "paper": ProfileSettings(
         preloads={r: tuple(float(p) for p in grid) for r, grid in PRELOAD_GRIDS.items()},
         frequencies=PROTOCOL.critical_amplitude_band,

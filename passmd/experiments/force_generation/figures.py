@@ -82,14 +82,9 @@ class ProfileSettings:
 
 
 PROFILE_SETTINGS = {
-    "quick": ProfileSettings(
-        panel_fractions=(0.0, 0.2, 0.7, 1.0),
-        grid_fractions=(1.0,),
-        grid_preloads={1.0e-3: (0.1, 0.3, 0.8), 0.25e-3: (0.2, 0.4)},
-        frequencies=(FORCE_FREQUENCY, 1000.0),
-        cycle_samples=1000,
-        cycle_preload=0.8,
-    ),
+    "quick": ProfileSettings(panel_fractions=(0.0, 0.2, 0.7, 1.0), grid_fractions=(1.0,),
+                             grid_preloads={1.0e-3: (0.1, 0.3, 0.8), 0.25e-3: (0.2, 0.4)},
+                             frequencies=(FORCE_FREQUENCY, 1000.0), cycle_samples=1000, cycle_preload=0.8),
     "paper": ProfileSettings(
         panel_fractions=tuple(i / 10 for i in range(11)),
         grid_fractions=(0.5, 1.0),

@@ -202,12 +202,9 @@ def stiffened_drive(drive: Drive, scale: float) -> Drive:
     """
     k = check_range("scale", scale, 0.0, lower_open=True)
     h, r = drive.hemisphere_material, drive.runner_material
-    return drive.replace(
-        hemisphere_material=Material(h.youngs_modulus * k, h.poissons_ratio, h.name),
-        runner_material=Material(r.youngs_modulus * k, r.poissons_ratio, r.name),
-        actuator=drive.actuator,
-        allow_extrapolation=True,
-    )
+    return drive.replace(hemisphere_material=Material(h.youngs_modulus * k, h.poissons_ratio, h.name),
+                         runner_material=Material(r.youngs_modulus * k, r.poissons_ratio, r.name),
+                         actuator=drive.actuator, allow_extrapolation=True)
 
 
 def rigid_coulomb_limit(
