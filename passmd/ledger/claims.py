@@ -34,6 +34,7 @@ __all__ = [
     "is_number",
     "is_study",
     "load_claims",
+    "required_keys",
     "tolerance_text",
 ]
 
@@ -100,7 +101,7 @@ def _row_errors(row: Mapping[str, str], reference_dir: Path) -> list[str]:
             continue  # a study states no sentence of the paper (passmd.ledger.rules)
         if not row[column].strip():
             errors.append(f"{column} is empty: it is required")
-    keys = [k for k in row["requires"].split(";") if k]
+    keys = required_keys(row)
     if not keys or any(not _FIGURE_KEY.match(k) for k in keys):
         bad("requires", "';'-separated result keys such as 'fig5a' or 'closed_forms'")
     for column in CONFIGURATION_COLUMNS:
@@ -145,6 +146,11 @@ def _row_errors(row: Mapping[str, str], reference_dir: Path) -> list[str]:
     if kind in ("ordering", "trend") and row["paper_value"]:
         bad("paper_value", f"empty for a {kind} claim")
     return errors
+
+
+def required_keys(row: Mapping) -> list[str]:
+    """The result keys a claims.csv row reads: its ``requires``, ``;``-separated."""
+    return [key for key in str(row["requires"]).split(";") if key]
 
 
 def is_study(row: Mapping[str, str]) -> bool:

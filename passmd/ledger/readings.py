@@ -36,6 +36,7 @@ from dataclasses import dataclass
 
 import pandas as pd
 
+from passmd.ledger.claims import required_keys
 from passmd.model.defaults import PROTOCOL
 
 __all__ = ["AC_TABLES", "AXES", "Axis", "SECTION5_TABLES", "applicable", "axis", "default_reading", "design",
@@ -79,7 +80,7 @@ class Axis:
     def applies_to(self, claim: Mapping) -> bool:
         """Whether a claims.csv row depends on this axis: it reads one of ``tables`` (its
         ``requires``) and, with ``only``, its column lists the value."""
-        if not set(str(claim["requires"]).split(";")) & set(self.tables):
+        if not set(required_keys(claim)) & set(self.tables):
             return False
         column, value = self.only if self.only else (None, None)
         return column is None or value in str(claim[column]).split(";")

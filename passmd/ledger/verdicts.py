@@ -29,7 +29,7 @@ from passmd.ledger.checks import (
     check_claim,
     format_number,
 )
-from passmd.ledger.claims import tolerance_text
+from passmd.ledger.claims import required_keys, tolerance_text
 from passmd.ledger.rules import FRAGILE_MARGIN
 
 __all__ = ["EXPERIMENT_BASIS", "NO_EXTRACTOR", "PointResult", "claim_points", "claim_row", "decisive_point",
@@ -193,7 +193,7 @@ NO_EXTRACTOR = "no extractor registered"
 def claim_points(claim: Mapping, results, functions: ClaimFunctions) -> tuple[list[PointResult], str]:
     """A claim's results at every reading of its :func:`passmd.ledger.readings.design` (defaults first),
     or no points and why it is not evaluated (results missing, no extractor)."""
-    needed = [k for k in claim["requires"].split(";") if k]
+    needed = required_keys(claim)
     missing = [k for k in needed if k not in results]
     if missing:
         return [], "needs results: " + ", ".join(missing)
@@ -273,7 +273,7 @@ def claim_row(claim: Mapping, results, functions: ClaimFunctions, *, joint: Mapp
     :func:`claim_points` when already computed; ``elsewhere`` what the claim's best other reading
     breaks (for the verdict of a claim that is not reproduced).
     """
-    needed = [k for k in claim["requires"].split(";") if k]
+    needed = required_keys(claim)
     basis = ("closed form" if set(needed) <= {"closed_forms"}
              else EXPERIMENT_BASIS if claim["id"] in functions.experiment else "simulation")
     depends = functions.depends_on.get(claim["id"], ())

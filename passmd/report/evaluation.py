@@ -48,7 +48,7 @@ from passmd.ledger.baseline import (  # re-exported: the tests and the command l
     write_baseline,
 )
 from passmd.ledger.checks import ClaimFunctions, collect_claim_functions, extractor
-from passmd.ledger.claims import STATUSES, is_study, load_claims
+from passmd.ledger.claims import STATUSES, is_study, load_claims, required_keys
 from passmd.ledger.export import SI_UNITS, records  # re-exported: passmd ledger --json
 from passmd.ledger.joint import (
     _elsewhere,
@@ -173,7 +173,7 @@ def collect_results(config: RunConfig, figures: Iterable[str] | None = None) -> 
     _check_config(config)
     available = result_sources()
     if figures is None:
-        required = {key for keys in load_claims()["requires"] for key in keys.split(";")}
+        required = {key for _, claim in load_claims().iterrows() for key in required_keys(claim)}
         required |= {name for key in required for name in _figures_of(key)}  # a reading table's defaults
         keys = [key for key in available if key in required]
     else:
@@ -410,9 +410,9 @@ def claims_for(claims: pd.DataFrame, figures) -> pd.DataFrame:
     among ``fig5a`` and ``fig5b`` or the tables of their readings (e.g. ``fig5b_readings``).
     """
     keys = {figures} if isinstance(figures, str) else set(figures)
-    needed = claims["requires"].str.split(";").map(lambda parts: [p for p in parts if p])
-    chosen = needed.map(lambda parts: all(set(_figures_of(p)) & keys for p in parts))
-    return claims[chosen].reset_index(drop=True)
+    chosen = [all(set(_figures_of(key)) & keys for key in required_keys(claim))
+              for _, claim in claims.iterrows()]
+    return claims.loc[chosen].reset_index(drop=True)
 
 
 def chapter_rows(figures, config: RunConfig) -> pd.DataFrame:
