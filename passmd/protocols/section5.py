@@ -168,6 +168,16 @@ def design_fields(row) -> dict:
             "acceleration_amplitude": float(row["acceleration_amplitude_m"])}
 
 
+def velocity_columns(table: pd.DataFrame) -> pd.DataFrame:
+    """Add a velocity sweep's ``variant`` (:func:`variant_name` of its waveform and short-period rule),
+    ``frequency_kHz`` and ``velocity_mm_per_s`` to ``table`` (in place, returned)."""
+    table["variant"] = [variant_name(w, r)
+                        for w, r in zip(table["waveform"], table["short_period"], strict=True)]
+    table["frequency_kHz"] = table["frequency"] / 1e3
+    table["velocity_mm_per_s"] = table["velocity_m_per_s"] * 1e3
+    return table
+
+
 def velocity_table(drives: list[dict], frequencies, config: RunConfig) -> pd.DataFrame:
     """Steady velocity of every configuration × waveform variant (:data:`VARIANTS`) × frequency.
 
@@ -184,10 +194,7 @@ def velocity_table(drives: list[dict], frequencies, config: RunConfig) -> pd.Dat
                 points.append({**c, "frequency": float(f), "waveform": waveform, "short_period": rule,
                                **fields})
     table = sweep.run(velocity_point, points, description="steady velocity", config=config)
-    table["variant"] = [variant_name(w, r)
-                        for w, r in zip(table["waveform"], table["short_period"], strict=True)]
-    table["frequency_kHz"] = table["frequency"] / 1e3
-    table["velocity_mm_per_s"] = table["velocity_m_per_s"] * 1e3
+    velocity_columns(table)
     table["step_nm"] = table["step_m"] * 1e9
     table["back_step_nm"] = table["back_step_m"] * 1e9
     table["radius_mm"] = table["hemisphere_radius"] * 1e3

@@ -28,7 +28,7 @@ from passmd.protocols.section5 import (
     designs,
     make_design,
     section5_drive,
-    variant_name,
+    velocity_columns,
 )
 from passmd.protocols.velocity import (
     STEP_PERIODS,
@@ -220,11 +220,7 @@ def flexible_study(config: RunConfig) -> pd.DataFrame:
                 points.append({**c, "frequency": float(f), "waveform": waveform, "short_period": rule,
                                **design_fields(d), "design_from": source})
     table = sweep.run(study_point, points, description="flexible study", config=config)
-    table["variant"] = [variant_name(w, r)
-                        for w, r in zip(table["waveform"], table["short_period"], strict=True)]
-    table["frequency_kHz"] = table["frequency"] / 1e3
-    table["velocity_mm_per_s"] = table["velocity_m_per_s"] * 1e3
-    return table
+    return velocity_columns(table)
 
 
 def study_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str, frequency: float,
