@@ -59,7 +59,7 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         value=("contact angle α = 90° (flat guide) unless given; one group: side 1; two groups: sides 1 "
                "and 2; the contacts of a side whose force is not given share what the given ones leave "
                "of F_p with equal normal force"),
-        unit="°",
+        unit="",
         rationale=("Eq. 1 holds for the paper's arrangement (two contacts at 45° on one side, four at 45° "
                    "on the other). For another guide the same statics apply: each side of the runner "
                    "carries F_p along the preload's line, a contact at angle α carries F_N sin α of it, "

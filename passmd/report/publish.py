@@ -39,6 +39,7 @@ __all__ = [
     "PROFILES",
     "PROFILE_ENV",
     "Markdown",
+    "assumption_value",
     "assumptions_frame",
     "book_config",
     "book_root",
@@ -338,19 +339,35 @@ def escape_markdown(text: str) -> str:
 def assumption_list(frame=None) -> Markdown:
     """The assumptions (:func:`assumptions_frame`, or ``frame``) as a markdown list.
 
-    One item per assumption: key, ``symbol = value unit`` (symbol and unit left out when
-    they are empty or a dash), rationale and where its effect is shown; text escaped.
+    One item per assumption: key, its value (:func:`assumption_value`), rationale and where its
+    effect is shown; text escaped.
     """
     frame = assumptions_frame() if frame is None else frame
     e = escape_markdown
     return Markdown("\n".join(
-        f"- **{e(row.key)}** ("
-        + (f"{e(row.symbol)} = " if row.symbol not in ("", "–", "-") else "")
-        + e(row.value)
-        + (f" {e(row.unit)}" if row.unit not in ("", "–") else "")
-        + f"). {e(row.rationale)} *Where its effect is shown:* {e(row.sensitivity)}"
+        f"- **{e(row.key)}** ({e(assumption_value(row.symbol, row.value, row.unit))}). {e(row.rationale)} "
+        f"*Where its effect is shown:* {e(row.sensitivity)}"
         for row in frame.itertuples()
     ))
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def assumption_value(symbol: str, value: str, unit: str) -> str:
+    """An assumption's value as one phrase: ``δ = 0.5 nm`` for a number, ``c_p [kg/s] = 2·ζ·√(k_p m_a) …``
+    for a description (the unit belongs to the symbol, not to the description's last word); symbol and
+    unit left out when empty or a dash."""
+    has_symbol, has_unit = symbol not in ("", "–", "-"), unit not in ("", "–", "-")
+    if _is_number(value):
+        return (f"{symbol} = " if has_symbol else "") + value + (f" {unit}" if has_unit else "")
+    named = (f"{symbol} [{unit}]" if has_unit else symbol) if has_symbol else (f"[{unit}]" if has_unit else "")
+    return f"{named} = {value}" if named else value
 
 
 def implementations(mapping: dict[str, str | list[str]]):

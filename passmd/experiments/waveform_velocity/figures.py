@@ -58,7 +58,7 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
         key="frequency_grid",
         symbol="f",
-        value="1, 5, 10, …, 130 kHz",
+        value=", ".join(f"{f / 1e3:g}" for f in FREQUENCIES["paper"][:3]) + f", …, {FREQUENCIES['paper'][-1] / 1e3:g}",
         unit="kHz",
         rationale=(
             "'from 1 to 130 kHz with a step of 5 kHz' (Section 5.2) does not say whether the grid is "
