@@ -49,6 +49,7 @@ __all__ = [
     "drive_parameters",
     "figure_png",
     "format_quantity",
+    "grid_text",
     "implementations",
     "parameter_frame",
     "put",
@@ -189,6 +190,18 @@ def format_quantity(value_si, unit: str, digits: int = 3) -> str:
     if np.ndim(value) != 0:
         raise ValueError(f"value_si = {value_si!r} is not allowed: must be a scalar")
     return f"{value:.{int(digits)}g} {unit}"
+
+
+def grid_text(values_si, unit: str, limit: int = 8) -> str:
+    """A profile's grid as a caption names it, in ``unit``: every value when there are at most
+    ``limit`` (``"1, 20, 60, 100 kHz"``), else the first three, the last and how many
+    (``"1, 5, 10, …, 130 kHz (27 values)"``)."""
+    shown = [f"{v:g}" for v in np.atleast_1d(to_unit(np.asarray(values_si, dtype=float), unit))]
+    if not shown:
+        raise ValueError("values_si is empty: a grid has at least one value")
+    if len(shown) <= limit:
+        return f"{', '.join(shown)} {unit}"
+    return f"{', '.join(shown[:3])}, …, {shown[-1]} {unit} ({len(shown)} values)"
 
 
 def drive_parameters(drive) -> dict[str, str]:
