@@ -447,7 +447,8 @@ def test_fig9b_fit_limit_is_the_command_lines(quick):
     assert status == 0, out.getvalue()
     line = next(x for x in out.getvalue().splitlines() if x.strip().startswith("Eq. 15 fits"))
     assert f"up to {found['fit_limit_kHz']:.4g} kHz " in line, line
-    chapter = (Path(__file__).resolve().parents[1] / "book" / "waveform_velocity.md").read_text(encoding="utf-8")
+    chapter = Path(__file__).resolve().parents[1] / "book" / "waveform_velocity.md"
+    chapter = chapter.read_text(encoding="utf-8")
     assert "{glue:text}`fit_limit_kHz:.4g` kHz" in chapter
 
 

@@ -62,8 +62,8 @@ class Assumption:
         # ("0.1 N" with unit "N") would read "0.1 N N"
         if self.unit not in ("", "–", "-") and re.search(rf"(^|[\s\d]){re.escape(self.unit)}$",
                                                            self.value.rstrip()):
-            raise InputError(f"value = {self.value!r} of assumption {self.key!r} is not allowed: it ends in its "
-                             f"unit {self.unit!r}, which is shown once (leave it out of the value)",
+            raise InputError(f"value = {self.value!r} of assumption {self.key!r} is not allowed: it ends in "
+                             f"its unit {self.unit!r}, which is shown once (leave it out of the value)",
                              name="value", value=self.value)
 
 
@@ -259,7 +259,8 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         key="preload_grids",
         symbol="F_p",
         value=" and ".join(f"{grid[0]:g}–{grid[-1]:.1f} at R = {radius * 1e3:g} mm" for radius, grid in
-                           PRELOAD_GRIDS.items()) + f", in steps of {PRELOAD_GRIDS[1.0e-3][1] - PRELOAD_GRIDS[1.0e-3][0]:.1g}",
+                           PRELOAD_GRIDS.items())
+        + f", in steps of {PRELOAD_GRIDS[1.0e-3][1] - PRELOAD_GRIDS[1.0e-3][0]:.1g}",
         unit="N",
         rationale=(
             "Table 2's 'Preload Range' column is lost; its header gives the 0.1 N step. "

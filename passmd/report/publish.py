@@ -379,7 +379,8 @@ def assumption_value(symbol: str, value: str, unit: str) -> str:
     has_symbol, has_unit = symbol not in ("", "–", "-"), unit not in ("", "–", "-")
     if _is_number(value):
         return (f"{symbol} = " if has_symbol else "") + value + (f" {unit}" if has_unit else "")
-    named = (f"{symbol} [{unit}]" if has_unit else symbol) if has_symbol else (f"[{unit}]" if has_unit else "")
+    unit_part = f"[{unit}]" if has_unit else ""
+    named = f"{symbol} {unit_part}".strip() if has_symbol else unit_part
     return f"{named} = {value}" if named else value
 
 

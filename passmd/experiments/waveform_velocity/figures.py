@@ -59,7 +59,8 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
         key="frequency_grid",
         symbol="f",
-        value=", ".join(f"{f / 1e3:g}" for f in FREQUENCIES["paper"][:3]) + f", …, {FREQUENCIES['paper'][-1] / 1e3:g}",
+        value=", ".join([*(f"{f / 1e3:g}" for f in FREQUENCIES["paper"][:3]), "…",
+                         f"{FREQUENCIES['paper'][-1] / 1e3:g}"]),
         unit="kHz",
         rationale=(
             "'from 1 to 130 kHz with a step of 5 kHz' (Section 5.2) does not say whether the grid is "
@@ -131,7 +132,8 @@ def _velocities(drives: list[dict], config: RunConfig) -> pd.DataFrame:
     limits = {}
     for c, (_, d) in zip(drives, designs(drives, config).iterrows(), strict=True):
         limits[tuple(c.values())] = eq15_fit_limit(d, section5_drive(**c))
-    table["eq15_highest_frequency_Hz"] = [limits[tuple(row[k] for k in drives[0])] for _, row in table.iterrows()]
+    table["eq15_highest_frequency_Hz"] = [limits[tuple(row[k] for k in drives[0])]
+                                          for _, row in table.iterrows()]
     return table
 
 
