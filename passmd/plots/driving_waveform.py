@@ -36,10 +36,19 @@ def _shade_status(ax, view) -> None:
                        label=name if start == edges[0] else None)
 
 
+#: Offsets (points) of the numbered labels of Fig. 8's points, in turn: points a fraction of a
+#: microsecond apart (4 and 5, the ends of t_s and t_a) get labels on opposite sides.
+_LABEL_OFFSETS = ((-9, 11), (9, 11), (-9, -13), (9, -13))
+
+
 def _points(ax, points, y="runner_position_nm") -> None:
-    for _, row in points.iterrows():
-        ax.plot(row["time_us"], row[y], "o", ms=9, mfc="white", mec="black", zorder=5)
-        ax.annotate(row["point"], (row["time_us"], row[y]), ha="center", va="center", fontsize=7, zorder=6)
+    """Mark the numbered points of Section 5.1 (small dots) with their numbers beside them."""
+    for k, (_, row) in enumerate(points.sort_values("time_us").iterrows()):
+        ax.plot(row["time_us"], row[y], "o", ms=4, mfc="white", mec="black", zorder=5)
+        ax.annotate(row["point"], (row["time_us"], row[y]), xytext=_LABEL_OFFSETS[k % len(_LABEL_OFFSETS)],
+                    textcoords="offset points", ha="center", va="center", fontsize=8, zorder=6,
+                    bbox={"boxstyle": "circle,pad=0.15", "fc": "white", "ec": "black", "lw": 0.6},
+                    arrowprops={"arrowstyle": "-", "lw": 0.5, "shrinkA": 0, "shrinkB": 2})
 
 
 def _response(df, title: str):
@@ -111,7 +120,7 @@ def plot_fig8b_window(df):
 
 
 def plot_fig9a(df):
-    """Fig. 9a: runner position over three 100 Hz periods for both waveforms.
+    """Fig. 9a: runner position x_r and hemisphere position x_p over three 100 Hz periods, both waveforms.
 
     Only the runs the data marks ``section5_friction`` (Section 5's μ) are drawn; the others are
     the ledger's alternative readings of μ.
@@ -128,9 +137,10 @@ def plot_fig9a(df):
         last = per.iloc[-1]
         ax.annotate(f"{last['settled_position_nm']:.0f} nm", (last["time_ms"], last["settled_position_nm"]),
                     (-40, 8), textcoords="offset points", fontsize=8, color=colours[waveform])
-    saw = df[(df["waveform"] == "sawtooth") & (df["view"] == "full")]
-    ax.plot(saw["time_ms"], saw["piezo_position_nm"], ":", color="grey", lw=0.8, label="saw-tooth x_p")
-    ax.set(xlabel="time (ms)", ylabel="runner position (nm)", title=f"three periods at {_STEP_HZ}")
+    for waveform, part in df[df["view"] == "full"].groupby("waveform", sort=False):  # both waveforms' x_p
+        ax.plot(part["time_ms"], part["piezo_position_nm"], ":", color=colours[waveform], lw=0.8, alpha=0.8,
+                label=f"{waveform}: x_p (hemispheres)")
+    ax.set(xlabel="time (ms)", ylabel="position (nm)", title=f"three periods at {_STEP_HZ}")
     ax.legend(fontsize=8)
     return fig
 

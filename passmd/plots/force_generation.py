@@ -44,16 +44,32 @@ def _groups(df: pd.DataFrame, keys: list[str]):
 
 
 def _curve(ax, rows: pd.DataFrame, colour, label: str | None, onset: bool = True) -> None:
-    """One F_gen(A) curve: stalled points joined, non-stalled crosses, the onset on the axis."""
+    """One F_gen(A) curve: stalled points, non-stalled crosses, the onset on the axis.
+
+    Where the onset was found, the line starts there and joins only the amplitudes above it; the
+    amplitudes below it (no step: the runner only follows the piezo) are markers, never joined
+    across the onset, which the line would otherwise cut as a straight chord.
+    """
     rows = rows.sort_values("amplitude_nm")
     style = STYLES.get(_key(rows), {"ls": "-", "marker": "o"})
     good = rows[rows["converged"]]
-    ax.plot(good["amplitude_nm"], good["generated_force_mN"], color=colour, ms=4, label=label, **style)
+    found = "onset_nm" in rows and np.isfinite(rows["onset_nm"].iloc[0])
+    if found:
+        a_c = float(rows["onset_nm"].iloc[0])
+        below, above = good[good["amplitude_nm"] <= a_c], good[good["amplitude_nm"] > a_c]
+        ax.plot(np.r_[a_c, above["amplitude_nm"]], np.r_[0.0, above["generated_force_mN"]], color=colour,
+                ls=style["ls"], label=label)
+        ax.plot(above["amplitude_nm"], above["generated_force_mN"], color=colour, ms=4, ls="none",
+                marker=style["marker"])
+        ax.plot(below["amplitude_nm"], below["generated_force_mN"], color=colour, ms=4, ls="none",
+                marker=style["marker"], mfc="none")
+    else:
+        ax.plot(good["amplitude_nm"], good["generated_force_mN"], color=colour, ms=4, label=label, **style)
     bad = rows[~rows["converged"]]
     if len(bad):
         ax.plot(bad["amplitude_nm"], bad["generated_force_mN"], "x", color="red", ms=8, mew=2,
                 label="did not stall")
-    if onset and "onset_nm" in rows and np.isfinite(rows["onset_nm"].iloc[0]):
+    if onset and found:
         ax.plot([rows["onset_nm"].iloc[0]], [0.0], marker=style["marker"], color=colour, mfc="white",
                 ms=6, ls="none", clip_on=False, zorder=5)
 

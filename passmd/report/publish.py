@@ -52,6 +52,7 @@ __all__ = [
     "grid_text",
     "implementations",
     "parameter_frame",
+    "partial_grid_text",
     "put",
     "put_text",
     "show_figure",
@@ -202,6 +203,27 @@ def grid_text(values_si, unit: str, limit: int = 8) -> str:
     if len(shown) <= limit:
         return f"{', '.join(shown)} {unit}"
     return f"{', '.join(shown[:3])}, …, {shown[-1]} {unit} ({len(shown)} values)"
+
+
+def partial_grid_text(names, profile: str) -> str | None:
+    """What a page built on ``profile`` lacks of the paper profile's grids for the figures ``names``
+    (:func:`passmd.experiments.figure_table.grid_shortfall`), as one paragraph of plain text; None on
+    the paper profile."""
+    from passmd.experiments.figure_table import grid_shortfall
+
+    check_choice("profile", profile, PROFILES)
+    if profile == "paper":
+        return None
+    short = grid_shortfall(names, profile)
+    if short.empty or not short["missing"].any():
+        return (f"Built on the {profile} profile. None of the grids of points this page's figures and verdicts "
+                "read is coarser than the paper profile's (a profile may still record or integrate the same "
+                "runs more coarsely).")
+    parts = [f"{row.figure}: {row.points} of the paper profile's {row.reference_points} points "
+             f"({row.axes}), {row.missing} missing" for row in short.itertuples() if row.missing]
+    return (f"Built on the {profile} profile, a partial grid: the figures and verdicts of this page are "
+            "computed on coarser grids than the paper profile's. " + "; ".join(parts) + ". A verdict may "
+            "differ on the paper's grids, which python3 -m nox -s book builds.")
 
 
 def drive_parameters(drive) -> dict[str, str]:

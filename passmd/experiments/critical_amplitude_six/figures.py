@@ -134,6 +134,18 @@ FIGURES = (
                "critical_amplitude_six", fig56_viscosity, "critical_amplitude:plot_viscosity"),
 )
 
+def _preload_grid(radius: float):
+    return lambda profile: {"preloads": PROFILE_SETTINGS[profile].preloads[radius],
+                            "drive frequencies": PROFILE_SETTINGS[profile].frequencies}
+
+
+#: The chapter's profile-dependent grids (:data:`passmd.experiments.figure_table.GRIDS`).
+GRIDS = {
+    "fig6a": _preload_grid(1.0e-3), "fig6b": _preload_grid(1.0e-3), "fig6c": _preload_grid(0.25e-3),
+    "fig56_frequency": lambda profile: {"drive frequencies": PROFILE_SETTINGS[profile].sensitivity_frequencies},
+    "fig56_viscosity": lambda profile: {"damping ratios": PROFILE_SETTINGS[profile].damping_ratios},
+}
+
 #: The ledger's readings of the chapter's figures.
 READING_TABLES = tuple(
     ReadingTable(f"{panel}_readings", f"Fig. {panel[3:]}'s A_c searches at every reading", (panel,),

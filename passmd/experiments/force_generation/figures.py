@@ -487,6 +487,19 @@ FIGURES = (
                "force_generation", fig7grid, "force_generation:plot_grid"),
 )
 
+def _panel_grid(name: str):
+    return lambda profile: {"amplitudes (fractions of A_max)": PROFILE_SETTINGS[profile].panel_fractions}
+
+
+#: The chapter's profile-dependent grids (:data:`passmd.experiments.figure_table.GRIDS`).
+GRIDS = {
+    "fig7a": _panel_grid("fig7a"), "fig7b": _panel_grid("fig7b"),
+    "fig7grid": lambda profile: {"(radius, preload, amplitude)": tuple(
+        (r, p, a) for r, preloads in PROFILE_SETTINGS[profile].grid_preloads.items() for p in preloads
+        for a in PROFILE_SETTINGS[profile].grid_fractions)},
+    "fig7freq": lambda profile: {"drive frequencies": PROFILE_SETTINGS[profile].frequencies},
+}
+
 #: The ledger's readings of the chapter's figures.
 READING_TABLES = (
     ReadingTable("fig7_readings", "This paper's force runs at half and full stroke at every reading",

@@ -242,6 +242,10 @@ FIGURES = tuple(FigureSpec(name, title, "waveform_velocity", compute, f"driving_
     ("fig10c", "Velocity of the optimized waveform, steel and molybdenum runner", fig10c, "plot_fig10c"),
 ))
 
+#: The chapter's profile-dependent grids (:data:`passmd.experiments.figure_table.GRIDS`).
+GRIDS = {name: (lambda profile: {"frequencies": tuple(_frequencies(profile))})
+         for name in ("fig9b", "fig10a", "fig10b", "fig10c")}
+
 #: The ledger's readings of the chapter's figures: each at every μ.
 READING_TABLES = (
     ReadingTable("fig9b_readings", "Fig. 9b at every μ", ("fig9b",), fig9b_readings),
