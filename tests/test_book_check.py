@@ -135,7 +135,8 @@ def test_text_defects_are_found(text, meaning):
 
 def test_correct_text_has_no_defects():
     text = ("c_p [kg/s] = 2·ζ·√(k_p m_a) with the damping ratio ζ = 0.05 (dimensionless); a nanometre; "
-            "Eq. 7 gives 39.5 nm, 0.2%·F_gen, μ = 0.2 is Section 4.2's; NaN if not within the hold; 10 % of it")
+            "Eq. 7 gives 39.5 nm, 0.2%·F_gen, μ = 0.2 is Section 4.2's; NaN if not within the hold; "
+            "10 % of it")
     assert checker.text_defects(text, ["1.25", "—", "fig5a"]) == []
     assert checker.text_defects("", ["NaN"]) == ["a table cell the build could not compute: 'NaN'"]
 

@@ -121,7 +121,8 @@ def test_verdict_pages_of_a_quick_build_carry_the_partial_grid_note(monkeypatch)
         monkeypatch.setenv("PASSMD_PROFILE", "quick")
         text = note("critical_amplitude_one")
         # computed from the figures' grids: fig5a's amplitudes, fig5b's preloads and frequencies
-        assert re.search(r"fig5a: \d+ of the paper profile's \d+ points \(amplitudes\), \d+ missing", text), text
+        pattern = r"fig5a: \d+ of the paper profile's \d+ points \(amplitudes\), \d+ missing"
+        assert re.search(pattern, text), text
         assert "fig5b" in text and "nox -s book" in text
         assert note("intro") is not None and note(ext.LEDGER_PAGE) is not None  # headline, whole ledger
         assert note("api") is None and note("model") is None  # no verdicts there

@@ -57,7 +57,8 @@ READING_TABLES: dict[str, ReadingTable] = {
 #: Every figure whose grid depends on the profile, by name: profile -> {axis: values}, the ``GRIDS`` of
 #: each chapter's ``figures.py``, built from the same settings as the figure's compute function. A
 #: figure computed alike on every profile has no entry.
-GRIDS: dict = {name: grid for module in chapter_modules("figures") for name, grid in getattr(module, "GRIDS", {}).items()}
+GRIDS: dict = {name: grid for module in chapter_modules("figures")
+               for name, grid in getattr(module, "GRIDS", {}).items()}
 
 #: The experiment modules whose functions carry claim extractors (Sections 4.1, 4.2, 5): every
 #: chapter's ``claims.py``.

@@ -142,7 +142,8 @@ def _preload_grid(radius: float):
 #: The chapter's profile-dependent grids (:data:`passmd.experiments.figure_table.GRIDS`).
 GRIDS = {
     "fig6a": _preload_grid(1.0e-3), "fig6b": _preload_grid(1.0e-3), "fig6c": _preload_grid(0.25e-3),
-    "fig56_frequency": lambda profile: {"drive frequencies": PROFILE_SETTINGS[profile].sensitivity_frequencies},
+    "fig56_frequency": lambda profile: {
+        "drive frequencies": PROFILE_SETTINGS[profile].sensitivity_frequencies},
     "fig56_viscosity": lambda profile: {"damping ratios": PROFILE_SETTINGS[profile].damping_ratios},
 }
 
