@@ -217,8 +217,8 @@ def partial_grid_text(names, profile: str) -> str | None:
     short = grid_shortfall(names, profile)
     if short.empty or not short["missing"].any():
         return (f"Built on the {profile} profile. None of the grids of points this page's figures and "
-                "verdicts read is coarser than the paper profile's (a profile may still record or integrate the same "
-                "runs more coarsely).")
+                "verdicts read is coarser than the paper profile's (a profile may still record or integrate "
+                "the same runs more coarsely).")
     parts = [f"{row.figure}: {row.points} of the paper profile's {row.reference_points} points "
              f"({row.axes}), {row.missing} missing" for row in short.itertuples() if row.missing]
     return (f"Built on the {profile} profile, a partial grid: the figures and verdicts of this page are "
