@@ -216,7 +216,8 @@ const ledgerSelector = arguments[0];
   const prose = [];
   const proseWalker = document.createTreeWalker(root, NodeFilter.SHOW_TEXT);
   for (let node = proseWalker.nextNode(); node; node = proseWalker.nextNode()) {
-    const code = 'pre, code, script, style, textarea, .highlight, mjx-container';
+    // code, and the API reference's entries (signatures and docstrings document code's values)
+    const code = 'pre, code, script, style, textarea, .highlight, mjx-container, dl.py';
     if (node.parentElement && node.parentElement.closest(code)) continue;
     prose.push(node.textContent);
   }

@@ -101,8 +101,8 @@ def verdict_figures(docname: str, root_doc: str) -> tuple[str, ...] | None:
 
 
 @functools.cache
-def partial_grid_note(docname: str, root_doc: str) -> str | None:
-    """The note a verdict-bearing page gets on a profile coarser than the paper's
+def partial_grid_note(docname: str, root_doc: str) -> tuple[str, str] | None:
+    """The note (title, text) a verdict-bearing page gets on a profile coarser than the paper's
     (:func:`passmd.report.publish.partial_grid_text`), None elsewhere."""
     from passmd.report.publish import current_profile, partial_grid_text
 
@@ -139,12 +139,13 @@ def _add_expectation(app, pagename: str, templatename, context: dict, doctree) -
 def _add_partial_grid(app, doctree) -> None:
     """On a build coarser than the paper profile, open every verdict-bearing page with the note of what
     it lacks of the paper's grids (:func:`partial_grid_note`)."""
-    text = partial_grid_note(app.env.docname, app.config.root_doc)
+    found = partial_grid_note(app.env.docname, app.config.root_doc)
     page = doctree.next_node(nodes.section)
-    if text is None or page is None:
+    if found is None or page is None:
         return
+    heading, text = found
     note = nodes.admonition(classes=["warning", "passmd-partial-grid"])
-    note += nodes.title(text="Partial grid")
+    note += nodes.title(text=heading)
     note += nodes.paragraph(text=text)
     title = page.next_node(nodes.title)
     page.insert(page.index(title) + 1 if title is not None and title.parent is page else 0, note)

@@ -205,10 +205,10 @@ def grid_text(values_si, unit: str, limit: int = 8) -> str:
     return f"{', '.join(shown[:3])}, …, {shown[-1]} {unit} ({len(shown)} values)"
 
 
-def partial_grid_text(names, profile: str) -> str | None:
+def partial_grid_text(names, profile: str) -> tuple[str, str] | None:
     """What a page built on ``profile`` lacks of the paper profile's grids for the figures ``names``
-    (:func:`passmd.experiments.figure_table.grid_shortfall`), as one paragraph of plain text; None on
-    the paper profile."""
+    (:func:`passmd.experiments.figure_table.grid_shortfall`): a title and one paragraph of plain
+    text; None on the paper profile."""
     from passmd.experiments.figure_table import grid_shortfall
 
     check_choice("profile", profile, PROFILES)
@@ -216,12 +216,14 @@ def partial_grid_text(names, profile: str) -> str | None:
         return None
     short = grid_shortfall(names, profile)
     if short.empty or not short["missing"].any():
-        return (f"Built on the {profile} profile. None of the grids of points this page's figures and "
+        return (f"{profile.capitalize()} profile",
+                f"Built on the {profile} profile. None of the grids of points this page's figures and "
                 "verdicts read is coarser than the paper profile's (a profile may still record or integrate "
                 "the same runs more coarsely).")
     parts = [f"{row.figure}: {row.points} of the paper profile's {row.reference_points} points "
              f"({row.axes}), {row.missing} missing" for row in short.itertuples() if row.missing]
-    return (f"Built on the {profile} profile, a partial grid: the figures and verdicts of this page are "
+    return ("Partial grid",
+            f"Built on the {profile} profile, a partial grid: the figures and verdicts of this page are "
             "computed on coarser grids than the paper profile's. " + "; ".join(parts) + ". A verdict may "
             "differ on the paper's grids, which python3 -m nox -s book builds.")
 

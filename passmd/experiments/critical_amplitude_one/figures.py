@@ -41,9 +41,10 @@ from passmd.runtime.config import RunConfig
 SECTION4_1_FRICTION = float(readings.axis("friction_coefficient").default)
 
 __all__ = [
-    "AC_PANELS", "FIG5A_DRIVE", "FIGURES", "FLYBACK_STEPS_TOLERANCE", "PROFILE_SETTINGS", "READING_TABLES",
-    "SECTION4_1_FRICTION", "ac_readings", "critical_amplitude_point", "fig5_flyback_steps", "fig5a",
-    "fig5a_readings", "fig5b", "paper_drive_for", "preload_figure", "primary", "run_searches", "step_point",
+    "AC_PANELS", "FIG5A_CLAIM", "FIG5A_DRIVE", "FIGURES", "FLYBACK_STEPS_TOLERANCE", "GRIDS",
+    "PROFILE_SETTINGS", "READING_TABLES", "SECTION4_1_FRICTION", "ac_readings", "critical_amplitude_point",
+    "fig5_flyback_steps", "fig5a", "fig5a_amplitudes", "fig5a_readings", "fig5b", "paper_drive_for",
+    "preload_figure", "primary", "run_searches", "step_point",
 ]
 
 def paper_drive_for(
@@ -253,7 +254,8 @@ def fig5a(config: RunConfig) -> pd.DataFrame:
     """Fig. 5a: first and steady-state step against the amplitude (one contact, F_p = 0.4 N, R = 1 mm).
 
     Rigid and flexible actuators with the slew-rate fly-back, and flexible with the fixed
-    2 µs fly-back, at ``PROTOCOL.drive_frequency``; on the amplitudes of :func:`fig5a_amplitudes`.
+    2 µs fly-back, at ``PROTOCOL.drive_frequency``; on the amplitudes of
+    :func:`~passmd.experiments.critical_amplitude_one.figures.fig5a_amplitudes`.
     Lengths in nm.
     """
     radius, preload = FIG5A_DRIVE

@@ -26,7 +26,7 @@ from passmd.model.tables import ACTUATOR_DAMPING_RATIO, actuator_for_radius
 from passmd.protocols.critical_amplitude import PROTOCOLS
 from passmd.runtime.config import RunConfig
 
-__all__ = ["FIG5A_DRIVE", "FIGURES", "PROFILE_SETTINGS", "READING_TABLES", "fig56_frequency",
+__all__ = ["FIG5A_DRIVE", "FIGURES", "GRIDS", "PROFILE_SETTINGS", "READING_TABLES", "fig56_frequency",
            "fig56_viscosity", "fig6a", "fig6b", "fig6c"]
 
 

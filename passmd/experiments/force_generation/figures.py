@@ -45,7 +45,7 @@ from passmd.runtime.config import PROFILES, RunConfig
 from passmd.runtime.validation import check_choice, check_range
 
 __all__ = [
-    "CYCLE_COMBINATIONS", "EARLIER", "FIGURES", "FORCE_FREQUENCY", "MODELS", "ONSET_TOLERANCE",
+    "CYCLE_COMBINATIONS", "EARLIER", "FIGURES", "FORCE_FREQUENCY", "GRIDS", "MODELS", "ONSET_TOLERANCE",
     "PANELS", "PANELS_FULL_STROKE_NM", "PROFILE_SETTINGS", "READING_TABLES", "THIS", "cycle_point",
     "fig7_difference", "fig7_readings", "fig7a", "fig7b", "fig7cycle", "fig7freq", "fig7grid",
     "force_difference", "force_drive", "model_rows", "onset_point", "readings_at", "stall_point",

@@ -367,13 +367,14 @@ def mass_study_facts(study: pd.DataFrame) -> dict:
     steady-state A_c lies within the tolerance of the ledger's claim
     (:func:`~passmd.experiments.model_numerics.figures.mass_study_tolerance`, the table's
     ``eq12_tolerance_rel``) of its Eq. 12. Returns the printed and the hemisphere's mass and their
-    ratio, the tolerance (%), ``mass_ac_text`` (which masses are consistent, each rule's A_c at the
-    printed and the hemisphere's mass), ``mass_ringing_text`` (the heaviest actuator's natural
-    frequencies and the runner's micro-vibration), ``mass_velocity_text`` (the saw-tooth's velocity at
-    the highest frequency for the printed and the heaviest mass, and the heaviest's over the profile's
-    frequencies), ``mass_verdict`` (whether the printed value is the consistent one and the
-    hemisphere's not) and ``mass_hypothesis`` (whether the heaviest actuator, the one that rings near
-    110 kHz, is consistent).
+    ratio, the tolerance (%) and the sentences: ``mass_grid_text`` (the masses), ``mass_ac_text``
+    (which masses are consistent, each rule's A_c at the printed and the hemisphere's mass),
+    ``mass_ringing_text`` (the heaviest actuator's natural frequencies and the runner's
+    micro-vibration), ``mass_velocity_text`` (the saw-tooth's velocity at the highest frequency for the
+    printed and the heaviest mass, and the heaviest's over the profile's frequencies),
+    ``mass_verdict`` (whether the printed value is the consistent one and the hemisphere's not) and
+    ``mass_hypothesis`` (whether the heaviest actuator, the one that rings near 110 kHz, is
+    consistent).
     """
     tolerance = float(study["eq12_tolerance_rel"].iloc[0])
     per_mass = study.drop_duplicates("actuator_mass").sort_values("actuator_mass").set_index("actuator_mass")
@@ -434,7 +435,8 @@ def mass_study_facts(study: pd.DataFrame) -> dict:
                   f"{'within' if consistent[heaviest] else 'outside'} the ledger's tolerance of Eq. 12"
                   + ("." if consistent[heaviest] else
                      ", so the actuator that would give the drive such a limit is not the one of Fig. 6b."))
-    return {"mass_printed_ug": printed * 1e9, "mass_hemisphere_mg": hemisphere * 1e6,
+    return {"mass_grid_text": _listed(per_mass.index), "mass_printed_ug": printed * 1e9,
+            "mass_hemisphere_mg": hemisphere * 1e6,
             "mass_ratio": hemisphere / printed, "mass_tolerance_pct": 100 * tolerance,
             "mass_ac_text": ac_text, "mass_ringing_text": ringing_text, "mass_velocity_text": velocity_text,
             "mass_verdict": verdict, "mass_hypothesis": hypothesis}

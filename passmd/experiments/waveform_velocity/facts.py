@@ -30,7 +30,8 @@ def startup_facts(fig9b_data: pd.DataFrame, frequency: float = PAPER_MAXIMUM_KHZ
 
 
 def fig9b_facts(fig9b_data: pd.DataFrame, design: pd.Series, drive: Drive) -> dict:
-    """Fig. 9b: up to which frequency one whole Eq. 15 period fits (kHz, :func:`eq15_fit_limit`, the
+    """Fig. 9b: up to which frequency one whole Eq. 15 period fits (kHz,
+    :func:`~passmd.experiments.waveform_velocity.figures.eq15_fit_limit`, the
     number ``passmd run --waveform optimized`` prints); the room for t_s in a period at the
     paper's 110 kHz (µs), the f_s it would need (kHz) and the contact-stiffness factor that means; the
     optimized velocity there; the skip variant's largest gain on the grid up to 110 kHz (mm/s, %, kHz,
