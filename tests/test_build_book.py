@@ -116,7 +116,7 @@ def test_verdict_pages_of_a_quick_build_carry_the_partial_grid_note(monkeypatch)
         for cached in (ext.partial_grid_note, ext.expectation):
             cached.cache_clear()
         found = ext.partial_grid_note(page, "intro")
-        return None if found is None else found[1]
+        return None if found is None else " ".join([found[1], *found[2]])
 
     try:
         monkeypatch.setenv("PASSMD_PROFILE", "quick")

@@ -101,9 +101,9 @@ def verdict_figures(docname: str, root_doc: str) -> tuple[str, ...] | None:
 
 
 @functools.cache
-def partial_grid_note(docname: str, root_doc: str) -> tuple[str, str] | None:
-    """The note (title, text) a verdict-bearing page gets on a profile coarser than the paper's
-    (:func:`passmd.report.publish.partial_grid_text`), None elsewhere."""
+def partial_grid_note(docname: str, root_doc: str) -> tuple[str, str, list[str]] | None:
+    """The note (title, text, one item per figure) a verdict-bearing page gets on a profile coarser
+    than the paper's (:func:`passmd.report.publish.partial_grid_text`), None elsewhere."""
     from passmd.report.publish import current_profile, partial_grid_text
 
     figures = verdict_figures(docname, root_doc)
@@ -143,10 +143,15 @@ def _add_partial_grid(app, doctree) -> None:
     page = doctree.next_node(nodes.section)
     if found is None or page is None:
         return
-    heading, text = found
+    heading, text, items = found
     note = nodes.admonition(classes=["warning", "passmd-partial-grid"])
     note += nodes.title(text=heading)
     note += nodes.paragraph(text=text)
+    if items:
+        listed = nodes.bullet_list()
+        for item in items:
+            listed += nodes.list_item("", nodes.paragraph(text=item))
+        note += listed
     title = page.next_node(nodes.title)
     page.insert(page.index(title) + 1 if title is not None and title.parent is page else 0, note)
 

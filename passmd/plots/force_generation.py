@@ -47,7 +47,7 @@ def _curve(ax, rows: pd.DataFrame, colour, label: str | None, onset: bool = True
     """One F_gen(A) curve: stalled points, non-stalled crosses, the onset on the axis.
 
     Where the onset was found, the line starts there and joins only the amplitudes above it; the
-    amplitudes below it (no step: the runner only follows the piezo) are markers, never joined
+    amplitudes below it (no step: the runner only follows the piezo) are small dots, never joined
     across the onset, which the line would otherwise cut as a straight chord.
     """
     rows = rows.sort_values("amplitude_nm")
@@ -61,8 +61,7 @@ def _curve(ax, rows: pd.DataFrame, colour, label: str | None, onset: bool = True
                 ls=style["ls"], label=label)
         ax.plot(above["amplitude_nm"], above["generated_force_mN"], color=colour, ms=4, ls="none",
                 marker=style["marker"])
-        ax.plot(below["amplitude_nm"], below["generated_force_mN"], color=colour, ms=4, ls="none",
-                marker=style["marker"], mfc="none")
+        ax.plot(below["amplitude_nm"], below["generated_force_mN"], color=colour, ms=3, ls="none", marker=".")
     else:
         ax.plot(good["amplitude_nm"], good["generated_force_mN"], color=colour, ms=4, label=label, **style)
     bad = rows[~rows["converged"]]
