@@ -208,8 +208,8 @@ def test_fig9a_plot_shows_section5_friction_only(quick):
     assert set(section5) == {SECTION5_FRICTION}
     assert len(FIG9A_FRICTION) > 1 and not frame["section5_friction"].all()
     fig = driving_waveform.plot_fig9a(frame)
-    # one runner trace and one set of settled positions per waveform, plus the piezo: μ = 0.2 runs only
-    assert len(fig.axes[0].lines) == 2 * 2 + 1
+    # one runner trace, one set of settled positions and one piezo trace per waveform: μ = 0.2 runs only
+    assert len(fig.axes[0].lines) == 2 * 3
 
 
 # --------------------------------------------------------------------------------------
