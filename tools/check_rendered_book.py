@@ -323,7 +323,7 @@ def text_defects(text: str, cells=()) -> list[str]:
 
 #: What the partial-grid note must say: per figure, what it computes of the paper profile's points, or
 #: that no grid is coarser.
-_PARTIAL_NOTE = re.compile(r"\d+ of the paper profile's \d+ points|None of the grids")
+_PARTIAL_NOTE = re.compile(r"\d+ of the paper profile's \d+ (?:grid )?points|None of the grids")
 
 
 def page_problems(facts: dict) -> list[str]:

@@ -21,8 +21,9 @@
   ledger judges claims of them and whether it carries the partial-grid note.
 * On a build coarser than the paper profile (``quick``), every page that states verdicts (the root
   page's headline, the replication report, each chapter with ledger rows) opens with a "Partial grid"
-  note: for each figure behind its verdicts, how many of the paper profile's grid points it computes
-  and how many it lacks (:func:`passmd.report.publish.partial_grid_text`).
+  note: how many of the paper profile's grid points the figures behind its verdicts lack, and for
+  each figure how many it computes and lacks (:func:`passmd.report.publish.partial_grid_text`); a
+  list of more than four figures is folded under the note's title.
 * Docstrings write absolute values as ``|x|`` (plain text, as ``help()`` shows them); for
   the API page the bars are escaped outside inline literals and roles, where
   reStructuredText would read ``|x|`` as a substitution.
@@ -144,7 +145,10 @@ def _add_partial_grid(app, doctree) -> None:
     if found is None or page is None:
         return
     heading, text, items = found
-    note = nodes.admonition(classes=["warning", "passmd-partial-grid"])
+    # a long list folds under its title (which says how much is missing), so the page's own first
+    # screen stays the page's
+    folded = ["dropdown"] if len(items) > 4 else []
+    note = nodes.admonition(classes=["warning", "passmd-partial-grid", *folded])
     note += nodes.title(text=heading)
     note += nodes.paragraph(text=text)
     if items:

@@ -135,8 +135,10 @@ def plot_fig9a(df):
                 label=f"{waveform}: x_r")
         ax.plot(per["time_ms"], per["settled_position_nm"], "o", color=colours[waveform], ms=5)
         last = per.iloc[-1]
+        highest = df.loc[df["view"] == "period", "settled_position_nm"].max()
+        offset = (-40, 8) if last["settled_position_nm"] >= highest else (-40, -14)  # the lower one below
         ax.annotate(f"{last['settled_position_nm']:.0f} nm", (last["time_ms"], last["settled_position_nm"]),
-                    (-40, 8), textcoords="offset points", fontsize=8, color=colours[waveform])
+                    offset, textcoords="offset points", fontsize=8, color=colours[waveform])
     for waveform, part in df[df["view"] == "full"].groupby("waveform", sort=False):  # both waveforms' x_p
         ax.plot(part["time_ms"], part["piezo_position_nm"], ":", color=colours[waveform], lw=0.8, alpha=0.8,
                 label=f"{waveform}: x_p (hemispheres)")

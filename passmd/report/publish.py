@@ -207,9 +207,9 @@ def grid_text(values_si, unit: str, limit: int = 8) -> str:
 
 def partial_grid_text(names, profile: str) -> tuple[str, str, list[str]] | None:
     """What a page built on ``profile`` lacks of the paper profile's grids for the figures ``names``
-    (:func:`passmd.experiments.figure_table.grid_shortfall`): a title, one sentence with the totals and
-    one item per figure that lacks points (``"fig5a: 18 of the paper profile's 203 points
-    (amplitudes), 185 missing"``); None on the paper profile."""
+    (:func:`passmd.experiments.figure_table.grid_shortfall`): a title with the points missing, one
+    sentence with the points computed and one item per figure that lacks points (``"fig5a: 18 of the
+    paper profile's 203 points (amplitudes), 185 missing"``); None on the paper profile."""
     from passmd.experiments.figure_table import grid_shortfall
 
     check_choice("profile", profile, PROFILES)
@@ -224,11 +224,11 @@ def partial_grid_text(names, profile: str) -> tuple[str, str, list[str]] | None:
                 "the same runs more coarsely).", [])
     items = [f"{row.figure}: {row.points} of the paper profile's {row.reference_points} points "
              f"({row.axes}), {row.missing} missing" for row in short.itertuples()]
-    return ("Partial grid",
-            f"Built on the {profile} profile, a partial grid: the figures behind this page's verdicts "
-            f"compute {short['points'].sum()} of the paper profile's {short['reference_points'].sum()} grid "
-            f"points ({short['missing'].sum()} missing), so a verdict may differ on the paper's grids "
-            "(python3 -m nox -s book builds them):", items)
+    total, computed, missing = (int(short[c].sum()) for c in ("reference_points", "points", "missing"))
+    return (f"Partial grid: {missing} of the paper profile's {total} grid points missing",
+            f"Built on the {profile} profile: the figures behind this page's verdicts compute {computed} of "
+            f"the paper profile's {total} grid points, so a verdict may differ on the paper's grids "
+            "(python3 -m nox -s book builds them). By figure:", items)
 
 
 def drive_parameters(drive) -> dict[str, str]:
