@@ -113,6 +113,8 @@ DRIVE_KEYS: dict[str, DriveKey] = {k.key: k for k in (
     DriveKey("runner_mass", "kg", "g", "m_r", "runner mass", "Table 1"),
     DriveKey("load_cell_stiffness", "N/m", "N/m", "k", "load cell stiffness", "Table 1"),
     DriveKey("load_cell", "bool", "", "–", "the runner pushes against the load cell", "Section 4.2"),
+    DriveKey("guide_rail", "bool", "", "–", "a rail takes the sideways force of contacts at α < 90° that "
+             "no placement on the groove's two flanks cancels (else such a guide is refused)", "default"),
     DriveKey("allow_extrapolation", "bool", "", "–", "accept values outside the plausible ranges "
              "(soft limits only)", "default"),
     DriveKey("hemisphere_material.name", "str", "", "–", "name of the hemispheres' material", "Table 1"),
@@ -356,7 +358,7 @@ def resolve(values: dict, origins: dict | None = None, **fixed) -> tuple[Drive, 
     amplifier = {key.split(".", 1)[1]: value for key, value in values.items() if key.startswith("amplifier.")}
     changes["amplifier"] = replace(Amplifier(), **amplifier)
     for key in ("hemisphere_radius", "preload", "friction_coefficient", "runner_mass", "load_cell_stiffness",
-                "load_cell", "allow_extrapolation", "actuator_model"):
+                "load_cell", "allow_extrapolation", "actuator_model", "guide_rail"):
         if key in values:
             changes[key] = values[key]
     if "contacts" in values:
