@@ -32,6 +32,8 @@ def _check_combinations(given, args, load_cell: bool, rigid: bool) -> None:
         if dynamics:
             raise UsageError(f"{dynamics[0]} contradicts --actuator rigid: ideally rigid actuators have no "
                              "stiffness, mass or viscosity (use --actuator flexible, or drop the option)")
+    if "--actuator-viscosity" in given and "--damping-ratio" in given:
+        raise UsageError("--actuator-viscosity contradicts --damping-ratio: give one (c_p = 2ζ√(k_p m_a))")
     if "--load-cell-stiffness" in given and not load_cell:
         raise UsageError("--load-cell-stiffness has no effect here: the runner is free (no load cell); "
                          "use it with `passmd force` or `passmd run --load-cell`")
@@ -62,6 +64,8 @@ def resolve_drive(args, **fixed) -> tuple[Drive, dict[str, str]]:
             origins[q.field] = f"option {q.flag}"
             if q.field == "actuator.viscosity":
                 values.pop("actuator.damping_ratio", None)
+            if q.field == "actuator.damping_ratio":
+                values.pop("actuator.viscosity", None)
     if getattr(args, "contacts", None) is not None:
         values["contacts"] = {1: "one", 6: "paper-six"}[args.contacts]
         origins["contacts"] = "option --contacts"
