@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["eq15_rows", "hz", "missing_rows", "resolution", "ringing_notes", "ringing_rows",
+__all__ = ["diagnosis_rows", "eq15_rows", "hz", "missing_rows", "resolution", "ringing_notes", "ringing_rows",
            "ringing_text", "sweep_figure", "sweep_title", "uses_eq15"]
 
 
@@ -106,7 +106,7 @@ def resolution(spec, frequencies) -> list[float]:
     return [delta * float(f) for f in frequencies] if spec.unit == "mm/s" else [0.0] * len(frequencies)
 
 
-def ringing_text(ring: dict, what: str) -> str:
+def ringing_text(ring: dict, what: str, *, diagnosed: bool = False) -> str:
     """One line on the runner's ringing after a fly-back (:func:`passmd.protocols.ringing.at_frequency`)
     and whether it is still there, beyond the measurable step, when the next fly-back starts;
     ``what``: the answer it affects (e.g. ``"the step"``)."""
@@ -117,10 +117,18 @@ def ringing_text(ring: dict, what: str) -> str:
     decay = ring["ringing_decay_time_s"]
     decays = f"decaying to 1/e in {decay * 1e3:.3g} ms" if decay is not None and math.isfinite(decay) else \
         "decaying by less than 1/e while recorded"
-    text = (f"after a fly-back the runner rings at {ring['ringing_frequency_Hz'] / 1e3:.3g} kHz, "
+    linear = ring.get("ringing_linear_frequency_Hz")
+    estimate = ""
+    if linear is not None and math.isfinite(linear):
+        estimate = (" (the linear estimate, each contact in series with its actuator: "
+                    f"{linear / 1e3:.3g} kHz; the first swings micro-slip)")
+    text = (f"after a fly-back the runner rings at {ring['ringing_frequency_Hz'] / 1e3:.3g} kHz{estimate}, "
             f"±{ring['ringing_amplitude_m'] * 1e9:.3g} nm, {decays}; "
             f"±{ring['ringing_at_next_flyback_m'] * 1e9:.3g} nm is left when the next fly-back starts "
             f"{ring['next_flyback_after_s'] * 1e3:.3g} ms later")
+    if ring["ringing_affects_steps"] and diagnosed:
+        return (f"{text}, more than the {MEASURABLE * 1e9:g} nm measurable step; how much it moves {what} is "
+                "computed below (runner ringing)")
     if ring["ringing_affects_steps"]:
         return (f"{text}, more than the {MEASURABLE * 1e9:g} nm measurable step: {what} depends on where in "
                 "its swing the runner is then, so it is not monotone in frequency, amplitude or preload (the "
@@ -168,3 +176,39 @@ def sweep_title(spec, axes, drive) -> str:
 
     varied = [a.name for a in axes]
     return f"{spec.label} over {' × '.join(varied)}\n{describe(drive, omit=varied)}"
+
+
+def _value_text(value, unit: str) -> str:
+    from passmd.cli.output import fmt
+
+    return "none" if value is None else fmt(value, unit)
+
+
+def diagnosis_rows(found: dict, symptom: str, unit: str, what: str) -> list[tuple[str, str]]:
+    """The computed "why" of a departure (:func:`passmd.protocols.diagnosis.diagnose`): the symptom,
+    each cause's counterfactual value and share, best explanation first, and the causes it names.
+    ``unit``: the display unit of the values; ``what``: the result's name (``"A_c"``)."""
+    from passmd.protocols.diagnosis import EXPLAINS
+
+    rows = [("why (computed)", f"{symptom}; re-run with one candidate cause removed at a time:")]
+    for c in found["causes"]:
+        if c["share"] is None:
+            rows.append((f"  {c['cause']}", f"not tried: {c['changed']}"))
+            continue
+        values = c["counterfactual_values"]
+        at = (f"{what} = {_value_text(values[-1], unit)}" if len(values) == 1 else
+              f"{what} = {' → '.join(_value_text(v, unit) for v in values)}")
+        closed = "" if c.get("counterfactual_expected") is None or c["key"] != "actuator" else \
+            f" (its closed form, Eq. 7/11: {_value_text(c['counterfactual_expected'], unit)})"
+        why = f": {c['why']}" if c.get("why") else ""
+        past = (" (past what is expected: a cause acting the other way remains)"
+                if c["share"] > 2 - EXPLAINS else "")
+        rows.append((f"  {c['cause']}", f"{100 * c['share']:.0f} % of it{past}: with {c['changed']} {at}"
+                     f"{closed}{why}"))
+    named = found["named"]
+    which = "it" if len(named) == 1 else "each"
+    rows.append(("cause", ", ".join(named) + f" (removing {which} takes away at "
+                 f"least {100 * EXPLAINS:.0f} % of the departure)" if named else
+                 f"none of the candidates: removing each takes away less than {100 * EXPLAINS:.0f} % of the "
+                 "departure"))
+    return rows
