@@ -54,8 +54,9 @@ from passmd.runtime import sweep
 from passmd.runtime.validation import check_choice
 from passmd.solver.results import SimulationError
 
-__all__ = ["AGREEMENT", "CAUSES", "EXPLAINS", "FLYBACK_PERIODS", "MAX_REST", "QUANTITIES", "REST_SWING",
-           "SHARE_FACTOR", "Cause", "counterfactual_point", "departs", "diagnose", "rest_time"]
+__all__ = ["AGREEMENT", "CAUSES", "EXPLAINS", "FLYBACK_PERIODS", "MAX_DIAGNOSED", "MAX_REST", "QUANTITIES",
+           "REST_SWING", "SHARE_FACTOR", "Cause", "counterfactual_point", "departs", "diagnose", "rest_time",
+           "running_max", "sweep_departures"]
 
 #: Relative departure of a simulated A_c from its closed form beyond which it is diagnosed, and of a
 #: value from its trend between two neighbouring sweep points: the 10 % band within which the critical
@@ -168,12 +169,14 @@ def counterfactual_point(quantity: str, cause: str, drive: Drive, frequency: flo
     dict
         ``value`` (SI; None where the cause does not apply or the counterfactual finds none),
         ``expected`` (the closed form of the counterfactual's drive, critical amplitude only),
-        ``changed`` (what the counterfactual changed, or why it does not apply), ``rest_s`` and
+        ``changed`` (what the counterfactual changed, or why it does not apply), ``tried`` (whether
+        it was run; with no value, ``changed`` says why), ``rest_s`` and
         ``swing_left_m`` (the ``ringing`` cause: the rest after each fly-back and the swing left).
     """
     check_choice("quantity", quantity, QUANTITIES)
     check_choice("cause", cause, tuple(CAUSES))
-    out = {"value": None, "expected": None, "changed": "", "rest_s": None, "swing_left_m": None}
+    out = {"value": None, "expected": None, "changed": "", "tried": False, "rest_s": None,
+           "swing_left_m": None}
     if quantity not in CAUSES[cause].quantities or (cause == "reading" and reading != "steady") or (
             cause == "ringing" and quantity == "critical-amplitude" and reading != "steady"):
         out["changed"] = "does not apply"
@@ -182,6 +185,7 @@ def counterfactual_point(quantity: str, cause: str, drive: Drive, frequency: flo
     out["changed"] = text
     if changed is None:
         return out
+    out["tried"] = True
     try:
         _counterfactual(out, quantity, cause, drive, changed, frequency, amplitude, reading)
     except (SimulationError, ValueError) as exc:  # the counterfactual cannot be run: said, not hidden
@@ -203,6 +207,8 @@ def _counterfactual(out: dict, quantity, cause, drive, changed, frequency, ampli
         found = critical_amplitude.critical_amplitude(changed, protocol=protocol, frequency=frequency,
                                                       rest=rest)
         out["value"] = None if math.isnan(found["critical_amplitude_m"]) else found["critical_amplitude_m"]
+        if out["value"] is None:
+            out["changed"] += ": no onset up to the full stroke"
         out["expected"] = theory.drive_theory(changed)["analytic_critical_amplitude_m"]
     elif cause == "ringing":  # velocity or step: the last step of a run with rests
         steps = critical_amplitude.steady_step(changed, amplitude, frequency, periods=_RESTED_PERIODS,
@@ -211,7 +217,10 @@ def _counterfactual(out: dict, quantity, cause, drive, changed, frequency, ampli
     elif quantity == "gain":
         from passmd.protocols.maps import gain_point
 
-        out["value"] = gain_point(changed, amplitude, frequency)["gain_m_per_s"]
+        gain = gain_point(changed, amplitude, frequency)
+        out["value"] = gain["gain_m_per_s"]
+        if gain["note"]:
+            out["changed"] += f": {gain['note']}"
     else:
         run = velocity.steady_run(changed, amplitude, frequency, "sawtooth", "cut")
         out["value"] = run["velocity_m_per_s"] if quantity == "velocity" else run["step_m"]
@@ -315,9 +324,61 @@ def diagnose(quantity: str, points: list[dict], values: list, *, reading: str = 
                       "counterfactual_values": cf, "counterfactual_value": cf[-1],
                       "counterfactual_expected": (cf_expected[-1] if quantity == "critical-amplitude"
                                                   else None),
-                      "share": share, "why": _why(key, points[-1]), "rest_s": _number(mine[-1]["rest_s"]),
+                      "share": share, "tried": bool(mine[-1]["tried"]), "why": _why(key, points[-1]),
+                      "rest_s": _number(mine[-1]["rest_s"]),
                       "swing_left_m": _number(mine[-1]["swing_left_m"])})
     found.sort(key=lambda c: math.inf if c["share"] is None else abs(1.0 - c["share"]))
     named = [c["cause"] for c in found if c["share"] is not None and c["share"] >= EXPLAINS]
     return {"quantity": quantity, "values": list(values), "expected": expected, "departure": departure,
             "causes": found, "named": named}
+
+
+#: Most departures of one sweep diagnosed (the largest first); each costs a few runs per cause.
+MAX_DIAGNOSED = 3
+
+
+def sweep_departures(quantity: str, values, expected, frequencies, resolution,
+                     limit: int = MAX_DIAGNOSED) -> list[tuple[int, ...]]:
+    """The points of a one-axis sweep (in axis order) whose departure :func:`diagnose` should explain.
+
+    * critical amplitude: neighbours (i, i + 1) whose second departs from the trend the first sets
+      (the closed form's scaling, :func:`diagnose`) by more than :data:`AGREEMENT` of it: a jump;
+    * velocity, step: each turn of the curve (:func:`passmd.protocols.ringing.turns`, changes beyond
+      ``resolution``) and the point after it: a roll-off or a non-monotone stretch;
+    * gain: the most negative gain below −``resolution``: Eq. 15 slower than the saw-tooth.
+
+    The largest ``limit`` departures, as index tuples; values None or NaN are skipped.
+    """
+    check_choice("quantity", quantity, QUANTITIES)
+    v = [_number(x) for x in values]
+    if quantity == "gain":
+        below = [(x, i) for i, x in enumerate(v) if x is not None and x < -float(resolution[i])]
+        return [(min(below)[1],)] if below else []
+    if quantity == "critical-amplitude":
+        found = []
+        for i in range(len(v) - 1):
+            if v[i] is None or v[i + 1] is None:
+                continue
+            trend = v[i] * float(expected[i + 1]) / float(expected[i])
+            if departs(v[i + 1], trend):
+                found.append((abs(v[i + 1] - trend), (i, i + 1)))
+        return [pair for _, pair in sorted(found, reverse=True)[:limit]]
+    found = []
+    for i in ringing.turns(values, resolution):
+        if i + 1 < len(v) and v[i] is not None and v[i + 1] is not None:
+            ratio = float(frequencies[i + 1]) / float(frequencies[i]) if quantity == "velocity" else 1.0
+            trend = v[i] * ratio
+            found.append((abs(v[i + 1] - trend), (i, i + 1)))
+    return [pair for _, pair in sorted(found, reverse=True)[:limit]]
+
+
+def running_max(values) -> list[float | None]:
+    """The largest value up to each point (None where none yet): along an axis, the amplitude that
+    moves the runner at every point up to there."""
+    out, top = [], None
+    for x in values:
+        x = _number(x)
+        if x is not None and (top is None or x > top):
+            top = x
+        out.append(top)
+    return out

@@ -220,7 +220,7 @@ def _diagnosis(args, drive, record) -> dict | None:
     out = diagnosis.diagnose("critical-amplitude", [point], [found], reading=args.protocol,
                              config=run_config(args))
     causes = [{"cause": c["cause"], "counterfactual_value_m": c["counterfactual_value"], "share": c["share"],
-               "changed": c["changed"], "why": c["why"], "key": c["key"],
+               "changed": c["changed"], "why": c["why"], "key": c["key"], "tried": c["tried"],
                "counterfactual_closed_form_m": c["counterfactual_expected"]} for c in out["causes"]]
     return {"departure_m": out["departure"], "closed_form_m": closed, "causes": causes, "named": out["named"]}
 
