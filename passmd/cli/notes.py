@@ -150,7 +150,17 @@ def sweep_figure(args, axes, spec, table, title):
                        resolution_label=f"|value| below the measurable step ({step}): no measurable "
                        + ("difference" if args.quantity == "gain" else "motion"))
     return map_figure(table, shown, value, title, also=also if len(axes) == 1 else (), marks=marks,
-                      notes=ringing_notes(table), color_scale=getattr(args, "color_scale", "auto"))
+                      notes=ringing_notes(table), color_scale=getattr(args, "color_scale", "auto"),
+                      band=_band(spec, table))
+
+
+def _band(spec, table):
+    """The fitted drive's band of a sweep (:func:`passmd.cli.sweep_rows.add_band`), for the figure."""
+    low, high = f"{spec.column}_band_low", f"{spec.column}_band_high"
+    if low not in table:
+        return None
+    return low, high, (f"fit's 95 % region ({table.attrs.get('band_points', 0)} points of it and the "
+                       "estimate)")
 
 
 def sweep_title(spec, axes, drive) -> str:

@@ -8,8 +8,8 @@ import math
 
 import numpy as np
 
-__all__ = ["DIAGNOSED", "curve_rows", "derived_columns", "diagnose_sweep", "diagnosis_rows", "extreme_rows",
-           "point_range", "warnings_of"]
+__all__ = ["DIAGNOSED", "add_band", "check_values", "curve_rows", "derived_columns", "diagnose_sweep",
+           "diagnosis_rows", "extreme_rows", "point_range", "warnings_of"]
 
 #: The sweep quantities a diagnosis covers, by the name :mod:`passmd.protocols.diagnosis` knows them.
 DIAGNOSED = {"critical-amplitude": "critical-amplitude", "velocity": "velocity", "step": "step",
@@ -124,6 +124,8 @@ def curve_rows(axes, spec, table, _shown) -> list[tuple[str, str]]:
     """A short curve in full: one row per value of its axis (a gain with its %, an A_c with the running
     maximum up to it)."""
     (axis,) = axes
+    low = table[f"{spec.column}_band_low"] if f"{spec.column}_band_low" in table else None
+    high = table[f"{spec.column}_band_high"] if low is not None else None
     beside = {"gain_percent": lambda p: f" ({p:+.3g} %)",
               "running_max_critical_amplitude_m":
                   lambda m: f" (at every {axis.name} up to here: {m * 1e9:.6g} nm)"}
@@ -135,6 +137,9 @@ def curve_rows(axes, spec, table, _shown) -> list[tuple[str, str]]:
             extra = table[column].iloc[i] if column in table else None
             if text != "–" and extra is not None and math.isfinite(float(extra)):
                 text += say(float(extra))
+        if low is not None and text != "–" and low.iloc[i] is not None and math.isfinite(float(low.iloc[i])):
+            text += (f" (fit's 95 % region: {float(low.iloc[i]) / spec.scale:.4g}–"
+                     f"{float(high.iloc[i]) / spec.scale:.4g} {spec.unit})")
         rows.append((f"{axis.name} {_shown(axis, x)}", text))
     return rows
 
@@ -165,3 +170,41 @@ def derived_columns(args, axes, table) -> None:
         from passmd.protocols.diagnosis import running_max
 
         table["running_max_critical_amplitude_m"] = running_max(table["critical_amplitude_m"])
+
+
+def add_band(args, spec, table, points_with, config) -> None:
+    """The band a fitted --drive file's region gives each point (in place): ``<column>_band_low`` and
+    ``_band_high``, the least and largest value over the estimate and the region's points.
+
+    ``points_with(build)``: the sweep's points with each drive made by ``build(args)``; the region's
+    drives come from :func:`passmd.cli.drive.region_drives` (none: no band)."""
+    from passmd.cli.drive import region_drives
+    from passmd.protocols.maps import compute_map
+
+    count = len(region_drives(args))
+    if not count:
+        return
+    values = [list(table[spec.column])]
+    for k in range(count):
+        points = points_with(lambda probe, k=k: region_drives(probe)[k])
+        other = compute_map(args.quantity, points, reading=args.reading or "steady",
+                            waveform=args.waveform or "sawtooth",
+                            design_response=args.design_response or "paper", config=config,
+                            description=f"fit region {k + 1}/{count}")
+        values.append(list(other[spec.column]))
+    spans = [_finite(column) for column in zip(*values, strict=True)]
+    table[f"{spec.column}_band_low"] = [min(s) if s else None for s in spans]
+    table[f"{spec.column}_band_high"] = [max(s) if s else None for s in spans]
+    table.attrs["band_points"] = count
+
+
+def check_values(args, column: str, table) -> None:
+    """The quantity is finite at every point; only an Eq. 15 quantity without an Eq. 15 waveform
+    and a critical amplitude above the full stroke may be missing (``None``, said in the output)."""
+    from passmd.cli.notes import uses_eq15
+    from passmd.cli.output import check_results
+
+    values = [v for v in table[column] if v is not None]
+    if args.quantity == "critical-amplitude" or uses_eq15(args):
+        values = [v for v in values if not (isinstance(v, float) and math.isnan(v))]
+    check_results({column: values})

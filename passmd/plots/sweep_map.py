@@ -122,7 +122,7 @@ _STYLE = {"missing": ("xx", "0.82", "x"), "unsteady": ("//", "0.92", "o"), "unre
 
 def map_figure(table, axes: Sequence[MapAxis], value: MapAxis, title: str,
                also: Sequence[MapAxis] = (), *, marks: CellMarks | None = None, notes: Sequence[str] = (),
-               color_scale: str = "auto") -> Figure:
+               color_scale: str = "auto", band: tuple[str, str, str] | None = None) -> Figure:
     """The map of ``value`` over one or two ``axes`` of ``table`` (grid order, last axis fastest).
 
     One axis: ``value`` (and the ``also`` columns, dashed) against it; marked points are drawn
@@ -132,6 +132,7 @@ def map_figure(table, axes: Sequence[MapAxis], value: MapAxis, title: str,
     ``notes``: lines the legend ends with (e.g. what makes a curve turn). ``color_scale``: a heat
     map's colour scale, ``"linear"``, ``"log"`` (values > 0 only; a map with a value <= 0 is refused)
     or ``"auto"`` (log where every value is > 0 and they span more than :data:`LOG_SPAN`).
+    ``band``: (low column, high column, label) of a band shaded about a curve (one axis only).
     """
     if color_scale not in COLOR_SCALES:
         raise ValueError(f"color_scale = {color_scale!r} is not allowed: must be one of "
@@ -145,6 +146,10 @@ def map_figure(table, axes: Sequence[MapAxis], value: MapAxis, title: str,
     ax = fig.add_subplot()
     handles = _curve(ax, table, axes[0], value, z, marks, also) if len(axes) == 1 else \
         _heat_map(fig, ax, table, axes, value, z, marks, color_scale)
+    if band is not None and len(axes) == 1:
+        low, high = (_values(table, MapAxis(c, "", value.unit, scale=value.scale)) for c in band[:2])
+        handles.append(ax.fill_between(axes[0].shown(table[axes[0].column]), low, high, color="C0", alpha=0.2,
+                                       lw=0, label=band[2]))
     handles += [Patch(visible=False, label=note) for note in notes]
     if handles:
         ax.legend(handles=handles, fontsize=7, loc="upper left", bbox_to_anchor=(0.0, -0.14), ncols=1,

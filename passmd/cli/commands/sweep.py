@@ -38,6 +38,8 @@ from passmd.cli.options import (
 from passmd.cli.output import JSON_HELP, check_output_file, describe, drive_record, emit_json, emit_rows, fmt
 from passmd.cli.streams import PipeClosed, check_outputs, write_atomically
 from passmd.cli.sweep_rows import (
+    add_band,
+    check_values,
     curve_rows,
     derived_columns,
     diagnose_sweep,
@@ -116,7 +118,10 @@ _EPILOG = textwrap.dedent("""\
     measurable step); ringing_* (every quantity but the stall force): the runner's swing after a
     fly-back and what is left of it when the next starts (ringing_at_next_flyback_m);
     running_max_critical_amplitude_m (critical-amplitude over one axis: the amplitude that moves the
-    runner at every point up to this one); gain_percent (gain: over the saw-tooth's velocity).
+    runner at every point up to this one); gain_percent (gain: over the saw-tooth's velocity);
+    <column>_band_low, <column>_band_high (a --drive file written by passmd fit: the least and largest
+    value over the fit's estimate and the points of its 95 % region the file records; a shaded band
+    in a curve's PNG).
     warnings[{{kind, points, of, range, text}}]: each warning once, with the points it covers.
 
     Over one axis, where a value departs from its trend (a critical amplitude jumping more than 10 %
@@ -312,9 +317,9 @@ def _check_options(args) -> None:
 # The grid
 # --------------------------------------------------------------------------------------
 
-def _points(args, axes: list[Axis], with_amplitude: bool) -> list[dict]:
-    """Every point of the grid: its drive (options, each drive axis' value replacing its option),
-    frequency and amplitude, and the axes' values as columns."""
+def _points(args, axes: list[Axis], with_amplitude: bool, build=build_drive) -> list[dict]:
+    """Every point of the grid: its drive (options, each drive axis' value replacing its option;
+    ``build`` makes it from them), frequency and amplitude, and the axes' values as columns."""
     drives: dict[tuple, object] = {}
     drive_axes = [a for a in axes if a.name not in ("amplitude", "frequency")]
     fixed_amplitude = AMPLITUDE.parse(args) if with_amplitude else None
@@ -328,7 +333,7 @@ def _points(args, axes: list[Axis], with_amplitude: bool) -> list[dict]:
             for a in drive_axes:
                 setattr(probe, a.quantity.dest, f"{at[a.name]!r} {a.si_unit}".strip())
             try:
-                drives[key] = build_drive(probe)
+                drives[key] = build(probe)
             except (UsageError, ValueError) as exc:
                 where = ", ".join(f"{a.name} = {_shown(a, at[a.name])}" for a in drive_axes)
                 raise UsageError(f"--vary at {where}: {explain(exc, probe)}") from None
@@ -449,17 +454,6 @@ def _write(args, record, axes, spec, table, title) -> dict:
     return files
 
 
-def _check_values(args, column: str, table) -> None:
-    """The quantity is finite at every point; only an Eq. 15 quantity without an Eq. 15 waveform
-    and a critical amplitude above the full stroke may be missing (``None``, said in the output)."""
-    from passmd.cli.output import check_results
-
-    values = [v for v in table[column] if v is not None]
-    if args.quantity == "critical-amplitude" or uses_eq15(args):
-        values = [v for v in values if not (isinstance(v, float) and math.isnan(v))]
-    check_results({column: values})
-
-
 def run_sweep(args, out) -> int:
     from passmd.protocols.maps import MAP_QUANTITIES, compute_map
 
@@ -472,7 +466,8 @@ def run_sweep(args, out) -> int:
     table = compute_map(args.quantity, points, reading=args.reading or "steady",
                         waveform=args.waveform or "sawtooth", design_response=args.design_response or "paper",
                         config=config)
-    _check_values(args, spec.column, table)
+    check_values(args, spec.column, table)
+    add_band(args, spec, table, lambda build: _points(args, axes, spec.amplitude, build), config)
     derived_columns(args, axes, table)
     title = sweep_title(spec, axes, base)
     warned = warnings_of(axes, spec, table, _shown)
