@@ -88,7 +88,8 @@ def test_fit_png_draws_one_series_per_preload_and_frequency():
     conditions = [(p, f, a) for p in (0.3, 0.4) for f in (100.0, 1e3) for a in (80, 120)]
     rows = [{"line": i, "quantity": "step_nm", "kind": "step", "unit": "nm", "preload_N": p,
              "frequency_Hz": f, "amplitude_nm": a, "measured": a / 2 + f / 100, "sd": 0.5,
-             "predicted": a / 2 + f / 100, "normalized_residual": 0.0} for i, (p, f, a) in enumerate(conditions)]
+             "predicted": a / 2 + f / 100, "normalized_residual": 0.0}
+            for i, (p, f, a) in enumerate(conditions)]
     table = pd.DataFrame(rows)
     table.attrs.update(estimates={"friction_coefficient": 0.2}, goodness_of_fit={})
     top = fit_figure(table).axes[0]
