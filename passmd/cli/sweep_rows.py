@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 __all__ = ["DIAGNOSED", "add_band", "check_values", "curve_rows", "derived_columns", "diagnose_sweep",
-           "diagnosis_rows", "extreme_rows", "point_range", "warnings_of"]
+           "extreme_rows", "point_range", "sweep_diagnosis_rows", "warnings_of"]
 
 #: The sweep quantities a diagnosis covers, by the name :mod:`passmd.protocols.diagnosis` knows them.
 DIAGNOSED = {"critical-amplitude": "critical-amplitude", "velocity": "velocity", "step": "step",
@@ -109,14 +109,15 @@ def _symptom(found: dict, axis, spec, table, shown) -> str:
             f"{found['departure'] / spec.scale:+.3g} {spec.unit} off {trend}")
 
 
-def diagnosis_rows(diagnoses, axis, spec, table, shown) -> list[tuple[str, str]]:
+def sweep_diagnosis_rows(diagnoses, axis, spec, table, shown) -> list[tuple[str, str]]:
     """The rows of each diagnosis (:func:`passmd.cli.notes.diagnosis_rows`)."""
-    from passmd.cli.notes import diagnosis_rows as rows_of
+    from passmd.cli.notes import diagnosis_rows
 
     rows = []
     for found in diagnoses:
         what = spec.label.split(" (")[0]
-        rows += rows_of(found, _symptom(found, axis, spec, table, shown), spec.unit, what, scale=spec.scale)
+        symptom = _symptom(found, axis, spec, table, shown)
+        rows += diagnosis_rows(found, symptom, spec.unit, what, scale=spec.scale)
     return rows
 
 

@@ -22,7 +22,7 @@ from matplotlib.patches import Patch, Rectangle
 from passmd.protocols.velocity import STEADY_DRIFT_LIMIT
 from passmd.runtime.units import from_si
 
-__all__ = ["COLOR_SCALES", "LOG_SPAN", "CellMarks", "MapAxis", "cell_marks", "map_figure"]
+__all__ = ["COLOR_SCALES", "LOG_SPAN", "CellMarks", "MapAxis", "cell_marks", "map_figure", "plain_log_ticks"]
 
 #: A heat map's colour scales (:func:`map_figure`).
 COLOR_SCALES = ("auto", "linear", "log")
@@ -178,7 +178,7 @@ def _curve(ax, table, axis: MapAxis, value: MapAxis, z, marks: CellMarks, also) 
     ax.set_ylabel(value.title)
     if axis.log:
         ax.set_xscale("log")
-        _plain_numbers(ax.xaxis)
+        plain_log_ticks(ax.xaxis)
     ax.grid(alpha=0.3)
     return handles
 
@@ -193,7 +193,7 @@ def _log_colors(shown, color_scale: str) -> bool:
     return positive and (color_scale == "log" or float(shown.max()) / float(shown.min()) > LOG_SPAN)
 
 
-def _plain_numbers(axis) -> None:
+def plain_log_ticks(axis) -> None:
     """Tick labels of a log axis as plain numbers (``6``, ``200``), not ``6×10⁰``."""
     label = ticker.FuncFormatter(lambda v, _: f"{v:g}")
     axis.set_major_formatter(label)
@@ -226,7 +226,7 @@ def _heat_map(fig, ax, table, axes, value: MapAxis, z, marks: CellMarks, color_s
     mesh = ax.pcolormesh(x_edges, y_edges, shown, shading="flat", cmap=cmap, norm=norm)
     bar = fig.colorbar(mesh, ax=ax, label=value.title + (" (log scale)" if log else ""))
     if log:
-        _plain_numbers(bar.ax.yaxis)
+        plain_log_ticks(bar.ax.yaxis)
     elif norm is not None:
         bar.locator = ticker.MaxNLocator(nbins=8, symmetric=True)
         bar.update_ticks()
@@ -252,8 +252,8 @@ def _heat_map(fig, ax, table, axes, value: MapAxis, z, marks: CellMarks, color_s
     ax.set_ylabel(second.title)
     if first.log:
         ax.set_xscale("log")
-        _plain_numbers(ax.xaxis)
+        plain_log_ticks(ax.xaxis)
     if second.log:
         ax.set_yscale("log")
-        _plain_numbers(ax.yaxis)
+        plain_log_ticks(ax.yaxis)
     return handles

@@ -43,8 +43,8 @@ from passmd.cli.sweep_rows import (
     curve_rows,
     derived_columns,
     diagnose_sweep,
-    diagnosis_rows,
     extreme_rows,
+    sweep_diagnosis_rows,
     warnings_of,
 )
 from passmd.model.defaults import PROTOCOL
@@ -490,7 +490,7 @@ def run_sweep(args, out) -> int:
     if len(axes) == 1:
         resolved = resolution(spec, table["frequency_Hz"])
         rows += turn_rows(axes[0], spec, table, resolved, _shown, bool(diagnoses))
-        rows += diagnosis_rows(diagnoses, axes[0], spec, table, _shown)
+        rows += sweep_diagnosis_rows(diagnoses, axes[0], spec, table, _shown)
     if record["missing_values"]:
         rows += missing_rows(args, table, record["missing_values"])
     if "files" in record:

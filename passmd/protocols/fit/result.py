@@ -322,8 +322,9 @@ def fitted_drive_file(result: FitResult, data_name: str, sources: dict | None = 
             if out[k].startswith("held")]
     notes = [f"Fitted to {data_name}: {', '.join(free)}; every other value as below (held)."]
     notes += [f"Held while fitting: {line}" for line in held]
-    if result.region_points:
-        notes.append(f"[fit_region] at the end: the fitted keys at {len(result.region_points)} points of the "
+    points = getattr(result, "region_points", ())  # a record of a fit made before regions were kept: none
+    if points:
+        notes.append(f"[fit_region] at the end: the fitted keys at {len(points)} points of the "
                      "fit's 95 % region, whose predictions span its band.")
     return drive_toml(result.drive, out, title=f"drive fitted by passmd fit to {data_name}",
                       damping_ratio=zeta, notes=notes, region=_region_values(result))
@@ -341,6 +342,8 @@ def _region_values(result: FitResult) -> list[dict]:
     from passmd.model.drive_file import parameter_rows
     from passmd.model.drive_keys import DRIVE_KEYS, SI_UNITS
 
+    if not getattr(result, "region_points", ()):
+        return []
     rows = [{r["key"]: r["value"] for r in parameter_rows(d)} for d in result.region_drives()]
     if len(rows) < 2:
         return []
