@@ -133,9 +133,9 @@ def diagnosis_table(found: dict) -> pd.DataFrame:
     """The causes of a critical amplitude's departure (:func:`passmd.protocols.diagnosis.diagnose`), one row
     each: the counterfactual (what was removed), its A_c (nm) and its share of the departure (%)."""
     return pd.DataFrame([{"cause": c["cause"], "counterfactual": c["changed"],
-                          "counterfactual A_c [nm]": (np.nan if c["counterfactual_value"] is None
-                                                      else c["counterfactual_value"] * 1e9),
-                          "share [%]": np.nan if c["share"] is None else 100 * c["share"]}
+                          "counterfactual A_c [nm]": ("–" if c["counterfactual_value"] is None
+                                                      else f"{c['counterfactual_value'] * 1e9:.4g}"),
+                          "share [%]": "–" if c["share"] is None else f"{100 * c['share']:.0f}"}
                          for c in found["causes"]])
 
 
