@@ -14,7 +14,10 @@ import math
 import textwrap
 
 import numpy as np
+from matplotlib import ticker
 from matplotlib.figure import Figure
+
+from passmd.plots.sweep_map import plain_log_ticks
 
 __all__ = ["fit_figure", "profile_figure"]
 
@@ -109,6 +112,8 @@ def profile_figure(table, zoom: float = 1.3) -> Figure:
             ax.axvline(truth * scale, color="black", lw=1.0, label="value that made the data")
         ax.set_xscale("log")
         ax.set_yscale("symlog", linthresh=max(level, 1.0))
+        plain_log_ticks(ax.xaxis)
+        ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
         ax.set_ylim(bottom=0.0)
         ax.set_xlim(left, right)
         ax.set_xlabel(f"{label} [{unit}]" if unit else label)
