@@ -129,3 +129,22 @@ def test_the_force_plot_has_a_force_axis_in_newtons(tmp_path):
     assert top.get_ylabel() == "force [N]"
     force = drive.load_cell_stiffness * result.runner_position
     np.testing.assert_allclose(top.get_lines()[0].get_ydata(), force)
+
+
+def test_progress_and_verdict_count_the_region_the_same_way():
+    """The progress names each parameter's region pieces, as the verdict and the report count them, and
+    every basin the report lists per parameter is one of the fit's basins."""
+    conditions = [(p, a * 1e-9, 100.0) for p in (0.2, 0.4) for a in (60, 100, 140)]
+    exact = independent_steps(RIGID.replace(friction_coefficient=0.25), conditions)
+    rows = [[repr(a * 1e9), repr(p), repr(f), repr(float(v * 1e9)), "0.5"]
+            for (p, a, f), v in zip(conditions, exact, strict=True)]
+    lines = []
+    data = fit.measurements_from_rows(HEADER, rows)
+    result = fit.fit(RIGID, data, ["friction_coefficient"], executor="serial", cache=False,
+                     progress=lines.append)
+    pieces = len(result.estimates["friction_coefficient"]["intervals"])
+    estimate_lines = [line for line in lines if line.startswith("estimate ")]
+    assert estimate_lines and f"friction_coefficient in {pieces} piece(s) (" in estimate_lines[-1]
+    assert not any("basin(s) within" in line for line in lines)
+    listed = {round(b["parameters"]["friction_coefficient"], 12) for b in result.basins}
+    assert {round(b["value"], 12) for b in result.estimates["friction_coefficient"]["basins"]} <= listed
