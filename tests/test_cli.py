@@ -135,7 +135,8 @@ def test_theory_json_matches_api():
     expected = drive_theory(drive)
     for key, value in expected.items():
         assert data[key] == value, key
-    assert data["runner_frequency_Hz"] == runner_frequency(drive)
+    assert data["runner_frequency_Hz"] == runner_frequency(drive, in_series=True)
+    assert data["runner_frequency_rigid_actuators_Hz"] == runner_frequency(drive)
     assert data["drive"]["preload_N"] == drive.preload
     assert data["drive"]["actuator_viscosity_kg_per_s"] == drive.actuator.viscosity
 

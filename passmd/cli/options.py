@@ -117,6 +117,9 @@ DRIVE_QUANTITIES = (
     Quantity("--actuator-viscosity", "kg/s", "c_p", "actuator viscosity",
              f"2ζ√(k_p m_a) with ζ = {ACTUATOR_DAMPING_RATIO:g}, {fmt(_ACT.viscosity, 'kg/s')} {_AT_R}",
              0.0, False, field="actuator.viscosity"),
+    Quantity("--damping-ratio", "", "zeta", "damping ratio of the bare actuator, c_p = 2ζ√(k_p m_a) (or give "
+             "--actuator-viscosity)", f"{ACTUATOR_DAMPING_RATIO:g}", plausible="actuator.damping_ratio",
+             field="actuator.damping_ratio"),
     Quantity("--full-stroke-amplitude", "nm", "A_max", "actuation amplitude at the full voltage",
              f"Table 2 for --radius, {fmt(_ACT.full_stroke_amplitude, 'nm')} {_AT_R}",
              plausible="actuator.full_stroke_amplitude", field="actuator.full_stroke_amplitude"),
@@ -127,7 +130,7 @@ DRIVE_QUANTITIES = (
              plausible="amplifier.slew_rate", field="amplifier.slew_rate"),
 )
 #: Options of the actuators' dynamics, which rigid actuators do not have.
-ACTUATOR_DYNAMICS = ("--actuator-stiffness", "--actuator-mass", "--actuator-viscosity")
+ACTUATOR_DYNAMICS = ("--actuator-stiffness", "--actuator-mass", "--actuator-viscosity", "--damping-ratio")
 MATERIAL_FLAGS = ("--hemisphere-modulus", "--hemisphere-poisson", "--runner-modulus", "--runner-poisson")
 
 AMPLITUDE = Quantity("--amplitude", "nm", "A", "actuation amplitude",

@@ -237,3 +237,33 @@ def plot_fig7_difference(df: pd.DataFrame):
         ax.legend(fontsize=8)
         ax.grid(alpha=0.3)
     return fig
+
+
+def stall_trace_figure(result, title: str, generated_force: float | None, coulomb_bound: float):
+    """``passmd force --plot``: the stall run as forces. Above, the force the runner presses on the
+    load cell, k·x_r (N), with the generated force (the period mean at stall) and the Coulomb bound
+    ±μΣF_N; below, the piezo and runner positions (nm) that make it."""
+    from matplotlib.figure import Figure
+
+    k = result.drive.effective_load_cell_stiffness
+    t_ms = result.time * 1e3
+    fig = Figure(figsize=(7, 5.6), layout="constrained")
+    top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=(3, 2))
+    top.plot(t_ms, k * result.runner_position, lw=0.8, color="C1", label="load-cell force k·x_r")
+    if generated_force is not None:
+        top.axhline(generated_force, color="k", lw=1.0, ls="--",
+                    label=f"generated force {generated_force * 1e3:.4g} mN (period mean at stall)")
+    for sign in (1, -1):
+        top.axhline(sign * coulomb_bound, color="C3", lw=0.8, ls=":",
+                    label=f"Coulomb bound ±μΣF_N = ±{coulomb_bound * 1e3:.4g} mN" if sign > 0 else None)
+    top.set_ylabel("force [N]")
+    top.grid(alpha=0.3)
+    top.legend(fontsize=8)
+    top.set_title(title, fontsize=9)
+    bottom.plot(t_ms, result.piezo_position * 1e9, lw=0.8, label="piezo x_p (the waveform)")
+    bottom.plot(t_ms, result.runner_position * 1e9, lw=0.8, label="runner x_r")
+    bottom.set_xlabel("time [ms]")
+    bottom.set_ylabel("position [nm]")
+    bottom.grid(alpha=0.3)
+    bottom.legend(fontsize=8)
+    return fig

@@ -87,17 +87,20 @@ def run_force(args, out) -> int:
     except stall.ForceBoundError as exc:
         raise ResultError(str(exc)) from exc
     check_results(found)
-    if args.csv or args.plot:  # the reported run again, for its time series
-        from passmd.model import waveforms
-        from passmd.solver import simulation
-
-        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=found["periods"])
-        write_outputs(args, simulation.simulate(drive, wave, max_points=args.max_points))
     force, bound = found["generated_force_N"], found["coulomb_bound_N"]
     # Only the runner's inertia carries a period mean past μΣF_N, in a run cut short while the
     # runner swings on the load cell: that reading is no generated force, and no force above
     # the Coulomb bound is reported.
     swinging = not found["converged"] and abs(force) > bound
+    if args.csv or args.plot:  # the reported run again, for its time series
+        from passmd.model import waveforms
+        from passmd.plots.force_generation import stall_trace_figure
+        from passmd.solver import simulation
+
+        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=found["periods"])
+        shown = None if swinging else force
+        write_outputs(args, simulation.simulate(drive, wave, max_points=args.max_points),
+                      figure=lambda result, title: stall_trace_figure(result, title, shown, bound))
     record = {"command": "force", "waveform": "sawtooth", "flyback": drive.amplifier.flyback,
               "amplitude_m": amplitude, "frequency_Hz": frequency, "drive": drive_record(drive), **found}
     if swinging:

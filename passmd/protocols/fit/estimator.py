@@ -252,7 +252,7 @@ def _regions(problem, profiles, basin_list, x_hat, cost, s2, threshold, say):
     """Per parameter: pieces (log), the walk profile's flatness at a bound, and every basin's local
     intervals."""
     cut = cost + threshold * s2
-    say(f"local intervals of {len(basin_list)} basin(s)")
+    say(f"local intervals around {len(basin_list)} local minimum/minima of the profiles")
     local = regions.basin_intervals(problem, basin_list, s2, threshold)
     out = []
     for j in range(problem.p):
@@ -324,9 +324,10 @@ def _fit(problem: Problem, drive, names, box, x_start, reading, keep, seed, say,
         basin_list = _basins(problem, profiles, cost + threshold * s2, s2)
         if not any(np.array_equal(x_hat, x) for x, _ in basin_list):
             basin_list = [(x_hat, cost), *basin_list][:MAX_BASINS]
-        say("estimate " + ", ".join(f"{k} = {v:.5g}" for k, v in zip(names, np.exp(x_hat), strict=True))
-            + f", cost {cost:.5g}; {len(basin_list)} basin(s) within the 95 % level")
         found = _regions(problem, profiles, basin_list, x_hat, cost, s2, threshold, say)
+        say("estimate " + ", ".join(f"{k} = {v:.5g}" for k, v in zip(names, np.exp(x_hat), strict=True))
+            + f", cost {cost:.5g}; 95 % region: " + ", ".join(
+                f"{k} in {len(parts)} piece(s)" for k, (parts, _) in zip(names, found, strict=True)))
         # the regions' points can form new local minima of a profile: their bottoms too
         bottoms(problem, profiles, level, lambda: threshold * _s2(problem, problem.best()[1]))
         lowest = problem.best()[1]
@@ -353,6 +354,7 @@ def _result(problem, drive, names, box, profiles, basin_list, found, x_hat, cost
         corr = cov / np.outer(se, se)
     corr = np.where(np.isfinite(corr), corr, 0.0)
     np.fill_diagonal(corr, 1.0)
+    basin_list = _with_piece_minima(profiles, basin_list, found)
     estimates = {}
     for j, name in enumerate(names):
         parts, flat = found[j]
@@ -404,4 +406,36 @@ def _result(problem, drive, names, box, profiles, basin_list, found, x_hat, cost
                      converged=converged, goodness_of_fit=gof, next_measurement=suggestion, keep=keep,
                      level=threshold,
                      basins=[{"parameters": dict(zip(names, np.exp(x).tolist(), strict=True)), "cost": c}
-                             for x, c in basin_list])
+                             for x, c in basin_list],
+                     region_points=_region_points(names, profiles, x_hat, cost + threshold * s2))
+
+
+def _with_piece_minima(profiles: dict[int, Profile], basin_list, found) -> list[tuple[np.ndarray, float]]:
+    """``basin_list`` and, for every piece of a region that holds none of them, the lowest profile point
+    in it: the basins the verdict counts, the report lists and the separating row tells apart."""
+    out = list(basin_list)
+    for j, (parts, _) in enumerate(found):
+        t, c, xs = profiles[j].arrays()
+        for a, b in parts:
+            if any(a - 1e-12 <= x[j] <= b + 1e-12 for x, _ in out):
+                continue
+            sel = np.flatnonzero((t >= a) & (t <= b))
+            if sel.size:
+                low = int(sel[np.argmin(c[sel])])
+                out.append((np.asarray(xs[low], float), float(c[low])))
+    return out
+
+
+def _region_points(names, profiles: dict[int, Profile], x_hat: np.ndarray, cut: float) -> list[dict]:
+    """The parameter sets at the ends of each parameter's 95 % region (the lowest and highest profile
+    points within the level, the others re-fitted there): distinct ones, the estimate left out."""
+    found = []
+    for profile in profiles.values():
+        t, c, xs = profile.arrays()
+        inside = np.flatnonzero(c <= cut)
+        found += [xs[k] for k in (inside[:1].tolist() + inside[-1:].tolist())]
+    out: list[np.ndarray] = [np.asarray(x_hat, float)]
+    for x in found:
+        if all(np.max(np.abs(np.asarray(x) - y)) > 1e-12 for y in out):
+            out.append(np.asarray(x, float))
+    return [dict(zip(names, np.exp(x).tolist(), strict=True)) for x in out[1:]]
