@@ -10,7 +10,7 @@ import warnings
 
 import numpy as np
 
-from passmd.cli import startup
+from passmd.cli import kernels, startup
 from passmd.cli.drive import explain
 from passmd.cli.errors import OPTIONAL_EXTRAS, MissingDependencyError, OutputError, UsageError
 from passmd.cli.parser import PROG, make_parser
@@ -99,6 +99,7 @@ def main(argv=None, out=None) -> int:
     except KeyboardInterrupt as exc:  # before the command started (parsing)
         return _interrupted(PROG, exc, "")
     finally:
+        kernels.disarm()
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
         startup.resume()
