@@ -10,7 +10,9 @@
   (the pool is running);
 * ``evaluate``: in the command, before a fit's second model evaluation (its pool is idle
   between two sweeps);
-* ``shutdown``: in the command, before a process pool's first shut-down (the pool is stopping).
+* ``shutdown``: in the command, before a process pool's first shut-down (the pool is stopping);
+* ``publish``: in the command, once every output file is written to its temporary name, before
+  the first is linked to its own (:func:`passmd.runtime.outputs.create_exclusively`).
 
 A hook writes the marker ``DIR/<moment>-<pid>`` and waits until the file ``DIR/open`` exists.
 The test waits for the markers it needs, sends its signal, then creates ``DIR/open``: the
@@ -91,6 +93,10 @@ def _install(moments: set[str]) -> None:
             return shutdown(self, *args, **kwargs)
 
         cfp.ProcessPoolExecutor.shutdown = gate_then_shutdown
+    if "publish" in moments:
+        from passmd.runtime import outputs
+
+        outputs._before_linking = lambda: gate("publish")
 
 
 if __name__ == "__main__":

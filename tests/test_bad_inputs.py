@@ -117,7 +117,7 @@ NAMED_CASES = {
                                               "--load-cell-stiffness has no effect"),
     "plot into a device": (["run", "--plot", "/dev/full"], 2, "no image extension"),
     "plot, unknown format": (["run", "--plot", "out.xyz"], 2, "unknown image extension"),
-    "csv into a missing directory": (["run", "--csv", "/nonexistent-dir/x.csv"], 1, "does not exist"),
+    "csv into a missing directory": (["run", "--csv", "/nonexistent-dir/x.csv"], 2, "does not exist"),
     "empty figure directory": (["figure", "fig5a", "--out", ""], 2, "--out = '' is not a directory name"),
     "figure name is a path": (["figure", "../../etc/passwd"], 2, "is not a figure name"),
     "unknown figure": (["figure", "fig0x"], 2, "figure 'fig0x' is not available"),

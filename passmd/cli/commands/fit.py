@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import sys
 import textwrap
@@ -16,6 +17,7 @@ from passmd.cli.options import (
     add_drive_options,
     add_sweep_options,
 )
+from passmd.cli.streams import check_new_outputs, create_outputs
 from passmd.cli.output import (
     JSON_HELP,
     check_results,
@@ -148,43 +150,53 @@ def _progress(config):
 
 
 def _check_out(args) -> Path | None:
+    """--out before any work: a directory (or one to create in an existing one) that files can be
+    created in, none of the outputs there yet (exit 2 naming the file)."""
     if args.out is None:
         return None
     target = Path(args.out)
     if target.exists() and not target.is_dir():
         raise UsageError(f"--out = {args.out!r} is not a directory")
-    if not target.exists() and not target.parent.is_dir():
-        raise OutputError(f"cannot write --out {args.out}: directory {str(target.parent)!r} does not exist")
-    for name in _OUTPUTS:
-        if (target / name).exists():
-            raise UsageError(f"--out {args.out}: {name} is already there; choose another directory "
-                             "(a fit keeps every file it did not create)")
+    check_new_outputs(f"--out {args.out}", [target / name for name in _OUTPUTS], folder=target)
     return target
 
 
 def _write(target: Path, result, record: dict, text: str) -> None:
-    from passmd.cli.streams import write_atomically
+    """fit.json, fit.png and fitted-drive.toml created together or not at all, never over a file
+    (:func:`passmd.cli.streams.create_outputs`); a folder the fit created is removed on failure."""
     from passmd.plots.fit import fit_figure
 
     fig = fit_figure(result.residual_table())  # before any file is written: a failing figure leaves none
+    option = f"--out {target}"
     try:
-        target.mkdir(exist_ok=True)
-        write_atomically(target / "fit.json",
-                         lambda tmp: Path(tmp).write_text(json.dumps(plain(record), indent=2) + "\n"))
-        write_atomically(target / "fit.png", lambda tmp: fig.savefig(tmp, dpi=150, format="png"))
-        write_atomically(target / "fitted-drive.toml", lambda tmp: Path(tmp).write_text(text))
+        target.mkdir()
+        created = True
+    except FileExistsError:
+        created = False
     except OSError as exc:
-        raise OutputError(f"cannot write --out {target}: {exc.strerror or exc}") from exc
+        raise OutputError(f"cannot create the directory {target} ({option}): {exc.strerror or exc}") from None
+    try:
+        create_outputs(option, {
+            target / "fit.json": lambda tmp: Path(tmp).write_text(json.dumps(plain(record), indent=2) + "\n"),
+            target / "fit.png": lambda tmp: fig.savefig(tmp, dpi=150, format="png"),
+            target / "fitted-drive.toml": lambda tmp: Path(tmp).write_text(text, encoding="utf-8"),
+        })
+    except BaseException:
+        if created:
+            with contextlib.suppress(OSError):
+                target.rmdir()  # only while empty: another run's files keep it
+        raise
 
 
 def run_fit(args, out) -> int:
-    from passmd.cli.configuration import execution_config
+    from passmd.cli.configuration import run_config
     from passmd.protocols import fit
 
     names = _free(args)
     bounds = _bounds(args, names)
     drive, sources = resolve_drive(args)
     target = _check_out(args)
+    config = run_config(args)  # the sweep log too, before any work
     try:
         data = fit.read_measurements(args.data)
     except FileNotFoundError:
@@ -193,7 +205,8 @@ def run_fit(args, out) -> int:
         raise UsageError(str(exc)) from None
     except IsADirectoryError:
         raise UsageError(f"DATA.csv = {args.data!r} is a directory") from None
-    config = execution_config(args)
+    except OSError as exc:  # unreadable: bad input, as an unreadable drive file
+        raise UsageError(f"DATA.csv = {args.data!r} cannot be read: {exc.strerror or exc}") from None
     library = {FREE_NAMES[n][0]: n for n in names}
     # c_p stays fixed while k_p or m_a moves only when the user gave c_p (drive show: "given"/"option")
     given_cp = sources.get("actuator.viscosity", "").startswith(("given", "option"))
