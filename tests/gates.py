@@ -64,9 +64,9 @@ def _install(moments: set[str]) -> None:
     if "worker" in moments:
         initializer = sweep._worker_signals
 
-        def gate_then_initialize():
+        def gate_then_initialize(*args):
             gate("worker")
-            initializer()
+            initializer(*args)
 
         sweep._worker_signals = gate_then_initialize
     if "point" in moments:

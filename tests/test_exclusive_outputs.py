@@ -22,8 +22,6 @@ from pathlib import Path
 import pytest
 from cli_runs import run_main
 
-from passmd.runtime import outputs
-
 GATES_PY = Path(__file__).with_name("gates.py")
 #: A fit of μ of one rigid contact to two steps at 2 kHz (the steady protocol, 20 periods a point):
 #: seconds, and cached after the first run.
@@ -109,7 +107,7 @@ def test_two_fits_to_one_new_out_leave_one_result_and_one_refusal(tmp_path, data
 
 def test_a_file_that_appears_while_a_fit_runs_is_kept(tmp_path, data, monkeypatch):
     out = tmp_path / "res"
-    monkeypatch.setattr(outputs, "_before_linking", lambda: (out / "fit.json").write_text("mine\n"))
+    monkeypatch.setattr("passmd.runtime.outputs._before_linking", lambda: (out / "fit.json").write_text("mine\n"))
     status, stdout, err = run_main(["fit", str(data), *FIT, "--out", str(out)])
     assert status == 2 and stdout == "", err
     _one_line(err)

@@ -13,7 +13,10 @@ order the points finish in. Execution is
 
 Every finished point is written to the on-disk cache (:mod:`passmd.runtime.cache`) as soon as
 it completes, so an interrupted sweep (Ctrl-C, SIGTERM, a failing point, a killed job) keeps
-every finished point and a rerun recomputes only the rest. The cache key covers the swept
+every finished point and a rerun recomputes only the rest. Worker processes never outlive the
+sweep: a process pool's workers end when the process that started them dies, even by ``kill -9``
+(:func:`_end_with_parent`), and a local Dask cluster's workers exit with it (``distributed`` watches
+their parent). The cache key covers the swept
 function's own code too (:func:`passmd.runtime.cache.keys.function_code`): a user's function that
 changed between two sweeps is recomputed, and one whose code cannot be fingerprinted is
 not cached (one :class:`~passmd.runtime.cache.store.CacheWarning` says why). Progress (points done, ETA;
@@ -103,16 +106,65 @@ def _signals_held():
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
-def _worker_signals():  # pragma: no cover - runs in pool workers
+def _worker_signals(parent: int | None = None):  # pragma: no cover - runs in pool workers
     """Pool worker initializer: Ctrl-C is handled by the parent, which stops the workers; SIGTERM
     (the parent's stop, or a stop of the whole process group) ends a worker at once, whatever
     handler the parent had installed before the fork. Then the signals the parent held back
     while forking (:func:`_signals_held`) are let through: a SIGTERM that came meanwhile ends
-    the worker silently, a Ctrl-C is dropped."""
+    the worker silently, a Ctrl-C is dropped. ``parent``: the pid of the process that started
+    the pool; the worker ends when that process dies, even by ``kill -9`` (:func:`_end_with_parent`)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if parent is not None:
+        _end_with_parent(parent)
     if hasattr(signal, "pthread_sigmask"):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, _HELD_SIGNALS)
+
+
+#: Linux's prctl option that sends the calling process a signal when its parent dies.
+_PR_SET_PDEATHSIG = 1
+#: Seconds between two looks at the parent of a worker where the kernel cannot signal its death.
+PARENT_POLL_S = 1.0
+
+
+def _end_with_parent(parent: int) -> None:  # pragma: no cover - runs in pool workers
+    """End this worker when the process that started its pool (``parent``) dies, even by ``kill -9``.
+
+    On Linux the kernel sends the worker SIGKILL when its own parent dies (prctl
+    ``PR_SET_PDEATHSIG``; that parent is ``parent``'s thread that forked it, which lives as long as
+    the pool, or a fork server that ends with ``parent``). Elsewhere a daemon thread looks every
+    :data:`PARENT_POLL_S` s whether the worker was orphaned (adopted by another process) or
+    ``parent`` is gone, and ends the process. A worker orphaned before this call ends at once.
+    """
+    direct = os.getppid()
+    armed = False
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(OSError, AttributeError):
+            import ctypes
+
+            armed = ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) == 0
+    if (direct == 1 and parent != 1) or os.getppid() != direct:  # orphaned before the signal was armed
+        os._exit(1)
+    if armed:
+        return
+    import threading
+    import time
+
+    def gone() -> bool:
+        try:
+            os.kill(parent, 0)
+        except ProcessLookupError:
+            return True
+        except OSError:
+            return False
+        return os.getppid() != direct
+
+    def watch():
+        while not gone():
+            time.sleep(PARENT_POLL_S)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="passmd-parent-watch", daemon=True).start()
 
 
 def _check_points(points) -> list[dict]:
@@ -246,7 +298,8 @@ def _run_process(func, todo, points, collect: _Collector, workers) -> None:
     pool, futures, interrupted = None, {}, False
     try:
         with _signals_held():
-            pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_worker_signals)
+            pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_worker_signals,
+                                          initargs=(os.getpid(),))
             futures = {pool.submit(_call, func, points[i]): i for i in todo}
         try:
             _collect_completed(futures, cf.as_completed, points, collect)
@@ -287,7 +340,8 @@ def process_pool(workers: int | None = None):
     pool, interrupted = None, False
     try:
         with _signals_held():
-            pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_worker_signals)
+            pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_worker_signals,
+                                          initargs=(os.getpid(),))
             pool.submit(int)  # forks the workers now (the fork start method starts them all at once)
         yield pool
     except KeyboardInterrupt:
@@ -302,25 +356,84 @@ def process_pool(workers: int | None = None):
 
 
 def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> None:
+    """Evaluate the points on the Dask cluster at ``scheduler``, or on a local one started and stopped here.
+
+    A local cluster's event loop is started with SIGINT and SIGTERM held back (:func:`_signals_held`),
+    and its worker processes are started from that loop's threads: they keep both blocked, so a
+    Ctrl-C to the process group reaches this process only (no traceback from a worker). On Ctrl-C
+    or SIGTERM the finished points are kept, the workers killed at once (running points are not
+    waited for) and the cluster closed with its loggers silenced (:func:`_close_dask`).
+    """
     try:
         from distributed import Client, LocalCluster, as_completed
     except ImportError as exc:  # pragma: no cover - dask is a declared extra
         raise ImportError(f"executor='dask' needs dask.distributed: {install_hint('dask')}") from exc
-    cluster = None if scheduler else LocalCluster(n_workers=workers, threads_per_worker=1,
-                                                  dashboard_address=None, silence_logs=logging.ERROR)
-    client = Client(scheduler or cluster)
-    futures = {}
+    import multiprocessing
+
+    cluster = client = None
+    futures, interrupted = {}, False
+    before = set(multiprocessing.active_children())
     try:
+        if not scheduler:
+            _start_resource_tracker()
+            with _signals_held():
+                cluster = LocalCluster(n_workers=0, threads_per_worker=1, dashboard_address=None,
+                                       silence_logs=logging.ERROR)
+            cluster.scale(workers)
+        client = Client(scheduler or cluster)
         futures = {client.submit(_call, func, points[i], pure=False): i for i in todo}
         _collect_completed(futures, as_completed, points, collect)
+    except KeyboardInterrupt:
+        interrupted = True
+        _harvest(futures, collect)
+        raise
     except BaseException:
         _harvest(futures, collect)
-        client.cancel(list(futures))
+        if client is not None:
+            client.cancel(list(futures))
         raise
     finally:
-        client.close()
+        with _signals_held():
+            workers_started = set(multiprocessing.active_children()) - before if cluster is not None else set()
+            _close_dask(client, cluster, interrupted, workers_started)
+
+
+def _start_resource_tracker() -> None:
+    """Start multiprocessing's resource tracker now, from this thread, if it is not running: started
+    later from the cluster's event loop, it would unblock SIGINT and SIGTERM in that thread (its
+    ``ensure_running`` ends with ``SIG_UNBLOCK``), and the workers started from there would get them."""
+    with contextlib.suppress(ImportError, AttributeError, OSError):
+        from multiprocessing import resource_tracker
+
+        resource_tracker.ensure_running()
+
+
+#: Seconds a Dask client and a local cluster get to close after Ctrl-C or SIGTERM.
+DASK_CLOSE_TIMEOUT = 2.0
+
+
+def _close_dask(client, cluster, interrupted: bool, processes) -> None:
+    """Close the client, and the local cluster this sweep started (its worker ``processes``); after
+    an interrupt at once and quietly: the loggers of ``distributed`` silenced, the worker processes
+    killed first (also those still starting), the close bounded by :data:`DASK_CLOSE_TIMEOUT`, and
+    the cluster taken off ``distributed``'s list of clusters to close at exit (no second close)."""
+    if not interrupted:
+        if client is not None:
+            client.close()
         if cluster is not None:
             cluster.close()
+        return
+    for name in ("distributed", "tornado", "asyncio"):
+        logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+    for process in processes:
+        with contextlib.suppress(Exception):
+            process.kill()
+    for closing in (client, cluster):
+        if closing is not None:
+            with contextlib.suppress(Exception):
+                closing.close(timeout=DASK_CLOSE_TIMEOUT)
+    with contextlib.suppress(Exception):
+        type(cluster)._instances.discard(cluster)
 
 
 def run(
