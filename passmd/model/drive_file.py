@@ -140,17 +140,30 @@ DRIVE_KEYS: dict[str, DriveKey] = {k.key: k for k in (
              "stated time (\"1.5 us\"; a bare number is s)", "assumed (Section 2 gives V_pp and SR)"),
 )}
 
+#: Keys of the actuators' dynamics (Eq. 3), which ideally rigid actuators do not have.
+_ACTUATOR_DYNAMICS = ("actuator.stiffness", "actuator.mass", "actuator.viscosity", "actuator.damping_ratio")
 _SI_UNITS = {"m", "kg", "s", "N", "N/m", "kg/s", "Pa", "V", "V/s", "Hz", ""}
 
 
-def _flatten(table: dict, prefix: str = "") -> dict:
+def _flatten(table: dict, name: str, prefix: str = "", section: str = "the top level",
+             seen: dict | None = None) -> dict:
+    """The file's keys, dotted (``[drive]`` dropped); a key given twice, e.g. ``preload`` at the top
+    level and in ``[drive]``, is refused naming both places (TOML refuses only a repeat within one
+    table, and the second would silently win)."""
+    seen = {} if seen is None else seen  # key -> where it was given
     out = {}
-    for name, value in table.items():
-        key = f"{prefix}{name}"
+    for part, value in table.items():
         if isinstance(value, dict):
-            out.update(_flatten(value, "" if key == "drive" and not prefix else key + "."))
-        else:
-            out[key] = value
+            key = f"{prefix}{part}"
+            inner = "" if key == "drive" and not prefix else key + "."
+            out.update(_flatten(value, name, inner, f"[{key}]", seen))
+            continue
+        key = f"{prefix}{part}"
+        if key in seen:
+            raise DriveFileError(f"{name}: {key} is given twice, in {seen[key]} and in {section}: give it once",
+                                 name=key, value=value)
+        seen[key] = section
+        out[key] = value
     return out
 
 
@@ -299,7 +312,7 @@ def read_drive_file(path, *, allow_extrapolation: bool | None = None) -> dict:
         raise DriveFileError(str(exc), name="drive", value=name) from None
     except tomllib.TOMLDecodeError as exc:
         raise DriveFileError(f"{name}: not a TOML file: {exc}", name="drive", value=name) from None
-    raw = _flatten(table)
+    raw = _flatten(table, name)
     unknown = [key for key in raw if key not in DRIVE_KEYS]
     if unknown:
         raise DriveFileError(f"{name}: unknown key {unknown[0]!r}: the known keys are "
@@ -309,6 +322,11 @@ def read_drive_file(path, *, allow_extrapolation: bool | None = None) -> dict:
     if "contacts" in values and "contact_groups" in values:
         raise DriveFileError(f"{name}: contacts and contact_groups both given: give one (a preset, or the "
                              "groups)", name="contacts", value=values["contacts"])
+    dynamics = [key for key in _ACTUATOR_DYNAMICS if key in values]
+    if values.get("actuator_model") == "rigid" and dynamics:
+        raise DriveFileError(f"{name}: {dynamics[0]} contradicts actuator_model = \"rigid\": ideally rigid "
+                             "actuators have no stiffness, mass or damping; remove it, or set actuator_model "
+                             "= \"flexible\"", name=dynamics[0], value=values[dynamics[0]])
     if "actuator.viscosity" in values and "actuator.damping_ratio" in values:
         raise DriveFileError(f"{name}: actuator.viscosity and actuator.damping_ratio both given: give one "
                              "(c_p = 2ζ√(k_p m_a))", name="actuator.viscosity",
@@ -419,12 +437,20 @@ def _number(value: float) -> str:
     return text if any(c in text for c in ".en") else text + ".0"
 
 
+def _string(text: str) -> str:
+    """``text`` as a TOML string (tomli-w escapes quotes, backslashes, newlines and every control
+    character), so that any name reads back as written."""
+    import tomli_w
+
+    return tomli_w.dumps({"k": text}).partition(" = ")[2].rstrip("\n")
+
+
 def _shown(value, spec: DriveKey) -> str:
     """A value as TOML: a string in the display unit when that reads back exactly, else SI."""
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        return _string(value)
     si_unit = "s" if spec.unit == "flyback" else spec.unit  # a stated fly-back time
     if spec.display and spec.display != si_unit:
         text = f"{float(from_si(value, spec.display)):.12g} {spec.display}"
@@ -466,7 +492,9 @@ def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None =
             spec = DRIVE_KEYS[key]
         unit = f" [{spec.unit}]" if spec.unit in _SI_UNITS and spec.unit else ""
         source = sources.get(key, spec.source)
-        lines.append(f"{name or key} = {_shown(value, spec)}  # {spec.symbol}: {spec.text}{unit}; {source}")
+        unused = "# (flexible actuators only) " if drive.actuator_model == "rigid" and key in _ACTUATOR_DYNAMICS \
+            else ""
+        lines.append(f"{unused}{name or key} = {_shown(value, spec)}  # {spec.symbol}: {spec.text}{unit}; {source}")
     for group in drive.contact_groups:  # arrays of tables come last in TOML
         lines += ["", "[[contact_groups]]  # contacts of one kind: count, side, contact angle α, F_N per "
                       "contact (or its share of F_p; else Eq. 1), radius R [m]"]

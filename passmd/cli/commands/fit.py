@@ -26,6 +26,7 @@ from passmd.cli.output import (
     emit_json,
     emit_rows,
     flyback_label,
+    fmt,
     plain,
 )
 from passmd.protocols.fit.free_parameters import FREE_PARAMETERS
@@ -123,8 +124,12 @@ def _free(args) -> list[str]:
     return names
 
 
-def _bounds(args, names) -> dict[str, tuple[float, float]]:
-    out = {}
+def _bounds(args, names, drive) -> dict[str, tuple[float, float]]:
+    """--bounds as typed: each free parameter once, 0 < LOW < HIGH, within its plausible range unless
+    --allow-extrapolation (or the drive file's allow_extrapolation) lifts it."""
+    from passmd.protocols.fit.free_parameters import plausible_bounds
+
+    out, typed = {}, {}
     for text in args.bounds:
         name, sep, span = text.partition("=")
         low, dots, high = span.partition("..")
@@ -134,11 +139,23 @@ def _bounds(args, names) -> dict[str, tuple[float, float]]:
         if name not in names:
             raise UsageError(f"--bounds = {text!r} names {name!r}, which is not in --free "
                              f"({', '.join(names)})")
+        if name in typed:
+            raise UsageError(f"--bounds = {text!r} bounds {name} again (--bounds {typed[name]!r}): give each "
+                             "parameter's bounds once")
+        typed[name] = text
         unit = FREE_NAMES[name][1]
         lo, hi = (parse_quantity(v.strip(), unit, name=f"--bounds {name}") for v in (low, high))
         if not 0 < lo < hi:
             raise UsageError(f"--bounds = {text!r} is out of range: must be 0 < LOW < HIGH")
-        out[FREE_NAMES[name][0]] = (lo, hi)
+        lib = FREE_NAMES[name][0]
+        low_ok, high_ok = plausible_bounds(drive, lib)
+        if not (args.allow_extrapolation or drive.allow_extrapolation) and (lo < low_ok or hi > high_ok):
+            shown = f" {unit}" if unit else ""
+            raise UsageError(f"--bounds = {text!r} is out of range: must be within {from_si(low_ok, unit):.4g}.."
+                             f"{from_si(high_ok, unit):.4g}{shown}, the plausible range of {name} (a search far "
+                             "outside it simulates drives the model was not checked for, and may never end); "
+                             "--allow-extrapolation goes beyond it")
+        out[lib] = (lo, hi)
     return out
 
 
@@ -193,8 +210,8 @@ def run_fit(args, out) -> int:
     from passmd.protocols import fit
 
     names = _free(args)
-    bounds = _bounds(args, names)
     drive, sources = resolve_drive(args)
+    bounds = _bounds(args, names, drive)
     target = _check_out(args)
     config = run_config(args)  # the sweep log too, before any work
     try:
@@ -232,6 +249,14 @@ def run_fit(args, out) -> int:
     return 0
 
 
+def _flyback(result, library: dict[str, str]) -> str:
+    """The fly-back rule, and the full-stroke time V_pp/SR when the fit set it (its slew rate free)."""
+    rule = flyback_label(result.drive.amplifier.flyback)
+    if {"flyback_time", "amplifier.slew_rate"} & set(library):
+        return f"{rule} with the fitted full-stroke time V_pp/SR = {fmt(result.drive.amplifier.full_stroke_time, 'us')}"
+    return rule
+
+
 def _rows(result, library: dict[str, str], data, target) -> list[tuple[str, str]]:
     """The human report: each estimate with its 95 % region, the goodness of fit, the verdict."""
     rows = []
@@ -250,7 +275,7 @@ def _rows(result, library: dict[str, str], data, target) -> list[tuple[str, str]
             if gof["testable"] else "no sd given: residual scale estimated, no test possible")
     rows.append(("goodness of fit", test))
     rows.append(("fit", f"{len(data)} measurements, {result.dof} degrees of freedom, fly-back "
-                        f"{flyback_label(result.drive.amplifier.flyback)}, {result.simulations} simulations, "
+                        f"{_flyback(result, library)}, {result.simulations} simulations, "
                         f"{result.wall_time_s:.1f} s"))
     rows.append(("verdict", result.verdict))
     rows += [("note", note) for note in result.notes]
