@@ -59,7 +59,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-__all__ = ["CONTACT_PRESETS", "DRIVE_KEYS", "EXAMPLE_DRIVE_FILE", "JOINT_READING_FILE", "DriveFileError",
+__all__ = ["CONTACT_PRESETS", "SHORTEST_FLYBACK", "SHORTEST_FLYBACK_WHY", "DRIVE_KEYS", "EXAMPLE_DRIVE_FILE", "JOINT_READING_FILE", "DriveFileError",
            "DriveKey", "drive_toml", "load_drive", "parameter_rows", "read_drive_file",
            "resolve"]
 
@@ -140,6 +140,11 @@ DRIVE_KEYS: dict[str, DriveKey] = {k.key: k for k in (
              "stated time (\"1.5 us\"; a bare number is s)", "assumed (Section 2 gives V_pp and SR)"),
 )}
 
+#: Shortest stated fly-back time (s): about a thousandth of Section 2's full-stroke fly-back V_pp/SR,
+#: far beyond any amplifier; much shorter, the saw-tooth's corner times are no longer distinct at the
+#: precision of a period's times.
+SHORTEST_FLYBACK = 1e-9
+SHORTEST_FLYBACK_WHY = "about a thousandth of the paper's full-stroke fly-back V_pp/SR, beyond any amplifier"
 #: Keys of the actuators' dynamics (Eq. 3), which ideally rigid actuators do not have.
 _ACTUATOR_DYNAMICS = ("actuator.stiffness", "actuator.mass", "actuator.viscosity", "actuator.damping_ratio")
 _SI_UNITS = {"m", "kg", "s", "N", "N/m", "kg/s", "Pa", "V", "V/s", "Hz", ""}
@@ -200,6 +205,10 @@ def _value(where: str, spec: DriveKey, raw, allow_extrapolation: bool):
         value = parse_quantity(raw, spec.unit, name=where)
     except QuantityError as exc:
         raise DriveFileError(str(exc), name=spec.key, value=raw) from None
+    except OverflowError:  # an integer beyond any float, e.g. 10**400
+        digits = str(raw)
+        raise _refuse(where, f"= {digits[:8]}… ({len(digits)} digits) is out of range: too large for a number",
+                      name=spec.key, value=raw) from None
     si = f" {spec.unit}" if spec.unit else ""
     if spec.plausible is not None:
         try:
@@ -226,9 +235,10 @@ def _flyback(label: str, spec: DriveKey, raw) -> str | float:
         value = parse_quantity(raw, "s", name=label)
     except QuantityError:
         raise refused from None
-    if not (math.isfinite(value) and value > 0.0):
-        raise _refuse(label, f"= {raw!r} is out of range: must be > 0 s", name=spec.key, value=raw,
-                      limits=((">", 0.0),))
+    if not (math.isfinite(value) and value >= SHORTEST_FLYBACK):
+        raise _refuse(label, f"= {raw!r} is out of range: must be >= {SHORTEST_FLYBACK:g} s "
+                             f"({SHORTEST_FLYBACK_WHY})", name=spec.key, value=raw,
+                      limits=((">=", SHORTEST_FLYBACK),))
     return value
 
 
@@ -312,6 +322,10 @@ def read_drive_file(path, *, allow_extrapolation: bool | None = None) -> dict:
         raise DriveFileError(str(exc), name="drive", value=name) from None
     except tomllib.TOMLDecodeError as exc:
         raise DriveFileError(f"{name}: not a TOML file: {exc}", name="drive", value=name) from None
+    except RecursionError:
+        raise DriveFileError(f"{name}: not a drive file: its arrays or tables are nested too deeply for the "
+                             "TOML reader (a drive file's values are numbers, strings and flat tables)",
+                             name="drive", value=name) from None
     raw = _flatten(table, name)
     unknown = [key for key in raw if key not in DRIVE_KEYS]
     if unknown:

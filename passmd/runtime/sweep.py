@@ -555,7 +555,8 @@ def _check_arguments(func, executor, scheduler, workers) -> None:
 
 
 def _check_picklable(func, executor) -> None:
-    if executor != "serial":
+    """A function sent to other processes must pickle; in this process (serial, a thread pool) not."""
+    if executor != "serial" and not isinstance(executor, cf.ThreadPoolExecutor):
         try:
             pickle.dumps(func)
         except Exception as exc:

@@ -191,8 +191,15 @@ def parse_vary(text: str) -> Axis:
     low, _, rest = spec.partition("..")
     high, *options = rest.split(":")
     spacing, count = "linear", 10
+    given: dict[str, str] = {}
     for option in options:
         option = option.strip()
+        what = "spacing" if option in ("log", "lin", "linear") else "N" if re.fullmatch(r"[0-9]+", option) \
+            else None
+        if what is not None and what in given:
+            raise _refuse(text, f"{what} is given twice ({given[what]!r} and {option!r}): give it once")
+        if what is not None:
+            given[what] = option
         if option in ("log", "lin", "linear"):
             spacing = "log" if option == "log" else "linear"
         elif re.fullmatch(r"[0-9]+", option):
@@ -326,8 +333,8 @@ def _points(args, axes: list[Axis], with_amplitude: bool) -> list[dict]:
             probe = argparse.Namespace(**vars(args))
             for a in drive_axes:
                 setattr(probe, a.quantity.dest, f"{at[a.name]!r} {a.si_unit}".strip())
-            try:
-                drives[key] = build_drive(probe)
+            try:  # the stall force pushes against the load cell: its stiffness is an option there
+                drives[key] = build_drive(probe, **({"load_cell": True} if args.quantity == "stall-force" else {}))
             except (UsageError, ValueError) as exc:
                 where = ", ".join(f"{a.name} = {_shown(a, at[a.name])}" for a in drive_axes)
                 raise UsageError(f"--vary at {where}: {explain(exc, probe)}") from None
