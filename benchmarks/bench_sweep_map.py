@@ -175,4 +175,6 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from passmd.runtime.scripts import run_script
+
+    sys.exit(run_script(main))  # one line on failure, never a traceback

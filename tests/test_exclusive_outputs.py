@@ -83,7 +83,8 @@ def test_two_fits_to_one_new_out_leave_one_result_and_one_refusal(tmp_path, data
     gates.mkdir()
     argv = [sys.executable, str(GATES_PY), str(gates), "publish", "fit", str(data), *FIT, "--out", "res"]
     procs = [subprocess.Popen(argv, cwd=tmp_path, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                              text=True, preexec_fn=_default_signals, start_new_session=True) for _ in range(2)]
+                              text=True, preexec_fn=_default_signals, start_new_session=True)
+             for _ in range(2)]
     try:
         deadline = time.monotonic() + HANG_S
         while len(list(gates.glob("publish-*"))) < 2:
@@ -107,7 +108,8 @@ def test_two_fits_to_one_new_out_leave_one_result_and_one_refusal(tmp_path, data
 
 def test_a_file_that_appears_while_a_fit_runs_is_kept(tmp_path, data, monkeypatch):
     out = tmp_path / "res"
-    monkeypatch.setattr("passmd.runtime.outputs._before_linking", lambda: (out / "fit.json").write_text("mine\n"))
+    monkeypatch.setattr("passmd.runtime.outputs._before_linking",
+                        lambda: (out / "fit.json").write_text("mine\n"))
     status, stdout, err = run_main(["fit", str(data), *FIT, "--out", str(out)])
     assert status == 2 and stdout == "", err
     _one_line(err)

@@ -11,7 +11,13 @@ from __future__ import annotations
 from passmd.cli.errors import UsageError
 from passmd.cli.options import ACTUATOR_DYNAMICS, DRIVE_QUANTITIES, OPTION_FOR, QUANTITIES
 from passmd.cli.output import flyback_label, fmt
-from passmd.model.drive_file import SHORTEST_FLYBACK, SHORTEST_FLYBACK_WHY, DriveFileError, read_drive_file, resolve
+from passmd.model.drive_file import (
+    SHORTEST_FLYBACK,
+    SHORTEST_FLYBACK_WHY,
+    DriveFileError,
+    read_drive_file,
+    resolve,
+)
 from passmd.model.parameters import Drive
 from passmd.model.tables import FLYBACK_RULES
 from passmd.runtime.units import QuantityError, dimension_name, from_si, parse_quantity

@@ -16,8 +16,8 @@ import numpy as np
 from passmd.cli.errors import UsageError
 from passmd.cli.result_bounds import ResultError
 from passmd.cli.streams import replaced_in
-from passmd.runtime.outputs import check_writable
 from passmd.model.parameters import Drive
+from passmd.runtime.outputs import check_writable
 from passmd.runtime.units import from_si
 
 __all__ = ["JSON_HELP", "check_output_file", "check_results", "describe", "drive_record", "emit_json",

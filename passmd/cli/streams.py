@@ -334,8 +334,8 @@ def create_outputs(option: str, writers) -> None:
     try:
         outputs.create_exclusively(writers)
     except outputs.OutputExists as exc:
-        raise UsageError(f"{option}: {exc.filename} appeared while this run was writing (another run?): it is "
-                         "kept, and this run wrote none of its files") from None
+        raise UsageError(f"{option}: {exc.filename} appeared while this run was writing (another run?): "
+                         "it is kept, and this run wrote none of its files") from None
     except BrokenPipeError as exc:
         raise PipeClosed() from exc
     except OSError as exc:

@@ -59,7 +59,8 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-__all__ = ["CONTACT_PRESETS", "SHORTEST_FLYBACK", "SHORTEST_FLYBACK_WHY", "DRIVE_KEYS", "EXAMPLE_DRIVE_FILE", "JOINT_READING_FILE", "DriveFileError",
+__all__ = ["CONTACT_PRESETS", "DRIVE_KEYS", "EXAMPLE_DRIVE_FILE", "JOINT_READING_FILE", "SHORTEST_FLYBACK",
+           "SHORTEST_FLYBACK_WHY", "DriveFileError",
            "DriveKey", "drive_toml", "load_drive", "parameter_rows", "read_drive_file",
            "resolve"]
 
@@ -165,7 +166,8 @@ def _flatten(table: dict, name: str, prefix: str = "", section: str = "the top l
             continue
         key = f"{prefix}{part}"
         if key in seen:
-            raise DriveFileError(f"{name}: {key} is given twice, in {seen[key]} and in {section}: give it once",
+            raise DriveFileError(f"{name}: {key} is given twice, in {seen[key]} and in {section}: give it "
+                                 "once",
                                  name=key, value=value)
         seen[key] = section
         out[key] = value
@@ -207,7 +209,8 @@ def _value(where: str, spec: DriveKey, raw, allow_extrapolation: bool):
         raise DriveFileError(str(exc), name=spec.key, value=raw) from None
     except OverflowError:  # an integer beyond any float, e.g. 10**400
         digits = str(raw)
-        raise _refuse(where, f"= {digits[:8]}… ({len(digits)} digits) is out of range: too large for a number",
+        raise _refuse(where, f"= {digits[:8]}… ({len(digits)} digits) is out of range: too large for a "
+                             "number",
                       name=spec.key, value=raw) from None
     si = f" {spec.unit}" if spec.unit else ""
     if spec.plausible is not None:
@@ -506,9 +509,10 @@ def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None =
             spec = DRIVE_KEYS[key]
         unit = f" [{spec.unit}]" if spec.unit in _SI_UNITS and spec.unit else ""
         source = sources.get(key, spec.source)
-        unused = "# (flexible actuators only) " if drive.actuator_model == "rigid" and key in _ACTUATOR_DYNAMICS \
-            else ""
-        lines.append(f"{unused}{name or key} = {_shown(value, spec)}  # {spec.symbol}: {spec.text}{unit}; {source}")
+        rigid = drive.actuator_model == "rigid" and key in _ACTUATOR_DYNAMICS
+        unused = "# (flexible actuators only) " if rigid else ""
+        lines.append(f"{unused}{name or key} = {_shown(value, spec)}  # {spec.symbol}: {spec.text}{unit}; "
+                     f"{source}")
     for group in drive.contact_groups:  # arrays of tables come last in TOML
         lines += ["", "[[contact_groups]]  # contacts of one kind: count, side, contact angle α, F_N per "
                       "contact (or its share of F_p; else Eq. 1), radius R [m]"]

@@ -321,9 +321,9 @@ def generated_force(
         total friction on the runner over the last period), ``no_slip_reference_force_N`` (k
         times the mean piezo position x̄_p: what the load cell would read if the runner followed
         the piezo without slipping; a reference for the generated force, never a force on the
-        runner, so not bounded by μΣF_N, which the contacts cannot exceed), ``last_step_m``, ``net_displacement_m`` (x̄_r − x̄_p over the last
-        period), ``wall_time_s`` (integration time), ``cpu_time_s`` (CPU time of the whole
-        call).
+        runner, so not bounded by μΣF_N, which the contacts cannot exceed), ``last_step_m``,
+        ``net_displacement_m`` (x̄_r − x̄_p over the last period), ``wall_time_s`` (integration
+        time), ``cpu_time_s`` (CPU time of the whole call).
 
     Raises
     ------

@@ -394,8 +394,8 @@ def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> No
         raise
     finally:
         with _signals_held():
-            workers_started = set(multiprocessing.active_children()) - before if cluster is not None else set()
-            _close_dask(client, cluster, interrupted, workers_started)
+            started = set(multiprocessing.active_children()) - before if cluster is not None else set()
+            _close_dask(client, cluster, interrupted, started)
 
 
 def _start_resource_tracker() -> None:

@@ -17,7 +17,6 @@ from passmd.cli.options import (
     add_drive_options,
     add_sweep_options,
 )
-from passmd.cli.streams import check_new_outputs, create_outputs
 from passmd.cli.output import (
     JSON_HELP,
     check_results,
@@ -29,6 +28,7 @@ from passmd.cli.output import (
     fmt,
     plain,
 )
+from passmd.cli.streams import check_new_outputs, create_outputs
 from passmd.protocols.fit.free_parameters import FREE_PARAMETERS
 from passmd.runtime.units import from_si, parse_quantity
 
@@ -151,10 +151,10 @@ def _bounds(args, names, drive) -> dict[str, tuple[float, float]]:
         low_ok, high_ok = plausible_bounds(drive, lib)
         if not (args.allow_extrapolation or drive.allow_extrapolation) and (lo < low_ok or hi > high_ok):
             shown = f" {unit}" if unit else ""
-            raise UsageError(f"--bounds = {text!r} is out of range: must be within {from_si(low_ok, unit):.4g}.."
-                             f"{from_si(high_ok, unit):.4g}{shown}, the plausible range of {name} (a search far "
-                             "outside it simulates drives the model was not checked for, and may never end); "
-                             "--allow-extrapolation goes beyond it")
+            raise UsageError(f"--bounds = {text!r} is out of range: must be within "
+                             f"{from_si(low_ok, unit):.4g}..{from_si(high_ok, unit):.4g}{shown}, the "
+                             f"plausible range of {name} (a search far outside it simulates drives the model "
+                             "was not checked for, and may never end); --allow-extrapolation goes beyond it")
         out[lib] = (lo, hi)
     return out
 
@@ -253,7 +253,8 @@ def _flyback(result, library: dict[str, str]) -> str:
     """The fly-back rule, and the full-stroke time V_pp/SR when the fit set it (its slew rate free)."""
     rule = flyback_label(result.drive.amplifier.flyback)
     if {"flyback_time", "amplifier.slew_rate"} & set(library):
-        return f"{rule} with the fitted full-stroke time V_pp/SR = {fmt(result.drive.amplifier.full_stroke_time, 'us')}"
+        time = fmt(result.drive.amplifier.full_stroke_time, "us")
+        return f"{rule} with the fitted full-stroke time V_pp/SR = {time}"
     return rule
 
 

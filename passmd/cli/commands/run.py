@@ -245,7 +245,8 @@ def _check_eq15_fits(args, design, amplitude, frequency, drive) -> None:
     raise UsageError(
         f"--frequency = {_typed('--frequency', args, frequency)} is out of range for --waveform optimized: "
         f"must be <= {hz(f_max, down=True)}, the highest frequency at which Eq. 15 fits this drive at A = "
-        f"{fmt(amplitude, 'nm')}: t_s + t_a = {(design.settling_time + design.acceleration_time) * 1e6:.4g} µs "
+        f"{fmt(amplitude, 'nm')}: t_s + t_a = "
+        f"{(design.settling_time + design.acceleration_time) * 1e6:.4g} µs "
         f"(from {source}), the fly-back and the slow ramp (at least half of the rest) need a period of "
         f"{1e6 / f_max:.4g} µs{remedy}")
 
@@ -343,7 +344,8 @@ def run_run(args, out) -> int:
     ]
     if design is not None:
         rows.insert(1, ("Eq. 15 design", design_row(design, summary["design_given_by_options"])))
-        rows.insert(2, ("Eq. 15 fits", f"up to {hz(summary['eq15_highest_frequency_Hz'], down=True)} for this drive at "
+        highest = hz(summary["eq15_highest_frequency_Hz"], down=True)
+        rows.insert(2, ("Eq. 15 fits", f"up to {highest} for this drive at "
                                        f"A = {fmt(summary['amplitude_m'], 'nm')}"))
     if "steady" in summary:
         steady = summary["steady"]

@@ -334,7 +334,8 @@ def _points(args, axes: list[Axis], with_amplitude: bool) -> list[dict]:
             for a in drive_axes:
                 setattr(probe, a.quantity.dest, f"{at[a.name]!r} {a.si_unit}".strip())
             try:  # the stall force pushes against the load cell: its stiffness is an option there
-                drives[key] = build_drive(probe, **({"load_cell": True} if args.quantity == "stall-force" else {}))
+                fixed = {"load_cell": True} if args.quantity == "stall-force" else {}
+                drives[key] = build_drive(probe, **fixed)
             except (UsageError, ValueError) as exc:
                 where = ", ".join(f"{a.name} = {_shown(a, at[a.name])}" for a in drive_axes)
                 raise UsageError(f"--vary at {where}: {explain(exc, probe)}") from None

@@ -139,9 +139,10 @@ def _check_travel(data: Measurements, i: int, row: Drive, amplitude: float, f: f
     value = float(data.value[i])
     if abs(value) > limit:
         scale, unit = data.display(i)
+        per = " × f" if data.kind[i] == "velocity" else ""
         raise MeasurementError(
             f"{_where(data, i, data.column[i], value / scale)} is out of range: must be at most "
             f"{limit / scale:.4g} {unit} in magnitude, {TRAVEL_FACTOR:g} × (A + u_x,max + u_x,a) = "
-            f"{TRAVEL_FACTOR:g} × {travel * 1e9:.4g} nm per period{' × f' if data.kind[i] == 'velocity' else ''} "
+            f"{TRAVEL_FACTOR:g} × {travel * 1e9:.4g} nm per period{per} "
             f"at A = {amplitude * 1e9:.4g} nm: no stick–slip drive moves that far (check the column's unit)",
             name=data.column[i], value=value)

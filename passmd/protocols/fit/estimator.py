@@ -187,7 +187,8 @@ def fit(
     hi = np.log([box[k][1] for k in names])
     x_start = np.clip(np.log([max(FREE_PARAMETERS[k].get(drive), 1e-300) for k in names]), lo, hi)
     config = RunConfig() if config is None else config
-    chosen = executor if executor is not None else config.executor or ("dask" if config.scheduler else "process")
+    chosen = executor if executor is not None else (
+        config.executor or ("dask" if config.scheduler else "process"))
     with contextlib.ExitStack() as stack:
         if chosen == "process":  # one pool for the whole fit (sweep.process_pool: signals, worker cap)
             chosen = stack.enter_context(sweep.process_pool(config.workers))

@@ -129,7 +129,8 @@ def measurements_from_rows(header: Sequence[str], rows: Sequence[Sequence[str]],
     if not rows:
         raise MeasurementError(f"{name}: no measurement rows below the header", name="rows", value=0)
     if len(rows) > MAX_ROWS:
-        raise MeasurementError(f"{name}: {len(rows)} measurement rows is out of range: must be at most {MAX_ROWS} "
+        raise MeasurementError(f"{name}: {len(rows)} measurement rows is out of range: must be at most "
+                               f"{MAX_ROWS} "
                                "(a fit simulates every distinct row for each parameter set it tries; give "
                                "repeated measurements of one condition as one row, their mean with its _sd)",
                                name="rows", value=len(rows))

@@ -4,10 +4,12 @@ in a directory it owns, and summarises, prunes or clears it (rules in :mod:`pass
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import json
 import os
 import stat
+import sys
 import time
 import warnings
 from collections.abc import Mapping
@@ -55,6 +57,18 @@ def default_cache_dir() -> Path:
     return (Path(platformdirs.user_cache_dir("passmd", appauthor=False)) / "results").resolve()
 
 
+def _default_origin() -> str:
+    """The environment variable the user cache folder comes from, as set (``XDG_CACHE_HOME = ...``,
+    else ``HOME = ...``), where platformdirs reads one (Linux and the other Unix systems)."""
+    if sys.platform in ("win32", "darwin"):
+        return ""
+    for name in ("XDG_CACHE_HOME", "HOME"):
+        value = os.environ.get(name, "").strip()
+        if value:
+            return f"{name} = {value}"
+    return ""
+
+
 def describe_default_cache_dir() -> str:
     """The default directory for messages and help: ``the user cache folder <path>``."""
     return f"the user cache folder {default_cache_dir()}"
@@ -85,6 +99,7 @@ class Cache:
 
     def __init__(self, directory: str | os.PathLike | None = None, *, fingerprint: str | None = None):
         self.directory = Path(directory).expanduser().resolve() if directory else default_cache_dir()
+        self._default = not directory  # the user cache folder: a problem names the variable it comes from
         self.fingerprint = fingerprint if fingerprint is not None else code_fingerprint()
         self._usable: bool | None = None  # decided on first use (see _ready)
         self._reported: set = set()  # what _report_once reported
@@ -146,8 +161,9 @@ class Cache:
             if state in ("empty", "own-layout"):
                 _write_marker(self.directory)
                 state, reason = inspect_directory(self.directory)
-        except OSError as exc:
-            verb = "write" if create else "read"
+        except OSError as exc:  # a readable folder that refuses its marker is read-only, not unreadable
+            verb = "use" if exc.errno == errno.ENOTDIR else "write" if (
+                create or exc.errno == errno.EROFS or os.access(self.directory, os.R_OK)) else "read"
             self._report_unusable(f"cannot {verb} the cache {self.directory}: {exc.strerror or exc}")
             self._usable = False
             return False
@@ -201,7 +217,8 @@ class Cache:
                 return _MISS
             kind, found = _examine(path, read=True)
         except OSError as exc:  # unreadable (permissions): a miss
-            self._report_unusable(f"cannot read the cache {self.directory}: {exc.strerror or exc}")
+            verb = "use" if exc.errno == errno.ENOTDIR else "read"
+            self._report_unusable(f"cannot {verb} the cache {self.directory}: {exc.strerror or exc}")
             return _MISS
         if kind == "missing":
             return _MISS
@@ -243,7 +260,10 @@ class Cache:
         marker = str(self.directory)
         if marker not in _REPORTED_UNWRITABLE:
             _REPORTED_UNWRITABLE.add(marker)
-            warnings.warn(f"{message}; continuing without the cache", CacheWarning, stacklevel=4)
+            origin = _default_origin() if self._default else ""
+            hint = (f" (the user cache folder, from {origin}; PASSMD_CACHE_DIR or --cache-dir choose "
+                    "another)") if origin else ""
+            warnings.warn(f"{message}{hint}; continuing without the cache", CacheWarning, stacklevel=4)
 
     def put(self, key: str, value, *, function: str = "") -> bool:
         """Store ``value`` atomically (temporary file in the same directory + ``os.replace``).
