@@ -372,7 +372,7 @@ def test_a_pool_never_starts_more_workers_than_points(monkeypatch):
     sizes = []
 
     class Pool(cf.ThreadPoolExecutor):
-        def __init__(self, max_workers, initializer=None):
+        def __init__(self, max_workers, initializer=None, initargs=()):
             sizes.append(max_workers)
             super().__init__(max_workers)
 

@@ -11,6 +11,7 @@ Its default text is computed from the defaults it stands for (:data:`DEFAULT_DRI
 from __future__ import annotations
 
 import argparse
+import re
 from dataclasses import dataclass
 
 from passmd.cli.output import JSON_HELP, fmt
@@ -92,11 +93,14 @@ def _as_typed(exc: InputError, flag: str, typed: str, value: float) -> InputErro
     if not text.startswith(head) or " is out of range" not in text:
         return exc
     shown = text[len(head):text.index(" is out of range")]
-    note = ""
-    if value == 0.0 and any(ch in "123456789" for ch in typed.split("e")[0].split("E")[0]):
+    number = re.match(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$", typed)
+    if value == 0.0 and number and float(number.group(1).replace("e", "E").split("E")[0] or 0) != 0.0:
         note = " (below the smallest number a double holds: it reads as 0)"
-    elif shown.replace(" ", "") != typed.replace(" ", ""):
+    elif number and number.group(2) and " " in shown and shown.partition(" ")[2] != number.group(2):
+        # typed in another unit than the one shown (1mHz against kHz)
         note = f" (= {shown})"
+    else:
+        return exc  # shown in the unit typed already
     return InputError(f"{head}{typed}{note}{text[text.index(' is out of range'):]}", name=exc.name,
                       value=exc.value, unit=exc.unit, limits=exc.limits, why=exc.why, soft=exc.soft)
 
