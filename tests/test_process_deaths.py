@@ -20,9 +20,9 @@ import subprocess
 import sys
 import textwrap
 import time
-from pathlib import Path
 
 import pytest
+from test_outputs_safety import _alive, _descendants  # (a zombie counts as ended)
 
 #: Hang detector: how long a marker may take to appear (a local Dask cluster starts in seconds).
 HANG_S = 120
@@ -60,29 +60,6 @@ _SLOW_POINTS = textwrap.dedent("""
 def _default_signals():  # a test runner started as a background job ignores SIGINT
     signal.signal(signal.SIGINT, signal.SIG_DFL)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
-
-
-def _alive(pid: int) -> bool:
-    try:
-        with open(f"/proc/{pid}/stat") as fh:
-            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"  # a zombie has ended
-    except OSError:
-        return False
-
-
-def _descendants(pid: int) -> set[int]:
-    parents = {}
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            with contextlib.suppress(OSError, IndexError, ValueError):
-                parents[int(entry.name)] = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
-    found, todo = set(), [pid]
-    while todo:
-        pid = todo.pop()
-        children = {child for child, parent in parents.items() if parent == pid}
-        todo += list(children - found)
-        found |= children
-    return found
 
 
 @contextlib.contextmanager
