@@ -523,7 +523,7 @@ _SLOW_POINTS = textwrap.dedent("""
 
     def point(x):
         if x > 2:  # points 1 and 2 finish at once, 3 and 4 announce themselves and sleep
-            Path(os.environ["MARKERS"], f"{x}-{os.getpid()}").write_text("")
+            Path(MARKERS, f"{x}-{os.getpid()}").write_text("")
             time.sleep(600)
         return {"y": x}
 """)
@@ -539,11 +539,12 @@ def test_sigterm_stops_a_process_pool_sweep_and_its_workers(tmp_path, to_group):
 
     code = tmp_path / "code"
     code.mkdir()
-    (code / "slow_points.py").write_text(_SLOW_POINTS)
     markers, out, cache = tmp_path / "markers", tmp_path / "out", tmp_path / "cache"
     markers.mkdir()
+    # the markers' folder written into the code: a point reading the environment is not cached
+    (code / "slow_points.py").write_text(f"MARKERS = {str(markers)!r}\n" + _SLOW_POINTS)
     argv = ["-c", _SWEEP_RUNNER, str(code), "figure", "fig99z", "--out", str(out)]
-    with _started(argv, tmp_path, env=_env(tmp_path, MARKERS=str(markers))) as proc:
+    with _started(argv, tmp_path, env=_env(tmp_path)) as proc:
         deadline = time.monotonic() + HANG_S
         # both workers inside a slow point, the fast ones cached
         while len(list(markers.iterdir())) < 2 or len(Cache(cache).entries()) < 2:

@@ -51,7 +51,7 @@ _SLOW_POINTS = textwrap.dedent("""
     from pathlib import Path
 
     def point(x):
-        Path(os.environ["MARKERS"], f"{x}-{os.getpid()}").write_text("")
+        Path(MARKERS, f"{x}-{os.getpid()}").write_text("")
         time.sleep(600)
         return {"y": x}
 """)
@@ -71,9 +71,10 @@ def _sweep_inside_points(tmp_path, executor: str, moment: str = "points running"
     code, markers = tmp_path / "code", tmp_path / "markers"
     code.mkdir()
     markers.mkdir()
-    (code / "slow_points.py").write_text(_SLOW_POINTS)
+    # the markers' folder written into the code: a point reading the environment is not cached
+    (code / "slow_points.py").write_text(f"MARKERS = {str(markers)!r}\n" + _SLOW_POINTS)
     env = {k: v for k, v in os.environ.items() if not k.startswith("PASSMD_")}
-    env.update(MPLBACKEND="Agg", CI="true", MARKERS=str(markers), PASSMD_CACHE_DIR=str(tmp_path / "cache"),
+    env.update(MPLBACKEND="Agg", CI="true", PASSMD_CACHE_DIR=str(tmp_path / "cache"),
                PYTHONPATH=os.pathsep.join([str(code), env.get("PYTHONPATH", "")]).rstrip(os.pathsep))
     argv = [sys.executable, "-c", _RUNNER, "figure", "fig99z", "--executor", executor, "--workers", "2",
             "--out", str(tmp_path / "out")]

@@ -376,8 +376,8 @@ def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> No
     try:
         if not scheduler:
             _start_resource_tracker()
-            with _signals_held():
-                cluster = LocalCluster(n_workers=0, threads_per_worker=1, dashboard_address=None,
+            with _signals_held():  # (":0": its HTTP server on a free port, never "port in use")
+                cluster = LocalCluster(n_workers=0, threads_per_worker=1, dashboard_address=":0",
                                        silence_logs=logging.ERROR)
             cluster.scale(workers)
         client = Client(scheduler or cluster)
@@ -394,8 +394,7 @@ def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> No
         raise
     finally:
         with _signals_held():
-            started = set(multiprocessing.active_children()) - before if cluster is not None else set()
-            _close_dask(client, cluster, interrupted, started)
+            _close_dask(client, cluster, interrupted, before)
 
 
 def _start_resource_tracker() -> None:
@@ -412,11 +411,15 @@ def _start_resource_tracker() -> None:
 DASK_CLOSE_TIMEOUT = 2.0
 
 
-def _close_dask(client, cluster, interrupted: bool, processes) -> None:
-    """Close the client, and the local cluster this sweep started (its worker ``processes``); after
-    an interrupt at once and quietly: the loggers of ``distributed`` silenced, the worker processes
-    killed first (also those still starting), the close bounded by :data:`DASK_CLOSE_TIMEOUT`, and
-    the cluster taken off ``distributed``'s list of clusters to close at exit (no second close)."""
+def _close_dask(client, cluster, interrupted: bool, before: set) -> None:
+    """Close the client, and the local cluster this sweep started; after an interrupt at once and
+    quietly: the loggers of ``distributed`` silenced, the worker processes the cluster started (this
+    process's children not in ``before``) killed first, also those still starting, and again once
+    the cluster is closed (its loop may have started one meanwhile), the close bounded by
+    :data:`DASK_CLOSE_TIMEOUT`, and the cluster taken off ``distributed``'s list of clusters to close
+    at exit (no second close)."""
+    import multiprocessing
+
     if not interrupted:
         if client is not None:
             client.close()
@@ -425,13 +428,19 @@ def _close_dask(client, cluster, interrupted: bool, processes) -> None:
         return
     for name in ("distributed", "tornado", "asyncio"):
         logging.getLogger(name).setLevel(logging.CRITICAL + 1)
-    for process in processes:
-        with contextlib.suppress(Exception):
-            process.kill()
+
+    def kill_workers():
+        if cluster is not None:
+            for process in set(multiprocessing.active_children()) - before:
+                with contextlib.suppress(Exception):
+                    process.kill()
+
+    kill_workers()
     for closing in (client, cluster):
         if closing is not None:
             with contextlib.suppress(Exception):
                 closing.close(timeout=DASK_CLOSE_TIMEOUT)
+    kill_workers()
     with contextlib.suppress(Exception):
         type(cluster)._instances.discard(cluster)
 
