@@ -104,10 +104,22 @@ def one_line_warnings(prog: str):
     """``warnings.showwarning`` printing ``prog: warning: message`` on one line."""
 
     def show(message, category, filename, lineno, file=None, line=None):
-        text = " ".join(str(message).split())
+        text = _cache_origin(" ".join(str(message).split()))
         sys.stderr.write(f"{prog}: warning: {text}\n")
 
     return show
+
+
+def _cache_origin(text: str) -> str:
+    """A warning about the user cache folder, with the variable that folder comes from as set
+    (``XDG_CACHE_HOME``, else ``HOME``, where platformdirs reads them)."""
+    if "(the user cache folder;" not in text or sys.platform in ("win32", "darwin"):
+        return text
+    for name in ("XDG_CACHE_HOME", "HOME"):
+        value = os.environ.get(name, "").strip()
+        if value:
+            return text.replace("(the user cache folder;", f"(the user cache folder, from {name} = {value};")
+    return text
 
 
 def silence_stdout() -> None:

@@ -9,7 +9,6 @@ import hashlib
 import json
 import os
 import stat
-import sys
 import time
 import warnings
 from collections.abc import Mapping
@@ -55,18 +54,6 @@ def default_cache_dir() -> Path:
     ``~/.cache/passmd/results`` on Linux, ``~/Library/Caches/passmd/results`` on macOS,
     ``%LOCALAPPDATA%\\passmd\\Cache\\results`` on Windows)."""
     return (Path(platformdirs.user_cache_dir("passmd", appauthor=False)) / "results").resolve()
-
-
-def _default_origin() -> str:
-    """The environment variable the user cache folder comes from, as set (``XDG_CACHE_HOME = ...``,
-    else ``HOME = ...``), where platformdirs reads one (Linux and the other Unix systems)."""
-    if sys.platform in ("win32", "darwin"):
-        return ""
-    for name in ("XDG_CACHE_HOME", "HOME"):
-        value = os.environ.get(name, "").strip()
-        if value:
-            return f"{name} = {value}"
-    return ""
 
 
 def describe_default_cache_dir() -> str:
@@ -260,9 +247,8 @@ class Cache:
         marker = str(self.directory)
         if marker not in _REPORTED_UNWRITABLE:
             _REPORTED_UNWRITABLE.add(marker)
-            origin = _default_origin() if self._default else ""
-            hint = (f" (the user cache folder, from {origin}; PASSMD_CACHE_DIR or --cache-dir choose "
-                    "another)") if origin else ""
+            hint = " (the user cache folder; PASSMD_CACHE_DIR or --cache-dir choose another)" \
+                if self._default else ""
             warnings.warn(f"{message}{hint}; continuing without the cache", CacheWarning, stacklevel=4)
 
     def put(self, key: str, value, *, function: str = "") -> bool:
