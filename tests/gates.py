@@ -4,7 +4,8 @@
 (:func:`passmd.cli.main`) with a hook at each moment named in ``MOMENTS`` (comma-separated):
 
 * ``spawn``: in the command, after a process pool forked its first worker (the pool is starting);
-* ``worker``: in a worker, before its initializer ran (it has just been forked);
+* ``worker``: in a worker, before its initializer (:func:`passmd.runtime.pools.worker_signals`) ran
+  (it has just been forked);
 * ``point``: in a worker, before a sweep point whose ``frequency`` is above ``GATE_ABOVE_HZ``
   (default 0: every point; a point without one, e.g. a fit's parameter set, always) is computed
   (the pool is running);
@@ -62,13 +63,15 @@ def _install(moments: set[str]) -> None:
 
         cfp.ProcessPoolExecutor._spawn_process = spawn_then_gate
     if "worker" in moments:
-        initializer = sweep._worker_signals
+        from passmd.runtime import pools
+
+        initializer = pools.worker_signals
 
         def gate_then_initialize(*args):
             gate("worker")
             initializer(*args)
 
-        sweep._worker_signals = gate_then_initialize
+        pools.worker_signals = gate_then_initialize
     if "point" in moments:
         sweep._call = gated_call
     if "evaluate" in moments:

@@ -366,7 +366,7 @@ def test_a_pool_never_starts_more_workers_than_points(monkeypatch):
     """``sweep.run(workers=1000)`` over three points forks three processes (two per core at most)."""
     import concurrent.futures as cf
 
-    from passmd.runtime import config, sweep
+    from passmd.runtime import config, pools, sweep
 
     monkeypatch.setattr(config, "usable_cores", lambda: 2)
     sizes = []
@@ -377,7 +377,7 @@ def test_a_pool_never_starts_more_workers_than_points(monkeypatch):
             super().__init__(max_workers)
 
     monkeypatch.setattr(cf, "ProcessPoolExecutor", Pool)
-    monkeypatch.setattr(sweep, "_worker_signals", lambda: None)
+    monkeypatch.setattr(pools, "worker_signals", lambda *args: None)
     with pytest.warns(config.WorkersCapped, match="workers = 1000 is more than the 2 usable cores"):
         sweep.run(_double, sweep.grid(x=[1, 2, 3]), executor="process", workers=1000, cache=False)
     sweep.run(_double, sweep.grid(x=[1, 2, 3]), executor="process", workers=4, cache=False)

@@ -42,7 +42,7 @@ from passmd.cli.streams import write_atomically
 from passmd.ledger.claims import CLAIMS_PATH
 from passmd.model import waveforms
 from passmd.model.parameters import Drive
-from passmd.runtime import progress, sweep
+from passmd.runtime import pools, progress, sweep
 from passmd.solver import simulation
 
 #: Generous limits: a refusal or a one-period run takes seconds (start-up included).
@@ -568,7 +568,7 @@ def test_pool_workers_end_on_sigterm_whatever_the_parent_handles(monkeypatch):
     previous = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         signal.signal(signal.SIGTERM, lambda signum, frame: None)
-        sweep._worker_signals()  # the pool's worker initializer
+        pools.worker_signals()  # the pool's worker initializer
         assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL
         assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
     finally:

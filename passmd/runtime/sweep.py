@@ -15,8 +15,8 @@ Every finished point is written to the on-disk cache (:mod:`passmd.runtime.cache
 it completes, so an interrupted sweep (Ctrl-C, SIGTERM, a failing point, a killed job) keeps
 every finished point and a rerun recomputes only the rest. Worker processes never outlive the
 sweep: a process pool's workers end when the process that started them dies, even by ``kill -9``
-(:func:`_end_with_parent`), and a local Dask cluster's workers exit with it (``distributed`` watches
-their parent). The cache key covers the swept
+(:func:`passmd.runtime.pools.end_with_parent`), and a local Dask cluster's workers exit with it
+(``distributed`` watches their parent). The cache key covers the swept
 function's own code too (:func:`passmd.runtime.cache.keys.function_code`): a user's function that
 changed between two sweeps is recomputed, and one whose code cannot be fingerprinted is
 not cached (one :class:`~passmd.runtime.cache.store.CacheWarning` says why). Progress (points done, ETA;
@@ -41,13 +41,13 @@ import itertools
 import logging
 import os
 import pickle
-import signal
 import sys
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 
 import pandas as pd
 
+from passmd.runtime import pools
 from passmd.runtime.cache import Cache, CacheWarning, Unfingerprintable, function_code, function_name
 from passmd.runtime.config import EXECUTORS, MAX_WORKERS, RunConfig, useful_workers
 from passmd.runtime.extras import install_hint
@@ -80,91 +80,6 @@ def progress_enabled(progress: bool | None = None, stream=None) -> bool:
 def _call(func, point):
     """Evaluate one point (runs in the worker)."""
     return func(**point)
-
-
-#: The signals a process pool's start and shut-down hold back: delivered right after, in the sweep.
-_HELD_SIGNALS = (signal.SIGINT, signal.SIGTERM)
-
-
-@contextlib.contextmanager
-def _signals_held():
-    """Hold SIGINT and SIGTERM back in this thread while worker processes are forked or stopped.
-
-    A worker forked meanwhile starts with both blocked, so that neither reaches it before its
-    initializer (:func:`_worker_signals`) has set its own handlers: a Ctrl-C or a SIGTERM to
-    the process group while the pool starts never raises inside a worker (a traceback). This
-    process receives a signal that came meanwhile as soon as the block ends, where the sweep
-    handles it (stopping the workers), never inside the executor's start or shut-down.
-    """
-    if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - Windows
-        yield
-        return
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD_SIGNALS)
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
-
-
-def _worker_signals(parent: int | None = None):  # pragma: no cover - runs in pool workers
-    """Pool worker initializer: Ctrl-C is handled by the parent, which stops the workers; SIGTERM
-    (the parent's stop, or a stop of the whole process group) ends a worker at once, whatever
-    handler the parent had installed before the fork. Then the signals the parent held back
-    while forking (:func:`_signals_held`) are let through: a SIGTERM that came meanwhile ends
-    the worker silently, a Ctrl-C is dropped. ``parent``: the pid of the process that started
-    the pool; the worker ends when that process dies, even by ``kill -9`` (:func:`_end_with_parent`)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    if parent is not None:
-        _end_with_parent(parent)
-    if hasattr(signal, "pthread_sigmask"):
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, _HELD_SIGNALS)
-
-
-#: Linux's prctl option that sends the calling process a signal when its parent dies.
-_PR_SET_PDEATHSIG = 1
-#: Seconds between two looks at the parent of a worker where the kernel cannot signal its death.
-PARENT_POLL_S = 1.0
-
-
-def _end_with_parent(parent: int) -> None:  # pragma: no cover - runs in pool workers
-    """End this worker when the process that started its pool (``parent``) dies, even by ``kill -9``.
-
-    On Linux the kernel sends the worker SIGKILL when its own parent dies (prctl
-    ``PR_SET_PDEATHSIG``; that parent is ``parent``'s thread that forked it, which lives as long as
-    the pool, or a fork server that ends with ``parent``). Elsewhere a daemon thread looks every
-    :data:`PARENT_POLL_S` s whether the worker was orphaned (adopted by another process) or
-    ``parent`` is gone, and ends the process. A worker orphaned before this call ends at once.
-    """
-    direct = os.getppid()
-    armed = False
-    if sys.platform.startswith("linux"):
-        with contextlib.suppress(OSError, AttributeError):
-            import ctypes
-
-            armed = ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) == 0
-    if (direct == 1 and parent != 1) or os.getppid() != direct:  # orphaned before the signal was armed
-        os._exit(1)
-    if armed:
-        return
-    import threading
-    import time
-
-    def gone() -> bool:
-        try:
-            os.kill(parent, 0)
-        except ProcessLookupError:
-            return True
-        except OSError:
-            return False
-        return os.getppid() != direct
-
-    def watch():
-        while not gone():
-            time.sleep(PARENT_POLL_S)
-        os._exit(1)
-
-    threading.Thread(target=watch, name="passmd-parent-watch", daemon=True).start()
 
 
 def _check_points(points) -> list[dict]:
@@ -247,16 +162,6 @@ def _harvest(futures: dict, collect: _Collector) -> None:
             continue
 
 
-def _stop_workers(pool: cf.ProcessPoolExecutor) -> None:
-    """Terminate a process pool's workers at once (Ctrl-C must not wait for running points)."""
-    terminate = getattr(pool, "terminate_workers", None)  # Python >= 3.14
-    if terminate is not None:
-        terminate()
-        return
-    for process in list((getattr(pool, "_processes", None) or {}).values()):
-        process.terminate()
-
-
 def _collect_completed(futures: dict, completed, points, collect: _Collector) -> None:
     """Hand each finished future's result to ``collect`` as ``completed(futures)`` yields it."""
     for future in completed(futures):
@@ -291,14 +196,15 @@ def _run_process(func, todo, points, collect: _Collector, workers) -> None:
     """Evaluate the points in a process pool of ``workers`` processes, started and stopped here.
 
     The pool starts (its workers are forked in ``submit``) and shuts down with SIGINT and
-    SIGTERM held back (:func:`_signals_held`); on Ctrl-C or SIGTERM the finished points are
-    kept and the workers terminated at once (running points are not waited for); when a point
-    fails, the points still running finish and are cached before its exception is raised.
+    SIGTERM held back (:func:`passmd.runtime.pools.signals_held`); on Ctrl-C or SIGTERM the
+    finished points are kept and the workers terminated at once (running points are not waited
+    for); when a point fails, the points still running finish and are cached before its exception
+    is raised.
     """
     pool, futures, interrupted = None, {}, False
     try:
-        with _signals_held():
-            pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_worker_signals,
+        with pools.signals_held():
+            pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=pools.worker_signals,
                                           initargs=(os.getpid(),))
             futures = {pool.submit(_call, func, points[i]): i for i in todo}
         try:
@@ -316,13 +222,13 @@ def _run_process(func, todo, points, collect: _Collector, workers) -> None:
         raise
     finally:
         if pool is not None:
-            with _signals_held():
+            with pools.signals_held():
                 if interrupted:
                     _harvest(futures, collect)
                     # Terminating the workers makes the pool fail its pending futures itself.
                     # Cancelling them first races with that: Python 3.11's executor thread then
                     # calls set_exception on a cancelled future and prints an InvalidStateError.
-                    _stop_workers(pool)
+                    pools.stop_workers(pool)
                 pool.shutdown(wait=True, cancel_futures=not interrupted)
 
 
@@ -339,8 +245,8 @@ def process_pool(workers: int | None = None):
     workers = useful_workers(workers, MAX_WORKERS)
     pool, interrupted = None, False
     try:
-        with _signals_held():
-            pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_worker_signals,
+        with pools.signals_held():
+            pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=pools.worker_signals,
                                           initargs=(os.getpid(),))
             pool.submit(int)  # forks the workers now (the fork start method starts them all at once)
         yield pool
@@ -349,20 +255,21 @@ def process_pool(workers: int | None = None):
         raise
     finally:
         if pool is not None:
-            with _signals_held():
+            with pools.signals_held():
                 if interrupted:
-                    _stop_workers(pool)
+                    pools.stop_workers(pool)
                 pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> None:
     """Evaluate the points on the Dask cluster at ``scheduler``, or on a local one started and stopped here.
 
-    A local cluster's event loop is started with SIGINT and SIGTERM held back (:func:`_signals_held`),
+    A local cluster's event loop is started with SIGINT and SIGTERM held back
+    (:func:`passmd.runtime.pools.signals_held`),
     and its worker processes are started from that loop's threads: they keep both blocked, so a
     Ctrl-C to the process group reaches this process only (no traceback from a worker). On Ctrl-C
     or SIGTERM the finished points are kept, the workers killed at once (running points are not
-    waited for) and the cluster closed with its loggers silenced (:func:`_close_dask`).
+    waited for) and the cluster closed with its loggers silenced (:func:`passmd.runtime.pools.close_dask`).
     """
     try:
         from distributed import Client, LocalCluster, as_completed
@@ -375,8 +282,8 @@ def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> No
     before = set(multiprocessing.active_children())
     try:
         if not scheduler:
-            _start_resource_tracker()
-            with _signals_held():  # (":0": its HTTP server on a free port, never "port in use")
+            pools.start_resource_tracker()
+            with pools.signals_held():  # (":0": its HTTP server on a free port, never "port in use")
                 cluster = LocalCluster(n_workers=0, threads_per_worker=1, dashboard_address=":0",
                                        silence_logs=logging.ERROR)
             cluster.scale(workers)
@@ -393,56 +300,8 @@ def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> No
             client.cancel(list(futures))
         raise
     finally:
-        with _signals_held():
-            _close_dask(client, cluster, interrupted, before)
-
-
-def _start_resource_tracker() -> None:
-    """Start multiprocessing's resource tracker now, from this thread, if it is not running: started
-    later from the cluster's event loop, it would unblock SIGINT and SIGTERM in that thread (its
-    ``ensure_running`` ends with ``SIG_UNBLOCK``), and the workers started from there would get them."""
-    with contextlib.suppress(ImportError, AttributeError, OSError):
-        from multiprocessing import resource_tracker
-
-        resource_tracker.ensure_running()
-
-
-#: Seconds a Dask client and a local cluster get to close after Ctrl-C or SIGTERM.
-DASK_CLOSE_TIMEOUT = 2.0
-
-
-def _close_dask(client, cluster, interrupted: bool, before: set) -> None:
-    """Close the client, and the local cluster this sweep started; after an interrupt at once and
-    quietly: the loggers of ``distributed`` silenced, the worker processes the cluster started (this
-    process's children not in ``before``) killed first, also those still starting, and again once
-    the cluster is closed (its loop may have started one meanwhile), the close bounded by
-    :data:`DASK_CLOSE_TIMEOUT`, and the cluster taken off ``distributed``'s list of clusters to close
-    at exit (no second close)."""
-    import multiprocessing
-
-    if not interrupted:
-        if client is not None:
-            client.close()
-        if cluster is not None:
-            cluster.close()
-        return
-    for name in ("distributed", "tornado", "asyncio"):
-        logging.getLogger(name).setLevel(logging.CRITICAL + 1)
-
-    def kill_workers():
-        if cluster is not None:
-            for process in set(multiprocessing.active_children()) - before:
-                with contextlib.suppress(Exception):
-                    process.kill()
-
-    kill_workers()
-    for closing in (client, cluster):
-        if closing is not None:
-            with contextlib.suppress(Exception):
-                closing.close(timeout=DASK_CLOSE_TIMEOUT)
-    kill_workers()
-    with contextlib.suppress(Exception):
-        type(cluster)._instances.discard(cluster)
+        with pools.signals_held():
+            pools.close_dask(client, cluster, interrupted, before)
 
 
 def run(
