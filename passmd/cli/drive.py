@@ -11,7 +11,15 @@ from __future__ import annotations
 from passmd.cli.errors import UsageError
 from passmd.cli.options import ACTUATOR_DYNAMICS, DRIVE_QUANTITIES, OPTION_FOR, QUANTITIES
 from passmd.cli.output import flyback_label, fmt
-from passmd.model.drive_file import REGION_KEY, DriveFileError, read_drive_file, region_values, resolve
+from passmd.model.drive_file import (
+    REGION_KEY,
+    SHORTEST_FLYBACK,
+    SHORTEST_FLYBACK_WHY,
+    DriveFileError,
+    read_drive_file,
+    region_values,
+    resolve,
+)
 from passmd.model.parameters import Drive
 from passmd.model.tables import FLYBACK_RULES
 from passmd.runtime.units import QuantityError, dimension_name, from_si, parse_quantity
@@ -119,8 +127,9 @@ def _flyback(raw: str) -> str | float:
             raise UsageError(str(exc)) from None
         raise UsageError(f"--flyback = {raw!r} is not allowed: must be slew, fixed or a time with its unit, "
                          "e.g. 1.5us") from None
-    if not value > 0.0:
-        raise UsageError(f"--flyback = {raw!r} is out of range: must be > 0 us")
+    if not value >= SHORTEST_FLYBACK:
+        raise UsageError(f"--flyback = {raw!r} is out of range: must be >= {SHORTEST_FLYBACK * 1e6:g} us "
+                         f"({SHORTEST_FLYBACK_WHY})")
     return value
 
 
@@ -170,7 +179,25 @@ def explain(exc: ValueError, args) -> str:
     if isinstance(cause, DriveFileError):  # already names the drive file and its key as typed
         return str(cause)
     text = _rephrase(cause, args) if isinstance(cause, InputError) else None
-    return text or str(exc)
+    text = text or str(exc)
+    if isinstance(cause, InputError) and cause.name == "frequency" and "fly-back" in (cause.why or ""):
+        text += f"; the fly-back is {_flyback_source(args)}"
+    return text
+
+
+def _flyback_source(args) -> str:
+    """Where the fly-back of a run comes from, as the user gave it."""
+    if getattr(args, "flyback", None) is not None:
+        return f"--flyback {args.flyback}"
+    path = getattr(args, "drive", None)
+    if path is not None:
+        try:
+            given = read_drive_file(path, allow_extrapolation=True).get("amplifier.flyback")
+        except (DriveFileError, ValueError):
+            given = None
+        if given is not None:
+            return f"amplifier.flyback in {path}"
+    return "the slew-rate rule (A/A_max)·V_pp/SR (--slew-rate, --amplifier-voltage; or --flyback)"
 
 
 def _rephrase(exc: InputError, args) -> str | None:
@@ -182,6 +209,9 @@ def _rephrase(exc: InputError, args) -> str | None:
         if not flags:
             return None
         given = [f"{flag} {_typed(flag, args)}" for flag in flags if getattr(args, _dest(flag)) is not None]
+        if not given and getattr(args, "drive", None) is not None:  # the file's contacts, not an option
+            return (f"{args.drive}: {exc.detail} (the contacts this drive file describes: its preload, "
+                    "hemisphere_radius, materials and contact_groups)") + (f"; {lifted}" if lifted else "")
         return f"{', '.join(given or flags)}: {exc.detail}" + (f"; {lifted}" if lifted else "")
     if exc.quantity and exc.source:  # a quantity computed from one option
         flag = _flag(exc.source, args)

@@ -9,9 +9,14 @@ __all__ = ["diagnosis_rows", "eq15_rows", "hz", "missing_rows", "resolution", "r
            "sweep_figure", "sweep_title", "turn_rows", "uses_eq15"]
 
 
-def hz(frequency: float) -> str:
-    """A frequency as a reader writes it: ``100 Hz``, ``4.908 kHz``."""
-    return f"{frequency:.4g} Hz" if frequency < 1e3 else f"{frequency / 1e3:.4g} kHz"
+def hz(frequency: float, *, down: bool = False) -> str:
+    """A frequency as a reader writes it: ``100 Hz``, ``4.908 kHz``; ``down``: rounded down to its
+    four digits (an upper limit, which typed back must stay within it)."""
+    value, unit = (frequency, "Hz") if frequency < 1e3 else (frequency / 1e3, "kHz")
+    if down and value > 0 and math.isfinite(value):
+        step = 10.0 ** (math.floor(math.log10(value)) - 3)
+        value = math.floor(value / step * (1 + 1e-12)) * step
+    return f"{value:.4g} {unit}"
 
 
 def uses_eq15(args) -> bool:
@@ -43,8 +48,8 @@ def eq15_rows(args, table) -> list[tuple[str, str]]:
     limits = _finite(table["eq15_highest_frequency_Hz"])
     source = ", ".join(hz(f) for f in sorted(set(_finite(table["response_frequency_Hz"])))) or "–"
     varies = limits and max(limits) > min(limits)
-    spread = f" … {hz(max(limits))} (by drive and amplitude)" if varies else ""
-    fits = f"fits up to {hz(min(limits))}{spread}" if limits else "–"
+    spread = f" … {hz(max(limits), down=True)} (by drive and amplitude)" if varies else ""
+    fits = f"fits up to {hz(min(limits), down=True)}{spread}" if limits else "–"
     return [("Eq. 15 design", f"from the saw-tooth response at {source}; {fits}")]
 
 

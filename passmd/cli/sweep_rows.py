@@ -177,7 +177,7 @@ def add_band(args, spec, table, points_with, config) -> None:
     """The band a fitted --drive file's region gives each point (in place): ``<column>_band_low`` and
     ``_band_high``, the least and largest value over the estimate and the region's points.
 
-    ``points_with(build)``: the sweep's points with each drive made by ``build(args)``; the region's
+    ``points_with(build)``: the sweep's points with each drive made by ``build(args, **fixed)``; the region's
     drives come from :func:`passmd.cli.drive.region_drives` (none: no band)."""
     from passmd.cli.drive import region_drives
     from passmd.protocols.maps import compute_map
@@ -187,7 +187,7 @@ def add_band(args, spec, table, points_with, config) -> None:
         return
     values = [list(table[spec.column])]
     for k in range(count):
-        points = points_with(lambda probe, k=k: region_drives(probe)[k])
+        points = points_with(lambda probe, k=k, **fixed: region_drives(probe, **fixed)[k])
         other = compute_map(args.quantity, points, reading=args.reading or "steady",
                             waveform=args.waveform or "sawtooth",
                             design_response=args.design_response or "paper", config=config,

@@ -62,8 +62,8 @@ else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 __all__ = ["CONTACT_PRESETS", "DRIVE_KEYS", "EXAMPLE_DRIVE_FILE", "JOINT_READING_FILE", "REGION_KEY",
-           "DriveFileError", "DriveKey", "drive_toml", "load_drive", "parameter_rows", "read_drive_file",
-           "region_values", "resolve"]
+           "SHORTEST_FLYBACK", "SHORTEST_FLYBACK_WHY", "DriveFileError", "DriveKey", "drive_toml", "load_drive",
+           "parameter_rows", "read_drive_file", "region_values", "resolve"]
 
 
 class DriveFileError(InputError):
@@ -73,16 +73,35 @@ class DriveFileError(InputError):
 _DEFAULT = Drive()
 
 
+#: Shortest stated fly-back time (s): about a thousandth of Section 2's full-stroke fly-back V_pp/SR,
+#: far beyond any amplifier; much shorter, the saw-tooth's corner times are no longer distinct at the
+#: precision of a period's times.
+SHORTEST_FLYBACK = 1e-9
+SHORTEST_FLYBACK_WHY = "about a thousandth of the paper's full-stroke fly-back V_pp/SR, beyond any amplifier"
+#: Keys of the actuators' dynamics (Eq. 3), which ideally rigid actuators do not have.
+_ACTUATOR_DYNAMICS = ("actuator.stiffness", "actuator.mass", "actuator.viscosity", "actuator.damping_ratio")
 
 
-def _flatten(table: dict, prefix: str = "") -> dict:
+def _flatten(table: dict, name: str, prefix: str = "", section: str = "the top level",
+             seen: dict | None = None) -> dict:
+    """The file's keys, dotted (``[drive]`` dropped); a key given twice, e.g. ``preload`` at the top
+    level and in ``[drive]``, is refused naming both places (TOML refuses only a repeat within one
+    table, and the second would silently win)."""
+    seen = {} if seen is None else seen  # key -> where it was given
     out = {}
-    for name, value in table.items():
-        key = f"{prefix}{name}"
+    for part, value in table.items():
         if isinstance(value, dict):
-            out.update(_flatten(value, "" if key == "drive" and not prefix else key + "."))
-        else:
-            out[key] = value
+            key = f"{prefix}{part}"
+            inner = "" if key == "drive" and not prefix else key + "."
+            out.update(_flatten(value, name, inner, f"[{key}]", seen))
+            continue
+        key = f"{prefix}{part}"
+        if key in seen:
+            raise DriveFileError(f"{name}: {key} is given twice, in {seen[key]} and in {section}: give it "
+                                 "once",
+                                 name=key, value=value)
+        seen[key] = section
+        out[key] = value
     return out
 
 
@@ -119,6 +138,11 @@ def _value(where: str, spec: DriveKey, raw, allow_extrapolation: bool):
         value = parse_quantity(raw, spec.unit, name=where)
     except QuantityError as exc:
         raise DriveFileError(str(exc), name=spec.key, value=raw) from None
+    except OverflowError:  # an integer beyond any float, e.g. 10**400
+        digits = str(raw)
+        raise _refuse(where, f"= {digits[:8]}… ({len(digits)} digits) is out of range: too large for a "
+                             "number",
+                      name=spec.key, value=raw) from None
     si = f" {spec.unit}" if spec.unit else ""
     if spec.plausible is not None:
         try:
@@ -145,9 +169,10 @@ def _flyback(label: str, spec: DriveKey, raw) -> str | float:
         value = parse_quantity(raw, "s", name=label)
     except QuantityError:
         raise refused from None
-    if not (math.isfinite(value) and value > 0.0):
-        raise _refuse(label, f"= {raw!r} is out of range: must be > 0 s", name=spec.key, value=raw,
-                      limits=((">", 0.0),))
+    if not (math.isfinite(value) and value >= SHORTEST_FLYBACK):
+        raise _refuse(label, f"= {raw!r} is out of range: must be >= {SHORTEST_FLYBACK:g} s "
+                             f"({SHORTEST_FLYBACK_WHY})", name=spec.key, value=raw,
+                      limits=((">=", SHORTEST_FLYBACK),))
     return value
 
 
@@ -267,7 +292,11 @@ def read_drive_file(path, *, allow_extrapolation: bool | None = None) -> dict:
         raise DriveFileError(str(exc), name="drive", value=name) from None
     except tomllib.TOMLDecodeError as exc:
         raise DriveFileError(f"{name}: not a TOML file: {exc}", name="drive", value=name) from None
-    raw = _flatten(table)
+    except RecursionError:
+        raise DriveFileError(f"{name}: not a drive file: its arrays or tables are nested too deeply for the "
+                             "TOML reader (a drive file's values are numbers, strings and flat tables)",
+                             name="drive", value=name) from None
+    raw = _flatten(table, name)
     region = raw.pop(REGION_KEY, None)
     unknown = [key for key in raw if key not in DRIVE_KEYS]
     if unknown:
@@ -280,6 +309,11 @@ def read_drive_file(path, *, allow_extrapolation: bool | None = None) -> dict:
     if "contacts" in values and "contact_groups" in values:
         raise DriveFileError(f"{name}: contacts and contact_groups both given: give one (a preset, or the "
                              "groups)", name="contacts", value=values["contacts"])
+    dynamics = [key for key in _ACTUATOR_DYNAMICS if key in values]
+    if values.get("actuator_model") == "rigid" and dynamics:
+        raise DriveFileError(f"{name}: {dynamics[0]} contradicts actuator_model = \"rigid\": ideally rigid "
+                             "actuators have no stiffness, mass or damping; remove it, or set actuator_model "
+                             "= \"flexible\"", name=dynamics[0], value=values[dynamics[0]])
     if "actuator.viscosity" in values and "actuator.damping_ratio" in values:
         raise DriveFileError(f"{name}: actuator.viscosity and actuator.damping_ratio both given: give one "
                              "(c_p = 2ζ√(k_p m_a))", name="actuator.viscosity",
@@ -390,12 +424,20 @@ def _number(value: float) -> str:
     return text if any(c in text for c in ".en") else text + ".0"
 
 
+def _string(text: str) -> str:
+    """``text`` as a TOML string (tomli-w escapes quotes, backslashes, newlines and every control
+    character), so that any name reads back as written."""
+    import tomli_w
+
+    return tomli_w.dumps({"k": text}).partition(" = ")[2].rstrip("\n")
+
+
 def _shown(value, spec: DriveKey) -> str:
     """A value as TOML: a string in the display unit when that reads back exactly, else SI."""
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        return _string(value)
     si_unit = "s" if spec.unit == "flyback" else spec.unit  # a stated fly-back time
     if spec.display and spec.display != si_unit:
         text = f"{float(from_si(value, spec.display)):.12g} {spec.display}"
@@ -440,7 +482,10 @@ def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None =
             spec = DRIVE_KEYS[key]
         unit = f" [{spec.unit}]" if spec.unit in SI_UNITS and spec.unit else ""
         source = sources.get(key, spec.source)
-        lines.append(f"{name or key} = {_shown(value, spec)}  # {spec.symbol}: {spec.text}{unit}; {source}")
+        rigid = drive.actuator_model == "rigid" and key in _ACTUATOR_DYNAMICS
+        unused = "# (flexible actuators only) " if rigid else ""
+        lines.append(f"{unused}{name or key} = {_shown(value, spec)}  # {spec.symbol}: {spec.text}{unit}; "
+                     f"{source}")
     for group in drive.contact_groups:  # arrays of tables come last in TOML
         lines += ["", "[[contact_groups]]  # contacts of one kind: count, side, contact angle α, F_N per "
                       "contact (or its share of F_p; else Eq. 1), radius R [m]"]

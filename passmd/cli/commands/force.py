@@ -26,7 +26,7 @@ _EPILOG = textwrap.dedent("""\
     --json keys (SI units): generated_force_N (k times the mean runner position over the
     last period), converged, coulomb_bound_N, periods, periods_simulated,
     remaining_force_N, remaining_force_note, force_spread_N, mean_friction_N,
-    piezo_mean_force_N, last_step_m, net_displacement_m, wall_time_s, cpu_time_s,
+    no_slip_reference_force_N, last_step_m, net_displacement_m, wall_time_s, cpu_time_s,
     amplitude_m, frequency_Hz, drive{...}""")
 
 

@@ -9,7 +9,7 @@ from typing import NamedTuple
 
 from passmd.cli import kernels, startup
 from passmd.cli.commands.contact import check_springs
-from passmd.cli.drive import build_drive, drive_rows
+from passmd.cli.drive import _typed, build_drive, drive_rows
 from passmd.cli.errors import OutputError, UsageError
 from passmd.cli.notes import hz, ringing_text
 from passmd.cli.options import (
@@ -236,13 +236,19 @@ def _check_eq15_fits(args, design, amplitude, frequency, drive) -> None:
     f_max = optimized_waveform.highest_fitting_frequency(design, amplitude, drive)
     if optimized_waveform.optimized_timing(design, amplitude, frequency, drive)["settling_fits"]:
         return
-    source = "the options' t_s, t_a" if args.settling_time or args.acceleration_time else \
-        f"the {hz(design.response_frequency)} saw-tooth response"
+    given = [f"{flag} {getattr(args, dest)}" for flag, dest in (("--settling-time", "settling_time"),
+                                                              ("--acceleration-time", "acceleration_time"))
+             if getattr(args, dest)]
+    source = " and ".join(given) if given else f"the {hz(design.response_frequency)} saw-tooth response"
+    remedy = f"; lower {' or '.join(g.split()[0] for g in given)}, or give a lower --frequency" \
+        if given and args.frequency is None else ""
     raise UsageError(
-        f"--frequency {args.frequency} is out of range for --waveform optimized: must be <= {hz(f_max)}, the "
-        f"highest frequency at which Eq. 15 fits this drive at A = {fmt(amplitude, 'nm')}: t_s + t_a = "
-        f"{(design.settling_time + design.acceleration_time) * 1e6:.4g} µs (from {source}), the fly-back and "
-        f"the slow ramp (at least half of the rest) need a period of {1e6 / f_max:.4g} µs")
+        f"--frequency = {_typed('--frequency', args, frequency)} is out of range for --waveform optimized: "
+        f"must be <= {hz(f_max, down=True)}, the highest frequency at which Eq. 15 fits this drive at A = "
+        f"{fmt(amplitude, 'nm')}: t_s + t_a = "
+        f"{(design.settling_time + design.acceleration_time) * 1e6:.4g} µs "
+        f"(from {source}), the fly-back and the slow ramp (at least half of the rest) need a period of "
+        f"{1e6 / f_max:.4g} µs{remedy}")
 
 
 def runner_ringing(drive, amplitude: float, frequency: float) -> dict:
@@ -347,7 +353,7 @@ def write_outputs(args, result, figure=None, band=None) -> None:
 
 
 def run_run(args, out) -> int:
-    drive = build_drive(args, load_cell=bool(args.load_cell))
+    drive = build_drive(args, **({"load_cell": True} if args.load_cell else {}))  # else the file's
     options = check_run_options(args, drive)
     check_memory(args)
     check_output_paths(args)
@@ -390,7 +396,8 @@ def run_run(args, out) -> int:
     ]
     if design is not None:
         rows.insert(1, ("Eq. 15 design", design_row(design, summary["design_given_by_options"])))
-        rows.insert(2, ("Eq. 15 fits", f"up to {hz(summary['eq15_highest_frequency_Hz'])} for this drive at "
+        highest = hz(summary["eq15_highest_frequency_Hz"], down=True)
+        rows.insert(2, ("Eq. 15 fits", f"up to {highest} for this drive at "
                                        f"A = {fmt(summary['amplitude_m'], 'nm')}"))
     if "steady" in summary:
         steady = summary["steady"]

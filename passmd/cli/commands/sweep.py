@@ -6,6 +6,7 @@ import argparse
 import itertools
 import json
 import math
+import os
 import re
 import textwrap
 from dataclasses import dataclass
@@ -16,7 +17,7 @@ import numpy as np
 
 from passmd.cli.configuration import run_config
 from passmd.cli.drive import _bound, build_drive, explain
-from passmd.cli.errors import OutputError, UsageError
+from passmd.cli.errors import UsageError
 from passmd.cli.notes import (
     eq15_rows,
     missing_rows,
@@ -36,7 +37,7 @@ from passmd.cli.options import (
     add_sweep_options,
 )
 from passmd.cli.output import JSON_HELP, check_output_file, describe, drive_record, emit_json, emit_rows, fmt
-from passmd.cli.streams import PipeClosed, check_outputs, write_atomically
+from passmd.cli.streams import check_new_outputs, check_outputs, create_outputs
 from passmd.cli.sweep_rows import (
     add_band,
     check_values,
@@ -217,8 +218,15 @@ def parse_vary(text: str) -> Axis:
     low, _, rest = spec.partition("..")
     high, *options = rest.split(":")
     spacing, count = "linear", 10
+    given: dict[str, str] = {}
     for option in options:
         option = option.strip()
+        what = "spacing" if option in ("log", "lin", "linear") else "N" if re.fullmatch(r"[0-9]+", option) \
+            else None
+        if what is not None and what in given:
+            raise _refuse(text, f"{what} is given twice ({given[what]!r} and {option!r}): give it once")
+        if what is not None:
+            given[what] = option
         if option in ("log", "lin", "linear"):
             spacing = "log" if option == "log" else "linear"
         elif re.fullmatch(r"[0-9]+", option):
@@ -308,9 +316,29 @@ def _check_options(args) -> None:
     if args.amplitude is not None and args.quantity == "critical-amplitude":
         raise UsageError("--amplitude has no effect on critical-amplitude: it searches over the amplitude")
     if args.out is not None:
-        for suffix in (".csv", ".json", ".png"):
-            check_output_file("--out", args.out + suffix)
-        check_outputs({f"{args.out}{s} (--out {args.out})": args.out + s for s in (".csv", ".json", ".png")})
+        _check_prefix(args.out)
+
+
+def _outputs(prefix: str, axes: int) -> dict[str, str]:
+    """PREFIX.csv, PREFIX.json and, for one or two axes, PREFIX.png."""
+    files = {"csv": prefix + ".csv", "json": prefix + ".json"}
+    if axes <= 2:
+        files["png"] = prefix + ".png"
+    return files
+
+
+def _check_prefix(prefix: str) -> None:
+    """--out PREFIX before any work: a file stem (not a folder, not ending in a separator), its
+    files absent and creatable in an existing folder (exit 2)."""
+    stem = os.path.basename(prefix)
+    if not stem or stem in (".", "..") or prefix.endswith(os.sep) or Path(prefix).is_dir():
+        raise UsageError(f"--out = {prefix!r} names a directory, not a PREFIX: give the files' stem, e.g. "
+                         f"{os.path.join(prefix.rstrip(os.sep) or '.', 'map')!r}")
+    files = _outputs(prefix, 2)
+    for suffix in (".csv", ".json", ".png"):
+        check_output_file("--out", prefix + suffix)
+    check_outputs({f"{path} (--out {prefix})": path for path in files.values()})
+    check_new_outputs(f"--out {prefix}", list(files.values()))
 
 
 # --------------------------------------------------------------------------------------
@@ -332,8 +360,9 @@ def _points(args, axes: list[Axis], with_amplitude: bool, build=build_drive) -> 
             probe = argparse.Namespace(**vars(args))
             for a in drive_axes:
                 setattr(probe, a.quantity.dest, f"{at[a.name]!r} {a.si_unit}".strip())
-            try:
-                drives[key] = build(probe)
+            try:  # the stall force pushes against the load cell: its stiffness is an option there
+                fixed = {"load_cell": True} if args.quantity == "stall-force" else {}
+                drives[key] = build(probe, **fixed)
             except (UsageError, ValueError) as exc:
                 where = ", ".join(f"{a.name} = {_shown(a, at[a.name])}" for a in drive_axes)
                 raise UsageError(f"--vary at {where}: {explain(exc, probe)}") from None
@@ -423,34 +452,30 @@ def _record(args, axes, table, spec, drive) -> dict:
 
 
 def _write(args, record, axes, spec, table, title) -> dict:
-    """PREFIX.csv, PREFIX.json and (one or two axes) PREFIX.png, each written atomically."""
+    """PREFIX.csv, PREFIX.json and (one or two axes) PREFIX.png, created together or not at all,
+    never over a file (:func:`passmd.cli.streams.create_outputs`)."""
     from passmd.cli.output import plain
 
     prefix = args.out
-    files = {"csv": prefix + ".csv", "json": prefix + ".json"}
-    if len(axes) <= 2:
-        files["png"] = prefix + ".png"
+    files = _outputs(prefix, len(axes))
     header = "".join(f"# {k}: {v}\n" for k, v in record["provenance"].items())
     header += f"# quantity: {args.quantity} ({spec.column})\n"
-    try:
-        def write_csv(tmp):
-            with open(tmp, "w", encoding="utf-8", newline="") as fh:
-                fh.write(header)
-                table.to_csv(fh, index=False, lineterminator="\n")
 
-        write_atomically(files["csv"], write_csv)
-        text = json.dumps(plain({**record, "files": files}), indent=2, allow_nan=False) + "\n"
-        write_atomically(files["json"], lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
-        if "png" in files:
-            fig = sweep_figure(args, axes, spec, table, title)
-            facts = record["provenance"]
-            summary = f"passmd {facts['passmd_version']}, commit {facts['git_commit']}"
-            write_atomically(files["png"], lambda tmp: fig.savefig(
-                tmp, dpi=150, format="png", metadata={"Description": summary}))
-    except BrokenPipeError as exc:
-        raise PipeClosed() from exc
-    except OSError as exc:
-        raise OutputError(f"cannot write --out {prefix}: {exc.strerror or exc}") from exc
+    def write_csv(tmp):
+        with open(tmp, "w", encoding="utf-8", newline="") as fh:
+            fh.write(header)
+            table.to_csv(fh, index=False, lineterminator="\n")
+
+    text = json.dumps(plain({**record, "files": files}), indent=2, allow_nan=False) + "\n"
+    writers = {files["csv"]: write_csv,
+               files["json"]: lambda tmp: Path(tmp).write_text(text, encoding="utf-8")}
+    if "png" in files:
+        fig = sweep_figure(args, axes, spec, table, title)
+        facts = record["provenance"]
+        summary = f"passmd {facts['passmd_version']}, commit {facts['git_commit']}"
+        writers[files["png"]] = lambda tmp: fig.savefig(tmp, dpi=150, format="png",
+                                                        metadata={"Description": summary})
+    create_outputs(f"--out {prefix}", writers)
     return files
 
 

@@ -238,7 +238,7 @@ def _stall_frame(points: list[dict], description: str, config: RunConfig) -> pd.
         "remaining_force_mN": f["remaining_force_N"].astype(float) * 1e3,  # None: not estimated
         "force_spread_mN": f["force_spread_N"] * 1e3,
         "mean_friction_mN": f["mean_friction_N"] * 1e3,
-        "piezo_mean_force_mN": f["piezo_mean_force_N"] * 1e3,
+        "piezo_mean_force_mN": f["no_slip_reference_force_N"] * 1e3,
         "net_displacement_nm": f["net_displacement_m"] * 1e9,
         "last_step_nm": f["last_step_m"] * 1e9,
         "cpu_time_s": f["cpu_time_s"],

@@ -169,8 +169,8 @@ def _advice(data: Measurements) -> str:
         tips.append("measurements at another driving frequency")
     if len(set(data.kind)) == 1:
         dynamic = "the critical amplitude or the stall force"
-        other = {"step": dynamic, "velocity": dynamic, "critical_amplitude": "steps against amplitude",
-                 "force": "steps against amplitude"}
+        other = {"step": dynamic, "velocity": dynamic, "position": dynamic,
+                 "critical_amplitude": "steps against amplitude", "force": "steps against amplitude"}
         tips.append(f"another kind of measurement ({other[data.kind[0]]})")
     amps = data.amplitude[np.isfinite(data.amplitude)]
     if amps.size and amps.max() < 1.5 * amps.min():
