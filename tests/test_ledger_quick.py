@@ -152,8 +152,9 @@ def test_the_readme_states_the_paper_baselines_held_out_count():
     found = re.search(r"reproduces (\d+) of its (\d+) claims[^.]*?(\d+) hold by construction, (\d+) are not "
                       r"reproduced and (\d+) inconclusive", re.sub(r"\s+", " ", readme))
     assert found, "the README does not state the ledger's held-out count"
-    assert [int(g) for g in found.groups()] == [reproduced, len(counted), status.count("holds by construction"),
-                                               status.count("not reproduced"), status.count("inconclusive")]
+    expected = [reproduced, len(counted), status.count("holds by construction"),
+                status.count("not reproduced"), status.count("inconclusive")]
+    assert [int(g) for g in found.groups()] == expected
 
 
 def test_baselines_say_how_they_were_made():
