@@ -104,6 +104,17 @@ def test_real_claims_load_and_contain_the_required_rows():
     assert (claims["tolerance_reason"].str.len() > 10).all()
 
 
+def test_every_ordering_names_what_it_compares():
+    """An ordering of computed values names its two sides (``compares``), so that its margin and verdict
+    say what is compared; the claims about the experiment compare nothing computed."""
+    claims = load_claims()
+    experiment = evaluation.claim_functions().experiment
+    orderings = claims[(claims["check"] == "ordering") & ~claims["id"].isin(experiment)]
+    unnamed = list(orderings.loc[orderings["compares"].str.count(r"\|") != 1, "id"])
+    assert not unnamed, unnamed
+    assert (claims.loc[claims["check"] != "ordering", "compares"] == "").all()
+
+
 def test_stated_numbers_of_the_paper():
     """The numbers the paper states in its text (a typo here would move a claim)."""
     claims = load_claims().set_index("id")
@@ -640,6 +651,7 @@ def test_fragile_margin_and_informative_flags(tmp_path):
     assert evaluated.at["val", "fragile"]
     assert evaluated.at["val", "fragile_reason"].startswith("fails at the runner-up reading")
     assert evaluated.at["val", "margin_text"] == "3.0% off the paper, tolerance 5 %"
+    assert evaluated.at["ord", "margin_text"] == "lhs > rhs: lhs 2 mm/s vs rhs 1 mm/s"
     assert evaluated.at["val", "margin"] == pytest.approx(0.6)
     assert not evaluated.at["ord", "fragile"] and not evaluated.at["ord", "informative"]
     assert evaluated.at["ord", "not_informative"] == "holds for any finite stiffness"
@@ -995,7 +1007,8 @@ def test_styled_one_line_per_claim_and_details(tmp_path):
     # one line per claim: the category, ours against the paper with units, the one reason, the readings
     table = ledger_views.styled(evaluated).data.set_index("claim")
     assert list(table.columns) == ["category", "ours vs paper", "why", "readings"]
-    assert table.at["val", "ours vs paper"] == "150 nm vs the paper's 100 nm (paper: 100 nm)"
+    assert table.at["val", "ours vs paper"] == "150 nm vs the paper's 100 nm"
+    assert table.at["ord", "ours vs paper"] == "2 mm/s vs 1 mm/s; paper: q"  # no 'compares': the quantity
     assert table.at["val", "why"] == "deviation 50 % exceeds the tolerance 5 %"
     assert table.at["val", "readings"] == "holds 0, fails 1, undecided 0 of 1"
     details = ledger_views.details_markdown(evaluated, claims)

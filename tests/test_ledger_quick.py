@@ -64,7 +64,15 @@ def test_quick_ledger_keeps_every_category():
     # The claim computed from closed forms needs no figure: a closed-form identity, it holds by construction.
     assert baseline["fig10b-r1-stiffer-contact"] == "holds by construction"
     _one_reading_per_count(evaluated)
+    _texts_say_what_they_compare(evaluated)
 
+
+def _texts_say_what_they_compare(evaluated):
+    """Every margin, reason and 'ours' of the ledger names what it compares and carries units: no bare
+    'lhs'/'rhs', no 'nan', no number written as the verdict of a grid point ('x = 40')."""
+    for row in evaluated.itertuples():
+        for text in (row.margin_text, row.why, row.ours_text, row.paper):
+            assert not re.search(r"\b(lhs|rhs)\b|\bnan\b|x = ", str(text)), (row.claim, text)
 
 def _one_reading_per_count(evaluated):
     """No category is a union of readings: the claims counted as reproduced (either kind) never outnumber

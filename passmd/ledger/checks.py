@@ -262,7 +262,7 @@ def check_ordering(ours, relation, tolerance=None, tolerance_kind="rel", *, unit
     shown = (f"{format_number(float(lhs[0]))} vs {format_number(float(rhs[0]))}" if lhs.size == 1
              else f"{int(ok.sum())} of {ok.size} hold")
     text = (f"{_with_unit(lhs[0], unit)} vs {_with_unit(rhs[0], unit)}" if lhs.size == 1
-            else f"{left} {symbol} {right} at {int(ok.sum())} of {ok.size}")
+            else f"holds at {int(ok.sum())} of {ok.size} points")
     resolved = f" (resolution {_with_unit(resolution, unit)})" if resolution > 0 else ""
     if wrong.any():
         bad = int(np.flatnonzero(wrong)[0])

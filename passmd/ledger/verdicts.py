@@ -50,6 +50,8 @@ def _paper_text(claim: Mapping) -> str:
         filename, _, column = claim["reference"].partition(":")
         return f"curve {column} ({filename})"
     if kind == "ordering":
+        if not claim.get("compares"):
+            return claim["quantity"]
         left, right = compared_names(claim)
         return f"{left} {ORDERING_SYMBOLS[relation]} {right}"
     if kind == "threshold":
@@ -224,24 +226,20 @@ def _margin(claim: Mapping, outcome: Outcome | None) -> tuple[float, str]:
     compares."""
     if outcome is None:
         return math.nan, "—"
-    unit = claim["unit"]
-    if math.isfinite(outcome.ratio):
-        relative = claim["tolerance_kind"] == "rel"
-        if claim["check"] == "value" and relative and math.isfinite(outcome.rel_deviation):
-            return float(outcome.ratio), (f"{outcome.rel_deviation:.1%} off the paper, tolerance "
-                                          f"{tolerance_text(claim)}")
-        if claim["check"] == "threshold":
-            return float(outcome.ratio), (f"switch {format_number(outcome.abs_deviation)} {unit} from the "
-                                          f"paper's {claim['paper_value']} {unit}, tolerance "
-                                          f"{tolerance_text(claim)}")
-        if claim["check"] == "trend":
-            return float(outcome.ratio), (f"{outcome.ratio:.2f} of the allowance {tolerance_text(claim)} "
-                                          f"({outcome.detail})")
-        if claim["check"] == "value":
-            return float(outcome.ratio), (f"off by {format_number(outcome.abs_deviation)} {unit}, tolerance "
-                                          f"{tolerance_text(claim)}")
-        return float(outcome.ratio), (f"|{' − '.join(compared_names(claim))}| is {outcome.ratio:.2f} of the "
-                                      f"tolerance {tolerance_text(claim)}")
+    unit, ratio = claim["unit"], float(outcome.ratio)
+    if claim["check"] == "value":
+        if claim["tolerance_kind"] == "rel" and math.isfinite(outcome.rel_deviation):
+            return ratio, f"{outcome.rel_deviation:.1%} off the paper, tolerance {tolerance_text(claim)}"
+        return ratio, (f"off by {format_number(outcome.abs_deviation)} {unit}, tolerance "
+                       f"{tolerance_text(claim)}")
+    if claim["check"] == "threshold" and math.isfinite(outcome.abs_deviation):
+        return ratio, (f"switch {outcome.text}: {format_number(outcome.abs_deviation)} {unit} from the "
+                       f"paper's {claim['paper_value']} {unit}, tolerance {tolerance_text(claim)}")
+    if claim["check"] == "trend" and math.isfinite(ratio):
+        return ratio, f"{ratio:.2f} times the allowance {tolerance_text(claim)} ({outcome.detail})"
+    if math.isfinite(ratio):
+        return ratio, (f"|{' − '.join(compared_names(claim))}| is {ratio:.2f} times the tolerance "
+                       f"{tolerance_text(claim)}")
     if not math.isfinite(outcome.score):
         return math.nan, "—"
     return float(outcome.score), outcome.detail

@@ -205,7 +205,9 @@ STATUS_COLOURS = {
 
 def _ours_vs_paper(row) -> str:
     """Our value at the held-out reading against the paper's, in one cell."""
-    return f"{row.ours_text} (paper: {row.paper})" if row.ours_text != "—" else f"— (paper: {row.paper})"
+    if "the paper's" in row.ours_text:  # a value check names the paper's number itself
+        return row.ours_text
+    return f"{row.ours_text}; paper: {row.paper}"
 
 
 def _short(text: str, limit: int = 160) -> str:
@@ -260,6 +262,11 @@ def styled(evaluated: pd.DataFrame, *, links: bool = False, grid: str = ""):
     return styler.set_caption(grid) if grid else styler
 
 
+def _state_verb(state: str) -> str:
+    """A state as a verb phrase: ``holds``, ``fails``, ``is undecided``."""
+    return {"holds": "holds", "fails": "fails", "inconclusive": "is undecided"}.get(state, "is not evaluated")
+
+
 def _details_block(row, claim, heading: str, members: tuple = ()) -> str:
     """One claim's (or study's) collapsed block: quote, verdict, flags, evidence, reason, configuration."""
     section, check = _section_text(claim), _check_text(claim)
@@ -276,8 +283,8 @@ def _details_block(row, claim, heading: str, members: tuple = ()) -> str:
     lines += [f"*Verdict (computed):* {_md_escape(row.verdict)}.", ""]
     if row.readings:
         lines += [f"*Judged at:* {_md_escape(row.held_out_reading)} (its held-out reading), where it "
-                  f"{row.held_out_state.replace('inconclusive', 'is undecided')}; at the in-sample joint "
-                  f"reading it is {row.joint_state}. *Readings:* {readings_count(row)}.", ""]
+                  f"{_state_verb(row.held_out_state)}; at the in-sample joint reading it "
+                  f"{_state_verb(row.joint_state)}. *Readings:* {readings_count(row)}.", ""]
     if members:
         lines += [f"*Family:* counted once with the rows implied by it, as one claim that holds only if "
                   f"every member holds: {_md_escape(', '.join(members))}.", ""]
