@@ -234,8 +234,7 @@ def load_claims(path=None) -> pd.DataFrame:
         if lead and (target or lead == row["id"] or lead not in leads):
             errors.append(f"row {row['id']!r}: implied_by = {lead!r} is not allowed: must name another claim "
                           "of this file that is neither a study nor implied by a third, and a study is "
-                          "implied "
-                          "by none")
+                          "implied by none")
     if errors:
         raise ValueError(f"{path.name} has {len(errors)} schema error(s):\n  " + "\n  ".join(errors))
     claims["paper_value_num"] = pd.to_numeric(claims["paper_value"].replace("", np.nan))

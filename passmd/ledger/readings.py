@@ -85,8 +85,7 @@ SECTIONS: dict[str, Section] = {
         Section("4.1", "Section 4.1", "critical amplitude, Figs. 5–6", SECTION4_1_TABLES),
         Section("4.2", "Section 4.2", "force generation, Fig. 7", FORCE_TABLES,
                 stated=(("friction_coefficient", 0.2, "it was found in the experiment work of Lübke [24] "
-                         "that "
-                         "the friction coefficient is equal to 0.2. Thus, this value was used for the "
+                         "that the friction coefficient is equal to 0.2. Thus, this value was used for the "
                          "simulations"),)),
         Section("5", "Section 5", "driving waveform, Figs. 8–10", SECTION5_TABLES),
     )
@@ -181,8 +180,7 @@ AXES: dict[str, Axis] = {
             "neither is Eq. 15, whose t_s = 1/(2 f_s) does not fit the period of Tables 1–2's drive above a "
             "few kHz",
             source="Section 5.2 says only that above 110 kHz there is 'not enough time for settling'; a "
-            "claim "
-            "decided only where Eq. 15 does not fit says so",
+            "claim decided only where Eq. 15 does not fit says so",
             tables=VELOCITY_TABLES,
             only=("waveform", "optimized"),
             assumption_key="optimized_short_period",
@@ -195,8 +193,7 @@ AXES: dict[str, Axis] = {
             unit="",
             plausible_range="0.005–0.5 (a decade either side of a lightly damped piezo stack, Q = 10)",
             source="Table 2's viscosity column c_p is lost in the available text; the paper states it once "
-            "for "
-            "every run of flexible actuators (Sections 4.1 and 4.2), so it is one unknown for both",
+            "for every run of flexible actuators (Sections 4.1 and 4.2), so it is one unknown for both",
             tables=(*SECTION4_1_TABLES, *FORCE_TABLES),
             only=("actuator_model", "flexible"),
             assumption_key="actuator_viscosity",
@@ -254,8 +251,7 @@ def section_of(claim: Mapping) -> str:
     found = [s.key for s in SECTIONS.values() if keys & set(s.tables)]
     if len(found) > 1:
         raise ValueError(f"claim {claim['id']!r} reads the tables of {' and '.join(found)}: a claim reads "
-                         "the "
-                         "runs of one section")
+                         "the runs of one section")
     return found[0] if found else ""
 
 

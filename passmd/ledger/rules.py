@@ -37,13 +37,12 @@ RULES = (
     ("Held-out judging", HELD_OUT + " A section's unstated inputs are its own: a reading of Section 5 never "
      "chooses Section 4.1's μ (passmd.ledger.readings)."),
     ("Families", "A row the paper's stronger statement implies (implied_by in claims.csv) is counted once "
-     "with "
-     "it, as one family that holds only if every member holds, fails if one fails, and votes once in the "
-     "choice of the joint reading."),
+     "with it, as one family that holds only if every member holds, fails if one fails, and votes once in "
+     "the choice of the joint reading."),
     ("Holds by construction", "A row whose check cannot fail on any result the model can produce (a "
-     "closed-form "
-     "identity, a statement every finite contact stiffness satisfies at the claim's amplitude) is shown as "
-     "holding by construction, with the reason, and never counted as reproduced; it does not vote."),
+     "closed-form identity, a statement every finite contact stiffness satisfies at the claim's amplitude) "
+     "is shown as holding by construction, with the reason, and never counted as reproduced; it does not "
+     "vote."),
     ("Ties", TIE_RULE),
     ("Claims about the experiment",
      "A claim whose object is a measurement of [12] (an agreement with it, a discrepancy from it, or "

@@ -34,7 +34,7 @@ from passmd.model import theory
 from passmd.protocols.section5 import WINDOW_SAMPLES_PER_ACCELERATION, section5_drive
 from passmd.protocols.velocity import FULL_SLIDING_SHARE
 
-__all__ = ["optimized_period_timing"]
+__all__ = ["fig8b_points", "optimized_period_timing"]
 
 
 def _fig9a_run(results, waveform: str, reading=None) -> pd.DataFrame:
@@ -110,9 +110,8 @@ def _fig8a_back_step(results, reading):
 #: A/T within a cycle of its micro-vibration, over two orders of magnitude below their sliding force.
 _RAMP_STICKS = ("the free runner of Section 5 needs, on the slow 100 Hz ramp, only the force of its inertia "
                 "(a 3 g runner brought to A/T = 20 µm/s within a cycle of its micro-vibration), over two "
-                "orders "
-                "of magnitude below the contacts' sliding force μ(2F_N1 + 4F_N2): no contact with static "
-                "friction lets it slide")
+                "orders of magnitude below the contacts' sliding force μ(2F_N1 + 4F_N2): no contact with "
+                "static friction lets it slide")
 
 
 def _first_ramp(results, reading) -> pd.DataFrame:
@@ -151,9 +150,8 @@ def _ringing(results, reading) -> pd.Series:
 #: tangential stiffness 2aG*, and the fly-back that makes the back-step (fully sliding contacts) leaves it
 #: moving: a mass on springs swings.
 _SLIP_RINGS = ("a runner on elastic contacts (tangential stiffness 2aG* per contact) that the fly-back "
-               "leaves "
-               "moving (the back-step row: every contact slides fully at 202 nm) swings at √(k/m_r): every "
-               "finite contact stiffness gives a micro-vibration after the slip phase")
+               "leaves moving (the back-step row: every contact slides fully at 202 nm) swings at "
+               "√(k/m_r): every finite contact stiffness gives a micro-vibration after the slip phase")
 
 
 @extractor("fig8a-runner-vibrates-after-slip", depends_on=_AXES, not_informative=_SLIP_RINGS)
@@ -317,16 +315,23 @@ def _fastest_at_point5_evidence(results):
             f"{(rows['time_s'].iloc[k] - acc['acceleration_end_s'].iloc[0]) * 1e6:.2f} µs after point 5"]
 
 
-@extractor("sec5-1-runner-overshoots-in-slip", depends_on=_AXES)
-def _overshoot(results, reading):
-    # Sub-phase II: from point 4 to the runner's forward extreme after point 5, the runner moves
-    # further than the hemispheres do over the same time (the acceleration Δ_a included).
+def fig8b_points(results, reading, needed: tuple[str, ...]) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Fig. 8b's numbered points (indexed by their label) and its zoomed trace (by time) at a reading's
+    μ; inconclusive when the trace or one of the ``needed`` points is missing."""
     table = at_mu(results, "fig8b", reading)
     points = table[table["view"] == "point"].set_index("point")
     points.index = points.index.astype(str)
     zoom = table[table["view"] == "zoom"].sort_values("time_us")
-    if zoom.empty or not {"4", "5"} <= set(points.index):
-        raise NotEvaluable("the Fig. 8b trace or its points 4 and 5 are missing")
+    if zoom.empty or not set(needed) <= set(points.index):
+        raise NotEvaluable(f"the Fig. 8b trace or its points {' and '.join(needed)} are missing")
+    return points, zoom
+
+
+@extractor("sec5-1-runner-overshoots-in-slip", depends_on=_AXES)
+def _overshoot(results, reading):
+    # Sub-phase II: from point 4 to the runner's forward extreme after point 5, the runner moves
+    # further than the hemispheres do over the same time (the acceleration Δ_a included).
+    points, zoom = fig8b_points(results, reading, ("4", "5"))
     after = zoom[zoom["time_us"] >= float(points.at["5", "time_us"])]
     if len(after) < 3:
         raise NotEvaluable("fewer than three trace samples after point 5")
@@ -344,17 +349,11 @@ def _backward_then_reverses(results, reading):
     # Sub-phase I: at point 2 the runner moves backward, at point 3 it starts to reverse, both within the
     # settling time t_s (before point 4). Ours: when, after the fly-back, the runner's velocity first turns
     # forward, against t_s (µs); the record's spacing is the resolution.
-    table = at_mu(results, "fig8b", reading)
-    points = table[table["view"] == "point"].set_index("point")
-    points.index = points.index.astype(str)
-    zoom = table[table["view"] == "zoom"].sort_values("time_us")
-    if zoom.empty or not {"2", "4"} <= set(points.index):
-        raise NotEvaluable("the Fig. 8b trace or its points 2 and 4 are missing")
+    points, zoom = fig8b_points(results, reading, ("2", "4"))
     v2 = float(points.at["2", "runner_velocity_m_per_s"])
     if v2 >= 0:
-        raise ClaimFails(f"the runner does not move backward after the fly-back: its slowest velocity within "
-                         "t_s "
-                         f"is {v2 * 1e3:.3g} mm/s")
+        raise ClaimFails("the runner does not move backward after the fly-back: its slowest velocity "
+                         f"within t_s is {v2 * 1e3:.3g} mm/s")
     t_s = float(points.at["4", "settling_time_s"]) * 1e6
     start = float(points.at["4", "time_us"]) - t_s
     after = zoom[zoom["time_us"] >= float(points.at["2", "time_us"])]

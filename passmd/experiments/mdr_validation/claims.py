@@ -50,6 +50,5 @@ def _mdr_reproduces(results) -> float:
 def _mdr_evidence(results) -> list:
     d = mdr_deviations(results)
     return [f"{max(VALIDATION_SPRINGS)} springs: normal force within {d['normal']:.3g} % of Hertz; "
-            "tangential "
-            f"force within {d['virgin']:.3g} % of μF_N of Cattaneo–Mindlin (virgin loading) and "
+            f"tangential force within {d['virgin']:.3g} % of μF_N of Cattaneo–Mindlin (virgin loading) and "
             f"{d['loops']:.3g} % of Masing (unloading and reloading)"]
