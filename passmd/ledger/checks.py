@@ -225,9 +225,10 @@ def check_ordering(ours, relation, tolerance=None, tolerance_kind="rel", *, unit
     The margin m is 0 without a tolerance, ``tolerance·|rhs|`` (rel) or ``tolerance`` (abs):
     ``<`` needs lhs < rhs − m, ``>`` needs lhs > rhs + m, ``approx`` needs |lhs − rhs| ≤ m. ``ours`` may
     carry ``'resolution'`` (in the values' unit, default 0) and ``'at'`` with ``'at_unit'`` (where each
-    element is, e.g. the preloads); :data:`TIE_RULE` decides elements closer than the resolution: an
+    element is, e.g. the preloads); the tie rule decides elements closer than the resolution: an
     ordering with tied elements and no failing one is undecided
-    (:class:`~passmd.ledger.tags.NotEvaluable`), an agreement counts them as holding (:data:`TIE_RULE`).
+    (:class:`~passmd.ledger.tags.NotEvaluable`), an agreement counts them as holding
+    (:data:`passmd.ledger.rules.TIE_RULE`).
     ``names`` names
     the two sides in the texts.
     """

@@ -70,8 +70,8 @@ RELATIONS = {
 }
 #: A tolerance is relative (a fraction) or absolute (in the claim's unit).
 TOLERANCE_KINDS = ("rel", "abs")
-#: Verdict classes, in the order the summary lists them (:mod:`passmd.ledger.verdicts` says when each
-#: applies): the first two are the reproduced ones; a row whose check cannot fail on any result the model
+#: Verdict classes, in the order the summary lists them (``passmd.ledger.verdicts.category`` says when
+#: each applies): the first two are the reproduced ones; a row whose check cannot fail on any result the model
 #: can produce holds *by construction* and is never counted as reproduced.
 STATUSES = ("reproduced", "reproduced under the joint reading", "holds by construction", "not reproduced",
             "inconclusive")

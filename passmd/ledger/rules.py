@@ -3,7 +3,7 @@ studies, fragile verdicts and coarse grids.
 
 The replication report quotes :data:`RULES` verbatim; the functions that apply them
 (:mod:`passmd.ledger.joint` for held-out judging and families, :mod:`passmd.ledger.checks` for ties and
-coarse grids, :mod:`passmd.ledger.claims` for studies, :mod:`passmd.ledger.verdicts` for categories and
+coarse grids, :mod:`passmd.ledger.claims` for studies, ``passmd.ledger.verdicts`` for categories and
 fragility) take their constants from here.
 """
 

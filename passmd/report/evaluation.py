@@ -250,7 +250,7 @@ def _plain(point: Mapping) -> dict:
 
 def _judgements(claims: pd.DataFrame, evaluated: Mapping, joint: Mapping, sections: Mapping,
                 studies: set) -> dict[str, Judgement]:
-    """Where each claim is judged (:class:`passmd.ledger.verdicts.Judgement`): a claim of the paper at
+    """Where each claim is judged (``passmd.ledger.verdicts.Judgement``): a claim of the paper at
     its unit's held-out point, a study at the defaults."""
     states = joint["states"]
     space, free_of = states["space"], states["free_of"]
@@ -291,7 +291,7 @@ def evaluate(
     one reading, its *held-out* reading: the point of the space where the most of the *other* claims
     hold together (:func:`passmd.ledger.joint.judge`: a row implied by another counted once with it, rows
     that cannot fail and claims about the experiment not voting). Its category
-    (:func:`passmd.ledger.verdicts.category`) comes from its state there:
+    (``passmd.ledger.verdicts.category``) comes from its state there:
 
     * ``reproduced``: it holds there and at the defaults;
     * ``reproduced under the joint reading``: it holds there, not at the defaults;
