@@ -1009,6 +1009,14 @@ def test_styled_one_line_per_claim_and_details(tmp_path):
     assert list(table.columns) == ["category", "ours vs paper", "why", "readings"]
     assert table.at["val", "ours vs paper"] == "150 nm vs the paper's 100 nm"
     assert table.at["ord", "ours vs paper"] == "2 mm/s vs 1 mm/s; paper: q"  # no 'compares': the quantity
+    # cells are HTML: a relation's '<' is escaped, never read as a tag
+    named = claims.copy()
+    named.loc[named["id"] == "ord", "compares"] = "a | b"
+    named.loc[named["id"] == "ord", "relation"] = "<"
+    module = _good_module({"val": 150.0})
+    _tag(module, "ord", lambda results: {"lhs": 2.0, "rhs": 1.0})
+    again = evaluation.evaluate(named, {"fig5a": pd.DataFrame()}, modules=[module])
+    assert "a &lt; b fails" in ledger_views.styled(again).to_html()
     assert table.at["val", "why"] == "deviation 50 % exceeds the tolerance 5 %"
     assert table.at["val", "readings"] == "holds 0, fails 1, undecided 0 of 1"
     details = ledger_views.details_markdown(evaluated, claims)

@@ -108,7 +108,7 @@ def test_the_report_leads_with_one_line_per_claim():
     if REPORT_HTML.is_file():  # in the page's body, before its first section
         raw = REPORT_HTML.read_text(encoding="utf-8")
         body = raw[raw.index('<h1>Replication report<a class="headerlink"'):]
-        assert body.index('class="passmd-ledger"') < body.index("<h2"), "the built report does not lead with it"
+        assert body.index('class="passmd-ledger"') < body.index("<h2"), "the built report leads otherwise"
 
 
 def _page_text(path: Path) -> str:

@@ -7,6 +7,7 @@ Presentation only: every function takes a table computed by :func:`passmd.report
 
 from __future__ import annotations
 
+import html
 import re
 from collections.abc import Mapping
 
@@ -215,6 +216,16 @@ def _short(text: str, limit: int = 160) -> str:
     return text if len(text) <= limit else text[:limit].rsplit(" ", 1)[0] + " …"
 
 
+def _category_text(row) -> str:
+    """A row's category with what it is counted as: with its family's lead, as a study, a closed form."""
+    text = row.status
+    if not row.counted and not row.study_of:
+        text += f" (counted with {row.family})"
+    if row.study_of:
+        text += f" (study of {row.study_of}, not counted)"
+    return text + (" (closed form)" if row.basis == "closed form" else "")
+
+
 def readings_count(row) -> str:
     """How a claim fares over all its readings: ``"holds 3, fails 20, undecided 1 of 24"``."""
     if not row.readings:
@@ -235,13 +246,11 @@ def styled(evaluated: pd.DataFrame, *, links: bool = False, grid: str = ""):
     looks for it) and wraps inside the content column.
     """
     rows = list(evaluated.itertuples())
-    shown = pd.DataFrame({
+    shown = pd.DataFrame({  # the cells are HTML: text is escaped ('<' of a relation), the links are not
         "claim": [f'<a href="#{claim_anchor(r.claim)}">{r.claim}</a>' if links else r.claim for r in rows],
-        "category": [r.status + (f" (counted with {r.family})" if not r.counted and not r.study_of else "")
-                     + (f" (study of {r.study_of}, not counted)" if r.study_of else "")
-                     + (" (closed form)" if r.basis == "closed form" else "") for r in rows],
-        "ours vs paper": [_ours_vs_paper(r) for r in rows],
-        "why": [_short(r.why) for r in rows],
+        "category": [html.escape(_category_text(r), quote=False) for r in rows],
+        "ours vs paper": [html.escape(_ours_vs_paper(r), quote=False) for r in rows],
+        "why": [html.escape(_short(r.why), quote=False) for r in rows],
         "readings": [readings_count(r) for r in rows],
     })
     statuses = evaluated["status"].to_numpy()
