@@ -307,6 +307,7 @@ def test_ledger_rows_of_fig7(quick):
         "fig7-flexible-covers-experiment", "fig7-force-depends-on-amplitude", "fig7-force-depends-on-preload",
         "study-fig7a-model-difference-115mn", "study-fig7a-model-difference-grows",
         "study-fig7b-model-difference-grows", "study-fig7-onsets-earlier-against-this-model",
+        "sec4-2-force-depends-on-radius-friction-material",
     }
     results = {k: quick[k] for k in ("fig7a", "fig7b")}
     results["fig7_readings"] = figures.fig7_readings(RunConfig(profile="quick"))

@@ -62,8 +62,8 @@ else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 __all__ = ["CONTACT_PRESETS", "DRIVE_KEYS", "EXAMPLE_DRIVE_FILE", "JOINT_READING_FILE", "REGION_KEY",
-           "SHORTEST_FLYBACK", "SHORTEST_FLYBACK_WHY", "DriveFileError", "DriveKey", "drive_toml", "load_drive",
-           "parameter_rows", "read_drive_file", "region_values", "resolve"]
+           "SHORTEST_FLYBACK", "SHORTEST_FLYBACK_WHY", "DriveFileError", "DriveKey", "drive_toml",
+           "load_drive", "parameter_rows", "read_drive_file", "region_values", "resolve"]
 
 
 class DriveFileError(InputError):
