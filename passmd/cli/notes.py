@@ -12,10 +12,11 @@ __all__ = ["diagnosis_rows", "eq15_rows", "hz", "missing_rows", "resolution", "r
 def hz(frequency: float, *, down: bool = False) -> str:
     """A frequency as a reader writes it: ``100 Hz``, ``4.908 kHz``; ``down``: rounded down to its
     four digits (an upper limit, which typed back must stay within it)."""
+    from passmd.runtime.units import round_down
+
     value, unit = (frequency, "Hz") if frequency < 1e3 else (frequency / 1e3, "kHz")
-    if down and value > 0 and math.isfinite(value):
-        step = 10.0 ** (math.floor(math.log10(value)) - 3)
-        value = math.floor(value / step * (1 + 1e-12)) * step
+    if down:
+        value = round_down(value, 4)
     return f"{value:.4g} {unit}"
 
 

@@ -34,6 +34,7 @@ __all__ = [
     "parse_quantities",
     "parse_quantity",
     "registry",
+    "round_down",
     "si_factor",
     "to_display",
 ]
@@ -118,6 +119,15 @@ class QuantityError(ValueError):
 
 
 @functools.lru_cache(maxsize=1)
+def round_down(value: float, digits: int = 4) -> float:
+    """``value`` rounded down to ``digits`` significant digits: how an upper limit is printed, so that
+    the printed number, typed back, stays within the limit (``passmd run``'s "Eq. 15 fits up to")."""
+    if not (value > 0 and math.isfinite(value)):
+        return value
+    step = 10.0 ** (math.floor(math.log10(value)) - (digits - 1))
+    return math.floor(value / step * (1 + 1e-12)) * step
+
+
 def registry() -> pint.UnitRegistry:  # noqa: F821 - pint is imported on first use
     """The package's unit registry (built once, on first use; building it takes a fraction of a second)."""
     import pint

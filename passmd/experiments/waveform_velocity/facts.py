@@ -18,6 +18,7 @@ from passmd.experiments.waveform_velocity.figures import (
 )
 from passmd.model import waveforms
 from passmd.model.parameters import Drive
+from passmd.runtime.units import round_down
 
 
 def startup_facts(fig9b_data: pd.DataFrame, frequency: float = PAPER_MAXIMUM_KHZ * 1e3) -> dict:
@@ -50,7 +51,8 @@ def fig9b_facts(fig9b_data: pd.DataFrame, design: pd.Series, drive: Drive) -> di
     below, above = grid[grid < at], grid[grid > at]
     either = [f"{side / 1e3:g} kHz" for side in (below.max() if below.size else None,
                                                    above.min() if above.size else None) if side is not None]
-    return {"fit_limit_kHz": eq15_fit_limit(design, drive) / 1e3, "t_s_room_us": t_s_max * 1e6,
+    # an upper limit, printed as the command line prints it: rounded down to its four digits
+    return {"fit_limit_kHz": round_down(eq15_fit_limit(design, drive) / 1e3, 4), "t_s_room_us": t_s_max * 1e6,
             "skip_gain_where": (f"at the grid point {at / 1e3:g} kHz, between {' and '.join(either)}"
                                 if len(either) == 2 else f"at {at / 1e3:g} kHz, the grid's edge"),
             # "within" this many per cent: rounded up
