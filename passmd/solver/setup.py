@@ -69,6 +69,8 @@ class Steps(NamedTuple):
     quiet: float  # step once the ringing has decayed: the quasi-static (first controlled) or coarse one
     controlled: bool  # error-controlled steps (rigid actuators; flexible ones while quasi-static)
     longest: float | None  # longest error-controlled step (None without error control)
+    newton_balance: bool  # Scheme.newton_balance
+    smooth_breakpoints: bool  # Scheme.smooth_breakpoints
 
 
 def scheme_steps(drive: Drive, plan: StepPlan, scheme: Scheme) -> Steps:
@@ -92,5 +94,6 @@ def scheme_steps(drive: Drive, plan: StepPlan, scheme: Scheme) -> Steps:
     quasi_static = scheme.quiet_step == "quasi-static" and drive.actuator_model == "flexible"
     quiet = plan.quasi_step if quasi_static else coarse
     controlled = scheme.error_control
-    return Steps(fine, coarse, quasi_static, quiet, controlled, plan.longest_step if controlled else None)
+    return Steps(fine, coarse, quasi_static, quiet, controlled, plan.longest_step if controlled else None,
+                 scheme.newton_balance, scheme.smooth_breakpoints)
 

@@ -92,7 +92,7 @@ def simulate(drive: Drive, waveform: Waveform, **options) -> SimulationResult:
 
     A :class:`Simulation` run through all periods at once: ``options`` are its keyword
     arguments (``contact_model``, ``springs``, ``scheme``, ``max_points``,
-    ``share_side_state``, ``progress``; documented there), e.g.
+    ``share_side_state``, ``energy``, ``progress``; documented there), e.g.
     ``simulate(drive, waveform, scheme="fixed")``.
 
     Raises
@@ -133,10 +133,12 @@ class Simulation:
         Exact continuum MDR contact (default) or ``springs`` discrete MDR springs.
     springs : int
         Number of MDR springs for the discrete model.
-    scheme : {"controlled", "adaptive", "quasi-static", "fixed"} or Scheme
+    scheme : {"controlled", "reference", "adaptive", "quasi-static", "fixed"} or Scheme
         Integration scheme (:data:`passmd.solver.steps.SCHEMES`). "controlled" (default):
         error-controlled steps for rigid actuators, and for flexible ones once their ringing
-        after a corner of x_p(t) has decayed (quasi-static actuator); "adaptive": explicit
+        after a corner of x_p(t) has decayed (quasi-static actuator); "reference": the same
+        error control with bracketed balance solves and a fresh start at every breakpoint of
+        x_p(t) (the integrator the default is tested against); "adaptive": explicit
         Verlet, fine while flexible actuators ring and coarse after; "quasi-static": the
         quasi-static actuator at a fixed runner step after the ringing; "fixed": the fine step
         throughout. A :class:`passmd.solver.steps.Scheme` refines one
@@ -147,6 +149,11 @@ class Simulation:
         Number of recorded samples (evenly spaced in time).
     share_side_state : bool
         Six contacts: one state per side (default) or six independent contacts.
+    energy : bool
+        Accumulate the terms of the energy balance (``SimulationResult.energy``,
+        :meth:`~passmd.solver.results.SimulationResult.energy_balance`). Off by default: they never
+        feed back into the motion, and their quadrature costs about a fifth of an error-controlled
+        run.
     progress : bool or "long", optional
         Progress on stderr (:mod:`passmd.runtime.progress`). Default: for runs of more than
         :data:`PROGRESS_MIN_WORK` (expected steps, a discrete contact's springs counted,
@@ -171,6 +178,7 @@ class Simulation:
         scheme: str | Scheme = DEFAULT_SCHEME,
         max_points: int = 20000,
         share_side_state: bool = True,
+        energy: bool = False,
         progress: bool | None = None,
     ):
         if not isinstance(drive, Drive):
@@ -181,6 +189,8 @@ class Simulation:
         scheme = resolve_scheme(scheme)
         if int(max_points) != max_points or max_points < 2:
             raise ValueError(f"max_points = {max_points!r} is out of range: must be an integer >= 2")
+        if not isinstance(energy, bool):
+            raise ValueError(f"energy = {energy!r} is not allowed: must be True or False")
         if not (progress is None or isinstance(progress, bool) or (isinstance(progress, str)
                                                                   and progress == "long")):
             raise ValueError(f"progress = {progress!r} is not allowed: must be True, False, None or 'long'")
@@ -221,7 +231,11 @@ class Simulation:
             plan.activity_threshold, plan.quiet_steps, steps.quasi_static,
             waveform.duration / (max_points - 1),
             LOCAL_ERROR_TOLERANCE / scheme.refine**4 if steps.controlled else 0.0,
+            steps.newton_balance,
+            steps.smooth_breakpoints,
+            energy,
         )
+        self._energy = energy
         sliding = np.array([sliding_force(params[g]) for g in range(G)])
         self._contacts = kernels.Contacts(params, state, sliding)
         self.periods_done = 0
@@ -307,7 +321,7 @@ class Simulation:
             waveform=self.leading_periods(self.periods_done),
             contact_model=self.contact_model,
             multiplicity=self._multiplicity,
-            **measures(self._buffers, self.periods_done, n_rec),
+            **measures(self._buffers, self.periods_done, n_rec, self._energy),
             steps=int(steps),
             fine_steps=int(fine_steps),
             fine_step=float(self._fine_step),

@@ -93,6 +93,16 @@ class Scheme:
         a local error estimate of the runner's position (:data:`LOCAL_ERROR_TOLERANCE`), with
         the runner's linear oscillation on its contacts integrated exactly (see
         :mod:`passmd.solver.kernels`). Without it rigid actuators take the fine step.
+    newton_balance : bool
+        (quasi-static actuators) Each actuator's force balance by a Newton step on the exact
+        contact's slope, accepted where its error is provably below the solve's tolerance
+        (:func:`passmd.solver.kernels.quasi_static_position` otherwise), and the trigonometric
+        coefficients of the error-controlled step by their series: the same solution to the
+        tolerance, at about half the arithmetic.
+    smooth_breakpoints : bool
+        The step control goes on across a breakpoint of x_p(t) where its rate does not change
+        (the settle window's start on a saw-tooth ramp) instead of starting afresh with the fine
+        step.
     refine : float
         Divides every step (convergence studies); under error control it divides the
         tolerance by the fourth power of ``refine`` instead (the controlled step scales as its fourth root).
@@ -106,6 +116,8 @@ class Scheme:
     error_control: bool
     refine: float = 1.0
     dt: float | None = None
+    newton_balance: bool = False
+    smooth_breakpoints: bool = False
 
     def __post_init__(self):
         check_choice("quiet_step", self.quiet_step, QUIET_STEPS)
@@ -130,7 +142,10 @@ class Scheme:
 #: The schemes by name (``simulate(..., scheme=name)``); "controlled" is the default.
 SCHEMES = {
     # error-controlled steps: rigid actuators throughout, flexible ones once quasi-static
-    "controlled": Scheme("controlled", "quasi-static", True),
+    "controlled": Scheme("controlled", "quasi-static", True, newton_balance=True, smooth_breakpoints=True),
+    # the same error control with bracketed balance solves and every breakpoint starting afresh: the
+    # scheme the default is tested against (tests/test_reference_scheme.py)
+    "reference": Scheme("reference", "quasi-static", True),
     # explicit adaptive Verlet: fine while flexible actuators ring, coarse after; rigid: fine
     "adaptive": Scheme("adaptive", "coarse", False),
     # fine while flexible actuators ring, then the quasi-static actuator at a fixed runner step
