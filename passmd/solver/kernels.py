@@ -410,10 +410,8 @@ def _save_position(carry, segment, mid, t, x_p, a_r, F, next_rec, track, n_rec, 
 @njit(inline="always", **KERNEL_OPTIONS)
 def _note_peak(peak, track, g, force, sliding_force):
     """Keep the largest |T_g|/μF_N since the tracked period's slip mark (no period tracked: track < 0)."""
-    if track >= 0:
-        ratio = abs(force) / sliding_force
-        if ratio > peak[track, g]:
-            peak[track, g] = ratio
+    if track >= 0 and abs(force) > peak[track, g] * sliding_force:  # (no division on every step)
+        peak[track, g] = abs(force) / sliding_force
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
@@ -808,15 +806,15 @@ def _quasi_kick(mechanics, rows, x_p, xp_new, v_r, vp, dt, K, inv_dt, inv_ma, si
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
-def _actuator_kick(mechanics, rows, x_p, xp_new, dt, gam, inv_ma, acc_damp, acc_in, energy):
-    """Velocity Verlet kick of flexible actuators (damping trapezoidal, implicit in v) and, with
-    ``energy``, its damping and input work. Returns (largest |ẍ_a|, acc_damp, acc_in)."""
+def _actuator_kick(mechanics, rows, x_p, xp_new, dt, gam, inv_ma, acc_damp, acc_in, energy, damp):
+    """Velocity Verlet kick of flexible actuators (damping trapezoidal, implicit in v; ``damp`` =
+    1/(1 + γ dt/2)) and, with ``energy``, its damping and input work. Returns (largest |ẍ_a|,
+    acc_damp, acc_in)."""
     multiplicity = mechanics.multiplicity
     actuator_stiffness = mechanics.actuator_stiffness
     half_kp = 0.5 * actuator_stiffness
     half_cp = 0.5 * mechanics.actuator_viscosity
     x_a, v_a, T, a_nd, stretch_old = rows[0], rows[1], rows[2], rows[4], rows[5]
-    damp = 1.0 / (1.0 + 0.5 * dt * gam)
     activity = 0.0
     for g in range(multiplicity.shape[0]):
         a_new = (actuator_stiffness * (xp_new - x_a[g]) - T[g]) * inv_ma
@@ -1049,6 +1047,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     actuator_mass, actuator_viscosity, linear_stiffness = mechanics[4], mechanics[6], mechanics[7]
     omega2, omega, beta = _linear_mode(linear_stiffness, load_stiffness, runner_mass)
     inv_omega = 1.0 / omega if omega > 0.0 else 0.0
+    dt_damp = damp = -1.0
     dt_trig = -1.0
     trig = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     y0 = w0 = ag0 = xp_mid = xr_mid = vr_mid = F_mid = 0.0  # drift terms and mid-step nodes
@@ -1170,8 +1169,11 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                     controlled = False
                     quiet = 0
             elif not rigid:
+                if dt != dt_damp:  # (the fine step repeats: its damping factor is kept)
+                    dt_damp = dt
+                    damp = 1.0 / (1.0 + 0.5 * dt * gam)
                 activity, acc_damp, acc_in = _actuator_kick(mechanics, rows, x_p, xp_new, dt, gam, inv_ma,
-                                                            acc_damp, acc_in, track_energy)
+                                                            acc_damp, acc_in, track_energy, damp)
                 if adaptive:
                     fine, quasi, controlled, quiet, dt_ctrl, g_rate, h_prev = _adapt(
                         activity, activity_threshold, quiet_steps, quasi_static, control_on, fine, quasi,
