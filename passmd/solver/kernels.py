@@ -292,7 +292,7 @@ def _newton_position(params, state, g, x_r, center, K, S, guess, guess_slope, to
 
 
 def integrate(segments: Segments, mechanics: Mechanics, control: StepControl, contacts: Contacts,
-              buffers: Buffers, step_limit: int):
+              buffers: Buffers, step_limit: int, checked: bool = False):
     """Check the kernel's arguments, then integrate over the segments (:func:`_integrate`).
 
     Returns (status, steps done, rows recorded, fine steps).
@@ -333,13 +333,21 @@ def integrate(segments: Segments, mechanics: Mechanics, control: StepControl, co
     ``segments.longest``; rigid actuators carry the step from piece to piece. Rejected steps count
     in ``steps`` (and in ``carry[C_REJECTED]``).
 
+    ``checked``: the caller has passed these arrays, or leading slices of them (the first pieces
+    of ``segments`` and the first periods of ``buffers.per`` and ``buffers.peak``), through
+    :func:`check_arguments` already (:class:`passmd.solver.simulation.Simulation` does, once per
+    run: the checks cost more than a short call into the loop).
+
     Raises
     ------
     ValueError
         An argument of the wrong type, dtype or shape, naming it: the compiled loop does
         no bounds checks, so a wrong shape would read or write outside an array.
     """
-    _check_arguments(segments, mechanics, control, contacts, buffers, step_limit)
+    if not checked:
+        check_arguments(segments, mechanics, control, contacts, buffers)
+    if int(step_limit) != step_limit or step_limit < 0:
+        raise ValueError(f"step_limit = {step_limit!r} is out of range: must be an integer >= 0")
     return _integrate(segments, mechanics, control, contacts, buffers, int(step_limit))
 
 
@@ -354,7 +362,7 @@ def _check_array(name, value, shape, dtype=np.float64):
         raise ValueError(f"{name} has shape {value.shape}, must be {wanted}")
 
 
-def _check_arguments(segments, mechanics, control, contacts, buffers, step_limit):
+def check_arguments(segments, mechanics, control, contacts, buffers):
     """Types and shapes of :func:`integrate`'s arguments (ValueError naming the first bad one)."""
     for name, value, kind in (("segments", segments, Segments), ("mechanics", mechanics, Mechanics),
                               ("control", control, StepControl), ("contacts", contacts, Contacts),
@@ -384,8 +392,6 @@ def _check_arguments(segments, mechanics, control, contacts, buffers, step_limit
     _check_array("buffers.energy", buffers.energy, (EN_COLUMNS,))
     if buffers.record.shape[0] < 1:
         raise ValueError("buffers.record must have at least one row")
-    if int(step_limit) != step_limit or step_limit < 0:
-        raise ValueError(f"step_limit = {step_limit!r} is out of range: must be an integer >= 0")
 
 
 @njit(inline="always", **KERNEL_OPTIONS)

@@ -176,18 +176,24 @@ class SimulationResult:
         return pd.DataFrame(data)
 
 
+def settled_positions(per: np.ndarray) -> np.ndarray:
+    """Settled position of each period from its per-period accumulators (``Buffers.per`` rows): the
+    mean of x_r − x_p over its settle window plus x_p at the window's end."""
+    window_len = per[:, kernels.PER_WINDOW_LENGTH]
+    if np.any(window_len <= 0):
+        raise SimulationError(
+            "a period has an empty settle window; the waveform's phase marks are inconsistent"
+        )
+    return per[:, kernels.PER_WINDOW_INTEGRAL] / window_len + per[:, kernels.PER_WINDOW_END_XP]
+
+
 def measures(buffers: kernels.Buffers, periods: int, n_rec: int, energy: bool = True) -> dict:
     """The recorded series, measures of the first ``periods`` periods, energies (``energy``: the
     run accumulated them; else None) and state of a run stopped after them (fields of
     :class:`SimulationResult`)."""
     per, terms = buffers.per[:periods], buffers.energy
     rec = buffers.record[:n_rec]
-    window_len = per[:, kernels.PER_WINDOW_LENGTH]
-    if np.any(window_len <= 0):
-        raise SimulationError(
-            "a period has an empty settle window; the waveform's phase marks are inconsistent"
-        )
-    settled = per[:, kernels.PER_WINDOW_INTEGRAL] / window_len + per[:, kernels.PER_WINDOW_END_XP]
+    settled = settled_positions(per)
     duration = per[:, kernels.PER_DURATION]
     return dict(
         time=rec[:, 0].copy(),

@@ -8,6 +8,7 @@ and the steps a :class:`passmd.solver.steps.Scheme` takes on a drive
 
 from __future__ import annotations
 
+import functools
 from typing import NamedTuple
 
 import numpy as np
@@ -42,8 +43,17 @@ def contact_groups(drive: Drive, share_side_state: bool = True):
 
 
 def contact_rows(drive: Drive, contact_model: str, springs: int, share_side_state: bool):
-    """Contact parameters and state of every group (:func:`passmd.model.contact.stack_contacts`) and
-    the groups' multiplicities (:func:`contact_groups`)."""
+    """Contact parameters and (virgin) state of every group
+    (:func:`passmd.model.contact.stack_contacts`) and the groups' multiplicities
+    (:func:`contact_groups`): new arrays on every call, the parameters computed once per drive."""
+    params, state, multiplicity = _contact_parameters(drive, contact_model, springs, share_side_state)
+    return params.copy(), state.copy(), multiplicity.copy()
+
+
+@functools.lru_cache(maxsize=256)
+def _contact_parameters(drive: Drive, contact_model: str, springs: int, share_side_state: bool):
+    """:func:`contact_rows` of the drives last used (a sweep or a fit simulates each drive many
+    times); the caller copies them."""
     forces, multiplicity, radii = _groups(drive, share_side_state)
     discrete = springs if contact_model == "discrete" else None
     rows = [drive_contact_arrays(drive, F, R, discrete) for F, R in zip(forces, radii, strict=True)]
