@@ -10,7 +10,8 @@ from matplotlib.ticker import NullLocator
 
 from passmd.solver.steps import CONVERGED_ACCURACY
 
-__all__ = ["CONVERGED_STEP_NM", "STEP_CONTROL_STYLES", "plot_convergence", "plot_coulomb_limit"]
+__all__ = ["CONVERGED_STEP_NM", "STEP_CONTROL_STYLES", "plot_convergence", "plot_coulomb_limit",
+           "plot_scaling"]
 
 #: Position error drawn as the convergence target (:data:`passmd.solver.steps.CONVERGED_ACCURACY`) (nm).
 CONVERGED_STEP_NM = CONVERGED_ACCURACY * 1e9
@@ -70,4 +71,44 @@ def plot_coulomb_limit(df: pd.DataFrame):
     ax.set_xlabel("factor k on the contact moduli E*, G*")
     ax.set_ylabel("|simulated step − Coulomb step| (nm)")
     ax.legend(fontsize=7)
+    return fig
+
+
+def plot_scaling(data: dict):
+    """The stored scaling measurement (``benchmarks/bench_scaling.py``): cost per 100 Hz period against
+    the contact states integrated, CPU time per simulated millisecond against the drive frequency (with
+    the share of fine steps), and a cold sweep's wall time against its points."""
+    fig, (ax1, ax2, ax3) = plt.subplots(1, 3, figsize=(10.5, 3.4))
+    contacts = pd.DataFrame(data["contacts"])
+    for shared, style, label in ((False, "o-", "one state per contact"), (True, "s--", "one state per side")):
+        rows = contacts[contacts["shared_side_state"] == shared]
+        ax1.plot(rows["contact_states"], rows["ms_per_100Hz_period"], style, label=label)
+        for _, r in rows.iterrows():
+            ax1.annotate(f"{int(r['contacts'])}", (r["contact_states"], r["ms_per_100Hz_period"]),
+                         textcoords="offset points", xytext=(4, -10 if shared else 4), fontsize=7)
+    ax1.set_xlabel("contact states integrated")
+    ax1.set_ylabel("CPU ms per 100 Hz period")
+    ax1.set_title("(a) contacts (labels: contacts)", fontsize=9)
+    ax1.legend(fontsize=7)
+    freq = pd.DataFrame(data["frequency"])
+    ax2.loglog(freq["frequency_Hz"], freq["ms_per_simulated_ms"], "o-", label="CPU ms per simulated ms")
+    ax2.set_xlabel("drive frequency (Hz)")
+    ax2.set_ylabel("CPU ms per simulated ms")
+    ax2.set_title("(b) frequency, six contacts", fontsize=9)
+    twin = ax2.twinx()
+    twin.semilogx(freq["frequency_Hz"], 100 * freq["fine_share"], "x:", color="C1", label="fine steps (%)")
+    twin.set_ylabel("fine steps (% of steps)", color="C1")
+    twin.set_ylim(0, 105)
+    sweep = data["sweep"]
+    points = np.asarray(sweep["points"], float)
+    ax3.plot(points, sweep["wall_s"], "o", label="measured")
+    ax3.plot(points, sweep["start_s"] + sweep["s_per_point"] * points, "k:",
+             label=f"{1e3 * sweep['s_per_point']:.1f} ms/point + {sweep['start_s']:.2f} s")
+    ax3.set_xlabel("sweep points (cold cache)")
+    ax3.set_ylabel("wall time (s)")
+    ax3.set_title(f"(c) settled steps, {sweep['workers']} workers", fontsize=9)
+    ax3.legend(fontsize=7)
+    fig.suptitle("stored measurement: benchmarks/bench_scaling.py (passmd/data/benchmarks/scaling.json)",
+                 fontsize=8)
+    fig.tight_layout()
     return fig
