@@ -50,7 +50,7 @@ def contact_rows(drive: Drive, contact_model: str, springs: int, share_side_stat
     return params.copy(), state.copy(), multiplicity.copy()
 
 
-@functools.lru_cache(maxsize=256)
+@functools.lru_cache(maxsize=32)
 def _contact_parameters(drive: Drive, contact_model: str, springs: int, share_side_state: bool):
     """:func:`contact_rows` of the drives last used (a sweep or a fit simulates each drive many
     times); the caller copies them."""

@@ -355,6 +355,8 @@ def scaling_facts(data: dict) -> dict:
     per_state = np.polyfit(own["contact_states"], own["ns_per_step"], 1)
     freq = pd.DataFrame(data["frequency"]).set_index("frequency_Hz")
     out = {f"scale_{n}_ms": float(own.loc[n, "ms_per_100Hz_period"]) for n in own.index}
+    shared = contacts[contacts["shared_side_state"]].set_index("contacts")
+    out.update({f"scale_{n}_shared_ms": float(shared.loc[n, "ms_per_100Hz_period"]) for n in shared.index})
     out.update({"scale_ns_per_state": float(per_state[0]), "scale_ns_base": float(per_state[1]),
                 "scale_f_low_Hz": float(freq.index.min()), "scale_f_high_kHz": float(freq.index.max()) / 1e3,
                 "scale_low_ms_per_ms": float(freq["ms_per_simulated_ms"].iloc[0]),
