@@ -3,12 +3,12 @@
 Runs the command in a subprocess with an empty temporary simulation cache (numba's compiled
 kernels stay warm: they are cached next to the package, not in the simulation cache), and records
 its wall time against the budget :data:`BUDGET_S`, the CPU time of the command and its sweep
-workers, the largest resident set of one of them (against :data:`MEMORY_BUDGET_MB`; this script's
-own processes are smaller), how many sweep points it computed, the machine's core count and its
-load average just before and after (the machine may be shared: a load above the core count
-stretches the wall time), the size of the assumption space it evaluated (points, covered,
-decided), the joint reading and the headline counts. Each run is appended to ``--out`` (a JSON
-list), which the book's execution statistics show.
+workers, the largest resident set of one of them (against :data:`MEMORY_BUDGET_MB`), how many
+sweep points it computed, the machine's core count and its load average just before and after (the
+machine may be shared: a load above the core count stretches the wall time), the size of the
+assumption space it evaluated (points, covered, decided), the joint reading and the headline
+counts. Each run is appended to ``--out`` (a JSON list), which the book's execution statistics
+show.
 
 Usage (one command, from the repository root)::
 
