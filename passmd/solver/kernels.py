@@ -623,44 +623,13 @@ def _quasi_midpoint(mechanics, contacts, rows, g, balance_terms, x_r, nodes, qua
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
-def _quasi_balance(mechanics, contacts, rows, x_p, xp_new, x_r, xr_old, dt, simpson, nodes):
+def _quasi_balance(mechanics, contacts, rows, x_p, xp_new, x_r, xr_old, dt, simpson, nodes, newton):
     """Drift of quasi-static actuators: each group's force balance solved at the step's end
-    (:func:`quasi_static_position`, backward Euler in the damping term), and with ``simpson``
-    its mid-step node (:func:`_quasi_midpoint`). Returns (K = k_p + c_p/dt, 1/dt, Σ n_g T_g at
-    the balance, and the start and mid-step quadrature terms of input, damping and contact)."""
-    multiplicity = mechanics.multiplicity
-    actuator_stiffness = mechanics.actuator_stiffness
-    params, state, sliding = contacts
-    x_a, T, stretch_old, xa_old, slope = rows[0], rows[2], rows[5], rows[6], rows[7]
-    inv_dt = 1.0 / dt
-    c_dt = mechanics.actuator_viscosity * inv_dt
-    K = actuator_stiffness + c_dt
-    c_half = 2.0 * c_dt  # (the balance over half the step)
-    K_half = actuator_stiffness + c_half
-    inv_K_half = 1.0 / K_half
-    F_trial = 0.0  # Σ n_g T_g at the solved balance, T_g = K (center − x_a,g)
-    quad = (0.0, 0.0, 0.0)
-    for g in range(multiplicity.shape[0]):
-        stretch_old[g] = x_p - x_a[g]
-        xa_old[g] = x_a[g]
-        center = (actuator_stiffness * xp_new + c_dt * x_a[g]) / K
-        # Newton predictor from the last solution: T moves by k_t Δu, k_t = slope − K
-        sg = max(slope[g], K)
-        guess = x_a[g] + (K * (center - x_a[g]) - T[g] - (sg - K) * (xr_old - x_r)) / sg
-        x_a[g], slope[g] = quasi_static_position(
-            params, state, g, x_r, center, K, sliding[g], guess, sg, QUASI_TOLERANCE * sliding[g] / K,
-        )
-        F_trial += multiplicity[g] * K * (center - x_a[g])
-        if simpson:
-            terms = (K, K_half, c_half, inv_K_half, inv_dt, center, dt)
-            quad = _quasi_midpoint(mechanics, contacts, rows, g, terms, x_r, nodes, quad)
-    return K, inv_dt, F_trial, quad[0], quad[1], quad[2]
-
-
-@njit(inline="always", **KERNEL_OPTIONS)
-def _newton_balance(mechanics, contacts, rows, x_p, xp_new, x_r, xr_old, dt, simpson, nodes):
-    """:func:`_quasi_balance` with each balance by a Newton step on the contact's exact slope
-    (:func:`_newton_position`) and one reciprocal of K instead of divisions by it."""
+    (:func:`quasi_static_position`, backward Euler in the damping term; with ``newton`` by a Newton
+    step on the contact's exact slope, :func:`_newton_position`, and one reciprocal of K instead of
+    divisions by it), and with ``simpson`` its mid-step node (:func:`_quasi_midpoint`). Returns
+    (K = k_p + c_p/dt, 1/dt, Σ n_g T_g at the balance, and the start and mid-step quadrature terms
+    of input, damping and contact)."""
     multiplicity = mechanics.multiplicity
     actuator_stiffness = mechanics.actuator_stiffness
     params, state, sliding = contacts
@@ -677,12 +646,18 @@ def _newton_balance(mechanics, contacts, rows, x_p, xp_new, x_r, xr_old, dt, sim
     for g in range(multiplicity.shape[0]):
         stretch_old[g] = x_p - x_a[g]
         xa_old[g] = x_a[g]
-        center = (actuator_stiffness * xp_new + c_dt * x_a[g]) * inv_K
+        pull = actuator_stiffness * xp_new + c_dt * x_a[g]
+        center = pull * inv_K if newton else pull / K
         # Newton predictor from the last solution: T moves by k_t Δu, k_t = slope − K
         sg = max(slope[g], K)
         guess = x_a[g] + (K * (center - x_a[g]) - T[g] - (sg - K) * (xr_old - x_r)) / sg
-        x_a[g], slope[g] = _newton_position(params, state, g, x_r, center, K, sliding[g], guess, sg,
-                                            QUASI_TOLERANCE * sliding[g] * inv_K)
+        if newton:
+            x_a[g], slope[g] = _newton_position(params, state, g, x_r, center, K, sliding[g], guess, sg,
+                                                QUASI_TOLERANCE * sliding[g] * inv_K)
+        else:
+            x_a[g], slope[g] = quasi_static_position(
+                params, state, g, x_r, center, K, sliding[g], guess, sg, QUASI_TOLERANCE * sliding[g] / K,
+            )
         F_trial += multiplicity[g] * K * (center - x_a[g])
         if simpson:
             terms = (K, K_half, c_half, inv_K_half, inv_dt, center, dt)
@@ -1127,13 +1102,9 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                 for g in range(x_a.shape[0]):
                     x_a[g] = xp_new
             elif quasi:
-                nodes = (xp_mid, xr_mid, vr_mid, vp, vr_old)
-                if newton:
-                    K, inv_dt, F_trial, quad_in, quad_damp, quad_contact = _newton_balance(
-                        mechanics, contacts, rows, x_p, xp_new, x_r, xr_old, dt, simpson, nodes)
-                else:
-                    K, inv_dt, F_trial, quad_in, quad_damp, quad_contact = _quasi_balance(
-                        mechanics, contacts, rows, x_p, xp_new, x_r, xr_old, dt, simpson, nodes)
+                K, inv_dt, F_trial, quad_in, quad_damp, quad_contact = _quasi_balance(
+                    mechanics, contacts, rows, x_p, xp_new, x_r, xr_old, dt, simpson,
+                    (xp_mid, xr_mid, vr_mid, vp, vr_old), newton)
             else:
                 for g in range(x_a.shape[0]):
                     stretch_old[g] = x_p - x_a[g]
