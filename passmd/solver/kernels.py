@@ -40,6 +40,14 @@ extremum of the quadratic through u's value and rate at the start and its value 
 is committed first, so the Masing branch turns there and not at a step boundary. Samples
 inside such a step are interpolated (cubic Hermite in x_r).
 
+Two switches (``StepControl``) make the default scheme cheaper without changing what it
+computes beyond the balance solve's tolerance; the scheme "reference" has both off. ``newton``:
+each quasi-static balance is one Newton step on the exact contact's slope
+(:func:`_newton_position`, the bracketed solve where that step is not provably converged), and
+the trigonometric coefficients come from their series (:func:`_series_coefficients`: no sine or
+cosine call). ``smooth_breakpoints``: a breakpoint of x_p(t) where its rate does not change
+(:func:`_smooth_breakpoint`) does not restart the step control.
+
 In every scheme the contact memory is updated exactly once per accepted step (twice when
 a reversal falls inside it), with the drifted positions, and the contact force is
 otherwise evaluated purely. Every corner of x_p(t) falls on a step boundary.
@@ -56,7 +64,8 @@ from the cubic Hermite in u through the step's ends (values, and tangents from t
 solves; evaluated instead when u turns inside the step or the start's tangent is not known);
 the actuator's velocity at the three nodes is that of the quadratic through its three
 positions. (A reversal inside a rigid step is not split for the middle node: the error is of
-second order in the distance from the reversal.) These terms never feed back into the motion.
+second order in the distance from the reversal.) These terms never feed back into the motion,
+and are summed only with ``StepControl.energy``.
 """
 
 from __future__ import annotations
