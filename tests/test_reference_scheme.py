@@ -73,3 +73,10 @@ def test_reference_scheme_is_the_former_default():
     assert reference.error_control and reference.quiet_step == default.quiet_step
     assert not reference.newton_balance and not reference.smooth_breakpoints
     assert default.newton_balance and default.smooth_breakpoints
+
+
+def test_command_line_names_every_scheme():
+    """``passmd run --scheme`` offers exactly the schemes the library has (its parser loads no solver)."""
+    from passmd.cli.commands.run import SCHEME_NAMES
+
+    assert SCHEME_NAMES == tuple(SCHEMES)
