@@ -32,8 +32,8 @@ Usage::
     python benchmarks/bench_scaling.py --smoke   # seconds, to a temporary file
 
 ``--smoke`` runs every part on its smallest input (one contact count, two frequencies, sweeps of
-two and four points, dask with 4 and 8 tasks when dask is installed) and writes to a temporary
-file: it checks that the script works, its numbers mean nothing.
+two and four points, dask with 2 and 3 tasks when dask is installed, no batch task) and writes
+to a temporary file: it checks that the script works, its numbers mean nothing.
 """
 
 from __future__ import annotations
@@ -175,7 +175,7 @@ def dask_part(sizes=DASK_TASKS, batch: int = DASK_BATCH) -> dict | None:
              for n in sizes]
     slope, intercept = _fit_line(sizes, walls)
     amplitudes = tuple(float(a) for a in np.linspace(90e-9, 200e-9, batch))
-    wall = _timed_sweep(_batch, [{"amplitudes": amplitudes}], executor="dask", workers=1)
+    wall = _timed_sweep(_batch, [{"amplitudes": amplitudes}], executor="dask", workers=1) if batch else None
     return {"tasks": list(sizes), "wall_s": walls, "s_per_task": slope, "start_s": intercept,
             "batch_points": batch, "batch_task_wall_s": wall}
 
@@ -205,7 +205,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     counts, frequencies, sizes, tasks, batch = CONTACTS, FREQUENCIES, SWEEP_SIZES, DASK_TASKS, DASK_BATCH
     if args.smoke:
-        args.repeats, counts, frequencies, sizes, tasks, batch = 1, (1,), (1e3, 30e3), (2, 4), (4, 8), 2
+        args.repeats, counts, frequencies, sizes, tasks, batch = 1, (1,), (1e3, 30e3), (2, 4), (2, 3), 0
     if args.out is None:
         args.out = (Path(tempfile.mkdtemp(prefix="passmd-bench-")) / "scaling.json" if args.smoke
                     else ROOT / "passmd/data/benchmarks/scaling.json")
