@@ -114,4 +114,9 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    try:  # one line on failure (the command line's contract), where passmd is installed
+        from passmd.runtime.scripts import run_script
+    except ImportError:  # pragma: no cover - run with a Python that has no passmd
+        def run_script(main):
+            return main() or 0
+    sys.exit(run_script(main))

@@ -31,6 +31,7 @@ import json
 import os
 import platform
 import statistics
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -131,4 +132,6 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from passmd.runtime.scripts import run_script
+
+    sys.exit(run_script(main))  # one line on failure, never a traceback

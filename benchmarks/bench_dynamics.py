@@ -56,6 +56,7 @@ import numpy as np
 from passmd.model import waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
+from passmd.runtime.scripts import child_json
 from passmd.solver import kernels, simulation
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -206,8 +207,8 @@ def startup(repeats: int) -> dict:
     times, heavy = [], []
     for i in range(repeats + 1):
         start = time.time()
-        proc = subprocess.run(argv, capture_output=True, text=True, env=_warm_env(), check=True)
-        report = json.loads(proc.stderr.splitlines()[0])
+        proc = subprocess.run(argv, capture_output=True, text=True, env=_warm_env())
+        report = child_json(proc, "passmd run (the start-up probe)", stream="stderr", line=0)
         if i:  # the first launch writes the caches
             times.append(report["ready"] - start)
         heavy = report["heavy"]
@@ -284,8 +285,8 @@ def across_processes(processes: int, repeats: int) -> dict:
     per_process = []
     for _ in range(processes):
         argv = [sys.executable, "-c", _ONE_PROCESS, str(PROTOCOL.drive_frequency), str(PERIODS), str(repeats)]
-        done = subprocess.run(argv, capture_output=True, text=True, env=_warm_env(), check=True)
-        per_process.append(json.loads(done.stdout))
+        done = subprocess.run(argv, capture_output=True, text=True, env=_warm_env())
+        per_process.append(child_json(done, "the timing process"))
     return {"configuration": "6 contacts, flexible, controlled, exact",
             "ms_per_100Hz_period_per_process": per_process,
             "median_ms_per_100Hz_period": statistics.median(per_process)}
@@ -368,4 +369,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from passmd.runtime.scripts import run_script
+
+    sys.exit(run_script(main))  # one line on failure, never a traceback

@@ -150,8 +150,11 @@ def main() -> int:
         "machine": platform.machine(),
     }
     out = output(args, "fit")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
+    except OSError as exc:
+        raise OSError(exc.errno, exc.strerror, str(out)) from None  # one line naming the file
     shown = ("wall_time_s", "row_evaluation_s", "parameter_set_s", "budget_parameter_sets",
              "model_evaluations", "regions_hold_truth", "load_average_before", "load_average_after")
     print(json.dumps({k: record[k] for k in shown}, indent=2))
@@ -160,4 +163,6 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from passmd.runtime.scripts import run_script
+
+    sys.exit(run_script(main))  # one line on failure, never a traceback

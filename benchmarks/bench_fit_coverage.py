@@ -219,4 +219,6 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from passmd.runtime.scripts import run_script
+
+    sys.exit(run_script(main))  # one line on failure, never a traceback

@@ -92,9 +92,9 @@ def measure(profile: str, python: str, cache_dir: str | None = None, cold: bool 
         wall = time.perf_counter() - start
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         load_after = os.getloadavg()
-        if done.returncode != 0:
-            sys.stderr.write(done.stderr[-4000:])
-            raise SystemExit(f"passmd ledger failed (exit status {done.returncode})")
+        if done.returncode != 0:  # its own one-line error, as the last line of its stderr
+            last = (done.stderr.strip().splitlines() or ["no message"])[-1]
+            raise RuntimeError(f"passmd ledger failed (exit status {done.returncode}): {last}")
         lines = log.read_text(encoding="utf-8").splitlines() if log.exists() else []
         sweeps = [json.loads(line) for line in lines]
     payload = json.loads(done.stdout)
@@ -157,4 +157,9 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    try:  # one line on failure (the command line's contract), where passmd is installed
+        from passmd.runtime.scripts import run_script
+    except ImportError:  # pragma: no cover - run with a Python that has no passmd
+        def run_script(main):
+            return main() or 0
+    sys.exit(run_script(main))

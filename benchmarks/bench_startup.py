@@ -49,7 +49,6 @@ VARIANTS = {
 COMMANDS = {"--help": ["--help"], "run": ["run"]}
 
 _LAUNCH = """
-import sys
 from passmd.cli import startup
 for name in sys.argv[1].split(",") if sys.argv[1] else ():
     setattr(startup, name, lambda *a, **k: None)
@@ -134,4 +133,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from passmd.runtime.scripts import run_script
+
+    sys.exit(run_script(main))  # one line on failure, never a traceback

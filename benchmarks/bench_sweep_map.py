@@ -115,16 +115,17 @@ def cli(n_frequencies: int, n_amplitudes: int, workers: int | None) -> dict:
         env = {k: v for k, v in os.environ.items() if k not in drop}
         env.update(PYTHONPYCACHEPREFIX=os.path.join(folder, "pycache"), MPLBACKEND="Agg")
 
-        def command(frequencies: str, amplitudes: str, cache: str) -> list[str]:
+        def command(frequencies: str, amplitudes: str, cache: str, out: str) -> list[str]:
             argv = [sys.executable, "-m", "passmd", "sweep", "velocity", "--vary", f"frequency={frequencies}",
                     "--vary", f"amplitude={amplitudes}", *DRIVE_OPTIONS,
-                    "--cache-dir", os.path.join(folder, cache), "--out", os.path.join(folder, "map")]
+                    "--cache-dir", os.path.join(folder, cache), "--out", os.path.join(folder, out)]
             return argv + (["--workers", str(workers)] if workers is not None else [])
 
-        _timed_cli(command("1kHz,2kHz", "100nm", "warm-up"), env)  # fills the bytecode cache
-        argv = command(f"100Hz..110kHz:log:{n_frequencies}", f"40nm..131nm:{n_amplitudes}", "cache")
+        _timed_cli(command("1kHz,2kHz", "100nm", "warm-up", "warm-up"), env)  # fills the bytecode cache
+        grid = (f"100Hz..110kHz:log:{n_frequencies}", f"40nm..131nm:{n_amplitudes}", "cache")
+        argv = command(*grid, "map")  # each run's outputs new: a sweep never replaces a file
         return {"command": " ".join(argv[3:]).replace(folder, "TMP"), "cold": _timed_cli(argv, env),
-                "cached": _timed_cli(argv, env)}
+                "cached": _timed_cli(command(*grid, "map-cached"), env)}
 
 
 def main() -> None:
@@ -175,4 +176,6 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from passmd.runtime.scripts import run_script
+
+    sys.exit(run_script(main))  # one line on failure, never a traceback

@@ -28,7 +28,8 @@ The names a drive designer needs are exported here, loaded on first use: ``Drive
 ``load_drive``/``drive_toml`` (read and write a drive file; ``EXAMPLE_DRIVE_FILE``, the book's
 worked example), ``contact_arrangement`` (each contact group's side, angle and normal force),
 ``compute_map`` (what ``passmd sweep`` computes), ``stick_ringing`` (the runner's swing after a
-fly-back), and ``fit``/``read_measurements`` (calibrate free drive parameters to measurements).
+fly-back), ``diagnose`` (why a result departs from its closed form or trend, one cause removed at a
+time), and ``fit``/``read_measurements`` (calibrate free drive parameters to measurements).
 """
 
 #: The version: its one source (pyproject.toml reads it, ``dynamic = ["version"]``; CITATION.cff
@@ -64,6 +65,7 @@ _API = {
     "contact_arrangement": "passmd.model.theory",
     "compute_map": "passmd.protocols.maps",
     "stick_ringing": "passmd.protocols.ringing",
+    "diagnose": "passmd.protocols.diagnosis",
     "fit": "passmd.protocols.fit",
     "read_measurements": "passmd.protocols.fit",
 }

@@ -4,13 +4,16 @@
 (:func:`passmd.cli.main`) with a hook at each moment named in ``MOMENTS`` (comma-separated):
 
 * ``spawn``: in the command, after a process pool forked its first worker (the pool is starting);
-* ``worker``: in a worker, before its initializer ran (it has just been forked);
+* ``worker``: in a worker, before its initializer (:func:`passmd.runtime.pools.worker_signals`) ran
+  (it has just been forked);
 * ``point``: in a worker, before a sweep point whose ``frequency`` is above ``GATE_ABOVE_HZ``
   (default 0: every point; a point without one, e.g. a fit's parameter set, always) is computed
   (the pool is running);
 * ``evaluate``: in the command, before a fit's second model evaluation (its pool is idle
   between two sweeps);
-* ``shutdown``: in the command, before a process pool's first shut-down (the pool is stopping).
+* ``shutdown``: in the command, before a process pool's first shut-down (the pool is stopping);
+* ``publish``: in the command, once every output file is written to its temporary name, before
+  the first is linked to its own (:func:`passmd.runtime.outputs.create_exclusively`).
 
 A hook writes the marker ``DIR/<moment>-<pid>`` and waits until the file ``DIR/open`` exists.
 The test waits for the markers it needs, sends its signal, then creates ``DIR/open``: the
@@ -60,13 +63,15 @@ def _install(moments: set[str]) -> None:
 
         cfp.ProcessPoolExecutor._spawn_process = spawn_then_gate
     if "worker" in moments:
-        initializer = sweep._worker_signals
+        from passmd.runtime import pools
 
-        def gate_then_initialize():
+        initializer = pools.worker_signals
+
+        def gate_then_initialize(*args):
             gate("worker")
-            initializer()
+            initializer(*args)
 
-        sweep._worker_signals = gate_then_initialize
+        pools.worker_signals = gate_then_initialize
     if "point" in moments:
         sweep._call = gated_call
     if "evaluate" in moments:
@@ -91,6 +96,10 @@ def _install(moments: set[str]) -> None:
             return shutdown(self, *args, **kwargs)
 
         cfp.ProcessPoolExecutor.shutdown = gate_then_shutdown
+    if "publish" in moments:
+        from passmd.runtime import outputs
+
+        outputs._before_linking = lambda: gate("publish")
 
 
 if __name__ == "__main__":

@@ -54,10 +54,10 @@ def _default(function, parameter):
 
 
 def _preload_grids(text: str) -> dict[float, np.ndarray]:
-    """``{R (m): preloads (N)}`` of the table's "R = 1 mm: 0.1–1.0 N; …; step 0.1 N"."""
-    step = float(re.search(r"step ([\d.]+) N", text)[1])
+    """``{R (m): preloads (N)}`` of the table's "0.1–1.0 at R = 1 mm and …, in steps of 0.1" (unit N)."""
+    step = float(re.search(r"in steps of ([\d.]+)", text)[1])
     grids = {}
-    for radius, low, high in re.findall(r"R = ([\d.]+) mm: ([\d.]+)–([\d.]+) N", text):
+    for low, high, radius in re.findall(r"([\d.]+)–([\d.]+) at R = ([\d.]+) mm", text):
         count = round((float(high) - float(low)) / step) + 1
         grids[float(radius) * 1e-3] = float(low) + step * np.arange(count)
     return grids
@@ -68,10 +68,11 @@ def test_the_table_states_the_defaults_a_user_gets():
     table = assumptions.all_assumptions()
     drive = passmd.Drive()
     # ζ of the actuator's viscosity c_p = 2·ζ·√(k_p m_a)
-    zeta = float(re.search(r"ζ = ([\d.]+)$", table["actuator_viscosity"].value)[1])
+    zeta = float(re.search(r"ζ = ([\d.]+) \(dimensionless\)$", table["actuator_viscosity"].value)[1])
     act = drive.actuator
     assert act.viscosity == pytest.approx(2 * zeta * math.sqrt(act.stiffness * act.mass), rel=1e-12)
     # the preload grids of Figs. 5b and 6
+    assert table["preload_grids"].unit == "N"
     grids = _preload_grids(table["preload_grids"].value)
     assert grids.keys() == tables.PRELOAD_GRIDS.keys()
     for radius, preloads in tables.PRELOAD_GRIDS.items():

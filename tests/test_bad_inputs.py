@@ -117,7 +117,7 @@ NAMED_CASES = {
                                               "--load-cell-stiffness has no effect"),
     "plot into a device": (["run", "--plot", "/dev/full"], 2, "no image extension"),
     "plot, unknown format": (["run", "--plot", "out.xyz"], 2, "unknown image extension"),
-    "csv into a missing directory": (["run", "--csv", "/nonexistent-dir/x.csv"], 1, "does not exist"),
+    "csv into a missing directory": (["run", "--csv", "/nonexistent-dir/x.csv"], 2, "does not exist"),
     "empty figure directory": (["figure", "fig5a", "--out", ""], 2, "--out = '' is not a directory name"),
     "figure name is a path": (["figure", "../../etc/passwd"], 2, "is not a figure name"),
     "unknown figure": (["figure", "fig0x"], 2, "figure 'fig0x' is not available"),
@@ -366,18 +366,18 @@ def test_a_pool_never_starts_more_workers_than_points(monkeypatch):
     """``sweep.run(workers=1000)`` over three points forks three processes (two per core at most)."""
     import concurrent.futures as cf
 
-    from passmd.runtime import config, sweep
+    from passmd.runtime import config, pools, sweep
 
     monkeypatch.setattr(config, "usable_cores", lambda: 2)
     sizes = []
 
     class Pool(cf.ThreadPoolExecutor):
-        def __init__(self, max_workers, initializer=None):
+        def __init__(self, max_workers, initializer=None, initargs=()):
             sizes.append(max_workers)
             super().__init__(max_workers)
 
     monkeypatch.setattr(cf, "ProcessPoolExecutor", Pool)
-    monkeypatch.setattr(sweep, "_worker_signals", lambda: None)
+    monkeypatch.setattr(pools, "worker_signals", lambda *args: None)
     with pytest.warns(config.WorkersCapped, match="workers = 1000 is more than the 2 usable cores"):
         sweep.run(_double, sweep.grid(x=[1, 2, 3]), executor="process", workers=1000, cache=False)
     sweep.run(_double, sweep.grid(x=[1, 2, 3]), executor="process", workers=4, cache=False)

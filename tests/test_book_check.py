@@ -62,9 +62,9 @@ def _overflow(**changes) -> dict:
 
 
 def test_parse_expect_defaults_and_values():
-    assert checker.parse_expect(None) == {"figures": 1, "ledger": 1}
-    assert checker.parse_expect("figures=3 ledger=0") == {"figures": 3, "ledger": 0}
-    assert checker.parse_expect("ledger=0") == {"figures": 1, "ledger": 0}
+    assert checker.parse_expect(None) == {"figures": 1, "ledger": 1, "partial": 0}
+    assert checker.parse_expect("figures=3 ledger=0") == {"figures": 3, "ledger": 0, "partial": 0}
+    assert checker.parse_expect("ledger=0 partial=1") == {"figures": 1, "ledger": 0, "partial": 1}
 
 
 @pytest.mark.parametrize("bad", ["figures=two", "plots=1", "figures", "figures=-1"])
@@ -110,11 +110,41 @@ def test_good_page_has_no_problems():
          "a code block shown as inline text"),
         ({"audience": "designer", "internal_imports": ["from passmd.report import publish"]},
          "imports an internal module"),
+        ({"text_defects": ["a unit written twice: 'N N' in 'step 0.1 N N'"]}, "text defect"),
+        ({"expect": "figures=1 ledger=1 partial=1"}, "no partial-grid note"),
+        ({"expect": "figures=1 ledger=1 partial=1", "partial_grid": "Built on the quick profile."},
+         "no partial-grid note"),
     ],
 )
 def test_each_defect_is_a_problem(changes, fragment):
     problems = checker.page_problems(_good_facts(**changes))
     assert any(fragment in p for p in problems), problems
+
+
+@pytest.mark.parametrize(("text", "meaning"), [
+    ("the optimum finds nan % at 110 kHz", "could not compute"),
+    ("a velocity of -inf mm/s", "could not compute"),
+    ("preload_grids (F_p = 0.1–1.0 N; step 0.1 N N)", "unit written twice"),
+    ("frequency_grid (f = 1, 5, 10, …, 130 kHz kHz)", "unit written twice"),
+    ("actuator_viscosity (c_p = 2·ζ·√(k_p m_a), ζ = 0.05 kg/s)", "dimensionless quantity given a unit"),
+])
+def test_text_defects_are_found(text, meaning):
+    found = checker.text_defects(text)
+    assert len(found) == 1 and meaning in found[0], found
+
+
+def test_correct_text_has_no_defects():
+    text = ("c_p [kg/s] = 2·ζ·√(k_p m_a) with the damping ratio ζ = 0.05 (dimensionless); a nanometre; "
+            "Eq. 7 gives 39.5 nm, 0.2%·F_gen, μ = 0.2 is Section 4.2's; NaN if not within the hold; "
+            "10 % of it")
+    assert checker.text_defects(text, ["1.25", "—", "fig5a"]) == []
+    assert checker.text_defects("", ["NaN"]) == ["a table cell the build could not compute: 'NaN'"]
+
+
+def test_partial_grid_note_satisfies_the_expectation():
+    note = ("Built on the quick profile, a partial grid: … fig5a: 18 of the paper profile's 203 points "
+            "(amplitudes), 185 missing.")
+    assert checker.page_problems(_good_facts(expect="figures=1 ledger=1 partial=1", partial_grid=note)) == []
 
 
 def test_internal_imports_matter_on_a_designers_page_only():
@@ -225,6 +255,9 @@ def test_check_fails_on_missing_figure_and_cell_error(broken_book_results):
     assert any("blank image" in p for p in problems), problems
     assert any("scrolls horizontally" in p and "1280 px window" in p for p in problems), problems
     assert not any("scrolls horizontally" in p for p in results["good"]["problems"])
+    defects = [p for p in problems if p.startswith("text defect")]
+    assert len(defects) == 3, defects  # nan, a unit twice, a unit on ζ; the code-font `nan` is no defect
+    assert any("'nan'" in p for p in defects) and any("'N N'" in p for p in defects), defects
 
 
 @pytest.mark.slow

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -191,6 +192,31 @@ def test_assumptions_frame_holds_every_assumption_in_the_tables_order():
     assert list(df.columns) == ["key", "symbol", "value", "unit", "rationale", "sensitivity"]
     assert list(df["key"]) == list(all_assumptions())
     assert {"actuator_viscosity", "preload_grids"} <= set(df["key"])
+
+
+@pytest.mark.parametrize(("symbol", "value", "unit", "shown"), [
+    ("δ", "0.5", "nm", "δ = 0.5 nm"),
+    ("μ", "0.2", "–", "μ = 0.2"),
+    # a description: the unit belongs to the symbol, not to the description's last word
+    ("c_p", "2·ζ·√(k_p m_a) with ζ = 0.05", "kg/s", "c_p [kg/s] = 2·ζ·√(k_p m_a) with ζ = 0.05"),
+    ("–", "1024 reversal points", "–", "1024 reversal points"),
+])
+def test_assumption_value_shows_the_unit_once_and_on_the_symbol(symbol, value, unit, shown):
+    assert publish.assumption_value(symbol, value, unit) == shown
+
+
+def test_an_assumption_whose_value_ends_in_its_unit_is_refused():
+    from passmd.model.tables import Assumption
+
+    fields = {"key": "k", "symbol": "f", "rationale": "r", "sensitivity": "s"}
+    for value, unit in (("1, 5, …, 130 kHz", "kHz"), ("R = 1 mm: 0.1–1.0 N; step 0.1 N", "N")):
+        with pytest.raises(ValueError, match="ends in its unit"):
+            Assumption(value=value, unit=unit, **fields)
+    Assumption(value="over the last 16 periods", unit="s", **fields)  # "periods" does not end in " s"
+    for row in publish.assumptions_frame().itertuples():  # and the registry renders no unit twice
+        text = publish.assumption_value(row.symbol, row.value, row.unit)
+        unit = re.escape(row.unit)
+        assert row.unit in ("", "–") or not re.search(rf"(?<!\w){unit}\W+{unit}(?!\w)", text), text
 
 
 def test_implementations_resolve_names_and_fail_on_stale_ones():

@@ -12,6 +12,7 @@ without it, except under ``nox -s book_check`` (PASSMD_REQUIRE_BROWSER=1).
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -91,7 +92,8 @@ def test_chapters_are_read_in_parallel(tmp_path):
     assert sweeps in html[PAGES - 1]
     assert not any("Run time" in html[i] for i in range(PAGES - 1))
     # no page of the tiny book is in the figure table: it expects no figure and no ledger
-    assert all('<meta name="passmd-expect" content="figures=0 ledger=0"' in page for page in html.values())
+    assert all('<meta name="passmd-expect" content="figures=0 ledger=0 partial=0"' in page
+               for page in html.values())
 
 
 def _extension():
@@ -103,8 +105,35 @@ def _extension():
 
 
 def _expect(page: str) -> dict[str, int]:
-    figures, ledger = (int(item.partition("=")[2]) for item in _extension().expectation(page).split())
-    return {"figures": figures, "ledger": ledger}
+    items = dict(item.partition("=")[::2] for item in _extension().expectation(page).split())
+    return {key: int(items[key]) for key in ("figures", "ledger")}
+
+
+def test_verdict_pages_of_a_quick_build_carry_the_partial_grid_note(monkeypatch):
+    ext = _extension()
+
+    def note(page):
+        for cached in (ext.partial_grid_note, ext.expectation):
+            cached.cache_clear()
+        found = ext.partial_grid_note(page, "intro")
+        return None if found is None else " ".join([found[1], *found[2]])
+
+    try:
+        monkeypatch.setenv("PASSMD_PROFILE", "quick")
+        text = note("critical_amplitude_one")
+        # computed from the figures' grids: fig5a's amplitudes, fig5b's preloads and frequencies
+        pattern = r"fig5a: \d+ of the paper profile's \d+ points \(amplitudes\), \d+ missing"
+        assert re.search(pattern, text), text
+        assert "fig5b" in text and "nox -s book" in text
+        assert note("intro") is not None and note(ext.LEDGER_PAGE) is not None  # headline, whole ledger
+        assert note("api") is None and note("model") is None  # no verdicts there
+        assert "partial=1" in ext.expectation("waveform_velocity", "intro")
+        monkeypatch.setenv("PASSMD_PROFILE", "paper")
+        assert note("critical_amplitude_one") is None
+        assert "partial=0" in ext.expectation("waveform_velocity", "intro")
+    finally:
+        for cached in (ext.partial_grid_note, ext.expectation):
+            cached.cache_clear()
 
 
 def test_a_page_expects_its_rows_of_the_figure_table():

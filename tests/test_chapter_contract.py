@@ -75,3 +75,16 @@ def test_claim_modules_are_every_chapters_claims_modules():
     on_disk = {f"passmd.experiments.{p.parent.name}.{p.stem}" for folder in _folders()
                for p in folder.glob("claims*.py")}
     assert found == on_disk
+
+
+def test_profile_grids_are_figures_whose_quick_grid_is_part_of_the_papers():
+    """GRIDS name figures of the table; the quick profile computes only points the paper profile also
+    computes, so "missing" counts the paper's points a quick build lacks (the partial-grid note)."""
+    from passmd.experiments.figure_table import GRIDS, figure_names, figures_read, grid_shortfall
+
+    assert set(GRIDS) <= set(figure_names())
+    short = grid_shortfall(list(GRIDS), "quick").set_index("figure")
+    assert (short["missing"] == short["reference_points"] - short["points"]).all()  # quick ⊂ paper
+    assert (short["missing"] > 0).all()  # a grid that does not differ has no entry
+    assert grid_shortfall(list(GRIDS), "paper")["missing"].eq(0).all()
+    assert figures_read(["fig5b_readings", "closed_forms", "fig9a"]) == ["fig5b", "fig9a"]

@@ -135,7 +135,8 @@ def test_theory_json_matches_api():
     expected = drive_theory(drive)
     for key, value in expected.items():
         assert data[key] == value, key
-    assert data["runner_frequency_Hz"] == runner_frequency(drive)
+    assert data["runner_frequency_Hz"] == runner_frequency(drive, in_series=True)
+    assert data["runner_frequency_rigid_actuators_Hz"] == runner_frequency(drive)
     assert data["drive"]["preload_N"] == drive.preload
     assert data["drive"]["actuator_viscosity_kg_per_s"] == drive.actuator.viscosity
 
@@ -634,12 +635,13 @@ def test_numba_registry_loads_without_scipy_and_scipy_stays_importable():
     assert done.stdout.split() == ["True", "True"]
 
 
-def test_unwritable_output_exits_1(tmp_path, capsys):
+def test_an_output_into_a_missing_folder_is_bad_input(tmp_path, capsys):
+    """Found before the run: exit 2, as every input refused before any work."""
     target = tmp_path / "missing-dir" / "series.csv"
     status, _ = run_cli("run", "--contacts", "1", "--actuator", "rigid", "--periods", "1",
                         "--csv", str(target))
     err = capsys.readouterr().err
-    assert status == 1 and "cannot write --csv" in err and err.count("\n") == 1
+    assert status == 2 and "cannot write --csv" in err and err.count("\n") == 1
 
 
 # --------------------------------------------------------------------------------------
@@ -693,15 +695,18 @@ def test_run_optimized_reports_its_eq15_design():
     row = next(line for line in text.splitlines() if line.strip().startswith("Eq. 15 design"))
     symbols = ("t_s =", "t_a =", "Δ_a =", "V_a =", "f_s =", "V_r =", "u_x,max =", "100 Hz saw-tooth response")
     assert all(symbol in row for symbol in symbols), row
-    assert re.search(rf"Eq. 15 fits +up to {f_max / 1e3:.4g} kHz", text), text
+    from passmd.cli.notes import hz
+
+    shown = hz(f_max, down=True)  # an upper limit is shown rounded down: typed back, it fits
+    assert float(shown.split()[0]) * 1e3 <= f_max
+    assert re.search(rf"Eq. 15 fits +up to {shown}", text), text
     # above it the run is refused in one line naming the highest frequency at which Eq. 15 fits
     err = io.StringIO()
     with contextlib.redirect_stderr(err):
         status, _ = run_cli("run", "--waveform", "optimized", "--frequency", "10kHz", "--periods", "3")
     text = err.getvalue()
     assert status == 2 and text.count("\n") <= 1, text
-    assert ("--frequency 10kHz is out of range for --waveform optimized: must be <= "
-            f"{f_max / 1e3:.4g} kHz") in text
+    assert f"--frequency = 10kHz is out of range for --waveform optimized: must be <= {shown}" in text
     data = run_json("run", "--waveform", "optimized", "--frequency", "2kHz", "--periods", "3",
                     "--design-response", "driving")
     assert data["design"]["response_frequency_Hz"] == 2e3

@@ -139,8 +139,11 @@ def test_a_map_writes_csv_json_png_in_grid_order_and_reruns_from_the_cache(tmp_p
     assert record["rows"][-1]["velocity_m_per_s"] == corner["velocity_m_per_s"]
     assert record["files"]["png"] == prefix + ".png"
     assert Path(prefix + ".png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    # the same map again, and a step map (same runs): every point from the cache
+    # the same map again (its files are never replaced: refused before any work), to a new prefix,
+    # and a step map (same runs): every point from the cache
     status, text = run_cli(*argv)
+    assert status == 2 and text == ""  # (one line on stderr naming map.csv)
+    status, text = run_cli(*argv[:-1], prefix + "-again")
     assert status == 0 and "12 (12 from the cache, 0 computed)" in text
     data = run_json("sweep", "step", "--vary", "frequency=500Hz..4kHz:log:3",
                     "--vary", "amplitude=60nm..180nm:4", *CHEAP, "--executor", "serial", "--cache-dir", cache)

@@ -372,7 +372,7 @@ def test_ledger_rows_of_figs_5_and_6():
     The experiment row has no measured data in the paper's text."""
     keys = ["fig5a", "fig5b", "fig6a", "fig6b", "fig6c"]
     claims = evaluation.claims_for(evaluation.load_claims(), keys)
-    assert len(claims) == 12
+    assert len(claims) == 13
     figures_read = [*keys, *(f"{k}_readings" for k in keys)]
     results = evaluation.collect_results(RunConfig(profile="quick"), figures_read)
     evaluated = evaluation.evaluate(claims, results)
@@ -382,7 +382,9 @@ def test_ledger_rows_of_figs_5_and_6():
     assert set(simulated["readings"]) == {2 * 2 * 3 * 2, 2 * 2 * 3 * 3 * 2}  # rigid, flexible
     points = [p for p in evaluated.attrs["points"] if p["claim"] != "fig6b-experiment-agreement"]
     undecided = [p for p in points if p["state"] == "inconclusive"]
-    assert all("part of the grid" in p["detail"] for p in undecided), undecided[:3]
+    # undecided only where the coarser grid cannot decide, or where two A_c tie within the search's bracket
+    assert all("part of the grid" in p["detail"] or p["detail"].startswith("tied: ") for p in undecided), (
+        undecided[:3])
     assert sum(p["state"] == "fails" for p in points) > len(points) // 4
     joint = evaluated.attrs["joint"]
     assert joint["covered_points"] == joint["points"]

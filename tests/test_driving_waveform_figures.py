@@ -208,8 +208,8 @@ def test_fig9a_plot_shows_section5_friction_only(quick):
     assert set(section5) == {SECTION5_FRICTION}
     assert len(FIG9A_FRICTION) > 1 and not frame["section5_friction"].all()
     fig = driving_waveform.plot_fig9a(frame)
-    # one runner trace and one set of settled positions per waveform, plus the piezo: μ = 0.2 runs only
-    assert len(fig.axes[0].lines) == 2 * 2 + 1
+    # one runner trace, one set of settled positions and one piezo trace per waveform: μ = 0.2 runs only
+    assert len(fig.axes[0].lines) == 2 * 3
 
 
 # --------------------------------------------------------------------------------------
@@ -419,6 +419,37 @@ def test_startup_and_fig9b_facts(quick):
     saw = table[table["variant"] == "sawtooth"].set_index("frequency")
     assert found["saw_step_1k"] == saw.loc[1e3, "step_nm"]
     assert found["saw_step_130k"] == saw.loc[130e3, "step_nm"]
+    # the limit is the exact criterion, not a grid point: the grid's fitting points lie below it,
+    # the others above, and the table's rows carry the same number
+    opt = table[table["variant"] == "optimized"]
+    limit = found["fit_limit_kHz"] * 1e3
+    assert (opt.loc[opt["settling_fits"].astype(bool), "frequency"] <= limit).all()
+    assert (opt.loc[~opt["settling_fits"].astype(bool), "frequency"] > limit).all()
+    assert not np.isclose(opt["frequency"], limit).any()
+    assert (table["eq15_highest_frequency_Hz"] == limit).all()
+
+
+def test_fig9b_fit_limit_is_the_command_lines(quick):
+    """The velocity chapter's Eq. 15 fitting limit is what `passmd run --waveform optimized` prints for
+    the Section 5 drive, to the digits it prints (and the chapter glues it with those digits)."""
+    import contextlib
+    import io
+    from pathlib import Path
+
+    from passmd import cli
+
+    design = designs([section5_fields()], QUICK).iloc[0]
+    found = fig9b_facts(quick["fig9b"], design, section5_drive(**section5_fields()))
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        status = cli.main(["run", "--waveform", "optimized", "--actuator", "rigid", "--frequency", "1kHz",
+                           "--periods", "2"])
+    assert status == 0, out.getvalue()
+    line = next(x for x in out.getvalue().splitlines() if x.strip().startswith("Eq. 15 fits"))
+    assert f"up to {found['fit_limit_kHz']:.4g} kHz " in line, line
+    chapter = Path(__file__).resolve().parents[1] / "book" / "waveform_velocity.md"
+    chapter = chapter.read_text(encoding="utf-8")
+    assert "{glue:text}`fit_limit_kHz:.4g` kHz" in chapter
 
 
 def test_reachable_table_and_stick_lost(quick):
@@ -450,5 +481,7 @@ def test_optimum_and_flexible_facts():
     assert carried.iloc[0]["gain (%)"] > 20
     flexible = designs([section5_fields(actuator_model="flexible")], QUICK).iloc[0]
     flex = flexible_facts(optimum, flexible, carried, section5_drive(**section5_fields()))
-    assert np.isnan(flex["flex_opt_gain"])  # the quick profile does not optimise flexible actuators
+    # the quick profile does not optimise flexible actuators: the sentence says so, with no number
+    assert "does not run differential evolution on the flexible drive" in flex["flex_opt_text"]
+    assert "nan" not in flex["flex_opt_text"].lower()
     assert flex["f_s_flex_kHz"] < design_facts(design, section5_drive(**section5_fields()))["f_s_kHz"]

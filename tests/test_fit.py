@@ -274,6 +274,20 @@ def test_the_papers_numbers_read_as_measurements():
     assert data.known_sd
 
 
+def test_the_book_holds_the_papers_numbers_to_the_ledgers_tolerances():
+    """The calibration chapter's standard deviations are the tolerances of the ledger's claims on the
+    same numbers (5 nm on the 50 nm, 5 % of the 552 nm), read from claims.csv, not typed."""
+    from passmd.experiments.calibration.figures import PAPER_DATA_CLAIMS, paper_measurements
+    from passmd.ledger.claims import load_claims
+
+    data = paper_measurements()
+    claims = load_claims().set_index("id")
+    fig5a, fig9a = (claims.loc[PAPER_DATA_CLAIMS[row]] for row in PAPER_DATA_CLAIMS)
+    assert data.sd[0] == pytest.approx(float(fig5a["tolerance_num"]) * 1e-9, rel=1e-12)
+    assert data.sd[1] == pytest.approx(float(fig9a["tolerance_num"]) * 552e-9, rel=1e-12)
+    assert fig9a["tolerance_kind"] == "rel" and data.sd[1] == pytest.approx(27.6e-9, rel=1e-9)
+
+
 def test_help_gives_every_option_a_default():
     status, text = _run(["fit", "--help"])
     assert status == 0

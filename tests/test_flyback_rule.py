@@ -41,7 +41,7 @@ def test_the_rule_reads_back_from_a_drive_file(rule, tmp_path):
 
 @pytest.mark.parametrize("text, fragment", [
     ('[amplifier]\nflyback = "slow"\n', "amplifier.flyback = 'slow': must be \"slew\", \"fixed\" or a time"),
-    ("[amplifier]\nflyback = -1\n", "amplifier.flyback = -1 is out of range: must be > 0 s"),
+    ("[amplifier]\nflyback = -1\n", "amplifier.flyback = -1 is out of range: must be >= 1e-09 s"),
     ('[amplifier]\nflyback = "3 mm"\n', "amplifier.flyback = '3 mm'"),
     ("[amplifier]\nflyback = true\n", "amplifier.flyback = True"),
 ])
@@ -128,7 +128,7 @@ def test_drive_show_lists_the_rule_with_its_source(tmp_path, capsys):
 @pytest.mark.parametrize("value, fragment", [
     ("slow", "--flyback = 'slow' is not allowed: must be slew, fixed or a time with its unit"),
     ("1.5", "--flyback = 1.5 has no unit"),
-    ("-2us", "--flyback = '-2us' is out of range: must be > 0 us"),
+    ("-2us", "--flyback = '-2us' is out of range: must be >= 0.001 us"),
 ])
 def test_a_bad_flyback_option_is_one_line(value, fragment, capsys):
     status, out, err = run(["run", "--periods", "2", f"--flyback={value}"], capsys)

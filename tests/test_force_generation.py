@@ -195,12 +195,12 @@ def test_force_is_zero_below_onset_and_grows_above():
         assert out["converged"]
         # No stepping: the load cell only follows the piezo's mean position; the difference is the
         # contacts' elastic give (well under 1 nm × k = 0.025 mN), 0.05 mN asserted.
-        assert abs(out["generated_force_N"] - out["piezo_mean_force_N"]) < 0.05e-3
+        assert abs(out["generated_force_N"] - out["no_slip_reference_force_N"]) < 0.05e-3
     above = [stall.generated_force(drive, a, figures.FORCE_FREQUENCY)
              for a in (1.3 * onset, 0.6 * 202e-9, 202e-9)]
     forces = [out["generated_force_N"] for out in above]
     assert all(out["converged"] for out in above)
-    assert forces[0] - above[0]["piezo_mean_force_N"] > 1e-3  # clearly generating force above onset
+    assert forces[0] - above[0]["no_slip_reference_force_N"] > 1e-3  # clearly generating force above onset
     assert forces[0] < forces[1] < forces[2]
 
 
@@ -307,6 +307,7 @@ def test_ledger_rows_of_fig7(quick):
         "fig7-flexible-covers-experiment", "fig7-force-depends-on-amplitude", "fig7-force-depends-on-preload",
         "study-fig7a-model-difference-115mn", "study-fig7a-model-difference-grows",
         "study-fig7b-model-difference-grows", "study-fig7-onsets-earlier-against-this-model",
+        "sec4-2-force-depends-on-radius-friction-material",
     }
     results = {k: quick[k] for k in ("fig7a", "fig7b")}
     results["fig7_readings"] = figures.fig7_readings(RunConfig(profile="quick"))

@@ -49,6 +49,20 @@ def test_notice_goes_to_stderr_once_and_json_stays_clean(monkeypatch, capsys):
     assert kernels.NOTICE not in capsys.readouterr().err
 
 
+def test_a_finished_command_leaves_no_stream_to_a_later_compile(monkeypatch):
+    """A command armed with a stderr that is closed once it returns (a caller running commands
+    in-process, a test's captured stream): a numba compile after it neither writes there nor
+    fails."""
+    import io
+
+    stderr = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", stderr)
+    assert main([a for a in RUN if a != "--json"]) == 0
+    monkeypatch.undo()
+    stderr.close()
+    assert numba.njit(lambda x: x * 3.0)(2.0) == 6.0  # a fresh function: numba compiles it now
+
+
 def test_no_notice_once_a_simulation_has_compiled_the_kernels(capsys):
     """After one simulation every kernel it needs is compiled: the next run is quiet."""
     assert main(RUN) == 0

@@ -380,3 +380,87 @@ def test_an_unknown_column_names_the_column_meant(tmp_path, column, message):
     with pytest.raises(MeasurementError) as info:
         read_measurements(path)
     assert str(info.value).startswith(f"{path} header, column 3 {message}"), str(info.value)
+
+
+# --------------------------------------------------------------------------------------
+# What the user typed, where the package's own terms or argparse's would hide it
+# --------------------------------------------------------------------------------------
+
+ANGLE_FILE = ('[[contact_groups]]\ncount = 2\nside = 1\ncontact_angle = "1e-6 deg"\n'
+              '[[contact_groups]]\ncount = 2\nside = 2\ncontact_angle = "1e-6 deg"\n')
+TYPED = {
+    "a frequency in another unit": (["--frequency", "1mHz"], None, (
+        "--frequency = 1mHz (= 1e-06 kHz) is out of range: must be > 1e-06 kHz",)),
+    "a value below the smallest double": (["--preload", "1e-400N"], None, (
+        "--preload = 1e-400N (below the smallest number a double holds: it reads as 0) is out of range",)),
+    "a negative value after an option": (["--flyback", "-1us"], None, (
+        "--flyback = '-1us' is out of range",)),
+    "a fly-back below any amplifier": (["--flyback", "1e-30us"], None, (
+        "--flyback = '1e-30us' is out of range: must be >= 0.001 us",)),
+    "a fly-back option longer than half a period": (["--flyback", "6ms"], None, (
+        "--frequency = 0.1 kHz (default) is out of range", "the fly-back is --flyback 6ms")),
+    "a drive file's fly-back longer than half a period": ([], '[amplifier]\nflyback = "6 ms"\n', (
+        "--frequency = 0.1 kHz (default) is out of range", "the fly-back is amplifier.flyback in {file}")),
+    "a drive file's contact angle": ([], ANGLE_FILE, ("{file}: the Hertz contact radius",
+                                                     "the contacts this drive file describes")),
+    "Eq. 15 times that do not fit the default frequency": (
+        ["--waveform", "optimized", "--settling-time", "5ms"], None,
+        ("--frequency = 0.1 kHz (default) is out of range", "(from --settling-time 5ms)",
+         "lower --settling-time, or give a lower --frequency")),
+}
+
+
+@pytest.mark.parametrize("name", list(TYPED))
+def test_a_refusal_names_the_input_as_typed(name, tmp_path):
+    argv, file_text, fragments = TYPED[name]
+    path = tmp_path / "mine.toml"
+    if file_text is not None:
+        path.write_text(file_text, encoding="utf-8")
+        argv = [*argv, "--drive", str(path)]
+    status, out, err = run_main(["run", "--periods", "1", *argv])
+    assert status == 2 and out == "", err
+    assert err.count("\n") == 1 and err.startswith("passmd run: error: ") and "Traceback" not in err, err
+    for fragment in fragments:
+        assert fragment.format(file=path) in err, (fragment, err)
+    if name == "a drive file's contact angle":
+        assert "--preload" not in err and "--radius" not in err  # options the user did not type
+
+
+def test_an_upper_frequency_limit_is_shown_rounded_down():
+    """Typed back, the highest frequency a message names is within the limit (never rounded up)."""
+    from passmd.cli.notes import hz
+
+    for limit in (99.9849, 99.98, 4908.7, 1e5 * (1 - 1e-9), 123456.0, 0.0123456):
+        shown = hz(limit, down=True)
+        value, unit = shown.split()
+        typed = float(value) * (1e3 if unit == "kHz" else 1.0)
+        assert typed <= limit * (1 + 1e-12) and typed > limit * (1 - 1e-3), (limit, shown)
+
+
+def test_an_unusable_user_cache_folder_names_its_variable(tmp_path, monkeypatch):
+    from passmd.runtime.cache import store
+
+    afile = tmp_path / "afile"
+    afile.write_text("")
+    monkeypatch.delenv("PASSMD_CACHE_DIR", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(afile))
+    monkeypatch.setattr(store, "_REPORTED_UNWRITABLE", set())
+    status, out, err = run_main(["sweep", "velocity", "--vary", "frequency=1kHz,2kHz", "--contacts", "1",
+                                 "--actuator", "rigid", "--executor", "serial", "--json"])
+    assert status == 0, err
+    warning = [line for line in err.splitlines() if "warning" in line]
+    assert len(warning) == 1, err
+    assert f"cannot use the cache {afile}/passmd/results: Not a directory" in warning[0]
+    assert f"from XDG_CACHE_HOME = {afile}" in warning[0] and "PASSMD_CACHE_DIR or --cache-dir" in warning[0]
+
+
+def test_a_kernel_cache_without_a_folder_names_the_variables(monkeypatch):
+    def no_locator(args, out):
+        raise RuntimeError("cannot cache function 'step': no locator available for file '/x/kernels.py'")
+
+    monkeypatch.setattr("passmd.cli.commands.theory.run_theory", no_locator)
+    monkeypatch.setenv("XDG_CACHE_HOME", "/nonexistent/file")
+    status, out, err = run_main(["theory"])
+    assert status == 1 and out == "", err
+    assert err.count("\n") == 1 and "cannot cache the compiled simulation kernels" in err
+    assert "XDG_CACHE_HOME = /nonexistent/file" in err and "NUMBA_CACHE_DIR" in err

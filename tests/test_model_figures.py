@@ -309,3 +309,49 @@ def test_step_plan_and_benchmark_facts():
     assert facts["bench_periods"] >= 1
     assert facts["bench_processes"] >= 1 and facts["bench_six_flex_processes_ms"] > 0
     assert facts["target_ms_per_period"] == TARGET_MS_PER_PERIOD
+
+
+def test_hemisphere_mass_is_half_a_ruby_sphere():
+    from passmd.experiments.model_numerics.figures import RUBY_DENSITY, actuator_masses, hemisphere_mass
+
+    assert hemisphere_mass(1e-3) == pytest.approx(2 / 3 * np.pi * 1e-9 * RUBY_DENSITY, rel=1e-12)
+    masses = actuator_masses("quick")  # the printed 22 µg to 22 mg, and the hemisphere's 8.3 mg
+    assert masses[0] == pytest.approx(2.2e-8) and masses[-1] == pytest.approx(2.2e-5)
+    assert any(np.isclose(masses, hemisphere_mass()))
+
+
+def _mass_table(ac_fixed_nm: dict) -> pd.DataFrame:
+    """A study table (figures.actuator_mass_study's columns) with the fixed fly-back's A_c per mass (µg)."""
+    from passmd.experiments.model_numerics.figures import hemisphere_mass
+
+    rows = []
+    for mass_ug, ac in ac_fixed_nm.items():
+        for f, v in ((100.0, 2e-5), (110e3, 0.02 if mass_ug < 1e3 else -0.005)):
+            rows.append({"actuator_mass": mass_ug * 1e-9, "critical_amplitude_slew_m": 15e-9,
+                         "critical_amplitude_fixed_m": ac * 1e-9, "eq12_m": 30e-9, "eq12_tolerance_rel": 0.1,
+                         "actuator_frequency_Hz": 8.65e4 * (22000 / mass_ug) ** 0.5,
+                         "actuator_on_contact_1_Hz": 1.0e5 * (22000 / mass_ug) ** 0.5,
+                         "actuator_on_contact_2_Hz": 0.99e5 * (22000 / mass_ug) ** 0.5,
+                         "ringing_frequency_Hz": 9e3, "frequency_Hz": f, "velocity_m_per_s": v,
+                         "printed": mass_ug == 22.0,
+                         "hemisphere": np.isclose(mass_ug * 1e-9, hemisphere_mass())})
+    return pd.DataFrame(rows)
+
+
+def test_mass_study_sentence_follows_the_data():
+    from passmd.experiments.model_numerics.facts import mass_study_facts
+    from passmd.experiments.model_numerics.figures import hemisphere_mass
+
+    heavy = hemisphere_mass() * 1e9
+    # the printed mass matches Eq. 12 and a hemisphere's does not: the book keeps the printed value
+    found = mass_study_facts(_mass_table({22.0: 30.3, 220.0: 29.0, heavy: 16.7, 22000.0: 16.2}))
+    assert found["mass_verdict"].startswith("So the printed m_a is consistent")
+    assert "22 µg and 220 µg" in found["mass_ac_text"] and "outside" in found["mass_hypothesis"]
+    assert "(the runner moves backwards)" in found["mass_velocity_text"]
+    assert found["mass_ratio"] == pytest.approx(heavy / 22.0)
+    # counter-examples: a hemisphere's mass matching too, or the printed one failing, say so
+    both = mass_study_facts(_mass_table({22.0: 30.3, heavy: 29.0, 22000.0: 28.0}))
+    assert both["mass_verdict"].startswith("Both the printed m_a and a hemisphere's")
+    assert "within" in both["mass_hypothesis"]
+    neither = mass_study_facts(_mass_table({22.0: 20.0, heavy: 16.7, 22000.0: 16.2}))
+    assert neither["mass_verdict"].startswith("The printed m_a is not consistent")

@@ -42,7 +42,7 @@ from passmd.cli.streams import write_atomically
 from passmd.ledger.claims import CLAIMS_PATH
 from passmd.model import waveforms
 from passmd.model.parameters import Drive
-from passmd.runtime import progress, sweep
+from passmd.runtime import pools, progress, sweep
 from passmd.solver import simulation
 
 #: Generous limits: a refusal or a one-period run takes seconds (start-up included).
@@ -523,7 +523,7 @@ _SLOW_POINTS = textwrap.dedent("""
 
     def point(x):
         if x > 2:  # points 1 and 2 finish at once, 3 and 4 announce themselves and sleep
-            Path(os.environ["MARKERS"], f"{x}-{os.getpid()}").write_text("")
+            Path(MARKERS, f"{x}-{os.getpid()}").write_text("")
             time.sleep(600)
         return {"y": x}
 """)
@@ -539,11 +539,12 @@ def test_sigterm_stops_a_process_pool_sweep_and_its_workers(tmp_path, to_group):
 
     code = tmp_path / "code"
     code.mkdir()
-    (code / "slow_points.py").write_text(_SLOW_POINTS)
     markers, out, cache = tmp_path / "markers", tmp_path / "out", tmp_path / "cache"
     markers.mkdir()
+    # the markers' folder written into the code: a point reading the environment is not cached
+    (code / "slow_points.py").write_text(f"MARKERS = {str(markers)!r}\n" + _SLOW_POINTS)
     argv = ["-c", _SWEEP_RUNNER, str(code), "figure", "fig99z", "--out", str(out)]
-    with _started(argv, tmp_path, env=_env(tmp_path, MARKERS=str(markers))) as proc:
+    with _started(argv, tmp_path, env=_env(tmp_path)) as proc:
         deadline = time.monotonic() + HANG_S
         # both workers inside a slow point, the fast ones cached
         while len(list(markers.iterdir())) < 2 or len(Cache(cache).entries()) < 2:
@@ -567,7 +568,7 @@ def test_pool_workers_end_on_sigterm_whatever_the_parent_handles(monkeypatch):
     previous = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         signal.signal(signal.SIGTERM, lambda signum, frame: None)
-        sweep._worker_signals()  # the pool's worker initializer
+        pools.worker_signals()  # the pool's worker initializer
         assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL
         assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
     finally:

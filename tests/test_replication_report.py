@@ -73,24 +73,42 @@ def test_cli_text_and_json_state_the_joint_reading_as_the_report_does(tmp_path, 
     out = io.StringIO()
     assert cli.main(["ledger", "--json"], out=out) == 0
     joint = json.loads(out.getvalue())["joint_reading"]
-    assert joint["covered_points"] == joint["points"] == joint["chosen_from"] == 144
-    assert joint["decided_points"] == 144 and joint["holding"] == 2 and joint["claims"] == 3
+    # the space is the product of the free axes the claims vary along: fly-back × A_c protocol
+    assert joint["covered_points"] == joint["points"] == joint["chosen_from"] == 4
+    assert joint["decided_points"] == 4 and joint["holding"] == 2 and joint["claims"] == 3
+    assert joint["best_single_point"] == 2 and joint["in_sample_gain"] == ["b"]
     assert [t["described"] for t in joint["ties"]] == ["fly-back rule = fixed; how A_c is read = first"]
     assert [(r["described"], r["holding"], r["margin"]) for r in joint["runner_ups"]] == [
         ("how A_c is read = first", 1, 1)]
     sentences = ledger_views.joint_sentences(joint)
-    assert sentences[0] == "Joint reading: defaults, where 2 of 3 claims hold together."
-    assert "chosen from 144 of the 144 points" in sentences[1] and "144 covered" in sentences[1]
+    assert sentences[0] == "Joint reading (in-sample): defaults, where 2 of 3 voting claims hold together."
+    assert "chosen from 4 of the 4 points" in sentences[1] and "4 covered" in sentences[1]
     assert sentences[3] == "Runner-ups: how A_c is read = first (1 hold, 1 fewer)."
     text = io.StringIO()
     assert cli.main(["ledger"], out=text) == 0
     printed = text.getvalue().splitlines()
-    assert printed[1:1 + len(sentences)] == sentences  # the same sentences, in the same order
+    held_out = [line for line in printed if line.startswith(("Each claim is judged", "In-sample"))]
+    assert len(held_out) == 2 and "+1 in-sample pass: b" in held_out[1]
+    assert printed[3:3 + len(sentences)] == sentences  # the same sentences, in the same order
     assert "1 pairs of claims never hold together, in 1 tensions:" in printed
     # the report renders the same function's sentences from the same record
     source = REPORT_SOURCE.read_text(encoding="utf-8")
     assert "ledger_views.joint_sentences(joint)" in source
+    assert "ledger_views.held_out_sentences(evaluated)" in source
     assert "ledger_views.tension_sentences(evaluated)" in source
+
+
+def test_the_report_leads_with_one_line_per_claim():
+    """The replication report's first screen is the one-line-per-claim table (category, ours against
+    the paper, the one reason, the readings): no section heading, rule or explanation comes before it."""
+    source = REPORT_SOURCE.read_text(encoding="utf-8")
+    table = source.index("ledger_views.styled(evaluation.counted(evaluated), links=True)")
+    assert table < source.index("\n## ") and table < source.index("rules.RULES")
+    assert source.index("headline_markdown") < table
+    if REPORT_HTML.is_file():  # in the page's body, before its first section
+        raw = REPORT_HTML.read_text(encoding="utf-8")
+        body = raw[raw.index('<h1>Replication report<a class="headerlink"'):]
+        assert body.index('class="passmd-ledger"') < body.index("<h2"), "the built report leads otherwise"
 
 
 def _page_text(path: Path) -> str:

@@ -20,6 +20,11 @@ all network requests blocked) with the system's Chromium driven by selenium, and
 * is written for a designer (``passmd-audience: designer`` meta tag) and shows a code cell that
   imports an internal module: its visible code uses only the public API (``import passmd``,
   ``from passmd import …``) and the command line,
+* shows a number the build could not compute or a unit written wrongly (:data:`TEXT_DEFECTS`): a
+  ``nan`` or ``inf`` in the text, ``NaN`` in a table, a unit written twice (``0.1 N N``, ``130 kHz
+  kHz``), a dimensionless ratio with a unit (``ζ = 0.05 kg/s``),
+* is built on a profile coarser than the paper's and states verdicts, but lacks the note saying how
+  much of the paper's grids it lacks (``passmd-expect`` ``partial=1``; ``.passmd-partial-grid``),
 * links to a local file that is not in the built book (e.g. a figure's CSV data),
 * tries to load anything from the network (the book must display offline),
 * scrolls horizontally in a window :data:`WINDOW_WIDTH` px wide (content wider than the window),
@@ -45,6 +50,7 @@ from __future__ import annotations
 import argparse
 import base64
 import json
+import re
 import shutil
 import sys
 import tempfile
@@ -71,7 +77,21 @@ CHROMIUM_FLAGS = (
 WINDOW_WIDTH = 1280
 WINDOW_HEIGHT = 1000
 #: What a page must show when it has no ``passmd-expect`` meta tag.
-DEFAULT_EXPECT = {"figures": 1, "ledger": 1}
+DEFAULT_EXPECT = {"figures": 1, "ledger": 1, "partial": 0}
+#: Units the book writes (a unit repeated after itself is a defect).
+UNITS = ("nm", "µm", "mm", "m", "µs", "us", "ms", "s", "ns", "Hz", "kHz", "MHz", "N", "mN", "N/m", "Pa",
+         "MPa", "GPa", "kg", "g", "mg", "µg", "kg/s", "m/s", "mm/s", "m/s²", "V", "V/µs", "%", "°")
+_UNIT = "|".join(re.escape(u) for u in sorted(UNITS, key=len, reverse=True))
+#: Patterns of the visible text (outside code) that are defects, with what each means.
+TEXT_DEFECTS = (
+    (re.compile(r"(?<![\w.\-])-?(?:nan|inf)(?![\w])"), "a number the build could not compute"),
+    (re.compile(rf"(?<![\w/²])({_UNIT})\s+\1(?![\w/²])"), "a unit written twice"),
+    (re.compile(rf"[ζμν]\s*=\s*[-+]?[\d.]+(?:e[-+]?\d+)?\s*(?:{_UNIT})(?![\w/²])"),
+     "a dimensionless quantity given a unit"),
+)
+#: Table cells that are defects: pandas' missing value.
+CELL_DEFECTS = ((re.compile(r"^\s*-?(?:NaN|nan|inf|<NA>|None)\s*$"),
+                 "a table cell the build could not compute"),)
 LEDGER_SELECTOR = "table.passmd-ledger"
 MAX_SCREENSHOT_HEIGHT = 30000  # px; Chromium refuses larger captures
 
@@ -192,6 +212,16 @@ const ledgerSelector = arguments[0];
     .map(line => line.trim().slice(0, 80));
   const maths = Array.from(root.querySelectorAll('.math'));
   const text = root.innerText || '';
+  // the visible text outside code, and every table cell, for the text-defect patterns
+  const prose = [];
+  const proseWalker = document.createTreeWalker(root, NodeFilter.SHOW_TEXT);
+  for (let node = proseWalker.nextNode(); node; node = proseWalker.nextNode()) {
+    // code, and the API reference's entries (signatures and docstrings document code's values)
+    const code = 'pre, code, script, style, textarea, .highlight, mjx-container, dl.py';
+    if (node.parentElement && node.parentElement.closest(code)) continue;
+    prose.push(node.textContent);
+  }
+  const note = root.querySelector('.passmd-partial-grid');
   done({
     title: document.title,
     has_article: !!article,
@@ -216,6 +246,9 @@ const ledgerSelector = arguments[0];
       .map(e => (e.getAttribute('data-mjx-error') || e.textContent).slice(0, 120)),
     mathjax_loaded: !!(window.MathJax && MathJax.startup),
     raw_tex: rawTex.slice(0, 5),
+    visible_text: prose.join(' '),
+    table_cells: Array.from(root.querySelectorAll('td')).map(td => td.innerText),
+    partial_grid: note ? note.innerText : null,
     ledger_tables: Array.from(root.querySelectorAll(ledgerSelector))
       .filter(t => t.querySelectorAll('tbody tr').length > 0).length,
     overflow: overflowing(root),
@@ -253,10 +286,11 @@ def toc_pages(toc_file: str | Path) -> list[str]:
 
 
 def parse_expect(content: str | None) -> dict[str, int]:
-    """Parse a ``passmd-expect`` meta value such as ``"figures=2 ledger=0"``.
+    """Parse a ``passmd-expect`` meta value such as ``"figures=2 ledger=0 partial=1"``.
 
     ``None`` gives :data:`DEFAULT_EXPECT`. Keys: ``figures`` (minimum number of decoded
-    images) and ``ledger`` (minimum number of ledger tables).
+    images), ``ledger`` (minimum number of ledger tables) and ``partial`` (1: the page must carry the
+    partial-grid note).
     """
     expect = dict(DEFAULT_EXPECT)
     if content is None:
@@ -265,10 +299,31 @@ def parse_expect(content: str | None) -> dict[str, int]:
         key, sep, value = item.partition("=")
         if not sep or key not in DEFAULT_EXPECT or not value.isdigit():
             raise ValueError(
-                f"passmd-expect = {content!r} is not allowed: must be 'figures=<n> ledger=<n>'"
+                f"passmd-expect = {content!r} is not allowed: must be "
+                "'figures=<n> ledger=<n> [partial=<0|1>]'"
             )
         expect[key] = int(value)
     return expect
+
+
+def text_defects(text: str, cells=()) -> list[str]:
+    """Each defect :data:`TEXT_DEFECTS` finds in a page's visible text (outside code) and
+    :data:`CELL_DEFECTS` in its table cells, with its context."""
+    found = []
+    for pattern, meaning in TEXT_DEFECTS:
+        for match in pattern.finditer(text):
+            context = " ".join(text[max(0, match.start() - 40):match.end() + 20].split())
+            found.append(f"{meaning}: {match.group(0)!r} in {context!r}")
+    for cell in cells:
+        for pattern, meaning in CELL_DEFECTS:
+            if pattern.search(cell):
+                found.append(f"{meaning}: {cell.strip()!r}")
+    return found
+
+
+#: What the partial-grid note must say: per figure, what it computes of the paper profile's points, or
+#: that no grid is coarser.
+_PARTIAL_NOTE = re.compile(r"\d+ of the paper profile's \d+ (?:grid )?points|None of the grids")
 
 
 def page_problems(facts: dict) -> list[str]:
@@ -323,6 +378,11 @@ def page_problems(facts: dict) -> list[str]:
         problems.append(f"MathJax error: {message}")
     for snippet in facts.get("raw_tex", []):
         problems.append(f"raw TeX left in the page: {snippet!r}")
+    for defect in facts.get("text_defects", []):
+        problems.append(f"text defect, {defect}")
+    if expect["partial"] and not _PARTIAL_NOTE.search(facts.get("partial_grid") or ""):
+        problems.append("no partial-grid note (.passmd-partial-grid saying what the page lacks of the paper "
+                        "profile's grids) on a page of a coarser profile that states verdicts")
     for snippet in facts.get("raw_myst", []):
         problems.append(f"raw MyST left in the page (a role, directive or fence not rendered): {snippet!r}")
     for snippet in facts.get("inline_blocks", []):
@@ -451,6 +511,7 @@ def check_book(html_dir: str | Path, pages: list[str], screenshots: str | Path |
             driver.get(path.as_uri())
             facts = driver.execute_async_script(PAGE_FACTS_JS, LEDGER_SELECTOR)
             facts["blank_images"] = blank_images(path, facts["images"])
+            facts["text_defects"] = text_defects(facts.pop("visible_text", ""), facts.pop("table_cells", []))
             facts["broken_links"] = broken_links(path, facts.pop("links", []))
             facts["network_errors"] = [
                 entry["message"][:200]

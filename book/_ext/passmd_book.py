@@ -17,8 +17,13 @@
   profile, myst-nb's execution time of the page and its sweep counts, the facts the execution
   statistics page tabulates for every page.
 * Every page gets a ``passmd-expect`` meta tag for ``tools/check_rendered_book.py``
-  (:func:`expectation`): the figures the figure table registers for the page and whether the
-  ledger judges claims of them.
+  (:func:`expectation`): the figures the figure table registers for the page, whether the
+  ledger judges claims of them and whether it carries the partial-grid note.
+* On a build coarser than the paper profile (``quick``), every page that states verdicts (the root
+  page's headline, the replication report, each chapter with ledger rows) opens with a "Partial grid"
+  note: how many of the paper profile's grid points the figures behind its verdicts lack, and for
+  each figure how many it computes and lacks (:func:`passmd.report.publish.partial_grid_text`); a
+  list of more than four figures is folded under the note's title.
 * Docstrings write absolute values as ``|x|`` (plain text, as ``help()`` shows them); for
   the API page the bars are escaped outside inline literals and roles, where
   reStructuredText would read ``|x|`` as a substitution.
@@ -70,31 +75,89 @@ def chapter_figures(docname: str) -> tuple[str, ...]:
     return tuple(spec.name for spec in FIGURES if spec.chapter == docname)
 
 
-@functools.cache
-def expectation(docname: str) -> str:
-    """The ``passmd-expect`` value of a page, e.g. ``"figures=3 ledger=1"``.
-
-    ``figures``: the page's rows of the figure table (:func:`chapter_figures`); ``ledger``: 1 on
-    :data:`LEDGER_PAGE` and where the ledger judges claims that need only those figures'
-    results (:func:`passmd.report.evaluation.claims_for`), else 0.
-    """
+def _judges_claims(docname: str) -> bool:
+    """Whether the page shows a ledger table: :data:`LEDGER_PAGE`, or claims need only its figures."""
     from passmd.report.evaluation import claims_for, load_claims
 
     figures = chapter_figures(docname)
-    ledger = docname == LEDGER_PAGE or bool(figures) and not claims_for(load_claims(), figures).empty
-    return f"figures={len(figures)} ledger={int(ledger)}"
+    return docname == LEDGER_PAGE or bool(figures) and not claims_for(load_claims(), figures).empty
+
+
+@functools.cache
+def verdict_figures(docname: str, root_doc: str) -> tuple[str, ...] | None:
+    """The figures behind the verdicts a page states, or None for a page that states none: every
+    claim's on the root page (its headline) and :data:`LEDGER_PAGE`, the page's own claims' elsewhere
+    (their ``requires``, reading tables resolved to their figures)."""
+    from passmd.experiments.figure_table import figures_read
+    from passmd.ledger.claims import required_keys
+    from passmd.report.evaluation import claims_for, load_claims
+
+    if docname in (root_doc, LEDGER_PAGE):
+        claims = load_claims()
+    elif _judges_claims(docname):
+        claims = claims_for(load_claims(), chapter_figures(docname))
+    else:
+        return None
+    return tuple(figures_read({key for _, claim in claims.iterrows() for key in required_keys(claim)}))
+
+
+@functools.cache
+def partial_grid_note(docname: str, root_doc: str) -> tuple[str, str, list[str]] | None:
+    """The note (title, text, one item per figure) a verdict-bearing page gets on a profile coarser
+    than the paper's (:func:`passmd.report.publish.partial_grid_text`), None elsewhere."""
+    from passmd.report.publish import current_profile, partial_grid_text
+
+    figures = verdict_figures(docname, root_doc)
+    return None if figures is None else partial_grid_text(figures, current_profile())
+
+
+@functools.cache
+def expectation(docname: str, root_doc: str = "intro") -> str:
+    """The ``passmd-expect`` value of a page, e.g. ``"figures=3 ledger=1 partial=0"``.
+
+    ``figures``: the page's rows of the figure table (:func:`chapter_figures`); ``ledger``: 1 on
+    :data:`LEDGER_PAGE` and where the ledger judges claims that need only those figures'
+    results (:func:`passmd.report.evaluation.claims_for`), else 0; ``partial``: 1 where the page
+    carries the partial-grid note (:func:`partial_grid_note`).
+    """
+    partial = partial_grid_note(docname, root_doc) is not None
+    return (f"figures={len(chapter_figures(docname))} ledger={int(_judges_claims(docname))} "
+            f"partial={int(partial)}")
 
 
 def _expect_every_page(app, env) -> None:
     """Compute every page's expectation once, before the writers (forked when parallel) need it."""
     for docname in env.found_docs:
-        expectation(docname)
+        expectation(docname, app.config.root_doc)
 
 
 def _add_expectation(app, pagename: str, templatename, context: dict, doctree) -> None:
     if doctree is not None:
         context["metatags"] = context.get("metatags", "") + (
-            f'<meta name="passmd-expect" content="{expectation(pagename)}" />\n')
+            f'<meta name="passmd-expect" content="{expectation(pagename, app.config.root_doc)}" />\n')
+
+
+def _add_partial_grid(app, doctree) -> None:
+    """On a build coarser than the paper profile, open every verdict-bearing page with the note of what
+    it lacks of the paper's grids (:func:`partial_grid_note`)."""
+    found = partial_grid_note(app.env.docname, app.config.root_doc)
+    page = doctree.next_node(nodes.section)
+    if found is None or page is None:
+        return
+    heading, text, items = found
+    # a long list folds under its title (which says how much is missing), so the page's own first
+    # screen stays the page's
+    folded = ["dropdown"] if len(items) > 4 else []
+    note = nodes.admonition(classes=["warning", "passmd-partial-grid", *folded])
+    note += nodes.title(text=heading)
+    note += nodes.paragraph(text=text)
+    if items:
+        listed = nodes.bullet_list()
+        for item in items:
+            listed += nodes.list_item("", nodes.paragraph(text=item))
+        note += listed
+    title = page.next_node(nodes.title)
+    page.insert(page.index(title) + 1 if title is not None and title.parent is page else 0, note)
 
 
 def _add_footer(app, config) -> None:
@@ -247,6 +310,7 @@ def setup(app):
     app.connect("source-read", _point_log_at_page)
     app.connect("doctree-resolved", _fill_tables)
     app.connect("doctree-read", _add_run_time, priority=400)  # before the page's table of contents
+    app.connect("doctree-read", _add_partial_grid, priority=400)
     app.connect("env-updated", _expect_every_page)
     app.connect("html-page-context", _add_expectation)
     app.add_node(sweep_table_placeholder)

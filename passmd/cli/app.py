@@ -10,7 +10,7 @@ import warnings
 
 import numpy as np
 
-from passmd.cli import startup
+from passmd.cli import kernels, startup
 from passmd.cli.drive import explain
 from passmd.cli.errors import OPTIONAL_EXTRAS, MissingDependencyError, OutputError, UsageError
 from passmd.cli.parser import PROG, make_parser
@@ -99,6 +99,7 @@ def main(argv=None, out=None) -> int:
     except KeyboardInterrupt as exc:  # before the command started (parsing)
         return _interrupted(PROG, exc, "")
     finally:
+        kernels.disarm()
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
         startup.resume()
@@ -128,6 +129,14 @@ def _interrupted(prog: str, exc: KeyboardInterrupt, kept: str) -> int:
     # exit at once: the interpreter's exit-time collection of numba's object graph takes ≈ 1 s
     gc.freeze()
     return 143 if isinstance(exc, Terminated) else 130
+
+
+def _numba_cache_folders() -> str:
+    """The folders numba tries for its cache, with the variable each comes from, as set."""
+    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    user = next((f"{name} = {os.environ[name]}" for name in ("NUMBA_CACHE_DIR", "XDG_CACHE_HOME", "HOME")
+                 if os.environ.get(name, "").strip()), "the user cache folder")
+    return f"the package folder {package} and the user cache folder (from {user})"
 
 
 def _error(prog: str, text: str, status: int) -> int:
@@ -162,6 +171,10 @@ def _dispatch(args, out: Out, prog: str, to_stdout: bool) -> int:  # noqa: C901 
     except (ResultError, MissingDependencyError) as exc:
         return _error(prog, str(exc), 1)
     except RuntimeError as exc:  # passmd.solver.results.SimulationError and other failed runs
+        if "no locator available" in str(exc):  # numba found no writable folder for its kernel cache
+            return _error(prog, "cannot cache the compiled simulation kernels: "
+                                f"{_numba_cache_folders()} cannot be written; set NUMBA_CACHE_DIR to a "
+                                "writable folder", 1)
         return _error(prog, f"run failed: {exc}", 1)
     except ModuleNotFoundError as exc:
         extra = OPTIONAL_EXTRAS.get((exc.name or "").split(".")[0])

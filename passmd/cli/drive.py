@@ -11,13 +11,21 @@ from __future__ import annotations
 from passmd.cli.errors import UsageError
 from passmd.cli.options import ACTUATOR_DYNAMICS, DRIVE_QUANTITIES, OPTION_FOR, QUANTITIES
 from passmd.cli.output import flyback_label, fmt
-from passmd.model.drive_file import DriveFileError, read_drive_file, resolve
+from passmd.model.drive_file import (
+    REGION_KEY,
+    SHORTEST_FLYBACK,
+    SHORTEST_FLYBACK_WHY,
+    DriveFileError,
+    read_drive_file,
+    region_values,
+    resolve,
+)
 from passmd.model.parameters import Drive
 from passmd.model.tables import FLYBACK_RULES
 from passmd.runtime.units import QuantityError, dimension_name, from_si, parse_quantity
 from passmd.runtime.validation import LIMIT_VERBS, InputError, file_message, safe_bound
 
-__all__ = ["build_drive", "drive_rows", "explain", "resolve_drive"]
+__all__ = ["build_drive", "drive_rows", "explain", "region_drives", "resolve_drive"]
 
 
 def _given(args) -> dict[str, float]:
@@ -32,6 +40,8 @@ def _check_combinations(given, args, load_cell: bool, rigid: bool) -> None:
         if dynamics:
             raise UsageError(f"{dynamics[0]} contradicts --actuator rigid: ideally rigid actuators have no "
                              "stiffness, mass or viscosity (use --actuator flexible, or drop the option)")
+    if "--actuator-viscosity" in given and "--damping-ratio" in given:
+        raise UsageError("--actuator-viscosity contradicts --damping-ratio: give one (c_p = 2ζ√(k_p m_a))")
     if "--load-cell-stiffness" in given and not load_cell:
         raise UsageError("--load-cell-stiffness has no effect here: the runner is free (no load cell); "
                          "use it with `passmd force` or `passmd run --load-cell`")
@@ -46,13 +56,33 @@ def resolve_drive(args, **fixed) -> tuple[Drive, dict[str, str]]:
     actuator of the radius, viscosity 2ζ√(k_p m_a) of the final k_p and m_a). Returns the
     drive and, by drive-file key, ``"file NAME"``, ``"option --flag"`` or the default's source.
     """
-    values, origins = {}, {}
+    return _resolve(args, _file_values(args), **fixed)
+
+
+def _file_values(args) -> dict:
+    """The values of the --drive file (none without one); its allow_extrapolation lifts the options'
+    soft limits too."""
     path = getattr(args, "drive", None)
-    if path is not None:
-        values = read_drive_file(path, allow_extrapolation=bool(getattr(args, "allow_extrapolation", False)))
-        origins = dict.fromkeys(values, f"given in {path}")
-        if values.get("allow_extrapolation") is True:
-            args.allow_extrapolation = True  # the file lifts the soft limits for the options too
+    if path is None:
+        return {}
+    values = read_drive_file(path, allow_extrapolation=bool(getattr(args, "allow_extrapolation", False)))
+    if values.get("allow_extrapolation") is True:
+        args.allow_extrapolation = True
+    return values
+
+
+def region_drives(args, **fixed) -> list[Drive]:
+    """The drives at the points of the fit's 95 % region a fitted --drive file records
+    (:func:`passmd.model.drive_file.region_values`), each with the options applied as
+    :func:`resolve_drive` applies them; none for a file without a region."""
+    return [_resolve(args, values, **fixed)[0] for values in region_values(_file_values(args))]
+
+
+def _resolve(args, values: dict, **fixed) -> tuple[Drive, dict[str, str]]:
+    """:func:`resolve_drive` from the drive file's ``values``."""
+    values = {k: v for k, v in values.items() if k != REGION_KEY}
+    path = getattr(args, "drive", None)
+    origins = dict.fromkeys(values, f"given in {path}")
     given = _given(args)
     rigid = (getattr(args, "actuator", None) or values.get("actuator_model")) == "rigid"
     _check_combinations(given, args, bool(fixed.get("load_cell", values.get("load_cell", False))), rigid)
@@ -62,6 +92,8 @@ def resolve_drive(args, **fixed) -> tuple[Drive, dict[str, str]]:
             origins[q.field] = f"option {q.flag}"
             if q.field == "actuator.viscosity":
                 values.pop("actuator.damping_ratio", None)
+            if q.field == "actuator.damping_ratio":
+                values.pop("actuator.viscosity", None)
     if getattr(args, "contacts", None) is not None:
         values["contacts"] = {1: "one", 6: "paper-six"}[args.contacts]
         origins["contacts"] = "option --contacts"
@@ -95,8 +127,9 @@ def _flyback(raw: str) -> str | float:
             raise UsageError(str(exc)) from None
         raise UsageError(f"--flyback = {raw!r} is not allowed: must be slew, fixed or a time with its unit, "
                          "e.g. 1.5us") from None
-    if not value > 0.0:
-        raise UsageError(f"--flyback = {raw!r} is out of range: must be > 0 us")
+    if not value >= SHORTEST_FLYBACK:
+        raise UsageError(f"--flyback = {raw!r} is out of range: must be >= {SHORTEST_FLYBACK * 1e6:g} us "
+                         f"({SHORTEST_FLYBACK_WHY})")
     return value
 
 
@@ -146,7 +179,25 @@ def explain(exc: ValueError, args) -> str:
     if isinstance(cause, DriveFileError):  # already names the drive file and its key as typed
         return str(cause)
     text = _rephrase(cause, args) if isinstance(cause, InputError) else None
-    return text or str(exc)
+    text = text or str(exc)
+    if isinstance(cause, InputError) and cause.name == "frequency" and "fly-back" in (cause.why or ""):
+        text += f"; the fly-back is {_flyback_source(args)}"
+    return text
+
+
+def _flyback_source(args) -> str:
+    """Where the fly-back of a run comes from, as the user gave it."""
+    if getattr(args, "flyback", None) is not None:
+        return f"--flyback {args.flyback}"
+    path = getattr(args, "drive", None)
+    if path is not None:
+        try:
+            given = read_drive_file(path, allow_extrapolation=True).get("amplifier.flyback")
+        except (DriveFileError, ValueError):
+            given = None
+        if given is not None:
+            return f"amplifier.flyback in {path}"
+    return "the slew-rate rule (A/A_max)·V_pp/SR (--slew-rate, --amplifier-voltage; or --flyback)"
 
 
 def _rephrase(exc: InputError, args) -> str | None:
@@ -158,6 +209,9 @@ def _rephrase(exc: InputError, args) -> str | None:
         if not flags:
             return None
         given = [f"{flag} {_typed(flag, args)}" for flag in flags if getattr(args, _dest(flag)) is not None]
+        if not given and getattr(args, "drive", None) is not None:  # the file's contacts, not an option
+            return (f"{args.drive}: {exc.detail} (the contacts this drive file describes: its preload, "
+                    "hemisphere_radius, materials and contact_groups)") + (f"; {lifted}" if lifted else "")
         return f"{', '.join(given or flags)}: {exc.detail}" + (f"; {lifted}" if lifted else "")
     if exc.quantity and exc.source:  # a quantity computed from one option
         flag = _flag(exc.source, args)

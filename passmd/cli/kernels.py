@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import sys
 
-__all__ = ["NOTICE", "notice_on_compile"]
+__all__ = ["NOTICE", "disarm", "notice_on_compile"]
 
 NOTICE = "compiling the simulation kernels (≈ 20 s, once) …"
 
@@ -29,8 +29,11 @@ def notice_on_compile(stream=None) -> None:
             def on_start(self, ev) -> None:
                 if self.stream is not None:
                     stream, self.stream = self.stream, None
-                    stream.write(f"passmd: {NOTICE}\n")
-                    stream.flush()
+                    try:
+                        stream.write(f"passmd: {NOTICE}\n")
+                        stream.flush()
+                    except (OSError, ValueError):  # a closed or failing stderr: the compile goes on
+                        pass
 
             def on_end(self, ev) -> None:
                 pass
@@ -38,3 +41,11 @@ def notice_on_compile(stream=None) -> None:
         _listener = Notice()
         event.register("numba:compile", _listener)
     _listener.stream = stream or sys.stderr
+
+
+def disarm() -> None:
+    """Forget the stream of the command that armed the notice, when that command returns: a
+    later compile in the same process (a caller running commands in-process) must not write to
+    a stream that belonged to a finished command, and may have been closed since."""
+    if _listener is not None:
+        _listener.stream = None

@@ -5,13 +5,18 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["eq15_rows", "hz", "missing_rows", "resolution", "ringing_notes", "ringing_rows",
-           "ringing_text", "sweep_figure", "sweep_title", "uses_eq15"]
+__all__ = ["diagnosis_rows", "eq15_rows", "hz", "missing_rows", "resolution", "ringing_notes", "ringing_text",
+           "sweep_figure", "sweep_title", "turn_rows", "uses_eq15"]
 
 
-def hz(frequency: float) -> str:
-    """A frequency as a reader writes it: ``100 Hz``, ``4.908 kHz``."""
-    return f"{frequency:.4g} Hz" if frequency < 1e3 else f"{frequency / 1e3:.4g} kHz"
+def hz(frequency: float, *, down: bool = False) -> str:
+    """A frequency as a reader writes it: ``100 Hz``, ``4.908 kHz``; ``down``: rounded down to its
+    four digits (an upper limit, which typed back must stay within it)."""
+    value, unit = (frequency, "Hz") if frequency < 1e3 else (frequency / 1e3, "kHz")
+    if down and value > 0 and math.isfinite(value):
+        step = 10.0 ** (math.floor(math.log10(value)) - 3)
+        value = math.floor(value / step * (1 + 1e-12)) * step
+    return f"{value:.4g} {unit}"
 
 
 def uses_eq15(args) -> bool:
@@ -43,50 +48,27 @@ def eq15_rows(args, table) -> list[tuple[str, str]]:
     limits = _finite(table["eq15_highest_frequency_Hz"])
     source = ", ".join(hz(f) for f in sorted(set(_finite(table["response_frequency_Hz"])))) or "–"
     varies = limits and max(limits) > min(limits)
-    spread = f" … {hz(max(limits))} (by drive and amplitude)" if varies else ""
-    fits = f"fits up to {hz(min(limits))}{spread}" if limits else "–"
+    spread = f" … {hz(max(limits), down=True)} (by drive and amplitude)" if varies else ""
+    fits = f"fits up to {hz(min(limits), down=True)}{spread}" if limits else "–"
     return [("Eq. 15 design", f"from the saw-tooth response at {source}; {fits}")]
 
 
-def ringing_rows(axes, spec, table, resolution, shown) -> list[tuple[str, str]]:
-    """The runner's ringing where it affects a sweep's values (``ringing_*`` columns of
-    :func:`passmd.protocols.maps.compute_map`), and the turns of a curve it explains.
+def turn_rows(axis, spec, table, resolution, shown, diagnosed: bool) -> list[tuple[str, str]]:
+    """Where a one-axis curve turns (changes beyond each point's ``resolution``, SI): one row, which
+    names the turns and points to the computed causes (``diagnosed``) rather than guessing one."""
+    from passmd.protocols import ringing
 
-    ``spec``: the quantity (its column, label, unit, scale); ``resolution``: each point's value
-    resolution (SI); ``shown(axis, value)``: an axis value as the sweep writes it.
-    """
-    from passmd.protocols.ringing import MEASURABLE
-
-    if "ringing_affects_steps" not in table:
+    values = table[spec.column]
+    turns = ringing.turns(values, resolution)
+    if not turns:
         return []
-    affected = [bool(v) for v in table["ringing_affects_steps"]]
-    f, a = _finite(table["ringing_frequency_Hz"]), _finite(table["ringing_amplitude_m"])
-    decay, left = _finite(table["ringing_decay_time_s"]), _finite(table["ringing_at_next_flyback_m"])
-    if not (any(affected) and f and a and left):
-        return []
-    decays = f"decaying to 1/e in {_span(decay, 1e3)} ms" if decay else \
-        "decaying by less than 1/e while recorded"
-    rows = [("runner ringing",
-             f"after each fly-back the runner rings at {_span(f, 1e-3)} kHz, ±{_span(a, 1e9)} nm, {decays}; "
-             f"at {sum(affected)} of {len(affected)} points up to ±{max(left) * 1e9:.3g} nm of it is left "
-             f"when the next fly-back starts (more than the {MEASURABLE * 1e9:g} nm measurable step), so the "
-             f"{spec.label} there depends on where in its swing the runner is")]
-    if len(axes) == 1:
-        from passmd.protocols import ringing
-
-        values = table[spec.column]
-        turns = ringing.turns(values, resolution)
-        if turns:
-            near = [k for k in (turns[0] - 1, turns[0], turns[0] + 1) if 0 <= k < len(values)]
-            where = ", ".join(f"{float(values.iloc[k]) / spec.scale:.4g} {spec.unit} at "
-                              f"{shown(axes[0], table[axes[0].column].iloc[k])}" for k in near)
-            times = f"{len(turns)} time{'s' * (len(turns) > 1)}"
-            rows.append(("not monotone",
-                         f"the {spec.label} turns {times} over {axes[0].name} ({where}); the runner still "
-                         "rings there when the next fly-back starts (above), which makes the value depend on "
-                         "its phase: the model's physics, not numerical noise (a finer grid shows more "
-                         "turns, not a smoother curve)"))
-    return rows
+    near = [k for k in (turns[0] - 1, turns[0], turns[0] + 1) if 0 <= k < len(values)]
+    where = ", ".join(f"{float(values.iloc[k]) / spec.scale:.4g} {spec.unit} at "
+                      f"{shown(axis, table[axis.column].iloc[k])}" for k in near)
+    times = f"{len(turns)} time{'s' * (len(turns) > 1)}"
+    why = ("its causes are computed below (why rows)" if diagnosed else
+           "its cause is computed where the sweep has one axis and a diagnosis (velocity, step, A_c, gain)")
+    return [("not monotone", f"the {spec.label} turns {times} over {axis.name} ({where}); {why}")]
 
 
 def _span(values, factor) -> str:
@@ -106,7 +88,7 @@ def resolution(spec, frequencies) -> list[float]:
     return [delta * float(f) for f in frequencies] if spec.unit == "mm/s" else [0.0] * len(frequencies)
 
 
-def ringing_text(ring: dict, what: str) -> str:
+def ringing_text(ring: dict, what: str, *, diagnosed: bool = False) -> str:
     """One line on the runner's ringing after a fly-back (:func:`passmd.protocols.ringing.at_frequency`)
     and whether it is still there, beyond the measurable step, when the next fly-back starts;
     ``what``: the answer it affects (e.g. ``"the step"``)."""
@@ -117,10 +99,18 @@ def ringing_text(ring: dict, what: str) -> str:
     decay = ring["ringing_decay_time_s"]
     decays = f"decaying to 1/e in {decay * 1e3:.3g} ms" if decay is not None and math.isfinite(decay) else \
         "decaying by less than 1/e while recorded"
-    text = (f"after a fly-back the runner rings at {ring['ringing_frequency_Hz'] / 1e3:.3g} kHz, "
+    linear = ring.get("ringing_linear_frequency_Hz")
+    estimate = ""
+    if linear is not None and math.isfinite(linear):
+        estimate = (" (the linear estimate, each contact in series with its actuator: "
+                    f"{linear / 1e3:.3g} kHz; the first swings micro-slip)")
+    text = (f"after a fly-back the runner rings at {ring['ringing_frequency_Hz'] / 1e3:.3g} kHz{estimate}, "
             f"±{ring['ringing_amplitude_m'] * 1e9:.3g} nm, {decays}; "
             f"±{ring['ringing_at_next_flyback_m'] * 1e9:.3g} nm is left when the next fly-back starts "
             f"{ring['next_flyback_after_s'] * 1e3:.3g} ms later")
+    if ring["ringing_affects_steps"] and diagnosed:
+        return (f"{text}, more than the {MEASURABLE * 1e9:g} nm measurable step; how much it moves {what} is "
+                "computed below (runner ringing)")
     if ring["ringing_affects_steps"]:
         return (f"{text}, more than the {MEASURABLE * 1e9:g} nm measurable step: {what} depends on where in "
                 "its swing the runner is then, so it is not monotone in frequency, amplitude or preload (the "
@@ -134,8 +124,10 @@ def ringing_notes(table) -> list[str]:
         return []
     left = max(_finite(table["ringing_at_next_flyback_m"]))
     f = _span(_finite(table["ringing_frequency_Hz"]), 1e-3)
-    return [f"values depend on the runner's ringing ({f} kHz): up to ±{left * 1e9:.3g} nm of it is left\n"
-            "at the next fly-back, so turns of the curve are the model's physics, not noise"]
+    count = sum(bool(v) for v in table["ringing_affects_steps"])
+    return [f"at {count} of {len(table)} points up to ±{left * 1e9:.3g} nm of the runner's swing ({f} kHz) "
+            "is left at\nthe next fly-back: a value there can depend on its phase (the causes of a turn: "
+            "passmd sweep's output)"]
 
 
 def sweep_figure(args, axes, spec, table, title):
@@ -148,6 +140,10 @@ def sweep_figure(args, axes, spec, table, title):
     value = MapAxis(spec.column, f"{spec.label}{reading}", spec.unit, scale=spec.scale)
     also = [MapAxis(c, "closed form (Eqs. 7–8, 11–12)" if c.startswith("analytic") else c, spec.unit,
                     scale=spec.scale) for c in spec.also]
+    if "running_max_critical_amplitude_m" in table:
+        also.append(MapAxis("running_max_critical_amplitude_m",
+                            f"moves the runner at every {axes[0].name} up to here (running maximum)",
+                            spec.unit, scale=spec.scale))
     from passmd.model.defaults import PROTOCOL
 
     step = f"{PROTOCOL.step_threshold * 1e9:g} nm" + ("" if spec.unit == "nm" else " × f")
@@ -159,7 +155,17 @@ def sweep_figure(args, axes, spec, table, title):
                        resolution_label=f"|value| below the measurable step ({step}): no measurable "
                        + ("difference" if args.quantity == "gain" else "motion"))
     return map_figure(table, shown, value, title, also=also if len(axes) == 1 else (), marks=marks,
-                      notes=ringing_notes(table))
+                      notes=ringing_notes(table), color_scale=getattr(args, "color_scale", "auto"),
+                      band=_band(spec, table))
+
+
+def _band(spec, table):
+    """The fitted drive's band of a sweep (:func:`passmd.cli.sweep_rows.add_band`), for the figure."""
+    low, high = f"{spec.column}_band_low", f"{spec.column}_band_high"
+    if low not in table:
+        return None
+    return low, high, (f"fit's 95 % region ({table.attrs.get('band_points', 0)} points of it and the "
+                       "estimate)")
 
 
 def sweep_title(spec, axes, drive) -> str:
@@ -168,3 +174,44 @@ def sweep_title(spec, axes, drive) -> str:
 
     varied = [a.name for a in axes]
     return f"{spec.label} over {' × '.join(varied)}\n{describe(drive, omit=varied)}"
+
+
+def _value_text(value, unit: str, scale: float | None = None) -> str:
+    from passmd.cli.output import fmt
+
+    if value is None:
+        return "none"
+    return f"{value / scale:.4g} {unit}" if scale is not None else fmt(value, unit)
+
+
+def diagnosis_rows(found: dict, symptom: str, unit: str, what: str, *,
+                   scale: float | None = None) -> list[tuple[str, str]]:
+    """The computed "why" of a departure (:func:`passmd.protocols.diagnosis.diagnose`): the symptom,
+    each cause's counterfactual value and share, best explanation first, and the causes it names.
+    ``unit``: the display unit of the values (``scale``: the SI value of one unit, else the unit's own);
+    ``what``: the result's name (``"A_c"``)."""
+    from passmd.protocols.diagnosis import EXPLAINS
+
+    rows = [("why (computed)", f"{symptom}; re-run with one candidate cause removed at a time:")]
+    for c in found["causes"]:
+        if c["share"] is None:
+            state = "no value" if c.get("tried") else "not tried"
+            rows.append((f"  {c['cause']}", f"{state}: {c['changed']}"))
+            continue
+        values = c["counterfactual_values"]
+        at = (f"{what} = {_value_text(values[-1], unit, scale)}" if len(values) == 1 else
+              f"{what} = {' → '.join(_value_text(v, unit, scale) for v in values)}")
+        closed = "" if c.get("counterfactual_expected") is None or c["key"] != "actuator" else \
+            f" (its closed form, Eq. 7/11: {_value_text(c['counterfactual_expected'], unit, scale)})"
+        why = f": {c['why']}" if c.get("why") else ""
+        past = (" (past what is expected: a cause acting the other way remains)"
+                if c["share"] > 2 - EXPLAINS else "")
+        rows.append((f"  {c['cause']}", f"{100 * c['share']:.0f} % of it{past}: with {c['changed']} {at}"
+                     f"{closed}{why}"))
+    named = found["named"]
+    which = "it" if len(named) == 1 else "each"
+    rows.append(("cause", ", ".join(named) + f" (removing {which} takes away at "
+                 f"least {100 * EXPLAINS:.0f} % of the departure)" if named else
+                 f"none of the candidates: removing each takes away less than {100 * EXPLAINS:.0f} % of the "
+                 "departure"))
+    return rows

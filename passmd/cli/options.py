@@ -11,6 +11,7 @@ Its default text is computed from the defaults it stands for (:data:`DEFAULT_DRI
 from __future__ import annotations
 
 import argparse
+import re
 from dataclasses import dataclass
 
 from passmd.cli.output import JSON_HELP, fmt
@@ -20,7 +21,7 @@ from passmd.model.tables import ACTUATOR_DAMPING_RATIO
 from passmd.runtime.cache import describe_default_cache_dir
 from passmd.runtime.config import ENVIRONMENT, MAX_WORKERS, WORKERS_PER_CORE
 from passmd.runtime.units import parse_quantity, si_factor, to_display
-from passmd.runtime.validation import check_range
+from passmd.runtime.validation import InputError, check_range
 
 __all__ = ["ACTUATOR_DYNAMICS", "AMPLITUDE", "CACHE_DIR_HELP", "DEFAULT_DRIVE", "DRIVE_QUANTITIES",
            "FREQUENCY", "MATERIAL_FLAGS", "NORMAL_FORCE", "OPTION_FOR", "QUANTITIES", "THRESHOLD",
@@ -64,21 +65,44 @@ class Quantity:
         if raw is None:
             return None
         value = parse_quantity(raw, self.unit, name=self.flag)
-        if self.plausible is not None:
-            scale = si_factor(self.unit)
-            PLAUSIBLE_RANGES[self.plausible].check(
-                self.flag, value, allow_extrapolation=bool(getattr(args, "allow_extrapolation", False)),
-                flag=self.flag, scale=scale, unit=self.unit, hint="--allow-extrapolation")
-            return value
-        shown = to_display(value, self.unit)  # the parsed value itself, in the unit shown
-        check_range(self.flag, shown, self.lower, self.upper, lower_open=self.lower_open,
-                    upper_open=self.upper_open, unit=self.unit or "–")
+        try:
+            if self.plausible is not None:
+                scale = si_factor(self.unit)
+                PLAUSIBLE_RANGES[self.plausible].check(
+                    self.flag, value, allow_extrapolation=bool(getattr(args, "allow_extrapolation", False)),
+                    flag=self.flag, scale=scale, unit=self.unit, hint="--allow-extrapolation")
+                return value
+            shown = to_display(value, self.unit)  # the parsed value itself, in the unit shown
+            check_range(self.flag, shown, self.lower, self.upper, lower_open=self.lower_open,
+                        upper_open=self.upper_open, unit=self.unit or "–")
+        except InputError as exc:
+            raise _as_typed(exc, self.flag, str(raw), value) from None
         return value
 
     def parse_or(self, args, default: float) -> float:
         """SI value of the option, ``default`` if not given."""
         value = self.parse(args)
         return default if value is None else value
+
+
+def _as_typed(exc: InputError, flag: str, typed: str, value: float) -> InputError:
+    """``exc`` naming the value as the user typed it (``1mHz``, not its display ``1e-06 kHz``; ``1e-400``,
+    not the 0 it reads as), the parsed value beside it where the two differ."""
+    head = f"{flag} = "
+    text = str(exc)
+    if not text.startswith(head) or " is out of range" not in text:
+        return exc
+    shown = text[len(head):text.index(" is out of range")]
+    number = re.match(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$", typed)
+    if value == 0.0 and number and float(number.group(1).replace("e", "E").split("E")[0] or 0) != 0.0:
+        note = " (below the smallest number a double holds: it reads as 0)"
+    elif number and number.group(2) and " " in shown and shown.partition(" ")[2] != number.group(2):
+        # typed in another unit than the one shown (1mHz against kHz)
+        note = f" (= {shown})"
+    else:
+        return exc  # shown in the unit typed already
+    return InputError(f"{head}{typed}{note}{text[text.index(' is out of range'):]}", name=exc.name,
+                      value=exc.value, unit=exc.unit, limits=exc.limits, why=exc.why, soft=exc.soft)
 
 
 _ACT = DEFAULT_DRIVE.actuator
@@ -117,6 +141,9 @@ DRIVE_QUANTITIES = (
     Quantity("--actuator-viscosity", "kg/s", "c_p", "actuator viscosity",
              f"2ζ√(k_p m_a) with ζ = {ACTUATOR_DAMPING_RATIO:g}, {fmt(_ACT.viscosity, 'kg/s')} {_AT_R}",
              0.0, False, field="actuator.viscosity"),
+    Quantity("--damping-ratio", "", "zeta", "damping ratio of the bare actuator, c_p = 2ζ√(k_p m_a) (or give "
+             "--actuator-viscosity)", f"{ACTUATOR_DAMPING_RATIO:g}", plausible="actuator.damping_ratio",
+             field="actuator.damping_ratio"),
     Quantity("--full-stroke-amplitude", "nm", "A_max", "actuation amplitude at the full voltage",
              f"Table 2 for --radius, {fmt(_ACT.full_stroke_amplitude, 'nm')} {_AT_R}",
              plausible="actuator.full_stroke_amplitude", field="actuator.full_stroke_amplitude"),
@@ -127,7 +154,7 @@ DRIVE_QUANTITIES = (
              plausible="amplifier.slew_rate", field="amplifier.slew_rate"),
 )
 #: Options of the actuators' dynamics, which rigid actuators do not have.
-ACTUATOR_DYNAMICS = ("--actuator-stiffness", "--actuator-mass", "--actuator-viscosity")
+ACTUATOR_DYNAMICS = ("--actuator-stiffness", "--actuator-mass", "--actuator-viscosity", "--damping-ratio")
 MATERIAL_FLAGS = ("--hemisphere-modulus", "--hemisphere-poisson", "--runner-modulus", "--runner-poisson")
 
 AMPLITUDE = Quantity("--amplitude", "nm", "A", "actuation amplitude",

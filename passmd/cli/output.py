@@ -13,9 +13,11 @@ from pathlib import Path
 
 import numpy as np
 
-from passmd.cli.errors import OutputError, UsageError
+from passmd.cli.errors import UsageError
 from passmd.cli.result_bounds import ResultError
+from passmd.cli.streams import replaced_in
 from passmd.model.parameters import Drive
+from passmd.runtime.outputs import check_writable
 from passmd.runtime.units import from_si
 
 __all__ = ["JSON_HELP", "check_output_file", "check_results", "describe", "drive_record", "emit_json",
@@ -25,13 +27,21 @@ JSON_HELP = "print one JSON object (SI units) instead (default: off)"
 
 
 def check_output_file(flag: str, name: str) -> None:
-    """An output option names a file (not a directory) in an existing directory (before running)."""
+    """An output option names a file (not a directory) in an existing directory (before running:
+    :class:`UsageError`, exit 2)."""
     target = Path(name)
     if target.is_dir():
         raise UsageError(f"{flag} = {name!r} is a directory: give a file name")
     parent = target.parent if str(target.parent) else Path(".")
     if not parent.is_dir():
-        raise OutputError(f"cannot write {flag} {name}: directory {str(parent)!r} does not exist")
+        raise UsageError(f"cannot write {flag} {name}: directory {str(parent)!r} does not exist")
+    folder = replaced_in(name)
+    if folder is not None:  # a regular file (new or replaced) is made in its real folder: probe it
+        try:
+            check_writable(folder)
+        except OSError as exc:
+            raise UsageError(f"cannot write {flag} {name}: cannot create files in {folder}: "
+                             f"{exc.strerror or exc}") from None
 
 
 def fmt(value_si: float, unit: str) -> str:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 
 from passmd import __version__
@@ -38,8 +39,19 @@ keys carry the unit (e.g. final_position_m)."""
 COMMANDS = (theory, critical_amplitude, run, force, sweep, fit, contact, drive, figure, cache, ledger)
 
 
+#: A command-line token that is a negative value, with or without a unit (``-1us``, ``-.5``, ``-2e-3N``).
+_NEGATIVE_VALUE = re.compile(r"^-\.?\d")
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors (no usage dump) and exit status 2."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        # A value that starts with a minus and a digit (--flyback -1us, --mu -0.2) is the option's
+        # value, refused by its range check with the option named; argparse reads only plain
+        # negative numbers so, and would say "expected one argument".
+        self._negative_number_matcher = _NEGATIVE_VALUE
 
     def error(self, message):  # noqa: D401 - argparse API
         self.exit(2, f"{self.prog}: error: {message}\n")

@@ -13,6 +13,10 @@
   input, or the regular file standard output or error goes to.
 * :func:`write_atomically` writes an output file completely or not at all, and never
   replaces what is not a regular file (a link stays a link, a device or pipe is written to).
+* :func:`check_new_outputs` and :func:`create_outputs`: the files a command names itself
+  (``fit --out DIR``, ``sweep --out PREFIX``) are checked absent and their folder writable before
+  any work, then created all together or not at all, never over a file
+  (:mod:`passmd.runtime.outputs`).
 """
 
 from __future__ import annotations
@@ -25,10 +29,12 @@ import stat
 import sys
 import tempfile
 
-from passmd.cli.errors import UsageError
+from passmd.cli.errors import OutputError, UsageError
+from passmd.runtime import outputs
 
-__all__ = ["Out", "PipeClosed", "StdoutError", "available_memory", "check_outputs", "one_line_warnings",
-           "reserve_closed_streams", "silence_stdout", "use_ascii_fallback", "write_atomically"]
+__all__ = ["Out", "PipeClosed", "StdoutError", "available_memory", "check_new_outputs", "check_outputs",
+           "create_outputs", "one_line_warnings", "reserve_closed_streams", "silence_stdout",
+           "use_ascii_fallback", "write_atomically"]
 
 #: ASCII stand-ins for the symbols of the human output (consoles that cannot encode them).
 _ASCII = {"μ": "mu", "µ": "u", "×": "x", "–": "-", "—": "-", "…": "...", "→": "->", "≈": "~",
@@ -98,10 +104,22 @@ def one_line_warnings(prog: str):
     """``warnings.showwarning`` printing ``prog: warning: message`` on one line."""
 
     def show(message, category, filename, lineno, file=None, line=None):
-        text = " ".join(str(message).split())
+        text = _cache_origin(" ".join(str(message).split()))
         sys.stderr.write(f"{prog}: warning: {text}\n")
 
     return show
+
+
+def _cache_origin(text: str) -> str:
+    """A warning about the user cache folder, with the variable that folder comes from as set
+    (``XDG_CACHE_HOME``, else ``HOME``, where platformdirs reads them)."""
+    if "(the user cache folder;" not in text or sys.platform in ("win32", "darwin"):
+        return text
+    for name in ("XDG_CACHE_HOME", "HOME"):
+        value = os.environ.get(name, "").strip()
+        if value:
+            return text.replace("(the user cache folder;", f"(the user cache folder, from {name} = {value};")
+    return text
 
 
 def silence_stdout() -> None:
@@ -247,6 +265,12 @@ def _replaceable(path) -> str | None:
     return os.path.realpath(path) if stat.S_ISREG(mode) else None
 
 
+def replaced_in(path) -> str | None:
+    """The folder :func:`write_atomically` makes ``path``'s new file in, or None (written into)."""
+    target = _replaceable(path)
+    return None if target is None else os.path.dirname(target)
+
+
 def write_atomically(path, write) -> None:
     """Call ``write(temporary_path)``, then put the complete file at ``path`` without destroying anything.
 
@@ -287,3 +311,45 @@ def write_atomically(path, write) -> None:
     finally:
         if folder is not None:
             shutil.rmtree(folder, ignore_errors=True)
+
+
+def check_new_outputs(option: str, paths, folder=None) -> None:
+    """Before any work (:class:`UsageError`, exit 2): none of ``paths`` exists (not even as a dangling
+    link) and files can be created in ``folder`` (default: the first path's; a folder the run will
+    create is probed in its parent). ``option`` is the option as typed (``"--out results"``)."""
+    paths = [os.fspath(p) for p in paths]
+    for path in paths:
+        try:
+            outputs.check_absent(path)
+        except outputs.OutputExists:
+            raise UsageError(f"{option}: {path} is already there: choose another name (the outputs are "
+                             "created new, never over a file)") from None
+    folder = os.fspath(folder) if folder is not None else os.path.dirname(paths[0]) or "."
+    probe = folder
+    if not os.path.lexists(folder):  # created by the run: one level, in an existing directory
+        probe = os.path.dirname(os.path.abspath(folder))
+        if not os.path.isdir(probe):
+            raise UsageError(f"{option}: the directory {probe!r} does not exist")
+    elif not os.path.isdir(folder):
+        raise UsageError(f"{option}: {folder} is not a directory")
+    try:
+        outputs.check_writable(probe)
+    except OSError as exc:
+        raise UsageError(f"{option}: cannot create files in {probe}: {exc.strerror or exc}") from None
+
+
+def create_outputs(option: str, writers) -> None:
+    """Create every file of ``writers`` (path -> ``write(temporary_path)``) all together or not at all
+    (:func:`passmd.runtime.outputs.create_exclusively`): a file that appeared meanwhile (another run)
+    is kept and refused (:class:`UsageError`, exit 2), a failed write names its file
+    (:class:`OutputError`, exit 1); either way none of this run's files is left."""
+    try:
+        outputs.create_exclusively(writers)
+    except outputs.OutputExists as exc:
+        raise UsageError(f"{option}: {exc.filename} appeared while this run was writing (another run?): "
+                         "it is kept, and this run wrote none of its files") from None
+    except BrokenPipeError as exc:
+        raise PipeClosed() from exc
+    except OSError as exc:
+        raise OutputError(f"cannot write {exc.filename or option} ({option}): {exc.strerror or exc}; none of "
+                          "the run's files was written") from None

@@ -24,8 +24,9 @@ from passmd.experiments import FigureSpec, ReadingTable
 from passmd.runtime.config import RunConfig
 
 __all__ = [
-    "CHAPTERS", "CLAIM_MODULES", "FIGURES", "READING_TABLES", "FigureSpec", "ReadingTable", "chapter_modules",
-    "figure_data", "figure_names", "figure_plot", "figure_spec",
+    "CHAPTERS", "CLAIM_MODULES", "FIGURES", "GRIDS", "READING_TABLES", "FigureSpec", "ReadingTable",
+    "chapter_modules", "figure_data", "figure_names", "figure_plot", "figure_spec", "figures_read",
+    "grid_shortfall",
 ]
 
 #: The book chapters that compute something, in the book's order (``book/_toc.yml``): each is a
@@ -52,6 +53,12 @@ FIGURES: tuple[FigureSpec, ...] = tuple(
 #: ``figures.py``.
 READING_TABLES: dict[str, ReadingTable] = {
     spec.key: spec for module in chapter_modules("figures") for spec in getattr(module, "READING_TABLES", ())}
+
+#: Every figure whose grid depends on the profile, by name: profile -> {axis: values}, the ``GRIDS`` of
+#: each chapter's ``figures.py``, built from the same settings as the figure's compute function. A
+#: figure computed alike on every profile has no entry.
+GRIDS: dict = {name: grid for module in chapter_modules("figures")
+               for name, grid in getattr(module, "GRIDS", {}).items()}
 
 #: The experiment modules whose functions carry claim extractors (Sections 4.1, 4.2, 5): every
 #: chapter's ``claims.py``.
@@ -83,3 +90,44 @@ def figure_data(name: str, config: RunConfig) -> pd.DataFrame:
 def figure_plot(name: str, data: pd.DataFrame):
     """Draw one figure panel from its data; returns a matplotlib Figure."""
     return figure_spec(name).plot_function()(data)
+
+
+def figures_read(keys) -> list[str]:
+    """The figures behind result keys (figure names, or reading tables and the figures they read), in
+    the book's order; keys that are neither (e.g. ``closed_forms``) name no figure."""
+    names = set()
+    for key in keys:
+        if key in READING_TABLES:
+            names.update(READING_TABLES[key].figures)
+        elif key in _BY_NAME:
+            names.add(key)
+    return [name for name in figure_names() if name in names]
+
+
+def _key(value):
+    """A grid value as a comparable key: numbers to 6 significant digits, tuples element by element."""
+    if isinstance(value, tuple):
+        return tuple(_key(v) for v in value)
+    return value if isinstance(value, str) else f"{value:.6g}"
+
+
+def _points(grid: dict) -> set:
+    """The grid points of one figure on one profile: the product of its axes (:func:`_key` of each value)."""
+    import itertools
+
+    return set(itertools.product(*([_key(v) for v in values] for values in grid.values())))
+
+
+def grid_shortfall(names, profile: str, reference: str = "paper") -> pd.DataFrame:
+    """How much of ``reference``'s grids the ``profile`` lacks for the figures ``names``: one row per
+    figure with a profile-dependent grid (:data:`GRIDS`): ``figure``, ``axes`` (their names),
+    ``points`` (on ``profile``), ``reference_points`` and ``missing`` (points of ``reference`` that
+    ``profile`` does not compute)."""
+    rows = []
+    for name in names:
+        if name not in GRIDS:
+            continue
+        here, there = _points(GRIDS[name](profile)), _points(GRIDS[name](reference))
+        rows.append({"figure": name, "axes": " × ".join(GRIDS[name](reference)), "points": len(here),
+                     "reference_points": len(there), "missing": len(there - here)})
+    return pd.DataFrame(rows, columns=["figure", "axes", "points", "reference_points", "missing"])

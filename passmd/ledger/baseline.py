@@ -1,6 +1,6 @@
 """The ledger's regression baselines: each claim's category on a profile, with the readings it was
-computed at, its state at each of them and the reading its category was judged at besides the
-defaults (``tests/ledger_baseline_<profile>.csv``).
+computed at, its state at each of them, the reading its category was judged at (its held-out
+reading) and its reading at the in-sample joint reading (``tests/ledger_baseline_<profile>.csv``).
 
 :func:`write_baseline` records an evaluated ledger (:func:`passmd.report.evaluation.evaluate`),
 :func:`load_baseline`, :func:`load_baseline_readings` and :func:`load_baseline_states` read one back,
@@ -59,31 +59,33 @@ def load_baseline_readings(path) -> dict[str, tuple[str, ...]]:
 
 
 def load_baseline_states(path) -> dict[str, dict]:
-    """``{claim id: {"states": {reading: state}, "joint": reading}}`` recorded in a baseline CSV: the
-    claim's state (``holds``, ``fails``, ``inconclusive``) at each of its readings and the reading of
-    its design its category was judged at besides the defaults (the joint reading's projection).
+    """``{claim id: {"states": {reading: state}, "held_out": reading, "joint": reading}}`` recorded in a
+    baseline CSV: the claim's state (``holds``, ``fails``, ``inconclusive``) at each of its readings, the
+    reading its category was judged at (held out) and its reading at the in-sample joint reading.
     Empty when the baseline records no states."""
     table = _read(path)
     if "states" not in table:
         return {}
     names = {letter: state for state, letter in STATE_LETTERS.items()}
+    held = table["held_out"] if "held_out" in table else table["joint"]
     return {claim: {"states": dict(zip(text.split(READINGS_SEPARATOR), (names[c] for c in letters),
-                                       strict=True)), "joint": joint}
-            for claim, text, letters, joint in zip(table["claim"], table["readings"], table["states"],
-                                                   table["joint"], strict=True)}
+                                       strict=True)), "held_out": h, "joint": joint}
+            for claim, text, letters, h, joint in zip(table["claim"], table["readings"], table["states"],
+                                                      held,
+                                                      table["joint"], strict=True)}
 
 
 def write_baseline(evaluated: pd.DataFrame, path, header: str = "") -> None:
-    """Write the claims' categories as a baseline CSV (``claim,status,readings,states,joint``),
+    """Write the claims' categories as a baseline CSV (``claim,status,readings,states,held_out,joint``),
     atomically.
 
     ``readings`` lists the readings each category was computed at (from the row's
     ``depends_on``), so that two baselines are compared only where they evaluated the same
     readings; ``states`` the claim's state at each
-    (:data:`passmd.ledger.baseline.STATE_LETTERS`, from the table's ``points``), ``joint`` the
-    reading of them its category was judged at besides the defaults (the joint reading's
-    projection; ``defaults`` for a study). ``header`` (e.g. the command and date that produced it)
-    is written as ``#`` lines.
+    (:data:`passmd.ledger.baseline.STATE_LETTERS`, from the table's ``points``), ``held_out`` the
+    reading of them its category was judged at (``defaults`` for a study) and ``joint`` its reading at
+    the in-sample joint reading. ``header`` (e.g. the command and date that produced it) is written as
+    ``#`` lines.
     """
     path = Path(path)
     table = evaluated[["claim", "status"]].copy()
@@ -92,9 +94,8 @@ def write_baseline(evaluated: pd.DataFrame, path, header: str = "") -> None:
     states = {(p["claim"], p["reading"]): p["state"] for p in evaluated.attrs.get("points", [])}
     table["states"] = ["".join(STATE_LETTERS[states.get((claim, r), "inconclusive")] for r in readings_of(d))
                        for claim, d in zip(evaluated["claim"], depends, strict=True)]
-    joint = evaluated.attrs.get("joint", {}).get("reading")
-    table["joint"] = [readings.describe(readings.project(joint, d)) if joint and not study else "defaults"
-                      for d, study in zip(depends, evaluated["study_of"].astype(bool), strict=True)]
+    table["held_out"] = [r if r != "—" else "defaults" for r in evaluated["held_out_reading"]]
+    table["joint"] = [r if r != "—" else "defaults" for r in evaluated["joint_reading"]]
     tmp = path.with_name(f".{path.name}.tmp")
     with open(tmp, "w", encoding="utf-8", newline="") as fh:
         for line in header.splitlines():

@@ -29,10 +29,12 @@ __all__ = [
     "CLAIM_ID",
     "CONFIGURATION_COLUMNS",
     "RELATIONS",
+    "REPRODUCED",
     "STATUSES",
     "TOLERANCE_KINDS",
     "is_number",
     "is_study",
+    "family_of",
     "load_claims",
     "required_keys",
     "tolerance_text",
@@ -47,7 +49,8 @@ CLAIM_COLUMNS = (
     "contacts", "actuator_model", "radius_mm", "preload_N", "friction_coefficient",
     "amplitude_nm", "frequency_Hz", "waveform", "assumed",
     "paper_value", "unit", "reference", "check", "relation", "tolerance", "tolerance_kind",
-    "tolerance_reason", "source_section", "source_quote", "study_of", "notes", "reason",
+    "tolerance_reason", "source_section", "source_quote", "study_of", "notes", "reason", "implied_by",
+    "compares",
 )
 #: The columns that state the configuration a claim is about.
 CONFIGURATION_COLUMNS = (
@@ -67,12 +70,17 @@ RELATIONS = {
 }
 #: A tolerance is relative (a fraction) or absolute (in the claim's unit).
 TOLERANCE_KINDS = ("rel", "abs")
-#: Verdict classes, in the order the summary lists them.
-STATUSES = ("reproduced", "reproduced under the joint reading", "not reproduced", "inconclusive")
+#: Verdict classes, in the order the summary lists them (``passmd.ledger.verdicts.category`` says when
+#: each applies): the first two are the reproduced ones; a row whose check cannot fail on any result the model
+#: can produce holds *by construction* and is never counted as reproduced.
+STATUSES = ("reproduced", "reproduced under the joint reading", "holds by construction", "not reproduced",
+            "inconclusive")
+#: The categories that count as reproduced.
+REPRODUCED = STATUSES[:2]
 #: A claim id: a slug of lower-case letters, digits, '.', '_' and '-'.
 CLAIM_ID = re.compile(r"^[a-z0-9][a-z0-9._-]*$")
 
-_FIGURE_KEY = re.compile(r"^(fig\d+[a-z_]*|closed_forms)$")
+_FIGURE_KEY = re.compile(r"^(fig\d+[a-z_]*|mdr_[a-z_]+|closed_forms)$")
 _NUMBER = r"[-+]?(\d+(\.\d*)?|\.\d+)([eE][-+]?\d+)?"
 _CONFIG_VALUE = re.compile(rf"^({_NUMBER}(;{_NUMBER})*|{_NUMBER}:{_NUMBER}(:{_NUMBER})?|grid)$")
 _WORDS = {"actuator_model": ("rigid", "flexible"), "waveform": ("sawtooth", "optimized")}
@@ -145,12 +153,21 @@ def _row_errors(row: Mapping[str, str], reference_dir: Path) -> list[str]:
         errors.append("paper_value is empty: a threshold claim needs the threshold x")
     if kind in ("ordering", "trend") and row["paper_value"]:
         bad("paper_value", f"empty for a {kind} claim")
+    compares = [p.strip() for p in row["compares"].split("|")] if row["compares"] else []
+    if compares and (kind != "ordering" or len(compares) != 2 or not all(compares)):
+        bad("compares", "'<lhs> | <rhs>' (what the two sides are) for an ordering claim, else empty")
     return errors
 
 
 def required_keys(row: Mapping) -> list[str]:
     """The result keys a claims.csv row reads: its ``requires``, ``;``-separated."""
     return [key for key in str(row["requires"]).split(";") if key]
+
+
+def family_of(row: Mapping[str, str]) -> str:
+    """The claim whose family a claims.csv row belongs to: its ``implied_by``, else its own id (a row
+    implied by another is counted with it, once)."""
+    return str(row.get("implied_by", "") or "") or str(row["id"])
 
 
 def is_study(row: Mapping[str, str]) -> bool:
@@ -212,6 +229,12 @@ def load_claims(path=None) -> pd.DataFrame:
             errors.append(f"row {row['id']!r}: study_of = {target!r} is not allowed: must name a claim of "
                           "this file that is not a study, and a study quotes no sentence (source_quote "
                           "empty)")
+        lead = row["implied_by"]
+        leads = set(claims.loc[(claims["study_of"] == "") & (claims["implied_by"] == ""), "id"])
+        if lead and (target or lead == row["id"] or lead not in leads):
+            errors.append(f"row {row['id']!r}: implied_by = {lead!r} is not allowed: must name another claim "
+                          "of this file that is neither a study nor implied by a third, and a study is "
+                          "implied by none")
     if errors:
         raise ValueError(f"{path.name} has {len(errors)} schema error(s):\n  " + "\n  ".join(errors))
     claims["paper_value_num"] = pd.to_numeric(claims["paper_value"].replace("", np.nan))

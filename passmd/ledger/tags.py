@@ -23,6 +23,7 @@ __all__ = [
     "NO_MEASURED_DATA",
     "ClaimFails",
     "ClaimFunctions",
+    "CoarseGrid",
     "ExtractorError",
     "Inconclusive",
     "NoRun",
@@ -48,6 +49,12 @@ class NotEvaluable(Exception):
 
 #: The name the verdict taxonomy uses for :class:`NotEvaluable`.
 Inconclusive = NotEvaluable
+
+
+class CoarseGrid(NotEvaluable):
+    """Raised by an extractor when its table lacks grid points of the paper's grid that could decide the
+    claim (a coarser profile): the claim is inconclusive at that reading *because of the grid*, where the
+    paper profile may decide it (the coarse-grid rule of :mod:`passmd.ledger.rules`)."""
 
 
 class NoRun(NotEvaluable):

@@ -17,6 +17,24 @@ which hemisphere radius; its normal force per contact is given (``normal_force``
 ``load_share`` × F_p) or follows from the side's balance (Eq. 1). Whatever is given, the
 groups of each side must balance the preload, Σ n_g F_N,g sin α_g = F_p
 (:func:`check_balance`); a drive whose groups do not is refused.
+
+The guide's statics have a second, sideways component. A contact at α < 90° pushes the runner
+sideways with F_N cos α, towards the flank of the groove it sits on; the paper's V-grooves put
+half of each side's contacts on either flank, so their sideways forces cancel. A group's contacts
+may sit on either flank, so a side is balanced sideways when some placement of its contacts on
+the two flanks cancels Σ ± F_N cos α (:func:`side_lateral`: the least force any placement leaves);
+one contact at 30° cannot be balanced, nor three at 60° with equal forces. Such a drive is refused
+unless its guide has a rail that takes the sideways force (``guide_rail``, which the model assumes
+adds no friction along the travel), and so is a drive whose contacts all press on one side (the
+other side then carries nothing of the preload); the paper's one-contact model is the preset
+``contacts = 1`` (:data:`ONE_CONTACT`), a reduced model of one side, not an arrangement.
+
+Angles, looking along the travel (the runner ▭ between its two sides, the preload ↓ along
+the line through them)::
+
+        side 2 (preloaded holder)     ↓ F_p
+      ──◣ α ───── ▭ ───── α ◢──        a contact's tangent plane makes α with the preload's line:
+        side 1 (fixed holder)          90° a flat guide (no sideways force), 45° the paper's V-groove
 """
 
 from __future__ import annotations
@@ -38,9 +56,11 @@ __all__ = [
     "SIDES",
     "ContactGroup",
     "check_balance",
+    "check_sides",
     "group_normal_forces",
     "group_sides",
     "preset_groups",
+    "side_lateral",
     "side_loads",
 ]
 
@@ -59,7 +79,7 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
         value=("contact angle α = 90° (flat guide) unless given; one group: side 1; two groups: sides 1 "
                "and 2; the contacts of a side whose force is not given share what the given ones leave "
                "of F_p with equal normal force"),
-        unit="°",
+        unit="",
         rationale=("Eq. 1 holds for the paper's arrangement (two contacts at 45° on one side, four at 45° "
                    "on the other). For another guide the same statics apply: each side of the runner "
                    "carries F_p along the preload's line, a contact at angle α carries F_N sin α of it, "
@@ -67,6 +87,21 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
                    "settles what statics alone leave open."),
         sensitivity=("A designer's arrangement only; the paper's (contacts = 1 or 6) is Eq. 1 exactly. "
                      "`passmd drive show` lists each group's side, angle and normal force."),
+    ),
+    Assumption(
+        key="guide_rail",
+        symbol="–",
+        value=("contacts at α < 90° sit on the groove's two flanks as evenly as their sideways forces "
+               "allow; a sideways force no placement cancels is refused unless guide_rail = true, whose "
+               "rail adds no friction along the travel"),
+        unit="–",
+        rationale=("The paper's V-grooves hold half of each side's contacts on either flank, so the "
+                   "sideways forces F_N cos α cancel and the runner needs no other guide. An arrangement "
+                   "whose sideways forces cannot cancel needs something else to take them; the model is "
+                   "one-dimensional along the travel and has no place for that force, so it is refused "
+                   "unless the designer says a rail takes it."),
+        sensitivity=("None for the paper's arrangements (balanced by symmetry). With guide_rail = true the "
+                     "simulated motion ignores the rail's friction, which a sliding rail would add."),
     ),
 )
 
@@ -226,6 +261,67 @@ def side_loads(preload: float, groups) -> dict[int, float]:
     for g, side, force in zip(groups, group_sides(groups), forces, strict=True):
         loads[side] = loads.get(side, 0.0) + g.count * float(force) * _sin(g.contact_angle)
     return dict(sorted(loads.items()))
+
+
+def _placements(lateral: list[tuple[int, float]]) -> float:
+    """The least |Σ ± L| over every placement of the contacts on the two flanks: ``lateral`` holds
+    (count, sideways force per contact) of each group; k of a group's n contacts on one flank give
+    (2k − n) L. Sums closer than 1e-12 of the largest force are one sum (the set stays small)."""
+    quantum = 1e-12 * max((abs(L) for _, L in lateral), default=1.0) or 1.0
+    sums = {0}
+    for n, L in lateral:
+        sums = {s + round((2 * k - n) * L / quantum) for s in sums for k in range(n + 1)}
+    return min(abs(s) for s in sums) * quantum
+
+
+def side_lateral(preload: float, groups) -> dict[int, float]:
+    """The sideways force each side with contacts leaves unbalanced (N): the least |Σ ± n F_N cos α|
+    over every placement of its contacts on the guide's two flanks (module docstring); 0 for a flat
+    guide (α = 90°) and for the paper's V-grooves."""
+    forces = group_normal_forces(preload, groups)
+    sides = group_sides(groups)
+    out = {}
+    for side in sorted(set(sides)):
+        lateral = [(g.count, float(f) * math.cos(g.contact_angle))
+                   for g, s, f in zip(groups, sides, forces, strict=True)
+                   if s == side and g.contact_angle < FLAT]
+        out[side] = _placements(lateral) if lateral else 0.0
+    return out
+
+
+def check_sides(preload: float, groups, *, guide_rail: bool = False) -> None:
+    """Refuse groups that press on one side only, or whose sideways forces no placement on the guide's
+    flanks cancels (unless ``guide_rail``: a rail takes them).
+
+    Raises
+    ------
+    InputError
+        One line naming the groups, the side and the numbers (the sideways forces, what is left).
+    """
+    sides = group_sides(groups)
+    empty = [side for side in SIDES if side not in sides]
+    if empty:
+        raise InputError(
+            f"{_label(range(len(groups)))}: every group presses on side {sides[0]}, none on side {empty[0]}: "
+            "each side of the runner carries the whole preload (Eq. 1), so each needs contacts; add a "
+            f"group with side = {empty[0]} (the paper's one-contact model is contacts = \"one\")",
+            name="contact_groups", value=None)
+    if guide_rail:
+        return
+    forces = group_normal_forces(preload, groups)
+    for side, left in side_lateral(preload, groups).items():
+        if left <= BALANCE_TOLERANCE * preload:
+            continue
+        members = [i for i, s in enumerate(sides) if s == side and groups[i].contact_angle < FLAT]
+        terms = " + ".join(f"{groups[i].count} × {float(forces[i]):.4g} N × cos "
+                           f"{math.degrees(groups[i].contact_angle):.4g}°" for i in members)
+        raise InputError(
+            f"{_label(members)}: the contacts on side {side} push the runner sideways: of Σ n F_N cos α = "
+            f"{terms}, {left:.4g} N is left unbalanced however they sit on the guide's two flanks, must be 0 "
+            f"(within {BALANCE_TOLERANCE:.1%} of F_p = {preload:.4g} N); set guide_rail = true if a rail "
+            "takes the sideways force, or balance the side (an even count per V-groove, or a flat guide, "
+            "contact_angle = 90 deg)",
+            name="contact_groups", value=left)
 
 
 def check_balance(preload: float, groups) -> None:

@@ -34,13 +34,15 @@ viscosity derived from the damping ratio ζ (assumption ``actuator_viscosity``).
 from __future__ import annotations
 
 import math
-import os
 import sys
-from dataclasses import dataclass, replace
-from importlib import resources
-from pathlib import Path
+from dataclasses import replace
 
 from passmd.model.arrangement import FLAT, ContactGroup, preset_groups
+from passmd.model.drive_keys import CONTACT_PRESETS as CONTACT_PRESETS
+from passmd.model.drive_keys import DRIVE_KEYS as DRIVE_KEYS
+from passmd.model.drive_keys import EXAMPLE_DRIVE_FILE as EXAMPLE_DRIVE_FILE
+from passmd.model.drive_keys import JOINT_READING_FILE as JOINT_READING_FILE
+from passmd.model.drive_keys import SI_UNITS, DriveKey
 from passmd.model.parameters import PLAUSIBLE_RANGES, Drive, check_drive
 from passmd.model.tables import (
     ACTUATOR_DAMPING_RATIO,
@@ -59,98 +61,47 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-__all__ = ["CONTACT_PRESETS", "DRIVE_KEYS", "EXAMPLE_DRIVE_FILE", "JOINT_READING_FILE", "DriveFileError",
-           "DriveKey", "drive_toml", "load_drive", "parameter_rows", "read_drive_file",
-           "resolve"]
+__all__ = ["CONTACT_PRESETS", "DRIVE_KEYS", "EXAMPLE_DRIVE_FILE", "JOINT_READING_FILE", "REGION_KEY",
+           "SHORTEST_FLYBACK", "SHORTEST_FLYBACK_WHY", "DriveFileError", "DriveKey", "drive_toml",
+           "load_drive", "parameter_rows", "read_drive_file", "region_values", "resolve"]
 
 
 class DriveFileError(InputError):
     """A drive file that cannot be read, or a key or value in it that is refused (one line)."""
 
 
-@dataclass(frozen=True)
-class DriveKey:
-    """One key of a drive file: its SI unit, display unit, symbol, meaning and default's source."""
-
-    key: str
-    unit: str  # SI unit of a bare number ("" for plain numbers, "str"/"bool"/"choice" for others)
-    display: str  # unit the template and ``drive show`` write the value in
-    symbol: str
-    text: str
-    source: str  # where the default comes from
-    plausible: str | None = None  # key of PLAUSIBLE_RANGES; None: the key's own (a material's for both)
-    choices: tuple = ()
-
-    def __post_init__(self):
-        own = self.key.replace("hemisphere_material.", "material.").replace("runner_material.", "material.")
-        object.__setattr__(self, "plausible", self.plausible or (own if own in PLAUSIBLE_RANGES else None))
-
-
 _DEFAULT = Drive()
-#: The worked example of the book's chapter "Design your own drive" (package data: an installed wheel
-#: has it; ``passmd drive template --example`` prints it).
-EXAMPLE_DRIVE_FILE = Path(os.fspath(resources.files("passmd") / "data" / "drives"
-                                    / "example_drive.toml"))
-#: The paper's drive under the replication ledger's joint reading, paper profile (package data;
-#: ``passmd drive template --joint-reading`` prints it, :mod:`passmd.ledger.joint_drive` writes it).
-JOINT_READING_FILE = EXAMPLE_DRIVE_FILE.with_name("joint_reading.toml")
-#: The paper's two contact arrangements, by name (Section 4.1).
-CONTACT_PRESETS = {"one": 1, "paper-six": 6}
-
-#: Every key a drive file may hold, by its dotted name (the Drive field path).
-DRIVE_KEYS: dict[str, DriveKey] = {k.key: k for k in (
-    DriveKey("contacts", "choice", "", "n", "contact arrangement: \"one\" (one contact) or \"paper-six\" "
-             "(two contacts on one side, four on the other)", "Section 4.1", choices=tuple(CONTACT_PRESETS)),
-    DriveKey("contact_groups", "groups", "", "n_g, side, α, F_N, R", "any other arrangement: "
-             "[[contact_groups]] tables of count, side (1 or 2), contact_angle (default 90 deg, flat), "
-             "radius (default: the drive's) and, optionally, load_share (F_N / F_p) or normal_force; each "
-             "side's Σ n F_N sin α must balance the preload (Eq. 1)", "instead of contacts"),
-    DriveKey("actuator_model", "choice", "", "–", "\"flexible\" (mass–spring–damper) or \"rigid\" actuators",
-             "Section 3.1", choices=("flexible", "rigid")),
-    DriveKey("hemisphere_radius", "m", "mm", "R", "radius of the hemispheres", "Table 1"),
-    DriveKey("preload", "N", "N", "F_p", "preload", "Section 4"),
-    DriveKey("friction_coefficient", "", "", "μ", "friction coefficient", "Table 1; Section 4.2"),
-    DriveKey("runner_mass", "kg", "g", "m_r", "runner mass", "Table 1"),
-    DriveKey("load_cell_stiffness", "N/m", "N/m", "k", "load cell stiffness", "Table 1"),
-    DriveKey("load_cell", "bool", "", "–", "the runner pushes against the load cell", "Section 4.2"),
-    DriveKey("allow_extrapolation", "bool", "", "–", "accept values outside the plausible ranges "
-             "(soft limits only)", "default"),
-    DriveKey("hemisphere_material.name", "str", "", "–", "name of the hemispheres' material", "Table 1"),
-    DriveKey("hemisphere_material.youngs_modulus", "Pa", "GPa", "E_1", "Young's modulus of the hemispheres",
-             "Table 1"),
-    DriveKey("hemisphere_material.poissons_ratio", "", "", "ν_1", "Poisson's ratio of the hemispheres",
-             "Table 1"),
-    DriveKey("runner_material.name", "str", "", "–", "name of the runner's material", "Table 1"),
-    DriveKey("runner_material.youngs_modulus", "Pa", "GPa", "E_2", "Young's modulus of the runner",
-             "Table 1"),
-    DriveKey("runner_material.poissons_ratio", "", "", "ν_2", "Poisson's ratio of the runner", "Table 1"),
-    DriveKey("actuator.stiffness", "N/m", "N/m", "k_p", "actuator stiffness", "Table 2"),
-    DriveKey("actuator.mass", "kg", "kg", "m_a", "actuator mass", "Table 2 (as printed)"),
-    DriveKey("actuator.viscosity", "kg/s", "kg/s", "c_p", "actuator viscosity (or give damping_ratio)",
-             f"derived from ζ = {ACTUATOR_DAMPING_RATIO:g}"),
-    DriveKey("actuator.damping_ratio", "", "", "ζ", "damping ratio of the bare actuator, "
-             "c_p = 2ζ√(k_p m_a) (or give viscosity)", "assumed (Table 2's column is lost)"),
-    DriveKey("actuator.full_stroke_amplitude", "m", "nm", "A_max", "actuation amplitude at the full voltage",
-             "Table 2"),
-    DriveKey("amplifier.peak_to_peak_voltage", "V", "V", "V_pp", "amplifier peak-to-peak voltage",
-             "Section 2"),
-    DriveKey("amplifier.slew_rate", "V/s", "V/us", "SR", "amplifier slew rate", "Section 2"),
-    DriveKey("amplifier.flyback", "flyback", "us", "t_fb", "fly-back of the saw-tooth: \"slew\" (slew-rate "
-             "limited, (A/A_max)·V_pp/SR), \"fixed\" (the full-stroke V_pp/SR at every amplitude) or a "
-             "stated time (\"1.5 us\"; a bare number is s)", "assumed (Section 2 gives V_pp and SR)"),
-)}
-
-_SI_UNITS = {"m", "kg", "s", "N", "N/m", "kg/s", "Pa", "V", "V/s", "Hz", ""}
 
 
-def _flatten(table: dict, prefix: str = "") -> dict:
+#: Shortest stated fly-back time (s): about a thousandth of Section 2's full-stroke fly-back V_pp/SR,
+#: far beyond any amplifier; much shorter, the saw-tooth's corner times are no longer distinct at the
+#: precision of a period's times.
+SHORTEST_FLYBACK = 1e-9
+SHORTEST_FLYBACK_WHY = "about a thousandth of the paper's full-stroke fly-back V_pp/SR, beyond any amplifier"
+#: Keys of the actuators' dynamics (Eq. 3), which ideally rigid actuators do not have.
+_ACTUATOR_DYNAMICS = ("actuator.stiffness", "actuator.mass", "actuator.viscosity", "actuator.damping_ratio")
+
+
+def _flatten(table: dict, name: str, prefix: str = "", section: str = "the top level",
+             seen: dict | None = None) -> dict:
+    """The file's keys, dotted (``[drive]`` dropped); a key given twice, e.g. ``preload`` at the top
+    level and in ``[drive]``, is refused naming both places (TOML refuses only a repeat within one
+    table, and the second would silently win)."""
+    seen = {} if seen is None else seen  # key -> where it was given
     out = {}
-    for name, value in table.items():
-        key = f"{prefix}{name}"
+    for part, value in table.items():
         if isinstance(value, dict):
-            out.update(_flatten(value, "" if key == "drive" and not prefix else key + "."))
-        else:
-            out[key] = value
+            key = f"{prefix}{part}"
+            inner = "" if key == "drive" and not prefix else key + "."
+            out.update(_flatten(value, name, inner, f"[{key}]", seen))
+            continue
+        key = f"{prefix}{part}"
+        if key in seen:
+            raise DriveFileError(f"{name}: {key} is given twice, in {seen[key]} and in {section}: give it "
+                                 "once",
+                                 name=key, value=value)
+        seen[key] = section
+        out[key] = value
     return out
 
 
@@ -187,6 +138,11 @@ def _value(where: str, spec: DriveKey, raw, allow_extrapolation: bool):
         value = parse_quantity(raw, spec.unit, name=where)
     except QuantityError as exc:
         raise DriveFileError(str(exc), name=spec.key, value=raw) from None
+    except OverflowError:  # an integer beyond any float, e.g. 10**400
+        digits = str(raw)
+        raise _refuse(where, f"= {digits[:8]}… ({len(digits)} digits) is out of range: too large for a "
+                             "number",
+                      name=spec.key, value=raw) from None
     si = f" {spec.unit}" if spec.unit else ""
     if spec.plausible is not None:
         try:
@@ -213,9 +169,10 @@ def _flyback(label: str, spec: DriveKey, raw) -> str | float:
         value = parse_quantity(raw, "s", name=label)
     except QuantityError:
         raise refused from None
-    if not (math.isfinite(value) and value > 0.0):
-        raise _refuse(label, f"= {raw!r} is out of range: must be > 0 s", name=spec.key, value=raw,
-                      limits=((">", 0.0),))
+    if not (math.isfinite(value) and value >= SHORTEST_FLYBACK):
+        raise _refuse(label, f"= {raw!r} is out of range: must be >= {SHORTEST_FLYBACK:g} s "
+                             f"({SHORTEST_FLYBACK_WHY})", name=spec.key, value=raw,
+                      limits=((">=", SHORTEST_FLYBACK),))
     return value
 
 
@@ -278,6 +235,42 @@ def _angle(where: str, raw) -> float:
     return value
 
 
+#: The table a fitted drive file records its fit's region in (:func:`drive_toml`'s ``region``): the
+#: values of the fitted keys at each extreme point of the 95 % region; not a drive parameter.
+REGION_KEY = "fit_region.points"
+_NUMERIC = {key for key, spec in DRIVE_KEYS.items() if spec.unit in SI_UNITS}
+
+
+def _region(where: str, raw, allow_extrapolation: bool) -> tuple[dict, ...]:
+    """``[fit_region] points``: a list of tables of numeric drive keys, each value checked as the key's."""
+    if not isinstance(raw, list) or not raw or not all(isinstance(t, dict) and t for t in raw):
+        raise _refuse(where, "must be a list of tables of drive keys and their values, e.g. "
+                             "[{friction_coefficient = 0.21}]", name=REGION_KEY, value=raw)
+    points = []
+    for i, table in enumerate(raw):
+        unknown = [k for k in table if k not in _NUMERIC]
+        if unknown:
+            raise _refuse(f"{where}[{i}].{unknown[0]}", "is not a numeric drive key", name=REGION_KEY,
+                          value=table)
+        points.append({k: _value(f"{where}[{i}].{k}", DRIVE_KEYS[k], v, allow_extrapolation)
+                       for k, v in table.items()})
+    return tuple(points)
+
+
+def region_values(values: dict) -> list[dict]:
+    """The drive-file values at each point of a fitted drive file's region (``values`` as
+    :func:`read_drive_file` returns them): the file's values with the point's keys replaced; none
+    when the file records no region."""
+    base = {k: v for k, v in values.items() if k != REGION_KEY}
+    out = []
+    for point in values.get(REGION_KEY, ()):
+        at = {**base, **point}
+        if "actuator.viscosity" in point:
+            at.pop("actuator.damping_ratio", None)
+        out.append(at)
+    return out
+
+
 def read_drive_file(path, *, allow_extrapolation: bool | None = None) -> dict:
     """The values a drive file gives, by key (SI floats, strings, booleans), each checked.
 
@@ -299,16 +292,28 @@ def read_drive_file(path, *, allow_extrapolation: bool | None = None) -> dict:
         raise DriveFileError(str(exc), name="drive", value=name) from None
     except tomllib.TOMLDecodeError as exc:
         raise DriveFileError(f"{name}: not a TOML file: {exc}", name="drive", value=name) from None
-    raw = _flatten(table)
+    except RecursionError:
+        raise DriveFileError(f"{name}: not a drive file: its arrays or tables are nested too deeply for the "
+                             "TOML reader (a drive file's values are numbers, strings and flat tables)",
+                             name="drive", value=name) from None
+    raw = _flatten(table, name)
+    region = raw.pop(REGION_KEY, None)
     unknown = [key for key in raw if key not in DRIVE_KEYS]
     if unknown:
         raise DriveFileError(f"{name}: unknown key {unknown[0]!r}: the known keys are "
                              f"{', '.join(DRIVE_KEYS)}", name=unknown[0], value=raw[unknown[0]])
     lift = raw.get("allow_extrapolation") is True or bool(allow_extrapolation)
     values = {key: _value(f"{name}: {key}", DRIVE_KEYS[key], value, lift) for key, value in raw.items()}
+    if region is not None:
+        values[REGION_KEY] = _region(f"{name}: {REGION_KEY}", region, lift)
     if "contacts" in values and "contact_groups" in values:
         raise DriveFileError(f"{name}: contacts and contact_groups both given: give one (a preset, or the "
                              "groups)", name="contacts", value=values["contacts"])
+    dynamics = [key for key in _ACTUATOR_DYNAMICS if key in values]
+    if values.get("actuator_model") == "rigid" and dynamics:
+        raise DriveFileError(f"{name}: {dynamics[0]} contradicts actuator_model = \"rigid\": ideally rigid "
+                             "actuators have no stiffness, mass or damping; remove it, or set actuator_model "
+                             "= \"flexible\"", name=dynamics[0], value=values[dynamics[0]])
     if "actuator.viscosity" in values and "actuator.damping_ratio" in values:
         raise DriveFileError(f"{name}: actuator.viscosity and actuator.damping_ratio both given: give one "
                              "(c_p = 2ζ√(k_p m_a))", name="actuator.viscosity",
@@ -356,7 +361,7 @@ def resolve(values: dict, origins: dict | None = None, **fixed) -> tuple[Drive, 
     amplifier = {key.split(".", 1)[1]: value for key, value in values.items() if key.startswith("amplifier.")}
     changes["amplifier"] = replace(Amplifier(), **amplifier)
     for key in ("hemisphere_radius", "preload", "friction_coefficient", "runner_mass", "load_cell_stiffness",
-                "load_cell", "allow_extrapolation", "actuator_model"):
+                "load_cell", "allow_extrapolation", "actuator_model", "guide_rail"):
         if key in values:
             changes[key] = values[key]
     if "contacts" in values:
@@ -408,7 +413,7 @@ def load_drive(path, **fixed) -> Drive:
 def parameter_rows(drive: Drive, sources: dict | None = None) -> list[dict]:
     """Every drive-file key of ``drive``: value (SI), unit, symbol, meaning and source."""
     sources = sources or {}
-    return [{"key": key, "value": _field(drive, key), "unit": spec.unit if spec.unit in _SI_UNITS else "",
+    return [{"key": key, "value": _field(drive, key), "unit": spec.unit if spec.unit in SI_UNITS else "",
              "display_unit": spec.display, "symbol": spec.symbol, "meaning": spec.text,
              "source": sources.get(key, spec.source)} for key, spec in DRIVE_KEYS.items()]
 
@@ -419,12 +424,20 @@ def _number(value: float) -> str:
     return text if any(c in text for c in ".en") else text + ".0"
 
 
+def _string(text: str) -> str:
+    """``text`` as a TOML string (tomli-w escapes quotes, backslashes, newlines and every control
+    character), so that any name reads back as written."""
+    import tomli_w
+
+    return tomli_w.dumps({"k": text}).partition(" = ")[2].rstrip("\n")
+
+
 def _shown(value, spec: DriveKey) -> str:
     """A value as TOML: a string in the display unit when that reads back exactly, else SI."""
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        return _string(value)
     si_unit = "s" if spec.unit == "flyback" else spec.unit  # a stated fly-back time
     if spec.display and spec.display != si_unit:
         text = f"{float(from_si(value, spec.display)):.12g} {spec.display}"
@@ -434,23 +447,26 @@ def _shown(value, spec: DriveKey) -> str:
 
 
 def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None = None,
-               damping_ratio: float | None = None) -> str:
+               damping_ratio: float | None = None, notes=(), region=()) -> str:
     """A commented drive file of ``drive``: :func:`load_drive` reads it back to an equal drive.
 
     Every key is written, with its symbol, meaning, unit and source (``sources`` by key,
     else the paper's source of the default). The viscosity is written as given (c_p), so that
     it reads back exactly; ``damping_ratio``: write this ζ instead, for a drive whose c_p is
     2ζ√(k_p m_a) of its own k_p and m_a (it then reads back exactly too, and ``drive show``
-    derives c_p from it).
+    derives c_p from it). ``notes``: lines the header ends with; ``region``: a fit's region as
+    drive-file values at its points (:data:`REGION_KEY`, written last).
     """
     check_drive(drive)
     sources = sources or {}
     lines = [f"# {title or 'passmd drive file'}",
              "# Values: a string with a unit (\"0.5 mm\", \"1.5e-5 kg\") or a bare number in SI units.",
              "# Keys left out take the paper's value (Tables 1-2; the actuator of Table 2 for the radius;",
-             "# c_p = 2ζ√(k_p m_a) with ζ = 0.05). Another arrangement of contacts: instead of `contacts`,",
-             "# one [[contact_groups]] table per kind of contact (see the end of this file).",
-             "# `passmd drive show --drive FILE` lists what a file resolves to, with sources."]
+             f"# c_p = 2ζ√(k_p m_a) with ζ = {ACTUATOR_DAMPING_RATIO:g} where the file gives neither).",
+             "# Another arrangement of contacts: instead of `contacts`, one [[contact_groups]] table per",
+             "# kind of contact (see the end of this file).",
+             "# `passmd drive show --drive FILE` lists what a file resolves to, with sources.",
+             *(f"# {line}" for line in notes)]
     section = None
     for key, spec in DRIVE_KEYS.items():
         if key in ("actuator.damping_ratio", "contact_groups") or (
@@ -464,9 +480,12 @@ def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None =
         if key == "actuator.viscosity" and damping_ratio is not None:
             key, name, value = "actuator.damping_ratio", "damping_ratio", float(damping_ratio)
             spec = DRIVE_KEYS[key]
-        unit = f" [{spec.unit}]" if spec.unit in _SI_UNITS and spec.unit else ""
+        unit = f" [{spec.unit}]" if spec.unit in SI_UNITS and spec.unit else ""
         source = sources.get(key, spec.source)
-        lines.append(f"{name or key} = {_shown(value, spec)}  # {spec.symbol}: {spec.text}{unit}; {source}")
+        rigid = drive.actuator_model == "rigid" and key in _ACTUATOR_DYNAMICS
+        unused = "# (flexible actuators only) " if rigid else ""
+        lines.append(f"{unused}{name or key} = {_shown(value, spec)}  # {spec.symbol}: {spec.text}{unit}; "
+                     f"{source}")
     for group in drive.contact_groups:  # arrays of tables come last in TOML
         lines += ["", "[[contact_groups]]  # contacts of one kind: count, side, contact angle α, F_N per "
                       "contact (or its share of F_p; else Eq. 1), radius R [m]"]
@@ -479,7 +498,20 @@ def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None =
         for group in preset_groups(drive.contacts):
             lines += ["# [[contact_groups]]"] + [f"# {name} = {_group_value(name, value)}"
                                                  for name, value in _group_items(group)]
+    if region:
+        lines += ["", "[fit_region]  # the fit's 95 % region: the fitted keys at the ends of each fitted "
+                      "parameter's region",
+                  "# (the others re-fitted there); passmd sweep and run with this file report the band "
+                      "these points span", "points = ["]
+        lines += [f"  {{{', '.join(f'{_toml_key(k)} = {_number(v)}' for k, v in point.items())}}},"
+                  for point in region]
+        lines.append("]")
     return "\n".join(lines) + "\n"
+
+
+def _toml_key(key: str) -> str:
+    """A drive key inside an inline table: quoted when dotted (``"actuator.stiffness"``)."""
+    return f'"{key}"' if "." in key else key
 
 
 def _group_items(group: ContactGroup) -> list[tuple[str, object]]:

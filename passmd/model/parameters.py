@@ -116,6 +116,10 @@ class Drive:
     #: (1 or 6). When given, ``contacts`` is their total count and each side's groups must balance
     #: the preload (Eq. 1, :func:`passmd.model.arrangement.check_balance`).
     contact_groups: tuple = ()
+    #: The guide has a rail that takes the sideways force of contacts at α < 90° which no placement on
+    #: the groove's flanks cancels (assumed to add no friction along the travel); without it such a
+    #: drive is refused (:func:`passmd.model.arrangement.check_sides`).
+    guide_rail: bool = False
 
     def __post_init__(self):
         if not isinstance(self.allow_extrapolation, bool):
@@ -127,6 +131,9 @@ class Drive:
                      "load_cell_stiffness"):
             PLAUSIBLE_RANGES[name].check(name, getattr(self, name),
                                          allow_extrapolation=self.allow_extrapolation)
+        if not isinstance(self.guide_rail, bool):
+            raise InputError(f"guide_rail = {shown(self.guide_rail)} is not allowed: must be True or False",
+                             name="guide_rail", value=self.guide_rail)
         if not isinstance(self.contact_groups, tuple) or not all(
                 isinstance(g, ContactGroup) for g in self.contact_groups):
             raise InputError(f"contact_groups = {shown(self.contact_groups)} is not allowed: must be a "
@@ -134,6 +141,7 @@ class Drive:
         if self.contact_groups:
             object.__setattr__(self, "contacts", sum(g.count for g in self.contact_groups))
             arrangement.check_balance(self.preload, self.contact_groups)
+            arrangement.check_sides(self.preload, self.contact_groups, guide_rail=self.guide_rail)
         elif not isinstance(self.contacts, (int, np.integer)) or isinstance(self.contacts, (bool, np.bool_)) \
                 or self.contacts not in (1, 6):
             raise InputError(f"contacts = {shown(self.contacts)} is not allowed: must be one of 1, 6",

@@ -14,6 +14,7 @@ parts is :class:`passmd.model.parameters.Drive`.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field, fields
 
 import numpy as np
@@ -55,6 +56,15 @@ class Assumption:
     unit: str  # display unit
     rationale: str  # why this default
     sensitivity: str  # where its effect is shown
+
+    def __post_init__(self):
+        # the unit is shown once, after the symbol or the number: a value that ends in it too
+        # ("0.1 N" with unit "N") would read "0.1 N N"
+        if self.unit not in ("", "–", "-") and re.search(rf"(^|[\s\d]){re.escape(self.unit)}$",
+                                                           self.value.rstrip()):
+            raise InputError(f"value = {self.value!r} of assumption {self.key!r} is not allowed: it ends in "
+                             f"its unit {self.unit!r}, which is shown once (leave it out of the value)",
+                             name="value", value=self.value)
 
 
 # --------------------------------------------------------------------------------------
@@ -237,7 +247,7 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
         key="actuator_viscosity",
         symbol="c_p",
-        value=f"2·ζ·√(k_p m_a), ζ = {ACTUATOR_DAMPING_RATIO:g}",
+        value=f"2·ζ·√(k_p m_a) with the damping ratio ζ = {ACTUATOR_DAMPING_RATIO:g} (dimensionless)",
         unit="kg/s",
         rationale=(
             "Table 2's 'Viscosity Factor' column is lost in the available text. A bare "
@@ -248,7 +258,9 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
         key="preload_grids",
         symbol="F_p",
-        value="R = 1 mm: 0.1–1.0 N; R = 0.25 mm: 0.1–0.5 N; step 0.1 N",
+        value=" and ".join(f"{grid[0]:g}–{grid[-1]:.1f} at R = {radius * 1e3:g} mm" for radius, grid in
+                           PRELOAD_GRIDS.items())
+        + f", in steps of {PRELOAD_GRIDS[1.0e-3][1] - PRELOAD_GRIDS[1.0e-3][0]:.1g}",
         unit="N",
         rationale=(
             "Table 2's 'Preload Range' column is lost; its header gives the 0.1 N step. "

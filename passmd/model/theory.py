@@ -249,16 +249,34 @@ def contact_arrangement(drive: Drive) -> list[dict]:
     return rows
 
 
-def runner_frequency(drive: Drive) -> float:
-    """Runner-on-contacts natural frequency √(Σ 2aG* / m_r) / (2π) in Hz (rigid actuators).
+#: The secant stiffness μF_N / u_x,max of a Cattaneo–Mindlin contact loaded to full slip, as a share of
+#: its initial 2aG* (the virgin curve's slope at zero is (3/2) μF_N / u_x,max).
+FULL_SLIP_SECANT = 2.0 / 3.0
+
+
+def runner_frequency(drive: Drive, *, in_series: bool = False, full_slip: bool = False) -> float:
+    """Runner-on-contacts natural frequency √(Σ k / m_r) / (2π) in Hz, k = 2aG* per contact.
 
     Σ runs over all contacts (2 × side 1 + 4 × side 2 for six contacts), plus the
-    load cell when engaged. This is the micro-vibration frequency's linear estimate.
+    load cell when engaged: the micro-vibration frequency's linear estimate with rigid actuators.
+    ``in_series=True``: each contact's 2aG* in series with its actuator's k_p, k = 2aG* k_p /
+    (2aG* + k_p), as the runner of a drive with flexible actuators rings (the actuator's mass,
+    10⁻⁵–10⁻⁶ of the runner's, moves with the contact at the runner's frequency, far below its
+    own); for rigid actuators both are the same. The ringing's first swings micro-slip, which
+    softens the contacts: the simulated ringing (:func:`passmd.protocols.ringing.stick_ringing`)
+    runs a few % below this linear estimate. ``full_slip=True``: each contact at the secant
+    stiffness of a swing reaching full slip, :data:`FULL_SLIP_SECANT` × 2aG*, the softest a
+    sticking contact gets: a swing within the presliding rings between the two.
     """
     _check_drive(drive)
     E_star, G_star = drive.contact_moduli
     forces, counts, radii = drive.contact_layout
     stiffness = 2.0 * _drive_contact_radius(drive, forces, E_star, radii) * G_star  # 2aG* per group
+    if full_slip:
+        stiffness = FULL_SLIP_SECANT * stiffness
+    if in_series and drive.actuator_model == "flexible":
+        k_p = drive.actuator.stiffness
+        stiffness = stiffness * k_p / (stiffness + k_p)
     k_total = sum(int(m) * float(k) for m, k in zip(counts, stiffness, strict=True))
     k_total += drive.effective_load_cell_stiffness
     return float(np.sqrt(k_total / drive.runner_mass) / (2 * np.pi))

@@ -95,7 +95,7 @@ def plot_fig5a(df: pd.DataFrame):
         for (model, flyback), rows in df.groupby(["actuator_model", "flyback"], sort=False):
             colour, name = styles[(model, flyback)]
             rows = rows.sort_values("amplitude_nm")
-            ax.plot(rows["amplitude_nm"], rows["steady_step_nm"], "-", color=colour, lw=1.4,
+            ax.plot(rows["amplitude_nm"], rows["steady_step_nm"], ".-", color=colour, lw=1.4, ms=4,
                     label=f"{name}: steady-state step")
             ax.plot(rows["amplitude_nm"], rows["first_step_nm"], ":", color=colour, lw=1.2,
                     label=f"{name}: first step")

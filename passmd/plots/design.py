@@ -11,7 +11,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from passmd.model.defaults import PROTOCOL
-from passmd.plots.sweep_map import MapAxis, cell_marks, map_figure
+from passmd.plots.sweep_map import MapAxis, cell_marks, map_figure, plain_log_ticks
 from passmd.protocols.maps import MAP_QUANTITIES
 
 __all__ = ["critical_amplitude_figure", "design_map", "gain_map_figure", "heldback_figure", "ringing_figure",
@@ -71,6 +71,8 @@ def ringing_figure(table) -> Figure:
         ax.axvline(delay, color=f"C{k + 1}", ls=":", lw=1.0, label=f"next fly-back at {f:g} Hz")
     ax.set_xlabel("time after the fly-back [ms]")
     ax.set_ylabel("swing of the runner [nm]")
+    plain_log_ticks(ax.xaxis)
+    plain_log_ticks(ax.yaxis)
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8)
     return fig

@@ -36,10 +36,19 @@ def _shade_status(ax, view) -> None:
                        label=name if start == edges[0] else None)
 
 
+#: Offsets (points) of the numbered labels of Fig. 8's points, in turn: points a fraction of a
+#: microsecond apart (4 and 5, the ends of t_s and t_a) get labels on opposite sides.
+_LABEL_OFFSETS = ((-9, 11), (9, 11), (-9, -13), (9, -13))
+
+
 def _points(ax, points, y="runner_position_nm") -> None:
-    for _, row in points.iterrows():
-        ax.plot(row["time_us"], row[y], "o", ms=9, mfc="white", mec="black", zorder=5)
-        ax.annotate(row["point"], (row["time_us"], row[y]), ha="center", va="center", fontsize=7, zorder=6)
+    """Mark the numbered points of Section 5.1 (small dots) with their numbers beside them."""
+    for k, (_, row) in enumerate(points.sort_values("time_us").iterrows()):
+        ax.plot(row["time_us"], row[y], "o", ms=4, mfc="white", mec="black", zorder=5)
+        ax.annotate(row["point"], (row["time_us"], row[y]), xytext=_LABEL_OFFSETS[k % len(_LABEL_OFFSETS)],
+                    textcoords="offset points", ha="center", va="center", fontsize=8, zorder=6,
+                    bbox={"boxstyle": "circle,pad=0.15", "fc": "white", "ec": "black", "lw": 0.6},
+                    arrowprops={"arrowstyle": "-", "lw": 0.5, "shrinkA": 0, "shrinkB": 2})
 
 
 def _response(df, title: str):
@@ -111,7 +120,7 @@ def plot_fig8b_window(df):
 
 
 def plot_fig9a(df):
-    """Fig. 9a: runner position over three 100 Hz periods for both waveforms.
+    """Fig. 9a: runner position x_r and hemisphere position x_p over three 100 Hz periods, both waveforms.
 
     Only the runs the data marks ``section5_friction`` (Section 5's μ) are drawn; the others are
     the ledger's alternative readings of μ.
@@ -126,11 +135,14 @@ def plot_fig9a(df):
                 label=f"{waveform}: x_r")
         ax.plot(per["time_ms"], per["settled_position_nm"], "o", color=colours[waveform], ms=5)
         last = per.iloc[-1]
+        highest = df.loc[df["view"] == "period", "settled_position_nm"].max()
+        offset = (-40, 8) if last["settled_position_nm"] >= highest else (-40, -14)  # the lower one below
         ax.annotate(f"{last['settled_position_nm']:.0f} nm", (last["time_ms"], last["settled_position_nm"]),
-                    (-40, 8), textcoords="offset points", fontsize=8, color=colours[waveform])
-    saw = df[(df["waveform"] == "sawtooth") & (df["view"] == "full")]
-    ax.plot(saw["time_ms"], saw["piezo_position_nm"], ":", color="grey", lw=0.8, label="saw-tooth x_p")
-    ax.set(xlabel="time (ms)", ylabel="runner position (nm)", title=f"three periods at {_STEP_HZ}")
+                    offset, textcoords="offset points", fontsize=8, color=colours[waveform])
+    for waveform, part in df[df["view"] == "full"].groupby("waveform", sort=False):  # both waveforms' x_p
+        ax.plot(part["time_ms"], part["piezo_position_nm"], ":", color=colours[waveform], lw=0.8, alpha=0.8,
+                label=f"{waveform}: x_p (hemispheres)")
+    ax.set(xlabel="time (ms)", ylabel="position (nm)", title=f"three periods at {_STEP_HZ}")
     ax.legend(fontsize=8)
     return fig
 
@@ -155,11 +167,10 @@ def plot_fig9b(df):
     """Fig. 9b: steady velocity against frequency for the saw-tooth and the optimized waveform."""
     fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
     _velocity_axes(ax, df)
-    opt = df[df["variant"] == "optimized"].sort_values("frequency")
-    fits = opt[opt["settling_fits"].astype(bool)]
-    if len(fits):
-        ax.axvline(fits["frequency_kHz"].max(), color="tab:green", lw=0.8, alpha=0.6)
-        ax.annotate("full t_s fits up to here", (fits["frequency_kHz"].max(), ax.get_ylim()[1]),
+    if "eq15_highest_frequency_Hz" in df:  # one design per drive: one limit
+        limit = float(df["eq15_highest_frequency_Hz"].iloc[0]) / 1e3
+        ax.axvline(limit, color="tab:green", lw=0.8, alpha=0.6)
+        ax.annotate(f"Eq. 15 fits up to {limit:.4g} kHz", (limit, ax.get_ylim()[1]),
                     (5, -12), textcoords="offset points", fontsize=8, color="tab:green")
     ax.legend(fontsize=8)
     ax.set_title("Section 5 drive: R = 1 mm, 0.4 N, 202 nm, rigid")

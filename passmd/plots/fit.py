@@ -3,15 +3,21 @@
 
 One column per measured quantity: above, the measurements (with their standard deviations
 where given) and the fitted model's value at each, against the amplitude (the preload for
-critical amplitudes), one colour per preload; below, the residuals over their σ.
+critical amplitudes), one series per measured condition — preload and frequency (frequency alone
+for critical amplitudes) — each in its own colour and marker, its model line joining only its own
+points; below, the residuals over their σ, in the series' colours.
 """
 
 from __future__ import annotations
 
+import math
 import textwrap
 
 import numpy as np
+from matplotlib import ticker
 from matplotlib.figure import Figure
+
+from passmd.plots.sweep_map import plain_log_ticks
 
 __all__ = ["fit_figure", "profile_figure"]
 
@@ -26,24 +32,26 @@ def fit_figure(table) -> Figure:
     columns = list(dict.fromkeys(table["quantity"]))
     fig = Figure(figsize=(4.8 * len(columns), 5.6), layout="constrained")
     axes = fig.subplots(2, len(columns), squeeze=False, sharex="col", height_ratios=(3, 1.3))
-    colours = {p: f"C{k}" for k, p in enumerate(sorted(set(table["preload_N"])))}
     for c, column in enumerate(columns):
         rows = table[table["quantity"] == column]
         by_preload = rows["kind"].iloc[0] == "critical_amplitude"
         top, bottom = axes[0, c], axes[1, c]
-        for p, sel in [(None, rows)] if by_preload else rows.groupby("preload_N", sort=True):
+        keys = ["frequency_Hz"] if by_preload else ["preload_N", "frequency_Hz"]
+        series = list(rows.groupby(keys, sort=True))
+        for k, (condition, sel) in enumerate(series):
+            condition = condition if isinstance(condition, tuple) else (condition,)
             xs = (sel["preload_N"] if by_preload else sel["amplitude_nm"]).to_numpy(float)
             order = np.argsort(xs)
-            colour = "black" if by_preload else colours[p]
+            colour, marker = f"C{k % 10}", "osD^v<>ph*"[k % 10]
             err = sel["sd"] if table["sd"].notna().all() else None
-            top.errorbar(xs, sel["measured"], yerr=err, fmt="o", ms=4, color=colour,
-                         label="measured" if by_preload else f"measured, F_p = {p:g} N")
-            top.plot(xs[order], sel["predicted"].to_numpy(float)[order], "-", marker="x",
-                     color="tab:red" if by_preload else colour,
-                     label="fitted model" if by_preload or p == min(colours) else None)
-            bottom.plot(xs, sel["normalized_residual"], "o", ms=4, color=colour)
+            top.errorbar(xs, sel["measured"], yerr=err, fmt=marker, ms=4, color=colour,
+                         label=_condition(keys, condition))
+            top.plot(xs[order], sel["predicted"].to_numpy(float)[order], "-", marker="x", ms=4, lw=1.0,
+                     color=colour, alpha=0.8)
+            bottom.plot(xs, sel["normalized_residual"], marker, ms=4, color=colour)
+        top.plot([], [], "-", marker="x", color="0.4", label="fitted model (× at each measurement)")
         top.set_ylabel(f"{_LABELS[column]} [{rows['unit'].iloc[0]}]")
-        top.legend(fontsize="small")
+        top.legend(fontsize="x-small", ncols=2 if len(series) > 6 else 1)
         bottom.axhline(0.0, color="grey", lw=0.8)
         bottom.set_ylabel("residual / σ")
         bottom.set_xlabel("preload [N]" if by_preload else "amplitude [nm]")
@@ -54,6 +62,17 @@ def fit_figure(table) -> Figure:
     title = table.attrs.get("title") or f"fitted {names}{test}"
     fig.suptitle(textwrap.fill(title, 64 * len(columns)), fontsize="medium")  # within the figure's width
     return fig
+
+
+def _condition(keys, values) -> str:
+    """A series' condition as a reader writes it: ``F_p = 0.4 N, f = 100 Hz``."""
+    parts = []
+    for key, value in zip(keys, values, strict=True):
+        if key == "preload_N":
+            parts.append(f"F_p = {value:g} N")
+        elif math.isfinite(value):
+            parts.append(f"f = {value:g} Hz" if value < 1e3 else f"f = {value / 1e3:g} kHz")
+    return "measured, " + ", ".join(parts) if parts else "measured"
 
 
 _AXIS = {"friction_coefficient": ("friction coefficient μ", 1.0, ""),
@@ -93,6 +112,8 @@ def profile_figure(table, zoom: float = 1.3) -> Figure:
             ax.axvline(truth * scale, color="black", lw=1.0, label="value that made the data")
         ax.set_xscale("log")
         ax.set_yscale("symlog", linthresh=max(level, 1.0))
+        plain_log_ticks(ax.xaxis)
+        ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
         ax.set_ylim(bottom=0.0)
         ax.set_xlim(left, right)
         ax.set_xlabel(f"{label} [{unit}]" if unit else label)

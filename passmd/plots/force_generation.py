@@ -44,16 +44,31 @@ def _groups(df: pd.DataFrame, keys: list[str]):
 
 
 def _curve(ax, rows: pd.DataFrame, colour, label: str | None, onset: bool = True) -> None:
-    """One F_gen(A) curve: stalled points joined, non-stalled crosses, the onset on the axis."""
+    """One F_gen(A) curve: stalled points, non-stalled crosses, the onset on the axis.
+
+    Where the onset was found, the line starts there and joins only the amplitudes above it; the
+    amplitudes below it (no step: the runner only follows the piezo) are small dots, never joined
+    across the onset, which the line would otherwise cut as a straight chord.
+    """
     rows = rows.sort_values("amplitude_nm")
     style = STYLES.get(_key(rows), {"ls": "-", "marker": "o"})
     good = rows[rows["converged"]]
-    ax.plot(good["amplitude_nm"], good["generated_force_mN"], color=colour, ms=4, label=label, **style)
+    found = "onset_nm" in rows and np.isfinite(rows["onset_nm"].iloc[0])
+    if found:
+        a_c = float(rows["onset_nm"].iloc[0])
+        below, above = good[good["amplitude_nm"] <= a_c], good[good["amplitude_nm"] > a_c]
+        ax.plot(np.r_[a_c, above["amplitude_nm"]], np.r_[0.0, above["generated_force_mN"]], color=colour,
+                ls=style["ls"], label=label)
+        ax.plot(above["amplitude_nm"], above["generated_force_mN"], color=colour, ms=4, ls="none",
+                marker=style["marker"])
+        ax.plot(below["amplitude_nm"], below["generated_force_mN"], color=colour, ms=3, ls="none", marker=".")
+    else:
+        ax.plot(good["amplitude_nm"], good["generated_force_mN"], color=colour, ms=4, label=label, **style)
     bad = rows[~rows["converged"]]
     if len(bad):
         ax.plot(bad["amplitude_nm"], bad["generated_force_mN"], "x", color="red", ms=8, mew=2,
                 label="did not stall")
-    if onset and "onset_nm" in rows and np.isfinite(rows["onset_nm"].iloc[0]):
+    if onset and found:
         ax.plot([rows["onset_nm"].iloc[0]], [0.0], marker=style["marker"], color=colour, mfc="white",
                 ms=6, ls="none", clip_on=False, zorder=5)
 
@@ -221,4 +236,34 @@ def plot_fig7_difference(df: pd.DataFrame):
                      fontsize=9)
         ax.legend(fontsize=8)
         ax.grid(alpha=0.3)
+    return fig
+
+
+def stall_trace_figure(result, title: str, generated_force: float | None, coulomb_bound: float):
+    """``passmd force --plot``: the stall run as forces. Above, the force the runner presses on the
+    load cell, k·x_r (N), with the generated force (the period mean at stall) and the Coulomb bound
+    ±μΣF_N; below, the piezo and runner positions (nm) that make it."""
+    from matplotlib.figure import Figure
+
+    k = result.drive.effective_load_cell_stiffness
+    t_ms = result.time * 1e3
+    fig = Figure(figsize=(7, 5.6), layout="constrained")
+    top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=(3, 2))
+    top.plot(t_ms, k * result.runner_position, lw=0.8, color="C1", label="load-cell force k·x_r")
+    if generated_force is not None:
+        top.axhline(generated_force, color="k", lw=1.0, ls="--",
+                    label=f"generated force {generated_force * 1e3:.4g} mN (period mean at stall)")
+    for sign in (1, -1):
+        top.axhline(sign * coulomb_bound, color="C3", lw=0.8, ls=":",
+                    label=f"Coulomb bound ±μΣF_N = ±{coulomb_bound * 1e3:.4g} mN" if sign > 0 else None)
+    top.set_ylabel("force [N]")
+    top.grid(alpha=0.3)
+    top.legend(fontsize=8)
+    top.set_title(title, fontsize=9)
+    bottom.plot(t_ms, result.piezo_position * 1e9, lw=0.8, label="piezo x_p (the waveform)")
+    bottom.plot(t_ms, result.runner_position * 1e9, lw=0.8, label="runner x_r")
+    bottom.set_xlabel("time [ms]")
+    bottom.set_ylabel("position [nm]")
+    bottom.grid(alpha=0.3)
+    bottom.legend(fontsize=8)
     return fig

@@ -10,8 +10,8 @@ from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter, Nul
 
 from passmd.solver.steps import CONVERGED_ACCURACY
 
-__all__ = ["CONVERGED_STEP_NM", "STEP_CONTROL_STYLES", "plot_convergence", "plot_coulomb_limit",
-           "plot_scaling"]
+__all__ = ["CONVERGED_STEP_NM", "STEP_CONTROL_STYLES", "plot_actuator_mass", "plot_convergence",
+           "plot_coulomb_limit", "plot_scaling"]
 
 #: Position error drawn as the convergence target (:data:`passmd.solver.steps.CONVERGED_ACCURACY`) (nm).
 CONVERGED_STEP_NM = CONVERGED_ACCURACY * 1e9
@@ -72,6 +72,54 @@ def plot_coulomb_limit(df: pd.DataFrame):
     ax.set_ylabel("|simulated step − Coulomb step| (nm)")
     ax.legend(fontsize=7)
     return fig
+
+
+def plot_actuator_mass(df: pd.DataFrame):
+    """The actuator-mass study against m_a (log axis): the steady-state A_c under each fly-back rule with
+    Eq. 12 and the band of the ledger's tolerance around it (left); the actuator's natural frequencies
+    and the runner's ringing, with the paper's 110 kHz (middle); the saw-tooth's steady velocity over
+    f, i.e. the step per period, at each frequency (right). Dotted verticals: Table 2's printed m_a and
+    a ruby hemisphere's mass."""
+    per_mass = df.drop_duplicates("actuator_mass").sort_values("actuator_mass")
+    m = per_mass["actuator_mass_ug"]
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4), constrained_layout=True)
+    ax = axes[0]
+    eq12, tolerance = per_mass["eq12_nm"], float(per_mass["eq12_tolerance_rel"].iloc[0])
+    ax.fill_between(m, (1 - tolerance) * eq12, (1 + tolerance) * eq12, color="0.85",
+                    label=f"Eq. 12 ± {100 * tolerance:g} % (the ledger's tolerance)")
+    ax.plot(m, eq12, "k--", lw=1, label="Eq. 12")
+    for rule, marker in (("slew", "o"), ("fixed", "s")):
+        ax.plot(m, per_mass[f"critical_amplitude_{rule}_nm"], marker=marker, ms=5, lw=1,
+                label=f"simulated, {rule} fly-back")
+    ax.set(xscale="log", xlabel="actuator mass m_a (µg)", ylabel="steady-state A_c (nm)",
+           title="critical amplitude (six contacts, 0.4 N)", ylim=(0, None))
+    ax.legend(fontsize=7)
+    ax = axes[1]
+    ax.plot(m, per_mass["actuator_frequency_Hz"] / 1e3, "o-", ms=4, lw=1, label="actuator, √(k_p/m_a)/2π")
+    for side, style in ((1, "--"), (2, ":")):
+        ax.plot(m, per_mass[f"actuator_on_contact_{side}_Hz"] / 1e3, ls=style, lw=1,
+                label=f"actuator on its contact, side {side}")
+    ax.plot(m, per_mass["ringing_frequency_Hz"] / 1e3, "s-", ms=4, lw=1, label="runner's micro-vibration")
+    ax.axhline(110.0, color="tab:red", lw=0.8, label="110 kHz (Section 5.2's limit)")
+    ax.set(xscale="log", yscale="log", xlabel="actuator mass m_a (µg)", ylabel="frequency (kHz)",
+           title="ringing frequencies")
+    ax.legend(fontsize=7, loc="center left")
+    ax = axes[2]
+    for f, part in df.groupby("frequency_Hz", sort=True):
+        part = part.sort_values("actuator_mass")
+        ax.plot(part["actuator_mass_ug"], part["velocity_m_per_s"] / f * 1e9, marker=".", ms=6, lw=1,
+                label=f"{f / 1e3:g} kHz")
+    ax.axhline(0.0, color="grey", lw=0.5)
+    ax.set(xscale="log", xlabel="actuator mass m_a (µg)", ylabel="steady velocity / f (nm per period)",
+           title="saw-tooth at the full stroke")
+    ax.legend(fontsize=7, title="frequency", title_fontsize=7)
+    for ax in axes:
+        for flag, label in (("printed", "Table 2"), ("hemisphere", "ruby hemisphere")):
+            mass = float(per_mass.loc[per_mass[flag].astype(bool), "actuator_mass_ug"].iloc[0])
+            ax.axvline(mass, color="grey", ls=":", lw=0.8)
+            ax.annotate(label, (mass, 1.0), xycoords=("data", "axes fraction"), xytext=(2, -3),
+                        textcoords="offset points", rotation=90, fontsize=7, va="top", ha="left",
+                        color="grey")
 
 
 def plot_scaling(data: dict):

@@ -22,7 +22,13 @@ from matplotlib.patches import Patch, Rectangle
 from passmd.protocols.velocity import STEADY_DRIFT_LIMIT
 from passmd.runtime.units import from_si
 
-__all__ = ["CellMarks", "MapAxis", "cell_marks", "map_figure"]
+__all__ = ["COLOR_SCALES", "LOG_SPAN", "CellMarks", "MapAxis", "cell_marks", "map_figure", "plain_log_ticks"]
+
+#: A heat map's colour scales (:func:`map_figure`).
+COLOR_SCALES = ("auto", "linear", "log")
+#: Largest/smallest value beyond which ``"auto"`` colours a map of positive values on a log scale: two
+#: decades, where a linear scale leaves the lowest decade one colour.
+LOG_SPAN = 100.0
 
 
 @dataclass(frozen=True)
@@ -115,16 +121,22 @@ _STYLE = {"missing": ("xx", "0.82", "x"), "unsteady": ("//", "0.92", "o"), "unre
 
 
 def map_figure(table, axes: Sequence[MapAxis], value: MapAxis, title: str,
-               also: Sequence[MapAxis] = (), *, marks: CellMarks | None = None, notes: Sequence[str] = ()
-               ) -> Figure:
+               also: Sequence[MapAxis] = (), *, marks: CellMarks | None = None, notes: Sequence[str] = (),
+               color_scale: str = "auto", band: tuple[str, str, str] | None = None) -> Figure:
     """The map of ``value`` over one or two ``axes`` of ``table`` (grid order, last axis fastest).
 
     One axis: ``value`` (and the ``also`` columns, dashed) against it; marked points are drawn
     apart (open markers, crosses for missing values at the axis' foot). Two axes: a heat map over
     the first (x) and second (y) axis; marked cells are hatched over a neutral face and left out
     of the colour scale and of the labelled contours. ``marks`` default: missing values only.
-    ``notes``: lines the legend ends with (e.g. what makes a curve turn).
+    ``notes``: lines the legend ends with (e.g. what makes a curve turn). ``color_scale``: a heat
+    map's colour scale, ``"linear"``, ``"log"`` (values > 0 only; a map with a value <= 0 is refused)
+    or ``"auto"`` (log where every value is > 0 and they span more than :data:`LOG_SPAN`).
+    ``band``: (low column, high column, label) of a band shaded about a curve (one axis only).
     """
+    if color_scale not in COLOR_SCALES:
+        raise ValueError(f"color_scale = {color_scale!r} is not allowed: must be one of "
+                         f"{', '.join(COLOR_SCALES)}")
     if len(axes) not in (1, 2):
         raise ValueError(f"axes = {len(axes)} axes: a map draws one or two")
     z = _values(table, value)
@@ -133,7 +145,11 @@ def map_figure(table, axes: Sequence[MapAxis], value: MapAxis, title: str,
     fig = Figure(figsize=(7, 4.8), layout="constrained")
     ax = fig.add_subplot()
     handles = _curve(ax, table, axes[0], value, z, marks, also) if len(axes) == 1 else \
-        _heat_map(fig, ax, table, axes, value, z, marks)
+        _heat_map(fig, ax, table, axes, value, z, marks, color_scale)
+    if band is not None and len(axes) == 1:
+        low, high = (_values(table, MapAxis(c, "", value.unit, scale=value.scale)) for c in band[:2])
+        handles.append(ax.fill_between(axes[0].shown(table[axes[0].column]), low, high, color="C0", alpha=0.2,
+                                       lw=0, label=band[2]))
     handles += [Patch(visible=False, label=note) for note in notes]
     if handles:
         ax.legend(handles=handles, fontsize=7, loc="upper left", bbox_to_anchor=(0.0, -0.14), ncols=1,
@@ -162,11 +178,30 @@ def _curve(ax, table, axis: MapAxis, value: MapAxis, z, marks: CellMarks, also) 
     ax.set_ylabel(value.title)
     if axis.log:
         ax.set_xscale("log")
+        plain_log_ticks(ax.xaxis)
     ax.grid(alpha=0.3)
     return handles
 
 
-def _heat_map(fig, ax, table, axes, value: MapAxis, z, marks: CellMarks) -> list:
+def _log_colors(shown, color_scale: str) -> bool:
+    """Whether the heat map's colours go on a log scale (:func:`map_figure`)."""
+    if color_scale == "linear" or not shown.count():
+        return False
+    positive = float(shown.min()) > 0
+    if color_scale == "log" and not positive:
+        raise ValueError(f"color_scale = 'log' needs values > 0: this map has {float(shown.min()):.4g}")
+    return positive and (color_scale == "log" or float(shown.max()) / float(shown.min()) > LOG_SPAN)
+
+
+def plain_log_ticks(axis) -> None:
+    """Tick labels of a log axis as plain numbers (``6``, ``200``), not ``6×10⁰``."""
+    label = ticker.FuncFormatter(lambda v, _: f"{v:g}")
+    axis.set_major_formatter(label)
+    axis.set_minor_formatter(ticker.FuncFormatter(
+        lambda v, _: f"{v:g}" if f"{v:.1e}"[0] in "25" else ""))
+
+
+def _heat_map(fig, ax, table, axes, value: MapAxis, z, marks: CellMarks, color_scale: str = "auto") -> list:
     first, second = axes
     xs = first.shown(table[first.column]).reshape(-1)
     ys = second.shown(table[second.column]).reshape(-1)
@@ -181,13 +216,18 @@ def _heat_map(fig, ax, table, axes, value: MapAxis, z, marks: CellMarks) -> list
     plain = grid(marks.plain)
     shown = np.ma.masked_array(grid(z), mask=~plain)
     norm, cmap = None, "viridis"
-    if shown.count() and shown.min() < 0:  # a signed value: diverging, symmetric, zero white
+    log = _log_colors(shown, color_scale)
+    if log:
+        norm = colors.LogNorm(vmin=float(shown.min()), vmax=float(shown.max()))
+    elif shown.count() and shown.min() < 0:  # a signed value: diverging, symmetric, zero white
         top = float(np.abs(shown).max())
         norm, cmap = colors.Normalize(vmin=-top, vmax=top), "RdBu_r"
     x_edges, y_edges = _edges(x, first.log), _edges(y, second.log)
     mesh = ax.pcolormesh(x_edges, y_edges, shown, shading="flat", cmap=cmap, norm=norm)
-    bar = fig.colorbar(mesh, ax=ax, label=value.title)
-    if norm is not None:
+    bar = fig.colorbar(mesh, ax=ax, label=value.title + (" (log scale)" if log else ""))
+    if log:
+        plain_log_ticks(bar.ax.yaxis)
+    elif norm is not None:
         bar.locator = ticker.MaxNLocator(nbins=8, symmetric=True)
         bar.update_ticks()
     handles = []
@@ -202,7 +242,8 @@ def _heat_map(fig, ax, table, axes, value: MapAxis, z, marks: CellMarks) -> list
         handles.append(Patch(facecolor=face, edgecolor="0.45", hatch=hatch,
                              label=getattr(marks, f"{kind}_label")))
     if shown.count() > 3 and min(nx, ny) >= 2 and float(shown.max()) > float(shown.min()):
-        levels = ticker.MaxNLocator(nbins=8).tick_values(float(shown.min()), float(shown.max()))
+        locator = ticker.LogLocator(subs=(1.0, 2.0, 5.0)) if log else ticker.MaxNLocator(nbins=8)
+        levels = locator.tick_values(float(shown.min()), float(shown.max()))
         levels = [v for v in levels if float(shown.min()) < v < float(shown.max())]
         if levels:
             lines = ax.contour(x, y, shown, levels=levels, colors="k", linewidths=0.6)
@@ -211,6 +252,8 @@ def _heat_map(fig, ax, table, axes, value: MapAxis, z, marks: CellMarks) -> list
     ax.set_ylabel(second.title)
     if first.log:
         ax.set_xscale("log")
+        plain_log_ticks(ax.xaxis)
     if second.log:
         ax.set_yscale("log")
+        plain_log_ticks(ax.yaxis)
     return handles

@@ -56,6 +56,7 @@ __all__ = [
     "bisect_amplitude",
     "critical_amplitude",
     "first_flyback_slip",
+    "rested_sawtooth",
     "search_amplitude",
     "steady_step",
 ]
@@ -123,6 +124,7 @@ def steady_step(
     *,
     periods: int = STEADY_PERIODS,
     flyback=None,
+    rest: float = 0.0,
 ) -> dict:
     """Step sizes of a saw-tooth run from rest; the last one is the steady-state step.
 
@@ -140,6 +142,10 @@ def steady_step(
     flyback : {"slew", "fixed"} or float, optional
         Fly-back rule overriding the drive's (default None: the drive's;
         :func:`passmd.model.waveforms.flyback_time`).
+    rest : float
+        Time (s) x_p rests at 0 after each fly-back before the next ramp starts (default 0: the
+        saw-tooth); long enough, the runner's ringing has died out when the next fly-back comes
+        (the counterfactual of :mod:`passmd.protocols.diagnosis`).
 
     Returns
     -------
@@ -149,7 +155,11 @@ def steady_step(
     """
     if int(periods) != periods or periods < 2:
         raise ValueError(f"periods = {periods!r} is out of range: must be an integer >= 2")
-    wave = waveforms.sawtooth(amplitude, frequency, drive, periods=int(periods), flyback=flyback)
+    if rest:
+        wave = rested_sawtooth(drive, amplitude, frequency, check_positive("rest", rest, "s"), int(periods),
+                               flyback)
+    else:
+        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=int(periods), flyback=flyback)
     result = simulation.simulate(drive, wave, max_points=2)
     steps = result.step_sizes
     return {
@@ -158,6 +168,23 @@ def steady_step(
         "last_step_m": float(steps[-1]),
         "wall_time_s": result.wall_time,
     }
+
+
+def rested_sawtooth(drive: Drive, amplitude: float, frequency: float, rest: float, periods: int,
+                    flyback=None) -> waveforms.Waveform:
+    """The saw-tooth at ``frequency`` (ramp, fly-back) with x_p resting at 0 for ``rest`` s after each
+    fly-back: the same ramp and fly-back, the runner left to settle before the next ramp."""
+    A = check_range("amplitude", amplitude, 0.0, drive.actuator.full_stroke_amplitude, lower_open=True,
+                    unit="m")
+    t_fb = waveforms.flyback_time(A, drive, flyback)
+    waveforms.check_flyback_fits(t_fb, frequency)
+    t_ramp = 1.0 / frequency - t_fb
+    settle = (1.0 - waveforms.SETTLE_FRACTION) * t_ramp
+    period = t_ramp + t_fb + rest
+    return waveforms.piecewise_linear([0.0, settle, t_ramp, t_ramp + t_fb, period],
+                                      [0.0, A * settle / t_ramp, A, 0.0, 0.0], 1.0 / period, periods,
+                                      settle_window=(settle, t_ramp), slip_mark=t_ramp,
+                                      kind="saw-tooth with rests")
 
 
 def first_flyback_slip(
@@ -357,6 +384,7 @@ def critical_amplitude(
     threshold: float = STEP_THRESHOLD,
     tolerance: float = PROTOCOL.search_tolerance,
     progress: bool | str | None = None,
+    rest: float = 0.0,
 ) -> dict:
     """Simulated critical amplitude A_c of a drive (protocols: see the module docstring).
 
@@ -381,6 +409,9 @@ def critical_amplitude(
     progress : bool or "long", optional
         The bisection's runs on stderr (:mod:`passmd.runtime.progress`): None on a terminal only,
         ``"long"`` also elsewhere, each once the search has taken a few seconds.
+    rest : float
+        Steady protocol: x_p rests this long (s) after each fly-back (:func:`steady_step`); 0, the
+        default, is the saw-tooth.
 
     Returns
     -------
@@ -397,6 +428,7 @@ def critical_amplitude(
     check_range("threshold", threshold, 0.0, lower_open=True, unit="m")
     if int(periods) != periods or periods < 2:
         raise ValueError(f"periods = {periods!r} is out of range: must be an integer >= 2")
+    check_range("rest", rest, 0.0, unit="s")
     if not (progress is None or isinstance(progress, bool) or progress == "long"):
         raise ValueError(f"progress = {progress!r} is not allowed: must be True, False, None or 'long'")
     wall = [0.0]
@@ -405,7 +437,7 @@ def critical_amplitude(
 
     def probe(amplitude):
         if protocol == "steady":  # the last step grows about 1 nm per nm of amplitude above A_c
-            out = steady_step(drive, amplitude, frequency, periods=int(periods), flyback=flyback)
+            out = steady_step(drive, amplitude, frequency, periods=int(periods), flyback=flyback, rest=rest)
             wall[0] += out["wall_time_s"]
             moved = out["last_step_m"] > threshold
             measure = out["last_step_m"] - threshold if moved else None

@@ -69,8 +69,10 @@ def stick_ringing(drive: Drive, amplitude: float, frequency: float = PROTOCOL.dr
         ``ringing_frequency_Hz`` (from the first three turning points, as Eq. 15's f_s),
         ``ringing_amplitude_m`` (the first swing), ``ringing_decay_time_s`` (time after the
         fly-back's end until the swing falls to 1/e of the first; NaN if not within the hold),
-        ``ringing_hold_s``, ``flyback_time_s``, and the envelope: ``swing_times_s`` (after the
-        fly-back's end) and ``swing_amplitudes_m``. Without turning points (no ringing) the
+        ``ringing_hold_s``, ``flyback_time_s``, ``ringing_linear_frequency_Hz`` (the linear estimate,
+        :func:`passmd.model.theory.runner_frequency` with the actuators in series, which the first
+        swings' micro-slip pulls the measured frequency below), and the envelope: ``swing_times_s``
+        (after the fly-back's end) and ``swing_amplitudes_m``. Without turning points (no ringing) the
         frequency is NaN and the swings empty.
     """
     check_drive(drive)
@@ -91,7 +93,8 @@ def stick_ringing(drive: Drive, amplitude: float, frequency: float = PROTOCOL.dr
     turns, times, swings = _swings(result.time, result.runner_position, result.runner_velocity, end)
     out = {"ringing_frequency_Hz": math.nan, "ringing_amplitude_m": 0.0, "ringing_decay_time_s": math.nan,
            "ringing_hold_s": hold, "flyback_time_s": t_fb, "swing_times_s": times,
-           "swing_amplitudes_m": swings}
+           "swing_amplitudes_m": swings,
+           "ringing_linear_frequency_Hz": theory.runner_frequency(drive, in_series=True)}
     if turns.size >= _MIN_TURNS:
         out["ringing_frequency_Hz"] = float(1.0 / (turns[_MIN_TURNS - 1] - turns[0]))
     if swings.size:
@@ -134,14 +137,15 @@ def at_frequency(ringing: dict, frequency: float) -> dict:
     """What the ringing of :func:`stick_ringing` means for driving at ``frequency``: the swing left
     when the next fly-back starts, one period minus the fly-back after the last one.
 
-    Returns ``ringing_frequency_Hz``, ``ringing_amplitude_m``, ``ringing_decay_time_s`` (as
-    measured), ``next_flyback_after_s``, ``ringing_at_next_flyback_m`` (:func:`left_after`; an
-    upper bound beyond the recorded hold) and ``ringing_affects_steps`` (that swing exceeds
-    :data:`MEASURABLE`: a step read at that resolution depends on the ringing's phase).
+    Returns ``ringing_frequency_Hz``, ``ringing_linear_frequency_Hz``, ``ringing_amplitude_m``,
+    ``ringing_decay_time_s`` (as measured), ``next_flyback_after_s``, ``ringing_at_next_flyback_m``
+    (:func:`left_after`; an upper bound beyond the recorded hold) and ``ringing_affects_steps`` (that
+    swing exceeds :data:`MEASURABLE`: a step read at that resolution depends on the ringing's phase).
     """
     delay = 1.0 / check_positive("frequency", frequency, "Hz") - ringing["flyback_time_s"]
     left = float(left_after(ringing, delay))
     return {"ringing_frequency_Hz": ringing["ringing_frequency_Hz"],
+            "ringing_linear_frequency_Hz": ringing.get("ringing_linear_frequency_Hz", math.nan),
             "ringing_amplitude_m": ringing["ringing_amplitude_m"],
             "ringing_decay_time_s": ringing["ringing_decay_time_s"], "next_flyback_after_s": delay,
             "ringing_at_next_flyback_m": left, "ringing_affects_steps": bool(left > MEASURABLE)}

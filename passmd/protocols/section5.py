@@ -36,9 +36,9 @@ from passmd.solver.results import SimulationError
 STEP_FREQUENCY = PROTOCOL.drive_frequency
 #: Runner materials of Fig. 10c.
 RUNNERS = {"steel": STEEL, "molybdenum": MOLYBDENUM}
-#: Waveform variants of Figs. 9b and 10: (waveform, short_period rule). ``skip`` (t_s = 0 where the
-#: settling time does not fit) is the chapter's study "what if the settling is dropped": it removes
-#: Eq. 15's settling phase, so it is no ledger reading of the Eq. 15 claims (passmd.ledger.readings).
+#: Waveform variants of Figs. 9b and 10: (waveform, short_period rule). Where Eq. 15's settling time does
+#: not fit the period, ``cut`` shortens it to the time left and ``skip`` drops it (t_s = 0): neither is
+#: Eq. 15, so both are the ledger's readings of the Eq. 15 claims there (passmd.ledger.readings).
 VARIANTS = (("sawtooth", ""), ("optimized", "cut"), ("optimized", "skip"))
 
 

@@ -318,11 +318,12 @@ def generated_force(
         ``remaining_force_N`` (estimated rise still to come, ``None`` if not credible:
         :func:`credible_tail`), ``remaining_force_note`` (why not, else ``None``),
         ``force_spread_N`` (over the window), ``mean_friction_N`` (mean
-        total friction on the runner over the last period), ``piezo_mean_force_N`` (k times
-        the mean piezo position x̄_p, what the load cell reads if the runner only follows
-        the piezo), ``last_step_m``, ``net_displacement_m`` (x̄_r − x̄_p over the last
-        period), ``wall_time_s`` (integration time), ``cpu_time_s`` (CPU time of the whole
-        call).
+        total friction on the runner over the last period), ``no_slip_reference_force_N`` (k
+        times the mean piezo position x̄_p: what the load cell would read if the runner followed
+        the piezo without slipping; a reference for the generated force, never a force on the
+        runner, so not bounded by μΣF_N, which the contacts cannot exceed), ``last_step_m``,
+        ``net_displacement_m`` (x̄_r − x̄_p over the last period), ``wall_time_s`` (integration
+        time), ``cpu_time_s`` (CPU time of the whole call).
 
     Raises
     ------
@@ -380,7 +381,7 @@ def generated_force(
         "remaining_force_note": note,
         "force_spread_N": estimate["spread_N"],
         "mean_friction_N": float(result.period_mean_friction[-1]),
-        "piezo_mean_force_N": k * piezo_mean,
+        "no_slip_reference_force_N": k * piezo_mean,
         "last_step_m": float(result.step_sizes[-1]),
         "net_displacement_m": float(result.period_mean_position[-1] - piezo_mean),
         "wall_time_s": float(result.wall_time),

@@ -19,10 +19,10 @@ Three pieces meet here:
 
 :func:`evaluate` runs the checks over the readings of the assumption space
 (:mod:`passmd.ledger.readings`: each claim on the full product of the axes that change the
-tables it reads) and computes every claim's category: ``reproduced``, ``reproduced under the
-joint reading``, ``not reproduced`` or ``inconclusive``, from the defaults and the joint reading
-of all claims (:mod:`passmd.ledger.joint`), with its evidence, its fragility and the tensions
-between claims; no category is typed in. :mod:`passmd.report.ledger_views` presents them in the
+tables it reads) and computes every claim's category (:data:`passmd.ledger.claims.STATUSES`) from its
+state at one reading, its held-out reading: the joint reading chosen from all the other claims
+(:mod:`passmd.ledger.joint`), with its evidence, its fragility and the tensions between claims; no
+category is typed in. :mod:`passmd.report.ledger_views` presents them in the
 book; :mod:`passmd.ledger.baseline` compares them with a committed baseline in the tests, and
 :func:`records` gives them to ``passmd ledger --json``.
 """
@@ -48,19 +48,19 @@ from passmd.ledger.baseline import (  # re-exported: the tests and the command l
     write_baseline,
 )
 from passmd.ledger.checks import ClaimFunctions, collect_claim_functions, extractor
-from passmd.ledger.claims import STATUSES, is_study, load_claims, required_keys
+from passmd.ledger.claims import REPRODUCED, STATUSES, family_of, is_study, load_claims, required_keys
 from passmd.ledger.export import SI_UNITS, records  # re-exported: passmd ledger --json
-from passmd.ledger.joint import (
-    _elsewhere,
-    _map_columns,
-    conflicting_pairs,
-    joint_reading,
-    state_table,
-    tensions,
-)
+from passmd.ledger.joint import conflicting_pairs, elsewhere, judge, map_columns, state_name, tensions
 from passmd.ledger.joint import joint_map as joint_map  # the ledger's views read it from here too
 from passmd.ledger.joint import joint_record as joint_record
-from passmd.ledger.verdicts import EXPERIMENT_BASIS, NO_EXTRACTOR, claim_points, claim_row
+from passmd.ledger.verdicts import (
+    EXPERIMENT_BASIS,
+    NO_EXTRACTOR,
+    Judgement,
+    claim_points,
+    claim_row,
+    not_informative,
+)
 from passmd.runtime.config import RunConfig
 
 __all__ = [
@@ -92,11 +92,13 @@ __all__ = [
 ]
 
 #: Columns of :func:`evaluate`'s result.
-LEDGER_COLUMNS = ("claim", "figure", "quantity", "paper", "ours", "unit", "abs_deviation", "rel_deviation",
-                  "tolerance", "status", "verdict", "evidence", "reason", "basis", "study_of", "check",
-                  "depends_on", "readings", "holds_at", "fails_at", "decided_at", "fraction_holds",
-                  "best_reading", "default_state", "joint_state", "margin", "margin_text", "fragile",
-                  "fragile_reason", "outside", "informative", "not_informative", "note")
+LEDGER_COLUMNS = ("claim", "figure", "quantity", "paper", "ours", "ours_text", "unit", "abs_deviation",
+                  "rel_deviation", "tolerance", "status", "verdict", "why", "evidence", "reason", "basis",
+                  "study_of", "family", "counted", "check", "depends_on", "readings", "holds_at", "fails_at",
+                  "decided_at", "undecided_at", "fraction_holds", "best_reading", "default_state",
+                  "held_out_reading", "held_out_state", "joint_reading", "joint_state", "margin",
+                  "margin_text", "fragile", "fragile_reason", "outside", "informative", "not_informative",
+                  "note")
 
 
 # ======================================================================================
@@ -196,8 +198,12 @@ def collect_results(config: RunConfig, figures: Iterable[str] | None = None) -> 
 
 
 def counted(evaluated: pd.DataFrame) -> pd.DataFrame:
-    """The rows of an :func:`evaluate` result that are claims of the paper (studies left out)."""
-    return evaluated[evaluated["study_of"] == ""]
+    """The rows of an :func:`evaluate` result that are counted: claims of the paper, each family once (its
+    lead row), studies and rows implied by another left out."""
+    keep = evaluated["study_of"] == ""
+    if "counted" in evaluated:
+        keep &= evaluated["counted"].astype(bool)
+    return evaluated[keep]
 
 
 def _design_problems(claim: Mapping, functions: ClaimFunctions, points) -> list[str]:
@@ -215,33 +221,58 @@ def _design_problems(claim: Mapping, functions: ClaimFunctions, points) -> list[
     return problems
 
 
-def _variants(evaluated: Mapping, computed: set, rows: list[dict], states: Mapping,
+def _variants(evaluated: Mapping, sections: Mapping, families: Mapping, voters: set, rows: list[dict],
               studies: Mapping) -> list[dict]:
-    """How the joint reading changes when rows are left out (the not-informative ones, and those
-    decided only where a method they rest on is undefined, e.g. Eq. 15) or when the studies (the
-    substitute and derived rows, never counted) are counted as claims."""
+    """How the in-sample joint reading changes when rows are left out (those decided only where a method
+    they rest on is undefined, e.g. Eq. 15) or when the studies (the substitute and derived rows, never
+    counted) are counted as claims."""
     out = []
     if studies:
         with_studies = {**evaluated, **studies}
-        joint = joint_reading(with_studies, computed | set(studies), states=state_table(with_studies))
+        joint = judge(with_studies, sections, families, voters | set(studies))
         out.append({"left_out": "studies counted as claims", "claims_left_out": [],
-                    "claims_added": sorted(studies), "reading": joint["reading"],
+                    "claims_added": sorted(studies), "reading": _plain(joint["point"]),
                     "described": joint["described"], "holding": joint["holding"], "claims": joint["claims"]})
-    for label, leave in (
-        ("not-informative rows left out", {r["claim"] for r in rows if not r["informative"]}),
-        ("rows decided only where a method they rest on is undefined left out",
-         {r["claim"] for r in rows if r["outside"]}),
-    ):
-        if not leave:
-            continue
+    leave = {r["claim"] for r in rows if r["outside"]}
+    if leave:
         kept = {c: v for c, v in evaluated.items() if c not in leave}
-        table = {"space": states["space"],
-                 "table": {i: {c: s for c, s in column.items() if c not in leave}
-                           for i, column in states["table"].items()}}
-        joint = joint_reading(kept, computed - leave, states=table)
-        out.append({"left_out": label, "claims_left_out": sorted(leave), "claims_added": [],
-                    "reading": joint["reading"], "described": joint["described"], "holding": joint["holding"],
-                    "claims": joint["claims"]})
+        joint = judge(kept, sections, families, voters - leave)
+        out.append({"left_out": "rows decided only where a method they rest on is undefined left out",
+                    "claims_left_out": sorted(leave), "claims_added": [], "reading": _plain(joint["point"]),
+                    "described": joint["described"], "holding": joint["holding"], "claims": joint["claims"]})
+    return out
+
+
+def _plain(point: Mapping) -> dict:
+    """A point of the space with its free axes as plain keys (``key@section``)."""
+    return {readings.point_key(f): v for f, v in point.items()}
+
+
+def _judgements(claims: pd.DataFrame, evaluated: Mapping, joint: Mapping, sections: Mapping,
+                studies: set) -> dict[str, Judgement]:
+    """Where each claim is judged (``passmd.ledger.verdicts.Judgement``): a claim of the paper at
+    its unit's held-out point, a study at the defaults."""
+    states = joint["states"]
+    space, free_of = states["space"], states["free_of"]
+    runner_ups = [e["point"] for e in joint["runner_ups"]]
+    out = {}
+    for unit in joint["units"]:
+        at = joint["held_out"][unit.lead]
+        codes = joint["unit_states"][unit.lead]
+        for claim in unit.members:
+            mine = free_of[claim]
+            lead = claim == unit.lead
+            family = unit.members if len(unit.members) > 1 else ()
+            out[claim] = Judgement(
+                held_out=readings.claim_reading(space[at], mine),
+                in_sample=readings.claim_reading(space[joint["best"]], mine),
+                family_state=state_name(codes[at]) if lead and family else "",
+                family_at_defaults=state_name(codes[0]) if lead and family else "",
+                family=family, counted=lead, grid_bound=joint["grid_bound"].get(unit.lead, False),
+                elsewhere=elsewhere(claim, states, at),
+                runner_ups=tuple(readings.claim_reading(p, mine) for p in runner_ups))
+    for claim in studies:
+        out[claim] = Judgement(readings.default_reading(), readings.default_reading(), counted=False)
     return out
 
 
@@ -256,25 +287,29 @@ def evaluate(
     """Evaluate every claim against the result tables, over its readings of the assumption space.
 
     Each claim is checked at every reading of :func:`passmd.ledger.readings.design` (the full product of the
-    axes that change the tables it reads, the defaults first). The joint reading
-    (:func:`~passmd.ledger.joint.joint_reading`) is the covered point of the whole space where the
-    most claims hold together; each claim's category is computed from two points only, the defaults
-    and the joint reading:
+    axes that change the tables it reads, the defaults first). Each claim of the paper is then judged at
+    one reading, its *held-out* reading: the point of the space where the most of the *other* claims
+    hold together (:func:`passmd.ledger.joint.judge`: a row implied by another counted once with it, rows
+    that cannot fail and claims about the experiment not voting). Its category
+    (``passmd.ledger.verdicts.category``) comes from its state there:
 
-    * ``reproduced``: the check holds at the defaults;
-    * ``reproduced under the joint reading``: it does not hold at the defaults and holds at the
-      joint reading;
-    * ``not reproduced``: it fails at the defaults or at the joint reading and holds at neither (a
-      total failure, e.g. no step up to the full stroke, is a failure); the verdict names another
-      reading where it holds, if any, and the claims that reading breaks;
-    * ``inconclusive``: neither point decides it (an extremum the grid cannot locate, non-finite
-      values, missing results, no measured data for a claim about the experiment).
+    * ``reproduced``: it holds there and at the defaults;
+    * ``reproduced under the joint reading``: it holds there, not at the defaults;
+    * ``holds by construction``: it holds there, and its check cannot fail on any result the model can
+      produce (never counted as reproduced);
+    * ``not reproduced``: it fails there; the verdict names another reading where it holds, if any, and
+      the claims that reading breaks;
+    * ``inconclusive``: it is undecided there (an extremum the grid cannot locate, a tie within the
+      resolution, non-finite values, missing results, no measured data for a claim about the
+      experiment), or its held-out reading rests on claims a coarser grid than the paper's leaves
+      undecided while its own state varies over its readings (not decided on that grid).
 
-    Studies (rows without a quotation, :mod:`passmd.ledger.rules`) are checked at the defaults and
-    counted nowhere. The table's ``attrs`` carry ``points`` (every claim at every evaluated
-    reading), ``joint`` (:func:`~passmd.ledger.joint.joint_reading` without its state table, with
-    ``variants``: how it changes when rows are left out), ``conflicts``
-    (:func:`~passmd.ledger.joint.conflicting_pairs`) and ``tensions``.
+    A family (a row and the rows ``implied_by`` it) is counted once, on its lead row, with the state of
+    the conjunction of its members. Studies (rows without a quotation, :mod:`passmd.ledger.rules`) are
+    checked at the defaults and counted nowhere. The table's ``attrs`` carry ``points`` (every claim at
+    every evaluated reading), ``joint`` (the in-sample joint reading, with ``held_out_counts``,
+    ``in_sample_gain`` (the claims that hold only in-sample), ``best_single_point`` and ``variants``),
+    ``conflicts`` (:func:`~passmd.ledger.joint.conflicting_pairs`) and ``tensions``.
 
     NaN never counts as holding (:class:`passmd.ledger.checks.NotEvaluable`). Claims whose ``requires``
     are only ``closed_forms`` have ``basis`` "closed form" and are not simulation results.
@@ -299,16 +334,16 @@ def evaluate(
     Returns
     -------
     pandas.DataFrame
-        Columns :data:`LEDGER_COLUMNS`: ``paper`` and ``ours`` (at the defaults) as shown,
-        ``abs_deviation`` (in ``unit``) and ``rel_deviation`` (fraction) where defined,
-        ``status`` (the category, one of :data:`passmd.ledger.claims.STATUSES`), ``verdict`` (one
-        computed line), ``evidence`` (computed lines, ``" | "``-separated), ``reason``
-        (claims.csv's human reason), ``basis``, ``study_of`` (the claim a study accompanies,
-        empty for a claim), ``readings`` (evaluated), ``holds_at`` (how many hold), ``fails_at``
-        and ``decided_at`` (how many fail, of the decided ones), ``fraction_holds``,
-        ``best_reading``, ``depends_on``, ``default_state`` and ``joint_state``, ``margin`` (the
-        check's ratio against its tolerance at the point deciding the category) with
-        ``margin_text``, ``fragile`` with ``fragile_reason`` (:mod:`passmd.ledger.rules`),
+        Columns :data:`LEDGER_COLUMNS`: ``paper`` as shown, ``ours`` and ``ours_text`` (with units) at the
+        held-out reading, ``abs_deviation`` (in ``unit``) and ``rel_deviation`` (fraction) there,
+        ``status`` (the category, one of :data:`passmd.ledger.claims.STATUSES`), ``verdict`` (one computed
+        line), ``why`` (the one reason: the check's finding at the held-out reading), ``evidence``
+        (computed lines, ``" | "``-separated), ``reason`` (claims.csv's human reason), ``basis``,
+        ``study_of``, ``family`` (the lead of its family, empty for a claim implied by none) and
+        ``counted``, ``readings`` (evaluated), ``holds_at``, ``fails_at``, ``decided_at`` and
+        ``undecided_at`` (of its readings), ``fraction_holds``, ``best_reading``, ``depends_on``,
+        ``default_state``, ``held_out_reading`` and ``held_out_state``, ``joint_state`` (in-sample),
+        ``margin`` with ``margin_text``, ``fragile`` with ``fragile_reason`` (:mod:`passmd.ledger.rules`),
         ``outside`` (where the deciding data lie outside a method's validity), ``informative`` and
         ``not_informative`` (why its check cannot fail, from the extractor).
     """
@@ -328,19 +363,19 @@ def evaluate(
         evaluated[claim["id"]] = (points, functions.depends_on.get(claim["id"], ()))
     if problems:
         raise LookupError("ledger evaluation is incomplete:\n  " + "\n  ".join(problems))
-    studies = {c for c, row in claims.set_index("id").iterrows() if is_study(row)}
+    by_id = claims.set_index("id")
+    studies = {c for c, row in by_id.iterrows() if is_study(row)}
+    sections = {c: readings.section_of(row) for c, row in by_id.iterrows()}
+    families = {c: family_of({**row, "id": c}) for c, row in by_id.iterrows() if c not in studies}
     claims_of_paper = {c: v for c, v in evaluated.items() if c not in studies}
-    computed = {c for c, (points, _) in claims_of_paper.items() if points and c not in functions.experiment}
-    states = state_table(claims_of_paper)
-    joint = joint_reading(claims_of_paper, computed, states=states)
-    runner_ups = tuple(r["reading"] for r in joint["runner_ups"])
+    voters = {c for c, (points, _) in claims_of_paper.items()
+              if points and c not in functions.experiment and not not_informative(functions, c)}
+    joint = judge(claims_of_paper, sections, families, voters)
+    judgements = _judgements(claims, evaluated, joint, sections, studies)
     rows, point_rows = [], []
     for _, claim in claims.iterrows():
         points, depends = evaluated[claim["id"]]
-        study = claim["id"] in studies
-        row, _ = claim_row(claim, results, functions, joint=None if study else joint["reading"],
-                           runner_ups=() if study else runner_ups, points=points or None,
-                           elsewhere="" if study else _elsewhere(claim["id"], joint["states"], joint))
+        row, _ = claim_row(claim, results, functions, judged=judgements[claim["id"]], points=points or None)
         rows.append(row)
         point_rows.extend({"claim": claim["id"], "reading": readings.describe(p.reading),
                            "point": {k: p.reading[k] for k in depends if k in p.reading},
@@ -349,26 +384,37 @@ def evaluate(
                                      and math.isfinite(p.outcome.score) else None)} for p in points)
     table = pd.DataFrame(rows, columns=list(LEDGER_COLUMNS))
     table.attrs["points"] = point_rows
-    conflicts = conflicting_pairs(joint["states"], computed)
-    table.attrs["joint"] = {**{k: v for k, v in joint.items() if k != "states"},
-                            "variants": _variants(claims_of_paper, computed,
-                                                  [r for r in rows if r["claim"] not in studies], states,
-                                                  {c: evaluated[c] for c in studies})}
+    counted_rows = [r for r in rows if r["counted"] and r["claim"] not in studies]
+    conflicts = conflicting_pairs(joint["states"], voters)
+    gain = [r["claim"] for r in counted_rows if r["claim"] in voters and r["status"] not in REPRODUCED
+            and joint["unit_states"][r["claim"]][joint["best"]] == 1]
+    table.attrs["joint"] = {
+        **{k: v for k, v in joint.items() if k not in ("states", "units", "unit_states", "held_out", "best",
+                                                        "grid_bound")},
+        "reading": joint["point"],
+        "held_out_counts": {s: sum(r["status"] == s for r in counted_rows) for s in STATUSES},
+        "in_sample_gain": gain,
+        "variants": _variants(claims_of_paper, sections, families, voters,
+                              [r for r in rows if r["claim"] not in studies],
+                              {c: evaluated[c] for c in studies}),
+    }
     table.attrs["conflicts"] = conflicts
     table.attrs["tensions"] = tensions(joint["states"], conflicts)
-    table.attrs["joint_map"] = _map_columns(joint)
+    table.attrs["joint_map"] = map_columns(joint)
     return table
 
 
 def headline(evaluated: pd.DataFrame) -> dict:
-    """Counts per category of the claims of the paper, plus the fragile rows, the rows whose check is
-    not informative, the claims about the experiment and the studies (shown, not counted)."""
+    """Counts per category of the claims of the paper, each family once (judged at its held-out
+    reading), plus the fragile rows, the rows whose check is not informative, the claims about the
+    experiment, the rows counted with their family and the studies (shown, not counted)."""
     claims = counted(evaluated)
     counts = {s: int((claims["status"] == s).sum()) for s in STATUSES}
     counts["fragile"] = int(claims["fragile"].astype(bool).sum())
     counts["not informative"] = int((~claims["informative"].astype(bool)).sum())
     counts["about the experiment"] = int((claims["basis"] == EXPERIMENT_BASIS).sum())
-    counts["studies"] = int(len(evaluated) - len(claims))
+    counts["counted with their family"] = int(((evaluated["study_of"] == "") & ~evaluated["counted"]).sum())
+    counts["studies"] = int((evaluated["study_of"] != "").sum())
     return counts
 
 

@@ -7,14 +7,14 @@ Presentation only: every function takes a table computed by :func:`passmd.report
 
 from __future__ import annotations
 
+import html
 import re
 from collections.abc import Mapping
 
-import numpy as np
 import pandas as pd
 
-from passmd.ledger.checks import format_number
-from passmd.ledger.claims import STATUSES, tolerance_text
+from passmd.ledger import readings
+from passmd.ledger.claims import REPRODUCED, STATUSES, tolerance_text
 from passmd.ledger.rules import FRAGILE_MARGIN
 from passmd.ledger.verdicts import EXPERIMENT_BASIS
 from passmd.report.assumptions import all_assumptions
@@ -29,6 +29,9 @@ __all__ = [
     "category_anchor",
     "claim_anchor",
     "details_markdown",
+    "families_markdown",
+    "held_out_sentences",
+    "readings_count",
     "headline_markdown",
     "sources_markdown",
     "styled",
@@ -39,43 +42,81 @@ __all__ = [
 
 
 def summary(evaluated: pd.DataFrame) -> str:
-    """One line such as ``"11 of 40 claims reproduced (1 a closed-form identity); 3 inconclusive"``.
+    """One line such as ``"9 of 41 claims reproduced (2 under the joint reading); 4 hold by construction,
+    20 not reproduced, 8 inconclusive (…)"``.
 
-    Counts the claims of the paper only (studies are shown, never counted, :mod:`passmd.ledger.rules`);
-    closed-form identities are counted apart: they are not simulation results.
+    Counts the claims of the paper, each family once, judged at their held-out readings (studies and
+    rows implied by another are shown, never counted, :mod:`passmd.ledger.rules`); rows holding by
+    construction are never counted as reproduced.
     """
     claims = counted(evaluated)
     counts = claims["status"].value_counts()
-    closed = int(((claims["status"] == "reproduced") & (claims["basis"] == "closed form")).sum())
-    text = f"{int(counts.get('reproduced', 0))} of {len(claims)} claims reproduced"
-    if closed:
-        text += f" ({closed} of them a closed-form identity, not a simulation)"
-    others = [f"{int(counts[s])} {s}" for s in STATUSES[1:] if counts.get(s, 0)]
-    studies = len(evaluated) - len(claims)
+    reproduced = sum(int(counts.get(s, 0)) for s in REPRODUCED)
+    text = f"{reproduced} of {len(claims)} claims reproduced"
+    under = int(counts.get(REPRODUCED[1], 0))
+    if under:
+        text += f" ({under} under the joint reading)"
+    others = [f"{int(counts[s])} {_plural(s, int(counts[s]))}" for s in STATUSES[2:] if counts.get(s, 0)]
+    studies = int((evaluated["study_of"] != "").sum())
+    implied = int(((evaluated["study_of"] == "") & ~evaluated["counted"].astype(bool)).sum()) \
+        if "counted" in evaluated else 0
+    shown = ([f"{implied} implied {'row' if implied == 1 else 'rows'} counted with their family"]
+             if implied else [])
+    shown += [f"{studies} {'study' if studies == 1 else 'studies'}"] if studies else []
     return (text + ("; " + ", ".join(others) if others else "")
-            + (f" ({studies} {'study' if studies == 1 else 'studies'} shown, not counted)"
-               if studies else ""))
+            + (f" ({' and '.join(shown)} shown, not counted)" if shown else ""))
+
+
+def _plain(point: Mapping) -> dict:
+    """A point of the space with plain keys (``key@section``), as ``passmd ledger --json`` writes it."""
+    return {(k if isinstance(k, str) else readings.point_key(k)): v for k, v in point.items()}
+
+
+def _plural(status: str, n: int) -> str:
+    """A category as a count reads it: ``"1 holds by construction"``, ``"4 hold by construction"``."""
+    return status.replace("holds", "hold") if status.startswith("holds") and n != 1 else status
+
+
+def held_out_sentences(evaluated: pd.DataFrame) -> list[str]:
+    """How the counts are judged, in sentences: every claim at its held-out reading, the largest number
+    of claims holding at one point, and the in-sample joint reading with its gain over held out."""
+    joint = evaluated.attrs.get("joint", {})
+    gain = joint.get("in_sample_gain", [])
+    claims = counted(evaluated)
+    reproduced = int(claims["status"].isin(REPRODUCED).sum())
+    lines = [f"Each claim is judged at its held-out reading: the joint reading chosen, by the same rule, "
+             f"from all the other claims. {reproduced} reproduced that way; at most "
+             f"{joint.get('best_single_point', 0)} claims hold together at any one point of the space."]
+    if joint:
+        lines.append(f"In-sample (the joint reading chosen with every claim, {joint['described']}): "
+                     f"{joint['holding']} of {joint['claims']} voting claims hold"
+                     + (f"; +{len(gain)} in-sample {'pass' if len(gain) == 1 else 'passes'}: "
+                        + ", ".join(gain)
+                        if gain else "; no claim holds only in-sample") + ".")
+    return lines
 
 
 def joint_sentences(joint: Mapping) -> list[str]:
-    """The joint reading in sentences: where it is, how many claims hold there, the points it was
-    chosen from and stands for, its ties, its runner-ups with their margins, and how it changes when
+    """The in-sample joint reading in sentences: where it is, how many claims hold there, the points it
+    was chosen from and stands for, its ties, its runner-ups with their margins, and how it changes when
     rows are left out. The replication report and ``passmd ledger`` print these same sentences."""
     lines = [
-        f"Joint reading: {joint['described']}, where {joint['holding']} of {joint['claims']} claims hold "
-        "together.",
+        f"Joint reading (in-sample): {joint['described']}, where {joint['holding']} of {joint['claims']} "
+        "voting claims hold together.",
         f"It was chosen from {joint['chosen_from']} of the {joint['points']} points of the declared "
         f"assumption space ({joint['covered_points']} covered: every claim resting on computed evidence "
         f"evaluated there from its runs; {joint['decided_points']} decided: every such claim holds or fails "
         f"there); {joint['equivalent_points']} of them give every claim the same state as it does.",
-        ("Tied with it: " + "; ".join(f"{t['described']} ({t['holding']})" for t in joint["ties"]) + "."
+        ("Tied with it: " + "; ".join(f"{t['described']} ({t['holding']})" for t in joint["ties"])
+         + (f" and {joint['tied_readings'] - len(joint['ties'])} more readings"
+            if joint.get("tied_readings", 0) > len(joint["ties"]) else "") + "."
          if joint["ties"] else "No other reading ties with it."),
         ("Runner-ups: " + "; ".join(f"{r['described']} ({r['holding']} hold, {r['margin']} fewer)"
                                     for r in joint["runner_ups"]) + "."
          if joint["runner_ups"] else "No runner-up: every other reading holds as many claims."),
     ]
     for variant in joint.get("variants", []):
-        same = variant["reading"] == joint["reading"]
+        same = variant["reading"] == _plain(joint["reading"])
         changed = len(variant["claims_left_out"]) or len(variant.get("claims_added", []))
         lines.append(f"With the {variant['left_out']} ({changed}): "
                      + ("the same reading" if same else variant["described"])
@@ -117,8 +158,9 @@ STUDIES_ANCHOR = "ledger-studies"
 
 
 def headline_markdown(evaluated: pd.DataFrame, page: str = "replication_report", *, ref: bool = False) -> str:
-    """The per-category counts of the claims of the paper as MyST markdown, each linking to that
-    category's claims, with the fragile, not-informative and experiment rows and the studies.
+    """The per-category counts of the claims of the paper (each family once, judged at its held-out
+    reading) as MyST markdown, each linking to that category's claims, with the fragile, not-informative
+    and experiment rows, the implied rows and the studies.
 
     Links go to the targets :func:`details_markdown` writes: ``{ref}`` roles when ``ref`` is
     true (the book), markdown links to ``page.md#anchor`` otherwise.
@@ -132,66 +174,91 @@ def headline_markdown(evaluated: pd.DataFrame, page: str = "replication_report",
     parts = []
     for status in STATUSES:
         n = int(counts.get(status, 0))
-        parts.append(link(f"{n} {status}", category_anchor(status)) if n else f"{n} {status}")
-    closed = int(((claims["status"] == "reproduced") & (claims["basis"] == "closed form")).sum())
-    note = f" ({closed} of the reproduced a closed-form identity, not a simulation)" if closed else ""
+        label = f"{n} {_plural(status, n)}"
+        parts.append(link(label, category_anchor(status)) if n else label)
     flags = ""
     if "fragile" in claims:
         experiment = int((claims["basis"] == EXPERIMENT_BASIS).sum())
         flags = (f"; {int(claims['fragile'].astype(bool).sum())} fragile (the verdict flips at a runner-up "
-                 "reading "
-                 f"or its margin is within {FRAGILE_MARGIN:.0%} of its tolerance), "
-                 f"{int((~claims['informative'].astype(bool)).sum())} not informative (their check cannot "
-                 "fail), "
+                 f"reading or its margin is within {FRAGILE_MARGIN:.0%} of its tolerance), "
                  f"{experiment} about the experiment (no measured data in the text)")
-    studies = len(evaluated) - len(claims)
+    implied = int(((evaluated["study_of"] == "") & ~evaluated["counted"].astype(bool)).sum()) \
+        if "counted" in evaluated else 0
+    if implied:
+        one = implied == 1
+        flags += (f"; {implied} implied {'row' if one else 'rows'} counted with "
+                  f"{'its' if one else 'their'} family")
+    studies = int((evaluated["study_of"] != "").sum())
     if studies:
         flags += "; " + link(f"{studies} studies", STUDIES_ANCHOR) + " shown, not counted"
-    return f"{len(claims)} claims: " + ", ".join(parts) + note + flags
+    return f"{len(claims)} claims, each judged at its held-out reading: " + ", ".join(parts) + flags
 
 
 #: Background colours of the categories in :func:`styled`.
 STATUS_COLOURS = {
     "reproduced": "#d4edda",
     "reproduced under the joint reading": "#d1ecf1",
+    "holds by construction": "#fff3cd",
     "not reproduced": "#f8d7da",
     "inconclusive": "#e9ecef",
 }
 
 
-def styled(evaluated: pd.DataFrame, *, links: bool = False):
-    """A pandas ``Styler`` of the ledger for the book: one short line per claim.
+def _ours_vs_paper(row) -> str:
+    """Our value at the held-out reading against the paper's, in one cell."""
+    if "the paper's" in row.ours_text:  # a value check names the paper's number itself
+        return row.ours_text
+    return f"{row.ours_text}; paper: {row.paper}"
 
-    Columns: claim, figure, paper, ours, category (coloured badge), margin at the defaults,
-    failing readings (of the decided ones) and flags (fragile, not informative). Details (quote, reason,
-    evidence, readings) are in :func:`details_markdown`; with ``links=True`` each claim links
-    to its details on the same page. The table carries the HTML class ``passmd-ledger`` (the
-    rendered-book check looks for it) and wraps inside the content column.
+
+def _short(text: str, limit: int = 160) -> str:
+    """A reason cut to about ``limit`` characters at a word boundary."""
+    return text if len(text) <= limit else text[:limit].rsplit(" ", 1)[0] + " …"
+
+
+def _category_text(row) -> str:
+    """A row's category with what it is counted as: with its family's lead, as a study, a closed form."""
+    text = row.status
+    if not row.counted and not row.study_of:
+        text += f" (counted with {row.family})"
+    if row.study_of:
+        text += f" (study of {row.study_of}, not counted)"
+    return text + (" (closed form)" if row.basis == "closed form" else "")
+
+
+def readings_count(row) -> str:
+    """How a claim fares over all its readings: ``"holds 3, fails 20, undecided 1 of 24"``."""
+    if not row.readings:
+        return "—"
+    return (f"holds {int(row.holds_at)}, fails {int(row.fails_at)}, undecided {int(row.undecided_at)} "
+            f"of {int(row.readings)}")
+
+
+def styled(evaluated: pd.DataFrame, *, links: bool = False, grid: str = ""):
+    """A pandas ``Styler`` of the ledger for the book: one line per claim.
+
+    Columns: claim, category (coloured; "counted with <lead>" for a row implied by another, "study of …"
+    for a study), ours against the paper (at the held-out reading, with units), the one reason (the
+    check's finding there), and its readings (holds, fails, undecided of all evaluated). Details
+    (quote, verdict, evidence at every reading) are in :func:`details_markdown`; with ``links=True``
+    each claim links to its details on the same page; ``grid`` (e.g. "quick: a partial grid") is
+    added to the caption. The table carries the HTML class ``passmd-ledger`` (the rendered-book check
+    looks for it) and wraps inside the content column.
     """
-    shown = evaluated[["claim", "figure", "paper", "ours", "status"]].copy()
-    shown["ours"] = [format_number(v) if isinstance(v, (float, np.floating)) else str(v)
-                     for v in shown["ours"]]
-    if "margin_text" in evaluated:
-        shown["margin"] = evaluated["margin_text"].to_numpy()
-        shown["fails at"] = [f"{int(f)} of {int(d)}" if d else "—"
-                             for f, d in zip(evaluated["fails_at"], evaluated["decided_at"], strict=True)]
-        shown["flags"] = [", ".join((["fragile"] if fr else []) + ([] if inf else ["not informative"])
-                                    + (["Eq. 15 undefined"] if out else [])
-                                    + ([f"study of {of}"] if of else []))
-                          for fr, inf, out, of in zip(evaluated["fragile"], evaluated["informative"],
-                                                      evaluated["outside"], evaluated["study_of"],
-                                                      strict=True)]
-    if links:
-        shown["claim"] = [f'<a href="#{claim_anchor(c)}">{c}</a>' for c in evaluated["claim"]]
-    shown["status"] = [s + (" (closed form)" if b == "closed form" else "")
-                       for s, b in zip(evaluated["status"], evaluated["basis"], strict=True)]
-    shown = shown.rename(columns={"status": "category"})
+    rows = list(evaluated.itertuples())
+    shown = pd.DataFrame({  # the cells are HTML: text is escaped ('<' of a relation), the links are not
+        "claim": [f'<a href="#{claim_anchor(r.claim)}">{r.claim}</a>' if links else r.claim for r in rows],
+        "category": [html.escape(_category_text(r), quote=False) for r in rows],
+        "ours vs paper": [html.escape(_ours_vs_paper(r), quote=False) for r in rows],
+        "why": [html.escape(_short(r.why), quote=False) for r in rows],
+        "readings": [readings_count(r) for r in rows],
+    })
     statuses = evaluated["status"].to_numpy()
 
     def colour(column):
         return [f"background-color: {STATUS_COLOURS[s]}" for s in statuses]
 
-    return (
+    styler = (
         shown.style.hide(axis="index")
         .apply(colour, subset=["category"])
         .set_table_attributes('class="passmd-ledger"')
@@ -201,9 +268,15 @@ def styled(evaluated: pd.DataFrame, *, links: bool = False):
                                             "word-break: break-word; white-space: normal;"},
         ])
     )
+    return styler.set_caption(grid) if grid else styler
 
 
-def _details_block(row, claim, heading: str) -> str:
+def _state_verb(state: str) -> str:
+    """A state as a verb phrase: ``holds``, ``fails``, ``is undecided``."""
+    return {"holds": "holds", "fails": "fails", "inconclusive": "is undecided"}.get(state, "is not evaluated")
+
+
+def _details_block(row, claim, heading: str, members: tuple = ()) -> str:
     """One claim's (or study's) collapsed block: quote, verdict, flags, evidence, reason, configuration."""
     section, check = _section_text(claim), _check_text(claim)
     basis = " (closed form)" if row.basis == "closed form" else ""
@@ -217,6 +290,15 @@ def _details_block(row, claim, heading: str) -> str:
         lines += [f"*Study* (not a sentence of the paper, not counted) of {_md_escape(row.study_of)} "
                   f"({_md_escape(section)}).", ""]
     lines += [f"*Verdict (computed):* {_md_escape(row.verdict)}.", ""]
+    if row.readings:
+        lines += [f"*Judged at:* {_md_escape(row.held_out_reading)} (its held-out reading), where it "
+                  f"{_state_verb(row.held_out_state)}; at the in-sample joint reading it "
+                  f"{_state_verb(row.joint_state)}. *Readings:* {readings_count(row)}.", ""]
+    if members:
+        lines += [f"*Family:* counted once with the rows implied by it, as one claim that holds only if "
+                  f"every member holds: {_md_escape(', '.join(members))}.", ""]
+    elif row.family:
+        lines += [f"*Implied by* {_md_escape(row.family)}: counted with it, once.", ""]
     if row.basis == "closed form":
         lines += ["*Basis:* a closed-form identity, not a simulation result.", ""]
     if row.fragile:
@@ -228,8 +310,7 @@ def _details_block(row, claim, heading: str) -> str:
         lines += [f"- {_md_escape(item)}" for item in row.evidence.split(" | ")]
         lines.append("")
     if row.depends_on:
-        lines += [f"*Readings:* holds at {row.holds_at} of {row.readings}; best: "
-                  f"{_md_escape(row.best_reading)}.", ""]
+        lines += [f"*Best reading:* {_md_escape(row.best_reading)}.", ""]
     if row.reason and row.status != "reproduced":
         lines += [f"*Reason (our reading of the evidence):* {_md_escape(row.reason)}", ""]
     lines += [f"*Configuration:* {_md_escape(_config_text(claim))}. "
@@ -252,15 +333,36 @@ def details_markdown(evaluated: pd.DataFrame, claims: pd.DataFrame) -> str:
     by_id = claims.set_index("id")
     blocks = []
     claims_of_paper, studies = counted(evaluated), evaluated[evaluated["study_of"] != ""]
+    implied = evaluated[(evaluated["study_of"] == "") & ~evaluated["counted"].astype(bool)]
     for status in STATUSES:
         rows = claims_of_paper[claims_of_paper["status"] == status]
         blocks.append(f"({category_anchor(status)})=\n**{status.capitalize()}: {len(rows)}**\n")
-        blocks.extend(_details_block(row, by_id.loc[row.claim], status) for row in rows.itertuples())
+        for row in rows.itertuples():
+            mine = implied[implied["family"] == row.claim]
+            blocks.append(_details_block(row, by_id.loc[row.claim], status, tuple(mine["claim"])))
+            blocks.extend(_details_block(member, by_id.loc[member.claim],
+                                         f"implied by {member.family}, {member.status}")
+                          for member in mine.itertuples())
     if len(studies):
         blocks.append(f"({STUDIES_ANCHOR})=\n**Studies (not counted): {len(studies)}**\n")
         blocks.extend(_details_block(row, by_id.loc[row.claim], f"study, {row.status}")
                       for row in studies.itertuples())
     return "\n".join(blocks)
+
+
+def families_markdown(evaluated: pd.DataFrame) -> str:
+    """Every family of claims as MyST markdown: its lead, its category (the conjunction of its members,
+    judged at its held-out reading) and each implied row with its own state there."""
+    members = evaluated[(evaluated["study_of"] == "") & ~evaluated["counted"].astype(bool)]
+    if members.empty:
+        return "No row is implied by another: every claim is counted on its own.\n"
+    by_id = evaluated.set_index("claim")
+    lines = ["A row the paper's stronger statement implies is counted once with it: the family holds only if "
+             "every member holds, and votes once in the joint reading.", ""]
+    for lead, group in members.groupby("family", sort=False):
+        implied = ", ".join(f"`{r.claim}` ({r.held_out_state})" for r in group.itertuples())
+        lines.append(f"* `{lead}`: {by_id.at[lead, 'status']}; implies {implied}.")
+    return "\n".join(lines) + "\n"
 
 
 def assumption_map_styled(evaluated: pd.DataFrame):

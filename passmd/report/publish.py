@@ -39,6 +39,7 @@ __all__ = [
     "PROFILES",
     "PROFILE_ENV",
     "Markdown",
+    "assumption_value",
     "assumptions_frame",
     "book_config",
     "book_root",
@@ -48,8 +49,10 @@ __all__ = [
     "drive_parameters",
     "figure_png",
     "format_quantity",
+    "grid_text",
     "implementations",
     "parameter_frame",
+    "partial_grid_text",
     "put",
     "put_text",
     "show_figure",
@@ -188,6 +191,44 @@ def format_quantity(value_si, unit: str, digits: int = 3) -> str:
     if np.ndim(value) != 0:
         raise ValueError(f"value_si = {value_si!r} is not allowed: must be a scalar")
     return f"{value:.{int(digits)}g} {unit}"
+
+
+def grid_text(values_si, unit: str, limit: int = 8) -> str:
+    """A profile's grid as a caption names it, in ``unit``: every value when there are at most
+    ``limit`` (``"1, 20, 60, 100 kHz"``), else the first three, the last and how many
+    (``"1, 5, 10, …, 130 kHz (27 values)"``)."""
+    shown = [f"{v:g}" for v in np.atleast_1d(to_unit(np.asarray(values_si, dtype=float), unit))]
+    if not shown:
+        raise ValueError("values_si is empty: a grid has at least one value")
+    if len(shown) <= limit:
+        return f"{', '.join(shown)} {unit}"
+    return f"{', '.join(shown[:3])}, …, {shown[-1]} {unit} ({len(shown)} values)"
+
+
+def partial_grid_text(names, profile: str) -> tuple[str, str, list[str]] | None:
+    """What a page built on ``profile`` lacks of the paper profile's grids for the figures ``names``
+    (:func:`passmd.experiments.figure_table.grid_shortfall`): a title with the points missing, one
+    sentence with the points computed and one item per figure that lacks points (``"fig5a: 18 of the
+    paper profile's 203 points (amplitudes), 185 missing"``); None on the paper profile."""
+    from passmd.experiments.figure_table import grid_shortfall
+
+    check_choice("profile", profile, PROFILES)
+    if profile == "paper":
+        return None
+    short = grid_shortfall(names, profile)
+    short = short[short["missing"] > 0]
+    if short.empty:
+        return (f"{profile.capitalize()} profile",
+                f"Built on the {profile} profile. None of the grids of points this page's figures and "
+                "verdicts read is coarser than the paper profile's (a profile may still record or integrate "
+                "the same runs more coarsely).", [])
+    items = [f"{row.figure}: {row.points} of the paper profile's {row.reference_points} points "
+             f"({row.axes}), {row.missing} missing" for row in short.itertuples()]
+    total, computed, missing = (int(short[c].sum()) for c in ("reference_points", "points", "missing"))
+    return (f"Partial grid: {missing} of the paper profile's {total} grid points missing",
+            f"Built on the {profile} profile: the figures behind this page's verdicts compute {computed} of "
+            f"the paper profile's {total} grid points, so a verdict may differ on the paper's grids "
+            "(python3 -m nox -s book builds them). By figure:", items)
 
 
 def drive_parameters(drive) -> dict[str, str]:
@@ -338,19 +379,36 @@ def escape_markdown(text: str) -> str:
 def assumption_list(frame=None) -> Markdown:
     """The assumptions (:func:`assumptions_frame`, or ``frame``) as a markdown list.
 
-    One item per assumption: key, ``symbol = value unit`` (symbol and unit left out when
-    they are empty or a dash), rationale and where its effect is shown; text escaped.
+    One item per assumption: key, its value (:func:`assumption_value`), rationale and where its
+    effect is shown; text escaped.
     """
     frame = assumptions_frame() if frame is None else frame
     e = escape_markdown
     return Markdown("\n".join(
-        f"- **{e(row.key)}** ("
-        + (f"{e(row.symbol)} = " if row.symbol not in ("", "–", "-") else "")
-        + e(row.value)
-        + (f" {e(row.unit)}" if row.unit not in ("", "–") else "")
-        + f"). {e(row.rationale)} *Where its effect is shown:* {e(row.sensitivity)}"
+        f"- **{e(row.key)}** ({e(assumption_value(row.symbol, row.value, row.unit))}). {e(row.rationale)} "
+        f"*Where its effect is shown:* {e(row.sensitivity)}"
         for row in frame.itertuples()
     ))
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def assumption_value(symbol: str, value: str, unit: str) -> str:
+    """An assumption's value as one phrase: ``δ = 0.5 nm`` for a number, ``c_p [kg/s] = 2·ζ·√(k_p m_a) …``
+    for a description (the unit belongs to the symbol, not to the description's last word); symbol and
+    unit left out when empty or a dash."""
+    has_symbol, has_unit = symbol not in ("", "–", "-"), unit not in ("", "–", "-")
+    if _is_number(value):
+        return (f"{symbol} = " if has_symbol else "") + value + (f" {unit}" if has_unit else "")
+    unit_part = f"[{unit}]" if has_unit else ""
+    named = f"{symbol} {unit_part}".strip() if has_symbol else unit_part
+    return f"{named} = {value}" if named else value
 
 
 def implementations(mapping: dict[str, str | list[str]]):

@@ -13,7 +13,10 @@ order the points finish in. Execution is
 
 Every finished point is written to the on-disk cache (:mod:`passmd.runtime.cache`) as soon as
 it completes, so an interrupted sweep (Ctrl-C, SIGTERM, a failing point, a killed job) keeps
-every finished point and a rerun recomputes only the rest. The cache key covers the swept
+every finished point and a rerun recomputes only the rest. Worker processes never outlive the
+sweep: a process pool's workers end when the process that started them dies, even by ``kill -9``
+(:func:`passmd.runtime.pools.end_with_parent`), and a local Dask cluster's workers exit with it
+(``distributed`` watches their parent). The cache key covers the swept
 function's own code too (:func:`passmd.runtime.cache.keys.function_code`): a user's function that
 changed between two sweeps is recomputed, and one whose code cannot be fingerprinted is
 not cached (one :class:`~passmd.runtime.cache.store.CacheWarning` says why). Progress (points done, ETA;
@@ -38,13 +41,13 @@ import itertools
 import logging
 import os
 import pickle
-import signal
 import sys
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 
 import pandas as pd
 
+from passmd.runtime import pools
 from passmd.runtime.cache import Cache, CacheWarning, Unfingerprintable, function_code, function_name
 from passmd.runtime.config import EXECUTORS, MAX_WORKERS, RunConfig, useful_workers
 from passmd.runtime.extras import install_hint
@@ -77,42 +80,6 @@ def progress_enabled(progress: bool | None = None, stream=None) -> bool:
 def _call(func, point):
     """Evaluate one point (runs in the worker)."""
     return func(**point)
-
-
-#: The signals a process pool's start and shut-down hold back: delivered right after, in the sweep.
-_HELD_SIGNALS = (signal.SIGINT, signal.SIGTERM)
-
-
-@contextlib.contextmanager
-def _signals_held():
-    """Hold SIGINT and SIGTERM back in this thread while worker processes are forked or stopped.
-
-    A worker forked meanwhile starts with both blocked, so that neither reaches it before its
-    initializer (:func:`_worker_signals`) has set its own handlers: a Ctrl-C or a SIGTERM to
-    the process group while the pool starts never raises inside a worker (a traceback). This
-    process receives a signal that came meanwhile as soon as the block ends, where the sweep
-    handles it (stopping the workers), never inside the executor's start or shut-down.
-    """
-    if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - Windows
-        yield
-        return
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD_SIGNALS)
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
-
-
-def _worker_signals():  # pragma: no cover - runs in pool workers
-    """Pool worker initializer: Ctrl-C is handled by the parent, which stops the workers; SIGTERM
-    (the parent's stop, or a stop of the whole process group) ends a worker at once, whatever
-    handler the parent had installed before the fork. Then the signals the parent held back
-    while forking (:func:`_signals_held`) are let through: a SIGTERM that came meanwhile ends
-    the worker silently, a Ctrl-C is dropped."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    if hasattr(signal, "pthread_sigmask"):
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, _HELD_SIGNALS)
 
 
 def _check_points(points) -> list[dict]:
@@ -195,16 +162,6 @@ def _harvest(futures: dict, collect: _Collector) -> None:
             continue
 
 
-def _stop_workers(pool: cf.ProcessPoolExecutor) -> None:
-    """Terminate a process pool's workers at once (Ctrl-C must not wait for running points)."""
-    terminate = getattr(pool, "terminate_workers", None)  # Python >= 3.14
-    if terminate is not None:
-        terminate()
-        return
-    for process in list((getattr(pool, "_processes", None) or {}).values()):
-        process.terminate()
-
-
 def _collect_completed(futures: dict, completed, points, collect: _Collector) -> None:
     """Hand each finished future's result to ``collect`` as ``completed(futures)`` yields it."""
     for future in completed(futures):
@@ -239,14 +196,16 @@ def _run_process(func, todo, points, collect: _Collector, workers) -> None:
     """Evaluate the points in a process pool of ``workers`` processes, started and stopped here.
 
     The pool starts (its workers are forked in ``submit``) and shuts down with SIGINT and
-    SIGTERM held back (:func:`_signals_held`); on Ctrl-C or SIGTERM the finished points are
-    kept and the workers terminated at once (running points are not waited for); when a point
-    fails, the points still running finish and are cached before its exception is raised.
+    SIGTERM held back (:func:`passmd.runtime.pools.signals_held`); on Ctrl-C or SIGTERM the
+    finished points are kept and the workers terminated at once (running points are not waited
+    for); when a point fails, the points still running finish and are cached before its exception
+    is raised.
     """
     pool, futures, interrupted = None, {}, False
     try:
-        with _signals_held():
-            pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_worker_signals)
+        with pools.signals_held():
+            pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=pools.worker_signals,
+                                          initargs=(os.getpid(),))
             futures = {pool.submit(_call, func, points[i]): i for i in todo}
         try:
             _collect_completed(futures, cf.as_completed, points, collect)
@@ -263,13 +222,13 @@ def _run_process(func, todo, points, collect: _Collector, workers) -> None:
         raise
     finally:
         if pool is not None:
-            with _signals_held():
+            with pools.signals_held():
                 if interrupted:
                     _harvest(futures, collect)
                     # Terminating the workers makes the pool fail its pending futures itself.
                     # Cancelling them first races with that: Python 3.11's executor thread then
                     # calls set_exception on a cancelled future and prints an InvalidStateError.
-                    _stop_workers(pool)
+                    pools.stop_workers(pool)
                 pool.shutdown(wait=True, cancel_futures=not interrupted)
 
 
@@ -286,8 +245,9 @@ def process_pool(workers: int | None = None):
     workers = useful_workers(workers, MAX_WORKERS)
     pool, interrupted = None, False
     try:
-        with _signals_held():
-            pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=_worker_signals)
+        with pools.signals_held():
+            pool = cf.ProcessPoolExecutor(max_workers=workers, initializer=pools.worker_signals,
+                                          initargs=(os.getpid(),))
             pool.submit(int)  # forks the workers now (the fork start method starts them all at once)
         yield pool
     except KeyboardInterrupt:
@@ -295,32 +255,53 @@ def process_pool(workers: int | None = None):
         raise
     finally:
         if pool is not None:
-            with _signals_held():
+            with pools.signals_held():
                 if interrupted:
-                    _stop_workers(pool)
+                    pools.stop_workers(pool)
                 pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> None:
+    """Evaluate the points on the Dask cluster at ``scheduler``, or on a local one started and stopped here.
+
+    A local cluster's event loop is started with SIGINT and SIGTERM held back
+    (:func:`passmd.runtime.pools.signals_held`),
+    and its worker processes are started from that loop's threads: they keep both blocked, so a
+    Ctrl-C to the process group reaches this process only (no traceback from a worker). On Ctrl-C
+    or SIGTERM the finished points are kept, the workers killed at once (running points are not
+    waited for) and the cluster closed with its loggers silenced (:func:`passmd.runtime.pools.close_dask`).
+    """
     try:
         from distributed import Client, LocalCluster, as_completed
     except ImportError as exc:  # pragma: no cover - dask is a declared extra
         raise ImportError(f"executor='dask' needs dask.distributed: {install_hint('dask')}") from exc
-    cluster = None if scheduler else LocalCluster(n_workers=workers, threads_per_worker=1,
-                                                  dashboard_address=None, silence_logs=logging.ERROR)
-    client = Client(scheduler or cluster)
-    futures = {}
+    import multiprocessing
+
+    cluster = client = None
+    futures, interrupted = {}, False
+    before = set(multiprocessing.active_children())
     try:
+        if not scheduler:
+            pools.start_resource_tracker()
+            with pools.signals_held():  # (":0": its HTTP server on a free port, never "port in use")
+                cluster = LocalCluster(n_workers=0, threads_per_worker=1, dashboard_address=":0",
+                                       silence_logs=logging.ERROR)
+            cluster.scale(workers)
+        client = Client(scheduler or cluster)
         futures = {client.submit(_call, func, points[i], pure=False): i for i in todo}
         _collect_completed(futures, as_completed, points, collect)
+    except KeyboardInterrupt:
+        interrupted = True
+        _harvest(futures, collect)
+        raise
     except BaseException:
         _harvest(futures, collect)
-        client.cancel(list(futures))
+        if client is not None:
+            client.cancel(list(futures))
         raise
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        with pools.signals_held():
+            pools.close_dask(client, cluster, interrupted, before)
 
 
 def run(
@@ -442,7 +423,8 @@ def _check_arguments(func, executor, scheduler, workers) -> None:
 
 
 def _check_picklable(func, executor) -> None:
-    if executor != "serial":
+    """A function sent to other processes must pickle; in this process (serial, a thread pool) not."""
+    if executor != "serial" and not isinstance(executor, cf.ThreadPoolExecutor):
         try:
             pickle.dumps(func)
         except Exception as exc:

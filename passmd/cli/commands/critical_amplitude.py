@@ -8,8 +8,8 @@ import textwrap
 from passmd.cli import kernels
 from passmd.cli.drive import build_drive, drive_rows
 from passmd.cli.errors import UsageError
-from passmd.cli.notes import ringing_text
-from passmd.cli.options import FREQUENCY, THRESHOLD, TOLERANCE, add_drive_options
+from passmd.cli.notes import diagnosis_rows, hz, ringing_text
+from passmd.cli.options import FREQUENCY, THRESHOLD, TOLERANCE, add_drive_options, add_sweep_options
 from passmd.cli.output import (
     JSON_HELP,
     check_results,
@@ -47,15 +47,33 @@ _EPILOG = textwrap.dedent("""\
     --periods saw-tooth periods from rest exceeds --threshold; first: every contact
     slides fully in the first fly-back from virgin contacts.
 
+    The steady A_c is read at one driving frequency (--frequency, default 100 Hz, Section 4.1's
+    saw-tooth) and can move several-fold with it. --frequency LO..HI[:lin][:N] reads it at N
+    frequencies over a band (log-spaced unless :lin, N default 10; e.g. 100Hz..20kHz) and reports
+    the worst case, the largest A_c, with the frequency where it occurs: the amplitude that moves
+    the runner at every frequency computed in the band (between two of them it may be larger).
+    Band points run in parallel and are cached (--cache-dir), as sweep points.
+
+    Where the simulated A_c departs from its closed form by more than 10 % (the band within which
+    the critical-amplitude chapters call the two in agreement), the command computes why: it
+    searches A_c again with one candidate cause removed at a time (a fly-back of 10 actuator
+    periods, rigid actuators, the runner at rest at each fly-back, the first-fly-back reading) and
+    names each cause by the share of the departure its removal takes away (passmd.protocols.diagnosis;
+    cached; --no-diagnosis skips it).
+
     --json keys (SI units): reading, critical_amplitude_m (null if none up to A_max),
     bracket_m, analytic_critical_amplitude_m, critical_amplitude_rigid_m,
     critical_amplitude_flexible_m, protocol, threshold_m, tolerance_m, frequency_Hz,
     periods, flyback, simulations, wall_time_s, ringing{...} (the runner's swing after a
-    fly-back at A_c and what is left of it at the next: as passmd run), drive{...}
+    fly-back at A_c and what is left of it at the next: as passmd run), band{frequencies_Hz,
+    critical_amplitudes_m, worst_m, worst_frequency_Hz} (a band only), diagnosis{departure_m,
+    causes[{cause, counterfactual_value_m, share, changed, why}], named} (null when A_c agrees
+    with its closed form), drive{...}
 
     The steady A_c can jump up and down with preload, frequency or radius: the runner still
     rings from the previous fly-back when the next one starts, and whether that one slips
-    depends on where in its swing the runner is (the "runner ringing" row says when).""")
+    depends on where in its swing the runner is (the "runner ringing" row says when, the
+    diagnosis whether it is what moves A_c).""")
 
 
 def add_parser(command) -> None:
@@ -64,12 +82,18 @@ def add_parser(command) -> None:
     group = p.add_argument_group("search")
     group.add_argument("--protocol", choices=("steady", "first"), default="steady",
                        help="steady-state A_c or first-fly-back onset (default: steady)")
-    FREQUENCY.add(group)
+    group.add_argument(FREQUENCY.flag, metavar="f", default=None,
+                       help=f"driving frequency, or a band LO..HI[:lin][:N] (e.g. 100Hz..20kHz) whose worst "
+                            f"case is reported [kHz; unit required] (default: {FREQUENCY.default})")
     group.add_argument("--periods", type=int, default=PROTOCOL.steady_periods, metavar="N",
                        help=f"periods of a steady-state run (default: {PROTOCOL.steady_periods})")
     THRESHOLD.add(group)
     TOLERANCE.add(group)
     group.add_argument("--analytic-only", action="store_true", help="skip the simulation (default: off)")
+    group.add_argument("--no-diagnosis", action="store_true",
+                       help="do not compute why A_c departs from its closed form (default: computed where it "
+                            "departs by more than 10 %%)")
+    add_sweep_options(p)
     p.add_argument("--json", action="store_true", help=JSON_HELP)
     p.set_defaults(handler=run_critical_amplitude)
 
@@ -85,10 +109,13 @@ def _search(args, drive) -> dict:
                          "step threshold (use --protocol steady, or drop --threshold)")
     threshold = THRESHOLD.parse_or(args, PROTOCOL.step_threshold)
     tolerance = TOLERANCE.parse_or(args, PROTOCOL.search_tolerance)
-    frequency = FREQUENCY.parse_or(args, PROTOCOL.drive_frequency)
+    band = _band(args)
+    frequency = FREQUENCY.parse_or(args, PROTOCOL.drive_frequency) if band is None else None
     if args.analytic_only:
         return {}
     kernels.notice_on_compile()
+    if band is not None:
+        return _band_search(args, drive, band, threshold, tolerance)
     # the book's search (critical-amplitude chapters): one protocol for users and book
     found = critical_amplitude.critical_amplitude(
         drive, protocol=args.protocol, frequency=frequency,
@@ -110,7 +137,92 @@ def _search(args, drive) -> dict:
         "simulations": found["runs"],
         "wall_time_s": found["wall_time_s"],
         "ringing": _ringing(drive, value, frequency, args),
+        "band": None,
     }
+
+
+def _band(args) -> tuple[float, ...] | None:
+    """The frequencies of ``--frequency LO..HI[:lin][:N]`` (log-spaced by default), None for one frequency."""
+    raw = getattr(args, "frequency", None)
+    if raw is None or ".." not in raw:
+        return None
+    from passmd.cli.commands.sweep import parse_vary
+
+    spec = raw.strip()
+    if not any(part.strip() in ("lin", "linear", "log") for part in spec.split(":")[1:]):
+        spec += ":log"
+    try:
+        axis = parse_vary(f"frequency={spec}")
+    except UsageError as exc:
+        typed = f"--vary = 'frequency={spec}'"
+        raise UsageError(str(exc).replace(typed, f"--frequency = {raw!r}", 1)) from None
+    for value in axis.values:
+        try:
+            FREQUENCY.parse(type(args)(**{**vars(args), "frequency": f"{value!r} Hz"}))
+        except (UsageError, ValueError) as exc:
+            reason = str(exc).split(" is ", 1)[-1]
+            raise UsageError(f"--frequency = {raw!r}: {hz(value)} is {reason}") from None
+    return axis.values
+
+
+def _band_search(args, drive, band, threshold, tolerance) -> dict:
+    """A_c at every frequency of the band (cached sweep points), the worst case and where it occurs."""
+    from passmd.cli.configuration import run_config
+    from passmd.protocols.maps import compute_map
+
+    if args.periods != PROTOCOL.steady_periods or threshold != PROTOCOL.step_threshold or \
+            tolerance != PROTOCOL.search_tolerance:
+        raise UsageError("--frequency with a band reads A_c with the sweep's protocol: leave --periods, "
+                         "--threshold and --tolerance at their defaults (or give one frequency)")
+    table = compute_map("critical-amplitude", [{"drive": drive, "frequency": f} for f in band],
+                        reading=args.protocol, config=run_config(args), description="critical amplitude band")
+    values = [None if v is None or math.isnan(v) else float(v) for v in table["critical_amplitude_m"]]
+    found = [(v, f) for v, f in zip(values, band, strict=True) if v is not None]
+    worst, at = max(found) if found else (None, None)
+    i = list(band).index(at) if at is not None else 0
+    row = table.iloc[i]
+    ring = {k: row[k] for k in ("ringing_frequency_Hz", "ringing_linear_frequency_Hz", "ringing_amplitude_m",
+                                "ringing_decay_time_s",
+                                "next_flyback_after_s", "ringing_at_next_flyback_m", "ringing_affects_steps")}
+    ring = {k: None if isinstance(v, float) and math.isnan(v) else v for k, v in ring.items()}
+    ring["ringing_affects_steps"] = bool(ring["ringing_affects_steps"])
+    ring["amplitude_m"] = worst if worst is not None else drive.actuator.full_stroke_amplitude
+    high = row["bracket_high_m"]
+    return {
+        "reading": f"simulated {args.protocol}",
+        "critical_amplitude_m": worst,
+        "bracket_m": [float(row["bracket_low_m"]), None if high is None or math.isnan(high) else float(high)],
+        "protocol": args.protocol,
+        "threshold_m": threshold if args.protocol == "steady" else None,
+        "tolerance_m": tolerance,
+        "frequency_Hz": at if at is not None else band[0],
+        "periods": args.periods if args.protocol == "steady" else 1,
+        "flyback": drive.amplifier.flyback,
+        "simulations": int(sum(table["runs"])),
+        "wall_time_s": float(sum(table["wall_time_s"])),
+        "ringing": ring,
+        "band": {"frequencies_Hz": list(band), "critical_amplitudes_m": values, "worst_m": worst,
+                 "worst_frequency_Hz": at},
+    }
+
+
+def _diagnosis(args, drive, record) -> dict | None:
+    """Why the simulated A_c departs from its closed form (None where it agrees within the band,
+    there is none, or --no-diagnosis)."""
+    from passmd.protocols import diagnosis
+
+    found, closed = record.get("critical_amplitude_m"), record["analytic_critical_amplitude_m"]
+    if args.no_diagnosis or found is None or not diagnosis.departs(found, closed):
+        return None
+    from passmd.cli.configuration import run_config
+
+    point = {"drive": drive, "frequency": record["frequency_Hz"], "amplitude": found}
+    out = diagnosis.diagnose("critical-amplitude", [point], [found], reading=args.protocol,
+                             config=run_config(args))
+    causes = [{"cause": c["cause"], "counterfactual_value_m": c["counterfactual_value"], "share": c["share"],
+               "changed": c["changed"], "why": c["why"], "key": c["key"], "tried": c["tried"],
+               "counterfactual_closed_form_m": c["counterfactual_expected"]} for c in out["causes"]]
+    return {"departure_m": out["departure"], "closed_form_m": closed, "causes": causes, "named": out["named"]}
 
 
 def _ringing(drive, found: float, frequency: float, args) -> dict:
@@ -138,13 +250,18 @@ def run_critical_amplitude(args, out) -> int:
         "critical_amplitude_flexible_m": theory["critical_amplitude_flexible_m"],
         **_search(args, drive),
     }
+    if not args.analytic_only:
+        record["diagnosis"] = _diagnosis(args, drive, record)
     check_results(record)
     if args.json:
         emit_json(record, out)
         return 0
     rows = [] if args.analytic_only else _search_rows(record, drive)
     eq = "Eq. 7/11" if drive.actuator_model == "rigid" else "Eq. 8/12"
-    rows.append((f"analytic A_c ({eq})", fmt(record["analytic_critical_amplitude_m"], "nm")))
+    analytic = (f"analytic A_c ({eq})", fmt(record["analytic_critical_amplitude_m"], "nm"))
+    rows.insert(1 if rows else 0, analytic)
+    if record.get("diagnosis"):
+        rows += _diagnosis_rows(record, eq)
     rows += [(f"what the {name} reading means", text.split(": ", 1)[1])
              for name, text in READINGS.items()]
     emit_rows(f"passmd critical-amplitude — {describe(drive)}", [*rows, *drive_rows(drive)], out)
@@ -159,15 +276,40 @@ def _search_rows(record: dict, drive) -> list[tuple[str, str]]:
         criterion = f"last of {record['periods']} steps > {fmt(record['threshold_m'], 'nm')}"
     else:
         criterion = "full sliding of every contact in the first fly-back"
-    return [
-        (f"simulated A_c, {record['protocol']} reading",
+    band = record.get("band")
+    where = (f"worst over {hz(band['frequencies_Hz'][0])}–{hz(band['frequencies_Hz'][-1])}, at "
+             f"{hz(record['frequency_Hz'])}" if band else f"at {hz(record['frequency_Hz'])}")
+    rows = [
+        (f"simulated A_c {where}, {record['protocol']} reading",
          f"{fmt(found, 'nm')}  (bracket {from_si(lo, 'nm'):.4g}–{from_si(hi, 'nm'):.4g} nm)"
          if found is not None else
          f"none up to the full stroke {fmt(a_max, 'nm')} ({criterion})"),
+    ]
+    if band:
+        shown = ["–" if v is None else f"{from_si(v, 'nm'):.4g} nm" for v in band["critical_amplitudes_m"]]
+        rows.append(("over the band", ", ".join(
+            f"{v} at {hz(f)}" for f, v in zip(band["frequencies_Hz"], shown, strict=True))
+            + "; the worst case moves the runner at every frequency computed"))
+    return rows + [
         ("search", f"{record['protocol']}: {criterion}, "
-                   f"f = {fmt(record['frequency_Hz'], 'kHz')}, {flyback_label(record['flyback'])} fly-back, "
-                   f"{record['simulations']} simulations"),
+                   f"{'f over the band' if band else 'f = ' + fmt(record['frequency_Hz'], 'kHz')}, "
+                   f"{flyback_label(record['flyback'])} fly-back, {record['simulations']} simulations"),
         ("runner ringing", f"at A = {fmt(record['ringing']['amplitude_m'], 'nm')}: "
                            + ringing_text(record["ringing"], f"the {record['protocol']} A_c"
-                                          if record["protocol"] == "steady" else "the first reading")),
+                                          if record["protocol"] == "steady" else "the first reading",
+                                          diagnosed=bool(record.get("diagnosis")))),
     ]
+
+
+def _diagnosis_rows(record: dict, eq: str) -> list[tuple[str, str]]:
+    """The diagnosis in rows: the departure, each cause with its counterfactual A_c and share."""
+    found, closed = record["critical_amplitude_m"], record["analytic_critical_amplitude_m"]
+    gap = found / closed - 1.0
+    side = "below" if gap < 0 else "above"
+    symptom = (f"A_c = {fmt(found, 'nm')} lies {100 * abs(gap):.0f} % {side} the closed form's "
+               f"{fmt(closed, 'nm')} ({eq}), beyond the 10 % band of agreement")
+    diagnosis = record["diagnosis"]
+    causes = [{**c, "counterfactual_values": [c["counterfactual_value_m"]],
+               "counterfactual_value": c["counterfactual_value_m"],
+               "counterfactual_expected": c["counterfactual_closed_form_m"]} for c in diagnosis["causes"]]
+    return diagnosis_rows({"causes": causes, "named": diagnosis["named"]}, symptom, "nm", "A_c")

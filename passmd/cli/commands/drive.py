@@ -113,4 +113,11 @@ def arrangement_rows(drive) -> list[tuple[str, str]]:
     balance = ", ".join(f"side {side} {load:.4g} N" for side, load in sorted(loads.items()))
     rows.append(("preload balance",
                  f"Σ n F_N sin α: {balance}; each side carries F_p = {drive.preload:.4g} N"))
+    from passmd.model.arrangement import preset_groups, side_lateral
+
+    left = side_lateral(drive.preload, drive.contact_groups or preset_groups(drive.contacts))
+    sideways = ", ".join(f"side {side} {force:.4g} N" for side, force in left.items())
+    taken = "taken by the guide's rail (guide_rail = true)" if drive.guide_rail and any(
+        f > 0 for f in left.values()) else "cancelled on the groove's flanks"
+    rows.append(("sideways balance", f"Σ ± n F_N cos α left over: {sideways}; {taken}"))
     return rows

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import sys
 import textwrap
@@ -24,8 +25,10 @@ from passmd.cli.output import (
     emit_json,
     emit_rows,
     flyback_label,
+    fmt,
     plain,
 )
+from passmd.cli.streams import check_new_outputs, create_outputs
 from passmd.protocols.fit.free_parameters import FREE_PARAMETERS
 from passmd.runtime.units import from_si, parse_quantity
 
@@ -121,8 +124,12 @@ def _free(args) -> list[str]:
     return names
 
 
-def _bounds(args, names) -> dict[str, tuple[float, float]]:
-    out = {}
+def _bounds(args, names, drive) -> dict[str, tuple[float, float]]:
+    """--bounds as typed: each free parameter once, 0 < LOW < HIGH, within its plausible range unless
+    --allow-extrapolation (or the drive file's allow_extrapolation) lifts it."""
+    from passmd.protocols.fit.free_parameters import plausible_bounds
+
+    out, typed = {}, {}
     for text in args.bounds:
         name, sep, span = text.partition("=")
         low, dots, high = span.partition("..")
@@ -132,11 +139,23 @@ def _bounds(args, names) -> dict[str, tuple[float, float]]:
         if name not in names:
             raise UsageError(f"--bounds = {text!r} names {name!r}, which is not in --free "
                              f"({', '.join(names)})")
+        if name in typed:
+            raise UsageError(f"--bounds = {text!r} bounds {name} again (--bounds {typed[name]!r}): give each "
+                             "parameter's bounds once")
+        typed[name] = text
         unit = FREE_NAMES[name][1]
         lo, hi = (parse_quantity(v.strip(), unit, name=f"--bounds {name}") for v in (low, high))
         if not 0 < lo < hi:
             raise UsageError(f"--bounds = {text!r} is out of range: must be 0 < LOW < HIGH")
-        out[FREE_NAMES[name][0]] = (lo, hi)
+        lib = FREE_NAMES[name][0]
+        low_ok, high_ok = plausible_bounds(drive, lib)
+        if not (args.allow_extrapolation or drive.allow_extrapolation) and (lo < low_ok or hi > high_ok):
+            shown = f" {unit}" if unit else ""
+            raise UsageError(f"--bounds = {text!r} is out of range: must be within "
+                             f"{from_si(low_ok, unit):.4g}..{from_si(high_ok, unit):.4g}{shown}, the "
+                             f"plausible range of {name} (a search far outside it simulates drives the model "
+                             "was not checked for, and may never end); --allow-extrapolation goes beyond it")
+        out[lib] = (lo, hi)
     return out
 
 
@@ -148,43 +167,53 @@ def _progress(config):
 
 
 def _check_out(args) -> Path | None:
+    """--out before any work: a directory (or one to create in an existing one) that files can be
+    created in, none of the outputs there yet (exit 2 naming the file)."""
     if args.out is None:
         return None
     target = Path(args.out)
     if target.exists() and not target.is_dir():
         raise UsageError(f"--out = {args.out!r} is not a directory")
-    if not target.exists() and not target.parent.is_dir():
-        raise OutputError(f"cannot write --out {args.out}: directory {str(target.parent)!r} does not exist")
-    for name in _OUTPUTS:
-        if (target / name).exists():
-            raise UsageError(f"--out {args.out}: {name} is already there; choose another directory "
-                             "(a fit keeps every file it did not create)")
+    check_new_outputs(f"--out {args.out}", [target / name for name in _OUTPUTS], folder=target)
     return target
 
 
 def _write(target: Path, result, record: dict, text: str) -> None:
-    from passmd.cli.streams import write_atomically
+    """fit.json, fit.png and fitted-drive.toml created together or not at all, never over a file
+    (:func:`passmd.cli.streams.create_outputs`); a folder the fit created is removed on failure."""
     from passmd.plots.fit import fit_figure
 
     fig = fit_figure(result.residual_table())  # before any file is written: a failing figure leaves none
+    option = f"--out {target}"
     try:
-        target.mkdir(exist_ok=True)
-        write_atomically(target / "fit.json",
-                         lambda tmp: Path(tmp).write_text(json.dumps(plain(record), indent=2) + "\n"))
-        write_atomically(target / "fit.png", lambda tmp: fig.savefig(tmp, dpi=150, format="png"))
-        write_atomically(target / "fitted-drive.toml", lambda tmp: Path(tmp).write_text(text))
+        target.mkdir()
+        created = True
+    except FileExistsError:
+        created = False
     except OSError as exc:
-        raise OutputError(f"cannot write --out {target}: {exc.strerror or exc}") from exc
+        raise OutputError(f"cannot create the directory {target} ({option}): {exc.strerror or exc}") from None
+    try:
+        create_outputs(option, {
+            target / "fit.json": lambda tmp: Path(tmp).write_text(json.dumps(plain(record), indent=2) + "\n"),
+            target / "fit.png": lambda tmp: fig.savefig(tmp, dpi=150, format="png"),
+            target / "fitted-drive.toml": lambda tmp: Path(tmp).write_text(text, encoding="utf-8"),
+        })
+    except BaseException:
+        if created:
+            with contextlib.suppress(OSError):
+                target.rmdir()  # only while empty: another run's files keep it
+        raise
 
 
 def run_fit(args, out) -> int:
-    from passmd.cli.configuration import execution_config
+    from passmd.cli.configuration import run_config
     from passmd.protocols import fit
 
     names = _free(args)
-    bounds = _bounds(args, names)
     drive, sources = resolve_drive(args)
+    bounds = _bounds(args, names, drive)
     target = _check_out(args)
+    config = run_config(args)  # the sweep log too, before any work
     try:
         data = fit.read_measurements(args.data)
     except FileNotFoundError:
@@ -193,7 +222,8 @@ def run_fit(args, out) -> int:
         raise UsageError(str(exc)) from None
     except IsADirectoryError:
         raise UsageError(f"DATA.csv = {args.data!r} is a directory") from None
-    config = execution_config(args)
+    except OSError as exc:  # unreadable: bad input, as an unreadable drive file
+        raise UsageError(f"DATA.csv = {args.data!r} cannot be read: {exc.strerror or exc}") from None
     library = {FREE_NAMES[n][0]: n for n in names}
     # c_p stays fixed while k_p or m_a moves only when the user gave c_p (drive show: "given"/"option")
     given_cp = sources.get("actuator.viscosity", "").startswith(("given", "option"))
@@ -219,6 +249,15 @@ def run_fit(args, out) -> int:
     return 0
 
 
+def _flyback(result, library: dict[str, str]) -> str:
+    """The fly-back rule, and the full-stroke time V_pp/SR when the fit set it (its slew rate free)."""
+    rule = flyback_label(result.drive.amplifier.flyback)
+    if {"flyback_time", "amplifier.slew_rate"} & set(library):
+        time = fmt(result.drive.amplifier.full_stroke_time, "us")
+        return f"{rule} with the fitted full-stroke time V_pp/SR = {time}"
+    return rule
+
+
 def _rows(result, library: dict[str, str], data, target) -> list[tuple[str, str]]:
     """The human report: each estimate with its 95 % region, the goodness of fit, the verdict."""
     rows = []
@@ -237,7 +276,7 @@ def _rows(result, library: dict[str, str], data, target) -> list[tuple[str, str]
             if gof["testable"] else "no sd given: residual scale estimated, no test possible")
     rows.append(("goodness of fit", test))
     rows.append(("fit", f"{len(data)} measurements, {result.dof} degrees of freedom, fly-back "
-                        f"{flyback_label(result.drive.amplifier.flyback)}, {result.simulations} simulations, "
+                        f"{_flyback(result, library)}, {result.simulations} simulations, "
                         f"{result.wall_time_s:.1f} s"))
     rows.append(("verdict", result.verdict))
     rows += [("note", note) for note in result.notes]

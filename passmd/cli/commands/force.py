@@ -26,7 +26,7 @@ _EPILOG = textwrap.dedent("""\
     --json keys (SI units): generated_force_N (k times the mean runner position over the
     last period), converged, coulomb_bound_N, periods, periods_simulated,
     remaining_force_N, remaining_force_note, force_spread_N, mean_friction_N,
-    piezo_mean_force_N, last_step_m, net_displacement_m, wall_time_s, cpu_time_s,
+    no_slip_reference_force_N, last_step_m, net_displacement_m, wall_time_s, cpu_time_s,
     amplitude_m, frequency_Hz, drive{...}""")
 
 
@@ -87,17 +87,20 @@ def run_force(args, out) -> int:
     except stall.ForceBoundError as exc:
         raise ResultError(str(exc)) from exc
     check_results(found)
-    if args.csv or args.plot:  # the reported run again, for its time series
-        from passmd.model import waveforms
-        from passmd.solver import simulation
-
-        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=found["periods"])
-        write_outputs(args, simulation.simulate(drive, wave, max_points=args.max_points))
     force, bound = found["generated_force_N"], found["coulomb_bound_N"]
     # Only the runner's inertia carries a period mean past μΣF_N, in a run cut short while the
     # runner swings on the load cell: that reading is no generated force, and no force above
     # the Coulomb bound is reported.
     swinging = not found["converged"] and abs(force) > bound
+    if args.csv or args.plot:  # the reported run again, for its time series
+        from passmd.model import waveforms
+        from passmd.plots.force_generation import stall_trace_figure
+        from passmd.solver import simulation
+
+        wave = waveforms.sawtooth(amplitude, frequency, drive, periods=found["periods"])
+        shown = None if swinging else force
+        write_outputs(args, simulation.simulate(drive, wave, max_points=args.max_points),
+                      figure=lambda result, title: stall_trace_figure(result, title, shown, bound))
     record = {"command": "force", "waveform": "sawtooth", "flyback": drive.amplifier.flyback,
               "amplitude_m": amplitude, "frequency_Hz": frequency, "drive": drive_record(drive), **found}
     if swinging:

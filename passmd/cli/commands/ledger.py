@@ -21,21 +21,25 @@ _EPILOG = textwrap.dedent(f"""\
     {describe_default_cache_dir()}; the book built with nox uses ./{DEFAULT_CACHE_DIR}/
     of the repository) every figure's results at --profile and evaluates every claim of
     passmd/data/reference/claims.csv on the product of the readings of passmd.ledger.readings it
-    depends on; each category comes from the defaults and the joint reading (the covered point of
-    the assumption space where the most claims hold together). Studies (rows that are not
-    sentences of the paper) are shown and never counted.
+    depends on; each claim is judged at its held-out reading (the joint reading chosen, by the
+    same rule, from all the other claims) and the counts come from those states; the in-sample
+    joint reading (chosen with every claim) is shown beside them. Studies (rows that are not
+    sentences of the paper) and rows implied by another (counted with it) are shown, not counted.
 
-    --json keys: profile, summary, counts{{category: n, fragile, not informative, about the
-    experiment, studies}}, joint_reading{{reading, described, holding, equivalent_points, claims,
-    points, covered_points, decided_points, chosen_from, ties[], runner_ups[{{reading, described, holding,
-    equivalent_points, margin}}], variants[{{left_out, claims_left_out[], claims_added[], reading,
-    described, holding, claims}}]}}, conflicting_pairs[{{claims, first_holds_at, second_holds_at, example}}],
+    --json keys: profile, summary, counts{{category: n (held out), fragile, not informative, about
+    the experiment, counted with their family, studies}}, joint_reading{{reading{{axis[@section]:
+    value}}, described, holding, equivalent_points, claims, points, covered_points, decided_points,
+    chosen_from, tied_readings, best_single_point, held_out_counts{{category: n}},
+    in_sample_gain[], ties[], runner_ups[{{reading, described, holding, equivalent_points, margin}}],
+    variants[{{left_out, claims_left_out[], claims_added[], reading, described, holding, claims}}]}},
+    conflicting_pairs[{{claims, first_holds_at, second_holds_at, example}}],
     tensions[{{separated_by[], sides[{{holds_only_at, claims[], linked[]}}], pairs}}],
-    claims[{{claim, figure, category, basis, study_of, verdict, evidence[], reason, depends_on[],
-    readings{{reading: state}}, points[{{reading, state, score, detail, outside}}], default_state,
-    joint_state, margin, margin_text, fails_at, decided_at, fragile, fragile_reason, outside,
-    informative, not_informative, fraction_holds, best_reading, tolerance, check,
-    paper_<SI unit>, ours_<SI unit>, ours_text, abs_deviation_<SI unit>, rel_deviation
+    claims[{{claim, figure, category, basis, study_of, family, counted, verdict, why, evidence[],
+    reason, depends_on[], readings{{reading: state}}, points[{{reading, state, score, detail,
+    outside}}], held_out_reading{{axis: value}}, held_out_described, held_out_state, default_state,
+    joint_state, margin, margin_text, holds_at, fails_at, undecided_at, decided_at, fragile,
+    fragile_reason, outside, informative, not_informative, fraction_holds, best_reading, tolerance,
+    check, paper_<SI unit>, ours_<SI unit>, ours_text, abs_deviation_<SI unit>, rel_deviation
     (fraction)}}]""")
 
 
@@ -119,7 +123,7 @@ def run_ledger(args, out) -> int:
                    "claims": evaluation.records(evaluated)}, out)
         return 0
     out.write(f"passmd ledger — profile {args.profile}: {ledger_views.summary(evaluated)}\n")
-    for line in ledger_views.joint_sentences(joint):
+    for line in ledger_views.held_out_sentences(evaluated) + ledger_views.joint_sentences(joint):
         out.write(line + "\n")
     out.write("counts: " + ", ".join(f"{n} {s}" for s, n in counts.items()) + "\n")
     out.write(f"{len(evaluated.attrs['conflicts'])} pairs of claims never hold together, in "

@@ -9,7 +9,7 @@ from typing import NamedTuple
 
 from passmd.cli import kernels, startup
 from passmd.cli.commands.contact import check_springs
-from passmd.cli.drive import build_drive, drive_rows
+from passmd.cli.drive import _typed, build_drive, drive_rows
 from passmd.cli.errors import OutputError, UsageError
 from passmd.cli.notes import hz, ringing_text
 from passmd.cli.options import (
@@ -245,13 +245,19 @@ def _check_eq15_fits(args, design, amplitude, frequency, drive) -> None:
     f_max = optimized_waveform.highest_fitting_frequency(design, amplitude, drive)
     if optimized_waveform.optimized_timing(design, amplitude, frequency, drive)["settling_fits"]:
         return
-    source = "the options' t_s, t_a" if args.settling_time or args.acceleration_time else \
-        f"the {hz(design.response_frequency)} saw-tooth response"
+    given = [f"{flag} {getattr(args, dest)}" for flag, dest in (("--settling-time", "settling_time"),
+                                                              ("--acceleration-time", "acceleration_time"))
+             if getattr(args, dest)]
+    source = " and ".join(given) if given else f"the {hz(design.response_frequency)} saw-tooth response"
+    remedy = f"; lower {' or '.join(g.split()[0] for g in given)}, or give a lower --frequency" \
+        if given and args.frequency is None else ""
     raise UsageError(
-        f"--frequency {args.frequency} is out of range for --waveform optimized: must be <= {hz(f_max)}, the "
-        f"highest frequency at which Eq. 15 fits this drive at A = {fmt(amplitude, 'nm')}: t_s + t_a = "
-        f"{(design.settling_time + design.acceleration_time) * 1e6:.4g} µs (from {source}), the fly-back and "
-        f"the slow ramp (at least half of the rest) need a period of {1e6 / f_max:.4g} µs")
+        f"--frequency = {_typed('--frequency', args, frequency)} is out of range for --waveform optimized: "
+        f"must be <= {hz(f_max, down=True)}, the highest frequency at which Eq. 15 fits this drive at A = "
+        f"{fmt(amplitude, 'nm')}: t_s + t_a = "
+        f"{(design.settling_time + design.acceleration_time) * 1e6:.4g} µs "
+        f"(from {source}), the fly-back and the slow ramp (at least half of the rest) need a period of "
+        f"{1e6 / f_max:.4g} µs{remedy}")
 
 
 def runner_ringing(drive, amplitude: float, frequency: float) -> dict:
@@ -279,12 +285,56 @@ def design_row(design, given=()) -> str:
             f"V_r = {design.runner_velocity * 1e3:.4g} mm/s, u_x,max = {fmt(design.presliding, 'nm')}")
 
 
-def write_outputs(args, result) -> None:
+def _region_band(args, result, options) -> dict | None:
+    """The runs of the drives at the fit's region a fitted --drive file records (none: None): the band
+    of the runner's position over time, and of the final position, steps and steady velocity."""
+    import numpy as np
+
+    from passmd.cli.drive import region_drives
+
+    drives = region_drives(args, load_cell=bool(args.load_cell))
+    if not drives:
+        return None
+    runs = [result] + [simulate(args, d, options)[0] for d in drives]
+    positions = np.array([r.runner_position for r in runs])
+    steps = np.array([r.step_sizes for r in runs]) if runs[0].step_sizes.size else np.zeros((len(runs), 0))
+    record = {"points": len(drives),
+              "final_position_m": [float(min(r.final_position for r in runs)),
+                                   float(max(r.final_position for r in runs))],
+              "step_sizes_low_m": steps.min(axis=0).tolist(), "step_sizes_high_m": steps.max(axis=0).tolist()}
+    if args.steady:
+        from passmd.protocols.velocity import steady_velocity
+
+        velocities = [steady_velocity(r)["velocity_m_per_s"] for r in runs]
+        record["steady_velocity_m_per_s"] = [float(min(velocities)), float(max(velocities))]
+    return {"record": record, "low": positions.min(axis=0), "high": positions.max(axis=0)}
+
+
+def _band_text(band: dict) -> str:
+    """The band of a fitted drive's run in one line."""
+    text = (f"over the estimate and {band['points']} points of the region: final position "
+            f"{fmt(band['final_position_m'][0], 'nm')} … {fmt(band['final_position_m'][1], 'nm')}")
+    if band["step_sizes_low_m"]:
+        text += (f", last step {fmt(band['step_sizes_low_m'][-1], 'nm')} … "
+                 f"{fmt(band['step_sizes_high_m'][-1], 'nm')}")
+    if "steady_velocity_m_per_s" in band:
+        low, high = band["steady_velocity_m_per_s"]
+        text += f", steady velocity {low * 1e3:.4g} … {high * 1e3:.4g} mm/s"
+    return text
+
+
+def write_outputs(args, result, figure=None, band=None) -> None:
     """The time series to --csv and the positions' plot to --plot, each written atomically (a
-    device or pipe such as /dev/stdout is written to; a reader that went away is a closed pipe)."""
+    device or pipe such as /dev/stdout is written to; a reader that went away is a closed pipe).
+    ``figure(result, title)``: the plot (default :func:`passmd.plots.trace.positions_figure`);
+    ``band``: the runner position's ``low`` and ``high`` over a fit's region (:func:`_region_band`),
+    two more CSV columns and a shaded band."""
     if args.csv:
         try:
             frame = result.to_frame()
+            if band is not None:
+                frame["runner_position_band_low_m"] = band["low"]
+                frame["runner_position_band_high_m"] = band["high"]
             write_atomically(args.csv, lambda tmp: frame.to_csv(tmp, index=False))
         except BrokenPipeError as exc:
             raise PipeClosed() from exc
@@ -296,7 +346,12 @@ def write_outputs(args, result) -> None:
         wave = result.waveform
         title = (f"{wave.kind}, A = {fmt(wave.amplitude, 'nm')}, f = {hz(wave.frequency)}, "
                  f"{wave.periods} periods\n{describe(result.drive)}")
-        fig = positions_figure(result, title)
+        fig = (figure or positions_figure)(result, title)
+        if band is not None:
+            ax = fig.axes[0]
+            ax.fill_between(result.time * 1e3, band["low"] * 1e9, band["high"] * 1e9, color="C1", alpha=0.25,
+                            lw=0, label="runner x_r over the fit's 95 % region")
+            ax.legend(fontsize=8)
         try:
             fmt_ = Path(args.plot).suffix.lstrip(".").lower()
             write_atomically(args.plot, lambda tmp: fig.savefig(tmp, dpi=150, format=fmt_))
@@ -307,7 +362,7 @@ def write_outputs(args, result) -> None:
 
 
 def run_run(args, out) -> int:
-    drive = build_drive(args, load_cell=bool(args.load_cell))
+    drive = build_drive(args, **({"load_cell": True} if args.load_cell else {}))  # else the file's
     options = check_run_options(args, drive)
     check_memory(args)
     check_output_paths(args)
@@ -332,7 +387,10 @@ def run_run(args, out) -> int:
     summary["ringing"] = ring
     check_results(summary)
     check_run_bounds(summary, drive, float(summary["amplitude_m"]))
-    write_outputs(args, result)
+    band = _region_band(args, result, options)
+    if band is not None:
+        summary["band"] = band.pop("record")
+    write_outputs(args, result, band=band)
     if args.json:
         emit_json({"command": "run", "waveform": args.waveform, "flyback": drive.amplifier.flyback,
                    "protocol": "steady" if args.steady else "from rest",
@@ -347,7 +405,8 @@ def run_run(args, out) -> int:
     ]
     if design is not None:
         rows.insert(1, ("Eq. 15 design", design_row(design, summary["design_given_by_options"])))
-        rows.insert(2, ("Eq. 15 fits", f"up to {hz(summary['eq15_highest_frequency_Hz'])} for this drive at "
+        highest = hz(summary["eq15_highest_frequency_Hz"], down=True)
+        rows.insert(2, ("Eq. 15 fits", f"up to {highest} for this drive at "
                                        f"A = {fmt(summary['amplitude_m'], 'nm')}"))
     if "steady" in summary:
         steady = summary["steady"]
@@ -358,6 +417,8 @@ def run_run(args, out) -> int:
         rows.append(("mean velocity from rest", f"{summary['mean_velocity_m_per_s'] * 1e3:.6g} mm/s"))
     if "generated_force_N" in summary:
         rows.append(("generated force", fmt(summary["generated_force_N"], "N")))
+    if "band" in summary:
+        rows.append(("fit's 95 % region", _band_text(summary["band"])))
     rows.append(("runner ringing", ringing_text(ring, "the step")))
     over = [b for b in summary["back_steps_m"] if b > float(summary["amplitude_m"])]
     if over and ring["ringing_affects_steps"]:

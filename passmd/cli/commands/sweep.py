@@ -6,6 +6,7 @@ import argparse
 import itertools
 import json
 import math
+import os
 import re
 import textwrap
 from dataclasses import dataclass
@@ -16,14 +17,14 @@ import numpy as np
 
 from passmd.cli.configuration import run_config
 from passmd.cli.drive import _bound, build_drive, explain
-from passmd.cli.errors import OutputError, UsageError
+from passmd.cli.errors import UsageError
 from passmd.cli.notes import (
     eq15_rows,
     missing_rows,
     resolution,
-    ringing_rows,
     sweep_figure,
     sweep_title,
+    turn_rows,
     uses_eq15,
 )
 from passmd.cli.options import (
@@ -36,7 +37,17 @@ from passmd.cli.options import (
     add_sweep_options,
 )
 from passmd.cli.output import JSON_HELP, check_output_file, describe, drive_record, emit_json, emit_rows, fmt
-from passmd.cli.streams import PipeClosed, check_outputs, write_atomically
+from passmd.cli.streams import check_new_outputs, check_outputs, create_outputs
+from passmd.cli.sweep_rows import (
+    add_band,
+    check_values,
+    curve_rows,
+    derived_columns,
+    diagnose_sweep,
+    extreme_rows,
+    sweep_diagnosis_rows,
+    warnings_of,
+)
 from passmd.model.defaults import PROTOCOL
 from passmd.runtime.config import ENVIRONMENT
 from passmd.runtime.units import QuantityError, from_si, parse_quantity
@@ -106,9 +117,21 @@ _EPILOG = textwrap.dedent("""\
     minus that of its third, over the velocity: beyond {STEADY_DRIFT_PERCENT} % the point is not
     steady (hatched in the PNG, as are points with no value and points whose magnitude is below the
     measurable step); ringing_* (every quantity but the stall force): the runner's swing after a
-    fly-back and what is left of it when the next starts (ringing_at_next_flyback_m): where that
-    exceeds the measurable step the value depends on the swing's phase, and a curve turns
-    (the output says so; the model's physics, not noise).""")
+    fly-back and what is left of it when the next starts (ringing_at_next_flyback_m);
+    running_max_critical_amplitude_m (critical-amplitude over one axis: the amplitude that moves the
+    runner at every point up to this one); gain_percent (gain: over the saw-tooth's velocity);
+    <column>_band_low, <column>_band_high (a --drive file written by passmd fit: the least and largest
+    value over the fit's estimate and the points of its 95 % region the file records; a shaded band
+    in a curve's PNG).
+    warnings[{{kind, points, of, range, text}}]: each warning once, with the points it covers.
+
+    Over one axis, where a value departs from its trend (a critical amplitude jumping more than 10 %
+    off its closed form's scaling, a step or velocity that turns, an Eq. 15 gain below 0), the
+    largest three departures are explained by computation: each is simulated again with one
+    candidate cause removed at a time (passmd.protocols.diagnosis; cached like the sweep's points)
+    and each cause is given with its counterfactual value and its share of the departure; --json:
+    diagnoses[{{at, quantity, values, departure, causes[{{cause, counterfactual_value, share, ...}}],
+    named}}]. --no-diagnosis skips it.""")
 
 
 @dataclass(frozen=True)
@@ -153,8 +176,13 @@ def add_parser(command) -> None:
                        help="saw-tooth response the Eq. 15 waveform is designed from: paper, the 100 Hz "
                             "response of Section 5.2 (one design per drive and amplitude); driving, the "
                             "response at each point's frequency (default: paper)")
+    group.add_argument("--no-diagnosis", action="store_true",
+                       help="do not compute the causes of a curve's departures (default: computed)")
     add_sweep_options(p)
     out = p.add_argument_group("output")
+    out.add_argument("--color-scale", choices=("auto", "linear", "log"), default="auto",
+                     help="a heat map's colour scale: log needs values > 0; auto is log where every value is "
+                          "and they span more than two decades (default: auto)")
     out.add_argument("--out", metavar="PREFIX", action=FilePath,
                      help="write PREFIX.csv, PREFIX.json and PREFIX.png (default: none)")
     out.add_argument("--json", action="store_true", help=JSON_HELP)
@@ -190,8 +218,15 @@ def parse_vary(text: str) -> Axis:
     low, _, rest = spec.partition("..")
     high, *options = rest.split(":")
     spacing, count = "linear", 10
+    given: dict[str, str] = {}
     for option in options:
         option = option.strip()
+        what = "spacing" if option in ("log", "lin", "linear") else "N" if re.fullmatch(r"[0-9]+", option) \
+            else None
+        if what is not None and what in given:
+            raise _refuse(text, f"{what} is given twice ({given[what]!r} and {option!r}): give it once")
+        if what is not None:
+            given[what] = option
         if option in ("log", "lin", "linear"):
             spacing = "log" if option == "log" else "linear"
         elif re.fullmatch(r"[0-9]+", option):
@@ -281,18 +316,38 @@ def _check_options(args) -> None:
     if args.amplitude is not None and args.quantity == "critical-amplitude":
         raise UsageError("--amplitude has no effect on critical-amplitude: it searches over the amplitude")
     if args.out is not None:
-        for suffix in (".csv", ".json", ".png"):
-            check_output_file("--out", args.out + suffix)
-        check_outputs({f"{args.out}{s} (--out {args.out})": args.out + s for s in (".csv", ".json", ".png")})
+        _check_prefix(args.out)
+
+
+def _outputs(prefix: str, axes: int) -> dict[str, str]:
+    """PREFIX.csv, PREFIX.json and, for one or two axes, PREFIX.png."""
+    files = {"csv": prefix + ".csv", "json": prefix + ".json"}
+    if axes <= 2:
+        files["png"] = prefix + ".png"
+    return files
+
+
+def _check_prefix(prefix: str) -> None:
+    """--out PREFIX before any work: a file stem (not a folder, not ending in a separator), its
+    files absent and creatable in an existing folder (exit 2)."""
+    stem = os.path.basename(prefix)
+    if not stem or stem in (".", "..") or prefix.endswith(os.sep) or Path(prefix).is_dir():
+        raise UsageError(f"--out = {prefix!r} names a directory, not a PREFIX: give the files' stem, e.g. "
+                         f"{os.path.join(prefix.rstrip(os.sep) or '.', 'map')!r}")
+    files = _outputs(prefix, 2)
+    for suffix in (".csv", ".json", ".png"):
+        check_output_file("--out", prefix + suffix)
+    check_outputs({f"{path} (--out {prefix})": path for path in files.values()})
+    check_new_outputs(f"--out {prefix}", list(files.values()))
 
 
 # --------------------------------------------------------------------------------------
 # The grid
 # --------------------------------------------------------------------------------------
 
-def _points(args, axes: list[Axis], with_amplitude: bool) -> list[dict]:
-    """Every point of the grid: its drive (options, each drive axis' value replacing its option),
-    frequency and amplitude, and the axes' values as columns."""
+def _points(args, axes: list[Axis], with_amplitude: bool, build=build_drive) -> list[dict]:
+    """Every point of the grid: its drive (options, each drive axis' value replacing its option;
+    ``build`` makes it from them), frequency and amplitude, and the axes' values as columns."""
     drives: dict[tuple, object] = {}
     drive_axes = [a for a in axes if a.name not in ("amplitude", "frequency")]
     fixed_amplitude = AMPLITUDE.parse(args) if with_amplitude else None
@@ -305,8 +360,9 @@ def _points(args, axes: list[Axis], with_amplitude: bool) -> list[dict]:
             probe = argparse.Namespace(**vars(args))
             for a in drive_axes:
                 setattr(probe, a.quantity.dest, f"{at[a.name]!r} {a.si_unit}".strip())
-            try:
-                drives[key] = build_drive(probe)
+            try:  # the stall force pushes against the load cell: its stiffness is an option there
+                fixed = {"load_cell": True} if args.quantity == "stall-force" else {}
+                drives[key] = build(probe, **fixed)
             except (UsageError, ValueError) as exc:
                 where = ", ".join(f"{a.name} = {_shown(a, at[a.name])}" for a in drive_axes)
                 raise UsageError(f"--vary at {where}: {explain(exc, probe)}") from None
@@ -396,70 +452,31 @@ def _record(args, axes, table, spec, drive) -> dict:
 
 
 def _write(args, record, axes, spec, table, title) -> dict:
-    """PREFIX.csv, PREFIX.json and (one or two axes) PREFIX.png, each written atomically."""
+    """PREFIX.csv, PREFIX.json and (one or two axes) PREFIX.png, created together or not at all,
+    never over a file (:func:`passmd.cli.streams.create_outputs`)."""
     from passmd.cli.output import plain
 
     prefix = args.out
-    files = {"csv": prefix + ".csv", "json": prefix + ".json"}
-    if len(axes) <= 2:
-        files["png"] = prefix + ".png"
+    files = _outputs(prefix, len(axes))
     header = "".join(f"# {k}: {v}\n" for k, v in record["provenance"].items())
     header += f"# quantity: {args.quantity} ({spec.column})\n"
-    try:
-        def write_csv(tmp):
-            with open(tmp, "w", encoding="utf-8", newline="") as fh:
-                fh.write(header)
-                table.to_csv(fh, index=False, lineterminator="\n")
 
-        write_atomically(files["csv"], write_csv)
-        text = json.dumps(plain({**record, "files": files}), indent=2, allow_nan=False) + "\n"
-        write_atomically(files["json"], lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
-        if "png" in files:
-            fig = sweep_figure(args, axes, spec, table, title)
-            facts = record["provenance"]
-            summary = f"passmd {facts['passmd_version']}, commit {facts['git_commit']}"
-            write_atomically(files["png"], lambda tmp: fig.savefig(
-                tmp, dpi=150, format="png", metadata={"Description": summary}))
-    except BrokenPipeError as exc:
-        raise PipeClosed() from exc
-    except OSError as exc:
-        raise OutputError(f"cannot write --out {prefix}: {exc.strerror or exc}") from exc
+    def write_csv(tmp):
+        with open(tmp, "w", encoding="utf-8", newline="") as fh:
+            fh.write(header)
+            table.to_csv(fh, index=False, lineterminator="\n")
+
+    text = json.dumps(plain({**record, "files": files}), indent=2, allow_nan=False) + "\n"
+    writers = {files["csv"]: write_csv,
+               files["json"]: lambda tmp: Path(tmp).write_text(text, encoding="utf-8")}
+    if "png" in files:
+        fig = sweep_figure(args, axes, spec, table, title)
+        facts = record["provenance"]
+        summary = f"passmd {facts['passmd_version']}, commit {facts['git_commit']}"
+        writers[files["png"]] = lambda tmp: fig.savefig(tmp, dpi=150, format="png",
+                                                        metadata={"Description": summary})
+    create_outputs(f"--out {prefix}", writers)
     return files
-
-
-def _curve_rows(axes, spec, table) -> list[tuple[str, str]]:
-    """A short curve in full: one row per value of its axis."""
-    (axis,) = axes
-    return [(f"{axis.name} {_shown(axis, x)}", "–" if v is None or (isinstance(v, float) and math.isnan(v))
-             else f"{v / spec.scale:.6g} {spec.unit}") for x, v in zip(table[axis.column], table[spec.column],
-                                                                    strict=True)]
-
-
-def _extreme_rows(axes, spec, table) -> list[tuple[str, str]]:
-    values = np.array([np.nan if v is None else float(v) for v in table[spec.column]], dtype=float)
-    if not np.isfinite(values).any():
-        return [(spec.label, "no value (see the note column)")]
-    from passmd.protocols.velocity import STEADY_DRIFT_LIMIT
-
-    rows = []
-    drift = table["velocity_drift"] if "velocity_drift" in table else None
-    for word, i in (("min", int(np.nanargmin(values))), ("max", int(np.nanargmax(values)))):
-        where = ", ".join(f"{a.name} {_shown(a, table[a.column].iloc[i])}" for a in axes)
-        unsteady = drift is not None and abs(float(drift.iloc[i])) > STEADY_DRIFT_LIMIT
-        rows.append((f"{word} {spec.label}", f"{values[i] / spec.scale:.6g} {spec.unit} at {where}"
-                     + (f" (not steady: velocity_drift {float(drift.iloc[i]):.2g})" if unsteady else "")))
-    return rows
-
-
-def _check_values(args, column: str, table) -> None:
-    """The quantity is finite at every point; only an Eq. 15 quantity without an Eq. 15 waveform
-    and a critical amplitude above the full stroke may be missing (``None``, said in the output)."""
-    from passmd.cli.output import check_results
-
-    values = [v for v in table[column] if v is not None]
-    if args.quantity == "critical-amplitude" or uses_eq15(args):
-        values = [v for v in values if not (isinstance(v, float) and math.isnan(v))]
-    check_results({column: values})
 
 
 def run_sweep(args, out) -> int:
@@ -474,9 +491,13 @@ def run_sweep(args, out) -> int:
     table = compute_map(args.quantity, points, reading=args.reading or "steady",
                         waveform=args.waveform or "sawtooth", design_response=args.design_response or "paper",
                         config=config)
-    _check_values(args, spec.column, table)
+    check_values(args, spec.column, table)
+    add_band(args, spec, table, lambda build: _points(args, axes, spec.amplitude, build), config)
+    derived_columns(args, axes, table)
     title = sweep_title(spec, axes, base)
-    record = _record(args, axes, table, spec, base)
+    warned = warnings_of(axes, spec, table, _shown)
+    diagnoses = diagnose_sweep(args, axes, spec, table, points, config)
+    record = {**_record(args, axes, table, spec, base), "warnings": warned, "diagnoses": diagnoses}
     if args.out is not None:
         record["files"] = _write(args, record, axes, spec, table, title)
     if args.json:
@@ -487,10 +508,14 @@ def run_sweep(args, out) -> int:
                                 f"({len(a.values)}, {a.spacing})" for a in axes)),
             ("points", f"{counts['points']} ({counts['cached']} from the cache, "
                        f"{counts['computed']} computed)")]
-    rows += _curve_rows(axes, spec, table) if len(axes) == 1 and len(table) <= MAX_SHOWN else \
-        _extreme_rows(axes, spec, table)
+    rows += curve_rows(axes, spec, table, _shown) if len(axes) == 1 and len(table) <= MAX_SHOWN else \
+        extreme_rows(axes, spec, table, _shown)
     rows += eq15_rows(args, table)
-    rows += ringing_rows(axes, spec, table, resolution(spec, table["frequency_Hz"]), _shown)
+    rows += [(w["kind"], f"at {w['points']} of {w['of']} points ({w['range']}): {w['text']}") for w in warned]
+    if len(axes) == 1:
+        resolved = resolution(spec, table["frequency_Hz"])
+        rows += turn_rows(axes[0], spec, table, resolved, _shown, bool(diagnoses))
+        rows += sweep_diagnosis_rows(diagnoses, axes[0], spec, table, _shown)
     if record["missing_values"]:
         rows += missing_rows(args, table, record["missing_values"])
     if "files" in record:

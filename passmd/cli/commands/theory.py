@@ -22,7 +22,14 @@ _EPILOG = textwrap.dedent("""\
     indentation_m, tangential_stiffness_N_per_m, presliding_m, actuator_deformation_m
     (per side: [side 1, side 2] for six contacts), critical_amplitude_rigid_m,
     critical_amplitude_flexible_m, analytic_critical_amplitude_m (for --actuator),
-    runner_frequency_Hz, actuator_natural_frequency_Hz, drive{...}""")
+    runner_frequency_Hz (the runner on its contacts, each in series with its actuator: the linear
+    estimate of its ringing), runner_frequency_rigid_actuators_Hz (contacts alone),
+    runner_frequency_full_slip_Hz (contacts at their full-slip secant stiffness, 2/3 of 2aG*: the
+    lowest a sticking swing rings at), actuator_natural_frequency_Hz, drive{...}
+
+    The runner rings after each fly-back a few % below runner_frequency_Hz: its first swings
+    micro-slip, which softens the contacts (passmd run and critical-amplitude print the simulated
+    ringing beside this estimate).""")
 
 
 def add_parser(command) -> None:
@@ -37,7 +44,9 @@ def run_theory(args, out) -> int:
 
     drive = build_drive(args)
     result = drive_theory(drive)
-    result["runner_frequency_Hz"] = runner_frequency(drive)
+    result["runner_frequency_Hz"] = runner_frequency(drive, in_series=True)
+    result["runner_frequency_rigid_actuators_Hz"] = runner_frequency(drive)
+    result["runner_frequency_full_slip_Hz"] = runner_frequency(drive, in_series=True, full_slip=True)
     result["actuator_natural_frequency_Hz"] = drive.actuator.natural_frequency
     check_results(result)
     if args.json:
@@ -59,8 +68,21 @@ def run_theory(args, out) -> int:
         ("actuator deformation u_x,a (Eq. 9/14)", per_group(result["actuator_deformation_m"], "nm")),
         ("A_c, rigid actuators (Eq. 7/11)", fmt(result["critical_amplitude_rigid_m"], "nm")),
         ("A_c, flexible actuators (Eq. 8/12)", fmt(result["critical_amplitude_flexible_m"], "nm")),
-        ("runner-on-contacts frequency", fmt(result["runner_frequency_Hz"], "kHz")),
+        ("runner-on-contacts frequency", _runner_text(drive, result)),
         ("bare actuator frequency", fmt(result["actuator_natural_frequency_Hz"], "kHz")),
     ]
     emit_rows(f"passmd theory — {describe(drive)}", [*rows, *drive_rows(drive)], out)
     return 0
+
+
+def _runner_text(drive, result) -> str:
+    """The runner's linear frequency with the actuators in series, and what it leaves out."""
+    linear = fmt(result["runner_frequency_Hz"], "kHz")
+    if drive.actuator_model == "rigid":
+        return (f"{linear} (√(Σ 2aG* / m_r) / 2π; the first swings after a fly-back micro-slip and ring down "
+                f"to {fmt(result['runner_frequency_full_slip_Hz'], 'kHz')})")
+    return (f"{linear} (each contact's 2aG* in series with its actuator's k_p; "
+            f"{fmt(result['runner_frequency_rigid_actuators_Hz'], 'kHz')} with rigid actuators); the first "
+            "swings after a fly-back micro-slip and ring down to "
+            f"{fmt(result['runner_frequency_full_slip_Hz'], 'kHz')} (contacts at their full-slip secant "
+            "stiffness)")

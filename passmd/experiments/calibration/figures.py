@@ -9,7 +9,7 @@
   and with the right rule.
 
 * :func:`paper_fit`: one unknown of the paper fitted to the numbers its text states
-  (:data:`PAPER_DATA`).
+  (:data:`PAPER_DATA`), each held to the tolerance of the ledger's claim on it (:func:`paper_measurements`).
 
 The comb's and the fly-back's data are made by other means than the fit's forward model
 (:func:`passmd.protocols.synthetic.noisy_steps`). :data:`FIGURES` holds a row per figure the chapter
@@ -25,6 +25,7 @@ import numpy as np
 import pandas as pd
 
 from passmd.experiments import FigureSpec
+from passmd.ledger.claims import load_claims
 from passmd.ledger.reference import REFERENCE_DIR
 from passmd.model.parameters import Drive
 from passmd.model.tables import Amplifier
@@ -33,8 +34,8 @@ from passmd.protocols.fit.prediction import drive_at
 from passmd.protocols.synthetic import noisy_steps
 from passmd.runtime.config import RunConfig
 
-__all__ = ["COMB", "FIGURES", "FLYBACK", "PAPER_DATA", "PAPER_TITLE", "WRONG_TITLE", "comb_fit",
-           "comb_profile", "fit_table", "flyback_fits", "join", "paper_fit"]
+__all__ = ["COMB", "FIGURES", "FLYBACK", "PAPER_DATA", "PAPER_DATA_CLAIMS", "PAPER_TITLE", "WRONG_TITLE",
+           "comb_fit", "comb_profile", "fit_table", "flyback_fits", "join", "paper_fit", "paper_measurements"]
 
 #: The comb example: one flexible contact (Table 1–2, R = 1 mm), k_p = 5e6 N/m, three steps at 0.4 N,
 #: 100 Hz, 1 nm noise.
@@ -92,14 +93,40 @@ def flyback_fits(config: RunConfig | None = None) -> dict:
 
 #: The paper's stated numbers as measurements (rules in ``passmd/data/reference/README.md``).
 PAPER_DATA = REFERENCE_DIR / "paper_as_data.csv"
+#: The ledger's claim on the same number as each row of :data:`PAPER_DATA` (by the row's ``id``): the
+#: book's fits hold each number to the tolerance the ledger judges it with (:func:`paper_measurements`).
+PAPER_DATA_CLAIMS = {"fig5a-critical-amplitude-50nm": "fig5a-no-step-below-50nm",
+                     "fig9a-standard-position-552nm": "fig9a-standard-position-552nm"}
+
+
+def paper_measurements() -> fit.Measurements:
+    """:data:`PAPER_DATA` with each row's standard deviation the tolerance of the ledger's claim on the same
+    number (:data:`PAPER_DATA_CLAIMS`; an absolute tolerance in the claim's unit, or a relative one times
+    the stated value), so that a fit and the ledger hold the paper's numbers to one tolerance."""
+    data = fit.read_measurements(PAPER_DATA)
+    ids = pd.read_csv(PAPER_DATA, dtype=str)["id"].tolist()
+    claims = load_claims().set_index("id")
+    sd = np.array(data.sd, dtype=float)
+    for i, row_id in enumerate(ids):
+        claim = claims.loc[PAPER_DATA_CLAIMS[row_id]]
+        scale, unit = data.display(i)
+        if claim["tolerance_kind"] == "rel":
+            sd[i] = float(claim["tolerance_num"]) * data.value[i]
+        elif claim["tolerance_kind"] == "abs" and claim["unit"] == unit:
+            sd[i] = float(claim["tolerance_num"]) * scale
+        else:
+            raise ValueError(f"claim {claim.name!r}: its tolerance ({claim['tolerance_kind']}, "
+                             f"{claim['unit']}) is not one a row in {unit} can take")
+    return replace(data, sd=sd)
 #: Titles of the fit figures: the rejected fly-back fit, and μ fitted to the paper's numbers.
 WRONG_TITLE = "Steps made with the fixed fly-back against the model with the slew-rate fly-back (μ fitted)"
 PAPER_TITLE = "Paper's numbers against the model with the fitted μ (others at the book's defaults)"
 
 
 def paper_fit(name: str, config: RunConfig | None = None) -> fit.FitResult:
-    """The parameter ``name`` of the book's default drive fitted alone to :data:`PAPER_DATA`."""
-    return fit.fit(Drive(), fit.read_measurements(PAPER_DATA), [name], config=config)
+    """The parameter ``name`` of the book's default drive fitted alone to the paper's numbers
+    (:func:`paper_measurements`)."""
+    return fit.fit(Drive(), paper_measurements(), [name], config=config)
 
 
 def comb_profile(result: fit.FitResult) -> pd.DataFrame:

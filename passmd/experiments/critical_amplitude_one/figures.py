@@ -24,6 +24,7 @@ import pandas as pd
 from passmd.experiments import FigureSpec, ReadingTable
 from passmd.ledger import readings, reference
 from passmd.ledger.checks import ClaimFails, NoRun
+from passmd.ledger.claims import load_claims
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
 from passmd.model.tables import ACTUATOR_DAMPING_RATIO, PRELOAD_GRIDS, actuator_for_radius
@@ -40,9 +41,10 @@ from passmd.runtime.config import RunConfig
 SECTION4_1_FRICTION = float(readings.axis("friction_coefficient").default)
 
 __all__ = [
-    "AC_PANELS", "FIG5A_DRIVE", "FIGURES", "FLYBACK_STEPS_TOLERANCE", "PROFILE_SETTINGS", "READING_TABLES",
-    "SECTION4_1_FRICTION", "ac_readings", "critical_amplitude_point", "fig5_flyback_steps", "fig5a",
-    "fig5a_readings", "fig5b", "paper_drive_for", "preload_figure", "primary", "run_searches", "step_point",
+    "AC_PANELS", "FIG5A_CLAIM", "FIG5A_DRIVE", "FIGURES", "FLYBACK_STEPS_TOLERANCE", "GRIDS",
+    "PROFILE_SETTINGS", "READING_TABLES", "SECTION4_1_FRICTION", "ac_readings", "critical_amplitude_point",
+    "fig5_flyback_steps", "fig5a", "fig5a_amplitudes", "fig5a_readings", "fig5b", "paper_drive_for",
+    "preload_figure", "primary", "run_searches", "step_point",
 ]
 
 def paper_drive_for(
@@ -222,17 +224,42 @@ def preload_figure(config: RunConfig, contacts: int, radius: float, models, curv
     return merged
 
 
+#: The ledger's claim on Fig. 5a's onset, whose tolerance bounds the figure's amplitude step near the
+#: onsets (:func:`fig5a_amplitudes`).
+FIG5A_CLAIM = "fig5a-no-step-below-50nm"
+
+
+def fig5a_amplitudes(profile: str) -> np.ndarray:
+    """Fig. 5a's amplitudes (m): 0 to the full stroke in the profile's step and, where that step is
+    coarser than the tolerance of the ledger's claim on the onset (:data:`FIG5A_CLAIM`, claims.csv),
+    steps of that tolerance from half Eq. 7 to Eq. 8 plus the tolerance, where the onsets of the three
+    series and the paper's 50 nm lie (Eqs. 7, 8 at Fig. 5a's drive)."""
+    s = PROFILE_SETTINGS[profile]
+    radius, preload = FIG5A_DRIVE
+    a_max = actuator_for_radius(radius).full_stroke_amplitude
+    grid = np.arange(0.0, a_max * (1 + 1e-9), s.amplitude_step)
+    claim = load_claims().set_index("id").loc[FIG5A_CLAIM]
+    tolerance = float(claim["tolerance_num"]) * 1e-9  # claims.csv: nm, absolute
+    if claim["tolerance_kind"] != "abs" or claim["unit"] != "nm":
+        raise ValueError(f"claim {FIG5A_CLAIM!r}: its tolerance must be absolute, in nm")
+    if s.amplitude_step > tolerance:
+        closed = reference.closed_form_curves("fig5b_closed_form").set_index("preload_N").loc[preload]
+        low, high = 0.5 * closed["u_x_max_nm"] * 1e-9, closed["u_x_max_plus_u_x_a_nm"] * 1e-9 + tolerance
+        band = np.arange(np.floor(low / tolerance) * tolerance, high + tolerance * 1e-9, tolerance)
+        grid = np.concatenate([grid, band])
+    return np.unique(np.round(grid, 15))
+
+
 def fig5a(config: RunConfig) -> pd.DataFrame:
     """Fig. 5a: first and steady-state step against the amplitude (one contact, F_p = 0.4 N, R = 1 mm).
 
     Rigid and flexible actuators with the slew-rate fly-back, and flexible with the fixed
-    2 µs fly-back, at ``PROTOCOL.drive_frequency``; the amplitude grid runs from 0 to the full
-    stroke in the profile's step. Lengths in nm.
+    2 µs fly-back, at ``PROTOCOL.drive_frequency``; on the amplitudes of
+    :func:`~passmd.experiments.critical_amplitude_one.figures.fig5a_amplitudes`.
+    Lengths in nm.
     """
-    s = _settings(config)
     radius, preload = FIG5A_DRIVE
-    a_max = actuator_for_radius(radius).full_stroke_amplitude
-    amplitudes = np.round(np.arange(0.0, a_max * (1 + 1e-9), s.amplitude_step), 15)
+    amplitudes = fig5a_amplitudes(config.profile)
     series = [("rigid", "slew"), ("flexible", "slew"), ("flexible", "fixed")]
     points = [
         {
@@ -442,6 +469,13 @@ FIGURES = (
     FigureSpec("fig5b", "Critical amplitude against preload, one contact, R = 1 mm",
                "critical_amplitude_one", fig5b, "critical_amplitude:plot_fig5b"),
 )
+
+#: The chapter's profile-dependent grids (:data:`passmd.experiments.figure_table.GRIDS`).
+GRIDS = {
+    "fig5a": lambda profile: {"amplitudes": tuple(fig5a_amplitudes(profile))},
+    "fig5b": lambda profile: {"preloads": PROFILE_SETTINGS[profile].preloads[1.0e-3],
+                              "drive frequencies": PROFILE_SETTINGS[profile].frequencies},
+}
 
 #: The ledger's readings of the chapter's figures.
 READING_TABLES = (

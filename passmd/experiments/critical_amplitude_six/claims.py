@@ -106,7 +106,8 @@ def _interaction(results, reading) -> dict:
     # the change the interaction makes: against the nearer of the two sides alone, at every preload
     sides = side_alone(results, reading)
     change = 100.0 * np.min(np.abs(sides["six_nm"][:, None] / sides["alone_nm"] - 1.0), axis=1)
-    ours = {"lhs": change, "rhs": np.full(change.size, INTERACTION_PERCENT)}
+    ours = {"lhs": change, "rhs": np.full(change.size, INTERACTION_PERCENT), "at": sides["preload_N"],
+            "at_unit": "N"}
     # each side's A_c is interpolated on the one-contact grid: on part of the two grids, a failure is
     # not the paper grids' either
     grids = np.intersect1d(*(np.round(ac_curve(results, key, "flexible", reading)["x"], 9)

@@ -26,7 +26,7 @@ from passmd.model.tables import ACTUATOR_DAMPING_RATIO, actuator_for_radius
 from passmd.protocols.critical_amplitude import PROTOCOLS
 from passmd.runtime.config import RunConfig
 
-__all__ = ["FIG5A_DRIVE", "FIGURES", "PROFILE_SETTINGS", "READING_TABLES", "fig56_frequency",
+__all__ = ["FIG5A_DRIVE", "FIGURES", "GRIDS", "PROFILE_SETTINGS", "READING_TABLES", "fig56_frequency",
            "fig56_viscosity", "fig6a", "fig6b", "fig6c"]
 
 
@@ -133,6 +133,19 @@ FIGURES = (
     FigureSpec("fig56_viscosity", "Critical amplitude against actuator viscosity c_p, 0.4 N, R = 1 mm",
                "critical_amplitude_six", fig56_viscosity, "critical_amplitude:plot_viscosity"),
 )
+
+def _preload_grid(radius: float):
+    return lambda profile: {"preloads": PROFILE_SETTINGS[profile].preloads[radius],
+                            "drive frequencies": PROFILE_SETTINGS[profile].frequencies}
+
+
+#: The chapter's profile-dependent grids (:data:`passmd.experiments.figure_table.GRIDS`).
+GRIDS = {
+    "fig6a": _preload_grid(1.0e-3), "fig6b": _preload_grid(1.0e-3), "fig6c": _preload_grid(0.25e-3),
+    "fig56_frequency": lambda profile: {
+        "drive frequencies": PROFILE_SETTINGS[profile].sensitivity_frequencies},
+    "fig56_viscosity": lambda profile: {"damping ratios": PROFILE_SETTINGS[profile].damping_ratios},
+}
 
 #: The ledger's readings of the chapter's figures.
 READING_TABLES = tuple(

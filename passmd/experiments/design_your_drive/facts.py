@@ -127,3 +127,26 @@ def ringing_facts(probe: dict, frequency: float) -> dict:
             "ring_left_nm": at["ringing_at_next_flyback_m"] * 1e9,
             "ring_hold_ms": probe["ringing_hold_s"] * 1e3, "ring_next_ms": at["next_flyback_after_s"] * 1e3,
             "ring_quiet_ms": float(times[below[0]] * 1e3) if below.size else math.nan}
+
+
+def diagnosis_table(found: dict) -> pd.DataFrame:
+    """The causes of a critical amplitude's departure (:func:`passmd.protocols.diagnosis.diagnose`), one row
+    each: the counterfactual (what was removed), its A_c (nm) and its share of the departure (%)."""
+    return pd.DataFrame([{"cause": c["cause"], "counterfactual": c["changed"],
+                          "counterfactual A_c [nm]": ("–" if c["counterfactual_value"] is None
+                                                      else f"{c['counterfactual_value'] * 1e9:.4g}"),
+                          "share [%]": "–" if c["share"] is None else f"{100 * c['share']:.0f}"}
+                         for c in found["causes"]])
+
+
+def diagnosis_facts(found: dict) -> dict:
+    """The numbers and words the page says of a diagnosis: the value, the closed form, the gap, the causes
+    named and those that gave no value (with why)."""
+    value, closed = found["values"][-1], found["expected"][-1]
+    named = found["named"]
+    untried = [f"{c['cause']}: {c['changed']}" for c in found["causes"] if c["share"] is None]
+    return {"why_value_nm": value * 1e9, "why_closed_nm": closed * 1e9,
+            "why_gap_pct": 100 * abs(value / closed - 1), "why_side": "below" if value < closed else "above",
+            "why_named": (" and ".join(f"**{n}**" for n in named) if named
+                          else "none of the candidates (each takes away less than half of the departure)"),
+            "why_untried": ("Without a value: " + "; ".join(untried) + ".") if untried else ""}

@@ -148,8 +148,8 @@ def parameter_table(drive: Drive, sources: dict) -> pd.DataFrame:
             shown = "; ".join(_group_text(g) for g in value) or "–"
         elif isinstance(value, bool):
             shown = str(value).lower()
-        elif isinstance(value, str):
-            shown = value
+        elif isinstance(value, str):  # a choice or a rule ("slew"): no unit
+            shown, unit = value, ""
         else:
             shown = f"{float(from_si(value, unit)) if unit else value:.4g}"
         rows.append({"key": row["key"], "symbol": row["symbol"], "value": shown, "unit": unit,

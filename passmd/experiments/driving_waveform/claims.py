@@ -1,17 +1,20 @@
 """Claim extractors of Section 5.1: the driving waveform's time series (Figs. 8 and 9a).
 
 Decides the ledger's Section 5.1 rows (``passmd/data/reference/claims.csv``) from the time series
-of Figs. 8 and 9a and the resolved fly-back window (``fig8b_window``), each at the ledger's
-reading of μ (the readings tables ``fig8a_readings``, ``fig8b_readings``,
-``fig8b_window_readings``, ``fig9a_response``): the saw-tooth's back step; the consequence the
-paper draws from a micro-vibration not damped within the next stick phase (the runner's velocity
-stops growing with the frequency); the response to the optimized waveform against the saw-tooth's
-it is designed from (the runner velocity V_r of Eq. 15 after an optimized period); t_a starting
-at the runner's velocity maximum, stick during t_a, the contacts deformed to u_x,max after the
-fly-back, the runner fastest at the end of t_a and slipping forward further than the hemispheres
-move (Sub-phase II); Fig. 9a's final positions and step increase. Section 5.2's velocities are in
-:mod:`passmd.experiments.waveform_velocity.claims`. Too few samples in a phase make a
-claim inconclusive.
+of Figs. 8 and 9a, the resolved fly-back window (``fig8b_window``) and the runner's ringing after
+Fig. 8a's fly-back (``fig8a_ringing``), each at the ledger's reading of Section 5's μ (the readings
+tables ``fig8a_readings``, ``fig8a_ringing_readings``, ``fig8b_readings``, ``fig8b_window_readings``,
+``fig9a_response``): in the saw-tooth's stick phase the runner moves with the hemispheres, the
+fly-back makes a back-step and leaves the runner vibrating, and that micro-vibration is (or is not)
+damped within the stick phase of the following period (the swing left at the next fly-back); the
+response to the optimized waveform against the saw-tooth's it is designed from; the runner moving
+backward and reversing within t_s, t_a starting at its velocity maximum, stick during t_a, the
+contacts deformed to u_x,max after the fly-back, the runner fastest and the contact spring's energy
+largest at the end of t_a, and the runner slipping forward further than the hemispheres move
+(Sub-phase II); Fig. 9a's final positions and step increase. Positions are ordered to the
+integrator's stated accuracy (the tie rule of :mod:`passmd.ledger.rules`). Section 5.2's velocities
+are in :mod:`passmd.experiments.waveform_velocity.claims`. Too few samples in a phase make a claim
+inconclusive.
 """
 
 from __future__ import annotations
@@ -19,13 +22,19 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from passmd.experiments.driving_waveform.figures import SECTION5_FRICTION, at_section5_friction
+from passmd.experiments.driving_waveform.figures import (
+    SECTION5_FRICTION,
+    at_section5_friction,
+    section5_fields,
+)
+from passmd.experiments.model_numerics.facts import POSITION_ACCURACY
 from passmd.ledger.checks import ClaimFails, NoRun, NotEvaluable, evidence, extractor
 from passmd.ledger.readings import default_reading
-from passmd.protocols.section5 import WINDOW_SAMPLES_PER_ACCELERATION
+from passmd.model import theory
+from passmd.protocols.section5 import WINDOW_SAMPLES_PER_ACCELERATION, section5_drive
 from passmd.protocols.velocity import FULL_SLIDING_SHARE
 
-__all__ = ["optimized_period_timing"]
+__all__ = ["fig8b_points", "optimized_period_timing"]
 
 
 def _fig9a_run(results, waveform: str, reading=None) -> pd.DataFrame:
@@ -50,6 +59,8 @@ def at_mu(results, key: str, reading) -> pd.DataFrame:
 
 #: The axis these claims depend on: Section 5's unstated μ.
 _AXES = ("friction_coefficient",)
+#: What two runner positions must differ by to be ordered (nm): the integrator's stated accuracy.
+_POSITION_NM = POSITION_ACCURACY * 1e9
 
 
 @extractor("fig9a-standard-position-552nm", depends_on=_AXES)
@@ -73,7 +84,7 @@ def _fig9a_increase(results, reading):
 def _fig9a_step_larger(results, reading):
     steps = {w: float(np.mean(np.diff(_fig9a_run(results, w, reading)["settled_position_m"].to_numpy())))
              * 1e9 for w in ("optimized", "sawtooth")}
-    return {"lhs": steps["optimized"], "rhs": steps["sawtooth"]}
+    return {"lhs": steps["optimized"], "rhs": steps["sawtooth"], "resolution": _POSITION_NM}
 
 
 #: Why the Fig. 8a back-step and the full sliding after the fly-back cannot fail: at 202 nm the
@@ -90,7 +101,64 @@ _FLYBACK_SLIDES = ("holds for any contact stiffness down to a sixteenth of Table
 
 @extractor("fig8a-back-step", depends_on=_AXES, not_informative=_FLYBACK_SLIDES)
 def _fig8a_back_step(results, reading):
-    return {"lhs": float(at_mu(results, "fig8a", reading)["first_back_step_m"].iloc[0]) * 1e9, "rhs": 0.0}
+    return {"lhs": float(at_mu(results, "fig8a", reading)["first_back_step_m"].iloc[0]) * 1e9, "rhs": 0.0,
+            "resolution": _POSITION_NM}
+
+
+#: Why the runner moves with the hemispheres in Fig. 8a's stick phase whatever the model: Section 5's
+#: runner is free (no load cell), so on the slow ramp the contacts carry only its inertia, brought to
+#: A/T within a cycle of its micro-vibration, over two orders of magnitude below their sliding force.
+_RAMP_STICKS = ("the free runner of Section 5 needs, on the slow 100 Hz ramp, only the force of its inertia "
+                "(a 3 g runner brought to A/T = 20 µm/s within a cycle of its micro-vibration), over two "
+                "orders of magnitude below the contacts' sliding force μ(2F_N1 + 4F_N2): no contact with "
+                "static friction lets it slide")
+
+
+def _first_ramp(results, reading) -> pd.DataFrame:
+    """Fig. 8a's full record over the first period's slow ramp (up to point 1, the first fly-back)."""
+    table = at_mu(results, "fig8a", reading)
+    points = table[table["view"] == "point"].set_index("point")
+    points.index = points.index.astype(str)
+    full = table[table["view"] == "full"].sort_values("time_s")
+    if full.empty or "1" not in points.index:
+        raise NotEvaluable("the Fig. 8a trace or its point 1 (end of the first stick phase) is missing")
+    return full[full["time_s"] < float(points.at["1", "time_s"])]
+
+
+@extractor("fig8a-runner-moves-with-hemispheres-in-stick", depends_on=_AXES, not_informative=_RAMP_STICKS)
+def _moves_with_hemispheres(results, reading):
+    # "moved together": the runner never slides against the hemispheres on the first ramp, its lag behind
+    # them staying below the presliding u_x,max of the weaker contact side (Eq. 10)
+    ramp = _first_ramp(results, reading)
+    lag = np.abs(ramp["piezo_position_m"].to_numpy() - ramp["runner_position_m"].to_numpy()).max() * 1e9
+    return {"lhs": float(lag), "rhs": _presliding_nm(reading), "resolution": _POSITION_NM}
+
+
+def _presliding_nm(reading) -> float:
+    """The smaller presliding u_x,max of the two contact sides of the Section 5 drive at a reading's μ
+    (nm)."""
+    drive = section5_drive(**section5_fields(friction_coefficient=float(reading["friction_coefficient"])))
+    return float(np.min(np.asarray(theory.drive_theory(drive)["presliding_m"]))) * 1e9
+
+
+def _ringing(results, reading) -> pd.Series:
+    rows = at_mu(results, "fig8a_ringing", reading)
+    return rows.iloc[0]
+
+
+#: Why the runner vibrates after the slip phase whatever the model: it sits on elastic contacts of
+#: tangential stiffness 2aG*, and the fly-back that makes the back-step (fully sliding contacts) leaves it
+#: moving: a mass on springs swings.
+_SLIP_RINGS = ("a runner on elastic contacts (tangential stiffness 2aG* per contact) that the fly-back "
+               "leaves moving (the back-step row: every contact slides fully at 202 nm) swings at "
+               "√(k/m_r): every finite contact stiffness gives a micro-vibration after the slip phase")
+
+
+@extractor("fig8a-runner-vibrates-after-slip", depends_on=_AXES, not_informative=_SLIP_RINGS)
+def _vibrates_after_slip(results, reading):
+    # the first swing of the micro-vibration after the fly-back against what a step measurement resolves
+    row = _ringing(results, reading)
+    return {"lhs": float(row["ringing_amplitude_m"]) * 1e9, "rhs": float(row["measurable_m"]) * 1e9}
 
 
 def optimized_period_timing(results, reading=None) -> dict:
@@ -191,10 +259,11 @@ def _window_phase(results, phases: tuple[str, ...], reading=None) -> pd.DataFram
 @extractor("sec5-1-stick-during-acceleration", depends_on=_AXES)
 def _stick_during_acceleration(results, reading):
     # Section 5.1 chooses V_a so that the runner still sticks during t_a: no contact group may
-    # reach full sliding (slip share 1) between points 4 and 5.
+    # reach full sliding (slip share 1) between points 4 and 5. Ours: the share of t_a's record in which
+    # one does (%).
     rows = _window_phase(results, ("acceleration",), reading)
-    share = float(rows[["slip_share_1", "slip_share_2"]].to_numpy().max())
-    return {"lhs": share, "rhs": FULL_SLIDING_SHARE}
+    full = rows[["slip_share_1", "slip_share_2"]].to_numpy().max(axis=1) >= FULL_SLIDING_SHARE
+    return 100.0 * float(full.mean())
 
 
 @evidence("sec5-1-stick-during-acceleration")
@@ -246,16 +315,23 @@ def _fastest_at_point5_evidence(results):
             f"{(rows['time_s'].iloc[k] - acc['acceleration_end_s'].iloc[0]) * 1e6:.2f} µs after point 5"]
 
 
-@extractor("sec5-1-runner-overshoots-in-slip", depends_on=_AXES)
-def _overshoot(results, reading):
-    # Sub-phase II: from point 4 to the runner's forward extreme after point 5, the runner moves
-    # further than the hemispheres do over the same time (the acceleration Δ_a included).
+def fig8b_points(results, reading, needed: tuple[str, ...]) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Fig. 8b's numbered points (indexed by their label) and its zoomed trace (by time) at a reading's
+    μ; inconclusive when the trace or one of the ``needed`` points is missing."""
     table = at_mu(results, "fig8b", reading)
     points = table[table["view"] == "point"].set_index("point")
     points.index = points.index.astype(str)
     zoom = table[table["view"] == "zoom"].sort_values("time_us")
-    if zoom.empty or not {"4", "5"} <= set(points.index):
-        raise NotEvaluable("the Fig. 8b trace or its points 4 and 5 are missing")
+    if zoom.empty or not set(needed) <= set(points.index):
+        raise NotEvaluable(f"the Fig. 8b trace or its points {' and '.join(needed)} are missing")
+    return points, zoom
+
+
+@extractor("sec5-1-runner-overshoots-in-slip", depends_on=_AXES)
+def _overshoot(results, reading):
+    # Sub-phase II: from point 4 to the runner's forward extreme after point 5, the runner moves
+    # further than the hemispheres do over the same time (the acceleration Δ_a included).
+    points, zoom = fig8b_points(results, reading, ("4", "5"))
     after = zoom[zoom["time_us"] >= float(points.at["5", "time_us"])]
     if len(after) < 3:
         raise NotEvaluable("fewer than three trace samples after point 5")
@@ -264,63 +340,64 @@ def _overshoot(results, reading):
         raise NotEvaluable("the runner is still moving forward at the last sample of the trace")
     start, extreme = points.loc["4"], after.iloc[k]
     return {"lhs": float(extreme["runner_position_nm"] - start["runner_position_nm"]),
-            "rhs": float(extreme["piezo_position_nm"] - start["piezo_position_nm"])}
+            "rhs": float(extreme["piezo_position_nm"] - start["piezo_position_nm"]),
+            "resolution": _POSITION_NM}
 
 
-#: 'Completely damped': the relative vibration has fallen below a tenth (20 dB) of its first swing.
-_DAMPED_SHARE = 0.1
+@extractor("sec5-1-runner-backward-then-reverses", depends_on=_AXES)
+def _backward_then_reverses(results, reading):
+    # Sub-phase I: at point 2 the runner moves backward, at point 3 it starts to reverse, both within the
+    # settling time t_s (before point 4). Ours: when, after the fly-back, the runner's velocity first turns
+    # forward, against t_s (µs); the record's spacing is the resolution.
+    points, zoom = fig8b_points(results, reading, ("2", "4"))
+    v2 = float(points.at["2", "runner_velocity_m_per_s"])
+    if v2 >= 0:
+        raise ClaimFails("the runner does not move backward after the fly-back: its slowest velocity "
+                         f"within t_s is {v2 * 1e3:.3g} mm/s")
+    t_s = float(points.at["4", "settling_time_s"]) * 1e6
+    start = float(points.at["4", "time_us"]) - t_s
+    after = zoom[zoom["time_us"] >= float(points.at["2", "time_us"])]
+    forward = after[after["runner_velocity_m_per_s"] >= 0]
+    turn = (float(forward["time_us"].iloc[0]) if len(forward) else float(after["time_us"].iloc[-1])) - start
+    return {"lhs": turn, "rhs": t_s, "resolution": float(np.diff(zoom["time_us"].to_numpy()).max())}
 
 
-def damping_time(fig8a_table: pd.DataFrame) -> tuple[float, bool]:
-    """How long after Fig. 8a's first fly-back the runner's vibration relative to the hemispheres takes
-    to fall below :data:`_DAMPED_SHARE` of its first swing and stay there for a whole micro-vibration
-    period (s), from the zoomed record; and whether it does so within the record (else the longest
-    time the record can tell, a lower bound, and False)."""
-    zoom = fig8a_table[fig8a_table["view"] == "zoom"].sort_values("time_s")
-    full = fig8a_table[fig8a_table["view"] == "full"]
-    f_s = float(fig8a_table["micro_vibration_frequency_Hz"].iloc[0])
-    if zoom.empty or full.empty or not np.isfinite(f_s):
-        raise NotEvaluable("the Fig. 8a trace or its micro-vibration frequency is missing")
-    flyback_end = float(full["time_s"].max()) / 2.0  # the first of Fig. 8a's two periods ends here
-    t = zoom["time_s"].to_numpy()
-    hemispheres = np.gradient(zoom["piezo_position_m"].to_numpy(), t)
-    relative = np.abs(zoom["runner_velocity_m_per_s"].to_numpy() - hemispheres)
-    after = t > flyback_end + 1e-6  # past the fly-back's corner
-    t, relative = t[after], relative[after]
-    period = 1.0 / f_s
-    if t.size < 3 or t[-1] - t[0] < 2 * period:
-        raise NotEvaluable("the zoomed record after the fly-back is shorter than two micro-vibration periods")
-    first = float(relative[t <= t[0] + period].max())
-    ends = np.searchsorted(t, t + period, side="right")
-    for i in np.flatnonzero(t + period <= t[-1]):
-        if relative[i:ends[i]].max() < _DAMPED_SHARE * first:
-            return float(t[i] - flyback_end), True
-    return float(t[-1] - period - flyback_end), False
+@extractor("sec5-1-potential-energy-maximal-at-point-5", depends_on=_AXES)
+def _potential_energy_at_point5(results, reading):
+    # Sub-phase II: at point 5 (end of t_a) "the potential energy due to the deformation of the spring" is
+    # maximal. In the paper's one-spring picture of the contacts it is F²/2k, F the force the contact springs
+    # exert on the free runner, m_r times its acceleration. Ours: how far below its largest value from point 4
+    # to the end of the window that energy lies at point 5 (% of the largest): 0 where it is largest there.
+    rows = _window_phase(results, ("acceleration", "after"), reading)
+    t = rows["time_s"].to_numpy()
+    force = np.gradient(rows["runner_velocity_m_per_s"].to_numpy(), t)  # ∝ F (m_r constant)
+    end = float(rows["acceleration_end_s"].iloc[0])
+    at5 = float(np.interp(end, t, force))
+    largest = float(force.max())
+    if largest <= 0:
+        raise ClaimFails("the contact springs never push the runner forward from point 4 on")
+    return 100.0 * (1.0 - min(max(at5, 0.0) / largest, 1.0) ** 2)
 
 
 @extractor("fig8a-micro-vibration-damped-within-next-stick", depends_on=_AXES)
 def _micro_vibration_damped(results, reading):
-    # The conditional: where the micro-vibration is not damped within the stick phase of the next
-    # period, it "prevents the drives from controlling with a high frequency and thus high operational
-    # velocity". Fig. 8a's decay time tells from which frequency on the stick phase is too short;
-    # above it the runner's saw-tooth velocity must stop growing with the frequency. Ours: its rise
-    # from the first such grid frequency to the top of the grid (%), against 0.
-    decay, _ = damping_time(at_mu(results, "fig8a", reading))  # a lower bound if the record ends first
-    table = at_mu(results, "fig9b", reading)
-    saw = table[table["variant"] == "sawtooth"].sort_values("frequency")
-    undamped = saw[1.0 / saw["frequency"] - saw["flyback_time_s"] < decay]
-    if len(undamped) < 2:
-        raise NotEvaluable(f"fewer than two grid frequencies where the stick phase is shorter than the "
-                           f"{decay * 1e6:.3g} µs the micro-vibration needs to die out")
-    v = undamped["velocity_mm_per_s"].to_numpy()
-    return {"lhs": 100.0 * (v[-1] - v[0]) / abs(v[0]), "rhs": 0.0}
+    # "completely damped within the stick phase of the following period": the swing of the runner's
+    # micro-vibration left when the next fly-back starts (the end of the following slow ramp), against the
+    # smallest swing a step measurement resolves (the measurable step of the A_c search)
+    row = _ringing(results, reading)
+    if not row["swings"]:
+        raise NotEvaluable("no swing of the runner after the fly-back to follow")
+    return {"lhs": float(row["ringing_at_next_flyback_m"]) * 1e9, "rhs": float(row["measurable_m"]) * 1e9}
 
 
 @evidence("fig8a-micro-vibration-damped-within-next-stick")
 def _micro_vibration_evidence(results):
-    decay, within = damping_time(results["fig8a"])
-    return [f"the runner's vibration relative to the hemispheres falls below {_DAMPED_SHARE:.0%} of its "
-            "first swing for good "
-            + (f"{decay * 1e6:.3g} µs after Fig. 8a's fly-back" if within else
-               f"later than {decay * 1e6:.3g} µs after Fig. 8a's fly-back, the end of the record")
-            + f": not within the stick phase above {1e-3 / decay:.3g} kHz (defaults)"]
+    row = _ringing(results, default_reading())
+    decay = row["ringing_decay_time_s"]
+    return [f"first swing {row['ringing_amplitude_m'] * 1e9:.3g} nm at "
+            f"{row['ringing_frequency_Hz'] / 1e3:.4g} "
+            f"kHz; it falls to 1/e "
+            + (f"in {decay * 1e6:.3g} µs" if np.isfinite(decay) else
+               f"not within the {row['ringing_hold_s'] * 1e3:.3g} ms recorded")
+            + f"; {row['ringing_at_next_flyback_m'] * 1e9:.3g} nm left when the next fly-back starts, "
+            f"{row['next_flyback_after_s'] * 1e3:.3g} ms after the first (defaults)"]

@@ -22,6 +22,7 @@ import pandas as pd
 
 from passmd.experiments import FigureSpec, ReadingTable
 from passmd.ledger import readings
+from passmd.protocols import ringing
 from passmd.protocols.section5 import (
     STEP_FREQUENCY,
     WINDOW_RESOLUTION,
@@ -29,6 +30,7 @@ from passmd.protocols.section5 import (
     design_fields,
     designs,
     full_stroke_flyback,
+    section5_drive,
     trace_point,
     window_point,
 )
@@ -274,8 +276,37 @@ def at_every_mu(compute):
     return readings_table
 
 
-fig8a_readings, fig8b_readings, fig8b_window_readings = (
-    at_every_mu(f) for f in (fig8a, fig8b, fig8b_window))
+def ringing_point(hemisphere_radius: float, preload: float, runner: str, actuator_model: str,
+                  friction_coefficient: float, frequency: float) -> dict:
+    """The ringing after the first fly-back of a full-stroke saw-tooth of a Section 5 drive at
+    ``frequency`` (:func:`passmd.protocols.ringing.ringing_point`)."""
+    drive = section5_drive(hemisphere_radius, preload, runner, actuator_model, friction_coefficient)
+    return ringing.ringing_point(drive, drive.actuator.full_stroke_amplitude, frequency)
+
+
+def fig8a_ringing(config: RunConfig, friction_coefficient: float = SECTION5_FRICTION) -> pd.DataFrame:
+    """The runner's micro-vibration after Fig. 8a's first fly-back (100 Hz, the Section 5 drive), one row:
+    its frequency, first swing (``ringing_amplitude_m``), 1/e decay time, and the swing left when the next
+    fly-back starts, at the end of the following stick phase (``ringing_at_next_flyback_m``,
+    :func:`passmd.protocols.ringing.at_frequency`), with the smallest swing a step measurement resolves
+    (``measurable_m``). ``friction_coefficient``: Section 5's unstated μ."""
+    c = section5_fields(friction_coefficient=friction_coefficient)
+    run = sweep.run(ringing_point, [{**c, "frequency": STEP_FREQUENCY}], description="ringing",
+                    config=config).iloc[0].to_dict()
+    left = ringing.at_frequency(run, STEP_FREQUENCY)
+    return pd.DataFrame([{
+        "frequency_Hz": STEP_FREQUENCY, "ringing_frequency_Hz": float(run["ringing_frequency_Hz"]),
+        "ringing_amplitude_m": float(run["ringing_amplitude_m"]),
+        "ringing_decay_time_s": float(run["ringing_decay_time_s"]),
+        "next_flyback_after_s": float(left["next_flyback_after_s"]),
+        "ringing_at_next_flyback_m": float(left["ringing_at_next_flyback_m"]),
+        "ringing_hold_s": float(run["ringing_hold_s"]), "measurable_m": ringing.MEASURABLE,
+        "swings": int(np.asarray(run["swing_amplitudes_m"]).size),
+    }])
+
+
+fig8a_readings, fig8b_readings, fig8b_window_readings, fig8a_ringing_readings = (
+    at_every_mu(f) for f in (fig8a, fig8b, fig8b_window, fig8a_ringing))
 
 
 def _settling_response(trace: dict, flyback_end: float, settling_time: float) -> dict:
@@ -345,6 +376,9 @@ FIGURES = tuple(FigureSpec(name, title, "driving_waveform", compute, f"driving_w
 #: The ledger's readings of the chapter's figures: each at every μ.
 READING_TABLES = (
     ReadingTable("fig8a_readings", "Fig. 8a at every μ", ("fig8a",), fig8a_readings),
+    ReadingTable("fig8a_ringing_readings", "The micro-vibration after Fig. 8a's fly-back, at every μ",
+                 ("fig8a",),
+                 fig8a_ringing_readings),
     ReadingTable("fig8b_readings", "Fig. 8b at every μ", ("fig8b",), fig8b_readings),
     ReadingTable("fig8b_window_readings", "Fig. 8b's fly-back window at every μ", ("fig8b_window",),
                  fig8b_window_readings),

@@ -1,10 +1,12 @@
 """Claim extractors of Section 4.2: the generated force of Fig. 7.
 
 Decides the ledger's Section 4.2 rows (``passmd/data/reference/claims.csv``). The claims about the
-simulated force are that it depends on the actuation amplitude and on the preload: this paper's
-model (flexible actuators, μ = 0.2) at half and full stroke and at the panels' two preloads, read
-from the ledger's readings (:func:`~passmd.experiments.force_generation.figures.fig7_readings`: every
-point of the fly-back rule, the actuator damping ζ and the drive frequency). Every other sentence of
+simulated force are that it depends on the actuation amplitude, the preload, the hemisphere radius,
+μ and the runner's material: this paper's model (flexible actuators, μ = 0.2) at half and full stroke
+and at the panels' two preloads, and with one of R, μ or the runner changed, read from the ledger's
+readings (:func:`~passmd.experiments.force_generation.figures.fig7_readings`,
+:func:`~passmd.experiments.force_generation.figures.fig7_dependence_readings`: every point of the
+fly-back rule, the actuator damping ζ and the drive frequency). Every other sentence of
 Section 4.2 compares a model with the experiment of [12] (the agreement, the discrepancy and its
 growth, its size of 115 mN, its causes, the other preloads' trends): the paper's text gives none of
 the measured data, so they are claims about the experiment, inconclusive
@@ -20,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from passmd.experiments.force_generation.figures import (
+    DEPENDENCE_PAIRS,
     EARLIER,
     PANELS,
     PANELS_FULL_STROKE_NM,
@@ -28,10 +31,18 @@ from passmd.experiments.force_generation.figures import (
     model_rows,
     readings_at,
 )
-from passmd.ledger.checks import ClaimFails, NotEvaluable, Subset, evidence, experiment_claim, extractor
+from passmd.ledger.checks import (
+    ClaimFails,
+    NoRun,
+    NotEvaluable,
+    Subset,
+    evidence,
+    experiment_claim,
+    extractor,
+)
 from passmd.model.tables import PRELOAD_GRIDS
 
-__all__ = ["DEPENDENCE_PERCENT", "full_and_half_stroke"]
+__all__ = ["DEPENDENCE_PERCENT", "dependence_pairs", "full_and_half_stroke"]
 
 #: Axes of passmd.ledger.readings this paper's force runs depend on.
 _FORCE_AXES = ("flyback", "damping_ratio", "force_frequency")
@@ -63,8 +74,46 @@ def _change(a: float, b: float) -> float:
 @extractor("fig7-force-depends-on-amplitude", depends_on=_FORCE_AXES)
 def _depends_on_amplitude(results, reading) -> dict:
     # F_gen at full stroke against half stroke, at each of the four panel preloads
-    change = np.array([_change(*pair) for pair in full_and_half_stroke(results, reading).values()])
+    pairs = full_and_half_stroke(results, reading)
+    change = np.array([_change(*pair) for pair in pairs.values()])
+    return {"lhs": change, "rhs": np.full(change.size, DEPENDENCE_PERCENT),
+            "at": [p for _, p in pairs], "at_unit": "N"}
+
+
+def dependence_pairs(results, reading) -> dict:
+    """This paper's F_gen (mN) of each pair of
+    :data:`~passmd.experiments.force_generation.figures.DEPENDENCE_PAIRS` at a reading: ``{pair name:
+    (base, changed)}`` (stalled runs only)."""
+    table = results["fig7_dependence_readings"]
+    rows = table[(table["flyback"] == reading["flyback"])
+                 & np.isclose(table["damping_ratio"], float(reading["damping_ratio"]), rtol=1e-9, atol=0)
+                 & np.isclose(table["frequency_Hz"], float(reading["force_frequency"]), rtol=1e-9, atol=0)]
+    if rows.empty:
+        raise NoRun(f"no force-dependence runs at {reading}")
+    out = {}
+    for pair in DEPENDENCE_PAIRS:
+        mine = rows[rows["pair"] == pair].set_index("side")
+        if not mine["converged"].all():
+            raise NotEvaluable(f"a force run of the {pair} pair did not stall")
+        out[pair] = (float(mine.at["base", "generated_force_mN"]),
+                     float(mine.at["changed", "generated_force_mN"]))
+    return out
+
+
+@extractor("sec4-2-force-depends-on-radius-friction-material", depends_on=_FORCE_AXES)
+def _depends_on_radius_friction_material(results, reading) -> dict:
+    # F_gen with one input changed (R, μ, runner material) against the same run without the change
+    pairs = dependence_pairs(results, reading)
+    change = np.array([_change(*pair) for pair in pairs.values()])
     return {"lhs": change, "rhs": np.full(change.size, DEPENDENCE_PERCENT)}
+
+
+@evidence("sec4-2-force-depends-on-radius-friction-material")
+def _dependence_evidence(results) -> list:
+    from passmd.ledger.readings import default_reading
+
+    return [f"{name}: {base:.4g} mN → {changed:.4g} mN ({_change(base, changed):.3g} %, defaults)"
+            for name, (base, changed) in dependence_pairs(results, default_reading()).items()]
 
 
 @extractor("fig7-force-depends-on-preload", depends_on=_FORCE_AXES)
@@ -75,7 +124,8 @@ def _depends_on_preload(results, reading) -> dict:
     for radius, preloads in PANELS.values():
         low, high = (forces[round(radius * 1e3, 9), round(p, 9)][1] for p in sorted(preloads))
         change.append(_change(low, high))
-    return {"lhs": np.array(change), "rhs": np.full(len(change), DEPENDENCE_PERCENT)}
+    return {"lhs": np.array(change), "rhs": np.full(len(change), DEPENDENCE_PERCENT),
+            "at": [radius * 1e3 for radius, _ in PANELS.values()], "at_unit": "mm"}
 
 
 @evidence("fig7-force-depends-on-amplitude")

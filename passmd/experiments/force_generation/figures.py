@@ -26,7 +26,7 @@ from passmd.experiments import FigureSpec, ReadingTable
 from passmd.ledger import readings
 from passmd.ledger.checks import NoRun
 from passmd.model.defaults import PROTOCOL
-from passmd.model.parameters import Drive, paper_drive
+from passmd.model.parameters import MOLYBDENUM, STEEL, Drive, paper_drive
 from passmd.model.tables import ACTUATOR_DAMPING_RATIO, PRELOAD_GRIDS, Assumption, actuator_for_radius
 from passmd.model.theory import drive_theory
 from passmd.protocols import stall
@@ -45,9 +45,10 @@ from passmd.runtime.config import PROFILES, RunConfig
 from passmd.runtime.validation import check_choice, check_range
 
 __all__ = [
-    "CYCLE_COMBINATIONS", "EARLIER", "FIGURES", "FORCE_FREQUENCY", "MODELS", "ONSET_TOLERANCE",
-    "PANELS", "PANELS_FULL_STROKE_NM", "PROFILE_SETTINGS", "READING_TABLES", "THIS", "cycle_point",
-    "fig7_difference", "fig7_readings", "fig7a", "fig7b", "fig7cycle", "fig7freq", "fig7grid",
+    "CYCLE_COMBINATIONS", "DEPENDENCE_PAIRS", "EARLIER", "FIGURES", "FORCE_FREQUENCY", "GRIDS", "MODELS",
+    "ONSET_TOLERANCE", "PANELS", "PANELS_FULL_STROKE_NM", "PROFILE_SETTINGS", "READING_TABLES",
+    "RUNNER_MATERIALS", "THIS", "cycle_point", "fig7_dependence_readings", "fig7_difference", "fig7_readings",
+    "fig7a", "fig7b", "fig7cycle", "fig7freq", "fig7grid",
     "force_difference", "force_drive", "model_rows", "onset_point", "readings_at", "stall_point",
 ]
 
@@ -144,14 +145,21 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
 )
 
 
+#: Runner materials a force run can have: Table 1's steel and Fig. 10c's molybdenum.
+RUNNER_MATERIALS = {"steel": STEEL, "molybdenum": MOLYBDENUM}
+
+
 def force_drive(
     hemisphere_radius: float, preload: float, actuator_model: str, friction_coefficient: float,
-    damping_ratio: float = ACTUATOR_DAMPING_RATIO,
+    damping_ratio: float = ACTUATOR_DAMPING_RATIO, runner: str = "steel",
 ) -> Drive:
     """The Fig. 7 drive: Tables 1–2, six contacts, load cell engaged (Section 4.2); actuator damping ζ
-    (Table 2's lost c_p, ledger axis ``damping_ratio``)."""
+    (Table 2's lost c_p, ledger axis ``damping_ratio``) and the runner's material
+    (:data:`RUNNER_MATERIALS`)."""
+    check_choice("runner", runner, tuple(RUNNER_MATERIALS))
     return paper_drive(hemisphere_radius, preload, actuator_model=actuator_model,
                        friction_coefficient=friction_coefficient, load_cell=True,
+                       runner_material=RUNNER_MATERIALS[runner],
                        actuator=actuator_for_radius(hemisphere_radius, damping_ratio=damping_ratio))
 
 
@@ -164,10 +172,12 @@ def stall_point(
     frequency: float,
     flyback: str = "slew",
     damping_ratio: float = ACTUATOR_DAMPING_RATIO,
+    runner: str = "steel",
 ) -> dict:
     """:func:`~passmd.protocols.stall.generated_force` of the Fig. 7 drive at ``amplitude_fraction`` × A_max,
-    with the ``flyback`` rule and actuator damping ζ."""
-    drive = force_drive(hemisphere_radius, preload, actuator_model, friction_coefficient, damping_ratio)
+    with the ``flyback`` rule, actuator damping ζ and the runner's material."""
+    drive = force_drive(hemisphere_radius, preload, actuator_model, friction_coefficient, damping_ratio,
+                        runner)
     fraction = check_range("amplitude_fraction", amplitude_fraction, 0.0, 1.0)
     amplitude = fraction * drive.actuator.full_stroke_amplitude
     out = generated_force(drive, amplitude, frequency, flyback=flyback)
@@ -238,7 +248,7 @@ def _stall_frame(points: list[dict], description: str, config: RunConfig) -> pd.
         "remaining_force_mN": f["remaining_force_N"].astype(float) * 1e3,  # None: not estimated
         "force_spread_mN": f["force_spread_N"] * 1e3,
         "mean_friction_mN": f["mean_friction_N"] * 1e3,
-        "piezo_mean_force_mN": f["piezo_mean_force_N"] * 1e3,
+        "piezo_mean_force_mN": f["no_slip_reference_force_N"] * 1e3,
         "net_displacement_nm": f["net_displacement_m"] * 1e9,
         "last_step_nm": f["last_step_m"] * 1e9,
         "cpu_time_s": f["cpu_time_s"],
@@ -339,6 +349,46 @@ def readings_at(results, reading) -> pd.DataFrame:
         raise NoRun(f"no force runs of this paper's model with the {reading['flyback']} fly-back, "
                     f"ζ = {reading['damping_ratio']:g} at {reading['force_frequency']:g} Hz")
     return rows.reset_index(drop=True)
+
+
+#: The runs of :func:`fig7_dependence_readings`: what changes against what, each a pair of stall runs of
+#: this paper's model (flexible actuators, μ = 0.2 unless changed) at the same point of the readings:
+#: name -> (base run, changed run), each ``(R in m, F_p in N, amplitude as a fraction of that R's
+#: A_max, μ, runner)``. The radius pair keeps F_p and the amplitude (R = 0.25 mm's full stroke, 96 nm,
+#: inside R = 1 mm's range), each radius with its Table 2 actuator; μ and the material change Fig. 7a's
+#: 0.8 N run at the full stroke (μ to Table 1's other value, the runner to Fig. 10c's molybdenum).
+DEPENDENCE_PAIRS = {
+    "radius": ((1.0e-3, 0.4, PANELS_FULL_STROKE_NM["fig7b"] / PANELS_FULL_STROKE_NM["fig7a"], 0.2, "steel"),
+               (0.25e-3, 0.4, 1.0, 0.2, "steel")),
+    "friction coefficient": ((1.0e-3, 0.8, 1.0, 0.2, "steel"), (1.0e-3, 0.8, 1.0, 0.3, "steel")),
+    "material": ((1.0e-3, 0.8, 1.0, 0.2, "steel"), (1.0e-3, 0.8, 1.0, 0.2, "molybdenum")),
+}
+
+
+def fig7_dependence_readings(config: RunConfig) -> pd.DataFrame:
+    """This paper's model's generated force for each pair of :data:`DEPENDENCE_PAIRS` (one input changed),
+    at every point of the axes that change the force runs: fly-back rule × actuator damping ζ × drive
+    frequency. Columns of :func:`fig7a`'s stall runs plus ``flyback``, ``damping_ratio``, ``runner``,
+    ``pair`` and ``side`` (``base`` or ``changed``)."""
+    model = MODELS[1][0]
+    points, labels = [], []
+    for reading in readings.design(("flyback", "damping_ratio", "force_frequency")):
+        zeta = float(reading["damping_ratio"])
+        for pair, runs in DEPENDENCE_PAIRS.items():
+            for side, (radius, preload, fraction, mu, runner) in zip(("base", "changed"), runs, strict=True):
+                points.append({"hemisphere_radius": radius, "preload": preload, "actuator_model": model,
+                               "friction_coefficient": mu, "amplitude_fraction": float(fraction),
+                               "frequency": float(reading["force_frequency"]), **_flyback(reading["flyback"]),
+                               **({} if zeta == ACTUATOR_DAMPING_RATIO else {"damping_ratio": zeta}),
+                               **({} if runner == "steel" else {"runner": runner})})
+                labels.append((pair, side, runner))
+    table = _stall_frame(points, "fig7 dependence readings", config)
+    table.insert(0, "flyback", [p.get("flyback", "slew") for p in points])
+    table.insert(1, "damping_ratio", [p.get("damping_ratio", ACTUATOR_DAMPING_RATIO) for p in points])
+    table.insert(2, "runner", [label[2] for label in labels])
+    table.insert(3, "pair", [label[0] for label in labels])
+    table.insert(4, "side", [label[1] for label in labels])
+    return table
 
 
 def fig7grid(config: RunConfig) -> pd.DataFrame:
@@ -487,8 +537,23 @@ FIGURES = (
                "force_generation", fig7grid, "force_generation:plot_grid"),
 )
 
+def _panel_grid(name: str):
+    return lambda profile: {"amplitudes (fractions of A_max)": PROFILE_SETTINGS[profile].panel_fractions}
+
+
+#: The chapter's profile-dependent grids (:data:`passmd.experiments.figure_table.GRIDS`).
+GRIDS = {
+    "fig7a": _panel_grid("fig7a"), "fig7b": _panel_grid("fig7b"),
+    "fig7grid": lambda profile: {"(radius, preload, amplitude)": tuple(
+        (r, p, a) for r, preloads in PROFILE_SETTINGS[profile].grid_preloads.items() for p in preloads
+        for a in PROFILE_SETTINGS[profile].grid_fractions)},
+    "fig7freq": lambda profile: {"drive frequencies": PROFILE_SETTINGS[profile].frequencies},
+}
+
 #: The ledger's readings of the chapter's figures.
 READING_TABLES = (
     ReadingTable("fig7_readings", "This paper's force runs at half and full stroke at every reading",
                  ("fig7a", "fig7b"), fig7_readings),
+    ReadingTable("fig7_dependence_readings", "This paper's force with R, μ or the runner changed, at every "
+                 "reading", ("fig7a", "fig7b"), fig7_dependence_readings),
 )

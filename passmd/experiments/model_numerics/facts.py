@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from passmd.experiments.model_numerics.figures import CONFIGURATIONS, EXPECTED_COULOMB_RATE
+from passmd.experiments.model_numerics.figures import CONFIGURATIONS, EXPECTED_COULOMB_RATE, MASS_FLYBACKS
 from passmd.model import theory
 from passmd.model.parameters import Drive
 from passmd.protocols import stall
@@ -400,3 +400,98 @@ def benchmark_facts(bench: pd.DataFrame) -> dict:
         "target_ms_per_period": TARGET_MS_PER_PERIOD,
         "target_ns_per_step": TARGET_NS_PER_STEP,
     }
+
+
+
+def _mass_label(mass_kg: float) -> str:
+    """A mass as the study's text writes it: µg below 1 mg, mg above."""
+    return f"{mass_kg * 1e9:.3g} µg" if mass_kg < 1e-6 else f"{mass_kg * 1e6:.3g} mg"
+
+
+def _listed(masses) -> str:
+    """Masses as a list in prose: ``"22 µg and 220 µg"``, ``"none"`` for no mass."""
+    labels = [_mass_label(m) for m in masses]
+    return " and ".join([", ".join(labels[:-1]), labels[-1]] if len(labels) > 1 else labels) or "none"
+
+
+def mass_study_facts(study: pd.DataFrame) -> dict:
+    """What the actuator-mass study (:func:`~passmd.experiments.model_numerics.figures.actuator_mass_study`)
+    supports, as numbers and computed sentences.
+
+    A mass is *consistent with Fig. 6b* when, under at least one fly-back rule, its simulated
+    steady-state A_c lies within the tolerance of the ledger's claim
+    (:func:`~passmd.experiments.model_numerics.figures.mass_study_tolerance`, the table's
+    ``eq12_tolerance_rel``) of its Eq. 12. Returns the printed and the hemisphere's mass and their
+    ratio, the tolerance (%) and the sentences: ``mass_grid_text`` (the masses), ``mass_ac_text``
+    (which masses are consistent, each rule's A_c at the printed and the hemisphere's mass),
+    ``mass_ringing_text`` (the heaviest actuator's natural frequencies and the runner's
+    micro-vibration), ``mass_velocity_text`` (the saw-tooth's velocity at the highest frequency for the
+    printed and the heaviest mass, and the heaviest's over the profile's frequencies),
+    ``mass_verdict`` (whether the printed value is the consistent one and the hemisphere's not) and
+    ``mass_hypothesis`` (whether the heaviest actuator, the one that rings near 110 kHz, is
+    consistent).
+    """
+    tolerance = float(study["eq12_tolerance_rel"].iloc[0])
+    per_mass = study.drop_duplicates("actuator_mass").sort_values("actuator_mass").set_index("actuator_mass")
+    within = pd.DataFrame({rule: (per_mass[f"critical_amplitude_{rule}_m"] / per_mass["eq12_m"] - 1).abs()
+                           <= tolerance for rule in MASS_FLYBACKS})
+    consistent = within.any(axis=1)
+    printed = float(per_mass.index[per_mass["printed"].astype(bool)][0])
+    hemisphere = float(per_mass.index[per_mass["hemisphere"].astype(bool)][0])
+    heaviest = float(per_mass.index.max())
+    names = {"slew": "slew-rate", "fixed": "fixed"}
+
+    def ac_at(mass):
+        row = per_mass.loc[mass]
+        found = ", ".join(f"{row[f'critical_amplitude_{rule}_m'] * 1e9:.1f} nm with the {names[rule]} "
+                          "fly-back" for rule in MASS_FLYBACKS)
+        return f"{found} against Eq. 12's {row['eq12_m'] * 1e9:.1f} nm"
+
+    ac_text = (f"On this grid A_c lies within the ledger's ±{100 * tolerance:g} % of Eq. 12 (the tolerance "
+               f"of Fig. 6b's claim) under some fly-back rule at {_listed(consistent.index[consistent])} and "
+               f"under neither at {_listed(consistent.index[~consistent])}. At the printed "
+               f"{_mass_label(printed)} it is {ac_at(printed)}; at a ruby hemisphere's own "
+               f"{_mass_label(hemisphere)}, {ac_at(hemisphere)}.")
+    heavy = per_mass.loc[heaviest]
+    on_contact = sorted(heavy[f"actuator_on_contact_{side}_Hz"] / 1e3 for side in (1, 2))
+    ringing_text = (f"An actuator of {_mass_label(heaviest)} rings at "
+                    f"{heavy['actuator_frequency_Hz'] / 1e3:.0f} kHz on its own stiffness and at "
+                    f"{on_contact[0]:.0f}–{on_contact[1]:.0f} kHz with its "
+                    "contact's tangential stiffness in parallel, the printed one at "
+                    f"{per_mass.loc[printed, 'actuator_frequency_Hz'] / 1e6:.2f} MHz; the runner's "
+                    "micro-vibration after a fly-back stays between "
+                    f"{per_mass['ringing_frequency_Hz'].min() / 1e3:.1f} and "
+                    f"{per_mass['ringing_frequency_Hz'].max() / 1e3:.1f} kHz at every mass.")
+    top = float(study["frequency_Hz"].max())
+    v = study.set_index(["actuator_mass", "frequency_Hz"])["velocity_m_per_s"] * 1e3
+    velocity_text = (f"At {top / 1e3:g} kHz the saw-tooth's steady velocity is {v[(printed, top)]:.1f} mm/s "
+                     f"with the printed mass and {v[(heaviest, top)]:.1f} mm/s with {_mass_label(heaviest)}"
+                     + (" (the runner moves backwards)." if v[(heaviest, top)] < 0 else "."))
+    curve = study[study["actuator_mass"] == heaviest].sort_values("frequency_Hz")
+    if len(curve) > 2:  # a curve over frequency, not two points
+        peak = curve.loc[curve["velocity_m_per_s"].idxmax()]
+        grid = ", ".join(f"{f / 1e3:g}" for f in curve["frequency_Hz"])
+        velocity_text += (f" Over this profile's frequencies ({grid} kHz) the heaviest actuator's velocity "
+                          f"is largest at the grid point {peak['frequency_Hz'] / 1e3:g} kHz "
+                          f"({peak['velocity_m_per_s'] * 1e3:.1f} mm/s).")
+    if consistent[printed] and not consistent[hemisphere]:
+        change = (per_mass["eq12_m"].max() / per_mass["eq12_m"].min() - 1) * 100
+        verdict = ("So the printed m_a is consistent with Fig. 6b's agreement and a hemisphere's own mass is "
+                   "not: A_c with a heavy actuator falls below Eq. 12, whose mass factor (m_r + m_a)/m_r "
+                   f"hardly moves it ({change:.2f} % over the grid). The book uses the printed value.")
+    elif consistent[printed]:
+        verdict = ("Both the printed m_a and a hemisphere's own mass are consistent with Fig. 6b's agreement "
+                   "on this grid, so A_c cannot tell them apart. The book uses the printed value, as Table 2 "
+                   "gives it.")
+    else:
+        verdict = ("The printed m_a is not consistent with Fig. 6b's agreement on this grid either. The book "
+                   "uses the printed value, as Table 2 gives it.")
+    hypothesis = (f"Section 5, however, uses rigid actuators; and at {_mass_label(heaviest)} A_c lies "
+                  f"{'within' if consistent[heaviest] else 'outside'} the ledger's tolerance of Eq. 12"
+                  + ("." if consistent[heaviest] else
+                     ", so the actuator that would give the drive such a limit is not the one of Fig. 6b."))
+    return {"mass_grid_text": _listed(per_mass.index), "mass_printed_ug": printed * 1e9,
+            "mass_hemisphere_mg": hemisphere * 1e6,
+            "mass_ratio": hemisphere / printed, "mass_tolerance_pct": 100 * tolerance,
+            "mass_ac_text": ac_text, "mass_ringing_text": ringing_text, "mass_velocity_text": velocity_text,
+            "mass_verdict": verdict, "mass_hypothesis": hypothesis}

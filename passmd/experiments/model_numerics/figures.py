@@ -12,9 +12,13 @@ import numpy as np
 import pandas as pd
 
 from passmd.experiments import FigureSpec
+from passmd.ledger.claims import load_claims
 from passmd.model import theory, waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Amplifier, Drive, Material
+from passmd.model.tables import Actuator, actuator_for_radius, actuator_viscosity
+from passmd.protocols import critical_amplitude, ringing
+from passmd.protocols.velocity import steady_run
 from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
 from passmd.runtime.validation import check_choice, check_count, check_range
@@ -332,10 +336,125 @@ def model_coulomb_limit(config: RunConfig) -> pd.DataFrame:
     return table
 
 
+# --------------------------------------------------------------------------------------
+# The actuator mass: what Table 2's printed m_a does, against heavier actuators
+# --------------------------------------------------------------------------------------
+
+#: Density of corundum (Al₂O₃), of which ruby is a variety (kg/m³; handbook value, not the paper's):
+#: a hemisphere's own mass, (2/3)πR³ρ, is a lower bound on a real actuator's moving mass.
+RUBY_DENSITY = 3980.0
+#: The drive of the actuator-mass study: Fig. 6b's six contacts, flexible actuators, R = 1 mm, 0.4 N.
+MASS_STUDY_DRIVE = {"hemisphere_radius": 1.0e-3, "preload": 0.4}
+#: Factors on Table 2's printed m_a (R = 1 mm) per profile: from the printed 2.2e-5 g to a thousand times
+#: it (22 mg); a ruby hemisphere's own mass is added to each grid.
+MASS_FACTORS = {"quick": (1.0, 10.0, 100.0, 1000.0), "paper": tuple(10.0 ** (k / 2) for k in range(7))}
+#: Saw-tooth frequencies of the study's steady velocities (Hz): the critical amplitude's 100 Hz and the
+#: paper's 110 kHz limit of control (Section 5.2), with the frequencies between them on the paper profile.
+MASS_FREQUENCIES = {"quick": (PROTOCOL.drive_frequency, 110e3),
+                    "paper": (PROTOCOL.drive_frequency, 10e3, 50e3, 80e3, 100e3, 110e3, 130e3)}
+#: Fly-back rules the study's critical amplitude is searched with (at the full stroke both take the same
+#: time, so the velocities and the ringing are the same under either).
+MASS_FLYBACKS = ("slew", "fixed")
+
+
+#: The ledger's claim whose tolerance the actuator-mass study applies: Fig. 6b's A_c against Eq. 12.
+MASS_STUDY_CLAIM = "fig6b-flexible-r1-ac-matches-eq12"
+
+
+def mass_study_tolerance() -> float:
+    """Relative tolerance of the ledger's claim :data:`MASS_STUDY_CLAIM` (claims.csv), which the
+    actuator-mass study holds each A_c to."""
+    claim = load_claims().set_index("id").loc[MASS_STUDY_CLAIM]
+    if claim["tolerance_kind"] != "rel":
+        raise ValueError(f"claim {MASS_STUDY_CLAIM!r} has tolerance_kind = {claim['tolerance_kind']!r}: the "
+                         "study compares relative deviations ('rel')")
+    return float(claim["tolerance_num"])
+
+
+def hemisphere_mass(hemisphere_radius: float = MASS_STUDY_DRIVE["hemisphere_radius"]) -> float:
+    """Mass (kg) of one ruby hemisphere of radius R: (2/3)πR³ρ with :data:`RUBY_DENSITY`."""
+    radius = check_range("hemisphere_radius", hemisphere_radius, 0.0, lower_open=True, unit="m")
+    return 2.0 / 3.0 * np.pi * radius**3 * RUBY_DENSITY
+
+
+def actuator_masses(profile: str) -> np.ndarray:
+    """The study's actuator masses (kg): :data:`MASS_FACTORS` times Table 2's m_a and a ruby
+    hemisphere's mass, sorted."""
+    check_choice("profile", profile, tuple(MASS_FACTORS))
+    printed = actuator_for_radius(MASS_STUDY_DRIVE["hemisphere_radius"]).mass
+    return np.array(sorted([printed * k for k in MASS_FACTORS[profile]] + [hemisphere_mass()]))
+
+
+def mass_study_drive(actuator_mass: float, hemisphere_radius: float, preload: float) -> Drive:
+    """Fig. 6b's drive (six flexible contacts, Table 2) with the actuator mass ``actuator_mass`` (kg) and
+    its viscosity for the same damping ratio ζ (c_p = 2ζ√(k_p m_a)). Masses beyond the plausible range
+    are allowed: this study explores them."""
+    table2 = actuator_for_radius(hemisphere_radius)
+    actuator = Actuator(stiffness=table2.stiffness, mass=actuator_mass,
+                        viscosity=actuator_viscosity(table2.stiffness, actuator_mass),
+                        full_stroke_amplitude=table2.full_stroke_amplitude)
+    return Drive(hemisphere_radius=hemisphere_radius, preload=preload, actuator=actuator,
+                 allow_extrapolation=True)
+
+
+def actuator_mass_point(actuator_mass: float, hemisphere_radius: float, preload: float,
+                        frequencies: tuple) -> dict:
+    """One mass of :func:`actuator_mass_study`: the steady-state A_c under each fly-back rule
+    (:data:`MASS_FLYBACKS`) and Eq. 12's, the actuator's natural frequencies (bare, and on each side's
+    contact stiffness 2aG*), the runner's ringing after a full-stroke fly-back
+    (:func:`passmd.protocols.ringing.stick_ringing`) and the saw-tooth's steady velocity at the full
+    stroke at each of ``frequencies`` (SI)."""
+    drive = mass_study_drive(actuator_mass, hemisphere_radius, preload)
+    closed = theory.drive_theory(drive)
+    stroke = drive.actuator.full_stroke_amplitude
+    out = {"eq12_m": closed["critical_amplitude_flexible_m"],
+           "actuator_frequency_Hz": drive.actuator.natural_frequency,
+           "ringing_frequency_Hz": ringing.stick_ringing(drive, stroke)["ringing_frequency_Hz"]}
+    for side, k_contact in enumerate(closed["tangential_stiffness_N_per_m"], start=1):
+        out[f"actuator_on_contact_{side}_Hz"] = float(
+            np.sqrt((drive.actuator.stiffness + k_contact) / actuator_mass) / (2 * np.pi))
+    for rule in MASS_FLYBACKS:
+        found = critical_amplitude.critical_amplitude(drive, flyback=rule)
+        out[f"critical_amplitude_{rule}_m"] = found["critical_amplitude_m"]
+    out["velocity_m_per_s"] = np.array([steady_run(drive, stroke, f, "sawtooth", "")["velocity_m_per_s"]
+                                        for f in frequencies])
+    return out
+
+
+def actuator_mass_study(config: RunConfig) -> pd.DataFrame:
+    """A_c, ringing frequencies and velocity of Fig. 6b's drive against the actuator mass
+    (:func:`actuator_masses`): one row per mass and frequency of :data:`MASS_FREQUENCIES` (the mass's
+    scalars repeated), with ``printed`` (Table 2's m_a) and ``hemisphere`` (a ruby hemisphere's mass)
+    marking those rows; display columns in nm, kHz, µg and mm/s."""
+    frequencies = tuple(float(f) for f in MASS_FREQUENCIES[config.profile])
+    points = [{"actuator_mass": float(m), **MASS_STUDY_DRIVE, "frequencies": frequencies}
+              for m in actuator_masses(config.profile)]
+    runs = sweep.run(actuator_mass_point, points, description="actuator mass", config=config)
+    printed = actuator_for_radius(MASS_STUDY_DRIVE["hemisphere_radius"]).mass
+    rows = []
+    for _, run in runs.iterrows():
+        scalars = {k: run[k] for k in runs.columns if k not in ("velocity_m_per_s", "frequencies")}
+        for f, v in zip(frequencies, np.asarray(run["velocity_m_per_s"]), strict=True):
+            rows.append({**scalars, "frequency_Hz": f, "velocity_m_per_s": float(v)})
+    table = pd.DataFrame(rows)
+    table["printed"] = np.isclose(table["actuator_mass"], printed, rtol=1e-9, atol=0)
+    table["hemisphere"] = np.isclose(table["actuator_mass"], hemisphere_mass(), rtol=1e-9, atol=0)
+    table["actuator_mass_ug"] = table["actuator_mass"] * 1e9
+    for column in ("eq12_m", *(f"critical_amplitude_{rule}_m" for rule in MASS_FLYBACKS)):
+        table[column[:-2] + "_nm"] = table[column] * 1e9
+    table["frequency_kHz"] = table["frequency_Hz"] / 1e3
+    table["velocity_mm_per_s"] = table["velocity_m_per_s"] * 1e3
+    table["eq12_tolerance_rel"] = mass_study_tolerance()
+    return table
+
+
 #: The chapter's rows of the figure table.
 FIGURES = (
     FigureSpec("model_convergence", "Time-step convergence of the runner position after three periods",
                "model_numerics", model_convergence, "numerics:plot_convergence"),
     FigureSpec("model_coulomb_limit", "Simulated step against the rigid Coulomb limit, stiffened contacts",
                "model_numerics", model_coulomb_limit, "numerics:plot_coulomb_limit"),
+    FigureSpec("model_actuator_mass", "Critical amplitude, ringing frequencies and velocity against the "
+               "actuator mass, 22 µg to 22 mg", "model_numerics", actuator_mass_study,
+               "numerics:plot_actuator_mass"),
 )

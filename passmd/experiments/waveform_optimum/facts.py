@@ -6,6 +6,7 @@ return the numbers and tables the chapter glues into its prose. Display units: n
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 
 from passmd.experiments.driving_waveform.figures import section5_fields
@@ -74,9 +75,17 @@ def carried_steps(optimum: pd.DataFrame) -> pd.DataFrame:
 def flexible_facts(optimum: pd.DataFrame, flexible_design: pd.Series, carried: pd.DataFrame, drive) -> dict:
     """Flexible actuators: their design's f_s (kHz) and its ratio to the linear estimate, the rigid
     optimum's gain on them (%, from :func:`carried_steps`), the actuators' natural frequency (MHz,
-    ``drive`` made flexible), the rigid optimum's t_a (µs) and the gain of the optimum found on the
-    flexible drive itself (%; nan when the profile does not optimise it)."""
+    ``drive`` made flexible), the rigid optimum's t_a (µs) and what the optimum found on the
+    flexible drive itself gains (``flex_opt_text``, a sentence: the profile may not optimise it)."""
     flexible = optimum[optimum["actuator_model"] == "flexible"]
+    if len(flexible):
+        row = flexible.iloc[0]
+        gain = 100 * (row["velocity_optimum_m_per_s"] / row["velocity_sawtooth_m_per_s"] - 1)
+        opt_text = (f"Differential evolution run on the flexible drive itself finds {gain:.0f} % at "
+                    f"{row['frequency_kHz']:g} kHz.")
+    else:
+        opt_text = ("This build's profile does not run differential evolution on the flexible drive itself "
+                    "(the paper profile does).")
     return {
         "f_s_flex_kHz": flexible_design["micro_vibration_frequency_Hz"] / 1e3,
         "f_ratio_flex": (flexible_design["micro_vibration_frequency_Hz"]
@@ -84,7 +93,19 @@ def flexible_facts(optimum: pd.DataFrame, flexible_design: pd.Series, carried: p
         "flex_carry_gain": carried.iloc[1]["gain (%)"],
         "actuator_MHz": drive.replace(actuator_model="flexible").actuator.natural_frequency / 1e6,
         "carry_us": optimum_at(optimum)["optimum_acceleration_time_s"] * 1e6,
-        "flex_opt_gain": (100 * (flexible.iloc[0]["velocity_optimum_m_per_s"]
-                                 / flexible.iloc[0]["velocity_sawtooth_m_per_s"] - 1)
-                          if len(flexible) else float("nan")),
+        "flex_opt_text": opt_text,
     }
+
+
+def scan_facts(scans: pd.DataFrame) -> dict:
+    """The settling scans (:func:`~passmd.experiments.waveform_optimum.figures.settling_scans`): where on
+    the scan's grid the step with Eq. 15's acceleration is smallest and largest and where the step with
+    the optimum's acceleration is largest (cycles of f_s), the scan's spacing (cycles) and how far the
+    latter's step rises above the saw-tooth's there (nm)."""
+    eq15, slow = (part.sort_values("settling_cycles") for _, part in scans.groupby("series", sort=False))
+    best = slow.loc[slow["step_nm"].idxmax()]
+    return {"scan_eq15_min_cycles": eq15.loc[eq15["step_nm"].idxmin(), "settling_cycles"],
+            "scan_eq15_max_cycles": eq15.loc[eq15["step_nm"].idxmax(), "settling_cycles"],
+            "scan_slow_max_cycles": best["settling_cycles"],
+            "scan_slow_gain_nm": best["step_nm"] - best["sawtooth_step_nm"],
+            "scan_spacing_cycles": float(np.diff(eq15["settling_cycles"]).min())}

@@ -16,7 +16,12 @@ the paper's frequencies (the quick profile) a maximum is only a lower bound and 
 a bracket: a claim is then decided only where every value they allow decides it. Where the
 frequencies that decide a claim are all above the one where Eq. 15's settling time, acceleration
 and fly-back still fit the period, the verdict says so (:class:`passmd.ledger.checks.Scoped`): it
-rests on the short-period rule, not on Eq. 15.
+rests on the short-period rule (``cut`` or ``skip``, both readings), not on Eq. 15. The frequency up
+to which Eq. 15 fits is computed exactly, by the criterion ``passmd run --waveform optimized``
+refuses a frequency by (:func:`eq15_limit_kHz`); two maxima located on the grid are tied within one
+grid step, two velocities or back-steps within the integrator's stated accuracy (the tie rule of
+:mod:`passmd.ledger.rules`); a coarser grid's gaps make a claim inconclusive as
+:class:`passmd.ledger.checks.CoarseGrid`.
 """
 
 from __future__ import annotations
@@ -26,11 +31,22 @@ import pandas as pd
 
 from passmd.experiments.model_numerics.facts import POSITION_ACCURACY, VELOCITY_ACCURACY
 from passmd.experiments.waveform_velocity.figures import FREQUENCIES, PAPER_MAXIMUM_KHZ
-from passmd.ledger.checks import ClaimFails, NoRun, NotEvaluable, Scoped, Subset, evidence, extractor
+from passmd.ledger.checks import (
+    ClaimFails,
+    CoarseGrid,
+    NoRun,
+    NotEvaluable,
+    Scoped,
+    Subset,
+    evidence,
+    extractor,
+)
 from passmd.ledger.readings import default_reading
-from passmd.protocols.section5 import variant_name
+from passmd.model.optimized_waveform import highest_fitting_frequency
+from passmd.protocols.section5 import make_design, section5_drive, variant_name
 
-__all__ = ["GRID_STEP_KHZ", "at_frequency", "complete_grid", "controllable_maximum", "eq15_scope",
+__all__ = ["GRID_STEP_KHZ", "at_frequency", "complete_grid", "controllable_maximum", "eq15_limit_kHz",
+           "eq15_scope",
            "maximum_location", "on_paper_grid", "stick_edge", "turning_point"]
 
 #: Axes of passmd.ledger.readings: Section 5's unstated μ, and the short-period rule of Eq. 15.
@@ -117,8 +133,8 @@ def _maxima(part: pd.DataFrame) -> pd.Series:
     """:func:`controllable_maximum`, only where the grid holds every paper frequency up to 110 kHz (on a
     coarser grid a missing frequency could be faster)."""
     if not complete_grid(part, PAPER_MAXIMUM_KHZ):
-        raise NotEvaluable("the grid lacks some of the paper's frequencies up to 110 kHz, where the "
-                           "reachable maximum could lie")
+        raise CoarseGrid("the grid lacks some of the paper's frequencies up to 110 kHz, where the "
+                         "reachable maximum could lie")
     return controllable_maximum(part)
 
 
@@ -140,7 +156,7 @@ def _located(part: pd.DataFrame, low: float, high: float, what: str) -> float:
     inside = lo >= low - 1e-9 and hi <= high + 1e-9
     outside = hi < low - 1e-9 or lo > high + 1e-9
     if not (inside or outside):
-        raise NotEvaluable(f"the largest velocity lies at {at:g} kHz of this grid; between its neighbours "
+        raise CoarseGrid(f"the largest velocity lies at {at:g} kHz of this grid; between its neighbours "
                            f"({lo:g}–{hi:g} kHz) a finer grid could move it "
                            f"{'into' if not inside else 'out of'} "
                            f"{what}")
@@ -151,7 +167,7 @@ def at_frequency(part: pd.DataFrame, frequency_kHz: float) -> pd.Series:
     """The row of a series at a grid frequency (kHz); inconclusive when the grid lacks it."""
     rows = part[np.isclose(part["frequency_kHz"], frequency_kHz)]
     if rows.empty:
-        raise NotEvaluable(f"the frequency grid has no point at {frequency_kHz:g} kHz")
+        raise CoarseGrid(f"the frequency grid has no point at {frequency_kHz:g} kHz")
     return rows.iloc[0]
 
 
@@ -164,7 +180,8 @@ def _fig9b_pair(results, reading):
 @extractor("fig9b-optimized-faster-below-110khz", depends_on=_OPTIMIZED_AXES)
 def _fig9b_faster(results, reading):
     f, v_saw, opt = _fig9b_pair(results, reading)
-    return on_paper_grid({"x": f, "holds": opt["velocity_mm_per_s"].to_numpy() > v_saw}, opt)
+    gain = opt["velocity_mm_per_s"].to_numpy() - v_saw  # the observed switch: where it crosses zero
+    return on_paper_grid({"x": f, "holds": gain > 0, "margin": gain}, opt)
 
 
 def _largest_gain(results, reading):
@@ -219,8 +236,8 @@ def _fig9b_opt_decreases(results, reading):
         after = turning_point(opt, PAPER_MAXIMUM_KHZ)
     except ClaimFails as failure:
         if not complete_grid(opt):  # a missing frequency could move the turning point
-            raise NotEvaluable(f"fails on this table's part of the grid ({failure}), which lacks some of the "
-                               "paper's frequencies") from None
+            raise CoarseGrid(f"fails on this table's part of the grid ({failure}), which lacks some of the "
+                             "paper's frequencies") from None
         at = float(opt.loc[opt["velocity_mm_per_s"].idxmax(), "frequency_kHz"])
         raise ClaimFails(str(failure), eq15_scope(opt, at)) from None
     if len(after) < 2:
@@ -270,11 +287,24 @@ def _fig9b_sawtooth_110(results):
     return float(at_frequency(part, PAPER_MAXIMUM_KHZ)["velocity_mm_per_s"])
 
 
+def eq15_limit_kHz(part: pd.DataFrame) -> float:
+    """The highest frequency (kHz) at which the Eq. 15 period of a series' drive fits whole, t_s and all:
+    :func:`passmd.model.optimized_waveform.highest_fitting_frequency`, the criterion ``passmd run
+    --waveform optimized`` refuses a frequency by."""
+    row = part.iloc[0]
+    drive = section5_drive(float(row["hemisphere_radius"]), float(row["preload"]), str(row["runner"]),
+                           str(row["actuator_model"]), float(row["friction_coefficient"]))
+    design = make_design(float(row["settling_time"]), float(row["acceleration_time"]),
+                         float(row["acceleration_amplitude"]))
+    return highest_fitting_frequency(design, drive.actuator.full_stroke_amplitude, drive) / 1e3
+
+
 @extractor("fig9b-no-time-to-settle-above-110khz", depends_on=_OPTIMIZED_AXES)
 def _fig9b_settling(results, reading):
     opt = _series(results, "fig9b", _optimized(reading), reading)
     return on_paper_grid({"x": opt["frequency_kHz"].to_numpy(),
-                          "holds": opt["settling_fits"].to_numpy(dtype=float)}, opt)
+                          "holds": opt["settling_fits"].to_numpy(dtype=float), "switch": eq15_limit_kHz(opt)},
+                         opt)
 
 
 def _fig10a_part(results, preload, reading):
@@ -289,8 +319,8 @@ def _fig10a_vmax(results, reading):
     best = controllable_maximum(part)
     value = float(best["velocity_mm_per_s"])
     if not complete_grid(part, PAPER_MAXIMUM_KHZ) and value <= 19.0 * 1.1:
-        raise NotEvaluable(f"{value:.3g} mm/s is the largest on this grid, a lower bound of the reachable "
-                           "maximum: a missing frequency up to 110 kHz could be faster")
+        raise CoarseGrid(f"{value:.3g} mm/s is the largest on this grid, a lower bound of the reachable "
+                         "maximum: a missing frequency up to 110 kHz could be faster")
     return _scoped(value, eq15_scope(part, float(best["frequency_kHz"])))
 
 
@@ -308,15 +338,10 @@ _RESOLUTION = {"back_step_nm": POSITION_ACCURACY * 1e9, "velocity_mm_per_s": VEL
 
 
 def _maximum_pair(first: pd.DataFrame, second: pd.DataFrame, column: str) -> dict:
-    """``column`` at the reachable maxima of two series (complete grids only), scoped by Eq. 15. Two
-    values within the integrator's stated accuracy cannot be ordered (e.g. no back-step at either
-    maximum): inconclusive."""
+    """``column`` at the reachable maxima of two series (complete grids only), scoped by Eq. 15, with the
+    integrator's stated accuracy as the resolution of the tie rule (two back-steps of 0 nm are tied)."""
     a, b = _maxima(first), _maxima(second)
-    ours = {"lhs": float(a[column]), "rhs": float(b[column])}
-    if abs(ours["lhs"] - ours["rhs"]) <= _RESOLUTION[column]:
-        raise NotEvaluable(f"{column.replace('_', ' ')} {ours['lhs']:.3g} and {ours['rhs']:.3g} at the two "
-                           "reachable maxima are equal within the integrator's stated accuracy: they cannot "
-                           "be ordered")
+    ours = {"lhs": float(a[column]), "rhs": float(b[column]), "resolution": _RESOLUTION[column]}
     return _scoped(ours, eq15_scope(first, float(a["frequency_kHz"])),
                    eq15_scope(second, float(b["frequency_kHz"])))
 
@@ -369,10 +394,10 @@ def _fig10a_01n_at_80(results, reading):
     # the maximum is limited by the loss of stick: it lies at the last frequency before stick is lost
     part = _fig10a_part(results, 0.1, reading)
     if not complete_grid(part):
-        raise NotEvaluable("the grid lacks some of the paper's frequencies, between which the maximum and "
-                           "the loss of stick could lie")
+        raise CoarseGrid("the grid lacks some of the paper's frequencies, between which the maximum and "
+                         "the loss of stick could lie")
     at = maximum_location(part)[0]
-    return _scoped({"lhs": at, "rhs": stick_edge(part)}, eq15_scope(part, at))
+    return _scoped({"lhs": at, "rhs": stick_edge(part), "resolution": GRID_STEP_KHZ}, eq15_scope(part, at))
 
 
 @evidence("fig10a-0.1n-maximum-at-or-below-80khz")
@@ -407,9 +432,11 @@ def _fig10b_faster(results, reading):
 def _fig10b_frequency(results, reading):
     r1, r025 = _fig10b_part(results, 1.0, reading), _fig10b_part(results, 0.25, reading)
     if not (complete_grid(r1) and complete_grid(r025)):
-        raise NotEvaluable("the grid lacks some of the paper's frequencies, where either maximum could lie")
+        raise CoarseGrid("the grid lacks some of the paper's frequencies, where either maximum could lie")
     at1, at025 = maximum_location(r1)[0], maximum_location(r025)[0]
-    return _scoped({"lhs": at1, "rhs": at025}, eq15_scope(r1, at1), eq15_scope(r025, at025))
+    # a maximum located on the grid is known to one grid step: closer ones are tied
+    return _scoped({"lhs": at1, "rhs": at025, "resolution": GRID_STEP_KHZ}, eq15_scope(r1, at1),
+                   eq15_scope(r025, at025))
 
 
 @extractor("fig10b-r1-smaller-back-step", depends_on=_OPTIMIZED_AXES)
@@ -441,7 +468,8 @@ def _conclusion_youngs(results, reading):
         scopes.append(ab.outside if isinstance(ab, Scoped) else "")
         ab = ab.ours if isinstance(ab, Scoped) else ab
         effect[name] = abs(ab["lhs"] - ab["rhs"])
-    return _scoped({"lhs": effect["material"], "rhs": min(effect["preload"], effect["radius"])}, *scopes)
+    return _scoped({"lhs": effect["material"], "rhs": min(effect["preload"], effect["radius"]),
+                    "resolution": 2 * _RESOLUTION["velocity_mm_per_s"]}, *scopes)
 
 
 # Evidence: the reachable maxima the Fig. 10 orderings compare, at the defaults.

@@ -10,7 +10,12 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from passmd.experiments.waveform_velocity.figures import FIG10A_PRELOADS, PAPER_MAXIMUM_KHZ, range_maximum
+from passmd.experiments.waveform_velocity.figures import (
+    FIG10A_PRELOADS,
+    PAPER_MAXIMUM_KHZ,
+    eq15_fit_limit,
+    range_maximum,
+)
 from passmd.model import waveforms
 from passmd.model.parameters import Drive
 
@@ -25,20 +30,32 @@ def startup_facts(fig9b_data: pd.DataFrame, frequency: float = PAPER_MAXIMUM_KHZ
 
 
 def fig9b_facts(fig9b_data: pd.DataFrame, design: pd.Series, drive: Drive) -> dict:
-    """Fig. 9b: up to which frequency the full t_s fits (kHz); the room for t_s in a period at the
+    """Fig. 9b: up to which frequency one whole Eq. 15 period fits (kHz,
+    :func:`~passmd.experiments.waveform_velocity.figures.eq15_fit_limit`, the
+    number ``passmd run --waveform optimized`` prints); the room for t_s in a period at the
     paper's 110 kHz (µs), the f_s it would need (kHz) and the contact-stiffness factor that means; the
-    optimized velocity there; the skip variant's largest gain up to 110 kHz (mm/s, %, kHz); the
-    saw-tooth's step at the grid's ends (nm)."""
+    optimized velocity there; the skip variant's largest gain on the grid up to 110 kHz (mm/s, %, kHz,
+    and the grid points either side of it: ``skip_gain_where``); the saw-tooth's step at the grid's
+    ends (nm); how far the measured f_s lies from its linear estimate (%)."""
     opt = fig9b_data[fig9b_data["variant"] == "optimized"].set_index("frequency")
     saw = fig9b_data[fig9b_data["variant"] == "sawtooth"].set_index("frequency")
     skip = fig9b_data[fig9b_data["variant"] == "optimized_skip"].set_index("frequency")
-    fits = opt.index[opt["settling_fits"].astype(bool)]
     paper_f = PAPER_MAXIMUM_KHZ * 1e3
     t_s_max = (1 / paper_f - waveforms.flyback_time(drive.actuator.full_stroke_amplitude, drive)
                - design["acceleration_time_s"])
     f_s_needed = 0.5 / t_s_max
     gain = (skip["velocity_mm_per_s"] - saw["velocity_mm_per_s"])[saw.index <= paper_f]
-    return {"fit_limit_kHz": fits.max() / 1e3, "t_s_room_us": t_s_max * 1e6,
+    grid = saw.index.to_numpy(dtype=float)
+    at = float(gain.idxmax())
+    below, above = grid[grid < at], grid[grid > at]
+    either = [f"{side / 1e3:g} kHz" for side in (below.max() if below.size else None,
+                                                   above.min() if above.size else None) if side is not None]
+    return {"fit_limit_kHz": eq15_fit_limit(design, drive) / 1e3, "t_s_room_us": t_s_max * 1e6,
+            "skip_gain_where": (f"at the grid point {at / 1e3:g} kHz, between {' and '.join(either)}"
+                                if len(either) == 2 else f"at {at / 1e3:g} kHz, the grid's edge"),
+            # "within" this many per cent: rounded up
+            "f_s_linear_dev_pct": float(np.ceil(100 * abs(design["micro_vibration_frequency_Hz"]
+                                                          / design["linear_frequency_Hz"] - 1))),
             "f_s_needed_kHz": f_s_needed / 1e3,
             "stiffness_factor": (f_s_needed / design["micro_vibration_frequency_Hz"]) ** 2,
             "v110_opt": opt.loc[paper_f, "velocity_mm_per_s"], "skip_gain_max": gain.max(),

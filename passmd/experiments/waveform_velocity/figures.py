@@ -25,6 +25,7 @@ from passmd.experiments.driving_waveform.figures import (
     section5_fields,
 )
 from passmd.ledger.checks import NotEvaluable
+from passmd.model.optimized_waveform import highest_fitting_frequency
 from passmd.model.parameters import Assumption
 from passmd.protocols.section5 import (
     RUNNERS,
@@ -58,7 +59,8 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
         key="frequency_grid",
         symbol="f",
-        value="1, 5, 10, …, 130 kHz",
+        value=", ".join([*(f"{f / 1e3:g}" for f in FREQUENCIES["paper"][:3]), "…",
+                         f"{FREQUENCIES['paper'][-1] / 1e3:g}"]),
         unit="kHz",
         rationale=(
             "'from 1 to 130 kHz with a step of 5 kHz' (Section 5.2) does not say whether the grid is "
@@ -113,29 +115,50 @@ def _frequencies(profile: str) -> np.ndarray:
     return FREQUENCIES[profile]
 
 
+def eq15_fit_limit(design, drive) -> float:
+    """Highest frequency (Hz) at which one whole Eq. 15 period of ``design`` (a
+    :func:`~passmd.protocols.section5.designs` row) fits ``drive`` at its full stroke: the criterion and
+    function ``passmd run --waveform optimized`` prints
+    (:func:`passmd.model.optimized_waveform.highest_fitting_frequency`), not a grid point."""
+    made = make_design(float(design["settling_time_s"]), float(design["acceleration_time_s"]),
+                       float(design["acceleration_amplitude_m"]))
+    return highest_fitting_frequency(made, drive.actuator.full_stroke_amplitude, drive)
+
+
+def _velocities(drives: list[dict], config: RunConfig) -> pd.DataFrame:
+    """:func:`~passmd.protocols.section5.velocity_table` over the profile's frequencies, with each row's
+    ``eq15_highest_frequency_Hz`` (:func:`eq15_fit_limit` of its drive's design)."""
+    table = velocity_table(drives, _frequencies(config.profile), config)
+    limits = {}
+    for c, (_, d) in zip(drives, designs(drives, config).iterrows(), strict=True):
+        limits[tuple(c.values())] = eq15_fit_limit(d, section5_drive(**c))
+    table["eq15_highest_frequency_Hz"] = [limits[tuple(row[k] for k in drives[0])]
+                                          for _, row in table.iterrows()]
+    return table
+
+
 def fig9b(config: RunConfig, friction_coefficient: float = SECTION5_FRICTION) -> pd.DataFrame:
     """Steady velocity of the Section 5 drive over the frequency grid, every waveform variant (μ:
     Section 5's unstated friction coefficient)."""
-    return velocity_table([section5_fields(friction_coefficient=friction_coefficient)],
-                          _frequencies(config.profile), config)
+    return _velocities([section5_fields(friction_coefficient=friction_coefficient)], config)
 
 
 def fig10a(config: RunConfig, friction_coefficient: float = SECTION5_FRICTION) -> pd.DataFrame:
     """Steady velocity against frequency for F_p = 0.1, 0.4, 1 N (R = 1 mm, steel)."""
-    return velocity_table([section5_fields(preload=p, friction_coefficient=friction_coefficient)
-                           for p in FIG10A_PRELOADS], _frequencies(config.profile), config)
+    return _velocities([section5_fields(preload=p, friction_coefficient=friction_coefficient)
+                        for p in FIG10A_PRELOADS], config)
 
 
 def fig10b(config: RunConfig, friction_coefficient: float = SECTION5_FRICTION) -> pd.DataFrame:
     """Steady velocity against frequency for R = 1 mm (A = 202 nm) and 0.25 mm (A = 96 nm), 0.4 N."""
-    return velocity_table([section5_fields(hemisphere_radius=r, friction_coefficient=friction_coefficient)
-                           for r in FIG10B_RADII], _frequencies(config.profile), config)
+    return _velocities([section5_fields(hemisphere_radius=r, friction_coefficient=friction_coefficient)
+                        for r in FIG10B_RADII], config)
 
 
 def fig10c(config: RunConfig, friction_coefficient: float = SECTION5_FRICTION) -> pd.DataFrame:
     """Steady velocity against frequency for a steel (210 GPa) and a molybdenum (310 GPa) runner."""
-    return velocity_table([section5_fields(runner=r, friction_coefficient=friction_coefficient)
-                           for r in RUNNERS], _frequencies(config.profile), config)
+    return _velocities([section5_fields(runner=r, friction_coefficient=friction_coefficient)
+                        for r in RUNNERS], config)
 
 
 fig9b_readings, fig10a_readings, fig10b_readings, fig10c_readings = (
@@ -218,6 +241,10 @@ FIGURES = tuple(FigureSpec(name, title, "waveform_velocity", compute, f"driving_
     ("fig10b", "Velocity of the optimized waveform for R = 1 mm and 0.25 mm", fig10b, "plot_fig10b"),
     ("fig10c", "Velocity of the optimized waveform, steel and molybdenum runner", fig10c, "plot_fig10c"),
 ))
+
+#: The chapter's profile-dependent grids (:data:`passmd.experiments.figure_table.GRIDS`).
+GRIDS = {name: (lambda profile: {"frequencies": tuple(_frequencies(profile))})
+         for name in ("fig9b", "fig10a", "fig10b", "fig10c")}
 
 #: The ledger's readings of the chapter's figures: each at every μ.
 READING_TABLES = (

@@ -66,11 +66,11 @@ import importlib
 #: ``__getattr__``, PEP 562): the command line builds ``--free`` from :data:`FREE_PARAMETERS`
 #: without importing the estimator and the simulator.
 _MODULES = {
-    "checks": ("check_rows",),
+    "checks": ("TRAVEL_FACTOR", "check_rows"),
     "estimator": ("DISTINCT", "GLOBAL_POINTS_PER_PARAMETER", "LOCAL_STARTS", "LOSSES", "MAX_BASINS",
-                  "POLISH_CANDIDATES", "REFIT_MARGIN", "REFITS", "fit", "region_level"),
-    "free_parameters": ("FREE_PARAMETERS", "KEEPS", "FreeParameter", "default_bounds"),
-    "measurements": ("CONDITIONS", "MEASURED", "MeasurementError", "Measurements",
+                  "POLISH_CANDIDATES", "PROGRESS_INTERVAL", "REFIT_MARGIN", "REFITS", "fit", "region_level"),
+    "free_parameters": ("FREE_PARAMETERS", "KEEPS", "FreeParameter", "default_bounds", "plausible_bounds"),
+    "measurements": ("CONDITIONS", "MAX_ROWS", "MEASURED", "MeasurementError", "Measurements",
                      "measurements_from_rows", "read_measurements", "write_measurements"),
     "prediction": ("predict", "predict_point"),
     "problem": ("GN_STEP_LIMIT", "JACOBIAN_STEPS", "LOCAL_EVALUATIONS"),

@@ -41,7 +41,13 @@ import numpy as np
 from passmd.model.parameters import Drive, check_drive
 from passmd.protocols.fit import regions
 from passmd.protocols.fit.checks import check_rows
-from passmd.protocols.fit.free_parameters import FREE_PARAMETERS, KEEPS, _check_free, default_bounds
+from passmd.protocols.fit.free_parameters import (
+    FREE_PARAMETERS,
+    KEEPS,
+    _check_free,
+    default_bounds,
+    plausible_bounds,
+)
 from passmd.protocols.fit.measurements import READINGS, Measurements
 from passmd.protocols.fit.next_measurement import separating_row
 from passmd.protocols.fit.prediction import _Model
@@ -53,7 +59,8 @@ from passmd.runtime.config import RunConfig
 from passmd.runtime.validation import InputError, check_choice
 
 __all__ = ["DISTINCT", "FIRST_SEARCH_EVALUATIONS", "GLOBAL_POINTS_PER_PARAMETER", "JACOBIAN_STEPS",
-           "LOCAL_STARTS", "LOSSES", "MAX_BASINS", "POLISH_CANDIDATES", "REFITS", "REFIT_MARGIN", "fit",
+           "LOCAL_STARTS", "LOSSES", "MAX_BASINS", "POLISH_CANDIDATES", "PROGRESS_INTERVAL", "REFITS",
+           "REFIT_MARGIN", "fit",
            "region_level"]
 
 #: Points of the global pass per free parameter (the Sobol design takes the next power of two).
@@ -86,6 +93,8 @@ def _weights(data: Measurements) -> np.ndarray:
 
 
 def _check_bounds(drive, names, bounds, f_max) -> dict[str, tuple[float, float]]:
+    """Each free parameter's (low, high): given, else :func:`default_bounds`; a given range beyond
+    :func:`plausible_bounds` needs the drive's ``allow_extrapolation``."""
     bounds = {} if bounds is None else dict(bounds)
     for name in bounds:
         if name not in names:
@@ -97,6 +106,11 @@ def _check_bounds(drive, names, bounds, f_max) -> dict[str, tuple[float, float]]
         if not (math.isfinite(low) and math.isfinite(high) and 0 < low < high):
             raise InputError(f"bounds of {name} = {low!r}..{high!r} are not allowed: must be 0 < low < high",
                              name=name, value=(low, high))
+        ok_low, ok_high = plausible_bounds(drive, name)
+        if name in bounds and not drive.allow_extrapolation and (low < ok_low or high > ok_high):
+            raise InputError(f"bounds of {name} = {low:.4g}..{high:.4g} are out of range: must be within "
+                             f"{ok_low:.4g}..{ok_high:.4g}, its plausible range (allow_extrapolation=True on "
+                             "the drive goes beyond it)", name="bounds", value=(low, high))
         out[name] = (float(low), float(high))
     return out
 
@@ -145,7 +159,8 @@ def fit(
         How the model evaluations run (:func:`passmd.runtime.sweep.run`); a process pool is kept for
         the whole fit.
     progress : callable, optional
-        Receives one line per stage.
+        Receives one line per stage, and at least one every :data:`PROGRESS_INTERVAL` s while a stage
+        runs (from another thread).
 
     Raises
     ------
@@ -167,12 +182,13 @@ def fit(
     f_max = float(np.max(data.frequency))
     box = _check_bounds(drive, names, bounds, f_max)
     check_rows(drive, data, box)
-    report = progress or (lambda line: None)
+    report = _Heartbeat(progress) if progress is not None else (lambda line: None)
     lo = np.log([box[k][0] for k in names])
     hi = np.log([box[k][1] for k in names])
     x_start = np.clip(np.log([max(FREE_PARAMETERS[k].get(drive), 1e-300) for k in names]), lo, hi)
     config = RunConfig() if config is None else config
-    chosen = executor if executor is not None else config.executor or "process"
+    chosen = executor if executor is not None else (
+        config.executor or ("dask" if config.scheduler else "process"))
     with contextlib.ExitStack() as stack:
         if chosen == "process":  # one pool for the whole fit (sweep.process_pool: signals, worker cap)
             chosen = stack.enter_context(sweep.process_pool(config.workers))
@@ -182,7 +198,48 @@ def fit(
             report(f"{line} ({model.evaluations} parameter sets so far)")
 
         problem = Problem(model, data, _weights(data), lo, hi, loss)
+        if isinstance(report, _Heartbeat):
+            stack.callback(report.stop)
+            report.start(lambda: model.evaluations)
         return _fit(problem, drive, names, box, x_start, reading, keep, seed, say, t0)
+
+
+#: Longest silence of a fit's progress (s): while one stage runs longer, a line says it still runs.
+PROGRESS_INTERVAL = 10.0
+
+
+class _Heartbeat:
+    """The fit's ``progress`` callback, with a line at least every :data:`PROGRESS_INTERVAL` s: a
+    daemon thread repeats the current stage ("still: ...") while a long sweep runs (a large data
+    file, slow points), so a fit is never silent for minutes."""
+
+    def __init__(self, report: Callable[[str], None]):
+        import threading
+
+        self.report, self.lock = report, threading.Lock()
+        self.stage, self.last = "the start values", time.monotonic()
+        self.done = threading.Event()
+        self.thread = threading.Thread(target=self._beat, name="passmd-fit-progress", daemon=True)
+        self.count: Callable[[], int] = lambda: 0
+
+    def __call__(self, line: str) -> None:
+        with self.lock:
+            self.stage, self.last = line.split(" (", 1)[0], time.monotonic()
+            self.report(line)
+
+    def start(self, count: Callable[[], int]) -> None:
+        self.count = count
+        self.thread.start()
+
+    def stop(self) -> None:
+        self.done.set()
+
+    def _beat(self) -> None:
+        while not self.done.wait(max(0.0, self.last + PROGRESS_INTERVAL - time.monotonic())):
+            with self.lock:
+                if time.monotonic() - self.last >= PROGRESS_INTERVAL and not self.done.is_set():
+                    self.report(f"still: {self.stage} ({self.count()} parameter sets so far)")
+                    self.last = time.monotonic()
 
 
 def _global_pass(problem: Problem, x_start: np.ndarray, seed: int, say) -> list[tuple[np.ndarray, float]]:
@@ -252,7 +309,7 @@ def _regions(problem, profiles, basin_list, x_hat, cost, s2, threshold, say):
     """Per parameter: pieces (log), the walk profile's flatness at a bound, and every basin's local
     intervals."""
     cut = cost + threshold * s2
-    say(f"local intervals of {len(basin_list)} basin(s)")
+    say(f"local intervals around {len(basin_list)} local minimum/minima of the profiles")
     local = regions.basin_intervals(problem, basin_list, s2, threshold)
     out = []
     for j in range(problem.p):
@@ -324,9 +381,10 @@ def _fit(problem: Problem, drive, names, box, x_start, reading, keep, seed, say,
         basin_list = _basins(problem, profiles, cost + threshold * s2, s2)
         if not any(np.array_equal(x_hat, x) for x, _ in basin_list):
             basin_list = [(x_hat, cost), *basin_list][:MAX_BASINS]
-        say("estimate " + ", ".join(f"{k} = {v:.5g}" for k, v in zip(names, np.exp(x_hat), strict=True))
-            + f", cost {cost:.5g}; {len(basin_list)} basin(s) within the 95 % level")
         found = _regions(problem, profiles, basin_list, x_hat, cost, s2, threshold, say)
+        say("estimate " + ", ".join(f"{k} = {v:.5g}" for k, v in zip(names, np.exp(x_hat), strict=True))
+            + f", cost {cost:.5g}; 95 % region: " + ", ".join(
+                f"{k} in {len(parts)} piece(s)" for k, (parts, _) in zip(names, found, strict=True)))
         # the regions' points can form new local minima of a profile: their bottoms too
         bottoms(problem, profiles, level, lambda: threshold * _s2(problem, problem.best()[1]))
         lowest = problem.best()[1]
@@ -353,6 +411,7 @@ def _result(problem, drive, names, box, profiles, basin_list, found, x_hat, cost
         corr = cov / np.outer(se, se)
     corr = np.where(np.isfinite(corr), corr, 0.0)
     np.fill_diagonal(corr, 1.0)
+    basin_list = _with_piece_minima(profiles, basin_list, found)
     estimates = {}
     for j, name in enumerate(names):
         parts, flat = found[j]
@@ -404,4 +463,36 @@ def _result(problem, drive, names, box, profiles, basin_list, found, x_hat, cost
                      converged=converged, goodness_of_fit=gof, next_measurement=suggestion, keep=keep,
                      level=threshold,
                      basins=[{"parameters": dict(zip(names, np.exp(x).tolist(), strict=True)), "cost": c}
-                             for x, c in basin_list])
+                             for x, c in basin_list],
+                     region_points=_region_points(names, profiles, x_hat, cost + threshold * s2))
+
+
+def _with_piece_minima(profiles: dict[int, Profile], basin_list, found) -> list[tuple[np.ndarray, float]]:
+    """``basin_list`` and, for every piece of a region that holds none of them, the lowest profile point
+    in it: the basins the verdict counts, the report lists and the separating row tells apart."""
+    out = list(basin_list)
+    for j, (parts, _) in enumerate(found):
+        t, c, xs = profiles[j].arrays()
+        for a, b in parts:
+            if any(a - 1e-12 <= x[j] <= b + 1e-12 for x, _ in out):
+                continue
+            sel = np.flatnonzero((t >= a) & (t <= b))
+            if sel.size:
+                low = int(sel[np.argmin(c[sel])])
+                out.append((np.asarray(xs[low], float), float(c[low])))
+    return out
+
+
+def _region_points(names, profiles: dict[int, Profile], x_hat: np.ndarray, cut: float) -> list[dict]:
+    """The parameter sets at the ends of each parameter's 95 % region (the lowest and highest profile
+    points within the level, the others re-fitted there): distinct ones, the estimate left out."""
+    found = []
+    for profile in profiles.values():
+        t, c, xs = profile.arrays()
+        inside = np.flatnonzero(c <= cut)
+        found += [xs[k] for k in (inside[:1].tolist() + inside[-1:].tolist())]
+    out: list[np.ndarray] = [np.asarray(x_hat, float)]
+    for x in found:
+        if all(np.max(np.abs(np.asarray(x) - y)) > 1e-12 for y in out):
+            out.append(np.asarray(x, float))
+    return [dict(zip(names, np.exp(x).tolist(), strict=True)) for x in out[1:]]

@@ -16,7 +16,7 @@ from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import PLAUSIBLE_RANGES, Drive, check_drive
 from passmd.runtime.validation import InputError
 
-__all__ = ['FREE_PARAMETERS', 'KEEPS', 'FreeParameter', 'default_bounds']
+__all__ = ['FREE_PARAMETERS', 'KEEPS', 'FreeParameter', 'default_bounds', 'plausible_bounds']
 
 @dataclass(frozen=True)
 class FreeParameter:
@@ -58,7 +58,8 @@ def _viscosity_bounds(drive: Drive, f_max: float) -> tuple[float, float]:
 def _flyback_bounds(drive: Drive, f_max: float) -> tuple[float, float]:
     sr = PLAUSIBLE_RANGES["amplifier.slew_rate"]
     v = drive.amplifier.peak_to_peak_voltage
-    return v / sr.soft_high, min(v / sr.soft_low, 0.25 / f_max)  # a fly-back within a quarter period
+    quarter = 0.25 / f_max if f_max > 0 else math.inf  # a fly-back within a quarter period
+    return v / sr.soft_high, min(v / sr.soft_low, quarter)
 
 
 def _slew_bounds(drive: Drive, f_max: float) -> tuple[float, float]:
@@ -154,4 +155,12 @@ def default_bounds(drive: Drive, name: str,
         raise InputError(f"name = {name!r} is not a parameter the fit can free: must be one of "
                          + ", ".join(FREE_PARAMETERS), name="name", value=name)
     low, high = FREE_PARAMETERS[name].bounds(drive, max_frequency)
+    return float(low), float(high)
+
+
+def plausible_bounds(drive: Drive, name: str) -> tuple[float, float]:
+    """The widest (low, high) of a free parameter without ``allow_extrapolation``: its plausible range
+    (:data:`~passmd.model.parameters.PLAUSIBLE_RANGES`), as :func:`default_bounds` without the limit
+    the data's frequencies set (the fly-back within a quarter period, checked row by row)."""
+    low, high = FREE_PARAMETERS[name].bounds(drive, 0.0)
     return float(low), float(high)

@@ -24,7 +24,8 @@ from passmd.model.defaults import PROTOCOL
 from passmd.runtime.inputs import RefusedFile, decode_text, read_bounded
 from passmd.runtime.validation import InputError
 
-__all__ = ["ANNOTATIONS", "CONDITIONS", "MEASURED", "MODELS", "READINGS", "MeasurementError", "Measurements",
+__all__ = ["ANNOTATIONS", "CONDITIONS", "MAX_ROWS", "MEASURED", "MODELS", "READINGS", "MeasurementError",
+           "Measurements",
            "measurements_from_rows", "read_measurements", "write_measurements"]
 
 #: Readings of the critical amplitude (:data:`passmd.protocols.critical_amplitude.PROTOCOLS`).
@@ -45,6 +46,10 @@ ANNOTATIONS = ("id", "source_section", "source_quote", "notes")
 #: Condition columns and their display units.
 CONDITIONS: dict[str, str] = {"amplitude_nm": "nm", "preload_N": "N", "frequency_Hz": "Hz", "radius_mm": "mm"}
 _SI = {"nm": 1e-9, "mm/s": 1e-3, "N": 1.0, "Hz": 1.0, "mm": 1e-3}
+#: Most measurement rows a file may hold: every parameter set a fit tries simulates each distinct row
+#: (identical conditions once), so the work grows with the rows. Repeated measurements of one condition
+#: belong in one row, their mean with its standard deviation (``<quantity>_sd``).
+MAX_ROWS = 1000
 
 
 class MeasurementError(InputError):
@@ -83,6 +88,8 @@ class Measurements:
 
 def _number(text: str, where: str, column: str) -> float:
     try:
+        if "_" in text:  # Python's float reads 1_20 as 120: a file's cell is refused, never misread
+            raise ValueError(text)
         value = float(text)
     except ValueError:
         raise MeasurementError(f"{where}, column {column}: {text!r} is not a number",
@@ -121,6 +128,12 @@ def measurements_from_rows(header: Sequence[str], rows: Sequence[Sequence[str]],
                                name="header", value=",".join(header))
     if not rows:
         raise MeasurementError(f"{name}: no measurement rows below the header", name="rows", value=0)
+    if len(rows) > MAX_ROWS:
+        raise MeasurementError(f"{name}: {len(rows)} measurement rows is out of range: must be at most "
+                               f"{MAX_ROWS} "
+                               "(a fit simulates every distinct row for each parameter set it tries; give "
+                               "repeated measurements of one condition as one row, their mean with its _sd)",
+                               name="rows", value=len(rows))
     out: dict[str, list] = {k: [] for k in ("kind", "column", "value", "sd", "amplitude", "frequency",
                                             "preload", "radius", "line", "model")}
     for k, row in enumerate(rows):
@@ -186,7 +199,7 @@ def measurements_from_rows(header: Sequence[str], rows: Sequence[Sequence[str]],
     sd = np.array(out["sd"])
     if np.any(np.isfinite(sd)) and not np.all(np.isfinite(sd)):
         k = int(np.flatnonzero(~np.isfinite(sd))[0])
-        raise MeasurementError(f"{name} row {out['line'][k] - 1} (line {out['line'][k]}), column "
+        raise MeasurementError(f"{name} row {k + 1} (line {out['line'][k]}), column "
                                f"{out['column'][k]}_sd: missing; give a standard deviation for every row or "
                                "for none", name=out["column"][k] + "_sd", value="")
     text = ("kind", "column", "line", "model")

@@ -129,9 +129,13 @@ class _Model:
         self.drive, self.data, self.names, self.reading = drive, data, list(names), reading
         self.executor, self.cache, self.config, self.keep = executor, cache, config, keep
         self.base = replace(drive, allow_extrapolation=True)
-        self.rows = tuple((data.kind[i], float(np.nan_to_num(data.amplitude[i])), float(data.frequency[i]),
-                           tuple(sorted(_row_changes(self.base, data, i).items())))
-                          for i in range(len(data)))
+        rows = [(data.kind[i], float(np.nan_to_num(data.amplitude[i])), float(data.frequency[i]),
+                 tuple(sorted(_row_changes(self.base, data, i).items()))) for i in range(len(data))]
+        # identical conditions (repeated measurements) are simulated once: each row reads its
+        # condition's prediction
+        index = {row: k for k, row in enumerate(dict.fromkeys(rows))}
+        self.rows = tuple(index)
+        self.row_of = np.array([index[row] for row in rows], dtype=int)
         self.memo: dict[bytes, np.ndarray] = {}
         self.settled: dict[bytes, np.ndarray] = {}
         self.simulations = 0
@@ -158,8 +162,8 @@ class _Model:
             frame = sweep.run(predict_set, points, executor=self.executor, cache=self.cache, progress=False,
                               config=self.config)
             for k, v, s in zip(todo, frame["predictions"], frame["settled"], strict=True):
-                self.memo[k] = np.asarray(v, float)
-                self.settled[k] = np.asarray(s, bool)
+                self.memo[k] = np.asarray(v, float)[self.row_of]
+                self.settled[k] = np.asarray(s, bool)[self.row_of]
             self.simulations += frame.attrs["sweep"]["computed"] * len(self.rows)
             self.evaluations += len(todo)
         return [self.memo[k] for k in keys]
@@ -174,5 +178,11 @@ def predict(drive: Drive, data: Measurements, *, reading: str = "steady", execut
                "frequency": float(data.frequency[i]),
                "reading": reading if data.kind[i] == "critical_amplitude" else ""}
               for i, d in enumerate(_row_drives(drive, data))]
-    frame = sweep.run(predict_point, points, executor=executor, cache=cache, progress=False, config=config)
-    return frame["prediction"].to_numpy(float)
+    distinct = list({_point_key(p): p for p in points}.values())  # identical conditions: simulated once
+    frame = sweep.run(predict_point, distinct, executor=executor, cache=cache, progress=False, config=config)
+    value = dict(zip((_point_key(p) for p in distinct), frame["prediction"].to_numpy(float), strict=True))
+    return np.array([value[_point_key(p)] for p in points], dtype=float)
+
+
+def _point_key(point: dict) -> tuple:
+    return tuple((k, repr(v)) for k, v in sorted(point.items()))

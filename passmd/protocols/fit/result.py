@@ -13,7 +13,7 @@ as a drive file whose every value names its source.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -66,6 +66,26 @@ class FitResult:
     keep: str = "damping_ratio"  # what of the damping stayed fixed while k_p or m_a moved
     basins: list[dict] = field(default_factory=list)  # every basin within the level: parameters, cost
     level: float = math.nan  # the 95 % rise of a profile in units of s² (the estimator sets it)
+    # the fitted drives at the ends of each parameter's 95 % region, the others re-fitted there (its
+    # extreme points): name -> value (SI) of every free parameter; predictions span the region with them
+    region_points: list[dict] = field(default_factory=list)
+
+    def region_drives(self) -> list[Drive]:
+        """The drives at :attr:`region_points` (as :attr:`drive` is the drive at the estimate)."""
+        from passmd.protocols.fit.prediction import drive_at
+
+        zeta = self.base.actuator.damping_ratio if self._holds_zeta() else None
+        out = []
+        for point in self.region_points:
+            at = drive_at(self.base, self.names, [point[n] for n in self.names], zeta)
+            out.append(replace(at, allow_extrapolation=self.drive.allow_extrapolation))
+        return out
+
+    def _holds_zeta(self) -> bool:
+        """Whether ζ stayed fixed while k_p or m_a moved (as the fit's model held it)."""
+        moving = any(n in self.names for n in ("actuator.stiffness", "actuator.mass"))
+        free_damping = any(n in self.names for n in ("actuator.viscosity", "actuator.damping_ratio"))
+        return self.keep == "damping_ratio" and moving and not free_damping
 
     @property
     def model_rejected(self) -> bool:
@@ -79,13 +99,15 @@ class FitResult:
 
     def residual_table(self) -> pd.DataFrame:
         """One row per measurement, values in its column's display unit (``unit``): the preload (the
-        drive's where the row gives none), the amplitude (nm), measured, sd, predicted and the
-        normalised residual. ``attrs``: the ``estimates`` (name -> value, SI) and ``goodness_of_fit``."""
+        drive's where the row gives none), the frequency, the amplitude (nm), measured, sd, predicted
+        and the normalised residual. ``attrs``: the ``estimates`` (name -> value, SI) and
+        ``goodness_of_fit``."""
         data = self.data
         scale, unit = zip(*(data.display(i) for i in range(len(data))), strict=True)
         table = pd.DataFrame({
             "line": data.line, "quantity": data.column, "kind": data.kind, "unit": unit,
             "preload_N": np.where(np.isfinite(data.preload), data.preload, self.base.preload),
+            "frequency_Hz": data.frequency,
             "amplitude_nm": data.amplitude * 1e9, "measured": data.value / scale, "sd": data.sd / scale,
             "predicted": self.predicted / scale, "normalized_residual": self.residuals})
         table.attrs.update(estimates={n: self.estimates[n]["value"] for n in self.names},
@@ -120,6 +142,7 @@ class FitResult:
             "next_measurement": self.next_measurement,
             "keep": self.keep,
             "level": self.level,
+            "region_points": list(self.region_points),
             "flyback": self.drive.amplifier.flyback,
             "converged": self.converged,
             "verdict": self.verdict,
@@ -146,8 +169,8 @@ def _advice(data: Measurements) -> str:
         tips.append("measurements at another driving frequency")
     if len(set(data.kind)) == 1:
         dynamic = "the critical amplitude or the stall force"
-        other = {"step": dynamic, "velocity": dynamic, "critical_amplitude": "steps against amplitude",
-                 "force": "steps against amplitude"}
+        other = {"step": dynamic, "velocity": dynamic, "position": dynamic,
+                 "critical_amplitude": "steps against amplitude", "force": "steps against amplitude"}
         tips.append(f"another kind of measurement ({other[data.kind[0]]})")
     amps = data.amplitude[np.isfinite(data.amplitude)]
     if amps.size and amps.max() < 1.5 * amps.min():
@@ -295,5 +318,34 @@ def fitted_drive_file(result: FitResult, data_name: str, sources: dict | None = 
     elif moving and "actuator.viscosity" not in free and "actuator.damping_ratio" not in free:
         out["actuator.viscosity"] = f"held while {' and '.join(moving)} was fitted (was: " \
                                     f"{out.get('actuator.viscosity', 'given')})"
+    held = [f"{DRIVE_KEYS[k].symbol} = {_key_value(result.drive, k)} ({k}: {out[k]})" for k in out
+            if out[k].startswith("held")]
+    notes = [f"Fitted to {data_name}: {', '.join(free)}; every other value as below (held)."]
+    notes += [f"Held while fitting: {line}" for line in held]
+    points = getattr(result, "region_points", ())  # a record of a fit made before regions were kept: none
+    if points:
+        notes.append(f"[fit_region] at the end: the fitted keys at {len(points)} points of the "
+                     "fit's 95 % region, whose predictions span its band.")
     return drive_toml(result.drive, out, title=f"drive fitted by passmd fit to {data_name}",
-                      damping_ratio=zeta)
+                      damping_ratio=zeta, notes=notes, region=_region_values(result))
+
+
+def _key_value(drive: Drive, key: str) -> str:
+    """A drive-file key's value in ``drive``, as a short number (ζ and c_p of the actuator)."""
+    value = drive.actuator.damping_ratio if key == "actuator.damping_ratio" else drive.actuator.viscosity
+    return f"{value:.4g}"
+
+
+def _region_values(result: FitResult) -> list[dict]:
+    """The drive-file values of the keys the fit moved, at each of its region's points (those that
+    differ between the region's drives)."""
+    from passmd.model.drive_file import parameter_rows
+    from passmd.model.drive_keys import DRIVE_KEYS, SI_UNITS
+
+    if not getattr(result, "region_points", ()):
+        return []
+    rows = [{r["key"]: r["value"] for r in parameter_rows(d)} for d in result.region_drives()]
+    if len(rows) < 2:
+        return []
+    keys = [k for k in DRIVE_KEYS if DRIVE_KEYS[k].unit in SI_UNITS and len({row[k] for row in rows}) > 1]
+    return [{k: row[k] for k in keys} for row in rows]

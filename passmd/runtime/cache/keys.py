@@ -115,11 +115,17 @@ def function_code(func) -> str:
     (the standard library, site-packages) count by name and version, ``functools.partial``
     by its function and arguments.
 
+    A result that depends on the environment cannot be keyed: the cache cannot tell which
+    variables a function reads (``os.environ`` is read through many names and mappings), so
+    user code that names ``environ``, ``getenv`` (and their bytes forms) is refused rather than
+    returned stale when a variable changes; pass the value as a point's parameter instead.
+
     Raises
     ------
     Unfingerprintable
         The function names something whose state cannot be fingerprinted (an arbitrary
-        object, a class without source, a callable instance); the message says what.
+        object, a class without source, a callable instance), or reads the environment; the
+        message says what.
     """
     digest = hashlib.sha256()
     digest.update(json.dumps(_code_node(func, set(), "func"), sort_keys=True,
@@ -149,6 +155,7 @@ def _code_node(obj, seen: set, where: str):
     seen.add(id(obj))
     if isinstance(obj, types.FunctionType):
         code = obj.__code__
+        _refuse_environment(set(_names(code)), f"{where} ({name})")
         closure = {}
         for var, cell in zip(code.co_freevars, obj.__closure__ or (), strict=True):
             try:
@@ -168,6 +175,7 @@ def _code_node(obj, seen: set, where: str):
             source = inspect.getsource(obj)
         except (OSError, TypeError) as exc:
             raise Unfingerprintable(f"{where} is the class {name}, whose source cannot be read") from exc
+        _refuse_environment({n for n in _ENVIRONMENT if n in source}, f"{where} (the class {name})")
         methods = {k: _code_node(v, seen, f"{name}.{k}") for k, v in vars(obj).items()
                    if isinstance(v, types.FunctionType)}
         return {"class": name, "source": hashlib.sha256(source.encode()).hexdigest(), "methods": methods}
@@ -175,6 +183,19 @@ def _code_node(obj, seen: set, where: str):
     if inner is not None and inner is not obj:
         return {"wrapper": type(obj).__qualname__, "wrapped": _code_node(inner, seen, where)}
     raise Unfingerprintable(f"{where} is a {type(obj).__name__} object ({name}), not a function")
+
+
+#: Names through which code reads the process environment (``os.environ``, ``os.getenv``, …).
+_ENVIRONMENT = ("environ", "environb", "getenv", "getenvb")
+
+
+def _refuse_environment(names: set, where: str) -> None:
+    """Raise :class:`Unfingerprintable` if ``names`` include a way to read the environment."""
+    used = sorted(set(_ENVIRONMENT) & names)
+    if used:
+        raise Unfingerprintable(f"{where} reads the environment ({', '.join(used)}): its result may change "
+                                "with a variable the cache key cannot see (pass the value as a parameter "
+                                "of the point instead)")
 
 
 def _bytecode(code: types.CodeType):
@@ -225,10 +246,13 @@ def _value_node(value, seen: set, where: str):
             return {"module": value.__name__, "origin": origin, "version": _library_version(value.__name__)}
         file = getattr(value, "__file__", None)
         try:
-            return {"module": value.__name__, "source": hashlib.sha256(Path(file).read_bytes()).hexdigest()}
+            source = Path(file).read_bytes()
         except (OSError, TypeError) as exc:
             raise Unfingerprintable(f"{where} is the module {value.__name__}, whose source cannot be "
                                     "read") from exc
+        _refuse_environment({n for n in _ENVIRONMENT if n.encode() in source},
+                            f"{where} (the module {value.__name__})")
+        return {"module": value.__name__, "source": hashlib.sha256(source).hexdigest()}
     if isinstance(value, (types.FunctionType, types.BuiltinFunctionType, types.MethodType, functools.partial,
                           type)) or hasattr(value, "__wrapped__") or hasattr(value, "py_func"):
         return _code_node(value, seen, where)

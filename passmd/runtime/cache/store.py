@@ -4,6 +4,7 @@ in a directory it owns, and summarises, prunes or clears it (rules in :mod:`pass
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import json
 import os
@@ -85,6 +86,7 @@ class Cache:
 
     def __init__(self, directory: str | os.PathLike | None = None, *, fingerprint: str | None = None):
         self.directory = Path(directory).expanduser().resolve() if directory else default_cache_dir()
+        self._default = not directory  # the user cache folder: a problem names the variable it comes from
         self.fingerprint = fingerprint if fingerprint is not None else code_fingerprint()
         self._usable: bool | None = None  # decided on first use (see _ready)
         self._reported: set = set()  # what _report_once reported
@@ -146,8 +148,9 @@ class Cache:
             if state in ("empty", "own-layout"):
                 _write_marker(self.directory)
                 state, reason = inspect_directory(self.directory)
-        except OSError as exc:
-            verb = "write" if create else "read"
+        except OSError as exc:  # a readable folder that refuses its marker is read-only, not unreadable
+            verb = "use" if exc.errno == errno.ENOTDIR else "write" if (
+                create or exc.errno == errno.EROFS or os.access(self.directory, os.R_OK)) else "read"
             self._report_unusable(f"cannot {verb} the cache {self.directory}: {exc.strerror or exc}")
             self._usable = False
             return False
@@ -201,7 +204,8 @@ class Cache:
                 return _MISS
             kind, found = _examine(path, read=True)
         except OSError as exc:  # unreadable (permissions): a miss
-            self._report_unusable(f"cannot read the cache {self.directory}: {exc.strerror or exc}")
+            verb = "use" if exc.errno == errno.ENOTDIR else "read"
+            self._report_unusable(f"cannot {verb} the cache {self.directory}: {exc.strerror or exc}")
             return _MISS
         if kind == "missing":
             return _MISS
@@ -243,7 +247,9 @@ class Cache:
         marker = str(self.directory)
         if marker not in _REPORTED_UNWRITABLE:
             _REPORTED_UNWRITABLE.add(marker)
-            warnings.warn(f"{message}; continuing without the cache", CacheWarning, stacklevel=4)
+            hint = " (the user cache folder; PASSMD_CACHE_DIR or --cache-dir choose another)" \
+                if self._default else ""
+            warnings.warn(f"{message}{hint}; continuing without the cache", CacheWarning, stacklevel=4)
 
     def put(self, key: str, value, *, function: str = "") -> bool:
         """Store ``value`` atomically (temporary file in the same directory + ``os.replace``).
