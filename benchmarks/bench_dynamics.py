@@ -1,48 +1,48 @@
-"""Speed of the hybrid simulator: ns per integrator step and wall time per 100 Hz period.
+"""Speed of the hybrid simulator: the default integrator against a plain fixed-step code and per scheme.
 
-Runs each configuration (one/six contacts × rigid/flexible × exact/discrete N = 200) with
-each integration scheme (:data:`passmd.solver.steps.SCHEMES`): the default error-controlled
-step ("controlled"), the fixed fine step ("fixed", the reference) and, for flexible
-actuators, the explicit adaptive step ("adaptive") and the quasi-static actuator at a fixed
-runner step ("quasi-static"). Each run is three 100 Hz saw-tooth periods (150 nm,
-0.4 N, R = 1 mm: the first from rest, two after a slip), repeated; the medians of the wall
-time give ms per period (wall / 3) and ns per integrator step (rejected error-controlled
-steps included). numba compilation happens in an untimed warm-up run. Each row also gives
-the largest difference of the settled positions of the three periods from the fixed fine
-step's.
+Headline (``headline``): one 100 Hz period of the paper's six-contact drive with flexible actuators
+and the exact contact (150 nm saw-tooth, three periods from rest per run), integrated by the plain
+fixed-step velocity-Verlet code of :mod:`verlet_baseline` (the yardstick), by the default scheme
+("controlled") and by the scheme it replaced ("reference": the before of this record), the three in
+turn within each of ``--headline-repeats`` rounds (the order rotating from round to round, so
+that load on the shared machine falls on all three alike), numba compilation in an untimed first
+round. The reference runs as the former default did, summing the energy terms. Recorded: the
+medians in ms per period of the wall time, the CPU time and the CPU time of the integration loop
+alone (the marginal cost of a period, what the budget is about), the ratios baseline/default and
+reference/default (the before/after), each run's settled positions against the package's fixed
+fine step, and the load average before and after.
 
-Kernel comparison: the kernel of :data:`OLD_KERNEL_COMMIT` (one numba function before its
-split into inline helpers, loaded from ``git show`` at the path it had then, its imports of
-modules moved since renamed, into a module of its own) and the current one run the same
-configurations in alternation in this one process, each first in every other pair; the
-medians of their wall times, their ratio (current / old), and whether the two runs agree to
-the last bit. Without that commit in the checkout's history (a shallow clone, an unpacked
-sdist) the comparison is skipped with a line saying so.
+Table (``rows``): each configuration (one/six contacts × rigid/flexible × exact/discrete N = 200)
+with each integration scheme (:data:`passmd.solver.steps.SCHEMES`): the default error-controlled
+step ("controlled"), the former one ("reference"), the fixed fine step ("fixed", the reference of
+the errors) and, for flexible actuators, the explicit adaptive step ("adaptive") and the
+quasi-static actuator at a fixed runner step ("quasi-static"); medians of the wall time of
+three-period runs give ms per period and ns per integrator step (rejected error-controlled steps
+included), and the largest difference of the settled positions from the fixed fine step's.
 
-Start-up: the median time from launching ``passmd run --periods 1`` to its first
-integrator step (warm: bytecode and numba caches written by an untimed first launch),
-the modules that command imports, and ``python -X importtime`` of the package's
-command-line and dynamics modules. The machine's load average is recorded with the numbers.
+Start-up: the median time from launching ``passmd run --periods 1`` to its first integrator step
+(warm: bytecode and numba caches written by an untimed first launch), the modules that command
+imports, and ``python -X importtime`` of the package's command-line and dynamics modules. The
+headline configuration is also timed in several fresh processes (the 2-core virtual machine's
+speed differs from one process to the next).
 
 Usage::
 
-    python benchmarks/bench_dynamics.py [--repeats 5] [--out passmd/data/benchmarks/dynamics.json]
+    python benchmarks/bench_dynamics.py [--repeats 5] [--headline-repeats 9]
+        [--out passmd/data/benchmarks/dynamics.json]
     python benchmarks/bench_dynamics.py --smoke   # seconds: every part once, to a temporary file
 
-``--smoke`` runs every part on its smallest input (one rigid contact with the fixed and the
-controlled step, one repeat, one old/new kernel pair on one configuration when the history
-holds the old commit, one launch) and writes to a temporary file: it checks that the script
-and its defaults work, its times mean nothing.
+``--smoke`` runs every part on its smallest input (the headline at 10 kHz with one round, one
+rigid contact with the fixed and the default step, one repeat, one launch, one process) and writes
+to a temporary file: it checks that the script and its defaults work, its times mean nothing.
 """
 
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import json
 import os
 import platform
-import re
 import statistics
 import subprocess
 import sys
@@ -59,135 +59,104 @@ from passmd.model.parameters import Drive
 from passmd.runtime.scripts import child_json
 from passmd.solver import kernels, simulation
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import verlet_baseline  # noqa: E402  (a sibling script: the plain fixed-step code)
+
 CONFIGS = [
     (contacts, model, contact, control)
     for contacts in (1, 6)
     for model in ("rigid", "flexible")
     for contact in ("exact", "discrete")
     # the fixed fine step first: it is the reference of the others' error
-    for control in (("fixed", "controlled", "adaptive", "quasi-static") if model == "flexible"
-                    else ("fixed", "controlled"))
+    for control in (("fixed", "controlled", "reference", "adaptive", "quasi-static") if model == "flexible"
+                    else ("fixed", "controlled", "reference"))
 ]
 #: 100 Hz periods of each timed run (the first from rest, the others after a slip).
 PERIODS = 3
-
-
-#: The commit whose kernel the current one is timed against (the last with ``_integrate`` as
-#: one function).
-OLD_KERNEL_COMMIT = "37f6f0a9a427d3fbfea40a9de15b88372af24c65"
-#: Configurations of the kernel comparison: (contacts, actuators, contact model, scheme).
-KERNEL_CONFIGS = [(6, "flexible", "exact", "controlled"), (6, "rigid", "exact", "controlled"),
-                  (6, "flexible", "exact", "adaptive"), (6, "flexible", "discrete", "controlled"),
-                  (1, "flexible", "exact", "quasi-static")]
 ROOT = Path(__file__).resolve().parents[1]
-#: The current kernel's path; at an older commit it may have lived elsewhere (:func:`moved_since`).
-KERNEL_PATH = "passmd/solver/kernels.py"
 
 
-def _git(*args: str) -> str:
-    return subprocess.run(["git", "-C", str(ROOT), *args], capture_output=True, text=True, check=True).stdout
-
-
-def in_history(commit: str) -> bool:
-    """Whether this checkout's git history holds ``commit`` (not in a shallow clone, an sdist or a wheel)."""
-    try:
-        _git("cat-file", "-e", f"{commit}^{{commit}}")
-    except (OSError, subprocess.CalledProcessError):
-        return False
-    return True
-
-
-def moved_since(commit: str) -> dict[str, str]:
-    """Files of ``passmd/`` moved since ``commit``: {path then: path now}, each commit's renames in turn."""
-    now: dict[str, str] = {}
-    for line in _git("log", "--reverse", "-M", "--name-status", "--format=", f"{commit}..HEAD", "--",
-                     "passmd").splitlines():
-        status, *paths = line.split("\t")
-        if status.startswith("R"):
-            origin = next((then for then, path in now.items() if path == paths[0]), paths[0])
-            now[origin] = paths[1]
-    return now
-
-
-def _module(path: str) -> str:
-    return path.removesuffix(".py").removesuffix("/__init__").replace("/", ".")
-
-
-def old_kernel_source(commit: str) -> str:
-    """The kernel of ``commit`` (at its path then), its imports of moved passmd modules renamed to today's."""
-    moved = moved_since(commit)
-    then = next((old for old, new in moved.items() if new == KERNEL_PATH), KERNEL_PATH)
-    modules = {_module(old): _module(new) for old, new in moved.items() if old.endswith(".py")}
-    try:
-        source = _git("show", f"{commit}:{then}")
-    except subprocess.CalledProcessError:
-        raise SystemExit(f"--old-kernel {commit}: that commit has no {then} (the kernel's path)") from None
-    return re.sub(r"^(\s*(?:from|import)\s+)(passmd[\w.]*)", lambda m: m[1] + modules.get(m[2], m[2]),
-                  source, flags=re.MULTILINE)
-
-
-def old_kernel(commit: str):
-    """The kernel of ``commit`` (:func:`old_kernel_source`) as a module of its own (in a temporary
-    directory, so that its numba cache does not touch the package's)."""
-    source = old_kernel_source(commit)
-    path = Path(tempfile.mkdtemp(prefix="passmd-old-kernel-")) / "passmd_old_kernel.py"
-    path.write_text(source)
-    spec = importlib.util.spec_from_file_location("passmd_old_kernel", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+#: The headline: the paper's six contacts with flexible actuators and the exact contact.
+HEADLINE_AMPLITUDE = 150e-9
+#: Schemes of the headline besides the baseline: the default and the one it replaced.
+HEADLINE_SCHEMES = ("controlled", "reference")
 
 
 @contextmanager
-def running(module):
-    """:mod:`passmd.solver.simulation` integrates with ``module``'s kernel (None: the current one); the
-    argument records are rebuilt as that module's NamedTuples."""
-    current = kernels.integrate
-    if module is not None:
-        def integrate(segments, mechanics, control, contacts, buffers, limit):
-            return module.integrate(module.Segments(*segments), module.Mechanics(*mechanics),
-                                    module.StepControl(*control), module.Contacts(*contacts),
-                                    module.Buffers(*buffers), limit)
-        kernels.integrate = integrate
+def kernel_cpu_time():
+    """Yields a one-item list that accumulates the CPU time spent in
+    :func:`passmd.solver.kernels.integrate` (the integration itself: the marginal cost of the
+    periods) while the block runs."""
+    spent = [0.0]
+    integrate = kernels.integrate
+
+    def timed(*args, **kwargs):
+        start = time.thread_time()
+        try:
+            return integrate(*args, **kwargs)
+        finally:
+            spent[0] += time.thread_time() - start
+
+    kernels.integrate = timed
     try:
-        yield
+        yield spent
     finally:
-        kernels.integrate = current
+        kernels.integrate = integrate
 
 
-def _outcome(res) -> tuple:
-    return (res.steps, res.fine_steps, res.rejected_steps, res.settled_positions.tobytes(),
-            res.final_state.tobytes(), res.runner_position.tobytes(), tuple(sorted(res.energy.items())))
+def _timed_run(drive, wf, name) -> tuple:
+    """One headline run (``name``: "baseline" or a scheme): settled positions, steps, the wall and
+    CPU time of the whole call (set-up and results included), and the CPU time of the integration
+    loop alone (the marginal cost of the periods; the CPU time of this thread does not count the
+    time other processes held the core)."""
+    wall, cpu = time.perf_counter(), time.thread_time()
+    if name == "baseline":
+        settled, steps, _, loop = verlet_baseline.run(drive, wf, cpu=True)
+    else:
+        with kernel_cpu_time() as spent:  # (the former default always summed the energy terms)
+            res = simulation.simulate(drive, wf, scheme=name, max_points=2, energy=name == "reference")
+        settled, steps, loop = res.settled_positions, res.steps, spent[0]
+    return settled, steps, time.perf_counter() - wall, time.thread_time() - cpu, loop
 
 
-def compare_kernels(commit: str, pairs: int, configs=KERNEL_CONFIGS, springs: int = 200) -> list:
-    """Old and current kernel on ``configs``, timed in ``pairs`` alternating pairs (each kernel
-    first in every other one): medians (ms per 100 Hz period), their ratio, and whether the
-    results are identical to the last bit."""
-    old = old_kernel(commit)
-    rows = []
-    for contacts, model, contact, scheme in configs:
-        drive = Drive(contacts=contacts, actuator_model=model)
-        kw = dict(contact_model=contact, springs=springs, scheme=scheme, max_points=2000)
-        wf = waveforms.sawtooth(150e-9, PROTOCOL.drive_frequency, drive, periods=PERIODS)
-        walls = {"old": [], "new": []}
-        outcome = {}
-        for i in range(pairs + 1):
-            # the order alternates: the second run of a pair is slowed by the first (measured:
-            # ≈ 20 % in either order), a fixed order would charge that to one kernel
-            pair = (("old", old), ("new", None)) if i % 2 else (("new", None), ("old", old))
-            for name, module in pair:
-                with running(module):
-                    res = simulation.simulate(drive, wf, **kw)
-                if i:  # the first round compiles
-                    walls[name].append(res.wall_time)
-                outcome[name] = _outcome(res)
-        old_ms, new_ms = (float(np.median(walls[n])) / PERIODS * 1e3 for n in ("old", "new"))
-        rows.append({"contacts": contacts, "actuator": model, "contact_model": contact, "step": scheme,
-                     "old_ms_per_100Hz_period": old_ms, "new_ms_per_100Hz_period": new_ms,
-                     "new_over_old": new_ms / old_ms, "identical": outcome["old"] == outcome["new"],
-                     "old_all_s": walls["old"], "new_all_s": walls["new"]})
-    return rows
+def headline(rounds: int, frequency: float = PROTOCOL.drive_frequency) -> dict:
+    """Baseline, default and reference on the headline configuration, in turn within each of
+    ``rounds`` timed rounds (module docstring): medians in ms per period of the wall time, of the
+    CPU time and of the integration loop's CPU time (the marginal cost: what a period adds to a
+    run), and their ratios. On a loaded machine the wall time of the long baseline runs stretches
+    more than that of the short ones (the scheduler shares a core in slices of milliseconds): the
+    CPU time ratios are the ones a quiet machine would show."""
+    drive = Drive(contacts=6, actuator_model="flexible")
+    wf = waveforms.sawtooth(HEADLINE_AMPLITUDE, frequency, drive, periods=PERIODS)
+    fixed = simulation.simulate(drive, wf, scheme="fixed", max_points=2).settled_positions
+    names = ("baseline",) + HEADLINE_SCHEMES
+    times = {kind: {name: [] for name in names} for kind in ("wall", "cpu", "loop")}
+    steps, errors = {}, {}
+    load_before = os.getloadavg()
+    for i in range(rounds + 1):
+        for name in names[i % 3:] + names[:i % 3]:
+            settled, n, *measured = _timed_run(drive, wf, name)
+            if i:  # the first round compiles
+                for kind, value in zip(("wall", "cpu", "loop"), measured, strict=True):
+                    times[kind][name].append(value / PERIODS * 1e3)
+            steps[name] = n / PERIODS
+            errors[name] = float(np.abs(settled - fixed).max()) * 1e9
+    median = {kind: {name: statistics.median(v) for name, v in by.items()} for kind, by in times.items()}
+    ratios = {kind: {"baseline_over_default": m["baseline"] / m["controlled"],
+                     "reference_over_default": m["reference"] / m["controlled"]}
+              for kind, m in median.items()}
+    return {
+        "configuration": "6 contacts, flexible, exact contact, 150 nm saw-tooth",
+        "frequency_Hz": frequency,
+        "rounds": rounds,
+        "ms_per_period": median,
+        "all_ms_per_period": times,
+        "ratios": ratios,
+        "steps_per_period": steps,
+        "error_vs_fixed_fine_nm": errors,
+        "load_average_before": list(load_before),
+        "load_average_after": list(os.getloadavg()),
+    }
 
 
 #: modules the ``run`` command should not need (imported only by other commands)
@@ -298,7 +267,7 @@ def bench(contacts: int, model: str, contact: str, control: str, repeats: int, s
 # contacts, flexible actuators, exact contact, in a process of its own
 _ONE_PROCESS = """
 import json, statistics, sys
-from passmd.solver import simulation
+from passmd.solver import kernels, simulation
 from passmd.model import waveforms
 from passmd.model.parameters import Drive
 d = Drive(contacts=6, actuator_model="flexible")
@@ -339,46 +308,37 @@ def markdown(rows: list) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeats", type=int, default=5, help="timed repeats per configuration (median)")
-    ap.add_argument("--old-kernel", default=None,
-                    help="commit whose kernel the current one is timed against (default: OLD_KERNEL_COMMIT, "
-                         "skipped when this checkout's history lacks it)")
-    ap.add_argument("--kernel-pairs", type=int, default=40,
-                    help="timed old/new pairs per configuration of the kernel comparison (even: each "
-                         "kernel first in half of them)")
-    ap.add_argument("--kernel-only", action="store_true", help="only the kernel comparison (not written)")
+    ap.add_argument("--repeats", type=int, default=5,
+                    help="timed repeats per configuration of the table (median)")
+    ap.add_argument("--headline-repeats", type=int, default=9,
+                    help="timed rounds of the headline (baseline, default and reference in turn; median)")
+    ap.add_argument("--headline-only", action="store_true", help="only the headline (printed, not written)")
     ap.add_argument("--smoke", action="store_true",
-                    help="every part on its smallest input (one contact, one repeat, one kernel pair, one "
-                         "launch), written to a temporary file: checks the script runs, measures nothing")
+                    help="every part on its smallest input (the headline at 10 kHz, one contact, one repeat, "
+                         "one launch), written to a temporary file: checks the script runs, measures nothing")
     ap.add_argument("--out", type=Path, default=None,
                     help="JSON written (default: passmd/data/benchmarks/dynamics.json; --smoke: a "
                          "temporary file)")
     args = ap.parse_args(argv)
-    if args.kernel_pairs < 2 or args.kernel_pairs % 2:
-        ap.error(f"--kernel-pairs {args.kernel_pairs} is out of range: must be an even number >= 2")
-    configs, kernel_configs = CONFIGS, KERNEL_CONFIGS
+    configs, frequency = CONFIGS, PROTOCOL.drive_frequency
     if args.smoke:
-        args.repeats, args.kernel_pairs = 1, 2
-        # one rigid contact (the fixed step first: the reference); the cheapest kernel comparison
-        configs, kernel_configs = CONFIGS[:2], KERNEL_CONFIGS[-1:]
+        args.repeats, args.headline_repeats = 1, 1
+        configs, frequency = CONFIGS[:2], 10e3  # one rigid contact: the fixed step first, the reference
     if args.out is None:
         args.out = (Path(tempfile.mkdtemp(prefix="passmd-bench-")) / "dynamics.json" if args.smoke
                     else ROOT / "passmd/data/benchmarks/dynamics.json")
     load_before = os.getloadavg()
-    commit = args.old_kernel or OLD_KERNEL_COMMIT
-    if in_history(commit):
-        kernel_rows = compare_kernels(commit, args.kernel_pairs, kernel_configs)
-    elif args.old_kernel:
-        ap.error(f"--old-kernel {commit} is not a commit of this checkout's git history")
-    else:
-        print(f"kernel comparison skipped: --old-kernel {commit[:12]} is not in this checkout's git history "
-              "(a shallow clone or no repository); fetch it (git fetch --unshallow) to compare")
-        kernel_rows = None
-    for r in kernel_rows or []:
-        print(f"kernel {r['contacts']} {r['actuator']} {r['contact_model']} {r['step']}: old "
-              f"{r['old_ms_per_100Hz_period']:.3f} ms, new {r['new_ms_per_100Hz_period']:.3f} ms per period, "
-              f"new/old {r['new_over_old']:.3f}, identical: {r['identical']}")
-    if args.kernel_only:
+    head = headline(args.headline_repeats, frequency)
+    ms, ratios = head["ms_per_period"], head["ratios"]
+    print(f"{head['configuration']}, {frequency:g} Hz, median of {head['rounds']} rounds (load "
+          f"{head['load_average_before'][0]:.2f} -> {head['load_average_after'][0]:.2f}), ms per period:")
+    for kind, label in (("loop", "integration loop, CPU"), ("cpu", "whole call, CPU"),
+                        ("wall", "whole call, wall")):
+        m, r = ms[kind], ratios[kind]
+        print(f"  {label:22s}: plain Verlet {m['baseline']:8.3f}, reference {m['reference']:.3f}, default "
+              f"{m['controlled']:.3f}; baseline/default {r['baseline_over_default']:.0f}x, reference/default "
+              f"{r['reference_over_default']:.2f}x")
+    if args.headline_only:
         return 0
     rows = [bench(c, m, k, control, args.repeats) for c, m, k, control in configs]
     start = startup(args.repeats)
@@ -391,7 +351,6 @@ def main(argv=None) -> int:
         "machine": platform.processor() or platform.machine(),
         "python": platform.python_version(),
         "repeats": args.repeats,
-        "kernel_pairs": args.kernel_pairs,
         "periods_per_run": PERIODS,
         "cpus": os.cpu_count(),
         "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()),
@@ -403,9 +362,8 @@ def main(argv=None) -> int:
     print(f"{spread['configuration']}: {spread['median_ms_per_100Hz_period']:.3f} ms per period, median of "
           f"{len(spread['ms_per_100Hz_period_per_process'])} processes "
           f"({', '.join(f'{v:.2f}' for v in spread['ms_per_100Hz_period_per_process'])})")
-    comparison = {"old_commit": commit, "rows": kernel_rows} if kernel_rows is not None else None
-    args.out.write_text(json.dumps({"meta": meta, "rows": rows, "startup": start, "across_processes": spread,
-                                    "kernel_comparison": comparison}, indent=2))
+    args.out.write_text(json.dumps({"meta": meta, "headline": head, "rows": rows, "startup": start,
+                                    "across_processes": spread}, indent=2))
     print(f"written {args.out}")
     return 0
 

@@ -1,13 +1,14 @@
 """Cost of the replication ledger: one cold ``passmd ledger --profile <p> --json``.
 
 Runs the command in a subprocess with an empty temporary simulation cache (numba's compiled
-kernels stay warm: they are cached next to the package, not in the simulation cache), and
-records its wall time against the budget :data:`BUDGET_S`, the CPU time of the command and its
-sweep workers, how many sweep points it computed, the machine's core count and its load average
-just before and after (the machine may be shared: a load above the core count stretches the wall
-time), the size of the assumption space it evaluated (points, covered, decided), the joint
-reading and the headline counts. Each run is appended to ``--out`` (a JSON list), which the
-book's execution statistics show.
+kernels stay warm: they are cached next to the package, not in the simulation cache), and records
+its wall time against the budget :data:`BUDGET_S`, the CPU time of the command and its sweep
+workers, the largest resident set of one of them (against :data:`MEMORY_BUDGET_MB`), how many
+sweep points it computed, the machine's core count and its load average just before and after (the
+machine may be shared: a load above the core count stretches the wall time), the size of the
+assumption space it evaluated (points, covered, decided), the joint reading and the headline
+counts. Each run is appended to ``--out`` (a JSON list), which the book's execution statistics
+show.
 
 Usage (one command, from the repository root)::
 
@@ -44,6 +45,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 #: The wall time a cold ledger of each profile should stay within on a quiet 2-core machine (s).
 BUDGET_S = {"paper": 360.0, "quick": 240.0}
+#: The largest resident set one process of the paper ledger (the command or a sweep worker) should
+#: reach (MB).
+MEMORY_BUDGET_MB = 400.0
 
 
 def git_commit() -> str:
@@ -100,6 +104,8 @@ def measure(profile: str, python: str, cache_dir: str | None = None, cold: bool 
         "profile": profile, "cold": cold, "git_commit": git_commit(),
         "wall_time_s": round(wall, 1), "budget_s": BUDGET_S[profile],
         "cpu_time_s": round(after.ru_utime + after.ru_stime - usage.ru_utime - usage.ru_stime, 1),
+        # the largest resident set of the command or one of its sweep workers (Linux: kB)
+        "peak_rss_mb": round(after.ru_maxrss / 1024, 1), "memory_budget_mb": MEMORY_BUDGET_MB,
         "points_computed": sum(int(s.get("computed", 0)) for s in sweeps),
         "cores": os.cpu_count(), "load_average_before": [round(x, 2) for x in load_before],
         "load_average_after": [round(x, 2) for x in load_after],

@@ -186,7 +186,7 @@ def test_unwritable_cache_warns_once_and_keeps_the_result(tmp_path, monkeypatch,
         def full(*args, **kwargs):
             raise OSError(28, "No space left on device")
 
-        monkeypatch.setattr(cache.store.os, "fsync", full)
+        monkeypatch.setattr(cache.store.os, "replace", full)
     else:  # another user's directory, also when the tests run as root
         def denied(*args, **kwargs):
             raise PermissionError(13, "Permission denied")

@@ -467,7 +467,7 @@ class _Terminated(BaseException):
 
 
 @pytest.mark.parametrize("exception", [KeyboardInterrupt, SystemExit, _Terminated, MemoryError])
-@pytest.mark.parametrize("where", ["fsync", "replace"])
+@pytest.mark.parametrize("where", ["fdopen", "replace"])
 def test_put_removes_its_temporary_file_on_any_exception(tmp_path, monkeypatch, exception, where):
     store = marked_cache(tmp_path / "cache")
 
@@ -499,16 +499,16 @@ if __name__ == "__main__":
         signal.signal(signal.SIGTERM, terminated)
     store = Cache(cache_dir)
     store.put(store.key(point, {"x": -1.0}), {"y": 0.0})
-    real_fsync, calls = os.fsync, []
+    real_replace, calls = os.replace, []
 
-    def slow_fsync(fd):  # the signal arrives while the first entry of the sweep is being written
-        calls.append(fd)
+    def slow_replace(source, target):  # the signal arrives while the first entry of the sweep is written
+        calls.append(source)
         if len(calls) == 1:
             print("writing", flush=True)
             time.sleep(60)
-        real_fsync(fd)
+        real_replace(source, target)
 
-    os.fsync = slow_fsync
+    os.replace = slow_replace
     try:
         sweep.run(point, [{"x": float(i)} for i in range(4)], executor="process", workers=2, cache=store,
                   progress=False)

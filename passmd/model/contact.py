@@ -26,8 +26,9 @@ on the runner and ``−T`` on the actuator. The paper writes u_x = x_r − x_a f
 spring deflection; that is −u here, and its spring forces are −T.
 
 Hot loops (the integrator) call the numba kernels on plain float64 arrays:
-:func:`contact_force`, :func:`contact_update`, :func:`contact_slip_share`,
-:func:`contact_reset`, :func:`contact_stiffness`, :func:`sliding_force`, with the arrays
+:func:`contact_force`, :func:`contact_update`, :func:`contact_force_tangent` (T and dT/du,
+for Newton solves), :func:`contact_slip_share`, :func:`contact_reset`,
+:func:`contact_stiffness`, :func:`sliding_force`, with the arrays
 made by :func:`contact_arrays` (one contact) or :func:`stack_contacts` (rows of a 2-D
 array). Inside a hot loop over stacked contacts prefer :func:`contact_update_row`
 ``(P, S, g, u)`` and friends to ``contact_update(P[g], S[g], u)``: making the view
@@ -63,6 +64,8 @@ from passmd.model.contact_kernels import (
     STATE_HEADER,
     contact_force,
     contact_force_row,
+    contact_force_tangent,
+    contact_force_tangent_row,
     contact_reset,
     contact_slip_share,
     contact_slip_share_row,
@@ -86,6 +89,8 @@ __all__ = [
     "contact_arrays",
     "contact_force",
     "contact_force_row",
+    "contact_force_tangent",
+    "contact_force_tangent_row",
     "contact_reset",
     "contact_slip_share",
     "contact_slip_share_row",

@@ -215,6 +215,42 @@ def _exact_slip_share(params, state, u):
 
 
 @njit(**KERNEL_OPTIONS)
+def _exact_force_tangent(params, state, u):
+    """(T, dT/du) of the exact contact at ``u`` on the branch it reaches (pure).
+
+    Every branch is T_k ± 2φ(|u − u_k|/2) (or φ(|u|) on the virgin curve), so its slope is
+    φ'(v) = 2aG* √(1 − v/u_max) with v the φ-argument :func:`_exact_core` returns; 0 in full
+    sliding. At a reversal point the slope is that of the branch u moves onto.
+    """
+    force, v = _exact_core(params, state, u, False)
+    if abs(force) >= params[P_SLIDING]:
+        return force, 0.0
+    rest = 1.0 - v / params[P_UMAX]
+    return force, params[P_STIFFNESS] * np.sqrt(rest) if rest > 0.0 else 0.0
+
+
+@njit(**KERNEL_OPTIONS)
+def _discrete_force_tangent(params, state, u):
+    """(T, dT/du) of the discrete contact at ``u`` (pure): G*Δx times the springs that stick
+    there (a spring exactly at its slip limit counts as sliding on)."""
+    n = int(params[P_SIZE])
+    k = params[P_SPRING_K]
+    total = 0.0
+    sticking = 0
+    for i in range(n):
+        w = params[PARAMS_HEADER + i]
+        e = u - state[STATE_HEADER + i]
+        if e >= w:
+            e = w
+        elif e <= -w:
+            e = -w
+        else:
+            sticking += 1
+        total += e
+    return k * total, k * sticking
+
+
+@njit(**KERNEL_OPTIONS)
 def _discrete_eval(params, state, u, commit):
     """Eq. 6: T = Σ G*Δx · clip(u − p_i, −w_i, w_i); sliding springs move their slip p_i."""
     n = int(params[P_SIZE])
@@ -274,6 +310,14 @@ def contact_update(params, state, u):
 
 
 @njit(**KERNEL_OPTIONS)
+def contact_force_tangent(params, state, u):
+    """Friction force T(u) and its slope dT/du on the branch u reaches; pure (writes nothing)."""
+    if params[P_MODEL] == EXACT:
+        return _exact_force_tangent(params, state, u)
+    return _discrete_force_tangent(params, state, u)
+
+
+@njit(**KERNEL_OPTIONS)
 def contact_slip_share(params, state, u):
     """Fraction (0..1) of the MDR springs in contact that slip at u; pure."""
     if params[P_MODEL] == EXACT:
@@ -314,6 +358,12 @@ def contact_force_row(P, S, g, u):
 def contact_update_row(P, S, g, u):
     """:func:`contact_update` of row ``g`` of stacked arrays."""
     return contact_update(P[g], S[g], u)
+
+
+@njit(**KERNEL_OPTIONS)
+def contact_force_tangent_row(P, S, g, u):
+    """:func:`contact_force_tangent` of row ``g`` of stacked arrays."""
+    return contact_force_tangent(P[g], S[g], u)
 
 
 @njit(**KERNEL_OPTIONS)

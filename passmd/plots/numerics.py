@@ -6,12 +6,12 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 from matplotlib.lines import Line2D
-from matplotlib.ticker import NullLocator
+from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter, NullLocator
 
 from passmd.solver.steps import CONVERGED_ACCURACY
 
 __all__ = ["CONVERGED_STEP_NM", "STEP_CONTROL_STYLES", "plot_actuator_mass", "plot_convergence",
-           "plot_coulomb_limit"]
+           "plot_coulomb_limit", "plot_scaling"]
 
 #: Position error drawn as the convergence target (:data:`passmd.solver.steps.CONVERGED_ACCURACY`) (nm).
 CONVERGED_STEP_NM = CONVERGED_ACCURACY * 1e9
@@ -120,4 +120,46 @@ def plot_actuator_mass(df: pd.DataFrame):
             ax.annotate(label, (mass, 1.0), xycoords=("data", "axes fraction"), xytext=(2, -3),
                         textcoords="offset points", rotation=90, fontsize=7, va="top", ha="left",
                         color="grey")
+
+
+def plot_scaling(data: dict):
+    """The stored scaling measurement (``benchmarks/bench_scaling.py``): cost per 100 Hz period against
+    the contact states integrated, CPU time per simulated millisecond against the drive frequency (with
+    the share of fine steps), and a cold sweep's wall time against its points."""
+    fig, (ax1, ax2, ax3) = plt.subplots(1, 3, figsize=(10.5, 3.4))
+    contacts = pd.DataFrame(data["contacts"])
+    for shared, style, label in ((False, "o-", "a state per contact"), (True, "s--", "a state per side")):
+        rows = contacts[contacts["shared_side_state"] == shared]
+        ax1.loglog(rows["contacts"], rows["ms_per_100Hz_period"], style, label=label)
+    ax1.set_xticks(sorted(contacts["contacts"].unique()))
+    ax1.set_xticklabels([str(n) for n in sorted(contacts["contacts"].unique())])
+    ax1.xaxis.set_minor_locator(NullLocator())
+    ax1.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+    ax1.yaxis.set_major_formatter(FormatStrFormatter("%g"))
+    ax1.yaxis.set_minor_formatter(NullFormatter())
+    ax1.set_xlabel("contacts")
+    ax1.set_ylabel("CPU ms per 100 Hz period")
+    ax1.set_title("(a) contacts, flexible actuators", fontsize=9)
+    ax1.legend(fontsize=7)
+    freq = pd.DataFrame(data["frequency"])
+    ax2.loglog(freq["frequency_Hz"], freq["ms_per_simulated_ms"], "o-", label="CPU ms per simulated ms")
+    ax2.set_xlabel("drive frequency (Hz)")
+    ax2.set_ylabel("CPU ms per simulated ms")
+    ax2.set_title("(b) frequency, six contacts", fontsize=9)
+    twin = ax2.twinx()
+    twin.semilogx(freq["frequency_Hz"], 100 * freq["fine_share"], "x:", color="C1", label="fine steps (%)")
+    twin.set_ylabel("fine steps (% of steps)", color="C1")
+    twin.set_ylim(0, 105)
+    sweep = data["sweep"]
+    points = np.asarray(sweep["points"], float)
+    ax3.plot(points, sweep["wall_s"], "o", label="measured")
+    ax3.plot(points, sweep["start_s"] + sweep["s_per_point"] * points, "k:",
+             label=f"{1e3 * sweep['s_per_point']:.1f} ms/point + {sweep['start_s']:.2f} s")
+    ax3.set_xlabel("sweep points (cold cache)")
+    ax3.set_ylabel("wall time (s)")
+    ax3.set_title(f"(c) settled steps, {sweep['workers']} workers", fontsize=9)
+    ax3.legend(fontsize=7)
+    fig.suptitle("stored measurement: benchmarks/bench_scaling.py (passmd/data/benchmarks/scaling.json)",
+                 fontsize=8)
+    fig.tight_layout()
     return fig

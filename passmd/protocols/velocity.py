@@ -167,7 +167,7 @@ def settled_step(drive, amplitude: float, frequency: float, *, accuracy: float =
     periods = SETTLED_STEPS + 1
     while True:
         run.run_to(periods)
-        steps = run.result().step_sizes
+        steps = np.diff(run.settled_positions())
         last = steps[-SETTLED_STEPS:]
         spread = float(np.max(last) - np.min(last))
         if spread <= accuracy or periods == max_periods:

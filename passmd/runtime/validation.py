@@ -141,23 +141,26 @@ def check_range(
     unit : str
         Unit shown in the error message.
     """
+    number = not isinstance(value, bool) and isinstance(value, (Real, np.floating, np.integer))
+    if number:
+        v = float(value)
+        bad = not math.isfinite(v)
+        if not bad and lower is not None:
+            bad = v <= lower if lower_open else v < lower
+        if not bad and upper is not None:
+            bad = v >= upper if upper_open else v > upper
+        if not bad:
+            return v
+    # the message is built only for a value refused (checks run on every simulation's inputs)
     rng = _describe(lower, upper, lower_open, upper_open)
     rng = f" {rng}" if rng else ""
     suffix = f" ({unit})" if unit else ""
     limits = limits_of(lower, upper, lower_open, upper_open)
-    if isinstance(value, bool) or not isinstance(value, (Real, np.floating, np.integer)):
+    if not number:
         raise InputError(f"{name} = {shown(value)} is not a number: must be a finite number{rng}{suffix}",
                          name=name, value=value, unit=unit, limits=limits)
-    v = float(value)
-    bad = not math.isfinite(v)
-    if not bad and lower is not None:
-        bad = v <= lower if lower_open else v < lower
-    if not bad and upper is not None:
-        bad = v >= upper if upper_open else v > upper
-    if bad:
-        raise InputError(f"{name} = {shown(value)} is out of range: must be a finite number{rng}{suffix}",
-                         name=name, value=v, unit=unit, limits=limits)
-    return v
+    raise InputError(f"{name} = {shown(value)} is out of range: must be a finite number{rng}{suffix}",
+                     name=name, value=v, unit=unit, limits=limits)
 
 
 def check_positive(name: str, value, unit: str = "") -> float:

@@ -40,6 +40,14 @@ extremum of the quadratic through u's value and rate at the start and its value 
 is committed first, so the Masing branch turns there and not at a step boundary. Samples
 inside such a step are interpolated (cubic Hermite in x_r).
 
+Two switches (``StepControl``) make the default scheme cheaper without changing what it
+computes beyond the balance solve's tolerance; the scheme "reference" has both off. ``newton``:
+each quasi-static balance is one Newton step on the exact contact's slope
+(:func:`_newton_position`, the bracketed solve where that step is not provably converged), and
+the trigonometric coefficients come from their series (:func:`_series_coefficients`: no sine or
+cosine call). ``smooth_breakpoints``: a breakpoint of x_p(t) where its rate does not change
+(:func:`_smooth_breakpoint`) does not restart the step control.
+
 In every scheme the contact memory is updated exactly once per accepted step (twice when
 a reversal falls inside it), with the drifted positions, and the contact force is
 otherwise evaluated purely. Every corner of x_p(t) falls on a step boundary.
@@ -56,7 +64,8 @@ from the cubic Hermite in u through the step's ends (values, and tangents from t
 solves; evaluated instead when u turns inside the step or the start's tangent is not known);
 the actuator's velocity at the three nodes is that of the quadratic through its three
 positions. (A reversal inside a rigid step is not split for the middle node: the error is of
-second order in the distance from the reversal.) These terms never feed back into the motion.
+second order in the distance from the reversal.) These terms never feed back into the motion,
+and are summed only with ``StepControl.energy``.
 """
 
 from __future__ import annotations
@@ -66,7 +75,13 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from passmd.model.contact import contact_force_row, contact_slip_share_row, contact_update_row
+from passmd.model.contact import (
+    contact_force_row,
+    contact_force_tangent_row,
+    contact_slip_share_row,
+    contact_update_row,
+)
+from passmd.model.contact_kernels import EXACT, P_MODEL, P_STIFFNESS, P_UMAX, S_U
 
 # columns of the per-period accumulator array
 PER_WINDOW_INTEGRAL = 0  # ∫ (x_r − x_p) dt over the settle window
@@ -154,6 +169,10 @@ STEP_SAFETY = 0.8
 #: Error-controlled step: largest growth and shrink factors from one step to the next.
 STEP_GROWTH = 1.25
 STEP_SHRINK = 0.2
+#: Two pieces of x_p(t) whose rates differ by no more than this (relative) join smoothly
+#: (``StepControl.smooth_breakpoints``): only rounding separates the rates of a ramp cut by a
+#: window's start.
+SMOOTH_BREAKPOINT_RTOL = 1e-9
 
 
 class Segments(NamedTuple):
@@ -193,6 +212,9 @@ class StepControl(NamedTuple):
     quasi_static: bool  # quiet phases use the quasi-static actuator step
     record_interval: float  # time between recorded samples (s)
     error_tolerance: float  # local position error per step of the runner (m); 0: uniform steps
+    newton: bool  # balances by a Newton step on the contact's slope, trigonometric terms by series
+    smooth_breakpoints: bool  # the step goes on across a breakpoint where x_p keeps its rate
+    energy: bool  # accumulate the energy terms (they never feed back into the motion)
 
 
 class Contacts(NamedTuple):
@@ -255,8 +277,31 @@ def quasi_static_position(params, state, g, x_r, center, K, S, guess, slope, tol
     return x, slope
 
 
+@njit(inline="always", **KERNEL_OPTIONS)
+def _newton_position(params, state, g, x_r, center, K, S, guess, guess_slope, tolerance):
+    """:func:`quasi_static_position` by one Newton step from ``guess`` with the exact contact's
+    slope k_t (:func:`passmd.model.contact.contact_force_tangent_row`), accepted when it is
+    provably within ``tolerance`` of the root; otherwise (a discrete contact, full sliding, the
+    step crossing the committed displacement, where the branch turns) the bracketed solve goes
+    on from there. On a branch |d²T/du²| ≤ (2aG*)²/(2 u_max k_t) (from φ' = 2aG* √(1 − v/u_max),
+    v = |u − u_k|/2 or |u|), so the Newton step δ leaves an error ≤ (2aG*)² δ² / (4 u_max k_t
+    (K + k_t)). ``guess_slope``: the slope the discrete contact's solve starts from. Returns (x, K + k_t)."""
+    if params[g, P_MODEL] != EXACT:
+        return quasi_static_position(params, state, g, x_r, center, K, S, guess, guess_slope, tolerance)
+    T, k_t = contact_force_tangent_row(params, state, g, guess - x_r)
+    slope = K + k_t
+    step = (K * (center - guess) - T) / slope
+    x = guess + step
+    u_c = state[g, S_U]
+    k0 = params[g, P_STIFFNESS]
+    if ((guess - x_r - u_c) * (x - x_r - u_c) > 0.0 and k_t > 0.0
+            and k0 * k0 * step * step <= 4.0 * params[g, P_UMAX] * k_t * slope * tolerance):
+        return x, slope
+    return quasi_static_position(params, state, g, x_r, center, K, S, x, slope, tolerance)
+
+
 def integrate(segments: Segments, mechanics: Mechanics, control: StepControl, contacts: Contacts,
-              buffers: Buffers, step_limit: int):
+              buffers: Buffers, step_limit: int, checked: bool = False):
     """Check the kernel's arguments, then integrate over the segments (:func:`_integrate`).
 
     Returns (status, steps done, rows recorded, fine steps).
@@ -297,13 +342,21 @@ def integrate(segments: Segments, mechanics: Mechanics, control: StepControl, co
     ``segments.longest``; rigid actuators carry the step from piece to piece. Rejected steps count
     in ``steps`` (and in ``carry[C_REJECTED]``).
 
+    ``checked``: the caller has passed these arrays, or leading slices of them (the first pieces
+    of ``segments`` and the first periods of ``buffers.per`` and ``buffers.peak``), through
+    :func:`check_arguments` already (:class:`passmd.solver.simulation.Simulation` does, once per
+    run: the checks cost more than a short call into the loop).
+
     Raises
     ------
     ValueError
         An argument of the wrong type, dtype or shape, naming it: the compiled loop does
         no bounds checks, so a wrong shape would read or write outside an array.
     """
-    _check_arguments(segments, mechanics, control, contacts, buffers, step_limit)
+    if not checked:
+        check_arguments(segments, mechanics, control, contacts, buffers)
+    if int(step_limit) != step_limit or step_limit < 0:
+        raise ValueError(f"step_limit = {step_limit!r} is out of range: must be an integer >= 0")
     return _integrate(segments, mechanics, control, contacts, buffers, int(step_limit))
 
 
@@ -318,7 +371,7 @@ def _check_array(name, value, shape, dtype=np.float64):
         raise ValueError(f"{name} has shape {value.shape}, must be {wanted}")
 
 
-def _check_arguments(segments, mechanics, control, contacts, buffers, step_limit):
+def check_arguments(segments, mechanics, control, contacts, buffers):
     """Types and shapes of :func:`integrate`'s arguments (ValueError naming the first bad one)."""
     for name, value, kind in (("segments", segments, Segments), ("mechanics", mechanics, Mechanics),
                               ("control", control, StepControl), ("contacts", contacts, Contacts),
@@ -348,8 +401,6 @@ def _check_arguments(segments, mechanics, control, contacts, buffers, step_limit
     _check_array("buffers.energy", buffers.energy, (EN_COLUMNS,))
     if buffers.record.shape[0] < 1:
         raise ValueError("buffers.record must have at least one row")
-    if int(step_limit) != step_limit or step_limit < 0:
-        raise ValueError(f"step_limit = {step_limit!r} is out of range: must be an integer >= 0")
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
@@ -374,10 +425,8 @@ def _save_position(carry, segment, mid, t, x_p, a_r, F, next_rec, track, n_rec, 
 @njit(inline="always", **KERNEL_OPTIONS)
 def _note_peak(peak, track, g, force, sliding_force):
     """Keep the largest |T_g|/μF_N since the tracked period's slip mark (no period tracked: track < 0)."""
-    if track >= 0:
-        ratio = abs(force) / sliding_force
-        if ratio > peak[track, g]:
-            peak[track, g] = ratio
+    if track >= 0 and abs(force) > peak[track, g] * sliding_force:  # (no division on every step)
+        peak[track, g] = abs(force) / sliding_force
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
@@ -401,7 +450,8 @@ def _turns_inside(du0, du):
 def _save_segment(carry, y, x_r, v_r, fine, quasi, controlled, g_rate, h_prev, quiet, acc):
     """Runner state into ``y``, step control and segment-local accumulators ``acc`` = (∫x_r,
     ∫F, ∫window, W_in, W_damp, W_contact, Σdt, min x_r) into ``carry`` at a pause inside a
-    segment (:func:`_restore_segment`)."""
+    segment and at the end of a call (:func:`_restore_segment`; a later call goes on with the
+    step control across a smooth breakpoint)."""
     y[0] = x_r
     y[1] = v_r
     carry[C_FINE] = 1.0 if fine else 0.0
@@ -473,6 +523,34 @@ def _trig_coefficients(dt, omega, omega2):
     half_one_minus_cos = sh * sh / (omega2 * (1.0 + ch))  # 1 − cos x = sin²x/(1 + cos x)
     half_sine_excess = (0.5 * dt * omega - sh) / (omega2 * omega)
     return sh, ch, cs, sn, one_minus_cos, sine_excess, half_one_minus_cos, half_sine_excess
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _s_series(x):
+    """(S_1, S_2, S_3) of 0 ≤ x ≤ 2, S_n(x) = Σ_j (−1)^j x^(n+2j)/(n+2j)!: S_1 = sin x,
+    S_2 = 1 − cos x, S_3 = x − sin x. S_4 and S_5 from their series (eight nested terms, exact to
+    rounding for x ≤ 2; the steps keep Ωh ≤ LONGEST_OMEGA_DT = 1.5), the others down from them
+    (S_n = x^n/n! − S_(n+2)): no library call, and no S_n loses digits to cancellation at small x."""
+    x2 = x * x
+    s5 = x2 * x2 * x * (1.0 / 120.0) * (1.0 - x2 * (1.0 / 42.0) * (1.0 - x2 * (1.0 / 72.0) * (
+        1.0 - x2 * (1.0 / 110.0) * (1.0 - x2 * (1.0 / 156.0) * (1.0 - x2 * (1.0 / 210.0) * (
+            1.0 - x2 * (1.0 / 272.0) * (1.0 - x2 * (1.0 / 342.0))))))))
+    s4 = x2 * x2 * (1.0 / 24.0) * (1.0 - x2 * (1.0 / 30.0) * (1.0 - x2 * (1.0 / 56.0) * (
+        1.0 - x2 * (1.0 / 90.0) * (1.0 - x2 * (1.0 / 132.0) * (1.0 - x2 * (1.0 / 182.0) * (
+            1.0 - x2 * (1.0 / 240.0) * (1.0 - x2 * (1.0 / 306.0))))))))
+    s3 = x2 * x * (1.0 / 6.0) - s5
+    return x - s3, 0.5 * x2 - s4, s3
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _series_coefficients(dt, omega, inv_omega):
+    """:func:`_trig_coefficients` from the series :func:`_s_series` (no sine or cosine call, the
+    divisions by Ω replaced by its reciprocal): the same numbers to rounding."""
+    io2 = inv_omega * inv_omega
+    io3 = io2 * inv_omega
+    s1, s2, s3 = _s_series(omega * dt)
+    h1, h2, h3 = _s_series(0.5 * omega * dt)
+    return h1, 1.0 - h2, 1.0 - s2, s1, s2 * io2, s3 * io3, h2 * io2, h3 * io3
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
@@ -554,11 +632,13 @@ def _quasi_midpoint(mechanics, contacts, rows, g, balance_terms, x_r, nodes, qua
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
-def _quasi_balance(mechanics, contacts, rows, x_p, xp_new, x_r, xr_old, dt, simpson, nodes):
+def _quasi_balance(mechanics, contacts, rows, x_p, xp_new, x_r, xr_old, dt, simpson, nodes, newton):
     """Drift of quasi-static actuators: each group's force balance solved at the step's end
-    (:func:`quasi_static_position`, backward Euler in the damping term), and with ``simpson``
-    its mid-step node (:func:`_quasi_midpoint`). Returns (K = k_p + c_p/dt, 1/dt, Σ n_g T_g at
-    the balance, and the start and mid-step quadrature terms of input, damping and contact)."""
+    (:func:`quasi_static_position`, backward Euler in the damping term; with ``newton`` by a Newton
+    step on the contact's exact slope, :func:`_newton_position`, and one reciprocal of K instead of
+    divisions by it), and with ``simpson`` its mid-step node (:func:`_quasi_midpoint`). Returns
+    (K = k_p + c_p/dt, 1/dt, Σ n_g T_g at the balance, and the start and mid-step quadrature terms
+    of input, damping and contact)."""
     multiplicity = mechanics.multiplicity
     actuator_stiffness = mechanics.actuator_stiffness
     params, state, sliding = contacts
@@ -569,18 +649,24 @@ def _quasi_balance(mechanics, contacts, rows, x_p, xp_new, x_r, xr_old, dt, simp
     c_half = 2.0 * c_dt  # (the balance over half the step)
     K_half = actuator_stiffness + c_half
     inv_K_half = 1.0 / K_half
+    inv_K = 1.0 / K
     F_trial = 0.0  # Σ n_g T_g at the solved balance, T_g = K (center − x_a,g)
     quad = (0.0, 0.0, 0.0)
     for g in range(multiplicity.shape[0]):
         stretch_old[g] = x_p - x_a[g]
         xa_old[g] = x_a[g]
-        center = (actuator_stiffness * xp_new + c_dt * x_a[g]) / K
+        pull = actuator_stiffness * xp_new + c_dt * x_a[g]
+        center = pull * inv_K if newton else pull / K
         # Newton predictor from the last solution: T moves by k_t Δu, k_t = slope − K
         sg = max(slope[g], K)
         guess = x_a[g] + (K * (center - x_a[g]) - T[g] - (sg - K) * (xr_old - x_r)) / sg
-        x_a[g], slope[g] = quasi_static_position(
-            params, state, g, x_r, center, K, sliding[g], guess, sg, QUASI_TOLERANCE * sliding[g] / K,
-        )
+        if newton:
+            x_a[g], slope[g] = _newton_position(params, state, g, x_r, center, K, sliding[g], guess, sg,
+                                                QUASI_TOLERANCE * sliding[g] * inv_K)
+        else:
+            x_a[g], slope[g] = quasi_static_position(
+                params, state, g, x_r, center, K, sliding[g], guess, sg, QUASI_TOLERANCE * sliding[g] / K,
+            )
         F_trial += multiplicity[g] * K * (center - x_a[g])
         if simpson:
             terms = (K, K_half, c_half, inv_K_half, inv_dt, center, dt)
@@ -627,9 +713,10 @@ def _rigid_mid_force(mechanics, contacts, xp_mid, xr_mid):
 
 @njit(inline="always", **KERNEL_OPTIONS)
 def _commit_contacts(mechanics, contacts, rows, peak, track, x_r, v_r, vp, dt, K, controlled, simpson, x_p,
-                     xp_new, acc_contact, acc_in):
+                     xp_new, acc_contact, acc_in, energy):
     """Contact forces at the step's end, the memory committed once (twice when u turns inside an
-    error-controlled step: first at the extremum). Returns (Σ n_g T_g, acc_contact, acc_in)."""
+    error-controlled step: first at the extremum). Returns (Σ n_g T_g, acc_contact, acc_in); the
+    trapezoidal energy terms only with ``energy`` (Simpson's are the caller's)."""
     multiplicity = mechanics.multiplicity
     rigid = mechanics.rigid
     params, state, sliding = contacts
@@ -649,13 +736,13 @@ def _commit_contacts(mechanics, contacts, rows, peak, track, x_r, v_r, vp, dt, K
                 excess = u - u_old[g] - du0  # curvature term of the quadratic, times dt²
                 u_ext = u_old[g] - du0 * du0 / (4.0 * excess)
                 T_ext = contact_update_row(params, state, g, u_ext)
-                if not simpson:
+                if energy and not simpson:
                     acc_contact += multiplicity[g] * 0.5 * (T[g] + T_ext) * (u_ext - u_old[g])
                 T[g] = T_ext
                 u_old[g] = u_ext
                 _note_peak(peak, track, g, T_ext, sliding[g])
         Tn = contact_update_row(params, state, g, u)
-        if not simpson:
+        if energy and not simpson:
             acc_contact += multiplicity[g] * 0.5 * (T[g] + Tn) * (u - u_old[g])
             if rigid:
                 acc_in += multiplicity[g] * 0.5 * (T_start + Tn) * (xp_new - x_p)
@@ -668,10 +755,10 @@ def _commit_contacts(mechanics, contacts, rows, peak, track, x_r, v_r, vp, dt, K
 
 @njit(inline="always", **KERNEL_OPTIONS)
 def _quasi_kick(mechanics, rows, x_p, xp_new, v_r, vp, dt, K, inv_dt, inv_ma, simpson, quad, acc_in, acc_damp,
-                acc_contact):
+                acc_contact, energy):
     """Actuator velocities and accelerations after a quasi-static step and its energy terms
     (Simpson's rule when ``simpson``, else backward Euler in the damping and trapezoidal input
-    work). Returns (largest implied |ẍ_a|, acc_in, acc_damp, acc_contact)."""
+    work; none without ``energy``). Returns (largest implied |ẍ_a|, acc_in, acc_damp, acc_contact)."""
     multiplicity = mechanics.multiplicity
     actuator_stiffness = mechanics.actuator_stiffness
     actuator_viscosity = mechanics.actuator_viscosity
@@ -685,7 +772,9 @@ def _quasi_kick(mechanics, rows, x_p, xp_new, v_r, vp, dt, K, inv_dt, inv_ma, si
         v_a[g] = (x_a[g] - xa_old[g]) / dt
         a_nd[g] = (actuator_stiffness * (xp_new - x_a[g]) - T[g]) * inv_ma
         tangent[g] = slope[g] - K  # (the next step's start: this step's end)
-        if simpson:
+        if not energy:
+            pass
+        elif simpson:
             # end terms of the quadrature (start and mid-step ones: at the drift)
             q1 = (xa_old[g] - 4.0 * xa_mid[g] + 3.0 * x_a[g]) * inv_dt
             quad_in += multiplicity[g] * actuator_stiffness * (xp_new - x_a[g])
@@ -699,7 +788,7 @@ def _quasi_kick(mechanics, rows, x_p, xp_new, v_r, vp, dt, K, inv_dt, inv_ma, si
         acc = abs(v_a[g] - v_old) / dt
         if acc > activity:
             activity = acc
-    if simpson:
+    if energy and simpson:
         acc_in += vp * dt / 6.0 * quad_in
         acc_damp += dt / 6.0 * quad_damp
         acc_contact += dt / 6.0 * quad_contact
@@ -707,24 +796,25 @@ def _quasi_kick(mechanics, rows, x_p, xp_new, v_r, vp, dt, K, inv_dt, inv_ma, si
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
-def _actuator_kick(mechanics, rows, x_p, xp_new, dt, gam, inv_ma, acc_damp, acc_in):
-    """Velocity Verlet kick of flexible actuators (damping trapezoidal, implicit in v) and its
-    damping and input work. Returns (largest |ẍ_a|, acc_damp, acc_in)."""
+def _actuator_kick(mechanics, rows, x_p, xp_new, dt, gam, inv_ma, acc_damp, acc_in, energy, damp):
+    """Velocity Verlet kick of flexible actuators (damping trapezoidal, implicit in v; ``damp`` =
+    1/(1 + γ dt/2)) and, with ``energy``, its damping and input work. Returns (largest |ẍ_a|,
+    acc_damp, acc_in)."""
     multiplicity = mechanics.multiplicity
     actuator_stiffness = mechanics.actuator_stiffness
     half_kp = 0.5 * actuator_stiffness
     half_cp = 0.5 * mechanics.actuator_viscosity
     x_a, v_a, T, a_nd, stretch_old = rows[0], rows[1], rows[2], rows[4], rows[5]
-    damp = 1.0 / (1.0 + 0.5 * dt * gam)
     activity = 0.0
     for g in range(multiplicity.shape[0]):
         a_new = (actuator_stiffness * (xp_new - x_a[g]) - T[g]) * inv_ma
         v_old = v_a[g]
         v_a[g] = (v_old + 0.5 * dt * (a_nd[g] - gam * v_old + a_new)) * damp
         a_nd[g] = a_new
-        acc_damp += multiplicity[g] * half_cp * (v_old * v_old + v_a[g] * v_a[g]) * dt
-        # work of the moving piezo base: k_p (x_p − x_a) dx_p, trapezoidal in (x_p − x_a)
-        acc_in += multiplicity[g] * half_kp * (stretch_old[g] + xp_new - x_a[g]) * (xp_new - x_p)
+        if energy:
+            acc_damp += multiplicity[g] * half_cp * (v_old * v_old + v_a[g] * v_a[g]) * dt
+            # work of the moving piezo base: k_p (x_p − x_a) dx_p, trapezoidal in (x_p − x_a)
+            acc_in += multiplicity[g] * half_kp * (stretch_old[g] + xp_new - x_a[g]) * (xp_new - x_p)
         acc = abs(a_new - gam * v_a[g])
         if acc > activity:
             activity = acc
@@ -819,6 +909,17 @@ def _record_step_end(contacts, rows, record, n_rec, next_rec, record_interval, t
     while next_rec <= t:
         next_rec += record_interval
     return n_rec, next_rec
+
+
+@njit(inline="always", **KERNEL_OPTIONS)
+def _smooth_breakpoint(segments, s, vp):
+    """Whether x_p(t) keeps its rate across the start of piece s (a breakpoint that only marks a
+    window, as the settle window's start on a saw-tooth ramp: nothing there excites the
+    actuators or changes g's rate)."""
+    if s == 0:
+        return False
+    before = (segments.x1[s - 1] - segments.x0[s - 1]) / (segments.t1[s - 1] - segments.t0[s - 1])
+    return abs(vp - before) <= SMOOTH_BREAKPOINT_RTOL * max(abs(vp), abs(before))
 
 
 @njit(inline="always", **KERNEL_OPTIONS)
@@ -927,17 +1028,22 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     """Integrate over the segments (see :func:`integrate`); returns (status, steps done, rows
     recorded, fine steps). Each step: choose its length, drift (runner, actuators), estimate
     its error (error control; a rejected step starts over shorter), commit the contacts, kick,
-    adapt the step, accumulate the period's measures, check for divergence, record."""
+    adapt the step, accumulate the period's measures, check for divergence, record. A piece of
+    x_p(t) starts the step control afresh (:func:`_open_segment`) unless ``smooth_breakpoints``
+    and x_p keeps its rate across its start."""
     (seg_t0, seg_t1, seg_x0, seg_x1, seg_fine, seg_coarse, seg_period, seg_window, seg_mark, seg_quasi,
      seg_longest) = segments
     runner_mass, load_stiffness, multiplicity, rigid = mechanics[:4]
     actuator_mass, actuator_viscosity, linear_stiffness = mechanics[4], mechanics[6], mechanics[7]
     omega2, omega, beta = _linear_mode(linear_stiffness, load_stiffness, runner_mass)
+    inv_omega = 1.0 / omega if omega > 0.0 else 0.0
+    dt_damp = damp = -1.0
     dt_trig = -1.0
     trig = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     y0 = w0 = ag0 = xp_mid = xr_mid = vr_mid = F_mid = 0.0  # drift terms and mid-step nodes
     K = inv_dt = 0.0  # the quasi-static balance's stiffness k_p + c_p/dt and 1/dt (its steps)
-    activity_threshold, quiet_steps, quasi_static, record_interval, error_tolerance = control
+    (activity_threshold, quiet_steps, quasi_static, record_interval, error_tolerance, newton, smooth,
+     track_energy) = control
     control_on = error_tolerance > 0.0
     # error estimates below this need no root: the step grows by the largest factor
     small_error = error_tolerance * (STEP_SAFETY / STEP_GROWTH) ** 4
@@ -951,6 +1057,9 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     gam = actuator_viscosity / actuator_mass
     inv_ma = 1.0 / actuator_mass
     inv_mr = 1.0 / runner_mass
+    # the step control where the last call stopped (zeros before the first call)
+    (fine, quasi, controlled, g_rate, h_prev, quiet, acc_xr, acc_f, acc_win, acc_in, acc_damp, acc_contact,
+     acc_t, min_xr) = _restore_segment(carry)
     (t, x_p, a_r, F, n_rec, next_rec, track, steps, fine_steps, first_segment, resume,
      dt_ctrl) = _begin_run(mechanics, contacts, y, rows, carry, seg_t0, seg_x0, seg_fine, inv_ma, inv_mr)
     for s in range(first_segment, seg_t0.shape[0]):
@@ -962,12 +1071,13 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
         adaptive = (not rigid) and seg_coarse[s] > dt_fine
         if resume:
             resume = False
-            (fine, quasi, controlled, g_rate, h_prev, quiet, acc_xr, acc_f, acc_win, acc_in, acc_damp,
-             acc_contact, acc_t, min_xr) = _restore_segment(carry)
         else:
-            track, fine, quasi, controlled, g_rate, h_prev, quiet, acc = _open_segment(
+            track, fine_o, quasi_o, controlled_o, g_rate_o, h_prev_o, quiet_o, acc = _open_segment(
                 per, seg_mark[s], in_window, k, track, x_r, rigid, control_on)
             acc_xr, acc_f, acc_win, acc_in, acc_damp, acc_contact, acc_t, min_xr = acc
+            if not (smooth and _smooth_breakpoint(segments, s, vp)):
+                fine, quasi, controlled, g_rate, h_prev, quiet = (fine_o, quasi_o, controlled_o, g_rate_o,
+                                                                  h_prev_o, quiet_o)
         done = False
         while not done:
             if steps >= step_limit:  # pause: everything the loop carries goes to carry, y and work
@@ -982,11 +1092,15 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
             xr_old = x_r
             vr_old = v_r
             F_old = F
-            simpson = controlled and omega > 0.0
-            if simpson:  # drift
+            exact_linear = controlled and omega > 0.0  # the runner's linear part integrated exactly
+            simpson = exact_linear and track_energy  # energy terms by Simpson's rule
+            if exact_linear:  # drift
                 if dt != dt_trig:  # (steps repeat at the longest step: their sines are kept)
                     dt_trig = dt
-                    trig = _trig_coefficients(dt, omega, omega2)
+                    if newton:
+                        trig = _series_coefficients(dt, omega, inv_omega)
+                    else:
+                        trig = _trig_coefficients(dt, omega, omega2)
                 x_r, y0, w0, ag0, xp_mid, xr_mid, vr_mid = _trig_drift(
                     trig, omega, omega2, beta, x_r, v_r, a_r, x_p, xp_new, vp, dt, g_rate)
             else:
@@ -999,7 +1113,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
             elif quasi:
                 K, inv_dt, F_trial, quad_in, quad_damp, quad_contact = _quasi_balance(
                     mechanics, contacts, rows, x_p, xp_new, x_r, xr_old, dt, simpson,
-                    (xp_mid, xr_mid, vr_mid, vp, vr_old))
+                    (xp_mid, xr_mid, vr_mid, vp, vr_old), newton)
             else:
                 for g in range(x_a.shape[0]):
                     stretch_old[g] = x_p - x_a[g]
@@ -1019,9 +1133,9 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
                 F_mid = _rigid_mid_force(mechanics, contacts, xp_mid, xr_mid)
             F, acc_contact, acc_in = _commit_contacts(mechanics, contacts, rows, peak, track, x_r, v_r, vp,
                                                       dt, K, controlled, simpson, x_p, xp_new, acc_contact,
-                                                      acc_in)
+                                                      acc_in, track_energy)
             a_r_new = (F - load_stiffness * x_r) * inv_mr  # kick
-            if simpson:
+            if exact_linear:
                 v_r, g_rate, h_prev = _trig_kick(trig, omega, omega2, beta, a_r_new, x_r, xp_new, vp, y0, w0,
                                                  ag0, dt, g_rate, h_prev)
             else:
@@ -1034,15 +1148,18 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
             if quasi:
                 activity, acc_in, acc_damp, acc_contact = _quasi_kick(
                     mechanics, rows, x_p, xp_new, v_r, vp, dt, K, inv_dt, inv_ma, simpson,
-                    (quad_in, quad_damp, quad_contact), acc_in, acc_damp, acc_contact)
+                    (quad_in, quad_damp, quad_contact), acc_in, acc_damp, acc_contact, track_energy)
                 if activity >= activity_threshold:
                     fine = True
                     quasi = False
                     controlled = False
                     quiet = 0
             elif not rigid:
+                if dt != dt_damp:  # (the fine step repeats: its damping factor is kept)
+                    dt_damp = dt
+                    damp = 1.0 / (1.0 + 0.5 * dt * gam)
                 activity, acc_damp, acc_in = _actuator_kick(mechanics, rows, x_p, xp_new, dt, gam, inv_ma,
-                                                            acc_damp, acc_in)
+                                                            acc_damp, acc_in, track_energy, damp)
                 if adaptive:
                     fine, quasi, controlled, quiet, dt_ctrl, g_rate, h_prev = _adapt(
                         activity, activity_threshold, quiet_steps, quasi_static, control_on, fine, quasi,
@@ -1071,5 +1188,7 @@ def _integrate(segments, mechanics, control, contacts, buffers, step_limit):
     # with these segments followed by more (the same arrays, longer) continues the run
     _save_position(carry, seg_t0.shape[0], 0.0, t, x_p, a_r, F, next_rec, track, n_rec, steps, fine_steps,
                    dt_ctrl)
+    _save_segment(carry, y, x_r, v_r, fine, quasi, controlled, g_rate, h_prev, quiet,
+                  (acc_xr, acc_f, acc_win, acc_in, acc_damp, acc_contact, acc_t, min_xr))
     _save_state(y, x_r, v_r, x_a, v_a)
     return STATUS_OK, steps, n_rec, fine_steps

@@ -44,8 +44,9 @@ class SimulationResult:
         is inspected, not only the recorded samples).
     period_mean_position, period_mean_friction : ndarray, shape (periods,)
         Means over each period of x_r and of the total friction force on the runner.
-    energy : dict
-        Work and energy terms of the balance (J); see :meth:`energy_balance`.
+    energy : dict or None
+        Work and energy terms of the balance (J); see :meth:`energy_balance`. None unless the
+        run accumulated them (``simulate(..., energy=True)``).
     """
 
     drive: Drive
@@ -64,7 +65,7 @@ class SimulationResult:
     peak_force_ratio: np.ndarray
     period_mean_position: np.ndarray
     period_mean_friction: np.ndarray
-    energy: dict
+    energy: dict | None
     steps: int  # integrator steps, rejected error-controlled steps included
     fine_steps: int
     fine_step: float
@@ -104,7 +105,15 @@ class SimulationResult:
 
         ``residual`` is W_in minus the right-hand side; ``relative_residual`` divides it by
         the largest term. W_contact = Σ ∫T du is what the contacts stored plus dissipated.
+
+        Raises
+        ------
+        ValueError
+            The run did not accumulate the energy terms (``simulate(..., energy=True)`` does).
         """
+        if self.energy is None:
+            raise ValueError("energy is not known: the run did not accumulate the energy terms; "
+                             "simulate with energy=True")
         y = self.final_state
         G = self.multiplicity.size
         d = self.drive
@@ -167,17 +176,24 @@ class SimulationResult:
         return pd.DataFrame(data)
 
 
-def measures(buffers: kernels.Buffers, periods: int, n_rec: int) -> dict:
-    """The recorded series, measures of the first ``periods`` periods, energies and state of a
-    run stopped after them (fields of :class:`SimulationResult`)."""
-    per, energy = buffers.per[:periods], buffers.energy
-    rec = buffers.record[:n_rec]
+def settled_positions(per: np.ndarray) -> np.ndarray:
+    """Settled position of each period from its per-period accumulators (``Buffers.per`` rows): the
+    mean of x_r − x_p over its settle window plus x_p at the window's end."""
     window_len = per[:, kernels.PER_WINDOW_LENGTH]
     if np.any(window_len <= 0):
         raise SimulationError(
             "a period has an empty settle window; the waveform's phase marks are inconsistent"
         )
-    settled = per[:, kernels.PER_WINDOW_INTEGRAL] / window_len + per[:, kernels.PER_WINDOW_END_XP]
+    return per[:, kernels.PER_WINDOW_INTEGRAL] / window_len + per[:, kernels.PER_WINDOW_END_XP]
+
+
+def measures(buffers: kernels.Buffers, periods: int, n_rec: int, energy: bool = True) -> dict:
+    """The recorded series, measures of the first ``periods`` periods, energies (``energy``: the
+    run accumulated them; else None) and state of a run stopped after them (fields of
+    :class:`SimulationResult`)."""
+    per, terms = buffers.per[:periods], buffers.energy
+    rec = buffers.record[:n_rec]
+    settled = settled_positions(per)
     duration = per[:, kernels.PER_DURATION]
     return dict(
         time=rec[:, 0].copy(),
@@ -193,10 +209,10 @@ def measures(buffers: kernels.Buffers, periods: int, n_rec: int) -> dict:
         period_mean_position=per[:, kernels.PER_XR_INTEGRAL] / duration,
         period_mean_friction=per[:, kernels.PER_FRICTION_INTEGRAL] / duration,
         energy={
-            "input": float(energy[kernels.EN_INPUT]),
-            "damping": float(energy[kernels.EN_DAMPING]),
-            "contact": float(energy[kernels.EN_CONTACT]),
-        },
+            "input": float(terms[kernels.EN_INPUT]),
+            "damping": float(terms[kernels.EN_DAMPING]),
+            "contact": float(terms[kernels.EN_CONTACT]),
+        } if energy else None,
         final_state=buffers.y.copy(),
     )
 

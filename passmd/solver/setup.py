@@ -8,6 +8,7 @@ and the steps a :class:`passmd.solver.steps.Scheme` takes on a drive
 
 from __future__ import annotations
 
+import functools
 from typing import NamedTuple
 
 import numpy as np
@@ -42,8 +43,17 @@ def contact_groups(drive: Drive, share_side_state: bool = True):
 
 
 def contact_rows(drive: Drive, contact_model: str, springs: int, share_side_state: bool):
-    """Contact parameters and state of every group (:func:`passmd.model.contact.stack_contacts`) and
-    the groups' multiplicities (:func:`contact_groups`)."""
+    """Contact parameters and (virgin) state of every group
+    (:func:`passmd.model.contact.stack_contacts`) and the groups' multiplicities
+    (:func:`contact_groups`): new arrays on every call, the parameters computed once per drive."""
+    params, state, multiplicity = _contact_parameters(drive, contact_model, springs, share_side_state)
+    return params.copy(), state.copy(), multiplicity.copy()
+
+
+@functools.lru_cache(maxsize=32)
+def _contact_parameters(drive: Drive, contact_model: str, springs: int, share_side_state: bool):
+    """:func:`contact_rows` of the drives last used (a sweep or a fit simulates each drive many
+    times); the caller copies them."""
     forces, multiplicity, radii = _groups(drive, share_side_state)
     discrete = springs if contact_model == "discrete" else None
     rows = [drive_contact_arrays(drive, F, R, discrete) for F, R in zip(forces, radii, strict=True)]
@@ -69,6 +79,8 @@ class Steps(NamedTuple):
     quiet: float  # step once the ringing has decayed: the quasi-static (first controlled) or coarse one
     controlled: bool  # error-controlled steps (rigid actuators; flexible ones while quasi-static)
     longest: float | None  # longest error-controlled step (None without error control)
+    newton_balance: bool  # Scheme.newton_balance
+    smooth_breakpoints: bool  # Scheme.smooth_breakpoints
 
 
 def scheme_steps(drive: Drive, plan: StepPlan, scheme: Scheme) -> Steps:
@@ -92,5 +104,6 @@ def scheme_steps(drive: Drive, plan: StepPlan, scheme: Scheme) -> Steps:
     quasi_static = scheme.quiet_step == "quasi-static" and drive.actuator_model == "flexible"
     quiet = plan.quasi_step if quasi_static else coarse
     controlled = scheme.error_control
-    return Steps(fine, coarse, quasi_static, quiet, controlled, plan.longest_step if controlled else None)
+    return Steps(fine, coarse, quasi_static, quiet, controlled, plan.longest_step if controlled else None,
+                 scheme.newton_balance, scheme.smooth_breakpoints)
 

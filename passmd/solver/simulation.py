@@ -36,19 +36,22 @@ import time as _time
 
 import numpy as np
 
-from passmd.model.contact import contact_stiffness, memory_diagnostics, sliding_force
+from passmd.model.contact import memory_diagnostics
+from passmd.model.contact_kernels import P_SLIDING, P_STIFFNESS
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
 from passmd.model.waveforms import Waveform
 from passmd.runtime.validation import check_choice, check_count
 from passmd.solver import kernels
-from passmd.solver.results import SimulationError, SimulationResult, measures
+from passmd.solver.results import SimulationError, SimulationResult, measures, settled_positions
 from passmd.solver.setup import contact_rows, linear_stiffness, scheme_steps
 from passmd.solver.steps import (
     DEFAULT_SCHEME,
     LOCAL_ERROR_TOLERANCE,
     Scheme,
     check_work,
+    piece_work,
+    refused,
     resolve_scheme,
     segments,
     step_plan,
@@ -92,7 +95,7 @@ def simulate(drive: Drive, waveform: Waveform, **options) -> SimulationResult:
 
     A :class:`Simulation` run through all periods at once: ``options`` are its keyword
     arguments (``contact_model``, ``springs``, ``scheme``, ``max_points``,
-    ``share_side_state``, ``progress``; documented there), e.g.
+    ``share_side_state``, ``energy``, ``progress``; documented there), e.g.
     ``simulate(drive, waveform, scheme="fixed")``.
 
     Raises
@@ -133,10 +136,12 @@ class Simulation:
         Exact continuum MDR contact (default) or ``springs`` discrete MDR springs.
     springs : int
         Number of MDR springs for the discrete model.
-    scheme : {"controlled", "adaptive", "quasi-static", "fixed"} or Scheme
+    scheme : {"controlled", "reference", "adaptive", "quasi-static", "fixed"} or Scheme
         Integration scheme (:data:`passmd.solver.steps.SCHEMES`). "controlled" (default):
         error-controlled steps for rigid actuators, and for flexible ones once their ringing
-        after a corner of x_p(t) has decayed (quasi-static actuator); "adaptive": explicit
+        after a corner of x_p(t) has decayed (quasi-static actuator); "reference": the same
+        error control with bracketed balance solves and a fresh start at every breakpoint of
+        x_p(t) (the integrator the default is tested against); "adaptive": explicit
         Verlet, fine while flexible actuators ring and coarse after; "quasi-static": the
         quasi-static actuator at a fixed runner step after the ringing; "fixed": the fine step
         throughout. A :class:`passmd.solver.steps.Scheme` refines one
@@ -147,6 +152,11 @@ class Simulation:
         Number of recorded samples (evenly spaced in time).
     share_side_state : bool
         Six contacts: one state per side (default) or six independent contacts.
+    energy : bool
+        Accumulate the terms of the energy balance (``SimulationResult.energy``,
+        :meth:`~passmd.solver.results.SimulationResult.energy_balance`). Off by default: they never
+        feed back into the motion, and their quadrature costs about a fifth of an error-controlled
+        run.
     progress : bool or "long", optional
         Progress on stderr (:mod:`passmd.runtime.progress`). Default: for runs of more than
         :data:`PROGRESS_MIN_WORK` (expected steps, a discrete contact's springs counted,
@@ -171,6 +181,7 @@ class Simulation:
         scheme: str | Scheme = DEFAULT_SCHEME,
         max_points: int = 20000,
         share_side_state: bool = True,
+        energy: bool = False,
         progress: bool | None = None,
     ):
         if not isinstance(drive, Drive):
@@ -181,12 +192,14 @@ class Simulation:
         scheme = resolve_scheme(scheme)
         if int(max_points) != max_points or max_points < 2:
             raise ValueError(f"max_points = {max_points!r} is out of range: must be an integer >= 2")
+        if not isinstance(energy, bool):
+            raise ValueError(f"energy = {energy!r} is not allowed: must be True or False")
         if not (progress is None or isinstance(progress, bool) or (isinstance(progress, str)
                                                                   and progress == "long")):
             raise ValueError(f"progress = {progress!r} is not allowed: must be True, False, None or 'long'")
 
         params, state, multiplicity = contact_rows(drive, contact_model, springs, share_side_state)
-        k_contacts = np.array([contact_stiffness(params[g]) for g in range(multiplicity.size)])
+        k_contacts = params[:, P_STIFFNESS].copy()  # (contact_stiffness of each row)
         self._total_stiffness = float(np.sum(multiplicity * k_contacts))
         self._plan = plan = step_plan(drive, float(k_contacts.max()), self._total_stiffness, scheme.refine)
         steps = scheme_steps(drive, plan, scheme)
@@ -207,6 +220,8 @@ class Simulation:
         self._segments = segments(waveform, steps.fine, steps.coarse, steps.quiet, steps.longest)
         # pieces of the first n periods: the first _ends[n − 1] (a piece's period never decreases)
         self._ends = np.searchsorted(self._segments.period, np.arange(1, waveform.periods + 1), side="left")
+        # what check_work decides for the first n periods, from these pieces once
+        self._resolved, self._expected = piece_work(self._segments, plan, self._fine_step, self._coarse_step)
         self._mechanics = kernels.Mechanics(
             drive.runner_mass,
             drive.effective_load_cell_stiffness,
@@ -221,13 +236,18 @@ class Simulation:
             plan.activity_threshold, plan.quiet_steps, steps.quasi_static,
             waveform.duration / (max_points - 1),
             LOCAL_ERROR_TOLERANCE / scheme.refine**4 if steps.controlled else 0.0,
+            steps.newton_balance,
+            steps.smooth_breakpoints,
+            energy,
         )
-        sliding = np.array([sliding_force(params[g]) for g in range(G)])
+        self._energy = energy
+        sliding = params[:, P_SLIDING].copy()  # (sliding_force of each row)
         self._contacts = kernels.Contacts(params, state, sliding)
         self.periods_done = 0
         self.wall_time = 0.0
         self._counts = (0, 0, 0)  # integrator steps, rows recorded, fine steps
         self._failed = False
+        self._checked = False
 
     def leading_periods(self, periods: int) -> Waveform:
         """The waveform cut after its first ``periods`` periods (the whole one for all of them)."""
@@ -259,11 +279,13 @@ class Simulation:
         leading = self.leading_periods(periods)
         if leading.periods <= self.periods_done:
             return
-        expected = check_work(
-            self.drive, leading, self._plan, self._fine_step, self._coarse_step, self._total_stiffness,
-            user_step=self._user_step,
-        )
         n, end = leading.periods, int(self._ends[leading.periods - 1])
+        expected = float(self._expected[end - 1])
+        if refused(self._resolved, self._expected, end):  # check_work raises, naming the cause
+            expected = check_work(
+                self.drive, leading, self._plan, self._fine_step, self._coarse_step, self._total_stiffness,
+                user_step=self._user_step,
+            )
         b = self._buffers
         arguments = (
             kernels.Segments(*(column[:end] for column in self._segments)),
@@ -272,6 +294,10 @@ class Simulation:
             self._contacts,
             b._replace(per=b.per[:n], peak=b.peak[:n]),
         )
+        if not self._checked:  # the kernel's arguments, once: every later call slices the same arrays
+            kernels.check_arguments(kernels.Segments(*self._segments), self._mechanics, self._control,
+                                    self._contacts, b)
+            self._checked = True
         start = _time.perf_counter()
         try:
             status, steps, n_rec, fine_steps = _integrate_in_chunks(
@@ -293,6 +319,13 @@ class Simulation:
         self._counts = (steps, n_rec, fine_steps)
         self.periods_done = n
 
+    def settled_positions(self) -> np.ndarray:
+        """The settled positions of the periods integrated so far (m): ``result().settled_positions``
+        without the rest of the result (a protocol that decides period by period reads only these)."""
+        if self.periods_done < 1:
+            raise ValueError("settled_positions() needs at least one integrated period: call run_to first")
+        return settled_positions(self._buffers.per[: self.periods_done])
+
     def result(self) -> SimulationResult:
         """Measures of the periods integrated so far; ``waveform`` is :meth:`leading_periods` of them.
 
@@ -307,7 +340,7 @@ class Simulation:
             waveform=self.leading_periods(self.periods_done),
             contact_model=self.contact_model,
             multiplicity=self._multiplicity,
-            **measures(self._buffers, self.periods_done, n_rec),
+            **measures(self._buffers, self.periods_done, n_rec, self._energy),
             steps=int(steps),
             fine_steps=int(fine_steps),
             fine_step=float(self._fine_step),
@@ -331,7 +364,7 @@ def _integrate_in_chunks(arguments: tuple, waveform: Waveform, expected: float, 
     try:
         limit = chunk
         while True:
-            status, steps, n_rec, fine_steps = kernels.integrate(*arguments, limit)
+            status, steps, n_rec, fine_steps = kernels.integrate(*arguments, limit, True)  # (checked)
             if status != kernels.STATUS_PAUSED:
                 return status, steps, n_rec, fine_steps
             limit = steps + chunk

@@ -93,6 +93,16 @@ class Scheme:
         a local error estimate of the runner's position (:data:`LOCAL_ERROR_TOLERANCE`), with
         the runner's linear oscillation on its contacts integrated exactly (see
         :mod:`passmd.solver.kernels`). Without it rigid actuators take the fine step.
+    newton_balance : bool
+        (quasi-static actuators) Each actuator's force balance by a Newton step on the exact
+        contact's slope, accepted where its error is provably below the solve's tolerance
+        (:func:`passmd.solver.kernels.quasi_static_position` otherwise), and the trigonometric
+        coefficients of the error-controlled step by their series: the same solution to the
+        tolerance, at about half the arithmetic.
+    smooth_breakpoints : bool
+        The step control goes on across a breakpoint of x_p(t) where its rate does not change
+        (the settle window's start on a saw-tooth ramp) instead of starting afresh with the fine
+        step.
     refine : float
         Divides every step (convergence studies); under error control it divides the
         tolerance by the fourth power of ``refine`` instead (the controlled step scales as its fourth root).
@@ -106,6 +116,8 @@ class Scheme:
     error_control: bool
     refine: float = 1.0
     dt: float | None = None
+    newton_balance: bool = False
+    smooth_breakpoints: bool = False
 
     def __post_init__(self):
         check_choice("quiet_step", self.quiet_step, QUIET_STEPS)
@@ -130,7 +142,10 @@ class Scheme:
 #: The schemes by name (``simulate(..., scheme=name)``); "controlled" is the default.
 SCHEMES = {
     # error-controlled steps: rigid actuators throughout, flexible ones once quasi-static
-    "controlled": Scheme("controlled", "quasi-static", True),
+    "controlled": Scheme("controlled", "quasi-static", True, newton_balance=True, smooth_breakpoints=True),
+    # the same error control with bracketed balance solves and every breakpoint starting afresh: the
+    # scheme the default is tested against (tests/test_reference_scheme.py)
+    "reference": Scheme("reference", "quasi-static", True),
     # explicit adaptive Verlet: fine while flexible actuators ring, coarse after; rigid: fine
     "adaptive": Scheme("adaptive", "coarse", False),
     # fine while flexible actuators ring, then the quasi-static actuator at a fixed runner step
@@ -241,10 +256,33 @@ def expected_steps(waveform: Waveform, plan: StepPlan, fine_step: float, coarse_
     estimate, which their controlled steps undercut several-fold on saw-tooth runs.
     """
     seg = segments(waveform, fine_step, coarse_step)
-    duration = seg.t1 - seg.t0
-    n_fine = np.minimum(np.ceil(duration / seg.fine), plan.quiet_steps if coarse_step > fine_step else 0)
-    rest = np.maximum(duration - n_fine * seg.fine, 0.0)
-    return n_fine + np.ceil(rest / seg.coarse)
+    return _expected(seg.t0, seg.t1, seg.fine, plan, fine_step, coarse_step)
+
+
+def _expected(t0, t1, fine, plan: StepPlan, fine_step: float, coarse_step: float) -> np.ndarray:
+    """:func:`expected_steps` of the pieces from t0 to t1 whose fine steps are ``fine``."""
+    duration = t1 - t0
+    coarse = np.minimum(coarse_step, duration / MIN_SEGMENT_STEPS)
+    n_fine = np.minimum(np.ceil(duration / fine), plan.quiet_steps if coarse_step > fine_step else 0)
+    rest = np.maximum(duration - n_fine * fine, 0.0)
+    return n_fine + np.ceil(rest / coarse)
+
+
+def piece_work(pieces: Segments, plan: StepPlan, fine_step: float, coarse_step: float):
+    """What :func:`check_work` checks, piece by piece of x_p(t) (``pieces`` from :func:`segments`
+    with ``fine_step``): whether each piece's fine step resolves the simulated time, and the
+    expected steps up to the end of each piece (cumulative). A run of the first n pieces is
+    refused exactly when one of them is not resolved or the cumulative steps of the n-th exceed
+    :data:`MAX_STEPS`; a simulation run period by period
+    (:class:`passmd.solver.simulation.Simulation`) decides this once per waveform."""
+    resolved = pieces.fine >= MIN_STEP_SPACINGS * np.spacing(pieces.t1)
+    return resolved, np.cumsum(_expected(pieces.t0, pieces.t1, pieces.fine, plan, fine_step, coarse_step))
+
+
+def refused(resolved: np.ndarray, cumulative: np.ndarray, pieces: int) -> bool:
+    """Whether :func:`check_work` refuses the run of the first ``pieces`` pieces, from
+    :func:`piece_work`'s arrays."""
+    return bool(cumulative[pieces - 1] > MAX_STEPS or not resolved[:pieces].all())
 
 
 def _step_setter(drive: Drive, plan: StepPlan, total_contact_stiffness: float) -> str:

@@ -81,6 +81,10 @@ EQ15_OVERRIDES = (
 _PLOT_FORMATS = ("png", "pdf", "svg", "ps", "eps", "jpg", "jpeg", "tif", "tiff", "webp")
 
 
+#: The names ``--scheme`` takes (:data:`passmd.solver.steps.SCHEMES`; listed here so that the parser
+#: loads no solver module).
+SCHEME_NAMES = ("controlled", "reference", "adaptive", "quasi-static", "fixed")
+
 _DEFAULT_PERIODS = 3
 #: Fewest periods of a --steady run: its second half must hold two quarters of >= 1 period.
 _STEADY_MIN_PERIODS = 4
@@ -94,6 +98,11 @@ def add_parser(command) -> None:
     p.set_defaults(periods=None)  # --steady's own length unless given
     p.add_argument("--load-cell", action="store_true",
                    help="the runner pushes against the load cell (default: off, free runner)")
+    p.add_argument("--scheme", choices=SCHEME_NAMES, default="controlled",
+                   help="integration scheme (passmd.solver.steps.SCHEMES): controlled, the default; "
+                        "reference, the error-controlled step the default is tested against; adaptive, "
+                        "quasi-static and fixed, the explicit schemes of the convergence study (default: "
+                        "controlled)")
     group = p.add_argument_group("steady velocity and the Eq. 15 design")
     group.add_argument("--steady", action="store_true",
                        help="the book's steady-velocity protocol: max(20, f·5 ms) periods from rest (unless "
@@ -224,7 +233,7 @@ def simulate(args, drive, options: RunOptions):
     result = simulation.simulate(
         drive, wave, contact_model="exact" if springs is None else "discrete",
         springs=PROTOCOL.springs if springs is None else springs, max_points=args.max_points,
-        progress="long",  # a long run's progress on stderr, also when it is not a terminal
+        scheme=args.scheme, progress="long",  # a long run's progress on stderr, also off a terminal
     )
     return result, design
 

@@ -69,7 +69,7 @@ SLIP_SHARE_ACCURACY = 0.02
 CRITICAL_AMPLITUDE_BRACKETS = 1.0
 
 #: Benchmark results shipped with the package (``passmd/data/benchmarks/<name>.json``).
-BENCHMARKS = ("contact", "driving_waveform", "dynamics", "fit", "fit_coverage")
+BENCHMARKS = ("contact", "driving_waveform", "dynamics", "fit", "fit_coverage", "scaling")
 
 
 def benchmark_results(name: str, path: str | Path | None = None) -> dict:
@@ -77,7 +77,7 @@ def benchmark_results(name: str, path: str | Path | None = None) -> dict:
 
     Parameters
     ----------
-    name : {"contact", "driving_waveform", "dynamics", "fit", "fit_coverage"}
+    name : {"contact", "driving_waveform", "dynamics", "fit", "fit_coverage", "scaling"}
         The benchmark (``fit_coverage``: ``benchmarks/bench_fit_coverage.py``).
     path : path-like, optional
         A results file to read instead of the one installed with the package
@@ -114,6 +114,7 @@ def benchmark_table(path: str | Path | None = None) -> pd.DataFrame:
     df = pd.DataFrame(data["rows"])
     df.attrs["meta"] = data.get("meta", {})
     df.attrs["across_processes"] = data.get("across_processes", {})
+    df.attrs["headline"] = data.get("headline", {})
     return df
 
 
@@ -320,6 +321,60 @@ def coulomb_rising_gaps(coulomb: pd.DataFrame) -> list[str]:
 #: six-contact flexible drive with the default (error-controlled) step and the exact contact,
 #: which a sweep of the assumption space needs, and ns per fixed step (exact contact).
 TARGET_MS_PER_PERIOD, TARGET_NS_PER_STEP = 1.0, 25.0
+#: Speed target against a plain fixed-step velocity-Verlet code of the same model
+#: (``benchmarks/verlet_baseline.py``): the default's marginal cost per 100 Hz period of the
+#: six-contact flexible drive this many times smaller.
+TARGET_BASELINE_RATIO = 150.0
+
+
+def headline_facts(bench: pd.DataFrame) -> dict:
+    """The headline of the speed benchmark (:func:`benchmark_table`'s ``attrs["headline"]``): ms per
+    100 Hz period of the integration loop (CPU time) for the plain Verlet code, the default and the
+    scheme it replaced, their ratios, the same ratio of wall times, the rounds, the load average
+    and the target ratio."""
+    head = bench.attrs["headline"]
+    loop, wall = head["ms_per_period"]["loop"], head["ratios"]["wall"]
+    return {"head_baseline_ms": loop["baseline"], "head_default_ms": loop["controlled"],
+            "head_reference_ms": loop["reference"],
+            "head_ratio": head["ratios"]["loop"]["baseline_over_default"],
+            "head_ratio_wall": wall["baseline_over_default"],
+            "head_before_after": head["ratios"]["loop"]["reference_over_default"],
+            "head_rounds": head["rounds"], "head_load": head["load_average_before"][0],
+            "head_default_err_nm": head["error_vs_fixed_fine_nm"]["controlled"],
+            "head_baseline_err_nm": head["error_vs_fixed_fine_nm"]["baseline"],
+            "target_ratio": TARGET_BASELINE_RATIO}
+
+
+def scaling_facts(data: dict) -> dict:
+    """Numbers the scaling paragraph quotes from ``benchmarks/bench_scaling.py``'s record
+    (:func:`benchmark_results` ``("scaling")``): ms per 100 Hz period with 1, 6 and 24 independent
+    contacts and ns per step per contact state, the frequency range's cost per simulated ms, the
+    sweep's cost per point and start-up, Dask's cost per task and start-up, and the 10⁶-point plan."""
+    contacts = pd.DataFrame(data["contacts"])
+    own = contacts[~contacts["shared_side_state"]].set_index("contacts")
+    per_state = np.polyfit(own["contact_states"], own["ns_per_step"], 1)
+    freq = pd.DataFrame(data["frequency"]).set_index("frequency_Hz")
+    out = {f"scale_{n}_ms": float(own.loc[n, "ms_per_100Hz_period"]) for n in own.index}
+    shared = contacts[contacts["shared_side_state"]].set_index("contacts")
+    out.update({f"scale_{n}_shared_ms": float(shared.loc[n, "ms_per_100Hz_period"]) for n in shared.index})
+    out.update({"scale_ns_per_state": float(per_state[0]), "scale_ns_base": float(per_state[1]),
+                "scale_f_low_Hz": float(freq.index.min()), "scale_f_high_kHz": float(freq.index.max()) / 1e3,
+                "scale_low_ms_per_ms": float(freq["ms_per_simulated_ms"].iloc[0]),
+                "scale_high_ms_per_ms": float(freq["ms_per_simulated_ms"].iloc[-1]),
+                "scale_high_fine_pct": 100 * float(freq["fine_share"].iloc[-1]),
+                "scale_low_fine_pct": 100 * float(freq["fine_share"].iloc[0]),
+                "sweep_ms_per_point": 1e3 * data["sweep"]["s_per_point"],
+                "sweep_start_s": data["sweep"]["start_s"], "sweep_workers": data["sweep"]["workers"]})
+    if data.get("dask"):
+        plan = data["dask_plan"]
+        out.update({"dask_ms_per_task": 1e3 * data["dask"]["s_per_task"],
+                    "dask_start_s": data["dask"]["start_s"],
+                    "dask_points_per_task": plan["points_per_task"], "dask_tasks": plan["tasks"],
+                    "dask_share_pct": 100 * plan["scheduler_share"],
+                    "dask_unbatched_pct": 100 * plan["unbatched_scheduler_share"],
+                    "dask_core_hours": plan["core_hours"], "dask_plan_points": plan["points"],
+                    "dask_ms_per_point": 1e3 * plan["s_per_point_one_core"]})
+    return out
 
 
 def benchmark_facts(bench: pd.DataFrame) -> dict:

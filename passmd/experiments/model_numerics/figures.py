@@ -154,7 +154,7 @@ def energy_balance_table(
         wf = waveforms.sawtooth(amplitude, frequency, drive, periods=periods)
         for contact in ("exact", "discrete"):
             res = simulation.simulate(drive, wf, contact_model=contact, springs=PROTOCOL.springs,
-                                    max_points=2, scheme=scheme)
+                                      max_points=2, scheme=scheme, energy=True)
             bal = res.energy_balance()
             rows.append({"configuration": label, "contact_model": contact, **bal})
     return pd.DataFrame(rows)

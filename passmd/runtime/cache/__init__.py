@@ -34,7 +34,8 @@ An entry whose size, checksum, header, key or (when the caller names it) functio
 check out, or whose path holds a link or a special file, is reported once
 (:class:`~passmd.runtime.cache.store.CacheWarning`), removed (a link itself, never its target)
 and recomputed. Writes are atomic: a temporary file ``.<key[:16]>-<random>.tmp`` in the same
-folder, flushed to disk, moved into place with :func:`os.replace`; any exception (also
+folder, moved into place with :func:`os.replace` (not flushed to disk first: an entry a crash
+tore fails its checksum, is reported and recomputed); any exception (also
 ``KeyboardInterrupt``) removes it, and one left by a killed process is removed by ``prune``
 once stale (:data:`~passmd.runtime.cache.store.STALE_TEMP_SECONDS`). A cache that cannot be
 written is reported once per directory and the caller goes on without it.

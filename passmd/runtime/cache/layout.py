@@ -102,16 +102,17 @@ def _read_marker(directory: Path) -> str | None:
 
 
 @contextlib.contextmanager
-def _temporary(folder: Path, prefix: str, data: bytes):
-    """A new file ``<prefix><random>.tmp`` in ``folder`` holding ``data``, flushed to disk, for
-    the block to move into place; removed on leaving it (also on ``KeyboardInterrupt`` or what
-    a SIGTERM handler raises) unless moved."""
+def _temporary(folder: Path, prefix: str, data: bytes, durable: bool = True):
+    """A new file ``<prefix><random>.tmp`` in ``folder`` holding ``data`` (with ``durable``, flushed
+    to disk), for the block to move into place; removed on leaving it (also on
+    ``KeyboardInterrupt`` or what a SIGTERM handler raises) unless moved."""
     fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=".tmp", dir=folder)
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
             fh.flush()
-            os.fsync(fh.fileno())
+            if durable:
+                os.fsync(fh.fileno())
         yield tmp
     finally:
         try:

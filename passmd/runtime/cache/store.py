@@ -284,7 +284,9 @@ class Cache:
             if kind == "foreign":
                 self._report_path(target, found)
                 return False
-            with _temporary(target.parent, f".{key[:16]}-", data) as tmp:
+            # not flushed to disk first: an entry torn by a crash fails its checksum and is recomputed,
+            # and a flush costs milliseconds per sweep point (more than a fit's row takes to compute)
+            with _temporary(target.parent, f".{key[:16]}-", data, durable=False) as tmp:
                 os.replace(tmp, target)
         except OSError as exc:
             self._report_unusable(f"cannot write the cache {self.directory}: {exc.strerror or exc}")
