@@ -152,4 +152,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from passmd.runtime.scripts import run_script
+
+    raise SystemExit(run_script(main))  # one line on failure, never a traceback

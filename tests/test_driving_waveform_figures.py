@@ -446,10 +446,11 @@ def test_fig9b_fit_limit_is_the_command_lines(quick):
                            "--periods", "2"])
     assert status == 0, out.getvalue()
     line = next(x for x in out.getvalue().splitlines() if x.strip().startswith("Eq. 15 fits"))
-    assert f"up to {found['fit_limit_kHz']:.4g} kHz " in line, line
+    assert f"up to {found['fit_limit_printed_kHz']:.4g} kHz " in line, line
+    assert found["fit_limit_printed_kHz"] <= found["fit_limit_kHz"]
     chapter = Path(__file__).resolve().parents[1] / "book" / "waveform_velocity.md"
     chapter = chapter.read_text(encoding="utf-8")
-    assert "{glue:text}`fit_limit_kHz:.4g` kHz" in chapter
+    assert "{glue:text}`fit_limit_printed_kHz:.4g` kHz" in chapter
 
 
 def test_reachable_table_and_stick_lost(quick):

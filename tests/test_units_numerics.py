@@ -248,7 +248,8 @@ def test_poisson_ratio_just_above_minus_one_is_accepted_beyond_the_plausible_ran
     (["--runner-poisson", "0.5000000000001"], "--runner-poisson = 0.5000000000001 is out of range"),
     (["--hemisphere-poisson", "0.5"],
      "--hemisphere-poisson = 0.5 is out of range: must be a finite number > -1 and < 0.5"),
-    (["--preload", "0.99999999999mN"], "--preload = 0.00099999999999 N is out of range: must be >= 0.001 N"),
+    (["--preload", "0.99999999999mN"],
+     "--preload = 0.99999999999mN (= 0.00099999999999 N) is out of range: must be >= 0.001 N"),
     (["--radius", "0.0099999999mm"], "--radius = 0.0099999999 mm is out of range: must be >= 0.01 mm"),
     (["--hemisphere-modulus", "0.999999999999GPa"], "= 0.999999999999 GPa is out of range: must be >= 1 GPa"),
 ])

@@ -32,12 +32,13 @@ def startup_facts(fig9b_data: pd.DataFrame, frequency: float = PAPER_MAXIMUM_KHZ
 
 def fig9b_facts(fig9b_data: pd.DataFrame, design: pd.Series, drive: Drive) -> dict:
     """Fig. 9b: up to which frequency one whole Eq. 15 period fits (kHz,
-    :func:`~passmd.experiments.waveform_velocity.figures.eq15_fit_limit`, the
-    number ``passmd run --waveform optimized`` prints); the room for t_s in a period at the
-    paper's 110 kHz (µs), the f_s it would need (kHz) and the contact-stiffness factor that means; the
-    optimized velocity there; the skip variant's largest gain on the grid up to 110 kHz (mm/s, %, kHz,
-    and the grid points either side of it: ``skip_gain_where``); the saw-tooth's step at the grid's
-    ends (nm); how far the measured f_s lies from its linear estimate (%)."""
+    :func:`~passmd.experiments.waveform_velocity.figures.eq15_fit_limit`; ``fit_limit_printed_kHz``
+    as ``passmd run --waveform optimized`` prints it, rounded down to four digits); the room for t_s
+    in a period at the paper's 110 kHz (µs), the f_s it would need (kHz) and the contact-stiffness
+    factor that means; the optimized velocity there; the skip variant's largest gain on the grid up to
+    110 kHz (mm/s, %, kHz, and the grid points either side of it: ``skip_gain_where``); the
+    saw-tooth's step at the grid's ends (nm); how far the measured f_s lies from its linear estimate
+    (%)."""
     opt = fig9b_data[fig9b_data["variant"] == "optimized"].set_index("frequency")
     saw = fig9b_data[fig9b_data["variant"] == "sawtooth"].set_index("frequency")
     skip = fig9b_data[fig9b_data["variant"] == "optimized_skip"].set_index("frequency")
@@ -51,8 +52,10 @@ def fig9b_facts(fig9b_data: pd.DataFrame, design: pd.Series, drive: Drive) -> di
     below, above = grid[grid < at], grid[grid > at]
     either = [f"{side / 1e3:g} kHz" for side in (below.max() if below.size else None,
                                                    above.min() if above.size else None) if side is not None]
-    # an upper limit, printed as the command line prints it: rounded down to its four digits
-    return {"fit_limit_kHz": round_down(eq15_fit_limit(design, drive) / 1e3, 4), "t_s_room_us": t_s_max * 1e6,
+    limit_kHz = eq15_fit_limit(design, drive) / 1e3
+    # an upper limit is printed as the command line prints it: rounded down to its four digits
+    return {"fit_limit_kHz": limit_kHz, "fit_limit_printed_kHz": round_down(limit_kHz, 4),
+            "t_s_room_us": t_s_max * 1e6,
             "skip_gain_where": (f"at the grid point {at / 1e3:g} kHz, between {' and '.join(either)}"
                                 if len(either) == 2 else f"at {at / 1e3:g} kHz, the grid's edge"),
             # "within" this many per cent: rounded up
