@@ -7,6 +7,7 @@ so "0.25mm" must give exactly the float 0.25e-3: equality, not a tolerance.
 import numpy as np
 import pytest
 
+from passmd.runtime import units
 from passmd.runtime.units import QuantityError, dimension_name, from_si, parse_quantities, parse_quantity
 
 
@@ -94,7 +95,6 @@ def test_from_si_inverts_parse():
 def test_display_factors_are_pints():
     """Bare numbers and output use a table of display-unit factors (no registry at start-up);
     each must be exactly the factor pint gives."""
-    from passmd.runtime import units
 
     for unit, factor in units._DISPLAY_FACTORS.items():
         expected = units.registry().Quantity(1.0, units._unit(unit)).to_base_units().magnitude
@@ -104,10 +104,22 @@ def test_display_factors_are_pints():
 def test_display_units_share_a_base_exactly_when_pint_gives_them_one_dimension():
     """A number given in a display unit (``150nm``, ``40kHz``) is read without the registry when
     the unit's base is the expected one; that must be pint's dimension check."""
-    from passmd.runtime import units
 
     assert units._DISPLAY_BASES.keys() == units._DISPLAY_FACTORS.keys()
     for a in units._DISPLAY_BASES:
         for b in units._DISPLAY_BASES:
             same = units._unit(a).dimensionality == units._unit(b).dimensionality
             assert (units._DISPLAY_BASES[a] == units._DISPLAY_BASES[b]) == same, (a, b)
+
+
+def test_the_unit_registry_is_built_once():
+    """pint's registry takes a fraction of a second to build: every parse shares one."""
+    assert units.registry() is units.registry()
+
+
+@pytest.mark.parametrize(("value", "digits", "expected"), [
+    (9.75596, 4, 9.755), (9.755, 4, 9.755), (123456.0, 3, 123000.0), (0.0012349, 2, 0.0012)])
+def test_round_down_keeps_an_upper_limit_within_it(value, digits, expected):
+    shown = units.round_down(value, digits)
+    assert shown == pytest.approx(expected, rel=1e-12)
+    assert shown <= value

@@ -118,7 +118,6 @@ class QuantityError(ValueError):
     """A quantity that cannot be read, or has the wrong dimension."""
 
 
-@functools.lru_cache(maxsize=1)
 def round_down(value: float, digits: int = 4) -> float:
     """``value`` rounded down to ``digits`` significant digits: how an upper limit is printed, so that
     the printed number, typed back, stays within the limit (``passmd run``'s "Eq. 15 fits up to")."""
@@ -128,6 +127,7 @@ def round_down(value: float, digits: int = 4) -> float:
     return math.floor(value / step * (1 + 1e-12)) * step
 
 
+@functools.lru_cache(maxsize=1)
 def registry() -> pint.UnitRegistry:  # noqa: F821 - pint is imported on first use
     """The package's unit registry (built once, on first use; building it takes a fraction of a second)."""
     import pint
