@@ -15,8 +15,8 @@ import os
 import signal
 import sys
 
-__all__ = ["DASK_CLOSE_TIMEOUT", "PARENT_POLL_S", "close_dask", "end_with_parent", "signals_held",
-           "start_resource_tracker", "stop_workers", "worker_signals"]
+__all__ = ["DASK_CLOSE_TIMEOUT", "PARENT_POLL_S", "close_dask", "descendants", "end_with_parent",
+           "signals_held", "start_resource_tracker", "stop_workers", "worker_signals"]
 
 
 #: The signals a process pool's start and shut-down hold back: delivered right after, in the sweep.
@@ -128,13 +128,39 @@ def start_resource_tracker() -> None:
 DASK_CLOSE_TIMEOUT = 2.0
 
 
+def descendants() -> set[int]:
+    """The pids of this process's descendants, read from ``/proc`` (empty where there is none).
+
+    A worker process still being spawned (forked, its interpreter not yet handed its task) is a
+    descendant before :func:`multiprocessing.active_children` lists it."""
+    parents = {}
+    with contextlib.suppress(OSError):
+        for entry in os.scandir("/proc"):
+            if not entry.name.isdigit():
+                continue
+            try:
+                with open(f"/proc/{entry.name}/stat", "rb") as fh:
+                    stat = fh.read()
+            except OSError:  # gone meanwhile
+                continue
+            # "pid (comm) state ppid …": comm may hold spaces and parentheses, so split after the last ")"
+            fields = stat[stat.rfind(b")") + 2:].split()
+            if len(fields) > 1:
+                parents[int(entry.name)] = int(fields[1])
+    found, frontier = set(), {os.getpid()}
+    while frontier:
+        frontier = {pid for pid, parent in parents.items() if parent in frontier} - found
+        found |= frontier
+    return found
+
+
 def close_dask(client, cluster, interrupted: bool, before: set) -> None:
     """Close the client, and the local cluster this sweep started; after an interrupt at once and
-    quietly: the loggers of ``distributed`` silenced, the worker processes the cluster started (this
-    process's children not in ``before``) killed first, also those still starting, and again once
-    the cluster is closed (its loop may have started one meanwhile), the close bounded by
-    :data:`DASK_CLOSE_TIMEOUT`, and the cluster taken off ``distributed``'s list of clusters to close
-    at exit (no second close)."""
+    quietly: the loggers of ``distributed`` silenced, the processes the cluster started (this
+    process's descendants whose pids are not in ``before``, :func:`descendants`) killed first, also
+    those still starting, and again once the cluster is closed (its loop may have started one
+    meanwhile), the close bounded by :data:`DASK_CLOSE_TIMEOUT`, and the cluster taken off
+    ``distributed``'s list of clusters to close at exit (no second close)."""
     import multiprocessing
 
     if not interrupted:
@@ -147,10 +173,15 @@ def close_dask(client, cluster, interrupted: bool, before: set) -> None:
         logging.getLogger(name).setLevel(logging.CRITICAL + 1)
 
     def kill_workers():
-        if cluster is not None:
-            for process in set(multiprocessing.active_children()) - before:
+        if cluster is None:
+            return
+        for process in multiprocessing.active_children():  # reaped by multiprocessing once killed
+            if process.pid not in before:
                 with contextlib.suppress(Exception):
                     process.kill()
+        for pid in descendants() - before:  # also those still being spawned
+            with contextlib.suppress(OSError):
+                os.kill(pid, signal.SIGKILL)
 
     kill_workers()
     for closing in (client, cluster):

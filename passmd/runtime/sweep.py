@@ -279,10 +279,12 @@ def _run_dask(func, todo, points, collect: _Collector, workers, scheduler) -> No
 
     cluster = client = None
     futures, interrupted = {}, False
-    before = set(multiprocessing.active_children())
+    if not scheduler:
+        pools.start_resource_tracker()
+    # the processes already there (the resource tracker, another pool's workers) are not the cluster's
+    before = pools.descendants() | {p.pid for p in multiprocessing.active_children()}
     try:
         if not scheduler:
-            pools.start_resource_tracker()
             with pools.signals_held():  # (":0": its HTTP server on a free port, never "port in use")
                 cluster = LocalCluster(n_workers=0, threads_per_worker=1, dashboard_address=":0",
                                        silence_logs=logging.ERROR)
