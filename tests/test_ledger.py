@@ -1116,15 +1116,15 @@ def test_reading_tables_hold_the_full_product():
 def test_force_readings_at_a_reading():
     """This paper's force runs at a reading come from fig7_readings by fly-back rule, ζ and frequency;
     a reading the table lacks is a missing run, not an undecided point."""
-    from passmd.experiments.force_generation import figures
+    from passmd.experiments.force_generation import claims
     from passmd.ledger import readings
 
     table = pd.DataFrame({"flyback": ["slew", "fixed"], "damping_ratio": [0.05, 0.05],
                           "frequency_Hz": [100.0, 100.0], "generated_force_mN": [1.0, 2.0]})
     reading = {**readings.default_reading(), "flyback": "fixed"}
-    assert figures.readings_at({"fig7_readings": table}, reading)["generated_force_mN"].tolist() == [2.0]
+    assert claims.readings_at({"fig7_readings": table}, reading)["generated_force_mN"].tolist() == [2.0]
     with pytest.raises(checks.NoRun, match="ζ = 0.5"):
-        figures.readings_at({"fig7_readings": table}, {**reading, "damping_ratio": 0.5})
+        claims.readings_at({"fig7_readings": table}, {**reading, "damping_ratio": 0.5})
     assert "fig7_readings" in evaluation.result_sources()
 
 

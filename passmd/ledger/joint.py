@@ -22,10 +22,11 @@ is held out, every claim holding at its held-out reading holds at the in-sample 
 claims judged as holding never exceeds the number holding together at one point of the space
 (:func:`judge` records ``best_single_point``).
 
-:func:`judge` does all of this on a state matrix; :func:`conflicting_pairs` lists every pair of claims
-that each hold somewhere but never together and :func:`tensions` groups them by the free axes that
-separate them; :func:`joint_map` gives the claims × readings map of an evaluated ledger and
-:func:`joint_record` the joint reading as plain data.
+:func:`judge` does all of this on a state matrix and :func:`held_out_judgements` says where it judges
+each claim; :func:`variants` chooses again with rows left out or studies counted;
+:func:`conflicting_pairs` lists every pair of claims that each hold somewhere but never together and
+:func:`tensions` groups them by the free axes that separate them; :func:`joint_map` gives the claims ×
+readings map of an evaluated ledger and :func:`joint_record` the joint reading as plain data.
 """
 
 from __future__ import annotations
@@ -39,10 +40,10 @@ import pandas as pd
 
 from passmd.ledger import readings
 from passmd.ledger.rules import RUNNER_UPS
-from passmd.ledger.verdicts import PointResult
+from passmd.ledger.verdicts import Judgement, PointResult
 
-__all__ = ["DECIDED", "Unit", "conflicting_pairs", "joint_map", "joint_record", "judge", "state_table",
-           "tensions"]
+__all__ = ["DECIDED", "Unit", "conflicting_pairs", "held_out_judgements", "joint_map", "joint_record",
+           "judge", "plain_point", "state_table", "tensions", "variants"]
 
 #: The states of a claim that decide it at a point.
 DECIDED = ("holds", "fails")
@@ -335,6 +336,66 @@ def elsewhere(claim: str, states: Mapping, at: int) -> str:
             + (", ".join(broken) if broken else "no claim holding there"))
 
 
+def held_out_judgements(joint: Mapping, studies: Iterable[str]) -> dict[str, Judgement]:
+    """Where each claim is judged (:class:`passmd.ledger.verdicts.Judgement`): a claim of the paper at
+    its unit's held-out point of ``joint`` (:func:`judge`'s result), a study at the defaults."""
+    states = joint["states"]
+    space, free_of = states["space"], states["free_of"]
+    runner_ups = [e["point"] for e in joint["runner_ups"]]
+    out = {}
+    for unit in joint["units"]:
+        at = joint["held_out"][unit.lead]
+        codes = joint["unit_states"][unit.lead]
+        for claim in unit.members:
+            mine = free_of[claim]
+            lead = claim == unit.lead
+            family = unit.members if len(unit.members) > 1 else ()
+            out[claim] = Judgement(
+                held_out=readings.claim_reading(space[at], mine),
+                in_sample=readings.claim_reading(space[joint["best"]], mine),
+                family_state=state_name(codes[at]) if lead and family else "",
+                family_at_defaults=state_name(codes[0]) if lead and family else "",
+                family=family, counted=lead, grid_bound=joint["grid_bound"].get(unit.lead, False),
+                elsewhere=elsewhere(claim, states, at),
+                runner_ups=tuple(readings.claim_reading(p, mine) for p in runner_ups))
+    for claim in studies:
+        out[claim] = Judgement(readings.default_reading(), readings.default_reading(), counted=False)
+    return out
+
+
+def variants(evaluated: Mapping, sections: Mapping, families: Mapping, voters: set, rows: list[dict],
+             studies: Mapping) -> list[dict]:
+    """How the in-sample joint reading changes when rows are left out (those decided only where a method
+    they rest on is undefined, e.g. Eq. 15) or when the studies (the substitute and derived rows, never
+    counted) are counted as claims.
+
+    ``evaluated``, ``sections``, ``families``, ``voters`` as :func:`judge` takes them; ``rows``: the
+    ledger rows of the claims of the paper (``claim``, ``outside``); ``studies``: ``{claim id: (points,
+    depends_on)}`` of the studies.
+    """
+    out = []
+    if studies:
+        with_studies = {**evaluated, **studies}
+        joint = judge(with_studies, sections, families, voters | set(studies))
+        out.append({"left_out": "studies counted as claims", "claims_left_out": [],
+                    "claims_added": sorted(studies), "reading": plain_point(joint["point"]),
+                    "described": joint["described"], "holding": joint["holding"], "claims": joint["claims"]})
+    leave = {r["claim"] for r in rows if r["outside"]}
+    if leave:
+        kept = {c: v for c, v in evaluated.items() if c not in leave}
+        joint = judge(kept, sections, families, voters - leave)
+        out.append({"left_out": "rows decided only where a method they rest on is undefined left out",
+                    "claims_left_out": sorted(leave), "claims_added": [],
+                    "reading": plain_point(joint["point"]), "described": joint["described"],
+                    "holding": joint["holding"], "claims": joint["claims"]})
+    return out
+
+
+def plain_point(point: Mapping) -> dict:
+    """A point of the space with its free axes as plain keys (``key@section``)."""
+    return {readings.point_key(f): v for f, v in point.items()}
+
+
 def map_columns(joint: Mapping) -> list[dict]:
     """The readings of the claims × readings map: the defaults, the joint reading, its ties and
     runner-ups (each once), with every claim's state there."""
@@ -379,7 +440,7 @@ def joint_record(joint: Mapping) -> dict:
     counts and margins, the held-out counts and the in-sample gain over them, the largest number of
     claims holding at one point, and how it changes when rows are left out or studies counted
     (``variants``)."""
-    out = {"reading": {readings.point_key(f): v for f, v in joint["point"].items()}}
+    out = {"reading": plain_point(joint["point"])}
     for k in ("described", "holding", "equivalent_points", "claims", "points", "covered_points",
               "decided_points", "chosen_from", "tied_readings", "best_single_point", "held_out_counts",
               "in_sample_gain", "variants"):
@@ -387,5 +448,5 @@ def joint_record(joint: Mapping) -> dict:
             out[k] = joint[k]
     for k in ("ties", "runner_ups"):
         out[k] = [{**{key: v for key, v in e.items() if key != "point"},
-                   "reading": {readings.point_key(f): v for f, v in e["point"].items()}} for e in joint[k]]
+                   "reading": plain_point(e["point"])} for e in joint[k]]
     return out

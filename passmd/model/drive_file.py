@@ -28,7 +28,8 @@ What is not given comes from the paper: Table 1 (materials, masses, μ), Section
 Table 2 for the actuator of the drive's radius (interpolated between its two rows), and the
 viscosity derived from the damping ratio ζ (assumption ``actuator_viscosity``).
 :func:`resolve` records where each value came from, for ``passmd drive show``.
-:func:`drive_toml` writes a file :func:`load_drive` reads back to an equal drive.
+:func:`drive_toml` (:mod:`passmd.model.drive_writer`) writes a file :func:`load_drive` reads back to an
+equal drive.
 """
 
 from __future__ import annotations
@@ -37,13 +38,14 @@ import math
 import sys
 from dataclasses import replace
 
-from passmd.model.arrangement import FLAT, ContactGroup, preset_groups
+from passmd.model.arrangement import FLAT, ContactGroup
+from passmd.model.drive_keys import ACTUATOR_DYNAMICS, GROUP_KEYS, SI_UNITS, DriveKey, drive_value
 from passmd.model.drive_keys import CONTACT_PRESETS as CONTACT_PRESETS
 from passmd.model.drive_keys import DRIVE_KEYS as DRIVE_KEYS
 from passmd.model.drive_keys import EXAMPLE_DRIVE_FILE as EXAMPLE_DRIVE_FILE
 from passmd.model.drive_keys import JOINT_READING_FILE as JOINT_READING_FILE
-from passmd.model.drive_keys import SI_UNITS, DriveKey
-from passmd.model.parameters import PLAUSIBLE_RANGES, Drive, check_drive
+from passmd.model.drive_writer import drive_toml as drive_toml
+from passmd.model.parameters import PLAUSIBLE_RANGES, Drive
 from passmd.model.tables import (
     ACTUATOR_DAMPING_RATIO,
     FLYBACK_RULES,
@@ -53,7 +55,7 @@ from passmd.model.tables import (
     table2_source,
 )
 from passmd.runtime.inputs import RefusedFile, decode_text, read_bounded
-from passmd.runtime.units import QuantityError, from_si, parse_angle, parse_quantity
+from passmd.runtime.units import QuantityError, parse_angle, parse_quantity
 from passmd.runtime.validation import InputError, file_message
 
 if sys.version_info >= (3, 11):
@@ -78,8 +80,6 @@ _DEFAULT = Drive()
 #: precision of a period's times.
 SHORTEST_FLYBACK = 1e-9
 SHORTEST_FLYBACK_WHY = "about a thousandth of the paper's full-stroke fly-back V_pp/SR, beyond any amplifier"
-#: Keys of the actuators' dynamics (Eq. 3), which ideally rigid actuators do not have.
-_ACTUATOR_DYNAMICS = ("actuator.stiffness", "actuator.mass", "actuator.viscosity", "actuator.damping_ratio")
 
 
 def _flatten(table: dict, name: str, prefix: str = "", section: str = "the top level",
@@ -176,10 +176,6 @@ def _flyback(label: str, spec: DriveKey, raw) -> str | float:
     return value
 
 
-_GROUP_KEYS = {"count": "", "side": "", "contact_angle": "angle", "load_share": "", "normal_force": "N",
-               "radius": "m"}
-
-
 def _groups(where: str, raw, allow_extrapolation: bool) -> tuple:
     """``[[contact_groups]]`` tables to :class:`~passmd.model.arrangement.ContactGroup` s, each key
     checked."""
@@ -189,10 +185,10 @@ def _groups(where: str, raw, allow_extrapolation: bool) -> tuple:
     groups = []
     for i, table in enumerate(raw):
         label = f"{where}[{i}]"
-        unknown = [k for k in table if k not in _GROUP_KEYS]
+        unknown = [k for k in table if k not in GROUP_KEYS]
         if unknown:
             raise _refuse(f"{label}.{unknown[0]}", f"is not a key of a contact group: the known keys are "
-                          f"{', '.join(_GROUP_KEYS)}", name="contact_groups", value=table)
+                          f"{', '.join(GROUP_KEYS)}", name="contact_groups", value=table)
         values = {}
         for key, allowed, rule in (("count", None, "must be an integer >= 1"), ("side", (1, 2), "must be 1 "
                                    "or 2 (the side of the runner the group presses on)")):
@@ -207,7 +203,7 @@ def _groups(where: str, raw, allow_extrapolation: bool) -> tuple:
             values["contact_angle"] = _angle(f"{label}.contact_angle", table["contact_angle"])
         for key in ("load_share", "normal_force", "radius"):
             if key in table:
-                spec = DriveKey(f"contact_groups.{key}", _GROUP_KEYS[key], "", "", key, "",
+                spec = DriveKey(f"contact_groups.{key}", GROUP_KEYS[key], "", "", key, "",
                                 {"normal_force": "preload", "radius": "hemisphere_radius"}.get(key))
                 values[key] = _value(f"{label}.{key}", spec, table[key], allow_extrapolation)
                 if key == "load_share" and not values[key] > 0:
@@ -309,7 +305,7 @@ def read_drive_file(path, *, allow_extrapolation: bool | None = None) -> dict:
     if "contacts" in values and "contact_groups" in values:
         raise DriveFileError(f"{name}: contacts and contact_groups both given: give one (a preset, or the "
                              "groups)", name="contacts", value=values["contacts"])
-    dynamics = [key for key in _ACTUATOR_DYNAMICS if key in values]
+    dynamics = [key for key in ACTUATOR_DYNAMICS if key in values]
     if values.get("actuator_model") == "rigid" and dynamics:
         raise DriveFileError(f"{name}: {dynamics[0]} contradicts actuator_model = \"rigid\": ideally rigid "
                              "actuators have no stiffness, mass or damping; remove it, or set actuator_model "
@@ -336,7 +332,7 @@ def resolve(values: dict, origins: dict | None = None, **fixed) -> tuple[Drive, 
         sources.setdefault(key, f"default ({spec.source})")
 
     def get(key):
-        return values.get(key, _field(_DEFAULT, key))
+        return values.get(key, drive_value(_DEFAULT, key))
 
     radius = get("hemisphere_radius")
     base = actuator_for_radius(radius)
@@ -379,21 +375,6 @@ def resolve(values: dict, origins: dict | None = None, **fixed) -> tuple[Drive, 
     return replace(_DEFAULT, **changes), sources
 
 
-def _field(drive: Drive, key: str):
-    """The value of a drive-file key in ``drive`` (``contacts`` by preset name)."""
-    if key == "contacts":
-        return {1: "one", 6: "paper-six"}[drive.contacts] if not drive.contact_groups else drive.contacts
-    if key == "contact_groups":
-        return [{name: value for name, value in vars(g).items() if value is not None}
-                for g in drive.contact_groups]
-    if key == "actuator.damping_ratio":
-        return drive.actuator.damping_ratio
-    value = drive
-    for part in key.split("."):
-        value = getattr(value, part)
-    return value
-
-
 def load_drive(path, **fixed) -> Drive:
     """The :class:`~passmd.model.parameters.Drive` a drive file describes (module docstring).
 
@@ -413,118 +394,6 @@ def load_drive(path, **fixed) -> Drive:
 def parameter_rows(drive: Drive, sources: dict | None = None) -> list[dict]:
     """Every drive-file key of ``drive``: value (SI), unit, symbol, meaning and source."""
     sources = sources or {}
-    return [{"key": key, "value": _field(drive, key), "unit": spec.unit if spec.unit in SI_UNITS else "",
+    return [{"key": key, "value": drive_value(drive, key), "unit": spec.unit if spec.unit in SI_UNITS else "",
              "display_unit": spec.display, "symbol": spec.symbol, "meaning": spec.text,
              "source": sources.get(key, spec.source)} for key, spec in DRIVE_KEYS.items()]
-
-
-def _number(value: float) -> str:
-    """A float as TOML that reads back to the same double (``repr``, integers with ``.0``)."""
-    text = repr(float(value))
-    return text if any(c in text for c in ".en") else text + ".0"
-
-
-def _string(text: str) -> str:
-    """``text`` as a TOML string (tomli-w escapes quotes, backslashes, newlines and every control
-    character), so that any name reads back as written."""
-    import tomli_w
-
-    return tomli_w.dumps({"k": text}).partition(" = ")[2].rstrip("\n")
-
-
-def _shown(value, spec: DriveKey) -> str:
-    """A value as TOML: a string in the display unit when that reads back exactly, else SI."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, str):
-        return _string(value)
-    si_unit = "s" if spec.unit == "flyback" else spec.unit  # a stated fly-back time
-    if spec.display and spec.display != si_unit:
-        text = f"{float(from_si(value, spec.display)):.12g} {spec.display}"
-        if parse_quantity(text, si_unit) == value:
-            return f'"{text}"'
-    return _number(value)  # a bare number: SI
-
-
-def drive_toml(drive: Drive, sources: dict | None = None, *, title: str | None = None,
-               damping_ratio: float | None = None, notes=(), region=()) -> str:
-    """A commented drive file of ``drive``: :func:`load_drive` reads it back to an equal drive.
-
-    Every key is written, with its symbol, meaning, unit and source (``sources`` by key,
-    else the paper's source of the default). The viscosity is written as given (c_p), so that
-    it reads back exactly; ``damping_ratio``: write this ζ instead, for a drive whose c_p is
-    2ζ√(k_p m_a) of its own k_p and m_a (it then reads back exactly too, and ``drive show``
-    derives c_p from it). ``notes``: lines the header ends with; ``region``: a fit's region as
-    drive-file values at its points (:data:`REGION_KEY`, written last).
-    """
-    check_drive(drive)
-    sources = sources or {}
-    lines = [f"# {title or 'passmd drive file'}",
-             "# Values: a string with a unit (\"0.5 mm\", \"1.5e-5 kg\") or a bare number in SI units.",
-             "# Keys left out take the paper's value (Tables 1-2; the actuator of Table 2 for the radius;",
-             f"# c_p = 2ζ√(k_p m_a) with ζ = {ACTUATOR_DAMPING_RATIO:g} where the file gives neither).",
-             "# Another arrangement of contacts: instead of `contacts`, one [[contact_groups]] table per",
-             "# kind of contact (see the end of this file).",
-             "# `passmd drive show --drive FILE` lists what a file resolves to, with sources.",
-             *(f"# {line}" for line in notes)]
-    section = None
-    for key, spec in DRIVE_KEYS.items():
-        if key in ("actuator.damping_ratio", "contact_groups") or (
-                key == "contacts" and drive.contact_groups):
-            continue
-        head, _, name = key.rpartition(".")
-        if head != section:
-            lines += ["", f"[{head}]"] if head else [""]
-            section = head
-        value = _field(drive, key)
-        if key == "actuator.viscosity" and damping_ratio is not None:
-            key, name, value = "actuator.damping_ratio", "damping_ratio", float(damping_ratio)
-            spec = DRIVE_KEYS[key]
-        unit = f" [{spec.unit}]" if spec.unit in SI_UNITS and spec.unit else ""
-        source = sources.get(key, spec.source)
-        rigid = drive.actuator_model == "rigid" and key in _ACTUATOR_DYNAMICS
-        unused = "# (flexible actuators only) " if rigid else ""
-        lines.append(f"{unused}{name or key} = {_shown(value, spec)}  # {spec.symbol}: {spec.text}{unit}; "
-                     f"{source}")
-    for group in drive.contact_groups:  # arrays of tables come last in TOML
-        lines += ["", "[[contact_groups]]  # contacts of one kind: count, side, contact angle α, F_N per "
-                      "contact (or its share of F_p; else Eq. 1), radius R [m]"]
-        lines += [f"{name} = {_group_value(name, value)}" for name, value in _group_items(group)]
-    if not drive.contact_groups:  # the preset, written out as groups (commented: a file gives one of the two)
-        lines += ["", f"# `contacts = \"{_field(drive, 'contacts')}\"` written as contact groups (Eq. 1: "
-                      "each side carries F_p, a",
-                  "# contact at angle α carries F_N sin α of it); replace `contacts` by tables like these "
-                  "for another guide:"]
-        for group in preset_groups(drive.contacts):
-            lines += ["# [[contact_groups]]"] + [f"# {name} = {_group_value(name, value)}"
-                                                 for name, value in _group_items(group)]
-    if region:
-        lines += ["", "[fit_region]  # the fit's 95 % region: the fitted keys at the ends of each fitted "
-                      "parameter's region",
-                  "# (the others re-fitted there); passmd sweep and run with this file report the band "
-                      "these points span", "points = ["]
-        lines += [f"  {{{', '.join(f'{_toml_key(k)} = {_number(v)}' for k, v in point.items())}}},"
-                  for point in region]
-        lines.append("]")
-    return "\n".join(lines) + "\n"
-
-
-def _toml_key(key: str) -> str:
-    """A drive key inside an inline table: quoted when dotted (``"actuator.stiffness"``)."""
-    return f'"{key}"' if "." in key else key
-
-
-def _group_items(group: ContactGroup) -> list[tuple[str, object]]:
-    """The given fields of a group, in the order a drive file lists them (as :data:`_GROUP_KEYS`)."""
-    return [(name, getattr(group, name)) for name in _GROUP_KEYS if getattr(group, name) is not None]
-
-
-def _group_value(name: str, value) -> str:
-    """A contact group's value as TOML: counts and sides as integers, the angle in degrees when that
-    reads back exactly (else rad, SI), the rest as SI numbers."""
-    if name in ("count", "side"):
-        return str(value)
-    if name == "contact_angle":
-        text = f"{math.degrees(value):.12g} deg"
-        return f'"{text}"' if parse_angle(text) == value else _number(value)
-    return _number(value)

@@ -1,6 +1,7 @@
 """The keys a drive file may hold (:data:`DRIVE_KEYS`): each with its SI unit, display unit, symbol,
 meaning and the source of its default; and the drive files the package ships (the book's worked
-example, the ledger's joint reading). Read and written by :mod:`passmd.model.drive_file`."""
+example, the ledger's joint reading). Read by :mod:`passmd.model.drive_file`, written by
+:mod:`passmd.model.drive_writer`."""
 
 from __future__ import annotations
 
@@ -12,8 +13,8 @@ from pathlib import Path
 from passmd.model.parameters import PLAUSIBLE_RANGES, Drive
 from passmd.model.tables import ACTUATOR_DAMPING_RATIO
 
-__all__ = ["CONTACT_PRESETS", "DRIVE_KEYS", "EXAMPLE_DRIVE_FILE", "JOINT_READING_FILE", "SI_UNITS",
-           "DriveKey"]
+__all__ = ["ACTUATOR_DYNAMICS", "CONTACT_PRESETS", "DRIVE_KEYS", "EXAMPLE_DRIVE_FILE", "GROUP_KEYS",
+           "JOINT_READING_FILE", "SI_UNITS", "DriveKey", "drive_value"]
 
 
 @dataclass(frozen=True)
@@ -92,3 +93,24 @@ DRIVE_KEYS: dict[str, DriveKey] = {k.key: k for k in (
 
 #: The SI units a bare number of a drive file is read in.
 SI_UNITS = {"m", "kg", "s", "N", "N/m", "kg/s", "Pa", "V", "V/s", "Hz", ""}
+#: Keys of the actuators' dynamics (Eq. 3), which ideally rigid actuators do not have.
+ACTUATOR_DYNAMICS = ("actuator.stiffness", "actuator.mass", "actuator.viscosity", "actuator.damping_ratio")
+#: The keys of a ``[[contact_groups]]`` table, in the order a drive file lists them, with their SI unit
+#: ("angle": read by :func:`passmd.runtime.units.parse_angle`).
+GROUP_KEYS = {"count": "", "side": "", "contact_angle": "angle", "load_share": "", "normal_force": "N",
+              "radius": "m"}
+
+
+def drive_value(drive: Drive, key: str):
+    """The value of a drive-file key in ``drive`` (``contacts`` by preset name)."""
+    if key == "contacts":
+        return {1: "one", 6: "paper-six"}[drive.contacts] if not drive.contact_groups else drive.contacts
+    if key == "contact_groups":
+        return [{name: value for name, value in vars(g).items() if value is not None}
+                for g in drive.contact_groups]
+    if key == "actuator.damping_ratio":
+        return drive.actuator.damping_ratio
+    value = drive
+    for part in key.split("."):
+        value = getattr(value, part)
+    return value

@@ -50,13 +50,12 @@ from passmd.ledger.baseline import (  # re-exported: the tests and the command l
 from passmd.ledger.checks import ClaimFunctions, collect_claim_functions, extractor
 from passmd.ledger.claims import REPRODUCED, STATUSES, family_of, is_study, load_claims, required_keys
 from passmd.ledger.export import SI_UNITS, records  # re-exported: passmd ledger --json
-from passmd.ledger.joint import conflicting_pairs, elsewhere, judge, map_columns, state_name, tensions
+from passmd.ledger.joint import conflicting_pairs, held_out_judgements, judge, map_columns, tensions, variants
 from passmd.ledger.joint import joint_map as joint_map  # the ledger's views read it from here too
 from passmd.ledger.joint import joint_record as joint_record
 from passmd.ledger.verdicts import (
     EXPERIMENT_BASIS,
     NO_EXTRACTOR,
-    Judgement,
     claim_points,
     claim_row,
     not_informative,
@@ -221,61 +220,6 @@ def _design_problems(claim: Mapping, functions: ClaimFunctions, points) -> list[
     return problems
 
 
-def _variants(evaluated: Mapping, sections: Mapping, families: Mapping, voters: set, rows: list[dict],
-              studies: Mapping) -> list[dict]:
-    """How the in-sample joint reading changes when rows are left out (those decided only where a method
-    they rest on is undefined, e.g. Eq. 15) or when the studies (the substitute and derived rows, never
-    counted) are counted as claims."""
-    out = []
-    if studies:
-        with_studies = {**evaluated, **studies}
-        joint = judge(with_studies, sections, families, voters | set(studies))
-        out.append({"left_out": "studies counted as claims", "claims_left_out": [],
-                    "claims_added": sorted(studies), "reading": _plain(joint["point"]),
-                    "described": joint["described"], "holding": joint["holding"], "claims": joint["claims"]})
-    leave = {r["claim"] for r in rows if r["outside"]}
-    if leave:
-        kept = {c: v for c, v in evaluated.items() if c not in leave}
-        joint = judge(kept, sections, families, voters - leave)
-        out.append({"left_out": "rows decided only where a method they rest on is undefined left out",
-                    "claims_left_out": sorted(leave), "claims_added": [], "reading": _plain(joint["point"]),
-                    "described": joint["described"], "holding": joint["holding"], "claims": joint["claims"]})
-    return out
-
-
-def _plain(point: Mapping) -> dict:
-    """A point of the space with its free axes as plain keys (``key@section``)."""
-    return {readings.point_key(f): v for f, v in point.items()}
-
-
-def _judgements(claims: pd.DataFrame, evaluated: Mapping, joint: Mapping, sections: Mapping,
-                studies: set) -> dict[str, Judgement]:
-    """Where each claim is judged (``passmd.ledger.verdicts.Judgement``): a claim of the paper at
-    its unit's held-out point, a study at the defaults."""
-    states = joint["states"]
-    space, free_of = states["space"], states["free_of"]
-    runner_ups = [e["point"] for e in joint["runner_ups"]]
-    out = {}
-    for unit in joint["units"]:
-        at = joint["held_out"][unit.lead]
-        codes = joint["unit_states"][unit.lead]
-        for claim in unit.members:
-            mine = free_of[claim]
-            lead = claim == unit.lead
-            family = unit.members if len(unit.members) > 1 else ()
-            out[claim] = Judgement(
-                held_out=readings.claim_reading(space[at], mine),
-                in_sample=readings.claim_reading(space[joint["best"]], mine),
-                family_state=state_name(codes[at]) if lead and family else "",
-                family_at_defaults=state_name(codes[0]) if lead and family else "",
-                family=family, counted=lead, grid_bound=joint["grid_bound"].get(unit.lead, False),
-                elsewhere=elsewhere(claim, states, at),
-                runner_ups=tuple(readings.claim_reading(p, mine) for p in runner_ups))
-    for claim in studies:
-        out[claim] = Judgement(readings.default_reading(), readings.default_reading(), counted=False)
-    return out
-
-
 def evaluate(
     claims: pd.DataFrame | None = None,
     results: Mapping[str, pd.DataFrame] | None = None,
@@ -371,7 +315,7 @@ def evaluate(
     voters = {c for c, (points, _) in claims_of_paper.items()
               if points and c not in functions.experiment and not not_informative(functions, c)}
     joint = judge(claims_of_paper, sections, families, voters)
-    judgements = _judgements(claims, evaluated, joint, sections, studies)
+    judgements = held_out_judgements(joint, studies)
     rows, point_rows = [], []
     for _, claim in claims.iterrows():
         points, depends = evaluated[claim["id"]]
@@ -394,9 +338,9 @@ def evaluate(
         "reading": joint["point"],
         "held_out_counts": {s: sum(r["status"] == s for r in counted_rows) for s in STATUSES},
         "in_sample_gain": gain,
-        "variants": _variants(claims_of_paper, sections, families, voters,
-                              [r for r in rows if r["claim"] not in studies],
-                              {c: evaluated[c] for c in studies}),
+        "variants": variants(claims_of_paper, sections, families, voters,
+                             [r for r in rows if r["claim"] not in studies],
+                             {c: evaluated[c] for c in studies}),
     }
     table.attrs["conflicts"] = conflicts
     table.attrs["tensions"] = tensions(joint["states"], conflicts)

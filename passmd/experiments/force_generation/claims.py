@@ -20,6 +20,7 @@ tables of :mod:`passmd.experiments.force_generation.figures` (stalled runs only,
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 
 from passmd.experiments.force_generation.figures import (
     DEPENDENCE_PAIRS,
@@ -29,7 +30,6 @@ from passmd.experiments.force_generation.figures import (
     THIS,
     force_difference,
     model_rows,
-    readings_at,
 )
 from passmd.ledger.checks import (
     ClaimFails,
@@ -42,13 +42,30 @@ from passmd.ledger.checks import (
 )
 from passmd.model.tables import PRELOAD_GRIDS
 
-__all__ = ["DEPENDENCE_PERCENT", "dependence_pairs", "full_and_half_stroke"]
+__all__ = ["DEPENDENCE_PERCENT", "dependence_pairs", "full_and_half_stroke", "readings_at"]
 
 #: Axes of passmd.ledger.readings this paper's force runs depend on.
 _FORCE_AXES = ("flyback", "damping_ratio", "force_frequency")
 #: The smallest relative change of F_gen that counts as a dependence (%): 5 %, the scatter the force
 #: chapter allows single stalled forces (counter-steps of its trends).
 DEPENDENCE_PERCENT = 5.0
+
+
+def _at_reading(table, reading):
+    """The rows of a force readings table at a ledger reading: its fly-back rule, ζ and drive frequency."""
+    return table[(table["flyback"] == reading["flyback"])
+                 & np.isclose(table["damping_ratio"], float(reading["damping_ratio"]), rtol=1e-9, atol=0)
+                 & np.isclose(table["frequency_Hz"], float(reading["force_frequency"]), rtol=1e-9, atol=0)]
+
+
+def readings_at(results, reading) -> pd.DataFrame:
+    """The rows of ``fig7_readings`` at a ledger reading (fly-back rule, ζ, drive frequency). Raises
+    :class:`passmd.ledger.checks.NoRun` when the table holds none."""
+    rows = _at_reading(results["fig7_readings"], reading)
+    if rows.empty:
+        raise NoRun(f"no force runs of this paper's model with the {reading['flyback']} fly-back, "
+                    f"ζ = {reading['damping_ratio']:g} at {reading['force_frequency']:g} Hz")
+    return rows.reset_index(drop=True)
 
 
 def full_and_half_stroke(results, reading) -> dict:
@@ -84,10 +101,7 @@ def dependence_pairs(results, reading) -> dict:
     """This paper's F_gen (mN) of each pair of
     :data:`~passmd.experiments.force_generation.figures.DEPENDENCE_PAIRS` at a reading: ``{pair name:
     (base, changed)}`` (stalled runs only)."""
-    table = results["fig7_dependence_readings"]
-    rows = table[(table["flyback"] == reading["flyback"])
-                 & np.isclose(table["damping_ratio"], float(reading["damping_ratio"]), rtol=1e-9, atol=0)
-                 & np.isclose(table["frequency_Hz"], float(reading["force_frequency"]), rtol=1e-9, atol=0)]
+    rows = _at_reading(results["fig7_dependence_readings"], reading)
     if rows.empty:
         raise NoRun(f"no force-dependence runs at {reading}")
     out = {}

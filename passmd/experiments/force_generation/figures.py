@@ -1,7 +1,7 @@
 """Force generation against the load cell: Fig. 7 (Section 4.2).
 
 The measurement itself — runs from rest against the load cell until the steps stall, the
-stall criterion and the onset of force generation — is the protocol of
+stall criterion and the onset of force generation, with their assumptions — is the protocol of
 :mod:`passmd.protocols.stall`. This module runs it over the grids of the figures (through
 the sweep engine, cached). By momentum balance over a periodic (stalled) cycle F_gen equals the
 mean total friction force on the runner; the tests check that.
@@ -24,22 +24,14 @@ import pandas as pd
 
 from passmd.experiments import FigureSpec, ReadingTable
 from passmd.ledger import readings
-from passmd.ledger.checks import NoRun
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import MOLYBDENUM, STEEL, Drive, paper_drive
 from passmd.model.tables import ACTUATOR_DAMPING_RATIO, PRELOAD_GRIDS, Assumption, actuator_for_radius
 from passmd.model.theory import drive_theory
 from passmd.protocols import stall
 from passmd.protocols.critical_amplitude import critical_amplitude
-from passmd.protocols.stall import (
-    MAX_PERIODS,
-    STALL_ABS_TOLERANCE,
-    STALL_REL_TOLERANCE,
-    STALL_WINDOW,
-    force_onset,
-    generated_force,
-    stall_cycle,
-)
+from passmd.protocols.stall import force_onset, generated_force
+from passmd.protocols.stall_period import stall_cycle
 from passmd.runtime import sweep
 from passmd.runtime.config import PROFILES, RunConfig
 from passmd.runtime.validation import check_choice, check_range
@@ -49,7 +41,7 @@ __all__ = [
     "ONSET_TOLERANCE", "PANELS", "PANELS_FULL_STROKE_NM", "PROFILE_SETTINGS", "READING_TABLES",
     "RUNNER_MATERIALS", "THIS", "cycle_point", "fig7_dependence_readings", "fig7_difference", "fig7_readings",
     "fig7a", "fig7b", "fig7cycle", "fig7freq", "fig7grid",
-    "force_difference", "force_drive", "model_rows", "onset_point", "readings_at", "stall_point",
+    "force_difference", "force_drive", "model_rows", "onset_point", "stall_point",
 ]
 
 #: Saw-tooth frequency of every force run (Hz): Section 5.2's 100 Hz (Fig. 9a), as in the
@@ -63,6 +55,8 @@ MODELS = (
     ("rigid", 0.3, "rigid actuators, μ = 0.3 (earlier work [12])"),
     ("flexible", 0.2, "flexible actuators, μ = 0.2 (this paper)"),
 )
+#: The earlier model of [12] (rigid actuators, μ = 0.3) and this paper's (flexible, μ = 0.2).
+EARLIER, THIS = MODELS[0][:2], MODELS[1][:2]
 #: Fig. 7 panels: hemisphere radius (m) and the preloads shown (N).
 PANELS = {"fig7a": (1.0e-3, (0.3, 0.8)), "fig7b": (0.25e-3, (0.2, 0.4))}
 #: Full stroke A_max of each panel's radius (nm), the amplitude of the 115 mN claim for fig7a.
@@ -111,36 +105,6 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
             "several times more from one frequency to the next."
         ),
         sensitivity="Force chapter: F_gen at full amplitude from 90 Hz to 1.1 kHz (fig7freq).",
-    ),
-    Assumption(
-        key="force_stall_criterion",
-        symbol="F_gen",
-        value=(
-            f"k·x̄_r over the last period, once the geometric tail of its rise and its spread over the "
-            f"last {STALL_WINDOW} periods are below max({STALL_ABS_TOLERANCE * 1e3:g} mN, "
-            f"{STALL_REL_TOLERANCE:.1%}·F_gen); at most {MAX_PERIODS} periods"
-        ),
-        unit="N",
-        rationale=(
-            "Section 4.2 does not say when a simulated force was read. The runner starts at rest at "
-            "the load cell's free length and steps until the load stops it; near stall the force "
-            "approaches its limit geometrically, so the tail left is estimated from two half-windows "
-            "rather than read from the last step alone, which would stop early when the approach is "
-            "slow. The tolerance is far below the force's own scatter with the drive frequency."
-        ),
-        sensitivity="Force chapter: periods used and the estimated remaining rise of every point.",
-    ),
-    Assumption(
-        key="force_onset",
-        symbol="A_c (load cell)",
-        value="critical amplitude of the drive with the load cell engaged (steady-state protocol)",
-        unit="nm",
-        rationale=(
-            "A runner that makes no step from the free length never loads the cell, and one that "
-            "does keeps stepping until stall, so force generation starts at the critical amplitude; "
-            "it is found with the critical-amplitude chapters' protocol, load cell engaged."
-        ),
-        sensitivity="Force chapter: F_gen just below the onset is the load cell following the piezo.",
     ),
 )
 
@@ -216,7 +180,8 @@ def cycle_point(
     periods: int,
     samples_per_period: int,
 ) -> dict:
-    """:func:`~passmd.protocols.stall.stall_cycle` of the Fig. 7 drive at ``amplitude_fraction`` × A_max."""
+    """:func:`~passmd.protocols.stall_period.stall_cycle` of the Fig. 7 drive at ``amplitude_fraction``
+    × A_max."""
     drive = force_drive(hemisphere_radius, preload, actuator_model, friction_coefficient)
     fraction = check_range("amplitude_fraction", amplitude_fraction, 0.0, 1.0)
     return stall_cycle(drive, fraction * drive.actuator.full_stroke_amplitude, frequency, int(periods),
@@ -322,33 +287,29 @@ def fig7_readings(config: RunConfig) -> pd.DataFrame:
     ``READINGS_FRACTIONS`` of the stroke, at every point of the axes that change its runs:
     fly-back rule × actuator damping ζ × drive frequency (mN, nm; the default runs are the panels'
     own). Columns of :func:`fig7a`'s stall runs plus ``flyback`` and ``damping_ratio``."""
-    model, mu, _ = MODELS[1]
+    model, mu = THIS
+    runs = [{"hemisphere_radius": radius, "preload": float(p), "actuator_model": model,
+             "friction_coefficient": mu, "amplitude_fraction": float(a)}
+            for radius, preloads in PANELS.values() for p in preloads for a in READINGS_FRACTIONS]
+    return _reading_runs(runs, "fig7 readings", config)
+
+
+def _reading_runs(runs: list[dict], description: str, config: RunConfig, **labels: list) -> pd.DataFrame:
+    """Stall runs ``runs`` (sweep points without drive frequency, fly-back rule and ζ) at every reading of
+    the axes that change them, fly-back rule × ζ × drive frequency (the readings outermost): the columns
+    of :func:`_stall_frame` after ``flyback``, ``damping_ratio`` and one column per ``labels`` (a value
+    per run)."""
     points = []
     for reading in readings.design(("flyback", "damping_ratio", "force_frequency")):
         zeta = float(reading["damping_ratio"])
-        points.extend(
-            {"hemisphere_radius": radius, "preload": float(p), "actuator_model": model,
-             "friction_coefficient": mu, "amplitude_fraction": float(a),
-             "frequency": float(reading["force_frequency"]), **_flyback(reading["flyback"]),
-             **({} if zeta == ACTUATOR_DAMPING_RATIO else {"damping_ratio": zeta})}
-            for radius, preloads in PANELS.values() for p in preloads for a in READINGS_FRACTIONS)
-    table = _stall_frame(points, "fig7 readings", config)
+        points.extend({**run, "frequency": float(reading["force_frequency"]), **_flyback(reading["flyback"]),
+                       **({} if zeta == ACTUATOR_DAMPING_RATIO else {"damping_ratio": zeta})} for run in runs)
+    table = _stall_frame(points, description, config)
     table.insert(0, "flyback", [p.get("flyback", "slew") for p in points])
     table.insert(1, "damping_ratio", [p.get("damping_ratio", ACTUATOR_DAMPING_RATIO) for p in points])
+    for i, (name, values) in enumerate(labels.items(), start=2):
+        table.insert(i, name, values * (len(points) // len(runs)))  # the same runs at every reading
     return table
-
-
-def readings_at(results, reading) -> pd.DataFrame:
-    """The rows of ``fig7_readings`` at a ledger reading (fly-back rule, ζ, drive frequency). Raises
-    :class:`passmd.ledger.checks.NoRun` when the table holds none."""
-    table = results["fig7_readings"]
-    rows = table[(table["flyback"] == reading["flyback"])
-                 & np.isclose(table["damping_ratio"], float(reading["damping_ratio"]), rtol=1e-9, atol=0)
-                 & np.isclose(table["frequency_Hz"], float(reading["force_frequency"]), rtol=1e-9, atol=0)]
-    if rows.empty:
-        raise NoRun(f"no force runs of this paper's model with the {reading['flyback']} fly-back, "
-                    f"ζ = {reading['damping_ratio']:g} at {reading['force_frequency']:g} Hz")
-    return rows.reset_index(drop=True)
 
 
 #: The runs of :func:`fig7_dependence_readings`: what changes against what, each a pair of stall runs of
@@ -370,25 +331,14 @@ def fig7_dependence_readings(config: RunConfig) -> pd.DataFrame:
     at every point of the axes that change the force runs: fly-back rule × actuator damping ζ × drive
     frequency. Columns of :func:`fig7a`'s stall runs plus ``flyback``, ``damping_ratio``, ``runner``,
     ``pair`` and ``side`` (``base`` or ``changed``)."""
-    model = MODELS[1][0]
-    points, labels = [], []
-    for reading in readings.design(("flyback", "damping_ratio", "force_frequency")):
-        zeta = float(reading["damping_ratio"])
-        for pair, runs in DEPENDENCE_PAIRS.items():
-            for side, (radius, preload, fraction, mu, runner) in zip(("base", "changed"), runs, strict=True):
-                points.append({"hemisphere_radius": radius, "preload": preload, "actuator_model": model,
-                               "friction_coefficient": mu, "amplitude_fraction": float(fraction),
-                               "frequency": float(reading["force_frequency"]), **_flyback(reading["flyback"]),
-                               **({} if zeta == ACTUATOR_DAMPING_RATIO else {"damping_ratio": zeta}),
-                               **({} if runner == "steel" else {"runner": runner})})
-                labels.append((pair, side, runner))
-    table = _stall_frame(points, "fig7 dependence readings", config)
-    table.insert(0, "flyback", [p.get("flyback", "slew") for p in points])
-    table.insert(1, "damping_ratio", [p.get("damping_ratio", ACTUATOR_DAMPING_RATIO) for p in points])
-    table.insert(2, "runner", [label[2] for label in labels])
-    table.insert(3, "pair", [label[0] for label in labels])
-    table.insert(4, "side", [label[1] for label in labels])
-    return table
+    runs = [{"hemisphere_radius": radius, "preload": preload, "actuator_model": THIS[0],
+             "friction_coefficient": mu, "amplitude_fraction": float(fraction),
+             **({} if runner == "steel" else {"runner": runner})}
+            for both in DEPENDENCE_PAIRS.values() for radius, preload, fraction, mu, runner in both]
+    return _reading_runs(runs, "fig7 dependence readings", config,
+                         runner=[run.get("runner", "steel") for run in runs],
+                         pair=[pair for pair in DEPENDENCE_PAIRS for _ in ("base", "changed")],
+                         side=["base", "changed"] * len(DEPENDENCE_PAIRS))
 
 
 def fig7grid(config: RunConfig) -> pd.DataFrame:
@@ -413,6 +363,17 @@ CYCLE_COMBINATIONS = (("rigid", 0.3), ("rigid", 0.2), ("flexible", 0.3), ("flexi
 #: Radius (m) and amplitude fraction of the stall-cycle figure: Fig. 7a's drive at the full stroke
 #: (the paper profile's preload, 0.8 N, is the one of the 115 mN claim).
 CYCLE_DRIVE = (1.0e-3, 1.0)
+#: What the stall-cycle figure shows of a stall cycle (:func:`~passmd.protocols.stall_period.stall_cycle`),
+#: in its columns' order: the time series, then the run's measures (repeated on every row of the run).
+_CYCLE_ENTRIES = (
+    "time_s", "piezo_m", "runner_m", "load_cell_N", "friction_N", "friction_side1_N", "deflection_side1_m",
+    "slip_share_side1", "friction_side2_N", "deflection_side2_m", "slip_share_side2",
+    "generated_force_N", "sliding_capacity_N", "back_slide_m", "full_slip_time_s", "sample_spacing_s",
+    "deflection_before_flyback_side1_m", "deflection_before_flyback_side2_m", "mean_slip_share_side1",
+    "mean_slip_share_side2",
+)
+#: The figure's units of an SI entry, by the suffix naming its unit: (suffix shown, factor).
+_SHOWN_UNITS = {"_N": ("_mN", 1e3), "_m": ("_nm", 1e9), "_s": ("_us", 1e6)}
 
 
 def fig7cycle(config: RunConfig) -> pd.DataFrame:
@@ -437,31 +398,12 @@ def fig7cycle(config: RunConfig) -> pd.DataFrame:
     frames = []
     for (_, row), stalled in zip(cycles.iterrows(), stalls.itertuples(), strict=True):
         n = len(row["time_s"])
-        frame = {
-            "actuator_model": [row["actuator_model"]] * n,
-            "friction_coefficient": row["friction_coefficient"],
-            "time_us": row["time_s"] * 1e6,
-            "piezo_nm": row["piezo_m"] * 1e9,
-            "runner_nm": row["runner_m"] * 1e9,
-            "load_cell_mN": row["load_cell_N"] * 1e3,
-            "friction_mN": row["friction_N"] * 1e3,
-        }
-        for side in ("side1", "side2"):
-            frame[f"friction_{side}_mN"] = row[f"friction_{side}_N"] * 1e3
-            frame[f"deflection_{side}_nm"] = row[f"deflection_{side}_m"] * 1e9
-            frame[f"slip_share_{side}"] = row[f"slip_share_{side}"]
-        for key, factor, name in (
-            ("generated_force_N", 1e3, "generated_force_mN"),
-            ("sliding_capacity_N", 1e3, "sliding_capacity_mN"),
-            ("back_slide_m", 1e9, "back_slide_nm"),
-            ("full_slip_time_s", 1e6, "full_slip_time_us"),
-            ("sample_spacing_s", 1e6, "sample_spacing_us"),
-            ("deflection_before_flyback_side1_m", 1e9, "deflection_before_flyback_side1_nm"),
-            ("deflection_before_flyback_side2_m", 1e9, "deflection_before_flyback_side2_nm"),
-            ("mean_slip_share_side1", 1.0, "mean_slip_share_side1"),
-            ("mean_slip_share_side2", 1.0, "mean_slip_share_side2"),
-        ):
-            frame[name] = row[key] * factor
+        frame = {"actuator_model": [row["actuator_model"]] * n,
+                 "friction_coefficient": row["friction_coefficient"]}
+        for key in _CYCLE_ENTRIES:
+            si = next((suffix for suffix in _SHOWN_UNITS if key.endswith(suffix)), "")
+            shown, factor = _SHOWN_UNITS.get(si, ("", 1.0))
+            frame[key.removesuffix(si) + shown] = row[key] * factor
         frame["periods"] = int(stalled.periods)
         frames.append(pd.DataFrame(frame))
     out = pd.concat(frames, ignore_index=True)
@@ -469,10 +411,6 @@ def fig7cycle(config: RunConfig) -> pd.DataFrame:
     out.insert(0, "preload_N", preload)
     out.insert(0, "radius_mm", radius * 1e3)
     return out
-
-
-#: The earlier model of [12] (rigid actuators, μ = 0.3) and this paper's (flexible, μ = 0.2).
-EARLIER, THIS = MODELS[0][:2], MODELS[1][:2]
 
 
 def model_rows(table: pd.DataFrame, model: tuple, preload: float) -> pd.DataFrame:
@@ -537,13 +475,13 @@ FIGURES = (
                "force_generation", fig7grid, "force_generation:plot_grid"),
 )
 
-def _panel_grid(name: str):
-    return lambda profile: {"amplitudes (fractions of A_max)": PROFILE_SETTINGS[profile].panel_fractions}
+def _panel_grid(profile: str) -> dict:
+    return {"amplitudes (fractions of A_max)": PROFILE_SETTINGS[profile].panel_fractions}
 
 
 #: The chapter's profile-dependent grids (:data:`passmd.experiments.figure_table.GRIDS`).
 GRIDS = {
-    "fig7a": _panel_grid("fig7a"), "fig7b": _panel_grid("fig7b"),
+    "fig7a": _panel_grid, "fig7b": _panel_grid,
     "fig7grid": lambda profile: {"(radius, preload, amplitude)": tuple(
         (r, p, a) for r, preloads in PROFILE_SETTINGS[profile].grid_preloads.items() for p in preloads
         for a in PROFILE_SETTINGS[profile].grid_fractions)},

@@ -346,25 +346,6 @@ def _maximum_pair(first: pd.DataFrame, second: pd.DataFrame, column: str) -> dic
                    eq15_scope(second, float(b["frequency_kHz"])))
 
 
-@extractor("fig10a-1n-slower", depends_on=_OPTIMIZED_AXES)
-def _fig10a_1n_slower(results, reading):
-    return _maximum_pair(_fig10a_part(results, 1.0, reading), _fig10a_part(results, 0.4, reading),
-                         "velocity_mm_per_s")
-
-
-@extractor("fig10a-1n-larger-back-step", depends_on=_OPTIMIZED_AXES)
-def _fig10a_1n_back(results, reading):
-    return _maximum_pair(_fig10a_part(results, 1.0, reading), _fig10a_part(results, 0.4, reading),
-                         "back_step_nm")
-
-
-@extractor("fig10a-0.1n-smaller-back-step", depends_on=_OPTIMIZED_AXES)
-def _fig10a_01n_back(results, reading):
-    # the back-step at each preload's reachable maximum, as for 1 N: the velocity the sentence explains
-    return _maximum_pair(_fig10a_part(results, 0.1, reading), _fig10a_part(results, 0.4, reading),
-                         "back_step_nm")
-
-
 @extractor("fig10a-0.1n-stick-lost-above-80khz", depends_on=_OPTIMIZED_AXES)
 def _fig10a_stick(results, reading):
     part = _fig10a_part(results, 0.1, reading)
@@ -411,21 +392,8 @@ def _fig10a_01n_at_80_evidence(results):
             f"at {', '.join(f'{x:g}' for x in stick) or 'no grid frequency'} kHz"]
 
 
-@extractor("fig10a-0.1n-slightly-slower", depends_on=_OPTIMIZED_AXES)
-def _fig10a_01n_slower(results, reading):
-    return _maximum_pair(_fig10a_part(results, 0.1, reading), _fig10a_part(results, 0.4, reading),
-                         "velocity_mm_per_s")
-
-
 def _fig10b_part(results, radius_mm, reading):
     return _series(results, "fig10b", _optimized(reading), reading, radius_mm=radius_mm)
-
-
-@extractor("fig10b-r1-faster", depends_on=_OPTIMIZED_AXES)
-def _fig10b_faster(results, reading):
-    # 'a higher velocity': Fig. 10b's quantity is each radius's reachable maximal velocity
-    return _maximum_pair(_fig10b_part(results, 1.0, reading), _fig10b_part(results, 0.25, reading),
-                         "velocity_mm_per_s")
 
 
 @extractor("fig10b-r1-higher-max-frequency", depends_on=_OPTIMIZED_AXES)
@@ -439,20 +407,8 @@ def _fig10b_frequency(results, reading):
                    eq15_scope(r025, at025))
 
 
-@extractor("fig10b-r1-smaller-back-step", depends_on=_OPTIMIZED_AXES)
-def _fig10b_back(results, reading):
-    return _maximum_pair(_fig10b_part(results, 1.0, reading), _fig10b_part(results, 0.25, reading),
-                         "back_step_nm")
-
-
 def _fig10c_part(results, runner, reading):
     return _series(results, "fig10c", _optimized(reading), reading, runner=runner)
-
-
-@extractor("fig10c-youngs-modulus-negligible", depends_on=_OPTIMIZED_AXES)
-def _fig10c_negligible(results, reading):
-    return _maximum_pair(_fig10c_part(results, "molybdenum", reading),
-                         _fig10c_part(results, "steel", reading), "velocity_mm_per_s")
 
 
 @extractor("conclusion-youngs-modulus-weaker-than-preload-and-radius", depends_on=_OPTIMIZED_AXES)
@@ -472,7 +428,9 @@ def _conclusion_youngs(results, reading):
                     "resolution": 2 * _RESOLUTION["velocity_mm_per_s"]}, *scopes)
 
 
-# Evidence: the reachable maxima the Fig. 10 orderings compare, at the defaults.
+# The Fig. 10 orderings: one column at the reachable maxima of two series of one table
+# (_maximum_pair); each claim's extractor and its evidence (the maxima at the defaults) are made
+# from one row of _FIG10_ORDERINGS.
 
 def _maxima_evidence(results, key, column, unit, pairs):
     out = []
@@ -492,17 +450,37 @@ def _fig10_evidence(claim_id, key, column, unit, pairs):
     return evidence(claim_id)(lambda results: _maxima_evidence(results, key, column, unit, pairs))
 
 
-#: The evidence functions of the Fig. 10 claims, one per claim (found by passmd.ledger.checks).
-_FIG10_EVIDENCE = tuple(_fig10_evidence(*spec) for spec in (
-    ("fig10a-max-velocity-19mm_s", "fig10a", "velocity_mm_per_s", "mm/s", ({"preload": 0.4},)),
+def _fig10_ordering(claim_id, key, column, unit, pairs) -> tuple:
+    """The extractor and the evidence of one Fig. 10 ordering: ``column`` at the reachable maxima of
+    the two series ``pairs`` of table ``key`` (the first is the claim's left-hand side)."""
+    first, second = pairs
+
+    @extractor(claim_id, depends_on=_OPTIMIZED_AXES)
+    def ordering(results, reading):
+        return _maximum_pair(_series(results, key, _optimized(reading), reading, **first),
+                             _series(results, key, _optimized(reading), reading, **second), column)
+
+    return ordering, _fig10_evidence(claim_id, key, column, unit, pairs)
+
+
+#: The Fig. 10 orderings: (claim, table, column, unit, (the series of its left-hand side, of its right)).
+_FIG10_ORDERINGS = (
     ("fig10a-1n-slower", "fig10a", "velocity_mm_per_s", "mm/s", ({"preload": 1.0}, {"preload": 0.4})),
     ("fig10a-1n-larger-back-step", "fig10a", "back_step_nm", "nm", ({"preload": 1.0}, {"preload": 0.4})),
+    # the back-step at each preload's reachable maximum, as for 1 N: the velocity the sentence explains
     ("fig10a-0.1n-smaller-back-step", "fig10a", "back_step_nm", "nm", ({"preload": 0.1}, {"preload": 0.4})),
     ("fig10a-0.1n-slightly-slower", "fig10a", "velocity_mm_per_s", "mm/s",
      ({"preload": 0.1}, {"preload": 0.4})),
+    # 'a higher velocity': Fig. 10b's quantity is each radius's reachable maximal velocity
     ("fig10b-r1-faster", "fig10b", "velocity_mm_per_s", "mm/s", ({"radius_mm": 1.0}, {"radius_mm": 0.25})),
     ("fig10b-r1-smaller-back-step", "fig10b", "back_step_nm", "nm",
      ({"radius_mm": 1.0}, {"radius_mm": 0.25})),
     ("fig10c-youngs-modulus-negligible", "fig10c", "velocity_mm_per_s", "mm/s",
      ({"runner": "molybdenum"}, {"runner": "steel"})),
-))
+)
+#: The Fig. 10 orderings' extractors and evidence functions, and the evidence of the 0.4 N maximum
+#: (found by passmd.ledger.checks).
+_FIG10_FUNCTIONS = (
+    _fig10_evidence("fig10a-max-velocity-19mm_s", "fig10a", "velocity_mm_per_s", "mm/s", ({"preload": 0.4},)),
+    *(function for row in _FIG10_ORDERINGS for function in _fig10_ordering(*row)),
+)
