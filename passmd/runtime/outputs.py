@@ -145,13 +145,13 @@ def _link(source: str, target: str, path: str) -> tuple[int, int]:
     return identity.st_dev, identity.st_ino
 
 
-def _replace(source: str, target: str, folder: str) -> str | None:
+def _replace(source: str, target: str) -> str | None:
     """``source`` renamed over ``target`` (keeping ``target``'s permission bits); returns a second name
-    of the file replaced (in ``folder``), to put it back if the run fails, or None."""
+    of the file replaced (beside ``source``), to put it back if the run fails, or None."""
     previous = None
     with contextlib.suppress(FileNotFoundError):
         os.chmod(source, stat.S_IMODE(os.stat(target).st_mode))
-        previous = os.path.join(folder, ".previous")
+        previous = source + ".previous"  # (beside ``source``, in this run's private folder)
         try:
             os.link(target, previous)
         except OSError:  # no hard links here: the file replaced cannot be put back
@@ -216,7 +216,7 @@ def write_files(writers: Mapping[object, Callable[[str], None]], *, overwrite: b
             try:
                 if overwrite:
                     identity = _identity(staged[path])
-                    placed.append((target, identity, _replace(staged[path], target, folders[path])))
+                    placed.append((target, identity, _replace(staged[path], target)))
                 else:
                     placed.append((target, _link(staged[path], target, path), None))
             except OutputExists:
