@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from passmd.ledger.reference import write_reference_curves
-from passmd.runtime.scripts import run_script
+from passmd.runtime.scripts import ScriptError, run_script
 
 REPOSITORY_REFERENCE_DIR = Path(__file__).resolve().parents[1] / "passmd" / "data" / "reference"
 
@@ -26,7 +26,12 @@ def main() -> None:
     parser.add_argument("--overwrite", action="store_true",
                         help="replace the tables already there (default: off: a table there is refused)")
     args = parser.parse_args()
-    for path in write_reference_curves(args.out, overwrite=args.overwrite):
+    try:
+        written = write_reference_curves(args.out, overwrite=args.overwrite)
+    except FileExistsError as exc:
+        raise ScriptError(f"{exc.filename} is already there: pass --overwrite to replace the tables "
+                          "(none was written)") from None
+    for path in written:
         print("wrote", path)
 
 
