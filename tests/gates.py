@@ -13,7 +13,7 @@
   between two sweeps);
 * ``shutdown``: in the command, before a process pool's first shut-down (the pool is stopping);
 * ``publish``: in the command, once every output file is written to its temporary name, before
-  the first is linked to its own (:func:`passmd.runtime.outputs.create_exclusively`).
+  the first is put in place (:func:`passmd.runtime.outputs.write_files`).
 
 A hook writes the marker ``DIR/<moment>-<pid>`` and waits until the file ``DIR/open`` exists.
 The test waits for the markers it needs, sends its signal, then creates ``DIR/open``: the

@@ -609,7 +609,7 @@ def test_named_cases_cover_every_command():
 
 def test_output_files_are_complete_or_absent(tmp_path):
     """A write that fails half-way (full disk, Ctrl-C) leaves neither a partial file nor a temporary."""
-    from passmd.cli.streams import write_atomically
+    from passmd.runtime.outputs import write_file
 
     target = tmp_path / "series.csv"
 
@@ -618,9 +618,9 @@ def test_output_files_are_complete_or_absent(tmp_path):
         raise OSError(28, "No space left on device")
 
     with pytest.raises(OSError, match="No space"):
-        write_atomically(target, half_then_fail)
+        write_file(target, half_then_fail)
     assert list(tmp_path.iterdir()) == []
-    write_atomically(target, lambda tmp: Path(tmp).write_text("time_s\n0.0\n"))
+    write_file(target, lambda tmp: Path(tmp).write_text("time_s\n0.0\n"))
     assert target.read_text() == "time_s\n0.0\n"
     assert oct(target.stat().st_mode & 0o777) == oct(0o666 & ~_umask())
     assert [p.name for p in tmp_path.iterdir()] == ["series.csv"]

@@ -21,7 +21,7 @@ BASELINES = Path(__file__).parent
 
 def test_the_shipped_file_is_the_paper_baselines_joint_reading():
     """Regenerate with
-    ``passmd ledger --profile paper --write-drive passmd/data/drives/joint_reading.toml``."""
+    ``passmd ledger --profile paper --overwrite --write-drive passmd/data/drives/joint_reading.toml``."""
     reading = reading_from_baseline(BASELINES / "ledger_baseline_paper.csv")
     assert JOINT_READING_FILE.read_text(encoding="utf-8") == joint_drive_file(reading, "paper")
 

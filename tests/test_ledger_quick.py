@@ -11,7 +11,7 @@ claims.csv. After reviewing a change, record it with
 
 The paper test evaluates the book's own profile (minutes on two cores with an empty cache: the
 whole assumption space) and fails with the same diff; its baseline is recorded with
-``passmd ledger --profile paper --write-baseline tests/ledger_baseline_paper.csv``.
+``passmd ledger --profile paper --overwrite --write-baseline tests/ledger_baseline_paper.csv``.
 
 Both profiles evaluate every claim at the same readings, and the baselines record the claim's state
 at each (``states``). Where the quick profile decides a claim at a reading, the paper profile must
@@ -58,7 +58,7 @@ def test_quick_ledger_keeps_every_category():
     if os.environ.get("PASSMD_UPDATE_LEDGER_BASELINE") == "1":
         header = (f"ledger categories, quick profile; produced {datetime.date.today().isoformat()} by\n"
                   "PASSMD_UPDATE_LEDGER_BASELINE=1 pytest tests/test_ledger_quick.py")
-        evaluation.write_baseline(evaluated, BASELINES["quick"], header=header)
+        evaluation.write_baseline(evaluated, BASELINES["quick"], header=header, overwrite=True)
     baseline = _check_baseline("quick", claims, evaluated)
     assert evaluation.orphan_extractors(claims) == [], "extractors tagged for ids not in claims.csv"
     # The claim computed from closed forms needs no figure: a closed-form identity, it holds by construction.

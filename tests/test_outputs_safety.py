@@ -2,9 +2,9 @@
 
 Contract (README, "Reliability"):
 
-* an output file is replaced atomically only when it is a regular file or missing; a link
-  stays a link (its target is written), a device, a pipe or ``/dev/stdout`` is written to,
-  never replaced; a writer's temporary files never outlive it;
+* an output file is put in place atomically only when it is a regular file (replaced only with
+  ``--overwrite``) or missing; a link stays a link (its target is written), a device, a pipe or
+  ``/dev/stdout`` is written to, never replaced; a writer's temporary files never outlive it;
 * outputs that would destroy each other, an input or the command's own standard output, and
   empty path options, are refused before anything runs, with one line naming the options;
 * a command started with standard output closed ends quietly with the closed-pipe status 141;
@@ -38,11 +38,11 @@ from pathlib import Path
 import pytest
 
 from passmd.cli import main
-from passmd.cli.streams import write_atomically
 from passmd.ledger.claims import CLAIMS_PATH
 from passmd.model import waveforms
 from passmd.model.parameters import Drive
 from passmd.runtime import pools, progress, sweep
+from passmd.runtime.outputs import write_file
 from passmd.solver import simulation
 
 #: Generous limits: a refusal or a one-period run takes seconds (start-up included).
@@ -139,6 +139,10 @@ def test_link_to_a_regular_file_stays_a_link(tmp_path, json_output):
     link = tmp_path / "series.csv"
     link.symlink_to(real)
     done = passmd([*QUICK_RUN, "--csv", "series.csv", *_json_flag(json_output)], tmp_path)
+    # a regular file, through the link: refused, then replaced with --overwrite
+    assert_refused(done, "--csv series.csv is already there", "--overwrite")
+    assert real.read_text() == "old\n"
+    done = passmd([*QUICK_RUN, "--csv", "series.csv", "--overwrite", *_json_flag(json_output)], tmp_path)
     assert done.returncode == 0, done.stderr
     assert link.is_symlink() and link.resolve() == real
     assert real.read_text().startswith("time_s,")
@@ -155,7 +159,7 @@ def test_descriptor_link_to_a_regular_file_is_appended_to_not_replaced(tmp_path)
         held.flush()
         link = tmp_path / "fd-link"
         link.symlink_to(f"/proc/self/fd/{held.fileno()}")
-        write_atomically(link, lambda tmp: Path(tmp).write_text("time_s\n0.0\n"))
+        write_file(link, lambda tmp: Path(tmp).write_text("time_s\n0.0\n"))
         assert link.is_symlink() and os.readlink(link) == f"/proc/self/fd/{held.fileno()}"
     assert log.read_text() == "printed before\ntime_s\n0.0\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["fd-link", "out.txt"]
@@ -164,7 +168,7 @@ def test_descriptor_link_to_a_regular_file_is_appended_to_not_replaced(tmp_path)
 def test_dangling_link_gets_its_target_created(tmp_path):
     link = tmp_path / "series.csv"
     link.symlink_to("target.csv")
-    write_atomically(link, lambda tmp: Path(tmp).write_text("a\n"))
+    write_file(link, lambda tmp: Path(tmp).write_text("a\n"))
     assert link.is_symlink() and (tmp_path / "target.csv").read_text() == "a\n"
 
 
@@ -173,7 +177,7 @@ def test_fifo_is_written_to_not_replaced(tmp_path):
     os.mkfifo(fifo)
     reader = subprocess.Popen(["cat", str(fifo)], stdout=subprocess.PIPE)
     try:
-        write_atomically(fifo, lambda tmp: Path(tmp).write_text("time_s\n0.0\n"))
+        write_file(fifo, lambda tmp: Path(tmp).write_text("time_s\n0.0\n"))
         assert reader.communicate(timeout=HANG_S)[0] == b"time_s\n0.0\n"
     finally:
         reader.kill()
@@ -183,11 +187,11 @@ def test_fifo_is_written_to_not_replaced(tmp_path):
 
 
 def test_device_stays_a_device(tmp_path):
-    write_atomically("/dev/null", lambda tmp: Path(tmp).write_text("x\n"))
+    write_file("/dev/null", lambda tmp: Path(tmp).write_text("x\n"))
     assert stat.S_ISCHR(os.stat("/dev/null").st_mode)
     link = tmp_path / "null"
     link.symlink_to("/dev/null")
-    write_atomically(link, lambda tmp: Path(tmp).write_text("x\n"))
+    write_file(link, lambda tmp: Path(tmp).write_text("x\n"))
     assert link.is_symlink() and stat.S_ISCHR(os.stat(link).st_mode)
 
 
@@ -195,13 +199,13 @@ def test_replaced_file_keeps_its_permissions(tmp_path):
     target = tmp_path / "series.csv"
     target.write_text("old\n")
     target.chmod(0o600)
-    write_atomically(target, lambda tmp: Path(tmp).write_text("new\n"))
+    write_file(target, lambda tmp: Path(tmp).write_text("new\n"), overwrite=True)
     assert target.read_text() == "new\n" and stat.S_IMODE(target.stat().st_mode) == 0o600
 
 
 def test_a_writers_own_temporary_files_are_removed_when_it_is_interrupted(tmp_path):
-    """A writer that makes its own temporary beside the file it was given (as
-    ``passmd.report.evaluation.write_baseline`` does) and is interrupted leaves nothing behind."""
+    """A writer that makes its own temporary beside the file it was given and is interrupted leaves
+    nothing behind."""
     (tmp_path / "kept.txt").write_text("mine\n")
 
     def interrupted(tmp):
@@ -209,7 +213,7 @@ def test_a_writers_own_temporary_files_are_removed_when_it_is_interrupted(tmp_pa
         raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        write_atomically(tmp_path / "baseline.csv", interrupted)
+        write_file(tmp_path / "baseline.csv", interrupted)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["kept.txt"]
 
 

@@ -26,7 +26,7 @@ from passmd.runtime.validation import InputError, check_range
 __all__ = ["ACTUATOR_DYNAMICS", "AMPLITUDE", "CACHE_DIR_HELP", "DEFAULT_DRIVE", "DRIVE_QUANTITIES",
            "FREQUENCY", "MATERIAL_FLAGS", "NORMAL_FORCE", "OPTION_FOR", "QUANTITIES", "THRESHOLD",
            "TOLERANCE", "DirectoryPath", "FilePath", "Quantity", "add_drive_options",
-           "add_output_options", "add_simulation_options", "add_sweep_options"]
+           "add_output_options", "add_overwrite_option", "add_simulation_options", "add_sweep_options"]
 
 #: The drive every option replaces a part of (Tables 1–2 at R = 1 mm, F_p = 0.4 N, μ = 0.2).
 DEFAULT_DRIVE = Drive()
@@ -261,14 +261,24 @@ def add_simulation_options(parser, default_periods: int) -> None:
                        help="discrete MDR contacts with N springs (default: exact contact, N → ∞)")
 
 
+OVERWRITE_HELP = ("replace output files that are already there, atomically (default: off: an output file "
+                  "already there is refused before any work, and a new one is never put over a file)")
+
+
+def add_overwrite_option(group) -> None:
+    """--overwrite, on every command that writes files (:mod:`passmd.runtime.outputs`)."""
+    group.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
+
+
 def add_output_options(parser) -> None:
-    """--json, and the time series' --csv, --plot and --max-points."""
+    """--json, and the time series' --csv, --plot, --overwrite and --max-points."""
     group = parser.add_argument_group("output")
     group.add_argument("--json", action="store_true", help=JSON_HELP)
     group.add_argument("--csv", metavar="FILE", action=FilePath,
                        help="write the time series to FILE (CSV, SI units) (default: none)")
     group.add_argument("--plot", metavar="FILE", action=FilePath,
                        help="plot piezo and runner position to FILE (PNG) (default: none)")
+    add_overwrite_option(group)
     group.add_argument("--max-points", type=int, default=20000, metavar="N",
                        help="samples of the recorded time series (default: 20000)")
 

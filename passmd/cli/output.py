@@ -9,15 +9,15 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from pathlib import Path
 
 import numpy as np
 
 from passmd.cli.errors import UsageError
 from passmd.cli.result_bounds import ResultError
-from passmd.cli.streams import replaced_in
 from passmd.model.parameters import Drive
-from passmd.runtime.outputs import check_writable
+from passmd.runtime.outputs import check_writable, file_target
 from passmd.runtime.units import from_si
 
 __all__ = ["JSON_HELP", "check_output_file", "check_results", "describe", "drive_record", "emit_json",
@@ -35,8 +35,9 @@ def check_output_file(flag: str, name: str) -> None:
     parent = target.parent if str(target.parent) else Path(".")
     if not parent.is_dir():
         raise UsageError(f"cannot write {flag} {name}: directory {str(parent)!r} does not exist")
-    folder = replaced_in(name)
-    if folder is not None:  # a regular file (new or replaced) is made in its real folder: probe it
+    made_at = file_target(name)
+    if made_at is not None:  # a regular file (new or replaced) is made in its real folder: probe it
+        folder = os.path.dirname(made_at)
         try:
             check_writable(folder)
         except OSError as exc:

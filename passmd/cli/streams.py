@@ -11,12 +11,10 @@
   without (``>&-``): a closed standard output behaves as a closed pipe.
 * :func:`check_outputs` refuses, before anything runs, outputs that name one file twice, an
   input, or the regular file standard output or error goes to.
-* :func:`write_atomically` writes an output file completely or not at all, and never
-  replaces what is not a regular file (a link stays a link, a device or pipe is written to).
-* :func:`check_new_outputs` and :func:`create_outputs`: the files a command names itself
-  (``fit --out DIR``, ``sweep --out PREFIX``) are checked absent and their folder writable before
-  any work, then created all together or not at all, never over a file
-  (:mod:`passmd.runtime.outputs`).
+* :func:`check_new_outputs` and :func:`create_outputs`: a command's output files are checked
+  before any work (none a regular file already there unless ``--overwrite``; a folder the command
+  creates, writable), then written all together or not at all, new ones never over a file
+  (:mod:`passmd.runtime.outputs`); a link stays a link, a device or pipe is written to.
 """
 
 from __future__ import annotations
@@ -24,17 +22,15 @@ from __future__ import annotations
 import codecs
 import contextlib
 import os
-import shutil
 import stat
 import sys
-import tempfile
 
 from passmd.cli.errors import OutputError, UsageError
 from passmd.runtime import outputs
 
 __all__ = ["Out", "PipeClosed", "StdoutError", "available_memory", "check_new_outputs", "check_outputs",
            "create_outputs", "one_line_warnings", "reserve_closed_streams", "silence_stdout",
-           "use_ascii_fallback", "write_atomically"]
+           "use_ascii_fallback"]
 
 #: ASCII stand-ins for the symbols of the human output (consoles that cannot encode them).
 _ASCII = {"μ": "mu", "µ": "u", "×": "x", "–": "-", "—": "-", "…": "...", "→": "->", "≈": "~",
@@ -235,121 +231,74 @@ def check_outputs(outputs: dict[str, object], inputs: dict[str, object] | None =
                              "give the output a file of its own")
 
 
-def _through_descriptor_link(path) -> bool:
-    """Whether ``path`` is in /proc or /dev/fd or its links pass through them (``/dev/stdout`` →
-    ``/proc/self/fd/1``): it names an open descriptor's file, to be written to, never replaced."""
-    current = os.path.abspath(path)
-    for _ in range(40):  # the kernel's limit of links followed (ELOOP)
-        parent = os.path.realpath(os.path.dirname(current))
-        if parent in ("/proc", "/dev/fd") or parent.startswith("/proc/"):
-            return True
-        current = os.path.join(parent, os.path.basename(current))
-        if not os.path.islink(current):
-            return False
-        current = os.path.join(parent, os.readlink(current))
-    return False
+def _named(option: str, path: str) -> str:
+    """The output as the user named it: ``--csv out.csv``, or ``map.json (--out map)``."""
+    return option if option.endswith(f" {path}") else f"{path} ({option})"
 
 
-def _replaceable(path) -> str | None:
-    """The real path at which an atomic replace may put the new file, or None: write into ``path``.
+def check_new_outputs(named, *, overwrite: bool = False, folder=None, parents: bool = False) -> None:
+    """Before any work (:class:`UsageError`, exit 2): no output of ``named`` (path -> the option as
+    typed, ``"--csv out.csv"``, ``"--out results"``) is a regular file already there, unless
+    ``overwrite`` (a device, a pipe or a link to one is written into: never refused).
 
-    Only a regular file or a missing path, its links resolved (a link stays a link, its target
-    is replaced; a dangling link's target is created), and not reached through /proc.
-    """
-    if _through_descriptor_link(path):
-        return None
-    try:
-        mode = os.stat(path).st_mode
-    except FileNotFoundError:
-        return os.path.realpath(path)
-    return os.path.realpath(path) if stat.S_ISREG(mode) else None
-
-
-def replaced_in(path) -> str | None:
-    """The folder :func:`write_atomically` makes ``path``'s new file in, or None (written into)."""
-    target = _replaceable(path)
-    return None if target is None else os.path.dirname(target)
-
-
-def write_atomically(path, write) -> None:
-    """Call ``write(temporary_path)``, then put the complete file at ``path`` without destroying anything.
-
-    * A regular file or a missing path (links followed: the link stays, its target is
-      replaced) gets the new file moved into place atomically, from a private temporary
-      folder beside the target; an existing file keeps its permission bits, a new one gets
-      those of a plainly created file.
-    * Anything else (a device such as /dev/null, a FIFO, a terminal, ``/dev/stdout`` and every
-      path through /proc, whatever it leads to) is opened for appending and the new file's
-      bytes are copied into it: it is written to, never replaced or truncated.
-
-    An interrupted or failed write (Ctrl-C, SIGTERM, full disk) leaves no partial regular file
-    and no temporary file, not even one ``write`` made beside its own; the error propagates.
-    """
-    name = os.path.basename(os.fspath(path)) or "output"
-    target = _replaceable(path)
-    if target is not None and os.path.isfile(target):
-        mode = stat.S_IMODE(os.stat(target).st_mode)
-    else:
-        mask = os.umask(0)
-        os.umask(mask)
-        mode = 0o666 & ~mask  # as a plainly created file
-    folder = None
-    try:
-        folder = tempfile.mkdtemp(prefix=f".{name}-", suffix=".part",
-                                  dir=None if target is None else os.path.dirname(target))
-        tmp = os.path.join(folder, name)
-        with open(tmp, "xb"):
-            pass
-        os.chmod(tmp, mode)
-        write(tmp)
-        if target is None:
-            with open(tmp, "rb") as source, open(path, "ab") as sink:
-                shutil.copyfileobj(source, sink)
-        else:
-            os.chmod(tmp, mode)  # (in case ``write`` replaced the file)
-            os.replace(tmp, target)
-    finally:
-        if folder is not None:
-            shutil.rmtree(folder, ignore_errors=True)
-
-
-def check_new_outputs(option: str, paths, folder=None) -> None:
-    """Before any work (:class:`UsageError`, exit 2): none of ``paths`` exists (not even as a dangling
-    link) and files can be created in ``folder`` (default: the first path's; a folder the run will
-    create is probed in its parent). ``option`` is the option as typed (``"--out results"``)."""
-    paths = [os.fspath(p) for p in paths]
-    for path in paths:
-        try:
-            outputs.check_absent(path)
-        except outputs.OutputExists:
-            raise UsageError(f"{option}: {path} is already there: choose another name (the outputs are "
-                             "created new, never over a file)") from None
-    folder = os.fspath(folder) if folder is not None else os.path.dirname(paths[0]) or "."
+    With ``folder`` (the folder the outputs are made in, which the run may create: one level, or any
+    number with ``parents``), files must be creatable in it (or in its nearest existing ancestor),
+    and in the real folder of every output that a link leads elsewhere."""
+    for path, option in named.items():
+        path = os.fspath(path)
+        if outputs.is_taken(path) and not overwrite:
+            raise UsageError(f"{_shown(option, path)} is already there: pass --overwrite to replace it, or "
+                             "choose another name (an output never replaces a file unasked)")
+    if folder is None:
+        return
+    option = next(iter(named.values()))
+    folder = os.fspath(folder)
     probe = folder
-    if not os.path.lexists(folder):  # created by the run: one level, in an existing directory
+    if not os.path.lexists(folder):  # created by the run
         probe = os.path.dirname(os.path.abspath(folder))
+        while parents and not os.path.lexists(probe):
+            probe = os.path.dirname(probe)
         if not os.path.isdir(probe):
             raise UsageError(f"{option}: the directory {probe!r} does not exist")
     elif not os.path.isdir(folder):
         raise UsageError(f"{option}: {folder} is not a directory")
+    _probe(option, probe)
+    created = os.path.realpath(folder)
+    for path, option in named.items():
+        target = outputs.file_target(path)
+        if target is not None and os.path.dirname(target) not in (created, os.path.realpath(probe)):
+            _probe(_shown(option, os.fspath(path)), os.path.dirname(target))  # (through a link)
+
+
+def _shown(option: str, path: str) -> str:
+    """``--csv out.csv``, or ``--out map: map.json``: the option as typed, and the file if it is not it."""
+    return option if option.endswith(f" {path}") else f"{option}: {path}"
+
+
+def _probe(option: str, folder: str) -> None:
     try:
-        outputs.check_writable(probe)
+        outputs.check_writable(folder)
     except OSError as exc:
-        raise UsageError(f"{option}: cannot create files in {probe}: {exc.strerror or exc}") from None
+        raise UsageError(f"{option}: cannot create files in {folder}: {exc.strerror or exc}") from None
 
 
-def create_outputs(option: str, writers) -> None:
-    """Create every file of ``writers`` (path -> ``write(temporary_path)``) all together or not at all
-    (:func:`passmd.runtime.outputs.create_exclusively`): a file that appeared meanwhile (another run)
-    is kept and refused (:class:`UsageError`, exit 2), a failed write names its file
-    (:class:`OutputError`, exit 1); either way none of this run's files is left."""
+def create_outputs(writers, named, *, overwrite: bool = False) -> None:
+    """Write every file of ``writers`` (path -> ``write(temporary_path)``) all together or not at all
+    (:func:`passmd.runtime.outputs.write_files`); ``named``: path -> the option as typed. Without
+    ``overwrite`` a file that appeared meanwhile (another run) is kept and refused (:class:`UsageError`,
+    exit 2); a failed write names its file (:class:`OutputError`, exit 1); either way none of this
+    run's files is left."""
+    named = {os.fspath(path): option for path, option in named.items()}
     try:
-        outputs.create_exclusively(writers)
+        outputs.write_files(writers, overwrite=overwrite)
     except outputs.OutputExists as exc:
+        option = named[exc.filename]
         raise UsageError(f"{option}: {exc.filename} appeared while this run was writing (another run?): "
-                         "it is kept, and this run wrote none of its files") from None
+                         "it is kept, and this run wrote none of its files; pass --overwrite to replace "
+                         "it") from None
     except BrokenPipeError as exc:
         raise PipeClosed() from exc
     except OSError as exc:
-        raise OutputError(f"cannot write {exc.filename or option} ({option}): {exc.strerror or exc}; none of "
-                          "the run's files was written") from None
+        where = _named(named[exc.filename], exc.filename) if exc.filename in named else exc.filename
+        raise OutputError(f"cannot write {where}: {exc.strerror or exc}"
+                          + ("; none of the run's files was written" if len(named) > 1 else "")) from None

@@ -2,7 +2,8 @@
 computed at, its state at each of them, the reading its category was judged at (its held-out
 reading) and its reading at the in-sample joint reading (``tests/ledger_baseline_<profile>.csv``).
 
-:func:`write_baseline` records an evaluated ledger (:func:`passmd.report.evaluation.evaluate`),
+:func:`write_baseline` (:func:`baseline_csv`, its text) records an evaluated ledger
+(:func:`passmd.report.evaluation.evaluate`),
 :func:`load_baseline`, :func:`load_baseline_readings` and :func:`load_baseline_states` read one back,
 and :func:`check_categories` fails with a readable diff when any claim changed category.
 """
@@ -17,9 +18,10 @@ import pandas as pd
 
 from passmd.ledger import readings
 from passmd.runtime.inputs import read_text
+from passmd.runtime.outputs import write_file
 
-__all__ = ["READINGS_SEPARATOR", "STATE_LETTERS", "category_changes", "check_categories", "load_baseline",
-           "load_baseline_readings", "load_baseline_states", "readings_of", "write_baseline"]
+__all__ = ["READINGS_SEPARATOR", "STATE_LETTERS", "baseline_csv", "category_changes", "check_categories",
+           "load_baseline", "load_baseline_readings", "load_baseline_states", "readings_of", "write_baseline"]
 
 #: Separator of the readings in a baseline's ``readings`` column.
 READINGS_SEPARATOR = " | "
@@ -75,9 +77,8 @@ def load_baseline_states(path) -> dict[str, dict]:
                                                       table["joint"], strict=True)}
 
 
-def write_baseline(evaluated: pd.DataFrame, path, header: str = "") -> None:
-    """Write the claims' categories as a baseline CSV (``claim,status,readings,states,held_out,joint``),
-    atomically.
+def baseline_csv(evaluated: pd.DataFrame, header: str = "") -> str:
+    """The claims' categories as a baseline CSV (``claim,status,readings,states,held_out,joint``).
 
     ``readings`` lists the readings each category was computed at (from the row's
     ``depends_on``), so that two baselines are compared only where they evaluated the same
@@ -87,7 +88,6 @@ def write_baseline(evaluated: pd.DataFrame, path, header: str = "") -> None:
     the in-sample joint reading. ``header`` (e.g. the command and date that produced it) is written as
     ``#`` lines.
     """
-    path = Path(path)
     table = evaluated[["claim", "status"]].copy()
     depends = [tuple(d for d in text.split(";") if d) for text in evaluated["depends_on"]]
     table["readings"] = [READINGS_SEPARATOR.join(readings_of(d)) for d in depends]
@@ -96,12 +96,20 @@ def write_baseline(evaluated: pd.DataFrame, path, header: str = "") -> None:
                        for claim, d in zip(evaluated["claim"], depends, strict=True)]
     table["held_out"] = [r if r != "—" else "defaults" for r in evaluated["held_out_reading"]]
     table["joint"] = [r if r != "—" else "defaults" for r in evaluated["joint_reading"]]
-    tmp = path.with_name(f".{path.name}.tmp")
-    with open(tmp, "w", encoding="utf-8", newline="") as fh:
-        for line in header.splitlines():
-            fh.write(f"# {line}\n")
-        table.to_csv(fh, index=False, lineterminator="\n")
-    tmp.replace(path)
+    comments = "".join(f"# {line}\n" for line in header.splitlines())
+    return comments + table.to_csv(index=False, lineterminator="\n")
+
+
+def write_baseline(evaluated: pd.DataFrame, path, header: str = "", *, overwrite: bool = False) -> None:
+    """Write :func:`baseline_csv` to ``path``, completely or not at all
+    (:func:`passmd.runtime.outputs.write_file`).
+
+    A regular file already at ``path`` is replaced only with ``overwrite`` (else
+    :class:`~passmd.runtime.outputs.OutputExists`, a ``FileExistsError``, and the file is kept).
+    """
+    text = baseline_csv(evaluated, header)
+    write_file(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8", newline=""),
+               overwrite=overwrite)
 
 
 def category_changes(evaluated: pd.DataFrame, baseline: Mapping[str, str]) -> pd.DataFrame:

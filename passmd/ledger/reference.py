@@ -30,6 +30,7 @@ from passmd.model import hertz, theory
 from passmd.model.parameters import paper_drive
 from passmd.model.tables import PRELOAD_GRIDS, Assumption
 from passmd.runtime.inputs import decode_text, read_bounded
+from passmd.runtime.outputs import write_files
 from passmd.runtime.validation import check_choice
 
 __all__ = [
@@ -217,8 +218,9 @@ def curve_header(name: str, friction_coefficient: float = REFERENCE_FRICTION_COE
 CSV_FLOAT_FORMAT = "%.10g"
 
 
-def write_reference_curves(directory: str | os.PathLike) -> list[Path]:
-    """Write every table of :data:`CURVES` as ``<directory>/<name>.csv`` (atomically).
+def write_reference_curves(directory: str | os.PathLike, *, overwrite: bool = False) -> list[Path]:
+    """Write every table of :data:`CURVES` as ``<directory>/<name>.csv``, all or none
+    (:func:`passmd.runtime.outputs.write_files`).
 
     Parameters
     ----------
@@ -226,6 +228,9 @@ def write_reference_curves(directory: str | os.PathLike) -> list[Path]:
         Target folder, created if missing. There is no default: the package never writes
         into its own installation (``tools/make_reference_curves.py`` passes the
         repository's ``passmd/data/reference/``).
+    overwrite : bool
+        Replace tables already there (default False: a file there raises
+        :class:`~passmd.runtime.outputs.OutputExists`, a ``FileExistsError``, before any is written).
 
     Returns
     -------
@@ -235,18 +240,19 @@ def write_reference_curves(directory: str | os.PathLike) -> list[Path]:
     if directory is None:
         raise ValueError("directory = None is not allowed: give the folder to write the curves into")
     folder = Path(directory)
+    targets = {name: folder / spec.filename for name, spec in CURVES.items()}
     folder.mkdir(parents=True, exist_ok=True)
-    written = []
-    for name, spec in CURVES.items():
-        target = folder / spec.filename
-        tmp = target.with_name(f".{target.name}.{os.getpid()}.tmp")
-        with open(tmp, "w", encoding="utf-8", newline="") as fh:
-            fh.write(curve_header(name))
-            table = closed_form_curves(name)
-            table.to_csv(fh, index=False, float_format=CSV_FLOAT_FORMAT, lineterminator="\n")
-        os.replace(tmp, target)  # atomic: a reader never sees a half-written file
-        written.append(target)
-    return written
+
+    def writer(name):
+        def write(tmp):
+            with open(tmp, "w", encoding="utf-8", newline="") as fh:
+                fh.write(curve_header(name))
+                table = closed_form_curves(name)
+                table.to_csv(fh, index=False, float_format=CSV_FLOAT_FORMAT, lineterminator="\n")
+        return write
+
+    write_files({target: writer(name) for name, target in targets.items()}, overwrite=overwrite)
+    return list(targets.values())
 
 
 def load_reference_curve(name: str, directory: str | os.PathLike | None = None) -> pd.DataFrame:

@@ -1,23 +1,32 @@
-"""Output files created exclusively: all of a run's files or none, never over a file that is there.
+"""Output files: written completely at the end, all of a run's or none, never over a file unasked.
 
-A command whose outputs the package names (``fit --out DIR``: ``fit.json``, ``fit.png``,
-``fitted-drive.toml``; ``sweep --out PREFIX``: ``PREFIX.csv``, ``.json``, ``.png``) creates them
-with :func:`create_exclusively` at the end of a successful run:
+Every file the package writes (the command line's ``--csv``, ``--plot``, ``--out``,
+``--write-baseline``, ``--write-drive``, and the API's ``write_baseline``, ``write_measurements``,
+``write_reference_curves``) goes through :func:`write_files` (one file: :func:`write_file`):
 
-1. every target is checked absent (a file, a link, even a dangling one: :func:`check_absent`);
-2. each file is written completely to a temporary name beside its target (same folder, so the
-   next step is a link, never a copy);
-3. each temporary is linked to its target with ``os.link``, which fails with ``EEXIST`` if the
-   name exists (``os.rename``/``os.replace`` would replace it): a file that appeared meanwhile,
-   or a concurrent run writing the same outputs, keeps its file and this run stops with
-   :class:`OutputExists` naming it;
-4. on any failure (a write, a link, Ctrl-C) the links this run made are removed again, so a
-   failed run leaves none of its outputs; the temporaries are always removed.
+1. each output's path is resolved through its links (:func:`file_target`): a regular file or a
+   missing name gets a new regular file there (a link stays a link, its target is written; a
+   dangling link's target is created); anything else (a device such as ``/dev/null``, a named
+   pipe, a terminal, ``/dev/stdout`` and every path through ``/proc``) is written into, never
+   replaced or truncated;
+2. each file is written completely to a temporary name in a private folder beside its target
+   (same file system, so the next step is a link or a rename, never a copy);
+3. without ``overwrite``, each temporary is linked to its target with ``os.link``, which fails
+   with ``EEXIST`` if the name exists (``os.rename``/``os.replace`` would replace it): a file that
+   appeared meanwhile, or a concurrent run writing the same outputs, keeps its file and this run
+   stops with :class:`OutputExists` naming it. With ``overwrite``, each temporary replaces its
+   target atomically (``os.replace``; the file keeps its permission bits): whatever is there at
+   the end is replaced, since no check made before the rename could be atomic with it;
+4. the outputs that are written into come last, once every regular file is in place;
+5. on any failure (a write, a link, Ctrl-C) the files this run put in place are removed again, and
+   a file it replaced is put back, so a failed run leaves none of its outputs; the temporaries are
+   always removed.
 
-Of two runs writing the same outputs at once, the one that links the first file wins all of
-them (both link in the same order), and the other refuses. :func:`check_writable` probes a
-folder before any work, by creating (and removing) a file in it: permission bits, read-only
-file systems and special folders (``/proc``, ``/sys``) all answer, also for root.
+Of two runs writing the same new outputs at once, the one that links the first file wins all of
+them (both link in the same order), and the other refuses. :func:`is_taken` tells, before any work,
+whether an output would need ``overwrite``; :func:`check_writable` probes a folder by creating (and
+removing) a file in it: permission bits, read-only file systems and special folders (``/proc``,
+``/sys``) all answer, also for root.
 """
 
 from __future__ import annotations
@@ -26,24 +35,20 @@ import contextlib
 import errno
 import os
 import shutil
+import stat
 import tempfile
 from collections.abc import Callable, Mapping
 
-__all__ = ["OutputExists", "OutputWriteError", "check_absent", "check_writable", "create_exclusively"]
+__all__ = ["OutputExists", "OutputWriteError", "check_writable", "file_target", "is_taken", "write_file",
+           "write_files"]
 
 
 class OutputExists(FileExistsError):
-    """An output's name is taken (before the run, or by a file that appeared while it ran)."""
+    """An output's name is taken by a regular file (before the run, or one that appeared while it ran)."""
 
 
 class OutputWriteError(OSError):
     """Writing or linking one output failed; ``filename`` is that output."""
-
-
-def check_absent(path) -> None:
-    """Raise :class:`OutputExists` if anything, even a dangling link, has the name ``path``."""
-    if os.path.lexists(path):
-        raise OutputExists(errno.EEXIST, "already there", os.fspath(path))
 
 
 def check_writable(folder) -> None:
@@ -59,6 +64,42 @@ def check_writable(folder) -> None:
     os.unlink(probe)
 
 
+def _through_descriptor_link(path) -> bool:
+    """Whether ``path`` is in /proc or /dev/fd or its links pass through them (``/dev/stdout`` →
+    ``/proc/self/fd/1``): it names an open descriptor's file, to be written to, never replaced."""
+    current = os.path.abspath(path)
+    for _ in range(40):  # the kernel's limit of links followed (ELOOP)
+        parent = os.path.realpath(os.path.dirname(current))
+        if parent in ("/proc", "/dev/fd") or parent.startswith("/proc/"):
+            return True
+        current = os.path.join(parent, os.path.basename(current))
+        if not os.path.islink(current):
+            return False
+        current = os.path.join(parent, os.readlink(current))
+    return False
+
+
+def file_target(path) -> str | None:
+    """The real path at which ``path``'s new regular file is put, or None: ``path`` is written into.
+
+    Only a regular file or a missing path, its links resolved (a link stays a link, its target
+    is written; a dangling link's target is created), and not reached through /proc.
+    """
+    if _through_descriptor_link(path):
+        return None
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        return os.path.realpath(path)
+    return os.path.realpath(path) if stat.S_ISREG(mode) else None
+
+
+def is_taken(path) -> bool:
+    """Whether a regular file (through links) is at ``path``: only ``overwrite`` may replace it."""
+    target = file_target(path)
+    return target is not None and os.path.isfile(target)
+
+
 def _plain_mode() -> int:
     """The permission bits of a plainly created file (0666 less the umask)."""
     mask = os.umask(0)
@@ -67,27 +108,33 @@ def _plain_mode() -> int:
 
 
 def _before_linking() -> None:
-    """Called once every output is written, before the first is linked (a test's gate hooks here)."""
+    """Called once every output is written, before the first is put in place (a test's gate hooks here)."""
 
 
-def _link(source: str, target: str) -> bool:
-    """``target`` made a new name of ``source`` (True); ``OutputExists`` if ``target`` exists.
+def _identity(path) -> tuple[int, int]:
+    info = os.stat(path)
+    return info.st_dev, info.st_ino
+
+
+def _link(source: str, target: str, path: str) -> tuple[int, int]:
+    """``target`` made a new name of ``source``; ``OutputExists`` (naming ``path``) if ``target`` exists.
 
     Where the file system has no hard links, ``target`` is created with ``O_EXCL`` and the
-    bytes copied (False): still never over an existing file.
+    bytes copied: still never over an existing file. Returns the identity of the file at ``target``.
     """
     try:
         os.link(source, target)
-        return True
+        return _identity(source)
     except FileExistsError:
-        raise OutputExists(errno.EEXIST, "appeared while the run was writing", target) from None
+        raise OutputExists(errno.EEXIST, "appeared while the run was writing", path) from None
     except OSError as exc:
         if exc.errno not in (errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP, errno.EXDEV, errno.EMLINK):
             raise
     try:
-        fd = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL, _plain_mode())
+        fd = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL, stat.S_IMODE(os.stat(source).st_mode))
     except FileExistsError:
-        raise OutputExists(errno.EEXIST, "appeared while the run was writing", target) from None
+        raise OutputExists(errno.EEXIST, "appeared while the run was writing", path) from None
+    identity = os.fstat(fd)
     try:
         with open(source, "rb") as src, os.fdopen(fd, "wb") as sink:
             shutil.copyfileobj(src, sink)
@@ -95,48 +142,105 @@ def _link(source: str, target: str) -> bool:
         with contextlib.suppress(OSError):
             os.unlink(target)
         raise
-    return False
+    return identity.st_dev, identity.st_ino
 
 
-def create_exclusively(writers: Mapping[object, Callable[[str], None]]) -> None:
-    """Create every file of ``writers`` (path -> ``write(temporary_path)``), all or none.
+def _replace(source: str, target: str) -> str | None:
+    """``source`` renamed over ``target`` (keeping ``target``'s permission bits); returns a second name
+    of the file replaced (beside ``source``), to put it back if the run fails, or None."""
+    previous = None
+    with contextlib.suppress(FileNotFoundError):
+        os.chmod(source, stat.S_IMODE(os.stat(target).st_mode))
+        previous = source + ".previous"  # (beside ``source``, in this run's private folder)
+        try:
+            os.link(target, previous)
+        except OSError:  # no hard links here: the file replaced cannot be put back
+            previous = None
+    os.replace(source, target)
+    return previous
 
-    See the module docstring. Raises :class:`OutputExists` (a target is there, or appeared),
-    :class:`OutputWriteError` (a write or link failed; ``filename`` is the output), or whatever
-    interrupted the run; in every case none of the outputs is left and no temporary either.
+
+def _undo(target: str, identity: tuple[int, int], previous: str | None) -> None:
+    """Remove this run's file at ``target`` (or put back the one it replaced), if it is still there."""
+    with contextlib.suppress(OSError):
+        if _identity(target) != identity:
+            return  # not this run's file any more
+        if previous is not None:
+            os.replace(previous, target)
+        else:
+            os.unlink(target)
+
+
+def write_files(writers: Mapping[object, Callable[[str], None]], *, overwrite: bool = False) -> None:
+    """Write every file of ``writers`` (path -> ``write(temporary_path)``), all or none.
+
+    See the module docstring. Raises :class:`OutputExists` (without ``overwrite``, a regular file
+    is there), :class:`OutputWriteError` (a write or link failed; ``filename`` is the output as
+    given), ``BrokenPipeError`` (a pipe written into lost its reader), or whatever interrupted the
+    run; in every case none of the outputs is left (a file replaced is put back) and no temporary
+    either.
     """
-    targets = [os.fspath(path) for path in writers]
-    for target in targets:
-        check_absent(target)
+    paths = [os.fspath(path) for path in writers]
+    targets = {path: file_target(path) for path in paths}
+    if not overwrite:
+        for path in paths:
+            if is_taken(path):
+                raise OutputExists(errno.EEXIST, "already there (overwrite replaces it)", path)
     mode = _plain_mode()
-    temporaries: dict[str, str] = {}
-    linked: list[tuple[str, bool]] = []
+    folders: dict[str, str] = {}
+    staged: dict[str, str] = {}
+    placed: list[tuple[str, tuple[int, int], str | None]] = []
     try:
-        for target, write in zip(targets, writers.values(), strict=True):
-            folder = os.path.dirname(os.path.abspath(target))
+        for path, write in zip(paths, writers.values(), strict=True):
+            target = targets[path]
+            name = os.path.basename(target or path) or "output"
             try:
-                fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(target)}.", suffix=".part", dir=folder)
-                os.close(fd)
-                temporaries[target] = tmp
+                folders[path] = tempfile.mkdtemp(prefix=f".{name}-", suffix=".part",
+                                                 dir=None if target is None else os.path.dirname(target))
+                tmp = os.path.join(folders[path], name)
+                with open(tmp, "xb"):
+                    pass
                 os.chmod(tmp, mode)
                 write(tmp)
+                os.chmod(tmp, mode)  # (in case ``write`` replaced the file)
+                staged[path] = tmp
+            except BrokenPipeError:
+                raise
             except OSError as exc:
-                raise OutputWriteError(exc.errno, exc.strerror or str(exc), target) from exc
+                raise OutputWriteError(exc.errno, exc.strerror or str(exc), path) from exc
         _before_linking()
-        for target in targets:
+        for path in paths:
+            target = targets[path]
+            if target is None:
+                continue
             try:
-                linked.append((target, _link(temporaries[target], target)))
+                if overwrite:
+                    identity = _identity(staged[path])
+                    placed.append((target, identity, _replace(staged[path], target)))
+                else:
+                    placed.append((target, _link(staged[path], target, path), None))
             except OutputExists:
                 raise
             except OSError as exc:
-                raise OutputWriteError(exc.errno, exc.strerror or str(exc), target) from exc
+                raise OutputWriteError(exc.errno, exc.strerror or str(exc), path) from exc
+        for path in paths:  # written into (a device, a pipe, /dev/stdout): last, it cannot be undone
+            if targets[path] is None:
+                try:
+                    with open(staged[path], "rb") as source, open(path, "ab") as sink:
+                        shutil.copyfileobj(source, sink)
+                except BrokenPipeError:
+                    raise
+                except OSError as exc:
+                    raise OutputWriteError(exc.errno, exc.strerror or str(exc), path) from exc
     except BaseException:
-        for target, hard in linked:  # only the names this run created (a link: still its own file)
-            with contextlib.suppress(OSError):
-                if not hard or os.path.samefile(target, temporaries[target]):
-                    os.unlink(target)
+        for target, identity, previous in reversed(placed):
+            _undo(target, identity, previous)
         raise
     finally:
-        for tmp in temporaries.values():
-            with contextlib.suppress(OSError):
-                os.unlink(tmp)
+        for folder in folders.values():
+            shutil.rmtree(folder, ignore_errors=True)
+
+
+def write_file(path, write: Callable[[str], None], *, overwrite: bool = False) -> None:
+    """Write one file with ``write(temporary_path)``: :func:`write_files` of ``{path: write}``."""
+    write_files({path: write}, overwrite=overwrite)

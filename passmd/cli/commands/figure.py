@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import re
 import sys
 import textwrap
@@ -9,10 +10,10 @@ from pathlib import Path
 
 from passmd.cli.configuration import run_config
 from passmd.cli.errors import NotAvailableError, OutputError, UsageError
-from passmd.cli.options import DirectoryPath, add_sweep_options
+from passmd.cli.options import DirectoryPath, add_overwrite_option, add_sweep_options
 from passmd.cli.output import JSON_HELP, emit_json
 from passmd.cli.result_bounds import check_table
-from passmd.cli.streams import PipeClosed, check_outputs, write_atomically
+from passmd.cli.streams import check_new_outputs, check_outputs, create_outputs
 from passmd.runtime.cache import describe_default_cache_dir
 from passmd.runtime.config import ENVIRONMENT, PROFILES
 
@@ -40,6 +41,7 @@ def add_parser(command) -> None:
                    help="resolution: quick (CI) or paper (the paper's grids) (default: paper)")
     p.add_argument("--out", metavar="DIR", default=".", action=DirectoryPath,
                    help="directory for NAME.csv and NAME.png (default: .)")
+    add_overwrite_option(p)
     add_sweep_options(p)
     p.add_argument("--json", action="store_true", help=JSON_HELP)
     p.set_defaults(handler=run_figure)
@@ -65,41 +67,61 @@ def _check_name(args, names) -> None:
         raise NotAvailableError(f"figure {args.name!r} is {NOT_AVAILABLE} (available: {known})")
 
 
+def _files(args) -> dict[Path, str]:
+    """NAME.csv and NAME.png in --out: path -> the option as typed."""
+    target = Path(args.out)
+    return {target / f"{args.name}{suffix}": f"--out {args.out}" for suffix in (".csv", ".png")}
+
+
 def _check_out(args, config) -> None:
-    """--out: a directory (or one to create); NAME.csv and NAME.png neither the sweep log nor
-    the file standard output goes to (blank names are refused by the parser)."""
+    """--out: a directory (or one to create) files can be created in; NAME.csv and NAME.png neither
+    there already (unless --overwrite), nor the sweep log or the file standard output goes to (blank
+    names are refused by the parser)."""
     if Path(args.out).exists() and not Path(args.out).is_dir():
         raise OutputError(f"cannot write to --out {args.out}: it is not a directory")
-    target = Path(args.out)
-    check_outputs({f"{target / name} (--out {args.out})": target / name
-                   for name in (f"{args.name}.csv", f"{args.name}.png")}
+    files = _files(args)
+    check_outputs({f"{path} (--out {args.out})": path for path in files}
                   | {f"{ENVIRONMENT['sweep_log']} {config.sweep_log}": config.sweep_log})
+    check_new_outputs(files, overwrite=args.overwrite, folder=args.out, parents=True)
 
 
 def _write(figure_table, provenance, args, data) -> tuple[Path, Path]:
-    """NAME.csv (with the provenance header) and NAME.png in --out, each written atomically."""
-    target = Path(args.out)
-    csv_path, png_path = target / f"{args.name}.csv", target / f"{args.name}.png"
+    """NAME.csv (with the provenance header) and NAME.png in --out, written together or not at all,
+    never over a file unless --overwrite (:func:`passmd.cli.streams.create_outputs`); the folders the
+    command created are removed again if that fails."""
+    files = _files(args)
+    csv_path, png_path = files
+    fig = figure_table.figure_plot(args.name, data)
+
+    def write_csv(tmp):  # '#' lines: version, commit, profile
+        with open(tmp, "w", encoding="utf-8", newline="") as fh:
+            fh.write(provenance.csv_header(args.profile))
+            data.to_csv(fh, index=False, lineterminator="\n")
+
+    created = _make_folders(Path(args.out))
     try:
-        target.mkdir(parents=True, exist_ok=True)
-
-        def write_csv(tmp):  # '#' lines: version, commit, profile
-            with open(tmp, "w", encoding="utf-8", newline="") as fh:
-                fh.write(provenance.csv_header(args.profile))
-                data.to_csv(fh, index=False, lineterminator="\n")
-
-        write_atomically(csv_path, write_csv)
-        fig = figure_table.figure_plot(args.name, data)
-        write_atomically(png_path, lambda tmp: fig.savefig(
-            tmp, dpi=150, format="png", metadata={"Description": provenance.summary(args.profile)}))
-    except BrokenPipeError as exc:  # (--out /dev/fd: a reader that went away)
-        raise PipeClosed() from exc
-    except OSError as exc:
-        raise OutputError(f"cannot write to --out {args.out}: {exc.strerror or exc}") from exc
+        create_outputs({csv_path: write_csv, png_path: lambda tmp: fig.savefig(
+            tmp, dpi=150, format="png", metadata={"Description": provenance.summary(args.profile)})},
+            files, overwrite=args.overwrite)
+    except BaseException:
+        for folder in reversed(created):
+            with contextlib.suppress(OSError):
+                folder.rmdir()  # only while empty
+        raise
     pyplot = sys.modules.get("matplotlib.pyplot")
     if pyplot is not None:
         pyplot.close(fig)
     return csv_path, png_path
+
+
+def _make_folders(folder: Path) -> list[Path]:
+    """Create ``folder`` and its missing parents; the ones created, outermost first."""
+    missing = [p for p in (folder, *folder.parents) if not p.exists()][::-1]
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"cannot write to --out {folder}: {exc.strerror or exc}") from exc
+    return missing
 
 
 def run_figure(args, out) -> int:

@@ -15,6 +15,7 @@ from passmd.cli.options import (
     DRIVE_QUANTITIES,
     DirectoryPath,
     add_drive_options,
+    add_overwrite_option,
     add_sweep_options,
 )
 from passmd.cli.output import (
@@ -106,7 +107,8 @@ def add_parser(command) -> None:
     out.add_argument("--json", action="store_true", help=JSON_HELP)
     out.add_argument("--out", metavar="DIR", action=DirectoryPath,
                      help="write " + ", ".join(_OUTPUTS) + " to DIR (created if missing; never replaces "
-                          "a file) (default: none)")
+                          "a file unless --overwrite) (default: none)")
+    add_overwrite_option(out)
     p.set_defaults(handler=run_fit)
 
 
@@ -168,19 +170,25 @@ def _progress(config):
 
 def _check_out(args) -> Path | None:
     """--out before any work: a directory (or one to create in an existing one) that files can be
-    created in, none of the outputs there yet (exit 2 naming the file)."""
+    created in, none of the outputs there yet unless --overwrite (exit 2 naming the file)."""
     if args.out is None:
         return None
     target = Path(args.out)
     if target.exists() and not target.is_dir():
         raise UsageError(f"--out = {args.out!r} is not a directory")
-    check_new_outputs(f"--out {args.out}", [target / name for name in _OUTPUTS], folder=target)
+    check_new_outputs(_named(target), overwrite=args.overwrite, folder=target)
     return target
 
 
-def _write(target: Path, result, record: dict, text: str) -> None:
-    """fit.json, fit.png and fitted-drive.toml created together or not at all, never over a file
-    (:func:`passmd.cli.streams.create_outputs`); a folder the fit created is removed on failure."""
+def _named(target: Path) -> dict[Path, str]:
+    """fit.json, fit.png and fitted-drive.toml in --out: path -> the option as typed."""
+    return {target / name: f"--out {target}" for name in _OUTPUTS}
+
+
+def _write(target: Path, result, record: dict, text: str, overwrite: bool) -> None:
+    """fit.json, fit.png and fitted-drive.toml written together or not at all, never over a file
+    unless ``overwrite`` (:func:`passmd.cli.streams.create_outputs`); a folder the fit created is
+    removed on failure."""
     from passmd.plots.fit import fit_figure
 
     fig = fit_figure(result.residual_table())  # before any file is written: a failing figure leaves none
@@ -193,11 +201,11 @@ def _write(target: Path, result, record: dict, text: str) -> None:
     except OSError as exc:
         raise OutputError(f"cannot create the directory {target} ({option}): {exc.strerror or exc}") from None
     try:
-        create_outputs(option, {
+        create_outputs({
             target / "fit.json": lambda tmp: Path(tmp).write_text(json.dumps(plain(record), indent=2) + "\n"),
             target / "fit.png": lambda tmp: fig.savefig(tmp, dpi=150, format="png"),
             target / "fitted-drive.toml": lambda tmp: Path(tmp).write_text(text, encoding="utf-8"),
-        })
+        }, _named(target), overwrite=overwrite)
     except BaseException:
         if created:
             with contextlib.suppress(OSError):
@@ -241,7 +249,7 @@ def run_fit(args, out) -> int:
     record = {"command": "fit", **result.report(), "drive": drive_record(result.drive)}
     check_results(record)
     if target is not None:
-        _write(target, result, record, text)
+        _write(target, result, record, text, args.overwrite)
     if args.json:
         emit_json(record, out)
         return 0

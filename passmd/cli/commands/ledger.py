@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import datetime
 import textwrap
+from pathlib import Path
 
 from passmd.cli.configuration import run_config
-from passmd.cli.errors import OutputError
-from passmd.cli.options import FilePath, add_sweep_options
+from passmd.cli.options import FilePath, add_overwrite_option, add_sweep_options
 from passmd.cli.output import JSON_HELP, check_output_file, emit_json
 from passmd.cli.result_bounds import check_table
-from passmd.cli.streams import PipeClosed, check_outputs, write_atomically
+from passmd.cli.streams import check_new_outputs, check_outputs, create_outputs
 from passmd.runtime.cache import DEFAULT_CACHE_DIR, describe_default_cache_dir
 from passmd.runtime.config import ENVIRONMENT, PROFILES
 
@@ -52,52 +52,56 @@ def add_parser(command) -> None:
     p.add_argument("--write-drive", metavar="TOML", default=None, action=FilePath,
                    help="also write the joint reading as a drive file: its drive axes as keys, its "
                         "protocol axes as the commands' options in its header (default: none)")
+    add_overwrite_option(p)
     add_sweep_options(p)
     p.add_argument("--json", action="store_true", help=JSON_HELP)
     p.set_defaults(handler=run_ledger)
 
 
+def _given(args) -> list[tuple[str, str]]:
+    """(option, path) of --write-baseline and --write-drive, where given."""
+    return [(option, name) for option, name in (("--write-baseline", args.write_baseline),
+                                                ("--write-drive", args.write_drive)) if name is not None]
+
+
+def _named(args) -> dict[str, str]:
+    """path -> the option as typed (``--write-drive joint.toml``)."""
+    return {name: f"{option} {name}" for option, name in _given(args)}
+
+
 def _check_outputs(args, config) -> None:
     """--write-baseline and --write-drive, before the ledger is computed: files in existing
-    directories, not the claims table the ledger reads, the sweep log or the file standard output
-    goes to, nor each other."""
+    directories, not there already (unless --overwrite), not the claims table the ledger reads, the
+    sweep log or the file standard output goes to, nor each other."""
     from passmd.ledger.claims import CLAIMS_PATH
 
-    names = {option: name for option, name in (("--write-baseline", args.write_baseline),
-                                               ("--write-drive", args.write_drive)) if name is not None}
-    if not names:
+    if not _given(args):
         return
-    for option, name in names.items():
+    for option, name in _given(args):
         check_output_file(option, name)
-    check_outputs({**{f"{option} {name}": name for option, name in names.items()},
+    named = _named(args)
+    check_outputs({**{typed: name for name, typed in named.items()},
                    f"{ENVIRONMENT['sweep_log']} {config.sweep_log}": config.sweep_log},
                   inputs={f"the claims table {CLAIMS_PATH}": CLAIMS_PATH})
+    check_new_outputs(named, overwrite=args.overwrite)
 
 
-def _write(option: str, name: str, write) -> None:
-    """``write(tmp)`` into ``name`` atomically; an OS error is one line naming ``option``."""
-    try:
-        write_atomically(name, write)
-    except BrokenPipeError as exc:
-        raise PipeClosed() from exc
-    except OSError as exc:
-        raise OutputError(f"cannot write {option} {name}: {exc.strerror or exc}") from exc
-
-
-def _write_baseline(evaluation, evaluated, args) -> None:
-    header = (f"ledger categories, {args.profile} profile; produced {datetime.date.today().isoformat()} by\n"
-              f"passmd ledger --profile {args.profile} --write-baseline {args.write_baseline}")
-    _write("--write-baseline", args.write_baseline,
-           lambda tmp: evaluation.write_baseline(evaluated, tmp, header=header))
-
-
-def _write_drive(joint, args) -> None:
-    from pathlib import Path
-
+def _write(evaluated, joint, args) -> None:
+    """--write-baseline (the categories) and --write-drive (the joint reading), written together or not
+    at all, never over a file unless --overwrite (:func:`passmd.cli.streams.create_outputs`)."""
+    from passmd.ledger.baseline import baseline_csv
     from passmd.ledger.joint_drive import joint_drive_file
 
-    text = joint_drive_file(joint["reading"], args.profile)
-    _write("--write-drive", args.write_drive, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+    texts = {}
+    if args.write_baseline:
+        command = f"passmd ledger --profile {args.profile}{' --overwrite' * args.overwrite}"
+        header = (f"ledger categories, {args.profile} profile; produced {datetime.date.today().isoformat()} "
+                  f"by\n{command} --write-baseline {args.write_baseline}")
+        texts[args.write_baseline] = baseline_csv(evaluated, header)
+    if args.write_drive:
+        texts[args.write_drive] = joint_drive_file(joint["reading"], args.profile)
+    create_outputs({name: lambda tmp, text=text: Path(tmp).write_text(text, encoding="utf-8", newline="")
+                    for name, text in texts.items()}, _named(args), overwrite=args.overwrite)
 
 
 def run_ledger(args, out) -> int:
@@ -110,12 +114,10 @@ def run_ledger(args, out) -> int:
     for name, table in results.items():  # finite before anything is written, as run and theory check
         check_table(name, table)
     evaluated = evaluation.evaluate(results=results)
-    if args.write_baseline:
-        _write_baseline(evaluation, evaluated, args)
     counts = evaluation.headline(evaluated)
     joint = evaluated.attrs["joint"]
-    if args.write_drive:
-        _write_drive(joint, args)
+    if args.write_baseline or args.write_drive:
+        _write(evaluated, joint, args)
     if args.json:
         emit_json({"command": "ledger", "profile": args.profile, "summary": ledger_views.summary(evaluated),
                    "counts": counts, "joint_reading": evaluation.joint_record(joint),

@@ -10,7 +10,7 @@ from typing import NamedTuple
 from passmd.cli import kernels, startup
 from passmd.cli.commands.contact import check_springs
 from passmd.cli.drive import _typed, build_drive, drive_rows
-from passmd.cli.errors import OutputError, UsageError
+from passmd.cli.errors import UsageError
 from passmd.cli.notes import hz, ringing_text
 from passmd.cli.options import (
     AMPLITUDE,
@@ -31,7 +31,7 @@ from passmd.cli.output import (
     nm,
 )
 from passmd.cli.result_bounds import check_run_bounds
-from passmd.cli.streams import PipeClosed, available_memory, check_outputs, write_atomically
+from passmd.cli.streams import available_memory, check_new_outputs, check_outputs, create_outputs
 from passmd.model.defaults import PROTOCOL
 from passmd.runtime.units import from_si
 
@@ -173,6 +173,12 @@ def check_output_paths(args) -> None:
             raise UsageError(f"--plot = {args.plot!r} has {'no' if not suffix else 'an unknown'} image "
                              f"extension: must end in one of {', '.join('.' + f for f in _PLOT_FORMATS)}")
     check_outputs({f"--csv {args.csv}": args.csv, f"--plot {args.plot}": args.plot})
+    check_new_outputs(_named(args), overwrite=args.overwrite)
+
+
+def _named(args) -> dict[str, str]:
+    """--csv and --plot given: path -> the option as typed."""
+    return {name: f"{flag} {name}" for flag, name in (("--csv", args.csv), ("--plot", args.plot)) if name}
 
 
 class RunOptions(NamedTuple):
@@ -324,22 +330,18 @@ def _band_text(band: dict) -> str:
 
 
 def write_outputs(args, result, figure=None, band=None) -> None:
-    """The time series to --csv and the positions' plot to --plot, each written atomically (a
-    device or pipe such as /dev/stdout is written to; a reader that went away is a closed pipe).
-    ``figure(result, title)``: the plot (default :func:`passmd.plots.trace.positions_figure`);
-    ``band``: the runner position's ``low`` and ``high`` over a fit's region (:func:`_region_band`),
-    two more CSV columns and a shaded band."""
+    """The time series to --csv and the positions' plot to --plot, written together or not at all,
+    never over a file unless --overwrite (:func:`passmd.cli.streams.create_outputs`; a device or pipe
+    such as /dev/stdout is written to). ``figure(result, title)``: the plot (default
+    :func:`passmd.plots.trace.positions_figure`); ``band``: the runner position's ``low`` and ``high``
+    over a fit's region (:func:`_region_band`), two more CSV columns and a shaded band."""
+    writers = {}
     if args.csv:
-        try:
-            frame = result.to_frame()
-            if band is not None:
-                frame["runner_position_band_low_m"] = band["low"]
-                frame["runner_position_band_high_m"] = band["high"]
-            write_atomically(args.csv, lambda tmp: frame.to_csv(tmp, index=False))
-        except BrokenPipeError as exc:
-            raise PipeClosed() from exc
-        except OSError as exc:
-            raise OutputError(f"cannot write --csv {args.csv}: {exc.strerror or exc}") from exc
+        frame = result.to_frame()
+        if band is not None:
+            frame["runner_position_band_low_m"] = band["low"]
+            frame["runner_position_band_high_m"] = band["high"]
+        writers[args.csv] = lambda tmp: frame.to_csv(tmp, index=False)
     if args.plot:
         from passmd.plots.trace import positions_figure
 
@@ -352,13 +354,10 @@ def write_outputs(args, result, figure=None, band=None) -> None:
             ax.fill_between(result.time * 1e3, band["low"] * 1e9, band["high"] * 1e9, color="C1", alpha=0.25,
                             lw=0, label="runner x_r over the fit's 95 % region")
             ax.legend(fontsize=8)
-        try:
-            fmt_ = Path(args.plot).suffix.lstrip(".").lower()
-            write_atomically(args.plot, lambda tmp: fig.savefig(tmp, dpi=150, format=fmt_))
-        except BrokenPipeError as exc:
-            raise PipeClosed() from exc
-        except OSError as exc:
-            raise OutputError(f"cannot write --plot {args.plot}: {exc.strerror or exc}") from exc
+        fmt_ = Path(args.plot).suffix.lstrip(".").lower()
+        writers[args.plot] = lambda tmp: fig.savefig(tmp, dpi=150, format=fmt_)
+    if writers:
+        create_outputs(writers, _named(args), overwrite=args.overwrite)
 
 
 def run_run(args, out) -> int:

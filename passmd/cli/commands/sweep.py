@@ -6,15 +6,14 @@ import argparse
 import itertools
 import json
 import math
-import os
 import re
 import textwrap
 from dataclasses import dataclass
 from decimal import Decimal, localcontext
-from pathlib import Path
 
 import numpy as np
 
+from passmd.cli import sweep_files
 from passmd.cli.configuration import run_config
 from passmd.cli.drive import _bound, build_drive, explain
 from passmd.cli.errors import UsageError
@@ -34,10 +33,10 @@ from passmd.cli.options import (
     FilePath,
     Quantity,
     add_drive_options,
+    add_overwrite_option,
     add_sweep_options,
 )
-from passmd.cli.output import JSON_HELP, check_output_file, describe, drive_record, emit_json, emit_rows, fmt
-from passmd.cli.streams import check_new_outputs, check_outputs, create_outputs
+from passmd.cli.output import JSON_HELP, describe, drive_record, emit_json, emit_rows, fmt
 from passmd.cli.sweep_rows import (
     add_band,
     check_values,
@@ -185,6 +184,7 @@ def add_parser(command) -> None:
                           "and they span more than two decades (default: auto)")
     out.add_argument("--out", metavar="PREFIX", action=FilePath,
                      help="write PREFIX.csv, PREFIX.json and PREFIX.png (default: none)")
+    add_overwrite_option(out)
     out.add_argument("--json", action="store_true", help=JSON_HELP)
     p.set_defaults(handler=run_sweep, profile="paper")
 
@@ -316,29 +316,7 @@ def _check_options(args) -> None:
     if args.amplitude is not None and args.quantity == "critical-amplitude":
         raise UsageError("--amplitude has no effect on critical-amplitude: it searches over the amplitude")
     if args.out is not None:
-        _check_prefix(args.out)
-
-
-def _outputs(prefix: str, axes: int) -> dict[str, str]:
-    """PREFIX.csv, PREFIX.json and, for one or two axes, PREFIX.png."""
-    files = {"csv": prefix + ".csv", "json": prefix + ".json"}
-    if axes <= 2:
-        files["png"] = prefix + ".png"
-    return files
-
-
-def _check_prefix(prefix: str) -> None:
-    """--out PREFIX before any work: a file stem (not a folder, not ending in a separator), its
-    files absent and creatable in an existing folder (exit 2)."""
-    stem = os.path.basename(prefix)
-    if not stem or stem in (".", "..") or prefix.endswith(os.sep) or Path(prefix).is_dir():
-        raise UsageError(f"--out = {prefix!r} names a directory, not a PREFIX: give the files' stem, e.g. "
-                         f"{os.path.join(prefix.rstrip(os.sep) or '.', 'map')!r}")
-    files = _outputs(prefix, 2)
-    for suffix in (".csv", ".json", ".png"):
-        check_output_file("--out", prefix + suffix)
-    check_outputs({f"{path} (--out {prefix})": path for path in files.values()})
-    check_new_outputs(f"--out {prefix}", list(files.values()))
+        sweep_files.check_prefix(args.out, overwrite=args.overwrite)
 
 
 # --------------------------------------------------------------------------------------
@@ -451,34 +429,6 @@ def _record(args, axes, table, spec, drive) -> dict:
     }
 
 
-def _write(args, record, axes, spec, table, title) -> dict:
-    """PREFIX.csv, PREFIX.json and (one or two axes) PREFIX.png, created together or not at all,
-    never over a file (:func:`passmd.cli.streams.create_outputs`)."""
-    from passmd.cli.output import plain
-
-    prefix = args.out
-    files = _outputs(prefix, len(axes))
-    header = "".join(f"# {k}: {v}\n" for k, v in record["provenance"].items())
-    header += f"# quantity: {args.quantity} ({spec.column})\n"
-
-    def write_csv(tmp):
-        with open(tmp, "w", encoding="utf-8", newline="") as fh:
-            fh.write(header)
-            table.to_csv(fh, index=False, lineterminator="\n")
-
-    text = json.dumps(plain({**record, "files": files}), indent=2, allow_nan=False) + "\n"
-    writers = {files["csv"]: write_csv,
-               files["json"]: lambda tmp: Path(tmp).write_text(text, encoding="utf-8")}
-    if "png" in files:
-        fig = sweep_figure(args, axes, spec, table, title)
-        facts = record["provenance"]
-        summary = f"passmd {facts['passmd_version']}, commit {facts['git_commit']}"
-        writers[files["png"]] = lambda tmp: fig.savefig(tmp, dpi=150, format="png",
-                                                        metadata={"Description": summary})
-    create_outputs(f"--out {prefix}", writers)
-    return files
-
-
 def run_sweep(args, out) -> int:
     from passmd.protocols.maps import MAP_QUANTITIES, compute_map
 
@@ -499,7 +449,8 @@ def run_sweep(args, out) -> int:
     diagnoses = diagnose_sweep(args, axes, spec, table, points, config)
     record = {**_record(args, axes, table, spec, base), "warnings": warned, "diagnoses": diagnoses}
     if args.out is not None:
-        record["files"] = _write(args, record, axes, spec, table, title)
+        figure = sweep_figure(args, axes, spec, table, title) if len(axes) <= 2 else None
+        record["files"] = sweep_files.write(args, record, table, figure)
     if args.json:
         emit_json(record, out)
         return 0

@@ -16,12 +16,12 @@ import math
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from passmd.model.defaults import PROTOCOL
 from passmd.runtime.inputs import RefusedFile, decode_text, read_bounded
+from passmd.runtime.outputs import write_file
 from passmd.runtime.validation import InputError
 
 __all__ = ["ANNOTATIONS", "CONDITIONS", "MAX_ROWS", "MEASURED", "MODELS", "READINGS", "MeasurementError",
@@ -295,20 +295,28 @@ def _refuse_decimal_commas(label: str, header, body, separator: str) -> None:
                                        "separator)", name=column.strip(), value=cell)
 
 
-def write_measurements(path, data: Measurements, values: np.ndarray | None = None) -> None:
-    """Write measurements (or ``values`` in their place) as a CSV :func:`read_measurements` reads."""
+def write_measurements(path, data: Measurements, values: np.ndarray | None = None, *,
+                       overwrite: bool = False) -> None:
+    """Write measurements (or ``values`` in their place) as a CSV :func:`read_measurements` reads,
+    completely or not at all (:func:`passmd.runtime.outputs.write_file`); a regular file already at
+    ``path`` is replaced only with ``overwrite`` (else :class:`~passmd.runtime.outputs.OutputExists`,
+    a ``FileExistsError``, and the file is kept)."""
     columns = list(dict.fromkeys(data.column))
     header = ["amplitude_nm", "preload_N", "frequency_Hz", "radius_mm", *columns]
     if data.known_sd:
         header += [c + "_sd" for c in columns]
     values = data.value if values is None else values
-    with open(Path(path), "w", newline="", encoding="utf-8") as handle:
-        out = csv.writer(handle)
-        out.writerow(header)
-        for i in range(len(data)):
-            scale = data.display(i)[0]
-            cell = {"amplitude_nm": data.amplitude[i] * 1e9, "preload_N": data.preload[i],
-                    "frequency_Hz": data.frequency[i], "radius_mm": data.radius[i] * 1e3,
-                    data.column[i]: values[i] / scale, data.column[i] + "_sd": data.sd[i] / scale}
-            out.writerow(["" if c not in cell or not math.isfinite(cell[c]) else repr(float(cell[c]))
-                          for c in header])
+
+    def write(tmp):
+        with open(tmp, "w", newline="", encoding="utf-8") as handle:
+            out = csv.writer(handle)
+            out.writerow(header)
+            for i in range(len(data)):
+                scale = data.display(i)[0]
+                cell = {"amplitude_nm": data.amplitude[i] * 1e9, "preload_N": data.preload[i],
+                        "frequency_Hz": data.frequency[i], "radius_mm": data.radius[i] * 1e3,
+                        data.column[i]: values[i] / scale, data.column[i] + "_sd": data.sd[i] / scale}
+                out.writerow(["" if c not in cell or not math.isfinite(cell[c]) else repr(float(cell[c]))
+                              for c in header])
+
+    write_file(path, write, overwrite=overwrite)
