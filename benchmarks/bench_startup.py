@@ -49,6 +49,7 @@ VARIANTS = {
 COMMANDS = {"--help": ["--help"], "run": ["run"]}
 
 _LAUNCH = """
+import sys
 from passmd.cli import startup
 for name in sys.argv[1].split(",") if sys.argv[1] else ():
     setattr(startup, name, lambda *a, **k: None)
