@@ -101,7 +101,7 @@ def baseline_csv(evaluated: pd.DataFrame, header: str = "") -> str:
 
 
 def write_baseline(evaluated: pd.DataFrame, path, header: str = "", *, overwrite: bool = False) -> None:
-    """Write :func:`baseline_csv` to ``path``, completely or not at all
+    """Write :func:`~passmd.ledger.baseline.baseline_csv` to ``path``, completely or not at all
     (:func:`passmd.runtime.outputs.write_file`).
 
     A regular file already at ``path`` is replaced only with ``overwrite`` (else

@@ -337,7 +337,7 @@ def elsewhere(claim: str, states: Mapping, at: int) -> str:
 
 
 def held_out_judgements(joint: Mapping, studies: Iterable[str]) -> dict[str, Judgement]:
-    """Where each claim is judged (:class:`passmd.ledger.verdicts.Judgement`): a claim of the paper at
+    """Where each claim is judged (``passmd.ledger.verdicts.Judgement``): a claim of the paper at
     its unit's held-out point of ``joint`` (:func:`judge`'s result), a study at the defaults."""
     states = joint["states"]
     space, free_of = states["space"], states["free_of"]

@@ -320,8 +320,8 @@ def read_drive_file(path, *, allow_extrapolation: bool | None = None) -> dict:
 def resolve(values: dict, origins: dict | None = None, **fixed) -> tuple[Drive, dict]:
     """The drive ``values`` describe, and where each of its parameters came from.
 
-    ``values``: SI values by drive-file key (:data:`DRIVE_KEYS`); ``origins``: how each was
-    given (``"file"``, ``"option"``; default ``"given"``). ``fixed`` replaces Drive fields last
+    ``values``: SI values by drive-file key (:data:`~passmd.model.drive_keys.DRIVE_KEYS`); ``origins``:
+    how each was given (``"file"``, ``"option"``; default ``"given"``). ``fixed`` replaces Drive fields last
     (``load_cell=True`` for a stall run). What is not given: the paper's default (its source),
     the Table 2 actuator of the radius (interpolated between its rows), the viscosity
     2ζ√(k_p m_a) of the final k_p and m_a. Returns ``(drive, sources)``, ``sources`` by key.

@@ -1,4 +1,4 @@
-"""Writing a drive file: :func:`drive_toml`, a commented TOML file of a
+"""Writing a drive file: :func:`~passmd.model.drive_writer.drive_toml`, a commented TOML file of a
 :class:`~passmd.model.parameters.Drive` that :func:`passmd.model.drive_file.load_drive` reads back to
 an equal drive (the keys and their units: :mod:`passmd.model.drive_keys`)."""
 

@@ -96,7 +96,7 @@ def parameter_frame(*records, labels=None, units=None):
         Column titles of the records' values; default ``value`` (one record) or
         ``value 1``, ``value 2``, ...
     units : dict, optional
-        Dotted field name → display unit; default :data:`DISPLAY_UNITS`.
+        Dotted field name → display unit; default :data:`~passmd.report.quantities.DISPLAY_UNITS`.
 
     Returns
     -------

@@ -132,7 +132,7 @@ def descendants() -> set[int]:
     """The pids of this process's descendants, read from ``/proc`` (empty where there is none).
 
     A worker process still being spawned (forked, its interpreter not yet handed its task) is a
-    descendant before :func:`multiprocessing.active_children` lists it."""
+    descendant before ``multiprocessing.active_children()`` lists it."""
     parents = {}
     with contextlib.suppress(OSError):
         for entry in os.scandir("/proc"):

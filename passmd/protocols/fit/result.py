@@ -71,7 +71,7 @@ class FitResult:
     region_points: list[dict] = field(default_factory=list)
 
     def region_drives(self) -> list[Drive]:
-        """The drives at :attr:`region_points` (as :attr:`drive` is the drive at the estimate)."""
+        """The drives at ``region_points`` (as ``drive`` is the drive at the estimate)."""
         from passmd.protocols.fit.prediction import drive_at
 
         zeta = self.base.actuator.damping_ratio if self._holds_zeta() else None
