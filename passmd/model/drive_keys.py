@@ -1,7 +1,7 @@
-"""The keys a drive file may hold (:data:`DRIVE_KEYS`): each with its SI unit, display unit, symbol,
-meaning and the source of its default; and the drive files the package ships (the book's worked
-example, the ledger's joint reading). Read by :mod:`passmd.model.drive_file`, written by
-:mod:`passmd.model.drive_writer`."""
+"""The keys a drive file may hold (:data:`~passmd.model.drive_keys.DRIVE_KEYS`): each with its SI
+unit, display unit, symbol, meaning and the source of its default; and the drive files the package
+ships (the book's worked example, the ledger's joint reading). Read by
+:mod:`passmd.model.drive_file`, written by :mod:`passmd.model.drive_writer`."""
 
 from __future__ import annotations
 
