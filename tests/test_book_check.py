@@ -127,6 +127,11 @@ def test_each_defect_is_a_problem(changes, fragment):
     ("preload_grids (F_p = 0.1–1.0 N; step 0.1 N N)", "unit written twice"),
     ("frequency_grid (f = 1, 5, 10, …, 130 kHz kHz)", "unit written twice"),
     ("actuator_viscosity (c_p = 2·ζ·√(k_p m_a), ζ = 0.05 kg/s)", "dimensionless quantity given a unit"),
+    ("fig10c-youngs-modulus-negligible: 1 vs 1", "margin without its unit"),
+    ("ours 640.8 nm; 640.8 vs 0 nm", "margin without its unit"),
+    ("deviation 133.8 exceeds the tolerance 1 t_a", "margin without its unit"),
+    ("deviation 133.8 t_a exceeds the tolerance 1.", "margin without its unit"),
+    ("(deviation 4 % within the tolerance 5)", "margin without its unit"),
 ])
 def test_text_defects_are_found(text, meaning):
     found = checker.text_defects(text)
@@ -136,7 +141,9 @@ def test_text_defects_are_found(text, meaning):
 def test_correct_text_has_no_defects():
     text = ("c_p [kg/s] = 2·ζ·√(k_p m_a) with the damping ratio ζ = 0.05 (dimensionless); a nanometre; "
             "Eq. 7 gives 39.5 nm, 0.2%·F_gen, μ = 0.2 is Section 4.2's; NaN if not within the hold; "
-            "10 % of it")
+            "10 % of it; ours 558.2 nm vs the paper's 552 nm; deviation 133.8 t_a exceeds the tolerance "
+            "1 t_a; deviation 0 share within the tolerance 1e-06 share; 2.95 % at 0.6 N (30.82 nm vs "
+            "31.76 nm); the tolerance 0.05 periods.")
     assert checker.text_defects(text, ["1.25", "—", "fig5a"]) == []
     assert checker.text_defects("", ["NaN"]) == ["a table cell the build could not compute: 'NaN'"]
 

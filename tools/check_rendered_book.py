@@ -82,12 +82,18 @@ DEFAULT_EXPECT = {"figures": 1, "ledger": 1, "partial": 0}
 UNITS = ("nm", "µm", "mm", "m", "µs", "us", "ms", "s", "ns", "Hz", "kHz", "MHz", "N", "mN", "N/m", "Pa",
          "MPa", "GPa", "kg", "g", "mg", "µg", "kg/s", "m/s", "mm/s", "m/s²", "V", "V/µs", "%", "°")
 _UNIT = "|".join(re.escape(u) for u in sorted(UNITS, key=len, reverse=True))
+_NUMBER = r"(?<![\w.])-?\d+(?:\.\d+)?(?:e[-+]?\d+)?(?!\w|\.\d)"
 #: Patterns of the visible text (outside code) that are defects, with what each means.
 TEXT_DEFECTS = (
     (re.compile(r"(?<![\w.\-])-?(?:nan|inf)(?![\w])"), "a number the build could not compute"),
     (re.compile(rf"(?<![\w/²])({_UNIT})\s+\1(?![\w/²])"), "a unit written twice"),
     (re.compile(rf"[ζμν]\s*=\s*[-+]?[\d.]+(?:e[-+]?\d+)?\s*(?:{_UNIT})(?![\w/²])"),
      "a dimensionless quantity given a unit"),
+    # A comparison or margin whose number carries no unit: "1 vs 1", "tolerance 1)", "deviation 133.8
+    # exceeds" (the ledger writes every value with its unit, or with what it counts).
+    (re.compile(rf"{_NUMBER}\s+vs\b"
+                rf"|\b(?:tolerance|deviation)\s+{_NUMBER}(?=\s*(?:[;,.)]|$|exceeds|within))"),
+     "a margin without its unit"),
 )
 #: Table cells that are defects: pandas' missing value.
 CELL_DEFECTS = ((re.compile(r"^\s*-?(?:NaN|nan|inf|<NA>|None)\s*$"),

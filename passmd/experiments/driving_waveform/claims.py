@@ -215,11 +215,16 @@ def _response_similar(results, reading):
 @evidence("sec5-response-to-optimized-similar")
 def _response_similar_evidence(results):
     row = _response(results, default_reading())
+
+    def reversal(waveform):
+        at = row[f"{waveform}_reversal_s"]
+        return f"{at * 1e6:.2f} µs" if np.isfinite(at) else "none within 1.5 t_s"
+
     return [f"at {row['frequency_Hz'] / 1e3:.3g} kHz, over t_s = {row['settling_time_s'] * 1e6:.2f} µs "
             "after the last fly-back: largest speed "
             f"{row['sawtooth_peak_speed_m_per_s'] * 1e3:.4g} mm/s (saw-tooth) against "
             f"{row['response_peak_speed_m_per_s'] * 1e3:.4g} mm/s (optimized), reversal "
-            f"{row['sawtooth_reversal_s'] * 1e6:.2f} µs against {row['response_reversal_s'] * 1e6:.2f} µs; "
+            f"{reversal('sawtooth')} against {reversal('response')}; "
             "V_r "
             f"{row['sawtooth_runner_velocity_m_per_s'] * 1e3:.3g} against "
             f"{row['response_runner_velocity_m_per_s'] * 1e3:.3g} mm/s; f_s = "
