@@ -245,7 +245,7 @@ def styled(evaluated: pd.DataFrame, *, links: bool = False, grid: str = ""):
     added to the caption. The table carries the HTML class ``passmd-ledger`` (the rendered-book check
     looks for it) and wraps inside the content column.
     """
-    rows = list(evaluated.itertuples())
+    rows = list(_rows_only(evaluated).itertuples())
     shown = pd.DataFrame({  # the cells are HTML: text is escaped ('<' of a relation), the links are not
         "claim": [f'<a href="#{claim_anchor(r.claim)}">{r.claim}</a>' if links else r.claim for r in rows],
         "category": [html.escape(_category_text(r), quote=False) for r in rows],
@@ -322,6 +322,14 @@ def _details_block(row, claim, heading: str, members: tuple = ()) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _rows_only(evaluated: pd.DataFrame) -> pd.DataFrame:
+    """The table without its ``attrs``: pandas deep-copies ``attrs`` (every claim's points) into the
+    result of each selection and row access, which costs seconds over a report's hundreds of them."""
+    rows = evaluated.copy(deep=False)
+    rows.attrs = {}
+    return rows
+
+
 def details_markdown(evaluated: pd.DataFrame, claims: pd.DataFrame) -> str:
     """Per claim, a collapsed block with an anchor: verdict, quote, evidence, reason and source.
 
@@ -330,7 +338,7 @@ def details_markdown(evaluated: pd.DataFrame, claims: pd.DataFrame) -> str:
     can link to it) and each row with the target of :func:`claim_anchor` (the ledger table links to
     it). The blocks are dropdown admonitions: closed until the reader opens them.
     """
-    by_id = claims.set_index("id")
+    evaluated, by_id = _rows_only(evaluated), _rows_only(claims).set_index("id")
     blocks = []
     claims_of_paper, studies = counted(evaluated), evaluated[evaluated["study_of"] != ""]
     implied = evaluated[(evaluated["study_of"] == "") & ~evaluated["counted"].astype(bool)]
@@ -353,6 +361,7 @@ def details_markdown(evaluated: pd.DataFrame, claims: pd.DataFrame) -> str:
 def families_markdown(evaluated: pd.DataFrame) -> str:
     """Every family of claims as MyST markdown: its lead, its category (the conjunction of its members,
     judged at its held-out reading) and each implied row with its own state there."""
+    evaluated = _rows_only(evaluated)
     members = evaluated[(evaluated["study_of"] == "") & ~evaluated["counted"].astype(bool)]
     if members.empty:
         return "No row is implied by another: every claim is counted on its own.\n"
