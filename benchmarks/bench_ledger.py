@@ -44,7 +44,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 #: The wall time a cold ledger of each profile should stay within on a quiet 2-core machine (s).
-BUDGET_S = {"paper": 360.0, "quick": 240.0}
+BUDGET_S = {"paper": 120.0, "quick": 240.0}
 #: The largest resident set one process of the paper ledger (the command or a sweep worker) should
 #: reach (MB).
 MEMORY_BUDGET_MB = 400.0

@@ -54,7 +54,7 @@ from passmd.protocols.maps import compute_map, steady_point
 from passmd.runtime.config import RunConfig
 
 #: Targets of the map on the 2-core machine (s).
-COLD_TARGET_S = 60.0
+COLD_TARGET_S = 10.0
 CACHED_TARGET_S = 5.0
 ROOT = Path(__file__).resolve().parents[1]
 
