@@ -39,8 +39,9 @@ def tests(session: nox.Session) -> None:
     # folder) only the first compiles the package and its dependencies, also where the environment
     # turned the cache off (PYTHONDONTWRITEBYTECODE).
     pycache = os.path.join(session.create_tmp(), "pycache")
-    session.run("pytest", *session.posargs, env={"MPLBACKEND": "Agg", "PASSMD_CACHE_DIR": CACHE_DIR,
-                                                 "PYTHONDONTWRITEBYTECODE": "", "PYTHONPYCACHEPREFIX": pycache})
+    env = {"MPLBACKEND": "Agg", "PASSMD_CACHE_DIR": CACHE_DIR, "PYTHONDONTWRITEBYTECODE": "",
+           "PYTHONPYCACHEPREFIX": pycache}
+    session.run("pytest", *session.posargs, env=env)
 
 
 @nox.session(python=PYTHON)

@@ -161,8 +161,9 @@ def main() -> int:
         out.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
     except OSError as exc:
         raise OSError(exc.errno, exc.strerror, str(out)) from None  # one line naming the file
-    shown = ("wall_time_s", "budget_s", "within_budget", "row_evaluation_s", "parameter_set_s", "budget_parameter_sets",
-             "model_evaluations", "regions_hold_truth", "load_average_before", "load_average_after")
+    shown = ("wall_time_s", "budget_s", "within_budget", "row_evaluation_s", "parameter_set_s",
+             "budget_parameter_sets", "model_evaluations", "regions_hold_truth", "load_average_before",
+             "load_average_after")
     print(json.dumps({k: record[k] for k in shown}, indent=2))
     print(f"written {out}")
     return 0
