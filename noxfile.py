@@ -219,7 +219,8 @@ def book(session: nox.Session) -> None:
     os.makedirs(build_dir, exist_ok=True)
     prefetch_log = os.path.abspath(os.path.join(build_dir, "passmd-prefetch.jsonl"))
     prefetch_time = os.path.abspath(os.path.join(build_dir, "passmd-prefetch-time.json"))
-    for old in (prefetch_log, prefetch_time):
+    ledger_file = os.path.abspath(os.path.join(build_dir, "passmd-ledger.pmc"))
+    for old in (prefetch_log, prefetch_time, ledger_file):
         if os.path.exists(old):
             os.remove(old)
     session.log(f"computing every table the claims read ({profile} profile) first (passmd ledger)")
@@ -227,8 +228,12 @@ def book(session: nox.Session) -> None:
                 env={**env, "PASSMD_SWEEP_LOG": prefetch_log})
     with open(prefetch_time, "w", encoding="utf-8") as fh:
         json.dump({"wall_seconds": time.monotonic() - start}, fh)
+    # The whole ledger evaluated once for every chapter (each shows its rows judged in it).
+    session.run("python", "-m", "passmd.report.stored_evaluation", "--profile", profile,
+                "--out", ledger_file, env=env)
     env["PASSMD_BOOK_PREFETCH_LOG"] = prefetch_log
     env["PASSMD_BOOK_PREFETCH_TIME"] = prefetch_time
+    env["PASSMD_BOOK_LEDGER"] = ledger_file
     session.run("python", "tools/build_book.py", "--jobs", str(os.cpu_count() or 1),
                 "book", "--all", "-W", "-n", "--keep-going", *args, env=env)
     elapsed = time.monotonic() - start

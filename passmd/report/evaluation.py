@@ -405,15 +405,17 @@ def claims_for(claims: pd.DataFrame, figures) -> pd.DataFrame:
     return claims.loc[chosen].reset_index(drop=True)
 
 
-def chapter_rows(figures, config: RunConfig) -> pd.DataFrame:
+def chapter_rows(figures, config: RunConfig, evaluated: pd.DataFrame | None = None) -> pd.DataFrame:
     """A chapter's ledger rows, judged in the whole ledger.
 
     The category of a claim depends on the joint reading, which only the whole ledger can find:
-    every claim is evaluated on ``config``'s results (:func:`evaluate`) and the rows of the
-    claims that need only the result keys ``figures`` (:func:`claims_for`) are returned, so that
-    every chapter shows the categories of the replication report.
+    every claim is evaluated on ``config``'s results (:func:`evaluate`; ``evaluated``: that
+    evaluation, already made) and the rows of the claims that need only the result keys ``figures``
+    (:func:`claims_for`) are returned, so that every chapter shows the categories of the
+    replication report.
     """
-    evaluated = evaluate(config=_check_config(config))
+    if evaluated is None:
+        evaluated = evaluate(config=_check_config(config))
     ids = set(claims_for(load_claims(), figures)["id"])
     rows = evaluated[evaluated["claim"].isin(ids)].reset_index(drop=True)
     rows.attrs = {**evaluated.attrs,

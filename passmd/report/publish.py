@@ -1,7 +1,8 @@
 """Helpers the book's chapters use: profile switch, CSV data links, captions, units.
 
 * :func:`current_profile` reads the build profile (``quick`` or ``paper``) from the
-  environment variable ``PASSMD_PROFILE`` that ``nox -s book -- --profile quick`` sets.
+  environment variable ``PASSMD_PROFILE`` that ``nox -s book -- --profile quick`` sets;
+  :func:`book_evaluation` reads the build's one evaluation of the ledger (``PASSMD_BOOK_LEDGER``).
 * :func:`data_link` writes a figure's data as CSV into the book's ``_generated/data/``
   folder and returns MyST markdown linking to it (Sphinx copies the file into the HTML).
 * :func:`caption` builds a figure caption naming the parameters the figure was run with,
@@ -361,6 +362,24 @@ def book_config():
     from passmd.runtime.config import RunConfig
 
     return RunConfig.from_environment()
+
+
+#: Set by ``nox -s book``: the file holding the build's one evaluation of the whole ledger.
+LEDGER_ENV = "PASSMD_BOOK_LEDGER"
+
+
+def book_evaluation(config):
+    """The whole ledger evaluated on ``config``'s results (:func:`passmd.report.evaluation.evaluate`).
+
+    Read from the file ``nox -s book`` wrote once for the build (``$PASSMD_BOOK_LEDGER``,
+    :mod:`passmd.report.stored_evaluation`) when it holds the evaluation of this profile by this
+    package's code and data; evaluated here otherwise.
+    """
+    from passmd.report import evaluation, stored_evaluation
+
+    path = os.environ.get(LEDGER_ENV, "").strip()
+    stored = stored_evaluation.read(path, config.profile) if path else None
+    return stored if stored is not None else evaluation.evaluate(config=config)
 
 
 def put(name: str, value) -> None:

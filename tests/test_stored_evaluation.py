@@ -1,0 +1,60 @@
+"""The book's one evaluation of the ledger: read back exactly, and never for another profile, code or data."""
+
+import math
+
+import pandas as pd
+import pytest
+
+from passmd.report import publish, stored_evaluation
+from passmd.runtime.config import RunConfig
+
+
+def _table() -> pd.DataFrame:
+    table = pd.DataFrame({"claim": ["a", "b"], "ours": ["text", 1.5], "margin": [math.nan, 0.25],
+                          "counted": [True, False], "readings": [4, 2]})
+    table.attrs = {"points": [{"claim": "a", "point": {"mu": 0.2}, "score": None}],
+                   "joint": {"point": {("mu", 0.3): 3}, "reading": (("flyback", "fixed"),),
+                             "odd": {"__items__": 1}}}
+    return table
+
+
+def test_a_table_reads_back_exactly():
+    table = _table()
+    back = stored_evaluation.decode_table(stored_evaluation.encode_table(table))
+    pd.testing.assert_frame_equal(back, table)
+    assert back.attrs == table.attrs
+
+
+def test_read_only_what_this_profile_code_and_data_wrote(tmp_path, monkeypatch):
+    path = tmp_path / "ledger.pmc"
+    assert stored_evaluation.read(path, "paper") is None  # no file: the caller evaluates
+    stored_evaluation.write(path, _table(), "paper")
+    pd.testing.assert_frame_equal(stored_evaluation.read(path, "paper"), _table())
+    assert stored_evaluation.read(path, "quick") is None
+    monkeypatch.setattr(stored_evaluation, "_data_fingerprint", lambda: "an edited claims.csv")
+    assert stored_evaluation.read(path, "paper") is None
+    monkeypatch.undo()
+    monkeypatch.setattr(stored_evaluation, "code_fingerprint", lambda: "another package")
+    assert stored_evaluation.read(path, "paper") is None
+    path.write_bytes(path.read_bytes()[:-5])  # a torn file is not read either
+    monkeypatch.undo()
+    assert stored_evaluation.read(path, "paper") is None
+
+
+@pytest.mark.parametrize("stored", [True, False], ids=["stored", "absent"])
+def test_book_evaluation_reads_the_builds_file_or_evaluates(tmp_path, monkeypatch, stored):
+    from passmd.report import evaluation
+
+    path = tmp_path / "ledger.pmc"
+    if stored:
+        stored_evaluation.write(path, _table(), "quick")
+    monkeypatch.setenv(publish.LEDGER_ENV, str(path))
+    calls = []
+    monkeypatch.setattr(evaluation, "evaluate", lambda config: calls.append(config) or "evaluated here")
+    config = RunConfig(profile="quick", cache_dir=tmp_path)
+    got = publish.book_evaluation(config)
+    if stored:
+        pd.testing.assert_frame_equal(got, _table())
+        assert calls == []
+    else:
+        assert got == "evaluated here" and calls == [config]
