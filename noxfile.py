@@ -38,7 +38,7 @@ def tests(session: nox.Session) -> None:
     # The command-line tests start hundreds of Pythons: with the bytecode cache (in the session's
     # folder) only the first compiles the package and its dependencies, also where the environment
     # turned the cache off (PYTHONDONTWRITEBYTECODE).
-    pycache = os.path.join(session.create_tmp(), "pycache")
+    pycache = os.path.abspath(os.path.join(session.create_tmp(), "pycache"))
     env = {"MPLBACKEND": "Agg", "PASSMD_CACHE_DIR": CACHE_DIR, "PYTHONDONTWRITEBYTECODE": "",
            "PYTHONPYCACHEPREFIX": pycache}
     session.run("pytest", *session.posargs, env=env)
