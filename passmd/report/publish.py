@@ -42,6 +42,7 @@ from passmd.runtime.validation import check_choice
 
 __all__ = [
     "DISPLAY_UNITS",
+    "LEDGER_ENV",
     "NUMBER_WORDS",
     "PROFILES",
     "PROFILE_ENV",
@@ -49,6 +50,7 @@ __all__ = [
     "assumption_value",
     "assumptions_frame",
     "book_config",
+    "book_evaluation",
     "book_root",
     "caption",
     "current_profile",
