@@ -58,3 +58,16 @@ def test_book_evaluation_reads_the_builds_file_or_evaluates(tmp_path, monkeypatc
         assert calls == []
     else:
         assert got == "evaluated here" and calls == [config]
+
+
+def test_the_data_fingerprint_follows_claims_and_references_not_benchmark_records(tmp_path, monkeypatch):
+    (tmp_path / "reference").mkdir()
+    (tmp_path / "benchmarks").mkdir()
+    (tmp_path / "reference" / "claims.csv").write_text("id,paper\na,1\n")
+    (tmp_path / "benchmarks" / "book.json").write_text("[]")
+    monkeypatch.setattr(stored_evaluation, "_DATA_DIR", tmp_path)
+    before = stored_evaluation._data_fingerprint()
+    (tmp_path / "benchmarks" / "book.json").write_text("[{}]")
+    assert stored_evaluation._data_fingerprint() == before
+    (tmp_path / "reference" / "claims.csv").write_text("id,paper\na,2\n")
+    assert stored_evaluation._data_fingerprint() != before

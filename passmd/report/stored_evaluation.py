@@ -18,7 +18,6 @@ from __future__ import annotations
 import argparse
 import hashlib
 import sys
-from importlib import resources
 from pathlib import Path
 
 import pandas as pd
@@ -30,24 +29,21 @@ from passmd.runtime.outputs import write_file
 __all__ = ["decode_table", "encode_table", "key", "read", "write"]
 
 _ITEMS = "__items__"  # marks a dict stored as its list of (key, value) pairs
+_DATA_DIR = Path(__file__).resolve().parents[1] / "data"  # passmd/data
 _FUNCTION = "passmd.report.evaluation.evaluate"
 
 
 def _data_fingerprint() -> str:
-    """A hash of the package's data files other than benchmark records: the evaluation reads them
-    (claims, reference values), and the code fingerprint covers the Python files only."""
+    """SHA-256 over the relative path and bytes of the package's data files other than benchmark
+    records: the evaluation reads them (claims, reference values), and the code fingerprint covers
+    the Python files only."""
+    root = _DATA_DIR.resolve()
     digest = hashlib.sha256()
-
-    def walk(folder, prefix=""):
-        for item in sorted(folder.iterdir(), key=lambda p: p.name):
-            name = f"{prefix}{item.name}"
-            if item.is_dir():
-                if name != "benchmarks" and item.name != "__pycache__":
-                    walk(item, name + "/")
-            elif item.is_file():
-                digest.update(name.encode() + b"\0" + item.read_bytes() + b"\0")
-
-    walk(resources.files("passmd") / "data")
+    for path in sorted(root.rglob("*")):
+        rel = path.relative_to(root)
+        if path.is_file() and rel.parts[0] != "benchmarks" and "__pycache__" not in rel.parts:
+            name, data = rel.as_posix().encode(), path.read_bytes()
+            digest.update(len(name).to_bytes(8, "little") + name + len(data).to_bytes(8, "little") + data)
     return digest.hexdigest()
 
 
