@@ -23,7 +23,7 @@ from pathlib import Path
 import pandas as pd
 
 from passmd.runtime.cache.entry import CorruptEntry, decode_entry, encode_entry
-from passmd.runtime.cache.keys import code_fingerprint
+from passmd.runtime.cache.keys import code_fingerprint, tree_fingerprint
 from passmd.runtime.outputs import write_file
 
 __all__ = ["decode_table", "encode_table", "key", "read", "write"]
@@ -34,17 +34,9 @@ _FUNCTION = "passmd.report.evaluation.evaluate"
 
 
 def _data_fingerprint() -> str:
-    """SHA-256 over the relative path and bytes of the package's data files other than benchmark
-    records: the evaluation reads them (claims, reference values), and the code fingerprint covers
-    the Python files only."""
-    root = _DATA_DIR.resolve()
-    digest = hashlib.sha256()
-    for path in sorted(root.rglob("*")):
-        rel = path.relative_to(root)
-        if path.is_file() and rel.parts[0] != "benchmarks" and "__pycache__" not in rel.parts:
-            name, data = rel.as_posix().encode(), path.read_bytes()
-            digest.update(len(name).to_bytes(8, "little") + name + len(data).to_bytes(8, "little") + data)
-    return digest.hexdigest()
+    """The package's data files other than benchmark records: the evaluation reads them (claims,
+    reference values), and the code fingerprint covers the Python files only."""
+    return tree_fingerprint(_DATA_DIR, "*", skip=("benchmarks",))
 
 
 def key(profile: str) -> str:

@@ -20,7 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Unfingerprintable", "canonical", "code_fingerprint", "function_code", "function_name"]
+__all__ = ["Unfingerprintable", "canonical", "code_fingerprint", "function_code", "function_name",
+           "tree_fingerprint"]
 
 #: The ``passmd`` package folder (this module is ``passmd/runtime/cache/keys.py``).
 _PACKAGE_DIR = Path(__file__).resolve().parents[2]
@@ -46,14 +47,22 @@ def _package_fingerprint() -> str:
 
 
 def _fingerprint(root: Path) -> str:
-    root = root.resolve()
+    return tree_fingerprint(root, "*.py")
+
+
+def tree_fingerprint(root: str | os.PathLike, pattern: str, skip: tuple[str, ...] = ()) -> str:
+    """SHA-256 over the relative path and bytes of every file under ``root`` matching ``pattern``,
+    leaving out ``__pycache__`` and any folder or file named in ``skip``."""
+    root = Path(root).resolve()
     if not root.is_dir():
         raise ValueError(f"package_dir = {str(root)!r} is not a directory")
+    left_out = {"__pycache__", *skip}
     digest = hashlib.sha256()
-    for path in sorted(root.rglob("*.py")):
-        if "__pycache__" in path.parts:
+    for path in sorted(root.rglob(pattern)):
+        parts = path.relative_to(root).parts
+        if not path.is_file() or left_out.intersection(parts):
             continue
-        rel = path.relative_to(root).as_posix().encode()
+        rel = "/".join(parts).encode()
         data = path.read_bytes()
         digest.update(len(rel).to_bytes(8, "little") + rel)
         digest.update(len(data).to_bytes(8, "little") + data)
