@@ -31,16 +31,21 @@ PYTHON = None  # the interpreter nox runs with
 CACHE_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), ".passmd-cache")
 
 
+def _bytecode_cache(folder: str) -> dict:
+    """Environment of Pythons that keep their bytecode in ``folder`` (absolute, so a subprocess in
+    another working folder finds it): of many Pythons importing the same modules only the first
+    compiles them, also where the environment turned the cache off (PYTHONDONTWRITEBYTECODE), and
+    no folder but ``folder`` is written."""
+    return {"PYTHONDONTWRITEBYTECODE": "", "PYTHONPYCACHEPREFIX": os.path.abspath(folder)}
+
+
 @nox.session(python=PYTHON)
 def tests(session: nox.Session) -> None:
     """Run the test suite (unit, physics, regression, CLI and ledger tests)."""
     session.install("-e", ".[test]")
-    # The command-line tests start hundreds of Pythons: with the bytecode cache (in the session's
-    # folder) only the first compiles the package and its dependencies, also where the environment
-    # turned the cache off (PYTHONDONTWRITEBYTECODE).
-    pycache = os.path.abspath(os.path.join(session.create_tmp(), "pycache"))
-    env = {"MPLBACKEND": "Agg", "PASSMD_CACHE_DIR": CACHE_DIR, "PYTHONDONTWRITEBYTECODE": "",
-           "PYTHONPYCACHEPREFIX": pycache}
+    # the command-line tests start hundreds of Pythons
+    env = {"MPLBACKEND": "Agg", "PASSMD_CACHE_DIR": CACHE_DIR,
+           **_bytecode_cache(os.path.join(session.create_tmp(), "pycache"))}
     session.run("pytest", *session.posargs, env=env)
 
 
@@ -188,11 +193,8 @@ def book(session: nox.Session) -> None:
     # Chapters run in book/; keep the simulation cache at the repository root, shared with
     # the CLI (`passmd figure` computes the same points), unless the user chose a place.
     env["PASSMD_CACHE_DIR"] = os.environ.get("PASSMD_CACHE_DIR") or os.path.abspath(".passmd-cache")
-    # Every chapter is a fresh kernel importing the same thousand modules: with Python's bytecode
-    # cache (in the build folder, so no other folder is written) only the first compiles them, also
-    # where the environment turned the cache off (PYTHONDONTWRITEBYTECODE).
-    env["PYTHONDONTWRITEBYTECODE"] = ""
-    env["PYTHONPYCACHEPREFIX"] = os.path.abspath(os.path.join("book", "_build", "pycache"))
+    # every chapter is a fresh kernel importing the same thousand modules
+    env.update(_bytecode_cache(os.path.join("book", "_build", "pycache")))
     # Validate the profile with the package's own check, and build matplotlib's font cache
     # now: its first-use notice on a fresh machine would otherwise be a stderr warning
     # inside the first chapter and fail the -W build.
