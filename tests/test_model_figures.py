@@ -33,9 +33,13 @@ from passmd.experiments.model.figures import (
     normal_force_balance,
 )
 from passmd.experiments.model_numerics.facts import (
+    BENCHMARKS,
     CONTROLLED_FIT_COARSEST,
+    TARGET_BASELINE_RATIO,
     TARGET_MS_PER_PERIOD,
+    before_after_table,
     benchmark_facts,
+    benchmark_results,
     benchmark_table,
     convergence_facts,
     coulomb_rising_gaps,
@@ -43,6 +47,7 @@ from passmd.experiments.model_numerics.facts import (
     energy_facts,
     fitted_order_above_floor,
     settle_facts,
+    speed_budgets,
     step_plan_table,
 )
 from passmd.experiments.model_numerics.figures import (
@@ -309,6 +314,36 @@ def test_step_plan_and_benchmark_facts():
     assert facts["bench_periods"] >= 1
     assert facts["bench_processes"] >= 1 and facts["bench_six_flex_processes_ms"] > 0
     assert facts["target_ms_per_period"] == TARGET_MS_PER_PERIOD
+
+
+def test_speed_budgets_hold_only_within_their_budget():
+    records = {name: benchmark_results(name) for name in BENCHMARKS}
+    stored = speed_budgets(records)
+    assert stored.equals(speed_budgets())  # the package's records by default
+    assert set(stored["unit"]) == {"× faster", "s", "MB"}
+    # each check can fail: a fit over its budget, a speed-up below its target, a map within its budget
+    fit = {**records["fit"], "wall_time_s": records["fit"]["budget_s"] * 1.01}
+    head = {**records["dynamics"]["headline"],
+            "ratios": {"loop": {"baseline_over_default": TARGET_BASELINE_RATIO * 0.99}}}
+    sweep = {**records["sweep_map"], "cold": {**records["sweep_map"]["cold"],
+                                               "wall_s": records["sweep_map"]["cold"]["target_s"]}}
+    changed = speed_budgets({**records, "fit": fit, "dynamics": {**records["dynamics"], "headline": head},
+                             "sweep_map": sweep}).set_index("measurement")["holds"]
+    assert not changed.iloc[0] and not changed.iloc[1] and changed.iloc[2]
+    # the ledger and book rows are the last cold paper runs, not a later quick one
+    quick = {**records["ledger"][-1], "profile": "quick", "wall_time_s": 1e6}
+    rows = speed_budgets({**records, "ledger": [*records["ledger"], quick]})
+    assert rows.equals(stored)
+
+
+def test_before_after_table_reads_both_sides():
+    data = {"date": "d", "before": "a" * 40, "after": "b" * 40, "benchmarks": {"fit": {
+        "before": {"wall_time_s": 80.0, "load_average_before": [0.5, 0, 0]},
+        "after": {"wall_time_s": 40.0, "load_average_before": [0.7, 0, 0]}, "ratio_before_over_after": 2.0}}}
+    table = before_after_table(data)
+    assert table.iloc[0].to_dict() == {"benchmark": "fit", "before (s)": 80.0, "after (s)": 40.0,
+                                       "before / after": 2.0, "load before": 0.5, "load after": 0.7}
+    assert table.attrs["before"] == "a" * 40
 
 
 def test_hemisphere_mass_is_half_a_ruby_sphere():

@@ -69,7 +69,8 @@ SLIP_SHARE_ACCURACY = 0.02
 CRITICAL_AMPLITUDE_BRACKETS = 1.0
 
 #: Benchmark results shipped with the package (``passmd/data/benchmarks/<name>.json``).
-BENCHMARKS = ("contact", "driving_waveform", "dynamics", "fit", "fit_coverage", "scaling")
+BENCHMARKS = ("before_after", "book", "contact", "driving_waveform", "dynamics", "fit", "fit_coverage",
+              "ledger", "scaling", "sweep_map")
 
 
 def benchmark_results(name: str, path: str | Path | None = None) -> dict:
@@ -77,8 +78,8 @@ def benchmark_results(name: str, path: str | Path | None = None) -> dict:
 
     Parameters
     ----------
-    name : {"contact", "driving_waveform", "dynamics", "fit", "fit_coverage", "scaling"}
-        The benchmark (``fit_coverage``: ``benchmarks/bench_fit_coverage.py``).
+    name : str
+        One of :data:`BENCHMARKS`: ``benchmarks/bench_<name>.py``'s record.
     path : path-like, optional
         A results file to read instead of the one installed with the package
         (``passmd/data/benchmarks/<name>.json``, package data, which the benchmark
@@ -401,6 +402,64 @@ def benchmark_facts(bench: pd.DataFrame) -> dict:
         "target_ns_per_step": TARGET_NS_PER_STEP,
     }
 
+
+def speed_budgets(records: dict | None = None) -> pd.DataFrame:
+    """Each speed budget the benchmark scripts state, against their last stored measurement.
+
+    ``records`` maps a :data:`BENCHMARKS` name to its record (default: :func:`benchmark_results`).
+    One row per budget: ``measurement``, ``script``, ``measured``, ``budget``, ``unit``, ``holds``
+    (measured within the budget: at most it, or at least it for a speed-up) and ``load`` (the
+    1-minute load average before the measurement; above the 2 cores a budget missed is no proof).
+    Every time is from an empty result cache (the period: the integration loop's CPU time, against
+    ``benchmarks/verlet_baseline.py``); the ledger and book rows are the last cold runs of the paper
+    profile, the memory row the largest resident set of one of the ledger's processes.
+    """
+    def record(name):
+        return records[name] if records is not None else benchmark_results(name)
+
+    head = record("dynamics")["headline"]
+    fit, sweep = record("fit"), record("sweep_map")
+    ledger = [r for r in record("ledger") if r.get("profile") == "paper" and r.get("cold", True)][-1]
+    book = [r for r in record("book") if r.get("profile") == "paper" and "session_wall_s" in r][-1]
+    rows = [
+        ("100 Hz period vs plain Verlet", "dynamics",
+         head["ratios"]["loop"]["baseline_over_default"], TARGET_BASELINE_RATIO, "× faster",
+         head["load_average_before"][0]),
+        ("fit: μ, k_p from 15 steps", "fit", fit["wall_time_s"], fit["budget_s"],
+         "s", fit["load_average_before"][0]),
+        ("24 × 24 velocity map", "sweep_map", sweep["cold"]["wall_s"], sweep["cold"]["target_s"],
+         "s", sweep["cold"]["load_average_before"][0]),
+        ("the map by passmd sweep", "sweep_map", sweep["cli_cold"]["wall_s"],
+         sweep["cli_cold"]["target_s"], "s", sweep["cli_cold"]["load_average_before"][0]),
+        ("paper ledger", "ledger", ledger["wall_time_s"], ledger["budget_s"], "s",
+         ledger["load_average_before"][0]),
+        ("paper ledger, memory", "ledger", ledger["peak_rss_mb"], ledger["memory_budget_mb"],
+         "MB", ledger["load_average_before"][0]),
+        ("paper book", "book", book["session_wall_s"], book["budget_s"], "s",
+         book["load_average_before"][0]),
+    ]
+    out = pd.DataFrame(rows, columns=["measurement", "script", "measured", "budget", "unit", "load"])
+    faster = out["unit"].str.startswith("×")
+    within = np.where(faster, out["measured"] >= out["budget"], out["measured"] <= out["budget"])
+    out.insert(5, "holds", within)
+    out["script"] = "bench_" + out["script"] + ".py"
+    return out
+
+
+def before_after_table(data: dict | None = None) -> pd.DataFrame:
+    """``benchmarks/bench_before_after.py``'s record as a table: per benchmark the wall time of the
+    earlier revision and of the later one (s), measured in one run, their ratio and the 1-minute
+    load average before each. ``attrs``: the two commits and the date."""
+    data = benchmark_results("before_after") if data is None else data
+    rows = [{"benchmark": name, "before (s)": run["before"]["wall_time_s"],
+             "after (s)": run["after"]["wall_time_s"],
+             "before / after": run["ratio_before_over_after"],
+             "load before": run["before"]["load_average_before"][0],
+             "load after": run["after"]["load_average_before"][0]}
+            for name, run in data["benchmarks"].items()]
+    out = pd.DataFrame(rows)
+    out.attrs.update(before=data["before"], after=data["after"], date=data["date"])
+    return out
 
 
 def _mass_label(mass_kg: float) -> str:
