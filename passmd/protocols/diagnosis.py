@@ -49,14 +49,15 @@ import numpy as np
 from passmd.model import theory, waveforms
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
+from passmd.model.tables import Assumption
 from passmd.protocols import critical_amplitude, ringing, velocity
 from passmd.runtime import sweep
 from passmd.runtime.validation import check_choice
 from passmd.solver.results import SimulationError
 
-__all__ = ["AGREEMENT", "CAUSES", "EXPLAINS", "FLYBACK_PERIODS", "MAX_DIAGNOSED", "MAX_REST", "QUANTITIES",
-           "REST_SWING", "SHARE_FACTOR", "Cause", "counterfactual_point", "departs", "diagnose", "rest_time",
-           "running_max", "sweep_departures"]
+__all__ = ["AGREEMENT", "ASSUMPTIONS", "CAUSES", "EXPLAINS", "FLYBACK_PERIODS", "MAX_DIAGNOSED",
+           "MAX_REST", "QUANTITIES", "REST_SWING", "SHARE_FACTOR", "Cause", "counterfactual_point",
+           "departs", "diagnose", "rest_time", "running_max", "sweep_departures"]
 
 #: Relative departure of a simulated A_c from its closed form beyond which it is diagnosed, and of a
 #: value from its trend between two neighbouring sweep points: the 10 % band within which the critical
@@ -77,6 +78,25 @@ MAX_REST = 1.0
 EXPLAINS = 0.5
 #: Quantities a diagnosis covers.
 QUANTITIES = ("critical-amplitude", "velocity", "step", "gain")
+
+ASSUMPTIONS: tuple[Assumption, ...] = (
+    Assumption(
+        key="diagnosis_thresholds",
+        symbol="–",
+        value=(f"a departure beyond {AGREEMENT:.0%} is diagnosed; a cause is named when its removal takes "
+               f"away at least {EXPLAINS:.0%} of it"),
+        unit="",
+        rationale=(
+            "The paper attributes the critical amplitude to the contacts' presliding, the actuators' "
+            "dynamics and their interaction (Section 4.1) without weighing them for a given drive; passmd "
+            "weighs them, one cause removed at a time. The agreement band is the one the "
+            "critical-amplitude chapters judge Fig. 6 by; half of the departure is the least share that "
+            "makes a cause the larger part of it."
+        ),
+        sensitivity=("Design chapter: the range of the naming share over which the causes named at the "
+                     "example drive's A_c stay the same, and the departure against the band."),
+    ),
+)
 #: Periods of a run with rests (its last step counts, as the steady critical-amplitude reading).
 _RESTED_PERIODS = PROTOCOL.steady_periods
 

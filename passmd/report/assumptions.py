@@ -16,7 +16,7 @@ import passmd.experiments.waveform_velocity.figures
 from passmd.ledger import reference
 from passmd.model import arrangement, contact, optimized_waveform, parameters, tables, waveforms
 from passmd.model.tables import Assumption
-from passmd.protocols import critical_amplitude, stall
+from passmd.protocols import critical_amplitude, diagnosis, stall
 
 __all__ = ["ASSUMPTION_MODULES", "all_assumptions"]
 
@@ -35,6 +35,7 @@ ASSUMPTION_MODULES: tuple[ModuleType, ...] = (
     stall,
     passmd.experiments.waveform_optimum.figures,
     optimized_waveform,
+    diagnosis,
 )
 
 
