@@ -155,3 +155,19 @@ def test_every_row_of_the_design_and_calibration_pages_is_a_passmd_figure(name, 
     assert cli.main(["figure", name, "--profile", "quick", "--out", str(tmp_path)]) == 0
     written = pd.read_csv(tmp_path / f"{name}.csv", comment="#")
     assert len(written) > 0 and (tmp_path / f"{name}.png").stat().st_size > 0
+
+
+def _found(*shares):
+    causes = [{"cause": f"c{k}", "changed": "x", "counterfactual_value": None if s is None else 1e-8,
+               "share": s} for k, s in enumerate(shares)]
+    named = [c["cause"] for c in causes if c["share"] is not None and c["share"] >= 0.5]
+    return {"values": [30e-9], "expected": [20e-9], "causes": causes, "named": named}
+
+
+def test_diagnosis_facts_give_the_naming_shares_that_name_the_same_causes():
+    """The sensitivity of assumption diagnosis_thresholds, from the shares the diagnosis computed."""
+    assert facts.diagnosis_facts(_found(1.05, 0.2, None))["why_naming_range"] == \
+        "for any naming share above 20 % and up to 105 %"
+    assert facts.diagnosis_facts(_found(0.6, 0.55))["why_naming_range"] == "for any naming share up to 55 %"
+    assert facts.diagnosis_facts(_found(0.3))["why_naming_range"] == "for any naming share above 30 %"
+    assert facts.diagnosis_facts(_found(None))["why_naming_range"] == "whatever the naming share"

@@ -19,7 +19,7 @@ import pandas as pd
 from passmd.experiments.design_your_drive.figures import run_config
 from passmd.model.defaults import PROTOCOL
 from passmd.model.parameters import Drive
-from passmd.protocols import fit, ringing
+from passmd.protocols import diagnosis, fit, ringing
 from passmd.runtime.config import RunConfig
 
 __all__ = ["curve_facts", "fit_facts", "gain_facts", "heldback_facts", "map_facts", "measurements_csv",
@@ -139,13 +139,31 @@ def diagnosis_table(found: dict) -> pd.DataFrame:
                          for c in found["causes"]])
 
 
+def _share_range(low: float, high: float) -> str:
+    """The naming shares between ``low`` (excluded) and ``high`` (included), in words."""
+    if math.isinf(low) and math.isinf(high):
+        return "whatever the naming share"
+    if math.isinf(low):
+        return f"for any naming share up to {100 * high:.0f} %"
+    if math.isinf(high):
+        return f"for any naming share above {100 * low:.0f} %"
+    return f"for any naming share above {100 * low:.0f} % and up to {100 * high:.0f} %"
+
+
 def diagnosis_facts(found: dict) -> dict:
     """The numbers and words the page says of a diagnosis: the value, the closed form, the gap, the causes
-    named and those that gave no value (with why)."""
+    named and those that gave no value (with why), and the naming shares that name the same causes
+    (``why_naming_range``, the sensitivity of assumption ``diagnosis_thresholds``)."""
     value, closed = found["values"][-1], found["expected"][-1]
     named = found["named"]
     untried = [f"{c['cause']}: {c['changed']}" for c in found["causes"] if c["share"] is None]
+    shares = [c["share"] for c in found["causes"] if c["share"] is not None]
+    below = [s for s in shares if s < diagnosis.EXPLAINS]
+    above = [s for s in shares if s >= diagnosis.EXPLAINS]
+    # the named causes are the same for every naming share in (largest share below, smallest at or above]
+    low, high = (max(below) if below else -math.inf), (min(above) if above else math.inf)
     return {"why_value_nm": value * 1e9, "why_closed_nm": closed * 1e9,
+            "why_naming_range": _share_range(low, high),
             "why_gap_pct": 100 * abs(value / closed - 1), "why_side": "below" if value < closed else "above",
             "why_named": (" and ".join(f"**{n}**" for n in named) if named
                           else "none of the candidates (each takes away less than half of the departure)"),
