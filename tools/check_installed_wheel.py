@@ -72,7 +72,10 @@ def main(argv: list[str] | None = None) -> int:
         table = reference.load_reference_curve(name)
         print(f"reference.load_reference_curve({name!r}): {len(table)} rows")
     for name in facts.BENCHMARKS:
-        print(f"facts.benchmark_results({name!r}): keys {', '.join(facts.benchmark_results(name))}")
+        record = facts.benchmark_results(name)  # a record, or a list of runs (ledger, book)
+        shown = f"{len(record)} runs" if isinstance(record, list) else f"keys {', '.join(record)}"
+        print(f"facts.benchmark_results({name!r}): {shown}")
+    print(f"facts.speed_budgets(): {len(facts.speed_budgets())} budgets")
 
     cache = ["--cache-dir", str(args.ledger_cache)] if args.ledger_cache else []
     ledger_out = json.loads(_run(exe, "ledger", "--profile", "quick", "--json", *cache))
