@@ -171,3 +171,5 @@ def test_diagnosis_facts_give_the_naming_shares_that_name_the_same_causes():
     assert facts.diagnosis_facts(_found(0.6, 0.55))["why_naming_range"] == "for any naming share up to 55 %"
     assert facts.diagnosis_facts(_found(0.3))["why_naming_range"] == "for any naming share above 30 %"
     assert facts.diagnosis_facts(_found(None))["why_naming_range"] == "whatever the naming share"
+    # a cause whose removal widens the departure (a negative share) bounds no threshold
+    assert facts.diagnosis_facts(_found(0.9, -0.05))["why_naming_range"] == "for any naming share up to 90 %"

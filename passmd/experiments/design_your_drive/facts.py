@@ -160,8 +160,10 @@ def diagnosis_facts(found: dict) -> dict:
     shares = [c["share"] for c in found["causes"] if c["share"] is not None]
     below = [s for s in shares if s < diagnosis.EXPLAINS]
     above = [s for s in shares if s >= diagnosis.EXPLAINS]
-    # the named causes are the same for every naming share in (largest share below, smallest at or above]
-    low, high = (max(below) if below else -math.inf), (min(above) if above else math.inf)
+    # the named causes are the same for every naming share in (largest share below, smallest at or above];
+    # a negative share (its removal widens the departure) bounds no threshold worth naming
+    low = max(below) if below and max(below) >= 0 else -math.inf
+    high = min(above) if above else math.inf
     return {"why_value_nm": value * 1e9, "why_closed_nm": closed * 1e9,
             "why_naming_range": _share_range(low, high),
             "why_gap_pct": 100 * abs(value / closed - 1), "why_side": "below" if value < closed else "above",
