@@ -44,6 +44,9 @@ import tempfile
 import time
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_book import nox_command  # noqa: E402  (a sibling script: this Python's nox, else nox on PATH)
+
 ROOT = Path(__file__).resolve().parents[1]
 #: The earlier revision of the default record: main before the speed work.
 BEFORE = "ba95e30"
@@ -142,8 +145,11 @@ def main() -> int:
         for k, warm in enumerate((tree, ROOT)):  # each tree's kernels into its own numba cache, untimed
             run_benchmark(warm, "bench_fit.py", ["--smoke"], folder / f"warm-{k}.json")
         if "book" in chosen:  # the worktree's book environment, untimed
-            subprocess.run([sys.executable, "-m", "nox", "-s", "book", "--install-only"], cwd=tree,
-                           env=environment(tree), check=True, capture_output=True)
+            done = subprocess.run([*nox_command(), "-s", "book", "--install-only"], cwd=tree,
+                                  env=environment(tree), capture_output=True, text=True)
+            if done.returncode != 0:
+                last = (done.stderr.strip().splitlines() or ["no message"])[-1]
+                raise SystemExit(f"installing the book environment of {commit[:12]} failed: {last}")
         for name, spec in chosen.items():
             start = time.perf_counter()
             before = side(tree, commit, name, spec, folder)
