@@ -83,8 +83,8 @@ ASSUMPTIONS: tuple[Assumption, ...] = (
     Assumption(
         key="diagnosis_thresholds",
         symbol="–",
-        value=(f"a departure beyond {AGREEMENT:.0%} is diagnosed; a cause is named when its removal takes "
-               f"away at least {EXPLAINS:.0%} of it"),
+        value=(f"a departure beyond {100 * AGREEMENT:.0f} % is diagnosed; a cause is named when its removal "
+               f"takes away at least {100 * EXPLAINS:.0f} % of it"),
         unit="",
         rationale=(
             "The paper attributes the critical amplitude to the contacts' presliding, the actuators' "
