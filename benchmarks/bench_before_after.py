@@ -46,8 +46,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_book import nox_command  # noqa: E402  (a sibling script: this Python's nox, else nox on PATH)
+from bench_ledger import ROOT, git_commit, output  # noqa: E402  (the commit with its dirty mark; --out or default)
 
-ROOT = Path(__file__).resolve().parents[1]
 #: The earlier revision of the default record: main before the speed work.
 BEFORE = "ba95e30"
 #: Each benchmark: its script, its arguments, and how to read the timed wall time (s) and the
@@ -61,8 +61,8 @@ BENCHMARKS = {
 SMOKE = {"fit": ("bench_fit.py", ["--smoke"], BENCHMARKS["fit"][2], BENCHMARKS["fit"][3])}
 
 
-def git(*args: str, cwd: Path = ROOT) -> str:
-    done = subprocess.run(["git", *args], cwd=cwd, capture_output=True, text=True)
+def git(*args: str) -> str:
+    done = subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True)
     if done.returncode != 0:
         raise SystemExit(f"git {' '.join(args)} failed: {' '.join(done.stderr.split()) or 'no message'}")
     return done.stdout.strip()
@@ -133,11 +133,8 @@ def main() -> int:
         if not chosen:
             raise SystemExit(f"--only {args.only!r} names no benchmark: give some of "
                              f"{', '.join(BENCHMARKS)}")
-    out = Path(args.out) if args.out else (
-        Path(tempfile.mkdtemp(prefix="passmd-bench-")) / "before_after.json" if args.smoke
-        else ROOT / "passmd" / "data" / "benchmarks" / "before_after.json")
-    here = git("rev-parse", "HEAD") + (" (uncommitted changes)" if git("status", "--porcelain",
-                                                                      "--untracked-files=no") else "")
+    out = output(args, "before_after")
+    here = git_commit()
     runs = {}
     with worktree(args.before or ("HEAD" if args.smoke else BEFORE)) as (tree, commit), \
             tempfile.TemporaryDirectory(prefix="passmd-before-after-") as scratch:

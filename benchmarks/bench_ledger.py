@@ -133,7 +133,7 @@ def output(args, name: str = "ledger") -> Path:
     ``passmd/data/benchmarks/<name>.json`` otherwise."""
     if args.out:
         return Path(args.out)
-    if args.quick or args.smoke:
+    if getattr(args, "quick", False) or args.smoke:  # a script without --quick has only --smoke
         return Path(tempfile.mkdtemp(prefix="passmd-bench-")) / f"{name}.json"
     return ROOT / "passmd" / "data" / "benchmarks" / f"{name}.json"
 
