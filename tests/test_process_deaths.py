@@ -129,3 +129,24 @@ def test_workers_end_when_the_sweep_is_killed(tmp_path, executor):
             assert time.monotonic() < deadline, \
                 f"processes {sorted(p for p in started if _alive(p))} outlived the sweep by {ORPHANS_S} s"
             time.sleep(0.1)
+
+
+def test_an_interrupted_dask_close_silences_every_logger_of_the_cluster():
+    """After an interrupt the cluster closes without a log line, also from loggers with a level of
+    their own: distributed configures tornado.application at ERROR, whose "Nanny failed to start"
+    (a worker killed while starting) setting the parent tornado logger alone lets through."""
+    import logging
+
+    pytest.importorskip("distributed")
+    from passmd.runtime import pools
+
+    quiet = ("distributed", "tornado", "asyncio")
+    names = [*quiet, *(n for n in list(logging.root.manager.loggerDict) if n.split(".")[0] in quiet)]
+    levels = {n: logging.getLogger(n).level for n in names}
+    try:
+        assert logging.getLogger("tornado.application").isEnabledFor(logging.ERROR)  # what would print
+        pools.close_dask(None, None, True, set())
+        assert not any(logging.getLogger(n).isEnabledFor(logging.CRITICAL) for n in names)
+    finally:
+        for n, level in levels.items():
+            logging.getLogger(n).setLevel(level)

@@ -169,7 +169,10 @@ def close_dask(client, cluster, interrupted: bool, before: set) -> None:
         if cluster is not None:
             cluster.close()
         return
-    for name in ("distributed", "tornado", "asyncio"):
+    quiet = ("distributed", "tornado", "asyncio")
+    # and their children with a level of their own (distributed's logging configuration gives
+    # tornado.application ERROR: a worker killed while starting would log "Nanny failed to start")
+    for name in [*quiet, *(n for n in list(logging.root.manager.loggerDict) if n.split(".")[0] in quiet)]:
         logging.getLogger(name).setLevel(logging.CRITICAL + 1)
 
     def kill_workers():
