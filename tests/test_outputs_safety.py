@@ -406,9 +406,9 @@ def test_work_estimate_counts_the_springs(monkeypatch):
     seen = {}
     original = simulation._integrate_in_chunks
 
-    def record(arguments, waveform, expected, step_work, progress):
+    def record(arguments, periods, period, expected, step_work, progress):
         seen["work"] = step_work
-        return original(arguments, waveform, expected, step_work, progress)
+        return original(arguments, periods, period, expected, step_work, progress)
 
     monkeypatch.setattr(simulation, "_integrate_in_chunks", record)
     drive = Drive(contacts=1)
@@ -647,9 +647,9 @@ MOMENTS = {
     "points running": ("point", ("point", "point")),  # both workers inside a point
     "pool shutting down": ("shutdown", ("shutdown",)),  # every point done, the pool stopping
 }
-#: a fit's first sweep is its start values, one parameter set: one worker inside a point
-FIT_MOMENTS = {**MOMENTS, "points running": ("point", ("point",)),
-               "between two sweeps": ("evaluate", ("evaluate",))}  # the pool idle
+#: a fit's first sweep is its start values, one parameter set whose rows are split between the two
+#: workers (passmd.protocols.fit.prediction.row_parts): both inside a point, as in a sweep
+FIT_MOMENTS = {**MOMENTS, "between two sweeps": ("evaluate", ("evaluate",))}  # the pool idle
 
 
 def _descendants(pid: int) -> set[int]:

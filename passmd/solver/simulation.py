@@ -70,7 +70,7 @@ SPRINGS_PER_STEP = 100
 PROGRESS_MIN_WORK = 2e6
 
 
-def _progress_bar(work: float, waveform: Waveform, show: bool | str | None):
+def _progress_bar(work: float, periods: int, show: bool | str | None):
     """Progress over simulated periods on stderr (:func:`passmd.runtime.progress.bar`), or None.
 
     ``work``: the run's expected work in steps of the exact contact. ``show`` None: runs of more than
@@ -86,7 +86,7 @@ def _progress_bar(work: float, waveform: Waveform, show: bool | str | None):
             return None
         if show is None and not progress.is_terminal(sys.stderr):
             return None
-    return progress.bar(waveform.periods, unit="period", desc="simulation", fractional=True,
+    return progress.bar(periods, unit="period", desc="simulation", fractional=True,
                         delay=0.0 if show is True else None)
 
 
@@ -276,15 +276,18 @@ class Simulation:
         """
         if self._failed:
             raise SimulationError("the simulation diverged earlier and cannot go on")
-        leading = self.leading_periods(periods)
-        if leading.periods <= self.periods_done:
+        n = check_count("periods", periods)
+        if n > self.waveform.periods:
+            raise ValueError(f"periods = {periods!r} is out of range: the waveform has "
+                             f"{self.waveform.periods} periods")
+        if n <= self.periods_done:
             return
-        n, end = leading.periods, int(self._ends[leading.periods - 1])
+        end = int(self._ends[n - 1])
         expected = float(self._expected[end - 1])
         if refused(self._resolved, self._expected, end):  # check_work raises, naming the cause
             expected = check_work(
-                self.drive, leading, self._plan, self._fine_step, self._coarse_step, self._total_stiffness,
-                user_step=self._user_step,
+                self.drive, self.leading_periods(n), self._plan, self._fine_step, self._coarse_step,
+                self._total_stiffness, user_step=self._user_step,
             )
         b = self._buffers
         arguments = (
@@ -301,7 +304,7 @@ class Simulation:
         start = _time.perf_counter()
         try:
             status, steps, n_rec, fine_steps = _integrate_in_chunks(
-                arguments, leading, expected, self._step_work, self._progress
+                arguments, n, self.waveform.period, expected, self._step_work, self._progress
             )
         finally:
             self.wall_time += _time.perf_counter() - start
@@ -351,15 +354,16 @@ class Simulation:
         )
 
 
-def _integrate_in_chunks(arguments: tuple, waveform: Waveform, expected: float, step_work: float,
+def _integrate_in_chunks(arguments: tuple, periods: int, period: float, expected: float, step_work: float,
                          progress: bool | str | None):
-    """Run the kernel in chunks of :data:`CHUNK_STEPS` work (Ctrl-C is honoured between chunks).
+    """Run the kernel over the first ``periods`` periods (each ``period`` s long) in chunks of
+    :data:`CHUNK_STEPS` work (Ctrl-C is honoured between chunks).
 
     ``expected`` steps of ``step_work`` each (:data:`SPRINGS_PER_STEP`). Returns the kernel's
     (status, steps, rows recorded, fine steps) of the last call.
     """
     carry = arguments[-1].carry
-    bar = _progress_bar(expected * step_work, waveform, progress)
+    bar = _progress_bar(expected * step_work, periods, progress)
     chunk = max(1, int(CHUNK_STEPS / step_work))
     try:
         limit = chunk
@@ -369,7 +373,7 @@ def _integrate_in_chunks(arguments: tuple, waveform: Waveform, expected: float, 
                 return status, steps, n_rec, fine_steps
             limit = steps + chunk
             if bar is not None:
-                bar.update(min(carry[kernels.C_TIME] / waveform.period, waveform.periods) - bar.n)
+                bar.update(min(carry[kernels.C_TIME] / period, periods) - bar.n)
     finally:
         if bar is not None:
             bar.close()
