@@ -57,6 +57,65 @@ def test_identical_conditions_are_simulated_once(monkeypatch):
     assert len(calls) == 2
 
 
+@pytest.mark.parametrize(("sets", "workers", "parts"), [
+    (1, 2, 2), (2, 2, 1), (3, 2, 2), (5, 2, 2), (7, 2, 2), (8, 2, 1), (129, 2, 1),  # two cores
+    (3, 8, 8), (4, 8, 2), (32, 8, 1),  # eight
+    (1, 1, 1), (5, 1, 1),  # one worker: nothing to balance
+])
+def test_small_batches_are_split_to_fill_the_workers(sets, workers, parts):
+    """A batch of a few parameter sets is split into row parts so that every worker has as many
+    points (one set's part each) to run; a large batch, or one worker, keeps whole sets."""
+    assert prediction.row_parts(sets, 15, workers) == parts
+    if parts > 1:
+        assert sets * parts % workers == 0 and parts <= 15
+    assert prediction.row_parts(sets, 1, workers) == 1  # one row cannot be split
+
+
+def test_split_rows_predict_what_whole_sets_do(monkeypatch):
+    """The same parameter sets evaluated in row parts on a pool of two (threads here) and whole in
+    this process: identical predictions, settled flags and simulation counts, each row its own."""
+    import concurrent.futures as cf
+
+    def stepped(drive, kind, amplitude, frequency, reading):
+        return {"prediction": amplitude * drive.friction_coefficient, "settled": amplitude < 180e-9}
+
+    monkeypatch.setattr(prediction, "predict_point", stepped)
+    rows = [[str(a), "2000", "30"] for a in (100, 120, 140, 160, 180, 200, 220)]
+    data = fit.measurements_from_rows(HEADER, rows)
+    xs = [np.log([0.2]), np.log([0.3]), np.log([0.4])]  # three sets on two workers: split in two
+    whole = prediction._Model(RIGID, data, ["friction_coefficient"], "steady", executor="serial", cache=False,
+                              config=None)
+    expected = whole.evaluate(xs)
+    with cf.ThreadPoolExecutor(max_workers=2) as pool:
+        split = prediction._Model(RIGID, data, ["friction_coefficient"], "steady", executor=pool, cache=False,
+                                  config=None)
+        assert prediction.row_parts(len(xs), len(split.rows), 2) == 2
+        got = split.evaluate(xs)
+    for a, b, mu in zip(got, expected, (0.2, 0.3, 0.4), strict=True):
+        assert a.tolist() == b.tolist() == (data.amplitude * mu).tolist()
+    for x in xs:
+        key = x.tobytes()
+        settled = (data.amplitude < 180e-9).tolist()
+        assert split.settled[key].tolist() == whole.settled[key].tolist() == settled
+    assert split.simulations == whole.simulations == 3 * len(rows) and split.evaluations == 3
+
+
+def test_row_parts_from_the_cache_are_not_counted_as_simulations(tmp_path, monkeypatch):
+    """A second model on the same cache reads every part: no simulation counted, same predictions."""
+    import concurrent.futures as cf
+
+    monkeypatch.setattr(prediction, "predict_point",
+                        lambda drive, kind, amplitude, frequency, reading: {"prediction": amplitude,
+                                                                            "settled": True})
+    data = fit.measurements_from_rows(HEADER, [[str(a), "2000", "30"] for a in (100, 150, 200)])
+    with cf.ThreadPoolExecutor(max_workers=2) as pool:
+        first, again = (prediction._Model(RIGID, data, ["friction_coefficient"], "steady", executor=pool,
+                                          cache=tmp_path, config=None) for _ in range(2))
+        (a,) = first.evaluate([np.log([0.2])])
+        (b,) = again.evaluate([np.log([0.2])])
+    assert first.simulations == 3 and again.simulations == 0 and a.tolist() == b.tolist()
+
+
 def test_a_file_beyond_the_row_limit_is_refused(tmp_path, monkeypatch):
     monkeypatch.setattr(prediction, "predict_point", _no_simulation)
     path = tmp_path / "many.csv"

@@ -363,7 +363,8 @@ def run(
     pandas.DataFrame
         One row per point, in the order of ``points``: the point's parameters, then
         the function's results. ``df.attrs["sweep"]`` records how many points were
-        taken from the cache and how many were computed.
+        taken from the cache and how many were computed; ``df.attrs["cached_points"]`` lists
+        the indices of those taken from the cache.
 
     Raises
     ------
@@ -408,6 +409,7 @@ def run(
         "computed": len(collect.results),
         "function": label,
     }
+    frame.attrs["cached_points"] = sorted(cached)
     config.log_sweep(frame.attrs["sweep"])
     return frame
 

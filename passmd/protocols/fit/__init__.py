@@ -29,8 +29,9 @@ checked against the drive before anything is simulated (:func:`~passmd.protocols
 The fly-back of the simulated saw-tooth is the drive's rule (:attr:`passmd.model.tables.Amplifier.flyback`).
 
 Estimator (:func:`~passmd.protocols.fit.estimator.fit`): weighted least squares over the logarithms
-of the free parameters, every model evaluation one cached sweep point per parameter set
-(:mod:`~passmd.protocols.fit.prediction`). The whole range is searched before anything is refined:
+of the free parameters, every model evaluation one cached sweep point per parameter set (per part
+of its rows when a batch has too few sets to keep the workers busy;
+:mod:`~passmd.protocols.fit.prediction`). The whole range is searched before anything is refined:
 a global pass (:data:`~passmd.protocols.fit.estimator.GLOBAL_POINTS_PER_PARAMETER` Sobol points per
 free parameter), local searches from its distinct best points, then each parameter's profile over
 its whole bounds (:mod:`~passmd.protocols.fit.profiles`: a coarse grid, fine sampling wherever a

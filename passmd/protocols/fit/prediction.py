@@ -26,7 +26,7 @@ from passmd.runtime import sweep
 from passmd.runtime.config import RunConfig
 from passmd.runtime.validation import check_choice
 
-__all__ = ['predict', 'predict_point']
+__all__ = ['SPLIT_BELOW_SETS_PER_WORKER', 'predict', 'predict_point', 'row_parts']
 
 #: Largest relative drift of a steady-velocity run (its fourth quarter against its third) whose
 #: velocity counts as steady; a larger one marks the prediction unsettled.
@@ -101,7 +101,8 @@ def drive_at(base: Drive, names: Sequence[str], values: Sequence[float], zeta: f
 
 def predict_set(drive: Drive, names: tuple, values: tuple, zeta: float | None, rows: tuple, reading: str
                 ) -> dict:
-    """The model's value of every row at one parameter set (a sweep function: one cache entry per set).
+    """The model's value of every row of ``rows`` at one parameter set (a sweep function: one cache entry
+    per set and rows).
 
     ``rows``: per measurement ``(kind, amplitude, frequency, changes)``, ``changes`` the row's
     changes of the drive as (field, value) pairs (:func:`_row_changes`). Returns ``predictions``
@@ -109,21 +110,68 @@ def predict_set(drive: Drive, names: tuple, values: tuple, zeta: float | None, r
     """
     at = drive_at(drive, names, values, zeta)
     predictions, settled = [], []
+    drives: dict[tuple, Drive] = {}  # rows of the same conditions (say, one preload) share their drive
     for kind, amplitude, frequency, changes in rows:
-        changes = dict(changes)
-        if "actuator" in changes:  # another radius: Table 2's actuator, then the fitted values on it
-            row = drive_at(replace(drive, **changes), names, values, zeta)
-        else:
-            row = replace(at, **changes) if changes else at
+        row = drives.get(changes)
+        if row is None:
+            given = dict(changes)
+            if "actuator" in given:  # another radius: Table 2's actuator, then the fitted values on it
+                row = drive_at(replace(drive, **given), names, values, zeta)
+            else:
+                row = replace(at, **given) if given else at
+            drives[changes] = row
         out = predict_point(row, kind, amplitude, frequency, reading if kind == "critical_amplitude" else "")
         predictions.append(out["prediction"])
         settled.append(out["settled"])
     return {"predictions": predictions, "settled": settled}
 
 
+#: A batch of fewer than this many parameter sets per worker has each set's rows split into parts,
+#: one sweep point each (:func:`row_parts`); larger batches keep the workers busy with whole sets.
+SPLIT_BELOW_SETS_PER_WORKER = 4
+
+
+def row_parts(sets: int, rows: int, workers: int) -> int:
+    """Parts to split each of ``sets`` parameter sets' ``rows`` rows into for ``workers`` workers.
+
+    A fit evaluates a few sets at a time (a Jacobian, a profile's inner steps); one point per set
+    then leaves workers idle while the last sets finish. The parts: the fewest (at least
+    ``workers / sets``) that make the number of points a multiple of ``workers``, at most one per
+    row; 1 for one worker or a batch of at least :data:`SPLIT_BELOW_SETS_PER_WORKER` sets per
+    worker. Every row is simulated on its own, so the predictions do not depend on the parts.
+    """
+    if workers <= 1 or rows <= 1 or sets >= SPLIT_BELOW_SETS_PER_WORKER * workers:
+        return 1
+    least = min(rows, -(-workers // sets))
+    for parts in range(least, rows + 1):
+        if sets * parts % workers == 0:
+            return parts
+    return least
+
+
+def _row_slices(rows: int, parts: int) -> list[slice]:
+    """``parts`` contiguous slices of ``rows`` rows, sizes differing by at most one."""
+    bounds = [round(k * rows / parts) for k in range(parts + 1)]
+    return [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+
+
+def _workers(executor, config: RunConfig) -> int:
+    """Workers a sweep on ``executor`` runs: the pool's, one for ``"serial"``, else as
+    :func:`passmd.runtime.sweep.run` counts them."""
+    from passmd.runtime.config import MAX_WORKERS, useful_workers
+
+    if executor == "serial":
+        return 1
+    pool = getattr(executor, "_max_workers", None)  # a concurrent.futures pool
+    if isinstance(pool, int) and pool >= 1:
+        return pool
+    return useful_workers(config.workers, MAX_WORKERS)
+
+
 class _Model:
     """Predictions of all rows at parameter vectors (log space), through the sweep engine: one sweep
-    point (and cache entry) per parameter vector."""
+    point (and cache entry) per parameter vector, or per part of its rows in a small batch
+    (:func:`row_parts`)."""
 
     def __init__(self, drive, data, names, reading, *, executor, cache, config, keep="damping_ratio"):
         self.drive, self.data, self.names, self.reading = drive, data, list(names), reading
@@ -156,15 +204,21 @@ class _Model:
         keys = [np.asarray(x, float).tobytes() for x in xs]
         todo = list(dict.fromkeys(k for k in keys if k not in self.memo))
         if todo:
+            config = self.config if self.config is not None else RunConfig()
+            parts = _row_slices(len(self.rows), row_parts(len(todo), len(self.rows),
+                                                          _workers(self.executor, config)))
             points = [{"drive": self.base, "names": tuple(self.names),
                        "values": tuple(np.exp(np.frombuffer(k)).tolist()), "zeta": self.zeta,
-                       "rows": self.rows, "reading": self.reading} for k in todo]
+                       "rows": self.rows[part], "reading": self.reading} for k in todo for part in parts]
             frame = sweep.run(predict_set, points, executor=self.executor, cache=self.cache, progress=False,
                               config=self.config)
-            for k, v, s in zip(todo, frame["predictions"], frame["settled"], strict=True):
-                self.memo[k] = np.asarray(v, float)[self.row_of]
-                self.settled[k] = np.asarray(s, bool)[self.row_of]
-            self.simulations += frame.attrs["sweep"]["computed"] * len(self.rows)
+            predictions, settled = frame["predictions"].tolist(), frame["settled"].tolist()
+            for i, k in enumerate(todo):
+                mine = range(i * len(parts), (i + 1) * len(parts))
+                self.memo[k] = np.concatenate([np.asarray(predictions[j], float) for j in mine])[self.row_of]
+                self.settled[k] = np.concatenate([np.asarray(settled[j], bool) for j in mine])[self.row_of]
+            cached = set(frame.attrs["cached_points"])
+            self.simulations += sum(len(points[j]["rows"]) for j in range(len(points)) if j not in cached)
             self.evaluations += len(todo)
         return [self.memo[k] for k in keys]
 
