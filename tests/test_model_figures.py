@@ -46,6 +46,7 @@ from passmd.experiments.model_numerics.facts import (
     coulomb_side,
     energy_facts,
     fitted_order_above_floor,
+    missed_budgets,
     settle_facts,
     speed_budgets,
     step_plan_table,
@@ -334,6 +335,21 @@ def test_speed_budgets_hold_only_within_their_budget():
     quick = {**records["ledger"][-1], "profile": "quick", "wall_time_s": 1e6}
     rows = speed_budgets({**records, "ledger": [*records["ledger"], quick]})
     assert rows.equals(stored)
+
+
+def test_missed_budgets_names_exactly_the_budgets_that_do_not_hold():
+    records = {name: benchmark_results(name) for name in BENCHMARKS}
+    table = speed_budgets(records)
+    every = table.assign(holds=True)
+    assert missed_budgets(every) == "none"
+    one = every.copy()
+    one.loc[1, ["measured", "holds", "load"]] = [32.29, False, 1.19]
+    assert missed_budgets(one) == "the fit: μ, k_p from 15 steps (32.3 s against 20 s, load 1.19)"
+    two = one.copy()
+    two.loc[6, "holds"] = False
+    text = missed_budgets(two)
+    assert text.startswith("the fit: μ") and " and the paper book (" in text and text.count(" and ") == 1
+    assert missed_budgets(table).count("(") == int((~table["holds"]).sum())  # the stored records'
 
 
 def test_before_after_table_reads_both_sides():

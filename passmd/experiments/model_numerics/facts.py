@@ -446,6 +446,14 @@ def speed_budgets(records: dict | None = None) -> pd.DataFrame:
     return out
 
 
+def missed_budgets(budgets: pd.DataFrame) -> str:
+    """The rows of :func:`speed_budgets` that do not hold, as prose: ``"the fit: μ, k_p from 15 steps
+    (32.3 s against 20 s, load 1.19)"``, joined by "and"; ``"none"`` when every budget holds."""
+    parts = [f"the {row.measurement} ({row.measured:.3g} {row.unit} against {row.budget:.3g} {row.unit}, "
+             f"load {row.load:.2f})" for row in budgets.itertuples() if not row.holds]
+    return " and ".join([", ".join(parts[:-1]), parts[-1]] if len(parts) > 1 else parts) or "none"
+
+
 def before_after_table(data: dict | None = None) -> pd.DataFrame:
     """``benchmarks/bench_before_after.py``'s record as a table: per benchmark the wall time of the
     earlier revision and of the later one (s), measured in one run, their ratio and the 1-minute
