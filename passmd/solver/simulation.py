@@ -249,12 +249,17 @@ class Simulation:
         self._failed = False
         self._checked = False
 
-    def leading_periods(self, periods: int) -> Waveform:
-        """The waveform cut after its first ``periods`` periods (the whole one for all of them)."""
-        periods = check_count("periods", periods)
-        if periods > self.waveform.periods:
+    def _check_periods(self, periods) -> int:
+        """``periods`` as a count of the waveform's periods (ValueError beyond them)."""
+        n = check_count("periods", periods)
+        if n > self.waveform.periods:
             raise ValueError(f"periods = {periods!r} is out of range: the waveform has "
                              f"{self.waveform.periods} periods")
+        return n
+
+    def leading_periods(self, periods: int) -> Waveform:
+        """The waveform cut after its first ``periods`` periods (the whole one for all of them)."""
+        periods = self._check_periods(periods)
         w = self.waveform
         if periods == w.periods:
             return w
@@ -276,10 +281,7 @@ class Simulation:
         """
         if self._failed:
             raise SimulationError("the simulation diverged earlier and cannot go on")
-        n = check_count("periods", periods)
-        if n > self.waveform.periods:
-            raise ValueError(f"periods = {periods!r} is out of range: the waveform has "
-                             f"{self.waveform.periods} periods")
+        n = self._check_periods(periods)
         if n <= self.periods_done:
             return
         end = int(self._ends[n - 1])
