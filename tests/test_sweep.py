@@ -187,6 +187,18 @@ def test_cache_skips_finished_points(tmp_path, store):
     assert len(evaluations(log)) == 10
 
 
+def test_run_with_hits_names_the_points_read_from_the_cache(tmp_path, store):
+    """The indices of the cached points, exactly; the table is run's, its attrs without them."""
+    log = tmp_path / "log.txt"
+    points = [{"x": float(x), "log": str(log)} for x in range(5)]
+    sweep.run(logged_square, [points[1], points[3]], executor="serial", cache=store)
+    frame, hits = sweep.run_with_hits(logged_square, points, executor="process", workers=2, cache=store)
+    assert hits == {1, 3} and sorted(evaluations(log)) == [0.0, 1.0, 2.0, 3.0, 4.0]
+    pd.testing.assert_frame_equal(frame, sweep.run(logged_square, points, executor="serial", cache=store))
+    assert set(frame.attrs) == {"sweep"}
+    assert sweep.run_with_hits(logged_square, points, executor="serial", cache=False)[1] == frozenset()
+
+
 def test_interrupted_serial_sweep_resumes(tmp_path, store):
     log, flag = tmp_path / "log.txt", tmp_path / "interrupted"
     points = [{"x": float(x), "log": str(log), "stop_at": 3.0, "flag": str(flag)} for x in range(6)]

@@ -54,7 +54,7 @@ from passmd.runtime.extras import install_hint
 from passmd.runtime.progress import bar, in_worker, is_terminal
 from passmd.runtime.validation import check_choice
 
-__all__ = ["EXECUTORS", "grid", "process_pool", "progress_enabled", "run"]
+__all__ = ["EXECUTORS", "grid", "process_pool", "progress_enabled", "run", "run_with_hits"]
 
 
 def grid(**axes) -> list[dict]:
@@ -363,8 +363,7 @@ def run(
     pandas.DataFrame
         One row per point, in the order of ``points``: the point's parameters, then
         the function's results. ``df.attrs["sweep"]`` records how many points were
-        taken from the cache and how many were computed; ``df.attrs["cached_points"]`` lists
-        the indices of those taken from the cache.
+        taken from the cache and how many were computed (:func:`run_with_hits` also says which).
 
     Raises
     ------
@@ -375,6 +374,29 @@ def run(
         The first exception a point raised (with a note naming the point), after the
         points still running finished and were cached.
     """
+    return _sweep(func, points, executor, scheduler, workers, cache, progress, description, config)[0]
+
+
+def run_with_hits(
+    func: Callable[..., Mapping],
+    points: Sequence[Mapping],
+    *,
+    executor: str | cf.Executor | None = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    cache: bool | Cache | str | os.PathLike = True,
+    progress: bool | None = None,
+    description: str | None = None,
+    config: RunConfig | None = None,
+) -> tuple[pd.DataFrame, frozenset[int]]:
+    """:func:`run`, and the indices of the points whose results came from the cache (for a caller that
+    counts the work a sweep did: the table's ``attrs`` carry only the counts, since pandas copies
+    them into every table derived from it)."""
+    return _sweep(func, points, executor, scheduler, workers, cache, progress, description, config)
+
+
+def _sweep(func, points, executor, scheduler, workers, cache, progress, description, config):
+    """The body of :func:`run` and :func:`run_with_hits`: (table, indices read from the cache)."""
     config = RunConfig() if config is None else config
     executor, scheduler, workers = _execution(executor, scheduler, workers, config)
     if cache is True and config.cache_dir is not None:
@@ -409,9 +431,8 @@ def run(
         "computed": len(collect.results),
         "function": label,
     }
-    frame.attrs["cached_points"] = sorted(cached)
     config.log_sweep(frame.attrs["sweep"])
-    return frame
+    return frame, frozenset(cached)
 
 
 def _check_arguments(func, executor, scheduler, workers) -> None:
@@ -445,7 +466,7 @@ def _function_code(store: Cache | None, func, label: str) -> str | None:
     try:
         return function_code(func)
     except Unfingerprintable as exc:
-        warnings.warn(f"sweep {label!r} is not cached: {exc}", CacheWarning, stacklevel=3)
+        warnings.warn(f"sweep {label!r} is not cached: {exc}", CacheWarning, stacklevel=4)  # (run's caller)
         return None
 
 

@@ -210,14 +210,13 @@ class _Model:
             points = [{"drive": self.base, "names": tuple(self.names),
                        "values": tuple(np.exp(np.frombuffer(k)).tolist()), "zeta": self.zeta,
                        "rows": self.rows[part], "reading": self.reading} for k in todo for part in parts]
-            frame = sweep.run(predict_set, points, executor=self.executor, cache=self.cache, progress=False,
-                              config=self.config)
+            frame, cached = sweep.run_with_hits(predict_set, points, executor=self.executor, cache=self.cache,
+                                                progress=False, config=self.config)
             predictions, settled = frame["predictions"].tolist(), frame["settled"].tolist()
             for i, k in enumerate(todo):
                 mine = range(i * len(parts), (i + 1) * len(parts))
                 self.memo[k] = np.concatenate([np.asarray(predictions[j], float) for j in mine])[self.row_of]
                 self.settled[k] = np.concatenate([np.asarray(settled[j], bool) for j in mine])[self.row_of]
-            cached = set(frame.attrs["cached_points"])
             self.simulations += sum(len(points[j]["rows"]) for j in range(len(points)) if j not in cached)
             self.evaluations += len(todo)
         return [self.memo[k] for k in keys]
