@@ -44,6 +44,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from passmd.runtime.outputs import write_file
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_book import nox_command  # noqa: E402  (a sibling script: this Python's nox, else nox on PATH)
 from bench_ledger import ROOT, git_commit, output  # noqa: E402  (the commit with its dirty mark; --out or default)
@@ -160,9 +162,8 @@ def main() -> int:
               "smoke": bool(args.smoke), "before": commit, "after": here, "cores": os.cpu_count(),
               "python": sys.version.split()[0], "benchmarks": runs}
     out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(f".{out.name}.tmp")
-    tmp.write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
-    tmp.replace(out)
+    text = json.dumps(record, indent=1) + "\n"
+    write_file(out, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"), overwrite=True)  # atomic
     print(f"written {out}")
     return 0
 

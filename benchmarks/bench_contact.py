@@ -44,6 +44,7 @@ from passmd.model.contact import (
 from passmd.model.mdr_contact import MDRContact
 from passmd.model.parameters import Drive
 from passmd.model.theory import contact_moduli, normal_forces
+from passmd.runtime.outputs import write_file
 
 SPRINGS = (100, 200, 1000, 10000)
 PATH_POINTS = 1_000_000  # samples of the exact model's path
@@ -187,9 +188,8 @@ def main(argv=None) -> int:
         },
     }
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = args.out.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps({"meta": meta, "rows": rows}, indent=2))
-    tmp.replace(args.out)  # atomic: a reader never sees a half-written file
+    text = json.dumps({"meta": meta, "rows": rows}, indent=2)
+    write_file(args.out, lambda tmp: Path(tmp).write_text(text), overwrite=True)  # atomic
     print(f"written {args.out}")
     return 0
 

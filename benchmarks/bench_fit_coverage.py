@@ -51,6 +51,7 @@ from passmd.protocols import fit
 from passmd.protocols.fit.prediction import drive_at
 from passmd.protocols.synthetic import independent_steps
 from passmd.runtime.config import RunConfig
+from passmd.runtime.outputs import write_file
 
 FREE = ("friction_coefficient", "actuator.stiffness")
 MU = 0.25
@@ -208,10 +209,10 @@ def main() -> int:
         print(f"draw {done}/{count} (seed {seed}): k_p = {stiffnesses[seed]:.4g} N/m, {d['verdict']}, "
               f"holds {d['holds']}, p = {d['p_value']:.3g}, {d['wall_time_s']:.0f} s (load {load[0]:.1f})",
               file=sys.stderr, flush=True)
-        tmp = out.with_name(f".{out.name}.tmp")
         record = record_of(draws, count, args, setting, start, load_before)
-        tmp.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
-        os.replace(tmp, out)  # a reader never sees a half-written record
+        text = json.dumps(record, indent=2) + "\n"
+        # atomic: a reader never sees a half-written record
+        write_file(out, lambda tmp, text=text: Path(tmp).write_text(text, encoding="utf-8"), overwrite=True)
     shown = ("coverage", "coverage_both", "verdicts", "identifiable_but_missed", "median_wall_time_s")
     print(json.dumps({k: record[k] for k in shown}, indent=2))
     print(f"written: {out}", file=sys.stderr)

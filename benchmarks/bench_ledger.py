@@ -42,6 +42,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from passmd.runtime.outputs import write_file
+
 ROOT = Path(__file__).resolve().parents[1]
 #: The wall time a cold ledger of each profile should stay within on a quiet 2-core machine (s).
 BUDGET_S = {"paper": 120.0, "quick": 240.0}
@@ -121,9 +123,8 @@ def append_run(out: Path, run: dict) -> None:
     and print the run."""
     runs = json.loads(out.read_text(encoding="utf-8")) if out.exists() else []
     runs.append(run)
-    tmp = out.with_name(f".{out.name}.tmp")
-    tmp.write_text(json.dumps(runs, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
-    tmp.replace(out)
+    text = json.dumps(runs, indent=1, ensure_ascii=False) + "\n"
+    write_file(out, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"), overwrite=True)  # atomic
     print(json.dumps(run, indent=1, ensure_ascii=False))
     print(f"appended to {out}")
 
