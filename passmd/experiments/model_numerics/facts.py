@@ -449,9 +449,8 @@ def speed_budgets(records: dict | None = None) -> pd.DataFrame:
 def missed_budgets(budgets: pd.DataFrame) -> str:
     """The rows of :func:`speed_budgets` that do not hold, as prose: ``"the fit: μ, k_p from 15 steps
     (32.3 s against 20 s, load 1.19)"``, joined by "and"; ``"none"`` when every budget holds."""
-    parts = [f"the {row.measurement} ({row.measured:.3g} {row.unit} against {row.budget:.3g} {row.unit}, "
-             f"load {row.load:.2f})" for row in budgets.itertuples() if not row.holds]
-    return " and ".join([", ".join(parts[:-1]), parts[-1]] if len(parts) > 1 else parts) or "none"
+    return _in_prose([f"the {row.measurement} ({row.measured:.3g} {row.unit} against {row.budget:.3g} "
+                      f"{row.unit}, load {row.load:.2f})" for row in budgets.itertuples() if not row.holds])
 
 
 def before_after_table(data: dict | None = None) -> pd.DataFrame:
@@ -475,10 +474,14 @@ def _mass_label(mass_kg: float) -> str:
     return f"{mass_kg * 1e9:.3g} µg" if mass_kg < 1e-6 else f"{mass_kg * 1e6:.3g} mg"
 
 
+def _in_prose(items: list[str]) -> str:
+    """Items as a list in prose: ``"a, b and c"``, ``"none"`` for no item."""
+    return " and ".join([", ".join(items[:-1]), items[-1]] if len(items) > 1 else items) or "none"
+
+
 def _listed(masses) -> str:
     """Masses as a list in prose: ``"22 µg and 220 µg"``, ``"none"`` for no mass."""
-    labels = [_mass_label(m) for m in masses]
-    return " and ".join([", ".join(labels[:-1]), labels[-1]] if len(labels) > 1 else labels) or "none"
+    return _in_prose([_mass_label(m) for m in masses])
 
 
 def mass_study_facts(study: pd.DataFrame) -> dict:
