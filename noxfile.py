@@ -226,13 +226,11 @@ def book(session: nox.Session) -> None:
         if os.path.exists(old):
             os.remove(old)
     session.log(f"computing every table the claims read ({profile} profile) first (passmd ledger)")
-    session.run("python", "-m", "passmd", "ledger", "--profile", profile, "--json", silent=True,
-                env={**env, "PASSMD_SWEEP_LOG": prefetch_log})
+    # The whole ledger, evaluated once, is written for every chapter (each shows its rows judged in it).
+    session.run("python", "-m", "passmd", "ledger", "--profile", profile, "--json",
+                "--write-evaluation", ledger_file, silent=True, env={**env, "PASSMD_SWEEP_LOG": prefetch_log})
     with open(prefetch_time, "w", encoding="utf-8") as fh:
         json.dump({"wall_seconds": time.monotonic() - start}, fh)
-    # The whole ledger evaluated once for every chapter (each shows its rows judged in it).
-    session.run("python", "-m", "passmd.report.stored_evaluation", "--profile", profile,
-                "--out", ledger_file, env=env)
     env["PASSMD_BOOK_PREFETCH_LOG"] = prefetch_log
     env["PASSMD_BOOK_PREFETCH_TIME"] = prefetch_time
     env["PASSMD_BOOK_LEDGER"] = ledger_file

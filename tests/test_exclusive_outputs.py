@@ -310,6 +310,8 @@ CASES = {
                                 "--write-baseline {d}/b.csv", _fake_ledger),
     "ledger --write-drive": (lambda d, data: ["ledger", "--write-drive", str(d / "j.toml")], "j.toml",
                              "--write-drive {d}/j.toml", _fake_ledger),
+    "ledger --write-evaluation": (lambda d, data: ["ledger", "--write-evaluation", str(d / "l.pmc")], "l.pmc",
+                                  "--write-evaluation {d}/l.pmc", _fake_ledger),
     "sweep --out": (lambda d, data: [*SWEEP, "--out", str(d / "map")], "map.json",
                     "--out {d}/map: {d}/map.json", None),
     "fit --out": (lambda d, data: ["fit", str(data), *FIT, "--out", str(d)], "fitted-drive.toml",

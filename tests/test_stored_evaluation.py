@@ -28,7 +28,7 @@ def test_a_table_reads_back_exactly():
 def test_read_only_what_this_profile_code_and_data_wrote(tmp_path, monkeypatch):
     path = tmp_path / "ledger.pmc"
     assert stored_evaluation.read(path, "paper") is None  # no file: the caller evaluates
-    stored_evaluation.write(path, _table(), "paper")
+    path.write_bytes(stored_evaluation.encode(_table(), "paper"))
     pd.testing.assert_frame_equal(stored_evaluation.read(path, "paper"), _table())
     assert stored_evaluation.read(path, "quick") is None
     monkeypatch.setattr(stored_evaluation, "_data_fingerprint", lambda: "an edited claims.csv")
@@ -41,13 +41,35 @@ def test_read_only_what_this_profile_code_and_data_wrote(tmp_path, monkeypatch):
     assert stored_evaluation.read(path, "paper") is None
 
 
+def test_the_ledger_command_writes_the_evaluation_it_printed(tmp_path, monkeypatch):
+    """``passmd ledger --write-evaluation``: the file holds the evaluation the command judged with,
+    readable for its profile only."""
+    import io
+    import json
+
+    from passmd import cli
+    from passmd.report import evaluation
+
+    monkeypatch.setattr(evaluation, "collect_results",  # the closed forms alone: every claim still evaluated
+                        lambda config: {"closed_forms": evaluation.closed_form_results(config)})
+    path = tmp_path / "ledger.pmc"
+    out = io.StringIO()
+    status = cli.main(["ledger", "--profile", "quick", "--cache-dir", str(tmp_path), "--json",
+                       "--write-evaluation", str(path)], out=out)
+    assert status == 0
+    printed = {c["claim"]: c["category"] for c in json.loads(out.getvalue())["claims"]}
+    stored = stored_evaluation.read(path, "quick")
+    assert dict(zip(stored["claim"], stored["status"], strict=True)) == printed
+    assert stored_evaluation.read(path, "paper") is None
+
+
 @pytest.mark.parametrize("stored", [True, False], ids=["stored", "absent"])
 def test_book_evaluation_reads_the_builds_file_or_evaluates(tmp_path, monkeypatch, stored):
     from passmd.report import evaluation
 
     path = tmp_path / "ledger.pmc"
     if stored:
-        stored_evaluation.write(path, _table(), "quick")
+        path.write_bytes(stored_evaluation.encode(_table(), "quick"))
     monkeypatch.setenv(publish.LEDGER_ENV, str(path))
     calls = []
     monkeypatch.setattr(evaluation, "evaluate", lambda config: calls.append(config) or "evaluated here")

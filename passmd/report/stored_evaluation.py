@@ -2,8 +2,8 @@
 
 Every chapter shows its ledger rows judged in the whole ledger (the joint reading needs every
 claim), so without this each chapter would evaluate all the claims again from the same cached
-results. ``nox -s book`` runs ``python -m passmd.report.stored_evaluation --profile P --out FILE``
-after ``passmd ledger`` and points ``$PASSMD_BOOK_LEDGER`` at the file;
+results. ``nox -s book`` runs ``passmd ledger --profile P --write-evaluation FILE``, which writes the
+evaluation it has just made (:func:`encode`), and points ``$PASSMD_BOOK_LEDGER`` at the file;
 :func:`passmd.report.publish.book_evaluation` reads it.
 
 The file is a checksummed data entry in the result cache's format (no pickle:
@@ -15,18 +15,15 @@ keyed by its axes' values) is stored as its list of items.
 
 from __future__ import annotations
 
-import argparse
 import hashlib
-import sys
 from pathlib import Path
 
 import pandas as pd
 
 from passmd.runtime.cache.entry import CorruptEntry, decode_entry, encode_entry
 from passmd.runtime.cache.keys import code_fingerprint, tree_fingerprint
-from passmd.runtime.outputs import write_file
 
-__all__ = ["decode_table", "encode_table", "key", "read", "write"]
+__all__ = ["decode_table", "encode", "encode_table", "key", "read"]
 
 _ITEMS = "__items__"  # marks a dict stored as its list of (key, value) pairs
 _DATA_DIR = Path(__file__).resolve().parents[1] / "data"  # passmd/data
@@ -79,10 +76,10 @@ def decode_table(value: dict) -> pd.DataFrame:
     return table
 
 
-def write(path, table: pd.DataFrame, profile: str) -> None:
-    """Write the evaluated ledger of ``profile`` to ``path`` (replacing the build's earlier one)."""
-    data = encode_entry(key(profile), encode_table(table), function=_FUNCTION, fingerprint=code_fingerprint())
-    write_file(path, lambda tmp: Path(tmp).write_bytes(data), overwrite=True)
+def encode(table: pd.DataFrame, profile: str) -> bytes:
+    """The file's bytes: the evaluated ledger of ``profile`` in a checksummed entry under :func:`key`."""
+    return encode_entry(key(profile), encode_table(table), function=_FUNCTION, fingerprint=code_fingerprint())
+
 
 
 def read(path, profile: str) -> pd.DataFrame | None:
@@ -97,22 +94,3 @@ def read(path, profile: str) -> pd.DataFrame | None:
     except CorruptEntry:
         return None
     return decode_table(value)
-
-
-def main(argv=None) -> int:
-    """``python -m passmd.report.stored_evaluation --profile P --out FILE``: evaluate the whole ledger
-    of profile P (its results from the cache ``passmd ledger`` filled) and write it to FILE."""
-    from passmd.report import evaluation
-    from passmd.runtime.config import PROFILES, RunConfig
-
-    parser = argparse.ArgumentParser(description=main.__doc__.splitlines()[0])
-    parser.add_argument("--profile", required=True, choices=PROFILES)
-    parser.add_argument("--out", required=True, help="the file the book's chapters read")
-    args = parser.parse_args(argv)
-    config = RunConfig.from_environment(profile=args.profile)
-    write(args.out, evaluation.evaluate(config=config), config.profile)
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -52,6 +52,10 @@ def add_parser(command) -> None:
     p.add_argument("--write-drive", metavar="TOML", default=None, action=FilePath,
                    help="also write the joint reading as a drive file: its drive axes as keys, its "
                         "protocol axes as the commands' options in its header (default: none)")
+    p.add_argument("--write-evaluation", metavar="PMC", default=None, action=FilePath,
+                   help="also write the evaluated ledger as a checksummed data file keyed on the profile "
+                        "and the package's code and data, which the book's chapters read instead of "
+                        "evaluating every claim again (nox -s book) (default: none)")
     add_overwrite_option(p)
     add_sweep_options(p)
     p.add_argument("--json", action="store_true", help=JSON_HELP)
@@ -59,9 +63,11 @@ def add_parser(command) -> None:
 
 
 def _given(args) -> list[tuple[str, str]]:
-    """(option, path) of --write-baseline and --write-drive, where given."""
+    """(option, path) of --write-baseline, --write-drive and --write-evaluation, where given."""
     return [(option, name) for option, name in (("--write-baseline", args.write_baseline),
-                                                ("--write-drive", args.write_drive)) if name is not None]
+                                                ("--write-drive", args.write_drive),
+                                                ("--write-evaluation", args.write_evaluation))
+            if name is not None]
 
 
 def _named(args) -> dict[str, str]:
@@ -70,7 +76,7 @@ def _named(args) -> dict[str, str]:
 
 
 def _check_outputs(args, config) -> None:
-    """--write-baseline and --write-drive, before the ledger is computed: files in existing
+    """The output files, before the ledger is computed: files in existing
     directories, not there already (unless --overwrite), not the claims table the ledger reads, the
     sweep log or the file standard output goes to, nor each other."""
     from passmd.ledger.claims import CLAIMS_PATH
@@ -87,10 +93,12 @@ def _check_outputs(args, config) -> None:
 
 
 def _write(evaluated, joint, args) -> None:
-    """--write-baseline (the categories) and --write-drive (the joint reading), written together or not
-    at all, never over a file unless --overwrite (:func:`passmd.cli.streams.create_outputs`)."""
+    """--write-baseline (the categories), --write-drive (the joint reading) and --write-evaluation (the
+    evaluated ledger, :mod:`passmd.report.stored_evaluation`), written together or not at all, never
+    over a file unless --overwrite (:func:`passmd.cli.streams.create_outputs`)."""
     from passmd.ledger.baseline import baseline_csv
     from passmd.ledger.joint_drive import joint_drive_file
+    from passmd.report import stored_evaluation
 
     texts = {}
     if args.write_baseline:
@@ -100,8 +108,12 @@ def _write(evaluated, joint, args) -> None:
         texts[args.write_baseline] = baseline_csv(evaluated, header)
     if args.write_drive:
         texts[args.write_drive] = joint_drive_file(joint["reading"], args.profile)
-    create_outputs({name: lambda tmp, text=text: Path(tmp).write_text(text, encoding="utf-8", newline="")
-                    for name, text in texts.items()}, _named(args), overwrite=args.overwrite)
+    writers = {name: lambda tmp, text=text: Path(tmp).write_text(text, encoding="utf-8", newline="")
+               for name, text in texts.items()}
+    if args.write_evaluation:
+        data = stored_evaluation.encode(evaluated, args.profile)
+        writers[args.write_evaluation] = lambda tmp: Path(tmp).write_bytes(data)
+    create_outputs(writers, _named(args), overwrite=args.overwrite)
 
 
 def run_ledger(args, out) -> int:
@@ -116,7 +128,7 @@ def run_ledger(args, out) -> int:
     evaluated = evaluation.evaluate(results=results)
     counts = evaluation.headline(evaluated)
     joint = evaluated.attrs["joint"]
-    if args.write_baseline or args.write_drive:
+    if _given(args):
         _write(evaluated, joint, args)
     if args.json:
         emit_json({"command": "ledger", "profile": args.profile, "summary": ledger_views.summary(evaluated),
