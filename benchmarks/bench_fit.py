@@ -49,6 +49,7 @@ from passmd.protocols import fit, velocity
 from passmd.protocols.fit.prediction import drive_at
 from passmd.protocols.synthetic import independent_steps
 from passmd.runtime.config import RunConfig
+from passmd.runtime.outputs import write_file
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_ledger import output  # noqa: E402  (a sibling script: --out, or a temporary file for --quick, --smoke)
@@ -156,11 +157,9 @@ def main() -> int:
         "machine": platform.machine(),
     }
     out = output(args, "fit")
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        out.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
-    except OSError as exc:
-        raise OSError(exc.errno, exc.strerror, str(out)) from None  # one line naming the file
+    text = json.dumps(record, indent=2) + "\n"
+    out.parent.mkdir(parents=True, exist_ok=True)
+    write_file(out, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"), overwrite=True)  # atomic
     shown = ("wall_time_s", "budget_s", "within_budget", "row_evaluation_s", "parameter_set_s",
              "budget_parameter_sets", "model_evaluations", "regions_hold_truth", "load_average_before",
              "load_average_after")
