@@ -83,10 +83,8 @@ def test_chapters_are_read_in_parallel(tmp_path):
     log = result.stdout + result.stderr
     assert result.returncode == 0, log[-3000:]
     assert "doing serial read" not in log
-    # one document per parallel chunk (Sphinx names a chunk by its documents, e.g. "index .. page2")
-    plain = re.sub(r"\x1b\[[0-9;]*m", "", log)  # (without the colours)
-    chunks = re.findall(r"reading sources\.\.\. \[\s*\d+%\] (\S+(?: \.\. \S+)?)", plain)
-    assert sorted(chunks) == sorted(["index", *(f"page{i}" for i in range(PAGES))]), log[-3000:]
+    # Sphinx names each parallel chunk by its first and last document, e.g. "index .. page2".
+    assert " .. page" in log, log[-3000:]
     # the executed page that ran a sweep ends with its Run time section; the others have none
     html = {i: (book / "_build" / "html" / f"page{i}.html").read_text(encoding="utf-8") for i in range(PAGES)}
     assert "Run time" in html[PAGES - 1]
@@ -169,22 +167,6 @@ def test_a_warning_in_a_parallel_reader_fails_the_build(tmp_path):
     log = result.stdout + result.stderr
     assert result.returncode != 0
     assert "stderr was found in the cell outputs" in log, log[-3000:]
-
-
-def test_the_longest_chapters_are_read_first():
-    """Every name the reading order puts first is a chapter of the book; the others keep Sphinx's order."""
-    _require_jupyter_book()
-    sys.path.insert(0, str(ROOT / "tools"))
-    import build_book
-
-    chapters = set(re.findall(r"file: (\S+)", (ROOT / "book" / "_toc.yml").read_text(encoding="utf-8")))
-    assert set(build_book.LONGEST_FIRST) <= chapters
-    docnames = sorted(chapters | {"intro"})
-    chunks = build_book.longest_first_chunks(docnames, 2)
-    assert all(len(chunk) == 1 for chunk in chunks)
-    order = [chunk[0] for chunk in chunks]
-    assert order[:len(build_book.LONGEST_FIRST)] == list(build_book.LONGEST_FIRST)
-    assert order[len(build_book.LONGEST_FIRST):] == [d for d in docnames if d not in build_book.LONGEST_FIRST]
 
 
 def test_jobs_must_be_positive():

@@ -7,11 +7,6 @@ starting a kernel and importing numpy, pandas, matplotlib and numba before its f
 with ``--jobs 2`` Sphinx reads (executes) two chapters at once in forked processes. Every
 other argument goes to ``jupyter-book build`` unchanged.
 
-Sphinx cuts the sorted documents into one fixed run per reader, so one reader can get most of
-the long chapters while the other idles. Each document is its own chunk here instead, taken by
-whichever reader is free, the longest chapters first (:data:`LONGEST_FIRST`, list scheduling):
-the readers finish within about one short chapter of each other.
-
 Kernels start one at a time. A Jupyter client picks a kernel's five TCP ports by binding and
 releasing them, and the kernel binds them again only once it has started; two readers that
 start kernels at the same moment can pick the same port, and one kernel then dies with
@@ -30,37 +25,8 @@ import sys
 import tempfile
 
 import jupyter_book.sphinx
-import sphinx.builders
 from jupyter_book.cli import main as jupyter_book_cli
 from nbclient import NotebookClient
-from sphinx.util.parallel import make_chunks
-
-#: The chapters that take longest to execute (their run times on the book's execution statistics
-#: page), longest first: read first when chapters are read in parallel. Only the order of reading
-#: depends on it; a name that is no chapter is ignored.
-LONGEST_FIRST = ("calibration", "model_numerics", "waveform_optimum", "design_your_drive", "force_generation",
-                 "critical_amplitude_six")
-
-
-def longest_first_chunks(docnames, nproc: int, maxbatch: int = 10) -> list[list[str]]:
-    """Sphinx's ``make_chunks`` for reading: one document per chunk, :data:`LONGEST_FIRST` first, the
-    others in Sphinx's order (``nproc`` and ``maxbatch`` do not apply)."""
-    rank = {name: i for i, name in enumerate(LONGEST_FIRST)}
-    return [[name] for name in sorted(docnames, key=lambda name: rank.get(name, len(rank)))]
-
-
-def read_longest_first() -> None:
-    """Make Sphinx's parallel reading take :func:`longest_first_chunks` (writing keeps Sphinx's chunks)."""
-    read_parallel = sphinx.builders.Builder._read_parallel
-
-    def _read_parallel(self, docnames, nproc):
-        sphinx.builders.make_chunks = longest_first_chunks  # (the builder module's reference to it)
-        try:
-            return read_parallel(self, docnames, nproc)
-        finally:
-            sphinx.builders.make_chunks = make_chunks
-
-    sphinx.builders.Builder._read_parallel = _read_parallel
 
 
 def serialize_kernel_starts(lock_path: str) -> None:
@@ -105,7 +71,6 @@ def main(argv: list[str]) -> None:
         parser.error(f"--jobs = {options.jobs} is out of range: must be an integer >= 1")
     # The build command imports build_sphinx from jupyter_book.sphinx when it runs.
     jupyter_book.sphinx.build_sphinx = functools.partial(jupyter_book.sphinx.build_sphinx, jobs=options.jobs)
-    read_longest_first()
     handle, lock_path = tempfile.mkstemp(prefix="passmd-kernel-start-", suffix=".lock")
     os.close(handle)
     serialize_kernel_starts(lock_path)
