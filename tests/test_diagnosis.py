@@ -187,3 +187,21 @@ def test_unbalanced_and_one_sided_guides_are_refused(tmp_path, groups, fragment)
     path.write_text(f'preload = "1.2 N"\nguide_rail = true\n{groups}', encoding="utf-8")
     status, _, err = run_main(["drive", "show", "--drive", str(path)])
     assert (status == 0) == ("sideways" in fragment)
+
+
+def test_the_diagnosed_band_is_the_claims_band_of_agreement():
+    """A departure is diagnosed beyond the band within which the ledger's Fig. 6 claims call A_c and its
+    closed form in agreement; the command line's help states that band."""
+    import argparse
+
+    from passmd.cli.parser import make_parser
+    from passmd.ledger.claims import load_claims
+
+    claims = load_claims()
+    matches = claims[claims["id"].str.match(r"fig6[abc]-.*-ac-matches-")]
+    assert len(matches) == 3
+    assert set(matches["tolerance_num"]) == {diagnosis.AGREEMENT}
+    assert set(matches["tolerance_kind"]) == {"rel"}
+    (commands,) = [a for a in make_parser()._actions if isinstance(a, argparse._SubParsersAction)]
+    help_text = " ".join(commands.choices["critical-amplitude"].format_help().split())
+    assert f"departs by more than {100 * diagnosis.AGREEMENT:.0f} %" in help_text

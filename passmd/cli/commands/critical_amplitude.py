@@ -303,11 +303,13 @@ def _search_rows(record: dict, drive) -> list[tuple[str, str]]:
 
 def _diagnosis_rows(record: dict, eq: str) -> list[tuple[str, str]]:
     """The diagnosis in rows: the departure, each cause with its counterfactual A_c and share."""
+    from passmd.protocols.diagnosis import AGREEMENT
+
     found, closed = record["critical_amplitude_m"], record["analytic_critical_amplitude_m"]
     gap = found / closed - 1.0
     side = "below" if gap < 0 else "above"
     symptom = (f"A_c = {fmt(found, 'nm')} lies {100 * abs(gap):.0f} % {side} the closed form's "
-               f"{fmt(closed, 'nm')} ({eq}), beyond the 10 % band of agreement")
+               f"{fmt(closed, 'nm')} ({eq}), beyond the {100 * AGREEMENT:.0f} % band of agreement")
     diagnosis = record["diagnosis"]
     causes = [{**c, "counterfactual_values": [c["counterfactual_value_m"]],
                "counterfactual_value": c["counterfactual_value_m"],

@@ -24,6 +24,7 @@ from passmd.experiments.critical_amplitude_one.claims import (
 )
 from passmd.ledger.checks import NotEvaluable, curve_deviation, experiment_claim, extractor
 from passmd.model.theory import normal_forces
+from passmd.protocols.diagnosis import AGREEMENT
 
 __all__ = ["INTERACTION_PERCENT", "side_alone"]
 
@@ -74,8 +75,9 @@ def _fig6c_not_eq13(results, reading) -> dict:
 
 
 #: The smallest change of A_c the actuators' interaction must make to be a 'strong influence' (%):
-#: the 10 % band within which the claims call A_c and a closed form in agreement (Fig. 6).
-INTERACTION_PERCENT = 10.0
+#: the band within which the claims call A_c and a closed form in agreement (Fig. 6,
+#: :data:`passmd.protocols.diagnosis.AGREEMENT`).
+INTERACTION_PERCENT = 100.0 * AGREEMENT
 
 
 def side_alone(results, reading) -> dict:
