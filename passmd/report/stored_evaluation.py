@@ -81,7 +81,6 @@ def encode(table: pd.DataFrame, profile: str) -> bytes:
     return encode_entry(key(profile), encode_table(table), function=_FUNCTION, fingerprint=code_fingerprint())
 
 
-
 def read(path, profile: str) -> pd.DataFrame | None:
     """The evaluated ledger at ``path`` if it was written for ``profile`` by this package's code and
     data; None if there is no such file or it was written for another (the caller evaluates)."""
