@@ -58,9 +58,14 @@ from passmd.model.contact_kernels import (
     P_STIFFNESS,
     P_UMAX,
     PARAMS_HEADER,
+    S_BASE,
+    S_DEPTH,
+    S_DIR,
+    S_FORCE,
     S_MAXDEPTH,
     S_OVERFLOW,
     S_REVERSALS,
+    S_U,
     STATE_HEADER,
     contact_force,
     contact_force_row,
@@ -100,6 +105,7 @@ __all__ = [
     "discrete_indentation",
     "drive_contact_arrays",
     "memory_diagnostics",
+    "memory_mismatch",
     "sliding_force",
     "stack_contacts",
 ]
@@ -308,3 +314,32 @@ def memory_diagnostics(params, state) -> dict:
         "max_depth": int(state[S_MAXDEPTH]),
         "overflows": int(state[S_OVERFLOW]),
     }
+
+
+def memory_mismatch(params, earlier, later, shift: float) -> float:
+    """How far one contact's memory ``later`` is from ``earlier`` moved by ``shift`` (m).
+
+    The runner moved on by ``shift`` while the hemisphere came back to where it was, so every
+    stored displacement ``u = x_a − x_r`` of a repeated state lies ``shift`` lower and every stored
+    force is the same. The mismatch is the largest departure, forces counted as displacements
+    through the contact's largest tangent stiffness 2aG*; infinite when the memory's structure
+    differs (virgin or sliding base, branch direction, number of reversal points), as no shift
+    then makes the two memories alike.
+
+    ``params``, ``earlier``, ``later``: one contact's arrays (rows of :func:`stack_contacts`).
+    """
+    if any(earlier[k] != later[k] for k in (S_BASE, S_DIR, S_DEPTH)):
+        return float("inf")
+    stiffness = params[P_STIFFNESS]
+    worst = max(abs(later[S_U] - earlier[S_U] + shift), abs(later[S_FORCE] - earlier[S_FORCE]) / stiffness)
+    if params[P_MODEL] == EXACT:
+        depth = int(later[S_DEPTH])
+        u = slice(STATE_HEADER, STATE_HEADER + 2 * depth, 2)
+        force = slice(STATE_HEADER + 1, STATE_HEADER + 2 * depth, 2)
+    else:  # each spring's slip p_i moves with u
+        u, force = slice(STATE_HEADER, STATE_HEADER + int(params[P_SIZE])), slice(0, 0)
+    if later[u].size:
+        worst = max(worst, float(np.max(np.abs(later[u] - earlier[u] + shift))))
+    if later[force].size:
+        worst = max(worst, float(np.max(np.abs(later[force] - earlier[force]))) / stiffness)
+    return float(worst)

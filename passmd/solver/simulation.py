@@ -31,6 +31,7 @@ step explicitly; the convergence studies compare them.
 
 from __future__ import annotations
 
+import math
 import sys
 import time as _time
 
@@ -43,6 +44,7 @@ from passmd.model.parameters import Drive
 from passmd.model.waveforms import Waveform
 from passmd.runtime.validation import check_choice, check_count
 from passmd.solver import kernels
+from passmd.solver.periodicity import BoundaryState
 from passmd.solver.results import SimulationError, SimulationResult, measures, settled_positions
 from passmd.solver.setup import contact_rows, linear_stiffness, scheme_steps
 from passmd.solver.steps import (
@@ -323,6 +325,19 @@ class Simulation:
             )
         self._counts = (steps, n_rec, fine_steps)
         self.periods_done = n
+
+    def boundary_state(self) -> BoundaryState:
+        """The state at the end of the last integrated period (a copy), for
+        :func:`passmd.solver.periodicity.mismatch`."""
+        if self.periods_done < 1:
+            raise ValueError("boundary_state() needs at least one integrated period: call run_to first")
+        drive, k = self.drive, self._params[:, P_STIFFNESS]
+        runner = math.sqrt((float(np.sum(self._multiplicity * k)) + drive.effective_load_cell_stiffness)
+                           / drive.runner_mass)
+        actuator = (math.sqrt((drive.actuator.stiffness + float(k.max())) / drive.actuator.mass)
+                    if drive.actuator_model == "flexible" else 0.0)
+        return BoundaryState(self._buffers.y.copy(), self._state.copy(), self._params, runner, actuator,
+                             drive.effective_load_cell_stiffness == 0.0)
 
     def settled_positions(self) -> np.ndarray:
         """The settled positions of the periods integrated so far (m): ``result().settled_positions``

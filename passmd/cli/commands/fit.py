@@ -39,8 +39,9 @@ _EPILOG = textwrap.dedent("""\
     DATA.csv: one measurement a row; column names carry their units. Conditions:
     amplitude_nm, preload_N, frequency_Hz, radius_mm (preload and radius default to the
     drive's; a critical amplitude's frequency to 100 Hz). Measured, one per row: step_nm
-    (the settled step of a running drive: below 1 kHz the step once three consecutive steps
-    agree to 0.01 nm, above it the steady-velocity protocol's velocity / f),
+    (the settled step of a running drive: below 1 kHz the step once a period's end state
+    repeats the last one's, moved on by the step, to 0.002 nm; above it the steady-velocity
+    protocol's velocity / f),
     velocity_mm_per_s (the same × f), critical_amplitude_nm, force_N, position_nm (the
     position after three periods from rest, Fig. 9a: a measurement of a start, not of a
     running drive), each with an optional <column>_sd (given for every row or for none;

@@ -70,7 +70,7 @@ CRITICAL_AMPLITUDE_BRACKETS = 1.0
 
 #: Benchmark results shipped with the package (``passmd/data/benchmarks/<name>.json``).
 BENCHMARKS = ("before_after", "book", "contact", "driving_waveform", "dynamics", "fit", "fit_coverage",
-              "ledger", "scaling", "sweep_map")
+              "ledger", "scaling", "settling", "sweep_map")
 
 
 def benchmark_results(name: str, path: str | Path | None = None) -> dict:

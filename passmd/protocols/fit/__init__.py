@@ -8,7 +8,7 @@ standard deviation ``<quantity>_sd``:
 ``step_nm``
     Steady step of a running drive under a saw-tooth, what a test stand measures once the drive
     runs: below :data:`passmd.protocols.velocity.STEP_PROTOCOL_BELOW` the step of a run continued
-    until three consecutive steps agree to :data:`passmd.protocols.velocity.STEP_ACCURACY`
+    until it repeats itself from one period to the next
     (:func:`passmd.protocols.velocity.settled_step`); above it the steady-velocity protocol's
     velocity / f (Figs. 9b/10).
 ``velocity_mm_per_s``
