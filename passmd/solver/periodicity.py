@@ -61,7 +61,7 @@ def mismatch(earlier: BoundaryState, later: BoundaryState) -> tuple[float, float
     shift = float(y1[0] - y0[0])
     moved = shift if later.translates else 0.0
     rows = later.memory.shape[0]
-    worst = abs(shift - moved) + abs(y1[1] - y0[1]) / later.runner_omega
+    worst = max(abs(shift - moved), abs(y1[1] - y0[1]) / later.runner_omega)
     if later.actuator_omega > 0.0:
         worst = max(worst, float(np.max(np.abs(y1[2:2 + rows] - y0[2:2 + rows]))),
                     float(np.max(np.abs(y1[2 + rows:] - y0[2 + rows:]))) / later.actuator_omega)
