@@ -100,17 +100,14 @@ def stop(steps, pairs, share):
     """(periods, step) where a rule stops (share None: three agreeing steps), or None."""
     accuracy = velocity.STEP_ACCURACY
     for periods in range(2, PERIODS + 1):
-        last = steps[:periods - 1][-velocity.SETTLED_STEPS:]
-        agree = last.size >= velocity.SETTLED_STEPS and last.max() - last.min() <= accuracy
         if share is None:
-            if agree:
-                return periods, float(last[-1])
-            continue
-        mismatch, shift = pairs[periods - 2]
-        if mismatch <= share * accuracy:
-            return periods, shift
-        if math.isinf(mismatch) and agree:
-            return periods, float(last[-1])
+            last = steps[:periods - 1][-velocity.SETTLED_STEPS:]
+            agree = last.size >= velocity.SETTLED_STEPS and last.max() - last.min() <= accuracy
+            step = float(last[-1]) if agree else None
+        else:
+            step = velocity.settled_value(steps[:periods - 1], *pairs[periods - 2], accuracy, share)
+        if step is not None:
+            return periods, step
     return None
 
 

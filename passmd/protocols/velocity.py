@@ -54,6 +54,7 @@ __all__ = [
     "STEP_PROTOCOL_BELOW",
     "make_waveform",
     "settled_step",
+    "settled_value",
     "steady_periods",
     "steady_run",
     "steady_velocity",
@@ -142,6 +143,24 @@ def step_run(drive, amplitude: float, frequency: float, waveform: str, design=No
             "final_position_m": result.final_position, "wall_time_s": result.wall_time}
 
 
+def settled_value(steps, mismatch: float, shift: float, accuracy: float = STEP_ACCURACY,
+                  share: float | None = None) -> float | None:
+    """The settled step once a run has repeated itself (:func:`settled_step`'s rule), else None.
+
+    ``steps``: the steps so far (m); ``mismatch``, ``shift``: of the last two end-of-period states
+    (:func:`passmd.solver.periodicity.mismatch`). The state rule at ``share`` × ``accuracy``; where
+    the memory changed its structure (infinite mismatch), the last :data:`SETTLED_STEPS` steps
+    agreeing to ``accuracy``. ``share`` None: :data:`STATE_SHARE` (read when called).
+    """
+    if mismatch <= (STATE_SHARE if share is None else share) * accuracy:
+        return float(shift)
+    last = steps[-SETTLED_STEPS:]
+    agree = steps.size >= SETTLED_STEPS and float(np.max(last) - np.min(last)) <= accuracy
+    if math.isinf(mismatch) and agree:
+        return float(steps[-1])
+    return None
+
+
 def settled_step(drive, amplitude: float, frequency: float, *, accuracy: float = STEP_ACCURACY,
                  max_periods: int = MAX_SETTLE_PERIODS, flyback=None) -> dict:
     """Steady step of a running saw-tooth drive: periods from rest until the run repeats itself.
@@ -186,7 +205,6 @@ def settled_step(drive, amplitude: float, frequency: float, *, accuracy: float =
     run = simulation.Simulation(drive, wave, max_points=2)
     run.run_to(1)
     earlier = run.boundary_state()
-    step = None
     for periods in range(2, max_periods + 1):
         run.run_to(periods)
         later = run.boundary_state()
@@ -194,10 +212,7 @@ def settled_step(drive, amplitude: float, frequency: float, *, accuracy: float =
         steps = np.diff(run.settled_positions())
         last = steps[-SETTLED_STEPS:]
         spread = float(np.max(last) - np.min(last))
-        if mismatch <= STATE_SHARE * accuracy:
-            step = shift
-        elif math.isinf(mismatch) and steps.size >= SETTLED_STEPS and spread <= accuracy:
-            step = float(steps[-1])
+        step = settled_value(steps, mismatch, shift, accuracy)
         if step is not None:
             break
         earlier = later

@@ -332,8 +332,7 @@ class Simulation:
         if self.periods_done < 1:
             raise ValueError("boundary_state() needs at least one integrated period: call run_to first")
         drive, k = self.drive, self._params[:, P_STIFFNESS]
-        runner = math.sqrt((float(np.sum(self._multiplicity * k)) + drive.effective_load_cell_stiffness)
-                           / drive.runner_mass)
+        runner = math.sqrt((self._total_stiffness + drive.effective_load_cell_stiffness) / drive.runner_mass)
         actuator = (math.sqrt((drive.actuator.stiffness + float(k.max())) / drive.actuator.mass)
                     if drive.actuator_model == "flexible" else 0.0)
         return BoundaryState(self._buffers.y.copy(), self._state.copy(), self._params, runner, actuator,
