@@ -19,6 +19,15 @@ The record says whether the regions hold the truth, the verdict and the goodness
 parameter sets per stage, and the machine's load average before and after (the 2-core machine
 may be shared: the times are not proof of speed when it is loaded).
 
+Then the same fit once more in this process alone (``executor="serial"``, another empty result
+cache), with the integrator's time of every settled step summed (``wall_time_s`` of
+:func:`~passmd.protocols.velocity.settled_step`: the compiled loop and its call): the integrator's
+share of the fit, and its floor, that time over the cores, the wall time the fit would take if
+nothing but the integration were left and every core were busy with it. A budget below the floor
+cannot hold without a faster integrator or fewer simulated periods. The serial fit must find the
+same estimates and regions as the pooled one (the record says whether it did: a fit does not
+depend on how its rows were shared out).
+
 ``--quick``: one flexible contact and six steps (a small run of the same machinery), written to a
 temporary file unless ``--out`` is given.
 ``--smoke``: μ alone of one rigid contact from three steps, written to a temporary file: the
@@ -125,6 +134,7 @@ def main() -> int:
         result = fit.fit(base, data, list(free), config=RunConfig(cache_dir=Path(cache)), progress=progress)
         wall = time.perf_counter() - start
         load_after = os.getloadavg()
+    serial = serial_fit(base, data, free)
     row_s = statistics.median(row_times)
     record = {
         "benchmark": f"fit: {setting['label']}",
@@ -149,6 +159,12 @@ def main() -> int:
         "identifiable": result.identifiable,
         "goodness_of_fit": result.goodness_of_fit,
         "verdict": result.verdict,
+        "serial_wall_time_s": serial["wall_s"],
+        "integrator_s": serial["integrator_s"],
+        "integrator_floor_s": serial["integrator_s"] / (os.cpu_count() or 1),
+        "simulated_periods": serial["periods"],
+        "serial_same_result": same_result(result, serial["result"], free),
+        "load_average_serial": serial["load_before"],
         "cpus": os.cpu_count(),
         "load_average_row_timing": list(load_row),
         "load_average_before": list(load_before),
@@ -161,11 +177,42 @@ def main() -> int:
     out.parent.mkdir(parents=True, exist_ok=True)
     write_file(out, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"), overwrite=True)  # atomic
     shown = ("wall_time_s", "budget_s", "within_budget", "row_evaluation_s", "parameter_set_s",
-             "budget_parameter_sets", "model_evaluations", "regions_hold_truth", "load_average_before",
-             "load_average_after")
+             "budget_parameter_sets", "model_evaluations", "regions_hold_truth", "integrator_floor_s",
+             "serial_same_result", "load_average_before", "load_average_after")
     print(json.dumps({k: record[k] for k in shown}, indent=2))
     print(f"written {out}")
     return 0
+
+
+def serial_fit(base, data, free) -> dict:
+    """The fit again in this process (empty result cache), with the integrator's time of its settled
+    steps summed: ``wall_s``, ``integrator_s``, ``periods``, ``result``, ``load_before``."""
+    spent = {"integrator_s": 0.0, "periods": 0}
+    settled_step = velocity.settled_step
+
+    def timed(*args, **kwargs):  # every step of the data (100 Hz) is a settled step
+        out = settled_step(*args, **kwargs)
+        spent["integrator_s"] += out["wall_time_s"]
+        spent["periods"] += out["periods"]
+        return out
+
+    velocity.settled_step = timed  # (read by passmd.protocols.fit.prediction.predict_point at each call)
+    try:
+        with tempfile.TemporaryDirectory() as cache:
+            load_before = os.getloadavg()
+            start = time.perf_counter()
+            result = fit.fit(base, data, list(free), executor="serial",
+                             config=RunConfig(cache_dir=Path(cache)))
+            wall = time.perf_counter() - start
+    finally:
+        velocity.settled_step = settled_step
+    return {"wall_s": wall, "result": result, "load_before": list(load_before), **spent}
+
+
+def same_result(first, second, free) -> bool:
+    """Whether two fits found the same estimates and the same regions (exactly)."""
+    return all(first.estimates[n]["value"] == second.estimates[n]["value"]
+               and first.estimates[n]["intervals"] == second.estimates[n]["intervals"] for n in free)
 
 
 if __name__ == "__main__":
