@@ -97,15 +97,11 @@ def record(drive, amplitude, frequency):
 
 
 def stop(steps, pairs, share):
-    """(periods, step) where a rule stops (share None: three agreeing steps), or None."""
-    accuracy = velocity.STEP_ACCURACY
+    """(periods, step) where a rule stops (share None: three agreeing steps, which is
+    ``velocity.settled_value``'s rule where the states cannot be compared), or None."""
     for periods in range(2, PERIODS + 1):
-        if share is None:
-            last = steps[:periods - 1][-velocity.SETTLED_STEPS:]
-            agree = last.size >= velocity.SETTLED_STEPS and last.max() - last.min() <= accuracy
-            step = float(last[-1]) if agree else None
-        else:
-            step = velocity.settled_value(steps[:periods - 1], *pairs[periods - 2], accuracy, share)
+        pair = (math.inf, 0.0) if share is None else pairs[periods - 2]
+        step = velocity.settled_value(steps[:periods - 1], *pair, velocity.STEP_ACCURACY, share)
         if step is not None:
             return periods, step
     return None
