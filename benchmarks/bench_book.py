@@ -1,7 +1,8 @@
 """Cost of a cold book build: one ``nox -s book -- --cold --profile <p>``.
 
 Runs the book session with empty simulation and numba caches (``--cold``: fresh temporary
-folders, no previous build output) and records its wall time against the budget
+folders, no previous build output; the bytecode of the installed modules is the environment's,
+kept beside it as pip keeps it in site-packages) and records its wall time against the budget
 :data:`BUDGET_S`, the time of its first part (``passmd ledger``, which computes every figure and
 the whole assumption space), the machine's core count and its load average before and after (the
 machine may be shared, which stretches the wall time). Each run is appended to ``--out`` (a JSON
